@@ -1,0 +1,73 @@
+#!/usr/bin/env python3
+"""Compare a ropedyn output with a reference output, quantity by quantity.
+
+usage: compare_h5.py REFERENCE.h5 NEW.h5
+
+Each quantity has an explicit absolute tolerance (TOLERANCES below, in its own units). The
+references are computed at rtol = 1e-8; the tolerances allow for the differences between
+compilers, optimization levels and LAPACK builds (measured: ~1e-9 m between the Debug and
+Release builds), and are far below what a change in the physics produces. Prints one line
+per quantity and exits 1 when any exceeds its tolerance.
+"""
+import sys
+
+import h5py
+import numpy as np
+
+#: dataset -> (absolute tolerance, units)
+TOLERANCES = {
+    "time": (1e-12, "s"),
+    "state/q": (5e-6, "m, rad"),
+    "state/qdot": (5e-4, "m/s, rad/s"),
+    "rope/points": (1e-6, "m"),
+    "energy/kinetic": (1e-7, "J"),
+    "energy/elastic": (1e-7, "J"),
+    "energy/gravity": (1e-7, "J"),
+    "energy/dissipated": (1e-7, "J"),
+    "energy/support_work": (1e-7, "J"),
+    "energy/total": (1e-7, "J"),
+}
+
+
+def compare(reference, new, out=sys.stdout):
+    """Return the list of failing quantities; print a readable table."""
+    failures = []
+    with h5py.File(reference, "r") as ref, h5py.File(new, "r") as cur:
+        for attr in ("model", "method", "status"):
+            a, b = ref.attrs[attr], cur.attrs[attr]
+            if a != b:
+                failures.append(attr)
+                print(f"  {attr:22s} differs: reference {a!r}, new {b!r}", file=out)
+        for name, (tol, units) in TOLERANCES.items():
+            a, b = ref[name][()], cur[name][()]
+            if a.shape != b.shape:
+                failures.append(name)
+                print(f"  {name:22s} shape {a.shape} != reference {a.shape}", file=out)
+                continue
+            diff = np.abs(a - b)
+            worst = float(diff.max()) if diff.size else 0.0
+            where = np.unravel_index(int(diff.argmax()), diff.shape) if diff.size else ()
+            ok = worst <= tol
+            if not ok:
+                failures.append(name)
+            t = ref["time"][where[0]] if where else 0.0
+            print(f"  {'ok  ' if ok else 'FAIL'} {name:22s} max |diff| {worst:9.2e} "
+                  f"(tolerance {tol:.0e} {units}) at index {tuple(int(i) for i in where)}"
+                  f", t = {t:.3f} s", file=out)
+    return failures
+
+
+def main(argv):
+    if len(argv) != 3:
+        print(__doc__, file=sys.stderr)
+        return 2
+    failures = compare(argv[1], argv[2])
+    if failures:
+        print(f"compare: {len(failures)} quantities differ: {', '.join(failures)}")
+        return 1
+    print("compare: all quantities within tolerance")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

@@ -1,0 +1,377 @@
+!> CVODE (BDF, Newton, band linear solver with the problem's analytic Jacobian) behind
+!! the integrator interface.
+!!
+!! We link CVODES, CVODE's superset from the same SUNDIALS release, for its quadrature
+!! feature: the problem's quadrature variables (dissipated energy, support work) are then
+!! integrated with error control but outside the Newton system. Every SUNDIALS-version
+!! detail (6.4.1: `fsundials_context_mod`, the band-matrix data pointer of extent 1) is
+!! kept inside this module.
+module ropedyn_cvode
+    use, intrinsic :: iso_c_binding
+    use ropedyn_kinds, only: wp, i8
+    use ropedyn_error, only: error_t, make_error, ERR_SOLVER
+    use ropedyn_problem, only: problem_t, STATUS_OK
+    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
+    use fsundials_context_mod, only: FSUNContext_Create, FSUNContext_Free
+    use fsundials_nvector_mod, only: N_Vector, FN_VDestroy, FN_VGetArrayPointer
+    use fsundials_matrix_mod, only: SUNMatrix, FSUNMatDestroy
+    use fsundials_linearsolver_mod, only: SUNLinearSolver, FSUNLinSolFree
+    use fnvector_serial_mod, only: FN_VMake_Serial
+    use fsunmatrix_band_mod, only: FSUNBandMatrix, FSUNBandMatrix_Data, FSUNBandMatrix_LDim, &
+                                   FSUNBandMatrix_StoredUpperBandwidth, FSUNBandMatrix_Columns
+    use fsunlinsol_band_mod, only: FSUNLinSol_Band
+    use fcvodes_mod
+    implicit none
+    private
+    public :: cvode_t
+
+    !> What the C callbacks see through user_data (non-polymorphic, so c_loc is valid).
+    type :: cvode_context_t
+        class(problem_t), pointer :: problem => null()
+        character(len=:), allocatable :: message  !< last message of CVODE's error handler
+        integer :: last_status = STATUS_OK        !< last status returned by the problem
+    end type cvode_context_t
+
+    type, extends(integrator_t) :: cvode_t
+        private
+        type(c_ptr) :: sunctx = c_null_ptr
+        type(c_ptr) :: mem = c_null_ptr
+        type(N_Vector), pointer :: nv_y => null()
+        type(N_Vector), pointer :: nv_q => null()
+        type(SUNMatrix), pointer :: matrix => null()
+        type(SUNLinearSolver), pointer :: solver => null()
+        real(c_double), pointer, contiguous :: y(:) => null()   !< storage wrapped by nv_y
+        real(c_double), pointer, contiguous :: yq(:) => null()  !< storage wrapped by nv_q
+        type(cvode_context_t), pointer :: ctx => null()
+        type(solver_options_t) :: options
+        integer :: n = 0, nq = 0
+        real(wp) :: t = 0.0_wp
+    contains
+        procedure :: init => cvode_init
+        procedure :: advance_to => cvode_advance_to
+        procedure :: stats => cvode_stats
+        procedure :: finalize => cvode_finalize
+        procedure :: name => cvode_name
+        final :: cvode_destroy
+    end type cvode_t
+
+    interface
+        pure integer(c_size_t) function c_strlen(s) bind(C, name='strlen')
+            import :: c_ptr, c_size_t
+            type(c_ptr), value, intent(in) :: s
+        end function c_strlen
+    end interface
+
+contains
+
+    pure function cvode_name(self) result(name)
+        class(cvode_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'cvode'
+    end function cvode_name
+
+    subroutine cvode_init(self, problem, t0, y0, yq0, options, err)
+        class(cvode_t), intent(inout) :: self
+        class(problem_t), intent(inout), target :: problem
+        real(wp), intent(in) :: t0
+        real(wp), intent(in) :: y0(:)
+        real(wp), intent(in) :: yq0(:)
+        type(solver_options_t), intent(in) :: options
+        type(error_t), allocatable, intent(out) :: err
+        integer :: ml, mu
+        integer(c_int) :: flag
+
+        call self%finalize()
+        self%options = options
+        self%n = problem%size()
+        self%nq = problem%quad_size()
+        self%t = t0
+        allocate (self%ctx)
+        self%ctx%problem => problem
+        self%ctx%message = ''
+        allocate (self%y(self%n), self%yq(max(self%nq, 1)))
+        self%y = y0
+        self%yq = 0.0_wp
+        if (self%nq > 0) self%yq(1:self%nq) = yq0(1:self%nq)
+
+        flag = FSUNContext_Create(c_null_ptr, self%sunctx)
+        if (check(flag, 'FSUNContext_Create')) return
+        self%nv_y => FN_VMake_Serial(int(self%n, c_int64_t), self%y, self%sunctx)
+        if (.not. associated(self%nv_y)) then
+            call make_error(err, ERR_SOLVER, 'cvode: cannot create the state vector')
+            return
+        end if
+        self%mem = FCVodeCreate(CV_BDF, self%sunctx)
+        if (.not. c_associated(self%mem)) then
+            call make_error(err, ERR_SOLVER, 'cvode: FCVodeCreate failed')
+            return
+        end if
+        flag = FCVodeSetErrHandlerFn(self%mem, c_funloc(cv_error_handler), c_loc(self%ctx))
+        if (check(flag, 'FCVodeSetErrHandlerFn')) return
+        flag = FCVodeInit(self%mem, c_funloc(cv_rhs), real(t0, c_double), self%nv_y)
+        if (check(flag, 'FCVodeInit')) return
+        flag = FCVodeSetUserData(self%mem, c_loc(self%ctx))
+        if (check(flag, 'FCVodeSetUserData')) return
+        flag = FCVodeSStolerances(self%mem, real(options%rtol, c_double), &
+                                  real(options%atol, c_double))
+        if (check(flag, 'FCVodeSStolerances')) return
+        flag = FCVodeSetMaxOrd(self%mem, int(options%max_order, c_int))
+        if (check(flag, 'FCVodeSetMaxOrd')) return
+        flag = FCVodeSetMaxHnilWarns(self%mem, -1_c_int)
+        if (check(flag, 'FCVodeSetMaxHnilWarns')) return
+
+        call problem%bandwidths(ml, mu)
+        self%matrix => FSUNBandMatrix(int(self%n, c_int64_t), int(mu, c_int64_t), &
+                                      int(ml, c_int64_t), self%sunctx)
+        self%solver => FSUNLinSol_Band(self%nv_y, self%matrix, self%sunctx)
+        if (.not. (associated(self%matrix) .and. associated(self%solver))) then
+            call make_error(err, ERR_SOLVER, 'cvode: cannot create the band linear solver')
+            return
+        end if
+        flag = FCVodeSetLinearSolver(self%mem, self%solver, self%matrix)
+        if (check(flag, 'FCVodeSetLinearSolver')) return
+        flag = FCVodeSetJacFn(self%mem, c_funloc(cv_jacobian))
+        if (check(flag, 'FCVodeSetJacFn')) return
+
+        if (self%nq > 0) then
+            self%nv_q => FN_VMake_Serial(int(self%nq, c_int64_t), self%yq, self%sunctx)
+            flag = FCVodeQuadInit(self%mem, c_funloc(cv_quad), self%nv_q)
+            if (check(flag, 'FCVodeQuadInit')) return
+            flag = FCVodeQuadSStolerances(self%mem, real(options%rtol, c_double), &
+                                          real(options%atol, c_double))
+            if (check(flag, 'FCVodeQuadSStolerances')) return
+            flag = FCVodeSetQuadErrCon(self%mem, 1_c_int)
+            if (check(flag, 'FCVodeSetQuadErrCon')) return
+        end if
+    contains
+        logical function check(flag, what)
+            integer(c_int), intent(in) :: flag
+            character(len=*), intent(in) :: what
+            check = flag < 0
+            if (check) call make_error(err, ERR_SOLVER, 'cvode: '//what//' failed: '// &
+                                       flag_name(flag)//' '//self%ctx%message)
+        end function check
+    end subroutine cvode_init
+
+    subroutine cvode_advance_to(self, tout, t, y, yq, err)
+        class(cvode_t), intent(inout) :: self
+        real(wp), intent(in) :: tout
+        real(wp), intent(out) :: t
+        real(wp), intent(inout) :: y(:)
+        real(wp), intent(inout) :: yq(:)
+        type(error_t), allocatable, intent(out) :: err
+        real(c_double) :: tret(1), hlast(1)
+        integer(c_long) :: nsteps(1)
+        integer(c_int) :: flag, qflag
+        integer(i8) :: remaining
+        character(len=64) :: where
+
+        if (.not. c_associated(self%mem)) then
+            call make_error(err, ERR_SOLVER, 'cvode: advance_to called before init')
+            return
+        end if
+        flag = FCVodeGetNumSteps(self%mem, nsteps)
+        remaining = self%options%max_steps - int(nsteps(1), i8)
+        if (remaining <= 0) remaining = 1
+        flag = FCVodeSetMaxNumSteps(self%mem, int(remaining, c_long))
+        self%ctx%message = ''
+        tret = self%t
+        flag = FCVode(self%mem, real(tout, c_double), self%nv_y, tret, CV_NORMAL)
+        self%t = tret(1)
+        if (self%nq > 0) then
+            qflag = FCVodeGetQuad(self%mem, tret, self%nv_q)
+            if (qflag >= 0) yq(1:self%nq) = self%yq(1:self%nq)
+        end if
+        y = self%y
+        t = self%t
+        if (flag < 0) then
+            hlast = 0.0_c_double
+            qflag = FCVodeGetLastStep(self%mem, hlast)
+            if (hlast(1) == 0.0_c_double) qflag = FCVodeGetCurrentStep(self%mem, hlast)
+            write (where, '(a, es12.5, a, es10.3, a)') 't = ', t, ' s, step size ', &
+                hlast(1), ' s'
+            if (flag == CV_TOO_MUCH_WORK) then
+                call make_error(err, ERR_SOLVER, 'cvode failed at '//trim(where)//': '// &
+                                flag_name(flag)//': max_steps exceeded')
+            else
+                call make_error(err, ERR_SOLVER, 'cvode failed at '//trim(where)//': '// &
+                                flag_name(flag)//': '//self%ctx%message)
+            end if
+        end if
+    end subroutine cvode_advance_to
+
+    function cvode_stats(self) result(stats)
+        class(cvode_t), intent(in) :: self
+        type(solver_stats_t) :: stats
+        integer(c_long) :: v(1)
+        integer(c_int) :: flag, order(1)
+        real(c_double) :: h(1)
+
+        if (.not. c_associated(self%mem)) return
+        flag = FCVodeGetNumSteps(self%mem, v)
+        stats%steps = v(1)
+        flag = FCVodeGetNumRhsEvals(self%mem, v)
+        stats%rhs_evals = v(1)
+        flag = FCVodeGetNumJacEvals(self%mem, v)
+        stats%jac_evals = v(1)
+        flag = FCVodeGetNumLinSolvSetups(self%mem, v)
+        stats%lin_setups = v(1)
+        flag = FCVodeGetNumErrTestFails(self%mem, v)
+        stats%err_test_fails = v(1)
+        flag = FCVodeGetNumNonlinSolvIters(self%mem, v)
+        stats%nonlin_iters = v(1)
+        flag = FCVodeGetNumNonlinSolvConvFails(self%mem, v)
+        stats%nonlin_conv_fails = v(1)
+        h = 0.0_c_double
+        flag = FCVodeGetLastStep(self%mem, h)
+        stats%last_step = h(1)
+        order = 0
+        flag = FCVodeGetLastOrder(self%mem, order)
+        stats%last_order = order(1)
+    end function cvode_stats
+
+    subroutine cvode_finalize(self)
+        class(cvode_t), intent(inout) :: self
+        integer(c_int) :: flag
+        if (c_associated(self%mem)) call FCVodeFree(self%mem)
+        self%mem = c_null_ptr
+        if (associated(self%solver)) flag = FSUNLinSolFree(self%solver)
+        self%solver => null()
+        if (associated(self%matrix)) call FSUNMatDestroy(self%matrix)
+        self%matrix => null()
+        if (associated(self%nv_y)) call FN_VDestroy(self%nv_y)
+        self%nv_y => null()
+        if (associated(self%nv_q)) call FN_VDestroy(self%nv_q)
+        self%nv_q => null()
+        if (c_associated(self%sunctx)) flag = FSUNContext_Free(self%sunctx)
+        self%sunctx = c_null_ptr
+        if (associated(self%y)) deallocate (self%y)
+        if (associated(self%yq)) deallocate (self%yq)
+        if (associated(self%ctx)) deallocate (self%ctx)
+    end subroutine cvode_finalize
+
+    subroutine cvode_destroy(self)
+        type(cvode_t), intent(inout) :: self
+        call self%finalize()
+    end subroutine cvode_destroy
+
+    ! ---- C callbacks -------------------------------------------------------------
+
+    integer(c_int) function cv_rhs(t, nv_y, nv_f, user_data) result(ierr) bind(C)
+        real(c_double), value :: t
+        type(N_Vector) :: nv_y, nv_f
+        type(c_ptr), value :: user_data
+        type(cvode_context_t), pointer :: ctx
+        real(c_double), pointer :: y(:), f(:)
+        integer :: status
+        call c_f_pointer(user_data, ctx)
+        y => FN_VGetArrayPointer(nv_y)
+        f => FN_VGetArrayPointer(nv_f)
+        call ctx%problem%rhs(t, y, f, status)
+        ctx%last_status = status
+        ierr = int(status, c_int)
+    end function cv_rhs
+
+    integer(c_int) function cv_quad(t, nv_y, nv_qdot, user_data) result(ierr) bind(C)
+        real(c_double), value :: t
+        type(N_Vector) :: nv_y, nv_qdot
+        type(c_ptr), value :: user_data
+        type(cvode_context_t), pointer :: ctx
+        real(c_double), pointer :: y(:), qdot(:)
+        integer :: status
+        call c_f_pointer(user_data, ctx)
+        y => FN_VGetArrayPointer(nv_y)
+        qdot => FN_VGetArrayPointer(nv_qdot)
+        call ctx%problem%quad_rhs(t, y, qdot, status)
+        ctx%last_status = status
+        ierr = int(status, c_int)
+    end function cv_quad
+
+    integer(c_int) function cv_jacobian(t, nv_y, nv_f, mat, user_data, tmp1, tmp2, tmp3) &
+        result(ierr) bind(C)
+        real(c_double), value :: t
+        type(N_Vector) :: nv_y, nv_f
+        type(SUNMatrix) :: mat
+        type(c_ptr), value :: user_data
+        type(N_Vector) :: tmp1, tmp2, tmp3
+        type(cvode_context_t), pointer :: ctx
+        real(c_double), pointer :: y(:), data1(:), jb(:, :)
+        integer :: status, ldim, ncols, smu
+        call c_f_pointer(user_data, ctx)
+        y => FN_VGetArrayPointer(nv_y)
+        ! SUNDIALS 6.4.1: FSUNBandMatrix_Data returns a pointer of extent 1; re-map it.
+        data1 => FSUNBandMatrix_Data(mat)
+        ldim = int(FSUNBandMatrix_LDim(mat))
+        ncols = int(FSUNBandMatrix_Columns(mat))
+        smu = int(FSUNBandMatrix_StoredUpperBandwidth(mat))
+        call c_f_pointer(c_loc(data1(1)), jb, [ldim, ncols])
+        jb = 0.0_c_double
+        call ctx%problem%jacobian(t, y, jb, smu + 1, status)
+        ctx%last_status = status
+        ierr = int(status, c_int)
+    end function cv_jacobian
+
+    !> Keeps CVODE's messages for our error text instead of printing them.
+    subroutine cv_error_handler(code, module, function, msg, user_data) bind(C)
+        integer(c_int), value :: code
+        type(c_ptr), value :: module, function, msg, user_data
+        type(cvode_context_t), pointer :: ctx
+        if (.not. c_associated(user_data)) return
+        call c_f_pointer(user_data, ctx)
+        if (code < 0) ctx%message = c_string(msg)
+        if (c_associated(module) .and. c_associated(function)) continue
+    end subroutine cv_error_handler
+
+    function c_string(p) result(s)
+        type(c_ptr), intent(in) :: p
+        character(len=:), allocatable :: s
+        character(kind=c_char), pointer :: chars(:)
+        integer :: i, n
+        if (.not. c_associated(p)) then
+            s = ''
+            return
+        end if
+        n = int(c_strlen(p))
+        call c_f_pointer(p, chars, [n])
+        allocate (character(len=n) :: s)
+        do i = 1, n
+            s(i:i) = chars(i)
+        end do
+    end function c_string
+
+    !> Name of a CVODE return flag.
+    function flag_name(flag) result(name)
+        integer(c_int), intent(in) :: flag
+        character(len=:), allocatable :: name
+        character(len=16) :: buffer
+        select case (flag)
+        case (CV_TOO_MUCH_WORK); name = 'CV_TOO_MUCH_WORK'
+        case (CV_TOO_MUCH_ACC); name = 'CV_TOO_MUCH_ACC'
+        case (CV_ERR_FAILURE); name = 'CV_ERR_FAILURE'
+        case (CV_CONV_FAILURE); name = 'CV_CONV_FAILURE'
+        case (CV_LINIT_FAIL); name = 'CV_LINIT_FAIL'
+        case (CV_LSETUP_FAIL); name = 'CV_LSETUP_FAIL'
+        case (CV_LSOLVE_FAIL); name = 'CV_LSOLVE_FAIL'
+        case (CV_RHSFUNC_FAIL); name = 'CV_RHSFUNC_FAIL'
+        case (CV_FIRST_RHSFUNC_ERR); name = 'CV_FIRST_RHSFUNC_ERR'
+        case (CV_REPTD_RHSFUNC_ERR); name = 'CV_REPTD_RHSFUNC_ERR'
+        case (CV_UNREC_RHSFUNC_ERR); name = 'CV_UNREC_RHSFUNC_ERR'
+        case (CV_QRHSFUNC_FAIL); name = 'CV_QRHSFUNC_FAIL'
+        case (CV_FIRST_QRHSFUNC_ERR); name = 'CV_FIRST_QRHSFUNC_ERR'
+        case (CV_REPTD_QRHSFUNC_ERR); name = 'CV_REPTD_QRHSFUNC_ERR'
+        case (CV_UNREC_QRHSFUNC_ERR); name = 'CV_UNREC_QRHSFUNC_ERR'
+        case (CV_NLS_FAIL); name = 'CV_NLS_FAIL'
+        case (CV_NLS_INIT_FAIL); name = 'CV_NLS_INIT_FAIL'
+        case (CV_NLS_SETUP_FAIL); name = 'CV_NLS_SETUP_FAIL'
+        case (CV_MEM_FAIL); name = 'CV_MEM_FAIL'
+        case (CV_MEM_NULL); name = 'CV_MEM_NULL'
+        case (CV_ILL_INPUT); name = 'CV_ILL_INPUT'
+        case (CV_NO_MALLOC); name = 'CV_NO_MALLOC'
+        case (CV_TOO_CLOSE); name = 'CV_TOO_CLOSE'
+        case (CV_VECTOROP_ERR); name = 'CV_VECTOROP_ERR'
+        case default
+            write (buffer, '(a, i0)') 'CV flag ', flag
+            name = trim(buffer)
+        end select
+    end function flag_name
+end module ropedyn_cvode

@@ -1,0 +1,91 @@
+!> The abstract integrator: what every time integrator in solvers/ offers.
+!!
+!! Life cycle: `init` (problem, initial state, options) -> `advance_to` (repeatedly, with
+!! increasing output times; the state is returned exactly at tout) -> `stats` -> `finalize`.
+!! An integrator keeps all its state in the object: two integrators never interfere.
+module ropedyn_integrator
+    use ropedyn_kinds, only: wp, i8
+    use ropedyn_error, only: error_t
+    use ropedyn_problem, only: problem_t
+    implicit none
+    private
+    public :: integrator_t, solver_options_t, solver_stats_t
+
+    !> Options shared by all integrators (same meaning for every method).
+    type :: solver_options_t
+        real(wp) :: rtol = 1.0e-6_wp         !< relative tolerance
+        real(wp) :: atol = 1.0e-8_wp         !< absolute tolerance (state units)
+        integer :: max_order = 5             !< highest order the method may use
+        integer(i8) :: max_steps = 1000000_i8 !< step budget for the whole run
+    end type solver_options_t
+
+    !> Counters of an integration so far.
+    type :: solver_stats_t
+        integer(i8) :: steps = 0              !< accepted steps
+        integer(i8) :: rhs_evals = 0          !< f evaluations (without Jacobian differencing)
+        integer(i8) :: jac_evals = 0          !< Jacobian evaluations
+        integer(i8) :: lin_setups = 0         !< linear solver setups (LU factorizations)
+        integer(i8) :: err_test_fails = 0     !< rejected steps (local error test)
+        integer(i8) :: nonlin_iters = 0       !< Newton iterations
+        integer(i8) :: nonlin_conv_fails = 0  !< Newton convergence failures
+        real(wp) :: last_step = 0.0_wp        !< size of the last step taken, s
+        integer :: last_order = 0             !< order of the last step taken
+    end type solver_stats_t
+
+    type, abstract :: integrator_t
+    contains
+        procedure(init_i), deferred :: init
+        procedure(advance_to_i), deferred :: advance_to
+        procedure(stats_i), deferred :: stats
+        procedure(finalize_i), deferred :: finalize
+        procedure(name_i), deferred :: name
+    end type integrator_t
+
+    abstract interface
+        !> Prepare to integrate `problem` from (t0, y0, yq0). The problem must outlive the
+        !! integrator (it is referenced, not copied).
+        subroutine init_i(self, problem, t0, y0, yq0, options, err)
+            import :: integrator_t, problem_t, wp, solver_options_t, error_t
+            class(integrator_t), intent(inout) :: self
+            class(problem_t), intent(inout), target :: problem
+            real(wp), intent(in) :: t0
+            real(wp), intent(in) :: y0(:)
+            real(wp), intent(in) :: yq0(:)
+            type(solver_options_t), intent(in) :: options
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine init_i
+
+        !> Integrate to tout and return the state there. On failure `err` says the
+        !! simulated time, the last step size and the cause; y, yq then hold the last
+        !! good state and t its time.
+        subroutine advance_to_i(self, tout, t, y, yq, err)
+            import :: integrator_t, wp, error_t
+            class(integrator_t), intent(inout) :: self
+            real(wp), intent(in) :: tout
+            real(wp), intent(out) :: t
+            real(wp), intent(inout) :: y(:)
+            real(wp), intent(inout) :: yq(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine advance_to_i
+
+        !> Counters so far.
+        function stats_i(self) result(stats)
+            import :: integrator_t, solver_stats_t
+            class(integrator_t), intent(in) :: self
+            type(solver_stats_t) :: stats
+        end function stats_i
+
+        !> Release all resources; the object may be initialized again afterwards.
+        subroutine finalize_i(self)
+            import :: integrator_t
+            class(integrator_t), intent(inout) :: self
+        end subroutine finalize_i
+
+        !> Method name as in &solver method.
+        pure function name_i(self) result(name)
+            import :: integrator_t
+            class(integrator_t), intent(in) :: self
+            character(len=:), allocatable :: name
+        end function name_i
+    end interface
+end module ropedyn_integrator

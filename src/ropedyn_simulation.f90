@@ -1,0 +1,204 @@
+!> Runs one scene: builds the model and the integrator it names, integrates to t_end
+!! with output at every output_interval, writes the HDF5 file and returns a summary.
+module ropedyn_simulation
+    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+    use ropedyn_kinds, only: wp, i8
+    use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_IO
+    use ropedyn_problem, only: energy_t
+    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
+    use ropedyn_cvode, only: cvode_t
+    use ropedyn_rope_model, only: rope_model_t
+    use ropedyn_rfem, only: rfem_t, rfem_create
+    use ropedyn_scene, only: scene_t, scene_namelist_text
+    use ropedyn_output, only: output_file_t
+    use ropedyn_progress, only: progress_t
+    use ropedyn_version, only: version_string
+    implicit none
+    private
+    public :: run_summary_t, run_scene, create_model, create_integrator, solver_options_of
+
+    !> What a run reports back to the driver.
+    type :: run_summary_t
+        type(solver_stats_t) :: stats
+        real(wp) :: cpu_time = 0.0_wp      !< s
+        real(wp) :: t_reached = 0.0_wp     !< s
+        type(energy_t) :: initial_energy
+        type(energy_t) :: final_energy
+        integer :: records = 0             !< output times written
+        character(len=:), allocatable :: file
+    end type run_summary_t
+
+    interface
+        integer(c_int) function c_mkdir(path, mode) bind(C, name='mkdir')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int), value :: mode
+        end function c_mkdir
+    end interface
+
+contains
+
+    !> The model a scene names.
+    subroutine create_model(scene, model, err)
+        type(scene_t), intent(in) :: scene
+        class(rope_model_t), allocatable, intent(out) :: model
+        type(error_t), allocatable, intent(out) :: err
+        type(rfem_t), allocatable :: rfem
+        select case (scene%model%kind)
+        case ('rfem')
+            allocate (rfem)
+            call rfem_create(rfem, scene, err)
+            if (allocated(err)) return
+            call move_alloc(rfem, model)
+        case default
+            call make_error(err, ERR_INPUT, scene%path//': &model: kind = "'// &
+                            trim(scene%model%kind)//'": not available in this version')
+        end select
+    end subroutine create_model
+
+    !> The integrator a scene names.
+    subroutine create_integrator(scene, integrator, err)
+        type(scene_t), intent(in) :: scene
+        class(integrator_t), allocatable, intent(out) :: integrator
+        type(error_t), allocatable, intent(out) :: err
+        select case (scene%solver%method)
+        case ('cvode')
+            allocate (cvode_t :: integrator)
+        case default
+            call make_error(err, ERR_INPUT, scene%path//': &solver: method = "'// &
+                            trim(scene%solver%method)//'": not available in this version')
+        end select
+    end subroutine create_integrator
+
+    pure function solver_options_of(scene) result(options)
+        type(scene_t), intent(in) :: scene
+        type(solver_options_t) :: options
+        options%rtol = scene%solver%rtol
+        options%atol = scene%solver%atol
+        options%max_order = scene%solver%max_order
+        options%max_steps = int(scene%solver%max_steps, i8)
+    end function solver_options_of
+
+    !> Run a validated scene. The output file is written as the run goes; a failed
+    !! integration leaves the data up to the failure and status 'failed'.
+    subroutine run_scene(scene, summary, err)
+        type(scene_t), intent(in) :: scene
+        type(run_summary_t), intent(out) :: summary
+        type(error_t), allocatable, intent(out) :: err
+        class(rope_model_t), allocatable, target :: model
+        class(integrator_t), allocatable :: integrator
+        type(output_file_t) :: out
+        type(progress_t) :: progress
+        type(error_t), allocatable :: io_err
+        real(wp), allocatable :: y(:), yq(:), q(:, :), qdot(:, :), points(:, :)
+        real(wp), allocatable :: lengths(:), masses(:)
+        real(wp) :: t, tout, cpu_start, cpu_now, dt, t_end
+        integer :: n, k, n_out
+        type(solver_stats_t) :: stats
+
+        call create_model(scene, model, err)
+        if (allocated(err)) return
+        call create_integrator(scene, integrator, err)
+        if (allocated(err)) return
+
+        n = model%n_elements()
+        allocate (y(model%size()), yq(max(1, model%quad_size())))
+        allocate (q(3, n), qdot(3, n), points(2, 2*n), lengths(n), masses(n))
+        call model%initial_state(y)
+        yq = 0.0_wp
+        t = 0.0_wp
+        summary%file = trim(scene%output%file)
+        summary%initial_energy = model%energy(t, y, yq)
+
+        call make_parent_dirs(summary%file, err)
+        if (allocated(err)) return
+        call model%element_data(lengths, masses)
+        call out%create(summary%file, n, lengths, masses, model%model_name(), &
+                        integrator%name(), version_string, scene_namelist_text(scene), err)
+        if (allocated(err)) return
+        call write_record(err)
+        if (allocated(err)) return
+
+        call cpu_time(cpu_start)
+        call integrator%init(model, t, y, yq(1:model%quad_size()), solver_options_of(scene), err)
+        if (allocated(err)) then
+            call finish('failed', err%message)
+            return
+        end if
+        dt = scene%solver%output_interval
+        t_end = scene%solver%t_end
+        n_out = max(1, ceiling(t_end/dt*(1.0_wp - 1.0e-12_wp)))
+        call progress%start_run(t_end, scene%output%progress)
+        do k = 1, n_out
+            tout = min(real(k, wp)*dt, t_end)
+            if (k == n_out) tout = t_end
+            call integrator%advance_to(tout, t, y, yq(1:model%quad_size()), err)
+            if (allocated(err)) then
+                call progress%done()
+                ! keep the last good state if the solver got past the previous record
+                if (t > real(k - 1, wp)*dt) call write_record(io_err)
+                call finish('failed', err%message)
+                return
+            end if
+            call write_record(err)
+            if (allocated(err)) return
+            stats = integrator%stats()
+            call progress%update(t, stats%steps)
+        end do
+        call progress%done()
+        call finish('complete', '')
+    contains
+        subroutine write_record(werr)
+            type(error_t), allocatable, intent(out) :: werr
+            type(energy_t) :: e
+            real(wp) :: h
+            integer :: order
+            h = 0.0_wp
+            order = 0
+            if (allocated(integrator)) then
+                stats = integrator%stats()
+                h = stats%last_step
+                order = stats%last_order
+            end if
+            call model%fields(y, q, qdot)
+            call model%polyline(y, points)
+            e = model%energy(t, y, yq)
+            call out%append(t, q, qdot, points, e, h, order, werr)
+            summary%records = summary%records + 1
+            summary%final_energy = e
+            summary%t_reached = t
+        end subroutine write_record
+
+        subroutine finish(status, reason)
+            character(len=*), intent(in) :: status, reason
+            type(error_t), allocatable :: ferr
+            call cpu_time(cpu_now)
+            summary%cpu_time = cpu_now - cpu_start
+            summary%stats = integrator%stats()
+            call out%write_stats(summary%stats, summary%cpu_time, ferr)
+            call out%close_run(status, reason, ferr)
+            if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
+            call integrator%finalize()
+        end subroutine finish
+    end subroutine run_scene
+
+    !> mkdir -p of the directory part of `path`.
+    subroutine make_parent_dirs(path, err)
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: err
+        integer :: k, rc
+        logical :: exists
+        do k = 2, len_trim(path)
+            if (path(k:k) /= '/') cycle
+            inquire (file=path(1:k - 1)//'/.', exist=exists)
+            if (exists) cycle
+            rc = c_mkdir(path(1:k - 1)//c_null_char, int(o'755', c_int))
+            inquire (file=path(1:k - 1)//'/.', exist=exists)
+            if (.not. exists) then
+                call make_error(err, ERR_IO, path//': cannot create directory "'// &
+                                path(1:k - 1)//'"')
+                return
+            end if
+        end do
+    end subroutine make_parent_dirs
+end module ropedyn_simulation

@@ -1,0 +1,30 @@
+"""Shared fixtures for the end-to-end tests: the ropedyn executable and a runner."""
+import os
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+sys.path.insert(0, str(ROOT / "scripts"))
+
+
+@pytest.fixture(scope="session")
+def ropedyn_exe():
+    exe = pathlib.Path(os.environ.get("ROPEDYN_EXE", ROOT / "build" / "debug" / "ropedyn")).resolve()
+    if not exe.is_file():
+        pytest.fail(f"ropedyn executable not found at {exe} (set ROPEDYN_EXE)")
+    return exe
+
+
+@pytest.fixture
+def run(ropedyn_exe, tmp_path):
+    """Run `ropedyn ARGS...` in tmp_path; returns the CompletedProcess."""
+
+    def _run(*args, cwd=None, timeout=600):
+        return subprocess.run([str(ropedyn_exe), *map(str, args)], cwd=cwd or tmp_path,
+                              capture_output=True, text=True, timeout=timeout)
+
+    return _run

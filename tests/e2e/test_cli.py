@@ -1,0 +1,107 @@
+"""Command line: bad input gets one clear message (file, group, key, value), exit code 2
+and no output file; a failed integration exits 3 and leaves a file marked failed."""
+import pathlib
+
+import h5py
+import pytest
+
+MODEL = "&model kind = 'rfem', elements = 4 /\n"
+GOOD = MODEL + "&solver t_end = 0.05, output_interval = 0.01 /\n"
+
+# (name, scene text, fragments the message must contain)
+BAD_SCENES = [
+    ("no_model", "&rope length = 1.0 /\n", ["no &model group"]),
+    ("malformed", "&model kind = 'rfem', elements = 4\n&rope length = 1.0 /\n", ["&model"]),
+    ("wrong_type", GOOD + "&rope length = 'long' /\n", ["&rope", "length", "long"]),
+    ("unknown_key", GOOD + "&rope lenght = 2.0 /\n", ["&rope", "lenght"]),
+    ("length", GOOD + "&rope length = -1.0 /\n", ["&rope", "length", "-1", "> 0"]),
+    ("diameter", GOOD + "&rope diameter = 0.0 /\n", ["&rope", "diameter", "> 0"]),
+    ("density", GOOD + "&rope density = -5.0 /\n", ["&rope", "density", "-5"]),
+    ("elements", "&model kind = 'rfem', elements = 1 /\n", ["&model", "elements", "1", ">= 2"]),
+    ("rtol", MODEL + "&solver rtol = 0.0 /\n", ["&solver", "rtol", "> 0"]),
+    ("t_end", "&model kind = 'rfem' /\n&solver t_end = -3.0 /\n", ["&solver", "t_end", "-3"]),
+    ("output_interval", "&model kind = 'rfem' /\n&solver output_interval = 0.0 /\n",
+     ["&solver", "output_interval"]),
+    ("kind", "&model kind = 'fem', elements = 4 /\n", ["&model", "kind", "fem", "rfem"]),
+    ("method", MODEL + "&solver method = 'rk4' /\n", ["&solver", "method", "rk4"]),
+    ("support", GOOD + "&supports top = 'glued' /\n", ["&supports", "top", "glued", "pinned"]),
+    ("shape", GOOD + "&initial shape = 'coiled' /\n", ["&initial", "shape", "coiled"]),
+    ("max_order", MODEL + "&solver max_order = 9 /\n", ["&solver", "max_order", "9"]),
+    ("twice", GOOD + "&solver rtol = 1e-6 /\n", ["&solver", "twice"]),
+]
+
+
+@pytest.mark.parametrize("name,text,fragments", BAD_SCENES, ids=[b[0] for b in BAD_SCENES])
+def test_bad_scene(run, tmp_path, name, text, fragments):
+    scene = tmp_path / f"{name}.nml"
+    scene.write_text(text)
+    result = run("run", scene.name)
+    assert result.returncode == 2, result.stderr
+    message = result.stderr.strip()
+    assert message.startswith("ropedyn: error: "), message
+    assert len(message.splitlines()) == 1, message
+    assert f"{name}.nml" in message, message
+    for fragment in fragments:
+        assert fragment in message, f"{fragment!r} not in {message!r}"
+    assert not (tmp_path / "out").exists(), "bad input must not create output"
+
+
+def test_unreadable_file(run, tmp_path):
+    result = run("run", "missing.nml")
+    assert result.returncode == 2
+    assert "missing.nml" in result.stderr and "cannot open" in result.stderr
+
+
+@pytest.mark.parametrize("override,fragments", [
+    ("rope.length", ["rope.length", "group.key=value"]),
+    ("foo.bar=1", ["foo", "unknown group"]),
+    ("rope.lenght=2", ["&rope", "lenght"]),
+    ("model.elements=abc", ["&model", "elements", "abc"]),
+    ("rope.length=-2", ["rope.length=-2", "length", "> 0"]),
+])
+def test_bad_override(run, tmp_path, override, fragments):
+    (tmp_path / "good.nml").write_text(GOOD)
+    result = run("run", "good.nml", "--set", override)
+    assert result.returncode == 2, result.stderr
+    for fragment in fragments:
+        assert fragment in result.stderr, f"{fragment!r} not in {result.stderr!r}"
+    assert not (tmp_path / "out").exists()
+
+
+def test_bad_command_line(run, tmp_path):
+    assert run("frobnicate").returncode == 2
+    assert run("run").returncode == 2
+    (tmp_path / "good.nml").write_text(GOOD)
+    result = run("run", "good.nml", "--bogus")
+    assert result.returncode == 2 and "--bogus" in result.stderr
+
+
+def test_version(run):
+    result = run("--version")
+    assert result.returncode == 0 and result.stdout.startswith("ropedyn ")
+
+
+def test_override_applies(run, tmp_path):
+    (tmp_path / "good.nml").write_text(GOOD)
+    result = run("run", "good.nml", "--set", "model.elements=6", "--set", "solver.rtol=1e-7")
+    assert result.returncode == 0, result.stderr
+    with h5py.File(tmp_path / "out" / "good.h5") as f:
+        assert f["state/q"].shape[1] == 6
+        scene = f.attrs["scene"].decode()
+    rtol = [line for line in scene.splitlines() if line.strip().startswith("rtol")]
+    assert len(rtol) == 1 and float(rtol[0].split("=")[1]) == 1e-7, rtol
+
+
+def test_failed_integration_is_marked(run, tmp_path):
+    (tmp_path / "short.nml").write_text(
+        "&model kind = 'rfem', elements = 8 /\n"
+        "&solver t_end = 1.0, output_interval = 0.01, max_steps = 300 /\n")
+    result = run("run", "short.nml")
+    assert result.returncode == 3, result.stderr
+    assert "max_steps" in result.stderr and "t =" in result.stderr
+    with h5py.File(tmp_path / "out" / "short.h5") as f:
+        assert f.attrs["status"].decode() == "failed"
+        assert "max_steps" in f.attrs["reason"].decode()
+        t = f["time"][:]
+        assert len(t) >= 2 and 0.0 < t[-1] < 1.0, "keeps the data before the failure"
+        assert f["solver/steps"][()] >= 300

@@ -1,0 +1,176 @@
+!> RFEM model derivatives: the analytic band Jacobian against central differences of
+!! the right-hand side, conservative forces against minus the gradient of the potential
+!! energy, and the damping forces against the dissipation power.
+program test_rfem_derivatives
+    use ropedyn_kinds, only: wp
+    use ropedyn_error, only: error_t
+    use ropedyn_scene, only: scene_t
+    use ropedyn_rfem, only: rfem_t, rfem_create
+    use ropedyn_assert, only: test_suite_t
+    implicit none
+    type(test_suite_t) :: suite
+    integer :: config
+
+    suite%name = 'rfem_derivatives'
+    call random_seed_fixed()
+    do config = 1, 3
+        call check_config(config)
+    end do
+    call suite%finish()
+
+contains
+
+    subroutine random_seed_fixed()
+        integer :: n
+        integer, allocatable :: seed(:)
+        call random_seed(size=n)
+        allocate (seed(n))
+        seed = 12345
+        call random_seed(put=seed)
+    end subroutine random_seed_fixed
+
+    !> 1: pinned top, free bottom (the paper); 2: clamped top, pinned bottom;
+    !! 3: free top, clamped bottom, gravity off.
+    subroutine check_config(config)
+        integer, intent(in) :: config
+        type(scene_t) :: scene
+        type(rfem_t) :: model
+        type(error_t), allocatable :: err
+        character(len=40) :: tag
+        integer :: trial
+
+        scene%model%elements = 7
+        scene%effects%damping = .true.
+        select case (config)
+        case (1)
+            scene%supports%top = 'pinned'
+            scene%supports%bottom = 'free'
+        case (2)
+            scene%supports%top = 'clamped'
+            scene%supports%bottom = 'pinned'
+            scene%supports%top_angle_deg = 10.0_wp
+        case (3)
+            scene%supports%top = 'free'
+            scene%supports%bottom = 'clamped'
+            scene%effects%gravity = .false.
+        end select
+        call rfem_create(model, scene, err)
+        call suite%check_true(.not. allocated(err), 'create model')
+        if (allocated(err)) return
+        do trial = 1, 3
+            write (tag, '(a, i0, a, i0)') ' config ', config, ' trial ', trial
+            call check_state(model, trim(tag))
+        end do
+    end subroutine check_config
+
+    subroutine check_state(model, tag)
+        type(rfem_t), intent(inout) :: model
+        character(len=*), intent(in) :: tag
+        real(wp), allocatable :: y(:), yp(:), ym(:), fp(:), fm(:), f0(:), jb(:, :), jfd(:, :)
+        real(wp), allocatable :: jan(:, :), gen(:, :), gen0(:, :), y0v(:)
+        real(wp) :: h, worst, col_scale, vp, vm, grad_err, grad_scale, power, power_check
+        integer :: n, ml, mu, i, j, status, offset, ne, k, c
+        logical :: outside_ok
+
+        n = model%size()
+        ne = model%n_elements()
+        allocate (y(n), yp(n), ym(n), fp(n), fm(n), f0(n), jfd(n, n), jan(n, n))
+        call model%initial_state(y)
+        call random_state(y)
+        call model%bandwidths(ml, mu)
+        offset = ml + mu + 1
+        allocate (jb(2*ml + mu + 1, n))
+        jb = 0.0_wp
+        call model%jacobian(0.0_wp, y, jb, offset, status)
+        jan = 0.0_wp
+        do j = 1, n
+            do i = max(1, j - mu), min(n, j + ml)
+                jan(i, j) = jb(offset + i - j, j)
+            end do
+        end do
+        ! central differences, column by column. F is linear in the velocities, so their
+        ! columns take a large step (no truncation error, less rounding: the angular
+        ! accelerations are ~1e6 rad/s^2 while their damping derivatives are ~10).
+        do j = 1, n
+            h = 1.0e-6_wp*max(1.0_wp, abs(y(j)))
+            if (mod(j - 1, 6) >= 3) h = 1.0e-2_wp
+            yp = y
+            ym = y
+            yp(j) = y(j) + h
+            ym(j) = y(j) - h
+            call model%rhs(0.0_wp, yp, fp, status)
+            call model%rhs(0.0_wp, ym, fm, status)
+            jfd(:, j) = (fp - fm)/(2.0_wp*h)
+        end do
+        worst = 0.0_wp
+        do j = 1, n
+            col_scale = max(maxval(abs(jfd(:, j))), 1.0_wp)
+            worst = max(worst, maxval(abs(jfd(:, j) - jan(:, j)))/col_scale)
+        end do
+        call suite%check_le(worst, 1.0e-6_wp, 'jacobian vs central differences'//tag)
+        ! nothing outside the declared band
+        outside_ok = .true.
+        do j = 1, n
+            do i = 1, n
+                if (i - j > ml .or. j - i > mu) then
+                    if (abs(jfd(i, j)) > 1.0e-9_wp*max(1.0_wp, maxval(abs(jfd(:, j))))) &
+                        outside_ok = .false.
+                end if
+            end do
+        end do
+        call suite%check_true(outside_ok, 'jacobian lies inside its band'//tag)
+
+        ! conservative forces = -grad V (at zero velocity, damping forces vanish)
+        allocate (gen(3, ne), gen0(3, ne), y0v(n))
+        y0v = y
+        do i = 1, ne
+            y0v(6*(i - 1) + 4:6*(i - 1) + 6) = 0.0_wp
+        end do
+        call model%generalized_forces(y0v, gen)
+        grad_err = 0.0_wp
+        grad_scale = maxval(abs(gen))
+        do i = 1, ne
+            do c = 1, 3
+                k = 6*(i - 1) + c
+                h = 1.0e-6_wp
+                yp = y0v
+                ym = y0v
+                yp(k) = yp(k) + h
+                ym(k) = ym(k) - h
+                vp = model%potential_energy(yp)
+                vm = model%potential_energy(ym)
+                grad_err = max(grad_err, abs(gen(c, i) + (vp - vm)/(2.0_wp*h)))
+            end do
+        end do
+        call suite%check_le(grad_err/grad_scale, 1.0e-6_wp, 'forces = -grad V'//tag)
+
+        ! damping forces F_d = F(q, q') - F(q, 0) satisfy -F_d . q' = 2D = power
+        call model%generalized_forces(y, gen, power=power)
+        call model%generalized_forces(y0v, gen0)
+        power_check = 0.0_wp
+        do i = 1, ne
+            power_check = power_check - dot_product(gen(:, i) - gen0(:, i), &
+                                                    y(6*(i - 1) + 4:6*(i - 1) + 6))
+        end do
+        call suite%check_close(power_check, power, 1.0e-10_wp, 1.0e-14_wp, &
+                               'dissipation power = -F_damp . qdot'//tag)
+        call suite%check_true(power > 0.0_wp, 'dissipation power positive'//tag)
+    end subroutine check_state
+
+    !> Perturb a straight state: positions by up to 2 mm, angles by up to 0.5 rad,
+    !! velocities up to 1 m/s and 3 rad/s.
+    subroutine random_state(y)
+        real(wp), intent(inout) :: y(:)
+        real(wp), allocatable :: r(:)
+        integer :: i
+        allocate (r(size(y)))
+        call random_number(r)
+        r = 2.0_wp*r - 1.0_wp
+        do i = 0, size(y)/6 - 1
+            y(6*i + 1:6*i + 2) = y(6*i + 1:6*i + 2) + 2.0e-3_wp*r(6*i + 1:6*i + 2)
+            y(6*i + 3) = y(6*i + 3) + 0.5_wp*r(6*i + 3)
+            y(6*i + 4:6*i + 5) = r(6*i + 4:6*i + 5)
+            y(6*i + 6) = 3.0_wp*r(6*i + 6)
+        end do
+    end subroutine random_state
+end program test_rfem_derivatives
