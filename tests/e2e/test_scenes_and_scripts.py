@@ -1,0 +1,46 @@
+"""Every shipped scene reads and runs; progress shows on request; the energy plot of
+scripts/run is made from an output file."""
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SCENES = sorted((ROOT / "input").glob("**/*.nml"))
+
+
+@pytest.mark.parametrize("scene", SCENES, ids=[s.stem for s in SCENES])
+def test_shipped_scene_runs(run, tmp_path, scene):
+    result = run("run", scene, "--set", "solver.t_end=0.02", "--set", "output.file=s.h5")
+    assert result.returncode == 0, result.stderr
+    assert "balance error" in result.stdout
+
+
+def test_progress_on_request(run, tmp_path):
+    (tmp_path / "p.nml").write_text(
+        "&model kind = 'rfem', elements = 4 /\n&solver t_end = 0.05 /\n"
+        "&output progress = .true. /\n")
+    result = run("run", "p.nml")
+    assert result.returncode == 0, result.stderr
+    assert "ETA" in result.stderr and "100.0 %" in result.stderr
+
+
+def test_silent_without_terminal(run, tmp_path):
+    (tmp_path / "q.nml").write_text("&model kind = 'rfem', elements = 4 /\n"
+                                    "&solver t_end = 0.05 /\n")
+    result = run("run", "q.nml")
+    assert result.returncode == 0 and result.stderr == ""
+
+
+def test_energy_plot(run, tmp_path):
+    (tmp_path / "e.nml").write_text("&model kind = 'rfem', elements = 4 /\n"
+                                    "&solver t_end = 0.2, output_interval = 0.01 /\n")
+    assert run("run", "e.nml").returncode == 0
+    png = tmp_path / "out" / "e_energy.png"
+    result = subprocess.run([sys.executable, str(ROOT / "scripts" / "plot_energy.py"),
+                             str(tmp_path / "out" / "e.h5"), "-o", str(png)],
+                            capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    data = png.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10000
