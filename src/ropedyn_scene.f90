@@ -3,7 +3,7 @@
 !! every key.
 !!
 !! Reading follows the Quantum ESPRESSO pattern: defaults -> for each group, look for its
-!! header in the file and, if present, read it with `read(unit, nml=...)` -> apply the
+!! header in the file and, if present, read it from the file's lines in memory -> apply the
 !! overrides of that group by an internal namelist read -> resolve derived defaults -> check
 !! every key. Every error is one message of class `ERR_INPUT` naming the file (or the
 !! `--set` argument), the group, the key and the value. The reference is docs/input.md.
@@ -333,43 +333,41 @@ contains
 
     ! ------------------------------------------------------------------------------------
     ! Namelist reads, one procedure per group (the keys of two groups share names).
-    ! Exactly one of `unit` (an open file) and `recs` (an internal file) is present.
+    ! Every group is read from an internal file (`recs`): the scene's lines or an override.
     ! ------------------------------------------------------------------------------------
 
-    subroutine read_group(g, scene, ios, msg, unit, recs)
+    subroutine read_group(g, scene, ios, msg, recs)
         integer, intent(in) :: g
         type(scene_t), intent(inout) :: scene
         integer, intent(out) :: ios
         character(len=*), intent(inout) :: msg
-        integer, intent(in), optional :: unit
-        character(len=*), intent(in), optional :: recs(:)
+        character(len=*), intent(in) :: recs(:)
         select case (g)
         case (G_ROPE)
-            call nml_rope(scene%rope, ios, msg, unit, recs)
+            call nml_rope(scene%rope, ios, msg, recs)
         case (G_MODEL)
-            call nml_model(scene%model, ios, msg, unit, recs)
+            call nml_model(scene%model, ios, msg, recs)
         case (G_SUPPORTS)
-            call nml_supports(scene%supports, ios, msg, unit, recs)
+            call nml_supports(scene%supports, ios, msg, recs)
         case (G_INITIAL)
-            call nml_initial(scene%initial, ios, msg, unit, recs)
+            call nml_initial(scene%initial, ios, msg, recs)
         case (G_EFFECTS)
-            call nml_effects(scene%effects, ios, msg, unit, recs)
+            call nml_effects(scene%effects, ios, msg, recs)
         case (G_SOLVER)
-            call nml_solver(scene%solver, ios, msg, unit, recs)
+            call nml_solver(scene%solver, ios, msg, recs)
         case (G_OUTPUT)
-            call nml_output(scene%output, ios, msg, unit, recs)
+            call nml_output(scene%output, ios, msg, recs)
         case default
             ios = -1
             msg = 'internal error: no such group'
         end select
     end subroutine read_group
 
-    subroutine nml_rope(p, ios, msg, unit, recs)
+    subroutine nml_rope(p, ios, msg, recs)
         type(rope_params_t), intent(inout) :: p
         integer, intent(out) :: ios
         character(len=*), intent(inout) :: msg
-        integer, intent(in), optional :: unit
-        character(len=*), intent(in), optional :: recs(:)
+        character(len=*), intent(in) :: recs(:)
         real(wp) :: length, density, diameter, young_modulus, shear_modulus, normal_damping, &
             tangential_damping, shape_factor, gravity
         namelist /rope/ length, density, diameter, young_modulus, shear_modulus, &
@@ -383,11 +381,7 @@ contains
         tangential_damping = p%tangential_damping
         shape_factor = p%shape_factor
         gravity = p%gravity
-        if (present(unit)) then
-            read (unit, nml=rope, iostat=ios, iomsg=msg)
-        else
-            read (recs, nml=rope, iostat=ios, iomsg=msg)
-        end if
+        read (recs, nml=rope, iostat=ios, iomsg=msg)
         if (ios /= 0) return
         p%length = length
         p%density = density
@@ -400,33 +394,27 @@ contains
         p%gravity = gravity
     end subroutine nml_rope
 
-    subroutine nml_model(p, ios, msg, unit, recs)
+    subroutine nml_model(p, ios, msg, recs)
         type(model_params_t), intent(inout) :: p
         integer, intent(out) :: ios
         character(len=*), intent(inout) :: msg
-        integer, intent(in), optional :: unit
-        character(len=*), intent(in), optional :: recs(:)
+        character(len=*), intent(in) :: recs(:)
         character(len=BUF_LEN) :: kind
         integer :: elements
         namelist /model/ kind, elements
         kind = p%kind
         elements = p%elements
-        if (present(unit)) then
-            read (unit, nml=model, iostat=ios, iomsg=msg)
-        else
-            read (recs, nml=model, iostat=ios, iomsg=msg)
-        end if
+        read (recs, nml=model, iostat=ios, iomsg=msg)
         if (ios /= 0) return
         call store_string(kind, 'kind', p%kind, ios, msg)
         p%elements = elements
     end subroutine nml_model
 
-    subroutine nml_supports(p, ios, msg, unit, recs)
+    subroutine nml_supports(p, ios, msg, recs)
         type(supports_params_t), intent(inout) :: p
         integer, intent(out) :: ios
         character(len=*), intent(inout) :: msg
-        integer, intent(in), optional :: unit
-        character(len=*), intent(in), optional :: recs(:)
+        character(len=*), intent(in) :: recs(:)
         character(len=BUF_LEN) :: top, bottom
         real(wp) :: top_anchor(2), bottom_anchor(2), top_angle_deg, bottom_angle_deg, &
             support_stiffness_factor
@@ -439,11 +427,7 @@ contains
         top_angle_deg = p%top_angle_deg
         bottom_angle_deg = p%bottom_angle_deg
         support_stiffness_factor = p%support_stiffness_factor
-        if (present(unit)) then
-            read (unit, nml=supports, iostat=ios, iomsg=msg)
-        else
-            read (recs, nml=supports, iostat=ios, iomsg=msg)
-        end if
+        read (recs, nml=supports, iostat=ios, iomsg=msg)
         if (ios /= 0) return
         call store_string(top, 'top', p%top, ios, msg)
         call store_string(bottom, 'bottom', p%bottom, ios, msg)
@@ -454,33 +438,27 @@ contains
         p%support_stiffness_factor = support_stiffness_factor
     end subroutine nml_supports
 
-    subroutine nml_initial(p, ios, msg, unit, recs)
+    subroutine nml_initial(p, ios, msg, recs)
         type(initial_params_t), intent(inout) :: p
         integer, intent(out) :: ios
         character(len=*), intent(inout) :: msg
-        integer, intent(in), optional :: unit
-        character(len=*), intent(in), optional :: recs(:)
+        character(len=*), intent(in) :: recs(:)
         character(len=BUF_LEN) :: shape
         real(wp) :: angle_deg
         namelist /initial/ shape, angle_deg
         shape = p%shape
         angle_deg = p%angle_deg
-        if (present(unit)) then
-            read (unit, nml=initial, iostat=ios, iomsg=msg)
-        else
-            read (recs, nml=initial, iostat=ios, iomsg=msg)
-        end if
+        read (recs, nml=initial, iostat=ios, iomsg=msg)
         if (ios /= 0) return
         call store_string(shape, 'shape', p%shape, ios, msg)
         p%angle_deg = angle_deg
     end subroutine nml_initial
 
-    subroutine nml_effects(p, ios, msg, unit, recs)
+    subroutine nml_effects(p, ios, msg, recs)
         type(effects_params_t), intent(inout) :: p
         integer, intent(out) :: ios
         character(len=*), intent(inout) :: msg
-        integer, intent(in), optional :: unit
-        character(len=*), intent(in), optional :: recs(:)
+        character(len=*), intent(in) :: recs(:)
         logical :: gravity, tension, shear, bending, damping
         namelist /effects/ gravity, tension, shear, bending, damping
         gravity = p%gravity
@@ -488,11 +466,7 @@ contains
         shear = p%shear
         bending = p%bending
         damping = p%damping
-        if (present(unit)) then
-            read (unit, nml=effects, iostat=ios, iomsg=msg)
-        else
-            read (recs, nml=effects, iostat=ios, iomsg=msg)
-        end if
+        read (recs, nml=effects, iostat=ios, iomsg=msg)
         if (ios /= 0) return
         p%gravity = gravity
         p%tension = tension
@@ -501,12 +475,11 @@ contains
         p%damping = damping
     end subroutine nml_effects
 
-    subroutine nml_solver(p, ios, msg, unit, recs)
+    subroutine nml_solver(p, ios, msg, recs)
         type(solver_params_t), intent(inout) :: p
         integer, intent(out) :: ios
         character(len=*), intent(inout) :: msg
-        integer, intent(in), optional :: unit
-        character(len=*), intent(in), optional :: recs(:)
+        character(len=*), intent(in) :: recs(:)
         character(len=BUF_LEN) :: method
         real(wp) :: rtol, atol, t_end, output_interval
         integer :: max_order, max_steps
@@ -518,11 +491,7 @@ contains
         max_steps = p%max_steps
         t_end = p%t_end
         output_interval = p%output_interval
-        if (present(unit)) then
-            read (unit, nml=solver, iostat=ios, iomsg=msg)
-        else
-            read (recs, nml=solver, iostat=ios, iomsg=msg)
-        end if
+        read (recs, nml=solver, iostat=ios, iomsg=msg)
         if (ios /= 0) return
         call store_string(method, 'method', p%method, ios, msg)
         p%rtol = rtol
@@ -533,22 +502,17 @@ contains
         p%output_interval = output_interval
     end subroutine nml_solver
 
-    subroutine nml_output(p, ios, msg, unit, recs)
+    subroutine nml_output(p, ios, msg, recs)
         type(output_params_t), intent(inout) :: p
         integer, intent(out) :: ios
         character(len=*), intent(inout) :: msg
-        integer, intent(in), optional :: unit
-        character(len=*), intent(in), optional :: recs(:)
+        character(len=*), intent(in) :: recs(:)
         character(len=BUF_LEN) :: file
         logical :: progress
         namelist /output/ file, progress
         file = p%file
         progress = p%progress
-        if (present(unit)) then
-            read (unit, nml=output, iostat=ios, iomsg=msg)
-        else
-            read (recs, nml=output, iostat=ios, iomsg=msg)
-        end if
+        read (recs, nml=output, iostat=ios, iomsg=msg)
         if (ios /= 0) return
         call store_string(file, 'file', p%file, ios, msg)
         p%progress = progress

@@ -16,6 +16,7 @@ program test_rfem_derivatives
     do config = 1, 3
         call check_config(config)
     end do
+    call check_effects_off()
     call suite%finish()
 
 contains
@@ -156,6 +157,47 @@ contains
                                'dissipation power = -F_damp . qdot'//tag)
         call suite%check_true(power > 0.0_wp, 'dissipation power positive'//tag)
     end subroutine check_state
+
+    !> Effects that are off contribute nothing: with tension, shear and bending off, a
+    !! deformed rope with free ends falls freely; with gravity off as well it feels no
+    !! force at all, and the pinned top still holds (supports are not effects).
+    subroutine check_effects_off()
+        type(scene_t) :: scene
+        type(rfem_t) :: model
+        type(error_t), allocatable :: err
+        real(wp), allocatable :: y(:), ydot(:), gen(:, :)
+        real(wp) :: e_el
+        integer :: status
+
+        scene%model%elements = 6
+        scene%effects%tension = .false.
+        scene%effects%shear = .false.
+        scene%effects%bending = .false.
+        scene%supports%top = 'free'
+        call rfem_create(model, scene, err)
+        allocate (y(model%size()), ydot(model%size()))
+        call model%initial_state(y)
+        call random_state(y)
+        call model%rhs(0.0_wp, y, ydot, status)
+        call suite%check_true(all(ydot(4::6) == scene%rope%gravity) .and. &
+                              all(ydot(5::6) == 0.0_wp) .and. all(ydot(6::6) == 0.0_wp), &
+                              'springs off, free ends: every element falls with g exactly')
+        allocate (gen(3, model%n_elements()))
+        call model%generalized_forces(y, gen, elastic=e_el)
+        call suite%check_true(e_el == 0.0_wp, 'springs off: no elastic energy')
+
+        scene%effects%gravity = .false.
+        scene%supports%top = 'pinned'
+        call rfem_create(model, scene, err)
+        call model%initial_state(y)
+        call model%rhs(0.0_wp, y, ydot, status)
+        call suite%check_true(all(ydot(4::6) == 0.0_wp), &
+                              'all effects off, undeformed: no acceleration')
+        y(1) = y(1) + 1.0e-3_wp  ! pull element 1 away from the pin
+        call model%rhs(0.0_wp, y, ydot, status)
+        call suite%check_true(ydot(4) < 0.0_wp .and. all(ydot(10::6) == 0.0_wp), &
+                              'the pin pulls element 1 back; the others feel nothing')
+    end subroutine check_effects_off
 
     !> Perturb a straight state: positions by up to 2 mm, angles by up to 0.5 rad,
     !! velocities up to 1 m/s and 3 rad/s.
