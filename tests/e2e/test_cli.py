@@ -105,3 +105,13 @@ def test_failed_integration_is_marked(run, tmp_path):
         t = f["time"][:]
         assert len(t) >= 2 and 0.0 < t[-1] < 1.0, "keeps the data before the failure"
         assert f["solver/steps"][()] >= 300
+
+
+def test_unwritable_output(run, tmp_path):
+    """An output file that cannot be created: exit code 4, a message naming the path."""
+    blocker = tmp_path / "blocker"
+    blocker.write_text("a file where a directory is needed")
+    (tmp_path / "w.nml").write_text(GOOD + "&output file = 'blocker/run.h5' /\n")
+    result = run("run", "w.nml")
+    assert result.returncode == 4, result.stderr
+    assert "blocker/run.h5" in result.stderr
