@@ -22,13 +22,12 @@
 !! its last output time with status 'running'. `/time` is written last in each record, so
 !! its length is the number of complete records.
 !!
-!! The HDF5 library is opened when the first output file of the process is created and
-!! closed when the last one is closed (a module-level count of open files; not solver state).
-!! A program that also calls HDF5 directly must call its own `h5open_f` while no output file
-!! is open, or keep its HDF5 objects closed whenever the last output file is closed.
+!! `create` calls `h5open_f` (which may be called any number of times) and silences HDF5's
+!! error printing; the library is never closed here, so the module keeps no state of its own
+!! and other HDF5 users in the process are not disturbed (HDF5 closes itself at exit).
 !! An `output_file_t` must not be copied while open (both copies would hold the same ids).
 module ropedyn_output
-    use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5close_f, h5eset_auto_f, &
+    use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5eset_auto_f, &
         h5fcreate_f, h5fclose_f, h5fflush_f, H5F_ACC_TRUNC_F, H5F_SCOPE_GLOBAL_F, &
         h5gcreate_f, h5gclose_f, h5lexists_f, &
         h5screate_f, h5screate_simple_f, h5sclose_f, h5sselect_hyperslab_f, &
@@ -62,7 +61,6 @@ module ropedyn_output
     integer, parameter :: MAX_CHUNK_RECORDS = 512
 
     !> Number of output files open in this process (owns the HDF5 library open/close).
-    integer :: library_users = 0
 
     !> One extendible dataset with time on its last Fortran axis.
     type :: series_t
@@ -128,7 +126,6 @@ contains
 
         call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%file_id, hdferr)
         if (hdferr < 0) then
-            call library_release()
             if (directory_exists(path)) then
                 call make_error(err, ERR_IO, path//': cannot create file (is it open in this '// &
                                 'or another program, or is the directory read-only?)')
@@ -384,35 +381,24 @@ contains
     ! Library and file life cycle
     ! ---------------------------------------------------------------------------------------
 
-    !> Open the HDF5 library for the first open file; silence HDF5's own error printing.
+    !> Open the HDF5 library (idempotent) and silence HDF5's own error printing.
     subroutine library_acquire(path, err)
         character(len=*), intent(in) :: path
         type(error_t), allocatable, intent(out) :: err
         integer :: hdferr
-        if (library_users == 0) then
-            call h5open_f(hdferr)
-            if (hdferr < 0) then
-                call make_error(err, ERR_IO, path//': cannot initialize the HDF5 library')
-                return
-            end if
+        call h5open_f(hdferr)
+        if (hdferr < 0) then
+            call make_error(err, ERR_IO, path//': cannot initialize the HDF5 library')
+            return
         end if
         call h5eset_auto_f(0, hdferr)
         if (hdferr < 0) then
-            if (library_users == 0) call h5close_f(hdferr)
             call make_error(err, ERR_IO, path//': cannot silence HDF5 error printing')
             return
         end if
-        library_users = library_users + 1
     end subroutine library_acquire
 
-    !> Close the HDF5 library after the last open file.
-    subroutine library_release()
-        integer :: hdferr
-        library_users = max(library_users - 1, 0)
-        if (library_users == 0) call h5close_f(hdferr)
-    end subroutine library_release
-
-    !> Close all datasets and the file, release the library and mark `self` closed.
+    !> Close all datasets and the file and mark `self` closed.
     !! Reports the first failure in `err` if present; closes everything regardless.
     subroutine shutdown(self, err)
         type(output_file_t), intent(inout) :: self
@@ -434,7 +420,6 @@ contains
         if (hdferr < 0 .and. len(message) == 0) message = self%path//': cannot close file'
         self%file_id = -1
         self%is_open = .false.
-        call library_release()
         if (present(err) .and. len(message) > 0) call make_error(err, ERR_IO, message)
     end subroutine shutdown
 
