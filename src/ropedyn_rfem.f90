@@ -531,8 +531,17 @@ contains
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: yqdot(:)
         integer, intent(out) :: status
-        real(wp) :: power
-        call self%generalized_forces(y, self%gen, power=power)
+        real(wp) :: power, s, g(6)
+        integer :: f, j
+        ! only the damped strains: no spring forces, no gravity, no scatter
+        power = 0.0_wp
+        do f = 1, size(self%families)
+            if (.not. self%families(f)%damped) cycle
+            do j = self%families(f)%first, self%families(f)%last
+                call self%strain(self%families(f)%kind, j, y, s, g)
+                power = power + self%families(f)%b*dot_product(g, self%local_rates(j, y))**2
+            end do
+        end do
         yqdot(1) = power
         status = STATUS_OK
         if (.not. ieee_is_finite(power)) status = STATUS_RECOVERABLE

@@ -140,9 +140,8 @@ contains
                 call finish('failed', err%message)
                 return
             end if
-            call write_record(err)
+            call write_record(err)  ! also refreshes `stats`
             if (allocated(err)) return
-            stats = integrator%stats()
             call progress%update(t, stats%steps)
         end do
         call progress%done()

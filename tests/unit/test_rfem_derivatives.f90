@@ -70,6 +70,7 @@ contains
         real(wp), allocatable :: y(:), yp(:), ym(:), fp(:), fm(:), f0(:), jb(:, :), jfd(:, :)
         real(wp), allocatable :: jan(:, :), gen(:, :), gen0(:, :), y0v(:)
         real(wp) :: h, worst, col_scale, vp, vm, grad_err, grad_scale, power, power_check
+        real(wp) :: qdot_quad(1)
         integer :: n, ml, mu, i, j, status, offset, ne, k, c
         logical :: outside_ok
 
@@ -156,6 +157,9 @@ contains
         call suite%check_close(power_check, power, 1.0e-10_wp, 1.0e-14_wp, &
                                'dissipation power = -F_damp . qdot'//tag)
         call suite%check_true(power > 0.0_wp, 'dissipation power positive'//tag)
+        call model%quad_rhs(0.0_wp, y, qdot_quad, status)
+        call suite%check_close(qdot_quad(1), power, 1.0e-12_wp, 0.0_wp, &
+                               'quadrature rate = dissipation power'//tag)
     end subroutine check_state
 
     !> Effects that are off contribute nothing: with tension, shear and bending off, a
