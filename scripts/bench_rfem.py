@@ -7,6 +7,7 @@ of that file (the reading of the numbers) is kept.
 """
 import argparse
 import datetime
+import os
 import pathlib
 import platform
 import re
@@ -28,7 +29,6 @@ def machine():
                 break
     except OSError:
         pass
-    import os
     return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
 
 

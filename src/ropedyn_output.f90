@@ -60,8 +60,6 @@ module ropedyn_output
     !> Most records in one chunk.
     integer, parameter :: MAX_CHUNK_RECORDS = 512
 
-    !> Number of output files open in this process (owns the HDF5 library open/close).
-
     !> One extendible dataset with time on its last Fortran axis.
     type :: series_t
         character(len=:), allocatable :: name     !< absolute path in the file

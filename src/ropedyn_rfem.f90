@@ -359,17 +359,16 @@ contains
     end function local_rates
 
     !> Generalized forces (3, n) of all enabled effects at state y; optionally the
-    !! dissipation power (W) and the elastic energy (J).
-    subroutine rfem_generalized_forces(self, y, gen, power, elastic)
+    !! elastic energy (J). (The dissipation power is `quad_rhs`.)
+    subroutine rfem_generalized_forces(self, y, gen, elastic)
         class(rfem_t), intent(inout) :: self
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: gen(:, :)
-        real(wp), intent(out), optional :: power, elastic
+        real(wp), intent(out), optional :: elastic
         integer :: f, j
         real(wp) :: sd
 
         gen = 0.0_wp
-        if (present(power)) power = 0.0_wp
         if (present(elastic)) elastic = 0.0_wp
         if (self%gravity_on) gen(1, :) = self%mass*self%g
         do f = 1, size(self%families)
@@ -384,7 +383,6 @@ contains
                     do j = fam%first, fam%last
                         sd = dot_product(self%grad(:, j), self%local_rates(j, y))
                         self%force(j) = self%force(j) + fam%b*sd
-                        if (present(power)) power = power + fam%b*sd**2
                     end do
                 end if
                 do j = fam%first, fam%last
