@@ -52,6 +52,9 @@ module ropedyn_cvode
         procedure :: stats => cvode_stats
         procedure :: finalize => cvode_finalize
         procedure :: name => cvode_name
+        procedure :: default_max_order => cvode_default_max_order
+        procedure :: min_order => cvode_min_order
+        procedure :: max_order_limit => cvode_max_order_limit
         final :: cvode_destroy
     end type cvode_t
 
@@ -70,6 +73,22 @@ contains
         name = 'cvode'
     end function cvode_name
 
+    !> CVODE's own limit, BDF order 5 (see docs/solvers.md on the choice).
+    pure integer function cvode_default_max_order(self) result(order)
+        class(cvode_t), intent(in) :: self
+        order = 5
+    end function cvode_default_max_order
+
+    pure integer function cvode_min_order(self) result(order)
+        class(cvode_t), intent(in) :: self
+        order = 1
+    end function cvode_min_order
+
+    pure integer function cvode_max_order_limit(self) result(order)
+        class(cvode_t), intent(in) :: self
+        order = 5
+    end function cvode_max_order_limit
+
     subroutine cvode_init(self, problem, t0, y0, yq0, options, err)
         class(cvode_t), intent(inout) :: self
         class(problem_t), intent(inout), target :: problem
@@ -78,8 +97,10 @@ contains
         real(wp), intent(in) :: yq0(:)
         type(solver_options_t), intent(in) :: options
         type(error_t), allocatable, intent(out) :: err
-        integer :: ml, mu
+        integer :: ml, mu, max_order
         integer(c_int) :: flag
+        type(N_Vector), pointer :: nv_atol
+        real(c_double), allocatable, target :: atol(:)
 
         call self%finalize()
         self%options = options
@@ -112,10 +133,28 @@ contains
         if (check(flag, 'FCVodeInit')) return
         flag = FCVodeSetUserData(self%mem, c_loc(self%ctx))
         if (check(flag, 'FCVodeSetUserData')) return
-        flag = FCVodeSStolerances(self%mem, real(options%rtol, c_double), &
-                                  real(options%atol, c_double))
-        if (check(flag, 'FCVodeSStolerances')) return
-        flag = FCVodeSetMaxOrd(self%mem, int(options%max_order, c_int))
+        if (allocated(options%atol_vector)) then
+            if (size(options%atol_vector) /= self%n) then
+                call make_error(err, ERR_SOLVER, 'cvode: atol_vector has the wrong size')
+                return
+            end if
+            atol = options%atol_vector
+            nv_atol => FN_VMake_Serial(int(self%n, c_int64_t), atol, self%sunctx)
+            flag = FCVodeSVtolerances(self%mem, real(options%rtol, c_double), nv_atol)
+            call FN_VDestroy(nv_atol)
+            if (check(flag, 'FCVodeSVtolerances')) return
+        else
+            flag = FCVodeSStolerances(self%mem, real(options%rtol, c_double), &
+                                      real(options%atol, c_double))
+            if (check(flag, 'FCVodeSStolerances')) return
+        end if
+        max_order = options%max_order
+        if (max_order == 0) max_order = self%default_max_order()
+        if (max_order < 1 .or. max_order > 5) then
+            call make_error(err, ERR_SOLVER, 'cvode: max_order must be 1 .. 5')
+            return
+        end if
+        flag = FCVodeSetMaxOrd(self%mem, int(max_order, c_int))
         if (check(flag, 'FCVodeSetMaxOrd')) return
         flag = FCVodeSetMaxHnilWarns(self%mem, -1_c_int)
         if (check(flag, 'FCVodeSetMaxHnilWarns')) return
@@ -130,8 +169,10 @@ contains
         end if
         flag = FCVodeSetLinearSolver(self%mem, self%solver, self%matrix)
         if (check(flag, 'FCVodeSetLinearSolver')) return
-        flag = FCVodeSetJacFn(self%mem, c_funloc(cv_jacobian))
-        if (check(flag, 'FCVodeSetJacFn')) return
+        if (problem%has_jacobian() .and. .not. options%fd_jacobian) then
+            flag = FCVodeSetJacFn(self%mem, c_funloc(cv_jacobian))
+            if (check(flag, 'FCVodeSetJacFn')) return
+        end if
 
         if (self%nq > 0) then
             self%nv_q => FN_VMake_Serial(int(self%nq, c_int64_t), self%yq, self%sunctx)
@@ -214,6 +255,8 @@ contains
         stats%rhs_evals = v(1)
         flag = FCVodeGetNumJacEvals(self%mem, v)
         stats%jac_evals = v(1)
+        flag = FCVodeGetNumLinRhsEvals(self%mem, v)
+        stats%jac_rhs_evals = v(1)
         flag = FCVodeGetNumLinSolvSetups(self%mem, v)
         stats%lin_setups = v(1)
         flag = FCVodeGetNumErrTestFails(self%mem, v)

@@ -9,27 +9,39 @@ module ropedyn_integrator
     use ropedyn_problem, only: problem_t
     implicit none
     private
-    public :: integrator_t, solver_options_t, solver_stats_t
+    public :: integrator_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT
+
+    !> No integrator here goes beyond this order of accuracy.
+    integer, parameter :: MAX_ORDER_LIMIT = 6
 
     !> Options shared by all integrators (same meaning for every method).
+    !! The error test of every method keeps the local error of component i near or below
+    !! rtol * |y_i| + atol_i.
     type :: solver_options_t
         real(wp) :: rtol = 1.0e-6_wp         !< relative tolerance
         real(wp) :: atol = 1.0e-8_wp         !< absolute tolerance (state units)
-        integer :: max_order = 5             !< highest order the method may use
+        !> per-component absolute tolerances; when allocated (size of the state) they
+        !! replace `atol` for the state (quadratures keep `atol`)
+        real(wp), allocatable :: atol_vector(:)
+        integer :: max_order = 0             !< highest order of accuracy (0: method default)
         integer(i8) :: max_steps = 1000000_i8 !< step budget for the whole run
+        logical :: fd_jacobian = .false.     !< difference f even if the problem has a Jacobian
     end type solver_options_t
 
     !> Counters of an integration so far.
     type :: solver_stats_t
         integer(i8) :: steps = 0              !< accepted steps
         integer(i8) :: rhs_evals = 0          !< f evaluations (without Jacobian differencing)
-        integer(i8) :: jac_evals = 0          !< Jacobian evaluations
+        integer(i8) :: jac_rhs_evals = 0      !< f evaluations spent differencing Jacobians
+        integer(i8) :: jac_evals = 0          !< Jacobian evaluations (analytic or differenced)
         integer(i8) :: lin_setups = 0         !< linear solver setups (LU factorizations)
         integer(i8) :: err_test_fails = 0     !< rejected steps (local error test)
         integer(i8) :: nonlin_iters = 0       !< Newton iterations
         integer(i8) :: nonlin_conv_fails = 0  !< Newton convergence failures
         real(wp) :: last_step = 0.0_wp        !< size of the last step taken, s
         integer :: last_order = 0             !< order of the last step taken
+        !> accepted steps taken at each order of accuracy (zero when a method does not say)
+        integer(i8) :: order_steps(MAX_ORDER_LIMIT) = 0
     end type solver_stats_t
 
     type, abstract :: integrator_t
@@ -39,6 +51,9 @@ module ropedyn_integrator
         procedure(stats_i), deferred :: stats
         procedure(finalize_i), deferred :: finalize
         procedure(name_i), deferred :: name
+        procedure(default_max_order_i), deferred :: default_max_order
+        procedure(min_order_i), deferred :: min_order
+        procedure(min_order_i), deferred :: max_order_limit
     end type integrator_t
 
     abstract interface
@@ -87,5 +102,19 @@ module ropedyn_integrator
             class(integrator_t), intent(in) :: self
             character(len=:), allocatable :: name
         end function name_i
+
+        !> The order limit used when options%max_order is 0, chosen to be safe for
+        !! lightly damped stiff oscillations.
+        pure integer function default_max_order_i(self)
+            import :: integrator_t
+            class(integrator_t), intent(in) :: self
+        end function default_max_order_i
+
+        !> The lowest (min_order) or highest (max_order_limit) value options%max_order may
+        !! take for this method.
+        pure integer function min_order_i(self)
+            import :: integrator_t
+            class(integrator_t), intent(in) :: self
+        end function min_order_i
     end interface
 end module ropedyn_integrator

@@ -63,6 +63,7 @@ module ropedyn_rfem
         procedure :: size => rfem_size
         procedure :: bandwidths => rfem_bandwidths
         procedure :: rhs => rfem_rhs
+        procedure :: has_jacobian => rfem_has_jacobian
         procedure :: jacobian => rfem_jacobian
         procedure :: energy => rfem_energy
         procedure :: quad_size => rfem_quad_size
@@ -415,6 +416,12 @@ contains
 
     !> Analytic Jacobian of the first-order system, banded. For each strain:
     !! dF/dq = -C g g^T - (C s + B s') H - B g (H q')^T,  dF/dq' = -B g g^T.
+    !> The RFEM Jacobian is analytic.
+    pure logical function rfem_has_jacobian(self) result(has)
+        class(rfem_t), intent(in) :: self
+        has = .true.
+    end function rfem_has_jacobian
+
     subroutine rfem_jacobian(self, t, y, jb, offset, status)
         class(rfem_t), intent(inout) :: self
         real(wp), intent(in) :: t

@@ -11,6 +11,7 @@ module ropedyn_scene
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
+    use ropedyn_solvers, only: method_order_range
     implicit none
     private
     public :: rope_params_t, model_params_t, supports_params_t, initial_params_t
@@ -75,10 +76,12 @@ module ropedyn_scene
 
     !> `&solver`: time integration.
     type :: solver_params_t
-        character(len=NAME_LEN) :: method = 'cvode'  !< 'cvode' ('mebdf' not available yet)
+        character(len=NAME_LEN) :: method = 'cvode'  !< 'cvode' | 'mebdf'
         real(wp) :: rtol = 1.0e-6_wp          !< relative tolerance [-]
         real(wp) :: atol = 1.0e-8_wp          !< absolute tolerance [state units]
-        integer :: max_order = 5              !< maximum BDF order [-]
+        !> highest order of accuracy; 0 in the file: the method's default (resolved by
+        !! `read_scene`: 5 for cvode, 4 for mebdf)
+        integer :: max_order = 0
         integer :: max_steps = 1000000        !< step budget for the whole run [-]
         real(wp) :: t_end = 30.0_wp           !< end time [s]
         real(wp) :: output_interval = 0.01_wp !< time between output records [s]
@@ -157,8 +160,7 @@ module ropedyn_scene
     ! Allowed values of the name keys; "known" values are recognised but not available yet.
     character(len=*), parameter :: KINDS_ALLOWED(1) = [character(len=8) :: 'rfem']
     character(len=*), parameter :: KINDS_KNOWN(1) = [character(len=8) :: 'mpp']
-    character(len=*), parameter :: METHODS_ALLOWED(1) = [character(len=8) :: 'cvode']
-    character(len=*), parameter :: METHODS_KNOWN(1) = [character(len=8) :: 'mebdf']
+    character(len=*), parameter :: METHODS_ALLOWED(2) = [character(len=8) :: 'cvode', 'mebdf']
     character(len=*), parameter :: SUPPORTS_ALLOWED(3) = [character(len=8) :: &
         'pinned', 'clamped', 'free']
     character(len=*), parameter :: SHAPES_ALLOWED(2) = [character(len=8) :: &
@@ -1036,6 +1038,7 @@ contains
         type(context_t), intent(in) :: ctx
         type(scene_t), intent(inout) :: scene
         type(error_t), allocatable, intent(out) :: err
+        integer :: lowest, highest, default
 
         associate (r => scene%rope)
             call check_real(ctx, G_ROPE, 'length', r%length, '>', 0.0_wp, err)
@@ -1107,7 +1110,7 @@ contains
         if (allocated(err)) return
 
         associate (v => scene%solver)
-            call check_name(ctx, G_SOLVER, 'method', v%method, METHODS_ALLOWED, METHODS_KNOWN, &
+            call check_name(ctx, G_SOLVER, 'method', v%method, METHODS_ALLOWED, NONE_KNOWN, &
                 err)
             if (allocated(err)) return
             call check_real(ctx, G_SOLVER, 'rtol', v%rtol, '>', 0.0_wp, err)
@@ -1116,8 +1119,16 @@ contains
             if (allocated(err)) return
             call check_real(ctx, G_SOLVER, 'atol', v%atol, '>', 0.0_wp, err)
             if (allocated(err)) return
-            call check_int(ctx, G_SOLVER, 'max_order', v%max_order, 1, 5, err)
+            call method_order_range(trim(v%method), lowest, highest, default, err)
             if (allocated(err)) return
+            if (v%max_order == 0) v%max_order = default
+            if (v%max_order < lowest .or. v%max_order > highest) then
+                call fail(ctx, G_SOLVER, 'max_order', int_text(v%max_order), &
+                    'out of range for method '//trim(v%method)//' (allowed: '// &
+                    int_text(lowest)//' .. '//int_text(highest)//', or 0 for the default '// &
+                    int_text(default)//')', err)
+                return
+            end if
             call check_int(ctx, G_SOLVER, 'max_steps', v%max_steps, 1, huge(1), err)
             if (allocated(err)) return
             call check_real(ctx, G_SOLVER, 't_end', v%t_end, '>', 0.0_wp, err)

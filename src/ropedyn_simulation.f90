@@ -6,7 +6,7 @@ module ropedyn_simulation
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_IO
     use ropedyn_problem, only: energy_t
     use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
-    use ropedyn_cvode, only: cvode_t
+    use ropedyn_solvers, only: new_integrator
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_rfem, only: rfem_t, rfem_create
     use ropedyn_scene, only: scene_t, scene_namelist_text
@@ -61,13 +61,8 @@ contains
         type(scene_t), intent(in) :: scene
         class(integrator_t), allocatable, intent(out) :: integrator
         type(error_t), allocatable, intent(out) :: err
-        select case (scene%solver%method)
-        case ('cvode')
-            allocate (cvode_t :: integrator)
-        case default
-            call make_error(err, ERR_INPUT, scene%path//': &solver: method = "'// &
-                            trim(scene%solver%method)//'": not available in this version')
-        end select
+        call new_integrator(trim(scene%solver%method), integrator, err)
+        if (allocated(err)) err%message = scene%path//': &solver: '//err%message
     end subroutine create_integrator
 
     pure function solver_options_of(scene) result(options)

@@ -421,7 +421,11 @@ contains
             NO_SET, [character(len=L) :: P//'atol.nml: &solver: atol = -1.0e-8: must be > 0'])
         call expect_error('max_order', [character(len=L) :: MODEL, '&solver max_order = 6 /'], &
             NO_SET, [character(len=L) :: P//'max_order.nml: &solver: max_order = 6: ', &
-            'must be in 1..5'])
+            'out of range for method cvode (allowed: 1 .. 5, or 0 for the default 5)'])
+        call expect_error('max_order_mebdf', [character(len=L) :: MODEL, &
+            '&solver method = ''mebdf'', max_order = 1 /'], NO_SET, [character(len=L) :: &
+            P//'max_order_mebdf.nml: &solver: max_order = 1: ', &
+            'out of range for method mebdf (allowed: 2 .. 6, or 0 for the default 4)'])
         call expect_error('max_steps', [character(len=L) :: MODEL, '&solver max_steps = 0 /'], &
             NO_SET, [character(len=L) :: P//'max_steps.nml: &solver: max_steps = 0: ', &
             'must be >= 1'])
@@ -445,10 +449,7 @@ contains
             'not available yet in this version (allowed: rfem)'])
         call expect_error('method', [character(len=L) :: MODEL, '&solver method = ''euler'' /'], &
             NO_SET, [character(len=L) :: &
-            P//'method.nml: &solver: method = "euler": unknown (allowed: cvode)'])
-        call expect_error('method_mebdf', [character(len=L) :: MODEL, &
-            '&solver method = ''mebdf'' /'], NO_SET, [character(len=L) :: &
-            P//'method_mebdf.nml: &solver: method = "mebdf": not available yet'])
+            P//'method.nml: &solver: method = "euler": unknown (allowed: cvode, mebdf)'])
         call expect_error('support', [character(len=L) :: MODEL, '&supports top = ''glued'' /'], &
             NO_SET, [character(len=L) :: P//'support.nml: &supports: top = "glued": ', &
             'unknown (allowed: pinned, clamped, free)'])
