@@ -12,7 +12,7 @@ module ropedyn_integrator
     public :: integrator_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT
 
     !> No integrator here goes beyond this order of accuracy.
-    integer, parameter :: MAX_ORDER_LIMIT = 6
+    integer, parameter :: MAX_ORDER_LIMIT = 7
 
     !> Options shared by all integrators (same meaning for every method).
     !! The error test of every method keeps the local error of component i near or below

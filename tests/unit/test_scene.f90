@@ -425,7 +425,7 @@ contains
         call expect_error('max_order_mebdf', [character(len=L) :: MODEL, &
             '&solver method = ''mebdf'', max_order = 1 /'], NO_SET, [character(len=L) :: &
             P//'max_order_mebdf.nml: &solver: max_order = 1: ', &
-            'out of range for method mebdf (allowed: 2 .. 6, or 0 for the default 4)'])
+            'out of range for method mebdf (allowed: 2 .. 7, or 0 for the default 4)'])
         call expect_error('max_steps', [character(len=L) :: MODEL, '&solver max_steps = 0 /'], &
             NO_SET, [character(len=L) :: P//'max_steps.nml: &solver: max_steps = 0: ', &
             'must be >= 1'])
