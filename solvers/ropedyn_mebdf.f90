@@ -35,7 +35,9 @@ module ropedyn_mebdf
     real(wp), parameter :: NEWTON_TOL = 0.03_wp    !< weighted-norm Newton tolerance per stage
     integer, parameter :: JACOBIAN_MAX_AGE = 50    !< steps before a Jacobian is refreshed
     real(wp), parameter :: REFACTOR_CHANGE = 0.3_wp  !< relative change of h*beta to refactor
-    integer, parameter :: MAX_ERROR_FAILS = 7      !< consecutive error-test failures allowed
+    !> consecutive error-test failures allowed in one step (as set for CVODE: at loose
+    !! tolerances E5 needs more than the classic 7)
+    integer, parameter :: MAX_ERROR_FAILS = 20
     integer, parameter :: MAX_CONV_FAILS = 10      !< consecutive Newton failures allowed
     real(wp), parameter :: EXTRA_CHECK = 2.0_wp    !< limit of |y_MEBDF - ybar_BDF|_w
     !> Safety factors of the step-size ratio at the same, the lower and the higher order.

@@ -41,8 +41,12 @@ module ropedyn_scene
 
     !> `&model`: which discretisation and how fine.
     type :: model_params_t
-        character(len=NAME_LEN) :: kind = 'rfem'  !< 'rfem' ('mpp' not available yet)
-        integer :: elements = 30                  !< number of elements [-]
+        character(len=NAME_LEN) :: kind = 'rfem'  !< 'rfem' | 'mpp'
+        integer :: elements = 30                  !< number of elements (mpp: members) [-]
+        !> mpp: factor on the member springs' damping eta A / l (the default rule) [-]
+        real(wp) :: mpp_axial_damping_factor = 1.0_wp
+        !> mpp: factor on the joints' bending damping eta I / l (the default rule) [-]
+        real(wp) :: mpp_bending_damping_factor = 1.0_wp
     end type model_params_t
 
     !> `&supports`: boundary conditions at both ends (x down, y horizontal).
@@ -117,7 +121,7 @@ module ropedyn_scene
 
     type :: key_info_t
         integer :: group
-        character(len=24) :: name
+        character(len=32) :: name
         integer :: type
     end type key_info_t
 
@@ -133,6 +137,8 @@ module ropedyn_scene
         key_info_t(G_ROPE, 'gravity', T_REAL), &
         key_info_t(G_MODEL, 'kind', T_STRING), &
         key_info_t(G_MODEL, 'elements', T_INT), &
+        key_info_t(G_MODEL, 'mpp_axial_damping_factor', T_REAL), &
+        key_info_t(G_MODEL, 'mpp_bending_damping_factor', T_REAL), &
         key_info_t(G_SUPPORTS, 'top', T_STRING), &
         key_info_t(G_SUPPORTS, 'bottom', T_STRING), &
         key_info_t(G_SUPPORTS, 'top_anchor', T_REAL2), &
@@ -158,8 +164,7 @@ module ropedyn_scene
         key_info_t(G_OUTPUT, 'progress', T_LOGICAL)]
 
     ! Allowed values of the name keys; "known" values are recognised but not available yet.
-    character(len=*), parameter :: KINDS_ALLOWED(1) = [character(len=8) :: 'rfem']
-    character(len=*), parameter :: KINDS_KNOWN(1) = [character(len=8) :: 'mpp']
+    character(len=*), parameter :: KINDS_ALLOWED(2) = [character(len=8) :: 'rfem', 'mpp']
     character(len=*), parameter :: METHODS_ALLOWED(2) = [character(len=8) :: 'cvode', 'mebdf']
     character(len=*), parameter :: SUPPORTS_ALLOWED(3) = [character(len=8) :: &
         'pinned', 'clamped', 'free']
@@ -296,7 +301,10 @@ contains
                 //I4//'gravity = '//real_text(r%gravity)//NL//'/'//NL
             text = text//'&model'//NL &
                 //I4//'kind = '//quoted(trim(m%kind))//NL &
-                //I4//'elements = '//int_text(m%elements)//NL//'/'//NL
+                //I4//'elements = '//int_text(m%elements)//NL &
+                //I4//'mpp_axial_damping_factor = '//real_text(m%mpp_axial_damping_factor)//NL &
+                //I4//'mpp_bending_damping_factor = '// &
+                real_text(m%mpp_bending_damping_factor)//NL//'/'//NL
             text = text//'&supports'//NL &
                 //I4//'top = '//quoted(trim(s%top))//NL &
                 //I4//'bottom = '//quoted(trim(s%bottom))//NL &
@@ -403,13 +411,18 @@ contains
         character(len=*), intent(in) :: recs(:)
         character(len=BUF_LEN) :: kind
         integer :: elements
-        namelist /model/ kind, elements
+        real(wp) :: mpp_axial_damping_factor, mpp_bending_damping_factor
+        namelist /model/ kind, elements, mpp_axial_damping_factor, mpp_bending_damping_factor
         kind = p%kind
         elements = p%elements
+        mpp_axial_damping_factor = p%mpp_axial_damping_factor
+        mpp_bending_damping_factor = p%mpp_bending_damping_factor
         read (recs, nml=model, iostat=ios, iomsg=msg)
         if (ios /= 0) return
         call store_string(kind, 'kind', p%kind, ios, msg)
         p%elements = elements
+        p%mpp_axial_damping_factor = mpp_axial_damping_factor
+        p%mpp_bending_damping_factor = mpp_bending_damping_factor
     end subroutine nml_model
 
     subroutine nml_supports(p, ios, msg, recs)
@@ -1064,14 +1077,25 @@ contains
             if (allocated(err)) return
         end associate
 
-        call check_name(ctx, G_MODEL, 'kind', scene%model%kind, KINDS_ALLOWED, KINDS_KNOWN, err)
+        call check_name(ctx, G_MODEL, 'kind', scene%model%kind, KINDS_ALLOWED, NONE_KNOWN, err)
         if (allocated(err)) return
         call check_int(ctx, G_MODEL, 'elements', scene%model%elements, 2, huge(1), err)
+        if (allocated(err)) return
+        call check_real(ctx, G_MODEL, 'mpp_axial_damping_factor', &
+            scene%model%mpp_axial_damping_factor, '>=', 0.0_wp, err)
+        if (allocated(err)) return
+        call check_real(ctx, G_MODEL, 'mpp_bending_damping_factor', &
+            scene%model%mpp_bending_damping_factor, '>=', 0.0_wp, err)
         if (allocated(err)) return
 
         associate (s => scene%supports)
             call check_name(ctx, G_SUPPORTS, 'top', s%top, SUPPORTS_ALLOWED, NONE_KNOWN, err)
             if (allocated(err)) return
+            if (scene%model%kind == 'mpp' .and. s%top == 'free') then
+                call fail(ctx, G_SUPPORTS, 'top', '"free"', 'the mpp model hangs from its '// &
+                    'top joint: use pinned or clamped (or the rfem model)', err)
+                return
+            end if
             call check_name(ctx, G_SUPPORTS, 'bottom', s%bottom, SUPPORTS_ALLOWED, NONE_KNOWN, &
                 err)
             if (allocated(err)) return

@@ -9,6 +9,7 @@ module ropedyn_simulation
     use ropedyn_solvers, only: new_integrator
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_rfem, only: rfem_t, rfem_create
+    use ropedyn_mpp, only: mpp_t, mpp_create
     use ropedyn_scene, only: scene_t, scene_namelist_text
     use ropedyn_output, only: output_file_t
     use ropedyn_progress, only: progress_t
@@ -44,12 +45,18 @@ contains
         class(rope_model_t), allocatable, intent(out) :: model
         type(error_t), allocatable, intent(out) :: err
         type(rfem_t), allocatable :: rfem
+        type(mpp_t), allocatable :: mpp
         select case (scene%model%kind)
         case ('rfem')
             allocate (rfem)
             call rfem_create(rfem, scene, err)
             if (allocated(err)) return
             call move_alloc(rfem, model)
+        case ('mpp')
+            allocate (mpp)
+            call mpp_create(mpp, scene, err)
+            if (allocated(err)) return
+            call move_alloc(mpp, model)
         case default
             call make_error(err, ERR_INPUT, scene%path//': &model: kind = "'// &
                             trim(scene%model%kind)//'": not available in this version')

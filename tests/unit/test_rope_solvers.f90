@@ -19,20 +19,31 @@ program test_rope_solvers
     character(len=120) :: label
 
     suite%name = 'rope_solvers'
-    call run('cvode', q_cvode, balance(1))
-    call run('mebdf', q_mebdf, balance(2))
-    scale = maxval(abs(q_cvode))
-    diff = maxval(abs(q_cvode - q_mebdf))
-    write (label, '(a, es9.2, a, f5.2, a)') 'paper rope n = 30, 2 s: |q_cvode - q_mebdf| = ', &
-        diff, ' (', diff/(RTOL*scale), ' rtol max|q|)'
-    call suite%check_le(diff, 5.0_wp*RTOL*scale, trim(label))
-    call suite%check_le(abs(balance(2)), 10.0_wp*RTOL*abs(e_initial), &
-                        'mebdf energy balance |T + V + dissipated - E0| <= 10 rtol |E0| (J)')
+    call compare('rfem', 30)
+    call compare('mpp', 10)
     call suite%finish()
 
 contains
 
-    subroutine run(method, q, balance_error)
+    subroutine compare(kind, n)
+        character(len=*), intent(in) :: kind
+        integer, intent(in) :: n
+        call run(kind, n, 'cvode', q_cvode, balance(1))
+        call run(kind, n, 'mebdf', q_mebdf, balance(2))
+        scale = maxval(abs(q_cvode))
+        diff = maxval(abs(q_cvode - q_mebdf))
+        write (label, '(a, i0, a, es9.2, a, f5.2, a)') 'paper rope, '//kind//', n = ', n, &
+            ', 2 s: |q_cvode - q_mebdf| = ', diff, ' (', diff/(RTOL*scale), ' rtol max|q|)'
+        call suite%check_le(diff, 5.0_wp*RTOL*scale, trim(label))
+        call suite%check_le(abs(balance(1)), 10.0_wp*RTOL*abs(e_initial), kind// &
+                            ': cvode energy balance |T + V + dissipated - E0| <= 10 rtol |E0| (J)')
+        call suite%check_le(abs(balance(2)), 10.0_wp*RTOL*abs(e_initial), kind// &
+                            ': mebdf energy balance |T + V + dissipated - E0| <= 10 rtol |E0| (J)')
+    end subroutine compare
+
+    subroutine run(kind, n, method, q, balance_error)
+        character(len=*), intent(in) :: kind
+        integer, intent(in) :: n
         character(len=*), intent(in) :: method
         real(wp), allocatable, intent(out) :: q(:, :)
         real(wp), intent(out) :: balance_error
@@ -44,14 +55,15 @@ contains
         real(wp) :: t
         real(wp), allocatable :: qe(:, :), qdot(:, :)
         type(energy_t) :: e0, e
-        character(len=64) :: sets(4)
+        character(len=80) :: sets(5)
         character(len=1024) :: source_dir
         integer :: j
 
         write (sets(1), '(a)') 'solver.method = "'//method//'"'
         write (sets(2), '(a, es10.3)') 'solver.rtol = ', RTOL
         sets(3) = 'solver.atol = 1e-10'
-        sets(4) = 'model.elements = 30'
+        write (sets(4), '(a, i0)') 'model.elements = ', n
+        sets(5) = 'model.kind = "'//kind//'"'
         ! the source directory is the first argument (CTest passes it)
         call get_command_argument(1, source_dir)
         if (len_trim(source_dir) == 0) source_dir = '.'

@@ -443,10 +443,14 @@ contains
 
         ! Names
         call expect_error('kind', [character(len=L) :: '&model kind = ''fem'' /'], NO_SET, &
-            [character(len=L) :: P//'kind.nml: &model: kind = "fem": unknown (allowed: rfem)'])
-        call expect_error('kind_mpp', [character(len=L) :: '&model kind = ''MPP'' /'], NO_SET, &
-            [character(len=L) :: P//'kind_mpp.nml: &model: kind = "MPP": ', &
-            'not available yet in this version (allowed: rfem)'])
+            [character(len=L) :: P//'kind.nml: &model: kind = "fem": unknown (allowed: rfem, mpp)'])
+        call expect_error('mpp_free_top', [character(len=L) :: '&model kind = ''MPP'' /', &
+            '&supports top = ''free'' /'], NO_SET, [character(len=L) :: &
+            P//'mpp_free_top.nml: &supports: top = "free": the mpp model hangs from its top'])
+        call expect_error('mpp_damping_factor', [character(len=L) :: &
+            '&model kind = ''mpp'', mpp_axial_damping_factor = -1 /'], NO_SET, &
+            [character(len=L) :: P//'mpp_damping_factor.nml: &model: ', &
+            'mpp_axial_damping_factor = -1.0: must be >= 0'])
         call expect_error('method', [character(len=L) :: MODEL, '&solver method = ''euler'' /'], &
             NO_SET, [character(len=L) :: &
             P//'method.nml: &solver: method = "euler": unknown (allowed: cvode, mebdf)'])
