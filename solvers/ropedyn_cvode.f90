@@ -20,6 +20,8 @@ module ropedyn_cvode
     use fsunmatrix_band_mod, only: FSUNBandMatrix, FSUNBandMatrix_Data, FSUNBandMatrix_LDim, &
                                    FSUNBandMatrix_StoredUpperBandwidth, FSUNBandMatrix_Columns
     use fsunlinsol_band_mod, only: FSUNLinSol_Band
+    use fsunmatrix_dense_mod, only: FSUNDenseMatrix, FSUNDenseMatrix_Data
+    use fsunlinsol_dense_mod, only: FSUNLinSol_Dense
     use fcvodes_mod
     implicit none
     private
@@ -30,6 +32,9 @@ module ropedyn_cvode
         class(problem_t), pointer :: problem => null()
         character(len=:), allocatable :: message  !< last message of CVODE's error handler
         integer :: last_status = STATUS_OK        !< last status returned by the problem
+        integer :: ml = 0, mu = 0                 !< the problem's bandwidths
+        !> band work array for a dense Jacobian (the problem writes band storage)
+        real(wp), allocatable :: band(:, :)
     end type cvode_context_t
 
     type, extends(integrator_t) :: cvode_t
@@ -98,6 +103,7 @@ contains
         type(solver_options_t), intent(in) :: options
         type(error_t), allocatable, intent(out) :: err
         integer :: ml, mu, max_order
+        logical :: dense
         integer(c_int) :: flag
         type(N_Vector), pointer :: nv_atol
         real(c_double), allocatable, target :: atol(:)
@@ -165,17 +171,34 @@ contains
         if (check(flag, 'FCVodeSetMaxHnilWarns')) return
 
         call problem%bandwidths(ml, mu)
-        self%matrix => FSUNBandMatrix(int(self%n, c_int64_t), int(mu, c_int64_t), &
-                                      int(ml, c_int64_t), self%sunctx)
-        self%solver => FSUNLinSol_Band(self%nv_y, self%matrix, self%sunctx)
+        ml = min(ml, self%n - 1)
+        mu = min(mu, self%n - 1)
+        self%ctx%ml = ml
+        self%ctx%mu = mu
+        ! A nearly full band: dense LU (LAPACK-style, blocked) beats the band LU.
+        dense = 2*ml + mu + 1 >= self%n
+        if (dense) then
+            self%matrix => FSUNDenseMatrix(int(self%n, c_int64_t), int(self%n, c_int64_t), &
+                                           self%sunctx)
+            self%solver => FSUNLinSol_Dense(self%nv_y, self%matrix, self%sunctx)
+            allocate (self%ctx%band(ml + mu + 1, self%n))
+        else
+            self%matrix => FSUNBandMatrix(int(self%n, c_int64_t), int(mu, c_int64_t), &
+                                          int(ml, c_int64_t), self%sunctx)
+            self%solver => FSUNLinSol_Band(self%nv_y, self%matrix, self%sunctx)
+        end if
         if (.not. (associated(self%matrix) .and. associated(self%solver))) then
-            call make_error(err, ERR_SOLVER, 'cvode: cannot create the band linear solver')
+            call make_error(err, ERR_SOLVER, 'cvode: cannot create the linear solver')
             return
         end if
         flag = FCVodeSetLinearSolver(self%mem, self%solver, self%matrix)
         if (check(flag, 'FCVodeSetLinearSolver')) return
         if (problem%has_jacobian() .and. .not. options%fd_jacobian) then
-            flag = FCVodeSetJacFn(self%mem, c_funloc(cv_jacobian))
+            if (dense) then
+                flag = FCVodeSetJacFn(self%mem, c_funloc(cv_jacobian_dense))
+            else
+                flag = FCVodeSetJacFn(self%mem, c_funloc(cv_jacobian))
+            end if
             if (check(flag, 'FCVodeSetJacFn')) return
         end if
 
@@ -359,6 +382,39 @@ contains
         ctx%last_status = status
         ierr = int(status, c_int)
     end function cv_jacobian
+
+    !> Dense Jacobian: the problem fills band storage (ml = mu = n - 1 here), copied into
+    !! the dense matrix (column-major n x n).
+    integer(c_int) function cv_jacobian_dense(t, nv_y, nv_f, mat, user_data, tmp1, tmp2, &
+                                              tmp3) result(ierr) bind(C)
+        real(c_double), value :: t
+        type(N_Vector) :: nv_y, nv_f
+        type(SUNMatrix) :: mat
+        type(c_ptr), value :: user_data
+        type(N_Vector) :: tmp1, tmp2, tmp3
+        type(cvode_context_t), pointer :: ctx
+        real(c_double), pointer :: y(:), data1(:), a(:, :)
+        integer :: status, n, i, j
+        call c_f_pointer(user_data, ctx)
+        y => FN_VGetArrayPointer(nv_y)
+        n = size(y)
+        ! SUNDIALS 6.4.1: FSUNDenseMatrix_Data returns a pointer of extent 1; re-map it.
+        data1 => FSUNDenseMatrix_Data(mat)
+        call c_f_pointer(c_loc(data1(1)), a, [n, n])
+        ctx%band = 0.0_wp
+        call ctx%problem%jacobian(t, y, ctx%band, ctx%mu + 1, status)
+        do j = 1, n
+            do i = 1, n
+                if (i - j > ctx%ml .or. j - i > ctx%mu) then
+                    a(i, j) = 0.0_c_double
+                else
+                    a(i, j) = ctx%band(ctx%mu + 1 + i - j, j)
+                end if
+            end do
+        end do
+        ctx%last_status = status
+        ierr = int(status, c_int)
+    end function cv_jacobian_dense
 
     !> Keeps CVODE's messages for our error text instead of printing them.
     subroutine cv_error_handler(code, module, function, msg, user_data) bind(C)
