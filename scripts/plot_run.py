@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""Overview plot of a ropedyn run: energies over time, the tip's trajectory, the solver's
+step size and order over time, and the axial force along the rope at chosen times.
+
+usage: plot_run.py RUN.h5 [-o RUN_plot.png] [--times 0.5,1,2] [--size 1200x900]
+
+Works from the HDF5 file alone (any model; the axial force is skipped with a note where
+the model's output does not determine it, see docs/visualization.md).
+"""
+import argparse
+import pathlib
+import sys
+
+import matplotlib
+import numpy as np
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+import rope_vis  # noqa: E402
+
+
+def plot_energies(ax, run):
+    """Energy parts relative to their start, the dissipated energy and the balance."""
+    t, e = run.time, run.energy
+    ax.plot(t, e["kinetic"], lw=1, label="kinetic T")
+    ax.plot(t, e["gravity"] - e["gravity"][0], lw=1, label="gravity - gravity(0)")
+    ax.plot(t, e["elastic"], lw=1, label="elastic")
+    if "dissipated" in e:
+        ax.plot(t, e["dissipated"], lw=1, ls="--", label="dissipated")
+    ax.plot(t, e["total"] - e["total"][0], "k", lw=1.4, label="total - E0")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("energy (J)")
+    ax.set_title("energies", fontsize=10)
+    ax.legend(fontsize=7, loc="best")
+    ax.grid(alpha=0.3)
+
+
+def plot_tip(ax, run):
+    """The free end's path, coloured by time, with the first and last rope shapes."""
+    tip = run.points[:, -1, :]
+    rope_vis.setup_picture_axes(ax, run)
+    rope_vis.draw_supports(ax, run)
+    ax.plot(run.points[0, :, 1], run.points[0, :, 0], color="0.6", lw=1.2, label="rope, start")
+    ax.plot(run.points[-1, :, 1], run.points[-1, :, 0], color="#1f4e9c", lw=1.6,
+            label="rope, end")
+    art = ax.scatter(tip[:, 1], tip[:, 0], c=run.time, s=2, cmap="viridis", lw=0)
+    ax.figure.colorbar(art, ax=ax, label="t (s)", fraction=0.046, pad=0.02)
+    ax.set_title("tip trajectory", fontsize=10)
+    ax.legend(fontsize=7, loc="lower right")
+
+
+def plot_solver(ax, run):
+    """Step size (log scale) and method order over time."""
+    if run.step_size is None:
+        ax.text(0.5, 0.5, "no solver data", ha="center", transform=ax.transAxes)
+        return
+    ax.semilogy(run.time, np.where(run.step_size > 0, run.step_size, np.nan), lw=1,
+                color="C0")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("step size (s)", color="C0")
+    ax.grid(alpha=0.3)
+    if run.order is not None:
+        bx = ax.twinx()
+        bx.step(run.time, run.order, where="post", color="C3", lw=0.8, alpha=0.8)
+        bx.set_ylabel("order", color="C3")
+        top = max(int(np.max(run.order)) if run.order.size else 1, 1)
+        bx.set_ylim(0, top + 1)
+        bx.set_yticks(range(0, top + 2))
+    ax.set_title("solver: last step size and order before each output", fontsize=10)
+
+
+def record_indices(times, wanted):
+    """Indices of the records nearest to the wanted times (sorted, unique)."""
+    wanted = np.asarray(wanted, dtype=float)
+    return np.unique(np.abs(times[None, :] - wanted[:, None]).argmin(axis=1))
+
+
+def default_times(times, count=5):
+    """count times evenly spread over the run, leaving out the start."""
+    return np.linspace(times[0], times[-1], count + 1)[1:]
+
+
+def plot_axial_force(ax, run, wanted):
+    """N along the rope (arc length from the top) at the records nearest to wanted."""
+    force, message = rope_vis.axial_force(run)
+    ax.set_title("axial force along the rope", fontsize=10)
+    if force is None:
+        ax.text(0.5, 0.5, message, ha="center", va="center", wrap=True, fontsize=9,
+                transform=ax.transAxes)
+        ax.set_axis_off()
+        return
+    for k in record_indices(run.time, wanted):
+        ax.plot(force.s, force.values[k], "-o", ms=2.5, lw=1, label=f"t = {run.time[k]:.3g} s")
+    ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.set_xlabel("s (m), along the unstretched rope from the top")
+    ax.set_ylabel("N (N), tension > 0")
+    ax.legend(fontsize=7, loc="best")
+    ax.grid(alpha=0.3)
+    ax.text(0.01, 0.01, force.definition, transform=ax.transAxes, fontsize=6, color="0.4",
+            va="bottom")
+
+
+def make_figure(run, wanted, size, dpi):
+    """The 2 x 2 overview figure."""
+    fig, axes = plt.subplots(2, 2, figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
+    plot_energies(axes[0, 0], run)
+    plot_tip(axes[0, 1], run)
+    plot_solver(axes[1, 0], run)
+    plot_axial_force(axes[1, 1], run, wanted)
+    fig.suptitle(f"{pathlib.Path(run.path).name}: {rope_vis.title(run)}", fontsize=11)
+    fig.tight_layout()
+    rope_vis.fit_equal(axes[0, 1])
+    return fig
+
+
+def parse_times(value):
+    """'0.5, 1, 2' -> [0.5, 1.0, 2.0]."""
+    try:
+        return [float(v) for v in value.split(",") if v.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{value}': expected times in s, e.g. 0.5,1,2")
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("run", help="HDF5 output of ropedyn run")
+    parser.add_argument("-o", "--output", help="PNG file (default: RUN_plot.png)")
+    parser.add_argument("--times", type=parse_times,
+                        help="times (s) of the axial-force curves, e.g. 0.5,1,2 "
+                             "(default: 5 times spread over the run)")
+    parser.add_argument("--size", default="1200x900", help="WIDTHxHEIGHT in pixels")
+    parser.add_argument("--dpi", type=int, default=100)
+    args = parser.parse_args(argv)
+    try:
+        size = rope_vis.parse_size(args.size)
+    except ValueError as exc:
+        parser.error(str(exc))
+    out = args.output or str(pathlib.Path(args.run).with_suffix("")) + "_plot.png"
+    run = rope_vis.load_run(args.run)
+    if run.time.size == 0:
+        print(f"plot: {args.run}: no output records", file=sys.stderr)
+        return 1
+    fig = make_figure(run, args.times or default_times(run.time), size, args.dpi)
+    fig.savefig(out, dpi=args.dpi)
+    plt.close(fig)
+    print(f"plot: {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

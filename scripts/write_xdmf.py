@@ -1,0 +1,169 @@
+#!/usr/bin/env python3
+"""Write an XDMF sidecar for a ropedyn run so that ParaView opens it as a time series of
+polylines (one line cell per element) with per-element and per-point fields.
+
+usage: write_xdmf.py RUN.h5 [--every K]     writes RUN.xmf and RUN_fields.h5 next to RUN.h5
+
+The geometry is read from the run file itself (/rope/points); the derived fields (axial
+force, curvature, speed, velocity, angle; definitions in docs/visualization.md) go into the
+small sidecar RUN_fields.h5. The run file is only read, never modified. Open RUN.xmf in
+ParaView with the "XDMF Reader" (or the Xdmf3 readers). The coordinates are the run's: x
+points down (gravity), y horizontal, z = 0.
+"""
+import argparse
+import pathlib
+import sys
+import xml.etree.ElementTree as ET
+
+import h5py
+import numpy as np
+
+import rope_vis
+
+FIELD_UNITS = {"tension": "N", "curvature": "1/m", "speed": "m/s", "velocity": "m/s",
+               "angle": "rad", "joint_tension": "N", "joint_curvature": "1/m"}
+
+
+def derived_fields(run):
+    """({'cell': {name: (T, n[, 3])}, 'point': {name: (T, 2n)}}, notes)."""
+    kappa = rope_vis.joint_curvature(run)
+    vel = rope_vis.velocity(run)
+    cell = {"curvature": rope_vis.joints_to_elements(kappa),
+            "speed": rope_vis.speed(run),
+            "velocity": np.concatenate([vel, np.zeros(vel.shape[:2] + (1,))], axis=-1),
+            "angle": rope_vis.element_angles(run)}
+    point = {"joint_curvature": rope_vis.joints_to_points(kappa)}
+    notes = {"curvature": "joint curvature wrap(phi_{j+1} - phi_j)/h (0 at pinned and free "
+                          "ends); cell: mean of the element's two joints",
+             "speed": "|(xdot, ydot)| of the element centre (/state/qdot)",
+             "velocity": "(xdot, ydot, 0) of the element centre",
+             "angle": "element direction from x towards y, from the polyline",
+             "joint_curvature": "joint curvature at the element end points: A_i takes its "
+                                "upper joint, B_i its lower joint"}
+    force, message = rope_vis.axial_force(run)
+    if force is not None:
+        cell["tension"] = force.per_element
+        point["joint_tension"] = force.per_point
+        notes["tension"] = force.definition
+        notes["joint_tension"] = ("the axial force at the element end points: A_i takes its "
+                                  "upper joint, B_i its lower joint (MPP: the member's value)")
+    else:
+        notes["tension"] = message
+    return {"cell": cell, "point": point}, notes
+
+
+def write_fields(path, run, fields, notes):
+    """The sidecar HDF5: /connectivity, /time, /cell/*, /point/*, each with units."""
+    with h5py.File(path, "w") as f:
+        f.attrs["source"] = pathlib.Path(run.path).name
+        f.attrs["model"] = run.model
+        f.attrs["written_by"] = "scripts/write_xdmf.py"
+        conn = np.arange(2 * run.n, dtype=np.int32).reshape(run.n, 2)
+        f.create_dataset("connectivity", data=conn)
+        f.create_dataset("time", data=run.time).attrs["units"] = "s"
+        for center, group in fields.items():
+            for name, values in group.items():
+                ds = f.create_dataset(f"{center}/{name}", data=values, chunks=True,
+                                      compression="gzip", compression_opts=4, shuffle=True)
+                ds.attrs["units"] = FIELD_UNITS[name]
+                ds.attrs["definition"] = notes[name]
+
+
+def _hdf_item(parent, file_name, path, shape, number_type="Float", precision=8):
+    item = ET.SubElement(parent, "DataItem", Format="HDF", NumberType=number_type,
+                         Precision=str(precision), Dimensions=" ".join(map(str, shape)))
+    item.text = f"{file_name}:{path}"
+    return item
+
+
+def _slab(parent, k, file_name, path, shape):
+    """Record k of a dataset whose first axis is time: a HyperSlab DataItem."""
+    rank = len(shape)
+    count = (1,) + tuple(shape[1:])
+    slab = ET.SubElement(parent, "DataItem", ItemType="HyperSlab",
+                         Dimensions=" ".join(map(str, count)), Type="HyperSlab")
+    select = ET.SubElement(slab, "DataItem", Dimensions=f"3 {rank}", Format="XML")
+    select.text = " ".join(map(str, (k,) + (0,) * (rank - 1) + (1,) * rank + count))
+    _hdf_item(slab, file_name, path, shape)
+    return slab
+
+
+def _whole(parent, file_name, path, shape):
+    """A whole integer dataset, written as a HyperSlab that selects all of it.
+
+    ParaView's XDMF (2) reader caches a grid's points keyed on the text of the first
+    DataItem of its Topology and Geometry. Our geometry is a HyperSlab of /rope/points, so
+    its key would be empty: the reader then logs an error and reads without the cache.
+    With the topology a HyperSlab too, the reader skips the cache silently, and every time
+    step is read from its own record."""
+    rank = len(shape)
+    slab = ET.SubElement(parent, "DataItem", ItemType="HyperSlab",
+                         Dimensions=" ".join(map(str, shape)), Type="HyperSlab")
+    select = ET.SubElement(slab, "DataItem", Dimensions=f"3 {rank}", Format="XML")
+    select.text = " ".join(map(str, (0,) * rank + (1,) * rank + tuple(shape)))
+    _hdf_item(slab, file_name, path, shape, "Int", 4)
+    return slab
+
+
+def build_xdmf(run_path, fields_path, records, points_shape, fields):
+    """The XDMF tree: a temporal collection with one uniform grid per selected record."""
+    run_name, fields_name = pathlib.Path(run_path).name, pathlib.Path(fields_path).name
+    n = points_shape[1] // 2
+    root = ET.Element("Xdmf", Version="2.0")
+    domain = ET.SubElement(root, "Domain")
+    series = ET.SubElement(domain, "Grid", Name="rope", GridType="Collection",
+                           CollectionType="Temporal")
+    for k, t in records:
+        grid = ET.SubElement(series, "Grid", Name=f"record {k}", GridType="Uniform")
+        ET.SubElement(grid, "Time", Value=repr(float(t)))
+        topo = ET.SubElement(grid, "Topology", TopologyType="Polyline", NodesPerElement="2",
+                             NumberOfElements=str(n))
+        _whole(topo, fields_name, "/connectivity", (n, 2))
+        geom = ET.SubElement(grid, "Geometry", GeometryType="XY")
+        _slab(geom, k, run_name, "/rope/points", points_shape)
+        for center, group in fields.items():
+            for name, values in group.items():
+                kind = "Vector" if values.ndim == 3 else "Scalar"
+                attr = ET.SubElement(grid, "Attribute", Name=name, AttributeType=kind,
+                                     Center={"cell": "Cell", "point": "Node"}[center])
+                _slab(attr, k, fields_name, f"/{center}/{name}", values.shape)
+    ET.indent(root, space=" ")
+    return ET.ElementTree(root)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("run", help="HDF5 output of ropedyn run")
+    parser.add_argument("--every", type=int, default=1,
+                        help="describe every K-th record only (default 1: all)")
+    args = parser.parse_args(argv)
+    if args.every < 1:
+        parser.error("--every must be >= 1")
+    run_path = pathlib.Path(args.run)
+    base = run_path.with_suffix("")
+    xmf_path = base.with_name(base.name + ".xmf")
+    fields_path = base.with_name(base.name + "_fields.h5")
+
+    run = rope_vis.load_run(run_path)
+    if run.time.size == 0:
+        print(f"xdmf: {run_path}: no output records", file=sys.stderr)
+        return 1
+    with h5py.File(run_path, "r") as f:
+        points_shape = f["rope/points"].shape  # may be one record longer than /time
+    fields, notes = derived_fields(run)
+    write_fields(fields_path, run, fields, notes)
+    picked = range(0, run.time.size, args.every)
+    tree = build_xdmf(run_path, fields_path, [(k, run.time[k]) for k in picked],
+                      points_shape, fields)
+    with open(xmf_path, "wb") as out:
+        out.write(b'<?xml version="1.0" ?>\n<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>\n')
+        tree.write(out, encoding="utf-8", xml_declaration=False)
+    if "tension" not in fields["cell"]:
+        print(f"xdmf: {notes['tension']}", file=sys.stderr)
+    print(f"xdmf: {xmf_path} ({len(picked)} times, {run.n} elements; fields in "
+          f"{fields_path.name})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

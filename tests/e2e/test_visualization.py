@@ -1,0 +1,297 @@
+"""Seeing the results (docs/visualization.md): animations, the overview plot, the XDMF
+sidecar read by ParaView, the README figures, and the derived fields they show.
+
+Small runs (5 elements, 0.2 s) are made once per module; each script runs as a user would
+run it, and its picture is checked for size and for not being blank."""
+import hashlib
+import json
+import pathlib
+import shutil
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+import h5py
+import numpy as np
+import pytest
+from PIL import Image
+
+import rope_vis
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SCRIPTS = ROOT / "scripts"
+G = np.array([9.81, 0.0])
+
+
+def ropedyn(exe, workdir, scene_text, name, *overrides):
+    """Run a scene (text) in workdir; returns the path of its HDF5 output."""
+    scene = workdir / f"{name}.nml"
+    scene.write_text(scene_text)
+    out = workdir / f"{name}.h5"
+    args = [str(exe), "run", str(scene), "--set", f"output.file={out}"]
+    for item in overrides:
+        args += ["--set", item]
+    result = subprocess.run(args, capture_output=True, text=True, timeout=300, cwd=workdir)
+    assert result.returncode == 0, result.stdout + result.stderr
+    return out
+
+
+def script(name, *args):
+    """Run scripts/NAME with this Python; returns the CompletedProcess."""
+    return subprocess.run([sys.executable, str(SCRIPTS / name), *map(str, args)],
+                          capture_output=True, text=True, timeout=120)
+
+
+def assert_picture(image, size):
+    """image has the pixel size (width, height) and is not blank."""
+    assert image.size == size
+    pixels = np.asarray(image.convert("RGB"), dtype=float)
+    assert pixels.std() > 5.0, "picture is blank"
+
+
+TINY = ("&model kind = 'rfem', elements = 5 /\n"
+        "&solver t_end = 0.2, output_interval = 0.01 /\n")
+TINY_MPP = ("&model kind = 'mpp', elements = 5 /\n"
+            "&supports top = 'clamped', top_angle_deg = 10.0 /\n"
+            "&solver t_end = 0.2, output_interval = 0.01 /\n")
+RECORDS = 21
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory):
+    return tmp_path_factory.mktemp("vis")
+
+
+@pytest.fixture(scope="module")
+def tiny(ropedyn_exe, workdir):
+    """An RFEM run: 5 elements, 0.2 s, 21 records."""
+    return ropedyn(ropedyn_exe, workdir, TINY, "tiny")
+
+
+@pytest.fixture(scope="module")
+def tiny_mpp(ropedyn_exe, workdir):
+    """An MPP run with a clamped top."""
+    return ropedyn(ropedyn_exe, workdir, TINY_MPP, "tiny_mpp")
+
+
+# --- animate -------------------------------------------------------------------------------
+
+def test_animate_gif(tiny, tmp_path):
+    gif = tmp_path / "rope.gif"
+    result = script("animate.py", tiny, "-o", gif, "--size", "320x240", "--max-frames", "12")
+    assert result.returncode == 0, result.stderr
+    with Image.open(gif) as image:
+        assert image.n_frames == 12
+        assert_picture(image, (320, 240))
+        first = np.asarray(image.convert("RGB")).copy()
+        image.seek(image.n_frames - 1)
+        last = np.asarray(image.convert("RGB"))
+        assert_picture(image, (320, 240))
+    assert np.any(first != last), "the rope does not move"
+
+
+def test_animate_mpp_with_energy_panel(tiny_mpp, tmp_path):
+    gif = tmp_path / "mpp.gif"
+    result = script("animate.py", tiny_mpp, "-o", gif, "--energy", "--size", "500x240")
+    assert result.returncode == 0, result.stderr
+    with Image.open(gif) as image:
+        assert image.n_frames == RECORDS  # fewer records than --max-frames: one frame each
+        assert_picture(image, (500, 240))
+
+
+def test_animate_default_output_next_to_run(tiny, workdir):
+    result = script("animate.py", tiny, "--max-frames", "3")
+    assert result.returncode == 0, result.stderr
+    assert (workdir / "tiny.gif").stat().st_size > 1000
+
+
+def test_animate_mp4_needs_ffmpeg(tiny, tmp_path):
+    mp4 = tmp_path / "rope.mp4"
+    result = script("animate.py", tiny, "-o", mp4, "--max-frames", "5", "--size", "320x240")
+    if shutil.which("ffmpeg"):
+        assert result.returncode == 0, result.stderr
+        assert mp4.stat().st_size > 1000
+    else:
+        assert result.returncode == 2
+        assert "needs the ffmpeg program" in result.stderr and ".gif" in result.stderr
+        assert not mp4.exists()
+
+
+def test_animate_rejects_unknown_format(tiny, tmp_path):
+    result = script("animate.py", tiny, "-o", tmp_path / "rope.avi")
+    assert result.returncode == 2 and "unknown animation format '.avi'" in result.stderr
+
+
+# --- plot ----------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("which", ["tiny", "tiny_mpp"])
+def test_plot(which, request, tmp_path):
+    run_file = request.getfixturevalue(which)
+    png = tmp_path / "plot.png"
+    result = script("plot_run.py", run_file, "-o", png, "--size", "900x700", "--times",
+                    "0.05,0.2")
+    assert result.returncode == 0, result.stderr
+    with Image.open(png) as image:
+        assert_picture(image, (900, 700))
+
+
+def test_plot_without_axial_force(ropedyn_exe, tmp_path):
+    """Inextensible MPP: the axial force is a constraint force; the panel says so."""
+    run_file = ropedyn(ropedyn_exe, tmp_path, TINY_MPP, "inext", "effects.tension=.false.")
+    force, message = rope_vis.axial_force(rope_vis.load_run(run_file))
+    assert force is None and "inextensible" in message
+    result = script("plot_run.py", run_file)
+    assert result.returncode == 0, result.stderr
+    with Image.open(tmp_path / "inext_plot.png") as image:
+        assert_picture(image, (1200, 900))
+
+
+# --- XDMF ----------------------------------------------------------------------------------
+
+def sha256(path):
+    return hashlib.sha256(pathlib.Path(path).read_bytes()).hexdigest()
+
+
+def hdf_items(root):
+    """(file, dataset, dimensions) of every HDF DataItem."""
+    for item in root.iter("DataItem"):
+        if item.get("Format") == "HDF":
+            file_name, dataset = item.text.strip().split(":", 1)
+            yield file_name, dataset, tuple(int(d) for d in item.get("Dimensions").split())
+
+
+@pytest.fixture(scope="module")
+def tiny_xmf(tiny):
+    before = sha256(tiny)
+    result = script("write_xdmf.py", tiny)
+    assert result.returncode == 0, result.stderr
+    assert sha256(tiny) == before, "write_xdmf.py changed the run file"
+    return tiny.with_suffix(".xmf")
+
+
+def test_xdmf_references_existing_datasets(tiny_xmf):
+    root = ET.parse(tiny_xmf).getroot()
+    grids = root.findall("./Domain/Grid/Grid")
+    assert len(grids) == RECORDS
+    with h5py.File(tiny_xmf.with_suffix(".h5")) as f:
+        times = f["time"][:]
+    assert [float(g.find("Time").get("Value")) for g in grids] == times.tolist()
+    seen = set()
+    for file_name, dataset, dims in hdf_items(root):
+        with h5py.File(tiny_xmf.parent / file_name, "r") as f:
+            assert dataset in f, f"{file_name}:{dataset}"
+            assert f[dataset].shape == dims, f"{file_name}:{dataset}"
+        seen.add(dataset)
+    assert {"/rope/points", "/connectivity", "/cell/tension", "/cell/curvature",
+            "/cell/speed", "/cell/velocity", "/point/joint_tension"} <= seen
+    first = grids[0]
+    assert first.find("Topology").get("NumberOfElements") == "5"
+    assert first.find("Geometry").get("GeometryType") == "XY"
+
+
+def test_paraview_reads_the_time_series(tiny_xmf, tmp_path):
+    pvpython = shutil.which("pvpython")
+    if pvpython is None:
+        pytest.skip("pvpython not found (Debian package python3-paraview, installed by "
+                    "scripts/setup)")
+    with h5py.File(tiny_xmf.with_suffix(".h5")) as f, \
+            h5py.File(tiny_xmf.with_name("tiny_fields.h5")) as g:
+        times = f["time"][:]
+        checks = [{"record": k, "tip": f["rope/points"][k, -1].tolist(),
+                   "tension": g["cell/tension"][k].tolist()} for k in (0, 7, RECORDS - 1)]
+    expected = tmp_path / "expected.json"
+    expected.write_text(json.dumps({"times": times.tolist(), "elements": 5,
+                                    "checks": checks}))
+    result = subprocess.run([pvpython, "--force-offscreen-rendering",
+                             str(ROOT / "tests" / "e2e" / "pv_check_xdmf.py"),
+                             str(tiny_xmf.resolve()), str(expected)],
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0 and "OK" in result.stdout, result.stdout + result.stderr
+    assert f"timesteps {RECORDS}" in result.stdout
+
+
+def test_xdmf_for_mpp(tiny_mpp):
+    result = script("write_xdmf.py", tiny_mpp, "--every", "5")
+    assert result.returncode == 0, result.stderr
+    root = ET.parse(tiny_mpp.with_suffix(".xmf")).getroot()
+    assert len(root.findall("./Domain/Grid/Grid")) == 5  # records 0, 5, 10, 15, 20
+    with h5py.File(tiny_mpp.with_name("tiny_mpp_fields.h5")) as f:
+        assert f["cell/tension"].shape == (RECORDS, 5)
+        assert "damper" in f["cell/tension"].attrs["definition"]
+
+
+# --- README figures -----------------------------------------------------------------------
+
+def test_readme_figures(tiny, tmp_path):
+    result = script("readme_figures.py", tiny, "--outdir", tmp_path, "--strobe-end", "0.2")
+    assert result.returncode == 0, result.stderr
+    for name, size in (("rope_motion.png", (800, 520)), ("energy.png", (800, 450))):
+        with Image.open(tmp_path / name) as image:
+            assert_picture(image, size)
+
+
+# --- the derived fields ---------------------------------------------------------------------
+
+def central_difference(values, times):
+    """d/dt along axis 0 by the 4th-order central difference (uniform times; the first and
+    last two records are NaN)."""
+    h = times[1] - times[0]
+    out = np.full_like(values, np.nan)
+    out[2:-2] = (-values[4:] + 8 * values[3:-1] - 8 * values[1:-3] + values[:-4]) / (12 * h)
+    return out
+
+
+FINE = "&solver t_end = 0.1, output_interval = 0.0005, rtol = 1e-9, atol = 1e-12 /\n"
+
+
+@pytest.mark.parametrize("model", ["rfem", "mpp"])
+def test_axial_force_is_newtons_law(ropedyn_exe, tmp_path, model):
+    """The axial force at each element's upper end equals the axial component of what the
+    rope below needs to move as it does: e . sum m (g - a), a by 4th-order central
+    differences of /state/qdot. RFEM: the joint springs + dampers; MPP: member spring +
+    damper. Leaving out the damper would be off by 1e-3 of the force, the check is 5e-5."""
+    run_file = ropedyn(ropedyn_exe, tmp_path, f"&model kind = '{model}', elements = 5 /\n"
+                       + FINE, model)
+    run = rope_vis.load_run(run_file)
+    force, _ = rope_vis.axial_force(run)
+    acc = central_difference(run.qdot[:, :, :2], run.time)[2:-2]
+    need = np.cumsum((run.element_mass[:, None] * (G - acc))[:, ::-1], axis=1)[:, ::-1]
+    phi = rope_vis.element_angles(run)[2:-2]
+    e = np.stack([np.cos(phi), np.sin(phi)], axis=-1)
+    if model == "rfem":
+        upper = force.values[:, :-1]  # joint above element i, in element i-1's frame
+        frame = np.concatenate([e[:, :1], e[:, :-1]], axis=1)
+    else:
+        upper, frame = force.per_element, e
+    newton = np.sum(frame * need, axis=-1)
+    scale = np.abs(newton).max()
+    assert scale > 0.5
+    assert np.abs(upper[2:-2] - newton).max() < 5e-5 * scale
+
+
+def test_curvature_and_speed_at_release(ropedyn_exe, tmp_path):
+    """Straight rope at rest released at 75 deg, top clamped at 0 deg: no speed, no
+    curvature at the inner joints, and (phi_1 - psi)/dl = 75 deg / dl at the clamp."""
+    run_file = ropedyn(ropedyn_exe, tmp_path, "&model kind = 'rfem', elements = 5 /\n"
+                       "&supports top = 'clamped' /\n&solver t_end = 0.01 /\n", "clamp")
+    run = rope_vis.load_run(run_file)
+    kappa = rope_vis.joint_curvature(run)
+    dl = 1.0 / 4
+    assert np.allclose(kappa[0, 1:], 0.0, atol=1e-12)
+    assert kappa[0, 0] == pytest.approx(np.radians(75.0) / dl)
+    assert np.allclose(rope_vis.joints_to_elements(kappa)[0], [kappa[0, 0] / 2, 0, 0, 0, 0])
+    assert np.all(rope_vis.speed(run)[0] == 0.0)
+
+
+def test_scene_text_parser():
+    text = ("! comment / with a slash\n&rope length = 2.0, diameter = 1d-3 /\n"
+            "&supports\n    top = 'clamped'  ! the top\n    top_anchor = 0.5, -1.0\n"
+            "    bottom_anchor = NaN, NaN\n    top_anchor(2) = 0.25\n/\n"
+            "&output file = 'out/a/b.h5', progress = .true. /\n&effects damping = F /\n")
+    groups = rope_vis.parse_namelist(text)
+    assert groups["rope"] == {"length": 2.0, "diameter": 1e-3}
+    assert groups["supports"]["top"] == "clamped"
+    assert groups["supports"]["top_anchor"] == [0.5, 0.25]
+    assert all(np.isnan(groups["supports"]["bottom_anchor"]))
+    assert groups["output"] == {"file": "out/a/b.h5", "progress": True}
+    assert groups["effects"] == {"damping": False}
