@@ -32,6 +32,7 @@ module ropedyn_cvode
         class(problem_t), pointer :: problem => null()
         character(len=:), allocatable :: message  !< last message of CVODE's error handler
         integer :: last_status = STATUS_OK        !< last status returned by the problem
+        integer :: recoverable = 0                !< recoverable errors of f in this call
         integer :: ml = 0, mu = 0                 !< the problem's bandwidths
         !> band work array for a dense Jacobian (the problem writes band storage)
         real(wp), allocatable :: band(:, :)
@@ -50,7 +51,8 @@ module ropedyn_cvode
         type(cvode_context_t), pointer :: ctx => null()
         type(solver_options_t) :: options
         integer :: n = 0, nq = 0
-        real(wp) :: t = 0.0_wp
+        real(wp) :: t = 0.0_wp    !< time of the state last returned (the last tout)
+        real(wp) :: tn = 0.0_wp   !< CVODE's internal time (end of its last step), >= t
     contains
         procedure :: init => cvode_init
         procedure :: advance_to => cvode_advance_to
@@ -78,7 +80,11 @@ contains
         name = 'cvode'
     end function cvode_name
 
-    !> CVODE's own limit, BDF order 5 (see docs/solvers.md on the choice).
+    !> CVODE's own limit, BDF order 5, kept after measuring orders 2 .. 5 with and without
+    !! stability-limit detection on the hard scenes (docs/stability.md): orders 3 and 4 let
+    !! undamped modes gain energy, order 2 crawls where the rope's oscillations must be
+    !! resolved, and order 5 never amplified. (Stiff, barely damped ropes such as the steel
+    !! wire run faster at max_order 2 or with MEBDF.)
     pure integer function cvode_default_max_order(self) result(order)
         class(cvode_t), intent(in) :: self
         order = 5
@@ -113,6 +119,7 @@ contains
         self%n = problem%size()
         self%nq = problem%quad_size()
         self%t = t0
+        self%tn = t0
         allocate (self%ctx)
         self%ctx%problem => problem
         self%ctx%message = ''
@@ -162,6 +169,10 @@ contains
         end if
         flag = FCVodeSetMaxOrd(self%mem, int(max_order, c_int))
         if (check(flag, 'FCVodeSetMaxOrd')) return
+        ! Stability-limit detection: CVODE watches the BDF error history at orders >= 3
+        ! and lowers the order when a mode approaches the stability boundary.
+        flag = FCVodeSetStabLimDet(self%mem, merge(1_c_int, 0_c_int, options%stab_lim_det))
+        if (check(flag, 'FCVodeSetStabLimDet')) return
         ! CVODE's default of 7 error-test failures in one step stops it at the steep fronts
         ! of OREGO and E5 at loose tolerances; MEBDF allows the same 7 but restarts at low
         ! order after 3. 20 lets CVODE through (measured by the test-set sweep).
@@ -222,6 +233,12 @@ contains
         end function check
     end subroutine cvode_init
 
+    !> CVODE in one-step mode, so that every step is seen: the step budget and the
+    !! round-off floor (as MEBDF's: a step h < 16 eps |t| ends the run) are checked after
+    !! each step, then the solution is interpolated at tout (what CV_NORMAL does inside;
+    !! the steps taken are the same). CVODE by itself accepts steps with t + h == t: a run
+    !! that runs into a region where f keeps failing (a NaN ahead) would crawl there until
+    !! max_steps.
     subroutine cvode_advance_to(self, tout, t, y, yq, err)
         class(cvode_t), intent(inout) :: self
         real(wp), intent(in) :: tout
@@ -232,43 +249,90 @@ contains
         real(c_double) :: tret(1), hlast(1)
         integer(c_long) :: nsteps(1)
         integer(c_int) :: flag, qflag
-        integer(i8) :: remaining
-        character(len=64) :: where
+        character(len=:), allocatable :: cause
 
         if (.not. c_associated(self%mem)) then
             call make_error(err, ERR_SOLVER, 'cvode: advance_to called before init')
             return
         end if
-        flag = FCVodeGetNumSteps(self%mem, nsteps)
-        remaining = self%options%max_steps - int(nsteps(1), i8)
-        if (remaining <= 0) remaining = 1
-        flag = FCVodeSetMaxNumSteps(self%mem, int(remaining, c_long))
         self%ctx%message = ''
-        tret = self%t
-        flag = FCVode(self%mem, real(tout, c_double), self%nv_y, tret, CV_NORMAL)
-        self%t = tret(1)
+        self%ctx%recoverable = 0
+        flag = CV_SUCCESS
+        cause = ''
+        do while (self%tn < tout)
+            qflag = FCVodeGetNumSteps(self%mem, nsteps)
+            if (int(nsteps(1), i8) >= self%options%max_steps) then
+                cause = 'max_steps exceeded ('//int_text(self%options%max_steps)//' steps)'
+                exit
+            end if
+            tret = self%tn
+            flag = FCVode(self%mem, real(tout, c_double), self%nv_y, tret, CV_ONE_STEP)
+            if (flag < 0) exit
+            self%tn = tret(1)
+            hlast = 0.0_c_double
+            qflag = FCVodeGetLastStep(self%mem, hlast)
+            if (hlast(1) < 16.0_wp*epsilon(1.0_wp)*abs(self%tn)) then
+                cause = 'step size fell below the round-off limit'
+                if (self%ctx%recoverable > 0) cause = cause//' after repeated recoverable '// &
+                    'errors of the right-hand side (e.g. a NaN or Inf in the forces)'
+                exit
+            end if
+        end do
+
+        if (flag >= 0 .and. len(cause) == 0) then
+            ! the step that reached tout is done: interpolate there
+            flag = FCVodeGetDky(self%mem, real(tout, c_double), 0_c_int, self%nv_y)
+            if (self%nq > 0 .and. flag >= 0) &
+                flag = FCVodeGetQuadDky(self%mem, real(tout, c_double), 0_c_int, self%nv_q)
+            if (flag >= 0) then
+                self%t = tout
+                y = self%y
+                if (self%nq > 0) yq(1:self%nq) = self%yq(1:self%nq)
+                t = self%t
+                return
+            end if
+            cause = flag_name(flag)//': interpolation at tout failed '//self%ctx%message
+        end if
+
+        ! Failure: the last good state is CVODE's current one (in y after a one-step call).
+        self%t = self%tn
         if (self%nq > 0) then
+            tret = self%tn
             qflag = FCVodeGetQuad(self%mem, tret, self%nv_q)
             if (qflag >= 0) yq(1:self%nq) = self%yq(1:self%nq)
         end if
         y = self%y
         t = self%t
-        if (flag < 0) then
-            ! the step being attempted when CVODE gave up (the last successful one if none)
-            hlast = 0.0_c_double
-            qflag = FCVodeGetCurrentStep(self%mem, hlast)
-            if (hlast(1) == 0.0_c_double) qflag = FCVodeGetLastStep(self%mem, hlast)
-            write (where, '(a, es12.5, a, es11.3e3, a)') 't = ', t, ' s, step size ', &
-                hlast(1), ' s'
-            if (flag == CV_TOO_MUCH_WORK) then
-                call make_error(err, ERR_SOLVER, 'cvode failed at '//trim(where)//': '// &
-                                flag_name(flag)//': max_steps exceeded')
-            else
-                call make_error(err, ERR_SOLVER, 'cvode failed at '//trim(where)//': '// &
-                                flag_name(flag)//': '//self%ctx%message)
-            end if
+        ! the step being attempted when CVODE gave up (the last successful one if none)
+        hlast = 0.0_c_double
+        qflag = FCVodeGetCurrentStep(self%mem, hlast)
+        if (hlast(1) == 0.0_c_double) qflag = FCVodeGetLastStep(self%mem, hlast)
+        if (len(cause) == 0) then
+            cause = flag_name(flag)//': '//self%ctx%message
+            if (flag == CV_REPTD_RHSFUNC_ERR .or. flag == CV_REPTD_QRHSFUNC_ERR) &
+                cause = cause//' (the model returned a recoverable error, e.g. a NaN or '// &
+                'Inf in the forces)'
         end if
+        call make_error(err, ERR_SOLVER, 'cvode failed at '//where_text(t, hlast(1))// &
+                        ': '//cause)
     end subroutine cvode_advance_to
+
+    !> 't = ... s, step size ... s' for messages.
+    function where_text(t, h) result(text)
+        real(wp), intent(in) :: t, h
+        character(len=:), allocatable :: text
+        character(len=64) :: buffer
+        write (buffer, '(a, es12.5, a, es11.3e3, a)') 't = ', t, ' s, step size ', h, ' s'
+        text = trim(buffer)
+    end function where_text
+
+    pure function int_text(i) result(s)
+        integer(i8), intent(in) :: i
+        character(len=:), allocatable :: s
+        character(len=24) :: buffer
+        write (buffer, '(i0)') i
+        s = trim(buffer)
+    end function int_text
 
     function cvode_stats(self) result(stats)
         class(cvode_t), intent(in) :: self
@@ -341,6 +405,7 @@ contains
         f => FN_VGetArrayPointer(nv_f)
         call ctx%problem%rhs(t, y, f, status)
         ctx%last_status = status
+        if (status > 0) ctx%recoverable = ctx%recoverable + 1
         ierr = int(status, c_int)
     end function cv_rhs
 
@@ -356,6 +421,7 @@ contains
         qdot => FN_VGetArrayPointer(nv_qdot)
         call ctx%problem%quad_rhs(t, y, qdot, status)
         ctx%last_status = status
+        if (status > 0) ctx%recoverable = ctx%recoverable + 1
         ierr = int(status, c_int)
     end function cv_quad
 

@@ -26,6 +26,9 @@ module ropedyn_integrator
         integer :: max_order = 0             !< highest order of accuracy (0: method default)
         integer(i8) :: max_steps = 1000000_i8 !< step budget for the whole run
         logical :: fd_jacobian = .false.     !< difference f even if the problem has a Jacobian
+        !> CVODE's BDF stability-limit detection (order reduction when a lightly damped
+        !! oscillatory mode nears the stability boundary); other methods reject .true.
+        logical :: stab_lim_det = .false.
     end type solver_options_t
 
     !> Counters of an integration so far.

@@ -157,6 +157,11 @@ contains
             call make_error(err, ERR_SOLVER, 'mebdf: max_order must be 2 .. 7')
             return
         end if
+        if (options%stab_lim_det) then
+            call make_error(err, ERR_SOLVER, 'mebdf: stability-limit detection is a CVODE ' &
+                            //'option (MEBDF up to order 4 is A-stable: use max_order)')
+            return
+        end if
         if (.not. (options%rtol > 0.0_wp .and. options%atol > 0.0_wp)) then
             call make_error(err, ERR_SOLVER, 'mebdf: rtol and atol must be > 0')
             return

@@ -13,6 +13,12 @@
 !! so that f = r(q, q', 0) and M q'' = f - r(q, q', q''). M(q) itself (dense) is
 !! assembled in O(n^2) for the solve (Cholesky, LAPACK dpotrf/dpotrs), which makes the
 !! explicit right-hand side O(n^3): the paper's reason RFEM wins at large n.
+!!
+!! External effects (drag, ground contact, point loads; ropedyn_effect) act on the rods as
+!! bodies: w_i gains the body force, r[phi_i] the body moment. Point masses sit at their
+!! place on a rod (they enter the residual like the rods' own inertia, and M(q) as
+!! m_p J_p^T J_p). The top joint may follow a prescribed motion P_0(t) (its acceleration
+!! starts the prefix sums); the bottom support may move or be released.
 module ropedyn_mpp
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp
@@ -20,6 +26,9 @@ module ropedyn_mpp
     use ropedyn_problem, only: energy_t, STATUS_OK, STATUS_RECOVERABLE
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_scene, only: scene_t, bottom_anchor_given
+    use ropedyn_effect, only: effect_box_t, bodies_t
+    use ropedyn_effect_factory, only: build_body_effects, attached_masses
+    use ropedyn_support_motion, only: support_motion_t, motion_state_t, MOTION_HARMONIC
     implicit none
     private
     public :: mpp_t, mpp_create
@@ -44,6 +53,16 @@ module ropedyn_mpp
         real(wp) :: top_anchor(2) = 0.0_wp, bottom_anchor(2) = 0.0_wp
         real(wp) :: top_angle = 0.0_wp, bottom_angle = 0.0_wp
         real(wp) :: init_angle = 0.0_wp
+        logical :: folded = .false.    !< initial shape 'folded' (n even)
+        ! supports (1 top joint, 2 bottom): base anchors and angles in top_anchor, ...
+        type(support_motion_t) :: motion(2)
+        logical :: moving(2) = .false.
+        real(wp) :: bottom_release = huge(1.0_wp)  !< s
+        logical :: with_work = .false.   !< external work is quadrature 2
+        type(effect_box_t), allocatable :: effects(:)
+        ! point masses: rod, offset from the rod's centre along it (m), mass (kg)
+        integer, allocatable :: pm_body(:)
+        real(wp), allocatable :: pm_r(:), pm_m(:)
     contains
         procedure :: size => mpp_size
         procedure :: bandwidths => mpp_bandwidths
@@ -64,7 +83,10 @@ module ropedyn_mpp
         procedure :: element_data => mpp_element_data
         procedure :: residual => mpp_residual
         procedure :: mass_dense => mpp_mass_dense
+        procedure :: coordinates => mpp_coordinates
+        procedure :: coordinate_mass => mpp_coordinate_mass
         procedure, private :: positions
+        procedure, private :: supports_at
     end type mpp_t
 
     interface
@@ -92,6 +114,7 @@ contains
         type(scene_t), intent(in) :: scene
         type(error_t), allocatable, intent(out) :: err
         real(wp) :: area, second_moment, total_mass, factor
+        integer :: k
 
         model%n = scene%model%elements
         if (model%n < 1) then
@@ -137,21 +160,94 @@ contains
             model%d_rot = factor*scene%rope%normal_damping*second_moment/model%l
         end if
 
-        if (scene%initial%shape == 'hanging') then
+        if (scene%initial%shape == 'hanging' .or. scene%initial%shape == 'folded') then
             model%init_angle = 0.0_wp
         else
             model%init_angle = scene%initial%angle_deg*pi/180.0_wp
         end if
+        model%folded = scene%initial%shape == 'folded'
         model%top_anchor = scene%supports%top_anchor
         model%top_angle = scene%supports%top_angle_deg*pi/180.0_wp
         model%bottom_angle = scene%supports%bottom_angle_deg*pi/180.0_wp
         if (bottom_anchor_given(scene)) then
             model%bottom_anchor = scene%supports%bottom_anchor
         else
+            ! the lower end P_n of the initial state (the top anchor when folded)
             model%bottom_anchor = model%top_anchor + scene%rope%length* &
                                   [cos(model%init_angle), sin(model%init_angle)]
+            if (model%folded) model%bottom_anchor = model%top_anchor + [0.0_wp, model%l]
         end if
+
+        call attached_masses(scene, [(model%l, k = 1, model%n)], model%pm_body, model%pm_r, &
+                             model%pm_m)
+        call build_body_effects(scene, [(model%l, k = 1, model%n)], model%effects)
+        model%motion(1)%p0 = model%top_anchor
+        model%motion(1)%angle0 = model%top_angle
+        model%motion(2)%p0 = model%bottom_anchor
+        model%motion(2)%angle0 = model%bottom_angle
+        if (scene%effects%support_motion) then
+            associate (s => scene%supports)
+                if (s%bottom_release_time >= 0.0_wp) model%bottom_release = s%bottom_release_time
+                if (.not. model%bottom_release > 0.0_wp) model%bottom = 0
+                call set_motion(1, s%top_motion, s%top_amplitude, s%top_frequency, &
+                                s%top_phase_deg, s%top_angle_amplitude_deg, &
+                                s%top_angle_phase_deg, s%top_table_rows)
+                if (model%bottom > 0) &
+                    call set_motion(2, s%bottom_motion, s%bottom_amplitude, &
+                                    s%bottom_frequency, s%bottom_phase_deg, &
+                                    s%bottom_angle_amplitude_deg, s%bottom_angle_phase_deg, &
+                                    s%bottom_table_rows)
+            end associate
+        end if
+        model%with_work = any(model%moving)
+        do k = 1, size(model%effects)
+            if (model%effects(k)%e%does_work()) model%with_work = .true.
+        end do
+    contains
+        subroutine set_motion(k, kind, amplitude, frequency, phase_deg, &
+                              angle_amplitude_deg, angle_phase_deg, rows)
+            integer, intent(in) :: k
+            character(len=*), intent(in) :: kind
+            real(wp), intent(in) :: amplitude(2), frequency, phase_deg(2), &
+                                    angle_amplitude_deg, angle_phase_deg
+            real(wp), allocatable, intent(in) :: rows(:, :)
+            select case (kind)
+            case ('harmonic')
+                model%motion(k)%kind = MOTION_HARMONIC
+                model%motion(k)%amplitude = amplitude
+                model%motion(k)%omega = 2.0_wp*pi*frequency
+                model%motion(k)%phase = phase_deg*pi/180.0_wp
+                model%motion(k)%angle_amplitude = angle_amplitude_deg*pi/180.0_wp
+                model%motion(k)%angle_phase = angle_phase_deg*pi/180.0_wp
+                model%moving(k) = .true.
+            case ('table')
+                call model%motion(k)%set_table(rows)
+                model%moving(k) = .true.
+            end select
+        end subroutine set_motion
     end subroutine mpp_create
+
+    !> The supports at time t: top joint, bottom anchor (motion states) and whether the
+    !! bottom support still holds.
+    pure subroutine supports_at(self, t, top, bottom, bottom_on)
+        class(mpp_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        type(motion_state_t), intent(out) :: top, bottom
+        logical, intent(out) :: bottom_on
+        if (self%moving(1)) then
+            top = self%motion(1)%state(t)
+        else
+            top%p = self%top_anchor
+            top%angle = self%top_angle
+        end if
+        if (self%moving(2)) then
+            bottom = self%motion(2)%state(t)
+        else
+            bottom%p = self%bottom_anchor
+            bottom%angle = self%bottom_angle
+        end if
+        bottom_on = self%bottom > 0 .and. t < self%bottom_release
+    end subroutine supports_at
 
     pure integer function mpp_size(self)
         class(mpp_t), intent(in) :: self
@@ -166,9 +262,10 @@ contains
         mu = 2*self%ndof - 1
     end subroutine mpp_bandwidths
 
+    !> 1: the dissipated energy; 2 (moving supports, working effects): external work.
     pure integer function mpp_quad_size(self)
         class(mpp_t), intent(in) :: self
-        mpp_quad_size = 1
+        mpp_quad_size = merge(2, 1, self%with_work)
     end function mpp_quad_size
 
     pure integer function mpp_n_elements(self)
@@ -204,6 +301,12 @@ contains
         real(wp), intent(out) :: y(:)
         y = 0.0_wp
         y(1:self%n) = self%init_angle
+        ! folded (n odd): (n-1)/2 members down, the middle one horizontal (towards +y), the
+        ! rest back up: two halves side by side, one member length apart
+        if (self%folded) then
+            y((self%n + 1)/2) = 0.5_wp*pi
+            y((self%n + 3)/2:self%n) = pi
+        end if
     end subroutine mpp_initial_state
 
     !> Split y into angles, elongations and their rates (elongations 0 if inextensible).
@@ -224,17 +327,25 @@ contains
         end if
     end subroutine unpack
 
-    !> Joints P_0 .. P_n, rod centres C_i, and their velocities.
-    pure subroutine positions(self, y, p, c, pd, cd)
+    !> Joints P_0 .. P_n, rod centres C_i, and their velocities at time t (default 0).
+    pure subroutine positions(self, y, p, c, pd, cd, t)
         class(mpp_t), intent(in) :: self
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: p(2, 0:self%n), c(2, self%n), pd(2, 0:self%n), cd(2, self%n)
+        real(wp), intent(in), optional :: t
         real(wp), dimension(self%n) :: phi, u, phid, ud
         real(wp) :: e(2), nv(2)
+        type(motion_state_t) :: top
         integer :: k
         call unpack(self, y, phi, u, phid, ud)
         p(:, 0) = self%top_anchor
         pd(:, 0) = 0.0_wp
+        if (self%moving(1)) then
+            top = self%motion(1)%state(0.0_wp)
+            if (present(t)) top = self%motion(1)%state(t)
+            p(:, 0) = top%p
+            pd(:, 0) = top%v
+        end if
         do k = 1, self%n
             e = [cos(phi(k)), sin(phi(k))]
             nv = [-e(2), e(1)]
@@ -246,19 +357,29 @@ contains
     end subroutine positions
 
     !> The Lagrange residual r = Q(q, q') - sum_i m J_i^T C_i''(q, q', q'') - J phi''
-    !! for the generalized accelerations qacc (size ndof), O(n).
-    pure subroutine mpp_residual(self, y, qacc, r)
+    !! (and the point masses' inertia) for the generalized accelerations qacc (size ndof)
+    !! at time t (default 0), O(n). `pin`: the force of the top joint on the rope (N),
+    !! meaningful when qacc are the true accelerations.
+    pure subroutine mpp_residual(self, y, qacc, r, t, pin)
         class(mpp_t), intent(in) :: self
         real(wp), intent(in) :: y(:)
         real(wp), intent(in) :: qacc(:)
         real(wp), intent(out) :: r(:)
-        real(wp), dimension(self%n) :: phi, u, phid, ud, phidd, udd, hk, lk
-        real(wp) :: e(2, self%n), nv(2, self%n), pacc(2), cacc(2), w(2, self%n)
-        real(wp) :: wsum(2), fb(2), pn(2), pnd(2), d, dd
-        integer :: k, n, nd
+        real(wp), intent(in), optional :: t
+        real(wp), intent(out), optional :: pin(2)
+        real(wp), dimension(self%n) :: phi, u, phid, ud, phidd, udd, hk, lk, mom
+        real(wp) :: e(2, self%n), nv(2, self%n), pacc(2), cacc(2, self%n), w(2, self%n)
+        real(wp) :: wsum(2), fb(2), pn(2), pnd(2), d, dd, tt, fp(2), pv(2)
+        type(motion_state_t) :: top, bottom
+        type(bodies_t) :: b
+        logical :: bottom_on
+        integer :: k, n, nd, i
 
         n = self%n
         nd = self%ndof
+        tt = 0.0_wp
+        if (present(t)) tt = t
+        call self%supports_at(tt, top, bottom, bottom_on)
         call unpack(self, y, phi, u, phid, ud)
         phidd = qacc(1:n)
         udd = 0.0_wp
@@ -270,34 +391,55 @@ contains
         nv(1, :) = -e(2, :)
         nv(2, :) = e(1, :)
 
-        ! Accelerations of the joints (prefix sums) and the applied-minus-inertial force on
-        ! each rod: w_i = m g x - m C_i''.
-        pacc = 0.0_wp
-        pn = self%top_anchor
-        pnd = 0.0_wp
+        ! Accelerations of the joints (prefix sums, from the top joint's) and the
+        ! applied-minus-inertial force on each rod: w_i = m g x - m C_i''.
+        pacc = top%a
+        pn = top%p
+        pnd = top%v
         do k = 1, n
-            cacc = pacc + (hk(k)*phidd(k) + 2.0_wp*ud(k)*phid(k))*nv(:, k) &
-                   + (udd(k) - hk(k)*phid(k)**2)*e(:, k)
+            cacc(:, k) = pacc + (hk(k)*phidd(k) + 2.0_wp*ud(k)*phid(k))*nv(:, k) &
+                         + (udd(k) - hk(k)*phid(k)**2)*e(:, k)
             pacc = pacc + (lk(k)*phidd(k) + 2.0_wp*ud(k)*phid(k))*nv(:, k) &
                    + (udd(k) - lk(k)*phid(k)**2)*e(:, k)
-            w(:, k) = -self%m*cacc
+            w(:, k) = -self%m*cacc(:, k)
             w(1, k) = w(1, k) + self%m*self%g
             pn = pn + lk(k)*e(:, k)
             pnd = pnd + lk(k)*phid(k)*nv(:, k) + ud(k)*e(:, k)
         end do
+        mom = 0.0_wp
 
-        ! Force of the bottom pin on the tip P_n.
+        ! Point masses at P = C_i + r e_i: their applied-minus-inertial force joins w_i,
+        ! its moment r e_i x f about the centre joins the rod's moment.
+        do k = 1, size(self%pm_body)
+            i = self%pm_body(k)
+            pv = cacc(:, i) + self%pm_r(k)*(phidd(i)*nv(:, i) - phid(i)**2*e(:, i))
+            fp = -self%pm_m(k)*pv
+            fp(1) = fp(1) + self%pm_m(k)*self%g
+            w(:, i) = w(:, i) + fp
+            mom(i) = mom(i) + self%pm_r(k)*dot_product(nv(:, i), fp)
+        end do
+
+        ! External effects on the rods as bodies.
+        if (size(self%effects) > 0) then
+            call rod_bodies(self, y, top, b)
+            do k = 1, size(self%effects)
+                call self%effects(k)%e%add_forces(tt, b, w, mom)
+            end do
+        end if
+
+        ! Force of the bottom support on the tip P_n.
         fb = 0.0_wp
-        if (self%bottom > 0) fb = -self%k_sup*(pn - self%bottom_anchor) - self%d_sup*pnd
+        if (bottom_on) fb = -self%k_sup*(pn - bottom%p) - self%d_sup*(pnd - bottom%v)
 
         ! Generalized forces by suffix sums: Q[phi_k] = n_k . (h_k w_k + l_k sum_{i>k} w_i
-        ! + l_k F_b), Q[u_k] = e_k . (sum_{i>=k} w_i + F_b).
+        ! + l_k F_b) + M_k, Q[u_k] = e_k . (sum_{i>=k} w_i + F_b).
         wsum = fb
         do k = n, 1, -1
-            r(k) = dot_product(nv(:, k), hk(k)*w(:, k) + lk(k)*wsum)
+            r(k) = dot_product(nv(:, k), hk(k)*w(:, k) + lk(k)*wsum) + mom(k)
             wsum = wsum + w(:, k)
             if (self%nu > 0) r(n + k) = dot_product(e(:, k), wsum)
         end do
+        if (present(pin)) pin = -wsum
         r(1:n) = r(1:n) - self%inertia*phidd
 
         ! Member springs and dampers.
@@ -312,14 +454,41 @@ contains
         end if
         ! Rotational springs of clamped supports.
         if (self%top_clamped) then
-            dd = self%c_rot*(phi(1) - self%top_angle) + self%d_rot*phid(1)
+            dd = self%c_rot*(phi(1) - top%angle) + self%d_rot*(phid(1) - top%rate)
             r(1) = r(1) - dd
         end if
-        if (self%bottom == 2) then
-            dd = self%c_rot*(phi(n) - self%bottom_angle) + self%d_rot*phid(n)
+        if (self%bottom == 2 .and. bottom_on) then
+            dd = self%c_rot*(phi(n) - bottom%angle) + self%d_rot*(phid(n) - bottom%rate)
             r(n) = r(n) - dd
         end if
     end subroutine mpp_residual
+
+    !> The rods as bodies (centre, angle, their rates, length l) for the effects.
+    pure subroutine rod_bodies(self, y, top, b)
+        class(mpp_t), intent(in) :: self
+        real(wp), intent(in) :: y(:)
+        type(motion_state_t), intent(in) :: top
+        type(bodies_t), intent(out) :: b
+        real(wp), dimension(self%n) :: phi, u, phid, ud
+        real(wp) :: p(2), pd(2), e(2), nv(2)
+        integer :: k
+        call unpack(self, y, phi, u, phid, ud)
+        b%n = self%n
+        allocate (b%c(2, self%n), b%v(2, self%n), b%l(self%n))
+        b%phi = phi
+        b%w = phid
+        b%l = self%l
+        p = top%p
+        pd = top%v
+        do k = 1, self%n
+            e = [cos(phi(k)), sin(phi(k))]
+            nv = [-e(2), e(1)]
+            b%c(:, k) = p + (u(k) + 0.5_wp*self%l)*e
+            b%v(:, k) = pd + (u(k) + 0.5_wp*self%l)*phid(k)*nv + ud(k)*e
+            p = p + (self%l + u(k))*e
+            pd = pd + (self%l + u(k))*phid(k)*nv + ud(k)*e
+        end do
+    end subroutine rod_bodies
 
     !> The dense mass matrix M(q) (ndof x ndof), O(n^2).
     pure subroutine mpp_mass_dense(self, y, mm)
@@ -327,8 +496,8 @@ contains
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: mm(:, :)
         real(wp), dimension(self%n) :: phi, u, phid, ud, hk, lk
-        real(wp) :: cjk, sjk, s
-        integer :: k, j, n
+        real(wp) :: cjk, sjk, s, jp(2, self%ndof), e(2), nv(2)
+        integer :: k, j, n, p, i
         n = self%n
         call unpack(self, y, phi, u, phid, ud)
         hk = u + 0.5_wp*self%l
@@ -365,6 +534,22 @@ contains
             end do
             mm(j, j) = mm(j, j) + self%inertia
         end do
+        ! point masses: m_p J_p^T J_p with J_p = dP/dq, P = C_i + r e_i
+        do p = 1, size(self%pm_body)
+            i = self%pm_body(p)
+            jp = 0.0_wp
+            do k = 1, i
+                e = [cos(phi(k)), sin(phi(k))]
+                nv = [-e(2), e(1)]
+                if (k < i) then
+                    jp(:, k) = lk(k)*nv
+                else
+                    jp(:, k) = (hk(k) + self%pm_r(p))*nv
+                end if
+                if (self%nu > 0) jp(:, n + k) = e
+            end do
+            mm = mm + self%pm_m(p)*matmul(transpose(jp), jp)
+        end do
     end subroutine mpp_mass_dense
 
     !> y' = (q', M^{-1} f): f = r(q, q', 0), solved by Cholesky.
@@ -378,7 +563,7 @@ contains
         integer :: nd, info
         nd = self%ndof
         zero = 0.0_wp
-        call self%residual(y, zero, f(:, 1))
+        call self%residual(y, zero, f(:, 1), t)
         call self%mass_dense(y, mm)
         call dpotrf('L', nd, mm, nd, info)
         if (info == 0) call dpotrs('L', nd, 1, mm, nd, f, nd, info)
@@ -400,7 +585,7 @@ contains
         nd = self%ndof
         zero = 0.0_wp
         f(1:nd) = y(nd + 1:2*nd)
-        call self%residual(y, zero, f(nd + 1:2*nd))
+        call self%residual(y, zero, f(nd + 1:2*nd), t)
         status = STATUS_OK
         if (.not. all(ieee_is_finite(f))) status = STATUS_RECOVERABLE
     end subroutine mpp_implicit_rhs
@@ -441,7 +626,7 @@ contains
         integer :: nd, j, i, info
         nd = self%ndof
         zero = 0.0_wp
-        call self%residual(y, zero, a0(:, 1))
+        call self%residual(y, zero, a0(:, 1), t)
         call self%mass_dense(y, mm)
         call dpotrf('L', nd, mm, nd, info)
         if (info /= 0) then
@@ -449,12 +634,12 @@ contains
             return
         end if
         call dpotrs('L', nd, 1, mm, nd, a0, nd, info)
-        call self%residual(y, a0(:, 1), r0)
+        call self%residual(y, a0(:, 1), r0, t)
         do j = 1, 2*nd
             yp = y
             inc = sqrt(epsilon(1.0_wp))*max(abs(y(j)), 1.0e-3_wp)
             yp(j) = y(j) + inc
-            call self%residual(yp, a0(:, 1), dr(:, j))
+            call self%residual(yp, a0(:, 1), dr(:, j), t)
             dr(:, j) = (dr(:, j) - r0)/inc
         end do
         call dpotrs('L', nd, 2*nd, mm, nd, dr, nd, info)
@@ -479,28 +664,51 @@ contains
         type(energy_t) :: en
         real(wp) :: p(2, 0:self%n), c(2, self%n), pd(2, 0:self%n), cd(2, self%n)
         real(wp), dimension(self%n) :: phi, u, phid, ud
-        integer :: k, n
+        real(wp) :: e(2), nv(2)
+        type(motion_state_t) :: top, bottom
+        type(bodies_t) :: b
+        logical :: bottom_on
+        integer :: k, n, i
         n = self%n
         call unpack(self, y, phi, u, phid, ud)
-        call self%positions(y, p, c, pd, cd)
+        call self%positions(y, p, c, pd, cd, t)
+        call self%supports_at(t, top, bottom, bottom_on)
         en%kinetic = 0.5_wp*(self%m*sum(cd**2) + self%inertia*sum(phid**2))
         en%gravity = -self%m*self%g*sum(c(1, :))
+        do k = 1, size(self%pm_body)
+            i = self%pm_body(k)
+            e = [cos(phi(i)), sin(phi(i))]
+            nv = [-e(2), e(1)]
+            en%kinetic = en%kinetic + 0.5_wp*self%pm_m(k)* &
+                         sum((cd(:, i) + self%pm_r(k)*phid(i)*nv)**2)
+            en%gravity = en%gravity - self%pm_m(k)*self%g*(c(1, i) + self%pm_r(k)*e(1))
+        end do
         en%elastic = 0.5_wp*self%ks*sum(u**2)
         do k = 2, n
             en%elastic = en%elastic + 0.5_wp*self%cb*(phi(k) - phi(k - 1))**2
         end do
         if (self%top_clamped) en%elastic = en%elastic + 0.5_wp*self%c_rot* &
-                                            (phi(1) - self%top_angle)**2
-        if (self%bottom > 0) en%elastic = en%elastic + 0.5_wp*self%k_sup* &
-                                          sum((p(:, n) - self%bottom_anchor)**2)
-        if (self%bottom == 2) en%elastic = en%elastic + 0.5_wp*self%c_rot* &
-                                           (phi(n) - self%bottom_angle)**2
+                                            (phi(1) - top%angle)**2
+        if (bottom_on) en%elastic = en%elastic + 0.5_wp*self%k_sup* &
+                                    sum((p(:, n) - bottom%p)**2)
+        if (self%bottom == 2 .and. bottom_on) en%elastic = en%elastic + 0.5_wp*self%c_rot* &
+                                                          (phi(n) - bottom%angle)**2
+        if (size(self%effects) > 0) then
+            call rod_bodies(self, y, top, b)
+            do k = 1, size(self%effects)
+                en%elastic = en%elastic + self%effects(k)%e%energy(t, b)
+            end do
+        end if
         en%dissipated = 0.0_wp
         if (size(yq) >= 1) en%dissipated = yq(1)
         en%support_work = 0.0_wp
+        if (self%with_work .and. size(yq) >= 2) en%support_work = yq(2)
     end function mpp_energy
 
-    !> Dissipation power 2D, W.
+    !> Dissipation power 2D (W) and, with moving supports or working effects, the external
+    !! power (W): the top joint's force on the rope (from the residual at the true
+    !! accelerations) times its velocity, the support springs' forces and moments times
+    !! their anchors' rates, and the effects' work rate.
     subroutine mpp_quad_rhs(self, t, y, yqdot, status)
         class(mpp_t), intent(inout) :: self
         real(wp), intent(in) :: t
@@ -508,36 +716,69 @@ contains
         real(wp), intent(out) :: yqdot(:)
         integer, intent(out) :: status
         real(wp), dimension(self%n) :: phi, u, phid, ud
-        real(wp) :: power, pnd(2)
-        integer :: k, n
+        real(wp) :: p(2, 0:self%n), c(2, self%n), pd(2, 0:self%n), cd(2, self%n)
+        real(wp) :: power, work, rel(2), pin(2), mm(self%ndof, self%ndof), a(self%ndof, 1)
+        real(wp) :: r(self%ndof), zero(self%ndof)
+        type(motion_state_t) :: top, bottom
+        type(bodies_t) :: b
+        logical :: bottom_on
+        integer :: k, n, info
         n = self%n
         call unpack(self, y, phi, u, phid, ud)
+        call self%supports_at(t, top, bottom, bottom_on)
         power = self%ds*sum(ud**2)
+        work = 0.0_wp
         do k = 2, n
             power = power + self%db*(phid(k) - phid(k - 1))**2
         end do
-        if (self%top_clamped) power = power + self%d_rot*phid(1)**2
-        if (self%bottom > 0) then
-            pnd = 0.0_wp
-            do k = 1, n
-                pnd = pnd + (self%l + u(k))*phid(k)*[-sin(phi(k)), cos(phi(k))] &
-                      + ud(k)*[cos(phi(k)), sin(phi(k))]
-            end do
-            power = power + self%d_sup*sum(pnd**2)
+        if (self%top_clamped) then
+            power = power + self%d_rot*(phid(1) - top%rate)**2
+            if (self%moving(1)) work = work - (self%c_rot*(phi(1) - top%angle) &
+                                                 + self%d_rot*(phid(1) - top%rate))*top%rate
         end if
-        if (self%bottom == 2) power = power + self%d_rot*phid(n)**2
-        yqdot(1) = power
+        if (bottom_on) then
+            call self%positions(y, p, c, pd, cd, t)
+            rel = pd(:, n) - bottom%v
+            power = power + self%d_sup*sum(rel**2)
+            if (self%moving(2)) work = work + dot_product(-self%k_sup*(p(:, n) - bottom%p) &
+                                                          - self%d_sup*rel, bottom%v)
+            if (self%bottom == 2) then
+                power = power + self%d_rot*(phid(n) - bottom%rate)**2
+                if (self%moving(2)) work = work - (self%c_rot*(phi(n) - bottom%angle) &
+                                                   + self%d_rot*(phid(n) - bottom%rate))*bottom%rate
+            end if
+        end if
+        if (size(self%effects) > 0) then
+            call rod_bodies(self, y, top, b)
+            do k = 1, size(self%effects)
+                call self%effects(k)%e%power(t, b, power, work)
+            end do
+        end if
         status = STATUS_OK
-        if (.not. ieee_is_finite(power)) status = STATUS_RECOVERABLE
+        if (self%moving(1)) then
+            ! the pin force needs the accelerations: a = M^{-1} f, then r(q, q', a) gives it
+            zero = 0.0_wp
+            call self%residual(y, zero, a(:, 1), t)
+            call self%mass_dense(y, mm)
+            call dpotrf('L', self%ndof, mm, self%ndof, info)
+            if (info == 0) call dpotrs('L', self%ndof, 1, mm, self%ndof, a, self%ndof, info)
+            if (info /= 0) status = STATUS_RECOVERABLE
+            call self%residual(y, a(:, 1), r, t, pin)
+            work = work + dot_product(pin, top%v)
+        end if
+        yqdot(1) = power
+        if (self%with_work) yqdot(2) = work
+        if (.not. (ieee_is_finite(power) .and. ieee_is_finite(work))) status = STATUS_RECOVERABLE
     end subroutine mpp_quad_rhs
 
     !> Members as elements: rod centre, angle and their rates.
-    subroutine mpp_fields(self, y, q, qdot)
+    subroutine mpp_fields(self, y, q, qdot, t)
         class(mpp_t), intent(in) :: self
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: q(:, :), qdot(:, :)
+        real(wp), intent(in), optional :: t  !< s: places a moving top joint
         real(wp) :: p(2, 0:self%n), c(2, self%n), pd(2, 0:self%n), cd(2, self%n)
-        call self%positions(y, p, c, pd, cd)
+        call self%positions(y, p, c, pd, cd, t)
         q(1:2, :) = c
         q(3, :) = y(1:self%n)
         qdot(1:2, :) = cd
@@ -545,16 +786,34 @@ contains
     end subroutine mpp_fields
 
     !> Member i drawn from joint P_{i-1} to joint P_i (spring and rod).
-    subroutine mpp_polyline(self, y, points)
+    subroutine mpp_polyline(self, y, points, t)
         class(mpp_t), intent(in) :: self
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: points(:, :)
+        real(wp), intent(in), optional :: t  !< s: places a moving top joint
         real(wp) :: p(2, 0:self%n), c(2, self%n), pd(2, 0:self%n), cd(2, self%n)
         integer :: i
-        call self%positions(y, p, c, pd, cd)
+        call self%positions(y, p, c, pd, cd, t)
         do i = 1, self%n
             points(:, 2*i - 1) = p(:, i - 1)
             points(:, 2*i) = p(:, i)
         end do
     end subroutine mpp_polyline
+
+    !> Coordinates q = y(1..ndof) (angles, then elongations), rates y(ndof+1..2 ndof).
+    pure subroutine mpp_coordinates(self, pos, vel)
+        class(mpp_t), intent(in) :: self
+        integer, allocatable, intent(out) :: pos(:), vel(:)
+        integer :: k
+        pos = [(k, k = 1, self%ndof)]
+        vel = [(self%ndof + k, k = 1, self%ndof)]
+    end subroutine mpp_coordinates
+
+    !> The configuration-dependent mass matrix M(q) (mass_dense).
+    subroutine mpp_coordinate_mass(self, y, mm)
+        class(mpp_t), intent(in) :: self
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: mm(:, :)
+        call self%mass_dense(y, mm)
+    end subroutine mpp_coordinate_mass
 end module ropedyn_mpp

@@ -12,6 +12,12 @@
 !! terms are evaluated only when damping is on. Nothing is computed for an effect that is
 !! off.
 !!
+!! External effects (drag, ground contact, point loads; ropedyn_effect) act on the elements
+!! as bodies and exist only when the scene enables them. Supports may move (their anchor
+!! and angle are functions of time, evaluated once per call) or be released at a time
+!! (their families are then off). Point masses sit at their true place on an element, which
+!! makes that element's 3x3 mass block non-diagonal; it is solved locally.
+!!
 !! State y (size 6n), element by element: x_i, y_i, phi_i, x_i', y_i', phi_i'.
 module ropedyn_rfem
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -20,6 +26,9 @@ module ropedyn_rfem
     use ropedyn_problem, only: energy_t, STATUS_OK, STATUS_RECOVERABLE
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_scene, only: scene_t, bottom_anchor_given
+    use ropedyn_effect, only: effect_box_t, bodies_t
+    use ropedyn_effect_factory, only: build_body_effects, attached_masses
+    use ropedyn_support_motion, only: support_motion_t, motion_state_t, MOTION_HARMONIC
     implicit none
     private
     public :: rfem_t, rfem_create
@@ -38,6 +47,9 @@ module ropedyn_rfem
         real(wp) :: c = 0.0_wp           !< stiffness (N/m or N m/rad)
         real(wp) :: b = 0.0_wp           !< damping (N s/m or N m s/rad)
         logical :: damped = .false.
+        integer :: end = 0               !< 0 internal, 1 top support, 2 bottom support
+        logical :: active = .true.       !< false once its support is released
+        real(wp) :: st = 0.0_wp          !< explicit rate ds/dt of a moving support's strain
     end type family_t
 
     type, extends(rope_model_t) :: rfem_t
@@ -54,6 +66,26 @@ module ropedyn_rfem
         real(wp) :: top_angle = 0.0_wp         !< clamp angle, rad
         real(wp) :: bottom_angle = 0.0_wp      !< clamp angle, rad
         real(wp) :: init_angle = 0.0_wp        !< angle of the straight initial state, rad
+        real(wp) :: init_velocity(2) = 0.0_wp  !< initial velocity of every element, m/s
+        logical :: folded = .false.            !< initial shape 'folded'
+        ! supports (index 1 top, 2 bottom): base anchors and prescribed motions; the anchors
+        ! and angles above are their values at the time of the current call
+        type(support_motion_t) :: motion(2)
+        logical :: moving(2) = .false.
+        real(wp) :: release(2) = huge(1.0_wp)  !< release times, s
+        logical :: timed = .false.             !< the supports depend on time
+        real(wp) :: anchor_vel(2, 2) = 0.0_wp  !< anchor velocities (top, bottom), m/s
+        real(wp) :: angle_rate(2) = 0.0_wp     !< support angle rates, rad/s
+        logical :: with_work = .false.         !< external work is quadrature 2
+        ! external effects (only those enabled) and their workspace
+        type(effect_box_t), allocatable :: effects(:)
+        type(bodies_t) :: bodies
+        real(wp), allocatable :: ejac(:, :, :)  !< (3, 6, n)
+        ! point masses: elements carrying them and their first moment sum m r (kg m);
+        ! mass and inertia above include them
+        integer, allocatable :: pm_elem(:)
+        real(wp), allocatable :: pm_moment(:)
+        real(wp), allocatable :: rowscale(:, :)  !< (3, n): 1/m, 1/m, 1/J; 1 on pm elements
         ! workspace (no state is kept between calls)
         real(wp), allocatable :: s(:)          !< strains of the current family
         real(wp), allocatable :: grad(:, :)    !< their gradients, (6, n+1)
@@ -74,10 +106,15 @@ module ropedyn_rfem
         procedure :: fields => rfem_fields
         procedure :: polyline => rfem_polyline
         procedure :: element_data => rfem_element_data
+        procedure :: coordinates => rfem_coordinates
+        procedure :: coordinate_mass => rfem_coordinate_mass
         procedure :: generalized_forces => rfem_generalized_forces
         procedure :: potential_energy => rfem_potential_energy
         procedure, private :: strain
         procedure, private :: local_rates
+        procedure, private :: set_time
+        procedure, private :: fill_bodies
+        procedure, private :: point_mass_accelerations
     end type rfem_t
 
 contains
@@ -87,10 +124,12 @@ contains
         type(rfem_t), intent(out) :: model
         type(scene_t), intent(in) :: scene
         type(error_t), allocatable, intent(out) :: err
-        integer :: n, nf
+        integer :: n, nf, k, i
         real(wp) :: area, second_moment, dl, total_mass, cx, cy, cphi, bx, by, bphi, factor
         type(family_t) :: fams(9)
         logical :: damped
+        integer, allocatable :: pm_body(:)
+        real(wp), allocatable :: pm_r(:), pm_m(:), y0(:)
 
         n = scene%model%elements
         if (n < 2) then
@@ -120,45 +159,111 @@ contains
         by = scene%rope%tangential_damping*area/(scene%rope%shape_factor*dl)
         bphi = scene%rope%normal_damping*second_moment/dl
         factor = scene%supports%support_stiffness_factor
+        if (scene%effects%support_motion) then
+            associate (s => scene%supports)
+                if (s%top_release_time >= 0.0_wp) model%release(1) = s%top_release_time
+                if (s%bottom_release_time >= 0.0_wp) model%release(2) = s%bottom_release_time
+            end associate
+        end if
 
         nf = 0
         if (scene%effects%tension) call add(FAM_TENSION, 2, n, cx, bx)
         if (scene%effects%shear) call add(FAM_SHEAR, 2, n, cy, by)
         if (scene%effects%bending) call add(FAM_BEND, 2, n, cphi, bphi)
-        select case (scene%supports%top)
-        case ('pinned')
-            call add(FAM_TOP_X, 1, 1, factor*cx, factor*bx)
-            call add(FAM_TOP_Y, 1, 1, factor*cx, factor*bx)
-        case ('clamped')
-            call add(FAM_TOP_X, 1, 1, factor*cx, factor*bx)
-            call add(FAM_TOP_Y, 1, 1, factor*cx, factor*bx)
-            call add(FAM_TOP_ROT, 1, 1, factor*cphi, factor*bphi)
-        end select
-        select case (scene%supports%bottom)
-        case ('pinned')
-            call add(FAM_BOTTOM_X, n + 1, n + 1, factor*cx, factor*bx)
-            call add(FAM_BOTTOM_Y, n + 1, n + 1, factor*cx, factor*bx)
-        case ('clamped')
-            call add(FAM_BOTTOM_X, n + 1, n + 1, factor*cx, factor*bx)
-            call add(FAM_BOTTOM_Y, n + 1, n + 1, factor*cx, factor*bx)
-            call add(FAM_BOTTOM_ROT, n + 1, n + 1, factor*cphi, factor*bphi)
-        end select
+        ! a support released at t <= 0 is free from the start: no family at all
+        if (model%release(1) > 0.0_wp) then
+            select case (scene%supports%top)
+            case ('pinned')
+                call add(FAM_TOP_X, 1, 1, factor*cx, factor*bx, 1)
+                call add(FAM_TOP_Y, 1, 1, factor*cx, factor*bx, 1)
+            case ('clamped')
+                call add(FAM_TOP_X, 1, 1, factor*cx, factor*bx, 1)
+                call add(FAM_TOP_Y, 1, 1, factor*cx, factor*bx, 1)
+                call add(FAM_TOP_ROT, 1, 1, factor*cphi, factor*bphi, 1)
+            end select
+        end if
+        if (model%release(2) > 0.0_wp) then
+            select case (scene%supports%bottom)
+            case ('pinned')
+                call add(FAM_BOTTOM_X, n + 1, n + 1, factor*cx, factor*bx, 2)
+                call add(FAM_BOTTOM_Y, n + 1, n + 1, factor*cx, factor*bx, 2)
+            case ('clamped')
+                call add(FAM_BOTTOM_X, n + 1, n + 1, factor*cx, factor*bx, 2)
+                call add(FAM_BOTTOM_Y, n + 1, n + 1, factor*cx, factor*bx, 2)
+                call add(FAM_BOTTOM_ROT, n + 1, n + 1, factor*cphi, factor*bphi, 2)
+            end select
+        end if
         model%families = fams(1:nf)
 
-        if (scene%initial%shape == 'hanging') then
+        if (scene%initial%shape == 'hanging' .or. scene%initial%shape == 'folded') then
             model%init_angle = 0.0_wp
         else
             model%init_angle = scene%initial%angle_deg*pi/180.0_wp
         end if
+        model%folded = scene%initial%shape == 'folded'
+        model%init_velocity = scene%initial%velocity
         model%top_anchor = scene%supports%top_anchor
         model%top_angle = scene%supports%top_angle_deg*pi/180.0_wp
         model%bottom_angle = scene%supports%bottom_angle_deg*pi/180.0_wp
+
+        ! point masses at their place on the elements: mass, inertia about the centre and
+        ! the first moment m r that couples translation and rotation
+        call attached_masses(scene, model%len, pm_body, pm_r, pm_m)
+        allocate (model%pm_elem(0), model%pm_moment(0))
+        do k = 1, size(pm_body)
+            i = pm_body(k)
+            model%mass(i) = model%mass(i) + pm_m(k)
+            model%inertia(i) = model%inertia(i) + pm_m(k)*pm_r(k)**2
+            if (.not. any(model%pm_elem == i)) then
+                model%pm_elem = [model%pm_elem, i]
+                model%pm_moment = [model%pm_moment, 0.0_wp]
+            end if
+            where (model%pm_elem == i) model%pm_moment = model%pm_moment + pm_m(k)*pm_r(k)
+        end do
+        allocate (model%rowscale(3, n))
+        model%rowscale(1, :) = 1.0_wp/model%mass
+        model%rowscale(2, :) = 1.0_wp/model%mass
+        model%rowscale(3, :) = 1.0_wp/model%inertia
+        model%rowscale(:, model%pm_elem) = 1.0_wp
+
+        call build_body_effects(scene, model%len, model%effects)
+        if (size(model%effects) > 0) then
+            model%bodies%n = n
+            model%bodies%l = model%len
+            allocate (model%bodies%c(2, n), model%bodies%phi(n), model%bodies%v(2, n), &
+                      model%bodies%w(n), model%ejac(3, 6, n))
+        end if
+
+        ! supports: base anchor and angle, prescribed motion
+        model%motion(1)%p0 = model%top_anchor
+        model%motion(1)%angle0 = model%top_angle
         if (bottom_anchor_given(scene)) then
             model%bottom_anchor = scene%supports%bottom_anchor
         else
-            model%bottom_anchor = model%top_anchor + scene%rope%length* &
-                                  [cos(model%init_angle), sin(model%init_angle)]
+            ! the rope's lower end in its initial state
+            allocate (y0(6*n))
+            call model%initial_state(y0)
+            model%bottom_anchor = y0(6*n - 5:6*n - 4) + 0.5_wp*model%len(n)* &
+                                  [cos(y0(6*n - 3)), sin(y0(6*n - 3))]
         end if
+        model%motion(2)%p0 = model%bottom_anchor
+        model%motion(2)%angle0 = model%bottom_angle
+        if (scene%effects%support_motion) then
+            associate (s => scene%supports)
+                call set_motion(1, s%top, s%top_motion, s%top_amplitude, s%top_frequency, &
+                                s%top_phase_deg, s%top_angle_amplitude_deg, &
+                                s%top_angle_phase_deg, s%top_table_rows)
+                call set_motion(2, s%bottom, s%bottom_motion, s%bottom_amplitude, &
+                                s%bottom_frequency, s%bottom_phase_deg, &
+                                s%bottom_angle_amplitude_deg, s%bottom_angle_phase_deg, &
+                                s%bottom_table_rows)
+            end associate
+        end if
+        model%timed = any(model%moving) .or. any(model%release < huge(1.0_wp))
+        model%with_work = any(model%moving)
+        do k = 1, size(model%effects)
+            if (model%effects(k)%e%does_work()) model%with_work = .true.
+        end do
 
         allocate (model%s(n + 1), model%grad(6, n + 1), model%force(n + 1), model%gen(3, n))
         model%s = 0.0_wp
@@ -166,14 +271,123 @@ contains
         model%force = 0.0_wp
         model%gen = 0.0_wp
     contains
-        subroutine add(kind, first, last, c, b)
+        subroutine add(kind, first, last, c, b, end)
             integer, intent(in) :: kind, first, last
             real(wp), intent(in) :: c, b
+            integer, intent(in), optional :: end
             nf = nf + 1
             fams(nf) = family_t(kind=kind, first=first, last=last, c=c, b=b, &
                                 damped=damped .and. b > 0.0_wp)
+            if (present(end)) fams(nf)%end = end
         end subroutine add
+
+        subroutine set_motion(k, support, kind, amplitude, frequency, phase_deg, &
+                              angle_amplitude_deg, angle_phase_deg, rows)
+            integer, intent(in) :: k
+            character(len=*), intent(in) :: support, kind
+            real(wp), intent(in) :: amplitude(2), frequency, phase_deg(2), &
+                                    angle_amplitude_deg, angle_phase_deg
+            real(wp), allocatable, intent(in) :: rows(:, :)
+            if (support == 'free' .or. .not. model%release(k) > 0.0_wp) return
+            select case (kind)
+            case ('harmonic')
+                model%motion(k)%kind = MOTION_HARMONIC
+                model%motion(k)%amplitude = amplitude
+                model%motion(k)%omega = 2.0_wp*pi*frequency
+                model%motion(k)%phase = phase_deg*pi/180.0_wp
+                model%motion(k)%angle_amplitude = angle_amplitude_deg*pi/180.0_wp
+                model%motion(k)%angle_phase = angle_phase_deg*pi/180.0_wp
+                model%moving(k) = .true.
+            case ('table')
+                call model%motion(k)%set_table(rows)
+                model%moving(k) = .true.
+            end select
+        end subroutine set_motion
     end subroutine rfem_create
+
+    !> Supports at time t: anchors, angles and their rates from the prescribed motions; the
+    !! families of released supports switched off. Once per call, never per element.
+    subroutine set_time(self, t)
+        class(rfem_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        type(motion_state_t) :: ms
+        integer :: f, k
+        if (.not. self%timed) return
+        do k = 1, 2
+            if (.not. self%moving(k)) cycle
+            ms = self%motion(k)%state(t)
+            if (k == 1) then
+                self%top_anchor = ms%p
+                self%top_angle = ms%angle
+            else
+                self%bottom_anchor = ms%p
+                self%bottom_angle = ms%angle
+            end if
+            self%anchor_vel(:, k) = ms%v
+            self%angle_rate(k) = ms%rate
+        end do
+        do f = 1, size(self%families)
+            associate (fam => self%families(f))
+                if (fam%end == 0) cycle
+                fam%active = t < self%release(fam%end)
+                if (.not. self%moving(fam%end)) cycle
+                ! ds/dt at fixed q: top strains are u . (A_1 - P), phi_1 - psi; bottom
+                ! strains u . (P - B_n), psi - phi_n
+                select case (fam%kind)
+                case (FAM_TOP_X)
+                    fam%st = -self%anchor_vel(1, 1)
+                case (FAM_TOP_Y)
+                    fam%st = -self%anchor_vel(2, 1)
+                case (FAM_TOP_ROT)
+                    fam%st = -self%angle_rate(1)
+                case (FAM_BOTTOM_X)
+                    fam%st = self%anchor_vel(1, 2)
+                case (FAM_BOTTOM_Y)
+                    fam%st = self%anchor_vel(2, 2)
+                case (FAM_BOTTOM_ROT)
+                    fam%st = self%angle_rate(2)
+                end select
+            end associate
+        end do
+    end subroutine set_time
+
+    !> Element kinematics for the effects.
+    subroutine fill_bodies(self, y)
+        class(rfem_t), intent(inout) :: self
+        real(wp), intent(in) :: y(:)
+        integer :: i, k
+        do i = 1, self%n
+            k = 6*(i - 1)
+            self%bodies%c(:, i) = y(k + 1:k + 2)
+            self%bodies%phi(i) = y(k + 3)
+            self%bodies%v(:, i) = y(k + 4:k + 5)
+            self%bodies%w(i) = y(k + 6)
+        end do
+    end subroutine fill_bodies
+
+    !> Accelerations of the elements carrying point masses: with s = sum m r, the mass block
+    !! [[m, 0, s n_x], [0, m, s n_y], [s n_x, s n_y, J]] times (x'', y'', phi'') equals the
+    !! generalized force plus s w^2 e (the point masses' centripetal term).
+    subroutine point_mass_accelerations(self, y, gen, ydot)
+        class(rfem_t), intent(in) :: self
+        real(wp), intent(in) :: y(:), gen(:, :)
+        real(wp), intent(inout) :: ydot(:)
+        integer :: p, i, k
+        real(wp) :: e(2), nv(2), g(3), sm, z3
+        do p = 1, size(self%pm_elem)
+            i = self%pm_elem(p)
+            k = 6*(i - 1)
+            sm = self%pm_moment(p)
+            e = [cos(y(k + 3)), sin(y(k + 3))]
+            nv = [-e(2), e(1)]
+            g = gen(:, i)
+            g(1:2) = g(1:2) + sm*y(k + 6)**2*e
+            z3 = (g(3) - sm*dot_product(nv, g(1:2))/self%mass(i)) &
+                 /(self%inertia(i) - sm**2/self%mass(i))
+            ydot(k + 4:k + 5) = (g(1:2) - sm*nv*z3)/self%mass(i)
+            ydot(k + 6) = z3
+        end do
+    end subroutine point_mass_accelerations
 
     pure integer function rfem_size(self)
         class(rfem_t), intent(in) :: self
@@ -188,9 +402,10 @@ contains
         mu = min(8, 6*self%n - 1)
     end subroutine rfem_bandwidths
 
+    !> 1: the dissipated energy; 2 (when supports move or effects do work): external work.
     pure integer function rfem_quad_size(self)
         class(rfem_t), intent(in) :: self
-        rfem_quad_size = 1
+        rfem_quad_size = merge(2, 1, self%with_work)
     end function rfem_quad_size
 
     pure integer function rfem_n_elements(self)
@@ -222,16 +437,41 @@ contains
         s_start = 0.0_wp
         do i = 1, self%n
             k = 6*(i - 1)
-            y(k + 1:k + 2) = self%top_anchor + (s_start + self%len(i)/2.0_wp)*dir
+            y(k + 1:k + 2) = self%motion(1)%p0 + (s_start + self%len(i)/2.0_wp)*dir
             y(k + 3) = self%init_angle
+            y(k + 4:k + 5) = self%init_velocity
             s_start = s_start + self%len(i)
         end do
+        if (self%folded) call fold(y)
+    contains
+        !> 'folded' (n odd): elements 1 .. m = (n-1)/2 hang down from the anchor, element
+        !! m+1 lies horizontal (the fold, towards +y), elements m+2 .. n go back up: two
+        !! straight halves side by side, one element length dl apart.
+        pure subroutine fold(y)
+            real(wp), intent(inout) :: y(:)
+            real(wp) :: depth, gap, s_up
+            integer :: m, j, kk
+            m = (self%n - 1)/2
+            depth = sum(self%len(1:m))
+            gap = self%len(m + 1)
+            kk = 6*m
+            y(kk + 1:kk + 2) = self%motion(1)%p0 + [depth, 0.5_wp*gap]
+            y(kk + 3) = 0.5_wp*pi
+            s_up = 0.0_wp
+            do j = m + 2, self%n
+                kk = 6*(j - 1)
+                y(kk + 1:kk + 2) = self%motion(1)%p0 + [depth - s_up - 0.5_wp*self%len(j), gap]
+                y(kk + 3) = pi
+                s_up = s_up + self%len(j)
+            end do
+        end subroutine fold
     end subroutine rfem_initial_state
 
-    subroutine rfem_fields(self, y, q, qdot)
+    subroutine rfem_fields(self, y, q, qdot, t)
         class(rfem_t), intent(in) :: self
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: q(:, :), qdot(:, :)
+        real(wp), intent(in), optional :: t  !< not needed: the state holds every position
         integer :: i
         do i = 1, self%n
             q(:, i) = y(6*(i - 1) + 1:6*(i - 1) + 3)
@@ -239,10 +479,11 @@ contains
         end do
     end subroutine rfem_fields
 
-    subroutine rfem_polyline(self, y, points)
+    subroutine rfem_polyline(self, y, points, t)
         class(rfem_t), intent(in) :: self
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: points(:, :)
+        real(wp), intent(in), optional :: t  !< not needed: the state holds every position
         integer :: i, k
         real(wp) :: e(2)
         do i = 1, self%n
@@ -359,21 +600,34 @@ contains
         if (j <= self%n) v(4:6) = y(6*(j - 1) + 4:6*(j - 1) + 6)
     end function local_rates
 
-    !> Generalized forces (3, n) of all enabled effects at state y; optionally the
-    !! elastic energy (J). (The dissipation power is `quad_rhs`.)
-    subroutine rfem_generalized_forces(self, y, gen, elastic)
+    !> Generalized forces (3, n) of all enabled effects at state y and time t (default 0);
+    !! optionally the elastic energy (J, with the effects' potential energy). (The
+    !! dissipation power is `quad_rhs`.)
+    subroutine rfem_generalized_forces(self, y, gen, elastic, t)
         class(rfem_t), intent(inout) :: self
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: gen(:, :)
         real(wp), intent(out), optional :: elastic
-        integer :: f, j
-        real(wp) :: sd
+        real(wp), intent(in), optional :: t
+        integer :: f, j, p, k
+        real(wp) :: sd, tt
 
+        tt = 0.0_wp
+        if (present(t)) tt = t
+        call self%set_time(tt)
         gen = 0.0_wp
         if (present(elastic)) elastic = 0.0_wp
-        if (self%gravity_on) gen(1, :) = self%mass*self%g
+        if (self%gravity_on) then
+            gen(1, :) = self%mass*self%g
+            ! moment of the point masses' weight about their element's centre
+            do p = 1, size(self%pm_elem)
+                gen(3, self%pm_elem(p)) = gen(3, self%pm_elem(p)) &
+                    - self%g*self%pm_moment(p)*sin(y(6*self%pm_elem(p) - 3))
+            end do
+        end if
         do f = 1, size(self%families)
             associate (fam => self%families(f))
+                if (.not. fam%active) cycle
                 do j = fam%first, fam%last
                     call self%strain(fam%kind, j, y, self%s(j), self%grad(:, j))
                 end do
@@ -385,6 +639,9 @@ contains
                         sd = dot_product(self%grad(:, j), self%local_rates(j, y))
                         self%force(j) = self%force(j) + fam%b*sd
                     end do
+                    ! a moving support's strain rate has the part ds/dt at fixed q
+                    if (fam%end > 0) self%force(fam%first:fam%last) = &
+                        self%force(fam%first:fam%last) + fam%b*fam%st
                 end if
                 do j = fam%first, fam%last
                     if (j >= 2) gen(:, j - 1) = gen(:, j - 1) - self%force(j)*self%grad(1:3, j)
@@ -392,6 +649,13 @@ contains
                 end do
             end associate
         end do
+        if (size(self%effects) > 0) then
+            call self%fill_bodies(y)
+            do k = 1, size(self%effects)
+                call self%effects(k)%e%add_forces(tt, self%bodies, gen(1:2, :), gen(3, :))
+                if (present(elastic)) elastic = elastic + self%effects(k)%e%energy(tt, self%bodies)
+            end do
+        end if
     end subroutine rfem_generalized_forces
 
     subroutine rfem_rhs(self, t, y, ydot, status)
@@ -402,7 +666,7 @@ contains
         integer, intent(out) :: status
         integer :: i, k
 
-        call self%generalized_forces(y, self%gen)
+        call self%generalized_forces(y, self%gen, t=t)
         do i = 1, self%n
             k = 6*(i - 1)
             ydot(k + 1:k + 3) = y(k + 4:k + 6)
@@ -410,6 +674,7 @@ contains
             ydot(k + 5) = self%gen(2, i)/self%mass(i)
             ydot(k + 6) = self%gen(3, i)/self%inertia(i)
         end do
+        if (size(self%pm_elem) > 0) call self%point_mass_accelerations(y, self%gen, ydot)
         status = STATUS_OK
         if (.not. all(ieee_is_finite(ydot))) status = STATUS_RECOVERABLE
     end subroutine rfem_rhs
@@ -429,9 +694,10 @@ contains
         real(wp), intent(inout) :: jb(:, :)
         integer, intent(in) :: offset
         integer, intent(out) :: status
-        integer :: i, c, f, j, r, l, row, col_q, col_v, er, el
+        integer :: i, c, f, j, r, l, row, col_q, col_v, er, el, k
         real(wp) :: s, g(6), h(6, 6), v(6), hv(6), sd, coef, kq(6, 6), kv(6, 6), inv_m(6)
 
+        call self%set_time(t)
         ! d(position)/dt = velocity
         do i = 1, self%n
             do c = 1, 3
@@ -441,13 +707,14 @@ contains
         end do
         do f = 1, size(self%families)
             associate (fam => self%families(f))
+                if (.not. fam%active) cycle
                 do j = fam%first, fam%last
                     call self%strain(fam%kind, j, y, s, g, h)
                     coef = fam%c*s
                     kq = -fam%c*outer(g, g)
                     if (fam%damped) then
                         v = self%local_rates(j, y)
-                        sd = dot_product(g, v)
+                        sd = dot_product(g, v) + fam%st
                         hv = matmul(h, v)
                         coef = coef + fam%b*sd
                         kq = kq - fam%b*outer(g, hv)
@@ -456,10 +723,8 @@ contains
                     kq = kq - coef*h
                     ! scatter: local dof r belongs to element er = j-1 (r <= 3) or j (r > 3)
                     inv_m = 0.0_wp
-                    if (j >= 2) inv_m(1:3) = 1.0_wp/[self%mass(j - 1), self%mass(j - 1), &
-                                                     self%inertia(j - 1)]
-                    if (j <= self%n) inv_m(4:6) = 1.0_wp/[self%mass(j), self%mass(j), &
-                                                          self%inertia(j)]
+                    if (j >= 2) inv_m(1:3) = self%rowscale(:, j - 1)
+                    if (j <= self%n) inv_m(4:6) = self%rowscale(:, j)
                     do r = 1, 6
                         if (inv_m(r) == 0.0_wp) cycle
                         er = j - 1 + (r - 1)/3
@@ -478,8 +743,62 @@ contains
                 end do
             end associate
         end do
+        ! external effects: 3x6 blocks on each element's own columns
+        if (size(self%effects) > 0) then
+            call self%fill_bodies(y)
+            self%ejac = 0.0_wp
+            do k = 1, size(self%effects)
+                call self%effects(k)%e%add_jacobian(t, self%bodies, self%ejac)
+            end do
+            do i = 1, self%n
+                do r = 1, 3
+                    row = 6*(i - 1) + 3 + r
+                    do l = 1, 6
+                        col_q = 6*(i - 1) + l
+                        jb(offset + row - col_q, col_q) = jb(offset + row - col_q, col_q) &
+                                                          + self%ejac(r, l, i)*self%rowscale(r, i)
+                    end do
+                end do
+            end do
+        end if
+        if (size(self%pm_elem) > 0) call point_mass_rows()
         status = STATUS_OK
     contains
+        !> Rows of the point-mass elements hold dG/dy so far (unscaled); add the terms of the
+        !! weight's moment and the centripetal force, subtract (dA/dphi) a, and multiply by
+        !! the inverse of the element's mass block A.
+        subroutine point_mass_rows()
+            real(wp) :: acc(6*self%n), raw(3), e(2), nv(2), sm, a(3), z3
+            integer :: p, col, k0, c1, c2
+            call self%generalized_forces(y, self%gen, t=t)
+            call self%point_mass_accelerations(y, self%gen, acc)
+            do p = 1, size(self%pm_elem)
+                i = self%pm_elem(p)
+                k0 = 6*(i - 1)
+                sm = self%pm_moment(p)
+                e = [cos(y(k0 + 3)), sin(y(k0 + 3))]
+                nv = [-e(2), e(1)]
+                a = acc(k0 + 4:k0 + 6)
+                c1 = max(1, k0 - 5)
+                c2 = min(6*self%n, k0 + 12)
+                do col = c1, c2
+                    raw = jb(offset + k0 + 4 - col:offset + k0 + 6 - col, col)
+                    if (col == k0 + 3) then
+                        raw(1:2) = raw(1:2) + sm*y(k0 + 6)**2*nv
+                        if (self%gravity_on) raw(3) = raw(3) - self%g*sm*cos(y(k0 + 3))
+                        raw = raw + sm*[e(1)*a(3), e(2)*a(3), dot_product(e, a(1:2))]
+                    else if (col == k0 + 6) then
+                        raw(1:2) = raw(1:2) + 2.0_wp*sm*y(k0 + 6)*e
+                    end if
+                    z3 = (raw(3) - sm*dot_product(nv, raw(1:2))/self%mass(i)) &
+                         /(self%inertia(i) - sm**2/self%mass(i))
+                    raw(1:2) = (raw(1:2) - sm*nv*z3)/self%mass(i)
+                    raw(3) = z3
+                    jb(offset + k0 + 4 - col:offset + k0 + 6 - col, col) = raw
+                end do
+            end do
+        end subroutine point_mass_rows
+
         pure function outer(a, b) result(m)
             real(wp), intent(in) :: a(6), b(6)
             real(wp) :: m(6, 6)
@@ -506,9 +825,10 @@ contains
         real(wp), intent(in) :: y(:)
         real(wp), intent(in) :: yq(:)
         type(energy_t) :: e
-        integer :: i, k, f, j
+        integer :: i, k, f, j, p
         real(wp) :: s, g(6)
 
+        call self%set_time(t)
         e%kinetic = 0.0_wp
         e%gravity = 0.0_wp
         do i = 1, self%n
@@ -517,38 +837,113 @@ contains
                                             self%inertia(i)*y(k + 6)**2)
             if (self%gravity_on) e%gravity = e%gravity - self%mass(i)*self%g*y(k + 1)
         end do
+        ! point masses off the element centres: T += s w (v . n), V_g -= g s cos(phi)
+        do p = 1, size(self%pm_elem)
+            k = 6*(self%pm_elem(p) - 1)
+            e%kinetic = e%kinetic + self%pm_moment(p)*y(k + 6)* &
+                        (-y(k + 4)*sin(y(k + 3)) + y(k + 5)*cos(y(k + 3)))
+            if (self%gravity_on) e%gravity = e%gravity - self%g*self%pm_moment(p)*cos(y(k + 3))
+        end do
         e%elastic = 0.0_wp
         do f = 1, size(self%families)
+            if (.not. self%families(f)%active) cycle
             do j = self%families(f)%first, self%families(f)%last
                 call self%strain(self%families(f)%kind, j, y, s, g)
                 e%elastic = e%elastic + 0.5_wp*self%families(f)%c*s**2
             end do
         end do
+        if (size(self%effects) > 0) then
+            call self%fill_bodies(y)
+            do k = 1, size(self%effects)
+                e%elastic = e%elastic + self%effects(k)%e%energy(t, self%bodies)
+            end do
+        end if
         e%dissipated = 0.0_wp
         if (size(yq) >= 1) e%dissipated = yq(1)
-        e%support_work = 0.0_wp  ! supports are fixed: they do no work
+        e%support_work = 0.0_wp  ! fixed supports and no loads: no external work
+        if (self%with_work .and. size(yq) >= 2) e%support_work = yq(2)
     end function rfem_energy
 
-    !> Quadrature: the dissipation power 2D = sum B s'^2, W.
+    !> Quadratures: the dissipation power 2D = sum B s'^2 (+ the effects' dissipation), W;
+    !! with moving supports or working effects also the external power: sum over moving
+    !! support strains of (C s + B s') ds/dt (the support's force on the rope times the
+    !! anchor's velocity) plus the effects' work rate, W.
     subroutine rfem_quad_rhs(self, t, y, yqdot, status)
         class(rfem_t), intent(inout) :: self
         real(wp), intent(in) :: t
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: yqdot(:)
         integer, intent(out) :: status
-        real(wp) :: power, s, g(6)
-        integer :: f, j
+        real(wp) :: power, work, s, g(6), sd
+        integer :: f, j, k
+        call self%set_time(t)
         ! only the damped strains: no spring forces, no gravity, no scatter
         power = 0.0_wp
+        work = 0.0_wp
         do f = 1, size(self%families)
-            if (.not. self%families(f)%damped) cycle
-            do j = self%families(f)%first, self%families(f)%last
-                call self%strain(self%families(f)%kind, j, y, s, g)
-                power = power + self%families(f)%b*dot_product(g, self%local_rates(j, y))**2
+            associate (fam => self%families(f))
+                if (.not. fam%active) cycle
+                if (fam%end > 0 .and. self%moving(max(fam%end, 1))) then
+                    do j = fam%first, fam%last
+                        call self%strain(fam%kind, j, y, s, g)
+                        sd = dot_product(g, self%local_rates(j, y)) + fam%st
+                        if (fam%damped) power = power + fam%b*sd**2
+                        work = work + (fam%c*s + merge(fam%b, 0.0_wp, fam%damped)*sd)*fam%st
+                    end do
+                else if (fam%damped) then
+                    do j = fam%first, fam%last
+                        call self%strain(fam%kind, j, y, s, g)
+                        power = power + fam%b*dot_product(g, self%local_rates(j, y))**2
+                    end do
+                end if
+            end associate
+        end do
+        if (size(self%effects) > 0) then
+            call self%fill_bodies(y)
+            do k = 1, size(self%effects)
+                call self%effects(k)%e%power(t, self%bodies, power, work)
+            end do
+        end if
+        yqdot(1) = power
+        if (self%with_work) yqdot(2) = work
+        status = STATUS_OK
+        if (.not. (ieee_is_finite(power) .and. ieee_is_finite(work))) status = STATUS_RECOVERABLE
+    end subroutine rfem_quad_rhs
+
+    !> Coordinates x_i, y_i, phi_i of each element: y(6(i-1)+1..3), rates y(6(i-1)+4..6).
+    pure subroutine rfem_coordinates(self, pos, vel)
+        class(rfem_t), intent(in) :: self
+        integer, allocatable, intent(out) :: pos(:), vel(:)
+        integer :: i, c
+        allocate (pos(3*self%n), vel(3*self%n))
+        do i = 1, self%n
+            do c = 1, 3
+                pos(3*(i - 1) + c) = 6*(i - 1) + c
+                vel(3*(i - 1) + c) = 6*(i - 1) + 3 + c
             end do
         end do
-        yqdot(1) = power
-        status = STATUS_OK
-        if (.not. ieee_is_finite(power)) status = STATUS_RECOVERABLE
-    end subroutine rfem_quad_rhs
+    end subroutine rfem_coordinates
+
+    !> The mass matrix of the coordinates: diag(m_i, m_i, J_i), plus the translation-rotation
+    !! coupling s n_i of elements with point masses off their centre.
+    subroutine rfem_coordinate_mass(self, y, mm)
+        class(rfem_t), intent(in) :: self
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: mm(:, :)
+        integer :: i, k
+        mm = 0.0_wp
+        do i = 1, self%n
+            k = 3*(i - 1)
+            mm(k + 1, k + 1) = self%mass(i)
+            mm(k + 2, k + 2) = self%mass(i)
+            mm(k + 3, k + 3) = self%inertia(i)
+        end do
+        ! point masses off the element centres couple translation and rotation: s n
+        do i = 1, size(self%pm_elem)
+            k = 3*(self%pm_elem(i) - 1)
+            mm(k + 1:k + 2, k + 3) = self%pm_moment(i)* &
+                [-sin(y(6*self%pm_elem(i) - 3)), cos(y(6*self%pm_elem(i) - 3))]
+            mm(k + 3, k + 1:k + 2) = mm(k + 1:k + 2, k + 3)
+        end do
+    end subroutine rfem_coordinate_mass
 end module ropedyn_rfem

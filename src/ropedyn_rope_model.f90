@@ -16,6 +16,8 @@ module ropedyn_rope_model
         procedure(fields_i), deferred :: fields
         procedure(polyline_i), deferred :: polyline
         procedure(element_data_i), deferred :: element_data
+        procedure(coordinates_i), deferred :: coordinates
+        procedure(coordinate_mass_i), deferred :: coordinate_mass
     end type rope_model_t
 
     abstract interface
@@ -39,20 +41,24 @@ module ropedyn_rope_model
             real(wp), intent(out) :: y(:)
         end subroutine initial_state_i
 
-        !> Element centre x, y (m), angle phi (rad) and their rates, shape (3, elements).
-        subroutine fields_i(self, y, q, qdot)
+        !> Element centre x, y (m), angle phi (rad) and their rates, shape (3, elements), at
+        !! time t (s, default 0: a model with a moving support needs it).
+        subroutine fields_i(self, y, q, qdot, t)
             import :: rope_model_t, wp
             class(rope_model_t), intent(in) :: self
             real(wp), intent(in) :: y(:)
             real(wp), intent(out) :: q(:, :), qdot(:, :)
+            real(wp), intent(in), optional :: t
         end subroutine fields_i
 
-        !> End points A_1, B_1, A_2, B_2, ... of the elements, shape (2, 2*elements), m.
-        subroutine polyline_i(self, y, points)
+        !> End points A_1, B_1, A_2, B_2, ... of the elements, shape (2, 2*elements), m, at
+        !! time t (s, default 0).
+        subroutine polyline_i(self, y, points, t)
             import :: rope_model_t, wp
             class(rope_model_t), intent(in) :: self
             real(wp), intent(in) :: y(:)
             real(wp), intent(out) :: points(:, :)
+            real(wp), intent(in), optional :: t
         end subroutine polyline_i
 
         !> Length (m) and mass (kg) of each element.
@@ -61,5 +67,22 @@ module ropedyn_rope_model
             class(rope_model_t), intent(in) :: self
             real(wp), intent(out) :: length(:), mass(:)
         end subroutine element_data_i
+
+        !> Generalized coordinates in the ODE state (statics and modes, ropedyn_statics):
+        !! y(pos(k)) is coordinate k, y(vel(k)) its rate and ydot(vel(k)) its acceleration.
+        pure subroutine coordinates_i(self, pos, vel)
+            import :: rope_model_t
+            class(rope_model_t), intent(in) :: self
+            integer, allocatable, intent(out) :: pos(:), vel(:)
+        end subroutine coordinates_i
+
+        !> Mass matrix of the generalized coordinates at state y (kinetic energy
+        !! T = qdot^T mm qdot / 2), dense, shape (size(pos), size(pos)), kg, kg m, kg m^2.
+        subroutine coordinate_mass_i(self, y, mm)
+            import :: rope_model_t, wp
+            class(rope_model_t), intent(in) :: self
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(out) :: mm(:, :)
+        end subroutine coordinate_mass_i
     end interface
 end module ropedyn_rope_model

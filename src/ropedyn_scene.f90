@@ -12,15 +12,19 @@ module ropedyn_scene
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_solvers, only: method_order_range
+    use ropedyn_support_motion, only: read_motion_table
+    use, intrinsic :: iso_c_binding, only: c_char, c_size_t, c_ptr, c_associated, c_null_char
     implicit none
     private
     public :: rope_params_t, model_params_t, supports_params_t, initial_params_t
     public :: effects_params_t, solver_params_t, output_params_t, scene_t
+    public :: fluid_params_t, ground_params_t, attachments_params_t, N_ATTACH
     public :: read_scene, scene_namelist_text, bottom_anchor_given
     public :: NAME_LEN, PATH_LEN
 
     integer, parameter :: NAME_LEN = 16    !< length of the kind/method/support/shape names
     integer, parameter :: PATH_LEN = 512   !< length of the output file name
+    integer, parameter :: N_ATTACH = 8     !< point masses and point loads at most
 
     !> A quiet NaN: the value of `bottom_anchor` when it is not given.
     real(wp), parameter :: NOT_SET = transfer(9221120237041090560_i8, 1.0_wp)
@@ -61,12 +65,39 @@ module ropedyn_scene
         real(wp) :: top_angle_deg = 0.0_wp           !< top clamp angle from down x [deg]
         real(wp) :: bottom_angle_deg = 0.0_wp        !< bottom clamp angle from down x [deg]
         real(wp) :: support_stiffness_factor = 1.0_wp  !< support springs/dampers factor [-]
+        !> prescribed motion of each support: 'fixed' | 'harmonic' | 'table'
+        character(len=NAME_LEN) :: top_motion = 'fixed'
+        character(len=NAME_LEN) :: bottom_motion = 'fixed'
+        real(wp) :: top_amplitude(2) = 0.0_wp           !< harmonic amplitudes (x, y) [m]
+        real(wp) :: bottom_amplitude(2) = 0.0_wp
+        real(wp) :: top_frequency = 0.0_wp              !< harmonic frequency [Hz]
+        real(wp) :: bottom_frequency = 0.0_wp
+        real(wp) :: top_phase_deg(2) = 0.0_wp           !< harmonic phases (x, y) [deg]
+        real(wp) :: bottom_phase_deg(2) = 0.0_wp
+        real(wp) :: top_angle_amplitude_deg = 0.0_wp    !< harmonic clamp rotation [deg]
+        real(wp) :: bottom_angle_amplitude_deg = 0.0_wp
+        real(wp) :: top_angle_phase_deg = 0.0_wp        !< its phase [deg]
+        real(wp) :: bottom_angle_phase_deg = 0.0_wp
+        !> motion table files (rows t, dx, dy, dangle_deg); resolved by `read_scene` against
+        !! the scene file's directory
+        character(len=PATH_LEN) :: top_table = ''
+        character(len=PATH_LEN) :: bottom_table = ''
+        real(wp) :: top_release_time = -1.0_wp          !< release time [s]; < 0: never
+        real(wp) :: bottom_release_time = -1.0_wp
+        !> the tables as read by `read_scene`, (4, rows): t [s], dx, dy [m], dangle [rad]
+        real(wp), allocatable :: top_table_rows(:, :), bottom_table_rows(:, :)
     end type supports_params_t
 
     !> `&initial`: initial state of the rope.
     type :: initial_params_t
-        character(len=NAME_LEN) :: shape = 'straight'  !< 'straight' | 'hanging'
+        !> 'straight' | 'hanging' | 'equilibrium' (static equilibrium, at rest) | 'mode'
+        !! (equilibrium plus mode `mode` with largest point displacement `mode_amplitude`)
+        character(len=NAME_LEN) :: shape = 'straight'
         real(wp) :: angle_deg = 75.0_wp   !< angle of the straight rope from down x [deg]
+        integer :: mode = 1                      !< shape 'mode': which mode (1 = lowest) [-]
+        real(wp) :: mode_amplitude = 0.01_wp     !< shape 'mode': largest displacement [m]
+        !> shape 'folded': the rope doubled up from its top anchor (both ends there)
+        real(wp) :: velocity(2) = 0.0_wp  !< initial velocity of every element (x, y) [m/s]
     end type initial_params_t
 
     !> `&effects`: switches for the physical effects.
@@ -76,7 +107,46 @@ module ropedyn_scene
         logical :: shear = .true.     !< shear springs Cy = GA/(chi dl)
         logical :: bending = .true.   !< rotational springs Cphi = EI/dl
         logical :: damping = .true.   !< dampers Bx, By, Bphi
+        logical :: drag = .false.     !< fluid drag (&fluid)
+        logical :: ground = .false.   !< ground contact (&ground)
+        logical :: support_motion = .true.  !< the motions and releases given in &supports
+        logical :: point_masses = .true.    !< the point masses given in &attachments
+        logical :: point_loads = .true.     !< the point loads given in &attachments
     end type effects_params_t
+
+    !> `&fluid`: the surrounding fluid (used with `&effects drag = .true.`).
+    type :: fluid_params_t
+        real(wp) :: density = 1.225_wp                     !< rho_f [kg/m^3] (air)
+        real(wp) :: normal_drag_coefficient = 1.2_wp       !< C_n on d l [-]
+        real(wp) :: tangential_drag_coefficient = 0.02_wp  !< C_t on pi d l [-]
+        real(wp) :: linear_normal_drag = 0.0_wp            !< [N s/m^2]
+        real(wp) :: linear_tangential_drag = 0.0_wp        !< [N s/m^2]
+        real(wp) :: current(2) = 0.0_wp                    !< fluid velocity (x, y) [m/s]
+    end type fluid_params_t
+
+    !> `&ground`: a ground plane (used with `&effects ground = .true.`).
+    type :: ground_params_t
+        real(wp) :: point(2) = [1.0_wp, 0.0_wp]    !< a point of the plane (x, y) [m]
+        real(wp) :: normal(2) = [-1.0_wp, 0.0_wp]  !< normal to the free side (up) [-]
+        real(wp) :: stiffness = 1.0e5_wp           !< per metre of rope [N/m^2]
+        real(wp) :: damping = 100.0_wp             !< per metre of rope [N s/m^2]
+        real(wp) :: friction_coefficient = 0.5_wp  !< Coulomb mu [-]
+        real(wp) :: friction_regularization_speed = 1.0e-3_wp  !< v_reg [m/s]
+    end type ground_params_t
+
+    !> `&attachments`: point masses and point loads; an entry is used when its position is
+    !! given (NaN: not given). Positions are arc lengths from the top end [m].
+    type :: attachments_params_t
+        real(wp) :: mass_positions(N_ATTACH) = NOT_SET  !< [m]
+        real(wp) :: masses(N_ATTACH) = 0.0_wp           !< [kg]
+        real(wp) :: load_positions(N_ATTACH) = NOT_SET  !< [m]
+        real(wp) :: load_force_x(N_ATTACH) = 0.0_wp     !< constant part [N]
+        real(wp) :: load_force_y(N_ATTACH) = 0.0_wp     !< [N]
+        real(wp) :: load_amplitude_x(N_ATTACH) = 0.0_wp !< harmonic part [N]
+        real(wp) :: load_amplitude_y(N_ATTACH) = 0.0_wp !< [N]
+        real(wp) :: load_frequency(N_ATTACH) = 0.0_wp   !< [Hz]
+        real(wp) :: load_phase_deg(N_ATTACH) = 0.0_wp   !< [deg]
+    end type attachments_params_t
 
     !> `&solver`: time integration.
     type :: solver_params_t
@@ -89,6 +159,11 @@ module ropedyn_scene
         integer :: max_steps = 1000000        !< step budget for the whole run [-]
         real(wp) :: t_end = 30.0_wp           !< end time [s]
         real(wp) :: output_interval = 0.01_wp !< time between output records [s]
+        !> CVODE only: BDF stability-limit detection (lowers the order near the stability
+        !! boundary of lightly damped oscillatory modes)
+        logical :: stability_limit_detection = .false.
+        !> testing aid: the right-hand side returns NaN for t > this time [s]; < 0: off
+        real(wp) :: fault_nan_after = -1.0_wp
     end type solver_params_t
 
     !> `&output`: where results go.
@@ -108,16 +183,22 @@ module ropedyn_scene
         type(effects_params_t) :: effects
         type(solver_params_t) :: solver
         type(output_params_t) :: output
+        type(fluid_params_t) :: fluid
+        type(ground_params_t) :: ground
+        type(attachments_params_t) :: attachments
     end type scene_t
 
     ! Groups, in the order they are read, checked and written.
     integer, parameter :: G_ROPE = 1, G_MODEL = 2, G_SUPPORTS = 3, G_INITIAL = 4, &
-        G_EFFECTS = 5, G_SOLVER = 6, G_OUTPUT = 7, N_GROUPS = 7
-    character(len=*), parameter :: GROUP_NAMES(N_GROUPS) = [character(len=8) :: &
-        'rope', 'model', 'supports', 'initial', 'effects', 'solver', 'output']
+        G_EFFECTS = 5, G_SOLVER = 6, G_OUTPUT = 7, G_FLUID = 8, G_GROUND = 9, &
+        G_ATTACHMENTS = 10, N_GROUPS = 10
+    character(len=*), parameter :: GROUP_NAMES(N_GROUPS) = [character(len=11) :: &
+        'rope', 'model', 'supports', 'initial', 'effects', 'solver', 'output', 'fluid', &
+        'ground', 'attachments']
 
     ! Key types.
     integer, parameter :: T_REAL = 1, T_INT = 2, T_LOGICAL = 3, T_STRING = 4, T_REAL2 = 5
+    integer, parameter :: T_REALN = 6  !< an array of N_ATTACH reals
 
     type :: key_info_t
         integer :: group
@@ -146,13 +227,37 @@ module ropedyn_scene
         key_info_t(G_SUPPORTS, 'top_angle_deg', T_REAL), &
         key_info_t(G_SUPPORTS, 'bottom_angle_deg', T_REAL), &
         key_info_t(G_SUPPORTS, 'support_stiffness_factor', T_REAL), &
+        key_info_t(G_SUPPORTS, 'top_motion', T_STRING), &
+        key_info_t(G_SUPPORTS, 'bottom_motion', T_STRING), &
+        key_info_t(G_SUPPORTS, 'top_amplitude', T_REAL2), &
+        key_info_t(G_SUPPORTS, 'bottom_amplitude', T_REAL2), &
+        key_info_t(G_SUPPORTS, 'top_frequency', T_REAL), &
+        key_info_t(G_SUPPORTS, 'bottom_frequency', T_REAL), &
+        key_info_t(G_SUPPORTS, 'top_phase_deg', T_REAL2), &
+        key_info_t(G_SUPPORTS, 'bottom_phase_deg', T_REAL2), &
+        key_info_t(G_SUPPORTS, 'top_angle_amplitude_deg', T_REAL), &
+        key_info_t(G_SUPPORTS, 'bottom_angle_amplitude_deg', T_REAL), &
+        key_info_t(G_SUPPORTS, 'top_angle_phase_deg', T_REAL), &
+        key_info_t(G_SUPPORTS, 'bottom_angle_phase_deg', T_REAL), &
+        key_info_t(G_SUPPORTS, 'top_table', T_STRING), &
+        key_info_t(G_SUPPORTS, 'bottom_table', T_STRING), &
+        key_info_t(G_SUPPORTS, 'top_release_time', T_REAL), &
+        key_info_t(G_SUPPORTS, 'bottom_release_time', T_REAL), &
         key_info_t(G_INITIAL, 'shape', T_STRING), &
         key_info_t(G_INITIAL, 'angle_deg', T_REAL), &
+        key_info_t(G_INITIAL, 'mode', T_INT), &
+        key_info_t(G_INITIAL, 'mode_amplitude', T_REAL), &
+        key_info_t(G_INITIAL, 'velocity', T_REAL2), &
         key_info_t(G_EFFECTS, 'gravity', T_LOGICAL), &
         key_info_t(G_EFFECTS, 'tension', T_LOGICAL), &
         key_info_t(G_EFFECTS, 'shear', T_LOGICAL), &
         key_info_t(G_EFFECTS, 'bending', T_LOGICAL), &
         key_info_t(G_EFFECTS, 'damping', T_LOGICAL), &
+        key_info_t(G_EFFECTS, 'drag', T_LOGICAL), &
+        key_info_t(G_EFFECTS, 'ground', T_LOGICAL), &
+        key_info_t(G_EFFECTS, 'support_motion', T_LOGICAL), &
+        key_info_t(G_EFFECTS, 'point_masses', T_LOGICAL), &
+        key_info_t(G_EFFECTS, 'point_loads', T_LOGICAL), &
         key_info_t(G_SOLVER, 'method', T_STRING), &
         key_info_t(G_SOLVER, 'rtol', T_REAL), &
         key_info_t(G_SOLVER, 'atol', T_REAL), &
@@ -160,16 +265,41 @@ module ropedyn_scene
         key_info_t(G_SOLVER, 'max_steps', T_INT), &
         key_info_t(G_SOLVER, 't_end', T_REAL), &
         key_info_t(G_SOLVER, 'output_interval', T_REAL), &
+        key_info_t(G_SOLVER, 'stability_limit_detection', T_LOGICAL), &
+        key_info_t(G_SOLVER, 'fault_nan_after', T_REAL), &
         key_info_t(G_OUTPUT, 'file', T_STRING), &
-        key_info_t(G_OUTPUT, 'progress', T_LOGICAL)]
+        key_info_t(G_OUTPUT, 'progress', T_LOGICAL), &
+        key_info_t(G_FLUID, 'density', T_REAL), &
+        key_info_t(G_FLUID, 'normal_drag_coefficient', T_REAL), &
+        key_info_t(G_FLUID, 'tangential_drag_coefficient', T_REAL), &
+        key_info_t(G_FLUID, 'linear_normal_drag', T_REAL), &
+        key_info_t(G_FLUID, 'linear_tangential_drag', T_REAL), &
+        key_info_t(G_FLUID, 'current', T_REAL2), &
+        key_info_t(G_GROUND, 'point', T_REAL2), &
+        key_info_t(G_GROUND, 'normal', T_REAL2), &
+        key_info_t(G_GROUND, 'stiffness', T_REAL), &
+        key_info_t(G_GROUND, 'damping', T_REAL), &
+        key_info_t(G_GROUND, 'friction_coefficient', T_REAL), &
+        key_info_t(G_GROUND, 'friction_regularization_speed', T_REAL), &
+        key_info_t(G_ATTACHMENTS, 'mass_positions', T_REALN), &
+        key_info_t(G_ATTACHMENTS, 'masses', T_REALN), &
+        key_info_t(G_ATTACHMENTS, 'load_positions', T_REALN), &
+        key_info_t(G_ATTACHMENTS, 'load_force_x', T_REALN), &
+        key_info_t(G_ATTACHMENTS, 'load_force_y', T_REALN), &
+        key_info_t(G_ATTACHMENTS, 'load_amplitude_x', T_REALN), &
+        key_info_t(G_ATTACHMENTS, 'load_amplitude_y', T_REALN), &
+        key_info_t(G_ATTACHMENTS, 'load_frequency', T_REALN), &
+        key_info_t(G_ATTACHMENTS, 'load_phase_deg', T_REALN)]
 
     ! Allowed values of the name keys; "known" values are recognised but not available yet.
     character(len=*), parameter :: KINDS_ALLOWED(2) = [character(len=8) :: 'rfem', 'mpp']
     character(len=*), parameter :: METHODS_ALLOWED(2) = [character(len=8) :: 'cvode', 'mebdf']
     character(len=*), parameter :: SUPPORTS_ALLOWED(3) = [character(len=8) :: &
         'pinned', 'clamped', 'free']
-    character(len=*), parameter :: SHAPES_ALLOWED(2) = [character(len=8) :: &
-        'straight', 'hanging']
+    character(len=*), parameter :: SHAPES_ALLOWED(5) = [character(len=11) :: &
+        'straight', 'hanging', 'equilibrium', 'mode', 'folded']
+    character(len=*), parameter :: MOTIONS_ALLOWED(3) = [character(len=8) :: &
+        'fixed', 'harmonic', 'table']
     character(len=*), parameter :: NONE_KNOWN(0) = [character(len=8) ::]
 
     ! Pseudo iostat of a string value longer than its component (message in iomsg).
@@ -181,6 +311,16 @@ module ropedyn_scene
     type :: line_t
         character(len=:), allocatable :: s
     end type line_t
+
+    interface
+        !> POSIX getcwd, to resolve input files named relative to a scene file.
+        function c_getcwd(buf, size) bind(C, name='getcwd') result(p)
+            import :: c_char, c_size_t, c_ptr
+            character(kind=c_char), intent(out) :: buf(*)
+            integer(c_size_t), value :: size
+            type(c_ptr) :: p
+        end function c_getcwd
+    end interface
 
     !> One `--set group.key=value` argument.
     type :: override_t
@@ -317,16 +457,29 @@ contains
                 //I4//'top_angle_deg = '//real_text(s%top_angle_deg)//NL &
                 //I4//'bottom_angle_deg = '//real_text(s%bottom_angle_deg)//NL &
                 //I4//'support_stiffness_factor = '//real_text(s%support_stiffness_factor) &
-                //NL//'/'//NL
+                //NL//motion_text('top', s%top_motion, s%top_amplitude, s%top_frequency, &
+                s%top_phase_deg, s%top_angle_amplitude_deg, s%top_angle_phase_deg, &
+                s%top_table, s%top_release_time) &
+                //motion_text('bottom', s%bottom_motion, s%bottom_amplitude, &
+                s%bottom_frequency, s%bottom_phase_deg, s%bottom_angle_amplitude_deg, &
+                s%bottom_angle_phase_deg, s%bottom_table, s%bottom_release_time)//'/'//NL
             text = text//'&initial'//NL &
                 //I4//'shape = '//quoted(trim(i%shape))//NL &
-                //I4//'angle_deg = '//real_text(i%angle_deg)//NL//'/'//NL
+                //I4//'angle_deg = '//real_text(i%angle_deg)//NL &
+                //I4//'mode = '//int_text(i%mode)//NL &
+                //I4//'mode_amplitude = '//real_text(i%mode_amplitude)//NL &
+                //I4//'velocity = '//pair_text(i%velocity)//NL//'/'//NL
             text = text//'&effects'//NL &
                 //I4//'gravity = '//logical_text(e%gravity)//NL &
                 //I4//'tension = '//logical_text(e%tension)//NL &
                 //I4//'shear = '//logical_text(e%shear)//NL &
                 //I4//'bending = '//logical_text(e%bending)//NL &
-                //I4//'damping = '//logical_text(e%damping)//NL//'/'//NL
+                //I4//'damping = '//logical_text(e%damping)//NL &
+                //I4//'drag = '//logical_text(e%drag)//NL &
+                //I4//'ground = '//logical_text(e%ground)//NL &
+                //I4//'support_motion = '//logical_text(e%support_motion)//NL &
+                //I4//'point_masses = '//logical_text(e%point_masses)//NL &
+                //I4//'point_loads = '//logical_text(e%point_loads)//NL//'/'//NL
             text = text//'&solver'//NL &
                 //I4//'method = '//quoted(trim(v%method))//NL &
                 //I4//'rtol = '//real_text(v%rtol)//NL &
@@ -334,12 +487,82 @@ contains
                 //I4//'max_order = '//int_text(v%max_order)//NL &
                 //I4//'max_steps = '//int_text(v%max_steps)//NL &
                 //I4//'t_end = '//real_text(v%t_end)//NL &
-                //I4//'output_interval = '//real_text(v%output_interval)//NL//'/'//NL
+                //I4//'output_interval = '//real_text(v%output_interval)//NL &
+                //I4//'stability_limit_detection = '// &
+                logical_text(v%stability_limit_detection)//NL &
+                //I4//'fault_nan_after = '//real_text(v%fault_nan_after)//NL//'/'//NL
             text = text//'&output'//NL &
                 //I4//'file = '//quoted(trim(o%file))//NL &
                 //I4//'progress = '//logical_text(o%progress)//NL//'/'
         end associate
+        associate (f => scene%fluid, g => scene%ground, a => scene%attachments)
+            text = text//NL//'&fluid'//NL &
+                //I4//'density = '//real_text(f%density)//NL &
+                //I4//'normal_drag_coefficient = '//real_text(f%normal_drag_coefficient)//NL &
+                //I4//'tangential_drag_coefficient = '// &
+                real_text(f%tangential_drag_coefficient)//NL &
+                //I4//'linear_normal_drag = '//real_text(f%linear_normal_drag)//NL &
+                //I4//'linear_tangential_drag = '//real_text(f%linear_tangential_drag)//NL &
+                //I4//'current = '//pair_text(f%current)//NL//'/'//NL
+            text = text//'&ground'//NL &
+                //I4//'point = '//pair_text(g%point)//NL &
+                //I4//'normal = '//pair_text(g%normal)//NL &
+                //I4//'stiffness = '//real_text(g%stiffness)//NL &
+                //I4//'damping = '//real_text(g%damping)//NL &
+                //I4//'friction_coefficient = '//real_text(g%friction_coefficient)//NL &
+                //I4//'friction_regularization_speed = '// &
+                real_text(g%friction_regularization_speed)//NL//'/'//NL
+            text = text//'&attachments'//NL &
+                //list_text('mass_positions', a%mass_positions, a%mass_positions) &
+                //list_text('masses', a%masses, a%mass_positions) &
+                //list_text('load_positions', a%load_positions, a%load_positions) &
+                //list_text('load_force_x', a%load_force_x, a%load_positions) &
+                //list_text('load_force_y', a%load_force_y, a%load_positions) &
+                //list_text('load_amplitude_x', a%load_amplitude_x, a%load_positions) &
+                //list_text('load_amplitude_y', a%load_amplitude_y, a%load_positions) &
+                //list_text('load_frequency', a%load_frequency, a%load_positions) &
+                //list_text('load_phase_deg', a%load_phase_deg, a%load_positions)//'/'
+        end associate
     end function scene_namelist_text
+
+    !> The motion keys of one support ('top' or 'bottom') for the echo, one a line.
+    function motion_text(end, motion, amplitude, frequency, phase_deg, angle_amplitude_deg, &
+            angle_phase_deg, table, release_time) result(text)
+        character(len=*), intent(in) :: end, motion, table
+        real(wp), intent(in) :: amplitude(2), frequency, phase_deg(2), angle_amplitude_deg, &
+            angle_phase_deg, release_time
+        character(len=:), allocatable :: text
+        character(len=*), parameter :: I4 = '    '
+        character(len=1), parameter :: NL = new_line('a')
+        text = I4//end//'_motion = '//quoted(trim(motion))//NL &
+            //I4//end//'_amplitude = '//pair_text(amplitude)//NL &
+            //I4//end//'_frequency = '//real_text(frequency)//NL &
+            //I4//end//'_phase_deg = '//pair_text(phase_deg)//NL &
+            //I4//end//'_angle_amplitude_deg = '//real_text(angle_amplitude_deg)//NL &
+            //I4//end//'_angle_phase_deg = '//real_text(angle_phase_deg)//NL &
+            //I4//end//'_table = '//quoted(trim(table))//NL &
+            //I4//end//'_release_time = '//real_text(release_time)//NL
+    end function motion_text
+
+    !> `key = v(1), ..., v(k)` with k the last entry whose position `used` is given; ''
+    !! when none is (the key keeps its default).
+    function list_text(key, v, used) result(text)
+        character(len=*), intent(in) :: key
+        real(wp), intent(in) :: v(:), used(:)
+        character(len=:), allocatable :: text
+        integer :: i, last
+        text = ''
+        last = 0
+        do i = 1, size(used)
+            if (.not. ieee_is_nan(used(i))) last = i
+        end do
+        if (last == 0) return
+        text = '    '//key//' = '//real_text(v(1))
+        do i = 2, last
+            text = text//', '//real_text(v(i))
+        end do
+        text = text//new_line('a')
+    end function list_text
 
     ! ------------------------------------------------------------------------------------
     ! Namelist reads, one procedure per group (the keys of two groups share names).
@@ -367,6 +590,12 @@ contains
             call nml_solver(scene%solver, ios, msg, recs)
         case (G_OUTPUT)
             call nml_output(scene%output, ios, msg, recs)
+        case (G_FLUID)
+            call nml_fluid(scene%fluid, ios, msg, recs)
+        case (G_GROUND)
+            call nml_ground(scene%ground, ios, msg, recs)
+        case (G_ATTACHMENTS)
+            call nml_attachments(scene%attachments, ios, msg, recs)
         case default
             ios = -1
             msg = 'internal error: no such group'
@@ -430,11 +659,35 @@ contains
         integer, intent(out) :: ios
         character(len=*), intent(inout) :: msg
         character(len=*), intent(in) :: recs(:)
-        character(len=BUF_LEN) :: top, bottom
+        character(len=BUF_LEN) :: top, bottom, top_motion, bottom_motion, top_table, bottom_table
         real(wp) :: top_anchor(2), bottom_anchor(2), top_angle_deg, bottom_angle_deg, &
             support_stiffness_factor
+        real(wp) :: top_amplitude(2), bottom_amplitude(2), top_frequency, bottom_frequency, &
+            top_phase_deg(2), bottom_phase_deg(2), top_angle_amplitude_deg, &
+            bottom_angle_amplitude_deg, top_angle_phase_deg, bottom_angle_phase_deg, &
+            top_release_time, bottom_release_time
         namelist /supports/ top, bottom, top_anchor, bottom_anchor, top_angle_deg, &
-            bottom_angle_deg, support_stiffness_factor
+            bottom_angle_deg, support_stiffness_factor, top_motion, bottom_motion, &
+            top_amplitude, bottom_amplitude, top_frequency, bottom_frequency, top_phase_deg, &
+            bottom_phase_deg, top_angle_amplitude_deg, bottom_angle_amplitude_deg, &
+            top_angle_phase_deg, bottom_angle_phase_deg, top_table, bottom_table, &
+            top_release_time, bottom_release_time
+        top_motion = p%top_motion
+        bottom_motion = p%bottom_motion
+        top_amplitude = p%top_amplitude
+        bottom_amplitude = p%bottom_amplitude
+        top_frequency = p%top_frequency
+        bottom_frequency = p%bottom_frequency
+        top_phase_deg = p%top_phase_deg
+        bottom_phase_deg = p%bottom_phase_deg
+        top_angle_amplitude_deg = p%top_angle_amplitude_deg
+        bottom_angle_amplitude_deg = p%bottom_angle_amplitude_deg
+        top_angle_phase_deg = p%top_angle_phase_deg
+        bottom_angle_phase_deg = p%bottom_angle_phase_deg
+        top_table = p%top_table
+        bottom_table = p%bottom_table
+        top_release_time = p%top_release_time
+        bottom_release_time = p%bottom_release_time
         top = p%top
         bottom = p%bottom
         top_anchor = p%top_anchor
@@ -451,6 +704,22 @@ contains
         p%top_angle_deg = top_angle_deg
         p%bottom_angle_deg = bottom_angle_deg
         p%support_stiffness_factor = support_stiffness_factor
+        call store_string(top_motion, 'top_motion', p%top_motion, ios, msg)
+        call store_string(bottom_motion, 'bottom_motion', p%bottom_motion, ios, msg)
+        call store_string(top_table, 'top_table', p%top_table, ios, msg)
+        call store_string(bottom_table, 'bottom_table', p%bottom_table, ios, msg)
+        p%top_amplitude = top_amplitude
+        p%bottom_amplitude = bottom_amplitude
+        p%top_frequency = top_frequency
+        p%bottom_frequency = bottom_frequency
+        p%top_phase_deg = top_phase_deg
+        p%bottom_phase_deg = bottom_phase_deg
+        p%top_angle_amplitude_deg = top_angle_amplitude_deg
+        p%bottom_angle_amplitude_deg = bottom_angle_amplitude_deg
+        p%top_angle_phase_deg = top_angle_phase_deg
+        p%bottom_angle_phase_deg = bottom_angle_phase_deg
+        p%top_release_time = top_release_time
+        p%bottom_release_time = bottom_release_time
     end subroutine nml_supports
 
     subroutine nml_initial(p, ios, msg, recs)
@@ -459,14 +728,21 @@ contains
         character(len=*), intent(inout) :: msg
         character(len=*), intent(in) :: recs(:)
         character(len=BUF_LEN) :: shape
-        real(wp) :: angle_deg
-        namelist /initial/ shape, angle_deg
+        real(wp) :: angle_deg, mode_amplitude, velocity(2)
+        integer :: mode
+        namelist /initial/ shape, angle_deg, mode, mode_amplitude, velocity
+        velocity = p%velocity
         shape = p%shape
         angle_deg = p%angle_deg
+        mode = p%mode
+        mode_amplitude = p%mode_amplitude
         read (recs, nml=initial, iostat=ios, iomsg=msg)
         if (ios /= 0) return
         call store_string(shape, 'shape', p%shape, ios, msg)
         p%angle_deg = angle_deg
+        p%mode = mode
+        p%mode_amplitude = mode_amplitude
+        p%velocity = velocity
     end subroutine nml_initial
 
     subroutine nml_effects(p, ios, msg, recs)
@@ -474,8 +750,15 @@ contains
         integer, intent(out) :: ios
         character(len=*), intent(inout) :: msg
         character(len=*), intent(in) :: recs(:)
-        logical :: gravity, tension, shear, bending, damping
-        namelist /effects/ gravity, tension, shear, bending, damping
+        logical :: gravity, tension, shear, bending, damping, drag, ground, support_motion, &
+            point_masses, point_loads
+        namelist /effects/ gravity, tension, shear, bending, damping, drag, ground, &
+            support_motion, point_masses, point_loads
+        drag = p%drag
+        ground = p%ground
+        support_motion = p%support_motion
+        point_masses = p%point_masses
+        point_loads = p%point_loads
         gravity = p%gravity
         tension = p%tension
         shear = p%shear
@@ -488,7 +771,93 @@ contains
         p%shear = shear
         p%bending = bending
         p%damping = damping
+        p%drag = drag
+        p%ground = ground
+        p%support_motion = support_motion
+        p%point_masses = point_masses
+        p%point_loads = point_loads
     end subroutine nml_effects
+
+    subroutine nml_fluid(p, ios, msg, recs)
+        type(fluid_params_t), intent(inout) :: p
+        integer, intent(out) :: ios
+        character(len=*), intent(inout) :: msg
+        character(len=*), intent(in) :: recs(:)
+        real(wp) :: density, normal_drag_coefficient, tangential_drag_coefficient, &
+            linear_normal_drag, linear_tangential_drag, current(2)
+        namelist /fluid/ density, normal_drag_coefficient, tangential_drag_coefficient, &
+            linear_normal_drag, linear_tangential_drag, current
+        density = p%density
+        normal_drag_coefficient = p%normal_drag_coefficient
+        tangential_drag_coefficient = p%tangential_drag_coefficient
+        linear_normal_drag = p%linear_normal_drag
+        linear_tangential_drag = p%linear_tangential_drag
+        current = p%current
+        read (recs, nml=fluid, iostat=ios, iomsg=msg)
+        if (ios /= 0) return
+        p%density = density
+        p%normal_drag_coefficient = normal_drag_coefficient
+        p%tangential_drag_coefficient = tangential_drag_coefficient
+        p%linear_normal_drag = linear_normal_drag
+        p%linear_tangential_drag = linear_tangential_drag
+        p%current = current
+    end subroutine nml_fluid
+
+    subroutine nml_ground(p, ios, msg, recs)
+        type(ground_params_t), intent(inout) :: p
+        integer, intent(out) :: ios
+        character(len=*), intent(inout) :: msg
+        character(len=*), intent(in) :: recs(:)
+        real(wp) :: point(2), normal(2), stiffness, damping, friction_coefficient, &
+            friction_regularization_speed
+        namelist /ground/ point, normal, stiffness, damping, friction_coefficient, &
+            friction_regularization_speed
+        point = p%point
+        normal = p%normal
+        stiffness = p%stiffness
+        damping = p%damping
+        friction_coefficient = p%friction_coefficient
+        friction_regularization_speed = p%friction_regularization_speed
+        read (recs, nml=ground, iostat=ios, iomsg=msg)
+        if (ios /= 0) return
+        p%point = point
+        p%normal = normal
+        p%stiffness = stiffness
+        p%damping = damping
+        p%friction_coefficient = friction_coefficient
+        p%friction_regularization_speed = friction_regularization_speed
+    end subroutine nml_ground
+
+    subroutine nml_attachments(p, ios, msg, recs)
+        type(attachments_params_t), intent(inout) :: p
+        integer, intent(out) :: ios
+        character(len=*), intent(inout) :: msg
+        character(len=*), intent(in) :: recs(:)
+        real(wp), dimension(N_ATTACH) :: mass_positions, masses, load_positions, load_force_x, &
+            load_force_y, load_amplitude_x, load_amplitude_y, load_frequency, load_phase_deg
+        namelist /attachments/ mass_positions, masses, load_positions, load_force_x, &
+            load_force_y, load_amplitude_x, load_amplitude_y, load_frequency, load_phase_deg
+        mass_positions = p%mass_positions
+        masses = p%masses
+        load_positions = p%load_positions
+        load_force_x = p%load_force_x
+        load_force_y = p%load_force_y
+        load_amplitude_x = p%load_amplitude_x
+        load_amplitude_y = p%load_amplitude_y
+        load_frequency = p%load_frequency
+        load_phase_deg = p%load_phase_deg
+        read (recs, nml=attachments, iostat=ios, iomsg=msg)
+        if (ios /= 0) return
+        p%mass_positions = mass_positions
+        p%masses = masses
+        p%load_positions = load_positions
+        p%load_force_x = load_force_x
+        p%load_force_y = load_force_y
+        p%load_amplitude_x = load_amplitude_x
+        p%load_amplitude_y = load_amplitude_y
+        p%load_frequency = load_frequency
+        p%load_phase_deg = load_phase_deg
+    end subroutine nml_attachments
 
     subroutine nml_solver(p, ios, msg, recs)
         type(solver_params_t), intent(inout) :: p
@@ -496,9 +865,11 @@ contains
         character(len=*), intent(inout) :: msg
         character(len=*), intent(in) :: recs(:)
         character(len=BUF_LEN) :: method
-        real(wp) :: rtol, atol, t_end, output_interval
+        real(wp) :: rtol, atol, t_end, output_interval, fault_nan_after
         integer :: max_order, max_steps
-        namelist /solver/ method, rtol, atol, max_order, max_steps, t_end, output_interval
+        logical :: stability_limit_detection
+        namelist /solver/ method, rtol, atol, max_order, max_steps, t_end, output_interval, &
+            stability_limit_detection, fault_nan_after
         method = p%method
         rtol = p%rtol
         atol = p%atol
@@ -506,6 +877,8 @@ contains
         max_steps = p%max_steps
         t_end = p%t_end
         output_interval = p%output_interval
+        stability_limit_detection = p%stability_limit_detection
+        fault_nan_after = p%fault_nan_after
         read (recs, nml=solver, iostat=ios, iomsg=msg)
         if (ios /= 0) return
         call store_string(method, 'method', p%method, ios, msg)
@@ -515,6 +888,8 @@ contains
         p%max_steps = max_steps
         p%t_end = t_end
         p%output_interval = output_interval
+        p%stability_limit_detection = stability_limit_detection
+        p%fault_nan_after = fault_nan_after
     end subroutine nml_solver
 
     subroutine nml_output(p, ios, msg, recs)
@@ -926,6 +1301,12 @@ contains
             else
                 text = 'expected two real numbers (x, y)'
             end if
+        case (T_REALN)
+            if (index(key, '(') > 0) then
+                text = 'expected a real number at an index 1 .. '//int_text(N_ATTACH)
+            else
+                text = 'expected up to '//int_text(N_ATTACH)//' real numbers'
+            end if
         case default
             text = 'expected a quoted string'
             if (len(value) > 0) then
@@ -1132,6 +1513,13 @@ contains
         if (allocated(err)) return
         call check_real(ctx, G_INITIAL, 'angle_deg', scene%initial%angle_deg, '', 0.0_wp, err)
         if (allocated(err)) return
+        call check_int(ctx, G_INITIAL, 'mode', scene%initial%mode, 1, huge(1), err)
+        if (allocated(err)) return
+        call check_real(ctx, G_INITIAL, 'mode_amplitude', scene%initial%mode_amplitude, '', &
+            0.0_wp, err)
+        if (allocated(err)) return
+        call check_effect_keys(ctx, scene, err)
+        if (allocated(err)) return
 
         associate (v => scene%solver)
             call check_name(ctx, G_SOLVER, 'method', v%method, METHODS_ALLOWED, NONE_KNOWN, &
@@ -1160,6 +1548,15 @@ contains
             call check_real(ctx, G_SOLVER, 'output_interval', v%output_interval, '>', 0.0_wp, &
                 err)
             if (allocated(err)) return
+            if (v%stability_limit_detection .and. v%method /= 'cvode') then
+                call fail(ctx, G_SOLVER, 'stability_limit_detection', '.true.', &
+                    'only for method cvode (method '//trim(v%method)//' has no such option; '// &
+                    'limit its order with max_order)', err)
+                return
+            end if
+            call check_real(ctx, G_SOLVER, 'fault_nan_after', v%fault_nan_after, '', 0.0_wp, &
+                err)
+            if (allocated(err)) return
         end associate
     end subroutine check_scene
 
@@ -1183,6 +1580,279 @@ contains
             scene%output%file = 'out/'//base//'.h5'
         end if
     end subroutine resolve_defaults
+
+    !> Checks of the keys of the effects beyond the paper's springs and gravity: motion and
+    !! release of the supports (&supports; reads the motion tables), the initial velocity and
+    !! the folded shape (&initial), &fluid, &ground and &attachments.
+    subroutine check_effect_keys(ctx, scene, err)
+        type(context_t), intent(in) :: ctx
+        type(scene_t), intent(inout) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        integer :: k
+        logical :: any_drag
+
+        associate (s => scene%supports)
+            call check_motion(ctx, 'top', s%top, s%top_motion, s%top_amplitude, &
+                s%top_frequency, s%top_phase_deg, s%top_angle_amplitude_deg, &
+                s%top_angle_phase_deg, s%top_table, s%top_release_time, s%top_table_rows, &
+                scene%path, err)
+            if (allocated(err)) return
+            call check_motion(ctx, 'bottom', s%bottom, s%bottom_motion, s%bottom_amplitude, &
+                s%bottom_frequency, s%bottom_phase_deg, s%bottom_angle_amplitude_deg, &
+                s%bottom_angle_phase_deg, s%bottom_table, s%bottom_release_time, &
+                s%bottom_table_rows, scene%path, err)
+            if (allocated(err)) return
+            if (scene%model%kind == 'mpp' .and. s%top_release_time >= 0.0_wp) then
+                call fail(ctx, G_SUPPORTS, 'top_release_time', real_text(s%top_release_time), &
+                    'the mpp model hangs from its top joint, which cannot be released (use ' &
+                    //'the rfem model)', err)
+                return
+            end if
+        end associate
+
+        associate (i => scene%initial)
+            if (.not. all(ieee_is_finite(i%velocity))) then
+                call fail(ctx, G_INITIAL, 'velocity', pair_text(i%velocity), 'must be finite', &
+                    err)
+                return
+            end if
+            if (scene%model%kind == 'mpp' .and. any(abs(i%velocity) > 0.0_wp)) then
+                call fail(ctx, G_INITIAL, 'velocity', pair_text(i%velocity), 'the mpp model ' &
+                    //'starts at rest from its pinned top joint (use the rfem model)', err)
+                return
+            end if
+            if (i%shape == 'folded' .and. mod(scene%model%elements, 2) /= 1) then
+                call fail(ctx, G_INITIAL, 'shape', '"folded"', 'needs an odd number of ' &
+                    //'elements (two equal halves and one across the fold; elements = ' &
+                    //int_text(scene%model%elements)//')', err)
+                return
+            end if
+        end associate
+
+        associate (f => scene%fluid)
+            call check_real(ctx, G_FLUID, 'density', f%density, '>=', 0.0_wp, err)
+            if (allocated(err)) return
+            call check_real(ctx, G_FLUID, 'normal_drag_coefficient', f%normal_drag_coefficient, &
+                '>=', 0.0_wp, err)
+            if (allocated(err)) return
+            call check_real(ctx, G_FLUID, 'tangential_drag_coefficient', &
+                f%tangential_drag_coefficient, '>=', 0.0_wp, err)
+            if (allocated(err)) return
+            call check_real(ctx, G_FLUID, 'linear_normal_drag', f%linear_normal_drag, '>=', &
+                0.0_wp, err)
+            if (allocated(err)) return
+            call check_real(ctx, G_FLUID, 'linear_tangential_drag', f%linear_tangential_drag, &
+                '>=', 0.0_wp, err)
+            if (allocated(err)) return
+            if (.not. all(ieee_is_finite(f%current))) then
+                call fail(ctx, G_FLUID, 'current', pair_text(f%current), 'must be finite', err)
+                return
+            end if
+            any_drag = f%density*(f%normal_drag_coefficient + f%tangential_drag_coefficient) &
+                > 0.0_wp .or. f%linear_normal_drag + f%linear_tangential_drag > 0.0_wp
+            if (scene%effects%drag .and. .not. any_drag) then
+                call fail(ctx, G_EFFECTS, 'drag', '.true.', 'every drag coefficient of &fluid ' &
+                    //'is zero (give density and a drag coefficient, or a linear drag)', err)
+                return
+            end if
+        end associate
+
+        associate (g => scene%ground)
+            if (.not. all(ieee_is_finite(g%point))) then
+                call fail(ctx, G_GROUND, 'point', pair_text(g%point), 'must be finite', err)
+                return
+            end if
+            if (.not. all(ieee_is_finite(g%normal)) .or. .not. norm2(g%normal) > 0.0_wp) then
+                call fail(ctx, G_GROUND, 'normal', pair_text(g%normal), 'must be a finite, ' &
+                    //'non-zero vector (towards the free side; (-1, 0) is up)', err)
+                return
+            end if
+            call check_real(ctx, G_GROUND, 'stiffness', g%stiffness, '>', 0.0_wp, err)
+            if (allocated(err)) return
+            call check_real(ctx, G_GROUND, 'damping', g%damping, '>=', 0.0_wp, err)
+            if (allocated(err)) return
+            call check_real(ctx, G_GROUND, 'friction_coefficient', g%friction_coefficient, '>=', &
+                0.0_wp, err)
+            if (allocated(err)) return
+            call check_real(ctx, G_GROUND, 'friction_regularization_speed', &
+                g%friction_regularization_speed, '>', 0.0_wp, err)
+            if (allocated(err)) return
+        end associate
+
+        associate (a => scene%attachments)
+            do k = 1, N_ATTACH
+                if (ieee_is_nan(a%mass_positions(k))) then
+                    call unused(k, 'masses', a%masses(k), 'mass_positions')
+                else
+                    call position(k, 'mass_positions', a%mass_positions(k))
+                    if (allocated(err)) return
+                    if (.not. (ieee_is_finite(a%masses(k)) .and. a%masses(k) > 0.0_wp)) &
+                        call fail_at(k, 'masses', a%masses(k), 'must be > 0 (a mass at ' &
+                        //'mass_positions('//int_text(k)//') = ' &
+                        //real_text(a%mass_positions(k))//' m)')
+                end if
+                if (allocated(err)) return
+                if (ieee_is_nan(a%load_positions(k))) then
+                    call unused(k, 'load_force_x', a%load_force_x(k), 'load_positions')
+                    if (.not. allocated(err)) &
+                        call unused(k, 'load_force_y', a%load_force_y(k), 'load_positions')
+                    if (.not. allocated(err)) &
+                        call unused(k, 'load_amplitude_x', a%load_amplitude_x(k), 'load_positions')
+                    if (.not. allocated(err)) &
+                        call unused(k, 'load_amplitude_y', a%load_amplitude_y(k), 'load_positions')
+                else
+                    call position(k, 'load_positions', a%load_positions(k))
+                    if (.not. allocated(err)) call finite(k, 'load_force_x', a%load_force_x(k))
+                    if (.not. allocated(err)) call finite(k, 'load_force_y', a%load_force_y(k))
+                    if (.not. allocated(err)) &
+                        call finite(k, 'load_amplitude_x', a%load_amplitude_x(k))
+                    if (.not. allocated(err)) &
+                        call finite(k, 'load_amplitude_y', a%load_amplitude_y(k))
+                    if (.not. allocated(err)) call finite(k, 'load_phase_deg', a%load_phase_deg(k))
+                    if (.not. allocated(err)) then
+                        if (.not. (ieee_is_finite(a%load_frequency(k)) .and. &
+                            a%load_frequency(k) >= 0.0_wp)) call fail_at(k, 'load_frequency', &
+                            a%load_frequency(k), 'must be >= 0')
+                    end if
+                end if
+                if (allocated(err)) return
+            end do
+        end associate
+    contains
+        subroutine fail_at(k, key, x, reason)
+            integer, intent(in) :: k
+            character(len=*), intent(in) :: key, reason
+            real(wp), intent(in) :: x
+            call make_error(err, ERR_INPUT, origin(ctx, G_ATTACHMENTS, key)//': &attachments: ' &
+                //key//'('//int_text(k)//') = '//real_text(x)//': '//reason)
+        end subroutine fail_at
+
+        subroutine position(k, key, x)
+            integer, intent(in) :: k
+            character(len=*), intent(in) :: key
+            real(wp), intent(in) :: x
+            if (.not. (ieee_is_finite(x) .and. x >= 0.0_wp .and. x <= scene%rope%length)) &
+                call fail_at(k, key, x, 'must be in 0 .. '//real_text(scene%rope%length) &
+                //' (m along the rope from its top end; length = ' &
+                //real_text(scene%rope%length)//')')
+        end subroutine position
+
+        subroutine finite(k, key, x)
+            integer, intent(in) :: k
+            character(len=*), intent(in) :: key
+            real(wp), intent(in) :: x
+            if (.not. ieee_is_finite(x)) call fail_at(k, key, x, 'must be finite')
+        end subroutine finite
+
+        subroutine unused(k, key, x, position_key)
+            integer, intent(in) :: k
+            character(len=*), intent(in) :: key, position_key
+            real(wp), intent(in) :: x
+            if (abs(x) > 0.0_wp .or. ieee_is_nan(x)) call fail_at(k, key, x, 'no ' &
+                //position_key//'('//int_text(k)//') given (an entry is used when its ' &
+                //'position is given)')
+        end subroutine unused
+    end subroutine check_effect_keys
+
+    !> Check the motion and release keys of one support ('top' or 'bottom'); read its
+    !! motion table, resolving a relative path against the scene file's directory.
+    subroutine check_motion(ctx, end, support, motion, amplitude, frequency, phase_deg, &
+            angle_amplitude_deg, angle_phase_deg, table, release_time, rows, scene_path, err)
+        type(context_t), intent(in) :: ctx
+        character(len=*), intent(in) :: end, support, scene_path
+        character(len=*), intent(inout) :: motion, table
+        real(wp), intent(in) :: amplitude(2), frequency, phase_deg(2), angle_amplitude_deg, &
+            angle_phase_deg, release_time
+        real(wp), allocatable, intent(out) :: rows(:, :)
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: full
+
+        call check_name(ctx, G_SUPPORTS, end//'_motion', motion, MOTIONS_ALLOWED, NONE_KNOWN, &
+            err)
+        if (allocated(err)) return
+        if (.not. all(ieee_is_finite(amplitude))) then
+            call fail(ctx, G_SUPPORTS, end//'_amplitude', pair_text(amplitude), 'must be finite', &
+                err)
+            return
+        end if
+        if (.not. all(ieee_is_finite(phase_deg))) then
+            call fail(ctx, G_SUPPORTS, end//'_phase_deg', pair_text(phase_deg), &
+                'must be finite', err)
+            return
+        end if
+        call check_real(ctx, G_SUPPORTS, end//'_frequency', frequency, '>=', 0.0_wp, err)
+        if (allocated(err)) return
+        call check_real(ctx, G_SUPPORTS, end//'_angle_amplitude_deg', angle_amplitude_deg, '', &
+            0.0_wp, err)
+        if (allocated(err)) return
+        call check_real(ctx, G_SUPPORTS, end//'_angle_phase_deg', angle_phase_deg, '', 0.0_wp, &
+            err)
+        if (allocated(err)) return
+        call check_real(ctx, G_SUPPORTS, end//'_release_time', release_time, '', 0.0_wp, err)
+        if (allocated(err)) return
+        if (motion /= 'fixed' .and. support == 'free') then
+            call fail(ctx, G_SUPPORTS, end//'_motion', '"'//trim(motion)//'"', 'the '//end// &
+                ' end is free: there is no support to move (set '//end//' = ''pinned'' or ' &
+                //'''clamped'')', err)
+            return
+        end if
+        if (release_time >= 0.0_wp .and. support == 'free') then
+            call fail(ctx, G_SUPPORTS, end//'_release_time', real_text(release_time), 'the ' &
+                //end//' end is free already (a release needs '//end//' = ''pinned'' or ' &
+                //'''clamped''; < 0 means never)', err)
+            return
+        end if
+        select case (motion)
+        case ('harmonic')
+            if (.not. frequency > 0.0_wp) then
+                call fail(ctx, G_SUPPORTS, end//'_frequency', real_text(frequency), 'must be ' &
+                    //'> 0 for '//end//'_motion = ''harmonic''', err)
+                return
+            end if
+            if (abs(angle_amplitude_deg) > 0.0_wp .and. support /= 'clamped') then
+                call fail(ctx, G_SUPPORTS, end//'_angle_amplitude_deg', &
+                    real_text(angle_amplitude_deg), 'only a clamped support turns (' &
+                    //end//' = "'//trim(support)//'")', err)
+                return
+            end if
+        case ('table')
+            if (len_trim(table) == 0) then
+                call fail(ctx, G_SUPPORTS, end//'_table', "''", 'a file is needed for ' &
+                    //end//'_motion = ''table'' (rows t, dx, dy, dangle_deg)', err)
+                return
+            end if
+            full = resolve_input_path(scene_path, trim(table))
+            if (len(full) > len(table)) then
+                call fail(ctx, G_SUPPORTS, end//'_table', '"'//full(:40)//'..."', &
+                    'too long (at most '//int_text(len(table))//' characters)', err)
+                return
+            end if
+            table = full
+            call read_motion_table(full, origin(ctx, G_SUPPORTS, end//'_table')// &
+                ': &supports: '//end//'_table', rows, err)
+            if (allocated(err)) return
+        end select
+    end subroutine check_motion
+
+    !> A file named in a scene: absolute as given, else relative to the scene file's
+    !! directory, made absolute so that the echo of the scene reads from anywhere.
+    function resolve_input_path(scene_path, name) result(full)
+        character(len=*), intent(in) :: scene_path, name
+        character(len=:), allocatable :: full
+        character(kind=c_char, len=4096) :: buf
+        integer :: slash, k
+        if (name(1:1) == '/') then
+            full = name
+            return
+        end if
+        slash = index(scene_path, '/', back=.true.)
+        full = scene_path(:slash)//name
+        if (full(1:1) == '/') return
+        if (.not. c_associated(c_getcwd(buf, int(len(buf), c_size_t)))) return
+        k = index(buf, c_null_char)
+        if (k <= 1) return
+        full = buf(:k - 1)//'/'//full
+    end function resolve_input_path
 
     !> Check that x is finite and, unless `op` is '', that `x op bound` holds.
     subroutine check_real(ctx, g, key, x, op, bound, err)

@@ -2,8 +2,9 @@
 !! with output at every output_interval, writes the HDF5 file and returns a summary.
 module ropedyn_simulation
     use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_IO
+    use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_IO, ERR_SOLVER
     use ropedyn_problem, only: energy_t
     use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
     use ropedyn_solvers, only: new_integrator
@@ -13,10 +14,13 @@ module ropedyn_simulation
     use ropedyn_scene, only: scene_t, scene_namelist_text
     use ropedyn_output, only: output_file_t
     use ropedyn_progress, only: progress_t
+    use ropedyn_fault, only: fault_problem_t, fault_wrap
     use ropedyn_version, only: version_string
+    use ropedyn_modes, only: equilibrium_initial_state
     implicit none
     private
     public :: run_summary_t, run_scene, create_model, create_integrator, solver_options_of
+    public :: make_parent_dirs
 
     !> What a run reports back to the driver.
     type :: run_summary_t
@@ -79,16 +83,20 @@ contains
         options%atol = scene%solver%atol
         options%max_order = scene%solver%max_order
         options%max_steps = int(scene%solver%max_steps, i8)
+        options%stab_lim_det = scene%solver%stability_limit_detection
     end function solver_options_of
 
     !> Run a validated scene. The output file is written as the run goes; a failed
-    !! integration leaves the data up to the failure and status 'failed'.
+    !! integration leaves the data up to the failure and status 'failed'. No record with a
+    !! NaN or Inf is ever written: a non-finite state or energy ends the run as a failed
+    !! integration (ERR_SOLVER) before it reaches the file.
     subroutine run_scene(scene, summary, err)
         type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(out) :: summary
         type(error_t), allocatable, intent(out) :: err
         class(rope_model_t), allocatable, target :: model
         class(integrator_t), allocatable :: integrator
+        type(fault_problem_t), target :: faulty
         type(output_file_t) :: out
         type(progress_t) :: progress
         type(error_t), allocatable :: io_err
@@ -107,6 +115,9 @@ contains
         allocate (y(model%size()), yq(max(1, model%quad_size())))
         allocate (q(3, n), qdot(3, n), points(2, 2*n), lengths(n), masses(n))
         call model%initial_state(y)
+        ! &initial shape = 'equilibrium' or 'mode': statics (and modes) first
+        call equilibrium_initial_state(model, scene, y, err, create_model)
+        if (allocated(err)) return
         yq = 0.0_wp
         t = 0.0_wp
         summary%file = trim(scene%output%file)
@@ -122,7 +133,15 @@ contains
         if (allocated(err)) return
 
         call cpu_time(cpu_start)
-        call integrator%init(model, t, y, yq(1:model%quad_size()), solver_options_of(scene), err)
+        if (scene%solver%fault_nan_after >= 0.0_wp) then
+            ! testing aid (docs/input.md): the integrator sees a NaN right-hand side later on
+            call fault_wrap(faulty, model, scene%solver%fault_nan_after)
+            call integrator%init(faulty, t, y, yq(1:model%quad_size()), &
+                                 solver_options_of(scene), err)
+        else
+            call integrator%init(model, t, y, yq(1:model%quad_size()), &
+                                 solver_options_of(scene), err)
+        end if
         if (allocated(err)) then
             call finish('failed', err%message)
             return
@@ -143,7 +162,11 @@ contains
                 return
             end if
             call write_record(err)  ! also refreshes `stats`
-            if (allocated(err)) return
+            if (allocated(err)) then
+                call progress%done()
+                if (err%code == ERR_SOLVER) call finish('failed', err%message)
+                return
+            end if
             call progress%update(t, stats%steps)
         end do
         call progress%done()
@@ -154,6 +177,7 @@ contains
             type(energy_t) :: e
             real(wp) :: h
             integer :: order
+            character(len=64) :: where
             h = 0.0_wp
             order = 0
             if (allocated(integrator)) then
@@ -161,9 +185,17 @@ contains
                 h = stats%last_step
                 order = stats%last_order
             end if
-            call model%fields(y, q, qdot)
-            call model%polyline(y, points)
+            call model%fields(y, q, qdot, t)
+            call model%polyline(y, points, t)
             e = model%energy(t, y, yq)
+            if (.not. (all(ieee_is_finite(y)) .and. all(ieee_is_finite(yq)) .and. &
+                       ieee_is_finite(e%balance()) .and. all(ieee_is_finite(points)))) then
+                write (where, '(a, es12.5, a, es11.3e3, a)') 't = ', t, ' s, step size ', h, ' s'
+                call make_error(werr, ERR_SOLVER, 'non-finite state or energy at '// &
+                                trim(where)//' (integrator '//integrator%name()// &
+                                '): not written to the output')
+                return
+            end if
             call out%append(t, q, qdot, points, e, h, order, werr)
             summary%records = summary%records + 1
             summary%final_energy = e

@@ -4,6 +4,10 @@
 !!   ropedyn testset PROBLEM|all [--method M] [--rtol R] [--atol A] [--max-order K]
 !!                   [--repeat-time S] [--csv]      (docs/testset.md)
 !!   ropedyn testset --list
+!!   ropedyn sweep SWEEP.nml [--jobs N | --task K | --summary | --list | --count]
+!!                   [--force] [--quiet] [--output-dir DIR]   (docs/sweeps.md)
+!!   ropedyn statics SCENE.nml [--set ...] [-o FILE.h5] [--max-iterations N]
+!!   ropedyn modes SCENE.nml [--count K] [--set ...] [-o FILE.h5]  (docs/statics-modes.md)
 !!   ropedyn --version | --help
 !!
 !! Exit codes: 0 success, 2 bad input or command line, 3 integration failed,
@@ -19,6 +23,8 @@ program ropedyn_main
     use ropedyn_testset, only: testset_problem_t, new_testset_problem, testset_names, &
                                testset_name_list
     use ropedyn_testset_driver, only: testset_run_t, run_testset, DEFAULT_REPEAT_TIME
+    use ropedyn_sweep_runner, only: sweep_command
+    use ropedyn_analysis, only: analysis_command
     implicit none
 
     character(len=:), allocatable :: command, scene_path
@@ -46,6 +52,12 @@ program ropedyn_main
     case ('run')
     case ('testset')
         call testset_command()
+        stop
+    case ('sweep')
+        call run_sweep_command()
+        stop
+    case ('statics', 'modes')
+        call run_analysis_command()
         stop
     case default
         call fail_usage('unknown command "'//command//'"')
@@ -117,6 +129,11 @@ contains
         write (unit, '(a)') '                       [--max-order K] [--repeat-time SECONDS] '// &
             '[--csv]'
         write (unit, '(a)') '       ropedyn testset --list'
+        write (unit, '(a)') '       ropedyn sweep SWEEP.nml [--jobs N | --task K | --summary '// &
+            '| --list | --count] ...'
+        write (unit, '(a)') '       ropedyn statics SCENE.nml [--set ...] [-o FILE.h5] '// &
+            '[--max-iterations N]'
+        write (unit, '(a)') '       ropedyn modes SCENE.nml [--count K] [--set ...] [-o FILE.h5]'
         write (unit, '(a)') '       ropedyn --version | --help'
         write (unit, '(a)') 'exit codes: 0 ok, 2 bad input, 3 integration failed, '// &
             '4 output error, 5 internal error'
@@ -149,6 +166,34 @@ contains
         write (unit, '(a)') '|y - yref|/(atol/rtol + |yref|); E5 is judged by mescd.'
         write (unit, '(a)') 'exit codes: 0 ok, 2 bad arguments, 3 integration failed'
     end subroutine testset_usage
+
+    !> ropedyn statics|modes SCENE.nml [options]: ropedyn_analysis does the work.
+    subroutine run_analysis_command()
+        character(len=1024), allocatable :: analysis_args(:)
+        type(error_t), allocatable :: aerr
+        integer :: k
+        allocate (analysis_args(nargs - 1))
+        do k = 2, nargs
+            call get_command_argument(k, analysis_args(k - 1))
+        end do
+        call analysis_command(command, analysis_args, aerr)
+        if (allocated(aerr)) call fail(aerr)
+    end subroutine run_analysis_command
+
+    !> ropedyn sweep SWEEP.nml [options]: ropedyn_sweep_runner does the work.
+    subroutine run_sweep_command()
+        character(len=4096), allocatable :: sweep_args(:)
+        character(len=4096) :: exe
+        type(error_t), allocatable :: serr
+        integer :: k
+        allocate (sweep_args(nargs - 1))
+        do k = 2, nargs
+            call get_command_argument(k, sweep_args(k - 1))
+        end do
+        call get_command_argument(0, exe)
+        call sweep_command(sweep_args, trim(exe), serr)
+        if (allocated(serr)) call fail(serr)
+    end subroutine run_sweep_command
 
     !> ropedyn testset PROBLEM|all [options] | --list
     subroutine testset_command()

@@ -29,7 +29,8 @@ module ropedyn_problem
         real(wp) :: elastic = 0.0_wp       !< springs (internal and supports)
         real(wp) :: gravity = 0.0_wp       !< -sum m g x
         real(wp) :: dissipated = 0.0_wp    !< integral of the dissipation power so far
-        real(wp) :: support_work = 0.0_wp  !< work done on the rope by moving supports so far
+        !> external work done on the rope so far: moving supports, point loads, a current
+        real(wp) :: support_work = 0.0_wp
     contains
         procedure :: total => energy_total
         procedure :: balance => energy_balance

@@ -7,7 +7,9 @@ import sys
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-SCENES = sorted((ROOT / "input").glob("**/*.nml"))
+# input/sweeps holds sweep files (ropedyn sweep), not scenes
+SCENES = sorted(p for p in (ROOT / "input").glob("**/*.nml") if "sweeps" not in p.parts)
+SWEEPS = sorted((ROOT / "input" / "sweeps").glob("*.nml"))
 
 
 @pytest.mark.parametrize("scene", SCENES, ids=[s.stem for s in SCENES])
@@ -15,6 +17,13 @@ def test_shipped_scene_runs(run, tmp_path, scene):
     result = run("run", scene, "--set", "solver.t_end=0.02", "--set", "output.file=s.h5")
     assert result.returncode == 0, result.stderr
     assert "balance error" in result.stdout
+
+
+@pytest.mark.parametrize("sweep", SWEEPS, ids=[s.stem for s in SWEEPS])
+def test_shipped_sweep_reads(run, tmp_path, sweep):
+    result = run("sweep", sweep, "--list")
+    assert result.returncode == 0, result.stderr
+    assert "missing" in result.stdout
 
 
 def test_progress_on_request(run, tmp_path):

@@ -24,6 +24,11 @@ program test_mpp
     call test_equations('inextensible, pinned top, clamped bottom', [character(len=64) :: &
         'model.elements = 3', 'effects.tension = .false.', 'supports.bottom = "clamped"', &
         'supports.bottom_anchor = 0.5, 0.6', 'rope.normal_damping = 50'])
+    call test_equations('point masses, ground contact (no damping, no friction)', &
+        [character(len=64) :: 'model.elements = 4', 'attachments.mass_positions = 0.4, 1.0', &
+        'attachments.masses = 0.05, 0.1', 'effects.ground = .true.', 'ground.point = 0.5, 0.0', &
+        'ground.stiffness = 50', 'ground.damping = 0', 'ground.friction_coefficient = 0', &
+        'rope.normal_damping = 50'])
     call test_energy()
     call suite%finish()
 

@@ -25,6 +25,7 @@ program test_scene
     call test_group_order()
     call test_round_trip()
     call test_errors()
+    call test_effect_keys()
 
     call suite%finish()
 
@@ -107,6 +108,12 @@ contains
         call suite%check_close(s%solver%t_end, 30.0_wp, TIGHT, 0.0_wp, 'defaults: t_end')
         call suite%check_close(s%solver%output_interval, 0.01_wp, TIGHT, 0.0_wp, &
             'defaults: output_interval')
+        call suite%check_true(.not. s%solver%stability_limit_detection, &
+            'defaults: stability_limit_detection off')
+        call suite%check_true(s%solver%fault_nan_after < 0.0_wp, 'defaults: fault_nan_after off')
+        call suite%check_true(index(scene_namelist_text(s), &
+            'stability_limit_detection = .false.') > 0, &
+            'defaults: echo of stability_limit_detection')
         call suite%check_true(s%output%file == 'out/defaults.h5', &
             'defaults: output file "'//trim(s%output%file)//'"')
         call suite%check_true(.not. s%output%progress, 'defaults: progress')
@@ -150,6 +157,7 @@ contains
             '    method = ''cvode'', rtol = 1e-9, atol = 1e-12', &
             '    max_order = 3, max_steps = 5000', &
             '    t_end = 2.0, output_interval = 0.5', &
+            '    stability_limit_detection = T, fault_nan_after = 1.5', &
             '/', &
             '&output file = ''results/run 1.h5'', progress = .true. /'])
         call read_ok(PATH, NO_SET, s, 'values')
@@ -183,6 +191,10 @@ contains
             'values: max_order, max_steps')
         call suite%check_close(s%solver%output_interval, 0.5_wp, TIGHT, 0.0_wp, &
             'values: output_interval')
+        call suite%check_true(s%solver%stability_limit_detection, &
+            'values: stability_limit_detection')
+        call suite%check_close(s%solver%fault_nan_after, 1.5_wp, TIGHT, 0.0_wp, &
+            'values: fault_nan_after')
         call suite%check_true(s%output%file == 'results/run 1.h5', 'values: file')
         call suite%check_true(s%output%progress, 'values: progress')
     end subroutine test_values
@@ -299,6 +311,8 @@ contains
             .and. a%solver%max_steps == b%solver%max_steps &
             .and. eq(a%solver%t_end, b%solver%t_end) &
             .and. eq(a%solver%output_interval, b%solver%output_interval) &
+            .and. (a%solver%stability_limit_detection .eqv. b%solver%stability_limit_detection) &
+            .and. eq(a%solver%fault_nan_after, b%solver%fault_nan_after) &
             .and. a%output%file == b%output%file &
             .and. (a%output%progress .eqv. b%output%progress)
         if (bottom_anchor_given(a) .and. bottom_anchor_given(b)) then
@@ -426,6 +440,17 @@ contains
             '&solver method = ''mebdf'', max_order = 1 /'], NO_SET, [character(len=L) :: &
             P//'max_order_mebdf.nml: &solver: max_order = 1: ', &
             'out of range for method mebdf (allowed: 2 .. 7, or 0 for the default 4)'])
+        call expect_error('stab_lim_det_mebdf', [character(len=L) :: MODEL, &
+            '&solver method = ''mebdf'', stability_limit_detection = .true. /'], NO_SET, &
+            [character(len=L) :: P//'stab_lim_det_mebdf.nml: &solver: ', &
+            'stability_limit_detection = .true.: only for method cvode'])
+        call expect_error('set_stab_lim_det_mebdf', MODEL, [character(len=L) :: &
+            'solver.method=mebdf', 'solver.stability_limit_detection=T'], [character(len=L) :: &
+            '--set solver.stability_limit_detection=T: &solver: stability_limit_detection', &
+            'only for method cvode'])
+        call expect_error('fault_nan_after', [character(len=L) :: MODEL, &
+            '&solver fault_nan_after = 1e999 /'], NO_SET, [character(len=L) :: &
+            P//'fault_nan_after.nml: &solver: fault_nan_after = +Infinity: must be finite'])
         call expect_error('max_steps', [character(len=L) :: MODEL, '&solver max_steps = 0 /'], &
             NO_SET, [character(len=L) :: P//'max_steps.nml: &solver: max_steps = 0: ', &
             'must be >= 1'])
@@ -459,7 +484,7 @@ contains
             'unknown (allowed: pinned, clamped, free)'])
         call expect_error('shape', [character(len=L) :: MODEL, '&initial shape = ''curly'' /'], &
             NO_SET, [character(len=L) :: P//'shape.nml: &initial: shape = "curly": ', &
-            'unknown (allowed: straight, hanging)'])
+            'unknown (allowed: straight, hanging'])
 
         ! --set
         call expect_error('set_syntax', MODEL, [character(len=L) :: 'rope.length'], &
@@ -468,7 +493,8 @@ contains
             [character(len=L) :: '--set length=2: expected group.key=value'])
         call expect_error('set_group', MODEL, [character(len=L) :: 'foo.bar=1'], &
             [character(len=L) :: '--set foo.bar=1: unknown group "foo" ', &
-            '(groups: rope, model, supports, initial, effects, solver, output)'])
+            '(groups: rope, model, supports, initial, effects, solver, output, fluid, ground, '// &
+            'attachments)'])
         call expect_error('set_key', MODEL, [character(len=L) :: 'rope.lenght=2'], &
             [character(len=L) :: '--set rope.lenght=2: &rope: unknown key "lenght"'])
         call expect_error('set_type', MODEL, [character(len=L) :: 'model.elements=abc'], &
@@ -483,4 +509,162 @@ contains
             [character(len=L) :: '--set supports.bottom=glued: &supports: bottom = "glued": ', &
             'unknown (allowed: pinned, clamped, free)'])
     end subroutine test_errors
+
+    !> The keys of the effects beyond springs and gravity: defaults, values, the motion
+    !! table (read relative to the scene file), the echo round trip and one error per group.
+    subroutine test_effect_keys()
+        type(scene_t) :: s, b
+        character(len=*), parameter :: PATH = DIR//'/effects.nml', ECHO = DIR//'/effects_echo.nml'
+        character(len=*), parameter :: P = DIR//'/'
+        integer, parameter :: L = 100
+        character(len=L), parameter :: MODEL(1) = [character(len=L) :: '&model /']
+        character(len=:), allocatable :: text
+        integer :: unit
+
+        call write_file(DIR//'/defaults.nml', [character(len=20) :: '&model /'])
+        call read_ok(DIR//'/defaults.nml', NO_SET, s, 'effect keys: defaults')
+        call suite%check_true(.not. s%effects%drag .and. .not. s%effects%ground .and. &
+            s%effects%support_motion .and. s%effects%point_masses .and. s%effects%point_loads, &
+            'effect keys: defaults of the switches (drag, ground off)')
+        call suite%check_true(s%supports%top_motion == 'fixed' .and. &
+            s%supports%bottom_motion == 'fixed' .and. s%supports%top_release_time < 0.0_wp &
+            .and. s%supports%bottom_release_time < 0.0_wp, &
+            'effect keys: supports fixed, never released')
+        call suite%check_true(all(eq(s%initial%velocity, 0.0_wp)), 'effect keys: at rest')
+        call suite%check_close(s%fluid%density, 1.225_wp, TIGHT, 0.0_wp, 'effect keys: air')
+        call suite%check_close(s%fluid%normal_drag_coefficient, 1.2_wp, TIGHT, 0.0_wp, &
+            'effect keys: C_n')
+        call suite%check_close(s%fluid%tangential_drag_coefficient, 0.02_wp, TIGHT, 0.0_wp, &
+            'effect keys: C_t')
+        call suite%check_true(all(eq(s%ground%point, [1.0_wp, 0.0_wp])) .and. &
+            all(eq(s%ground%normal, [-1.0_wp, 0.0_wp])), 'effect keys: ground 1 m below, up')
+        call suite%check_close(s%ground%stiffness, 1.0e5_wp, TIGHT, 0.0_wp, 'effect keys: k')
+        call suite%check_close(s%ground%friction_coefficient, 0.5_wp, TIGHT, 0.0_wp, &
+            'effect keys: mu')
+        call suite%check_true(all(s%attachments%mass_positions /= s%attachments%mass_positions) &
+            .and. all(s%attachments%load_positions /= s%attachments%load_positions), &
+            'effect keys: no attachments (positions NaN)')
+
+        call write_file(DIR//'/shake.dat', [character(len=40) :: '# t dx dy dangle', &
+            '0 0 0 0', '0.5, 0.01, -0.02, 4', '1.0 0 0 0'])
+        call write_file(PATH, [character(len=L) :: &
+            '&model elements = 9 /', &
+            '&supports top = ''clamped'', top_motion = ''Harmonic'', top_amplitude = 0.01, 0.02', &
+            '   top_frequency = 2.5, top_phase_deg = 10, 20, top_angle_amplitude_deg = 3', &
+            '   top_angle_phase_deg = 45, bottom = ''pinned'', bottom_motion = ''table''', &
+            '   bottom_table = ''shake.dat'', bottom_release_time = 0.75 /', &
+            '&initial shape = ''folded'', velocity = 0.1, -0.2 /', &
+            '&effects drag = T, ground = T, point_loads = F /', &
+            '&fluid density = 1000, normal_drag_coefficient = 1.1, current = 0.3, 0 /', &
+            '&ground point = 0.8, 0.1, normal = -1, 0.5, stiffness = 2e4, damping = 10 /', &
+            '&attachments mass_positions = 1.0, 0.5, masses = 0.2, 0.1', &
+            '   load_positions(3) = 0.25, load_force_x(3) = 1.5, load_frequency(3) = 2 /'])
+        call read_ok(PATH, NO_SET, s, 'effect keys: values')
+        call suite%check_true(s%supports%top_motion == 'harmonic', 'effect keys: motion lower case')
+        call suite%check_close(s%supports%top_amplitude(2), 0.02_wp, TIGHT, 0.0_wp, &
+            'effect keys: top_amplitude(2)')
+        call suite%check_true(allocated(s%supports%bottom_table_rows), 'effect keys: table read')
+        if (allocated(s%supports%bottom_table_rows)) then
+            call suite%check_true(size(s%supports%bottom_table_rows, 2) == 3, &
+                'effect keys: three table rows')
+            call suite%check_close(s%supports%bottom_table_rows(4, 2), &
+                4.0_wp*acos(-1.0_wp)/180.0_wp, &
+                TIGHT, 0.0_wp, 'effect keys: table angle in rad')
+        end if
+        call suite%check_true(s%supports%bottom_table(1:1) == '/' .and. index(s%supports% &
+            bottom_table, DIR//'/shake.dat') > 0, 'effect keys: table resolved against the '// &
+            'scene directory, absolute: '//trim(s%supports%bottom_table))
+        call suite%check_true(s%initial%shape == 'folded' .and. eq(s%initial%velocity(2), &
+            -0.2_wp), 'effect keys: folded, velocity')
+        call suite%check_true(s%effects%drag .and. s%effects%ground .and. &
+            .not. s%effects%point_loads, 'effect keys: switches')
+        call suite%check_close(s%attachments%masses(1), 0.2_wp, TIGHT, 0.0_wp, &
+            'effect keys: masses(1)')
+        call suite%check_close(s%attachments%load_force_x(3), 1.5_wp, TIGHT, 0.0_wp, &
+            'effect keys: load_force_x(3)')
+        text = scene_namelist_text(s)
+        call suite%check_true(index(text, '&fluid') > 0 .and. index(text, '&ground') > 0 .and. &
+            index(text, '&attachments') > 0, 'effect keys: the new groups in the echo')
+        call suite%check_true(index(text, 'mass_positions = 1.0, 0.5') > 0 .and. &
+            index(text, 'load_positions = NaN, NaN, 0.25') > 0, 'effect keys: lists in the echo')
+        open (newunit=unit, file=ECHO, status='replace', action='write')
+        write (unit, '(a)') text
+        close (unit)
+        call read_ok(ECHO, NO_SET, b, 'effect keys: echo read')
+        call suite%check_true(scene_namelist_text(b) == text, 'effect keys: the echo reads '// &
+            'back to the same scene')
+
+        ! one error per group (at least)
+        call expect_error('motion_name', [character(len=L) :: MODEL, &
+            '&supports top_motion = ''wobble'' /'], NO_SET, [character(len=L) :: &
+            P//'motion_name.nml: &supports: top_motion = "wobble": ', &
+            'unknown (allowed: fixed, harmonic, table)'])
+        call expect_error('motion_frequency', [character(len=L) :: MODEL, &
+            '&supports top_motion = ''harmonic'', top_amplitude = 0.01, 0 /'], NO_SET, &
+            [character(len=L) :: P//'motion_frequency.nml: &supports: top_frequency = 0.0: ', &
+            'must be > 0 for top_motion = ''harmonic'''])
+        call expect_error('motion_free', [character(len=L) :: MODEL, &
+            '&supports bottom_motion = ''harmonic'', bottom_frequency = 1 /'], NO_SET, &
+            [character(len=L) :: P//'motion_free.nml: &supports: bottom_motion = "harmonic": '// &
+            'the bottom end is free'])
+        call expect_error('release_free', [character(len=L) :: MODEL, &
+            '&supports bottom_release_time = 0.5 /'], NO_SET, [character(len=L) :: &
+            P//'release_free.nml: &supports: bottom_release_time = 0.5: the bottom end is free'])
+        call expect_error('angle_pinned', [character(len=L) :: MODEL, &
+            '&supports top_motion = ''harmonic'', top_frequency = 1, '// &
+            'top_angle_amplitude_deg = 2 /'], &
+            NO_SET, [character(len=L) :: P//'angle_pinned.nml: &supports: ', &
+            'top_angle_amplitude_deg = 2.0: only a clamped support turns'])
+        call expect_error('table_missing', [character(len=L) :: MODEL, &
+            '&supports top_motion = ''table'', top_table = ''nowhere.dat'' /'], NO_SET, &
+            [character(len=L) :: P//'table_missing.nml: &supports: top_table = "', &
+            'nowhere.dat": cannot open'])
+        call write_file(DIR//'/bad_table.dat', [character(len=20) :: '0 0 0 0', '0.5 0 0', &
+            '1 0 0 0'])
+        call expect_error('table_bad', [character(len=L) :: MODEL, &
+            '&supports top_motion = ''table'', top_table = ''bad_table.dat'' /'], NO_SET, &
+            [character(len=L) :: 'bad_table.dat": line 2 ("0.5 0 0"): expected four numbers'])
+        call expect_error('table_none', [character(len=L) :: MODEL, &
+            '&supports top_motion = ''table'' /'], NO_SET, [character(len=L) :: &
+            P//'table_none.nml: &supports: top_table = '''': a file is needed'])
+        call expect_error('mpp_release', [character(len=L) :: '&model kind = ''mpp'' /', &
+            '&supports top_release_time = 0 /'], NO_SET, [character(len=L) :: &
+            P//'mpp_release.nml: &supports: top_release_time = 0.0: the mpp model hangs'])
+        call expect_error('folded_even', [character(len=L) :: '&model elements = 10 /', &
+            '&initial shape = ''folded'' /'], NO_SET, [character(len=L) :: &
+            P//'folded_even.nml: &initial: shape = "folded": needs an odd number of elements'])
+        call expect_error('mpp_velocity', [character(len=L) :: '&model kind = ''mpp'' /', &
+            '&initial velocity = 1, 0 /'], NO_SET, [character(len=L) :: &
+            P//'mpp_velocity.nml: &initial: velocity = 1.0, 0.0: the mpp model starts at rest'])
+        call expect_error('drag_zero', [character(len=L) :: MODEL, '&effects drag = T /', &
+            '&fluid density = 0 /'], NO_SET, [character(len=L) :: &
+            P//'drag_zero.nml: &effects: drag = .true.: every drag coefficient of &fluid is zero'])
+        call expect_error('fluid_density', [character(len=L) :: MODEL, &
+            '&fluid density = -1 /'], NO_SET, [character(len=L) :: &
+            P//'fluid_density.nml: &fluid: density = -1.0: must be >= 0'])
+        call expect_error('ground_normal', [character(len=L) :: MODEL, &
+            '&ground normal = 0, 0 /'], NO_SET, [character(len=L) :: &
+            P//'ground_normal.nml: &ground: normal = 0.0, 0.0: must be a finite, non-zero vector'])
+        call expect_error('ground_stiffness', [character(len=L) :: MODEL, &
+            '&ground stiffness = 0 /'], NO_SET, [character(len=L) :: &
+            P//'ground_stiffness.nml: &ground: stiffness = 0.0: must be > 0'])
+        call expect_error('mass_position', [character(len=L) :: MODEL, &
+            '&attachments mass_positions = 1.5, masses = 0.1 /'], NO_SET, [character(len=L) :: &
+            P//'mass_position.nml: &attachments: mass_positions(1) = 1.5: must be in 0 .. 1'])
+        call expect_error('mass_value', [character(len=L) :: MODEL, &
+            '&attachments mass_positions = 0.5 /'], NO_SET, [character(len=L) :: &
+            P//'mass_value.nml: &attachments: masses(1) = 0.0: must be > 0'])
+        call expect_error('set_mass_unused', MODEL, [character(len=L) :: &
+            'attachments.masses(2)=0.5'], [character(len=L) :: &
+            '--set attachments.masses(2)=0.5: &attachments: masses(2) = 0.5: no '// &
+            'mass_positions(2) given'])
+        call expect_error('load_frequency', [character(len=L) :: MODEL, &
+            '&attachments load_positions = 0.5, load_frequency = -1 /'], NO_SET, &
+            [character(len=L) :: P//'load_frequency.nml: &attachments: load_frequency(1) = '// &
+            '-1.0: must be >= 0'])
+        call expect_error('too_many_masses', [character(len=L) :: MODEL, &
+            '&attachments masses = 1, 2, 3, 4, 5, 6, 7, 8, 9 /'], NO_SET, [character(len=L) :: &
+            P//'too_many_masses.nml: &attachments: cannot read masses', &
+            'expected up to 8 real numbers'])
+    end subroutine test_effect_keys
 end program test_scene

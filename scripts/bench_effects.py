@@ -1,0 +1,175 @@
+#!/usr/bin/env python3
+"""Cost of the right-hand side per element for sets of effects (issue #7).
+
+Called by scripts/bench_effects (which builds the Release configuration first). Times the
+RFEM right-hand side and Jacobian with tests/bench/bench_rhs for: gravity + tension; all
+internal effects (the paper's rope); each external effect added on its own; all effects;
+all internal effects with every external effect configured but switched off; and, with
+--baseline REV, all internal effects built from git revision REV (before the effects
+existed), which shows that effects that are off cost nothing. The table goes into
+docs/benchmarks.md between the markers of the section "Cost of the effects".
+"""
+import argparse
+import datetime
+import os
+import pathlib
+import platform
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+BEGIN = "<!-- bench_effects:begin -->"
+END = "<!-- bench_effects:end -->"
+
+INTERNAL_OFF = ["effects.shear=F", "effects.bending=F", "effects.damping=F"]
+DRAG = ["effects.drag=T", "fluid.density=1000", "fluid.linear_normal_drag=0.1",
+        "fluid.current=0.1, 0.2"]
+GROUND = ["effects.ground=T", "ground.point=0.13, 0.0", "ground.normal=-1.0, 0.1"]
+MOTION = ["supports.top_motion=harmonic", "supports.top_amplitude=0.01, 0.02",
+          "supports.top_frequency=2"]
+MASSES = ["attachments.mass_positions=1.0, 0.5", "attachments.masses=0.1, 0.05"]
+LOADS = ["attachments.load_positions=0.3, 0.7", "attachments.load_force_x=0.1, 0.2",
+         "attachments.load_amplitude_y=0.1, 0.0", "attachments.load_frequency=2, 0"]
+# every external effect configured, every switch off: the model must be the paper's
+CONFIGURED_OFF = (DRAG + GROUND + MOTION + MASSES + LOADS) + [
+    "effects.drag=F", "effects.ground=F", "effects.support_motion=F",
+    "effects.point_masses=F", "effects.point_loads=F"]
+
+CONFIGS = [
+    ("gravity + tension", INTERNAL_OFF),
+    ("all internal effects (gravity, tension, shear, bending, damping)", []),
+    ("internal + drag (quadratic and linear, current)", DRAG),
+    ("internal + ground contact (about half the rope touching)", GROUND),
+    ("internal + moving top (harmonic)", MOTION),
+    ("internal + 2 point masses", MASSES),
+    ("internal + 2 point loads", LOADS),
+    ("all effects", DRAG + GROUND + MOTION + MASSES + LOADS),
+    ("all internal, external effects configured but off", CONFIGURED_OFF),
+]
+
+
+def machine():
+    cpu = "unknown CPU"
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
+
+
+def bench(exe, n, sets, seconds):
+    cmd = [str(exe), str(ROOT / "input" / "paper.nml"), "--set", f"model.elements={n}",
+           "--seconds", str(seconds)]
+    for s in sets:
+        cmd += ["--set", s]
+    out = subprocess.run(cmd, capture_output=True, text=True)
+    if out.returncode != 0:
+        raise SystemExit(f"bench_rhs failed: {' '.join(cmd)}\n{out.stderr}")
+    fields = out.stdout.split()
+    return float(fields[1]), float(fields[2])
+
+
+def build_baseline(rev, workdir):
+    """Build bench_rhs from git revision `rev` (git archive: the working tree is untouched)."""
+    src = workdir / "src"
+    src.mkdir()
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev], capture_output=True,
+                             check=True)
+    subprocess.run(["tar", "-x", "-C", str(src)], input=archive.stdout, check=True)
+    (src / "tests" / "bench").mkdir(exist_ok=True)
+    shutil.copy(ROOT / "tests" / "bench" / "bench_rhs.f90", src / "tests" / "bench")
+    with open(src / "tests" / "CMakeLists.txt", "a") as f:
+        f.write("\nadd_executable(bench_rhs bench/bench_rhs.f90)\n"
+                "ropedyn_fortran_target(bench_rhs)\n"
+                "target_link_libraries(bench_rhs PRIVATE ropedyn_lib)\n")
+    build = workdir / "build"
+    log = workdir / "build.log"
+    with open(log, "w") as f:
+        ok = subprocess.run(["cmake", "-S", str(src), "-B", str(build),
+                             "-DCMAKE_BUILD_TYPE=Release"], stdout=f, stderr=f).returncode == 0
+        ok = ok and subprocess.run(["cmake", "--build", str(build), "--target", "bench_rhs",
+                                    "-j", str(os.cpu_count())], stdout=f,
+                                   stderr=f).returncode == 0
+    if not ok:
+        raise SystemExit(f"baseline build of {rev} failed; log: {log.read_text()[-3000:]}")
+    return build / "tests" / "bench_rhs"
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--build", required=True, help="Release build directory")
+    parser.add_argument("--elements", type=int, default=100)
+    parser.add_argument("--seconds", type=float, default=0.5,
+                        help="time per repetition of each timing (5 repetitions, fastest kept)")
+    parser.add_argument("--baseline", default=None,
+                        help="git revision to time 'all internal effects' at (e.g. HEAD)")
+    parser.add_argument("--no-write", action="store_true", help="print only")
+    args = parser.parse_args(argv)
+    exe = pathlib.Path(args.build) / "tests" / "bench_rhs"
+    n = args.elements
+
+    rows = []
+    header = ("| configuration | RHS (ns per element) | relative to all internal | "
+              "Jacobian (ns per element) |")
+    print(header)
+    print("|---|---|---|---|")
+    results = []
+    for label, sets in CONFIGS:
+        rhs, jac = bench(exe, n, sets, args.seconds)
+        results.append((label, rhs, jac))
+    baseline_line = None
+    if args.baseline:
+        with tempfile.TemporaryDirectory() as tmp:
+            base_exe = build_baseline(args.baseline, pathlib.Path(tmp))
+            rev = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", args.baseline],
+                                 capture_output=True, text=True).stdout.strip()
+            rhs, jac = bench(base_exe, n, [], args.seconds)
+            # the current build once more, right after, for a fair pair
+            now_rhs, now_jac = bench(exe, n, [], args.seconds)
+            results.append((f"all internal effects at {args.baseline} ({rev}), before the "
+                            "effects existed", rhs, jac))
+            results.append(("all internal effects, this build (timed right after)", now_rhs,
+                            now_jac))
+    internal = results[1][1]
+    for label, rhs, jac in results:
+        line = f"| {label} | {rhs:.1f} | {rhs / internal:.2f} | {jac:.1f} |"
+        print(line, flush=True)
+        rows.append(line)
+
+    if args.no_write:
+        return 0
+    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    cmd = "scripts/bench_effects" + (f" --baseline {args.baseline}" if args.baseline else "") \
+        + (f" --elements {n}" if n != 100 else "")
+    block = "\n".join([
+        BEGIN,
+        f"Command: `{cmd}` (Release build, RFEM, the paper's rope, n = {n}; "
+        "`tests/bench/bench_rhs`: CPU time per call divided by n, fastest of 5 repetitions "
+        f"of about {args.seconds} s; state: the initial state with velocities up to 0.3 m/s).",
+        f"Machine: {machine()}. Run: {stamp}.",
+        "",
+        header,
+        "|---|---|---|---|",
+        *rows,
+        END,
+    ])
+    doc = ROOT / "docs" / "benchmarks.md"
+    text = doc.read_text()
+    if BEGIN in text and END in text:
+        text = re.sub(re.escape(BEGIN) + ".*?" + re.escape(END), lambda m: block, text,
+                      flags=re.S)
+    else:
+        text = text.rstrip("\n") + "\n\n## Cost of the effects\n\n" + block + "\n"
+    doc.write_text(text)
+    print(f"wrote {doc}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,271 @@
+#!/usr/bin/env python3
+"""Run the hard scenes (input/hard) and the CVODE order study; write docs/stability.md.
+
+Called by scripts/stability_report (which builds the Release executable first). Two
+sections of docs/stability.md are rewritten between their markers; the text around them
+(the reading of the numbers) is kept:
+
+- `cvode-order`: the measurements behind CVODE's default maximum order: the light-damping
+  and undamped paper scenes (n = 30) and the steel wire at CVODE max_order 2 .. 5, with and
+  without stability-limit detection, and MEBDF at its default for comparison;
+- `hard-scenes`: one table per hard scene (solver, settings, steps, CPU time, energy-balance
+  error, energy growth, max tip speed, outcome).
+
+Horizons are chosen so that the whole report takes under 20 minutes on 2 cores
+(`--jobs 2`, the default); `--quick` divides every horizon by 10 for a smoke run (no file written unless
+`--write` is given). Measures: scripts/stability_metrics.py.
+"""
+import argparse
+import concurrent.futures
+import datetime
+import os
+import pathlib
+import platform
+import re
+import subprocess
+import sys
+import tempfile
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import stability_metrics  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+DOC = ROOT / "docs" / "stability.md"
+HARD = ROOT / "input" / "hard"
+
+# (label, scene file, horizon in s, extra --set overrides)
+ORDER_SCENES = [
+    ("paper_light_damping (n = 30)", ROOT / "input" / "paper_light_damping.nml", 5.0, []),
+    ("undamped (n = 30)", HARD / "undamped.nml", 5.0, []),
+    ("steel_wire (n = 30)", HARD / "steel_wire.nml", 0.1, []),
+]
+# (label, overrides) of the order study: CVODE orders with and without STALD, MEBDF default
+ORDER_SETTINGS = (
+    [(f"cvode {k}", ["solver.method=cvode", f"solver.max_order={k}",
+                     "solver.stability_limit_detection=F"]) for k in (2, 3, 4, 5)]
+    + [(f"cvode {k} + STALD", ["solver.method=cvode", f"solver.max_order={k}",
+                               "solver.stability_limit_detection=T"]) for k in (3, 4, 5)]
+    + [("mebdf 4 (default)", ["solver.method=mebdf", "solver.max_order=0"])])
+
+# Hard scenes: (scene, horizon in s, settings). The settings are the defaults of both
+# solvers and the alternatives studied where they are affordable.
+DEFAULTS = [("cvode (default: max order 5)", ["solver.method=cvode"]),
+            ("mebdf (default: max order 4)", ["solver.method=mebdf"])]
+CVODE2 = [("cvode, max_order = 2", ["solver.method=cvode", "solver.max_order=2"])]
+STALD = [("cvode + stability_limit_detection", ["solver.method=cvode",
+                                                "solver.stability_limit_detection=T"])]
+HARD_SCENES = [
+    ("steel_wire", 1.0, DEFAULTS + CVODE2 + STALD),
+    ("undamped", 5.0, DEFAULTS),
+    ("light_damping", 5.0, DEFAULTS),
+    ("no_bending", 2.0, DEFAULTS),
+    ("thin_thread", 2.0, DEFAULTS),
+    ("long_rope", 10.0, DEFAULTS),
+    ("whip", 1.5, DEFAULTS),
+    ("clamped_taut", 1.0, DEFAULTS + CVODE2),
+    ("mpp_light_damping", 5.0, DEFAULTS),
+    ("elements_1000", 0.2, DEFAULTS + CVODE2),
+    ("elements_3000", 0.05, DEFAULTS + CVODE2),
+]
+
+
+def machine():
+    cpu = "unknown CPU"
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
+
+
+def run(exe, scene, t_end, overrides, out, timeout):
+    """Run one case; return the measures (or the reason it gave no file)."""
+    cmd = [str(exe), "run", str(scene), "--set", f"solver.t_end={t_end}",
+           "--set", f"output.file={out}"]
+    for o in overrides:
+        cmd += ["--set", o]
+    try:
+        res = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return {"outcome": f"killed after {timeout} s wall time"}
+    if not out.exists():
+        return {"outcome": f"no output (exit {res.returncode}): {res.stderr.strip()}"}
+    m = stability_metrics.analyse(out)
+    bad = stability_metrics.all_finite(out)
+    if m["status"] == "complete" and res.returncode == 0:
+        outcome = "complete"
+    else:
+        outcome = f"failed (exit {res.returncode}) at t = {m['t_reached']:.4g} s: {m['reason']}"
+    if bad:
+        outcome += f"; NON-FINITE data in {', '.join(bad)}"
+    m["outcome"] = outcome
+    out.unlink()
+    return m
+
+
+def run_all(exe, cases, jobs, timeout):
+    """cases: list of (key, scene, t_end, overrides); returns {key: measures}."""
+    results = {}
+    with tempfile.TemporaryDirectory() as tmp, \
+            concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = {}
+        for i, (key, scene, t_end, overrides) in enumerate(cases):
+            out = pathlib.Path(tmp) / f"case{i}.h5"
+            futures[pool.submit(run, exe, scene, t_end, overrides, out, timeout)] = key
+        for fut in concurrent.futures.as_completed(futures):
+            key = futures[fut]
+            results[key] = fut.result()
+            r = results[key]
+            print(f"  {key}: {r['outcome']}"
+                  + (f", {r['steps']} steps, {r['cpu_time']:.2f} s" if "steps" in r else ""),
+                  flush=True)
+    return results
+
+
+def fmt(x, spec):
+    return "" if x is None else format(x, spec)
+
+
+def order_table(results, scale):
+    lines = []
+    for label, scene, t_end, _ in ORDER_SCENES:
+        lines.append(f"**{label}**, {t_end * scale:g} s, rtol 1e-6, atol 1e-8\n")
+        lines.append("| solver, max order | steps | error-test fails | CPU (s) | "
+                     "energy-balance error (J) | final balance B-E0 (J) | energy growth (J) | "
+                     "final T+V-E0 (J) | outcome |")
+        lines.append("|---|---|---|---|---|---|---|---|---|")
+        for slabel, _ in ORDER_SETTINGS:
+            r = results[(label, slabel)]
+            if "steps" not in r:
+                lines.append(f"| {slabel} |  |  |  |  |  |  |  | {r['outcome']} |")
+                continue
+            final = r["mech"][-1] - r["mech"][0]
+            lines.append(
+                f"| {slabel} | {r['steps']} | {r['err_test_fails']} | "
+                f"{fmt(r['cpu_time'], '.2f')} | {r['balance_error']:.1e} | "
+                f"{r['balance_drift'][-1]:+.1e} | {r['energy_growth']:.1e} | {final:.2e} | "
+                f"{short(r['outcome'])} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def short(outcome):
+    return outcome if len(outcome) < 160 else outcome[:157] + "..."
+
+
+def hard_tables(results, scale):
+    lines = []
+    for scene in dict.fromkeys(s for s, _, _ in HARD_SCENES):
+        text = (HARD / f"{scene}.nml").read_text()
+        header = []
+        for line in text.splitlines():
+            if not line.startswith("!"):
+                break
+            header.append(line[1:].strip())
+        what = " ".join(header)[len("HARD: "):]
+        lines.append(f"### {scene}\n")
+        lines.append(f"`input/hard/{scene}.nml`: {what}\n")
+        lines.append("| solver, settings | horizon (s) | steps | error-test fails | CPU (s) | "
+                     "energy-balance error (J) | error / (rtol S) | energy growth (J) | "
+                     "max tip speed (m/s) | outcome |")
+        lines.append("|---|---|---|---|---|---|---|---|---|---|")
+        for s, t_end, settings in HARD_SCENES:
+            if s != scene:
+                continue
+            for slabel, _ in settings:
+                r = results[(s, t_end, slabel)]
+                if "steps" not in r:
+                    lines.append(f"| {slabel} | {t_end * scale:g} |  |  |  |  |  |  |  | "
+                                 f"{r['outcome']} |")
+                    continue
+                ratio = r["balance_error"] / (r["rtol"] * r["energy_scale"])
+                if r["bottom_free"]:
+                    speed, where = r["tip_speed"], ""
+                else:
+                    speed, where = r["mid_speed"], " (midpoint)"
+                k = int(speed.argmax())
+                lines.append(
+                    f"| {slabel} | {r['t_reached']:.4g} | {r['steps']} | {r['err_test_fails']} | "
+                    f"{fmt(r['cpu_time'], '.2f')} | {r['balance_error']:.1e} | {ratio:.2g} | "
+                    f"{r['energy_growth']:.1e} | {speed[k]:.3g} at {r['time'][k]:.3g} s{where} | "
+                    f"{short(r['outcome'])} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def replace_section(text, name, body):
+    begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
+    pattern = re.compile(re.escape(begin) + ".*?" + re.escape(end), re.S)
+    if not pattern.search(text):
+        raise SystemExit(f"{DOC}: markers {begin} ... {end} not found")
+    return pattern.sub(lambda _: f"{begin}\n{body}\n{end}", text)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--exe", required=True)
+    parser.add_argument("--jobs", type=int, default=2, help="runs at a time (default 2)")
+    parser.add_argument("--only", choices=["cvode-order", "hard-scenes"], default=None)
+    parser.add_argument("--quick", action="store_true", help="horizons / 10, no file written")
+    parser.add_argument("--write", action="store_true", help="write docs/stability.md "
+                        "even with --quick")
+    parser.add_argument("--no-write", action="store_true", help="print only")
+    parser.add_argument("--timeout", type=float, default=1200.0, help="wall time per run (s)")
+    args = parser.parse_args(argv)
+    scale = 0.1 if args.quick else 1.0
+    write = not args.no_write and (args.write or not args.quick)
+    started = datetime.datetime.now(datetime.timezone.utc)
+    stamp = (f"Machine: {machine()}. Run: {started:%Y-%m-%d %H:%M} UTC, "
+             f"--jobs {args.jobs}.")
+    command = "Command: `scripts/stability_report" + (" --quick" if args.quick else "") + "`"
+    sections = {}
+
+    if args.only in (None, "cvode-order"):
+        cases = [((label, slabel), scene, t_end * scale, ov + sov)
+                 for label, scene, t_end, ov in ORDER_SCENES
+                 for slabel, sov in ORDER_SETTINGS]
+        # the slow ones (low orders) first, so that the workers finish together
+        cases.sort(key=lambda c: not re.search(r"cvode [23]", c[0][1]))
+        print("CVODE order study:", flush=True)
+        res = run_all(args.exe, cases, args.jobs, args.timeout)
+        sections["cvode-order"] = (
+            f"{command} (Release build). {stamp}\n\n"
+            "Energy-balance error: max |B - E0| with B = T+V+dissipated; final balance: B - E0 "
+            "at the end, signed (positive: the integrator created energy, negative: it damped "
+            "some numerically); energy growth: the largest rise of T+V above an earlier value "
+            "(with damping on any rise beyond the integration error is an instability); final "
+            "T+V-E0: the mechanical energy lost (dissipated, or damped numerically) or gained."
+            "\n\n" + order_table(res, scale))
+        print(sections["cvode-order"])
+
+    if args.only in (None, "hard-scenes"):
+        cases = [((s, t_end, slabel), HARD / f"{s}.nml", t_end * scale, sov)
+                 for s, t_end, settings in HARD_SCENES for slabel, sov in settings]
+        slow = ["steel_wire", "long_rope", "light_damping", "undamped", "elements_3000"]
+        cases.sort(key=lambda c: slow.index(c[0][0]) if c[0][0] in slow else len(slow))
+        print("Hard scenes:", flush=True)
+        res = run_all(args.exe, cases, args.jobs, args.timeout)
+        sections["hard-scenes"] = (
+            f"{command} (Release build). {stamp}\n\n"
+            "rtol 1e-6, atol 1e-8 (the scenes' solver settings) unless stated; S is the "
+            "energy scale (max T + max elastic + gravity range + dissipated); max tip speed: "
+            "of the free end at the output times (of the midpoint for clamped_taut, held at "
+            "both ends).\n\n"
+            + hard_tables(res, scale))
+        print(sections["hard-scenes"])
+
+    elapsed = datetime.datetime.now(datetime.timezone.utc) - started
+    print(f"elapsed: {elapsed.total_seconds():.0f} s")
+    if write:
+        text = DOC.read_text()
+        for name, body in sections.items():
+            text = replace_section(text, name, body)
+        DOC.write_text(text)
+        print(f"wrote {DOC}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,124 @@
+!> External effects acting on the bodies of a rope model (RFEM elements, MPP rods).
+!!
+!! A body is a rigid segment: centre c (m), angle phi (rad) from the x axis (down) towards y,
+!! centre velocity v (m/s), angular velocity w (rad/s), length l (m); unit vectors
+!! e = (cos phi, sin phi) along it and n = (-sin phi, cos phi) across it. An effect adds to
+!! the force (2) and moment (1, about the centre) of each body it acts on; it reports its
+!! potential energy (e.g. contact springs), the rate at which it dissipates energy and the
+!! rate at which it does external work (e.g. a current or a prescribed load), so that
+!!     T + V + dissipated - external work = E0
+!! holds with these terms included; and, for RFEM's analytic Jacobian, the 3x6 block of the
+!! derivatives of each body's (Fx, Fy, M) with respect to its own (x, y, phi, vx, vy, w).
+!! Every effect here acts on each body separately, so the blocks keep RFEM's band.
+!!
+!! A model holds only the effects a scene enables (`effect_box_t` array): an effect that is
+!! off is not allocated and costs nothing.
+module ropedyn_effect
+    use ropedyn_kinds, only: wp
+    implicit none
+    private
+    public :: body_effect_t, effect_box_t, bodies_t, point_force_block
+
+    !> Kinematics of all bodies of a model at one instant.
+    type :: bodies_t
+        integer :: n = 0
+        real(wp), allocatable :: c(:, :)    !< centres (2, n), m
+        real(wp), allocatable :: phi(:)     !< angles (n), rad
+        real(wp), allocatable :: v(:, :)    !< centre velocities (2, n), m/s
+        real(wp), allocatable :: w(:)       !< angular velocities (n), rad/s
+        real(wp), allocatable :: l(:)       !< lengths (n), m
+    end type bodies_t
+
+    type, abstract :: body_effect_t
+    contains
+        procedure(name_i), deferred :: name
+        procedure(add_forces_i), deferred :: add_forces
+        procedure(add_jacobian_i), deferred :: add_jacobian
+        procedure :: energy => effect_energy
+        procedure :: power => effect_power
+        procedure :: does_work => effect_does_work
+    end type body_effect_t
+
+    !> A container, so that a model can hold an array of different effects.
+    type :: effect_box_t
+        class(body_effect_t), allocatable :: e
+    end type effect_box_t
+
+    abstract interface
+        pure function name_i(self) result(name)
+            import :: body_effect_t
+            class(body_effect_t), intent(in) :: self
+            character(len=:), allocatable :: name
+        end function name_i
+
+        !> Add the effect's forces f(2, n) (N) and moments m(n) (N m) on the bodies at time t.
+        pure subroutine add_forces_i(self, t, b, f, m)
+            import :: body_effect_t, bodies_t, wp
+            class(body_effect_t), intent(in) :: self
+            real(wp), intent(in) :: t
+            type(bodies_t), intent(in) :: b
+            real(wp), intent(inout) :: f(:, :), m(:)
+        end subroutine add_forces_i
+
+        !> Add d(Fx, Fy, M)/d(x, y, phi, vx, vy, w) of each body into jac(3, 6, n).
+        pure subroutine add_jacobian_i(self, t, b, jac)
+            import :: body_effect_t, bodies_t, wp
+            class(body_effect_t), intent(in) :: self
+            real(wp), intent(in) :: t
+            type(bodies_t), intent(in) :: b
+            real(wp), intent(inout) :: jac(:, :, :)
+        end subroutine add_jacobian_i
+    end interface
+
+contains
+
+    !> Potential energy of the effect, J (default: none).
+    pure real(wp) function effect_energy(self, t, b) result(e)
+        class(body_effect_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        e = 0.0_wp
+    end function effect_energy
+
+    !> Add the dissipation rate (W, >= 0: energy the effect takes out of the rope for good)
+    !! and the external power (W: work rate of an outside agent on the rope) at time t.
+    pure subroutine effect_power(self, t, b, dissipation, work)
+        class(body_effect_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp), intent(inout) :: dissipation, work
+    end subroutine effect_power
+
+    !> True when the effect can do external work (then the model integrates it).
+    pure logical function effect_does_work(self) result(does)
+        class(body_effect_t), intent(in) :: self
+        does = .false.
+    end function effect_does_work
+
+    !> Block (3, 6) of a force F acting at the point X = c + r e of a body, with velocity
+    !! V = v + r w n, for the force's derivatives dfdx = dF/dX and dfdv = dF/dV (2, 2):
+    !! d(F, M)/d(c, phi, v, w) with M = r e x F (moment about the centre).
+    pure function point_force_block(r, phi, w, f, dfdx, dfdv) result(blk)
+        real(wp), intent(in) :: r            !< offset of the point along the body, m
+        real(wp), intent(in) :: phi, w       !< body angle (rad) and angular velocity (rad/s)
+        real(wp), intent(in) :: f(2)         !< the force, N
+        real(wp), intent(in) :: dfdx(2, 2), dfdv(2, 2)
+        real(wp) :: blk(3, 6)
+        real(wp) :: e(2), nv(2), dfdphi(2), dfdw(2)
+        integer :: l
+        e = [cos(phi), sin(phi)]
+        nv = [-e(2), e(1)]
+        ! dX/dphi = r n, dV/dphi = -r w e, dV/dw = r n
+        dfdphi = matmul(dfdx, r*nv) - matmul(dfdv, r*w*e)
+        dfdw = matmul(dfdv, r*nv)
+        blk(1:2, 1:2) = dfdx
+        blk(1:2, 3) = dfdphi
+        blk(1:2, 4:5) = dfdv
+        blk(1:2, 6) = dfdw
+        ! M = r (e_x F_y - e_y F_x); dM = r (e x dF) + dphi r (n x F)
+        do l = 1, 6
+            blk(3, l) = r*(e(1)*blk(2, l) - e(2)*blk(1, l))
+        end do
+        blk(3, 3) = blk(3, 3) + r*(nv(1)*f(2) - nv(2)*f(1))
+    end function point_force_block
+end module ropedyn_effect

@@ -1,0 +1,115 @@
+!> Builds the external effects a scene enables, for a model whose bodies tile the rope:
+!! body i covers the arc lengths [s_i, s_i + l_i] of the unstretched rope from its top end.
+!! Only enabled effects are allocated (docs/input.md, `&effects`).
+module ropedyn_effect_factory
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
+    use ropedyn_kinds, only: wp
+    use ropedyn_scene, only: scene_t, N_ATTACH
+    use ropedyn_effect, only: effect_box_t
+    use ropedyn_effect_drag, only: drag_effect
+    use ropedyn_effect_ground, only: ground_effect
+    use ropedyn_effect_loads, only: loads_effect_t, point_load_t
+    implicit none
+    private
+    public :: build_body_effects, locate_on_bodies, attached_masses
+
+    real(wp), parameter :: pi = acos(-1.0_wp)
+
+contains
+
+    !> The body containing arc length s (m) and the offset r (m) of that point from the
+    !! body's centre along the body. A point on a joint belongs to the body below it (the
+    !! last body for s = L).
+    pure subroutine locate_on_bodies(lengths, s, body, r)
+        real(wp), intent(in) :: lengths(:)
+        real(wp), intent(in) :: s
+        integer, intent(out) :: body
+        real(wp), intent(out) :: r
+        real(wp) :: start
+        integer :: i
+        start = 0.0_wp
+        body = size(lengths)
+        do i = 1, size(lengths)
+            if (s < start + lengths(i) .or. i == size(lengths)) then
+                body = i
+                exit
+            end if
+            start = start + lengths(i)
+        end do
+        r = s - (start + 0.5_wp*lengths(body))
+    end subroutine locate_on_bodies
+
+    !> The effects of a scene acting on bodies of the given lengths (m): drag, ground contact,
+    !! point loads, each only when enabled and given.
+    subroutine build_body_effects(scene, lengths, effects)
+        type(scene_t), intent(in) :: scene
+        real(wp), intent(in) :: lengths(:)
+        type(effect_box_t), allocatable, intent(out) :: effects(:)
+        type(loads_effect_t) :: loads
+        integer :: n_eff, k, m
+        logical :: with_loads
+
+        with_loads = .false.
+        if (scene%effects%point_loads) &
+            with_loads = any(.not. ieee_is_nan(scene%attachments%load_positions))
+        n_eff = count([scene%effects%drag, scene%effects%ground, with_loads])
+        allocate (effects(n_eff))
+        k = 0
+        if (scene%effects%drag) then
+            k = k + 1
+            associate (f => scene%fluid)
+                allocate (effects(k)%e, source=drag_effect(f%density, &
+                    f%normal_drag_coefficient, f%tangential_drag_coefficient, &
+                    f%linear_normal_drag, f%linear_tangential_drag, f%current, &
+                    scene%rope%diameter))
+            end associate
+        end if
+        if (scene%effects%ground) then
+            k = k + 1
+            associate (g => scene%ground)
+                allocate (effects(k)%e, source=ground_effect(g%point, g%normal, g%stiffness, &
+                    g%damping, g%friction_coefficient, g%friction_regularization_speed))
+            end associate
+        end if
+        if (with_loads) then
+            k = k + 1
+            associate (a => scene%attachments)
+                allocate (loads%loads(count(.not. ieee_is_nan(a%load_positions))))
+                m = 0
+                do k = 1, N_ATTACH
+                    if (ieee_is_nan(a%load_positions(k))) cycle
+                    m = m + 1
+                    call locate_on_bodies(lengths, a%load_positions(k), loads%loads(m)%body, &
+                                          loads%loads(m)%r)
+                    loads%loads(m)%f0 = [a%load_force_x(k), a%load_force_y(k)]
+                    loads%loads(m)%amplitude = [a%load_amplitude_x(k), a%load_amplitude_y(k)]
+                    loads%loads(m)%omega = 2.0_wp*pi*a%load_frequency(k)
+                    loads%loads(m)%phase = a%load_phase_deg(k)*pi/180.0_wp
+                end do
+            end associate
+            allocate (effects(n_eff)%e, source=loads)
+        end if
+    end subroutine build_body_effects
+
+    !> The point masses of a scene (none when `&effects point_masses` is off): for each, the
+    !! body, the offset r (m) from the body's centre along it, and the mass (kg).
+    subroutine attached_masses(scene, lengths, body, r, mass)
+        type(scene_t), intent(in) :: scene
+        real(wp), intent(in) :: lengths(:)
+        integer, allocatable, intent(out) :: body(:)
+        real(wp), allocatable, intent(out) :: r(:), mass(:)
+        integer :: k, m, n
+        n = 0
+        if (scene%effects%point_masses) &
+            n = count(.not. ieee_is_nan(scene%attachments%mass_positions))
+        allocate (body(n), r(n), mass(n))
+        m = 0
+        if (n == 0) return
+        do k = 1, N_ATTACH
+            if (ieee_is_nan(scene%attachments%mass_positions(k))) cycle
+            m = m + 1
+            call locate_on_bodies(lengths, scene%attachments%mass_positions(k), body(m), r(m))
+            mass(m) = scene%attachments%masses(k)
+        end do
+    end subroutine attached_masses
+end module ropedyn_effect_factory

@@ -1,0 +1,192 @@
+!> Contact of the rope with a ground plane (docs/physics-rfem.md, "Ground contact").
+!!
+!! The plane passes through p0 with unit normal n_g pointing to the free side. Contact acts
+!! at both end points X = c +- (l/2) e of each body, each point standing for half the body's
+!! length: stiffness k_p = k l/2, damping c_p = c l/2 (k in N/m per metre of rope, c in
+!! N s/m per metre). With the penetration delta = -(X - p0) . n_g > 0 and its rate
+!! delta' = -V . n_g (V the point's velocity), the normal force is
+!!     F_N = max(0, k_p delta + c_p delta'),
+!! and regularized Coulomb friction acts along the tangent t_g = (-n_g2, n_g1):
+!!     F_T = -mu F_N tanh(v_t / v_reg),  v_t = V . t_g.
+!! The contact springs store V_c = sum k_p delta^2/2 (in the elastic energy); the
+!! dissipation rate is (F_N - k_p delta) delta' + mu F_N tanh(v_t/v_reg) v_t >= 0.
+module ropedyn_effect_ground
+    use ropedyn_kinds, only: wp
+    use ropedyn_effect, only: body_effect_t, bodies_t, point_force_block
+    implicit none
+    private
+    public :: ground_effect_t, ground_effect
+
+    type, extends(body_effect_t) :: ground_effect_t
+        private
+        real(wp) :: p0(2) = 0.0_wp       !< a point of the plane, m
+        real(wp) :: ng(2) = [-1.0_wp, 0.0_wp]  !< unit normal to the free side
+        real(wp) :: tg(2) = [0.0_wp, -1.0_wp]  !< unit tangent
+        real(wp) :: k = 0.0_wp           !< stiffness per length, N/m^2
+        real(wp) :: c = 0.0_wp           !< damping per length, N s/m^2
+        real(wp) :: mu = 0.0_wp          !< friction coefficient
+        real(wp) :: v_reg = 1.0e-3_wp    !< regularization speed, m/s
+    contains
+        procedure :: name => ground_name
+        procedure :: add_forces => ground_add_forces
+        procedure :: add_jacobian => ground_add_jacobian
+        procedure :: energy => ground_energy
+        procedure :: power => ground_power
+        procedure :: total_normal_force => ground_total_normal_force
+    end type ground_effect_t
+
+contains
+
+    !> Ground through point p0 (m) with normal `normal` (any length > 0, towards the free
+    !! side), stiffness k (N/m^2), damping c (N s/m^2), friction coefficient mu and
+    !! regularization speed v_reg (m/s).
+    pure function ground_effect(p0, normal, k, c, mu, v_reg) result(eff)
+        real(wp), intent(in) :: p0(2), normal(2), k, c, mu, v_reg
+        type(ground_effect_t) :: eff
+        eff%p0 = p0
+        eff%ng = normal/norm2(normal)
+        eff%tg = [-eff%ng(2), eff%ng(1)]
+        eff%k = k
+        eff%c = c
+        eff%mu = mu
+        eff%v_reg = v_reg
+    end function ground_effect
+
+    pure function ground_name(self) result(name)
+        class(ground_effect_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'ground'
+    end function ground_name
+
+    !> Contact at the point of body i at offset r: penetration, its rate, normal force,
+    !! tangential speed and the force vector (zero when not in contact).
+    pure subroutine contact(self, b, i, r, delta, ddelta, fn, vt, th, f)
+        class(ground_effect_t), intent(in) :: self
+        type(bodies_t), intent(in) :: b
+        integer, intent(in) :: i
+        real(wp), intent(in) :: r
+        real(wp), intent(out) :: delta, ddelta, fn, vt, th, f(2)
+        real(wp) :: e(2), nv(2), x(2), v(2), kp, cp
+        e = [cos(b%phi(i)), sin(b%phi(i))]
+        nv = [-e(2), e(1)]
+        x = b%c(:, i) + r*e
+        delta = -dot_product(x - self%p0, self%ng)
+        fn = 0.0_wp
+        ddelta = 0.0_wp
+        vt = 0.0_wp
+        th = 0.0_wp
+        f = 0.0_wp
+        if (delta <= 0.0_wp) return
+        v = b%v(:, i) + r*b%w(i)*nv
+        ddelta = -dot_product(v, self%ng)
+        kp = 0.5_wp*self%k*b%l(i)
+        cp = 0.5_wp*self%c*b%l(i)
+        fn = kp*delta + cp*ddelta
+        if (fn <= 0.0_wp) then
+            fn = 0.0_wp
+            return
+        end if
+        vt = dot_product(v, self%tg)
+        th = tanh(vt/self%v_reg)
+        f = fn*(self%ng - self%mu*th*self%tg)
+    end subroutine contact
+
+    pure subroutine ground_add_forces(self, t, b, f, m)
+        class(ground_effect_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp), intent(inout) :: f(:, :), m(:)
+        real(wp) :: delta, ddelta, fn, vt, th, fp(2), r, e(2)
+        integer :: i, s
+        do i = 1, b%n
+            do s = -1, 1, 2
+                r = 0.5_wp*real(s, wp)*b%l(i)
+                call contact(self, b, i, r, delta, ddelta, fn, vt, th, fp)
+                if (fn <= 0.0_wp) cycle
+                e = [cos(b%phi(i)), sin(b%phi(i))]
+                f(:, i) = f(:, i) + fp
+                m(i) = m(i) + r*(e(1)*fp(2) - e(2)*fp(1))
+            end do
+        end do
+    end subroutine ground_add_forces
+
+    pure subroutine ground_add_jacobian(self, t, b, jac)
+        class(ground_effect_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp), intent(inout) :: jac(:, :, :)
+        real(wp) :: delta, ddelta, fn, vt, th, fp(2), r, kp, cp, dir(2), dfdx(2, 2), dfdv(2, 2)
+        integer :: i, s, p
+        do i = 1, b%n
+            do s = -1, 1, 2
+                r = 0.5_wp*real(s, wp)*b%l(i)
+                call contact(self, b, i, r, delta, ddelta, fn, vt, th, fp)
+                if (fn <= 0.0_wp) cycle
+                kp = 0.5_wp*self%k*b%l(i)
+                cp = 0.5_wp*self%c*b%l(i)
+                dir = self%ng - self%mu*th*self%tg
+                ! dF_N/dX = -k_p n_g, dF_N/dV = -c_p n_g; d tanh/dV = (1 - th^2)/v_reg t_g
+                do p = 1, 2
+                    dfdx(:, p) = -kp*dir*self%ng(p)
+                    dfdv(:, p) = -cp*dir*self%ng(p) - self%mu*fn*(1.0_wp - th**2)/self%v_reg &
+                                 *self%tg*self%tg(p)
+                end do
+                jac(:, :, i) = jac(:, :, i) + point_force_block(r, b%phi(i), b%w(i), fp, &
+                                                                dfdx, dfdv)
+            end do
+        end do
+    end subroutine ground_add_jacobian
+
+    pure real(wp) function ground_energy(self, t, b) result(e)
+        class(ground_effect_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp) :: x(2), delta, r
+        integer :: i, s
+        e = 0.0_wp
+        do i = 1, b%n
+            do s = -1, 1, 2
+                r = 0.5_wp*real(s, wp)*b%l(i)
+                x = b%c(:, i) + r*[cos(b%phi(i)), sin(b%phi(i))]
+                delta = -dot_product(x - self%p0, self%ng)
+                if (delta > 0.0_wp) e = e + 0.25_wp*self%k*b%l(i)*delta**2
+            end do
+        end do
+    end function ground_energy
+
+    pure subroutine ground_power(self, t, b, dissipation, work)
+        class(ground_effect_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp), intent(inout) :: dissipation, work
+        real(wp) :: delta, ddelta, fn, vt, th, fp(2), r
+        integer :: i, s
+        do i = 1, b%n
+            do s = -1, 1, 2
+                r = 0.5_wp*real(s, wp)*b%l(i)
+                call contact(self, b, i, r, delta, ddelta, fn, vt, th, fp)
+                if (delta <= 0.0_wp) cycle
+                ! F_N = 0 when separating faster than the spring relaxes: then the spring's
+                ! energy still falls at -k_p delta delta' > 0 (th = 0 there)
+                dissipation = dissipation + (fn - 0.5_wp*self%k*b%l(i)*delta)*ddelta &
+                              + self%mu*fn*th*vt
+            end do
+        end do
+    end subroutine ground_power
+
+    !> Sum of the normal contact forces on all bodies, N (a diagnostic).
+    pure real(wp) function ground_total_normal_force(self, b) result(total)
+        class(ground_effect_t), intent(in) :: self
+        type(bodies_t), intent(in) :: b
+        real(wp) :: delta, ddelta, fn, vt, th, fp(2)
+        integer :: i, s
+        total = 0.0_wp
+        do i = 1, b%n
+            do s = -1, 1, 2
+                call contact(self, b, i, 0.5_wp*real(s, wp)*b%l(i), delta, ddelta, fn, vt, &
+                             th, fp)
+                total = total + fn
+            end do
+        end do
+    end function ground_total_normal_force
+end module ropedyn_effect_ground

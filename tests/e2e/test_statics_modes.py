@@ -1,0 +1,131 @@
+"""`ropedyn statics` and `ropedyn modes`: exit codes, printed summary, HDF5 layout (every
+dataset with units), errors; `&initial shape = 'equilibrium'` starts a run at rest."""
+import h5py
+import numpy as np
+import pytest
+
+HANGING = ("&model kind = '{kind}', elements = {n} /\n"
+           "&initial shape = 'hanging' /\n"
+           "&effects bending = .false. /\n")
+CATENARY = ("&model kind = '{kind}', elements = {n} /\n"
+            "&supports bottom = 'pinned', bottom_anchor = 0.0, 0.8,"
+            " support_stiffness_factor = 100.0 /\n"
+            "&initial shape = 'hanging' /\n"
+            "&effects bending = .false. /\n")
+
+
+def datasets(f):
+    out = {}
+    f.visititems(lambda name, obj: out.setdefault(name, obj) if isinstance(obj, h5py.Dataset)
+                 else None)
+    return out
+
+
+@pytest.mark.parametrize("kind", ["rfem", "mpp"])
+def test_statics_file(run, tmp_path, kind):
+    n = 12
+    (tmp_path / "cat.nml").write_text(CATENARY.format(kind=kind, n=n))
+    result = run("statics", "cat.nml")
+    assert result.returncode == 0, result.stderr
+    assert "equilibrium" in result.stdout and "out/cat_statics.h5" in result.stdout
+    with h5py.File(tmp_path / "out" / "cat_statics.h5") as f:
+        assert f.attrs["status"] == b"complete" and f.attrs["analysis"] == b"statics"
+        assert f.attrs["model"].decode() == kind
+        assert "&supports" in f.attrs["scene"].decode()
+        for name, d in datasets(f).items():
+            assert "units" in d.attrs, name
+        assert f["rope/points"].shape == (1, 2 * n, 2)
+        assert f["state/q"].shape == (1, n, 3)
+        assert f["statics/residual_relative"][()] < 1e-8
+        top, bottom = f["statics/support_force_top"][:], f["statics/support_force_bottom"][:]
+        weight = f["statics/weight"][()]
+        assert abs(-(top[0] + bottom[0]) - weight) < 1e-9
+        assert abs(top[1] + bottom[1]) < 1e-9
+        sag = f["rope/points"][0, :, 0].max()
+        assert abs(sag / 0.265999 - 1) < 0.02, sag       # coarse n: 2 %
+
+
+def test_modes_file(run, tmp_path):
+    n = 20
+    (tmp_path / "hang.nml").write_text(HANGING.format(kind="rfem", n=n))
+    result = run("modes", "hang.nml", "--count", "5", "-o", "m.h5")
+    assert result.returncode == 0, result.stderr
+    rows = [line for line in result.stdout.splitlines() if line.strip()[:1].isdigit()]
+    assert len(rows) == 5, result.stdout
+    with h5py.File(tmp_path / "m.h5") as f:
+        assert f.attrs["analysis"] == b"modes"
+        for name, d in datasets(f).items():
+            assert "units" in d.attrs, name
+        omega = f["modes/omega"][:]
+        assert f["modes/omega"].attrs["units"] == b"rad/s"
+        assert omega.shape == (5,) and np.all(np.diff(omega) > 0)
+        assert abs(omega[0] / 3.766067 - 1) < 0.01
+        assert np.allclose(f["modes/period"][:], 2 * np.pi / omega)
+        assert np.allclose(f["modes/frequency_hz"][:], omega / (2 * np.pi))
+        shape = f["modes/shape"][:]
+        assert shape.shape == (5, 3 * n)
+        assert np.allclose(np.abs(shape).max(axis=1), 1.0)
+        assert f["modes/shape_points"].shape == (5, 2 * n, 2)
+        assert np.all(f["modes/axial_fraction"][:] < 0.01)
+        assert f["modes/stiffness_asymmetry"][()] < 1e-8
+
+
+def test_initial_equilibrium_run(run, tmp_path):
+    """A run started at the equilibrium stays at rest: no swing, no axial ringing."""
+    (tmp_path / "eq.nml").write_text(
+        "&model kind = 'rfem', elements = 10 /\n"
+        "&initial shape = 'equilibrium', angle_deg = 30.0 /\n"
+        "&solver t_end = 0.05, output_interval = 0.01 /\n")
+    result = run("run", "eq.nml")
+    assert result.returncode == 0, result.stderr
+    with h5py.File(tmp_path / "out" / "eq.h5") as f:
+        assert "shape = 'equilibrium'" in f.attrs["scene"].decode()
+        q, qdot = f["state/q"][:], f["state/qdot"][:]
+        kinetic = f["energy/kinetic"][:]
+    assert np.max(np.abs(q[0, :, 1])) < 1e-12, "the equilibrium hangs vertically"
+    assert np.max(np.abs(qdot)) < 1e-6
+    assert np.max(kinetic) < 1e-12
+
+
+@pytest.mark.parametrize("args,code,fragments", [
+    (["statics"], 2, ["needs a scene file"]),
+    (["statics", "s.nml", "--count", "3"], 2, ["--count"]),
+    (["modes", "s.nml", "--count", "0"], 2, ["--count", "0"]),
+    (["modes", "s.nml", "--bogus"], 2, ["--bogus"]),
+    (["modes", "missing.nml"], 2, ["missing.nml"]),
+    (["statics", "s.nml", "-o", "/proc/x.h5"], 4, ["/proc/x.h5"]),
+])
+def test_usage_errors(run, tmp_path, args, code, fragments):
+    (tmp_path / "s.nml").write_text(HANGING.format(kind="rfem", n=4))
+    result = run(*args)
+    assert result.returncode == code, result.stderr
+    assert result.stderr.startswith("ropedyn: error: ")
+    for fragment in fragments:
+        assert fragment in result.stderr, result.stderr
+
+
+def test_no_equilibrium(run, tmp_path):
+    (tmp_path / "ff.nml").write_text("&model kind = 'rfem', elements = 6 /\n"
+                                     "&supports top = 'free', bottom = 'free' /\n")
+    for command in ("statics", "modes", "run"):
+        if command == "run":
+            (tmp_path / "ff.nml").write_text(
+                "&model kind = 'rfem', elements = 6 /\n"
+                "&supports top = 'free', bottom = 'free' /\n"
+                "&initial shape = 'equilibrium' /\n")
+        result = run(command, "ff.nml")
+        assert result.returncode == 3, (command, result.stderr)
+        assert "no equilibrium" in result.stderr and "free" in result.stderr
+
+
+def test_no_convergence(run, tmp_path):
+    (tmp_path / "s.nml").write_text("&model kind = 'rfem', elements = 10 /\n")
+    result = run("statics", "s.nml", "--max-iterations", "2")
+    assert result.returncode == 3, result.stderr
+    assert "no convergence in 2 iterations" in result.stderr
+
+
+def test_help(run):
+    for command in ("statics", "modes"):
+        result = run(command, "--help")
+        assert result.returncode == 0 and "usage: ropedyn " + command in result.stdout

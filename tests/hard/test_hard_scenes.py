@@ -1,0 +1,147 @@
+"""The stiff-case suite: every hard scene of input/hard, with both solvers at their defaults,
+keeps the guarantees of docs/stability.md:
+
+1. it completes within its step budget (`&solver max_steps`), or it fails with exit code 3,
+   status 'failed' and a reason naming the time, the step size and the cause;
+2. no NaN or Inf reaches the output (every float dataset is finite);
+3. energy balance: |T + V + dissipated - support work - E0| <= C_E rtol S at every record;
+4. the two solvers agree on the tip position within C_X rtol L over the horizon;
+5. with damping on (and fixed supports) T + V never rises by more than C_E rtol S, and the
+   dissipated energy never falls by more than that.
+
+S is the energy scale of the run (scripts/stability_metrics.py: max T + max elastic +
+gravity range + dissipated) and L the rope length. The constants and their reasons are in
+docs/stability.md ("The guarantees"): C_E = 20 (measured: error / (rtol S) <= 0.4 on these
+horizons, <= 3.2 for the whip at rtol 1e-5 .. 1e-8, while CVODE at orders 3-4 gains 50-600
+rtol S on the undamped rope), C_X = 10 (measured: the solvers differ by <= 0.15 rtol L).
+The whip is also run at rtol 1e-8, so that the energy bound is seen to follow the
+tolerance.
+
+Horizons are short so that the suite stays within about half a minute of a Debug build on
+two cores; the long runs are in scripts/stability_report.
+"""
+import pathlib
+
+import numpy as np
+import pytest
+
+import stability_metrics
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+HARD = ROOT / "input" / "hard"
+
+C_E = 20.0
+C_X = 10.0
+TIGHT = 1e-8        # the tolerance-proportionality case (whip)
+
+# scene: (horizon in s, step budget max_steps, damping on, rope length in m)
+SCENES = {
+    "steel_wire": (0.02, 20000, True, 1.0),
+    "undamped": (0.2, 20000, False, 1.0),
+    "light_damping": (0.2, 20000, True, 1.0),
+    "no_bending": (0.3, 20000, True, 1.0),
+    "thin_thread": (0.3, 20000, True, 1.0),
+    "long_rope": (1.0, 20000, True, 100.0),
+    "whip": (0.6, 40000, True, 1.0),
+    "clamped_taut": (0.3, 20000, True, 1.0),
+    "mpp_light_damping": (0.3, 20000, True, 1.0),
+    "elements_1000": (0.005, 5000, True, 1.0),
+}
+SOLVERS = ("cvode", "mebdf")
+CASES = [(s, m) for s in SCENES for m in SOLVERS]
+TIGHT_SCENE = "whip"
+
+
+def case_key(scene, method):
+    return f"{scene}_{method}"
+
+
+@pytest.fixture(scope="module")
+def runs(run_many, tmp_path_factory):
+    """Run every case once (two at a time); {key: (process, measures or None, h5 path)}."""
+    workdir = tmp_path_factory.mktemp("hard")
+    jobs = {}
+    for scene, method in CASES:
+        t_end, budget, _, _ = SCENES[scene]
+        jobs[case_key(scene, method)] = (HARD / f"{scene}.nml", [
+            f"solver.method={method}", f"solver.t_end={t_end}", f"solver.max_steps={budget}",
+            f"solver.output_interval={t_end / 40}"])
+    t_end, budget, _, _ = SCENES[TIGHT_SCENE]
+    for method in SOLVERS:
+        jobs[f"tight_{method}"] = (HARD / f"{TIGHT_SCENE}.nml", [
+            f"solver.method={method}", f"solver.t_end={t_end}", f"solver.rtol={TIGHT}",
+            f"solver.atol={TIGHT * 1e-2}", f"solver.output_interval={t_end / 40}"])
+    # the longest runs first, so that the two workers finish together
+    jobs = dict(sorted(jobs.items(), key=lambda kv: "tight" not in kv[0]
+                       and "elements" not in kv[0] and "steel" not in kv[0]))
+    done = run_many(jobs, workdir)
+    results = {}
+    for key, (proc, out) in done.items():
+        measures = stability_metrics.analyse(out) if out.exists() else None
+        results[key] = (proc, measures, out)
+    return results
+
+
+def diagnosis_ok(proc, m):
+    """Exit 3 with a failed file whose reason names time, step size and cause."""
+    return (proc.returncode == 3 and m is not None and m["status"] == "failed"
+            and "t =" in m["reason"] and "step size" in m["reason"]
+            and len(m["reason"].split(":")) >= 3)
+
+
+@pytest.mark.parametrize("scene,method", CASES)
+def test_completes_within_budget(runs, scene, method):
+    proc, m, _ = runs[case_key(scene, method)]
+    assert m is not None, f"no output file: {proc.stderr}"
+    if proc.returncode == 0:
+        assert m["status"] == "complete"
+        assert m["t_reached"] == pytest.approx(SCENES[scene][0], rel=1e-12)
+        assert m["steps"] <= SCENES[scene][1]
+    else:
+        assert diagnosis_ok(proc, m), (proc.returncode, proc.stderr, m["reason"])
+        pytest.fail(f"{scene} with {method} did not complete (all hard scenes are expected "
+                    f"to; the failure itself was diagnosed): {m['reason']}")
+
+
+@pytest.mark.parametrize("scene,method", CASES)
+def test_output_finite(runs, scene, method):
+    _, m, out = runs[case_key(scene, method)]
+    assert m is not None
+    assert stability_metrics.all_finite(out) == []
+
+
+@pytest.mark.parametrize("scene,method", CASES)
+def test_energy_balance(runs, scene, method):
+    _, m, _ = runs[case_key(scene, method)]
+    bound = C_E * m["rtol"] * m["energy_scale"]
+    assert m["balance_error"] <= bound, (m["balance_error"], bound)
+
+
+@pytest.mark.parametrize("method", SOLVERS)
+def test_energy_balance_follows_tolerance(runs, method):
+    proc, m, out = runs[f"tight_{method}"]
+    assert proc.returncode == 0 and m["status"] == "complete", proc.stderr
+    assert stability_metrics.all_finite(out) == []
+    assert m["rtol"] == TIGHT
+    bound = C_E * TIGHT * m["energy_scale"]
+    assert m["balance_error"] <= bound, (m["balance_error"], bound)
+
+
+@pytest.mark.parametrize("scene,method", [c for c in CASES if SCENES[c[0]][2]])
+def test_no_energy_growth_with_damping(runs, scene, method):
+    _, m, _ = runs[case_key(scene, method)]
+    slack = C_E * m["rtol"] * m["energy_scale"]
+    assert np.all(np.diff(m["mech"]) <= slack), np.diff(m["mech"]).max()
+    assert m["energy_growth"] <= slack, (m["energy_growth"], slack)
+    assert np.all(np.diff(m["dissipated"]) >= -slack)
+
+
+@pytest.mark.parametrize("scene", list(SCENES))
+def test_solvers_agree(runs, scene):
+    _, a, _ = runs[case_key(scene, "cvode")]
+    _, b, _ = runs[case_key(scene, "mebdf")]
+    assert np.array_equal(a["time"], b["time"])
+    diff = np.abs(a["tip"] - b["tip"]).max()
+    assert a["rtol"] == b["rtol"]
+    bound = C_X * a["rtol"] * SCENES[scene][3]
+    assert diff <= bound, (diff, bound)

@@ -1,0 +1,384 @@
+!> One physics check per effect (docs/physics-rfem.md, "Effects"):
+!! - drag: the terminal speed of a falling horizontal rope against the balance of weight and
+!!   quadratic drag; with linear drag and a current, the drift velocity (lambda g / c_n, u);
+!! - ground: a rope sliding along the ground carries its weight in contact force and stops
+!!   after v0^2/(2 mu g) (Coulomb friction);
+!! - moving support: the work of a shaken top equals the energy change of an undamped rope
+!!   (RFEM and MPP);
+!! - release: a folded rope with one end released falls with tip acceleration > g and the
+!!   fall distance of the energy-conserving chain theory (Calkin & March);
+!! - point mass: a tip mass lowers the swing frequency to the value of a heavy chain with
+!!   a tip mass (Bessel functions) and of a compound-pendulum estimate (RFEM and MPP);
+!! - all effects at once: T + V + dissipated - external work = E0 over a run.
+program test_effects_physics
+    use ropedyn_kinds, only: wp
+    use ropedyn_error, only: error_t
+    use ropedyn_problem, only: energy_t
+    use ropedyn_scene, only: scene_t, read_scene
+    use ropedyn_rope_model, only: rope_model_t
+    use ropedyn_simulation, only: create_model
+    use ropedyn_integrator, only: integrator_t, solver_options_t
+    use ropedyn_solvers, only: new_integrator
+    use ropedyn_effect, only: bodies_t
+    use ropedyn_effect_ground, only: ground_effect_t, ground_effect
+    use ropedyn_assert, only: test_suite_t
+    implicit none
+
+    type(test_suite_t) :: suite
+    real(wp), parameter :: pi = acos(-1.0_wp), g = 9.81_wp
+    !> weight per length of the paper's rope, N/m, and its mass, kg
+    real(wp), parameter :: lam = 6000.0_wp*pi*0.005_wp**2/4.0_wp, rope_mass = lam
+
+    !> One run: output times, states, quadratures, energies.
+    type :: run_t
+        real(wp), allocatable :: t(:), y(:, :)
+        type(energy_t), allocatable :: e(:)
+        class(rope_model_t), allocatable :: model
+        logical :: ok = .false.
+    end type run_t
+
+    suite%name = 'effects_physics'
+    call drag_terminal_speed()
+    call ground_friction()
+    call shaken_top('rfem')
+    call shaken_top('mpp')
+    call folded_fall()
+    call tip_mass('rfem')
+    call tip_mass('mpp')
+    call every_effect_balance('rfem')
+    call every_effect_balance('mpp')
+    call suite%finish()
+
+contains
+
+    !> Build the scene (defaults = the paper's rope, plus overrides) and integrate it with
+    !! CVODE to t_end, recording every dt.
+    subroutine simulate(sets, t_end, dt, rtol, run)
+        character(len=*), intent(in) :: sets(:)
+        real(wp), intent(in) :: t_end, dt, rtol
+        type(run_t), intent(out) :: run
+        type(scene_t) :: scene
+        type(error_t), allocatable :: err
+        class(integrator_t), allocatable :: solver
+        type(solver_options_t) :: options
+        real(wp), allocatable :: y(:), yq(:)
+        real(wp) :: t
+        integer :: k, nout, unit
+        open (newunit=unit, file='test_effects_physics.nml', status='replace', action='write')
+        write (unit, '(a)') '&model /'
+        close (unit)
+        call read_scene('test_effects_physics.nml', sets, scene, err)
+        if (.not. allocated(err)) call create_model(scene, run%model, err)
+        if (.not. allocated(err)) call new_integrator('cvode', solver, err)
+        if (allocated(err)) then
+            call suite%check_true(.false., 'setup: '//err%message)
+            return
+        end if
+        allocate (y(run%model%size()), yq(run%model%quad_size()))
+        call run%model%initial_state(y)
+        yq = 0.0_wp
+        options%rtol = rtol
+        options%atol = 1.0e-2_wp*rtol
+        call solver%init(run%model, 0.0_wp, y, yq, options, err)
+        if (allocated(err)) then
+            call suite%check_true(.false., 'init: '//err%message)
+            return
+        end if
+        nout = nint(t_end/dt)
+        allocate (run%t(0:nout), run%y(size(y), 0:nout), run%e(0:nout))
+        run%t(0) = 0.0_wp
+        run%y(:, 0) = y
+        run%e(0) = run%model%energy(0.0_wp, y, yq)
+        do k = 1, nout
+            call solver%advance_to(real(k, wp)*dt, t, y, yq, err)
+            if (allocated(err)) then
+                call suite%check_true(.false., 'integration: '//err%message)
+                return
+            end if
+            run%t(k) = t
+            run%y(:, k) = y
+            run%e(k) = run%model%energy(t, y, yq)
+        end do
+        call solver%finalize()
+        run%ok = .true.
+    end subroutine simulate
+
+    !> 'model.kind = "rfem"' (built apart: gfortran mis-sizes a concatenation inside a typed
+    !! character array constructor).
+    function kind_key(kind) result(key)
+        character(len=*), intent(in) :: kind
+        character(len=64) :: key
+        key = 'model.kind = "'//kind//'"'
+    end function kind_key
+
+    !> Element fields (centre x, y, angle and rates) of record k.
+    subroutine fields_at(run, k, q, qdot)
+        type(run_t), intent(in) :: run
+        integer, intent(in) :: k
+        real(wp), allocatable, intent(out) :: q(:, :), qdot(:, :)
+        allocate (q(3, run%model%n_elements()), qdot(3, run%model%n_elements()))
+        call run%model%fields(run%y(:, k), q, qdot, run%t(k))
+    end subroutine fields_at
+
+    !> The free tip (last polyline point) of record k.
+    function tip_at(run, k) result(tip)
+        type(run_t), intent(in) :: run
+        integer, intent(in) :: k
+        real(wp) :: tip(2)
+        real(wp) :: points(2, 2*run%model%n_elements())
+        call run%model%polyline(run%y(:, k), points, run%t(k))
+        tip = points(:, size(points, 2))
+    end function tip_at
+
+    !> A horizontal rope with free ends falls in water: every element reaches
+    !! sqrt(2 lambda g / (rho C_n d)) (normal drag balancing the weight). With linear drag
+    !! and a current along the rope, the rope drifts at (lambda g / c_n, u_y).
+    subroutine drag_terminal_speed()
+        type(run_t) :: run
+        real(wp), allocatable :: q(:, :), qdot(:, :)
+        real(wp) :: v_term
+        character(len=64), parameter :: base(*) = [character(len=64) :: 'model.elements = 6', &
+            'supports.top = "free"', 'initial.angle_deg = 90', 'effects.drag = .true.']
+        call simulate([character(len=64) :: base, 'fluid.density = 1000', &
+            'fluid.normal_drag_coefficient = 1.2'], 0.6_wp, 0.1_wp, 1.0e-7_wp, run)
+        if (.not. run%ok) return
+        call fields_at(run, ubound(run%t, 1), q, qdot)
+        v_term = sqrt(2.0_wp*lam*g/(1000.0_wp*1.2_wp*0.005_wp))
+        write (*, '(a, 2f12.7, a)') '  drag: speed', maxval(qdot(1, :)), v_term, ' m/s'
+        call suite%check_le(maxval(abs(qdot(1, :) - v_term))/v_term, 1.0e-5_wp, &
+                            'drag: terminal speed = sqrt(2 lambda g/(rho C_n d))')
+        call suite%check_le(run%e(ubound(run%e, 1))%balance() - run%e(0)%balance(), &
+                            1.0e-6_wp, 'drag: energy balance')
+
+        call simulate([character(len=64) :: base, 'fluid.density = 0', &
+            'fluid.linear_normal_drag = 2.0', 'fluid.linear_tangential_drag = 2.0', &
+            'fluid.current = 0.0, 0.3'], 1.0_wp, 0.1_wp, 1.0e-7_wp, run)
+        if (.not. run%ok) return
+        call fields_at(run, ubound(run%t, 1), q, qdot)
+        write (*, '(a, 2f12.7, a)') '  linear drag: velocity', sum(qdot(1:2, :), 2)/size(q, 2), &
+            ' m/s'
+        call suite%check_le(maxval(abs(qdot(1, :) - lam*g/2.0_wp)), 1.0e-5_wp, &
+                            'linear drag: terminal speed = lambda g / c_n')
+        call suite%check_le(maxval(abs(qdot(2, :) - 0.3_wp)), 1.0e-5_wp, &
+                            'linear drag: the rope drifts with the current')
+        call suite%check_le(abs(run%e(ubound(run%e, 1))%balance() - run%e(0)%balance()), &
+                            1.0e-6_wp, 'linear drag with current: T + V + dissipated - W = E0')
+    end subroutine drag_terminal_speed
+
+    !> A rope lying on the ground slides along its length at 1 m/s: Coulomb friction stops
+    !! it after v0^2/(2 mu g); at rest the contact forces carry its weight.
+    subroutine ground_friction()
+        type(run_t) :: run
+        type(ground_effect_t) :: ground
+        type(bodies_t) :: b
+        real(wp), allocatable :: q(:, :), qdot(:, :), q0(:, :), qdot0(:, :), len(:), mass(:)
+        real(wp) :: slide, expected, normal_force, weight, mu
+        integer :: last, n
+        mu = 0.3_wp
+        call simulate([character(len=64) :: 'model.elements = 10', 'supports.top = "free"', &
+            'supports.top_anchor = 1.0, 0.0', 'initial.angle_deg = 90', &
+            'initial.velocity = 0.0, 1.0', 'effects.ground = .true.', &
+            'ground.point = 1.0, 0.0', 'ground.stiffness = 1e5', 'ground.damping = 200', &
+            'ground.friction_coefficient = 0.3', 'ground.friction_regularization_speed = 1e-3'], &
+            0.6_wp, 0.05_wp, 1.0e-7_wp, run)
+        if (.not. run%ok) return
+        last = ubound(run%t, 1)
+        call fields_at(run, 0, q0, qdot0)
+        call fields_at(run, last, q, qdot)
+        n = size(q, 2)
+        allocate (len(n), mass(n))
+        call run%model%element_data(len, mass)
+        slide = sum(mass*(q(2, :) - q0(2, :)))/sum(mass)
+        expected = 1.0_wp/(2.0_wp*mu*g)
+        write (*, '(a, 2f12.7, a)') '  ground: slide', slide, expected, ' m'
+        call suite%check_close(slide, expected, 1.0e-3_wp, 0.0_wp, &
+                               'ground: sliding distance = v0^2/(2 mu g)')
+        call suite%check_le(maxval(abs(qdot(1:2, :))), 1.0e-6_wp, 'ground: the rope comes to rest')
+        ground = ground_effect([1.0_wp, 0.0_wp], [-1.0_wp, 0.0_wp], 1.0e5_wp, 200.0_wp, mu, &
+                               1.0e-3_wp)
+        b%n = n
+        b%c = q(1:2, :)
+        b%phi = q(3, :)
+        b%v = qdot(1:2, :)
+        b%w = qdot(3, :)
+        b%l = len
+        normal_force = ground%total_normal_force(b)
+        weight = sum(mass)*g
+        write (*, '(a, 2f12.8, a)') '  ground: contact force, weight', normal_force, weight, ' N'
+        call suite%check_close(normal_force, weight, 1.0e-6_wp, 0.0_wp, &
+                               'ground: the contact forces carry the weight')
+        call suite%check_le(abs(run%e(last)%balance() - run%e(0)%balance()), 1.0e-6_wp, &
+                            'ground: T + V + dissipated = E0 (friction and contact damping)')
+    end subroutine ground_friction
+
+    !> An undamped rope whose top is shaken (2 Hz, 1 cm and 2 cm): the work of the support
+    !! equals the change of T + V.
+    subroutine shaken_top(kind)
+        character(len=*), intent(in) :: kind
+        type(run_t) :: run
+        real(wp) :: worst, work, de
+        integer :: k
+        call simulate([character(len=64) :: kind_key(kind), 'model.elements = 8', &
+            'initial.shape = "hanging"', 'effects.damping = .false.', &
+            'supports.top_motion = "harmonic"', 'supports.top_amplitude = 0.01, 0.02', &
+            'supports.top_frequency = 2.0'], 1.0_wp, 0.02_wp, 1.0e-8_wp, run)
+        if (.not. run%ok) return
+        worst = 0.0_wp
+        work = 0.0_wp
+        do k = 1, ubound(run%t, 1)
+            work = max(work, abs(run%e(k)%support_work))
+            de = run%e(k)%total() - run%e(0)%total()
+            worst = max(worst, abs(de - run%e(k)%support_work))
+        end do
+        write (*, '(a, 3es11.3, a)') '  shaken '//kind//': final T+V-E0, work, worst mismatch', &
+            run%e(ubound(run%e, 1))%total() - run%e(0)%total(), &
+            run%e(ubound(run%e, 1))%support_work, worst, ' J'
+        call suite%check_true(work > 1.0e-3_wp, kind//': the shaken top does work')
+        call suite%check_le(worst/work, 1.0e-4_wp, kind//': support work = change of T + V '// &
+                            '(undamped, shaken top)')
+    end subroutine shaken_top
+
+    !> Folded rope (both halves hanging from the top, bending off as for a chain), the free
+    !! end released at t = 0: the tip falls faster than g (theory: x = 0.04947, 0.20363 m
+    !! at 0.1, 0.2 s; a/g = 1.288 at 0.2 s).
+    subroutine folded_fall()
+        type(run_t) :: run
+        real(wp) :: x(0:60), a_rel, tip(2), tip0(2)
+        integer :: k
+        call simulate([character(len=64) :: 'model.elements = 41', 'supports.bottom = "pinned"', &
+            'supports.bottom_release_time = 0', 'initial.shape = "folded"', &
+            'effects.bending = .false.'], 0.3_wp, 0.005_wp, 1.0e-7_wp, run)
+        if (.not. run%ok) return
+        tip0 = tip_at(run, 0)
+        do k = 0, 60
+            tip = tip_at(run, k)
+            x(k) = tip(1) - tip0(1)
+        end do
+        write (*, '(a, 3f10.5, a)') '  folded: tip fall at 0.1, 0.2, 0.3 s', x(20), x(40), &
+            x(60), ' m (theory 0.04947, 0.20363, 0.48980)'
+        call suite%check_close(x(20), 0.04947_wp, 0.02_wp, 0.0_wp, 'folded: fall at 0.1 s')
+        call suite%check_close(x(40), 0.20363_wp, 0.02_wp, 0.0_wp, 'folded: fall at 0.2 s')
+        call suite%check_close(x(60), 0.48980_wp, 0.03_wp, 0.0_wp, 'folded: fall at 0.3 s')
+        a_rel = (x(42) - 2.0_wp*x(40) + x(38))/(0.01_wp**2*g)
+        write (*, '(a, f8.4, a)') '  folded: a/g at 0.2 s', a_rel, ' (theory 1.288)'
+        call suite%check_true(a_rel > 1.15_wp, 'folded: tip acceleration > g')
+        call suite%check_true(x(60) > 0.5_wp*g*0.3_wp**2, 'folded: faster than free fall')
+        call suite%check_le(abs(run%e(60)%balance() - run%e(0)%balance()), &
+                            1.0e-5_wp, 'folded: T + V + dissipated = E0')
+    end subroutine folded_fall
+
+    !> A tip mass equal to the rope's mass: the small-swing frequency against the heavy
+    !! chain with a tip mass (continuum, EI = 0: J2(xi_a) Y0(xi_L) = Y2(xi_a) J0(xi_L),
+    !! xi = 2 omega sqrt(z/g), z_a = m_p/lambda, z_L = L + z_a) and the compound-pendulum
+    !! estimate omega^2 = g (M/2 + m_p) / (L (M/3 + m_p)).
+    subroutine tip_mass(kind)
+        character(len=*), intent(in) :: kind
+        type(run_t) :: run
+        real(wp) :: crossings(8), y_prev, y_now, omega, chain, compound, tc, tip_prev(2), tip(2)
+        integer :: k, nc
+        character(len=64) :: mass_key
+        write (mass_key, '(a, es24.16)') 'attachments.masses = ', rope_mass
+        call simulate([character(len=64) :: kind_key(kind), 'model.elements = 10', &
+            'initial.angle_deg = 2', 'attachments.mass_positions = 1.0', mass_key], &
+            5.5_wp, 0.005_wp, 1.0e-7_wp, run)
+        if (.not. run%ok) return
+        nc = 0
+        tip_prev = tip_at(run, 0)
+        do k = 1, ubound(run%t, 1)
+            tip = tip_at(run, k)
+            y_prev = tip_prev(2)
+            y_now = tip(2)
+            if (y_prev < 0.0_wp .and. y_now >= 0.0_wp .and. nc < size(crossings)) then
+                tc = run%t(k - 1) + (run%t(k) - run%t(k - 1))*(-y_prev)/(y_now - y_prev)
+                nc = nc + 1
+                crossings(nc) = tc
+            end if
+            tip_prev = tip
+        end do
+        call suite%check_true(nc >= 3, kind//': tip mass: two full swings')
+        if (nc < 2) return
+        omega = 2.0_wp*pi*real(nc - 1, wp)/(crossings(nc) - crossings(1))
+        chain = chain_with_tip_mass(rope_mass)
+        compound = sqrt(g*(rope_mass/2.0_wp + rope_mass)/(rope_mass/3.0_wp + rope_mass))
+        write (*, '(a, 4f11.6, a)') '  '//kind//' tip mass: omega, chain+tip, compound, '// &
+            'bare chain', omega, chain, compound, chain_with_tip_mass(0.0_wp), ' rad/s'
+        call suite%check_close(omega, chain, 3.0e-3_wp, 0.0_wp, &
+                               kind//': tip mass: omega = heavy chain with tip mass')
+        call suite%check_close(omega, compound, 1.0e-2_wp, 0.0_wp, &
+                               kind//': tip mass: omega = compound-pendulum estimate')
+        call suite%check_true(omega < 0.9_wp*chain_with_tip_mass(0.0_wp), &
+                              kind//': the tip mass lowers the frequency')
+    end subroutine tip_mass
+
+    !> First frequency of a hanging chain (L = 1, weight lambda g per length) with a tip mass
+    !! m_p (rad/s), by bisection of the Bessel determinant.
+    real(wp) function chain_with_tip_mass(mp) result(omega)
+        real(wp), intent(in) :: mp
+        real(wp) :: lo, hi, mid
+        integer :: it
+        lo = 2.5_wp
+        hi = 3.9_wp
+        do it = 1, 100
+            mid = 0.5_wp*(lo + hi)
+            if (bessel_det(lo, mp)*bessel_det(mid, mp) <= 0.0_wp) then
+                hi = mid
+            else
+                lo = mid
+            end if
+        end do
+        omega = 0.5_wp*(lo + hi)
+    end function chain_with_tip_mass
+
+    !> The frequency determinant of the chain with a tip mass at omega = w.
+    real(wp) function bessel_det(w, mp) result(det)
+        real(wp), intent(in) :: w, mp
+        real(wp) :: a, xa, xl
+        a = mp/lam
+        xl = 2.0_wp*w*sqrt((1.0_wp + a)/g)
+        if (a <= 0.0_wp) then
+            det = bessel_j0(xl)
+        else
+            xa = 2.0_wp*w*sqrt(a/g)
+            det = bessel_jn(2, xa)*bessel_y0(xl) - bessel_yn(2, xa)*bessel_j0(xl)
+        end if
+    end function bessel_det
+
+    !> Every effect at once (damping, drag with a current, ground contact with friction,
+    !! point loads, point masses, a shaken clamped top, a pinned bottom following a
+    !! harmonic motion): T + V + dissipated - external work stays E0.
+    subroutine every_effect_balance(kind)
+        character(len=*), intent(in) :: kind
+        type(run_t) :: run
+        real(wp) :: worst, scale
+        integer :: k
+        call simulate([character(len=64) :: kind_key(kind), 'model.elements = 7', &
+            'effects.drag = .true.', 'effects.ground = .true.', 'fluid.density = 1000', &
+            'fluid.current = 0.1, -0.2', 'ground.point = 0.2, 0.0', &
+            'ground.normal = -1.0, 0.2', 'ground.stiffness = 1e4', &
+            'ground.friction_regularization_speed = 0.01', &
+            'attachments.mass_positions = 0.4, 1.0', 'attachments.masses = 0.02, 0.05', &
+            'attachments.load_positions = 0.7', 'attachments.load_force_y = 0.2', &
+            'attachments.load_amplitude_x = 0.3', 'attachments.load_frequency = 3', &
+            'supports.top = "clamped"', 'supports.top_motion = "harmonic"', &
+            'supports.top_amplitude = 0.01, 0.02', 'supports.top_frequency = 2', &
+            'supports.top_angle_amplitude_deg = 3', 'supports.bottom = "pinned"', &
+            'supports.bottom_anchor = 0.25, 0.9', 'supports.bottom_motion = "harmonic"', &
+            'supports.bottom_amplitude = 0.0, 0.02', 'supports.bottom_frequency = 1'], &
+            0.5_wp, 0.01_wp, 1.0e-8_wp, run)
+        if (.not. run%ok) return
+        worst = 0.0_wp
+        scale = 0.0_wp
+        do k = 1, ubound(run%t, 1)
+            worst = max(worst, abs(run%e(k)%balance() - run%e(0)%balance()))
+            scale = max(scale, abs(run%e(k)%dissipated) + abs(run%e(k)%support_work))
+        end do
+        write (*, '(a, 3es11.3, a)') '  '//kind//' every effect: dissipated, work, balance '// &
+            'error', run%e(ubound(run%e, 1))%dissipated, run%e(ubound(run%e, 1))%support_work, &
+            worst, ' J'
+        call suite%check_true(run%e(ubound(run%e, 1))%dissipated > 0.0_wp .and. &
+                              abs(run%e(ubound(run%e, 1))%support_work) > 0.0_wp, &
+                              kind//': every effect: energy is dissipated and work is done')
+        call suite%check_le(worst, 1.0e-5_wp*scale, kind//': every effect: T + V + '// &
+                            'dissipated - work = E0')
+    end subroutine every_effect_balance
+end program test_effects_physics

@@ -1,0 +1,264 @@
+!> Static equilibrium (ropedyn_statics) of both models against closed forms:
+!! - the hanging rope's static stretch (exact for each discretization) and support force,
+!!   reached from a straight start at 75 degrees;
+!! - the elastic catenary (Irvine; shared/docs/physics.md): sag, H and T_max of a stiff
+!!   (EA = 687.22 N) and a soft (EA = 10 N) rope hung between two pins 0.8 m apart, started
+!!   hanging vertically with the bottom support spring stretched by 1.28 m;
+!! - the equilibrium residual, the 'equilibrium' and 'mode' initial shapes, and the errors
+!!   for a scene without equilibrium (free-free under gravity) and a capped iteration.
+program test_statics
+    use ropedyn_kinds, only: wp
+    use ropedyn_error, only: error_t, ERR_SOLVER
+    use ropedyn_scene, only: scene_t, read_scene
+    use ropedyn_rope_model, only: rope_model_t
+    use ropedyn_simulation, only: create_model
+    use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
+                               generalized_force
+    use ropedyn_modes, only: equilibrium_initial_state
+    use ropedyn_analysis, only: support_forces
+    use ropedyn_assert, only: test_suite_t
+    implicit none
+
+    real(wp), parameter :: PI = 4.0_wp*atan(1.0_wp)
+    real(wp), parameter :: AREA = PI*0.005_wp**2/4.0_wp       !< m^2
+    real(wp), parameter :: W_LEN = 6000.0_wp*AREA*9.81_wp     !< weight per length, N/m
+    type(test_suite_t) :: suite
+    character(len=1024) :: source_dir
+
+    suite%name = 'statics'
+    call get_command_argument(1, source_dir)
+    if (len_trim(source_dir) == 0) source_dir = '.'
+    call test_hanging('rfem')
+    call test_hanging('mpp')
+    ! Irvine's elastic catenary, span 0.8 m, supports at equal height (physics.md)
+    call test_catenary('rfem', 100, 35.0e6_wp, 0.389941_wp, 0.265999_wp, 0.697117_wp)
+    call test_catenary('rfem', 100, 10.0_wp/AREA, 0.340871_wp, 0.300012_wp, 0.670904_wp)
+    call test_catenary('mpp', 50, 35.0e6_wp, 0.389941_wp, 0.265999_wp, 0.697117_wp)
+    call test_catenary('mpp', 50, 10.0_wp/AREA, 0.340871_wp, 0.300012_wp, 0.670904_wp)
+    call test_initial_shapes()
+    call test_errors()
+    call suite%finish()
+
+contains
+
+    subroutine scene_of(sets, scene)
+        character(len=*), intent(in) :: sets(:)
+        type(scene_t), intent(out) :: scene
+        type(error_t), allocatable :: err
+        call read_scene(trim(source_dir)//'/input/paper.nml', sets, scene, err)
+        if (allocated(err)) then
+            call suite%check_true(.false., err%message)
+            call suite%finish()
+        end if
+    end subroutine scene_of
+
+    !> Equilibrium of the scene from its initial state; stops the test on an error.
+    subroutine equilibrium(scene, model, y, res)
+        type(scene_t), intent(in) :: scene
+        class(rope_model_t), allocatable, intent(out) :: model
+        real(wp), allocatable, intent(out) :: y(:)
+        type(statics_result_t), intent(out) :: res
+        type(error_t), allocatable :: err
+        call create_model(scene, model, err)
+        if (allocated(err)) then
+            call suite%check_true(.false., err%message)
+            call suite%finish()
+        end if
+        allocate (y(model%size()))
+        call model%initial_state(y)
+        call find_equilibrium(model, scene, y, statics_options_t(), res, err, create_model)
+        if (allocated(err)) then
+            call suite%check_true(.false., 'equilibrium found: '//err%message)
+        else
+            call suite%check_true(.true., 'equilibrium found')
+        end if
+        if (allocated(err)) call suite%finish()
+    end subroutine equilibrium
+
+    !> n = 100, bending off, from the straight rope at 75 degrees. Static stretch of the tip:
+    !! RFEM sum_j T_j dl/EA = w L^2/(2 EA) exactly, plus W dl/EA in the top support spring;
+    !! MPP sum_k T_k l/EA = W L (n+1)/(2 n EA). Top support force (-W, 0).
+    subroutine test_hanging(kind)
+        character(len=*), intent(in) :: kind
+        type(scene_t) :: scene
+        class(rope_model_t), allocatable :: model
+        real(wp), allocatable :: y(:), points(:, :)
+        type(statics_result_t) :: res
+        type(error_t), allocatable :: err
+        real(wp) :: stretch, top(2), bottom(2), ea
+        integer, parameter :: n = 100
+        character(len=120) :: label
+        character(len=64) :: sets(3)
+
+        sets(1) = 'model.kind = "'//kind//'"'   ! (gfortran: no concatenation in [character :: ])
+        sets(2) = 'model.elements = 100'
+        sets(3) = 'effects.bending = .false.'
+        call scene_of(sets, scene)
+        call equilibrium(scene, model, y, res)
+        write (label, '(a, i0, a, i0, a, es9.2)') kind//' hanging from 75 deg: ', &
+            res%iterations, ' iterations (', res%rejected, ' rejected), residual ', &
+            res%residual_relative
+        call suite%check_le(res%residual_relative, 1.0e-9_wp, trim(label))
+        allocate (points(2, 2*n))
+        call model%polyline(y, points)
+        ea = 35.0e6_wp*AREA
+        if (kind == 'rfem') then
+            stretch = W_LEN/(2*ea) + W_LEN*(1.0_wp/(n - 1))/ea
+        else
+            stretch = W_LEN*(n + 1)/(2.0_wp*n*ea)
+        end if
+        call suite%check_close(points(1, 2*n) - 1.0_wp, stretch, 1.0e-7_wp, 0.0_wp, &
+                               kind//': static stretch of the tip (discrete closed form)')
+        call suite%check_le(abs(points(2, 2*n)), 1.0e-12_wp, kind//': hangs vertically')
+        call support_forces(scene, model, y, top, bottom, err)
+        call suite%check_close(top(1), -W_LEN, 1.0e-9_wp, 0.0_wp, kind// &
+                               ': top support force = -weight')
+        call suite%check_le(abs(top(2)), 1.0e-9_wp, kind//': no horizontal support force')
+    end subroutine test_hanging
+
+    !> Two pins at equal height 0.8 m apart (support_stiffness_factor 100: nearly rigid
+    !! pins; at 1 the pins' own compliance adds a joint's stretch at each end, +0.3 % sag
+    !! for EA = 10 N), bending off, started hanging vertically. Sag (lowest polyline point),
+    !! H and T_max against the closed form within 0.5 %.
+    subroutine test_catenary(kind, n, young, h_ref, sag_ref, t_ref)
+        character(len=*), intent(in) :: kind
+        integer, intent(in) :: n
+        real(wp), intent(in) :: young, h_ref, sag_ref, t_ref
+        type(scene_t) :: scene
+        class(rope_model_t), allocatable :: model
+        real(wp), allocatable :: y(:), points(:, :)
+        type(statics_result_t) :: res
+        type(error_t), allocatable :: err
+        real(wp) :: top(2), bottom(2)
+        character(len=64) :: sets(8)
+        character(len=120) :: label
+
+        sets(1) = 'model.kind = "'//kind//'"'
+        write (sets(2), '(a, i0)') 'model.elements = ', n
+        write (sets(3), '(a, es22.15)') 'rope.young_modulus = ', young
+        sets(4) = 'supports.bottom = "pinned"'
+        sets(5) = 'supports.bottom_anchor = 0.0, 0.8'
+        sets(6) = 'supports.support_stiffness_factor = 100'
+        sets(7) = 'initial.shape = "hanging"'
+        sets(8) = 'effects.bending = .false.'
+        call scene_of(sets, scene)
+        call equilibrium(scene, model, y, res)
+        write (label, '(a, i0, a, f7.2, a, i0, a, i0, a, es9.2)') kind//' n = ', n, &
+            ', EA = ', young*AREA, ' N: ', res%iterations, ' iterations, ', res%stages, &
+            ' continuation stages, residual ', res%residual_relative
+        ! stiff pins (100 EA/dl): the rounding floor of the forces is ~1e-9 of the weight
+        call suite%check_le(res%residual_relative, 2.0e-8_wp, trim(label))
+        allocate (points(2, 2*n))
+        call model%polyline(y, points)
+        call suite%check_close(maxval(points(1, :)), sag_ref, 5.0e-3_wp, 0.0_wp, &
+                               kind//': catenary sag (0.5 %)')
+        call suite%check_close(points(2, maxloc(points(1, :), 1)), 0.4_wp, 0.0_wp, 2.0e-3_wp, &
+                               kind//': lowest point at midspan')
+        call support_forces(scene, model, y, top, bottom, err)
+        call suite%check_true(.not. allocated(err), kind//': support forces')
+        call suite%check_close(abs(top(2)), h_ref, 5.0e-3_wp, 0.0_wp, kind//': H (0.5 %)')
+        call suite%check_close(bottom(2), -top(2), 1.0e-9_wp, 0.0_wp, &
+                               kind//': horizontal forces balance')
+        call suite%check_close(-(top(1) + bottom(1)), W_LEN, 1.0e-9_wp, 0.0_wp, &
+                               kind//': vertical forces carry the weight')
+        call suite%check_close(max(norm2(top), norm2(bottom)), t_ref, 5.0e-3_wp, 0.0_wp, &
+                               kind//': T_max (0.5 %)')
+    end subroutine test_catenary
+
+    !> &initial shape = 'equilibrium' starts at the equilibrium, at rest (forces ~ 0);
+    !! 'mode' adds mode 1 with its largest point displacement = mode_amplitude.
+    subroutine test_initial_shapes()
+        type(scene_t) :: scene
+        class(rope_model_t), allocatable :: model
+        real(wp), allocatable :: y(:), y_eq(:), f(:), p0(:, :), p1(:, :)
+        integer, allocatable :: pos(:), vel(:)
+        type(error_t), allocatable :: err
+        integer :: status
+        real(wp) :: largest
+
+        call scene_of([character(len=64) :: 'model.elements = 20', &
+                       'initial.shape = "equilibrium"'], scene)
+        call create_model(scene, model, err)
+        allocate (y(model%size()), p0(2, 40), p1(2, 40))
+        call model%initial_state(y)
+        call equilibrium_initial_state(model, scene, y, err, create_model)
+        call suite%check_true(.not. allocated(err), "shape = 'equilibrium': solved")
+        call model%coordinates(pos, vel)
+        allocate (f(size(pos)))
+        call generalized_force(model, y, pos, vel, f, status)
+        call suite%check_le(maxval(abs(f)), 1.0e-9_wp, "shape = 'equilibrium': max |f| (N)")
+        call suite%check_true(all(y(vel) == 0.0_wp), "shape = 'equilibrium': at rest")
+        y_eq = y
+        call model%polyline(y_eq, p0)
+
+        call scene_of([character(len=64) :: 'model.elements = 20', 'initial.shape = "mode"', &
+                       'initial.mode = 1', 'initial.mode_amplitude = 0.002'], scene)
+        call create_model(scene, model, err)
+        call model%initial_state(y)
+        call equilibrium_initial_state(model, scene, y, err, create_model)
+        call suite%check_true(.not. allocated(err), "shape = 'mode': solved")
+        call model%polyline(y, p1)
+        largest = maxval(norm2(p1 - p0, dim=1))
+        call suite%check_close(largest, 0.002_wp, 1.0e-3_wp, 0.0_wp, &
+                               "shape = 'mode': largest point displacement = mode_amplitude")
+        call suite%check_true(all(y(vel) == 0.0_wp), "shape = 'mode': at rest")
+
+        call scene_of([character(len=64) :: 'model.elements = 4', 'initial.shape = "mode"', &
+                       'initial.mode = 99'], scene)
+        call create_model(scene, model, err)
+        deallocate (y)
+        allocate (y(model%size()))
+        call model%initial_state(y)
+        call equilibrium_initial_state(model, scene, y, err, create_model)
+        call suite%check_true(allocated(err), "shape = 'mode', mode = 99 > 12 modes: error")
+        if (allocated(err)) call suite%check_contains(err%message, 'only 12 modes', &
+                                                      'mode beyond the count')
+    end subroutine test_initial_shapes
+
+    !> No equilibrium (both ends free under gravity) and a capped iteration: ERR_SOLVER with
+    !! a message naming the cause.
+    subroutine test_errors()
+        type(scene_t) :: scene
+        class(rope_model_t), allocatable :: model
+        real(wp), allocatable :: y(:)
+        type(statics_result_t) :: res
+        type(statics_options_t) :: options
+        type(error_t), allocatable :: err
+
+        call scene_of([character(len=64) :: 'supports.top = "free"', &
+                       'supports.bottom = "free"'], scene)
+        call create_model(scene, model, err)
+        allocate (y(model%size()))
+        call model%initial_state(y)
+        call find_equilibrium(model, scene, y, statics_options_t(), res, err, create_model)
+        call suite%check_true(allocated(err), 'free-free with gravity: error')
+        if (allocated(err)) then
+            call suite%check_true(err%code == ERR_SOLVER, 'free-free: class ERR_SOLVER (exit 3)')
+            call suite%check_contains(err%message, 'no equilibrium', 'free-free: message')
+            call suite%check_contains(err%message, "bottom = 'free'", 'free-free: names keys')
+        end if
+
+        ! gravity off: a free rope at rest is in (neutral) equilibrium already
+        call scene_of([character(len=64) :: 'supports.top = "free"', &
+                       'supports.bottom = "free"', 'effects.gravity = .false.'], scene)
+        call create_model(scene, model, err)
+        call model%initial_state(y)
+        call find_equilibrium(model, scene, y, statics_options_t(), res, err, create_model)
+        call suite%check_true(.not. allocated(err) .and. res%iterations == 0, &
+                              'free-free without gravity: the start is an equilibrium')
+
+        call scene_of([character(len=64) :: 'model.elements = 30'], scene)
+        call create_model(scene, model, err)
+        deallocate (y)
+        allocate (y(model%size()))
+        call model%initial_state(y)
+        options%max_iterations = 3
+        call find_equilibrium(model, scene, y, options, res, err, create_model)
+        call suite%check_true(allocated(err), 'capped iteration: error')
+        if (allocated(err)) then
+            call suite%check_true(err%code == ERR_SOLVER, 'capped: class ERR_SOLVER')
+            call suite%check_contains(err%message, 'no convergence in 3 iterations', &
+                                      'capped: message')
+        end if
+    end subroutine test_errors
+end program test_statics
