@@ -531,15 +531,13 @@ contains
         class(mebdf_t), intent(inout) :: self
         type(error_t), allocatable, intent(out) :: err
         real(wp), dimension(self%nt) :: pred, psi, c, ybar1, ybar2, y3, d1, hg1, hg2, p2
-        real(wp) :: gam(KMAX_MEBDF + 1), hmin, tn, err1, errkm1, errkp1, beta, hbeta
+        real(wp) :: gam(KMAX_MEBDF), hmin, tn, err1, errkm1, errkp1, beta, hbeta
         real(wp) :: ratio, r_same, r_down, r_up, binom
         integer :: k, j, i, outcome, status, error_fails, conv_fails, knew
         logical :: refresh
         character(len=:), allocatable :: last_cause
 
-        do j = 1, KMAX_MEBDF + 1
-            gam(j) = sum([(1.0_wp/real(i, wp), i=1, j)])
-        end do
+        gam = 1.0_wp/self%coef%beta   ! gamma_j = sum_{i<=j} 1/i = 1/beta_j
         error_fails = 0
         conv_fails = 0
         refresh = .false.
@@ -594,10 +592,6 @@ contains
             ybar1 = pred
             call self%stage(tn, hbeta, c, ybar1, outcome)
             if (outcome /= STAGE_OK) then
-                if (outcome == STAGE_FATAL) then
-                    call self%failure(err, 'the right-hand side reported a fatal error')
-                    return
-                end if
                 call newton_failed(outcome)
                 if (allocated(err)) return
                 cycle attempts
@@ -627,10 +621,6 @@ contains
             ybar2 = pred
             call self%stage(tn + self%h, hbeta, c, ybar2, outcome)
             if (outcome /= STAGE_OK) then
-                if (outcome == STAGE_FATAL) then
-                    call self%failure(err, 'the right-hand side reported a fatal error')
-                    return
-                end if
                 call newton_failed(outcome)
                 if (allocated(err)) return
                 cycle attempts
@@ -653,10 +643,6 @@ contains
             y3 = ybar1
             call self%stage(tn, hbeta, c, y3, outcome)
             if (outcome /= STAGE_OK) then
-                if (outcome == STAGE_FATAL) then
-                    call self%failure(err, 'the right-hand side reported a fatal error')
-                    return
-                end if
                 call newton_failed(outcome)
                 if (allocated(err)) return
                 cycle attempts
@@ -726,9 +712,14 @@ contains
 
     contains
 
-        !> Newton failed: refresh an old Jacobian and retry, else cut the step by 4.
+        !> A stage failed: a fatal right-hand side ends the run; otherwise refresh an old
+        !! Jacobian and retry, else cut the step by 4.
         subroutine newton_failed(why)
             integer, intent(in) :: why
+            if (why == STAGE_FATAL) then
+                call self%failure(err, 'the right-hand side reported a fatal error')
+                return
+            end if
             self%counters%nonlin_conv_fails = self%counters%nonlin_conv_fails + 1
             conv_fails = conv_fails + 1
             self%any_failure = .true.

@@ -28,7 +28,7 @@ module ropedyn_rfem
     use ropedyn_scene, only: scene_t, bottom_anchor_given
     use ropedyn_effect, only: effect_box_t, bodies_t
     use ropedyn_effect_factory, only: build_body_effects, attached_masses
-    use ropedyn_support_motion, only: support_motion_t, motion_state_t, MOTION_HARMONIC
+    use ropedyn_support_motion, only: support_motion_t, motion_state_t
     implicit none
     private
     public :: rfem_t, rfem_create
@@ -289,19 +289,8 @@ contains
                                     angle_amplitude_deg, angle_phase_deg
             real(wp), allocatable, intent(in) :: rows(:, :)
             if (support == 'free' .or. .not. model%release(k) > 0.0_wp) return
-            select case (kind)
-            case ('harmonic')
-                model%motion(k)%kind = MOTION_HARMONIC
-                model%motion(k)%amplitude = amplitude
-                model%motion(k)%omega = 2.0_wp*pi*frequency
-                model%motion(k)%phase = phase_deg*pi/180.0_wp
-                model%motion(k)%angle_amplitude = angle_amplitude_deg*pi/180.0_wp
-                model%motion(k)%angle_phase = angle_phase_deg*pi/180.0_wp
-                model%moving(k) = .true.
-            case ('table')
-                call model%motion(k)%set_table(rows)
-                model%moving(k) = .true.
-            end select
+            model%moving(k) = model%motion(k)%configure(kind, amplitude, frequency, phase_deg, &
+                angle_amplitude_deg, angle_phase_deg, rows)
         end subroutine set_motion
     end subroutine rfem_create
 

@@ -44,6 +44,7 @@ module ropedyn_support_motion
     contains
         procedure :: state => motion_state
         procedure :: set_table => motion_set_table
+        procedure :: configure => motion_configure
     end type support_motion_t
 
 contains
@@ -125,6 +126,32 @@ contains
             end if
         end do
     end function interval
+
+    !> Set the motion from a scene's `&supports` values of one end: kind 'harmonic' or
+    !! 'table' (anything else leaves the support fixed); frequency in Hz, phases and the
+    !! angle amplitude in degrees, table rows as for `set_table`. True when it moves.
+    logical function motion_configure(self, kind, amplitude, frequency, phase_deg, &
+                                      angle_amplitude_deg, angle_phase_deg, rows) result(moving)
+        class(support_motion_t), intent(inout) :: self
+        character(len=*), intent(in) :: kind
+        real(wp), intent(in) :: amplitude(2), frequency, phase_deg(2), &
+                                angle_amplitude_deg, angle_phase_deg
+        real(wp), allocatable, intent(in) :: rows(:, :)
+        moving = .false.
+        select case (kind)
+        case ('harmonic')
+            self%kind = MOTION_HARMONIC
+            self%amplitude = amplitude
+            self%omega = 2.0_wp*pi*frequency
+            self%phase = phase_deg*pi/180.0_wp
+            self%angle_amplitude = angle_amplitude_deg*pi/180.0_wp
+            self%angle_phase = angle_phase_deg*pi/180.0_wp
+            moving = .true.
+        case ('table')
+            call self%set_table(rows)
+            moving = .true.
+        end select
+    end function motion_configure
 
     !> Store table rows (4, m) (t in s, dx and dy in m, dangle in rad) and compute the
     !! Hermite slopes: three-point rule inside, zero at the ends.
