@@ -7,6 +7,7 @@ module ropedyn_integrator
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t
     use ropedyn_problem, only: problem_t
+    use ropedyn_methods, only: METHODS, method_index
     implicit none
     private
     public :: integrator_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT
@@ -54,9 +55,9 @@ module ropedyn_integrator
         procedure(stats_i), deferred :: stats
         procedure(finalize_i), deferred :: finalize
         procedure(name_i), deferred :: name
-        procedure(default_max_order_i), deferred :: default_max_order
-        procedure(min_order_i), deferred :: min_order
-        procedure(min_order_i), deferred :: max_order_limit
+        procedure :: default_max_order => integrator_default_max_order
+        procedure :: min_order => integrator_min_order
+        procedure :: max_order_limit => integrator_max_order_limit
     end type integrator_t
 
     abstract interface
@@ -105,19 +106,25 @@ module ropedyn_integrator
             class(integrator_t), intent(in) :: self
             character(len=:), allocatable :: name
         end function name_i
-
-        !> The order limit used when options%max_order is 0, chosen to be safe for
-        !! lightly damped stiff oscillations.
-        pure integer function default_max_order_i(self)
-            import :: integrator_t
-            class(integrator_t), intent(in) :: self
-        end function default_max_order_i
-
-        !> The lowest (min_order) or highest (max_order_limit) value options%max_order may
-        !! take for this method.
-        pure integer function min_order_i(self)
-            import :: integrator_t
-            class(integrator_t), intent(in) :: self
-        end function min_order_i
     end interface
+contains
+
+    !> The order limit used when options%max_order is 0, chosen to be safe for lightly
+    !! damped stiff oscillations (ropedyn_methods says why, per method).
+    pure integer function integrator_default_max_order(self) result(order)
+        class(integrator_t), intent(in) :: self
+        order = METHODS(method_index(self%name()))%default_order
+    end function integrator_default_max_order
+
+    !> The lowest value options%max_order may take for this method.
+    pure integer function integrator_min_order(self) result(order)
+        class(integrator_t), intent(in) :: self
+        order = METHODS(method_index(self%name()))%lowest_order
+    end function integrator_min_order
+
+    !> The highest value options%max_order may take for this method.
+    pure integer function integrator_max_order_limit(self) result(order)
+        class(integrator_t), intent(in) :: self
+        order = METHODS(method_index(self%name()))%highest_order
+    end function integrator_max_order_limit
 end module ropedyn_integrator

@@ -1,15 +1,14 @@
-!> The integrators ropedyn offers, by the name used in `&solver method`.
+!> The integrators ropedyn offers, by the name used in `&solver method` (the names and
+!! their order ranges are plain data in ropedyn_methods).
 module ropedyn_solvers
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
+    use ropedyn_methods, only: METHODS, method_index, method_list
     use ropedyn_integrator, only: integrator_t
     use ropedyn_cvode, only: cvode_t
     use ropedyn_mebdf, only: mebdf_t
     implicit none
     private
-    public :: new_integrator, method_names, method_order_range
-
-    !> Names of the available methods.
-    character(len=*), parameter :: method_names(2) = [character(len=8) :: 'cvode', 'mebdf']
+    public :: new_integrator, method_order_range
 
 contains
 
@@ -25,7 +24,7 @@ contains
             allocate (mebdf_t :: integrator)
         case default
             call make_error(err, ERR_INPUT, 'unknown integration method "'//method// &
-                            '" (available: cvode, mebdf)')
+                            '" (available: '//method_list()//')')
         end select
     end subroutine new_integrator
 
@@ -34,14 +33,18 @@ contains
         character(len=*), intent(in) :: method
         integer, intent(out) :: lowest, highest, default
         type(error_t), allocatable, intent(out) :: err
-        class(integrator_t), allocatable :: integrator
+        integer :: k
         lowest = 0
         highest = 0
         default = 0
-        call new_integrator(method, integrator, err)
-        if (allocated(err)) return
-        lowest = integrator%min_order()
-        highest = integrator%max_order_limit()
-        default = integrator%default_max_order()
+        k = method_index(method)
+        if (k == 0) then
+            call make_error(err, ERR_INPUT, 'unknown integration method "'//method// &
+                            '" (available: '//method_list()//')')
+            return
+        end if
+        lowest = METHODS(k)%lowest_order
+        highest = METHODS(k)%highest_order
+        default = METHODS(k)%default_order
     end subroutine method_order_range
 end module ropedyn_solvers

@@ -1,4 +1,4 @@
-!> The one interface between models (src/) and integrators (solvers/).
+!> The one interface between models (src/models) and integrators (solvers/).
 !!
 !! A problem is a first-order system y' = f(t, y) of `size()` unknowns whose Jacobian
 !! df/dy lies in a band of `ml` sub- and `mu` super-diagonals, plus optional quadrature
@@ -15,7 +15,7 @@ module ropedyn_problem
     use ropedyn_kinds, only: wp
     implicit none
     private
-    public :: problem_t, energy_t
+    public :: problem_t
     public :: STATUS_OK, STATUS_RECOVERABLE, STATUS_FATAL
 
     !> Return codes of rhs/jacobian/quad_rhs (the CVODE convention).
@@ -23,25 +23,11 @@ module ropedyn_problem
     integer, parameter :: STATUS_RECOVERABLE = 1  !< e.g. a NaN: the integrator may retry smaller
     integer, parameter :: STATUS_FATAL = -1       !< stop the integration
 
-    !> Energy bookkeeping of a state, all in J.
-    type :: energy_t
-        real(wp) :: kinetic = 0.0_wp       !< T
-        real(wp) :: elastic = 0.0_wp       !< springs (internal and supports)
-        real(wp) :: gravity = 0.0_wp       !< -sum m g x
-        real(wp) :: dissipated = 0.0_wp    !< integral of the dissipation power so far
-        !> external work done on the rope so far: moving supports, point loads, a current
-        real(wp) :: support_work = 0.0_wp
-    contains
-        procedure :: total => energy_total
-        procedure :: balance => energy_balance
-    end type energy_t
-
     type, abstract :: problem_t
     contains
         procedure(size_i), deferred :: size
         procedure(bandwidths_i), deferred :: bandwidths
         procedure(rhs_i), deferred :: rhs
-        procedure(energy_i), deferred :: energy
         procedure :: has_jacobian => problem_has_jacobian
         procedure :: jacobian => problem_jacobian
         procedure :: quad_size => problem_quad_size
@@ -76,16 +62,6 @@ module ropedyn_problem
             real(wp), intent(out) :: ydot(:)
             integer, intent(out) :: status
         end subroutine rhs_i
-
-        !> Energies of state y at time t with quadrature values yq.
-        function energy_i(self, t, y, yq) result(e)
-            import :: problem_t, wp, energy_t
-            class(problem_t), intent(inout) :: self
-            real(wp), intent(in) :: t
-            real(wp), intent(in) :: y(:)
-            real(wp), intent(in) :: yq(:)
-            type(energy_t) :: e
-        end function energy_i
     end interface
 
 contains
@@ -171,16 +147,4 @@ contains
         yqdot = 0.0_wp
         status = STATUS_OK
     end subroutine problem_quad_rhs
-
-    !> T + V (kinetic + elastic + gravity), J.
-    pure real(wp) function energy_total(self) result(e)
-        class(energy_t), intent(in) :: self
-        e = self%kinetic + self%elastic + self%gravity
-    end function energy_total
-
-    !> T + V + dissipated - support work: equals E0 for every run, J.
-    pure real(wp) function energy_balance(self) result(e)
-        class(energy_t), intent(in) :: self
-        e = self%kinetic + self%elastic + self%gravity + self%dissipated - self%support_work
-    end function energy_balance
 end module ropedyn_problem

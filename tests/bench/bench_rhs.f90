@@ -51,7 +51,7 @@ program bench_rhs
         error stop 2
     end if
     call read_scene(trim(scene_path), sets(1:nsets), scene, err)
-    if (.not. allocated(err)) call create_model(scene, model, err)
+    if (.not. allocated(err)) call create_model(scene%rope_spec_t, model, err)
     if (allocated(err)) then
         write (error_unit, '(a)') err%message
         error stop 2

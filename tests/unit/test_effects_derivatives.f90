@@ -8,7 +8,7 @@
 program test_effects_derivatives
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t
-    use ropedyn_problem, only: energy_t
+    use ropedyn_rope_model, only: energy_t
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_rfem, only: rfem_t, rfem_create
@@ -81,7 +81,7 @@ contains
             'supports.top_angle_amplitude_deg = 5', 'supports.bottom = "pinned"', &
             'supports.bottom_motion = "table"', 'supports.bottom_table = "'//TABLE//'"']
         call make_scene(sets, scene)
-        call rfem_create(model, scene, err)
+        call rfem_create(model, scene%rope_spec_t, err)
         call suite%check_true(.not. allocated(err), 'rfem: create with every effect')
         if (allocated(err)) return
         do trial = 1, 3
@@ -224,7 +224,7 @@ contains
             'supports.top_amplitude = 0.02, 0.03', 'supports.top_frequency = 2.0', &
             'supports.top_phase_deg = 40, 70', 'supports.top_angle_amplitude_deg = 5', &
             'supports.top_angle_phase_deg = 60'], scene)
-        call rfem_create(model, scene, err)
+        call rfem_create(model, scene%rope_spec_t, err)
         call random_state(model, 5, y)
         ne = model%n_elements()
         do i = 1, ne
@@ -267,7 +267,7 @@ contains
             'supports.bottom = "clamped"', 'supports.bottom_motion = "table"', '']
         sets(size(sets)) = 'supports.bottom_table = "'//TABLE//'"'
         call make_scene(sets, scene)
-        call mpp_create(model, scene, err)
+        call mpp_create(model, scene%rope_spec_t, err)
         call suite%check_true(.not. allocated(err), 'mpp: create with every effect')
         if (allocated(err)) return
         do trial = 1, 3

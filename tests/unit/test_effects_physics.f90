@@ -13,7 +13,7 @@
 program test_effects_physics
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t
-    use ropedyn_problem, only: energy_t
+    use ropedyn_rope_model, only: energy_t
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_simulation, only: create_model
@@ -68,7 +68,7 @@ contains
         write (unit, '(a)') '&model /'
         close (unit)
         call read_scene('test_effects_physics.nml', sets, scene, err)
-        if (.not. allocated(err)) call create_model(scene, run%model, err)
+        if (.not. allocated(err)) call create_model(scene%rope_spec_t, run%model, err)
         if (.not. allocated(err)) call new_integrator('cvode', solver, err)
         if (allocated(err)) then
             call suite%check_true(.false., 'setup: '//err%message)

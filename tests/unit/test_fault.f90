@@ -51,7 +51,7 @@ contains
         write (sets(2), '(a, i0)') 'model.elements = ', n
         sets(3) = 'solver.method = "'//method//'"'
         call read_scene(trim(source_dir)//'/input/paper.nml', sets, scene, err)
-        if (.not. allocated(err)) call create_model(scene, model, err)
+        if (.not. allocated(err)) call create_model(scene%rope_spec_t, model, err)
         if (allocated(err)) then
             call suite%check_true(.false., kind//': '//err%message)
             call suite%finish()

@@ -4,7 +4,7 @@
 !! on a lightly damped stiff oscillator; failure reports.
 module test_mebdf_problems
     use ropedyn_kinds, only: wp
-    use ropedyn_problem, only: problem_t, energy_t, STATUS_OK, STATUS_RECOVERABLE
+    use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_RECOVERABLE
     implicit none
     private
     public :: linear_t, oscillator_t, implicit_t
@@ -23,7 +23,6 @@ module test_mebdf_problems
         procedure :: rhs => lin_rhs
         procedure :: has_jacobian => lin_has_jacobian
         procedure :: jacobian => lin_jacobian
-        procedure :: energy => lin_energy
         procedure :: quad_size => lin_quad_size
         procedure :: quad_rhs => lin_quad_rhs
         procedure :: exact => lin_exact
@@ -42,7 +41,6 @@ module test_mebdf_problems
         procedure :: rhs => osc_rhs
         procedure :: has_jacobian => osc_has_jacobian
         procedure :: jacobian => osc_jacobian
-        procedure :: energy => osc_energy
     end type oscillator_t
 
     !> The same motion as linear_t written as M(y) y' = F(y) with the state-dependent
@@ -102,15 +100,6 @@ contains
         jb(offset, 3) = jb(offset, 3) - self%mu
         status = STATUS_OK
     end subroutine lin_jacobian
-
-    function lin_energy(self, t, y, yq) result(e)
-        class(linear_t), intent(inout) :: self
-        real(wp), intent(in) :: t
-        real(wp), intent(in) :: y(:)
-        real(wp), intent(in) :: yq(:)
-        type(energy_t) :: e
-        e%kinetic = 0.5_wp*sum(y(1:2)**2)
-    end function lin_energy
 
     pure integer function lin_quad_size(self)
         class(linear_t), intent(in) :: self
@@ -200,16 +189,6 @@ contains
             z = 0.0_wp
         end if
     end subroutine mode
-
-    function osc_energy(self, t, y, yq) result(e)
-        class(oscillator_t), intent(inout) :: self
-        real(wp), intent(in) :: t
-        real(wp), intent(in) :: y(:)
-        real(wp), intent(in) :: yq(:)
-        type(energy_t) :: e
-        e%kinetic = 0.5_wp*sum(y(2::2)**2)
-        e%elastic = 0.5_wp*self%omega**2*sum(y(1::2)**2)
-    end function osc_energy
 
     pure logical function imp_has_mass(self)
         class(implicit_t), intent(in) :: self

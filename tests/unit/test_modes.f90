@@ -66,11 +66,11 @@ contains
         type(modes_result_t), intent(out) :: res
         type(statics_result_t) :: sres
         type(error_t), allocatable :: err
-        call create_model(scene, model, err)
+        call create_model(scene%rope_spec_t, model, err)
         if (.not. allocated(err)) then
             allocate (y(model%size()))
             call model%initial_state(y)
-            call find_equilibrium(model, scene, y, statics_options_t(), sres, err, create_model)
+            call find_equilibrium(model, scene%rope_spec_t, y, statics_options_t(), sres, err, create_model)
         end if
         if (.not. allocated(err)) call compute_modes(model, y, count, res, err)
         if (allocated(err)) then
@@ -166,7 +166,7 @@ contains
         allocate (y(size(y_eq)), yq(model%quad_size()), p0(2, 20), p(2, 20))
         call model%polyline(y_eq, p0)
         call model%initial_state(y)
-        call equilibrium_initial_state(model, scene, y, err, create_model)
+        call equilibrium_initial_state(model, scene%rope_spec_t, y, err, create_model)
         yq = 0.0_wp
         call new_integrator('cvode', integ, err)
         call integ%init(model, 0.0_wp, y, yq, solver_options_of(scene), err)

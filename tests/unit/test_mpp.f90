@@ -4,7 +4,7 @@
 program test_mpp
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t
-    use ropedyn_problem, only: energy_t
+    use ropedyn_rope_model, only: energy_t
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_mpp, only: mpp_t, mpp_create
     use ropedyn_integrator, only: integrator_t, solver_options_t
@@ -43,7 +43,7 @@ contains
         all_sets(1) = 'model.kind = "mpp"'
         all_sets(2:) = sets
         call read_scene(trim(source_dir)//'/input/paper.nml', all_sets, scene, err)
-        if (.not. allocated(err)) call mpp_create(model, scene, err)
+        if (.not. allocated(err)) call mpp_create(model, scene%rope_spec_t, err)
         if (allocated(err)) then
             call suite%check_true(.false., err%message)
             call suite%finish()

@@ -69,7 +69,7 @@ contains
         call scene_of([character(len=64) :: 'model.kind = "mpp"', 'model.elements = 30', &
                        'effects.tension = .false.', 'effects.damping = .false.', &
                        'initial.shape = "hanging"'], scene)
-        call mpp_create(model, scene, err)
+        call mpp_create(model, scene%rope_spec_t, err)
         allocate (y(model%size()))
         call model%initial_state(y)
         nd = size(y)/2
@@ -168,7 +168,7 @@ contains
         sets(3) = 'solver.rtol = 1e-8'
         sets(4) = 'solver.atol = 1e-10'
         call scene_of(sets, scene)
-        call create_model(scene, model, err)
+        call create_model(scene%rope_spec_t, model, err)
         call new_integrator('cvode', integ, err)
         allocate (y(model%size()), yq(model%quad_size()), points(2, 2*n), tips(2, 50))
         call model%initial_state(y)

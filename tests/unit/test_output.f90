@@ -11,7 +11,7 @@ program test_output
         h5fget_obj_count_f, H5F_OBJ_ALL_F
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, ERR_IO, ERR_INTERNAL
-    use ropedyn_problem, only: energy_t
+    use ropedyn_rope_model, only: energy_t
     use ropedyn_integrator, only: solver_stats_t
     use ropedyn_output, only: output_file_t
     use ropedyn_assert, only: test_suite_t

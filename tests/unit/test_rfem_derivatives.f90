@@ -55,7 +55,7 @@ contains
             scene%supports%bottom = 'clamped'
             scene%effects%gravity = .false.
         end select
-        call rfem_create(model, scene, err)
+        call rfem_create(model, scene%rope_spec_t, err)
         call suite%check_true(.not. allocated(err), 'create model')
         if (allocated(err)) return
         do trial = 1, 3
@@ -178,7 +178,7 @@ contains
         scene%effects%shear = .false.
         scene%effects%bending = .false.
         scene%supports%top = 'free'
-        call rfem_create(model, scene, err)
+        call rfem_create(model, scene%rope_spec_t, err)
         allocate (y(model%size()), ydot(model%size()))
         call model%initial_state(y)
         call random_state(y)
@@ -192,7 +192,7 @@ contains
 
         scene%effects%gravity = .false.
         scene%supports%top = 'pinned'
-        call rfem_create(model, scene, err)
+        call rfem_create(model, scene%rope_spec_t, err)
         call model%initial_state(y)
         call model%rhs(0.0_wp, y, ydot, status)
         call suite%check_true(all(ydot(4::6) == 0.0_wp), &

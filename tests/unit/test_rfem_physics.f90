@@ -5,7 +5,7 @@
 program test_rfem_physics
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t
-    use ropedyn_problem, only: energy_t
+    use ropedyn_rope_model, only: energy_t
     use ropedyn_scene, only: scene_t
     use ropedyn_rfem, only: rfem_t, rfem_create
     use ropedyn_cvode, only: cvode_t
@@ -38,7 +38,7 @@ contains
         integer :: k, nout, ne
 
         ok = .false.
-        call rfem_create(model, scene, err)
+        call rfem_create(model, scene%rope_spec_t, err)
         if (allocated(err)) return
         ne = model%n_elements()
         allocate (y(model%size()), yq(model%quad_size()), q(3, ne), qdot(3, ne))

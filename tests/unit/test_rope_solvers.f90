@@ -3,7 +3,7 @@
 program test_rope_solvers
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t
-    use ropedyn_problem, only: energy_t
+    use ropedyn_rope_model, only: energy_t
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_integrator, only: integrator_t, solver_stats_t
@@ -68,7 +68,7 @@ contains
         call get_command_argument(1, source_dir)
         if (len_trim(source_dir) == 0) source_dir = '.'
         call read_scene(trim(source_dir)//'/input/paper.nml', sets, scene, err)
-        if (.not. allocated(err)) call create_model(scene, model, err)
+        if (.not. allocated(err)) call create_model(scene%rope_spec_t, model, err)
         if (.not. allocated(err)) call create_integrator(scene, integ, err)
         if (allocated(err)) then
             call suite%check_true(.false., method//': '//err%message)

@@ -5,7 +5,8 @@
 program test_scene
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, ERR_INPUT
-    use ropedyn_scene, only: scene_t, read_scene, scene_namelist_text, bottom_anchor_given
+    use ropedyn_scene, only: scene_t, read_scene, scene_namelist_text
+    use ropedyn_rope_spec, only: bottom_anchor_given
     use ropedyn_assert, only: test_suite_t
     implicit none
 

@@ -59,14 +59,14 @@ contains
         real(wp), allocatable, intent(out) :: y(:)
         type(statics_result_t), intent(out) :: res
         type(error_t), allocatable :: err
-        call create_model(scene, model, err)
+        call create_model(scene%rope_spec_t, model, err)
         if (allocated(err)) then
             call suite%check_true(.false., err%message)
             call suite%finish()
         end if
         allocate (y(model%size()))
         call model%initial_state(y)
-        call find_equilibrium(model, scene, y, statics_options_t(), res, err, create_model)
+        call find_equilibrium(model, scene%rope_spec_t, y, statics_options_t(), res, err, create_model)
         if (allocated(err)) then
             call suite%check_true(.false., 'equilibrium found: '//err%message)
         else
@@ -110,7 +110,7 @@ contains
         call suite%check_close(points(1, 2*n) - 1.0_wp, stretch, 1.0e-7_wp, 0.0_wp, &
                                kind//': static stretch of the tip (discrete closed form)')
         call suite%check_le(abs(points(2, 2*n)), 1.0e-12_wp, kind//': hangs vertically')
-        call support_forces(scene, model, y, top, bottom, err)
+        call support_forces(scene%rope_spec_t, model, y, top, bottom, err)
         call suite%check_close(top(1), -W_LEN, 1.0e-9_wp, 0.0_wp, kind// &
                                ': top support force = -weight')
         call suite%check_le(abs(top(2)), 1.0e-9_wp, kind//': no horizontal support force')
@@ -154,7 +154,7 @@ contains
                                kind//': catenary sag (0.5 %)')
         call suite%check_close(points(2, maxloc(points(1, :), 1)), 0.4_wp, 0.0_wp, 2.0e-3_wp, &
                                kind//': lowest point at midspan')
-        call support_forces(scene, model, y, top, bottom, err)
+        call support_forces(scene%rope_spec_t, model, y, top, bottom, err)
         call suite%check_true(.not. allocated(err), kind//': support forces')
         call suite%check_close(abs(top(2)), h_ref, 5.0e-3_wp, 0.0_wp, kind//': H (0.5 %)')
         call suite%check_close(bottom(2), -top(2), 1.0e-9_wp, 0.0_wp, &
@@ -178,10 +178,10 @@ contains
 
         call scene_of([character(len=64) :: 'model.elements = 20', &
                        'initial.shape = "equilibrium"'], scene)
-        call create_model(scene, model, err)
+        call create_model(scene%rope_spec_t, model, err)
         allocate (y(model%size()), p0(2, 40), p1(2, 40))
         call model%initial_state(y)
-        call equilibrium_initial_state(model, scene, y, err, create_model)
+        call equilibrium_initial_state(model, scene%rope_spec_t, y, err, create_model)
         call suite%check_true(.not. allocated(err), "shape = 'equilibrium': solved")
         call model%coordinates(pos, vel)
         allocate (f(size(pos)))
@@ -193,9 +193,9 @@ contains
 
         call scene_of([character(len=64) :: 'model.elements = 20', 'initial.shape = "mode"', &
                        'initial.mode = 1', 'initial.mode_amplitude = 0.002'], scene)
-        call create_model(scene, model, err)
+        call create_model(scene%rope_spec_t, model, err)
         call model%initial_state(y)
-        call equilibrium_initial_state(model, scene, y, err, create_model)
+        call equilibrium_initial_state(model, scene%rope_spec_t, y, err, create_model)
         call suite%check_true(.not. allocated(err), "shape = 'mode': solved")
         call model%polyline(y, p1)
         largest = maxval(norm2(p1 - p0, dim=1))
@@ -205,11 +205,11 @@ contains
 
         call scene_of([character(len=64) :: 'model.elements = 4', 'initial.shape = "mode"', &
                        'initial.mode = 99'], scene)
-        call create_model(scene, model, err)
+        call create_model(scene%rope_spec_t, model, err)
         deallocate (y)
         allocate (y(model%size()))
         call model%initial_state(y)
-        call equilibrium_initial_state(model, scene, y, err, create_model)
+        call equilibrium_initial_state(model, scene%rope_spec_t, y, err, create_model)
         call suite%check_true(allocated(err), "shape = 'mode', mode = 99 > 12 modes: error")
         if (allocated(err)) call suite%check_contains(err%message, 'only 12 modes', &
                                                       'mode beyond the count')
@@ -227,10 +227,10 @@ contains
 
         call scene_of([character(len=64) :: 'supports.top = "free"', &
                        'supports.bottom = "free"'], scene)
-        call create_model(scene, model, err)
+        call create_model(scene%rope_spec_t, model, err)
         allocate (y(model%size()))
         call model%initial_state(y)
-        call find_equilibrium(model, scene, y, statics_options_t(), res, err, create_model)
+        call find_equilibrium(model, scene%rope_spec_t, y, statics_options_t(), res, err, create_model)
         call suite%check_true(allocated(err), 'free-free with gravity: error')
         if (allocated(err)) then
             call suite%check_true(err%code == ERR_SOLVER, 'free-free: class ERR_SOLVER (exit 3)')
@@ -241,19 +241,19 @@ contains
         ! gravity off: a free rope at rest is in (neutral) equilibrium already
         call scene_of([character(len=64) :: 'supports.top = "free"', &
                        'supports.bottom = "free"', 'effects.gravity = .false.'], scene)
-        call create_model(scene, model, err)
+        call create_model(scene%rope_spec_t, model, err)
         call model%initial_state(y)
-        call find_equilibrium(model, scene, y, statics_options_t(), res, err, create_model)
+        call find_equilibrium(model, scene%rope_spec_t, y, statics_options_t(), res, err, create_model)
         call suite%check_true(.not. allocated(err) .and. res%iterations == 0, &
                               'free-free without gravity: the start is an equilibrium')
 
         call scene_of([character(len=64) :: 'model.elements = 30'], scene)
-        call create_model(scene, model, err)
+        call create_model(scene%rope_spec_t, model, err)
         deallocate (y)
         allocate (y(model%size()))
         call model%initial_state(y)
         options%max_iterations = 3
-        call find_equilibrium(model, scene, y, options, res, err, create_model)
+        call find_equilibrium(model, scene%rope_spec_t, y, options, res, err, create_model)
         call suite%check_true(allocated(err), 'capped iteration: error')
         if (allocated(err)) then
             call suite%check_true(err%code == ERR_SOLVER, 'capped: class ERR_SOLVER')

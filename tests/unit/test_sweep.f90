@@ -4,7 +4,8 @@
 program test_sweep
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, ERR_INPUT
-    use ropedyn_sweep, only: sweep_t, read_sweep, case_name, real_text
+    use ropedyn_sweep, only: sweep_t, read_sweep, case_name
+    use ropedyn_text, only: real_text
     use ropedyn_assert, only: test_suite_t
     implicit none
 
@@ -42,12 +43,12 @@ contains
     subroutine test_names()
         call suite%check_true(case_name(7, 12) == 'case_0007.h5', 'case_name: 4 digits')
         call suite%check_true(case_name(7, 12345) == 'case_00007.h5', 'case_name: 5 digits')
-        call suite%check_true(real_text(1.0e-4_wp) == '1e-4', 'real_text 1e-4: '// &
-                              real_text(1.0e-4_wp))
-        call suite%check_true(real_text(2.5e-7_wp) == '2.5e-7', 'real_text 2.5e-7')
-        call suite%check_true(real_text(0.001_wp) == '0.001', 'real_text 0.001')
-        call suite%check_true(real_text(30.0_wp) == '30.0', 'real_text 30.0')
-        call suite%check_true(real_text(0.1_wp) == '0.1', 'real_text 0.1')
+        call suite%check_true(real_text(1.0e-4_wp, compact=.true.) == '1e-4', 'real_text 1e-4: '// &
+                              real_text(1.0e-4_wp, compact=.true.))
+        call suite%check_true(real_text(2.5e-7_wp, compact=.true.) == '2.5e-7', 'real_text 2.5e-7')
+        call suite%check_true(real_text(0.001_wp, compact=.true.) == '0.001', 'real_text 0.001')
+        call suite%check_true(real_text(30.0_wp, compact=.true.) == '30.0', 'real_text 30.0')
+        call suite%check_true(real_text(0.1_wp, compact=.true.) == '0.1', 'real_text 0.1')
     end subroutine test_names
 
     !> 2 elements x 2 vary values x 2 methods x 3 rtols = 24 cases in product order.

@@ -38,8 +38,10 @@ module ropedyn_output
         h5tcopy_f, h5tclose_f, h5tset_size_f, h5tset_strpad_f, &
         H5T_NATIVE_CHARACTER, H5T_STR_NULLPAD_F, h5kind_to_type, H5_REAL_KIND, H5_INTEGER_KIND
     use ropedyn_kinds, only: wp, i8
+    use ropedyn_os, only: utc_timestamp
+    use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INTERNAL
-    use ropedyn_problem, only: energy_t
+    use ropedyn_rope_model, only: energy_t
     use ropedyn_integrator, only: solver_stats_t
     implicit none
     private
@@ -824,14 +826,6 @@ contains
         if (ios /= 0) exists = .false.
     end function directory_exists
 
-    !> Decimal text of an integer.
-    pure function int_text(i) result(text)
-        integer, intent(in) :: i
-        character(len=:), allocatable :: text
-        character(len=24) :: buffer
-        write (buffer, '(i0)') i
-        text = trim(buffer)
-    end function int_text
 
     !> "a, b" text of a shape.
     pure function shape_text(extents) result(text)
@@ -844,66 +838,4 @@ contains
             text = text//int_text(extents(k))
         end do
     end function shape_text
-
-    !> Current time as ISO 8601 UTC, e.g. 2024-05-01T12:34:56Z.
-    function utc_timestamp() result(text)
-        character(len=20) :: text
-        integer :: values(8), offset, days, minutes, year, month, day
-        call date_and_time(values=values)
-        offset = values(4)
-        if (offset == -huge(0)) offset = 0
-        minutes = values(5)*60 + values(6) - offset
-        days = days_from_civil(values(1), values(2), values(3)) &
-               + (minutes - modulo(minutes, 1440))/1440
-        minutes = modulo(minutes, 1440)
-        call civil_from_days(days, year, month, day)
-        write (text, '(i4.4, "-", i2.2, "-", i2.2, "T", i2.2, ":", i2.2, ":", i2.2, "Z")') &
-            year, month, day, minutes/60, modulo(minutes, 60), values(7)
-    end function utc_timestamp
-
-    !> Days since 1970-01-01 of a proleptic Gregorian date (H. Hinnant's algorithm).
-    pure integer function days_from_civil(year, month, day) result(days)
-        integer, intent(in) :: year, month, day
-        integer :: y, era, yoe, doy, doe
-        y = year
-        if (month <= 2) y = y - 1
-        if (y >= 0) then
-            era = y/400
-        else
-            era = (y - 399)/400
-        end if
-        yoe = y - era*400
-        if (month > 2) then
-            doy = (153*(month - 3) + 2)/5 + day - 1
-        else
-            doy = (153*(month + 9) + 2)/5 + day - 1
-        end if
-        doe = yoe*365 + yoe/4 - yoe/100 + doy
-        days = era*146097 + doe - 719468
-    end function days_from_civil
-
-    !> Inverse of days_from_civil.
-    pure subroutine civil_from_days(days, year, month, day)
-        integer, intent(in) :: days
-        integer, intent(out) :: year, month, day
-        integer :: z, era, doe, yoe, doy, mp
-        z = days + 719468
-        if (z >= 0) then
-            era = z/146097
-        else
-            era = (z - 146096)/146097
-        end if
-        doe = z - era*146097
-        yoe = (doe - doe/1460 + doe/36524 - doe/146096)/365
-        doy = doe - (365*yoe + yoe/4 - yoe/100)
-        mp = (5*doy + 2)/153
-        day = doy - (153*mp + 2)/5 + 1
-        if (mp < 10) then
-            month = mp + 3
-        else
-            month = mp - 9
-        end if
-        year = yoe + era*400
-        if (month <= 2) year = year + 1
-    end subroutine civil_from_days
 end module ropedyn_output

@@ -17,9 +17,11 @@ module ropedyn_modes
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER, ERR_INPUT, ERR_INTERNAL
-    use ropedyn_problem, only: STATUS_OK, energy_t
+    use ropedyn_problem, only: STATUS_OK
+    use ropedyn_rope_model, only: energy_t
     use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_scene, only: scene_t
+    use ropedyn_text, only: int_text
+    use ropedyn_rope_spec, only: rope_spec_t
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
                                tangent_matrices, bandwidth, rope_length, model_factory_i
     implicit none
@@ -135,11 +137,11 @@ contains
         end if
         if (info > nd) then
             call make_error(err, ERR_SOLVER, 'modes: the mass matrix is not positive '// &
-                            'definite ('//res%eigensolver//' info '//itoa(info)//')')
+                            'definite ('//res%eigensolver//' info '//int_text(info)//')')
             return
         else if (info /= 0 .or. k < m) then
             call make_error(err, ERR_SOLVER, 'modes: the eigensolver '//res%eigensolver// &
-                            ' failed (info '//itoa(info)//', '//itoa(k)//' of '//itoa(m)// &
+                            ' failed (info '//int_text(info)//', '//int_text(k)//' of '//int_text(m)// &
                             ' eigenvalues)')
             return
         end if
@@ -225,9 +227,9 @@ contains
     !! rest, found from the 'straight' start in y) or 'mode' (that equilibrium plus mode
     !! `mode` scaled so that its largest point displacement is `mode_amplitude`, at rest).
     !! Other shapes leave y unchanged.
-    subroutine equilibrium_initial_state(model, scene, y, err, factory)
+    subroutine equilibrium_initial_state(model, spec, y, err, factory)
         class(rope_model_t), intent(inout) :: model
-        type(scene_t), intent(in) :: scene
+        type(rope_spec_t), intent(in) :: spec
         real(wp), intent(inout) :: y(:)
         type(error_t), allocatable, intent(out) :: err
         procedure(model_factory_i), optional :: factory  !< for continuation (create_model)
@@ -237,40 +239,33 @@ contains
         integer :: k
         real(wp) :: largest
 
-        select case (trim(scene%initial%shape))
+        select case (trim(spec%initial%shape))
         case ('equilibrium', 'mode')
         case default
             return
         end select
-        call find_equilibrium(model, scene, y, statics_options_t(), sres, err, factory)
+        call find_equilibrium(model, spec, y, statics_options_t(), sres, err, factory)
         if (allocated(err)) then
-            err%message = err%message//" (&initial shape = '"//trim(scene%initial%shape)//"')"
+            err%message = err%message//" (&initial shape = '"//trim(spec%initial%shape)//"')"
             return
         end if
-        if (trim(scene%initial%shape) /= 'mode') return
-        k = scene%initial%mode
+        if (trim(spec%initial%shape) /= 'mode') return
+        k = spec%initial%mode
         call compute_modes(model, y, k, mres, err)
         if (allocated(err)) return
         if (mres%count < k) then
-            call make_error(err, ERR_INPUT, scene%path//': &initial: mode = '//itoa(k)// &
-                            ': the model has only '//itoa(mres%ndof)//' modes')
+            call make_error(err, ERR_INPUT, spec%path//': &initial: mode = '//int_text(k)// &
+                            ': the model has only '//int_text(mres%ndof)//' modes')
             return
         end if
         largest = maxval(norm2(mres%shape_points(:, :, k), dim=1))
         if (.not. largest > 0.0_wp) then
-            call make_error(err, ERR_SOLVER, scene%path//': &initial: mode = '//itoa(k)// &
+            call make_error(err, ERR_SOLVER, spec%path//': &initial: mode = '//int_text(k)// &
                             ': the mode does not move the rope')
             return
         end if
         call model%coordinates(pos, vel)
-        y(pos) = y(pos) + (scene%initial%mode_amplitude/largest)*mres%shape(:, k)
+        y(pos) = y(pos) + (spec%initial%mode_amplitude/largest)*mres%shape(:, k)
     end subroutine equilibrium_initial_state
 
-    pure function itoa(i) result(text)
-        integer, intent(in) :: i
-        character(len=:), allocatable :: text
-        character(len=16) :: buffer
-        write (buffer, '(i0)') i
-        text = trim(buffer)
-    end function itoa
 end module ropedyn_modes

@@ -23,11 +23,12 @@
 module ropedyn_sweep
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_is_finite
     use ropedyn_kinds, only: wp, i8
+    use ropedyn_text, only: int_text, real_text, lower
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_scene, only: scene_t, read_scene
     implicit none
     private
-    public :: text_t, sweep_case_t, sweep_t, read_sweep, case_name, real_text, int_text
+    public :: text_t, sweep_case_t, sweep_t, read_sweep, case_name
     public :: MAX_LIST, MAX_VARY, REF_NONE, REF_TIGHTEST, REF_FILE
 
     integer, parameter :: MAX_LIST = 64   !< most values of one list key
@@ -182,7 +183,7 @@ contains
         if (.not. (ieee_is_nan(atol_per_rtol))) then
             if (.not. (ieee_is_finite(atol_per_rtol) .and. atol_per_rtol > 0.0_wp)) then
                 call make_error(err, ERR_INPUT, where//'atol_per_rtol = '// &
-                    real_text(atol_per_rtol)//': must be > 0')
+                    real_text(atol_per_rtol, compact=.true.)//': must be > 0')
                 return
             end if
         end if
@@ -597,7 +598,7 @@ contains
         do k = n + 2, size(rtols)
             if (.not. ieee_is_nan(rtols(k))) then
                 call make_error(err, ERR_INPUT, where//'rtols('//int_text(k)//') = '// &
-                    real_text(rtols(k))//': given, but rtols('//int_text(n + 1)// &
+                    real_text(rtols(k), compact=.true.)//': given, but rtols('//int_text(n + 1)// &
                     ') is not (lists have no gaps)')
                 return
             end if
@@ -606,10 +607,10 @@ contains
         do k = 1, n
             if (.not. (rtols(k) > 0.0_wp .and. rtols(k) < 1.0_wp)) then
                 call make_error(err, ERR_INPUT, where//'rtols('//int_text(k)//') = '// &
-                    real_text(rtols(k))//': must be > 0 and < 1')
+                    real_text(rtols(k), compact=.true.)//': must be > 0 and < 1')
                 return
             end if
-            call append(d%values, real_text(rtols(k)))
+            call append(d%values, real_text(rtols(k), compact=.true.))
         end do
         nd = nd + 1
         dims(nd) = d
@@ -707,7 +708,7 @@ contains
                 end if
                 if (.not. ieee_is_nan(atol_per_rtol)) then
                     rtol = cs%scene%solver%rtol
-                    call append(cs%overrides, 'solver.atol='//real_text(atol_per_rtol*rtol))
+                    call append(cs%overrides, 'solver.atol='//real_text(atol_per_rtol*rtol, compact=.true.))
                     call read_scene(sweep%base, case_overrides(sweep, cs%overrides, cs%file), &
                         cs%scene, err)
                     if (allocated(err)) then
@@ -832,71 +833,6 @@ contains
     ! Text helpers
     ! ------------------------------------------------------------------------------------
 
-    !> Shortest text that reads back to x: 1e-4, 0.5, 0.001, 2.5e-7, 30.0, 35000.0.
-    function real_text(x) result(s)
-        real(wp), intent(in) :: x
-        character(len=:), allocatable :: s
-        character(len=40) :: buf
-        character(len=:), allocatable :: digits, sign
-        real(wp) :: y
-        integer :: d, ios, epos, e
-        if (ieee_is_nan(x)) then
-            s = 'NaN'
-            return
-        else if (.not. abs(x) > 0.0_wp) then
-            s = '0.0'
-            return
-        end if
-        do d = 0, 16
-            write (buf, '(es30.'//int_text(d)//'e3)') x
-            read (buf, *, iostat=ios) y
-            if (ios == 0 .and. y == x) exit
-        end do
-        buf = adjustl(buf)
-        sign = ''
-        if (buf(1:1) == '-') then
-            sign = '-'
-            buf = buf(2:)
-        end if
-        epos = scan(buf, 'Ee')
-        read (buf(epos + 1:), *) e
-        digits = buf(1:1)//buf(3:epos - 1)   ! without the decimal point
-        do while (len(digits) > 1)
-            if (digits(len(digits):) /= '0') exit
-            digits = digits(:len(digits) - 1)
-        end do
-        if (e >= 0 .and. e <= 5) then
-            if (len(digits) <= e + 1) then
-                s = digits//repeat('0', e + 1 - len(digits))//'.0'
-            else
-                s = digits(:e + 1)//'.'//digits(e + 2:)
-            end if
-        else if (e < 0 .and. e >= -3) then
-            s = '0.'//repeat('0', -e - 1)//digits
-        else if (len(digits) == 1) then
-            s = digits//'e'//int_text(e)
-        else
-            s = digits(1:1)//'.'//digits(2:)//'e'//int_text(e)
-        end if
-        s = sign//s
-    end function real_text
 
-    pure function int_text(n) result(s)
-        integer, intent(in) :: n
-        character(len=:), allocatable :: s
-        character(len=12) :: buf
-        write (buf, '(i0)') n
-        s = trim(buf)
-    end function int_text
 
-    pure function lower(s) result(t)
-        character(len=*), intent(in) :: s
-        character(len=len(s)) :: t
-        integer :: i, c
-        t = s
-        do i = 1, len(s)
-            c = iachar(s(i:i))
-            if (c >= iachar('A') .and. c <= iachar('Z')) t(i:i) = achar(c + 32)
-        end do
-    end function lower
 end module ropedyn_sweep

@@ -3,9 +3,9 @@
 !! Shown when stderr is a terminal or when the scene asks for it (&output progress);
 !! silent otherwise. Redraws at most every 0.2 s of wall time.
 module ropedyn_progress
-    use, intrinsic :: iso_c_binding, only: c_int
     use, intrinsic :: iso_fortran_env, only: error_unit, int64
     use ropedyn_kinds, only: wp, i8
+    use ropedyn_os, only: is_terminal
     implicit none
     private
     public :: progress_t
@@ -22,13 +22,6 @@ module ropedyn_progress
         procedure :: done
     end type progress_t
 
-    interface
-        integer(c_int) function c_isatty(fd) bind(C, name='isatty')
-            import :: c_int
-            integer(c_int), value :: fd
-        end function c_isatty
-    end interface
-
 contains
 
     !> Decide whether to show progress (forced, or stderr is a terminal).
@@ -36,7 +29,7 @@ contains
         class(progress_t), intent(inout) :: self
         real(wp), intent(in) :: t_end   !< final simulated time, s
         logical, intent(in) :: forced
-        self%enabled = forced .or. c_isatty(2_c_int) == 1
+        self%enabled = forced .or. is_terminal(2)
         self%t_end = t_end
         call system_clock(self%start, self%rate)
         self%last = self%start

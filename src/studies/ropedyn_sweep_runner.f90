@@ -1,10 +1,6 @@
-!> `ropedyn sweep`: list, run (locally with N worker processes, or one case for a Slurm
-!! array task) and summarize a sweep (docs/sweeps.md).
-!!
-!!     ropedyn sweep SWEEP.nml [--jobs N] [--force] [--quiet] [--output-dir DIR]
-!!     ropedyn sweep SWEEP.nml --list | --count
-!!     ropedyn sweep SWEEP.nml --task K [--force] [--quiet] [--output-dir DIR]
-!!     ropedyn sweep SWEEP.nml --summary [--output-dir DIR]
+!> Running a sweep (docs/sweeps.md): list its cases, run them locally with N worker
+!! processes or one case for a Slurm array task, and summarize (the command line is
+!! src/app/ropedyn_cmd_sweep.f90).
 !!
 !! Parallel runs are processes, not threads (the HDF5 library is not thread-safe, and a
 !! crashing case must not take the others down): the local runner starts each case as
@@ -15,211 +11,45 @@
 !! writes 128 + signal). The summary is built from the case files only, so the Slurm array
 !! and the local runner produce the same summary, and `--summary` can rebuild it at any time.
 module ropedyn_sweep_runner
-    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
     use ropedyn_kinds, only: wp
+    use ropedyn_os, only: make_dirs, is_terminal, sleep_microseconds, processor_count
     use ropedyn_error, only: error_t, make_error, ERR_USAGE, ERR_SOLVER, ERR_IO
     use ropedyn_simulation, only: run_summary_t, run_scene
-    use ropedyn_sweep, only: sweep_t, read_sweep, int_text
+    use ropedyn_sweep, only: sweep_t
+    use ropedyn_text, only: int_text
     use ropedyn_sweep_summary, only: case_row_t, case_status, build_summary
     use ropedyn_case_file, only: write_wall_time
     implicit none
     private
-    public :: sweep_command, sweep_usage
+    public :: sweep_options_t, list_cases, run_task, run_local, summarize
 
     !> Poll interval of the local runner, microseconds.
     integer, parameter :: POLL_US = 50000
 
-    interface
-        integer(c_int) function c_mkdir(path, mode) bind(C, name='mkdir')
-            import :: c_char, c_int
-            character(kind=c_char), intent(in) :: path(*)
-            integer(c_int), value :: mode
-        end function c_mkdir
-        integer(c_int) function c_usleep(microseconds) bind(C, name='usleep')
-            import :: c_int
-            integer(c_int), value :: microseconds
-        end function c_usleep
-        integer(c_int) function c_get_nprocs() bind(C, name='get_nprocs')
-            import :: c_int
-        end function c_get_nprocs
-        integer(c_int) function c_isatty(fd) bind(C, name='isatty')
-            import :: c_int
-            integer(c_int), value :: fd
-        end function c_isatty
-    end interface
-
     !> The options of one `ropedyn sweep` command line.
-    type :: options_t
+    type :: sweep_options_t
         character(len=:), allocatable :: path, output_dir
         logical :: list = .false., count = .false., summary = .false., force = .false., &
             quiet = .false.
         integer :: jobs = 0, task = 0
-    end type options_t
+    end type sweep_options_t
 
 contains
 
-    subroutine sweep_usage(unit)
-        integer, intent(in) :: unit
-        write (unit, '(a)') 'usage: ropedyn sweep SWEEP.nml [--jobs N] [--force] [--quiet] '// &
-            '[--output-dir DIR]'
-        write (unit, '(a)') '       ropedyn sweep SWEEP.nml --list | --count'
-        write (unit, '(a)') '       ropedyn sweep SWEEP.nml --task K [--force] [--quiet] '// &
-            '[--output-dir DIR]'
-        write (unit, '(a)') '       ropedyn sweep SWEEP.nml --summary [--output-dir DIR]'
-        write (unit, '(a)') 'Runs every case of a sweep file (a base scene and lists of '// &
-            'models, elements,'
-        write (unit, '(a)') 'methods, max_orders, rtols and any group.key) and writes '// &
-            '<output_dir>/case_<id>.h5'
-        write (unit, '(a)') 'and summary.csv / summary.h5 (docs/sweeps.md).'
-        write (unit, '(a)') '  --jobs N        worker processes (default: the number of cores)'
-        write (unit, '(a)') '  --list          print the cases: id, status of its file, overrides'
-        write (unit, '(a)') '  --count         print the number of cases'
-        write (unit, '(a)') '  --task K        run case K only (a Slurm array task); no summary'
-        write (unit, '(a)') '  --summary       rebuild the summary from the case files that exist'
-        write (unit, '(a)') '  --force         run cases again even if their output is complete'
-        write (unit, '(a)') '  --quiet         no progress and no per-case lines'
-        write (unit, '(a)') '  --output-dir D  case files and summary in D (instead of output_dir)'
-        write (unit, '(a)') 'A case whose file is complete and holds the same scene is skipped.'
-        write (unit, '(a)') 'exit codes: 0 ok, 2 bad input, 3 a case failed, 4 output error'
-    end subroutine sweep_usage
-
-    !> `ropedyn sweep ARGS`: `args` are the arguments after `sweep`; `exe` is how this
-    !! program was started (argument 0), used to start the workers.
-    subroutine sweep_command(args, exe, err)
-        character(len=*), intent(in) :: args(:)
-        character(len=*), intent(in) :: exe
+    !> --summary: rebuild the summary from the case files and report it.
+    subroutine summarize(sweep, quiet, err)
+        type(sweep_t), intent(in) :: sweep
+        logical, intent(in) :: quiet
         type(error_t), allocatable, intent(out) :: err
-        type(options_t) :: opt
-        type(sweep_t) :: sweep
         type(case_row_t), allocatable :: rows(:)
-
-        call parse_options(args, opt, err)
+        call make_dirs(sweep%output_dir, err, 'sweep')
         if (allocated(err)) return
-        if (.not. allocated(opt%path)) return   ! --help
-        call read_sweep(opt%path, sweep, err, opt%output_dir)
+        call build_summary(sweep, rows, err)
         if (allocated(err)) return
-        if (opt%count) then
-            write (output_unit, '(i0)') size(sweep%cases)
-        else if (opt%list) then
-            call list_cases(sweep, err)
-        else if (opt%task > 0) then
-            if (opt%task > size(sweep%cases)) then
-                call make_error(err, ERR_USAGE, 'sweep: --task '//int_text(opt%task)// &
-                    ': no such case ('//opt%path//' has '//int_text(size(sweep%cases))// &
-                    ' cases, 1 .. '//int_text(size(sweep%cases))//')')
-                return
-            end if
-            call run_task(sweep, opt%task, opt%force, opt%quiet, err)
-        else if (opt%summary) then
-            call make_dirs(sweep%output_dir, err)
-            if (allocated(err)) return
-            call build_summary(sweep, rows, err)
-            if (allocated(err)) return
-            call report_summary(sweep, rows, opt%quiet, err)
-        else
-            call run_local(sweep, opt, exe, err)
-        end if
-    end subroutine sweep_command
-
-    subroutine parse_options(args, opt, err)
-        character(len=*), intent(in) :: args(:)
-        type(options_t), intent(out) :: opt
-        type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: a, value
-        integer :: i, ios, modes
-        logical :: have_jobs
-
-        have_jobs = .false.
-        i = 1
-        do while (i <= size(args))
-            a = trim(args(i))
-            i = i + 1
-            select case (a)
-            case ('--help', '-h')
-                call sweep_usage(output_unit)
-                return
-            case ('--list')
-                opt%list = .true.
-            case ('--count')
-                opt%count = .true.
-            case ('--summary')
-                opt%summary = .true.
-            case ('--force')
-                opt%force = .true.
-            case ('--quiet')
-                opt%quiet = .true.
-            case ('--jobs', '--task', '--output-dir')
-                if (i > size(args)) then
-                    call usage_error('sweep: '//a//' needs a value', err)
-                    return
-                end if
-                value = trim(args(i))
-                i = i + 1
-                select case (a)
-                case ('--output-dir')
-                    if (len(value) == 0) then
-                        call usage_error('sweep: --output-dir needs a directory', err)
-                        return
-                    end if
-                    opt%output_dir = value
-                case ('--jobs')
-                    ios = 1
-                    if (verify(value, '0123456789') == 0 .and. len(value) > 0 .and. &
-                        len(value) < 9) read (value, *, iostat=ios) opt%jobs
-                    if (ios /= 0 .or. opt%jobs < 1) then
-                        call usage_error('sweep: --jobs "'//value//'": expected a whole ' &
-                            //'number >= 1', err)
-                        return
-                    end if
-                    have_jobs = .true.
-                case ('--task')
-                    ios = 1
-                    if (verify(value, '0123456789') == 0 .and. len(value) > 0 .and. &
-                        len(value) < 9) read (value, *, iostat=ios) opt%task
-                    if (ios /= 0 .or. opt%task < 1) then
-                        call usage_error('sweep: --task "'//value//'": expected a case id ' &
-                            //'>= 1', err)
-                        return
-                    end if
-                end select
-            case default
-                if (len(a) == 0) then
-                    call usage_error('sweep: empty argument', err)
-                    return
-                else if (a(1:1) == '-') then
-                    call usage_error('sweep: unknown option "'//a//'"', err)
-                    return
-                else if (allocated(opt%path)) then
-                    call usage_error('sweep: more than one sweep file: "'//opt%path//'", "' &
-                        //a//'"', err)
-                    return
-                end if
-                opt%path = a
-            end select
-        end do
-        if (.not. allocated(opt%path)) then
-            call usage_error('sweep needs a sweep file', err)
-            return
-        end if
-        if (.not. allocated(opt%output_dir)) opt%output_dir = ''
-        modes = count([opt%list, opt%count, opt%summary, opt%task > 0])
-        if (modes > 1) then
-            call usage_error('sweep: --list, --count, --summary and --task exclude each other', &
-                err)
-        else if (have_jobs .and. modes > 0) then
-            call usage_error('sweep: --jobs is for running the whole sweep', err)
-        else if (opt%force .and. (opt%list .or. opt%count .or. opt%summary)) then
-            call usage_error('sweep: --force is for running cases', err)
-        end if
-        if (.not. have_jobs) opt%jobs = max(1, int(c_get_nprocs()))
-    end subroutine parse_options
-
-    subroutine usage_error(message, err)
-        character(len=*), intent(in) :: message
-        type(error_t), allocatable, intent(out) :: err
-        call make_error(err, ERR_USAGE, message//' (see ropedyn sweep --help)')
-    end subroutine usage_error
+        call report_summary(sweep, rows, quiet, err)
+    end subroutine summarize
 
     !> --list: one line per case: id, status of its file, overrides.
     subroutine list_cases(sweep, err)
@@ -271,7 +101,7 @@ contains
                     return
                 end if
             end if
-            call make_dirs(sweep%output_dir, err)
+            call make_dirs(sweep%output_dir, err, 'sweep')
             if (allocated(err)) return
             call system_clock(start, rate)
             call run_scene(c%scene, summary, err)
@@ -296,7 +126,7 @@ contains
     !! its own process; then the summary.
     subroutine run_local(sweep, opt, exe, err)
         type(sweep_t), intent(in) :: sweep
-        type(options_t), intent(in) :: opt
+        type(sweep_options_t), intent(in) :: opt
         character(len=*), intent(in) :: exe
         type(error_t), allocatable, intent(out) :: err
         type(error_t), allocatable :: serr
@@ -318,9 +148,9 @@ contains
             end if
             todo = [todo, c]
         end do
-        call make_dirs(sweep%output_dir, err)
+        call make_dirs(sweep%output_dir, err, 'sweep')
         if (allocated(err)) return
-        tty = c_isatty(2_c_int) == 1 .and. .not. opt%quiet
+        tty = is_terminal(2) .and. .not. opt%quiet
         if (.not. opt%quiet) write (error_unit, '(a)') 'sweep '//sweep%path//': '// &
             int_text(n)//' cases, '//int_text(n - size(todo))//' complete already, '// &
             'running '//int_text(size(todo))//' with '//int_text(min(opt%jobs, &
@@ -356,7 +186,7 @@ contains
                 slot(s) = c
                 running = running + 1
             end do
-            rc = c_usleep(int(POLL_US, c_int))
+            call sleep_microseconds(POLL_US)
             ! collect finished workers
             redraw = .false.
             do s = 1, size(slot)
@@ -458,28 +288,6 @@ contains
     ! ------------------------------------------------------------------------------------
     ! Files and text
     ! ------------------------------------------------------------------------------------
-
-    !> mkdir -p.
-    subroutine make_dirs(dir, err)
-        character(len=*), intent(in) :: dir
-        type(error_t), allocatable, intent(out) :: err
-        integer :: k, rc
-        logical :: exists
-        character(len=:), allocatable :: path
-        path = dir//'/'
-        do k = 2, len(path)
-            if (path(k:k) /= '/') cycle
-            inquire (file=path(1:k - 1)//'/.', exist=exists)
-            if (exists) cycle
-            rc = c_mkdir(path(1:k - 1)//c_null_char, int(o'755', c_int))
-            inquire (file=path(1:k - 1)//'/.', exist=exists)
-            if (.not. exists) then
-                call make_error(err, ERR_IO, 'sweep: cannot create directory "'// &
-                                path(1:k - 1)//'"')
-                return
-            end if
-        end do
-    end subroutine make_dirs
 
     subroutine remove_file(path)
         character(len=*), intent(in) :: path

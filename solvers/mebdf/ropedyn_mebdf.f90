@@ -22,6 +22,7 @@
 module ropedyn_mebdf
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp, i8
+    use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
     use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
@@ -93,9 +94,6 @@ module ropedyn_mebdf
         procedure :: stats => mebdf_stats
         procedure :: finalize => mebdf_finalize
         procedure :: name => mebdf_name
-        procedure :: default_max_order => mebdf_default_max_order
-        procedure :: min_order => mebdf_min_order
-        procedure :: max_order_limit => mebdf_max_order_limit
         procedure :: start_fixed => mebdf_start_fixed
         procedure, private :: initial_step
         procedure, private :: initial_slope
@@ -115,25 +113,6 @@ contains
         character(len=:), allocatable :: name
         name = 'mebdf'
     end function mebdf_name
-
-    !> Order 4 (k = 3): the highest order at which MEBDF is A-stable and does not amplify
-    !! undamped oscillations (order 5 amplifies by up to 1.027 per step on the imaginary
-    !! axis, order 6 by 1.114; docs/solvers.md), so lightly damped stiff modes stay safe.
-    pure integer function mebdf_default_max_order(self) result(order)
-        class(mebdf_t), intent(in) :: self
-        order = 4
-    end function mebdf_default_max_order
-
-    !> The lowest order is 2 (k = 1).
-    pure integer function mebdf_min_order(self) result(order)
-        class(mebdf_t), intent(in) :: self
-        order = 2
-    end function mebdf_min_order
-
-    pure integer function mebdf_max_order_limit(self) result(order)
-        class(mebdf_t), intent(in) :: self
-        order = KMAX_MEBDF + 1
-    end function mebdf_max_order_limit
 
     subroutine mebdf_init(self, problem, t0, y0, yq0, options, err)
         class(mebdf_t), intent(inout) :: self
@@ -792,9 +771,4 @@ contains
         call make_error(err, ERR_SOLVER, 'mebdf failed at '//trim(where)//': '//cause)
     end subroutine failure
 
-    pure function int_text(i) result(s)
-        integer(i8), intent(in) :: i
-        character(len=24) :: s
-        write (s, '(i0)') i
-    end function int_text
 end module ropedyn_mebdf

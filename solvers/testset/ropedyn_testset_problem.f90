@@ -8,10 +8,10 @@
 !! (scd or mescd) is meaningful for it. Every problem here has an analytic Jacobian: an
 !! extension writes df/dy as a dense n x n matrix in `dense_jacobian`, and this base type
 !! stores it in the band layout of `problem_t%jacobian` (dense band, ml = mu = n - 1).
-!! The problems are autonomous, carry no quadrature variables and have no energy.
+!! The problems are autonomous and carry no quadrature variables.
 module ropedyn_testset_problem
     use ropedyn_kinds, only: wp
-    use ropedyn_problem, only: problem_t, energy_t, STATUS_OK
+    use ropedyn_problem, only: problem_t, STATUS_OK
     implicit none
     private
     public :: testset_problem_t
@@ -34,7 +34,6 @@ module ropedyn_testset_problem
         procedure(dense_jacobian_i), deferred :: dense_jacobian
         procedure :: size => testset_size
         procedure :: bandwidths => testset_bandwidths
-        procedure :: energy => testset_energy
         procedure :: has_jacobian => testset_has_jacobian
         procedure :: jacobian => testset_jacobian
         procedure :: recommended_atol => testset_recommended_atol
@@ -74,16 +73,6 @@ contains
         ml = max(self%size() - 1, 0)
         mu = ml
     end subroutine testset_bandwidths
-
-    !> Test problems have no mechanical energy: all terms zero.
-    function testset_energy(self, t, y, yq) result(e)
-        class(testset_problem_t), intent(inout) :: self
-        real(wp), intent(in) :: t
-        real(wp), intent(in) :: y(:)
-        real(wp), intent(in) :: yq(:)
-        type(energy_t) :: e
-        e = energy_t()
-    end function testset_energy
 
     !> Every test-set problem here has an analytic Jacobian.
     pure logical function testset_has_jacobian(self) result(has)

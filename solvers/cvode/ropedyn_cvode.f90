@@ -9,6 +9,7 @@
 module ropedyn_cvode
     use, intrinsic :: iso_c_binding
     use ropedyn_kinds, only: wp, i8
+    use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK
     use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
@@ -59,9 +60,6 @@ module ropedyn_cvode
         procedure :: stats => cvode_stats
         procedure :: finalize => cvode_finalize
         procedure :: name => cvode_name
-        procedure :: default_max_order => cvode_default_max_order
-        procedure :: min_order => cvode_min_order
-        procedure :: max_order_limit => cvode_max_order_limit
         final :: cvode_destroy
     end type cvode_t
 
@@ -79,26 +77,6 @@ contains
         character(len=:), allocatable :: name
         name = 'cvode'
     end function cvode_name
-
-    !> CVODE's own limit, BDF order 5, kept after measuring orders 2 .. 5 with and without
-    !! stability-limit detection on the hard scenes (docs/stability.md): orders 3 and 4 let
-    !! undamped modes gain energy, order 2 crawls where the rope's oscillations must be
-    !! resolved, and order 5 never amplified. (Stiff, barely damped ropes such as the steel
-    !! wire run faster at max_order 2 or with MEBDF.)
-    pure integer function cvode_default_max_order(self) result(order)
-        class(cvode_t), intent(in) :: self
-        order = 5
-    end function cvode_default_max_order
-
-    pure integer function cvode_min_order(self) result(order)
-        class(cvode_t), intent(in) :: self
-        order = 1
-    end function cvode_min_order
-
-    pure integer function cvode_max_order_limit(self) result(order)
-        class(cvode_t), intent(in) :: self
-        order = 5
-    end function cvode_max_order_limit
 
     subroutine cvode_init(self, problem, t0, y0, yq0, options, err)
         class(cvode_t), intent(inout) :: self
@@ -326,13 +304,6 @@ contains
         text = trim(buffer)
     end function where_text
 
-    pure function int_text(i) result(s)
-        integer(i8), intent(in) :: i
-        character(len=:), allocatable :: s
-        character(len=24) :: buffer
-        write (buffer, '(i0)') i
-        s = trim(buffer)
-    end function int_text
 
     function cvode_stats(self) result(stats)
         class(cvode_t), intent(in) :: self

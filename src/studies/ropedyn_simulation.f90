@@ -1,17 +1,17 @@
 !> Runs one scene: builds the model and the integrator it names, integrates to t_end
 !! with output at every output_interval, writes the HDF5 file and returns a summary.
 module ropedyn_simulation
-    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_IO, ERR_SOLVER
-    use ropedyn_problem, only: energy_t
+    use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
     use ropedyn_solvers, only: new_integrator
-    use ropedyn_rope_model, only: rope_model_t
     use ropedyn_rfem, only: rfem_t, rfem_create
     use ropedyn_mpp, only: mpp_t, mpp_create
+    use ropedyn_rope_spec, only: rope_spec_t
     use ropedyn_scene, only: scene_t, scene_namelist_text
+    use ropedyn_os, only: make_parent_dirs
     use ropedyn_output, only: output_file_t
     use ropedyn_progress, only: progress_t
     use ropedyn_fault, only: fault_problem_t, fault_wrap
@@ -20,7 +20,6 @@ module ropedyn_simulation
     implicit none
     private
     public :: run_summary_t, run_scene, create_model, create_integrator, solver_options_of
-    public :: make_parent_dirs
 
     !> What a run reports back to the driver.
     type :: run_summary_t
@@ -33,37 +32,29 @@ module ropedyn_simulation
         character(len=:), allocatable :: file
     end type run_summary_t
 
-    interface
-        integer(c_int) function c_mkdir(path, mode) bind(C, name='mkdir')
-            import :: c_char, c_int
-            character(kind=c_char), intent(in) :: path(*)
-            integer(c_int), value :: mode
-        end function c_mkdir
-    end interface
-
 contains
 
-    !> The model a scene names.
-    subroutine create_model(scene, model, err)
-        type(scene_t), intent(in) :: scene
+    !> The model a spec names.
+    subroutine create_model(spec, model, err)
+        type(rope_spec_t), intent(in) :: spec
         class(rope_model_t), allocatable, intent(out) :: model
         type(error_t), allocatable, intent(out) :: err
         type(rfem_t), allocatable :: rfem
         type(mpp_t), allocatable :: mpp
-        select case (scene%model%kind)
+        select case (spec%model%kind)
         case ('rfem')
             allocate (rfem)
-            call rfem_create(rfem, scene, err)
+            call rfem_create(rfem, spec, err)
             if (allocated(err)) return
             call move_alloc(rfem, model)
         case ('mpp')
             allocate (mpp)
-            call mpp_create(mpp, scene, err)
+            call mpp_create(mpp, spec, err)
             if (allocated(err)) return
             call move_alloc(mpp, model)
         case default
-            call make_error(err, ERR_INPUT, scene%path//': &model: kind = "'// &
-                            trim(scene%model%kind)//'": not available in this version')
+            call make_error(err, ERR_INPUT, spec%path//': &model: kind = "'// &
+                            trim(spec%model%kind)//'": not available in this version')
         end select
     end subroutine create_model
 
@@ -106,7 +97,7 @@ contains
         integer :: n, k, n_out
         type(solver_stats_t) :: stats
 
-        call create_model(scene, model, err)
+        call create_model(scene%rope_spec_t, model, err)
         if (allocated(err)) return
         call create_integrator(scene, integrator, err)
         if (allocated(err)) return
@@ -116,7 +107,7 @@ contains
         allocate (q(3, n), qdot(3, n), points(2, 2*n), lengths(n), masses(n))
         call model%initial_state(y)
         ! &initial shape = 'equilibrium' or 'mode': statics (and modes) first
-        call equilibrium_initial_state(model, scene, y, err, create_model)
+        call equilibrium_initial_state(model, scene%rope_spec_t, y, err, create_model)
         if (allocated(err)) return
         yq = 0.0_wp
         t = 0.0_wp
@@ -214,24 +205,4 @@ contains
             call integrator%finalize()
         end subroutine finish
     end subroutine run_scene
-
-    !> mkdir -p of the directory part of `path`.
-    subroutine make_parent_dirs(path, err)
-        character(len=*), intent(in) :: path
-        type(error_t), allocatable, intent(out) :: err
-        integer :: k, rc
-        logical :: exists
-        do k = 2, len_trim(path)
-            if (path(k:k) /= '/') cycle
-            inquire (file=path(1:k - 1)//'/.', exist=exists)
-            if (exists) cycle
-            rc = c_mkdir(path(1:k - 1)//c_null_char, int(o'755', c_int))
-            inquire (file=path(1:k - 1)//'/.', exist=exists)
-            if (.not. exists) then
-                call make_error(err, ERR_IO, path//': cannot create directory "'// &
-                                path(1:k - 1)//'"')
-                return
-            end if
-        end do
-    end subroutine make_parent_dirs
 end module ropedyn_simulation

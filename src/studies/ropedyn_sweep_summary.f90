@@ -9,9 +9,10 @@ module ropedyn_sweep_summary
         h5tcopy_f, h5tset_size_f, h5tset_strpad_f, h5tclose_f, H5T_NATIVE_CHARACTER, &
         H5T_STR_NULLPAD_F, h5kind_to_type, H5_REAL_KIND, H5_INTEGER_KIND
     use ropedyn_kinds, only: wp, i8
+    use ropedyn_text, only: int_text, real_text
     use ropedyn_error, only: error_t, make_error, ERR_IO
     use ropedyn_scene, only: scene_namelist_text
-    use ropedyn_sweep, only: sweep_t, sweep_case_t, text_t, real_text, int_text, REF_NONE, &
+    use ropedyn_sweep, only: sweep_t, sweep_case_t, text_t, REF_NONE, &
         REF_TIGHTEST, REF_FILE
     use ropedyn_case_file, only: case_data_t, read_case_file, write_text_attribute
     use ropedyn_version, only: version_string
@@ -224,12 +225,12 @@ contains
             associate (r => rows(c), s => sweep%cases(c)%scene)
                 line = int_text(r%id)//','//r%status//','//csv_text(trim(s%model%kind))// &
                     ','//int_text(s%model%elements)//','//csv_text(trim(s%solver%method))// &
-                    ','//int_text(s%solver%max_order)//','//real_text(s%solver%rtol)//','// &
-                    real_text(s%solver%atol)
+                    ','//int_text(s%solver%max_order)//','//real_text(s%solver%rtol, compact=.true.)//','// &
+                    real_text(s%solver%atol, compact=.true.)
                 do v = 1, size(sweep%vary_keys)
                     line = line//','//csv_text(sweep%cases(c)%vary_values(v)%s)
                 end do
-                line = line//','//real_text(s%solver%t_end)//','//num(r%t_reached)//','// &
+                line = line//','//real_text(s%solver%t_end, compact=.true.)//','//num(r%t_reached)//','// &
                     num(r%wall_time)//','//num(r%cpu_time)//','//count_text(r%steps)//','// &
                     count_text(r%rhs_evals)//','//count_text(r%jac_evals)//','// &
                     count_text(r%lin_setups)//','//count_text(r%err_test_fails)//','// &
@@ -253,7 +254,7 @@ contains
         if (ieee_is_nan(x)) then
             s = ''
         else
-            s = real_text(x)
+            s = real_text(x, compact=.true.)
         end if
     end function num
 

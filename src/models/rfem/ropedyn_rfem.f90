@@ -13,7 +13,7 @@
 !! off.
 !!
 !! External effects (drag, ground contact, point loads; ropedyn_effect) act on the elements
-!! as bodies and exist only when the scene enables them. Supports may move (their anchor
+!! as bodies and exist only when the spec enables them. Supports may move (their anchor
 !! and angle are functions of time, evaluated once per call) or be released at a time
 !! (their families are then off). Point masses sit at their true place on an element, which
 !! makes that element's 3x3 mass block non-diagonal; it is solved locally.
@@ -23,9 +23,9 @@ module ropedyn_rfem
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
-    use ropedyn_problem, only: energy_t, STATUS_OK, STATUS_RECOVERABLE
-    use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_scene, only: scene_t, bottom_anchor_given
+    use ropedyn_problem, only: STATUS_OK, STATUS_RECOVERABLE
+    use ropedyn_rope_model, only: rope_model_t, energy_t
+    use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_effect, only: effect_box_t, bodies_t
     use ropedyn_effect_factory, only: build_body_effects, attached_masses
     use ropedyn_support_motion, only: support_motion_t, motion_state_t
@@ -119,10 +119,10 @@ module ropedyn_rfem
 
 contains
 
-    !> Build the model of a scene (scene values are already validated).
-    subroutine rfem_create(model, scene, err)
+    !> Build the model of a spec (its values are already validated).
+    subroutine rfem_create(model, spec, err)
         type(rfem_t), intent(out) :: model
-        type(scene_t), intent(in) :: scene
+        type(rope_spec_t), intent(in) :: spec
         type(error_t), allocatable, intent(out) :: err
         integer :: n, nf, k, i
         real(wp) :: area, second_moment, dl, total_mass, cx, cy, cphi, bx, by, bphi, factor
@@ -131,48 +131,48 @@ contains
         integer, allocatable :: pm_body(:)
         real(wp), allocatable :: pm_r(:), pm_m(:), y0(:)
 
-        n = scene%model%elements
+        n = spec%model%elements
         if (n < 2) then
             call make_error(err, ERR_INPUT, 'rfem: elements must be >= 2')
             return
         end if
         model%n = n
-        area = pi*scene%rope%diameter**2/4.0_wp
-        second_moment = pi*scene%rope%diameter**4/64.0_wp
-        dl = scene%rope%length/real(n - 1, wp)
-        total_mass = scene%rope%density*area*scene%rope%length
+        area = pi*spec%rope%diameter**2/4.0_wp
+        second_moment = pi*spec%rope%diameter**4/64.0_wp
+        dl = spec%rope%length/real(n - 1, wp)
+        total_mass = spec%rope%density*area*spec%rope%length
         allocate (model%len(n), model%mass(n), model%inertia(n))
         model%len = dl
         model%len(1) = dl/2.0_wp
         model%len(n) = dl/2.0_wp
-        model%mass = total_mass*model%len/scene%rope%length
-        model%inertia = model%mass*(model%len**2/12.0_wp + scene%rope%diameter**2/16.0_wp)
+        model%mass = total_mass*model%len/spec%rope%length
+        model%inertia = model%mass*(model%len**2/12.0_wp + spec%rope%diameter**2/16.0_wp)
 
-        model%g = scene%rope%gravity
-        model%gravity_on = scene%effects%gravity
-        damped = scene%effects%damping
+        model%g = spec%rope%gravity
+        model%gravity_on = spec%effects%gravity
+        damped = spec%effects%damping
 
-        cx = scene%rope%young_modulus*area/dl
-        cy = scene%rope%shear_modulus*area/(scene%rope%shape_factor*dl)
-        cphi = scene%rope%young_modulus*second_moment/dl
-        bx = scene%rope%normal_damping*area/dl
-        by = scene%rope%tangential_damping*area/(scene%rope%shape_factor*dl)
-        bphi = scene%rope%normal_damping*second_moment/dl
-        factor = scene%supports%support_stiffness_factor
-        if (scene%effects%support_motion) then
-            associate (s => scene%supports)
+        cx = spec%rope%young_modulus*area/dl
+        cy = spec%rope%shear_modulus*area/(spec%rope%shape_factor*dl)
+        cphi = spec%rope%young_modulus*second_moment/dl
+        bx = spec%rope%normal_damping*area/dl
+        by = spec%rope%tangential_damping*area/(spec%rope%shape_factor*dl)
+        bphi = spec%rope%normal_damping*second_moment/dl
+        factor = spec%supports%support_stiffness_factor
+        if (spec%effects%support_motion) then
+            associate (s => spec%supports)
                 if (s%top_release_time >= 0.0_wp) model%release(1) = s%top_release_time
                 if (s%bottom_release_time >= 0.0_wp) model%release(2) = s%bottom_release_time
             end associate
         end if
 
         nf = 0
-        if (scene%effects%tension) call add(FAM_TENSION, 2, n, cx, bx)
-        if (scene%effects%shear) call add(FAM_SHEAR, 2, n, cy, by)
-        if (scene%effects%bending) call add(FAM_BEND, 2, n, cphi, bphi)
+        if (spec%effects%tension) call add(FAM_TENSION, 2, n, cx, bx)
+        if (spec%effects%shear) call add(FAM_SHEAR, 2, n, cy, by)
+        if (spec%effects%bending) call add(FAM_BEND, 2, n, cphi, bphi)
         ! a support released at t <= 0 is free from the start: no family at all
         if (model%release(1) > 0.0_wp) then
-            select case (scene%supports%top)
+            select case (spec%supports%top)
             case ('pinned')
                 call add(FAM_TOP_X, 1, 1, factor*cx, factor*bx, 1)
                 call add(FAM_TOP_Y, 1, 1, factor*cx, factor*bx, 1)
@@ -183,7 +183,7 @@ contains
             end select
         end if
         if (model%release(2) > 0.0_wp) then
-            select case (scene%supports%bottom)
+            select case (spec%supports%bottom)
             case ('pinned')
                 call add(FAM_BOTTOM_X, n + 1, n + 1, factor*cx, factor*bx, 2)
                 call add(FAM_BOTTOM_Y, n + 1, n + 1, factor*cx, factor*bx, 2)
@@ -195,20 +195,20 @@ contains
         end if
         model%families = fams(1:nf)
 
-        if (scene%initial%shape == 'hanging' .or. scene%initial%shape == 'folded') then
+        if (spec%initial%shape == 'hanging' .or. spec%initial%shape == 'folded') then
             model%init_angle = 0.0_wp
         else
-            model%init_angle = scene%initial%angle_deg*pi/180.0_wp
+            model%init_angle = spec%initial%angle_deg*pi/180.0_wp
         end if
-        model%folded = scene%initial%shape == 'folded'
-        model%init_velocity = scene%initial%velocity
-        model%top_anchor = scene%supports%top_anchor
-        model%top_angle = scene%supports%top_angle_deg*pi/180.0_wp
-        model%bottom_angle = scene%supports%bottom_angle_deg*pi/180.0_wp
+        model%folded = spec%initial%shape == 'folded'
+        model%init_velocity = spec%initial%velocity
+        model%top_anchor = spec%supports%top_anchor
+        model%top_angle = spec%supports%top_angle_deg*pi/180.0_wp
+        model%bottom_angle = spec%supports%bottom_angle_deg*pi/180.0_wp
 
         ! point masses at their place on the elements: mass, inertia about the centre and
         ! the first moment m r that couples translation and rotation
-        call attached_masses(scene, model%len, pm_body, pm_r, pm_m)
+        call attached_masses(spec, model%len, pm_body, pm_r, pm_m)
         allocate (model%pm_elem(0), model%pm_moment(0))
         do k = 1, size(pm_body)
             i = pm_body(k)
@@ -226,7 +226,7 @@ contains
         model%rowscale(3, :) = 1.0_wp/model%inertia
         model%rowscale(:, model%pm_elem) = 1.0_wp
 
-        call build_body_effects(scene, model%len, model%effects)
+        call build_body_effects(spec, model%len, model%effects)
         if (size(model%effects) > 0) then
             model%bodies%n = n
             model%bodies%l = model%len
@@ -237,8 +237,8 @@ contains
         ! supports: base anchor and angle, prescribed motion
         model%motion(1)%p0 = model%top_anchor
         model%motion(1)%angle0 = model%top_angle
-        if (bottom_anchor_given(scene)) then
-            model%bottom_anchor = scene%supports%bottom_anchor
+        if (bottom_anchor_given(spec)) then
+            model%bottom_anchor = spec%supports%bottom_anchor
         else
             ! the rope's lower end in its initial state
             allocate (y0(6*n))
@@ -248,8 +248,8 @@ contains
         end if
         model%motion(2)%p0 = model%bottom_anchor
         model%motion(2)%angle0 = model%bottom_angle
-        if (scene%effects%support_motion) then
-            associate (s => scene%supports)
+        if (spec%effects%support_motion) then
+            associate (s => spec%supports)
                 call set_motion(1, s%top, s%top_motion, s%top_amplitude, s%top_frequency, &
                                 s%top_phase_deg, s%top_angle_amplitude_deg, &
                                 s%top_angle_phase_deg, s%top_table_rows)

@@ -9,144 +9,21 @@
 !! `--set` argument), the group, the key and the value. The reference is docs/input.md.
 module ropedyn_scene
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
-    use ropedyn_kinds, only: wp, i8
+    use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
-    use ropedyn_solvers, only: method_order_range
-    use ropedyn_support_motion, only: read_motion_table
-    use, intrinsic :: iso_c_binding, only: c_char, c_size_t, c_ptr, c_associated, c_null_char
+    use ropedyn_text, only: int_text, real_text, pair_text, logical_text, quoted, lower, &
+                            line_quote
+    use ropedyn_os, only: absolute_path
+    use ropedyn_methods, only: METHODS, method_index
+    use ropedyn_rope_spec, only: rope_spec_t, rope_params_t, model_params_t, &
+        supports_params_t, initial_params_t, effects_params_t, fluid_params_t, &
+        ground_params_t, attachments_params_t, bottom_anchor_given, NOT_SET, NAME_LEN, &
+        PATH_LEN, N_ATTACH
+    use ropedyn_motion_table, only: read_motion_table
     implicit none
     private
-    public :: rope_params_t, model_params_t, supports_params_t, initial_params_t
-    public :: effects_params_t, solver_params_t, output_params_t, scene_t
-    public :: fluid_params_t, ground_params_t, attachments_params_t, N_ATTACH
-    public :: read_scene, scene_namelist_text, bottom_anchor_given
-    public :: NAME_LEN, PATH_LEN
-
-    integer, parameter :: NAME_LEN = 16    !< length of the kind/method/support/shape names
-    integer, parameter :: PATH_LEN = 512   !< length of the output file name
-    integer, parameter :: N_ATTACH = 8     !< point masses and point loads at most
-
-    !> A quiet NaN: the value of `bottom_anchor` when it is not given.
-    real(wp), parameter :: NOT_SET = transfer(9221120237041090560_i8, 1.0_wp)
-
-    !> `&rope`: material and geometry of the rope (defaults: the paper's rope).
-    type :: rope_params_t
-        real(wp) :: length = 1.0_wp             !< rope length [m]
-        real(wp) :: density = 6000.0_wp         !< mass density [kg/m^3]
-        real(wp) :: diameter = 0.005_wp         !< diameter of the circular cross-section [m]
-        real(wp) :: young_modulus = 35.0e6_wp   !< Young's modulus E [Pa]
-        real(wp) :: shear_modulus = 14.0e6_wp   !< shear modulus G [Pa]
-        real(wp) :: normal_damping = 1.0e3_wp   !< eta [N s/m^2]
-        !> eta_bar [N s/m^2]; when not given, normal_damping*shear_modulus/young_modulus
-        real(wp) :: tangential_damping = 400.0_wp
-        real(wp) :: shape_factor = 10.0_wp/9.0_wp  !< shear shape factor chi [-]
-        real(wp) :: gravity = 9.81_wp           !< gravitational acceleration [m/s^2]
-    end type rope_params_t
-
-    !> `&model`: which discretisation and how fine.
-    type :: model_params_t
-        character(len=NAME_LEN) :: kind = 'rfem'  !< 'rfem' | 'mpp'
-        integer :: elements = 30                  !< number of elements (mpp: members) [-]
-        !> mpp: factor on the member springs' damping eta A / l (the default rule) [-]
-        real(wp) :: mpp_axial_damping_factor = 1.0_wp
-        !> mpp: factor on the joints' bending damping eta I / l (the default rule) [-]
-        real(wp) :: mpp_bending_damping_factor = 1.0_wp
-    end type model_params_t
-
-    !> `&supports`: boundary conditions at both ends (x down, y horizontal).
-    type :: supports_params_t
-        character(len=NAME_LEN) :: top = 'pinned'    !< 'pinned' | 'clamped' | 'free'
-        character(len=NAME_LEN) :: bottom = 'free'   !< 'pinned' | 'clamped' | 'free'
-        real(wp) :: top_anchor(2) = [0.0_wp, 0.0_wp] !< top anchor point (x, y) [m]
-        !> bottom anchor point (x, y) [m]; NaN when not given: the rope's lower end in its
-        !! initial state, resolved by the model (see `bottom_anchor_given`)
-        real(wp) :: bottom_anchor(2) = [NOT_SET, NOT_SET]
-        logical :: bottom_anchor_set = .false.       !< bottom_anchor was given
-        real(wp) :: top_angle_deg = 0.0_wp           !< top clamp angle from down x [deg]
-        real(wp) :: bottom_angle_deg = 0.0_wp        !< bottom clamp angle from down x [deg]
-        real(wp) :: support_stiffness_factor = 1.0_wp  !< support springs/dampers factor [-]
-        !> prescribed motion of each support: 'fixed' | 'harmonic' | 'table'
-        character(len=NAME_LEN) :: top_motion = 'fixed'
-        character(len=NAME_LEN) :: bottom_motion = 'fixed'
-        real(wp) :: top_amplitude(2) = 0.0_wp           !< harmonic amplitudes (x, y) [m]
-        real(wp) :: bottom_amplitude(2) = 0.0_wp
-        real(wp) :: top_frequency = 0.0_wp              !< harmonic frequency [Hz]
-        real(wp) :: bottom_frequency = 0.0_wp
-        real(wp) :: top_phase_deg(2) = 0.0_wp           !< harmonic phases (x, y) [deg]
-        real(wp) :: bottom_phase_deg(2) = 0.0_wp
-        real(wp) :: top_angle_amplitude_deg = 0.0_wp    !< harmonic clamp rotation [deg]
-        real(wp) :: bottom_angle_amplitude_deg = 0.0_wp
-        real(wp) :: top_angle_phase_deg = 0.0_wp        !< its phase [deg]
-        real(wp) :: bottom_angle_phase_deg = 0.0_wp
-        !> motion table files (rows t, dx, dy, dangle_deg); resolved by `read_scene` against
-        !! the scene file's directory
-        character(len=PATH_LEN) :: top_table = ''
-        character(len=PATH_LEN) :: bottom_table = ''
-        real(wp) :: top_release_time = -1.0_wp          !< release time [s]; < 0: never
-        real(wp) :: bottom_release_time = -1.0_wp
-        !> the tables as read by `read_scene`, (4, rows): t [s], dx, dy [m], dangle [rad]
-        real(wp), allocatable :: top_table_rows(:, :), bottom_table_rows(:, :)
-    end type supports_params_t
-
-    !> `&initial`: initial state of the rope.
-    type :: initial_params_t
-        !> 'straight' | 'hanging' | 'equilibrium' (static equilibrium, at rest) | 'mode'
-        !! (equilibrium plus mode `mode` with largest point displacement `mode_amplitude`)
-        character(len=NAME_LEN) :: shape = 'straight'
-        real(wp) :: angle_deg = 75.0_wp   !< angle of the straight rope from down x [deg]
-        integer :: mode = 1                      !< shape 'mode': which mode (1 = lowest) [-]
-        real(wp) :: mode_amplitude = 0.01_wp     !< shape 'mode': largest displacement [m]
-        !> shape 'folded': the rope doubled up from its top anchor (both ends there)
-        real(wp) :: velocity(2) = 0.0_wp  !< initial velocity of every element (x, y) [m/s]
-    end type initial_params_t
-
-    !> `&effects`: switches for the physical effects.
-    type :: effects_params_t
-        logical :: gravity = .true.   !< gravity load
-        logical :: tension = .true.   !< axial springs Cx = EA/dl
-        logical :: shear = .true.     !< shear springs Cy = GA/(chi dl)
-        logical :: bending = .true.   !< rotational springs Cphi = EI/dl
-        logical :: damping = .true.   !< dampers Bx, By, Bphi
-        logical :: drag = .false.     !< fluid drag (&fluid)
-        logical :: ground = .false.   !< ground contact (&ground)
-        logical :: support_motion = .true.  !< the motions and releases given in &supports
-        logical :: point_masses = .true.    !< the point masses given in &attachments
-        logical :: point_loads = .true.     !< the point loads given in &attachments
-    end type effects_params_t
-
-    !> `&fluid`: the surrounding fluid (used with `&effects drag = .true.`).
-    type :: fluid_params_t
-        real(wp) :: density = 1.225_wp                     !< rho_f [kg/m^3] (air)
-        real(wp) :: normal_drag_coefficient = 1.2_wp       !< C_n on d l [-]
-        real(wp) :: tangential_drag_coefficient = 0.02_wp  !< C_t on pi d l [-]
-        real(wp) :: linear_normal_drag = 0.0_wp            !< [N s/m^2]
-        real(wp) :: linear_tangential_drag = 0.0_wp        !< [N s/m^2]
-        real(wp) :: current(2) = 0.0_wp                    !< fluid velocity (x, y) [m/s]
-    end type fluid_params_t
-
-    !> `&ground`: a ground plane (used with `&effects ground = .true.`).
-    type :: ground_params_t
-        real(wp) :: point(2) = [1.0_wp, 0.0_wp]    !< a point of the plane (x, y) [m]
-        real(wp) :: normal(2) = [-1.0_wp, 0.0_wp]  !< normal to the free side (up) [-]
-        real(wp) :: stiffness = 1.0e5_wp           !< per metre of rope [N/m^2]
-        real(wp) :: damping = 100.0_wp             !< per metre of rope [N s/m^2]
-        real(wp) :: friction_coefficient = 0.5_wp  !< Coulomb mu [-]
-        real(wp) :: friction_regularization_speed = 1.0e-3_wp  !< v_reg [m/s]
-    end type ground_params_t
-
-    !> `&attachments`: point masses and point loads; an entry is used when its position is
-    !! given (NaN: not given). Positions are arc lengths from the top end [m].
-    type :: attachments_params_t
-        real(wp) :: mass_positions(N_ATTACH) = NOT_SET  !< [m]
-        real(wp) :: masses(N_ATTACH) = 0.0_wp           !< [kg]
-        real(wp) :: load_positions(N_ATTACH) = NOT_SET  !< [m]
-        real(wp) :: load_force_x(N_ATTACH) = 0.0_wp     !< constant part [N]
-        real(wp) :: load_force_y(N_ATTACH) = 0.0_wp     !< [N]
-        real(wp) :: load_amplitude_x(N_ATTACH) = 0.0_wp !< harmonic part [N]
-        real(wp) :: load_amplitude_y(N_ATTACH) = 0.0_wp !< [N]
-        real(wp) :: load_frequency(N_ATTACH) = 0.0_wp   !< [Hz]
-        real(wp) :: load_phase_deg(N_ATTACH) = 0.0_wp   !< [deg]
-    end type attachments_params_t
+    public :: solver_params_t, output_params_t, scene_t
+    public :: read_scene, scene_namelist_text
 
     !> `&solver`: time integration.
     type :: solver_params_t
@@ -173,19 +50,11 @@ module ropedyn_scene
         logical :: progress = .false.         !< print progress while integrating
     end type output_params_t
 
-    !> A complete scene: every group with its effective values.
-    type :: scene_t
-        character(len=:), allocatable :: path  !< file the scene was read from
-        type(rope_params_t) :: rope
-        type(model_params_t) :: model
-        type(supports_params_t) :: supports
-        type(initial_params_t) :: initial
-        type(effects_params_t) :: effects
+    !> A complete scene: the rope models' parameters (the parent `rope_spec_t`, whose
+    !! `path` is the file the scene was read from), the solver and the output.
+    type, extends(rope_spec_t) :: scene_t
         type(solver_params_t) :: solver
         type(output_params_t) :: output
-        type(fluid_params_t) :: fluid
-        type(ground_params_t) :: ground
-        type(attachments_params_t) :: attachments
     end type scene_t
 
     ! Groups, in the order they are read, checked and written.
@@ -293,7 +162,6 @@ module ropedyn_scene
 
     ! Allowed values of the name keys; "known" values are recognised but not available yet.
     character(len=*), parameter :: KINDS_ALLOWED(2) = [character(len=8) :: 'rfem', 'mpp']
-    character(len=*), parameter :: METHODS_ALLOWED(2) = [character(len=8) :: 'cvode', 'mebdf']
     character(len=*), parameter :: SUPPORTS_ALLOWED(3) = [character(len=8) :: &
         'pinned', 'clamped', 'free']
     character(len=*), parameter :: SHAPES_ALLOWED(5) = [character(len=11) :: &
@@ -311,16 +179,6 @@ module ropedyn_scene
     type :: line_t
         character(len=:), allocatable :: s
     end type line_t
-
-    interface
-        !> POSIX getcwd, to resolve input files named relative to a scene file.
-        function c_getcwd(buf, size) bind(C, name='getcwd') result(p)
-            import :: c_char, c_size_t, c_ptr
-            character(kind=c_char), intent(out) :: buf(*)
-            integer(c_size_t), value :: size
-            type(c_ptr) :: p
-        end function c_getcwd
-    end interface
 
     !> One `--set group.key=value` argument.
     type :: override_t
@@ -411,13 +269,6 @@ contains
         if (allocated(err)) return
         call resolve_defaults(scene)
     end subroutine read_scene
-
-    !> True when `bottom_anchor` was given in the scene (otherwise the model places it at the
-    !! rope's lower end in its initial state).
-    pure logical function bottom_anchor_given(scene)
-        type(scene_t), intent(in) :: scene
-        bottom_anchor_given = .not. any(ieee_is_nan(scene%supports%bottom_anchor))
-    end function bottom_anchor_given
 
     !> The effective scene as namelist text: all groups and keys, one per line,
     !! re-readable by `read_scene`.
@@ -1433,6 +1284,7 @@ contains
         type(scene_t), intent(inout) :: scene
         type(error_t), allocatable, intent(out) :: err
         integer :: lowest, highest, default
+        character(len=len(METHODS%name)), allocatable :: method_names(:)
 
         associate (r => scene%rope)
             call check_real(ctx, G_ROPE, 'length', r%length, '>', 0.0_wp, err)
@@ -1522,7 +1374,8 @@ contains
         if (allocated(err)) return
 
         associate (v => scene%solver)
-            call check_name(ctx, G_SOLVER, 'method', v%method, METHODS_ALLOWED, NONE_KNOWN, &
+            method_names = METHODS%name
+            call check_name(ctx, G_SOLVER, 'method', v%method, method_names, NONE_KNOWN, &
                 err)
             if (allocated(err)) return
             call check_real(ctx, G_SOLVER, 'rtol', v%rtol, '>', 0.0_wp, err)
@@ -1531,8 +1384,11 @@ contains
             if (allocated(err)) return
             call check_real(ctx, G_SOLVER, 'atol', v%atol, '>', 0.0_wp, err)
             if (allocated(err)) return
-            call method_order_range(trim(v%method), lowest, highest, default, err)
-            if (allocated(err)) return
+            associate (m => METHODS(method_index(v%method)))
+                lowest = m%lowest_order
+                highest = m%highest_order
+                default = m%default_order
+            end associate
             if (v%max_order == 0) v%max_order = default
             if (v%max_order < lowest .or. v%max_order > highest) then
                 call fail(ctx, G_SOLVER, 'max_order', int_text(v%max_order), &
@@ -1839,19 +1695,7 @@ contains
     function resolve_input_path(scene_path, name) result(full)
         character(len=*), intent(in) :: scene_path, name
         character(len=:), allocatable :: full
-        character(kind=c_char, len=4096) :: buf
-        integer :: slash, k
-        if (name(1:1) == '/') then
-            full = name
-            return
-        end if
-        slash = index(scene_path, '/', back=.true.)
-        full = scene_path(:slash)//name
-        if (full(1:1) == '/') return
-        if (.not. c_associated(c_getcwd(buf, int(len(buf), c_size_t)))) return
-        k = index(buf, c_null_char)
-        if (k <= 1) return
-        full = buf(:k - 1)//'/'//full
+        full = absolute_path(name, scene_path)
     end function resolve_input_path
 
     !> Check that x is finite and, unless `op` is '', that `x op bound` holds.
@@ -2050,61 +1894,6 @@ contains
     ! Text helpers
     ! ------------------------------------------------------------------------------------
 
-    !> Shortest decimal text that reads back to x exactly ('1.0', '0.005', '3.5e7', 'NaN').
-    function real_text(x) result(s)
-        real(wp), intent(in) :: x
-        character(len=:), allocatable :: s
-        character(len=40) :: buf
-        character(len=16) :: fmt
-        character(len=:), allocatable :: mant, digits
-        real(wp) :: y
-        integer :: d, ios, epos, e, n
-        logical :: negative
-
-        if (ieee_is_nan(x)) then
-            s = 'NaN'
-            return
-        else if (.not. ieee_is_finite(x)) then
-            s = merge('+Infinity', '-Infinity', x > 0.0_wp)
-            return
-        else if (.not. abs(x) > 0.0_wp) then
-            s = '0.0'
-            return
-        end if
-        do d = 1, 17
-            write (fmt, '(a, i0, a)') '(es40.', d, 'e3)'
-            write (buf, fmt) x
-            read (buf, *, iostat=ios) y
-            if (ios == 0 .and. abs(y - x) <= 0.0_wp) exit
-        end do
-        buf = adjustl(buf)
-        negative = buf(1:1) == '-'
-        if (negative) buf = buf(2:)
-        epos = scan(buf, 'Ee')
-        read (buf(epos + 1:), *) e
-        mant = buf(:epos - 1)
-        digits = mant(1:1)//mant(3:)
-        n = len(digits)
-        do while (n > 1)
-            if (digits(n:n) /= '0') exit
-            n = n - 1
-        end do
-        digits = digits(:n)
-        if (e >= 0 .and. e <= 6) then
-            if (n <= e + 1) then
-                s = digits//repeat('0', e + 1 - n)//'.0'
-            else
-                s = digits(:e + 1)//'.'//digits(e + 2:)
-            end if
-        else if (e < 0 .and. e >= -4) then
-            s = '0.'//repeat('0', -e - 1)//digits
-        else if (n == 1) then
-            s = digits//'.0e'//int_text(e)
-        else
-            s = digits(1:1)//'.'//digits(2:)//'e'//int_text(e)
-        end if
-        if (negative) s = '-'//s
-    end function real_text
 
     !> A bound for a message: '0', '1', else as real_text.
     function bound_text(x) result(s)
@@ -2117,45 +1906,9 @@ contains
         end if
     end function bound_text
 
-    function pair_text(x) result(s)
-        real(wp), intent(in) :: x(2)
-        character(len=:), allocatable :: s
-        s = real_text(x(1))//', '//real_text(x(2))
-    end function pair_text
 
-    pure function int_text(n) result(s)
-        integer, intent(in) :: n
-        character(len=:), allocatable :: s
-        character(len=12) :: buf
-        write (buf, '(i0)') n
-        s = trim(buf)
-    end function int_text
 
-    pure function logical_text(b) result(s)
-        logical, intent(in) :: b
-        character(len=:), allocatable :: s
-        if (b) then
-            s = '.true.'
-        else
-            s = '.false.'
-        end if
-    end function logical_text
 
-    !> A Fortran string literal: 'text', with embedded quotes doubled.
-    pure function quoted(text) result(s)
-        character(len=*), intent(in) :: text
-        character(len=:), allocatable :: s
-        integer :: i
-        s = "'"
-        do i = 1, len(text)
-            if (text(i:i) == "'") then
-                s = s//"''"
-            else
-                s = s//text(i:i)
-            end if
-        end do
-        s = s//"'"
-    end function quoted
 
     !> True if s is exactly one quoted literal ('a', "a", 'it''s').
     pure logical function is_single_literal(s) result(ok)
@@ -2181,27 +1934,7 @@ contains
         end do
     end function is_single_literal
 
-    !> A line for a message: quoted, trailing blanks removed, long lines shortened.
-    pure function line_quote(line) result(s)
-        character(len=*), intent(in) :: line
-        character(len=:), allocatable :: s
-        if (len_trim(line) > 80) then
-            s = '"'//line(:77)//'..."'
-        else
-            s = '"'//trim(line)//'"'
-        end if
-    end function line_quote
 
-    pure function lower(s) result(t)
-        character(len=*), intent(in) :: s
-        character(len=len(s)) :: t
-        integer :: i, c
-        t = s
-        do i = 1, len(s)
-            c = iachar(s(i:i))
-            if (c >= iachar('A') .and. c <= iachar('Z')) t(i:i) = achar(c + 32)
-        end do
-    end function lower
 
     pure integer function first_nonblank(s) result(i)
         character(len=*), intent(in) :: s

@@ -1,17 +1,17 @@
-!> The `ropedyn statics` and `ropedyn modes` commands: read a scene, find its static
-!! equilibrium (ropedyn_statics), optionally the lowest modes about it (ropedyn_modes), the
-!! support forces, write one HDF5 file and print a summary. Layout and method:
-!! docs/statics-modes.md.
-!!
-!!   ropedyn statics SCENE.nml [--set group.key=value ...] [-o FILE.h5] [--max-iterations N]
-!!   ropedyn modes SCENE.nml [--count K] [--set ...] [-o FILE.h5] [--max-iterations N]
+!> The work of `ropedyn statics` and `ropedyn modes` (src/app/ropedyn_cmd_statics.f90): the
+!! static equilibrium of a scene (ropedyn_statics), optionally the lowest modes about it
+!! (ropedyn_modes), the support forces, one HDF5 file and a printed summary. Layout and
+!! method: docs/statics-modes.md.
 module ropedyn_analysis
     use, intrinsic :: iso_fortran_env, only: output_unit
     use ropedyn_kinds, only: wp
-    use ropedyn_error, only: error_t, make_error, ERR_USAGE, ERR_INTERNAL
-    use ropedyn_scene, only: scene_t, read_scene, scene_namelist_text, bottom_anchor_given
+    use ropedyn_error, only: error_t, make_error, ERR_INTERNAL
+    use ropedyn_scene, only: scene_t, scene_namelist_text
+    use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_simulation, only: create_model, make_parent_dirs
+    use ropedyn_os, only: make_parent_dirs, utc_timestamp
+    use ropedyn_text, only: int_text
+    use ropedyn_simulation, only: create_model
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
                                potential_energy, rope_length
     use ropedyn_modes, only: modes_result_t, compute_modes
@@ -19,111 +19,39 @@ module ropedyn_analysis
     use ropedyn_version, only: version_string
     implicit none
     private
-    public :: analysis_command, support_forces, DEFAULT_MODE_COUNT
+    public :: run_analysis, support_forces, DEFAULT_MODE_COUNT
 
     integer, parameter :: DEFAULT_MODE_COUNT = 10
     real(wp), parameter :: PI = 4.0_wp*atan(1.0_wp)
 
 contains
 
-    !> Run `ropedyn statics|modes` with the arguments after the command.
-    subroutine analysis_command(command, args, err)
+    !> `ropedyn statics|modes` on a scene that is read already: the equilibrium from the
+    !! scene's initial shape, the support forces, for 'modes' the lowest `count` modes;
+    !! the HDF5 file `out_path` ('': out/<scene>_<command>.h5) and a printed summary.
+    subroutine run_analysis(command, scene, options, count, out_path_given, err)
         character(len=*), intent(in) :: command   !< 'statics' or 'modes'
-        character(len=*), intent(in) :: args(:)
+        type(scene_t), intent(in) :: scene
+        type(statics_options_t), intent(in) :: options
+        integer, intent(in) :: count              !< modes wanted ('modes' only)
+        character(len=*), intent(in) :: out_path_given
         type(error_t), allocatable, intent(out) :: err
-        character(len=1024), allocatable :: overrides(:)
-        character(len=:), allocatable :: scene_path, out_path, arg, value, option
-        type(statics_options_t) :: options
-        type(scene_t) :: scene
+        character(len=:), allocatable :: out_path
         class(rope_model_t), allocatable :: model
         type(statics_result_t) :: sres
         type(modes_result_t) :: mres
         real(wp), allocatable :: y(:)
         real(wp) :: force_top(2), force_bottom(2)
-        integer :: i, n_over, count, eq
-        logical :: has_value
 
-        allocate (overrides(size(args)))
-        n_over = 0
-        count = DEFAULT_MODE_COUNT
-        i = 1
-        do while (i <= size(args))
-            arg = trim(args(i))
-            i = i + 1
-            option = arg
-            has_value = .false.
-            eq = index(arg, '=')
-            if (len(arg) > 2 .and. eq > 0) then
-                if (arg(1:2) == '--') then
-                    option = arg(1:eq - 1)
-                    value = arg(eq + 1:)
-                    has_value = .true.
-                end if
-            end if
-            select case (option)
-            case ('--help', '-h')
-                call usage(command)
-                return
-            case ('--no-continuation')
-                options%continuation = .false.
-            case ('--set', '-o', '--output', '--count', '--max-iterations')
-                if (.not. has_value) then
-                    if (i > size(args)) then
-                        call usage_error(option//' needs a value')
-                        return
-                    end if
-                    value = trim(args(i))
-                    i = i + 1
-                end if
-                select case (option)
-                case ('--set')
-                    n_over = n_over + 1
-                    overrides(n_over) = value
-                case ('-o', '--output')
-                    out_path = value
-                case ('--count')
-                    if (command /= 'modes') then
-                        call usage_error('--count is an option of "ropedyn modes"')
-                        return
-                    end if
-                    count = int_value(option, value, 1)
-                    if (allocated(err)) return
-                case ('--max-iterations')
-                    options%max_iterations = int_value(option, value, 1)
-                    if (allocated(err)) return
-                end select
-            case default
-                if (len(arg) == 0) then
-                    call usage_error('empty argument')
-                    return
-                end if
-                if (arg(1:1) == '-') then
-                    call usage_error('unknown option "'//arg//'"')
-                    return
-                end if
-                if (allocated(scene_path)) then
-                    call usage_error('more than one scene file: "'//scene_path//'", "'// &
-                                     arg//'"')
-                    return
-                end if
-                scene_path = arg
-            end select
-        end do
-        if (.not. allocated(scene_path)) then
-            call usage_error(command//' needs a scene file')
-            return
-        end if
-
-        call read_scene(scene_path, overrides(1:n_over), scene, err)
-        if (allocated(err)) return
-        if (.not. allocated(out_path)) out_path = default_output(scene, command)
-        call create_model(scene, model, err)
+        out_path = out_path_given
+        if (len(out_path) == 0) out_path = default_output(scene, command)
+        call create_model(scene%rope_spec_t, model, err)
         if (allocated(err)) return
         allocate (y(model%size()))
         call model%initial_state(y)
-        call find_equilibrium(model, scene, y, options, sres, err, create_model)
+        call find_equilibrium(model, scene%rope_spec_t, y, options, sres, err, create_model)
         if (allocated(err)) return
-        call support_forces(scene, model, y, force_top, force_bottom, err)
+        call support_forces(scene%rope_spec_t, model, y, force_top, force_bottom, err)
         if (allocated(err)) return
         if (command == 'modes') then
             call compute_modes(model, y, count, mres, err)
@@ -143,24 +71,6 @@ contains
             if (sres%stages > 0) write (text, '(a, i0, a)') '; ', sres%stages, &
                 ' continuation stages'
         end function stage_text
-
-        subroutine usage_error(message)
-            character(len=*), intent(in) :: message
-            call make_error(err, ERR_USAGE, command//': '//message//' (see ropedyn '// &
-                            command//' --help)')
-        end subroutine usage_error
-
-        integer function int_value(name, text, lowest) result(n)
-            character(len=*), intent(in) :: name, text
-            integer, intent(in) :: lowest
-            integer :: ios
-            n = 0
-            ios = 1
-            if (len_trim(text) > 0 .and. verify(trim(text), '0123456789+') == 0) &
-                read (text, *, iostat=ios) n
-            if (ios /= 0 .or. n < lowest) call usage_error(name//' "'//text// &
-                '": expected an integer >= '//itoa(lowest))
-        end function int_value
 
         subroutine write_file()
             type(result_file_t) :: h5
@@ -188,7 +98,7 @@ contains
                 if (allocated(err)) exit steps
                 call h5%attribute('/', 'scene', scene_namelist_text(scene), err)
                 if (allocated(err)) exit steps
-                call h5%attribute('/', 'created', timestamp(), err)
+                call h5%attribute('/', 'created', utc_timestamp(), err)
                 if (allocated(err)) exit steps
                 call h5%attribute('/', 'units_convention', 'SI; x points down (gravity), '// &
                                   'y horizontal, angles from x towards y', err)
@@ -293,7 +203,7 @@ contains
             call model%polyline(y, points)
             deepest = maxloc(points(1, :), 1)
             write (output_unit, '(a)') 'ropedyn '//version_string//': '//command//', '// &
-                model%model_name()//' model, '//itoa(n)//' elements, scene '//scene%path
+                model%model_name()//' model, '//int_text(n)//' elements, scene '//scene%path
             write (output_unit, '(a, i0, a, i0, a, i0, a)') '  equilibrium     '// &
                 sres%criterion//' after ', sres%iterations, ' iterations (', sres%rejected, &
                 ' rejected, ', sres%newton_steps, ' Newton'//trim(stage_text())//')'
@@ -326,19 +236,19 @@ contains
             end if
             write (output_unit, '(a)') '  output          '//out_path
         end subroutine print_summary
-    end subroutine analysis_command
+    end subroutine run_analysis
 
     !> Forces of the supports on the rope at the equilibrium y, N: R = dV/d(anchor) with
     !! the coordinates held fixed (virtual work), by central differences of the potential
     !! energy of models rebuilt with the anchor moved by +-h (V is quadratic in the anchor
     !! of a pinned support: exact up to rounding). Zero for a free end.
     subroutine support_forces(scene, model, y, top, bottom, err)
-        type(scene_t), intent(in) :: scene
+        type(rope_spec_t), intent(in) :: scene
         class(rope_model_t), intent(inout) :: model
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: top(2), bottom(2)
         type(error_t), allocatable, intent(out) :: err
-        type(scene_t) :: base, moved
+        type(rope_spec_t) :: base, moved
         class(rope_model_t), allocatable :: probe
         real(wp), allocatable :: y0(:), points(:, :)
         real(wp) :: h, vp, vm, v0
@@ -387,7 +297,7 @@ contains
         end do
     contains
         subroutine shift(sc, side, comp, d)
-            type(scene_t), intent(inout) :: sc
+            type(rope_spec_t), intent(inout) :: sc
             integer, intent(in) :: side, comp
             real(wp), intent(in) :: d
             if (side == 1) then
@@ -424,47 +334,5 @@ contains
         end select
     end function coordinate_units
 
-    subroutine usage(command)
-        character(len=*), intent(in) :: command
-        if (command == 'modes') then
-            write (output_unit, '(a)') 'usage: ropedyn modes SCENE.nml [--count K] '// &
-                '[--set group.key=value ...] [-o FILE.h5] [--max-iterations N]'
-            write (output_unit, '(a)') 'The lowest K (default 10) natural frequencies and '// &
-                'mode shapes about the static equilibrium'
-            write (output_unit, '(a)') '(undamped, linearized), printed and written to '// &
-                'FILE.h5 (default out/<scene>_modes.h5).'
-        else
-            write (output_unit, '(a)') 'usage: ropedyn statics SCENE.nml '// &
-                '[--set group.key=value ...] [-o FILE.h5] [--max-iterations N]'
-            write (output_unit, '(a)') 'The static equilibrium of the scene (started from '// &
-                'its &initial shape), printed and'
-            write (output_unit, '(a)') 'written to FILE.h5 (default out/<scene>_statics.h5).'
-        end if
-        write (output_unit, '(a)') '  --max-iterations N  limit of the equilibrium iteration '// &
-            '(default 2000)'
-        write (output_unit, '(a)') '  --no-continuation   solve directly even when the bottom '// &
-            'anchor is far from the start'
-        write (output_unit, '(a)') 'exit codes: 0 ok, 2 bad input, 3 no equilibrium or '// &
-            'solver failure, 4 output error'
-        write (output_unit, '(a)') 'See docs/statics-modes.md.'
-    end subroutine usage
 
-    !> Local time in ISO 8601 with its UTC offset.
-    function timestamp() result(text)
-        character(len=:), allocatable :: text
-        character(len=8) :: d
-        character(len=10) :: t
-        character(len=5) :: z
-        call date_and_time(d, t, z)
-        text = d(1:4)//'-'//d(5:6)//'-'//d(7:8)//'T'//t(1:2)//':'//t(3:4)//':'//t(5:6)// &
-               z(1:3)//':'//z(4:5)
-    end function timestamp
-
-    pure function itoa(i) result(text)
-        integer, intent(in) :: i
-        character(len=:), allocatable :: text
-        character(len=16) :: buffer
-        write (buffer, '(i0)') i
-        text = trim(buffer)
-    end function itoa
 end module ropedyn_analysis

@@ -23,9 +23,9 @@ module ropedyn_mpp
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
-    use ropedyn_problem, only: energy_t, STATUS_OK, STATUS_RECOVERABLE
-    use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_scene, only: scene_t, bottom_anchor_given
+    use ropedyn_problem, only: STATUS_OK, STATUS_RECOVERABLE
+    use ropedyn_rope_model, only: rope_model_t, energy_t
+    use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_effect, only: effect_box_t, bodies_t
     use ropedyn_effect_factory, only: build_body_effects, attached_masses
     use ropedyn_support_motion, only: support_motion_t, motion_state_t
@@ -109,42 +109,42 @@ module ropedyn_mpp
 
 contains
 
-    subroutine mpp_create(model, scene, err)
+    subroutine mpp_create(model, spec, err)
         type(mpp_t), intent(out) :: model
-        type(scene_t), intent(in) :: scene
+        type(rope_spec_t), intent(in) :: spec
         type(error_t), allocatable, intent(out) :: err
         real(wp) :: area, second_moment, total_mass, factor
         integer :: k
 
-        model%n = scene%model%elements
+        model%n = spec%model%elements
         if (model%n < 1) then
             call make_error(err, ERR_INPUT, 'mpp: elements must be >= 1')
             return
         end if
-        if (scene%supports%top == 'free') then
+        if (spec%supports%top == 'free') then
             call make_error(err, ERR_INPUT, 'mpp: the top support must be pinned or clamped')
             return
         end if
-        model%nu = merge(model%n, 0, scene%effects%tension)
+        model%nu = merge(model%n, 0, spec%effects%tension)
         model%ndof = model%n + model%nu
-        area = pi*scene%rope%diameter**2/4.0_wp
-        second_moment = pi*scene%rope%diameter**4/64.0_wp
-        total_mass = scene%rope%density*area*scene%rope%length
-        model%l = scene%rope%length/real(model%n, wp)
+        area = pi*spec%rope%diameter**2/4.0_wp
+        second_moment = pi*spec%rope%diameter**4/64.0_wp
+        total_mass = spec%rope%density*area*spec%rope%length
+        model%l = spec%rope%length/real(model%n, wp)
         model%m = total_mass/real(model%n, wp)
-        model%inertia = model%m*(model%l**2/12.0_wp + scene%rope%diameter**2/16.0_wp)
-        model%g = merge(scene%rope%gravity, 0.0_wp, scene%effects%gravity)
-        model%ks = scene%rope%young_modulus*area/model%l
-        if (scene%effects%bending) model%cb = scene%rope%young_modulus*second_moment/model%l
-        if (scene%effects%damping) then
-            model%ds = scene%model%mpp_axial_damping_factor* &
-                       scene%rope%normal_damping*area/model%l
-            if (scene%effects%bending) model%db = scene%model%mpp_bending_damping_factor* &
-                                                  scene%rope%normal_damping*second_moment/model%l
+        model%inertia = model%m*(model%l**2/12.0_wp + spec%rope%diameter**2/16.0_wp)
+        model%g = merge(spec%rope%gravity, 0.0_wp, spec%effects%gravity)
+        model%ks = spec%rope%young_modulus*area/model%l
+        if (spec%effects%bending) model%cb = spec%rope%young_modulus*second_moment/model%l
+        if (spec%effects%damping) then
+            model%ds = spec%model%mpp_axial_damping_factor* &
+                       spec%rope%normal_damping*area/model%l
+            if (spec%effects%bending) model%db = spec%model%mpp_bending_damping_factor* &
+                                                  spec%rope%normal_damping*second_moment/model%l
         end if
-        factor = scene%supports%support_stiffness_factor
-        model%top_clamped = scene%supports%top == 'clamped'
-        select case (scene%supports%bottom)
+        factor = spec%supports%support_stiffness_factor
+        model%top_clamped = spec%supports%top == 'clamped'
+        select case (spec%supports%bottom)
         case ('pinned')
             model%bottom = 1
         case ('clamped')
@@ -153,40 +153,40 @@ contains
             model%bottom = 0
         end select
         ! Supports take the values of the rope's own springs (as in RFEM), times the factor.
-        model%k_sup = factor*scene%rope%young_modulus*area/model%l
-        model%c_rot = factor*scene%rope%young_modulus*second_moment/model%l
-        if (scene%effects%damping) then
-            model%d_sup = factor*scene%rope%normal_damping*area/model%l
-            model%d_rot = factor*scene%rope%normal_damping*second_moment/model%l
+        model%k_sup = factor*spec%rope%young_modulus*area/model%l
+        model%c_rot = factor*spec%rope%young_modulus*second_moment/model%l
+        if (spec%effects%damping) then
+            model%d_sup = factor*spec%rope%normal_damping*area/model%l
+            model%d_rot = factor*spec%rope%normal_damping*second_moment/model%l
         end if
 
-        if (scene%initial%shape == 'hanging' .or. scene%initial%shape == 'folded') then
+        if (spec%initial%shape == 'hanging' .or. spec%initial%shape == 'folded') then
             model%init_angle = 0.0_wp
         else
-            model%init_angle = scene%initial%angle_deg*pi/180.0_wp
+            model%init_angle = spec%initial%angle_deg*pi/180.0_wp
         end if
-        model%folded = scene%initial%shape == 'folded'
-        model%top_anchor = scene%supports%top_anchor
-        model%top_angle = scene%supports%top_angle_deg*pi/180.0_wp
-        model%bottom_angle = scene%supports%bottom_angle_deg*pi/180.0_wp
-        if (bottom_anchor_given(scene)) then
-            model%bottom_anchor = scene%supports%bottom_anchor
+        model%folded = spec%initial%shape == 'folded'
+        model%top_anchor = spec%supports%top_anchor
+        model%top_angle = spec%supports%top_angle_deg*pi/180.0_wp
+        model%bottom_angle = spec%supports%bottom_angle_deg*pi/180.0_wp
+        if (bottom_anchor_given(spec)) then
+            model%bottom_anchor = spec%supports%bottom_anchor
         else
             ! the lower end P_n of the initial state (the top anchor when folded)
-            model%bottom_anchor = model%top_anchor + scene%rope%length* &
+            model%bottom_anchor = model%top_anchor + spec%rope%length* &
                                   [cos(model%init_angle), sin(model%init_angle)]
             if (model%folded) model%bottom_anchor = model%top_anchor + [0.0_wp, model%l]
         end if
 
-        call attached_masses(scene, [(model%l, k = 1, model%n)], model%pm_body, model%pm_r, &
+        call attached_masses(spec, [(model%l, k = 1, model%n)], model%pm_body, model%pm_r, &
                              model%pm_m)
-        call build_body_effects(scene, [(model%l, k = 1, model%n)], model%effects)
+        call build_body_effects(spec, [(model%l, k = 1, model%n)], model%effects)
         model%motion(1)%p0 = model%top_anchor
         model%motion(1)%angle0 = model%top_angle
         model%motion(2)%p0 = model%bottom_anchor
         model%motion(2)%angle0 = model%bottom_angle
-        if (scene%effects%support_motion) then
-            associate (s => scene%supports)
+        if (spec%effects%support_motion) then
+            associate (s => spec%supports)
                 if (s%bottom_release_time >= 0.0_wp) model%bottom_release = s%bottom_release_time
                 if (.not. model%bottom_release > 0.0_wp) model%bottom = 0
                 call set_motion(1, s%top_motion, s%top_amplitude, s%top_frequency, &

@@ -9,12 +9,10 @@
 !! at the end values, so the motion is C1 for all t. Frame: x down, y horizontal, angles
 !! from x towards y (docs/input.md, `&supports`).
 module ropedyn_support_motion
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp
-    use ropedyn_error, only: error_t, make_error, ERR_INPUT
     implicit none
     private
-    public :: support_motion_t, motion_state_t, read_motion_table
+    public :: support_motion_t, motion_state_t
     public :: MOTION_FIXED, MOTION_HARMONIC, MOTION_TABLE
 
     integer, parameter :: MOTION_FIXED = 0, MOTION_HARMONIC = 1, MOTION_TABLE = 2
@@ -127,7 +125,7 @@ contains
         end do
     end function interval
 
-    !> Set the motion from a scene's `&supports` values of one end: kind 'harmonic' or
+    !> Set the motion from the `&supports` values of one end: kind 'harmonic' or
     !! 'table' (anything else leaves the support fixed); frequency in Hz, phases and the
     !! angle amplitude in degrees, table rows as for `set_table`. True when it moves.
     logical function motion_configure(self, kind, amplitude, frequency, phase_deg, &
@@ -172,90 +170,4 @@ contains
                                 h0*(rows(2:4, k + 1) - rows(2:4, k))/h1)/(h0 + h1)
         end do
     end subroutine motion_set_table
-
-    !> Read a motion table: rows of four numbers t (s), dx (m), dy (m), dangle (deg),
-    !! separated by blanks or commas; blank lines and lines starting with '#' or '!' are
-    !! skipped. At least two rows, t strictly increasing, every value finite. Returns
-    !! rows (4, m) with the angle in rad. Errors (ERR_INPUT) name `where`, the file and the
-    !! line.
-    subroutine read_motion_table(path, where, rows, err)
-        character(len=*), intent(in) :: path   !< the file
-        !> prefix of messages, e.g. 'x.nml: &supports: top_table'
-        character(len=*), intent(in) :: where
-        real(wp), allocatable, intent(out) :: rows(:, :)
-        type(error_t), allocatable, intent(out) :: err
-        real(wp), allocatable :: grown(:, :)
-        real(wp) :: r(4), extra
-        character(len=1024) :: line, msg
-        integer :: unit, ios, m, lineno, lead, i, ios2
-
-        allocate (rows(4, 64))
-        m = 0
-        msg = ''
-        open (newunit=unit, file=path, status='old', action='read', form='formatted', &
-              iostat=ios, iomsg=msg)
-        if (ios /= 0) then
-            call make_error(err, ERR_INPUT, where//' = "'//path//'": cannot open: '//trim(msg))
-            return
-        end if
-        lineno = 0
-        do
-            read (unit, '(a)', iostat=ios, iomsg=msg) line
-            if (is_iostat_end(ios)) exit
-            lineno = lineno + 1
-            if (ios /= 0) then
-                call fail('cannot read: '//trim(msg))
-                return
-            end if
-            lead = verify(line, ' '//achar(9))
-            if (lead == 0) cycle
-            if (line(lead:lead) == '#' .or. line(lead:lead) == '!') cycle
-            do i = 1, len(line)
-                if (line(i:i) == ',' .or. line(i:i) == achar(9)) line(i:i) = ' '
-            end do
-            read (line, *, iostat=ios) r
-            if (ios /= 0) then
-                call fail('expected four numbers t, dx, dy, dangle_deg')
-                return
-            end if
-            read (line, *, iostat=ios2) r, extra
-            if (ios2 == 0) then
-                call fail('more than four numbers (t, dx, dy, dangle_deg)')
-                return
-            end if
-            if (.not. all(ieee_is_finite(r))) then
-                call fail('every value must be finite')
-                return
-            end if
-            if (m > 0) then
-                if (.not. r(1) > rows(1, m)) then
-                    call fail('times must increase strictly')
-                    return
-                end if
-            end if
-            if (m == size(rows, 2)) then
-                allocate (grown(4, 2*m))
-                grown(:, :m) = rows
-                call move_alloc(grown, rows)
-            end if
-            m = m + 1
-            rows(:, m) = [r(1:3), r(4)*pi/180.0_wp]
-        end do
-        close (unit)
-        if (m < 2) then
-            call make_error(err, ERR_INPUT, where//' = "'//path//'": needs at least two rows '// &
-                            '(t, dx, dy, dangle_deg)')
-            return
-        end if
-        rows = rows(:, :m)
-    contains
-        subroutine fail(reason)
-            character(len=*), intent(in) :: reason
-            character(len=12) :: num
-            write (num, '(i0)') lineno
-            call make_error(err, ERR_INPUT, where//' = "'//path//'": line '//trim(num)// &
-                            ' ("'//trim(line(:min(len_trim(line), 60)))//'"): '//reason)
-            close (unit)
-        end subroutine fail
-    end subroutine read_motion_table
 end module ropedyn_support_motion

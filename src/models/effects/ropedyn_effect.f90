@@ -11,7 +11,7 @@
 !! derivatives of each body's (Fx, Fy, M) with respect to its own (x, y, phi, vx, vy, w).
 !! Every effect here acts on each body separately, so the blocks keep RFEM's band.
 !!
-!! A model holds only the effects a scene enables (`effect_box_t` array): an effect that is
+!! A model holds only the effects its spec enables (`effect_box_t` array): an effect that is
 !! off is not allocated and costs nothing.
 module ropedyn_effect
     use ropedyn_kinds, only: wp

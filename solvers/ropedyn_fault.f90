@@ -10,7 +10,7 @@
 module ropedyn_fault
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_finite
     use ropedyn_kinds, only: wp
-    use ropedyn_problem, only: problem_t, energy_t, STATUS_OK, STATUS_RECOVERABLE
+    use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_RECOVERABLE
     implicit none
     private
     public :: fault_problem_t, fault_wrap
@@ -24,7 +24,6 @@ module ropedyn_fault
         procedure :: size => fault_size
         procedure :: bandwidths => fault_bandwidths
         procedure :: rhs => fault_rhs
-        procedure :: energy => fault_energy
         procedure :: has_jacobian => fault_has_jacobian
         procedure :: jacobian => fault_jacobian
         procedure :: quad_size => fault_quad_size
@@ -78,15 +77,6 @@ contains
         call self%inner%rhs(t, y, ydot, status)
         call inject(self, t, ydot, status)
     end subroutine fault_rhs
-
-    function fault_energy(self, t, y, yq) result(e)
-        class(fault_problem_t), intent(inout) :: self
-        real(wp), intent(in) :: t
-        real(wp), intent(in) :: y(:)
-        real(wp), intent(in) :: yq(:)
-        type(energy_t) :: e
-        e = self%inner%energy(t, y, yq)
-    end function fault_energy
 
     pure logical function fault_has_jacobian(self) result(has)
         class(fault_problem_t), intent(in) :: self

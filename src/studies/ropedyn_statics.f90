@@ -25,9 +25,10 @@ module ropedyn_statics
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
-    use ropedyn_problem, only: energy_t, STATUS_OK
-    use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_scene, only: scene_t, bottom_anchor_given
+    use ropedyn_problem, only: STATUS_OK
+    use ropedyn_rope_model, only: rope_model_t, energy_t
+    use ropedyn_text, only: int_text, fixed_text
+    use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     implicit none
     private
     public :: statics_options_t, statics_result_t
@@ -70,10 +71,10 @@ module ropedyn_statics
     end type ldl_t
 
     abstract interface
-        !> Builds the model of a scene (ropedyn_simulation's create_model).
-        subroutine model_factory_i(scene, model, err)
-            import :: scene_t, rope_model_t, error_t
-            type(scene_t), intent(in) :: scene
+        !> Builds the model of a spec (ropedyn_simulation's create_model).
+        subroutine model_factory_i(spec, model, err)
+            import :: rope_spec_t, rope_model_t, error_t
+            type(rope_spec_t), intent(in) :: spec
             class(rope_model_t), allocatable, intent(out) :: model
             type(error_t), allocatable, intent(out) :: err
         end subroutine model_factory_i
@@ -82,13 +83,13 @@ module ropedyn_statics
 
 contains
 
-    !> ERR_SOLVER when the scene cannot have an equilibrium: both ends free under gravity.
-    subroutine check_equilibrium_exists(scene, err)
-        type(scene_t), intent(in) :: scene
+    !> ERR_SOLVER when the spec cannot have an equilibrium: both ends free under gravity.
+    subroutine check_equilibrium_exists(spec, err)
+        type(rope_spec_t), intent(in) :: spec
         type(error_t), allocatable, intent(out) :: err
-        if (trim(scene%supports%top) == 'free' .and. trim(scene%supports%bottom) == 'free' &
-            .and. scene%effects%gravity .and. scene%rope%gravity > 0.0_wp) then
-            call make_error(err, ERR_SOLVER, scene%path//': statics: no equilibrium: both '// &
+        if (trim(spec%supports%top) == 'free' .and. trim(spec%supports%bottom) == 'free' &
+            .and. spec%effects%gravity .and. spec%rope%gravity > 0.0_wp) then
+            call make_error(err, ERR_SOLVER, spec%path//': statics: no equilibrium: both '// &
                 "supports are free (&supports top = 'free', bottom = 'free') and gravity is "// &
                 'on, so the rope falls freely; pin or clamp an end, or switch gravity off')
         end if
@@ -102,14 +103,14 @@ contains
         length = sum(lengths)
     end function rope_length
 
-    !> Total weight of the rope in the scene, N (0 when gravity is off).
-    real(wp) function total_weight(model, scene) result(weight)
+    !> Total weight of the rope in the spec, N (0 when gravity is off).
+    real(wp) function total_weight(model, spec) result(weight)
         class(rope_model_t), intent(in) :: model
-        type(scene_t), intent(in) :: scene
+        type(rope_spec_t), intent(in) :: spec
         real(wp) :: lengths(model%n_elements()), masses(model%n_elements())
         call model%element_data(lengths, masses)
         weight = 0.0_wp
-        if (scene%effects%gravity) weight = sum(masses)*scene%rope%gravity
+        if (spec%effects%gravity) weight = sum(masses)*spec%rope%gravity
     end function total_weight
 
     !> Potential energy V = elastic + gravity of state y (velocities are ignored by both), J.
@@ -361,27 +362,27 @@ contains
         x = fac%scale*x
     end function ldl_solve
 
-    !> The equilibrium of the scene from the starting state y. When the bottom end is
+    !> The equilibrium of the spec from the starting state y. When the bottom end is
     !! pinned or clamped to an anchor far (> L/1000) from the lower end of the starting
     !! configuration, the support spring starts hugely stretched: its pull (~ EA/dl times the
     !! distance) dwarfs the weight and pushes the straight rope along its axis, a saddle
     !! (compression) where the steps must be tiny. Then (given `factory`) the solution is
     !! first continued in `support_stiffness_factor`: from the value at which the spring pulls
-    !! with 0.3 times the weight up to the scene's value in geometric stages, each started
+    !! with 0.3 times the weight up to the spec's value in geometric stages, each started
     !! from the previous equilibrium (models rebuilt by `factory`); a stage multiplies the
     !! factor by 10 at first, by 100 after an easy stage, and its step is cut by 4 after a
     !! failure. If the first stage fails or the continuation stalls (RFEM: its top support
     !! softens too and the rope drops far), it solves directly from the start, which the
     !! RFEM's Cartesian coordinates tolerate. Otherwise it is `solve_statics`.
-    subroutine find_equilibrium(model, scene, y, options, result, err, factory)
+    subroutine find_equilibrium(model, spec, y, options, result, err, factory)
         class(rope_model_t), intent(inout) :: model
-        type(scene_t), intent(in) :: scene
+        type(rope_spec_t), intent(in) :: spec
         real(wp), intent(inout) :: y(:)
         type(statics_options_t), intent(in) :: options
         type(statics_result_t), intent(out) :: result
         type(error_t), allocatable, intent(out) :: err
         procedure(model_factory_i), optional :: factory
-        type(scene_t) :: stage_scene
+        type(rope_spec_t) :: stage_spec
         class(rope_model_t), allocatable :: stage_model
         type(statics_result_t) :: stage
         type(statics_options_t) :: stage_options
@@ -395,16 +396,16 @@ contains
         rejected = 0
         stages = 0
         fallback = ''
-        call check_equilibrium_exists(scene, err)
+        call check_equilibrium_exists(spec, err)
         if (allocated(err)) return
-        weight = total_weight(model, scene)
+        weight = total_weight(model, spec)
         continuation: if (present(factory) .and. options%continuation .and. &
-                          trim(scene%supports%bottom) /= 'free' .and. &
-                          bottom_anchor_given(scene) .and. weight > 0.0_wp) then
+                          trim(spec%supports%bottom) /= 'free' .and. &
+                          bottom_anchor_given(spec) .and. weight > 0.0_wp) then
             allocate (points(2, 2*model%n_elements()))
             call model%polyline(y, points)
             p_end = points(:, size(points, 2))
-            target = scene%supports%bottom_anchor
+            target = spec%supports%bottom_anchor
             distance = norm2(target - p_end)
             if (distance <= 1.0e-3_wp*rope_length(model)) exit continuation
             ! the spring's pull at the start: dV/d(anchor) along the anchor's offset
@@ -412,7 +413,7 @@ contains
             if (allocated(err)) return
             if (pull <= 0.3_wp*weight) exit continuation
             y_start = y
-            log_f1 = log(scene%supports%support_stiffness_factor)
+            log_f1 = log(spec%supports%support_stiffness_factor)
             log_f0 = log_f1 + log(0.3_wp*weight/pull)
             stage_options%max_iterations = 100
             stage_options%step_tolerance = 1.0e-8_wp
@@ -421,13 +422,13 @@ contains
             ! the first stage starts at s = 0 itself
             s_try = 0.0_wp
             do
-                stage_scene = scene
-                stage_scene%supports%support_stiffness_factor = &
+                stage_spec = spec
+                stage_spec%supports%support_stiffness_factor = &
                     exp(log_f0 + s_try*(log_f1 - log_f0))
-                call factory(stage_scene, stage_model, err)
+                call factory(stage_spec, stage_model, err)
                 if (allocated(err)) return
                 y_try = y
-                call solve_statics(stage_model, stage_scene, y_try, stage_options, stage, &
+                call solve_statics(stage_model, stage_spec, y_try, stage_options, stage, &
                                    stage_err)
                 iterations = iterations + stage%iterations
                 rejected = rejected + stage%rejected
@@ -438,7 +439,7 @@ contains
                     if (ds < 1.0e-3_wp .or. stages == 1) then
                         ! give up the continuation: solve directly from the start
                         fallback = 'continuation in support_stiffness_factor stalled at '// &
-                                   real_text(100*s)//' % of the way, then '
+                                   fixed_text(100*s, 1)//' % of the way, then '
                         y = y_start
                         stages = 0
                         exit
@@ -453,7 +454,7 @@ contains
                 if (s_try > 1.0_wp - 1.0e-9_wp) s_try = 1.0_wp
             end do
         end if continuation
-        call solve_statics(model, scene, y, options, result, err)
+        call solve_statics(model, spec, y, options, result, err)
         if (allocated(err) .and. len(fallback) > 0) then
             err%message = err%message//' ('//fallback//'solved directly from the start)'
         end if
@@ -463,13 +464,13 @@ contains
     contains
         !> |dV/d(anchor)| along the unit offset of the bottom anchor, N (central differences).
         real(wp) function anchor_pull() result(r)
-            type(scene_t) :: moved
+            type(rope_spec_t) :: moved
             class(rope_model_t), allocatable :: probe
             real(wp) :: u(2), h, vp, vm
             u = (target - p_end)/distance
             h = 1.0e-4_wp*rope_length(model)
             r = 0.0_wp
-            moved = scene
+            moved = spec
             moved%supports%bottom_anchor = target + h*u
             call factory(moved, probe, err)
             if (allocated(err)) return
@@ -487,9 +488,9 @@ contains
     !! success it holds the equilibrium at rest. Errors (ERR_SOLVER) name the cause:
     !! no equilibrium (free-free under gravity), no convergence, divergence, non-finite
     !! forces, or no step that lowers the energy.
-    subroutine solve_statics(model, scene, y, options, result, err)
+    subroutine solve_statics(model, spec, y, options, result, err)
         class(rope_model_t), intent(inout) :: model
-        type(scene_t), intent(in) :: scene
+        type(rope_spec_t), intent(in) :: spec
         real(wp), intent(inout) :: y(:)
         type(statics_options_t), intent(in) :: options
         type(statics_result_t), intent(out) :: result
@@ -504,7 +505,7 @@ contains
         type(ldl_t) :: fac
         character(len=200) :: text
 
-        call check_equilibrium_exists(scene, err)
+        call check_equilibrium_exists(spec, err)
         if (allocated(err)) return
         call model%coordinates(pos, vel)
         nd = size(pos)
@@ -512,12 +513,12 @@ contains
         y(vel) = 0.0_wp
         length = rope_length(model)
         step_limit = 0.5_wp*max(length, 1.0_wp)
-        result%weight = total_weight(model, scene)
+        result%weight = total_weight(model, spec)
         q0 = y(pos)
 
         call generalized_force(model, y, pos, vel, f, status)
         if (status /= STATUS_OK) then
-            call make_error(err, ERR_SOLVER, scene%path//': statics: non-finite forces '// &
+            call make_error(err, ERR_SOLVER, spec%path//': statics: non-finite forces '// &
                             'in the starting configuration')
             return
         end if
@@ -537,8 +538,8 @@ contains
             if (fresh) then
                 call tangent_matrices(model, y, pos, vel, kt, status)
                 if (status /= STATUS_OK) then
-                    call make_error(err, ERR_SOLVER, scene%path//': statics: the stiffness '// &
-                                    'matrix is not finite at iteration '//itoa(result%iterations))
+                    call make_error(err, ERR_SOLVER, spec%path//': statics: the stiffness '// &
+                                    'matrix is not finite at iteration '//int_text(result%iterations))
                     return
                 end if
                 kt = 0.5_wp*(kt + transpose(kt))
@@ -553,7 +554,7 @@ contains
                 write (text, '(a, i0, a, es10.3, a, es10.3, a, es9.2)') 'no convergence in ', &
                     result%iterations, ' iterations (max |f| = ', maxval(abs(f)), &
                     ' N, last step ', result%last_step, ' m or rad, shift ', sigma
-                call make_error(err, ERR_SOLVER, scene%path//': statics: '//trim(text)// &
+                call make_error(err, ERR_SOLVER, spec%path//': statics: '//trim(text)// &
                     '); the rope may have no stable equilibrium near the start, or needs '// &
                     'more iterations (--max-iterations)')
                 return
@@ -586,9 +587,9 @@ contains
                 result%rejected = result%rejected + 1
                 consecutive = consecutive + 1
                 if (consecutive > 40) then
-                    call make_error(err, ERR_SOLVER, scene%path//': statics: no step lowers '// &
+                    call make_error(err, ERR_SOLVER, spec%path//': statics: no step lowers '// &
                         'the potential energy (40 rejections in a row at iteration '// &
-                        itoa(result%iterations)//'); the forces may be inconsistent with '// &
+                        int_text(result%iterations)//'); the forces may be inconsistent with '// &
                         'the energy, or the equilibrium is singular')
                     return
                 end if
@@ -609,7 +610,7 @@ contains
             result%last_step = step
             if (newton) result%newton_steps = result%newton_steps + 1
             if (maxval(abs(y(pos) - q0)) > 1.0e4_wp*(length + maxval(abs(q0)))) then
-                call make_error(err, ERR_SOLVER, scene%path//': statics: diverged: the '// &
+                call make_error(err, ERR_SOLVER, spec%path//': statics: diverged: the '// &
                     'rope moves away without bound (no equilibrium?)')
                 return
             end if
@@ -695,19 +696,5 @@ contains
         end function at_rounding_level
     end subroutine solve_statics
 
-    function real_text(x) result(text)
-        real(wp), intent(in) :: x
-        character(len=:), allocatable :: text
-        character(len=16) :: buffer
-        write (buffer, '(f0.1)') x
-        text = trim(buffer)
-    end function real_text
 
-    pure function itoa(i) result(text)
-        integer, intent(in) :: i
-        character(len=:), allocatable :: text
-        character(len=16) :: buffer
-        write (buffer, '(i0)') i
-        text = trim(buffer)
-    end function itoa
 end module ropedyn_statics

@@ -1,15 +1,29 @@
-!> What every rope model offers beyond the generic problem: element data for output,
-!! the initial state of a scene, and the mapping from the ODE state to element fields
-!! and to the polyline used for drawing.
+!> What every rope model offers beyond the generic problem: its energies, element data for
+!! output, the initial state of its spec, and the mapping from the ODE state to element
+!! fields and to the polyline used for drawing.
 module ropedyn_rope_model
     use ropedyn_kinds, only: wp
     use ropedyn_problem, only: problem_t
     implicit none
     private
-    public :: rope_model_t
+    public :: rope_model_t, energy_t
+
+    !> Energy bookkeeping of a state, all in J.
+    type :: energy_t
+        real(wp) :: kinetic = 0.0_wp       !< T
+        real(wp) :: elastic = 0.0_wp       !< springs (internal and supports)
+        real(wp) :: gravity = 0.0_wp       !< -sum m g x
+        real(wp) :: dissipated = 0.0_wp    !< integral of the dissipation power so far
+        !> external work done on the rope so far: moving supports, point loads, a current
+        real(wp) :: support_work = 0.0_wp
+    contains
+        procedure :: total => energy_total
+        procedure :: balance => energy_balance
+    end type energy_t
 
     type, abstract, extends(problem_t) :: rope_model_t
     contains
+        procedure(energy_i), deferred :: energy
         procedure(n_elements_i), deferred :: n_elements
         procedure(model_name_i), deferred :: model_name
         procedure(initial_state_i), deferred :: initial_state
@@ -21,6 +35,16 @@ module ropedyn_rope_model
     end type rope_model_t
 
     abstract interface
+        !> Energies of state y at time t with quadrature values yq.
+        function energy_i(self, t, y, yq) result(e)
+            import :: rope_model_t, wp, energy_t
+            class(rope_model_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(in) :: yq(:)
+            type(energy_t) :: e
+        end function energy_i
+
         !> Number of bodies (rigid elements or pendulum members).
         pure integer function n_elements_i(self)
             import :: rope_model_t
@@ -34,7 +58,7 @@ module ropedyn_rope_model
             character(len=:), allocatable :: name
         end function model_name_i
 
-        !> The ODE state of the scene's initial configuration.
+        !> The ODE state of the spec's initial configuration.
         subroutine initial_state_i(self, y)
             import :: rope_model_t, wp
             class(rope_model_t), intent(in) :: self
@@ -85,4 +109,17 @@ module ropedyn_rope_model
             real(wp), intent(out) :: mm(:, :)
         end subroutine coordinate_mass_i
     end interface
+contains
+
+    !> T + V (kinetic + elastic + gravity), J.
+    pure real(wp) function energy_total(self) result(e)
+        class(energy_t), intent(in) :: self
+        e = self%kinetic + self%elastic + self%gravity
+    end function energy_total
+
+    !> T + V + dissipated - support work: equals E0 for every run, J.
+    pure real(wp) function energy_balance(self) result(e)
+        class(energy_t), intent(in) :: self
+        e = self%kinetic + self%elastic + self%gravity + self%dissipated - self%support_work
+    end function energy_balance
 end module ropedyn_rope_model

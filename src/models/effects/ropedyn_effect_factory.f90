@@ -1,10 +1,10 @@
-!> Builds the external effects a scene enables, for a model whose bodies tile the rope:
+!> Builds the external effects a spec enables, for a model whose bodies tile the rope:
 !! body i covers the arc lengths [s_i, s_i + l_i] of the unstretched rope from its top end.
 !! Only enabled effects are allocated (docs/input.md, `&effects`).
 module ropedyn_effect_factory
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
     use ropedyn_kinds, only: wp
-    use ropedyn_scene, only: scene_t, N_ATTACH
+    use ropedyn_rope_spec, only: rope_spec_t, N_ATTACH
     use ropedyn_effect, only: effect_box_t
     use ropedyn_effect_drag, only: drag_effect
     use ropedyn_effect_ground, only: ground_effect
@@ -39,10 +39,10 @@ contains
         r = s - (start + 0.5_wp*lengths(body))
     end subroutine locate_on_bodies
 
-    !> The effects of a scene acting on bodies of the given lengths (m): drag, ground contact,
+    !> The effects of a spec acting on bodies of the given lengths (m): drag, ground contact,
     !! point loads, each only when enabled and given.
-    subroutine build_body_effects(scene, lengths, effects)
-        type(scene_t), intent(in) :: scene
+    subroutine build_body_effects(spec, lengths, effects)
+        type(rope_spec_t), intent(in) :: spec
         real(wp), intent(in) :: lengths(:)
         type(effect_box_t), allocatable, intent(out) :: effects(:)
         type(loads_effect_t) :: loads
@@ -50,30 +50,30 @@ contains
         logical :: with_loads
 
         with_loads = .false.
-        if (scene%effects%point_loads) &
-            with_loads = any(.not. ieee_is_nan(scene%attachments%load_positions))
-        n_eff = count([scene%effects%drag, scene%effects%ground, with_loads])
+        if (spec%effects%point_loads) &
+            with_loads = any(.not. ieee_is_nan(spec%attachments%load_positions))
+        n_eff = count([spec%effects%drag, spec%effects%ground, with_loads])
         allocate (effects(n_eff))
         k = 0
-        if (scene%effects%drag) then
+        if (spec%effects%drag) then
             k = k + 1
-            associate (f => scene%fluid)
+            associate (f => spec%fluid)
                 allocate (effects(k)%e, source=drag_effect(f%density, &
                     f%normal_drag_coefficient, f%tangential_drag_coefficient, &
                     f%linear_normal_drag, f%linear_tangential_drag, f%current, &
-                    scene%rope%diameter))
+                    spec%rope%diameter))
             end associate
         end if
-        if (scene%effects%ground) then
+        if (spec%effects%ground) then
             k = k + 1
-            associate (g => scene%ground)
+            associate (g => spec%ground)
                 allocate (effects(k)%e, source=ground_effect(g%point, g%normal, g%stiffness, &
                     g%damping, g%friction_coefficient, g%friction_regularization_speed))
             end associate
         end if
         if (with_loads) then
             k = k + 1
-            associate (a => scene%attachments)
+            associate (a => spec%attachments)
                 allocate (loads%loads(count(.not. ieee_is_nan(a%load_positions))))
                 m = 0
                 do k = 1, N_ATTACH
@@ -91,25 +91,25 @@ contains
         end if
     end subroutine build_body_effects
 
-    !> The point masses of a scene (none when `&effects point_masses` is off): for each, the
+    !> The point masses of a spec (none when `&effects point_masses` is off): for each, the
     !! body, the offset r (m) from the body's centre along it, and the mass (kg).
-    subroutine attached_masses(scene, lengths, body, r, mass)
-        type(scene_t), intent(in) :: scene
+    subroutine attached_masses(spec, lengths, body, r, mass)
+        type(rope_spec_t), intent(in) :: spec
         real(wp), intent(in) :: lengths(:)
         integer, allocatable, intent(out) :: body(:)
         real(wp), allocatable, intent(out) :: r(:), mass(:)
         integer :: k, m, n
         n = 0
-        if (scene%effects%point_masses) &
-            n = count(.not. ieee_is_nan(scene%attachments%mass_positions))
+        if (spec%effects%point_masses) &
+            n = count(.not. ieee_is_nan(spec%attachments%mass_positions))
         allocate (body(n), r(n), mass(n))
         m = 0
         if (n == 0) return
         do k = 1, N_ATTACH
-            if (ieee_is_nan(scene%attachments%mass_positions(k))) cycle
+            if (ieee_is_nan(spec%attachments%mass_positions(k))) cycle
             m = m + 1
-            call locate_on_bodies(lengths, scene%attachments%mass_positions(k), body(m), r(m))
-            mass(m) = scene%attachments%masses(k)
+            call locate_on_bodies(lengths, spec%attachments%mass_positions(k), body(m), r(m))
+            mass(m) = spec%attachments%masses(k)
         end do
     end subroutine attached_masses
 end module ropedyn_effect_factory

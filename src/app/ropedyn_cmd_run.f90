@@ -1,0 +1,96 @@
+!> `ropedyn run SCENE.nml [--set group.key=value ...]`: run one scene, print its summary.
+module ropedyn_cmd_run
+    use, intrinsic :: iso_fortran_env, only: output_unit
+    use ropedyn_kinds, only: wp
+    use ropedyn_error, only: error_t
+    use ropedyn_cli, only: cli_t
+    use ropedyn_scene, only: scene_t, read_scene
+    use ropedyn_simulation, only: run_summary_t, run_scene
+    use ropedyn_version, only: version_string
+    implicit none
+    private
+    public :: run_command, run_usage
+
+contains
+
+    subroutine run_usage(unit)
+        integer, intent(in) :: unit
+        write (unit, '(a)') 'usage: ropedyn run SCENE.nml [--set group.key=value ...]'
+        write (unit, '(a)') 'Integrates the scene and writes its HDF5 file (&output file); '// &
+            'prints a summary.'
+        write (unit, '(a)') '  --set group.key=value   override a key of the scene file '// &
+            '(repeatable)'
+        write (unit, '(a)') 'exit codes: 0 ok, 2 bad input, 3 integration failed, '// &
+            '4 output error'
+        write (unit, '(a)') 'input reference: docs/input.md'
+    end subroutine run_usage
+
+    subroutine run_command(cli, err)
+        type(cli_t), intent(inout) :: cli
+        type(error_t), allocatable, intent(out) :: err
+        character(len=1024), allocatable :: overrides(:)
+        character(len=:), allocatable :: scene_path, value
+        type(scene_t) :: scene
+        type(run_summary_t) :: summary
+        integer :: n_over
+
+        allocate (overrides(cli%count()))
+        n_over = 0
+        do while (cli%next())
+            select case (cli%option)
+            case ('--help', '-h')
+                call run_usage(output_unit)
+                return
+            case ('--set')
+                call cli%take_value(value, err)
+                if (allocated(err)) return
+                n_over = n_over + 1
+                overrides(n_over) = value
+            case default
+                if (cli%arg(1:min(1, len(cli%arg))) == '-') then
+                    call cli%usage_error('unknown option "'//cli%arg//'"', err)
+                    return
+                end if
+                if (allocated(scene_path)) then
+                    call cli%usage_error('more than one scene file: "'//scene_path//'", "'// &
+                                         cli%arg//'"', err)
+                    return
+                end if
+                scene_path = cli%arg
+            end select
+        end do
+        if (.not. allocated(scene_path)) then
+            call cli%usage_error('needs a scene file', err)
+            return
+        end if
+
+        call read_scene(scene_path, overrides(1:n_over), scene, err)
+        if (allocated(err)) return
+        call run_scene(scene, summary, err)
+        if (summary%records > 0) call print_summary(scene, summary)
+    end subroutine run_command
+
+    subroutine print_summary(scene, s)
+        type(scene_t), intent(in) :: scene
+        type(run_summary_t), intent(in) :: s
+        real(wp) :: e0, drift
+        e0 = s%initial_energy%balance()
+        drift = s%final_energy%balance() - e0
+        write (output_unit, '(a)') 'ropedyn '//version_string//': '//trim(scene%model%kind)// &
+            ' model, '//trim(scene%solver%method)//' solver, scene '//scene%path
+        write (output_unit, '(a, i0, a, es10.3, a, f9.4, a)') '  elements        ', &
+            scene%model%elements, '   rtol ', scene%solver%rtol, '   t = ', s%t_reached, ' s'
+        write (output_unit, '(a, i0, a, i0, a, i0, a, i0)') '  steps           ', &
+            s%stats%steps, '   rhs evals ', s%stats%rhs_evals, '   jacobians ', &
+            s%stats%jac_evals, '   error-test fails ', s%stats%err_test_fails
+        write (output_unit, '(a, f10.4, a)') '  cpu time        ', s%cpu_time, ' s'
+        write (output_unit, '(a, 5(es13.5))') '  energy (J)      kinetic, elastic, '// &
+            'gravity, dissipated, total:'
+        write (output_unit, '(a, 5(es13.5))') '                  ', s%final_energy%kinetic, &
+            s%final_energy%elastic, s%final_energy%gravity, s%final_energy%dissipated, &
+            s%final_energy%total()
+        write (output_unit, '(a, es13.5, a, es10.2, a)') '  E0              ', e0, &
+            ' J   balance error (T+V+dissipated-E0) ', drift, ' J'
+        write (output_unit, '(a)') '  output          '//s%file
+    end subroutine print_summary
+end module ropedyn_cmd_run

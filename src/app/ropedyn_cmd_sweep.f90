@@ -1,0 +1,149 @@
+!> `ropedyn sweep SWEEP.nml [options]`: list, run and summarize a sweep (docs/sweeps.md).
+!!
+!!     ropedyn sweep SWEEP.nml [--jobs N] [--force] [--quiet] [--output-dir DIR]
+!!     ropedyn sweep SWEEP.nml --list | --count
+!!     ropedyn sweep SWEEP.nml --task K [--force] [--quiet] [--output-dir DIR]
+!!     ropedyn sweep SWEEP.nml --summary [--output-dir DIR]
+module ropedyn_cmd_sweep
+    use, intrinsic :: iso_fortran_env, only: output_unit
+    use ropedyn_error, only: error_t, make_error, ERR_USAGE
+    use ropedyn_text, only: int_text
+    use ropedyn_os, only: processor_count
+    use ropedyn_cli, only: cli_t
+    use ropedyn_sweep, only: sweep_t, read_sweep
+    use ropedyn_sweep_runner, only: sweep_options_t, list_cases, run_task, run_local, summarize
+    implicit none
+    private
+    public :: sweep_command, sweep_usage
+
+contains
+
+    subroutine sweep_usage(unit)
+        integer, intent(in) :: unit
+        write (unit, '(a)') 'usage: ropedyn sweep SWEEP.nml [--jobs N] [--force] [--quiet] '// &
+            '[--output-dir DIR]'
+        write (unit, '(a)') '       ropedyn sweep SWEEP.nml --list | --count'
+        write (unit, '(a)') '       ropedyn sweep SWEEP.nml --task K [--force] [--quiet] '// &
+            '[--output-dir DIR]'
+        write (unit, '(a)') '       ropedyn sweep SWEEP.nml --summary [--output-dir DIR]'
+        write (unit, '(a)') 'Runs every case of a sweep file (a base scene and lists of '// &
+            'models, elements,'
+        write (unit, '(a)') 'methods, max_orders, rtols and any group.key) and writes '// &
+            '<output_dir>/case_<id>.h5'
+        write (unit, '(a)') 'and summary.csv / summary.h5 (docs/sweeps.md).'
+        write (unit, '(a)') '  --jobs N        worker processes (default: the number of cores)'
+        write (unit, '(a)') '  --list          print the cases: id, status of its file, overrides'
+        write (unit, '(a)') '  --count         print the number of cases'
+        write (unit, '(a)') '  --task K        run case K only (a Slurm array task); no summary'
+        write (unit, '(a)') '  --summary       rebuild the summary from the case files that exist'
+        write (unit, '(a)') '  --force         run cases again even if their output is complete'
+        write (unit, '(a)') '  --quiet         no progress and no per-case lines'
+        write (unit, '(a)') '  --output-dir D  case files and summary in D (instead of output_dir)'
+        write (unit, '(a)') 'A case whose file is complete and holds the same scene is skipped.'
+        write (unit, '(a)') 'exit codes: 0 ok, 2 bad input, 3 a case failed, 4 output error'
+    end subroutine sweep_usage
+
+    !> `ropedyn sweep ARGS`: `cli` holds the arguments after `sweep`; `exe` is how this
+    !! program was started (argument 0), used to start the workers.
+    subroutine sweep_command(cli, exe, err)
+        type(cli_t), intent(inout) :: cli
+        character(len=*), intent(in) :: exe
+        type(error_t), allocatable, intent(out) :: err
+        type(sweep_options_t) :: opt
+        type(sweep_t) :: sweep
+
+        call parse_options(cli, opt, err)
+        if (allocated(err)) return
+        if (.not. allocated(opt%path)) return   ! --help
+        call read_sweep(opt%path, sweep, err, opt%output_dir)
+        if (allocated(err)) return
+        if (opt%count) then
+            write (output_unit, '(i0)') size(sweep%cases)
+        else if (opt%list) then
+            call list_cases(sweep, err)
+        else if (opt%task > 0) then
+            if (opt%task > size(sweep%cases)) then
+                call make_error(err, ERR_USAGE, 'sweep: --task '//int_text(opt%task)// &
+                    ': no such case ('//opt%path//' has '//int_text(size(sweep%cases))// &
+                    ' cases, 1 .. '//int_text(size(sweep%cases))//')')
+                return
+            end if
+            call run_task(sweep, opt%task, opt%force, opt%quiet, err)
+        else if (opt%summary) then
+            call summarize(sweep, opt%quiet, err)
+        else
+            call run_local(sweep, opt, exe, err)
+        end if
+    end subroutine sweep_command
+
+    subroutine parse_options(cli, opt, err)
+        type(cli_t), intent(inout) :: cli
+        type(sweep_options_t), intent(out) :: opt
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: value
+        integer :: modes
+        logical :: have_jobs
+
+        have_jobs = .false.
+        do while (cli%next())
+            select case (cli%option)
+            case ('--help', '-h')
+                call sweep_usage(output_unit)
+                return
+            case ('--list')
+                opt%list = .true.
+            case ('--count')
+                opt%count = .true.
+            case ('--summary')
+                opt%summary = .true.
+            case ('--force')
+                opt%force = .true.
+            case ('--quiet')
+                opt%quiet = .true.
+            case ('--output-dir')
+                call cli%take_value(value, err)
+                if (allocated(err)) return
+                if (len(value) == 0) then
+                    call cli%usage_error('--output-dir needs a directory', err)
+                    return
+                end if
+                opt%output_dir = value
+            case ('--jobs')
+                call cli%int_value(opt%jobs, 1, err)
+                if (allocated(err)) return
+                have_jobs = .true.
+            case ('--task')
+                call cli%int_value(opt%task, 1, err)
+                if (allocated(err)) return
+            case default
+                if (len(cli%arg) == 0) then
+                    call cli%usage_error('empty argument', err)
+                    return
+                else if (cli%arg(1:1) == '-') then
+                    call cli%usage_error('unknown option "'//cli%arg//'"', err)
+                    return
+                else if (allocated(opt%path)) then
+                    call cli%usage_error('more than one sweep file: "'//opt%path//'", "' &
+                        //cli%arg//'"', err)
+                    return
+                end if
+                opt%path = cli%arg
+            end select
+        end do
+        if (.not. allocated(opt%path)) then
+            call cli%usage_error('needs a sweep file', err)
+            return
+        end if
+        if (.not. allocated(opt%output_dir)) opt%output_dir = ''
+        modes = count([opt%list, opt%count, opt%summary, opt%task > 0])
+        if (modes > 1) then
+            call cli%usage_error('--list, --count, --summary and --task exclude each other', &
+                err)
+        else if (have_jobs .and. modes > 0) then
+            call cli%usage_error('--jobs is for running the whole sweep', err)
+        else if (opt%force .and. (opt%list .or. opt%count .or. opt%summary)) then
+            call cli%usage_error('--force is for running cases', err)
+        end if
+        if (.not. have_jobs) opt%jobs = processor_count()
+    end subroutine parse_options
+end module ropedyn_cmd_sweep

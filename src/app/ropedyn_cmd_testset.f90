@@ -1,0 +1,318 @@
+!> `ropedyn testset PROBLEM|all [options]` and `ropedyn testset --list`: the stiff test
+!! problems of the Bari test set against their reference solutions (docs/testset.md).
+module ropedyn_cmd_testset
+    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+    use ropedyn_kinds, only: wp
+    use ropedyn_error, only: error_t, make_error, ERR_SOLVER
+    use ropedyn_text, only: int_text
+    use ropedyn_methods, only: method_index, method_list
+    use ropedyn_cli, only: cli_t
+    use ropedyn_testset, only: testset_problem_t, new_testset_problem, testset_names, &
+                               testset_name_list
+    use ropedyn_testset_driver, only: testset_run_t, run_testset, DEFAULT_REPEAT_TIME
+    implicit none
+    private
+    public :: testset_command, testset_usage
+
+contains
+
+    subroutine testset_usage(unit)
+        integer, intent(in) :: unit
+        write (unit, '(a)') 'usage: ropedyn testset PROBLEM|all [options]   '// &
+            '(ropedyn testset --list: the problems)'
+        write (unit, '(a)') 'Solves a stiff problem of the Bari Test Set for IVP Solvers '// &
+            'from t0 to t_end'
+        write (unit, '(a)') 'and compares with its reference solution (docs/testset.md).'
+        write (unit, '(a)') '  --method M          integrator: cvode (default) or mebdf'
+        write (unit, '(a)') '  --rtol R            relative tolerance, 0 < R < 1 '// &
+            '(default 1e-6)'
+        write (unit, '(a)') '  --atol A            absolute tolerance, A > 0 (default: '// &
+            'the test-set rule:'
+        write (unit, '(a)') '                      atol = rtol; ROBER atol = 1e-6 rtol; '// &
+            'E5 atol = 1.7e-24)'
+        write (unit, '(a)') '  --max-order K       highest order (0 = method default: '// &
+            'cvode 5, mebdf 4)'
+        write (unit, '(a, f3.1, a)') '  --repeat-time S     repeat until S s of CPU time '// &
+            '(default ', DEFAULT_REPEAT_TIME, '; 0: one run);'
+        write (unit, '(a)') '                      the median CPU time per run is reported'
+        write (unit, '(a)') '  --csv               one header line and one line per problem'
+        write (unit, '(a)') 'Accuracy: scd = -log10 max |y - yref|/|yref| (|yref| >= 1e-200), '// &
+            'mescd = -log10 max'
+        write (unit, '(a)') '|y - yref|/(atol/rtol + |yref|); E5 is judged by mescd.'
+        write (unit, '(a)') 'exit codes: 0 ok, 2 bad arguments, 3 integration failed'
+    end subroutine testset_usage
+
+    !> ropedyn testset PROBLEM|all [options] | --list
+    subroutine testset_command(cli, err)
+        type(cli_t), intent(inout) :: cli
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: problem_name, method, value
+        class(testset_problem_t), allocatable :: problem
+        type(testset_run_t) :: result
+        type(error_t), allocatable :: terr
+        real(wp) :: rtol, atol, repeat_time
+        integer :: max_order, k, first, last, failures
+        logical :: have_atol, csv, list
+
+        method = 'cvode'
+        rtol = 1.0e-6_wp
+        atol = 0.0_wp
+        have_atol = .false.
+        max_order = 0
+        repeat_time = DEFAULT_REPEAT_TIME
+        csv = .false.
+        list = .false.
+        do while (cli%next())
+            select case (cli%option)
+            case ('--help', '-h')
+                call testset_usage(output_unit)
+                return
+            case ('--list')
+                list = .true.
+            case ('--csv')
+                csv = .true.
+            case ('--method')
+                call cli%take_value(value, err)
+                if (allocated(err)) return
+                if (method_index(value) == 0) then
+                    call cli%usage_error('--method "'//value//'": unknown method '// &
+                                         '(available: '//method_list()//')', err)
+                    return
+                end if
+                method = value
+            case ('--rtol')
+                call cli%real_value(rtol, err)
+                if (allocated(err)) return
+                if (.not. (rtol > 0.0_wp .and. rtol < 1.0_wp)) then
+                    call cli%usage_error('--rtol '//cli%value//': must be > 0 and < 1', err)
+                    return
+                end if
+            case ('--atol')
+                call cli%real_value(atol, err)
+                if (allocated(err)) return
+                if (.not. (atol > 0.0_wp)) then
+                    call cli%usage_error('--atol '//cli%value//': must be > 0', err)
+                    return
+                end if
+                have_atol = .true.
+            case ('--max-order')
+                call cli%int_value(max_order, 0, err)
+                if (allocated(err)) return
+            case ('--repeat-time')
+                call cli%real_value(repeat_time, err)
+                if (allocated(err)) return
+                if (.not. (repeat_time >= 0.0_wp .and. repeat_time <= 3600.0_wp)) then
+                    call cli%usage_error('--repeat-time '//cli%value//': must be 0 .. 3600 s', err)
+                    return
+                end if
+            case default
+                if (len(cli%arg) == 0) then
+                    call cli%usage_error('empty argument', err)
+                    return
+                end if
+                if (cli%arg(1:1) == '-') then
+                    call cli%usage_error('unknown option "'//cli%arg//'"', err)
+                    return
+                end if
+                if (allocated(problem_name)) then
+                    call cli%usage_error('more than one problem: "'//problem_name//'", "'// &
+                                         cli%arg//'"', err)
+                    return
+                end if
+                problem_name = cli%arg
+            end select
+        end do
+
+        if (list) then
+            call list_problems(err)
+            return
+        end if
+        if (.not. allocated(problem_name)) then
+            call cli%usage_error('needs a problem name or "all" (available: '// &
+                                 testset_name_list()//')', err)
+            return
+        end if
+        if (problem_name == 'all' .or. problem_name == 'ALL') then
+            first = 1
+            last = size(testset_names)
+        else
+            call new_testset_problem(problem_name, problem, terr)
+            if (allocated(terr)) then
+                call cli%usage_error(terr%message, err)
+                return
+            end if
+            first = 0
+            last = 0
+        end if
+
+        if (csv) call write_csv_header()
+        failures = 0
+        do k = first, last
+            if (k > 0) then
+                call new_testset_problem(testset_names(k), problem, err)
+                if (allocated(err)) return
+            end if
+            if (have_atol) then
+                call run_testset(problem, method, rtol, result, terr, atol=atol, &
+                                 max_order=max_order, repeat_time=repeat_time)
+            else
+                call run_testset(problem, method, rtol, result, terr, max_order=max_order, &
+                                 repeat_time=repeat_time)
+            end if
+            if (allocated(terr)) then
+                if (terr%code /= ERR_SOLVER) then
+                    call cli%usage_error(terr%message, err)
+                    return
+                end if
+                failures = failures + 1
+                if (first == 0) then
+                    call move_alloc(terr, err)
+                    return
+                end if
+                write (error_unit, '(a)') 'ropedyn: error: '//terr%message
+                cycle
+            end if
+            if (csv) then
+                call write_csv_row(result)
+            else
+                if (k > first) write (output_unit, '(a)') ''
+                call print_testset_result(problem, result, have_atol)
+            end if
+        end do
+        if (failures > 0) call make_error(err, ERR_SOLVER, 'testset: '//int_text(failures)// &
+            ' of '//int_text(last - first + 1)//' test problems failed')
+    end subroutine testset_command
+
+    subroutine list_problems(err)
+        type(error_t), allocatable, intent(out) :: err
+        class(testset_problem_t), allocatable :: problem
+        integer :: k
+        write (output_unit, '(a)') pad('problem', 8)//pad('n', 4)//pad('interval', 24)// &
+            pad('atol rule', 22)//pad('measure', 9)//'description'
+        do k = 1, size(testset_names)
+            call new_testset_problem(testset_names(k), problem, err)
+            if (allocated(err)) return
+            write (output_unit, '(a)') pad(problem%name, 8)//pad(int_text(problem%size()), 4)// &
+                pad('t = '//number(problem%t0)//' .. '//number(problem%t_end), 24)// &
+                pad(problem%atol_rule(), 22)//pad(merge('mescd', 'scd  ', problem%use_mescd), 9)// &
+                problem%title
+        end do
+    end subroutine list_problems
+
+    subroutine print_testset_result(problem, r, atol_given)
+        class(testset_problem_t), intent(in) :: problem
+        type(testset_run_t), intent(in) :: r
+        logical, intent(in) :: atol_given
+        character(len=:), allocatable :: rule
+        write (output_unit, '(a, i0, a)') 'ropedyn testset '//problem%name//': '// &
+            problem%title//', ', problem%size(), ' equations, t = '//number(problem%t0)// &
+            ' .. '//number(problem%t_end)
+        write (output_unit, '(a, i0, a)') '  method          '//r%method//' (max order ', &
+            r%max_order, ')'
+        if (atol_given) then
+            rule = 'given'
+        else
+            rule = problem%atol_rule()
+        end if
+        write (output_unit, '(a)') '  rtol            '//number(r%rtol)//'   atol '// &
+            atol_text(r)//' ('//rule//')'
+        write (output_unit, '(a, f7.3, a, f7.3, a)') '  accuracy        scd ', r%scd, &
+            '   mescd ', r%mescd, '   ('//trim(merge('mescd', 'scd  ', r%use_mescd))// &
+            ' is the measure for this problem)'
+        write (output_unit, '(a, i0, a, i0)') '  steps           ', r%stats%steps, &
+            '   rejected (error test) ', r%stats%err_test_fails
+        write (output_unit, '(a, i0, a, i0, a)') '  f evaluations   ', r%stats%rhs_evals, &
+            '   (+ ', r%stats%jac_rhs_evals, ' for Jacobian differencing)'
+        write (output_unit, '(a, i0, a, i0)') '  Jacobians       ', r%stats%jac_evals, &
+            '   LU factorizations ', r%stats%lin_setups
+        write (output_unit, '(a, i0, a, i0)') '  Newton          iterations ', &
+            r%stats%nonlin_iters, '   convergence failures ', r%stats%nonlin_conv_fails
+        if (any(r%stats%order_steps > 0)) write (output_unit, '(a, 7(1x, i0))') &
+            '  steps at order 1..7', r%stats%order_steps
+        write (output_unit, '(a, es10.3, a, i0, a)') '  cpu time        ', r%cpu_time, &
+            ' s per run (median of ', r%runs, ' runs)'
+    end subroutine print_testset_result
+
+    subroutine write_csv_header()
+        write (output_unit, '(a)') 'problem,method,rtol,atol,max_order,scd,mescd,measure,'// &
+            'accuracy,steps,rejected,rhs_evals,jac_rhs_evals,jac_evals,lin_setups,'// &
+            'nonlin_iters,nonlin_conv_fails,cpu_time,runs'
+    end subroutine write_csv_header
+
+    subroutine write_csv_row(r)
+        type(testset_run_t), intent(in) :: r
+        character(len=400) :: line
+        write (line, '(9(a, ","), 8(i0, ","), es12.5, ",", i0)') r%problem, &
+            r%method, number(r%rtol), atol_text(r), int_text(r%max_order), decimal(r%scd), &
+            decimal(r%mescd), merge('mescd', 'scd  ', r%use_mescd), decimal(r%accuracy()), &
+            r%stats%steps, r%stats%err_test_fails, r%stats%rhs_evals, r%stats%jac_rhs_evals, &
+            r%stats%jac_evals, r%stats%lin_setups, r%stats%nonlin_iters, &
+            r%stats%nonlin_conv_fails, r%cpu_time, r%runs
+        write (output_unit, '(a)') remove_blanks(line)
+    end subroutine write_csv_row
+
+    !> The atol of a run: one number, or 'vector' when components differ.
+    function atol_text(r) result(text)
+        type(testset_run_t), intent(in) :: r
+        character(len=:), allocatable :: text
+        if (r%uniform_atol()) then
+            text = number(r%atol(1))
+        else
+            text = 'vector'
+        end if
+    end function atol_text
+
+    !> A real in short form: 321.8122, 60, 1.00000E-06.
+    function number(x) result(text)
+        real(wp), intent(in) :: x
+        character(len=:), allocatable :: text
+        character(len=32) :: buffer
+        if (x == 0.0_wp) then
+            text = '0'
+        else if (abs(x) >= 1.0e-3_wp .and. abs(x) < 1.0e6_wp) then
+            write (buffer, '(f0.10)') x
+            text = trim(adjustl(buffer))
+            do while (text(len(text):len(text)) == '0')
+                text = text(1:len(text) - 1)
+            end do
+            if (text(len(text):len(text)) == '.') text = text(1:len(text) - 1)
+            if (text(1:1) == '.') text = '0'//text
+        else
+            write (buffer, '(es12.5)') x
+            text = trim(adjustl(buffer))
+        end if
+    end function number
+
+    !> text, left-justified in a field of the given width (at least one blank after it).
+    pure function pad(text, width) result(field)
+        character(len=*), intent(in) :: text
+        integer, intent(in) :: width
+        character(len=max(width, len(text) + 1)) :: field
+        field = text
+    end function pad
+
+    !> A real with 4 decimals: 2.5125, 0.5813, -0.1200.
+    function decimal(x) result(text)
+        real(wp), intent(in) :: x
+        character(len=:), allocatable :: text
+        character(len=32) :: buffer
+        write (buffer, '(f0.4)') x
+        text = trim(adjustl(buffer))
+        if (text(1:1) == '.') then
+            text = '0'//text
+        else if (text(1:min(2, len(text))) == '-.') then
+            text = '-0'//text(2:)
+        end if
+    end function decimal
+
+
+    pure function remove_blanks(text) result(out)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: out
+        integer :: j
+        out = ''
+        do j = 1, len_trim(text)
+            if (text(j:j) /= ' ') out = out//text(j:j)
+        end do
+    end function remove_blanks
+end module ropedyn_cmd_testset

@@ -1,0 +1,48 @@
+!> The integration methods by name, with the orders each allows: plain data shared by the
+!! scene reader (which checks `&solver max_order`) and the integrators (which apply it), so
+!! that input checking needs no solver module.
+!!
+!! Why the defaults: CVODE keeps its own limit, BDF order 5, after measuring orders 2 .. 5
+!! with and without stability-limit detection on the hard scenes (docs/stability.md): orders
+!! 3 and 4 let undamped modes gain energy, order 2 crawls where the rope's oscillations must
+!! be resolved, and order 5 never amplified. MEBDF defaults to order 4 (k = 3), the highest
+!! at which it is A-stable and does not amplify undamped oscillations (order 5 amplifies by
+!! up to 1.027 per step on the imaginary axis, order 6 by 1.114; docs/solvers.md).
+module ropedyn_methods
+    implicit none
+    private
+    public :: method_info_t, METHODS, method_index, method_list
+
+    !> One method: its name in `&solver method` and the orders of accuracy it allows.
+    type :: method_info_t
+        character(len=8) :: name = ''
+        integer :: lowest_order = 1     !< smallest allowed max_order
+        integer :: highest_order = 1    !< largest allowed max_order
+        integer :: default_order = 1    !< the max_order used when max_order = 0
+    end type method_info_t
+
+    type(method_info_t), parameter :: METHODS(*) = [ &
+        method_info_t('cvode', 1, 5, 5), &
+        method_info_t('mebdf', 2, 7, 4)]
+
+contains
+
+    !> Index of a method in METHODS, 0 if there is none of that name.
+    pure integer function method_index(name) result(k)
+        character(len=*), intent(in) :: name
+        do k = 1, size(METHODS)
+            if (trim(METHODS(k)%name) == trim(name)) return
+        end do
+        k = 0
+    end function method_index
+
+    !> 'cvode, mebdf': the names for messages.
+    pure function method_list() result(list)
+        character(len=:), allocatable :: list
+        integer :: k
+        list = trim(METHODS(1)%name)
+        do k = 2, size(METHODS)
+            list = list//', '//trim(METHODS(k)%name)
+        end do
+    end function method_list
+end module ropedyn_methods

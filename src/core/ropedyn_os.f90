@@ -1,0 +1,188 @@
+!> The operating-system services ropedyn needs, through POSIX: directories, the working
+!! directory, whether a stream is a terminal, sleeping, the number of processors.
+module ropedyn_os
+    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_size_t, c_ptr, c_null_char, &
+                                           c_associated
+    use ropedyn_error, only: error_t, make_error, ERR_IO
+    implicit none
+    private
+    public :: make_dirs, make_parent_dirs, current_dir, is_terminal, sleep_microseconds, &
+              processor_count, absolute_path, utc_timestamp
+
+    interface
+        integer(c_int) function c_mkdir(path, mode) bind(C, name='mkdir')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int), value :: mode
+        end function c_mkdir
+        function c_getcwd(buf, size) bind(C, name='getcwd') result(p)
+            import :: c_char, c_size_t, c_ptr
+            character(kind=c_char), intent(out) :: buf(*)
+            integer(c_size_t), value :: size
+            type(c_ptr) :: p
+        end function c_getcwd
+        integer(c_int) function c_isatty(fd) bind(C, name='isatty')
+            import :: c_int
+            integer(c_int), value :: fd
+        end function c_isatty
+        integer(c_int) function c_usleep(microseconds) bind(C, name='usleep')
+            import :: c_int
+            integer(c_int), value :: microseconds
+        end function c_usleep
+        integer(c_int) function c_get_nprocs() bind(C, name='get_nprocs')
+            import :: c_int
+        end function c_get_nprocs
+    end interface
+
+contains
+
+    !> mkdir -p of `dir`; `what` starts the error message (e.g. the command or file).
+    subroutine make_dirs(dir, err, what)
+        character(len=*), intent(in) :: dir
+        type(error_t), allocatable, intent(out) :: err
+        character(len=*), intent(in), optional :: what
+        integer :: k, rc
+        logical :: exists
+        character(len=:), allocatable :: path
+        path = dir//'/'
+        do k = 2, len(path)
+            if (path(k:k) /= '/') cycle
+            inquire (file=path(1:k - 1)//'/.', exist=exists)
+            if (exists) cycle
+            rc = c_mkdir(path(1:k - 1)//c_null_char, int(o'755', c_int))
+            inquire (file=path(1:k - 1)//'/.', exist=exists)
+            if (.not. exists) then
+                if (present(what)) then
+                    call make_error(err, ERR_IO, what//': cannot create directory "'// &
+                                    path(1:k - 1)//'"')
+                else
+                    call make_error(err, ERR_IO, 'cannot create directory "'// &
+                                    path(1:k - 1)//'"')
+                end if
+                return
+            end if
+        end do
+    end subroutine make_dirs
+
+    !> mkdir -p of the directory part of the file name `path`.
+    subroutine make_parent_dirs(path, err)
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: err
+        integer :: slash
+        slash = index(trim(path), '/', back=.true.)
+        if (slash <= 1) return
+        call make_dirs(path(:slash - 1), err, path)
+    end subroutine make_parent_dirs
+
+    !> The working directory ('' if it cannot be found).
+    function current_dir() result(dir)
+        character(len=:), allocatable :: dir
+        character(kind=c_char, len=4096) :: buf
+        integer :: k
+        dir = ''
+        if (.not. c_associated(c_getcwd(buf, int(len(buf), c_size_t)))) return
+        k = index(buf, c_null_char)
+        if (k <= 1) return
+        dir = buf(:k - 1)
+    end function current_dir
+
+    !> `name` made absolute: as given when it starts with '/', else relative to the
+    !! directory of the file `relative_to` (if given) and then to the working directory.
+    function absolute_path(name, relative_to) result(full)
+        character(len=*), intent(in) :: name
+        character(len=*), intent(in), optional :: relative_to
+        character(len=:), allocatable :: full, cwd
+        integer :: slash
+        if (name(1:1) == '/') then
+            full = name
+            return
+        end if
+        full = name
+        if (present(relative_to)) then
+            slash = index(relative_to, '/', back=.true.)
+            full = relative_to(:slash)//name
+            if (full(1:1) == '/') return
+        end if
+        cwd = current_dir()
+        if (len(cwd) > 0) full = cwd//'/'//full
+    end function absolute_path
+
+    !> True when the file descriptor (0 stdin, 1 stdout, 2 stderr) is a terminal.
+    logical function is_terminal(fd)
+        integer, intent(in) :: fd
+        is_terminal = c_isatty(int(fd, c_int)) == 1
+    end function is_terminal
+
+    subroutine sleep_microseconds(us)
+        integer, intent(in) :: us
+        integer(c_int) :: rc
+        rc = c_usleep(int(us, c_int))
+    end subroutine sleep_microseconds
+
+    !> Number of processors available (at least 1).
+    integer function processor_count()
+        processor_count = max(1, int(c_get_nprocs()))
+    end function processor_count
+
+    !> Current time as ISO 8601 UTC, e.g. 2024-05-01T12:34:56Z.
+    function utc_timestamp() result(text)
+        character(len=20) :: text
+        integer :: values(8), offset, days, minutes, year, month, day
+        call date_and_time(values=values)
+        offset = values(4)
+        if (offset == -huge(0)) offset = 0
+        minutes = values(5)*60 + values(6) - offset
+        days = days_from_civil(values(1), values(2), values(3)) &
+               + (minutes - modulo(minutes, 1440))/1440
+        minutes = modulo(minutes, 1440)
+        call civil_from_days(days, year, month, day)
+        write (text, '(i4.4, "-", i2.2, "-", i2.2, "T", i2.2, ":", i2.2, ":", i2.2, "Z")') &
+            year, month, day, minutes/60, modulo(minutes, 60), values(7)
+    end function utc_timestamp
+
+    !> Days since 1970-01-01 of a proleptic Gregorian date (H. Hinnant's algorithm).
+    pure integer function days_from_civil(year, month, day) result(days)
+        integer, intent(in) :: year, month, day
+        integer :: y, era, yoe, doy, doe
+        y = year
+        if (month <= 2) y = y - 1
+        if (y >= 0) then
+            era = y/400
+        else
+            era = (y - 399)/400
+        end if
+        yoe = y - era*400
+        if (month > 2) then
+            doy = (153*(month - 3) + 2)/5 + day - 1
+        else
+            doy = (153*(month + 9) + 2)/5 + day - 1
+        end if
+        doe = yoe*365 + yoe/4 - yoe/100 + doy
+        days = era*146097 + doe - 719468
+    end function days_from_civil
+
+    !> Inverse of days_from_civil.
+    pure subroutine civil_from_days(days, year, month, day)
+        integer, intent(in) :: days
+        integer, intent(out) :: year, month, day
+        integer :: z, era, doe, yoe, doy, mp
+        z = days + 719468
+        if (z >= 0) then
+            era = z/146097
+        else
+            era = (z - 146096)/146097
+        end if
+        doe = z - era*146097
+        yoe = (doe - doe/1460 + doe/36524 - doe/146096)/365
+        doy = doe - (365*yoe + yoe/4 - yoe/100)
+        mp = (5*doy + 2)/153
+        day = doy - (153*mp + 2)/5 + 1
+        if (mp < 10) then
+            month = mp + 3
+        else
+            month = mp - 9
+        end if
+        year = yoe + era*400
+        if (month <= 2) year = year + 1
+    end subroutine civil_from_days
+end module ropedyn_os

@@ -1,0 +1,168 @@
+!> Text of numbers, logicals and names for messages, echoes and file names: the one place
+!! every layer takes them from.
+module ropedyn_text
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
+    use ropedyn_kinds, only: wp, i8
+    implicit none
+    private
+    public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, lower, line_quote
+
+    !> Decimal text of an integer (default or 64-bit kind).
+    interface int_text
+        module procedure int_text_default, int_text_i8
+    end interface int_text
+
+contains
+
+    pure function int_text_default(n) result(s)
+        integer, intent(in) :: n
+        character(len=:), allocatable :: s
+        character(len=12) :: buf
+        write (buf, '(i0)') n
+        s = trim(buf)
+    end function int_text_default
+
+    pure function int_text_i8(n) result(s)
+        integer(i8), intent(in) :: n
+        character(len=:), allocatable :: s
+        character(len=24) :: buf
+        write (buf, '(i0)') n
+        s = trim(buf)
+    end function int_text_i8
+
+    !> Shortest decimal text that reads back to x exactly: '1.0', '0.005', '3.5e7', 'NaN',
+    !! '+Infinity'. Plain decimals for exponents -4 .. 6, else 'd.ddde<exp>'. With
+    !! `compact`, plain decimals only for exponents -3 .. 5 and a one-digit mantissa
+    !! without '.0' ('1e-4'): the form of sweep labels.
+    function real_text(x, compact) result(s)
+        real(wp), intent(in) :: x
+        logical, intent(in), optional :: compact
+        character(len=:), allocatable :: s
+        character(len=40) :: buf
+        character(len=16) :: fmt
+        character(len=:), allocatable :: mant, digits
+        real(wp) :: y
+        integer :: d, ios, epos, e, n, e_low, e_high
+        logical :: negative, short
+
+        short = .false.
+        if (present(compact)) short = compact
+        e_low = merge(-3, -4, short)
+        e_high = merge(5, 6, short)
+        if (ieee_is_nan(x)) then
+            s = 'NaN'
+            return
+        else if (.not. ieee_is_finite(x)) then
+            s = merge('+Infinity', '-Infinity', x > 0.0_wp)
+            return
+        else if (.not. abs(x) > 0.0_wp) then
+            s = '0.0'
+            return
+        end if
+        do d = 1, 17
+            write (fmt, '(a, i0, a)') '(es40.', d, 'e3)'
+            write (buf, fmt) x
+            read (buf, *, iostat=ios) y
+            if (ios == 0 .and. abs(y - x) <= 0.0_wp) exit
+        end do
+        buf = adjustl(buf)
+        negative = buf(1:1) == '-'
+        if (negative) buf = buf(2:)
+        epos = scan(buf, 'Ee')
+        read (buf(epos + 1:), *) e
+        mant = buf(:epos - 1)
+        digits = mant(1:1)//mant(3:)
+        n = len(digits)
+        do while (n > 1)
+            if (digits(n:n) /= '0') exit
+            n = n - 1
+        end do
+        digits = digits(:n)
+        if (e >= 0 .and. e <= e_high) then
+            if (n <= e + 1) then
+                s = digits//repeat('0', e + 1 - n)//'.0'
+            else
+                s = digits(:e + 1)//'.'//digits(e + 2:)
+            end if
+        else if (e < 0 .and. e >= e_low) then
+            s = '0.'//repeat('0', -e - 1)//digits
+        else if (n == 1) then
+            if (short) then
+                s = digits//'e'//int_text(e)
+            else
+                s = digits//'.0e'//int_text(e)
+            end if
+        else
+            s = digits(1:1)//'.'//digits(2:)//'e'//int_text(e)
+        end if
+        if (negative) s = '-'//s
+    end function real_text
+
+    !> x with `decimals` digits after the point ('12.3' for decimals = 1).
+    function fixed_text(x, decimals) result(s)
+        real(wp), intent(in) :: x
+        integer, intent(in) :: decimals
+        character(len=:), allocatable :: s
+        character(len=48) :: buf
+        character(len=16) :: fmt
+        write (fmt, '(a, i0, a)') '(f0.', decimals, ')'
+        write (buf, fmt) x
+        s = trim(buf)
+    end function fixed_text
+
+    !> 'x, y' of a pair, each as `real_text`.
+    function pair_text(x) result(s)
+        real(wp), intent(in) :: x(2)
+        character(len=:), allocatable :: s
+        s = real_text(x(1))//', '//real_text(x(2))
+    end function pair_text
+
+    pure function logical_text(b) result(s)
+        logical, intent(in) :: b
+        character(len=:), allocatable :: s
+        if (b) then
+            s = '.true.'
+        else
+            s = '.false.'
+        end if
+    end function logical_text
+
+    !> A Fortran string literal: 'text', with embedded quotes doubled.
+    pure function quoted(text) result(s)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: s
+        integer :: i
+        s = "'"
+        do i = 1, len(text)
+            if (text(i:i) == "'") then
+                s = s//"''"
+            else
+                s = s//text(i:i)
+            end if
+        end do
+        s = s//"'"
+    end function quoted
+
+    !> ASCII lower case.
+    pure function lower(s) result(t)
+        character(len=*), intent(in) :: s
+        character(len=len(s)) :: t
+        integer :: i, c
+        t = s
+        do i = 1, len(s)
+            c = iachar(s(i:i))
+            if (c >= iachar('A') .and. c <= iachar('Z')) t(i:i) = achar(c + 32)
+        end do
+    end function lower
+
+    !> A line for a message: in double quotes, trailing blanks removed, long lines shortened.
+    pure function line_quote(line) result(s)
+        character(len=*), intent(in) :: line
+        character(len=:), allocatable :: s
+        if (len_trim(line) > 80) then
+            s = '"'//line(:77)//'..."'
+        else
+            s = '"'//trim(line)//'"'
+        end if
+    end function line_quote
+end module ropedyn_text
