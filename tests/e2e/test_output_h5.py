@@ -3,7 +3,7 @@ effective scene stored in the file re-runs to the same result."""
 import h5py
 import numpy as np
 
-from check_output_layout import check_layout
+from ropedyn.layout import check_layout
 
 SCENE = """
 &model kind = 'rfem', elements = 5 /

@@ -6,7 +6,7 @@ import shutil
 import h5py
 import pytest
 
-from compare_h5 import compare
+from ropedyn.compare import compare
 
 REFERENCE = pathlib.Path(__file__).resolve().parents[1] / "reference"
 SCENES = sorted(p.stem for p in REFERENCE.glob("*.nml"))

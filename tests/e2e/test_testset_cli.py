@@ -9,8 +9,6 @@ import sys
 
 import pytest
 
-from conftest import ROOT
-
 COLUMNS = ["problem", "method", "rtol", "atol", "max_order", "scd", "mescd", "measure",
            "accuracy", "steps", "rejected", "rhs_evals", "jac_rhs_evals", "jac_evals",
            "lin_setups", "nonlin_iters", "nonlin_conv_fails", "cpu_time", "runs"]
@@ -117,8 +115,8 @@ def test_failed_integration_exits_3(run):
 
 
 def test_work_precision_script_print_only(ropedyn_exe):
-    script = ROOT / "scripts" / "work_precision_testset.py"
-    result = subprocess.run([sys.executable, str(script), "--exe", str(ropedyn_exe), "--quick",
+    result = subprocess.run([sys.executable, "-m", "ropedyn.studies.work_precision_testset",
+                             "--exe", str(ropedyn_exe), "--quick",
                              "--no-write", "--problems", "HIRES,ROBER", "--methods", "cvode",
                              "--repeat-time", "0"], capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr

@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 from PIL import Image
 
-import rope_vis
+from ropedyn import fields, io
+from ropedyn.namelist import parse_namelist
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-SCRIPTS = ROOT / "scripts"
 G = np.array([9.81, 0.0])
 
 
@@ -36,9 +36,10 @@ def ropedyn(exe, workdir, scene_text, name, *overrides):
     return out
 
 
-def script(name, *args):
-    """Run scripts/NAME with this Python; returns the CompletedProcess."""
-    return subprocess.run([sys.executable, str(SCRIPTS / name), *map(str, args)],
+def script(module, *args):
+    """Run `python -m ropedyn.MODULE ARGS` (the code of scripts/animate, scripts/plot, ...)
+    with this Python; returns the CompletedProcess."""
+    return subprocess.run([sys.executable, "-m", f"ropedyn.{module}", *map(str, args)],
                           capture_output=True, text=True, timeout=120)
 
 
@@ -78,7 +79,7 @@ def tiny_mpp(ropedyn_exe, workdir):
 
 def test_animate_gif(tiny, tmp_path):
     gif = tmp_path / "rope.gif"
-    result = script("animate.py", tiny, "-o", gif, "--size", "320x240", "--max-frames", "12")
+    result = script("animate", tiny, "-o", gif, "--size", "320x240", "--max-frames", "12")
     assert result.returncode == 0, result.stderr
     with Image.open(gif) as image:
         assert image.n_frames == 12
@@ -92,7 +93,7 @@ def test_animate_gif(tiny, tmp_path):
 
 def test_animate_mpp_with_energy_panel(tiny_mpp, tmp_path):
     gif = tmp_path / "mpp.gif"
-    result = script("animate.py", tiny_mpp, "-o", gif, "--energy", "--size", "500x240")
+    result = script("animate", tiny_mpp, "-o", gif, "--energy", "--size", "500x240")
     assert result.returncode == 0, result.stderr
     with Image.open(gif) as image:
         assert image.n_frames == RECORDS  # fewer records than --max-frames: one frame each
@@ -100,14 +101,14 @@ def test_animate_mpp_with_energy_panel(tiny_mpp, tmp_path):
 
 
 def test_animate_default_output_next_to_run(tiny, workdir):
-    result = script("animate.py", tiny, "--max-frames", "3")
+    result = script("animate", tiny, "--max-frames", "3")
     assert result.returncode == 0, result.stderr
     assert (workdir / "tiny.gif").stat().st_size > 1000
 
 
 def test_animate_mp4_needs_ffmpeg(tiny, tmp_path):
     mp4 = tmp_path / "rope.mp4"
-    result = script("animate.py", tiny, "-o", mp4, "--max-frames", "5", "--size", "320x240")
+    result = script("animate", tiny, "-o", mp4, "--max-frames", "5", "--size", "320x240")
     if shutil.which("ffmpeg"):
         assert result.returncode == 0, result.stderr
         assert mp4.stat().st_size > 1000
@@ -118,7 +119,7 @@ def test_animate_mp4_needs_ffmpeg(tiny, tmp_path):
 
 
 def test_animate_rejects_unknown_format(tiny, tmp_path):
-    result = script("animate.py", tiny, "-o", tmp_path / "rope.avi")
+    result = script("animate", tiny, "-o", tmp_path / "rope.avi")
     assert result.returncode == 2 and "unknown animation format '.avi'" in result.stderr
 
 
@@ -128,7 +129,7 @@ def test_animate_rejects_unknown_format(tiny, tmp_path):
 def test_plot(which, request, tmp_path):
     run_file = request.getfixturevalue(which)
     png = tmp_path / "plot.png"
-    result = script("plot_run.py", run_file, "-o", png, "--size", "900x700", "--times",
+    result = script("plot", run_file, "-o", png, "--size", "900x700", "--times",
                     "0.05,0.2")
     assert result.returncode == 0, result.stderr
     with Image.open(png) as image:
@@ -138,9 +139,9 @@ def test_plot(which, request, tmp_path):
 def test_plot_without_axial_force(ropedyn_exe, tmp_path):
     """Inextensible MPP: the axial force is a constraint force; the panel says so."""
     run_file = ropedyn(ropedyn_exe, tmp_path, TINY_MPP, "inext", "effects.tension=.false.")
-    force, message = rope_vis.axial_force(rope_vis.load_run(run_file))
+    force, message = fields.axial_force(io.load_run(run_file))
     assert force is None and "inextensible" in message
-    result = script("plot_run.py", run_file)
+    result = script("plot", run_file)
     assert result.returncode == 0, result.stderr
     with Image.open(tmp_path / "inext_plot.png") as image:
         assert_picture(image, (1200, 900))
@@ -163,9 +164,9 @@ def hdf_items(root):
 @pytest.fixture(scope="module")
 def tiny_xmf(tiny):
     before = sha256(tiny)
-    result = script("write_xdmf.py", tiny)
+    result = script("xdmf", tiny)
     assert result.returncode == 0, result.stderr
-    assert sha256(tiny) == before, "write_xdmf.py changed the run file"
+    assert sha256(tiny) == before, "ropedyn.xdmf changed the run file"
     return tiny.with_suffix(".xmf")
 
 
@@ -211,7 +212,7 @@ def test_paraview_reads_the_time_series(tiny_xmf, tmp_path):
 
 
 def test_xdmf_for_mpp(tiny_mpp):
-    result = script("write_xdmf.py", tiny_mpp, "--every", "5")
+    result = script("xdmf", tiny_mpp, "--every", "5")
     assert result.returncode == 0, result.stderr
     root = ET.parse(tiny_mpp.with_suffix(".xmf")).getroot()
     assert len(root.findall("./Domain/Grid/Grid")) == 5  # records 0, 5, 10, 15, 20
@@ -223,7 +224,7 @@ def test_xdmf_for_mpp(tiny_mpp):
 # --- README figures -----------------------------------------------------------------------
 
 def test_readme_figures(tiny, tmp_path):
-    result = script("readme_figures.py", tiny, "--outdir", tmp_path, "--strobe-end", "0.2")
+    result = script("studies.readme_figures", tiny, "--outdir", tmp_path, "--strobe-end", "0.2")
     assert result.returncode == 0, result.stderr
     for name, size in (("rope_motion.png", (800, 520)), ("energy.png", (800, 450))):
         with Image.open(tmp_path / name) as image:
@@ -252,11 +253,11 @@ def test_axial_force_is_newtons_law(ropedyn_exe, tmp_path, model):
     damper. Leaving out the damper would be off by 1e-3 of the force, the check is 5e-5."""
     run_file = ropedyn(ropedyn_exe, tmp_path, f"&model kind = '{model}', elements = 5 /\n"
                        + FINE, model)
-    run = rope_vis.load_run(run_file)
-    force, _ = rope_vis.axial_force(run)
+    run = io.load_run(run_file)
+    force, _ = fields.axial_force(run)
     acc = central_difference(run.qdot[:, :, :2], run.time)[2:-2]
     need = np.cumsum((run.element_mass[:, None] * (G - acc))[:, ::-1], axis=1)[:, ::-1]
-    phi = rope_vis.element_angles(run)[2:-2]
+    phi = fields.element_angles(run)[2:-2]
     e = np.stack([np.cos(phi), np.sin(phi)], axis=-1)
     if model == "rfem":
         upper = force.values[:, :-1]  # joint above element i, in element i-1's frame
@@ -274,13 +275,13 @@ def test_curvature_and_speed_at_release(ropedyn_exe, tmp_path):
     curvature at the inner joints, and (phi_1 - psi)/dl = 75 deg / dl at the clamp."""
     run_file = ropedyn(ropedyn_exe, tmp_path, "&model kind = 'rfem', elements = 5 /\n"
                        "&supports top = 'clamped' /\n&solver t_end = 0.01 /\n", "clamp")
-    run = rope_vis.load_run(run_file)
-    kappa = rope_vis.joint_curvature(run)
+    run = io.load_run(run_file)
+    kappa = fields.joint_curvature(run)
     dl = 1.0 / 4
     assert np.allclose(kappa[0, 1:], 0.0, atol=1e-12)
     assert kappa[0, 0] == pytest.approx(np.radians(75.0) / dl)
-    assert np.allclose(rope_vis.joints_to_elements(kappa)[0], [kappa[0, 0] / 2, 0, 0, 0, 0])
-    assert np.all(rope_vis.speed(run)[0] == 0.0)
+    assert np.allclose(fields.joints_to_elements(kappa)[0], [kappa[0, 0] / 2, 0, 0, 0, 0])
+    assert np.all(fields.speed(run)[0] == 0.0)
 
 
 def test_scene_text_parser():
@@ -288,7 +289,7 @@ def test_scene_text_parser():
             "&supports\n    top = 'clamped'  ! the top\n    top_anchor = 0.5, -1.0\n"
             "    bottom_anchor = NaN, NaN\n    top_anchor(2) = 0.25\n/\n"
             "&output file = 'out/a/b.h5', progress = .true. /\n&effects damping = F /\n")
-    groups = rope_vis.parse_namelist(text)
+    groups = parse_namelist(text)
     assert groups["rope"] == {"length": 2.0, "diameter": 1e-3}
     assert groups["supports"]["top"] == "clamped"
     assert groups["supports"]["top_anchor"] == [0.5, 0.25]

@@ -9,7 +9,7 @@ keeps the guarantees of docs/stability.md:
 5. with damping on (and fixed supports) T + V never rises by more than C_E rtol S, and the
    dissipated energy never falls by more than that.
 
-S is the energy scale of the run (scripts/stability_metrics.py: max T + max elastic +
+S is the energy scale of the run (ropedyn.studies.stability_metrics: max T + max elastic +
 gravity range + dissipated) and L the rope length. The constants and their reasons are in
 docs/stability.md ("The guarantees"): C_E = 20 (measured: error / (rtol S) <= 0.4 on these
 horizons, <= 3.2 for the whip at rtol 1e-5 .. 1e-8, while CVODE at orders 3-4 gains 50-600
@@ -25,7 +25,7 @@ import pathlib
 import numpy as np
 import pytest
 
-import stability_metrics
+from ropedyn.studies import stability_metrics
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 HARD = ROOT / "input" / "hard"

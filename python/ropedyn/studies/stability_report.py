@@ -1,7 +1,7 @@
-#!/usr/bin/env python3
 """Run the hard scenes (input/hard) and the CVODE order study; write docs/stability.md.
 
-Called by scripts/stability_report (which builds the Release executable first). Two
+The code of scripts/stability_report (python -m ropedyn.studies.stability_report; without
+--exe it builds the Release executable first). Two
 sections of docs/stability.md are rewritten between their markers; the text around them
 (the reading of the numbers) is kept:
 
@@ -13,29 +13,26 @@ sections of docs/stability.md are rewritten between their markers; the text arou
 
 Horizons are chosen so that the whole report takes under 20 minutes on 2 cores
 (`--jobs 2`, the default); `--quick` divides every horizon by 10 for a smoke run (no file written unless
-`--write` is given). Measures: scripts/stability_metrics.py.
+`--write` is given). Measures: ropedyn.studies.stability_metrics.
 """
 import argparse
 import concurrent.futures
 import datetime
-import os
 import pathlib
-import platform
 import re
 import subprocess
-import sys
 import tempfile
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-import stability_metrics  # noqa: E402
+from ropedyn.run import DOCS, INPUT, add_exe_argument, exe_or_build, set_args
+from ropedyn.studies import stability_metrics
+from ropedyn.studies.common import machine, splice
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-DOC = ROOT / "docs" / "stability.md"
-HARD = ROOT / "input" / "hard"
+DOC = DOCS / "stability.md"
+HARD = INPUT / "hard"
 
 # (label, scene file, horizon in s, extra --set overrides)
 ORDER_SCENES = [
-    ("paper_light_damping (n = 30)", ROOT / "input" / "paper_light_damping.nml", 5.0, []),
+    ("paper_light_damping (n = 30)", INPUT / "paper_light_damping.nml", 5.0, []),
     ("undamped (n = 30)", HARD / "undamped.nml", 5.0, []),
     ("steel_wire (n = 30)", HARD / "steel_wire.nml", 0.1, []),
 ]
@@ -69,24 +66,10 @@ HARD_SCENES = [
 ]
 
 
-def machine():
-    cpu = "unknown CPU"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
-
-
 def run(exe, scene, t_end, overrides, out, timeout):
     """Run one case; return the measures (or the reason it gave no file)."""
-    cmd = [str(exe), "run", str(scene), "--set", f"solver.t_end={t_end}",
-           "--set", f"output.file={out}"]
-    for o in overrides:
-        cmd += ["--set", o]
+    cmd = [str(exe), "run", str(scene),
+           *set_args([f"solver.t_end={t_end}", f"output.file={out}", *overrides])]
     try:
         res = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
@@ -198,15 +181,54 @@ def hard_tables(results, scale):
 
 def replace_section(text, name, body):
     begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
-    pattern = re.compile(re.escape(begin) + ".*?" + re.escape(end), re.S)
-    if not pattern.search(text):
+    new = splice(text, begin, end, f"{begin}\n{body}\n{end}")
+    if new is None:
         raise SystemExit(f"{DOC}: markers {begin} ... {end} not found")
-    return pattern.sub(lambda _: f"{begin}\n{body}\n{end}", text)
+    return new
+
+
+def order_cases(scale):
+    """The cases of the CVODE order study: (key, scene, t_end, overrides), slow ones first."""
+    cases = [((label, slabel), scene, t_end * scale, ov + sov)
+             for label, scene, t_end, ov in ORDER_SCENES
+             for slabel, sov in ORDER_SETTINGS]
+    # the slow ones (low orders) first, so that the workers finish together
+    cases.sort(key=lambda c: not re.search(r"cvode [23]", c[0][1]))
+    return cases
+
+
+def hard_cases(scale):
+    """The cases of the hard scenes: (key, scene, t_end, overrides), slow ones first."""
+    cases = [((s, t_end, slabel), HARD / f"{s}.nml", t_end * scale, sov)
+             for s, t_end, settings in HARD_SCENES for slabel, sov in settings]
+    slow = ["steel_wire", "long_rope", "light_damping", "undamped", "elements_3000"]
+    cases.sort(key=lambda c: slow.index(c[0][0]) if c[0][0] in slow else len(slow))
+    return cases
+
+
+# section name -> (what is printed first, its cases, its introduction, its tables)
+STUDIES = {
+    "cvode-order": (
+        "CVODE order study:", order_cases,
+        "Energy-balance error: max |B - E0| with B = T+V+dissipated; final balance: B - E0 "
+        "at the end, signed (positive: the integrator created energy, negative: it damped "
+        "some numerically); energy growth: the largest rise of T+V above an earlier value "
+        "(with damping on any rise beyond the integration error is an instability); final "
+        "T+V-E0: the mechanical energy lost (dissipated, or damped numerically) or gained.",
+        order_table),
+    "hard-scenes": (
+        "Hard scenes:", hard_cases,
+        "rtol 1e-6, atol 1e-8 (the scenes' solver settings) unless stated; S is the "
+        "energy scale (max T + max elastic + gravity range + dissipated); max tip speed: "
+        "of the free end at the output times (of the midpoint for clamped_taut, held at "
+        "both ends).",
+        hard_tables),
+}
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--exe", required=True)
+    add_exe_argument(parser)
     parser.add_argument("--jobs", type=int, default=2, help="runs at a time (default 2)")
     parser.add_argument("--only", choices=["cvode-order", "hard-scenes"], default=None)
     parser.add_argument("--quick", action="store_true", help="horizons / 10, no file written")
@@ -215,6 +237,7 @@ def main(argv=None):
     parser.add_argument("--no-write", action="store_true", help="print only")
     parser.add_argument("--timeout", type=float, default=1200.0, help="wall time per run (s)")
     args = parser.parse_args(argv)
+    exe = exe_or_build(args.exe)
     scale = 0.1 if args.quick else 1.0
     write = not args.no_write and (args.write or not args.quick)
     started = datetime.datetime.now(datetime.timezone.utc)
@@ -223,39 +246,13 @@ def main(argv=None):
     command = "Command: `scripts/stability_report" + (" --quick" if args.quick else "") + "`"
     sections = {}
 
-    if args.only in (None, "cvode-order"):
-        cases = [((label, slabel), scene, t_end * scale, ov + sov)
-                 for label, scene, t_end, ov in ORDER_SCENES
-                 for slabel, sov in ORDER_SETTINGS]
-        # the slow ones (low orders) first, so that the workers finish together
-        cases.sort(key=lambda c: not re.search(r"cvode [23]", c[0][1]))
-        print("CVODE order study:", flush=True)
-        res = run_all(args.exe, cases, args.jobs, args.timeout)
-        sections["cvode-order"] = (
-            f"{command} (Release build). {stamp}\n\n"
-            "Energy-balance error: max |B - E0| with B = T+V+dissipated; final balance: B - E0 "
-            "at the end, signed (positive: the integrator created energy, negative: it damped "
-            "some numerically); energy growth: the largest rise of T+V above an earlier value "
-            "(with damping on any rise beyond the integration error is an instability); final "
-            "T+V-E0: the mechanical energy lost (dissipated, or damped numerically) or gained."
-            "\n\n" + order_table(res, scale))
-        print(sections["cvode-order"])
-
-    if args.only in (None, "hard-scenes"):
-        cases = [((s, t_end, slabel), HARD / f"{s}.nml", t_end * scale, sov)
-                 for s, t_end, settings in HARD_SCENES for slabel, sov in settings]
-        slow = ["steel_wire", "long_rope", "light_damping", "undamped", "elements_3000"]
-        cases.sort(key=lambda c: slow.index(c[0][0]) if c[0][0] in slow else len(slow))
-        print("Hard scenes:", flush=True)
-        res = run_all(args.exe, cases, args.jobs, args.timeout)
-        sections["hard-scenes"] = (
-            f"{command} (Release build). {stamp}\n\n"
-            "rtol 1e-6, atol 1e-8 (the scenes' solver settings) unless stated; S is the "
-            "energy scale (max T + max elastic + gravity range + dissipated); max tip speed: "
-            "of the free end at the output times (of the midpoint for clamped_taut, held at "
-            "both ends).\n\n"
-            + hard_tables(res, scale))
-        print(sections["hard-scenes"])
+    for name, (heading, cases, intro, table) in STUDIES.items():
+        if args.only not in (None, name):
+            continue
+        print(heading, flush=True)
+        res = run_all(exe, cases(scale), args.jobs, args.timeout)
+        sections[name] = f"{command} (Release build). {stamp}\n\n{intro}\n\n" + table(res, scale)
+        print(sections[name])
 
     elapsed = datetime.datetime.now(datetime.timezone.utc) - started
     print(f"elapsed: {elapsed.total_seconds():.0f} s")

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Fit the MPP damping constants so that its energy history matches an RFEM run.
 
 The paper matched the two models' damping "by trial and error". ropedyn's default rule
@@ -21,26 +20,23 @@ residual of the default rule (a = b = 1). Use the printed `--set` line in a scen
 """
 import argparse
 import math
-import pathlib
 import subprocess
 import sys
 import tempfile
 
-import h5py
 import numpy as np
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+from ropedyn import io
+from ropedyn.run import PAPER, add_exe_argument, exe_or_build, set_args
 
 
 def energy_history(exe, scene, sets, out):
-    cmd = [exe, "run", scene, "--set", f'output.file="{out}"']
-    for s in sets:
-        cmd += ["--set", s]
+    cmd = [exe, "run", scene, "--set", f'output.file="{out}"', *set_args(sets)]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
         raise RuntimeError(f"ropedyn failed ({' '.join(cmd)}): {proc.stderr.strip()}")
-    with h5py.File(out, "r") as f:
-        return f["time"][:], f["energy/total"][:]
+    run = io.load_run(out)
+    return run.time, run.energy["total"]
 
 
 def nelder_mead(fun, x0, step=0.5, tol=1e-3, max_evals=40):
@@ -84,8 +80,8 @@ def nelder_mead(fun, x0, step=0.5, tol=1e-3, max_evals=40):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("scene", nargs="?", default=str(ROOT / "input" / "paper.nml"))
-    parser.add_argument("--exe", required=True)
+    parser.add_argument("scene", nargs="?", default=str(PAPER))
+    add_exe_argument(parser)
     parser.add_argument("--elements", type=int, default=10)
     parser.add_argument("--t-fit", type=float, default=5.0, help="fitted time span (s)")
     parser.add_argument("--method", default="mebdf")
@@ -94,11 +90,12 @@ def main(argv=None):
                         help="averaging window of the energy histories (s)")
     parser.add_argument("--set", action="append", default=[], dest="sets")
     args = parser.parse_args(argv)
+    exe = exe_or_build(args.exe)
 
     common = [f"model.elements={args.elements}", f"solver.t_end={args.t_fit}",
               f'solver.method="{args.method}"', "solver.output_interval=0.05"] + args.sets
     with tempfile.TemporaryDirectory() as tmp:
-        t_ref, e_ref = energy_history(args.exe, args.scene, common + ['model.kind="rfem"'],
+        t_ref, e_ref = energy_history(exe, args.scene, common + ['model.kind="rfem"'],
                                       f"{tmp}/rfem.h5")
         width = max(1, int(round(args.window / 0.05)))
 
@@ -113,7 +110,7 @@ def main(argv=None):
             a, b = math.exp(x[0]), math.exp(x[1])
             key = (round(x[0], 6), round(x[1], 6))
             if key not in cache:
-                _, e = energy_history(args.exe, args.scene, common + [
+                _, e = energy_history(exe, args.scene, common + [
                     'model.kind="mpp"', f"model.mpp_axial_damping_factor={a:.6g}",
                     f"model.mpp_bending_damping_factor={b:.6g}"], f"{tmp}/mpp.h5")
                 e = windowed(e)

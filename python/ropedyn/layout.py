@@ -1,13 +1,13 @@
 """Check that a ropedyn HDF5 output file has the documented layout (docs/output.md).
 
-Use from pytest::
+Use from Python (the end-to-end tests do)::
 
-    from check_output_layout import check_layout
+    from ropedyn.layout import check_layout
     summary = check_layout("out/run.h5", n_elements=20)
 
 or by hand::
 
-    python check_output_layout.py out/run.h5 20
+    .venv/bin/python -m ropedyn.layout out/run.h5 20
 
 `check_layout` raises AssertionError naming the file and the dataset or attribute at fault,
 and returns a small summary dict (records, status, reason) when the layout is right.
@@ -19,6 +19,8 @@ import sys
 
 import h5py
 import numpy as np
+
+from ropedyn.io import text as _text
 
 #: Step-by-step datasets: path -> (record shape as h5py sees it without the time axis, units)
 #: (the record shapes use "n" for n_elements and "2n" for 2 * n_elements).
@@ -65,15 +67,6 @@ ROOT_ATTRIBUTES = ("status", "version", "model", "method", "scene", "created",
                    "units_convention")
 
 UNITS_CONVENTION = "SI; x points down (gravity), y horizontal, angles from x towards y"
-
-
-def _text(value):
-    """An HDF5 string attribute as str, whether h5py gives bytes, str or a 0-d array."""
-    if isinstance(value, np.ndarray) and value.shape == ():
-        value = value[()]
-    if isinstance(value, (bytes, np.bytes_)):
-        return bytes(value).decode("utf-8")
-    return str(value)
 
 
 def _require(condition, message):
@@ -177,16 +170,17 @@ def check_layout(path, n_elements):
         return {"records": int(n_times), "status": status, "reason": reason}
 
 
-def main(argv):
-    if len(argv) != 3:
-        print(f"usage: {argv[0]} FILE N_ELEMENTS", file=sys.stderr)
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    if len(argv) != 2:
+        print("usage: python -m ropedyn.layout FILE N_ELEMENTS", file=sys.stderr)
         return 2
     try:
-        summary = check_layout(argv[1], int(argv[2]))
+        summary = check_layout(argv[0], int(argv[1]))
     except (AssertionError, OSError, KeyError, ValueError) as exc:
         print(f"FAIL {exc}", file=sys.stderr)
         return 1
-    line = f"{argv[1]}: layout OK ({summary['records']} records, status {summary['status']}"
+    line = f"{argv[0]}: layout OK ({summary['records']} records, status {summary['status']}"
     if summary["reason"]:
         line += f", reason: {summary['reason']}"
     print(line + ")")
@@ -194,4 +188,4 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    sys.exit(main())

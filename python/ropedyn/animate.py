@@ -1,8 +1,8 @@
-#!/usr/bin/env python3
 """Animate a ropedyn run: the rope's polyline over time, the tip's trail, the supports,
 a time stamp and optionally an energy panel. Works from the HDF5 file alone (any model).
 
-usage: animate.py RUN.h5 [-o RUN.gif|RUN.mp4] [--max-frames 300] [--fps F] [--energy]
+usage: scripts/animate RUN.h5 [-o RUN.gif|RUN.mp4] [--max-frames 300] [--fps F] [--energy]
+       (python -m ropedyn.animate)
 
 GIF is written with Pillow (comes with matplotlib); MP4 needs the ffmpeg program.
 Frames are subsampled evenly from the records (--max-frames); by default the animation
@@ -21,7 +21,7 @@ import numpy as np
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-import rope_vis  # noqa: E402
+from ropedyn import io, plot  # noqa: E402
 
 ROPE_COLOR = "#1f4e9c"
 TIP_COLOR = "#d62728"
@@ -69,9 +69,9 @@ def build_figure(run, size, dpi, energy):
         ax, ex = fig.add_subplot(grid[0]), fig.add_subplot(grid[1])
     else:
         ax, ex = fig.add_subplot(), None
-    rope_vis.setup_picture_axes(ax, run)
-    rope_vis.draw_supports(ax, run)
-    ax.set_title(rope_vis.title(run), fontsize=9)
+    plot.setup_picture_axes(ax, run)
+    plot.draw_supports(ax, run)
+    ax.set_title(io.title(run), fontsize=9)
     return fig, ax, ex
 
 
@@ -91,7 +91,7 @@ class RopeFrames:
                              bbox={"fc": "white", "ec": "0.7", "alpha": 0.8})
         self.cursor = energy_panel(ex, run) if ex is not None else None
         self.fig.tight_layout()
-        rope_vis.fit_equal(ax)
+        plot.fit_equal(ax)
         self.fig.tight_layout()  # the tick labels may have changed width
         self.axes = [(ax, [self.trail_line, self.rope, self.tip, self.stamp])]
         if ex is not None:
@@ -196,7 +196,7 @@ def parse_args(argv):
     if args.fps is not None and args.fps <= 0:
         parser.error("--fps must be > 0")
     try:
-        args.size = rope_vis.parse_size(args.size or ("1000x480" if args.energy else "640x520"))
+        args.size = plot.parse_size(args.size or ("1000x480" if args.energy else "640x520"))
     except ValueError as exc:
         parser.error(str(exc))
     return args
@@ -205,7 +205,7 @@ def parse_args(argv):
 def main(argv=None):
     args = parse_args(argv)
     out = pathlib.Path(args.output or str(pathlib.Path(args.run).with_suffix(".gif")))
-    run = rope_vis.load_run(args.run)
+    run = io.load_run(args.run)
     if run.time.size == 0:
         print(f"animate: {args.run}: no output records", file=sys.stderr)
         return 1

@@ -1,7 +1,7 @@
-#!/usr/bin/env python3
 """Work-precision diagrams of the stiff test-set problems for ropedyn's integrators.
 
-Called by scripts/work_precision_testset (which builds the Release executable first).
+The code of scripts/work_precision_testset (python -m ropedyn.studies.work_precision_testset;
+without --exe it builds the Release executable first).
 For each problem, method and max order it sweeps rtol = 10^-(3 + m/2), m = 0 .. 16
 (1e-3 .. 1e-11; atol by the test-set rules of `ropedyn testset`: atol = rtol, ROBER
 1e-6 rtol, E5 1.7e-24), runs `ropedyn testset ... --csv` and collects the accuracy (scd;
@@ -17,17 +17,15 @@ A method whose runs fail (e.g. not implemented yet) is skipped with a note.
 """
 import argparse
 import csv
-import datetime
 import io
-import os
-import pathlib
-import platform
 import subprocess
 import sys
 
 import numpy as np
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+from ropedyn.run import DOCS, add_exe_argument, exe_or_build
+from ropedyn.studies.common import machine, update_doc, utc_stamp
+
 BEGIN = "<!-- testset-wp:begin -->"
 END = "<!-- testset-wp:end -->"
 PROBLEMS = ["HIRES", "VDPOL", "OREGO", "ROBER", "E5", "POLLU"]
@@ -50,19 +48,6 @@ FIELDS = ["problem", "method", "max_order", "m", "rtol", "atol", "scd", "mescd",
           "accuracy", "steps", "rejected", "rhs_evals", "jac_rhs_evals", "jac_evals",
           "lin_setups", "nonlin_iters", "nonlin_conv_fails", "cpu_time", "runs", "status",
           "message"]
-
-
-def machine():
-    cpu = "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    cpu = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
 
 
 def label(method, order):
@@ -275,7 +260,7 @@ def write_csv(rows, path):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--exe", required=True, help="the ropedyn executable")
+    add_exe_argument(parser)
     parser.add_argument("--methods", default="cvode,mebdf",
                         help="comma-separated methods (default: cvode,mebdf)")
     parser.add_argument("--problems", default=",".join(PROBLEMS),
@@ -301,7 +286,7 @@ def main(argv=None):
     repeat_time = args.repeat_time if args.repeat_time is not None else (
         0.05 if args.quick else 0.5)
 
-    rows, skipped = sweep(args.exe, problems, settings, m_values, repeat_time)
+    rows, skipped = sweep(exe_or_build(args.exe), problems, settings, m_values, repeat_time)
     failed = [r for r in rows if r["status"] != "ok"]
     notes = [f"- {label(*key)} skipped: {message}" for key, message in skipped.items()]
     for key in settings:
@@ -321,12 +306,12 @@ def main(argv=None):
                          *comparison(rows, problems, shown)]))
         return 0
 
-    data = ROOT / "docs" / "data" / "testset_wp.csv"
+    data = DOCS / "data" / "testset_wp.csv"
     write_csv(rows, data)
     for problem in problems:
-        plot(rows, problem, shown, ROOT / "docs" / "figures" / f"wp_{problem.lower()}.png")
+        plot(rows, problem, shown, DOCS / "figures" / f"wp_{problem.lower()}.png")
 
-    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    stamp = utc_stamp()
     command = "scripts/work_precision_testset"
     if args.quick:
         command += " --quick"
@@ -350,16 +335,11 @@ def main(argv=None):
         *comparison(rows, problems, shown),
         END,
     ]
-    doc = ROOT / "docs" / "benchmarks.md"
-    text = doc.read_text() if doc.exists() else "# Benchmarks\n"
-    if BEGIN in text and END in text:
-        text = text[:text.index(BEGIN)] + "\n".join(block) + text[text.index(END) + len(END):]
-    else:
-        text = (text.rstrip() + "\n\n## Stiff test problems: work-precision\n\n"
-                "The six stiff problems of the Bari test set ([testset.md](testset.md)) with\n"
-                "every integrator; each point is one `ropedyn testset ... --csv` run.\n\n"
-                + "\n".join(block) + "\n")
-    doc.write_text(text)
+    doc = DOCS / "benchmarks.md"
+    update_doc(doc, BEGIN, END, "\n".join(block), default="# Benchmarks\n",
+               heading="## Stiff test problems: work-precision\n\n"
+               "The six stiff problems of the Bari test set ([testset.md](testset.md)) with\n"
+               "every integrator; each point is one `ropedyn testset ... --csv` run.\n\n")
     print(f"work_precision_testset: {data}, docs/figures/wp_*.png and {doc} written")
     return 0
 

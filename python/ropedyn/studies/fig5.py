@@ -1,9 +1,9 @@
-#!/usr/bin/env python3
 """The paper's Figure 5: total energy E(t) - E0 of the RFEM and MPP ropes.
 
 Runs input/paper.nml (released from 75 deg, Table 1 damping 1e3/400) with both models at
 n = 30 and n = 70 for 30 s, then plots T + V - E0 and the energy-balance error of each run.
 Writes docs/figures/fig5_energy.png and docs/data/fig5_energy.csv (final values).
+The code of scripts/fig5 (python -m ropedyn.studies.fig5).
 """
 import argparse
 import concurrent.futures as cf
@@ -12,21 +12,20 @@ import pathlib
 import subprocess
 import sys
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+from ropedyn import io  # noqa: E402
+from ropedyn.run import DOCS, PAPER, ROOT, add_exe_argument, exe_or_build, set_args  # noqa: E402
 
 
 def run_case(exe, model, n, t_end, method, outdir):
     out = outdir / f"fig5_{model}_{n}.h5"
-    cmd = [exe, "run", str(ROOT / "input" / "paper.nml"),
-           "--set", f'model.kind="{model}"', "--set", f"model.elements={n}",
-           "--set", f"solver.t_end={t_end}", "--set", f'solver.method="{method}"',
-           "--set", f'output.file="{out}"']
+    cmd = [exe, "run", str(PAPER), *set_args([
+        f'model.kind="{model}"', f"model.elements={n}", f"solver.t_end={t_end}",
+        f'solver.method="{method}"', f'output.file="{out}"'])]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
         raise RuntimeError(f"{model} n={n}: {proc.stderr.strip()}")
@@ -35,20 +34,21 @@ def run_case(exe, model, n, t_end, method, outdir):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--exe", required=True, help="ropedyn executable")
+    add_exe_argument(parser)
     parser.add_argument("--t-end", type=float, default=30.0)
     parser.add_argument("--method", default="mebdf", choices=["cvode", "mebdf"])
     parser.add_argument("--elements", default="30,70")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--outdir", default=str(ROOT / "out" / "fig5"))
-    parser.add_argument("--figure", default=str(ROOT / "docs" / "figures" / "fig5_energy.png"))
+    parser.add_argument("--figure", default=str(DOCS / "figures" / "fig5_energy.png"))
     args = parser.parse_args(argv)
+    exe = exe_or_build(args.exe)
     outdir = pathlib.Path(args.outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     ns = [int(x) for x in args.elements.split(",")]
     cases = [(m, n) for n in ns for m in ("rfem", "mpp")]
     with cf.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        futures = [pool.submit(run_case, args.exe, m, n, args.t_end, args.method, outdir)
+        futures = [pool.submit(run_case, exe, m, n, args.t_end, args.method, outdir)
                    for m, n in cases]
         results = [f.result() for f in futures]
 
@@ -57,12 +57,9 @@ def main(argv=None):
     rows = []
     styles = {"rfem": "-", "mpp": "--"}
     for model, n, path in results:
-        with h5py.File(path, "r") as f:
-            t = f["time"][:]
-            total = f["energy/total"][:]
-            dissipated = f["energy/dissipated"][:]
-            cpu = float(f["solver/cpu_time"][()])
-            steps = int(f["solver/steps"][()])
+        run = io.load_run(path)
+        t, total, dissipated = run.time, run.energy["total"], run.energy["dissipated"]
+        cpu, steps = float(run.stats["cpu_time"]), run.stats["steps"]
         e0 = total[0]
         balance = total + dissipated - e0
         ax.plot(t, total - e0, styles[model], label=f"{model.upper()} n = {n}")
@@ -82,7 +79,7 @@ def main(argv=None):
     fig.tight_layout()
     pathlib.Path(args.figure).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(args.figure, dpi=110)
-    data = ROOT / "docs" / "data" / "fig5_energy.csv"
+    data = DOCS / "data" / "fig5_energy.csv"
     data.parent.mkdir(parents=True, exist_ok=True)
     with open(data, "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=list(rows[0]))

@@ -1,7 +1,6 @@
-#!/usr/bin/env python3
 """Compare a ropedyn output with a reference output, quantity by quantity.
 
-usage: compare_h5.py REFERENCE.h5 NEW.h5
+usage: python -m ropedyn.compare REFERENCE.h5 NEW.h5
 
 Each quantity has an explicit absolute tolerance (TOLERANCES below, in its own units). The
 references are computed at rtol = 1e-8; the tolerances allow for the differences between
@@ -57,11 +56,12 @@ def compare(reference, new, out=sys.stdout):
     return failures
 
 
-def main(argv):
-    if len(argv) != 3:
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    if len(argv) != 2:
         print(__doc__, file=sys.stderr)
         return 2
-    failures = compare(argv[1], argv[2])
+    failures = compare(argv[0], argv[1])
     if failures:
         print(f"compare: {len(failures)} quantities differ: {', '.join(failures)}")
         return 1
@@ -70,4 +70,4 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    sys.exit(main())

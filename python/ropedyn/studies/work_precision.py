@@ -1,7 +1,7 @@
-#!/usr/bin/env python3
 """Accuracy versus cost for the rope: work-precision of every (model, n, solver, max order).
 
-Called by scripts/work_precision (which builds the Release executable first). The scene is
+The code of scripts/work_precision (python -m ropedyn.studies.work_precision; without --exe
+it builds the Release executable first). The scene is
 input/paper.nml cut to --t-end seconds (default 2). For every model and number of elements:
 
 1. Two references, one per integrator (CVODE and MEBDF), at rtol_ref = --ref-factor times the
@@ -26,21 +26,19 @@ docs/figures/rope_horizon.png and the section between the markers in docs/result
 """
 import argparse
 import csv
-import datetime
-import os
 import pathlib
-import platform
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
 
-import h5py
 import numpy as np
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-PAPER = ROOT / "input" / "paper.nml"
+from ropedyn import io
+from ropedyn.run import DOCS, PAPER, ROOT, add_exe_argument, exe_or_build
+from ropedyn.studies.common import machine, update_doc, utc_stamp
+
 BEGIN = "<!-- work-precision:begin -->"
 END = "<!-- work-precision:end -->"
 OTHER = {"cvode": "mebdf", "mebdf": "cvode"}
@@ -48,19 +46,6 @@ FIELDS = ["model", "elements", "method", "max_order", "rtol", "atol", "status", 
           "rhs_evals", "jac_evals", "lin_setups", "err_test_fails", "cpu_time", "runs",
           "reference_method", "horizon", "tip_final", "tip_l2", "points_final", "points_l2",
           "energy_error_max", "energy_error_final", "reason"]
-
-
-def machine():
-    cpu = "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    cpu = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
 
 
 def number_list(text, kind=float):
@@ -108,12 +93,11 @@ def write_sweep(path, model, elements, methods, rtols, max_orders, t_end, atol_p
 
 
 def load(path):
-    with h5py.File(path, "r") as f:
-        e = f["energy"]
-        balance = (e["kinetic"][:] + e["elastic"][:] + e["gravity"][:] + e["dissipated"][:]
-                   - e["support_work"][:])
-        return {"time": f["time"][:], "points": f["rope/points"][:], "balance": balance,
-                "scene": f.attrs["scene"].decode()}
+    run = io.load_run(path)
+    e = run.energy
+    balance = e["kinetic"] + e["elastic"] + e["gravity"] + e["dissipated"] - e["support_work"]
+    return {"time": run.time, "points": run.points, "balance": balance,
+            "scene": run.attrs["scene"]}
 
 
 def agreement(a, b):
@@ -155,8 +139,7 @@ def repeat_cpu(exe, row, first_cpu, repeat_time, work):
                                capture_output=True, text=True)
             if r.returncode != 0:
                 break
-            with h5py.File(out, "r") as f:
-                times.append(float(f["solver/cpu_time"][()]))
+            times.append(float(io.load_run(out).stats["cpu_time"]))
     return statistics.median(times), len(times)
 
 
@@ -181,9 +164,9 @@ def fmt(x, digits=2):
     return f"{x:.{digits}e}" if (abs(x) < 1e-2 or abs(x) >= 1e4) else f"{x:.{digits + 1}g}"
 
 
-def main():
+def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--exe", required=True)
+    add_exe_argument(p)
     p.add_argument("--models", default="rfem,mpp",
                    help="models to study (those that `ropedyn run` accepts)")
     p.add_argument("--elements", default=None, help="default 10,30,70,100 (--quick: 10,30)")
@@ -209,7 +192,7 @@ def main():
     p.add_argument("--quick", action="store_true",
                    help="n = 10, 30; rtol 1e-3 .. 1e-5; references 1e-8; horizon check 3 s")
     p.add_argument("--no-write", action="store_true", help="do not touch docs/")
-    args = p.parse_args()
+    args = p.parse_args(argv)
     if args.quick:
         args.elements = args.elements or "10,30"
         args.model_elements = args.model_elements or []
@@ -218,7 +201,7 @@ def main():
     args.elements = args.elements or "10,30,70,100"
     args.rtols = args.rtols or "1e-3,1e-4,1e-5,1e-6"
     args.horizon_t = args.horizon_t or 6.0
-    exe = pathlib.Path(args.exe).resolve()
+    exe = pathlib.Path(exe_or_build(args.exe)).resolve()
     work = pathlib.Path(args.work)
     work.mkdir(parents=True, exist_ok=True)
     started = time.monotonic()
@@ -331,7 +314,7 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
     import matplotlib.pyplot as plt
     import matplotlib.ticker
 
-    data_dir, fig_dir = ROOT / "docs" / "data", ROOT / "docs" / "figures"
+    data_dir, fig_dir = DOCS / "data", DOCS / "figures"
     data_dir.mkdir(parents=True, exist_ok=True)
     fig_dir.mkdir(parents=True, exist_ok=True)
     with open(data_dir / "rope_wp.csv", "w", newline="") as f:
@@ -438,7 +421,7 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
 
     # the generated block of docs/results.md
     cmd = "scripts/work_precision" + (" --quick" if args.quick else "")
-    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    stamp = utc_stamp()
     b = [BEGIN, ""]
     b.append(f"Command: `{cmd}` ({elapsed / 60:.1f} min). Machine: {machine()}. Run: {stamp}.")
     b.append("")
@@ -531,16 +514,11 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
     b.append("")
     b.append(END)
 
-    results = ROOT / "docs" / "results.md"
-    text = results.read_text() if results.exists() else "# Results\n\n" + BEGIN + "\n" + END + "\n"
-    if BEGIN in text and END in text:
-        text = text[:text.index(BEGIN)] + "\n".join(b) + text[text.index(END) + len(END):]
-    else:
-        text = text.rstrip("\n") + "\n\n" + "\n".join(b) + "\n"
-    results.write_text(text)
+    update_doc(DOCS / "results.md", BEGIN, END, "\n".join(b), strip="\n",
+               default="# Results\n\n" + BEGIN + "\n" + END + "\n")
     print(f"work_precision: wrote docs/results.md, docs/data/rope_wp.csv, figures "
           f"{', '.join(figures)}", file=sys.stderr)
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

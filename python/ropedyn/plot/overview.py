@@ -1,8 +1,8 @@
-#!/usr/bin/env python3
 """Overview plot of a ropedyn run: energies over time, the tip's trajectory, the solver's
 step size and order over time, and the axial force along the rope at chosen times.
 
-usage: plot_run.py RUN.h5 [-o RUN_plot.png] [--times 0.5,1,2] [--size 1200x900]
+usage: scripts/plot RUN.h5 [-o RUN_plot.png] [--times 0.5,1,2] [--size 1200x900]
+       (python -m ropedyn.plot, or python -m ropedyn.plot.overview)
 
 Works from the HDF5 file alone (any model; the axial force is skipped with a note where
 the model's output does not determine it, see docs/visualization.md).
@@ -17,7 +17,7 @@ import numpy as np
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-import rope_vis  # noqa: E402
+from ropedyn import fields, io, plot  # noqa: E402
 
 
 def plot_energies(ax, run):
@@ -39,8 +39,8 @@ def plot_energies(ax, run):
 def plot_tip(ax, run):
     """The free end's path, coloured by time, with the first and last rope shapes."""
     tip = run.points[:, -1, :]
-    rope_vis.setup_picture_axes(ax, run)
-    rope_vis.draw_supports(ax, run)
+    plot.setup_picture_axes(ax, run)
+    plot.draw_supports(ax, run)
     ax.plot(run.points[0, :, 1], run.points[0, :, 0], color="0.6", lw=1.2, label="rope, start")
     ax.plot(run.points[-1, :, 1], run.points[-1, :, 0], color="#1f4e9c", lw=1.6,
             label="rope, end")
@@ -83,7 +83,7 @@ def default_times(times, count=5):
 
 def plot_axial_force(ax, run, wanted):
     """N along the rope (arc length from the top) at the records nearest to wanted."""
-    force, message = rope_vis.axial_force(run)
+    force, message = fields.axial_force(run)
     ax.set_title("axial force along the rope", fontsize=10)
     if force is None:
         ax.text(0.5, 0.5, message, ha="center", va="center", wrap=True, fontsize=9,
@@ -108,9 +108,9 @@ def make_figure(run, wanted, size, dpi):
     plot_tip(axes[0, 1], run)
     plot_solver(axes[1, 0], run)
     plot_axial_force(axes[1, 1], run, wanted)
-    fig.suptitle(f"{pathlib.Path(run.path).name}: {rope_vis.title(run)}", fontsize=11)
+    fig.suptitle(f"{pathlib.Path(run.path).name}: {io.title(run)}", fontsize=11)
     fig.tight_layout()
-    rope_vis.fit_equal(axes[0, 1])
+    plot.fit_equal(axes[0, 1])
     return fig
 
 
@@ -133,11 +133,11 @@ def main(argv=None):
     parser.add_argument("--dpi", type=int, default=100)
     args = parser.parse_args(argv)
     try:
-        size = rope_vis.parse_size(args.size)
+        size = plot.parse_size(args.size)
     except ValueError as exc:
         parser.error(str(exc))
     out = args.output or str(pathlib.Path(args.run).with_suffix("")) + "_plot.png"
-    run = rope_vis.load_run(args.run)
+    run = io.load_run(args.run)
     if run.time.size == 0:
         print(f"plot: {args.run}: no output records", file=sys.stderr)
         return 1

@@ -1,8 +1,8 @@
-#!/usr/bin/env python3
 """Write an XDMF sidecar for a ropedyn run so that ParaView opens it as a time series of
 polylines (one line cell per element) with per-element and per-point fields.
 
-usage: write_xdmf.py RUN.h5 [--every K]     writes RUN.xmf and RUN_fields.h5 next to RUN.h5
+usage: scripts/xdmf RUN.h5 [--every K]     writes RUN.xmf and RUN_fields.h5 next to RUN.h5
+       (python -m ropedyn.xdmf)
 
 The geometry is read from the run file itself (/rope/points); the derived fields (axial
 force, curvature, speed, velocity, angle; definitions in docs/visualization.md) go into the
@@ -18,7 +18,8 @@ import xml.etree.ElementTree as ET
 import h5py
 import numpy as np
 
-import rope_vis
+from ropedyn import fields as derived
+from ropedyn import io
 
 FIELD_UNITS = {"tension": "N", "curvature": "1/m", "speed": "m/s", "velocity": "m/s",
                "angle": "rad", "joint_tension": "N", "joint_curvature": "1/m"}
@@ -26,13 +27,13 @@ FIELD_UNITS = {"tension": "N", "curvature": "1/m", "speed": "m/s", "velocity": "
 
 def derived_fields(run):
     """({'cell': {name: (T, n[, 3])}, 'point': {name: (T, 2n)}}, notes)."""
-    kappa = rope_vis.joint_curvature(run)
-    vel = rope_vis.velocity(run)
-    cell = {"curvature": rope_vis.joints_to_elements(kappa),
-            "speed": rope_vis.speed(run),
+    kappa = derived.joint_curvature(run)
+    vel = derived.velocity(run)
+    cell = {"curvature": derived.joints_to_elements(kappa),
+            "speed": derived.speed(run),
             "velocity": np.concatenate([vel, np.zeros(vel.shape[:2] + (1,))], axis=-1),
-            "angle": rope_vis.element_angles(run)}
-    point = {"joint_curvature": rope_vis.joints_to_points(kappa)}
+            "angle": derived.element_angles(run)}
+    point = {"joint_curvature": derived.joints_to_points(kappa)}
     notes = {"curvature": "joint curvature wrap(phi_{j+1} - phi_j)/h (0 at pinned and free "
                           "ends); cell: mean of the element's two joints",
              "speed": "|(xdot, ydot)| of the element centre (/state/qdot)",
@@ -40,7 +41,7 @@ def derived_fields(run):
              "angle": "element direction from x towards y, from the polyline",
              "joint_curvature": "joint curvature at the element end points: A_i takes its "
                                 "upper joint, B_i its lower joint"}
-    force, message = rope_vis.axial_force(run)
+    force, message = derived.axial_force(run)
     if force is not None:
         cell["tension"] = force.per_element
         point["joint_tension"] = force.per_point
@@ -57,7 +58,7 @@ def write_fields(path, run, fields, notes):
     with h5py.File(path, "w") as f:
         f.attrs["source"] = pathlib.Path(run.path).name
         f.attrs["model"] = run.model
-        f.attrs["written_by"] = "scripts/write_xdmf.py"
+        f.attrs["written_by"] = "ropedyn.xdmf (scripts/xdmf)"
         conn = np.arange(2 * run.n, dtype=np.int32).reshape(run.n, 2)
         f.create_dataset("connectivity", data=conn)
         f.create_dataset("time", data=run.time).attrs["units"] = "s"
@@ -144,7 +145,7 @@ def main(argv=None):
     xmf_path = base.with_name(base.name + ".xmf")
     fields_path = base.with_name(base.name + "_fields.h5")
 
-    run = rope_vis.load_run(run_path)
+    run = io.load_run(run_path)
     if run.time.size == 0:
         print(f"xdmf: {run_path}: no output records", file=sys.stderr)
         return 1

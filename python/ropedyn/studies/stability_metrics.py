@@ -1,5 +1,5 @@
 """Measures of one ropedyn run file used by the stiff-case suite (tests/hard) and by
-scripts/stability_report (docs/stability.md).
+scripts/stability_report (ropedyn.studies.stability_report; docs/stability.md).
 
 Every measure is read from the HDF5 file alone (layout: docs/output.md):
 
@@ -23,9 +23,7 @@ import re
 import h5py
 import numpy as np
 
-
-def _decode(value):
-    return value.decode() if isinstance(value, bytes) else str(value)
+from ropedyn import io
 
 
 def all_finite(path):
@@ -44,29 +42,20 @@ def all_finite(path):
 
 def analyse(path):
     """A dict of the measures above plus status, reason, counters and the raw series."""
-    with h5py.File(path, "r") as f:
-        r = {"status": _decode(f.attrs["status"]),
-             "reason": _decode(f.attrs.get("reason", "")),
-             "scene": _decode(f.attrs["scene"]),
-             "model": _decode(f.attrs["model"]),
-             "method": _decode(f.attrs["method"])}
-        n_rec = len(f["time"])
-        t = f["time"][:]
-        e = f["energy"]
-        kinetic = e["kinetic"][:n_rec]
-        elastic = e["elastic"][:n_rec]
-        gravity = e["gravity"][:n_rec]
-        dissipated = e["dissipated"][:n_rec]
-        work = e["support_work"][:n_rec]
-        mech = kinetic + elastic + gravity
-        q = f["state/q"][:n_rec]
-        qdot = f["state/qdot"][:n_rec]
-        tip = f["rope/points"][:n_rec, -1, :]
-        lengths = f["rope/element_length"][:]
-        for name in ("steps", "rhs_evals", "jac_evals", "err_test_fails", "nonlin_conv_fails"):
-            r[name] = int(f["solver"][name][()]) if name in f["solver"] else None
-        r["cpu_time"] = float(f["solver/cpu_time"][()]) if "cpu_time" in f["solver"] else None
-        r["order"] = f["solver/order"][:n_rec]
+    run = io.load_run(path)
+    r = {"status": run.attrs["status"], "reason": run.attrs.get("reason", ""),
+         "scene": run.attrs["scene"], "model": run.attrs["model"], "method": run.attrs["method"]}
+    t, e = run.time, run.energy
+    kinetic, elastic, gravity = e["kinetic"], e["elastic"], e["gravity"]
+    dissipated, work = e["dissipated"], e["support_work"]
+    mech = kinetic + elastic + gravity
+    q, qdot = run.q, run.qdot
+    tip = run.points[:, -1, :]
+    lengths = run.element_length
+    for name in ("steps", "rhs_evals", "jac_evals", "err_test_fails", "nonlin_conv_fails",
+                 "cpu_time"):
+        r[name] = run.stats.get(name)
+    r["order"] = run.order
     balance = mech + dissipated - work
     r["rtol"] = float(re.search(r"^\s*rtol = (\S+)", r["scene"], re.M).group(1))
     r["time"] = t

@@ -1,43 +1,29 @@
-#!/usr/bin/env python3
 """Run the paper scene at several numbers of elements and tabulate the cost.
 
-Called by scripts/bench_rfem (which builds the Release executable first). The table goes
-into docs/benchmarks.md between the markers of the section "RFEM cost versus n"; the rest
-of that file (the reading of the numbers) is kept.
+The code of scripts/bench_rfem (python -m ropedyn.studies.bench_rfem; without --exe it
+builds the Release executable first). The table goes into docs/benchmarks.md between the
+markers of the section "RFEM cost versus n"; the rest of that file (the reading of the
+numbers) is kept.
 """
 import argparse
-import datetime
-import os
 import pathlib
-import platform
 import re
 import subprocess
 import sys
 import tempfile
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+from ropedyn.run import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
+from ropedyn.studies.common import machine, update_doc, utc_stamp
+
 BEGIN = "<!-- bench_rfem:begin -->"
 END = "<!-- bench_rfem:end -->"
 
 
-def machine():
-    cpu = "unknown CPU"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
-
-
 def run_case(exe, n, t_end, rtol, workdir):
     out = workdir / f"bench_n{n}.h5"
-    cmd = [str(exe), "run", str(ROOT / "input" / "paper.nml"),
-           "--set", f"model.elements={n}", "--set", f"solver.rtol={rtol}",
-           "--set", f"solver.t_end={t_end}", "--set", f"output.file={out}",
-           "--set", "solver.output_interval=0.1"]
+    cmd = [str(exe), "run", str(PAPER), *set_args([
+        f"model.elements={n}", f"solver.rtol={rtol}", f"solver.t_end={t_end}",
+        f"output.file={out}", "solver.output_interval=0.1"])]
     result = subprocess.run(cmd, capture_output=True, text=True)
     text = result.stdout
     if result.returncode != 0:
@@ -54,12 +40,13 @@ def run_case(exe, n, t_end, rtol, workdir):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--exe", required=True)
+    add_exe_argument(parser)
     parser.add_argument("--t-end", type=float, default=30.0)
     parser.add_argument("--rtol", type=float, default=1e-6)
     parser.add_argument("--elements", default="10 30 70 100 300 1000")
     parser.add_argument("--no-write", action="store_true", help="print only")
     args = parser.parse_args(argv)
+    exe = exe_or_build(args.exe)
 
     rows = []
     header = ("| n | steps | RHS evals | Jacobians | error-test fails | CPU (s) | "
@@ -68,7 +55,7 @@ def main(argv=None):
     print("|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
         for n in map(int, args.elements.split()):
-            r = run_case(args.exe, n, args.t_end, args.rtol, pathlib.Path(tmp))
+            r = run_case(exe, n, args.t_end, args.rtol, pathlib.Path(tmp))
             if r["status"] != "complete":
                 line = f"| {n} | {r['status']} |  |  |  |  |  |  |"
             else:
@@ -80,7 +67,7 @@ def main(argv=None):
 
     if args.no_write:
         return 0
-    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    stamp = utc_stamp()
     block = "\n".join([
         BEGIN,
         f"Command: `scripts/bench_rfem --t-end {args.t_end:g} --elements \"{args.elements}\"` "
@@ -92,13 +79,8 @@ def main(argv=None):
         *rows,
         END,
     ])
-    doc = ROOT / "docs" / "benchmarks.md"
-    text = doc.read_text() if doc.exists() else "# Benchmarks\n\n## RFEM cost versus n\n\n"
-    if BEGIN in text and END in text:
-        text = text[:text.index(BEGIN)] + block + text[text.index(END) + len(END):]
-    else:
-        text = text.rstrip() + "\n\n" + block + "\n"
-    doc.write_text(text)
+    doc = DOCS / "benchmarks.md"
+    update_doc(doc, BEGIN, END, block, default="# Benchmarks\n\n## RFEM cost versus n\n\n")
     print(f"bench_rfem: table written to {doc}")
     return 0
 

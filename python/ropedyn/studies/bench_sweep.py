@@ -1,24 +1,24 @@
-#!/usr/bin/env python3
 """Benchmark of the local sweep runner: wall time of one sweep with 1 and with 2 workers.
 
-Called by scripts/bench_sweep (which builds the Release executable first). The sweep is 16
+The code of scripts/bench_sweep (python -m ropedyn.studies.bench_sweep; without --exe it
+builds the Release executable first). The sweep is 16
 cases of the paper scene (n = 30, 1 s, CVODE and MEBDF, two tolerances, two release angles,
 two dampings), each run with `ropedyn sweep --force` into a fresh directory; the median wall
 time of --repeat runs per worker count gives the speed-up. The result goes into
 docs/benchmarks.md between the markers of the section "Sweep runner: parallel workers".
 """
 import argparse
-import datetime
 import os
 import pathlib
-import platform
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+from ropedyn.run import DOCS, PAPER, add_exe_argument, exe_or_build
+from ropedyn.studies.common import machine, update_doc, utc_stamp
+
 BEGIN = "<!-- bench_sweep:begin -->"
 END = "<!-- bench_sweep:end -->"
 SWEEP = """&sweep
@@ -31,19 +31,6 @@ SWEEP = """&sweep
     set = 'solver.t_end={t_end}'
 /
 """
-
-
-def machine():
-    cpu = "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    cpu = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
 
 
 SPIN = "x = 0\nfor i in range(15_000_000):\n    x += i\n"
@@ -62,21 +49,21 @@ def machine_capacity():
     return 2 * one / two
 
 
-def main():
+def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--exe", required=True)
+    add_exe_argument(p)
     p.add_argument("--t-end", type=float, default=1.0)
     p.add_argument("--repeat", type=int, default=3)
     p.add_argument("--no-write", action="store_true")
-    args = p.parse_args()
-    exe = pathlib.Path(args.exe).resolve()
+    args = p.parse_args(argv)
+    exe = pathlib.Path(exe_or_build(args.exe)).resolve()
     walls = {1: [], 2: []}
     load_before = os.getloadavg()[0]
     cpu_total = None
     with tempfile.TemporaryDirectory() as tmp:
         tmp = pathlib.Path(tmp)
         sweep = tmp / "bench.nml"
-        sweep.write_text(SWEEP.format(base=ROOT / "input" / "paper.nml", t_end=args.t_end))
+        sweep.write_text(SWEEP.format(base=PAPER, t_end=args.t_end))
         n = int(subprocess.run([str(exe), "sweep", str(sweep), "--count"], check=True,
                                capture_output=True, text=True).stdout)
         capacity = []
@@ -105,7 +92,7 @@ def main():
           f"{cap:.2f}")
     if args.no_write:
         return
-    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    stamp = utc_stamp()
     block = "\n".join([
         BEGIN,
         f"Command: `scripts/bench_sweep` (Release; {n} cases of the paper scene, n = 30, "
@@ -131,18 +118,13 @@ def main():
         f"{', '.join(f'{c:.2f}' for c in capacity)}; 2.0 on two idle cores). The sweep "
         f"runner's median speed-up was {speedup / cap:.0%} of that.",
         END])
-    bench = ROOT / "docs" / "benchmarks.md"
-    text = bench.read_text()
-    if BEGIN in text and END in text:
-        text = text[:text.index(BEGIN)] + block + text[text.index(END) + len(END):]
-    else:
-        text = (text.rstrip("\n") + "\n\n## Sweep runner: parallel workers\n\n"
-                "`ropedyn sweep` runs each case in its own process; this measures what a "
-                "second worker buys on a 2-core machine. The section between the markers is "
-                "rewritten by `scripts/bench_sweep`.\n\n" + block + "\n")
-    bench.write_text(text)
+    update_doc(DOCS / "benchmarks.md", BEGIN, END, block, strip="\n",
+               heading="## Sweep runner: parallel workers\n\n"
+               "`ropedyn sweep` runs each case in its own process; this measures what a "
+               "second worker buys on a 2-core machine. The section between the markers is "
+               "rewritten by `scripts/bench_sweep`.\n\n")
     print("bench_sweep: wrote docs/benchmarks.md", file=sys.stderr)
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Validation of statics and modal analysis against theory: writes docs/validation.md.
 
 Runs `ropedyn modes`, `ropedyn statics` and `ropedyn run` (Release build) on scenes built
@@ -8,6 +7,7 @@ hanging rod, Irvine's elastic catenary; each cross-checked in the time domain by
 small swing started in the mode shape.
 
     scripts/validation [--quick] [--out docs/validation.md]
+    (python -m ropedyn.studies.validation; without --exe it builds the Release executable)
 """
 import argparse
 import math
@@ -21,7 +21,7 @@ import time
 import h5py
 import numpy as np
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+from ropedyn.run import DOCS, add_exe_argument, exe_or_build
 
 G, L, RHO, D, E, GSHEAR = 9.81, 1.0, 6000.0, 0.005, 35e6, 14e6
 AREA = math.pi * D**2 / 4
@@ -179,17 +179,18 @@ def modal_period_check(runner, text_modes, text_run, k, periods=3):
     return 2 * math.pi / omega, period, cpu
 
 
-def main():
+def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--exe", default=str(ROOT / "build" / "release" / "ropedyn"))
-    parser.add_argument("--out", default=str(ROOT / "docs" / "validation.md"))
+    add_exe_argument(parser)
+    parser.add_argument("--out", default=str(DOCS / "validation.md"))
     parser.add_argument("--quick", action="store_true", help="n up to 100 only (a smoke test)")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
+    exe = exe_or_build(args.exe)
     ns = [10, 30, 100] if args.quick else [10, 30, 100, 300]
     wall0 = time.perf_counter()
     md = []
     with tempfile.TemporaryDirectory() as tmp:
-        runner = Runner(args.exe, tmp)
+        runner = Runner(exe, tmp)
         md += hanging_chain(runner, ns)
         md += extensibility(runner, ns[-1])
         md += beam(runner, ns)

@@ -1,14 +1,17 @@
-#!/usr/bin/env python3
 """The README's figures from one run of the paper scene: a strobe picture of the rope in
 motion (docs/figures/rope_motion.png) and its energies (docs/figures/energy.png).
 
-usage: readme_figures.py RUN.h5 [--outdir docs/figures] [--strobe-end 1.4] [--snapshots 15]
+usage: scripts/readme_figures [RUN.h5] [--t-end 5] [--outdir docs/figures] [--strobe-end 1.4]
+                              [--snapshots 15] [--exe PATH]
 
-scripts/readme_figures runs the paper scene (5 s) and calls this.
+The code of scripts/readme_figures (python -m ropedyn.studies.readme_figures). Without
+RUN.h5 it runs the paper scene for --t-end seconds (default 5) with the Release build.
 """
 import argparse
 import pathlib
+import subprocess
 import sys
+import tempfile
 
 import matplotlib
 import numpy as np
@@ -17,7 +20,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 
-import rope_vis  # noqa: E402
+from ropedyn import io, plot  # noqa: E402
+from ropedyn.run import PAPER, add_exe_argument, exe_or_build, set_args  # noqa: E402
 
 DPI = 100
 
@@ -27,10 +31,10 @@ def strobe_figure(run, t_end, snapshots, size=(800, 520)):
     path over the same window."""
     fig, ax = plt.subplots(figsize=(size[0] / DPI, size[1] / DPI), dpi=DPI)
     window = run.time <= t_end + 1e-12
-    shown = rope_vis.Run(**{**run.__dict__, "points": run.points[window],
+    shown = io.Run(**{**run.__dict__, "points": run.points[window],
                             "time": run.time[window]})
-    rope_vis.setup_picture_axes(ax, shown)
-    rope_vis.draw_supports(ax, run)
+    plot.setup_picture_axes(ax, shown)
+    plot.draw_supports(ax, run)
     tip = shown.points[:, -1, :]
     ax.plot(tip[:, 1], tip[:, 0], color="#d62728", lw=1, alpha=0.7, label="tip path")
     picks = np.unique(np.abs(shown.time[None, :] - np.linspace(0.0, t_end, snapshots)[:, None])
@@ -46,7 +50,7 @@ def strobe_figure(run, t_end, snapshots, size=(800, 520)):
                  "later ones darker", fontsize=9)
     ax.legend(fontsize=8, loc="lower left")
     fig.tight_layout()
-    rope_vis.fit_equal(ax)
+    plot.fit_equal(ax)
     return fig
 
 
@@ -75,23 +79,43 @@ def energy_figure(run, size=(800, 450)):
     return fig
 
 
+def draw(run_file, outdir, strobe_end, snapshots):
+    """Both figures of the run file into outdir."""
+    run = io.load_run(run_file)
+    outdir = pathlib.Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    for name, fig in (("rope_motion.png", strobe_figure(run, strobe_end, snapshots)),
+                      ("energy.png", energy_figure(run))):
+        fig.savefig(outdir / name, dpi=DPI)
+        plt.close(fig)
+        print(f"readme_figures: {outdir / name}")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("run", help="HDF5 output of the paper scene")
+    parser.add_argument("run", nargs="?", help="HDF5 output of the paper scene (default: "
+                        "run input/paper.nml for --t-end seconds)")
     parser.add_argument("--outdir", default="docs/figures", help="where the PNGs go")
     parser.add_argument("--strobe-end", type=float, default=1.4,
                         help="last time (s) of the strobe picture (default 1.4)")
     parser.add_argument("--snapshots", type=int, default=15,
                         help="polylines in the strobe picture (default 15)")
+    parser.add_argument("--t-end", default="5",
+                        help="without RUN.h5: seconds of the paper scene to run (default 5)")
+    add_exe_argument(parser, "without RUN.h5: the ropedyn executable")
     args = parser.parse_args(argv)
-    run = rope_vis.load_run(args.run)
-    outdir = pathlib.Path(args.outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    for name, fig in (("rope_motion.png", strobe_figure(run, args.strobe_end, args.snapshots)),
-                      ("energy.png", energy_figure(run))):
-        fig.savefig(outdir / name, dpi=DPI)
-        plt.close(fig)
-        print(f"readme_figures: {outdir / name}")
+    if args.run is not None:
+        draw(args.run, args.outdir, args.strobe_end, args.snapshots)
+        return 0
+    exe = exe_or_build(args.exe)
+    with tempfile.TemporaryDirectory() as work:
+        run_file = pathlib.Path(work) / "paper.h5"
+        result = subprocess.run([exe, "run", str(PAPER), *set_args(
+            [f"solver.t_end={args.t_end}", f"output.file={run_file}"])],
+            stdout=subprocess.DEVNULL)
+        if result.returncode != 0:
+            return result.returncode
+        draw(run_file, args.outdir, args.strobe_end, args.snapshots)
     return 0
 
 

@@ -1,7 +1,7 @@
-#!/usr/bin/env python3
 """Cost of the right-hand side per element for sets of effects (issue #7).
 
-Called by scripts/bench_effects (which builds the Release configuration first). Times the
+The code of scripts/bench_effects (python -m ropedyn.studies.bench_effects; without
+--build it builds the Release configuration first). Times the
 RFEM right-hand side and Jacobian with tests/bench/bench_rhs for: gravity + tension; all
 internal effects (the paper's rope); each external effect added on its own; all effects;
 all internal effects with every external effect configured but switched off; and, with
@@ -10,17 +10,16 @@ existed), which shows that effects that are off cost nothing. The table goes int
 docs/benchmarks.md between the markers of the section "Cost of the effects".
 """
 import argparse
-import datetime
 import os
 import pathlib
-import platform
-import re
 import shutil
 import subprocess
 import sys
 import tempfile
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+from ropedyn.run import DOCS, PAPER, ROOT, build, set_args
+from ropedyn.studies.common import machine, update_doc, utc_stamp
+
 BEGIN = "<!-- bench_effects:begin -->"
 END = "<!-- bench_effects:end -->"
 
@@ -51,23 +50,9 @@ CONFIGS = [
 ]
 
 
-def machine():
-    cpu = "unknown CPU"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
-
-
 def bench(exe, n, sets, seconds):
-    cmd = [str(exe), str(ROOT / "input" / "paper.nml"), "--set", f"model.elements={n}",
-           "--seconds", str(seconds)]
-    for s in sets:
-        cmd += ["--set", s]
+    cmd = [str(exe), str(PAPER), "--set", f"model.elements={n}", "--seconds", str(seconds),
+           *set_args(sets)]
     out = subprocess.run(cmd, capture_output=True, text=True)
     if out.returncode != 0:
         raise SystemExit(f"bench_rhs failed: {' '.join(cmd)}\n{out.stderr}")
@@ -103,7 +88,8 @@ def build_baseline(rev, workdir):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--build", required=True, help="Release build directory")
+    parser.add_argument("--build", default=None, help="Release build directory (default: "
+                        "build the Release configuration with scripts/build and use it)")
     parser.add_argument("--elements", type=int, default=100)
     parser.add_argument("--seconds", type=float, default=0.5,
                         help="time per repetition of each timing (5 repetitions, fastest kept)")
@@ -111,7 +97,7 @@ def main(argv=None):
                         help="git revision to time 'all internal effects' at (e.g. HEAD)")
     parser.add_argument("--no-write", action="store_true", help="print only")
     args = parser.parse_args(argv)
-    exe = pathlib.Path(args.build) / "tests" / "bench_rhs"
+    exe = pathlib.Path(args.build or build("Release")) / "tests" / "bench_rhs"
     n = args.elements
 
     rows = []
@@ -144,7 +130,7 @@ def main(argv=None):
 
     if args.no_write:
         return 0
-    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    stamp = utc_stamp()
     cmd = "scripts/bench_effects" + (f" --baseline {args.baseline}" if args.baseline else "") \
         + (f" --elements {n}" if n != 100 else "")
     block = "\n".join([
@@ -159,14 +145,8 @@ def main(argv=None):
         *rows,
         END,
     ])
-    doc = ROOT / "docs" / "benchmarks.md"
-    text = doc.read_text()
-    if BEGIN in text and END in text:
-        text = re.sub(re.escape(BEGIN) + ".*?" + re.escape(END), lambda m: block, text,
-                      flags=re.S)
-    else:
-        text = text.rstrip("\n") + "\n\n## Cost of the effects\n\n" + block + "\n"
-    doc.write_text(text)
+    doc = DOCS / "benchmarks.md"
+    update_doc(doc, BEGIN, END, block, heading="## Cost of the effects\n\n", strip="\n")
     print(f"wrote {doc}")
     return 0
 

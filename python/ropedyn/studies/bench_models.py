@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Cost of the RFEM and MPP ropes versus the number of elements, with CVODE and MEBDF.
 
 The paper's Figure 4 compares the CPU time of RFEM and MPP against n: "the MPP model is
@@ -7,64 +6,50 @@ Table 1 damping) for a short horizon at a fixed tolerance for every (model, solv
 skipping the larger n of a (model, solver) once one case exceeds the time budget, and
 writes a table (between the bench_models markers in docs/benchmarks.md) and
 docs/figures/cost_vs_n.png. The crossover n where RFEM becomes cheaper is printed.
+The code of scripts/bench_models (python -m ropedyn.studies.bench_models).
 """
 import argparse
-import datetime
-import os
 import pathlib
-import platform
 import subprocess
 import sys
 import tempfile
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+from ropedyn import io  # noqa: E402
+from ropedyn.run import DOCS, PAPER, add_exe_argument, exe_or_build, set_args  # noqa: E402
+from ropedyn.studies.common import machine, update_doc, utc_stamp  # noqa: E402
+
 BEGIN = "<!-- bench_models:begin -->"
 END = "<!-- bench_models:end -->"
 
 
-def machine():
-    cpu = "unknown CPU"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
-
-
 def run_case(exe, model, method, n, t_end, rtol, workdir, timeout):
     out = workdir / f"bench_{model}_{method}_{n}.h5"
-    cmd = [str(exe), "run", str(ROOT / "input" / "paper.nml"),
-           "--set", f'model.kind="{model}"', "--set", f"model.elements={n}",
-           "--set", f'solver.method="{method}"', "--set", f"solver.rtol={rtol}",
-           "--set", f"solver.t_end={t_end}", "--set", f'output.file="{out}"',
-           "--set", "solver.output_interval=0.1"]
+    cmd = [str(exe), "run", str(PAPER), *set_args([
+        f'model.kind="{model}"', f"model.elements={n}", f'solver.method="{method}"',
+        f"solver.rtol={rtol}", f"solver.t_end={t_end}", f'output.file="{out}"',
+        "solver.output_interval=0.1"])]
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
         return {"status": f"over {timeout:.0f} s"}
     if proc.returncode != 0:
         return {"status": "failed: " + proc.stderr.strip()[:80]}
-    with h5py.File(out, "r") as f:
-        total = f["energy/total"][:]
-        dissipated = f["energy/dissipated"][:]
-        return {"status": "complete", "cpu": float(f["solver/cpu_time"][()]),
-                "steps": int(f["solver/steps"][()]), "rhs": int(f["solver/rhs_evals"][()]),
-                "jac": int(f["solver/jac_evals"][()]),
-                "balance": float(abs(total + dissipated - total[0]).max())}
+    run = io.load_run(out)
+    total, dissipated = run.energy["total"], run.energy["dissipated"]
+    return {"status": "complete", "cpu": float(run.stats["cpu_time"]),
+            "steps": run.stats["steps"], "rhs": run.stats["rhs_evals"],
+            "jac": run.stats["jac_evals"],
+            "balance": float(abs(total + dissipated - total[0]).max())}
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--exe", required=True)
+    add_exe_argument(parser)
     parser.add_argument("--t-end", type=float, default=1.0)
     parser.add_argument("--rtol", type=float, default=1e-6)
     parser.add_argument("--elements", default="10 20 30 50 70 100 150 200 300")
@@ -72,6 +57,7 @@ def main(argv=None):
                         help="skip larger n of a (model, solver) after a case above this (s)")
     parser.add_argument("--no-write", action="store_true")
     args = parser.parse_args(argv)
+    exe = exe_or_build(args.exe)
     ns = [int(x) for x in args.elements.split()]
     settings = [("rfem", "cvode"), ("rfem", "mebdf"), ("mpp", "cvode"), ("mpp", "mebdf")]
     results = {}
@@ -84,7 +70,7 @@ def main(argv=None):
                 if over:
                     results[(model, method, n)] = {"status": "skipped (budget)"}
                     continue
-                r = run_case(args.exe, model, method, n, args.t_end, args.rtol,
+                r = run_case(exe, model, method, n, args.t_end, args.rtol,
                              pathlib.Path(tmp), timeout=4 * args.budget)
                 results[(model, method, n)] = r
                 if r["status"] != "complete" or r["cpu"] > args.budget:
@@ -125,10 +111,10 @@ def main(argv=None):
     fig.tight_layout()
     if args.no_write:
         return 0
-    figpath = ROOT / "docs" / "figures" / "cost_vs_n.png"
+    figpath = DOCS / "figures" / "cost_vs_n.png"
     figpath.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(figpath, dpi=110)
-    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    stamp = utc_stamp()
     lines = [BEGIN,
              f"Command: `scripts/bench_models --t-end {args.t_end:g} --elements "
              f"\"{args.elements}\"` (input/paper.nml, rtol {args.rtol:g}, atol 1e-8, default "
@@ -139,15 +125,9 @@ def main(argv=None):
     lines += ["", *(f"Crossover with {m}: RFEM cheaper than MPP from n = {n}."
                     for m, n in crossover.items()),
               f"Crossover with the best solver for each model: n = {best_cross}.", END]
-    doc = ROOT / "docs" / "benchmarks.md"
-    text = doc.read_text()
-    block = "\n".join(lines)
-    if BEGIN in text and END in text:
-        text = text[:text.index(BEGIN)] + block + text[text.index(END) + len(END):]
-    else:
-        text = text.rstrip() + "\n\n## RFEM and MPP cost versus n (the paper's Figure 4)\n\n" \
-            + block + "\n"
-    doc.write_text(text)
+    doc = DOCS / "benchmarks.md"
+    update_doc(doc, BEGIN, END, "\n".join(lines),
+               heading="## RFEM and MPP cost versus n (the paper's Figure 4)\n\n")
     print(f"bench_models: {doc}, {figpath}")
     return 0
 

@@ -1,0 +1,96 @@
+"""Read a ropedyn run file (HDF5, layout: docs/output.md) into numpy arrays with units.
+
+    run = load_run("out/paper.h5")
+    run.time, run.q, run.qdot, run.points, run.energy["total"], run.stats["steps"]
+    run.units["state/q"]  # 'm, m, rad', from the file's own "units" attributes
+
+The one reader of run files for the plots, the animation, the XDMF sidecar and the
+studies. Records beyond len(/time) (a half-written last record) are dropped.
+"""
+import dataclasses
+
+import h5py
+import numpy as np
+
+from ropedyn.namelist import parse_namelist
+
+ENERGY_NAMES = ("kinetic", "elastic", "gravity", "dissipated", "support_work", "total")
+#: Scalar solver statistics written at the end of a run (/solver/NAME).
+SOLVER_STATS = ("steps", "rhs_evals", "jac_evals", "lin_setups", "err_test_fails",
+                "nonlin_iters", "nonlin_conv_fails", "cpu_time")
+
+
+def text(value):
+    """An HDF5 string attribute as str, whether h5py gives bytes, str or a 0-d array."""
+    if isinstance(value, np.ndarray) and value.shape == ():
+        value = value[()]
+    if isinstance(value, (bytes, np.bytes_)):
+        return bytes(value).decode("utf-8")
+    return str(value)
+
+
+@dataclasses.dataclass
+class Run:
+    """One ropedyn output file, read into memory (records: len(/time))."""
+
+    path: str
+    time: np.ndarray            # (T,) s
+    points: np.ndarray          # (T, 2n, 2) m: A_1, B_1, A_2, ... (x down, y horizontal)
+    q: np.ndarray               # (T, n, 3) element centre x, y (m), angle phi (rad)
+    qdot: np.ndarray            # (T, n, 3)
+    element_length: np.ndarray  # (n,) m
+    element_mass: np.ndarray    # (n,) kg
+    energy: dict                # name -> (T,) J
+    step_size: np.ndarray       # (T,) s
+    order: np.ndarray           # (T,)
+    model: str                  # lower case: 'rfem', 'mpp'
+    method: str
+    status: str
+    scene: dict                 # parse_namelist of the scene attribute
+    stats: dict = dataclasses.field(default_factory=dict)  # /solver/steps, ...: int; cpu_time: s
+    attrs: dict = dataclasses.field(default_factory=dict)  # root attributes as str, unchanged
+    units: dict = dataclasses.field(default_factory=dict)  # dataset path -> its "units"
+
+    @property
+    def n(self):
+        """Number of elements (members)."""
+        return self.q.shape[1]
+
+    def group(self, name):
+        """A scene group as a dict ({} when absent)."""
+        return self.scene.get(name, {})
+
+
+def load_run(path):
+    """Read a run file; records beyond len(/time) (a half-written record) are dropped."""
+    with h5py.File(path, "r") as f:
+        records = f["time"].shape[0]
+
+        def series(name):
+            return f[name][:records] if name in f else None
+
+        energy = {k: series(f"energy/{k}") for k in ENERGY_NAMES if f"energy/{k}" in f}
+        stats = {k: f[f"solver/{k}"][()].item() for k in SOLVER_STATS if f"solver/{k}" in f}
+        attrs = {k: text(v) for k, v in f.attrs.items()}
+        units = {}
+
+        def note_units(name, obj):
+            if isinstance(obj, h5py.Dataset) and "units" in obj.attrs:
+                units[name] = text(obj.attrs["units"])
+
+        f.visititems(note_units)
+        return Run(path=str(path), time=f["time"][:], points=series("rope/points"),
+                   q=series("state/q"), qdot=series("state/qdot"),
+                   element_length=f["rope/element_length"][:],
+                   element_mass=f["rope/element_mass"][:], energy=energy,
+                   step_size=series("solver/step_size"), order=series("solver/order"),
+                   model=attrs.get("model", "unknown").strip().lower(),
+                   method=attrs.get("method", "").strip(),
+                   status=attrs.get("status", "").strip(),
+                   scene=parse_namelist(attrs.get("scene", "")), stats=stats, attrs=attrs,
+                   units=units)
+
+
+def title(run):
+    """A one-line description: model, n, method, status."""
+    return f"{run.model.upper()}, n = {run.n}, {run.method} ({run.status})"

@@ -1,0 +1,51 @@
+"""Plot the energies of a ropedyn run: E - E0 by part and the balance error.
+
+usage: scripts/plot_energy.py RUN.h5 [-o RUN_energy.png]   (python -m ropedyn.plot.energy)
+"""
+import argparse
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from ropedyn import io  # noqa: E402
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("run", help="HDF5 output of ropedyn run")
+    parser.add_argument("-o", "--output", help="PNG file (default: RUN_energy.png)")
+    args = parser.parse_args(argv)
+    out = args.output or args.run.rsplit(".h5", 1)[0] + "_energy.png"
+
+    run = io.load_run(args.run)
+    t, e = run.time, run.energy
+    e0 = e["total"][0]
+    balance = e["total"] + e["dissipated"] - e["support_work"] - e0
+
+    fig, (ax, bx) = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True,
+                                 gridspec_kw={"height_ratios": [3, 1]})
+    ax.plot(t, e["total"] - e0, "k", lw=1.6, label="total E - E0 = T + V - E0")
+    ax.plot(t, e["kinetic"], lw=1, label="kinetic T")
+    ax.plot(t, e["gravity"] - e["gravity"][0], lw=1, label="gravity - gravity(0)")
+    ax.plot(t, e["elastic"], lw=1, label="elastic")
+    ax.plot(t, -e["dissipated"], "--", lw=1, label="- dissipated")
+    ax.set_ylabel("energy (J)")
+    ax.set_title(io.title(run))
+    ax.legend(fontsize=8, loc="lower left")
+    ax.grid(alpha=0.3)
+    bx.plot(t, balance, "r", lw=1)
+    bx.set_ylabel("balance error (J)")
+    bx.set_xlabel("time (s)")
+    bx.grid(alpha=0.3)
+    bx.set_title("T + V + dissipated - support work - E0", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    print(f"plot: {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,98 @@
+"""The ropedyn Python package (python/ropedyn, installed editable into .venv by
+scripts/setup) and the scripts/ commands that are thin entry points into it: the package
+imports from any directory, its reader gives a run file's arrays with their units, and every
+command answers --help (without building or running anything)."""
+import importlib
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+# scripts/NAME (bash) -> the module it runs
+COMMANDS = {
+    "animate": "ropedyn.animate",
+    "plot": "ropedyn.plot.overview",
+    "xdmf": "ropedyn.xdmf",
+    "readme_figures": "ropedyn.studies.readme_figures",
+    "fig5": "ropedyn.studies.fig5",
+    "calibrate": "ropedyn.studies.calibrate",
+    "bench_effects": "ropedyn.studies.bench_effects",
+    "bench_models": "ropedyn.studies.bench_models",
+    "bench_rfem": "ropedyn.studies.bench_rfem",
+    "bench_sweep": "ropedyn.studies.bench_sweep",
+    "validation": "ropedyn.studies.validation",
+    "work_precision": "ropedyn.studies.work_precision",
+    "work_precision_testset": "ropedyn.studies.work_precision_testset",
+    "stability_report": "ropedyn.studies.stability_report",
+}
+# Python files under scripts/ that the README and docs/ call by path
+SHIMS = {"plot_energy.py": "ropedyn.plot.energy",
+         "mebdf_stability.py": "ropedyn.studies.mebdf_stability"}
+
+
+def test_import_from_another_directory(tmp_path):
+    """The venv's Python finds this checkout's package wherever it runs."""
+    result = subprocess.run([sys.executable, "-c", "import ropedyn, ropedyn.io, ropedyn.studies;"
+                             "print(ropedyn.__file__); print(ropedyn.load_run is ropedyn.io."
+                             "load_run)"], cwd=tmp_path, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    path, same = result.stdout.split()
+    assert pathlib.Path(path) == ROOT / "python" / "ropedyn" / "__init__.py"
+    assert same == "True"
+
+
+def test_reader_gives_arrays_with_units(run, tmp_path):
+    from ropedyn.io import load_run
+
+    (tmp_path / "r.nml").write_text("&model kind = 'rfem', elements = 4 /\n"
+                                    "&solver t_end = 0.1, output_interval = 0.01 /\n")
+    assert run("run", "r.nml").returncode == 0
+    r = load_run(tmp_path / "out" / "r.h5")
+    records = r.time.size
+    assert records == 11 and r.n == 4
+    assert r.q.shape == r.qdot.shape == (records, 4, 3)
+    assert r.points.shape == (records, 8, 2)
+    assert r.element_length.shape == r.element_mass.shape == (4,)
+    assert set(r.energy) == {"kinetic", "elastic", "gravity", "dissipated", "support_work",
+                             "total"}
+    assert all(e.shape == (records,) and e.dtype == np.float64 for e in r.energy.values())
+    assert r.units["time"] == "s" and r.units["state/q"] == "m, m, rad"
+    assert r.units["rope/points"] == "m" and r.units["energy/total"] == "J"
+    assert r.units["rope/element_mass"] == "kg" and r.units["solver/cpu_time"] == "s"
+    assert isinstance(r.stats["steps"], int) and r.stats["steps"] > 0
+    assert isinstance(r.stats["cpu_time"], float)
+    assert r.attrs["status"] == "complete" and r.status == "complete"
+    assert r.model == "rfem" and r.group("model")["elements"] == 4
+    assert r.group("solver")["t_end"] == 0.1
+
+
+@pytest.mark.filterwarnings("ignore::DeprecationWarning")  # pyparsing, from matplotlib
+@pytest.mark.parametrize("module", sorted(set(COMMANDS.values()) | set(SHIMS.values())))
+def test_module_main_takes_argv(module, capsys):
+    """Each command's module has main(argv=None), usable from Python."""
+    main = importlib.import_module(module).main
+    with pytest.raises(SystemExit) as stop:
+        main(["--help"])
+    assert stop.value.code == 0
+    assert "usage:" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("name", sorted(COMMANDS))
+def test_command_answers_help(name):
+    """scripts/NAME --help: exit 0 and the module's usage; no build (it would take minutes)."""
+    result = subprocess.run(["bash", str(ROOT / "scripts" / name), "--help"],
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith("usage:"), result.stdout
+
+
+@pytest.mark.parametrize("name", sorted(SHIMS))
+def test_shim_answers_help(name, tmp_path):
+    result = subprocess.run([sys.executable, str(ROOT / "scripts" / name), "--help"],
+                            cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith("usage:"), result.stdout
