@@ -1,7 +1,7 @@
 !> Unit test of ropedyn_output: write files, read them back with the HDF5 Fortran API.
 !!
 !! Leaves test_output.h5 (complete), test_output_failed.h5 and test_output_crashed.h5 in the
-!! current directory, for tests/e2e/check_output_layout.py.
+!! current directory, for python/ropedyn/layout.py (run by tests/e2e).
 program test_output
     use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5close_f, h5fopen_f, h5fclose_f, &
         H5F_ACC_RDONLY_F, h5dopen_f, h5dclose_f, h5dread_f, h5dget_space_f, &

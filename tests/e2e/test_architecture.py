@@ -1,0 +1,25 @@
+"""The layer rule holds in the code and docs/architecture.md is its current picture
+(scripts/architecture --check: every `use` goes to the same or a lower layer, solvers and
+models never use each other; the generated tables match the code)."""
+import subprocess
+import sys
+
+from conftest import ROOT
+
+
+def test_layers_and_architecture_page_current():
+    result = subprocess.run([sys.executable, "-m", "ropedyn.studies.architecture", "--check"],
+                            cwd=ROOT, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+
+
+def test_check_catches_an_upward_use(tmp_path, monkeypatch):
+    from ropedyn.studies import architecture as arch
+    units = arch.scan()
+    assert not arch.violations(units)
+    # a model that used the scene (io) would break the rule
+    units["ropedyn_rfem"]["uses"].add("ropedyn_scene")
+    assert any("ropedyn_rfem" in v for v in arch.violations(units))
+    units["ropedyn_rfem"]["uses"].discard("ropedyn_scene")
+    units["ropedyn_mebdf"]["uses"].add("ropedyn_rope_model")   # solvers -> models
+    assert any("ropedyn_mebdf" in v for v in arch.violations(units))
