@@ -18,6 +18,9 @@
 !! and never closed here: no module state, other HDF5 users undisturbed (HDF5 closes itself
 !! at exit). An open `h5_file_t` or `h5_series_t` must not be copied (the copies would
 !! share ids); series are closed by their owner before the file.
+!!
+!! Files and groups are here; attributes, datasets and readers in the submodule
+!! ropedyn_h5_data, series in ropedyn_h5_series.
 module ropedyn_h5
     use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr
     use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5eset_auto_f, &
@@ -85,6 +88,143 @@ module ropedyn_h5
         procedure :: close => series_close
         procedure :: is_open => series_is_open
     end type h5_series_t
+
+    interface
+        !> Create the empty series `name` whose records have extents `record_dims` (none for a
+        !! scalar time series; at most 2), of real(wp) values or, with `is_integer`, default
+        !! integers; write its units (and `columns`, if not empty). The series stays open.
+        module subroutine h5_create_series(self, series, name, record_dims, is_integer, units, &
+                                           columns, err)
+            class(h5_file_t), intent(inout) :: self
+            type(h5_series_t), intent(inout) :: series
+            character(len=*), intent(in) :: name
+            integer(hsize_t), intent(in) :: record_dims(:)
+            logical, intent(in) :: is_integer
+            character(len=*), intent(in) :: units
+            character(len=*), intent(in) :: columns
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine h5_create_series
+
+        module pure logical function series_is_open(self)
+            class(h5_series_t), intent(in) :: self
+        end function series_is_open
+
+        !> Close the series' dataset (nothing to do when it is not open).
+        module subroutine series_close(self, err)
+            class(h5_series_t), intent(inout) :: self
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine series_close
+
+        !> Write record number `record` (1-based; the series is extended to `record` records):
+        !! `values` is the record in Fortran order.
+        module subroutine append_real(self, record, values, err)
+            class(h5_series_t), intent(inout) :: self
+            integer(hsize_t), intent(in) :: record
+            real(wp), intent(in), target :: values(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine append_real
+
+        !> Write record number `record` of an integer series, as `append_real`.
+        module subroutine append_integer(self, record, values, err)
+            class(h5_series_t), intent(inout) :: self
+            integer(hsize_t), intent(in) :: record
+            integer, intent(in), target :: values(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine append_integer
+
+        !> A fixed-length, null-padded string type of `width` characters (at least 1).
+        module subroutine string_type(width, type_id, hdferr)
+            integer, intent(in) :: width
+            integer(hid_t), intent(out) :: type_id
+            integer, intent(out) :: hdferr
+        end subroutine string_type
+
+        !> Write (or replace) a scalar string attribute `name` on the open object `loc_id`
+        !! (`where` names the object in messages).
+        module subroutine string_attribute(path, loc_id, where, name, value, err)
+            character(len=*), intent(in) :: path
+            integer(hid_t), intent(in) :: loc_id
+            character(len=*), intent(in) :: where, name, value
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine string_attribute
+
+        !> Real dataset `name` (rank 0 to 3, Fortran shape) with its units and a description
+        !! (none when absent or ''). An existing dataset of that name is overwritten (its
+        !! attributes are kept).
+        module subroutine write_real(self, name, values, units, err, description)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name, units
+            real(wp), intent(in), target :: values(..)
+            type(error_t), allocatable, intent(out) :: err
+            character(len=*), intent(in), optional :: description
+        end subroutine write_real
+
+        !> 64-bit integer dataset `name` (rank 0 to 3), as `write_real`.
+        module subroutine write_int64(self, name, values, units, err, description)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name, units
+            integer(i8), intent(in), target :: values(..)
+            type(error_t), allocatable, intent(out) :: err
+            character(len=*), intent(in), optional :: description
+        end subroutine write_int64
+
+        !> A column of strings: a 1-d fixed-length, null-padded string dataset of width
+        !! len(values) >= 1 (shorter entries NUL-padded by the caller: trailing blanks are kept).
+        module subroutine h5_write_text(self, name, values, units, err)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name, units
+            character(len=*), intent(in), target :: values(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine h5_write_text
+
+        !> Create dataset `name` of `type_id` with Fortran extents `dims` (none: scalar); with
+        !! `max_dims` and `chunk` extendible and chunked. `dset_id` is open only on success.
+        module subroutine new_dataset(self, name, type_id, dims, dset_id, err, max_dims, chunk)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            integer(hid_t), intent(in) :: type_id
+            integer(hsize_t), intent(in) :: dims(:)
+            integer(hid_t), intent(out) :: dset_id
+            type(error_t), allocatable, intent(out) :: err
+            integer(hsize_t), intent(in), optional :: max_dims(:), chunk(:)
+        end subroutine new_dataset
+
+        !> A scalar string attribute of the root group, NULs removed ('' when missing). Without
+        !! `found` a missing attribute is an error.
+        module subroutine h5_read_attribute(self, name, value, err, found)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            character(len=:), allocatable, intent(out) :: value
+            type(error_t), allocatable, intent(out) :: err
+            logical, intent(out), optional :: found
+        end subroutine h5_read_attribute
+
+        !> A scalar real dataset; `value` is unchanged when it is absent.
+        module subroutine read_real_scalar(self, name, value, err)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            real(wp), intent(inout), target :: value
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine read_real_scalar
+
+        !> A scalar 64-bit integer dataset; `value` is unchanged when it is absent.
+        module subroutine read_int64_scalar(self, name, value, err)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            integer(i8), intent(inout), target :: value
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine read_int64_scalar
+
+        !> A real dataset of rank size(dims) >= 1: its values in Fortran order and its Fortran
+        !! extents `dims` (a missing dataset reads as empty, extents 0).
+        module subroutine h5_read_reals(self, name, values, dims, err)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            real(wp), allocatable, target, intent(out) :: values(:)
+            integer(hsize_t), intent(out) :: dims(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine h5_read_reals
+    end interface
 
 contains
 
@@ -225,7 +365,7 @@ contains
     end function directory_exists
 
     ! ---------------------------------------------------------------------------------------
-    ! Groups, attributes, datasets
+    ! Groups and objects
     ! ---------------------------------------------------------------------------------------
 
     !> Create group `name` (its parent must exist).
@@ -280,551 +420,4 @@ contains
         call string_attribute(self%path, obj, where, name, value, err)
         call h5oclose_f(obj, hdferr)
     end subroutine h5_attribute
-
-    !> A fixed-length, null-padded string type of `width` characters (at least 1).
-    subroutine string_type(width, type_id, hdferr)
-        integer, intent(in) :: width
-        integer(hid_t), intent(out) :: type_id
-        integer, intent(out) :: hdferr
-        call h5tcopy_f(H5T_NATIVE_CHARACTER, type_id, hdferr)
-        if (hdferr < 0) then
-            type_id = -1
-            return
-        end if
-        call h5tset_size_f(type_id, int(max(width, 1), size_t), hdferr)
-        if (hdferr >= 0) call h5tset_strpad_f(type_id, H5T_STR_NULLPAD_F, hdferr)
-    end subroutine string_type
-
-    !> Write (or replace) a scalar string attribute `name` on the open object `loc_id`
-    !! (`where` names the object in messages).
-    subroutine string_attribute(path, loc_id, where, name, value, err)
-        character(len=*), intent(in) :: path
-        integer(hid_t), intent(in) :: loc_id
-        character(len=*), intent(in) :: where, name, value
-        type(error_t), allocatable, intent(out) :: err
-        integer(hid_t) :: type_id, space_id, attr_id
-        integer(hsize_t), parameter :: dims(1) = 1
-        logical :: exists
-        integer :: hdferr
-        character(len=:), allocatable :: label
-
-        label = path//': '//where//' attribute '//name
-        type_id = -1
-        space_id = -1
-        attr_id = -1
-        steps: block
-            call h5aexists_f(loc_id, name, exists, hdferr)
-            if (hdferr < 0) then
-                call make_error(err, ERR_IO, label//': cannot check existence')
-                exit steps
-            end if
-            if (exists) then
-                call h5adelete_f(loc_id, name, hdferr)
-                if (hdferr < 0) then
-                    call make_error(err, ERR_IO, label//': cannot delete old value')
-                    exit steps
-                end if
-            end if
-            call string_type(len(value), type_id, hdferr)
-            if (hdferr < 0) then
-                call make_error(err, ERR_IO, label//': cannot set up the string type')
-                exit steps
-            end if
-            call h5screate_f(H5S_SCALAR_F, space_id, hdferr)
-            if (hdferr < 0) then
-                space_id = -1
-                call make_error(err, ERR_IO, label//': cannot create dataspace')
-                exit steps
-            end if
-            call h5acreate_f(loc_id, name, type_id, space_id, attr_id, hdferr)
-            if (hdferr < 0) then
-                attr_id = -1
-                call make_error(err, ERR_IO, label//': cannot create attribute')
-                exit steps
-            end if
-            if (len(value) > 0) then
-                call h5awrite_f(attr_id, type_id, value, dims, hdferr)
-            else
-                call h5awrite_f(attr_id, type_id, achar(0), dims, hdferr)
-            end if
-            if (hdferr < 0) call make_error(err, ERR_IO, label//': cannot write attribute')
-        end block steps
-        if (attr_id >= 0) then
-            call h5aclose_f(attr_id, hdferr)
-            if (hdferr < 0 .and. .not. allocated(err)) &
-                call make_error(err, ERR_IO, label//': cannot close attribute')
-        end if
-        if (space_id >= 0) call h5sclose_f(space_id, hdferr)
-        if (type_id >= 0) call h5tclose_f(type_id, hdferr)
-    end subroutine string_attribute
-
-    !> Real dataset `name` (rank 0 to 3, Fortran shape) with its units and a description
-    !! (none when absent or ''). An existing dataset of that name is overwritten (its
-    !! attributes are kept).
-    subroutine write_real(self, name, values, units, err, description)
-        class(h5_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: name, units
-        real(wp), intent(in), target :: values(..)
-        type(error_t), allocatable, intent(out) :: err
-        character(len=*), intent(in), optional :: description
-        call write_data(self, name, h5kind_to_type(wp, H5_REAL_KIND), &
-                        int(shape(values), hsize_t), c_loc(values), is_contiguous(values), &
-                        units, err, description)
-    end subroutine write_real
-
-    !> 64-bit integer dataset `name` (rank 0 to 3), as `write_real`.
-    subroutine write_int64(self, name, values, units, err, description)
-        class(h5_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: name, units
-        integer(i8), intent(in), target :: values(..)
-        type(error_t), allocatable, intent(out) :: err
-        character(len=*), intent(in), optional :: description
-        call write_data(self, name, h5kind_to_type(i8, H5_INTEGER_KIND), &
-                        int(shape(values), hsize_t), c_loc(values), is_contiguous(values), &
-                        units, err, description)
-    end subroutine write_int64
-
-    !> A column of strings: a 1-d fixed-length, null-padded string dataset of width
-    !! len(values) >= 1 (shorter entries NUL-padded by the caller: trailing blanks are kept).
-    subroutine h5_write_text(self, name, values, units, err)
-        class(h5_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: name, units
-        character(len=*), intent(in), target :: values(:)
-        type(error_t), allocatable, intent(out) :: err
-        integer(hid_t) :: type_id
-        type(c_ptr) :: buffer
-        integer :: hdferr
-        buffer = c_null_ptr
-        if (size(values) > 0 .and. len(values) > 0) buffer = c_loc(values(1)(1:1))
-        call string_type(len(values), type_id, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot set up the string type')
-        else
-            call write_data(self, name, type_id, [size(values, kind=hsize_t)], buffer, &
-                            is_contiguous(values), units, err)
-        end if
-        if (type_id >= 0) call h5tclose_f(type_id, hdferr)
-    end subroutine h5_write_text
-
-    !> Create (or open, if it exists) dataset `name` of `type_id` and Fortran extents `dims`
-    !! (none: scalar), write the values at `buffer` (`packed`: they are one block), add
-    !! units and description to a new one.
-    subroutine write_data(self, name, type_id, dims, buffer, packed, units, err, description)
-        class(h5_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: name
-        integer(hid_t), intent(in) :: type_id
-        integer(hsize_t), intent(in) :: dims(:)
-        type(c_ptr), intent(in) :: buffer
-        logical, intent(in) :: packed
-        character(len=*), intent(in) :: units
-        type(error_t), allocatable, intent(out) :: err
-        character(len=*), intent(in), optional :: description
-        integer(hid_t) :: dset_id
-        logical :: exists
-        integer :: hdferr
-
-        if (.not. self%is_open) then
-            call make_error(err, ERR_IO, name//': the HDF5 file is not open')
-            return
-        end if
-        if (.not. packed) then
-            call make_error(err, ERR_INTERNAL, self%path//': '//name//': values not contiguous')
-            return
-        end if
-        exists = self%exists(name)
-        if (exists) then
-            call h5dopen_f(self%id, name, dset_id, hdferr)
-            if (hdferr < 0) then
-                call make_error(err, ERR_IO, self%path//': '//name//': cannot open dataset')
-                return
-            end if
-        else
-            call new_dataset(self, name, type_id, dims, dset_id, err)
-            if (allocated(err)) return
-        end if
-        hdferr = 0
-        if (product(dims) > 0) call h5dwrite_f(dset_id, type_id, buffer, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot write dataset')
-        else if (.not. exists) then
-            call string_attribute(self%path, dset_id, name, 'units', units, err)
-            if (.not. allocated(err) .and. present(description)) then
-                if (len(description) > 0) call string_attribute(self%path, dset_id, name, &
-                                                                'description', description, err)
-            end if
-        end if
-        call h5dclose_f(dset_id, hdferr)
-        if (hdferr < 0 .and. .not. allocated(err)) &
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot close dataset')
-    end subroutine write_data
-
-    !> Create dataset `name` of `type_id` with Fortran extents `dims` (none: scalar); with
-    !! `max_dims` and `chunk` extendible and chunked. `dset_id` is open only on success.
-    subroutine new_dataset(self, name, type_id, dims, dset_id, err, max_dims, chunk)
-        class(h5_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: name
-        integer(hid_t), intent(in) :: type_id
-        integer(hsize_t), intent(in) :: dims(:)
-        integer(hid_t), intent(out) :: dset_id
-        type(error_t), allocatable, intent(out) :: err
-        integer(hsize_t), intent(in), optional :: max_dims(:), chunk(:)
-        integer(hid_t) :: space_id, plist_id
-        integer :: hdferr
-
-        dset_id = -1
-        space_id = -1
-        plist_id = H5P_DEFAULT_F
-        steps: block
-            if (size(dims) == 0) then
-                call h5screate_f(H5S_SCALAR_F, space_id, hdferr)
-            else if (present(max_dims)) then
-                call h5screate_simple_f(size(dims), dims, space_id, hdferr, max_dims)
-            else
-                call h5screate_simple_f(size(dims), dims, space_id, hdferr)
-            end if
-            if (hdferr < 0) then
-                space_id = -1
-                call make_error(err, ERR_IO, self%path//': '//name//': cannot create dataspace')
-                exit steps
-            end if
-            if (present(chunk)) then
-                call h5pcreate_f(H5P_DATASET_CREATE_F, plist_id, hdferr)
-                if (hdferr < 0) then
-                    plist_id = H5P_DEFAULT_F
-                    call make_error(err, ERR_IO, self%path//': '//name// &
-                                    ': cannot create property list')
-                    exit steps
-                end if
-                call h5pset_chunk_f(plist_id, size(chunk), chunk, hdferr)
-                if (hdferr < 0) then
-                    call make_error(err, ERR_IO, self%path//': '//name// &
-                                    ': cannot set chunk size')
-                    exit steps
-                end if
-            end if
-            call h5dcreate_f(self%id, name, type_id, space_id, dset_id, hdferr, dcpl_id=plist_id)
-            if (hdferr < 0) then
-                dset_id = -1
-                call make_error(err, ERR_IO, self%path//': '//name//': cannot create dataset')
-            end if
-        end block steps
-        if (plist_id /= H5P_DEFAULT_F) call h5pclose_f(plist_id, hdferr)
-        if (space_id >= 0) call h5sclose_f(space_id, hdferr)
-    end subroutine new_dataset
-
-    ! ---------------------------------------------------------------------------------------
-    ! Readers
-    ! ---------------------------------------------------------------------------------------
-
-    !> A scalar string attribute of the root group, NULs removed ('' when missing). Without
-    !! `found` a missing attribute is an error.
-    subroutine h5_read_attribute(self, name, value, err, found)
-        class(h5_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: name
-        character(len=:), allocatable, intent(out) :: value
-        type(error_t), allocatable, intent(out) :: err
-        logical, intent(out), optional :: found
-        integer(hid_t) :: attr_id, type_id
-        integer(size_t) :: length
-        integer(hsize_t), parameter :: dims(1) = 1
-        logical :: exists
-        integer :: hdferr, nul
-        character(len=:), allocatable :: label
-
-        label = self%path//': attribute '//name
-        value = ''
-        if (present(found)) found = .false.
-        call h5aexists_f(self%id, name, exists, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, label//': cannot check existence')
-            return
-        end if
-        if (.not. exists) then
-            if (.not. present(found)) call make_error(err, ERR_IO, label//' is missing')
-            return
-        end if
-        if (present(found)) found = .true.
-        call h5aopen_f(self%id, name, attr_id, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, label//': cannot open')
-            return
-        end if
-        call h5aget_type_f(attr_id, type_id, hdferr)
-        if (hdferr >= 0) call h5tget_size_f(type_id, length, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, label//': cannot get its type')
-        else
-            block
-                character(len=length) :: buffer
-                buffer = ''
-                call h5aread_f(attr_id, type_id, buffer, dims, hdferr)
-                if (hdferr < 0) then
-                    call make_error(err, ERR_IO, label//': cannot read')
-                else
-                    nul = index(buffer, achar(0))
-                    if (nul > 0) then
-                        value = buffer(:nul - 1)
-                    else
-                        value = buffer
-                    end if
-                end if
-            end block
-            call h5tclose_f(type_id, hdferr)
-        end if
-        call h5aclose_f(attr_id, hdferr)
-    end subroutine h5_read_attribute
-
-    !> A scalar real dataset; `value` is unchanged when it is absent.
-    subroutine read_real_scalar(self, name, value, err)
-        class(h5_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: name
-        real(wp), intent(inout), target :: value
-        type(error_t), allocatable, intent(out) :: err
-        integer(hsize_t) :: dims(0)
-        call read_data(self, name, h5kind_to_type(wp, H5_REAL_KIND), c_loc(value), dims, err)
-    end subroutine read_real_scalar
-
-    !> A scalar 64-bit integer dataset; `value` is unchanged when it is absent.
-    subroutine read_int64_scalar(self, name, value, err)
-        class(h5_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: name
-        integer(i8), intent(inout), target :: value
-        type(error_t), allocatable, intent(out) :: err
-        integer(hsize_t) :: dims(0)
-        call read_data(self, name, h5kind_to_type(i8, H5_INTEGER_KIND), c_loc(value), dims, err)
-    end subroutine read_int64_scalar
-
-    !> A real dataset of rank size(dims) >= 1: its values in Fortran order and its Fortran
-    !! extents `dims` (a missing dataset reads as empty, extents 0).
-    subroutine h5_read_reals(self, name, values, dims, err)
-        class(h5_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: name
-        real(wp), allocatable, target, intent(out) :: values(:)
-        integer(hsize_t), intent(out) :: dims(:)
-        type(error_t), allocatable, intent(out) :: err
-        dims = 0
-        call read_data(self, name, h5kind_to_type(wp, H5_REAL_KIND), values=values, &
-                       dims=dims, err=err)
-        if (.not. allocated(values)) allocate (values(0))
-    end subroutine h5_read_reals
-
-    !> Read dataset `name` (nothing when absent): a scalar to `buffer`, or, with `values`,
-    !! an array of rank size(dims) into `values` (allocated here, extents `dims`).
-    subroutine read_data(self, name, type_id, buffer, dims, err, values)
-        class(h5_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: name
-        integer(hid_t), intent(in) :: type_id
-        type(c_ptr), intent(in), optional :: buffer
-        integer(hsize_t), intent(inout) :: dims(:)
-        type(error_t), allocatable, intent(out) :: err
-        real(wp), allocatable, target, intent(inout), optional :: values(:)
-        integer(hid_t) :: dset_id
-        type(c_ptr) :: target_ptr
-        integer :: hdferr
-
-        if (.not. self%exists(name)) return
-        call h5dopen_f(self%id, name, dset_id, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot open dataset')
-            return
-        end if
-        steps: block
-            if (present(values)) then
-                call extents(self, name, dset_id, dims, err)
-                if (allocated(err)) exit steps
-                allocate (values(product(dims)))
-                if (size(values) == 0) exit steps
-                target_ptr = c_loc(values)
-            else
-                target_ptr = buffer
-            end if
-            call h5dread_f(dset_id, type_id, target_ptr, hdferr)
-            if (hdferr < 0) call make_error(err, ERR_IO, self%path//': '//name//': cannot read')
-        end block steps
-        call h5dclose_f(dset_id, hdferr)
-    end subroutine read_data
-
-    !> The Fortran extents of an open dataset that must have rank size(dims).
-    subroutine extents(self, name, dset_id, dims, err)
-        class(h5_file_t), intent(in) :: self
-        character(len=*), intent(in) :: name
-        integer(hid_t), intent(in) :: dset_id
-        integer(hsize_t), intent(out) :: dims(:)
-        type(error_t), allocatable, intent(out) :: err
-        integer(hid_t) :: space_id
-        integer(hsize_t) :: maxdims(size(dims))
-        integer :: hdferr, actual
-        dims = 0
-        call h5dget_space_f(dset_id, space_id, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot get dataspace')
-            return
-        end if
-        call h5sget_simple_extent_ndims_f(space_id, actual, hdferr)
-        if (hdferr < 0 .or. actual /= size(dims)) then
-            call make_error(err, ERR_IO, self%path//': '//name//': not of rank '// &
-                            int_text(size(dims)))
-        else
-            call h5sget_simple_extent_dims_f(space_id, dims, maxdims, hdferr)
-            if (hdferr < 0) call make_error(err, ERR_IO, self%path//': '//name// &
-                                            ': cannot get extents')
-        end if
-        call h5sclose_f(space_id, hdferr)
-    end subroutine extents
-
-    ! ---------------------------------------------------------------------------------------
-    ! Series: extendible datasets written one record at a time
-    ! ---------------------------------------------------------------------------------------
-
-    !> Create the empty series `name` whose records have extents `record_dims` (none for a
-    !! scalar time series; at most 2), of real(wp) values or, with `is_integer`, default
-    !! integers; write its units (and `columns`, if not empty). The series stays open.
-    subroutine h5_create_series(self, series, name, record_dims, is_integer, units, columns, err)
-        class(h5_file_t), intent(inout) :: self
-        type(h5_series_t), intent(inout) :: series
-        character(len=*), intent(in) :: name
-        integer(hsize_t), intent(in) :: record_dims(:)
-        logical, intent(in) :: is_integer
-        character(len=*), intent(in) :: units
-        character(len=*), intent(in) :: columns
-        type(error_t), allocatable, intent(out) :: err
-        integer(hsize_t) :: dims(3), max_dims(3), chunk(3), record_bytes
-        integer(hid_t) :: type_id
-        integer :: rank
-
-        rank = size(record_dims) + 1
-        series%path = self%path
-        series%name = name
-        series%rank = rank
-        series%record_dims = 1
-        series%record_dims(1:rank - 1) = record_dims
-
-        if (is_integer) then
-            type_id = h5kind_to_type(kind(0), H5_INTEGER_KIND)
-            record_bytes = int(storage_size(0)/8, hsize_t)*product(record_dims)
-        else
-            type_id = h5kind_to_type(wp, H5_REAL_KIND)
-            record_bytes = int(storage_size(1.0_wp)/8, hsize_t)*product(record_dims)
-        end if
-        dims(1:rank - 1) = record_dims
-        dims(rank) = 0
-        max_dims(1:rank - 1) = record_dims
-        max_dims(rank) = H5S_UNLIMITED_F
-        chunk(1:rank - 1) = record_dims
-        chunk(rank) = max(1_hsize_t, min(int(MAX_CHUNK_RECORDS, hsize_t), &
-                                         int(CHUNK_BYTES, hsize_t)/max(record_bytes, 1_hsize_t)))
-
-        call new_dataset(self, name, type_id, dims(1:rank), series%id, err, max_dims(1:rank), &
-                         chunk(1:rank))
-        if (allocated(err)) return
-        call string_attribute(self%path, series%id, name, 'units', units, err)
-        if (allocated(err)) return
-        if (len(columns) > 0) &
-            call string_attribute(self%path, series%id, name, 'columns', columns, err)
-    end subroutine h5_create_series
-
-    pure logical function series_is_open(self)
-        class(h5_series_t), intent(in) :: self
-        series_is_open = self%id >= 0
-    end function series_is_open
-
-    !> Close the series' dataset (nothing to do when it is not open).
-    subroutine series_close(self, err)
-        class(h5_series_t), intent(inout) :: self
-        type(error_t), allocatable, intent(out) :: err
-        integer :: hdferr
-        if (self%id < 0) return
-        call h5dclose_f(self%id, hdferr)
-        self%id = -1
-        if (hdferr < 0) call make_error(err, ERR_IO, self%path//': '//self%name// &
-                                        ': cannot close dataset')
-    end subroutine series_close
-
-    !> Write record number `record` (1-based; the series is extended to `record` records):
-    !! `values` is the record in Fortran order.
-    subroutine append_real(self, record, values, err)
-        class(h5_series_t), intent(inout) :: self
-        integer(hsize_t), intent(in) :: record
-        real(wp), intent(in), target :: values(:)
-        type(error_t), allocatable, intent(out) :: err
-        call write_record(self, record, size(values), h5kind_to_type(wp, H5_REAL_KIND), &
-                          c_loc(values), is_contiguous(values), err)
-    end subroutine append_real
-
-    !> Write record number `record` of an integer series, as `append_real`.
-    subroutine append_integer(self, record, values, err)
-        class(h5_series_t), intent(inout) :: self
-        integer(hsize_t), intent(in) :: record
-        integer, intent(in), target :: values(:)
-        type(error_t), allocatable, intent(out) :: err
-        call write_record(self, record, size(values), h5kind_to_type(kind(0), H5_INTEGER_KIND), &
-                          c_loc(values), is_contiguous(values), err)
-    end subroutine append_integer
-
-    !> Extend the series to `record` records and write the `n_values` values at `buffer`
-    !! (`packed`: one block) as that record.
-    subroutine write_record(self, record, n_values, type_id, buffer, packed, err)
-        class(h5_series_t), intent(inout) :: self
-        integer(hsize_t), intent(in) :: record
-        integer, intent(in) :: n_values
-        integer(hid_t), intent(in) :: type_id
-        type(c_ptr), intent(in) :: buffer
-        logical, intent(in) :: packed
-        type(error_t), allocatable, intent(out) :: err
-        integer(hsize_t) :: dims(3), start(3), count(3)
-        integer(hid_t) :: file_space, mem_space
-        integer :: rank, hdferr
-        character(len=:), allocatable :: label
-
-        label = self%path//': '//self%name
-        rank = self%rank
-        if (.not. packed) then
-            call make_error(err, ERR_INTERNAL, label//': record not contiguous')
-            return
-        end if
-        if (int(product(self%record_dims(1:rank - 1))) /= n_values) then
-            call make_error(err, ERR_INTERNAL, label//': record of '//int_text(n_values)// &
-                            ' values, expected '// &
-                            int_text(int(product(self%record_dims(1:rank - 1)))))
-            return
-        end if
-        dims(1:rank - 1) = self%record_dims(1:rank - 1)
-        dims(rank) = record
-        call h5dset_extent_f(self%id, dims(1:rank), hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, label//': cannot extend dataset')
-            return
-        end if
-        call h5dget_space_f(self%id, file_space, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, label//': cannot get dataspace')
-            return
-        end if
-        start = 0
-        start(rank) = record - 1
-        count(1:rank - 1) = self%record_dims(1:rank - 1)
-        count(rank) = 1
-        mem_space = -1
-        steps: block
-            call h5sselect_hyperslab_f(file_space, H5S_SELECT_SET_F, start(1:rank), &
-                                       count(1:rank), hdferr)
-            if (hdferr < 0) then
-                call make_error(err, ERR_IO, label//': cannot select record '// &
-                                int_text(int(record)))
-                exit steps
-            end if
-            call h5screate_simple_f(1, [int(n_values, hsize_t)], mem_space, hdferr)
-            if (hdferr < 0) then
-                mem_space = -1
-                call make_error(err, ERR_IO, label//': cannot create memory dataspace')
-                exit steps
-            end if
-            call h5dwrite_f(self%id, type_id, buffer, hdferr, mem_space_id=mem_space, &
-                            file_space_id=file_space)
-            if (hdferr < 0) call make_error(err, ERR_IO, label//': cannot write record '// &
-                                            int_text(int(record)))
-        end block steps
-        if (mem_space >= 0) call h5sclose_f(mem_space, hdferr)
-        call h5sclose_f(file_space, hdferr)
-    end subroutine write_record
 end module ropedyn_h5
