@@ -32,6 +32,8 @@ module ropedyn_mpp
     use ropedyn_effect, only: effect_box_t, bodies_t
     use ropedyn_effect_factory, only: build_body_effects, attached_masses
     use ropedyn_support_motion, only: support_motion_t, motion_state_t
+    use ropedyn_rope_setup, only: cross_section, initial_angle, clamp_angles, &
+                                  configure_motions, any_does_work
     implicit none
     private
     public :: mpp_t, mpp_create
@@ -205,7 +207,7 @@ contains
         type(mpp_t), intent(out) :: model
         type(rope_spec_t), intent(in) :: spec
         type(error_t), allocatable, intent(out) :: err
-        real(wp) :: area, second_moment, total_mass, factor
+        real(wp) :: area, second_moment, total_mass, factor, angles(2)
         integer :: k
 
         model%n = spec%model%elements
@@ -219,8 +221,7 @@ contains
         end if
         model%nu = merge(model%n, 0, spec%effects%tension)
         model%ndof = model%n + model%nu
-        area = pi*spec%rope%diameter**2/4.0_wp
-        second_moment = pi*spec%rope%diameter**4/64.0_wp
+        call cross_section(spec, area, second_moment)
         total_mass = spec%rope%density*area*spec%rope%length
         model%l = spec%rope%length/real(model%n, wp)
         model%m = total_mass/real(model%n, wp)
@@ -252,15 +253,12 @@ contains
             model%d_rot = factor*spec%rope%normal_damping*second_moment/model%l
         end if
 
-        if (spec%initial%shape == 'hanging' .or. spec%initial%shape == 'folded') then
-            model%init_angle = 0.0_wp
-        else
-            model%init_angle = spec%initial%angle_deg*pi/180.0_wp
-        end if
+        model%init_angle = initial_angle(spec)
         model%folded = spec%initial%shape == 'folded'
         model%top_anchor = spec%supports%top_anchor
-        model%top_angle = spec%supports%top_angle_deg*pi/180.0_wp
-        model%bottom_angle = spec%supports%bottom_angle_deg*pi/180.0_wp
+        angles = clamp_angles(spec)
+        model%top_angle = angles(1)
+        model%bottom_angle = angles(2)
         if (bottom_anchor_given(spec)) then
             model%bottom_anchor = spec%supports%bottom_anchor
         else
@@ -281,31 +279,11 @@ contains
             associate (s => spec%supports)
                 if (s%bottom_release_time >= 0.0_wp) model%bottom_release = s%bottom_release_time
                 if (.not. model%bottom_release > 0.0_wp) model%bottom = 0
-                call set_motion(1, s%top_motion, s%top_amplitude, s%top_frequency, &
-                                s%top_phase_deg, s%top_angle_amplitude_deg, &
-                                s%top_angle_phase_deg, s%top_table_rows)
-                if (model%bottom > 0) &
-                    call set_motion(2, s%bottom_motion, s%bottom_amplitude, &
-                                    s%bottom_frequency, s%bottom_phase_deg, &
-                                    s%bottom_angle_amplitude_deg, s%bottom_angle_phase_deg, &
-                                    s%bottom_table_rows)
             end associate
+            ! the top joint is never free; a free or released bottom has no motion
+            call configure_motions(spec, [.true., model%bottom > 0], model%motion, model%moving)
         end if
-        model%with_work = any(model%moving)
-        do k = 1, size(model%effects)
-            if (model%effects(k)%e%does_work()) model%with_work = .true.
-        end do
-    contains
-        subroutine set_motion(k, kind, amplitude, frequency, phase_deg, &
-                              angle_amplitude_deg, angle_phase_deg, rows)
-            integer, intent(in) :: k
-            character(len=*), intent(in) :: kind
-            real(wp), intent(in) :: amplitude(2), frequency, phase_deg(2), &
-                                    angle_amplitude_deg, angle_phase_deg
-            real(wp), allocatable, intent(in) :: rows(:, :)
-            model%moving(k) = model%motion(k)%configure(kind, amplitude, frequency, phase_deg, &
-                angle_amplitude_deg, angle_phase_deg, rows)
-        end subroutine set_motion
+        model%with_work = any_does_work(model%moving, model%effects)
     end subroutine mpp_create
 
     !> The supports at time t: top joint, bottom anchor (motion states) and whether the

@@ -32,6 +32,8 @@ module ropedyn_rfem
     use ropedyn_effect, only: effect_box_t, bodies_t
     use ropedyn_effect_factory, only: build_body_effects, attached_masses
     use ropedyn_support_motion, only: support_motion_t, motion_state_t
+    use ropedyn_rope_setup, only: cross_section, initial_angle, clamp_angles, &
+                                  configure_motions, any_does_work
     implicit none
     private
     public :: rfem_t, rfem_create
@@ -226,6 +228,7 @@ contains
         type(error_t), allocatable, intent(out) :: err
         integer :: n, nf, k, i
         real(wp) :: area, second_moment, dl, total_mass, cx, cy, cphi, bx, by, bphi, factor
+        real(wp) :: angles(2)
         type(family_t) :: fams(9)
         logical :: damped
         integer, allocatable :: pm_body(:)
@@ -237,8 +240,7 @@ contains
             return
         end if
         model%n = n
-        area = pi*spec%rope%diameter**2/4.0_wp
-        second_moment = pi*spec%rope%diameter**4/64.0_wp
+        call cross_section(spec, area, second_moment)
         dl = spec%rope%length/real(n - 1, wp)
         total_mass = spec%rope%density*area*spec%rope%length
         allocate (model%len(n), model%mass(n), model%inertia(n))
@@ -295,16 +297,13 @@ contains
         end if
         model%families = fams(1:nf)
 
-        if (spec%initial%shape == 'hanging' .or. spec%initial%shape == 'folded') then
-            model%init_angle = 0.0_wp
-        else
-            model%init_angle = spec%initial%angle_deg*pi/180.0_wp
-        end if
+        model%init_angle = initial_angle(spec)
         model%folded = spec%initial%shape == 'folded'
         model%init_velocity = spec%initial%velocity
         model%top_anchor = spec%supports%top_anchor
-        model%top_angle = spec%supports%top_angle_deg*pi/180.0_wp
-        model%bottom_angle = spec%supports%bottom_angle_deg*pi/180.0_wp
+        angles = clamp_angles(spec)
+        model%top_angle = angles(1)
+        model%bottom_angle = angles(2)
 
         ! point masses at their place on the elements: mass, inertia about the centre and
         ! the first moment m r that couples translation and rotation
@@ -348,22 +347,12 @@ contains
         end if
         model%motion(2)%p0 = model%bottom_anchor
         model%motion(2)%angle0 = model%bottom_angle
-        if (spec%effects%support_motion) then
-            associate (s => spec%supports)
-                call set_motion(1, s%top, s%top_motion, s%top_amplitude, s%top_frequency, &
-                                s%top_phase_deg, s%top_angle_amplitude_deg, &
-                                s%top_angle_phase_deg, s%top_table_rows)
-                call set_motion(2, s%bottom, s%bottom_motion, s%bottom_amplitude, &
-                                s%bottom_frequency, s%bottom_phase_deg, &
-                                s%bottom_angle_amplitude_deg, s%bottom_angle_phase_deg, &
-                                s%bottom_table_rows)
-            end associate
-        end if
+        ! a free or released support has no motion
+        if (spec%effects%support_motion) call configure_motions(spec, &
+            [spec%supports%top /= 'free', spec%supports%bottom /= 'free'] .and. &
+            model%release > 0.0_wp, model%motion, model%moving)
         model%timed = any(model%moving) .or. any(model%release < huge(1.0_wp))
-        model%with_work = any(model%moving)
-        do k = 1, size(model%effects)
-            if (model%effects(k)%e%does_work()) model%with_work = .true.
-        end do
+        model%with_work = any_does_work(model%moving, model%effects)
 
         allocate (model%s(n + 1), model%grad(6, n + 1), model%force(n + 1), model%gen(3, n))
         model%s = 0.0_wp
@@ -380,18 +369,6 @@ contains
                                 damped=damped .and. b > 0.0_wp)
             if (present(end)) fams(nf)%end = end
         end subroutine add
-
-        subroutine set_motion(k, support, kind, amplitude, frequency, phase_deg, &
-                              angle_amplitude_deg, angle_phase_deg, rows)
-            integer, intent(in) :: k
-            character(len=*), intent(in) :: support, kind
-            real(wp), intent(in) :: amplitude(2), frequency, phase_deg(2), &
-                                    angle_amplitude_deg, angle_phase_deg
-            real(wp), allocatable, intent(in) :: rows(:, :)
-            if (support == 'free' .or. .not. model%release(k) > 0.0_wp) return
-            model%moving(k) = model%motion(k)%configure(kind, amplitude, frequency, phase_deg, &
-                angle_amplitude_deg, angle_phase_deg, rows)
-        end subroutine set_motion
     end subroutine rfem_create
 
     !> Supports at time t: anchors, angles and their rates from the prescribed motions; the
