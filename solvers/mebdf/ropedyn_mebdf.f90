@@ -209,12 +209,8 @@ contains
         self%n = problem%size()
         self%nq = problem%quad_size()
         self%nt = self%n + self%nq
-        max_order = options%max_order
-        if (max_order == 0) max_order = self%default_max_order()
-        if (max_order < self%min_order() .or. max_order > self%max_order_limit()) then
-            call make_error(err, ERR_SOLVER, 'mebdf: max_order must be 2 .. 7')
-            return
-        end if
+        call self%check_options(options, self%n, max_order, err)
+        if (allocated(err)) return
         if (options%stab_lim_det) then
             call make_error(err, ERR_SOLVER, 'mebdf: stability-limit detection is a CVODE ' &
                             //'option (MEBDF up to order 4 is A-stable: use max_order)')
@@ -235,13 +231,7 @@ contains
         allocate (self%dif(self%nt, 0:KMAX_MEBDF + 2), self%atol(self%nt), self%w(self%nt))
         allocate (self%f(self%n), self%mv(self%n), self%r(self%n), self%gq(max(self%nq, 1)))
         self%atol = options%atol
-        if (allocated(options%atol_vector)) then
-            if (size(options%atol_vector) /= self%n) then
-                call make_error(err, ERR_SOLVER, 'mebdf: atol_vector has the wrong size')
-                return
-            end if
-            self%atol(1:self%n) = options%atol_vector
-        end if
+        if (allocated(options%atol_vector)) self%atol(1:self%n) = options%atol_vector
         self%dif = 0.0_wp
         self%dif(1:self%n, 0) = y0
         if (self%nq > 0) self%dif(self%n + 1:, 0) = yq0(1:self%nq)
