@@ -75,9 +75,7 @@ contains
         ! External effects on the rods as bodies.
         if (size(self%effects) > 0) then
             call rod_bodies(self, y, top, b)
-            do k = 1, size(self%effects)
-                call self%effects(k)%e%add_forces(tt, b, w, mom)
-            end do
+            call add_forces_of(self%effects, tt, b, w, mom)
         end if
 
         ! Force of the bottom support on the tip P_n.
@@ -311,9 +309,7 @@ contains
                                                           (phi(n) - bottom%angle)**2
         if (size(self%effects) > 0) then
             call rod_bodies(self, y, top, b)
-            do k = 1, size(self%effects)
-                en%elastic = en%elastic + self%effects(k)%e%energy(t, b)
-            end do
+            call add_energies_of(self%effects, t, b, en%elastic)
         end if
         en%dissipated = 0.0_wp
         if (size(yq) >= 1) en%dissipated = yq(1)
@@ -357,9 +353,7 @@ contains
         end if
         if (size(self%effects) > 0) then
             call rod_bodies(self, y, top, b)
-            do k = 1, size(self%effects)
-                call self%effects(k)%e%power(t, b, power, work)
-            end do
+            call add_powers_of(self%effects, t, b, power, work)
         end if
         status = STATUS_OK
         if (self%moving(1)) then

@@ -29,7 +29,8 @@ module ropedyn_rfem
     use ropedyn_problem, only: STATUS_OK, STATUS_RECOVERABLE
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
-    use ropedyn_effect, only: effect_box_t, bodies_t
+    use ropedyn_effect, only: effect_box_t, bodies_t, add_forces_of, add_jacobians_of, &
+                              add_energies_of, add_powers_of
     use ropedyn_effect_factory, only: build_body_effects, attached_masses
     use ropedyn_support_motion, only: support_motion_t, motion_state_t
     use ropedyn_rope_setup, only: cross_section, initial_angle, clamp_angles, &

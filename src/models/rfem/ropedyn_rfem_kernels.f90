@@ -129,7 +129,7 @@ contains
     end procedure point_mass_accelerations
 
     module procedure rfem_generalized_forces
-        integer :: f, j, p, k
+        integer :: f, j, p
         real(wp) :: sd, tt
 
         tt = 0.0_wp
@@ -171,10 +171,8 @@ contains
         end do
         if (size(self%effects) > 0) then
             call self%fill_bodies(y)
-            do k = 1, size(self%effects)
-                call self%effects(k)%e%add_forces(tt, self%bodies, gen(1:2, :), gen(3, :))
-                if (present(elastic)) elastic = elastic + self%effects(k)%e%energy(tt, self%bodies)
-            end do
+            call add_forces_of(self%effects, tt, self%bodies, gen(1:2, :), gen(3, :))
+            if (present(elastic)) call add_energies_of(self%effects, tt, self%bodies, elastic)
         end if
     end procedure rfem_generalized_forces
 
@@ -199,7 +197,7 @@ contains
     end procedure rfem_has_jacobian
 
     module procedure rfem_jacobian
-        integer :: i, c, f, j, r, l, row, col_q, col_v, er, el, k
+        integer :: i, c, f, j, r, l, row, col_q, col_v, er, el
         real(wp) :: s, g(6), h(6, 6), v(6), hv(6), sd, coef, kq(6, 6), kv(6, 6), inv_m(6)
 
         call self%set_time(t)
@@ -252,9 +250,7 @@ contains
         if (size(self%effects) > 0) then
             call self%fill_bodies(y)
             self%ejac = 0.0_wp
-            do k = 1, size(self%effects)
-                call self%effects(k)%e%add_jacobian(t, self%bodies, self%ejac)
-            end do
+            call add_jacobians_of(self%effects, t, self%bodies, self%ejac)
             do i = 1, self%n
                 do r = 1, 3
                     row = 6*(i - 1) + 3 + r
@@ -350,9 +346,7 @@ contains
         end do
         if (size(self%effects) > 0) then
             call self%fill_bodies(y)
-            do k = 1, size(self%effects)
-                e%elastic = e%elastic + self%effects(k)%e%energy(t, self%bodies)
-            end do
+            call add_energies_of(self%effects, t, self%bodies, e%elastic)
         end if
         e%dissipated = 0.0_wp
         if (size(yq) >= 1) e%dissipated = yq(1)
@@ -362,7 +356,7 @@ contains
 
     module procedure rfem_quad_rhs
         real(wp) :: power, work, s, g(6), sd
-        integer :: f, j, k
+        integer :: f, j
         call self%set_time(t)
         ! only the damped strains: no spring forces, no gravity, no scatter
         power = 0.0_wp
@@ -387,9 +381,7 @@ contains
         end do
         if (size(self%effects) > 0) then
             call self%fill_bodies(y)
-            do k = 1, size(self%effects)
-                call self%effects(k)%e%power(t, self%bodies, power, work)
-            end do
+            call add_powers_of(self%effects, t, self%bodies, power, work)
         end if
         yqdot(1) = power
         if (self%with_work) yqdot(2) = work
