@@ -2,6 +2,7 @@
 !! ropedyn carries, by name: the umbrella module of src/testset (docs/testset.md).
 module ropedyn_testset
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
+    use ropedyn_text, only: upper
     use ropedyn_testset_problem, only: testset_problem_t
     use ropedyn_testset_hires, only: hires_t
     use ropedyn_testset_vdpol, only: vdpol_t
@@ -54,15 +55,4 @@ contains
             list = list//', '//trim(testset_names(i))
         end do
     end function testset_name_list
-
-    pure function upper(text) result(up)
-        character(len=*), intent(in) :: text
-        character(len=len(text)) :: up
-        integer :: i, c
-        up = text
-        do i = 1, len(text)
-            c = iachar(text(i:i))
-            if (c >= iachar('a') .and. c <= iachar('z')) up(i:i) = achar(c - 32)
-        end do
-    end function upper
 end module ropedyn_testset

@@ -5,7 +5,8 @@ module ropedyn_text
     use ropedyn_kinds, only: wp, i8
     implicit none
     private
-    public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, lower, line_quote
+    public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, enclosed
+    public :: lower, upper, line_quote
 
     !> Decimal text of an integer (default or 64-bit kind).
     interface int_text
@@ -131,29 +132,55 @@ contains
     pure function quoted(text) result(s)
         character(len=*), intent(in) :: text
         character(len=:), allocatable :: s
+        s = enclosed(text, "'", "''")
+    end function quoted
+
+    !> `text` between two `mark` characters, each `mark` inside it written as `escape`
+    !! (a Fortran literal: mark ', escape ''; a CSV field: mark ", escape "").
+    pure function enclosed(text, mark, escape) result(s)
+        character(len=*), intent(in) :: text
+        character(len=1), intent(in) :: mark
+        character(len=*), intent(in) :: escape
+        character(len=:), allocatable :: s
         integer :: i
-        s = "'"
+        s = mark
         do i = 1, len(text)
-            if (text(i:i) == "'") then
-                s = s//"''"
+            if (text(i:i) == mark) then
+                s = s//escape
             else
                 s = s//text(i:i)
             end if
         end do
-        s = s//"'"
-    end function quoted
+        s = s//mark
+    end function enclosed
 
     !> ASCII lower case.
     pure function lower(s) result(t)
         character(len=*), intent(in) :: s
         character(len=len(s)) :: t
+        t = shifted(s, 'A', 'Z', iachar('a') - iachar('A'))
+    end function lower
+
+    !> ASCII upper case.
+    pure function upper(s) result(t)
+        character(len=*), intent(in) :: s
+        character(len=len(s)) :: t
+        t = shifted(s, 'a', 'z', iachar('A') - iachar('a'))
+    end function upper
+
+    !> `s` with the letters first .. last moved by `shift` places in ASCII.
+    pure function shifted(s, first, last, shift) result(t)
+        character(len=*), intent(in) :: s
+        character(len=1), intent(in) :: first, last
+        integer, intent(in) :: shift
+        character(len=len(s)) :: t
         integer :: i, c
         t = s
         do i = 1, len(s)
             c = iachar(s(i:i))
-            if (c >= iachar('A') .and. c <= iachar('Z')) t(i:i) = achar(c + 32)
+            if (c >= iachar(first) .and. c <= iachar(last)) t(i:i) = achar(c + shift)
         end do
-    end function lower
+    end function shifted
 
     !> A line for a message: in double quotes, trailing blanks removed, long lines shortened.
     pure function line_quote(line) result(s)

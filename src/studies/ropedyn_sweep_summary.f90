@@ -5,7 +5,7 @@
 module ropedyn_sweep_summary
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_text, only: int_text, real_text
+    use ropedyn_text, only: int_text, real_text, enclosed
     use ropedyn_error, only: error_t, make_error, ERR_IO
     use ropedyn_scene, only: scene_namelist_text
     use ropedyn_sweep, only: sweep_t, sweep_case_t, REF_NONE, &
@@ -284,20 +284,11 @@ contains
     pure function csv_text(text) result(s)
         character(len=*), intent(in) :: text
         character(len=:), allocatable :: s
-        integer :: i
         if (scan(text, ',"'//new_line('a')) == 0) then
             s = text
-            return
+        else
+            s = enclosed(text, '"', '""')
         end if
-        s = '"'
-        do i = 1, len(text)
-            if (text(i:i) == '"') then
-                s = s//'""'
-            else
-                s = s//text(i:i)
-            end if
-        end do
-        s = s//'"'
     end function csv_text
 
     !> Newlines replaced by blanks.
