@@ -144,31 +144,34 @@ contains
         real(wp), intent(out) :: kt(:, :)
         integer, intent(out) :: status
         real(wp), intent(out), optional :: cv(:, :)
-        real(wp), allocatable :: mm(:, :), jb(:, :), yp(:), fp(:), fm(:), w(:)
+        real(wp), allocatable :: mm(:, :), jb(:, :), yp(:), gp(:), gm(:)
         integer, allocatable :: vel_of_row(:)
         integer :: nd, ns, ml, mu, offset, j, r, c, i, st
         real(wp) :: h
+        logical :: implicit
 
         nd = size(pos)
         ns = size(y)
         status = STATUS_OK
-        if (model%has_mass_matrix()) then
-            ! f = F(vel) of the implicit form: central differences (F is cheap, O(n))
-            allocate (yp(ns), fp(nd), fm(nd), w(ns))
+        implicit = model%has_mass_matrix()
+        if (.not. implicit) then
+            allocate (mm(nd, nd))
+            call model%coordinate_mass(y, mm)
+        end if
+        if (implicit .or. .not. model%has_jacobian()) then
+            ! central differences: of f = F(vel) of the implicit form (F is cheap, O(n)), or
+            ! of the accelerations of an explicit model without a Jacobian
+            allocate (yp(ns), gp(ns), gm(ns))
             do j = 1, nd
-                call column(pos(j), kt(:, j))
+                call differenced(pos(j), kt(:, j))
                 if (status /= STATUS_OK) return
                 if (present(cv)) then
-                    call column(vel(j), cv(:, j))
+                    call differenced(vel(j), cv(:, j))
                     if (status /= STATUS_OK) return
                 end if
             end do
-            return
-        end if
-
-        allocate (mm(nd, nd))
-        call model%coordinate_mass(y, mm)
-        if (model%has_jacobian()) then
+            if (implicit) return
+        else
             call model%bandwidths(ml, mu)
             offset = mu + 1
             allocate (jb(ml + mu + 1, ns), vel_of_row(ns))
@@ -191,17 +194,6 @@ contains
                     end do
                 end if
             end do
-        else
-            ! no analytic Jacobian: central differences of the accelerations
-            allocate (yp(ns), fp(ns), fm(ns))
-            do j = 1, nd
-                call accel_column(pos(j), kt(:, j))
-                if (status /= STATUS_OK) return
-                if (present(cv)) then
-                    call accel_column(vel(j), cv(:, j))
-                    if (status /= STATUS_OK) return
-                end if
-            end do
         end if
         ! da/dz -> df/dz = M da/dz at rest (the dM/dq a term vanishes at an equilibrium and
         ! is left out elsewhere: Newton on a(q) = 0 in the metric M)
@@ -210,35 +202,36 @@ contains
         kt = -kt
         if (present(cv)) cv = -cv
     contains
-        !> -dF(vel)/dy(k) by central differences (implicit models).
-        subroutine column(k, out)
+        !> By central differences in y(k): -dF(vel)/dy(k) of an implicit model, da/dy(k)
+        !! (a = ydot(vel)) of an explicit one.
+        subroutine differenced(k, out)
             integer, intent(in) :: k
             real(wp), intent(out) :: out(:)
             h = 1.0e-6_wp*max(1.0_wp, abs(y(k)))
             yp = y
             yp(k) = y(k) + h
-            call model%implicit_rhs(0.0_wp, yp, w, st)
-            fp = w(vel)
+            call evaluate(yp, gp, st)
             yp(k) = y(k) - h
-            call model%implicit_rhs(0.0_wp, yp, w, status)
+            call evaluate(yp, gm, status)
             if (st /= STATUS_OK) status = st
-            fm = w(vel)
-            out = -(fp - fm)/(2.0_wp*h)
-        end subroutine column
+            if (implicit) then
+                out = -(gp(vel) - gm(vel))/(2.0_wp*h)
+            else
+                out = (gp(vel) - gm(vel))/(2.0_wp*h)
+            end if
+        end subroutine differenced
 
-        !> da/dy(k) by central differences (explicit models without a Jacobian).
-        subroutine accel_column(k, out)
-            integer, intent(in) :: k
-            real(wp), intent(out) :: out(:)
-            h = 1.0e-6_wp*max(1.0_wp, abs(y(k)))
-            yp = y
-            yp(k) = y(k) + h
-            call model%rhs(0.0_wp, yp, fp, st)
-            yp(k) = y(k) - h
-            call model%rhs(0.0_wp, yp, fm, status)
-            if (st /= STATUS_OK) status = st
-            out = (fp(vel) - fm(vel))/(2.0_wp*h)
-        end subroutine accel_column
+        !> F(t = 0, z) of the implicit form, or the right-hand side f(0, z).
+        subroutine evaluate(z, g, stat)
+            real(wp), intent(in) :: z(:)
+            real(wp), intent(out) :: g(:)
+            integer, intent(out) :: stat
+            if (implicit) then
+                call model%implicit_rhs(0.0_wp, z, g, stat)
+            else
+                call model%rhs(0.0_wp, z, g, stat)
+            end if
+        end subroutine evaluate
     end subroutine tangent_matrices
 
     !> a <- mm a, with a fast path for a diagonal mm.
