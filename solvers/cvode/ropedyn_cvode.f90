@@ -295,37 +295,31 @@ contains
         text = trim(buffer)
     end function where_text
 
-
     function cvode_stats(self) result(stats)
         class(cvode_t), intent(in) :: self
         type(solver_stats_t) :: stats
-        integer(c_long) :: v(1)
-        integer(c_int) :: flag, order(1)
-        real(c_double) :: h(1)
+        integer(c_long) :: steps(1), rhs_evals(1), lin_setups(1), err_test_fails(1), v(1), w(1)
+        integer(c_int) :: flag, order(1), next_order(1)
+        real(c_double) :: h0(1), h(1), h_next(1), tcur(1)
 
         if (.not. c_associated(self%mem)) return
-        flag = FCVodeGetNumSteps(self%mem, v)
-        stats%steps = v(1)
-        flag = FCVodeGetNumRhsEvals(self%mem, v)
-        stats%rhs_evals = v(1)
+        h = 0.0_c_double
+        order = 0
+        flag = FCVodeGetIntegratorStats(self%mem, steps, rhs_evals, lin_setups, err_test_fails, &
+                                        order, next_order, h0, h, h_next, tcur)
+        stats%steps = steps(1)
+        stats%rhs_evals = rhs_evals(1)
+        stats%lin_setups = lin_setups(1)
+        stats%err_test_fails = err_test_fails(1)
+        stats%last_step = h(1)
+        stats%last_order = order(1)
+        flag = FCVodeGetNonlinSolvStats(self%mem, v, w)
+        stats%nonlin_iters = v(1)
+        stats%nonlin_conv_fails = w(1)
         flag = FCVodeGetNumJacEvals(self%mem, v)
         stats%jac_evals = v(1)
         flag = FCVodeGetNumLinRhsEvals(self%mem, v)
         stats%jac_rhs_evals = v(1)
-        flag = FCVodeGetNumLinSolvSetups(self%mem, v)
-        stats%lin_setups = v(1)
-        flag = FCVodeGetNumErrTestFails(self%mem, v)
-        stats%err_test_fails = v(1)
-        flag = FCVodeGetNumNonlinSolvIters(self%mem, v)
-        stats%nonlin_iters = v(1)
-        flag = FCVodeGetNumNonlinSolvConvFails(self%mem, v)
-        stats%nonlin_conv_fails = v(1)
-        h = 0.0_c_double
-        flag = FCVodeGetLastStep(self%mem, h)
-        stats%last_step = h(1)
-        order = 0
-        flag = FCVodeGetLastOrder(self%mem, order)
-        stats%last_order = order(1)
     end function cvode_stats
 
     subroutine cvode_finalize(self)
