@@ -10,6 +10,7 @@ module ropedyn_case_file
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_IO
     use ropedyn_h5, only: h5_file_t
+    use ropedyn_output, only: COUNTER_NAMES
     implicit none
     private
     public :: case_data_t, read_case_file, write_wall_time
@@ -22,8 +23,8 @@ module ropedyn_case_file
         character(len=:), allocatable :: scene    !< the effective namelist text
         character(len=:), allocatable :: model, method
         real(wp) :: cpu_time = 0.0_wp, wall_time = 0.0_wp  !< s (NaN when absent)
-        integer(i8) :: steps = -1, rhs_evals = -1, jac_evals = -1, lin_setups = -1, &
-            err_test_fails = -1, nonlin_iters = -1, nonlin_conv_fails = -1
+        !> the solver counters named in ropedyn_output's COUNTER_NAMES
+        integer(i8) :: counters(size(COUNTER_NAMES)) = -1
         integer :: records = 0                      !< complete output records
         real(wp), allocatable :: time(:)            !< (records) s
         real(wp), allocatable :: points(:, :, :)    !< (2, 2n, records) m
@@ -114,23 +115,11 @@ contains
 
         !> The solver counters (-1 when absent).
         subroutine read_counters()
-            character(len=*), parameter :: NAMES(7) = [character(len=17) :: 'steps', &
-                'rhs_evals', 'jac_evals', 'lin_setups', 'err_test_fails', 'nonlin_iters', &
-                'nonlin_conv_fails']
-            integer(i8) :: counters(size(NAMES))
             integer :: j
-            counters = -1
-            do j = 1, size(NAMES)
-                call h5%read_scalar('/solver/'//trim(NAMES(j)), counters(j), err)
+            do j = 1, size(COUNTER_NAMES)
+                call h5%read_scalar('/solver/'//trim(COUNTER_NAMES(j)), data%counters(j), err)
                 if (allocated(err)) return
             end do
-            data%steps = counters(1)
-            data%rhs_evals = counters(2)
-            data%jac_evals = counters(3)
-            data%lin_setups = counters(4)
-            data%err_test_fails = counters(5)
-            data%nonlin_iters = counters(6)
-            data%nonlin_conv_fails = counters(7)
         end subroutine read_counters
     end subroutine read_case_file
 

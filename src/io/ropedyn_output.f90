@@ -35,7 +35,7 @@ module ropedyn_output
     use ropedyn_h5, only: h5_file_t, h5_series_t
     implicit none
     private
-    public :: output_file_t, write_provenance
+    public :: output_file_t, write_provenance, COUNTER_NAMES, counter_values
 
     !> The convention written into every file (root attribute `units_convention`).
     character(len=*), parameter :: units_convention = &
@@ -61,8 +61,9 @@ module ropedyn_output
     integer, parameter :: RECORD_ROWS(N_SERIES) = [0, 3, 3, 2, 0, 0, 0, 0, 0, 0, 0, 0]
     integer, parameter :: RECORD_PER_ELEMENT(N_SERIES) = [0, 1, 1, 2, 0, 0, 0, 0, 0, 0, 0, 0]
 
-    !> The solver counters of `write_stats` (/solver/<name>, int64, units 1).
-    character(len=*), parameter :: COUNTER_NAME(7) = [character(len=17) :: 'steps', &
+    !> The solver counters of `write_stats` (/solver/<name>, int64, units 1), in the order
+    !! of `counter_values`.
+    character(len=*), parameter :: COUNTER_NAMES(7) = [character(len=17) :: 'steps', &
         'rhs_evals', 'jac_evals', 'lin_setups', 'err_test_fails', 'nonlin_iters', &
         'nonlin_conv_fails']
 
@@ -255,7 +256,7 @@ contains
         type(solver_stats_t), intent(in) :: stats  !< counters of the integration
         real(wp), intent(in) :: cpu_time           !< CPU time of the run, s
         type(error_t), allocatable, intent(out) :: err
-        integer(i8) :: counters(size(COUNTER_NAME))
+        integer(i8) :: counters(size(COUNTER_NAMES))
         integer :: k
 
         if (.not. self%is_open) then
@@ -263,10 +264,9 @@ contains
                             file_label(self)//': write_stats: file is not open')
             return
         end if
-        counters = [stats%steps, stats%rhs_evals, stats%jac_evals, stats%lin_setups, &
-                    stats%err_test_fails, stats%nonlin_iters, stats%nonlin_conv_fails]
-        do k = 1, size(COUNTER_NAME)
-            call self%file%write('/solver/'//trim(COUNTER_NAME(k)), counters(k), '1', err)
+        counters = counter_values(stats)
+        do k = 1, size(COUNTER_NAMES)
+            call self%file%write('/solver/'//trim(COUNTER_NAMES(k)), counters(k), '1', err)
             if (allocated(err)) return
         end do
         call self%file%write('/solver/cpu_time', cpu_time, 's', err)
@@ -274,6 +274,14 @@ contains
 
         call self%file%flush(err)
     end subroutine output_write_stats
+
+    !> The counters of `stats` named in COUNTER_NAMES, in that order.
+    pure function counter_values(stats) result(counters)
+        type(solver_stats_t), intent(in) :: stats
+        integer(i8) :: counters(size(COUNTER_NAMES))
+        counters = [stats%steps, stats%rhs_evals, stats%jac_evals, stats%lin_setups, &
+                    stats%err_test_fails, stats%nonlin_iters, stats%nonlin_conv_fails]
+    end function counter_values
 
     !> Set the root status ('complete' or 'failed', with `reason` if failed) and close
     !! everything. The file is closed even when writing the status fails.

@@ -12,6 +12,7 @@ module ropedyn_sweep_summary
         REF_TIGHTEST, REF_FILE
     use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_h5, only: h5_file_t
+    use ropedyn_output, only: COUNTER_NAMES
     use ropedyn_version, only: version_string
     implicit none
     private
@@ -22,10 +23,6 @@ module ropedyn_sweep_summary
         't_reached', 's', 'wall_time', 's', 'cpu_time', 's', 'tip_error_final', 'm', &
         'tip_error_max', 'm', 'position_error_max', 'm', 'energy_error_final', 'J', &
         'energy_error_max', 'J'], [2, 8])
-    !> Counter columns of summary.h5 (int64, units 1; absent: -1, reference 0: none).
-    character(len=*), parameter :: COUNTERS(8) = [character(len=17) :: 'steps', 'rhs_evals', &
-        'jac_evals', 'lin_setups', 'err_test_fails', 'nonlin_iters', 'nonlin_conv_fails', &
-        'reference']
 
     !> One row of the summary.
     type :: case_row_t
@@ -33,8 +30,8 @@ module ropedyn_sweep_summary
         character(len=:), allocatable :: status  !< complete|failed|running|stale|missing
         character(len=:), allocatable :: reason
         real(wp) :: t_reached, wall_time, cpu_time                     !< s (NaN: absent)
-        integer(i8) :: steps = -1, rhs_evals = -1, jac_evals = -1, lin_setups = -1, &
-            err_test_fails = -1, nonlin_iters = -1, nonlin_conv_fails = -1
+        !> the solver counters named in ropedyn_output's COUNTER_NAMES (-1: absent)
+        integer(i8) :: counters(size(COUNTER_NAMES)) = -1
         integer :: reference = 0                 !< case id of the reference (0: none)
         real(wp) :: tip_error_final, tip_error_max, position_error_max  !< m
         real(wp) :: energy_error_final, energy_error_max                !< J
@@ -99,13 +96,7 @@ contains
                 rows(c)%status == 'stale') cycle
             rows(c)%wall_time = data%wall_time
             rows(c)%cpu_time = data%cpu_time
-            rows(c)%steps = data%steps
-            rows(c)%rhs_evals = data%rhs_evals
-            rows(c)%jac_evals = data%jac_evals
-            rows(c)%lin_setups = data%lin_setups
-            rows(c)%err_test_fails = data%err_test_fails
-            rows(c)%nonlin_iters = data%nonlin_iters
-            rows(c)%nonlin_conv_fails = data%nonlin_conv_fails
+            rows(c)%counters = data%counters
             if (data%records > 0) rows(c)%t_reached = data%time(data%records)
         end do
 
@@ -222,10 +213,12 @@ contains
         do v = 1, size(sweep%vary_keys)
             line = line//','//sweep%vary_keys(v)%s
         end do
-        line = line//',t_end,t_reached,wall_time,cpu_time,steps,rhs_evals,jac_evals,' &
-            //'lin_setups,err_test_fails,nonlin_iters,nonlin_conv_fails,reference,' &
-            //'tip_error_final,tip_error_max,position_error_max,energy_error_final,' &
-            //'energy_error_max,file,reason'
+        line = line//',t_end,t_reached,wall_time,cpu_time'
+        do v = 1, size(COUNTER_NAMES)
+            line = line//','//trim(COUNTER_NAMES(v))
+        end do
+        line = line//',reference,tip_error_final,tip_error_max,position_error_max,' &
+            //'energy_error_final,energy_error_max,file,reason'
         write (unit, '(a)', iostat=ios, iomsg=msg) line
         do c = 1, size(rows)
             if (ios /= 0) exit
@@ -239,11 +232,10 @@ contains
                     line = line//','//csv_text(sweep%cases(c)%vary_values(v)%s)
                 end do
                 line = line//','//real_text(s%solver%t_end, compact=.true.)//','// &
-                    num(r%t_reached)//','//num(r%wall_time)//','//num(r%cpu_time)//','// &
-                    count_text(r%steps)//','//count_text(r%rhs_evals)//','// &
-                    count_text(r%jac_evals)//','//count_text(r%lin_setups)//','// &
-                    count_text(r%err_test_fails)//','//count_text(r%nonlin_iters)//','// &
-                    count_text(r%nonlin_conv_fails)//','
+                    num(r%t_reached)//','//num(r%wall_time)//','//num(r%cpu_time)//','
+                do v = 1, size(COUNTER_NAMES)
+                    line = line//count_text(r%counters(v))//','
+                end do
                 if (r%reference > 0) line = line//int_text(r%reference)
                 line = line//','//num(r%tip_error_final)//','//num(r%tip_error_max)//','// &
                     num(r%position_error_max)//','//num(r%energy_error_final)//','// &
@@ -322,9 +314,7 @@ contains
         measures = reshape([rows%t_reached, rows%wall_time, rows%cpu_time, &
                             rows%tip_error_final, rows%tip_error_max, rows%position_error_max, &
                             rows%energy_error_final, rows%energy_error_max], [n, 8])
-        counts = reshape([rows%steps, rows%rhs_evals, rows%jac_evals, rows%lin_setups, &
-                          rows%err_test_fails, rows%nonlin_iters, rows%nonlin_conv_fails, &
-                          int(rows%reference, i8)], [n, 8])
+        counts = transpose(reshape([(rows(c)%counters, c=1, n)], [size(COUNTER_NAMES), n]))
         call h5%create(path, err)
         if (allocated(err)) return
         steps: block
@@ -358,10 +348,12 @@ contains
                               err)
                 if (allocated(err)) exit steps
             end do
-            do k = 1, size(COUNTERS)
-                call h5%write('/'//trim(COUNTERS(k)), counts(:, k), '1', err)
+            do k = 1, size(COUNTER_NAMES)
+                call h5%write('/'//trim(COUNTER_NAMES(k)), counts(:, k), '1', err)
                 if (allocated(err)) exit steps
             end do
+            call h5%write('/reference', int(rows%reference, i8), '1', err)
+            if (allocated(err)) exit steps
             call text_column('file')
             if (allocated(err)) exit steps
             call text_column('reason')
