@@ -2,7 +2,7 @@
 !! ropedyn carries, by name: the umbrella module of src/testset (docs/testset.md).
 module ropedyn_testset
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
-    use ropedyn_text, only: upper
+    use ropedyn_text, only: lower
     use ropedyn_testset_problem, only: testset_problem_t
     use ropedyn_testset_hires, only: hires_t
     use ropedyn_testset_vdpol, only: vdpol_t
@@ -25,18 +25,18 @@ contains
         character(len=*), intent(in) :: name
         class(testset_problem_t), allocatable, intent(out) :: problem
         type(error_t), allocatable, intent(out) :: err
-        select case (upper(trim(adjustl(name))))
-        case ('HIRES')
+        select case (lower(trim(adjustl(name))))
+        case ('hires')
             allocate (hires_t :: problem)
-        case ('VDPOL')
+        case ('vdpol')
             allocate (vdpol_t :: problem)
-        case ('OREGO')
+        case ('orego')
             allocate (orego_t :: problem)
-        case ('ROBER')
+        case ('rober')
             allocate (rober_t :: problem)
-        case ('E5')
+        case ('e5')
             allocate (e5_t :: problem)
-        case ('POLLU')
+        case ('pollu')
             allocate (pollu_t :: problem)
         case default
             call make_error(err, ERR_INPUT, 'unknown test problem "'//trim(name)// &

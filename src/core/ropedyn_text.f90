@@ -6,7 +6,7 @@ module ropedyn_text
     implicit none
     private
     public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, enclosed
-    public :: lower, upper, line_quote
+    public :: lower, line_quote
 
     !> Decimal text of an integer (default or 64-bit kind).
     interface int_text
@@ -158,29 +158,13 @@ contains
     pure function lower(s) result(t)
         character(len=*), intent(in) :: s
         character(len=len(s)) :: t
-        t = shifted(s, 'A', 'Z', iachar('a') - iachar('A'))
-    end function lower
-
-    !> ASCII upper case.
-    pure function upper(s) result(t)
-        character(len=*), intent(in) :: s
-        character(len=len(s)) :: t
-        t = shifted(s, 'a', 'z', iachar('A') - iachar('a'))
-    end function upper
-
-    !> `s` with the letters first .. last moved by `shift` places in ASCII.
-    pure function shifted(s, first, last, shift) result(t)
-        character(len=*), intent(in) :: s
-        character(len=1), intent(in) :: first, last
-        integer, intent(in) :: shift
-        character(len=len(s)) :: t
         integer :: i, c
         t = s
         do i = 1, len(s)
             c = iachar(s(i:i))
-            if (c >= iachar(first) .and. c <= iachar(last)) t(i:i) = achar(c + shift)
+            if (c >= iachar('A') .and. c <= iachar('Z')) t(i:i) = achar(c + 32)
         end do
-    end function shifted
+    end function lower
 
     !> A line for a message: in double quotes, trailing blanks removed, long lines shortened.
     pure function line_quote(line) result(s)
