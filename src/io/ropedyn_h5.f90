@@ -57,7 +57,6 @@ module ropedyn_h5
         procedure :: open => h5_open
         procedure :: close => h5_close
         procedure :: flush => h5_flush
-        procedure :: opened => h5_opened
         procedure :: file_name => h5_file_name
         procedure :: group => h5_group
         procedure :: exists => h5_exists
@@ -86,7 +85,6 @@ module ropedyn_h5
         procedure, private :: append_real, append_integer
         generic :: append => append_real, append_integer
         procedure :: close => series_close
-        procedure :: is_open => series_is_open
     end type h5_series_t
 
     interface
@@ -104,10 +102,6 @@ module ropedyn_h5
             character(len=*), intent(in) :: columns
             type(error_t), allocatable, intent(out) :: err
         end subroutine h5_create_series
-
-        module pure logical function series_is_open(self)
-            class(h5_series_t), intent(in) :: self
-        end function series_is_open
 
         !> Close the series' dataset (nothing to do when it is not open).
         module subroutine series_close(self, err)
@@ -333,11 +327,6 @@ contains
         call h5fflush_f(self%id, H5F_SCOPE_GLOBAL_F, hdferr)
         if (hdferr < 0) call make_error(err, ERR_IO, self%path//': cannot flush file')
     end subroutine h5_flush
-
-    pure logical function h5_opened(self)
-        class(h5_file_t), intent(in) :: self
-        h5_opened = self%is_open
-    end function h5_opened
 
     !> The path given to the last successful create/open ('' if none).
     pure function h5_file_name(self) result(path)

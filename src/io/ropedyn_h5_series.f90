@@ -40,10 +40,6 @@ contains
             call string_attribute(self%path, series%id, name, 'columns', columns, err)
     end procedure h5_create_series
 
-    module procedure series_is_open
-        series_is_open = self%id >= 0
-    end procedure series_is_open
-
     module procedure series_close
         integer :: hdferr
         if (self%id < 0) return
