@@ -259,8 +259,8 @@ contains
             elapsed = real(time_now - start, wp)/real(rate, wp)
             ! a finished worker's slot is refilled at once: count it as running
             text = int_text(finished)//'/'//int_text(size(todo))//' done, '// &
-                int_text(min(size(slot), size(todo) - finished))//' running, '//int_text(failed)//' failed, elapsed '// &
-                clock_text(elapsed)
+                int_text(min(size(slot), size(todo) - finished))//' running, '// &
+                int_text(failed)//' failed, elapsed '//clock_text(elapsed)
             if (finished > 0 .and. finished < size(todo)) then
                 eta = elapsed/real(finished, wp)*real(size(todo) - finished, wp)
                 text = text//', ETA '//clock_text(eta)
