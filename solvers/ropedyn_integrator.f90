@@ -31,6 +31,10 @@ module ropedyn_integrator
         !> CVODE's BDF stability-limit detection (order reduction when a lightly damped
         !! oscillatory mode nears the stability boundary); other methods reject .true.
         logical :: stab_lim_det = .false.
+        !> solve the Newton systems on the first-order matrix even when the problem has
+        !! second-order structure (the reduced matrix M - g C - g^2 K of half the size is
+        !! the default then; ropedyn_iteration_matrix)
+        logical :: first_order_newton = .false.
     end type solver_options_t
 
     !> Counters of an integration so far.

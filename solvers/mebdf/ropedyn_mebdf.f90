@@ -247,7 +247,9 @@ contains
         self%fixed = .false.
         self%crate = 1.0_wp
         self%counters = solver_stats_t()
-        call self%matrix%setup(problem)
+        call self%matrix%setup(problem, implicit_form=.true., &
+                               first_order=options%first_order_newton, &
+                               fd_jacobian=options%fd_jacobian)
     end subroutine mebdf_init
 
     !> Switch an initialized integrator to constant step h and constant k (order k + 1)

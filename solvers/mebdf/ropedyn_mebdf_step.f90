@@ -12,9 +12,7 @@ contains
                        self%counters%jac_evals == 0
         if (new_jacobian .and. .not. self%jacobian_current) then
             call self%matrix%evaluate_jacobian(self%problem, self%t, self%dif(1:self%n, 0), &
-                self%w, self%h, self%options%fd_jacobian .or. &
-                .not. self%problem%has_implicit_jacobian(), status, &
-                self%counters%jac_rhs_evals)
+                self%w, self%h, status, self%counters%jac_rhs_evals)
             self%counters%jac_evals = self%counters%jac_evals + 1
             if (status /= STATUS_OK) return
             self%jacobian_age = 0

@@ -39,6 +39,9 @@ module ropedyn_scene
         !> CVODE only: BDF stability-limit detection (lowers the order near the stability
         !! boundary of lightly damped oscillatory modes)
         logical :: stability_limit_detection = .false.
+        !> Newton systems on the first-order matrix of all unknowns instead of the reduced
+        !! second-order one (half the size; the default for the rope models)
+        logical :: first_order_newton = .false.
         !> testing aid: the right-hand side returns NaN for t > this time [s]; < 0: off
         real(wp) :: fault_nan_after = -1.0_wp
     end type solver_params_t
@@ -135,6 +138,7 @@ module ropedyn_scene
         key_info_t(G_SOLVER, 't_end', T_REAL), &
         key_info_t(G_SOLVER, 'output_interval', T_REAL), &
         key_info_t(G_SOLVER, 'stability_limit_detection', T_LOGICAL), &
+        key_info_t(G_SOLVER, 'first_order_newton', T_LOGICAL), &
         key_info_t(G_SOLVER, 'fault_nan_after', T_REAL), &
         key_info_t(G_OUTPUT, 'file', T_STRING), &
         key_info_t(G_OUTPUT, 'progress', T_LOGICAL), &
@@ -341,6 +345,7 @@ contains
                 //I4//'output_interval = '//real_text(v%output_interval)//NL &
                 //I4//'stability_limit_detection = '// &
                 logical_text(v%stability_limit_detection)//NL &
+                //I4//'first_order_newton = '//logical_text(v%first_order_newton)//NL &
                 //I4//'fault_nan_after = '//real_text(v%fault_nan_after)//NL//'/'//NL
             text = text//'&output'//NL &
                 //I4//'file = '//quoted(trim(o%file))//NL &
@@ -718,9 +723,9 @@ contains
         character(len=BUF_LEN) :: method
         real(wp) :: rtol, atol, t_end, output_interval, fault_nan_after
         integer :: max_order, max_steps
-        logical :: stability_limit_detection
+        logical :: stability_limit_detection, first_order_newton
         namelist /solver/ method, rtol, atol, max_order, max_steps, t_end, output_interval, &
-            stability_limit_detection, fault_nan_after
+            stability_limit_detection, first_order_newton, fault_nan_after
         method = p%method
         rtol = p%rtol
         atol = p%atol
@@ -729,6 +734,7 @@ contains
         t_end = p%t_end
         output_interval = p%output_interval
         stability_limit_detection = p%stability_limit_detection
+        first_order_newton = p%first_order_newton
         fault_nan_after = p%fault_nan_after
         read (recs, nml=solver, iostat=ios, iomsg=msg)
         if (ios /= 0) return
@@ -740,6 +746,7 @@ contains
         p%t_end = t_end
         p%output_interval = output_interval
         p%stability_limit_detection = stability_limit_detection
+        p%first_order_newton = first_order_newton
         p%fault_nan_after = fault_nan_after
     end subroutine nml_solver
 
