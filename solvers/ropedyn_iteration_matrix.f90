@@ -386,7 +386,7 @@ contains
             ! dgbtrf storage: (i, j) at row kl + ku + 1 + i - j of 2 kl + ku + 1 rows
             self%rlu(1:kl, :) = 0.0_wp
             self%rlu(kl + 1:, :) = self%mk - g*self%cb - g2*self%kb
-            call dgbtrf(np, np, kl, ku, self%rlu, 2*kl + ku + 1, self%ripiv, info)
+            call band_lu_factor(np, kl, ku, self%rlu, self%ripiv, info)
         end if
         status = merge(STATUS_OK, STATUS_RECOVERABLE, info == 0)
     end subroutine factor_reduced
@@ -471,17 +471,11 @@ contains
             self%rq(i) = b(self%pos(i))
             self%rv(i) = b(self%vel(i))
         end do
-        do j = 1, np
-            x = g*self%rq(j)
-            do i = max(1, j - ku), min(np, j + kl)
-                self%rv(i) = self%rv(i) + self%kb(ku + 1 + i - j, j)*x
-            end do
-        end do
+        call band_add_product(np, kl, ku, self%kb, g, self%rq, self%rv)
         if (self%rdense) then
             call dgetrs('N', np, 1, self%rlu, np, self%ripiv, self%rv, np, info)
         else
-            call dgbtrs('N', np, kl, ku, 1, self%rlu, 2*kl + ku + 1, self%ripiv, self%rv, np, &
-                        info)
+            call band_lu_solve(np, kl, ku, self%rlu, self%ripiv, self%rv)
         end if
         do i = 1, np
             b(self%vel(i)) = self%rv(i)
@@ -530,6 +524,113 @@ contains
             end do
         end do
     end subroutine matrix_mass_times
+
+    !> LU factorization with partial pivoting of a band matrix in LAPACK's dgbtrf storage
+    !! (entry (i, j) at row kl + ku + 1 + i - j of 2 kl + ku + 1 rows; rows 1 .. kl are
+    !! the fill-in and must be zero on entry): dgbtf2's algorithm and output, written out
+    !! as loops, except that the diagonal of U is stored inverted (the solve multiplies).
+    !! For the small bandwidths of the reduced rope matrices (5/5) LAPACK's BLAS calls per
+    !! column cost more than their arithmetic. info = j > 0: U(j, j) = 0.
+    pure subroutine band_lu_factor(n, kl, ku, ab, ipiv, info)
+        integer, intent(in) :: n, kl, ku
+        real(wp), intent(inout) :: ab(2*kl + ku + 1, n)
+        integer, intent(out) :: ipiv(n)
+        integer, intent(out) :: info
+        integer :: kv, j, jp, km, ju, i, c
+        real(wp) :: pivot, big, x, u
+
+        kv = kl + ku
+        info = 0
+        ju = 1
+        do j = 1, n
+            km = min(kl, n - j)
+            ! pivot: largest |A(i, j)|, i = j .. j + km (row kv + 1 + i - j)
+            jp = 1
+            big = abs(ab(kv + 1, j))
+            do i = 2, km + 1
+                if (abs(ab(kv + i, j)) > big) then
+                    big = abs(ab(kv + i, j))
+                    jp = i
+                end if
+            end do
+            ipiv(j) = jp + j - 1
+            if (ab(kv + jp, j) == 0.0_wp) then
+                if (info == 0) info = j
+                cycle
+            end if
+            ju = max(ju, min(j + ku + jp - 1, n))
+            if (jp /= 1) then
+                ! swap rows j and j + jp - 1 in columns j .. ju
+                do c = j, ju
+                    x = ab(kv + jp - (c - j), c)
+                    ab(kv + jp - (c - j), c) = ab(kv + 1 - (c - j), c)
+                    ab(kv + 1 - (c - j), c) = x
+                end do
+            end if
+            pivot = 1.0_wp/ab(kv + 1, j)
+            ab(kv + 1, j) = pivot
+            ab(kv + 2:kv + 1 + km, j) = ab(kv + 2:kv + 1 + km, j)*pivot
+            ! A(j+1 : j+km, c) -= l * A(j, c) for c = j+1 .. ju
+            do c = j + 1, ju
+                u = ab(kv + 1 + j - c, c)
+                if (u /= 0.0_wp) then
+                    do i = 1, km
+                        ab(kv + 1 + j + i - c, c) = ab(kv + 1 + j + i - c, c) - ab(kv + 1 + i, j)*u
+                    end do
+                end if
+            end do
+        end do
+    end subroutine band_lu_factor
+
+    !> b <- A^{-1} b with the factors of band_lu_factor (dgbtrs's algorithm).
+    pure subroutine band_lu_solve(n, kl, ku, ab, ipiv, b)
+        integer, intent(in) :: n, kl, ku
+        real(wp), intent(in) :: ab(2*kl + ku + 1, n)
+        integer, intent(in) :: ipiv(n)
+        real(wp), intent(inout) :: b(n)
+        integer :: kv, j, km, l, i
+        real(wp) :: x
+
+        kv = kl + ku
+        ! L y = P b
+        do j = 1, n - 1
+            km = min(kl, n - j)
+            l = ipiv(j)
+            x = b(l)
+            if (l /= j) then
+                b(l) = b(j)
+                b(j) = x
+            end if
+            do i = 1, km
+                b(j + i) = b(j + i) - ab(kv + 1 + i, j)*x
+            end do
+        end do
+        ! U x = y (U has kv super-diagonals; its diagonal is stored inverted)
+        do j = n, 1, -1
+            x = b(j)*ab(kv + 1, j)
+            b(j) = x
+            do i = max(1, j - kv), j - 1
+                b(i) = b(i) - ab(kv + 1 + i - j, j)*x
+            end do
+        end do
+    end subroutine band_lu_solve
+
+    !> y <- y + g A x for A in compact band storage (row ku + 1 + i - j).
+    pure subroutine band_add_product(n, kl, ku, a, g, x, y)
+        integer, intent(in) :: n, kl, ku
+        real(wp), intent(in) :: a(kl + ku + 1, n)
+        real(wp), intent(in) :: g
+        real(wp), intent(in) :: x(n)
+        real(wp), intent(inout) :: y(n)
+        integer :: i, j
+        real(wp) :: gx
+        do j = 1, n
+            gx = g*x(j)
+            do i = max(1, j - ku), min(n, j + kl)
+                y(i) = y(i) + a(ku + 1 + i - j, j)*gx
+            end do
+        end do
+    end subroutine band_add_product
 
     !> Entry (i, j) of a matrix in compact band storage (row mu + 1 + i - j), 0 off the band.
     pure real(wp) function full_entry(band, ml, mu, i, j) result(x)

@@ -29,7 +29,7 @@ module ropedyn_mebdf
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
-    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
+    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, clock_seconds
     use ropedyn_mebdf_coefficients, only: mebdf_coefficients_t, mebdf_coefficients, KMAX_MEBDF
     use ropedyn_iteration_matrix, only: iteration_matrix_t
     implicit none
@@ -296,6 +296,7 @@ contains
         class(mebdf_t), intent(in) :: self
         type(solver_stats_t) :: stats
         stats = self%counters
+        stats%reduced_newton = self%matrix%is_reduced()
     end function mebdf_stats
 
     subroutine mebdf_finalize(self)

@@ -42,6 +42,9 @@ module ropedyn_scene
         !> Newton systems on the first-order matrix of all unknowns instead of the reduced
         !! second-order one (half the size; the default for the rope models)
         logical :: first_order_newton = .false.
+        !> time the parts of the integration (right-hand side, Jacobian, factorizations,
+        !! solves): printed and written to /solver (costs a few % on small ropes)
+        logical :: profile = .false.
         !> testing aid: the right-hand side returns NaN for t > this time [s]; < 0: off
         real(wp) :: fault_nan_after = -1.0_wp
     end type solver_params_t
@@ -139,6 +142,7 @@ module ropedyn_scene
         key_info_t(G_SOLVER, 'output_interval', T_REAL), &
         key_info_t(G_SOLVER, 'stability_limit_detection', T_LOGICAL), &
         key_info_t(G_SOLVER, 'first_order_newton', T_LOGICAL), &
+        key_info_t(G_SOLVER, 'profile', T_LOGICAL), &
         key_info_t(G_SOLVER, 'fault_nan_after', T_REAL), &
         key_info_t(G_OUTPUT, 'file', T_STRING), &
         key_info_t(G_OUTPUT, 'progress', T_LOGICAL), &
@@ -346,6 +350,7 @@ contains
                 //I4//'stability_limit_detection = '// &
                 logical_text(v%stability_limit_detection)//NL &
                 //I4//'first_order_newton = '//logical_text(v%first_order_newton)//NL &
+                //I4//'profile = '//logical_text(v%profile)//NL &
                 //I4//'fault_nan_after = '//real_text(v%fault_nan_after)//NL//'/'//NL
             text = text//'&output'//NL &
                 //I4//'file = '//quoted(trim(o%file))//NL &
@@ -723,9 +728,9 @@ contains
         character(len=BUF_LEN) :: method
         real(wp) :: rtol, atol, t_end, output_interval, fault_nan_after
         integer :: max_order, max_steps
-        logical :: stability_limit_detection, first_order_newton
+        logical :: stability_limit_detection, first_order_newton, profile
         namelist /solver/ method, rtol, atol, max_order, max_steps, t_end, output_interval, &
-            stability_limit_detection, first_order_newton, fault_nan_after
+            stability_limit_detection, first_order_newton, profile, fault_nan_after
         method = p%method
         rtol = p%rtol
         atol = p%atol
@@ -735,6 +740,7 @@ contains
         output_interval = p%output_interval
         stability_limit_detection = p%stability_limit_detection
         first_order_newton = p%first_order_newton
+        profile = p%profile
         fault_nan_after = p%fault_nan_after
         read (recs, nml=solver, iostat=ios, iomsg=msg)
         if (ios /= 0) return
@@ -747,6 +753,7 @@ contains
         p%output_interval = output_interval
         p%stability_limit_detection = stability_limit_detection
         p%first_order_newton = first_order_newton
+        p%profile = profile
         p%fault_nan_after = fault_nan_after
     end subroutine nml_solver
 

@@ -76,6 +76,7 @@ contains
         options%max_steps = int(scene%solver%max_steps, i8)
         options%stab_lim_det = scene%solver%stability_limit_detection
         options%first_order_newton = scene%solver%first_order_newton
+        options%profile = scene%solver%profile
     end function solver_options_of
 
     !> Run a validated scene. The output file is written as the run goes; a failed
