@@ -58,7 +58,9 @@ module ropedyn_integrator
         !> Where the time went (s, monotonic clock; with options%profile only, else 0):
         !! right-hand side evaluations (f, F and M v of a mass matrix, quadratures),
         !! Jacobians (or the reduced blocks), factorizations of the Newton matrix, and the
-        !! linear solves. The rest of a step is the integrator's own work.
+        !! linear solves, out of the whole time spent in `advance_to` (time_advance, measured
+        !! by the caller: ropedyn_simulation); the rest of that is the integrator's own work.
+        real(wp) :: time_advance = 0.0_wp
         real(wp) :: time_rhs = 0.0_wp
         real(wp) :: time_jac = 0.0_wp
         real(wp) :: time_factor = 0.0_wp

@@ -14,8 +14,8 @@
 !!     /solver/order           (times,)               1
 !!     /solver/{steps, rhs_evals, jac_evals, lin_setups, err_test_fails, nonlin_iters,
 !!              nonlin_conv_fails} () int64 1;  /solver/cpu_time () s   (write_stats)
-!!     /solver/{time_rhs, time_jacobian, time_factor, time_solve} () s: where the time went
-!!              (&solver profile = .true.; 0 otherwise);  /solver/reduced_newton () int64 1:
+!!     /solver/{time_advance, time_rhs, time_jacobian, time_factor, time_solve} () s: the
+!!              time in the integrator and where it went (&solver profile = .true.; else 0);  /solver/reduced_newton () int64 1:
 !!              1 when the Newton systems were solved on the reduced second-order matrix
 !!
 !! Root attributes: status ('running' | 'complete' | 'failed'), reason (failed only),
@@ -72,8 +72,8 @@ module ropedyn_output
 
     !> The time split of `write_stats` (/solver/<name>, s; solver_stats_t's time_* fields,
     !! measured with &solver profile = .true.), in the order of `timer_values`.
-    character(len=*), parameter :: TIMER_NAMES(4) = [character(len=13) :: 'time_rhs', &
-        'time_jacobian', 'time_factor', 'time_solve']
+    character(len=*), parameter :: TIMER_NAMES(5) = [character(len=13) :: 'time_advance', &
+        'time_rhs', 'time_jacobian', 'time_factor', 'time_solve']
 
     !> One HDF5 file of one simulation run.
     type, public :: output_file_t
@@ -296,7 +296,8 @@ contains
     pure function timer_values(stats) result(times)
         type(solver_stats_t), intent(in) :: stats
         real(wp) :: times(size(TIMER_NAMES))
-        times = [stats%time_rhs, stats%time_jac, stats%time_factor, stats%time_solve]
+        times = [stats%time_advance, stats%time_rhs, stats%time_jac, stats%time_factor, &
+                 stats%time_solve]
     end function timer_values
 
     !> The counters of `stats` named in COUNTER_NAMES, in that order.

@@ -6,12 +6,16 @@ import numpy as np
 def test_paper_experiment_energy_budget(run, tmp_path):
     """The paper's experiment with n = 6: E0 = -m g (L/2) cos 75 deg = -0.1495603 J, and an
     independent RFEM implementation dissipates about 0.18 J in 30 s (physics.md, "Energy
-    budget"). The motion is sensitive to perturbations at the tolerance level (CVODE's first
-    step depends on the first output time), so the 30 s value scatters: measured 0.183 J
-    (rtol 1e-8, output every 0.01 s), 0.189 J (rtol 1e-6, 0.01 s), 0.162 J (rtol 1e-8,
-    0.1 s). The check allows 20 % and guards against gross errors only: the energy
+    budget"). The motion is chaotic after about 4 s: rounding alone changes the 30 s value.
+    Measured with the settings below: 0.114 J (CVODE on the first-order Newton matrix,
+    Release build), 0.171 J (CVODE on the reduced second-order matrix, Release), 0.254 J
+    (reduced, Debug build), 0.160 J (MEBDF, Release); earlier 0.183 J (rtol 1e-8, output
+    every 0.01 s), 0.189 J (rtol 1e-6, 0.01 s), 0.162 J (rtol 1e-8, 0.1 s). The energy
     dissipated is not even monotonic in the damping constants here (halved: 0.239 J,
-    doubled: 0.160 J). The damping magnitude is checked sharply by the axial decay below."""
+    doubled: 0.160 J). So the 30 s check only guards against gross errors (a factor of 2);
+    before the motion turns chaotic all paths agree closely: at 3 s every one of those
+    runs has dissipated 0.0056183 J (within 1e-5 relative), checked to 1e-4. The damping
+    magnitude is checked sharply by the axial decay below."""
     (tmp_path / "n6.nml").write_text(
         "&model kind = 'rfem', elements = 6 /\n"
         "&solver t_end = 30.0, output_interval = 0.1, rtol = 1e-8, atol = 1e-10 /\n")
@@ -20,8 +24,9 @@ def test_paper_experiment_energy_budget(run, tmp_path):
     with h5py.File(tmp_path / "out" / "n6.h5") as f:
         e = {k: f["energy"][k][:] for k in f["energy"]}
     assert abs(e["total"][0] - (-0.1495603)) < 1e-7
+    assert abs(e["dissipated"][30] / 0.0056183 - 1) < 1e-4, e["dissipated"][30]   # t = 3 s
     dissipated = e["dissipated"][-1]
-    assert abs(dissipated - 0.18) < 0.036, dissipated
+    assert 0.09 < dissipated < 0.36, dissipated
     # at most the drop to the hanging rest state, 0.42862 J, can be dissipated
     assert dissipated < 0.42862
     balance = e["total"] + e["dissipated"] - e["support_work"]
