@@ -49,6 +49,7 @@ module ropedyn_iteration_matrix
         integer :: np = 0, kl = 0, ku = 0
         logical :: rdense = .false.
         integer, allocatable :: pos(:), vel(:)
+        logical :: vel_contiguous = .false.   !< vel(k) = vel(1) + k - 1
         real(wp), allocatable :: kb(:, :), cb(:, :), mk(:, :)  !< band (kl+ku+1, np), row ku+1+i-j
         real(wp), allocatable :: rlu(:, :)    !< factors (dense np x np or band 2kl+ku+1 x np)
         integer, allocatable :: ripiv(:)
@@ -143,6 +144,8 @@ contains
                 covered = all(self%f0 == 1.0_wp)
             end if
             self%reduced = covered
+            if (covered) self%vel_contiguous = all(self%vel == [(self%vel(1) + k - 1, &
+                                                                 k = 1, self%np)])
         end if
         if (allocated(self%kb)) deallocate (self%kb, self%cb, self%mk, self%rlu, self%ripiv, &
                                             self%rq, self%rv)
@@ -178,7 +181,10 @@ contains
         if (.not. needed) n = 0
         self%dense = 2*self%ml + self%mu + 1 >= self%n
         allocate (self%jac(self%ml + self%mu + 1, n))
-        if (self%mass) allocate (self%mb(self%ml + self%mu + 1, n))
+        if (self%mass) then
+            allocate (self%mb(self%ml + self%mu + 1, n))
+            self%mb = 0.0_wp
+        end if
         if (self%dense) then
             allocate (self%lu(n, n))
         else
@@ -499,7 +505,9 @@ contains
         call self%solve_first_order(b)
     end subroutine matrix_solve_mass
 
-    !> mv = M(t, y) v.
+    !> mv = M(t, y) v. With second-order structure M = blockdiag(I, M_v) (the coordinate
+    !! rows are q' = v): only the entries of M_v and the coordinates' diagonal are cleared,
+    !! filled and used (for the dense MPP a quarter of the full matrix).
     subroutine matrix_mass_times(self, problem, t, y, v, mv, status)
         class(iteration_matrix_t), intent(inout) :: self
         class(problem_t), intent(inout) :: problem
@@ -508,10 +516,37 @@ contains
         real(wp), intent(in) :: v(:)
         real(wp), intent(out) :: mv(:)
         integer, intent(out) :: status
-        integer :: i, j
+        integer :: i, j, b, v0, lo, hi
+        real(wp) :: x
         if (.not. self%mass) then
             mv = v(1:self%n)
             status = STATUS_OK
+            return
+        end if
+        if (self%reduced .and. self%vel_contiguous) then
+            ! the rates are y(v0 + 1 .. v0 + np): M_v's column b is a slice of band column
+            ! v0 + b (M_v is within the first-order band: the problem's bandwidths cover M)
+            v0 = self%vel(1) - 1
+            do b = 1, self%np
+                self%mb(self%mu + 1, self%pos(b)) = 0.0_wp
+                lo = max(1, b - self%ku)
+                hi = min(self%np, b + self%kl)
+                self%mb(self%mu + 1 + lo - b:self%mu + 1 + hi - b, v0 + b) = 0.0_wp
+            end do
+            call problem%mass_matrix(t, y, self%mb, self%mu + 1, status)
+            if (status /= STATUS_OK) return
+            do b = 1, self%np
+                i = self%pos(b)
+                mv(i) = self%mb(self%mu + 1, i)*v(i)
+            end do
+            mv(v0 + 1:v0 + self%np) = 0.0_wp
+            do b = 1, self%np
+                x = v(v0 + b)
+                lo = max(1, b - self%ku)
+                hi = min(self%np, b + self%kl)
+                mv(v0 + lo:v0 + hi) = mv(v0 + lo:v0 + hi) + &
+                    self%mb(self%mu + 1 + lo - b:self%mu + 1 + hi - b, v0 + b)*x
+            end do
             return
         end if
         self%mb = 0.0_wp
