@@ -6,6 +6,12 @@ module ropedyn_text
     implicit none
     private
     public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, lower, line_quote
+    public :: text_t, append_text, printable
+
+    !> A string of any length, for lists of strings of different lengths.
+    type :: text_t
+        character(len=:), allocatable :: s
+    end type text_t
 
     !> Decimal text of an integer (default or 64-bit kind).
     interface int_text
@@ -155,14 +161,48 @@ contains
         end do
     end function lower
 
-    !> A line for a message: in double quotes, trailing blanks removed, long lines shortened.
+    !> A line for a message: in double quotes, trailing blanks removed, long lines shortened,
+    !! control characters shown as `printable` does.
     pure function line_quote(line) result(s)
         character(len=*), intent(in) :: line
         character(len=:), allocatable :: s
         if (len_trim(line) > 80) then
-            s = '"'//line(:77)//'..."'
+            s = '"'//printable(line(:77))//'..."'
         else
-            s = '"'//trim(line)//'"'
+            s = '"'//printable(trim(line))//'"'
         end if
     end function line_quote
+
+    !> Text safe to print: a control character (byte < 32 except tab, or 127) as `\xNN`.
+    pure function printable(text) result(s)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: s
+        character(len=*), parameter :: HEX = '0123456789abcdef'
+        integer :: i, c
+        s = ''
+        do i = 1, len(text)
+            c = iachar(text(i:i))
+            if ((c < 32 .and. c /= 9) .or. c == 127) then
+                s = s//'\x'//HEX(c/16 + 1:c/16 + 1)//HEX(mod(c, 16) + 1:mod(c, 16) + 1)
+            else
+                s = s//text(i:i)
+            end if
+        end do
+    end function printable
+
+    !> Append one string to a list (grown by one).
+    pure subroutine append_text(list, value)
+        type(text_t), allocatable, intent(inout) :: list(:)
+        character(len=*), intent(in) :: value
+        type(text_t), allocatable :: grown(:)
+        integer :: k, n
+        if (.not. allocated(list)) allocate (list(0))
+        n = size(list)
+        allocate (grown(n + 1))
+        do k = 1, n
+            call move_alloc(list(k)%s, grown(k)%s)
+        end do
+        grown(n + 1)%s = value
+        call move_alloc(grown, list)
+    end subroutine append_text
 end module ropedyn_text
