@@ -23,7 +23,7 @@ module ropedyn_namelist_file
     private
     public :: nml_value_t, nml_assignment_t, nml_group_t, nml_file_t
     public :: read_namelist_file, parse_namelist_lines, parse_values
-    public :: value_real, value_int, value_logical
+    public :: value_real, value_int, value_logical, name_hint
     public :: V_WORD, V_STRING, MAX_FILE_BYTES, MAX_VALUES
 
     integer, parameter :: MAX_FILE_BYTES = 4194304  !< largest file read (4 MiB)
@@ -217,17 +217,16 @@ contains
                     ': '//t%text//' '//line_quote(p%lines(line)%s))
                 return
             end if
-            if (t%kind /= TK_GROUP .or. t%text == '' .or. t%text == 'end') then
-                if (line == p%closed_line) then
-                    call make_error(err, ERR_INPUT, p%origin//': line '//int_text(line)// &
-                        ': text after the end of &'//file%groups(size(file%groups))%name// &
-                        ': '//line_quote(p%lines(line)%s)//' (one group ends with /; ' &
-                        //'put the next group on a line of its own)')
-                else
-                    call make_error(err, ERR_INPUT, p%origin//': line '//int_text(line)// &
-                        ': text outside any group: '//line_quote(p%lines(line)%s)// &
-                        ' (a group starts with &name and ends with /)')
-                end if
+            if (line == p%closed_line) then
+                call make_error(err, ERR_INPUT, p%origin//': line '//int_text(line)// &
+                    ': text after the end of &'//file%groups(size(file%groups))%name// &
+                    ': '//line_quote(p%lines(line)%s)//' (after the / of a group only a ' &
+                    //'comment may follow on its line)')
+                return
+            else if (t%kind /= TK_GROUP .or. t%text == '' .or. t%text == 'end') then
+                call make_error(err, ERR_INPUT, p%origin//': line '//int_text(line)// &
+                    ': text outside any group: '//line_quote(p%lines(line)%s)// &
+                    ' (a group starts with &name and ends with /)')
                 return
             end if
             name = t%text
@@ -450,9 +449,15 @@ contains
             return
         end if
         p%a%value_text = value_so_far(p, p%end)
-        associate (g => file%groups(p%group))
-            g%assignments = [g%assignments, p%a]
-        end associate
+        block
+            type(nml_assignment_t), allocatable :: grown(:)
+            integer :: n
+            n = size(file%groups(p%group)%assignments)
+            allocate (grown(n + 1))
+            grown(:n) = file%groups(p%group)%assignments
+            grown(n + 1) = p%a
+            call move_alloc(grown, file%groups(p%group)%assignments)
+        end block
         p%open = .false.
     end subroutine finish_assignment
 
@@ -496,14 +501,70 @@ contains
                     if (x%name /= y%name) cycle
                     if (max(x%index, 1) > max(y%index, 1) + size(y%values) - 1 .or. &
                         max(y%index, 1) > max(x%index, 1) + size(x%values) - 1) cycle
-                    call make_error(err, ERR_INPUT, origin//': &'//g%name//': '//y%key// &
-                        ' given twice (line '//int_text(x%line)//': '// &
-                        line_quote(x%line_text)//', line '//int_text(y%line)//': '// &
-                        line_quote(y%line_text)//'; keys are case-insensitive)')
+                    if (x%line == y%line) then
+                        call make_error(err, ERR_INPUT, origin//': &'//g%name//': '//y%key// &
+                            ' given twice (as '//x%key//' and '//y%key//' on line '// &
+                            int_text(y%line)//': '//line_quote(y%line_text)// &
+                            '; keys are case-insensitive)')
+                    else
+                        call make_error(err, ERR_INPUT, origin//': &'//g%name//': '//y%key// &
+                            ' given twice (line '//int_text(x%line)//': '// &
+                            line_quote(x%line_text)//', line '//int_text(y%line)//': '// &
+                            line_quote(y%line_text)//'; keys are case-insensitive)')
+                    end if
                     return
                 end associate
             end do
         end do
     end subroutine check_duplicates
 
+    !> '; did you mean "x"?' for a near miss of one of `names`, else '; keys: ' and the list.
+    function name_hint(names, key) result(text)
+        type(text_t), intent(in) :: names(:)
+        character(len=*), intent(in) :: key
+        character(len=:), allocatable :: text
+        integer :: k, d, best, best_k
+        best = huge(1)
+        best_k = 0
+        text = ''
+        do k = 1, size(names)
+            d = huge(1)
+            if (len(key) <= 64) d = edit_distance(lower(key), names(k)%s)
+            if (d < best) then
+                best = d
+                best_k = k
+            end if
+            if (k > 1) text = text//', '
+            text = text//names(k)%s
+        end do
+        if (best_k > 0 .and. best <= 2) then
+            text = '; did you mean "'//names(best_k)%s//'"?'
+        else
+            text = '; keys: '//text
+        end if
+    end function name_hint
+
+    !> Optimal string alignment distance (Levenshtein with transpositions).
+    pure integer function edit_distance(a, b) result(dist)
+        character(len=*), intent(in) :: a, b
+        integer :: d(0:len(a), 0:len(b)), i, j, cost
+        do i = 0, len(a)
+            d(i, 0) = i
+        end do
+        do j = 0, len(b)
+            d(0, j) = j
+        end do
+        do j = 1, len(b)
+            do i = 1, len(a)
+                cost = merge(0, 1, a(i:i) == b(j:j))
+                d(i, j) = min(d(i - 1, j) + 1, d(i, j - 1) + 1, d(i - 1, j - 1) + cost)
+                if (i > 1 .and. j > 1) then
+                    if (a(i:i) == b(j - 1:j - 1) .and. a(i - 1:i - 1) == b(j:j)) then
+                        d(i, j) = min(d(i, j), d(max(i - 2, 0), max(j - 2, 0)) + 1)
+                    end if
+                end if
+            end do
+        end do
+        dist = d(len(a), len(b))
+    end function edit_distance
 end module ropedyn_namelist_file

@@ -68,7 +68,17 @@ contains
             reason = 'more than '//int_text(MAX_VALUES)//' values'
             return
         end if
-        values = [values, spread(v, 1, r)]
+        block
+            type(nml_value_t), allocatable :: grown(:)
+            integer :: n, k
+            n = size(values)
+            allocate (grown(n + r))
+            grown(:n) = values
+            do k = n + 1, n + r
+                grown(k) = v
+            end do
+            call move_alloc(grown, values)
+        end block
     end subroutine value_token
 
     !> The values of one `--set` argument (`text` after the '='); `reason` is '' or why they

@@ -176,7 +176,9 @@ contains
                 call parse_values(value, values, reason)
                 if (len(reason) > 0 .or. size(values) /= 1) reason = 'unbalanced quotes'
             else
-                values = [nml_value_t(V_STRING, value)]
+                allocate (values(1))
+                values(1)%kind = V_STRING
+                values(1)%text = value
             end if
         else if (scan(value, '=/&$!''"') > 0) then
             allocate (values(0))

@@ -11,7 +11,8 @@ module ropedyn_scene_keys
     use ropedyn_scene_key, only: scene_key_t, T_REAL, T_INT, T_LOGICAL, T_NAME, T_PATH, &
         T_PAIR, T_LIST, R_NONE, R_FINITE, R_POSITIVE, R_NONNEGATIVE, R_UNIT, R_AT_LEAST, &
         R_NAMES
-    use ropedyn_text, only: lower
+    use ropedyn_text, only: text_t, append_text
+    use ropedyn_namelist_file, only: name_hint
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     implicit none
     private
@@ -341,52 +342,12 @@ contains
         integer, intent(in) :: g
         character(len=*), intent(in) :: key
         character(len=:), allocatable :: text
-        integer :: k, d, best, best_k
-        best = huge(1)
-        best_k = 0
-        text = ''
+        type(text_t), allocatable :: names(:)
+        integer :: k
+        allocate (names(0))
         do k = 1, size(keys)
-            if (keys(k)%group /= g) cycle
-            d = huge(1)
-            if (len(key) <= 64) d = edit_distance(lower(key), keys(k)%name)
-            if (d < best) then
-                best = d
-                best_k = k
-            end if
-            if (len(text) == 0) then
-                text = keys(k)%name
-            else
-                text = text//', '//keys(k)%name
-            end if
+            if (keys(k)%group == g) call append_text(names, keys(k)%name)
         end do
-        if (best_k > 0 .and. best <= 2) then
-            text = '; did you mean "'//keys(best_k)%name//'"?'
-        else
-            text = '; keys: '//text
-        end if
+        text = name_hint(names, key)
     end function key_hint
-
-    !> Optimal string alignment distance (Levenshtein with transpositions).
-    pure integer function edit_distance(a, b) result(dist)
-        character(len=*), intent(in) :: a, b
-        integer :: d(0:len(a), 0:len(b)), i, j, cost
-        do i = 0, len(a)
-            d(i, 0) = i
-        end do
-        do j = 0, len(b)
-            d(0, j) = j
-        end do
-        do j = 1, len(b)
-            do i = 1, len(a)
-                cost = merge(0, 1, a(i:i) == b(j:j))
-                d(i, j) = min(d(i - 1, j) + 1, d(i, j - 1) + 1, d(i - 1, j - 1) + cost)
-                if (i > 1 .and. j > 1) then
-                    if (a(i:i) == b(j - 1:j - 1) .and. a(i - 1:i - 1) == b(j:j)) then
-                        d(i, j) = min(d(i, j), d(max(i - 2, 0), max(j - 2, 0)) + 1)
-                    end if
-                end if
-            end do
-        end do
-        dist = d(len(a), len(b))
-    end function edit_distance
 end module ropedyn_scene_keys
