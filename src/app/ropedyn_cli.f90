@@ -3,14 +3,10 @@
 module ropedyn_cli
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_USAGE
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, text_t
     implicit none
     private
     public :: cli_t, cli_from_command_line
-
-    type :: text_t
-        character(len=:), allocatable :: s
-    end type text_t
 
     type :: cli_t
         character(len=:), allocatable :: command  !< the subcommand, for messages

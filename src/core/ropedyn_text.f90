@@ -6,7 +6,7 @@ module ropedyn_text
     implicit none
     private
     public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, lower, line_quote
-    public :: text_t, append_text, printable
+    public :: text_t, append_text, text_array, printable
 
     !> A string of any length, for lists of strings of different lengths.
     type :: text_t
@@ -189,6 +189,21 @@ contains
             end if
         end do
     end function printable
+
+    !> A list of strings as a character array (as long as the longest, at least 1).
+    pure function text_array(list) result(arr)
+        type(text_t), intent(in) :: list(:)
+        character(len=:), allocatable :: arr(:)
+        integer :: k, width
+        width = 1
+        do k = 1, size(list)
+            width = max(width, len(list(k)%s))
+        end do
+        allocate (character(len=width) :: arr(size(list)))
+        do k = 1, size(list)
+            arr(k) = list(k)%s
+        end do
+    end function text_array
 
     !> Append one string to a list (grown by one).
     pure subroutine append_text(list, value)

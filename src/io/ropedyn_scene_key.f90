@@ -273,6 +273,8 @@ contains
         case default
             allowed = self%allowed
         end select
+        if (self%type == T_LOGICAL) allowed = '.true., .false.'
+        if (self%type == T_PATH) allowed = 'at most '//int_text(len(self%s))//' characters'
         text = group//TAB//self%name//TAB//type//TAB//self%unit//TAB//default//TAB// &
             allowed//TAB//self%doc
     end function key_listing

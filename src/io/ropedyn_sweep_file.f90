@@ -28,11 +28,11 @@ module ropedyn_sweep_file
         value_real, value_int, name_hint, V_STRING
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_case_file, only: case_data_t, read_case_file
-    use ropedyn_sweep_lists, only: dimension_t, build_dimensions, override_array, &
-        without_set, MAX_LIST, MAX_VARY, MAX_CASES
+    use ropedyn_sweep_lists, only: dimension_t, build_dimensions, without_set, MAX_LIST, &
+        MAX_VARY, MAX_CASES
     implicit none
     private
-    public :: sweep_file_t, dimension_t, read_sweep_file, override_array, without_set
+    public :: sweep_file_t, dimension_t, read_sweep_file, without_set
     public :: MAX_LIST, MAX_VARY, MAX_CASES, REF_NONE, REF_TIGHTEST, REF_FILE
 
     !> How the errors of the summary are measured.

@@ -6,11 +6,11 @@
 module ropedyn_sweep_lists
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
-    use ropedyn_text, only: int_text, real_text, lower, text_t, append_text
+    use ropedyn_text, only: int_text, real_text, lower, text_t, append_text, text_array
     use ropedyn_scene, only: scene_t, read_scene, check_override_value
     implicit none
     private
-    public :: dimension_t, build_dimensions, override_array, without_set
+    public :: dimension_t, build_dimensions, without_set
     public :: MAX_LIST, MAX_VARY, MAX_CASES
 
     integer, parameter :: MAX_LIST = 64     !< most values of one list key
@@ -229,7 +229,7 @@ contains
         type(text_t), allocatable :: all(:)
         all = set
         if (len(extra) > 0) call append_text(all, extra)
-        call read_scene(base, override_array(all), scene, err)
+        call read_scene(base, text_array(all), scene, err)
         if (.not. allocated(err)) return
         if (keep_set) then
             err%message = where//err%message
@@ -251,18 +251,4 @@ contains
         if (colon > 0) text = message(colon + 2:)
     end function without_set
 
-    !> Overrides as a character array for read_scene.
-    pure function override_array(list) result(arr)
-        type(text_t), intent(in) :: list(:)
-        character(len=:), allocatable :: arr(:)
-        integer :: k, width
-        width = 1
-        do k = 1, size(list)
-            width = max(width, len(list(k)%s))
-        end do
-        allocate (character(len=width) :: arr(size(list)))
-        do k = 1, size(list)
-            arr(k) = list(k)%s
-        end do
-    end function override_array
 end module ropedyn_sweep_lists

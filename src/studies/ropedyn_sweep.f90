@@ -7,12 +7,11 @@
 !! scene (`read_scene`), so a bad combination is reported before anything runs, naming the
 !! sweep file, the case and its overrides.
 module ropedyn_sweep
-    use ropedyn_kinds, only: wp
-    use ropedyn_text, only: int_text, real_text, text_t, append_text
+    use ropedyn_text, only: int_text, real_text, text_t, append_text, text_array
     use ropedyn_error, only: error_t
     use ropedyn_scene, only: scene_t, read_scene
-    use ropedyn_sweep_file, only: sweep_file_t, dimension_t, read_sweep_file, override_array, &
-        without_set, MAX_LIST, MAX_VARY, REF_NONE, REF_TIGHTEST, REF_FILE
+    use ropedyn_sweep_file, only: sweep_file_t, read_sweep_file, without_set, MAX_LIST, &
+        MAX_VARY, REF_NONE, REF_TIGHTEST, REF_FILE
     implicit none
     private
     public :: text_t, sweep_case_t, sweep_t, read_sweep, case_name
@@ -149,7 +148,7 @@ contains
         end do
         call append_text(all, 'output.file='//file)
         call append_text(all, 'output.progress=.false.')
-        arr = override_array(all)
+        arr = text_array(all)
     end function case_overrides
 
     pure function join(list) result(text)
