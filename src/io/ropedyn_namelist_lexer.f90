@@ -14,6 +14,9 @@ module ropedyn_namelist_lexer
         TK_LPAREN = 6, TK_RPAREN = 7, TK_GROUP = 8, TK_BAD_CHAR = 9, TK_BAD_QUOTE = 10
 
     character(len=*), parameter :: TAB = achar(9)
+    !> The one-character tokens and their kinds.
+    character(len=*), parameter :: PUNCTUATION_CHARS = '=,/()'
+    integer, parameter :: PUNCTUATION(5) = [TK_EQ, TK_COMMA, TK_SLASH, TK_LPAREN, TK_RPAREN]
     !> Characters that end a word.
     character(len=*), parameter :: WORD_END = ' ,/=()!&''"'//TAB
 
@@ -82,20 +85,8 @@ contains
                 end if
                 call add(TK_STRING, text, c, e)
                 c = e + 1
-            case ('=')
-                call add(TK_EQ, '=', c, c)
-                c = c + 1
-            case (',')
-                call add(TK_COMMA, ',', c, c)
-                c = c + 1
-            case ('/')
-                call add(TK_SLASH, '/', c, c)
-                c = c + 1
-            case ('(')
-                call add(TK_LPAREN, '(', c, c)
-                c = c + 1
-            case (')')
-                call add(TK_RPAREN, ')', c, c)
+            case ('=', ',', '/', '(', ')')
+                call add(PUNCTUATION(index(PUNCTUATION_CHARS, s(c:c))), s(c:c), c, c)
                 c = c + 1
             case ('&')
                 e = c + 1
@@ -127,11 +118,7 @@ contains
                 call move_alloc(grown, tk)
             end if
             n = n + 1
-            tk(n)%kind = kind
-            tk(n)%text = text
-            tk(n)%line = line
-            tk(n)%first = first
-            tk(n)%last = last
+            tk(n) = token_t(kind, text, line, first, last)
         end subroutine add
     end subroutine lex_line
 

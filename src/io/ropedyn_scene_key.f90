@@ -24,6 +24,13 @@ module ropedyn_scene_key
     integer, parameter :: R_NONE = 0, R_FINITE = 1, R_POSITIVE = 2, R_NONNEGATIVE = 3, &
         R_UNIT = 4, R_AT_LEAST = 5, R_NAMES = 6
 
+    !> The types' names in the listing, and what a value of each must be.
+    character(len=*), parameter :: TYPE_NAMES(7) = [character(len=8) :: 'real', 'integer', &
+        'logical', 'string', 'string', 'real, ', 'real, ']
+    character(len=*), parameter :: EXPECTED_TEXT(7) = [character(len=32) :: 'a real number', &
+        'an integer', '.true. or .false.', 'a quoted string', 'a quoted string', &
+        'two real numbers (x, y)', '']
+
     type :: scene_key_t
         integer :: group = 0
         character(len=:), allocatable :: name        !< lower case
@@ -106,29 +113,18 @@ contains
         integer, intent(in) :: index
         type(nml_value_t), intent(in) :: values(:)
         character(len=:), allocatable :: text
-        select case (key%type)
-        case (T_REAL)
-            text = 'expected a real number'
-        case (T_INT)
-            text = 'expected an integer'
-        case (T_LOGICAL)
-            text = 'expected .true. or .false.'
-        case (T_PAIR)
-            text = 'expected two real numbers (x, y)'
-            if (index > 0) text = 'expected a real number at an index 1 or 2'
-        case (T_LIST)
-            text = 'expected up to '//int_text(size(key%v))//' real numbers'
-            if (index > 0) text = 'expected a real number at an index 1 .. '// &
-                int_text(size(key%v))
-        case default
-            text = 'expected a quoted string'
-            if (size(values) == 1) then
-                if (values(1)%kind /= V_STRING) text = text//' ('//key%name//' = '// &
-                    quoted(values(1)%text)//')'
-            end if
-        end select
-        if (index > 0 .and. key%type /= T_PAIR .and. key%type /= T_LIST) &
+        text = 'expected '//trim(EXPECTED_TEXT(key%type))
+        if (key%type == T_LIST) text = 'expected up to '//int_text(size(key%v))//' real numbers'
+        if (key%type == T_PAIR .or. key%type == T_LIST) then
+            if (index > 0) text = 'expected a real number at an index 1 '// &
+                merge(' or ', ' .. ', key%type == T_PAIR)//int_text(size(key%v))
+        else if (index > 0) then
             text = text//' ('//key%name//' takes no index)'
+        end if
+        if ((key%type == T_NAME .or. key%type == T_PATH) .and. size(values) == 1) then
+            if (values(1)%kind /= V_STRING) text = text//' ('//key%name//' = '// &
+                quoted(values(1)%text)//')'
+        end if
     end function key_expected
 
     !> The key's own rule: '' if the value obeys it, else the reason. A name is stored in
@@ -236,18 +232,9 @@ contains
         character(len=*), intent(in) :: group
         character(len=:), allocatable :: text, type, default, allowed
         character(len=*), parameter :: TAB = achar(9)
-        select case (self%type)
-        case (T_REAL)
-            type = 'real'
-        case (T_INT)
-            type = 'integer'
-        case (T_LOGICAL)
-            type = 'logical'
-        case (T_NAME, T_PATH)
-            type = 'string'
-        case default
-            type = 'real, '//int_text(size(self%v))
-        end select
+        type = trim(TYPE_NAMES(self%type))
+        if (self%type == T_PAIR .or. self%type == T_LIST) type = type//' '// &
+            int_text(size(self%v))
         select case (self%type)
         case (T_NAME, T_PATH)
             default = quoted(trim(self%s))

@@ -191,14 +191,8 @@ contains
             integer, intent(in) :: group, type, rule
             character(len=*), intent(in) :: name, unit, doc
             n = n + 1
-            keys(n)%group = group
-            keys(n)%name = name
-            keys(n)%type = type
-            keys(n)%rule = rule
-            keys(n)%unit = unit
-            keys(n)%doc = doc
-            keys(n)%allowed = ''
-            keys(n)%unset = ''
+            keys(n) = scene_key_t(group=group, name=name, type=type, rule=rule, unit=unit, &
+                doc=doc, allowed='', unset='')
         end subroutine add
 
         subroutine add_real(group, name, x, rule, unit, doc)
