@@ -294,7 +294,7 @@ contains
             if (after > 0) then
                 call finish_assignment(p, file, where, err)
                 if (allocated(err)) return
-                call start_assignment(p, after, err)
+                call start_assignment(p, after, where, err)
             else if (.not. p%open) then
                 call make_error(err, ERR_INPUT, where//'line '//int_text(line)// &
                     ': expected key = value, found "'//printable(p%tk(p%j)%text)//'" (' &
@@ -321,7 +321,7 @@ contains
         case default
             if (p%open) then
                 call make_error(err, ERR_INPUT, where//'cannot read '//p%a%key//' = ' &
-                    //value_so_far(p, p%j)//': unexpected "'//p%tk(p%j)%text//'" (line ' &
+                    //value_so_far(p, p%end)//': unexpected "'//p%tk(p%j)%text//'" (line ' &
                     //int_text(line)//': '//line_quote(p%lines(line)%s)//')')
             else
                 call make_error(err, ERR_INPUT, where//'line '//int_text(line)// &
@@ -346,9 +346,10 @@ contains
     end function key_end
 
     !> Start the assignment whose key is tokens p%j .. eq - 1.
-    subroutine start_assignment(p, eq, err)
+    subroutine start_assignment(p, eq, where, err)
         type(parser_t), intent(inout) :: p
         integer, intent(in) :: eq
+        character(len=*), intent(in) :: where
         type(error_t), allocatable, intent(out) :: err
         character(len=:), allocatable :: name
         integer :: ios, line
@@ -364,7 +365,7 @@ contains
         allocate (p%a%values(0))
         if (verify(p%a%name, 'abcdefghijklmnopqrstuvwxyz0123456789_') > 0 .or. &
             verify(p%a%name(1:1), 'abcdefghijklmnopqrstuvwxyz') > 0) then
-            call make_error(err, ERR_INPUT, p%origin//': line '//int_text(line)//': "' &
+            call make_error(err, ERR_INPUT, where//'line '//int_text(line)//': "' &
                 //printable(name)//'" is not a key name ('//line_quote(p%lines(line)%s)//')')
             return
         end if
@@ -374,7 +375,7 @@ contains
             if (verify(p%tk(p%j + 2)%text, '0123456789') == 0 .and. &
                 len(p%tk(p%j + 2)%text) <= 9) read (p%tk(p%j + 2)%text, *, iostat=ios) i
             if (ios /= 0 .or. i < 1) then
-                call make_error(err, ERR_INPUT, p%origin//': line '//int_text(line)//': ' &
+                call make_error(err, ERR_INPUT, where//'line '//int_text(line)//': ' &
                     //printable(p%a%key)//': the index must be a whole number >= 1 (' &
                     //line_quote(p%lines(line)%s)//')')
                 return
