@@ -210,6 +210,7 @@ contains
         character(len=:), allocatable :: name, list
         integer :: k, line
 
+        call to_bad_token(p)
         associate (t => p%tk(p%j))
             line = t%line
             if (t%kind == TK_BAD_CHAR) then
@@ -269,6 +270,7 @@ contains
         integer :: line, after
 
         where = p%origin//': &'//file%groups(p%group)%name//': '
+        call to_bad_token(p)
         line = p%tk(p%j)%line
         select case (p%tk(p%j)%kind)
         case (TK_GROUP)
@@ -330,6 +332,15 @@ contains
             end if
         end select
     end subroutine inside
+
+    !> A control character right after the next token (which it cut short) is reported
+    !! first: move to it.
+    subroutine to_bad_token(p)
+        type(parser_t), intent(inout) :: p
+        if (p%j + 1 > size(p%tk)) return
+        if (p%tk(p%j + 1)%kind == TK_BAD_CHAR .and. p%tk(p%j + 1)%line == p%tk(p%j)%line &
+            .and. p%tk(p%j + 1)%first == p%tk(p%j)%last + 1) p%j = p%j + 1
+    end subroutine to_bad_token
 
     !> If tokens j.. are `name =` or `name ( int ) =`, the index of the '='; else 0.
     pure integer function key_end(tk, j) result(eq)

@@ -116,7 +116,7 @@ contains
         text = 'expected '//trim(EXPECTED_TEXT(key%type))
         if (key%type == T_LIST) text = 'expected up to '//int_text(size(key%v))//' real numbers'
         if (key%type == T_PAIR .or. key%type == T_LIST) then
-            if (index > 0) text = 'expected a real number at an index 1 '// &
+            if (index > 0) text = 'expected a real number at an index 1'// &
                 merge(' or ', ' .. ', key%type == T_PAIR)//int_text(size(key%v))
         else if (index > 0) then
             text = text//' ('//key%name//' takes no index)'

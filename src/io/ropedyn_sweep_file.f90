@@ -314,7 +314,8 @@ contains
         if (key%most == 1) expected = expected(:len(expected) - 1)
         if (key%most == 1) expected = replace_plural(expected)
         ok = first + size(a%values) - 1 <= key%most
-        if (.not. ok) expected = expected//' (at most '//int_text(key%most)//')'
+        if (.not. ok .and. key%most > 1) expected = expected//' (at most '// &
+            int_text(key%most)//')'
         do k = 1, size(a%values)
             if (.not. ok) exit
             associate (v => a%values(k), i => first + k - 1)
