@@ -45,16 +45,8 @@ contains
                 if (allocated(err)) return
                 call append_text(overrides, value)
             case default
-                if (cli%arg(1:min(1, len(cli%arg))) == '-') then
-                    call cli%usage_error('unknown option "'//cli%arg//'"', err)
-                    return
-                end if
-                if (allocated(scene_path)) then
-                    call cli%usage_error('more than one scene file: "'//scene_path//'", "'// &
-                                         cli%arg//'"', err)
-                    return
-                end if
-                scene_path = cli%arg
+                call cli%positional('scene file', scene_path, err)
+                if (allocated(err)) return
             end select
         end do
         if (.not. allocated(scene_path)) then

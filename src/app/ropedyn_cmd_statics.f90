@@ -61,20 +61,8 @@ contains
                 call cli%int_value(options%max_iterations, 1, err)
                 if (allocated(err)) return
             case default
-                if (len(cli%arg) == 0) then
-                    call cli%usage_error('empty argument', err)
-                    return
-                end if
-                if (cli%arg(1:1) == '-') then
-                    call cli%usage_error('unknown option "'//cli%arg//'"', err)
-                    return
-                end if
-                if (allocated(scene_path)) then
-                    call cli%usage_error('more than one scene file: "'//scene_path//'", "'// &
-                                         cli%arg//'"', err)
-                    return
-                end if
-                scene_path = cli%arg
+                call cli%positional('scene file', scene_path, err)
+                if (allocated(err)) return
             end select
         end do
         if (.not. allocated(scene_path)) then
