@@ -133,17 +133,21 @@ contains
         end if
     end function logical_text
 
-    !> A Fortran string literal: 'text', with embedded quotes doubled.
-    pure function quoted(text) result(s)
+    !> A Fortran string literal: 'text', with embedded quotes doubled; with `escape`, each
+    !! embedded quote is written as `escape` instead (a shell word: escape = "'\''").
+    pure function quoted(text, escape) result(s)
         character(len=*), intent(in) :: text
+        character(len=*), intent(in), optional :: escape
         character(len=:), allocatable :: s
         integer :: i
         s = "'"
         do i = 1, len(text)
-            if (text(i:i) == "'") then
-                s = s//"''"
-            else
+            if (text(i:i) /= "'") then
                 s = s//text(i:i)
+            else if (present(escape)) then
+                s = s//escape
+            else
+                s = s//"''"
             end if
         end do
         s = s//"'"
