@@ -6,7 +6,7 @@ module ropedyn_text
     implicit none
     private
     public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, lower, line_quote
-    public :: text_t, append_text, text_array, printable
+    public :: text_t, append_text, text_array, printable, clip, name_hint
 
     !> A string of any length, for lists of strings of different lengths.
     type :: text_t
@@ -182,17 +182,33 @@ contains
         character(len=*), intent(in) :: text
         character(len=:), allocatable :: s
         character(len=*), parameter :: HEX = '0123456789abcdef'
-        integer :: i, c
-        s = ''
+        character(len=:), allocatable :: buf
+        integer :: i, c, n
+        allocate (character(len=4*len(text)) :: buf)
+        n = 0
         do i = 1, len(text)
             c = iachar(text(i:i))
             if ((c < 32 .and. c /= 9) .or. c == 127) then
-                s = s//'\x'//HEX(c/16 + 1:c/16 + 1)//HEX(mod(c, 16) + 1:mod(c, 16) + 1)
+                buf(n + 1:n + 4) = '\x'//HEX(c/16 + 1:c/16 + 1)//HEX(mod(c, 16) + 1:mod(c, 16) + 1)
+                n = n + 4
             else
-                s = s//text(i:i)
+                buf(n + 1:n + 1) = text(i:i)
+                n = n + 1
             end if
         end do
+        s = buf(:n)
     end function printable
+
+    !> A value for a message: at most 60 characters (a longer one as its first 40 and '...').
+    pure function clip(text) result(s)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: s
+        if (len(text) > 60) then
+            s = text(:40)//'...'
+        else
+            s = text
+        end if
+    end function clip
 
     !> A list of strings as a character array (as long as the longest, at least 1).
     pure function text_array(list) result(arr)
@@ -224,4 +240,53 @@ contains
         grown(n + 1)%s = value
         call move_alloc(grown, list)
     end subroutine append_text
+    !> '; did you mean "x"?' for a near miss of one of `names`, else '; keys: ' and the list.
+    function name_hint(names, key) result(text)
+        type(text_t), intent(in) :: names(:)
+        character(len=*), intent(in) :: key
+        character(len=:), allocatable :: text
+        integer :: k, d, best, best_k
+        best = huge(1)
+        best_k = 0
+        text = ''
+        do k = 1, size(names)
+            d = huge(1)
+            if (len(key) <= 64) d = edit_distance(lower(key), names(k)%s)
+            if (d < best) then
+                best = d
+                best_k = k
+            end if
+            if (k > 1) text = text//', '
+            text = text//names(k)%s
+        end do
+        if (best_k > 0 .and. best <= 2) then
+            text = '; did you mean "'//names(best_k)%s//'"?'
+        else
+            text = '; keys: '//text
+        end if
+    end function name_hint
+
+    !> Optimal string alignment distance (Levenshtein with transpositions).
+    pure integer function edit_distance(a, b) result(dist)
+        character(len=*), intent(in) :: a, b
+        integer :: d(0:len(a), 0:len(b)), i, j, cost
+        do i = 0, len(a)
+            d(i, 0) = i
+        end do
+        do j = 0, len(b)
+            d(0, j) = j
+        end do
+        do j = 1, len(b)
+            do i = 1, len(a)
+                cost = merge(0, 1, a(i:i) == b(j:j))
+                d(i, j) = min(d(i - 1, j) + 1, d(i, j - 1) + 1, d(i - 1, j - 1) + cost)
+                if (i > 1 .and. j > 1) then
+                    if (a(i:i) == b(j - 1:j - 1) .and. a(i - 1:i - 1) == b(j:j)) then
+                        d(i, j) = min(d(i, j), d(max(i - 2, 0), max(j - 2, 0)) + 1)
+                    end if
+                end if
+            end do
+        end do
+        dist = d(len(a), len(b))
+    end function edit_distance
 end module ropedyn_text

@@ -14,7 +14,7 @@
 module ropedyn_namelist_file
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
-    use ropedyn_text, only: int_text, lower, line_quote, printable, text_t
+    use ropedyn_text, only: int_text, lower, line_quote, printable, text_t, clip
     use ropedyn_namelist_lexer, only: token_t, lex_lines, TK_WORD, TK_STRING, TK_EQ, &
         TK_COMMA, TK_SLASH, TK_LPAREN, TK_RPAREN, TK_GROUP, TK_BAD_CHAR, TK_BAD_QUOTE
     use ropedyn_namelist_values, only: nml_value_t, value_token, parse_values, value_real, &
@@ -23,10 +23,11 @@ module ropedyn_namelist_file
     private
     public :: nml_value_t, nml_assignment_t, nml_group_t, nml_file_t
     public :: read_namelist_file, parse_namelist_lines, parse_values
-    public :: value_real, value_int, value_logical, name_hint
-    public :: V_WORD, V_STRING, MAX_FILE_BYTES, MAX_VALUES
+    public :: value_real, value_int, value_logical
+    public :: V_WORD, V_STRING, MAX_FILE_BYTES, MAX_VALUES, MAX_ASSIGNMENTS
 
-    integer, parameter :: MAX_FILE_BYTES = 4194304  !< largest file read (4 MiB)
+    integer, parameter :: MAX_FILE_BYTES = 1048576  !< largest file read (1 MiB)
+    integer, parameter :: MAX_ASSIGNMENTS = 1000    !< most assignments in one group
 
     !> `key = values` or `key(index) = values`.
     type :: nml_assignment_t
@@ -66,6 +67,7 @@ module ropedyn_namelist_file
         type(nml_assignment_t) :: a
         integer :: eq = 0                  !< the token '=' of the assignment
         integer :: end = 0                 !< its last token so far
+        integer :: count = 0               !< assignments of the open group so far
     end type parser_t
 
 contains
@@ -230,7 +232,7 @@ contains
                     ' (a group starts with &name and ends with /)')
                 return
             end if
-            name = t%text
+            name = clip(printable(t%text))
         end associate
         if (.not. any(allowed == name)) then
             list = trim(allowed(1))
@@ -239,7 +241,7 @@ contains
             end do
             if (present(hint)) list = hint
             if (.not. present(hint)) list = 'groups: '//list
-            call make_error(err, ERR_INPUT, p%origin//': &'//printable(name)// &
+            call make_error(err, ERR_INPUT, p%origin//': &'//name// &
                 ': unknown group (line '//int_text(line)//': '// &
                 line_quote(p%lines(line)%s)//'; '//list//')')
             return
@@ -258,6 +260,7 @@ contains
         call move_alloc(grown, file%groups)
         p%group = size(file%groups)
         p%open = .false.
+        p%count = 0
         p%j = p%j + 1
     end subroutine outside
 
@@ -299,7 +302,7 @@ contains
                 call start_assignment(p, after, where, err)
             else if (.not. p%open) then
                 call make_error(err, ERR_INPUT, where//'line '//int_text(line)// &
-                    ': expected key = value, found "'//printable(p%tk(p%j)%text)//'" (' &
+                    ': expected key = value, found "'//clip(printable(p%tk(p%j)%text))//'" (' &
                     //line_quote(p%lines(line)%s)//')')
             else
                 call take_value(p, where, err)
@@ -323,11 +326,11 @@ contains
         case default
             if (p%open) then
                 call make_error(err, ERR_INPUT, where//'cannot read '//p%a%key//' = ' &
-                    //value_so_far(p, p%end)//': unexpected "'//p%tk(p%j)%text//'" (line ' &
-                    //int_text(line)//': '//line_quote(p%lines(line)%s)//')')
+                    //clip(value_so_far(p, p%end))//': unexpected "'//clip(p%tk(p%j)%text)// &
+                    '" (line '//int_text(line)//': '//line_quote(p%lines(line)%s)//')')
             else
                 call make_error(err, ERR_INPUT, where//'line '//int_text(line)// &
-                    ': expected key = value, found "'//p%tk(p%j)%text//'" (' &
+                    ': expected key = value, found "'//clip(p%tk(p%j)%text)//'" (' &
                     //line_quote(p%lines(line)%s)//')')
             end if
         end select
@@ -369,7 +372,7 @@ contains
         line = p%tk(p%j)%line
         name = p%tk(p%j)%text
         p%a = nml_assignment_t()
-        p%a%key = name
+        p%a%key = clip(printable(name))
         p%a%name = lower(name)
         p%a%line = line
         p%a%line_text = p%lines(line)%s
@@ -377,17 +380,17 @@ contains
         if (verify(p%a%name, 'abcdefghijklmnopqrstuvwxyz0123456789_') > 0 .or. &
             verify(p%a%name(1:1), 'abcdefghijklmnopqrstuvwxyz') > 0) then
             call make_error(err, ERR_INPUT, where//'line '//int_text(line)//': "' &
-                //printable(name)//'" is not a key name ('//line_quote(p%lines(line)%s)//')')
+                //p%a%key//'" is not a key name ('//line_quote(p%lines(line)%s)//')')
             return
         end if
         if (eq > p%j + 1) then
-            p%a%key = name//'('//p%tk(p%j + 2)%text//')'
+            p%a%key = p%a%key//'('//clip(printable(p%tk(p%j + 2)%text))//')'
             ios = 1
             if (verify(p%tk(p%j + 2)%text, '0123456789') == 0 .and. &
                 len(p%tk(p%j + 2)%text) <= 9) read (p%tk(p%j + 2)%text, *, iostat=ios) i
             if (ios /= 0 .or. i < 1) then
                 call make_error(err, ERR_INPUT, where//'line '//int_text(line)//': ' &
-                    //printable(p%a%key)//': the index must be a whole number >= 1 (' &
+                    //p%a%key//': the index must be a whole number >= 1 (' &
                     //line_quote(p%lines(line)%s)//')')
                 return
             end if
@@ -410,7 +413,7 @@ contains
         call value_token(p%tk, p%j, p%a%values, used, reason)
         if (len(reason) > 0) then
             call make_error(err, ERR_INPUT, where//'cannot read '//p%a%key//' = ' &
-                //value_so_far(p, p%j + max(used, 1) - 1)//': '//reason//' (line ' &
+                //clip(value_so_far(p, p%j + max(used, 1) - 1))//': '//reason//' (line ' &
                 //int_text(p%tk(p%j)%line)//': '//line_quote(p%lines(p%tk(p%j)%line)%s)//')')
             return
         end if
@@ -442,11 +445,12 @@ contains
             if (len(text) > 0) text = text//' '
             text = text//trim(adjustl(p%lines(line)%s(a:b)))
         end do
-        text = printable(trim(text))
+        text = trim(text)
         do while (len(text) > 0)
             if (text(len(text):) /= ',') exit
             text = trim(text(:len(text) - 1))
         end do
+        text = printable(text)
     end function value_so_far
 
     !> End the open assignment (if any) and store it in the group.
@@ -461,15 +465,23 @@ contains
             return
         end if
         p%a%value_text = value_so_far(p, p%end)
-        block
-            type(nml_assignment_t), allocatable :: grown(:)
-            integer :: n
-            n = size(file%groups(p%group)%assignments)
-            allocate (grown(n + 1))
-            grown(:n) = file%groups(p%group)%assignments
-            grown(n + 1) = p%a
-            call move_alloc(grown, file%groups(p%group)%assignments)
-        end block
+        if (p%count == MAX_ASSIGNMENTS) then
+            call make_error(err, ERR_INPUT, where//'more than '//int_text(MAX_ASSIGNMENTS)// &
+                ' keys in one group (line '//int_text(p%a%line)//')')
+            return
+        end if
+        associate (g => file%groups(p%group))
+            if (p%count == size(g%assignments)) then
+                block
+                    type(nml_assignment_t), allocatable :: grown(:)
+                    allocate (grown(max(16, 2*p%count)))
+                    grown(:p%count) = g%assignments(:p%count)
+                    call move_alloc(grown, g%assignments)
+                end block
+            end if
+            p%count = p%count + 1
+            g%assignments(p%count) = p%a
+        end associate
         p%open = .false.
     end subroutine finish_assignment
 
@@ -496,6 +508,7 @@ contains
         type(error_t), allocatable, intent(out) :: err
         call finish_assignment(p, file, p%origin//': &'//file%groups(p%group)%name//': ', err)
         if (allocated(err)) return
+        file%groups(p%group)%assignments = file%groups(p%group)%assignments(:p%count)
         p%closed_line = p%tk(p%j)%line
         p%group = 0
         p%j = p%j + 1
@@ -530,53 +543,4 @@ contains
         end do
     end subroutine check_duplicates
 
-    !> '; did you mean "x"?' for a near miss of one of `names`, else '; keys: ' and the list.
-    function name_hint(names, key) result(text)
-        type(text_t), intent(in) :: names(:)
-        character(len=*), intent(in) :: key
-        character(len=:), allocatable :: text
-        integer :: k, d, best, best_k
-        best = huge(1)
-        best_k = 0
-        text = ''
-        do k = 1, size(names)
-            d = huge(1)
-            if (len(key) <= 64) d = edit_distance(lower(key), names(k)%s)
-            if (d < best) then
-                best = d
-                best_k = k
-            end if
-            if (k > 1) text = text//', '
-            text = text//names(k)%s
-        end do
-        if (best_k > 0 .and. best <= 2) then
-            text = '; did you mean "'//names(best_k)%s//'"?'
-        else
-            text = '; keys: '//text
-        end if
-    end function name_hint
-
-    !> Optimal string alignment distance (Levenshtein with transpositions).
-    pure integer function edit_distance(a, b) result(dist)
-        character(len=*), intent(in) :: a, b
-        integer :: d(0:len(a), 0:len(b)), i, j, cost
-        do i = 0, len(a)
-            d(i, 0) = i
-        end do
-        do j = 0, len(b)
-            d(0, j) = j
-        end do
-        do j = 1, len(b)
-            do i = 1, len(a)
-                cost = merge(0, 1, a(i:i) == b(j:j))
-                d(i, j) = min(d(i - 1, j) + 1, d(i, j - 1) + 1, d(i - 1, j - 1) + cost)
-                if (i > 1 .and. j > 1) then
-                    if (a(i:i) == b(j - 1:j - 1) .and. a(i - 1:i - 1) == b(j:j)) then
-                        d(i, j) = min(d(i, j), d(max(i - 2, 0), max(j - 2, 0)) + 1)
-                    end if
-                end if
-            end do
-        end do
-        dist = d(len(a), len(b))
-    end function edit_distance
 end module ropedyn_namelist_file

@@ -64,13 +64,9 @@ contains
             case (' ', TAB)
                 c = c + 1
             case ('!')
-                do e = c + 1, len(s)
-                    if (control_at(s(e:e)) >= 0) then
-                        call add(TK_BAD_CHAR, 'control character '//printable(s(e:e))// &
-                            ' at column '//int_text(e)//' (in a comment)', e, e)
-                        return
-                    end if
-                end do
+                e = first_control(s(c + 1:))
+                if (e > 0) call add(TK_BAD_CHAR, 'control character '//printable(s(c + e:c + e)) &
+                    //' at column '//int_text(c + e)//' (in a comment)', c + e, c + e)
                 return
             case ("'", '"')
                 call string_at(s, c, text, e, bad)
@@ -132,31 +128,46 @@ contains
         integer, intent(out) :: e, bad
         character :: q
         integer :: i
+        integer :: j, k
         q = s(c:c)
         text = ''
         e = 0
         bad = 0
         i = c + 1
-        do while (i <= len(s))
-            if (control_at(s(i:i)) >= 0) then
-                bad = i
+        do
+            j = index(s(i:), q)     ! the next quote; a doubled one stands for one
+            if (j == 0) then
+                k = first_control(s(i:))
+                if (k > 0) bad = i + k - 1
                 return
             end if
-            if (s(i:i) == q) then
-                if (i < len(s)) then
-                    if (s(i + 1:i + 1) == q) then
-                        text = text//q
-                        i = i + 2
-                        cycle
-                    end if
+            k = first_control(s(i:i + j - 2))
+            if (k > 0) then
+                bad = i + k - 1
+                return
+            end if
+            text = text//s(i:i + j - 2)
+            i = i + j
+            if (i <= len(s)) then
+                if (s(i:i) == q) then
+                    text = text//q
+                    i = i + 1
+                    cycle
                 end if
-                e = i
-                return
             end if
-            text = text//s(i:i)
-            i = i + 1
+            e = i - 1
+            return
         end do
     end subroutine string_at
+
+    !> Position of the first control character in s, 0 if there is none.
+    pure integer function first_control(s) result(k)
+        character(len=*), intent(in) :: s
+        do k = 1, len(s)
+            if (control_at(s(k:k)) >= 0) return
+        end do
+        k = 0
+    end function first_control
 
     !> The code of a control character (other than tab), else -1.
     elemental integer function control_at(ch) result(code)

@@ -10,7 +10,7 @@
 !! `--set` argument), the group, the key and the value.
 module ropedyn_scene
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
-    use ropedyn_text, only: int_text, lower, line_quote, printable, text_t
+    use ropedyn_text, only: int_text, lower, line_quote, printable, text_t, clip
     use ropedyn_namelist_file, only: nml_file_t, nml_value_t, read_namelist_file, &
         parse_values, V_STRING
     use ropedyn_scene_types, only: scene_t, solver_params_t, output_params_t
@@ -92,14 +92,14 @@ contains
                 line = ' (line '//int_text(a%line)//': '//line_quote(a%line_text)//')'
                 ki = find_key(keys, g, a%name)
                 if (ki == 0) then
-                    call make_error(err, ERR_INPUT, where//'unknown key "'//printable(a%key)// &
+                    call make_error(err, ERR_INPUT, where//'unknown key "'//a%key// &
                         '"'//line//key_hint(keys, g, a%name))
                     return
                 end if
                 call keys(ki)%assign(a%values, a%index, reason)
                 if (len(reason) > 0) then
                     call make_error(err, ERR_INPUT, where//'cannot read '//a%key//' = '// &
-                        short(a%value_text)//': '//reason//line)
+                        clip(a%value_text)//': '//reason//line)
                     return
                 end if
                 keys(ki)%origin = file%origin
@@ -117,7 +117,7 @@ contains
         integer :: eq, dot, paren
 
         s = trim(adjustl(arg))
-        ov%text = printable(s)
+        ov%text = clip(printable(s))
         loc = '--set '//ov%text
         eq = index(s, '=')
         if (eq <= 1) then
@@ -135,7 +135,7 @@ contains
         ov%name = lower(trim(adjustl(lhs(dot + 1:))))
         ov%group = group_index(group)
         if (ov%group == 0) then
-            call make_error(err, ERR_INPUT, loc//': unknown group "'//printable(group)// &
+            call make_error(err, ERR_INPUT, loc//': unknown group "'//clip(printable(group))// &
                 '" (groups: '//group_list()//')')
             return
         end if
@@ -154,13 +154,13 @@ contains
         end if
         ov%key = find_key(keys, ov%group, base)
         if (ov%key == 0) then
-            call make_error(err, ERR_INPUT, loc//'unknown key "'//printable(ov%name)//'"' &
+            call make_error(err, ERR_INPUT, loc//'unknown key "'//clip(printable(ov%name))//'"' &
                 //key_hint(keys, ov%group, base))
             return
         end if
         call override_values(keys(ov%key), ov%value, ov%values, reason)
         if (len(reason) > 0) call make_error(err, ERR_INPUT, loc//'cannot read '//ov%name// &
-            ' = '//short(ov%value)//': '//reason)
+            ' = '//clip(ov%value)//': '//reason)
     end subroutine parse_override
 
     !> The values of `--set group.key=value`: a bare string for a string key, else namelist
@@ -198,7 +198,7 @@ contains
         if (len(reason) > 0) then
             call make_error(err, ERR_INPUT, '--set '//ov%text//': &'// &
                 trim(GROUP_NAMES(ov%group))//': cannot read '//ov%name//' = '// &
-                short(ov%value)//': '//reason)
+                clip(ov%value)//': '//reason)
             return
         end if
         keys(ov%key)%origin = '--set '//ov%text
@@ -223,13 +223,6 @@ contains
         reason = keys(ov%key)%check()
     end function check_override_value
 
-    !> A value for a message: at most 60 characters.
-    pure function short(text) result(s)
-        character(len=*), intent(in) :: text
-        character(len=:), allocatable :: s
-        s = text
-        if (len(s) > 60) s = s(:40)//'...'
-    end function short
 
     !> The effective scene as namelist text: all groups and keys, one per line,
     !! re-readable by `read_scene`.

@@ -11,8 +11,7 @@ module ropedyn_scene_keys
     use ropedyn_scene_key, only: scene_key_t, T_REAL, T_INT, T_LOGICAL, T_NAME, T_PATH, &
         T_PAIR, T_LIST, R_NONE, R_FINITE, R_POSITIVE, R_NONNEGATIVE, R_UNIT, R_AT_LEAST, &
         R_NAMES
-    use ropedyn_text, only: text_t, append_text
-    use ropedyn_namelist_file, only: name_hint
+    use ropedyn_text, only: text_t, append_text, name_hint
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     implicit none
     private

@@ -22,10 +22,10 @@ module ropedyn_sweep_file
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
-    use ropedyn_text, only: int_text, real_text, lower, line_quote, text_t, append_text
+    use ropedyn_text, only: int_text, real_text, lower, line_quote, text_t, clip, name_hint
     use ropedyn_os, only: unwritable_dir
     use ropedyn_namelist_file, only: nml_file_t, nml_assignment_t, read_namelist_file, &
-        value_real, value_int, name_hint, V_STRING
+        value_real, value_int, V_STRING
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_sweep_lists, only: dimension_t, build_dimensions, without_set, MAX_LIST, &
@@ -114,7 +114,7 @@ contains
         sweep%base = relative_to(dir, raw(K_BASE)%text(1)%s)
         call read_scene(sweep%base, [character(len=1) ::], scene, err)
         if (allocated(err)) then
-            err%message = where//'base = "'//raw(K_BASE)%text(1)%s//'": '//err%message
+            err%message = where//'base = "'//clip(raw(K_BASE)%text(1)%s)//'": '//err%message
             return
         end if
 
@@ -280,6 +280,7 @@ contains
                 end do
                 do i = r%n + 2, size(r%given)
                     if (.not. r%given(i)) cycle
+                    r%text(i)%s = clip(r%text(i)%s)
                     if (KEYS(k)%type == 's') r%text(i)%s = '"'//r%text(i)%s//'"'
                     call make_error(err, ERR_INPUT, path//': &sweep: '//trim(KEYS(k)%name)// &
                         '('//int_text(i)//') = '//r%text(i)%s//': given, but '// &
@@ -335,7 +336,7 @@ contains
             end associate
         end do
         if (.not. ok) call make_error(err, ERR_INPUT, path//': &sweep: cannot read '//a%key// &
-            ' = '//a%value_text//': '//expected//' (line '//int_text(a%line)//': '// &
+            ' = '//clip(a%value_text)//': '//expected//' (line '//int_text(a%line)//': '// &
             line_quote(a%line_text)//')')
     end subroutine store
 

@@ -6,7 +6,7 @@
 module ropedyn_sweep_lists
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
-    use ropedyn_text, only: int_text, real_text, lower, text_t, append_text, text_array
+    use ropedyn_text, only: int_text, real_text, lower, text_t, append_text, text_array, clip
     use ropedyn_scene, only: scene_t, read_scene, check_override_value
     implicit none
     private
@@ -105,9 +105,9 @@ contains
         integer :: i
         if (d%key(1:min(4, len(d%key))) == 'vary') then
             read (d%key(6:len(d%key) - 1), *) i
-            text = d%key//' = "'//trim(adjustl(vary_in(i)%s))//'", value '//int_text(k)
+            text = d%key//' = "'//clip(trim(adjustl(vary_in(i)%s)))//'", value '//int_text(k)
         else
-            text = d%key//'('//int_text(k)//') = "'//d%values(k)%s//'"'
+            text = d%key//'('//int_text(k)//') = "'//clip(d%values(k)%s)//'"'
         end if
     end function label
 
@@ -119,7 +119,7 @@ contains
         character(len=:), allocatable :: reason, shown
         integer :: k, j
         do k = 1, size(d%values)
-            shown = d%values(k)%s
+            shown = clip(d%values(k)%s)
             if (d%key == 'models' .or. d%key == 'methods') shown = '"'//shown//'"'
             reason = check_override_value(d%target//'='//d%values(k)%s)
             if (len(reason) == 0) then
@@ -146,15 +146,16 @@ contains
         type(text_t), allocatable, intent(inout) :: targets(:)
         type(dimension_t), intent(out) :: d
         type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: entry, values, value, key
+        character(len=:), allocatable :: entry, values, value, key, shown
         integer :: eq, k, j
         entry = trim(adjustl(text))
+        shown = clip(entry)
         key = 'vary('//int_text(i)//')'
         d%key = key
         allocate (d%values(0))
         eq = index(entry, '=')
         if (eq <= 1) then
-            call make_error(err, ERR_INPUT, key//' = "'//entry//'": expected "group.key = ' &
+            call make_error(err, ERR_INPUT, key//' = "'//shown//'": expected "group.key = ' &
                 //'value1; value2; ..."')
             return
         end if
@@ -167,13 +168,13 @@ contains
             if (k == 0) k = len(values) + 1
             value = trim(adjustl(values(:k - 1)))
             if (len(value) == 0) then
-                call make_error(err, ERR_INPUT, key//' = "'//entry//'": empty value (values ' &
+                call make_error(err, ERR_INPUT, key//' = "'//shown//'": empty value (values ' &
                     //'are separated by ";")')
                 return
             end if
             do j = 1, size(d%values)
                 if (lower(d%values(j)%s) /= lower(value)) cycle
-                call make_error(err, ERR_INPUT, key//' = "'//entry//'": value "'//value// &
+                call make_error(err, ERR_INPUT, key//' = "'//shown//'": value "'//value// &
                     '" given twice: a case would run twice')
                 return
             end do
@@ -191,11 +192,12 @@ contains
         logical, intent(in) :: atol_given
         type(text_t), allocatable, intent(inout) :: targets(:)
         type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: target, list
+        character(len=:), allocatable :: target, list, shown
         integer :: eq, k
+        shown = clip(entry)
         eq = index(entry, '=')
         if (eq == 0) then
-            call make_error(err, ERR_INPUT, key//' = "'//entry//'": expected group.key=value')
+            call make_error(err, ERR_INPUT, key//' = "'//shown//'": expected group.key=value')
             return
         end if
         target = lower(trim(adjustl(entry(:eq - 1))))
@@ -205,13 +207,13 @@ contains
         end do
         if (target == 'solver.atol' .and. atol_given) list = 'atol_per_rtol'
         if (target == 'output.file' .or. target == 'output.progress') then
-            call make_error(err, ERR_INPUT, key//' = "'//entry//'": '//target// &
+            call make_error(err, ERR_INPUT, key//' = "'//shown//'": '//target// &
                 ' is set by the sweep for every case (use output_dir)')
         else if (len(list) > 0) then
-            call make_error(err, ERR_INPUT, key//' = "'//entry//'": '//target// &
+            call make_error(err, ERR_INPUT, key//' = "'//shown//'": '//target// &
                 ' is already set by '//list)
         else if (any([(targets(k)%s == target, k = 1, size(targets))])) then
-            call make_error(err, ERR_INPUT, key//' = "'//entry//'": '//target// &
+            call make_error(err, ERR_INPUT, key//' = "'//shown//'": '//target// &
                 ' is already set by another set or vary entry')
         else
             call append_text(targets, target)

@@ -205,7 +205,7 @@ contains
         write (unit) big
         close (unit)
         call read_namelist_file(DIR//'/big.nml', GROUPS, f, err)
-        call expect(err, [character(len=40) :: 'big.nml: 4194314 bytes: too large'], &
+        call expect(err, [character(len=40) :: 'big.nml: 1048586 bytes: too large'], &
             'file too large')
         open (newunit=unit, file=DIR//'/empty.nml', status='replace')
         close (unit)
@@ -280,5 +280,7 @@ contains
             'cannot read x = 1: unexpected "("'], 'parenthesis in a value')
         call parse_error('&end', [character(len=L) :: 'text outside any group'], &
             '&end outside a group')
+        call parse_error('&rope|'//repeat('x = 1|', 1001)//'/', [character(len=L) :: &
+            'x.nml: &rope: more than 1000 keys in one group (line 1002)'], 'too many keys')
     end subroutine test_errors
 end program test_namelist_file

@@ -68,7 +68,8 @@ contains
             do
                 comma = index(names, ',')
                 if (comma == 0) exit
-                if (names(:comma - 1) /= trim(key%s)) call append_text(values, "'"//names(:comma - 1)//"'")
+                if (names(:comma - 1) /= trim(key%s)) &
+                    call append_text(values, "'"//names(:comma - 1)//"'")
                 names = adjustl(names(comma + 1:))
             end do
         case (T_PATH)
