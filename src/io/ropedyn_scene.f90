@@ -53,6 +53,11 @@ contains
         integer :: i, g, k
 
         scene%path = trim(path)
+        if (printable(scene%path) /= scene%path) then
+            call make_error(err, ERR_INPUT, printable(scene%path)//': a control character in ' &
+                //'the file name')
+            return
+        end if
         call bind_keys(scene, keys)
         allocate (ov(size(overrides)))
         do i = 1, size(overrides)
@@ -119,6 +124,10 @@ contains
         s = trim(adjustl(arg))
         ov%text = clip(printable(s))
         loc = '--set '//ov%text
+        if (printable(s) /= s) then
+            call make_error(err, ERR_INPUT, loc//': a control character in the argument')
+            return
+        end if
         eq = index(s, '=')
         if (eq <= 1) then
             call make_error(err, ERR_INPUT, loc//': expected group.key=value')

@@ -28,6 +28,7 @@ program test_scene_keys
         call round_trip(keys(k))
     end do
     call test_listing()
+    call test_control_character()
     call suite%finish()
 
 contains
@@ -139,6 +140,20 @@ contains
         if (.not. allocated(err)) call suite%check_true(scene_namelist_text(c) == echo, &
             group//'.'//key%name//': --set gives the same scene as the file')
     end subroutine round_trip
+
+    !> A control character in a --set value (a new line in a file name would break the
+    !! echo) is an error.
+    subroutine test_control_character()
+        type(scene_t) :: s
+        type(error_t), allocatable :: err
+        character(len=40) :: arg(1)
+        call write_file(DIR//'/model.nml', '&model /')
+        arg(1) = 'output.file=a'//new_line('a')//'b.h5'
+        call read_scene(DIR//'/model.nml', arg, s, err)
+        call suite%check_true(allocated(err), '--set with a new line: an error')
+        if (allocated(err)) call suite%check_true(index(err%message, &
+            '--set output.file=a\x0ab.h5: a control character') == 1, err%message)
+    end subroutine test_control_character
 
     !> `ropedyn keys` lists every key once with the default of a fresh scene.
     subroutine test_listing()
