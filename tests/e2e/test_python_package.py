@@ -24,6 +24,7 @@ COMMANDS = {
     "bench_models": "ropedyn.studies.bench_models",
     "bench_rfem": "ropedyn.studies.bench_rfem",
     "bench_sweep": "ropedyn.studies.bench_sweep",
+    "profile_step": "ropedyn.studies.profile_step",
     "validation": "ropedyn.studies.validation",
     "work_precision": "ropedyn.studies.work_precision",
     "work_precision_testset": "ropedyn.studies.work_precision_testset",
