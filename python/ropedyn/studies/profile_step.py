@@ -45,9 +45,11 @@ def inclusive_costs(cg_file):
     return costs
 
 
-def total_of(costs, *needles):
-    """Sum of the inclusive costs of the functions whose names end with one of needles."""
-    return sum(v for k, v in costs.items() if any(k.endswith(n) for n in needles))
+def total_of(costs, *names):
+    """Sum of the inclusive costs of the functions named: C functions by their exact name,
+    Fortran module procedures ('_MOD_name') by the end of their mangled name."""
+    return sum(v for k, v in costs.items()
+               if any(k.endswith(n) if n.startswith("_MOD_") else k == n for n in names))
 
 
 def split(costs, method):
