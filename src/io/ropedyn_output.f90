@@ -15,8 +15,9 @@
 !!     /solver/{steps, rhs_evals, jac_evals, lin_setups, err_test_fails, nonlin_iters,
 !!              nonlin_conv_fails} () int64 1;  /solver/cpu_time () s   (write_stats)
 !!     /solver/{time_advance, time_rhs, time_jacobian, time_factor, time_solve} () s: the
-!!              time in the integrator and where it went (&solver profile = .true.; else 0);  /solver/reduced_newton () int64 1:
-!!              1 when the Newton systems were solved on the reduced second-order matrix
+!!              time in the integrator and where it went (&solver profile = .true.; else 0)
+!!     /solver/reduced_newton () int64 1: 1 when the Newton systems were solved on the
+!!              reduced second-order matrix
 !!
 !! Root attributes: status ('running' | 'complete' | 'failed'), reason (failed only),
 !! version, model, method, scene, created, units_convention. See docs/output.md.
