@@ -147,7 +147,7 @@ contains
         write (*, '(a, 2f12.7, a)') '  drag: speed', maxval(qdot(1, :)), v_term, ' m/s'
         call suite%check_le(maxval(abs(qdot(1, :) - v_term))/v_term, 1.0e-5_wp, &
                             'drag: terminal speed = sqrt(2 lambda g/(rho C_n d))')
-        call suite%check_le(run%e(ubound(run%e, 1))%balance() - run%e(0)%balance(), &
+        call suite%check_le(abs(run%e(ubound(run%e, 1))%balance() - run%e(0)%balance()), &
                             1.0e-6_wp, 'drag: energy balance')
 
         call simulate([character(len=64) :: base, 'fluid.density = 0', &
