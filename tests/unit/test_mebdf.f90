@@ -374,8 +374,11 @@ contains
         end do
     end subroutine test_observed_order
 
-    !> Adaptive runs on the stiff linear problem: error within a small multiple of rtol,
-    !! shrinking with rtol; the max_order limit is respected.
+    !> Adaptive runs on the stiff linear problem: the error is proportional to rtol with the
+    !! same factor at every tolerance (measured: 2.41, 2.29, 2.18 rtol at rtol 1e-4, 1e-7,
+    !! 1e-10, Debug and Release alike), checked to +-50 % of 2.3: the band is narrow on
+    !! purpose, since it guards the scale of the error estimate (a halved estimate doubles
+    !! the error: 4.4 rtol); the max_order limit is respected.
     subroutine test_adaptive_accuracy()
         type(linear_t), target :: p
         type(mebdf_t) :: integ
@@ -403,7 +406,8 @@ contains
             st = integ%stats()
             write (label, '(a, es8.1, a, es9.2, a, i0, a)') 'adaptive rtol ', rtols(m), &
                 ': max error at 20 output times ', e(m), ' (', st%steps, ' steps)'
-            call suite%check_le(e(m), 10.0_wp*rtols(m), trim(label))
+            call suite%check_close(e(m)/rtols(m), 2.3_wp, 0.5_wp, 0.0_wp, trim(label)// &
+                                   ': error/rtol = 2.3 +- 50 % (the error estimate''s scale)')
             call suite%check_true(all(st%order_steps(5:) == 0) .and. st%order_steps(4) > 0, &
                                   'default max_order 4 is used and respected')
             call suite%check_true(t == tout, 'output time hit exactly')
