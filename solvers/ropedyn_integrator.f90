@@ -5,7 +5,8 @@
 !! An integrator keeps all its state in the object: two integrators never interfere.
 module ropedyn_integrator
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_error, only: error_t
+    use ropedyn_error, only: error_t, make_error, ERR_SOLVER
+    use ropedyn_text, only: int_text
     use ropedyn_problem, only: problem_t
     use ropedyn_methods, only: METHODS, method_index
     implicit none
@@ -58,6 +59,7 @@ module ropedyn_integrator
         procedure :: default_max_order => integrator_default_max_order
         procedure :: min_order => integrator_min_order
         procedure :: max_order_limit => integrator_max_order_limit
+        procedure :: check_options => integrator_check_options
     end type integrator_t
 
     abstract interface
@@ -127,4 +129,26 @@ contains
         class(integrator_t), intent(in) :: self
         order = METHODS(method_index(self%name()))%highest_order
     end function integrator_max_order_limit
+
+    !> The checks every `init` starts with: the order limit to use (options%max_order, the
+    !! method's default when 0) within the method's range, per-component absolute tolerances
+    !! for the `n` unknowns of the state.
+    subroutine integrator_check_options(self, options, n, max_order, err)
+        class(integrator_t), intent(in) :: self
+        type(solver_options_t), intent(in) :: options
+        integer, intent(in) :: n                 !< unknowns of the state
+        integer, intent(out) :: max_order        !< the order limit to use
+        type(error_t), allocatable, intent(out) :: err
+        max_order = options%max_order
+        if (max_order == 0) max_order = self%default_max_order()
+        if (max_order < self%min_order() .or. max_order > self%max_order_limit()) then
+            call make_error(err, ERR_SOLVER, self%name()//': max_order must be '// &
+                            int_text(self%min_order())//' .. '//int_text(self%max_order_limit()))
+            return
+        end if
+        if (allocated(options%atol_vector)) then
+            if (size(options%atol_vector) /= n) &
+                call make_error(err, ERR_SOLVER, self%name()//': atol_vector has the wrong size')
+        end if
+    end subroutine integrator_check_options
 end module ropedyn_integrator

@@ -63,6 +63,9 @@ module ropedyn_cvode
         final :: cvode_destroy
     end type cvode_t
 
+    !> What `evaluate` evaluates.
+    integer, parameter :: EVAL_RHS = 1, EVAL_QUAD = 2
+
     interface
         pure integer(c_size_t) function c_strlen(s) bind(C, name='strlen')
             import :: c_ptr, c_size_t
@@ -96,6 +99,8 @@ contains
         self%options = options
         self%n = problem%size()
         self%nq = problem%quad_size()
+        call self%check_options(options, self%n, max_order, err)
+        if (allocated(err)) return
         self%t = t0
         self%tn = t0
         allocate (self%ctx)
@@ -125,10 +130,6 @@ contains
         flag = FCVodeSetUserData(self%mem, c_loc(self%ctx))
         if (check(flag, 'FCVodeSetUserData')) return
         if (allocated(options%atol_vector)) then
-            if (size(options%atol_vector) /= self%n) then
-                call make_error(err, ERR_SOLVER, 'cvode: atol_vector has the wrong size')
-                return
-            end if
             atol = options%atol_vector
             nv_atol => FN_VMake_Serial(int(self%n, c_int64_t), atol, self%sunctx)
             flag = FCVodeSVtolerances(self%mem, real(options%rtol, c_double), nv_atol)
@@ -138,12 +139,6 @@ contains
             flag = FCVodeSStolerances(self%mem, real(options%rtol, c_double), &
                                       real(options%atol, c_double))
             if (check(flag, 'FCVodeSStolerances')) return
-        end if
-        max_order = options%max_order
-        if (max_order == 0) max_order = self%default_max_order()
-        if (max_order < 1 .or. max_order > 5) then
-            call make_error(err, ERR_SOLVER, 'cvode: max_order must be 1 .. 5')
-            return
         end if
         flag = FCVodeSetMaxOrd(self%mem, int(max_order, c_int))
         if (check(flag, 'FCVodeSetMaxOrd')) return
@@ -183,11 +178,7 @@ contains
         flag = FCVodeSetLinearSolver(self%mem, self%solver, self%matrix)
         if (check(flag, 'FCVodeSetLinearSolver')) return
         if (problem%has_jacobian() .and. .not. options%fd_jacobian) then
-            if (dense) then
-                flag = FCVodeSetJacFn(self%mem, c_funloc(cv_jacobian_dense))
-            else
-                flag = FCVodeSetJacFn(self%mem, c_funloc(cv_jacobian))
-            end if
+            flag = FCVodeSetJacFn(self%mem, c_funloc(cv_jacobian))
             if (check(flag, 'FCVodeSetJacFn')) return
         end if
 
@@ -304,37 +295,31 @@ contains
         text = trim(buffer)
     end function where_text
 
-
     function cvode_stats(self) result(stats)
         class(cvode_t), intent(in) :: self
         type(solver_stats_t) :: stats
-        integer(c_long) :: v(1)
-        integer(c_int) :: flag, order(1)
-        real(c_double) :: h(1)
+        integer(c_long) :: steps(1), rhs_evals(1), lin_setups(1), err_test_fails(1), v(1), w(1)
+        integer(c_int) :: flag, order(1), next_order(1)
+        real(c_double) :: h0(1), h(1), h_next(1), tcur(1)
 
         if (.not. c_associated(self%mem)) return
-        flag = FCVodeGetNumSteps(self%mem, v)
-        stats%steps = v(1)
-        flag = FCVodeGetNumRhsEvals(self%mem, v)
-        stats%rhs_evals = v(1)
+        h = 0.0_c_double
+        order = 0
+        flag = FCVodeGetIntegratorStats(self%mem, steps, rhs_evals, lin_setups, err_test_fails, &
+                                        order, next_order, h0, h, h_next, tcur)
+        stats%steps = steps(1)
+        stats%rhs_evals = rhs_evals(1)
+        stats%lin_setups = lin_setups(1)
+        stats%err_test_fails = err_test_fails(1)
+        stats%last_step = h(1)
+        stats%last_order = order(1)
+        flag = FCVodeGetNonlinSolvStats(self%mem, v, w)
+        stats%nonlin_iters = v(1)
+        stats%nonlin_conv_fails = w(1)
         flag = FCVodeGetNumJacEvals(self%mem, v)
         stats%jac_evals = v(1)
         flag = FCVodeGetNumLinRhsEvals(self%mem, v)
         stats%jac_rhs_evals = v(1)
-        flag = FCVodeGetNumLinSolvSetups(self%mem, v)
-        stats%lin_setups = v(1)
-        flag = FCVodeGetNumErrTestFails(self%mem, v)
-        stats%err_test_fails = v(1)
-        flag = FCVodeGetNumNonlinSolvIters(self%mem, v)
-        stats%nonlin_iters = v(1)
-        flag = FCVodeGetNumNonlinSolvConvFails(self%mem, v)
-        stats%nonlin_conv_fails = v(1)
-        h = 0.0_c_double
-        flag = FCVodeGetLastStep(self%mem, h)
-        stats%last_step = h(1)
-        order = 0
-        flag = FCVodeGetLastOrder(self%mem, order)
-        stats%last_order = order(1)
     end function cvode_stats
 
     subroutine cvode_finalize(self)
@@ -368,34 +353,42 @@ contains
         real(c_double), value :: t
         type(N_Vector) :: nv_y, nv_f
         type(c_ptr), value :: user_data
-        type(cvode_context_t), pointer :: ctx
-        real(c_double), pointer :: y(:), f(:)
-        integer :: status
-        call c_f_pointer(user_data, ctx)
-        y => FN_VGetArrayPointer(nv_y)
-        f => FN_VGetArrayPointer(nv_f)
-        call ctx%problem%rhs(t, y, f, status)
-        ctx%last_status = status
-        if (status > 0) ctx%recoverable = ctx%recoverable + 1
-        ierr = int(status, c_int)
+        ierr = evaluate(EVAL_RHS, t, nv_y, nv_f, user_data)
     end function cv_rhs
 
     integer(c_int) function cv_quad(t, nv_y, nv_qdot, user_data) result(ierr) bind(C)
         real(c_double), value :: t
         type(N_Vector) :: nv_y, nv_qdot
         type(c_ptr), value :: user_data
+        ierr = evaluate(EVAL_QUAD, t, nv_y, nv_qdot, user_data)
+    end function cv_quad
+
+    !> The problem's right-hand side (EVAL_RHS) or quadrature right-hand side (EVAL_QUAD)
+    !! at (t, y) into f; its status is kept for the messages and returned to CVODE.
+    integer(c_int) function evaluate(what, t, nv_y, nv_f, user_data) result(ierr)
+        integer, intent(in) :: what
+        real(c_double), intent(in) :: t
+        type(N_Vector) :: nv_y, nv_f
+        type(c_ptr), intent(in) :: user_data
         type(cvode_context_t), pointer :: ctx
-        real(c_double), pointer :: y(:), qdot(:)
+        real(c_double), pointer :: y(:), f(:)
         integer :: status
         call c_f_pointer(user_data, ctx)
         y => FN_VGetArrayPointer(nv_y)
-        qdot => FN_VGetArrayPointer(nv_qdot)
-        call ctx%problem%quad_rhs(t, y, qdot, status)
+        f => FN_VGetArrayPointer(nv_f)
+        if (what == EVAL_RHS) then
+            call ctx%problem%rhs(t, y, f, status)
+        else
+            call ctx%problem%quad_rhs(t, y, f, status)
+        end if
         ctx%last_status = status
         if (status > 0) ctx%recoverable = ctx%recoverable + 1
         ierr = int(status, c_int)
-    end function cv_quad
+    end function evaluate
 
+    !> The problem's Jacobian, which it writes in band storage: straight into a band matrix
+    !! or, for a dense matrix (ml = mu = n - 1 then), into the band work array and copied
+    !! from there (column-major n x n).
     integer(c_int) function cv_jacobian(t, nv_y, nv_f, mat, user_data, tmp1, tmp2, tmp3) &
         result(ierr) bind(C)
         real(c_double), value :: t
@@ -404,54 +397,39 @@ contains
         type(c_ptr), value :: user_data
         type(N_Vector) :: tmp1, tmp2, tmp3
         type(cvode_context_t), pointer :: ctx
-        real(c_double), pointer :: y(:), data1(:), jb(:, :)
-        integer :: status, ldim, ncols, smu
+        real(c_double), pointer :: y(:), data1(:), jb(:, :), a(:, :)
+        integer :: status, ldim, ncols, smu, n, i, j
         call c_f_pointer(user_data, ctx)
         y => FN_VGetArrayPointer(nv_y)
-        ! SUNDIALS 6.4.1: FSUNBandMatrix_Data returns a pointer of extent 1; re-map it.
-        data1 => FSUNBandMatrix_Data(mat)
-        ldim = int(FSUNBandMatrix_LDim(mat))
-        ncols = int(FSUNBandMatrix_Columns(mat))
-        smu = int(FSUNBandMatrix_StoredUpperBandwidth(mat))
-        call c_f_pointer(c_loc(data1(1)), jb, [ldim, ncols])
-        jb = 0.0_c_double
-        call ctx%problem%jacobian(t, y, jb, smu + 1, status)
+        if (allocated(ctx%band)) then
+            n = size(y)
+            ! SUNDIALS 6.4.1: FSUNDenseMatrix_Data returns a pointer of extent 1; re-map it.
+            data1 => FSUNDenseMatrix_Data(mat)
+            call c_f_pointer(c_loc(data1(1)), a, [n, n])
+            ctx%band = 0.0_wp
+            call ctx%problem%jacobian(t, y, ctx%band, ctx%mu + 1, status)
+            do j = 1, n
+                do i = 1, n
+                    if (i - j > ctx%ml .or. j - i > ctx%mu) then
+                        a(i, j) = 0.0_c_double
+                    else
+                        a(i, j) = ctx%band(ctx%mu + 1 + i - j, j)
+                    end if
+                end do
+            end do
+        else
+            ! SUNDIALS 6.4.1: FSUNBandMatrix_Data returns a pointer of extent 1; re-map it.
+            data1 => FSUNBandMatrix_Data(mat)
+            ldim = int(FSUNBandMatrix_LDim(mat))
+            ncols = int(FSUNBandMatrix_Columns(mat))
+            smu = int(FSUNBandMatrix_StoredUpperBandwidth(mat))
+            call c_f_pointer(c_loc(data1(1)), jb, [ldim, ncols])
+            jb = 0.0_c_double
+            call ctx%problem%jacobian(t, y, jb, smu + 1, status)
+        end if
         ctx%last_status = status
         ierr = int(status, c_int)
     end function cv_jacobian
-
-    !> Dense Jacobian: the problem fills band storage (ml = mu = n - 1 here), copied into
-    !! the dense matrix (column-major n x n).
-    integer(c_int) function cv_jacobian_dense(t, nv_y, nv_f, mat, user_data, tmp1, tmp2, &
-                                              tmp3) result(ierr) bind(C)
-        real(c_double), value :: t
-        type(N_Vector) :: nv_y, nv_f
-        type(SUNMatrix) :: mat
-        type(c_ptr), value :: user_data
-        type(N_Vector) :: tmp1, tmp2, tmp3
-        type(cvode_context_t), pointer :: ctx
-        real(c_double), pointer :: y(:), data1(:), a(:, :)
-        integer :: status, n, i, j
-        call c_f_pointer(user_data, ctx)
-        y => FN_VGetArrayPointer(nv_y)
-        n = size(y)
-        ! SUNDIALS 6.4.1: FSUNDenseMatrix_Data returns a pointer of extent 1; re-map it.
-        data1 => FSUNDenseMatrix_Data(mat)
-        call c_f_pointer(c_loc(data1(1)), a, [n, n])
-        ctx%band = 0.0_wp
-        call ctx%problem%jacobian(t, y, ctx%band, ctx%mu + 1, status)
-        do j = 1, n
-            do i = 1, n
-                if (i - j > ctx%ml .or. j - i > ctx%mu) then
-                    a(i, j) = 0.0_c_double
-                else
-                    a(i, j) = ctx%band(ctx%mu + 1 + i - j, j)
-                end if
-            end do
-        end do
-        ctx%last_status = status
-        ierr = int(status, c_int)
-    end function cv_jacobian_dense
 
     !> Keeps CVODE's messages for our error text instead of printing them.
     subroutine cv_error_handler(code, module, function, msg, user_data) bind(C)

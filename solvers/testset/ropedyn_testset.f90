@@ -2,6 +2,7 @@
 !! ropedyn carries, by name: the umbrella module of src/testset (docs/testset.md).
 module ropedyn_testset
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
+    use ropedyn_text, only: lower
     use ropedyn_testset_problem, only: testset_problem_t
     use ropedyn_testset_hires, only: hires_t
     use ropedyn_testset_vdpol, only: vdpol_t
@@ -24,18 +25,18 @@ contains
         character(len=*), intent(in) :: name
         class(testset_problem_t), allocatable, intent(out) :: problem
         type(error_t), allocatable, intent(out) :: err
-        select case (upper(trim(adjustl(name))))
-        case ('HIRES')
+        select case (lower(trim(adjustl(name))))
+        case ('hires')
             allocate (hires_t :: problem)
-        case ('VDPOL')
+        case ('vdpol')
             allocate (vdpol_t :: problem)
-        case ('OREGO')
+        case ('orego')
             allocate (orego_t :: problem)
-        case ('ROBER')
+        case ('rober')
             allocate (rober_t :: problem)
-        case ('E5')
+        case ('e5')
             allocate (e5_t :: problem)
-        case ('POLLU')
+        case ('pollu')
             allocate (pollu_t :: problem)
         case default
             call make_error(err, ERR_INPUT, 'unknown test problem "'//trim(name)// &
@@ -54,15 +55,4 @@ contains
             list = list//', '//trim(testset_names(i))
         end do
     end function testset_name_list
-
-    pure function upper(text) result(up)
-        character(len=*), intent(in) :: text
-        character(len=len(text)) :: up
-        integer :: i, c
-        up = text
-        do i = 1, len(text)
-            c = iachar(text(i:i))
-            if (c >= iachar('a') .and. c <= iachar('z')) up(i:i) = achar(c - 32)
-        end do
-    end function upper
 end module ropedyn_testset

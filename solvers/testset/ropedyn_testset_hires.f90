@@ -9,6 +9,18 @@ module ropedyn_testset_hires
     private
     public :: hires_t
 
+    !> The constant entries of df/dy, one row of the matrix per line (rows 6 to 8 also
+    !! depend on y: hires_dense_jacobian sets those entries).
+    real(wp), parameter :: JAC_CONSTANT(8, 8) = reshape([ &
+        -1.71_wp, 0.43_wp, 8.32_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
+        1.71_wp, -8.75_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
+        0.0_wp, 0.0_wp, -10.03_wp, 0.43_wp, 0.035_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
+        0.0_wp, 8.32_wp, 1.71_wp, -1.12_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
+        0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, -1.745_wp, 0.43_wp, 0.43_wp, 0.0_wp, &
+        0.0_wp, 0.0_wp, 0.0_wp, 0.69_wp, 1.71_wp, 0.0_wp, 0.69_wp, 0.0_wp, &
+        0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, -1.81_wp, 0.0_wp, &
+        0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp], [8, 8], order=[2, 1])
+
     type, extends(testset_problem_t) :: hires_t
     contains
         procedure :: setup => hires_setup
@@ -57,28 +69,10 @@ contains
         real(wp), intent(in) :: t
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: dfdy(:, :)
-        dfdy = 0.0_wp
-        dfdy(1, 1) = -1.71_wp
-        dfdy(1, 2) = 0.43_wp
-        dfdy(1, 3) = 8.32_wp
-        dfdy(2, 1) = 1.71_wp
-        dfdy(2, 2) = -8.75_wp
-        dfdy(3, 3) = -10.03_wp
-        dfdy(3, 4) = 0.43_wp
-        dfdy(3, 5) = 0.035_wp
-        dfdy(4, 2) = 8.32_wp
-        dfdy(4, 3) = 1.71_wp
-        dfdy(4, 4) = -1.12_wp
-        dfdy(5, 5) = -1.745_wp
-        dfdy(5, 6) = 0.43_wp
-        dfdy(5, 7) = 0.43_wp
-        dfdy(6, 4) = 0.69_wp
-        dfdy(6, 5) = 1.71_wp
+        dfdy = JAC_CONSTANT
         dfdy(6, 6) = -280.0_wp*y(8) - 0.43_wp
-        dfdy(6, 7) = 0.69_wp
         dfdy(6, 8) = -280.0_wp*y(6)
         dfdy(7, 6) = 280.0_wp*y(8)
-        dfdy(7, 7) = -1.81_wp
         dfdy(7, 8) = 280.0_wp*y(6)
         dfdy(8, :) = -dfdy(7, :)
     end subroutine hires_dense_jacobian

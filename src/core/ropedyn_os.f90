@@ -146,11 +146,7 @@ contains
         integer :: y, era, yoe, doy, doe
         y = year
         if (month <= 2) y = y - 1
-        if (y >= 0) then
-            era = y/400
-        else
-            era = (y - 399)/400
-        end if
+        era = floor_div(y, 400)
         yoe = y - era*400
         if (month > 2) then
             doy = (153*(month - 3) + 2)/5 + day - 1
@@ -167,11 +163,7 @@ contains
         integer, intent(out) :: year, month, day
         integer :: z, era, doe, yoe, doy, mp
         z = days + 719468
-        if (z >= 0) then
-            era = z/146097
-        else
-            era = (z - 146096)/146097
-        end if
+        era = floor_div(z, 146097)
         doe = z - era*146097
         yoe = (doe - doe/1460 + doe/36524 - doe/146096)/365
         doy = doe - (365*yoe + yoe/4 - yoe/100)
@@ -185,4 +177,14 @@ contains
         year = yoe + era*400
         if (month <= 2) year = year + 1
     end subroutine civil_from_days
+
+    !> floor(a / b) for b > 0 (Fortran's / truncates towards zero).
+    pure integer function floor_div(a, b) result(q)
+        integer, intent(in) :: a, b
+        if (a >= 0) then
+            q = a/b
+        else
+            q = (a - (b - 1))/b
+        end if
+    end function floor_div
 end module ropedyn_os

@@ -5,7 +5,8 @@ module ropedyn_text
     use ropedyn_kinds, only: wp, i8
     implicit none
     private
-    public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, lower, line_quote
+    public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, enclosed
+    public :: lower, line_quote
 
     !> Decimal text of an integer (default or 64-bit kind).
     interface int_text
@@ -131,17 +132,27 @@ contains
     pure function quoted(text) result(s)
         character(len=*), intent(in) :: text
         character(len=:), allocatable :: s
+        s = enclosed(text, "'", "''")
+    end function quoted
+
+    !> `text` between two `mark` characters, each `mark` inside it written as `escape`
+    !! (a Fortran literal: mark ', escape ''; a CSV field: mark ", escape "").
+    pure function enclosed(text, mark, escape) result(s)
+        character(len=*), intent(in) :: text
+        character(len=1), intent(in) :: mark
+        character(len=*), intent(in) :: escape
+        character(len=:), allocatable :: s
         integer :: i
-        s = "'"
+        s = mark
         do i = 1, len(text)
-            if (text(i:i) == "'") then
-                s = s//"''"
+            if (text(i:i) == mark) then
+                s = s//escape
             else
                 s = s//text(i:i)
             end if
         end do
-        s = s//"'"
-    end function quoted
+        s = s//mark
+    end function enclosed
 
     !> ASCII lower case.
     pure function lower(s) result(t)

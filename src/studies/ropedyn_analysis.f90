@@ -4,18 +4,19 @@
 !! method: docs/statics-modes.md.
 module ropedyn_analysis
     use, intrinsic :: iso_fortran_env, only: output_unit
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_INTERNAL
     use ropedyn_scene, only: scene_t, scene_namelist_text
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_os, only: make_parent_dirs, utc_timestamp
+    use ropedyn_os, only: make_parent_dirs
     use ropedyn_text, only: int_text
     use ropedyn_simulation, only: create_model
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
                                potential_energy, rope_length
     use ropedyn_modes, only: modes_result_t, compute_modes
-    use ropedyn_result_file, only: result_file_t
+    use ropedyn_h5, only: h5_file_t
+    use ropedyn_output, only: write_provenance
     use ropedyn_version, only: version_string
     implicit none
     private
@@ -23,6 +24,25 @@ module ropedyn_analysis
 
     integer, parameter :: DEFAULT_MODE_COUNT = 10
     real(wp), parameter :: PI = 4.0_wp*atan(1.0_wp)
+
+    !> The scalar results in /statics: name, units, description ('': none).
+    character(len=*), parameter :: STATICS_REALS(3, 4) = reshape([character(len=54) :: &
+        'residual', 'N', 'max |generalized force| at the equilibrium (N or N m)', &
+        'residual_relative', '1', 'residual / total weight', &
+        'last_step', 'm', 'max |delta q| of the last step (m or rad)', &
+        'weight', 'N', 'total weight'], [3, 4])
+    character(len=*), parameter :: STATICS_COUNTS(3, 3) = reshape([character(len=51) :: &
+        'iterations', '1', 'linear solves (accepted and rejected steps)', &
+        'rejected', '1', '', &
+        'stages', '1', 'continuation stages in the bottom anchor (0: none)'], [3, 3])
+    !> The per-mode results in /modes of one value per mode: name, units, description.
+    character(len=*), parameter :: MODE_VALUES(3, 5) = reshape([character(len=74) :: &
+        'omega', 'rad/s', &
+        'natural angular frequencies, ascending (negative: unstable, sqrt(-lambda))', &
+        'frequency_hz', 'Hz', '', &
+        'period', 's', '', &
+        'damping_ratio', '1', 'z^T C z / (2 omega z^T M z)', &
+        'axial_fraction', '1', 'share of the point motion along the rope'], [3, 5])
 
 contains
 
@@ -73,17 +93,21 @@ contains
         end function stage_text
 
         subroutine write_file()
-            type(result_file_t) :: h5
+            type(h5_file_t) :: h5
             type(error_t), allocatable :: close_err
             real(wp), allocatable :: q(:, :), qdot(:, :), points(:, :), lengths(:), masses(:)
             integer, allocatable :: pos(:), vel(:)
-            integer :: n
+            real(wp) :: reals(size(STATICS_REALS, 2))
+            integer(i8) :: counts(size(STATICS_COUNTS, 2))
+            integer :: n, k
             n = model%n_elements()
             allocate (q(3, n), qdot(3, n), points(2, 2*n), lengths(n), masses(n))
             call model%fields(y, q, qdot)
             call model%polyline(y, points)
             call model%element_data(lengths, masses)
             call model%coordinates(pos, vel)
+            reals = [sres%residual, sres%residual_relative, sres%last_step, sres%weight]
+            counts = int([sres%iterations, sres%rejected, sres%stages], i8)
 
             call h5%create(out_path, err)
             if (allocated(err)) return
@@ -92,16 +116,8 @@ contains
                 if (allocated(err)) exit steps
                 call h5%attribute('/', 'analysis', command, err)
                 if (allocated(err)) exit steps
-                call h5%attribute('/', 'version', version_string, err)
-                if (allocated(err)) exit steps
-                call h5%attribute('/', 'model', model%model_name(), err)
-                if (allocated(err)) exit steps
-                call h5%attribute('/', 'scene', scene_namelist_text(scene), err)
-                if (allocated(err)) exit steps
-                call h5%attribute('/', 'created', utc_timestamp(), err)
-                if (allocated(err)) exit steps
-                call h5%attribute('/', 'units_convention', 'SI; x points down (gravity), '// &
-                                  'y horizontal, angles from x towards y', err)
+                call write_provenance(h5, version_string, model%model_name(), &
+                                      scene_namelist_text(scene), err)
                 if (allocated(err)) exit steps
                 call h5%group('/statics', err)
                 if (allocated(err)) exit steps
@@ -110,25 +126,16 @@ contains
                 if (allocated(err)) exit steps
                 call h5%attribute('/statics', 'criterion', sres%criterion, err)
                 if (allocated(err)) exit steps
-                call h5%write('/statics/residual', sres%residual, 'N', err, &
-                              'max |generalized force| at the equilibrium (N or N m)')
-                if (allocated(err)) exit steps
-                call h5%write('/statics/residual_relative', sres%residual_relative, '1', err, &
-                              'residual / total weight')
-                if (allocated(err)) exit steps
-                call h5%write('/statics/iterations', sres%iterations, '1', err, &
-                              'linear solves (accepted and rejected steps)')
-                if (allocated(err)) exit steps
-                call h5%write('/statics/rejected', sres%rejected, '1', err)
-                if (allocated(err)) exit steps
-                call h5%write('/statics/stages', sres%stages, '1', err, &
-                              'continuation stages in the bottom anchor (0: none)')
-                if (allocated(err)) exit steps
-                call h5%write('/statics/last_step', sres%last_step, 'm', err, &
-                              'max |delta q| of the last step (m or rad)')
-                if (allocated(err)) exit steps
-                call h5%write('/statics/weight', sres%weight, 'N', err, 'total weight')
-                if (allocated(err)) exit steps
+                do k = 1, size(reals)
+                    call h5%write('/statics/'//trim(STATICS_REALS(1, k)), reals(k), &
+                                  trim(STATICS_REALS(2, k)), err, trim(STATICS_REALS(3, k)))
+                    if (allocated(err)) exit steps
+                end do
+                do k = 1, size(counts)
+                    call h5%write('/statics/'//trim(STATICS_COUNTS(1, k)), counts(k), &
+                                  trim(STATICS_COUNTS(2, k)), err, trim(STATICS_COUNTS(3, k)))
+                    if (allocated(err)) exit steps
+                end do
                 if (trim(scene%supports%top) /= 'free') then
                     call h5%write('/statics/support_force_top', force_top, 'N', err, &
                                   'force of the top support on the rope (x, y)')
@@ -166,30 +173,29 @@ contains
         end subroutine write_file
 
         subroutine write_modes(h5)
-            type(result_file_t), intent(inout) :: h5
+            type(h5_file_t), intent(inout) :: h5
+            real(wp) :: values(mres%count, size(MODE_VALUES, 2))
+            integer :: k
+            values(:, 1) = mres%omega
+            values(:, 2) = mres%omega/(2*PI)
+            values(:, 3) = 2*PI/max(abs(mres%omega), tiny(1.0_wp))
+            values(:, 4) = mres%damping_ratio
+            values(:, 5) = mres%axial_fraction
             call h5%group('/modes', err)
             if (allocated(err)) return
             call h5%attribute('/modes', 'eigensolver', mres%eigensolver, err)
             if (allocated(err)) return
-            call h5%write('/modes/omega', mres%omega, 'rad/s', err, 'natural angular '// &
-                          'frequencies, ascending (negative: unstable, sqrt(-lambda))')
-            if (allocated(err)) return
-            call h5%write('/modes/frequency_hz', mres%omega/(2*PI), 'Hz', err)
-            if (allocated(err)) return
-            call h5%write('/modes/period', 2*PI/max(abs(mres%omega), tiny(1.0_wp)), 's', err)
-            if (allocated(err)) return
+            do k = 1, size(MODE_VALUES, 2)
+                call h5%write('/modes/'//trim(MODE_VALUES(1, k)), values(:, k), &
+                              trim(MODE_VALUES(2, k)), err, trim(MODE_VALUES(3, k)))
+                if (allocated(err)) return
+            end do
             call h5%write('/modes/shape', mres%shape, coordinate_units(model%model_name()), &
                           err, 'mode shapes in the generalized coordinates of /statics/q, '// &
                           '(mode, coordinate), largest entry 1')
             if (allocated(err)) return
             call h5%write('/modes/shape_points', mres%shape_points, 'm', err, &
                           'displacement of the /rope/points per unit of /modes/shape')
-            if (allocated(err)) return
-            call h5%write('/modes/damping_ratio', mres%damping_ratio, '1', err, &
-                          'z^T C z / (2 omega z^T M z)')
-            if (allocated(err)) return
-            call h5%write('/modes/axial_fraction', mres%axial_fraction, '1', err, &
-                          'share of the point motion along the rope')
             if (allocated(err)) return
             call h5%write('/modes/stiffness_asymmetry', mres%asymmetry, '1', err, &
                           'max |K - K^T| / max |K| before symmetrization')

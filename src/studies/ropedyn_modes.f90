@@ -23,7 +23,8 @@ module ropedyn_modes
     use ropedyn_text, only: int_text
     use ropedyn_rope_spec, only: rope_spec_t
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
-                               tangent_matrices, bandwidth, rope_length, model_factory_i
+                               tangent_matrices, rope_length, model_factory_i
+    use ropedyn_ldl, only: bandwidth
     implicit none
     private
     public :: modes_result_t, compute_modes, equilibrium_initial_state
@@ -141,8 +142,8 @@ contains
             return
         else if (info /= 0 .or. k < m) then
             call make_error(err, ERR_SOLVER, 'modes: the eigensolver '//res%eigensolver// &
-                            ' failed (info '//int_text(info)//', '//int_text(k)//' of '//int_text(m)// &
-                            ' eigenvalues)')
+                            ' failed (info '//int_text(info)//', '//int_text(k)//' of '// &
+                            int_text(m)//' eigenvalues)')
             return
         end if
 

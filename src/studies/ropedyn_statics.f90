@@ -30,12 +30,12 @@ module ropedyn_statics
     use ropedyn_text, only: int_text, fixed_text
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given, N_ATTACH
     use ropedyn_effect_factory, only: locate_on_bodies
+    use ropedyn_ldl, only: ldl_t, ldl_factor, ldl_solve, bandwidth
     implicit none
     private
     public :: statics_options_t, statics_result_t
     public :: solve_statics, find_equilibrium, check_equilibrium_exists, model_factory_i
     public :: generalized_force, tangent_matrices, potential_energy, rope_length, total_weight
-    public :: bandwidth
 
     real(wp), parameter :: PI = 4.0_wp*atan(1.0_wp)
 
@@ -63,14 +63,6 @@ module ropedyn_statics
         character(len=:), allocatable :: criterion  !< 'newton step' or 'rounding level'
     end type statics_result_t
 
-    !> A modified L D L^T factorization of S a S (see `ldl_factor`), band storage.
-    type :: ldl_t
-        integer :: n = 0, kd = 0
-        real(wp), allocatable :: lb(:, :)    !< L below the diagonal, lb(i - j, j)
-        real(wp), allocatable :: d(:)        !< D
-        real(wp), allocatable :: scale(:)    !< S
-    end type ldl_t
-
     abstract interface
         !> Builds the model of a spec (ropedyn_simulation's create_model).
         subroutine model_factory_i(spec, model, err)
@@ -80,7 +72,6 @@ module ropedyn_statics
             type(error_t), allocatable, intent(out) :: err
         end subroutine model_factory_i
     end interface
-
 
 contains
 
@@ -184,31 +175,34 @@ contains
         real(wp), intent(out) :: kt(:, :)
         integer, intent(out) :: status
         real(wp), intent(out), optional :: cv(:, :)
-        real(wp), allocatable :: mm(:, :), jb(:, :), yp(:), fp(:), fm(:), w(:)
+        real(wp), allocatable :: mm(:, :), jb(:, :), yp(:), gp(:), gm(:)
         integer, allocatable :: vel_of_row(:)
         integer :: nd, ns, ml, mu, offset, j, r, c, i, st
         real(wp) :: h
+        logical :: implicit
 
         nd = size(pos)
         ns = size(y)
         status = STATUS_OK
-        if (model%has_mass_matrix()) then
-            ! f = F(vel) of the implicit form: central differences (F is cheap, O(n))
-            allocate (yp(ns), fp(nd), fm(nd), w(ns))
+        implicit = model%has_mass_matrix()
+        if (.not. implicit) then
+            allocate (mm(nd, nd))
+            call model%coordinate_mass(y, mm)
+        end if
+        if (implicit .or. .not. model%has_jacobian()) then
+            ! central differences: of f = F(vel) of the implicit form (F is cheap, O(n)), or
+            ! of the accelerations of an explicit model without a Jacobian
+            allocate (yp(ns), gp(ns), gm(ns))
             do j = 1, nd
-                call column(pos(j), kt(:, j))
+                call differenced(pos(j), kt(:, j))
                 if (status /= STATUS_OK) return
                 if (present(cv)) then
-                    call column(vel(j), cv(:, j))
+                    call differenced(vel(j), cv(:, j))
                     if (status /= STATUS_OK) return
                 end if
             end do
-            return
-        end if
-
-        allocate (mm(nd, nd))
-        call model%coordinate_mass(y, mm)
-        if (model%has_jacobian()) then
+            if (implicit) return
+        else
             call model%bandwidths(ml, mu)
             offset = mu + 1
             allocate (jb(ml + mu + 1, ns), vel_of_row(ns))
@@ -231,17 +225,6 @@ contains
                     end do
                 end if
             end do
-        else
-            ! no analytic Jacobian: central differences of the accelerations
-            allocate (yp(ns), fp(ns), fm(ns))
-            do j = 1, nd
-                call accel_column(pos(j), kt(:, j))
-                if (status /= STATUS_OK) return
-                if (present(cv)) then
-                    call accel_column(vel(j), cv(:, j))
-                    if (status /= STATUS_OK) return
-                end if
-            end do
         end if
         ! da/dz -> df/dz = M da/dz at rest (the dM/dq a term vanishes at an equilibrium and
         ! is left out elsewhere: Newton on a(q) = 0 in the metric M)
@@ -250,35 +233,36 @@ contains
         kt = -kt
         if (present(cv)) cv = -cv
     contains
-        !> -dF(vel)/dy(k) by central differences (implicit models).
-        subroutine column(k, out)
+        !> By central differences in y(k): -dF(vel)/dy(k) of an implicit model, da/dy(k)
+        !! (a = ydot(vel)) of an explicit one.
+        subroutine differenced(k, out)
             integer, intent(in) :: k
             real(wp), intent(out) :: out(:)
             h = 1.0e-6_wp*max(1.0_wp, abs(y(k)))
             yp = y
             yp(k) = y(k) + h
-            call model%implicit_rhs(0.0_wp, yp, w, st)
-            fp = w(vel)
+            call evaluate(yp, gp, st)
             yp(k) = y(k) - h
-            call model%implicit_rhs(0.0_wp, yp, w, status)
+            call evaluate(yp, gm, status)
             if (st /= STATUS_OK) status = st
-            fm = w(vel)
-            out = -(fp - fm)/(2.0_wp*h)
-        end subroutine column
+            if (implicit) then
+                out = -(gp(vel) - gm(vel))/(2.0_wp*h)
+            else
+                out = (gp(vel) - gm(vel))/(2.0_wp*h)
+            end if
+        end subroutine differenced
 
-        !> da/dy(k) by central differences (explicit models without a Jacobian).
-        subroutine accel_column(k, out)
-            integer, intent(in) :: k
-            real(wp), intent(out) :: out(:)
-            h = 1.0e-6_wp*max(1.0_wp, abs(y(k)))
-            yp = y
-            yp(k) = y(k) + h
-            call model%rhs(0.0_wp, yp, fp, st)
-            yp(k) = y(k) - h
-            call model%rhs(0.0_wp, yp, fm, status)
-            if (st /= STATUS_OK) status = st
-            out = (fp(vel) - fm(vel))/(2.0_wp*h)
-        end subroutine accel_column
+        !> F(t = 0, z) of the implicit form, or the right-hand side f(0, z).
+        subroutine evaluate(z, g, stat)
+            real(wp), intent(in) :: z(:)
+            real(wp), intent(out) :: g(:)
+            integer, intent(out) :: stat
+            if (implicit) then
+                call model%implicit_rhs(0.0_wp, z, g, stat)
+            else
+                call model%rhs(0.0_wp, z, g, stat)
+            end if
+        end subroutine evaluate
     end subroutine tangent_matrices
 
     !> a <- mm a, with a fast path for a diagonal mm.
@@ -294,104 +278,6 @@ contains
             a = matmul(mm, a)
         end if
     end subroutine scale_by_mass
-
-    !> Largest |i - j| of a non-zero entry of a square matrix.
-    pure integer function bandwidth(a) result(kd)
-        real(wp), intent(in) :: a(:, :)
-        integer :: i, j
-        kd = 0
-        do j = 1, size(a, 2)
-            do i = 1, size(a, 1)
-                if (a(i, j) /= 0.0_wp) kd = max(kd, abs(i - j))
-            end do
-        end do
-    end function bandwidth
-
-    !> The modified Cholesky factorization of Gill, Murray & Wright (Practical Optimization,
-    !! 1981, sec. 4.4.2.2) of a symmetric matrix: L D L^T = S a S + E with E >= 0 diagonal,
-    !! zero when S a S is safely positive definite and just large enough otherwise, so that
-    !! the solution of (a + S^-1 E S^-1) x = b is always a descent direction. S = diag(scale)
-    !! evens out the rows (here scale = 1/sqrt(diag M)) so that E is measured in the same
-    !! units for every coordinate. Band storage when a is narrow (bandwidth kd < n/4:
-    !! O(n kd^2)), the same code with kd = n - 1 otherwise. `modified`: E /= 0.
-    subroutine ldl_factor(a_in, scale, fac, modified)
-        real(wp), intent(in) :: a_in(:, :), scale(:)
-        type(ldl_t), intent(out) :: fac
-        logical, intent(out) :: modified
-        real(wp), allocatable :: c(:), a(:, :)
-        real(wp) :: gamma, xi, beta2, delta, cjj, theta, acc
-        integer :: n, kd, i, j, k
-
-        n = size(scale)
-        kd = bandwidth(a_in)
-        if (4*kd >= n) kd = n - 1
-        fac%n = n
-        fac%kd = kd
-        fac%scale = scale
-        allocate (a(n, n), fac%lb(0:kd, n), fac%d(n), c(0:kd))
-        associate (lb => fac%lb, d => fac%d)
-            do j = 1, n
-                do i = max(1, j - kd), min(n, j + kd)
-                    a(i, j) = scale(i)*a_in(i, j)*scale(j)
-                end do
-            end do
-            lb = 0.0_wp
-            gamma = 0.0_wp
-            xi = 0.0_wp
-            do j = 1, n
-                gamma = max(gamma, abs(a(j, j)))
-                do i = j + 1, min(n, j + kd)
-                    xi = max(xi, abs(a(i, j)))
-                end do
-            end do
-            beta2 = max(gamma, epsilon(1.0_wp))
-            if (n > 1) beta2 = max(beta2, xi/sqrt(real(n, wp)**2 - 1.0_wp))
-            delta = epsilon(1.0_wp)*max(gamma + xi, 1.0_wp)
-            modified = .false.
-            do j = 1, n
-                acc = a(j, j)
-                do k = max(1, j - kd), j - 1
-                    acc = acc - d(k)*lb(j - k, k)**2
-                end do
-                cjj = acc
-                theta = 0.0_wp
-                do i = j + 1, min(n, j + kd)
-                    acc = a(i, j)
-                    do k = max(1, i - kd), j - 1
-                        acc = acc - lb(i - k, k)*d(k)*lb(j - k, k)
-                    end do
-                    c(i - j) = acc
-                    theta = max(theta, abs(acc))
-                end do
-                d(j) = max(delta, abs(cjj), theta**2/beta2)
-                if (d(j) - cjj > 1.0e-12_wp*abs(cjj) + delta) modified = .true.
-                do i = j + 1, min(n, j + kd)
-                    lb(i - j, j) = c(i - j)/d(j)
-                end do
-            end do
-        end associate
-    end subroutine ldl_factor
-
-    !> x = S (L D L^T)^-1 S b.
-    function ldl_solve(fac, b) result(x)
-        type(ldl_t), intent(in) :: fac
-        real(wp), intent(in) :: b(:)
-        real(wp) :: x(size(b))
-        integer :: i, j
-        x = fac%scale*b
-        do j = 1, fac%n
-            do i = j + 1, min(fac%n, j + fac%kd)
-                x(i) = x(i) - fac%lb(i - j, j)*x(j)
-            end do
-        end do
-        x = x/fac%d
-        do j = fac%n, 1, -1
-            do i = j + 1, min(fac%n, j + fac%kd)
-                x(j) = x(j) - fac%lb(i - j, j)*x(i)
-            end do
-        end do
-        x = fac%scale*x
-    end function ldl_solve
 
     !> The equilibrium of the spec from the starting state y. When the bottom end is
     !! pinned or clamped to an anchor far (> L/1000) from the lower end of the starting
@@ -570,7 +456,8 @@ contains
                 call tangent_matrices(model, y, pos, vel, kt, status)
                 if (status /= STATUS_OK) then
                     call make_error(err, ERR_SOLVER, spec%path//': statics: the stiffness '// &
-                                    'matrix is not finite at iteration '//int_text(result%iterations))
+                                    'matrix is not finite at iteration '// &
+                                    int_text(result%iterations))
                     return
                 end if
                 kt = 0.5_wp*(kt + transpose(kt))
@@ -726,6 +613,4 @@ contains
             yes = result%rounding_level <= 1.0_wp
         end function at_rounding_level
     end subroutine solve_statics
-
-
 end module ropedyn_statics

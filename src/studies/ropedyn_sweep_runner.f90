@@ -18,7 +18,7 @@ module ropedyn_sweep_runner
     use ropedyn_error, only: error_t, make_error, ERR_USAGE, ERR_SOLVER, ERR_IO
     use ropedyn_simulation, only: run_summary_t, run_scene
     use ropedyn_sweep, only: sweep_t
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, enclosed
     use ropedyn_sweep_summary, only: case_row_t, case_status, build_summary
     use ropedyn_case_file, only: write_wall_time
     implicit none
@@ -259,8 +259,8 @@ contains
             elapsed = real(time_now - start, wp)/real(rate, wp)
             ! a finished worker's slot is refilled at once: count it as running
             text = int_text(finished)//'/'//int_text(size(todo))//' done, '// &
-                int_text(min(size(slot), size(todo) - finished))//' running, '//int_text(failed)//' failed, elapsed '// &
-                clock_text(elapsed)
+                int_text(min(size(slot), size(todo) - finished))//' running, '// &
+                int_text(failed)//' failed, elapsed '//clock_text(elapsed)
             if (finished > 0 .and. finished < size(todo)) then
                 eta = elapsed/real(finished, wp)*real(size(todo) - finished, wp)
                 text = text//', ETA '//clock_text(eta)
@@ -323,16 +323,7 @@ contains
     pure function quote(text) result(s)
         character(len=*), intent(in) :: text
         character(len=:), allocatable :: s
-        integer :: i
-        s = "'"
-        do i = 1, len(text)
-            if (text(i:i) == "'") then
-                s = s//"'\''"
-            else
-                s = s//text(i:i)
-            end if
-        end do
-        s = s//"'"
+        s = enclosed(text, "'", "'\''")
     end function quote
 
     pure function zero_padded(n, width) result(s)

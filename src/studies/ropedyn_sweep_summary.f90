@@ -4,21 +4,25 @@
 !! (docs/sweeps.md lists the columns).
 module ropedyn_sweep_summary
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
-    use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5eset_auto_f, h5fcreate_f, h5fclose_f, &
-        H5F_ACC_TRUNC_F, h5screate_simple_f, h5sclose_f, h5dcreate_f, h5dwrite_f, h5dclose_f, &
-        h5tcopy_f, h5tset_size_f, h5tset_strpad_f, h5tclose_f, H5T_NATIVE_CHARACTER, &
-        H5T_STR_NULLPAD_F, h5kind_to_type, H5_REAL_KIND, H5_INTEGER_KIND
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_text, only: int_text, real_text
+    use ropedyn_text, only: int_text, real_text, enclosed
     use ropedyn_error, only: error_t, make_error, ERR_IO
     use ropedyn_scene, only: scene_namelist_text
-    use ropedyn_sweep, only: sweep_t, sweep_case_t, text_t, REF_NONE, &
+    use ropedyn_sweep, only: sweep_t, sweep_case_t, REF_NONE, &
         REF_TIGHTEST, REF_FILE
-    use ropedyn_case_file, only: case_data_t, read_case_file, write_text_attribute
+    use ropedyn_case_file, only: case_data_t, read_case_file
+    use ropedyn_h5, only: h5_file_t
+    use ropedyn_output, only: COUNTER_NAMES
     use ropedyn_version, only: version_string
     implicit none
     private
     public :: case_row_t, case_status, build_summary
+
+    !> Columns of summary.h5 measured per case: name and units (docs/sweeps.md).
+    character(len=*), parameter :: MEASURED(2, 8) = reshape([character(len=18) :: &
+        't_reached', 's', 'wall_time', 's', 'cpu_time', 's', 'tip_error_final', 'm', &
+        'tip_error_max', 'm', 'position_error_max', 'm', 'energy_error_final', 'J', &
+        'energy_error_max', 'J'], [2, 8])
 
     !> One row of the summary.
     type :: case_row_t
@@ -26,8 +30,8 @@ module ropedyn_sweep_summary
         character(len=:), allocatable :: status  !< complete|failed|running|stale|missing
         character(len=:), allocatable :: reason
         real(wp) :: t_reached, wall_time, cpu_time                     !< s (NaN: absent)
-        integer(i8) :: steps = -1, rhs_evals = -1, jac_evals = -1, lin_setups = -1, &
-            err_test_fails = -1, nonlin_iters = -1, nonlin_conv_fails = -1
+        !> the solver counters named in ropedyn_output's COUNTER_NAMES (-1: absent)
+        integer(i8) :: counters(size(COUNTER_NAMES)) = -1
         integer :: reference = 0                 !< case id of the reference (0: none)
         real(wp) :: tip_error_final, tip_error_max, position_error_max  !< m
         real(wp) :: energy_error_final, energy_error_max                !< J
@@ -92,13 +96,7 @@ contains
                 rows(c)%status == 'stale') cycle
             rows(c)%wall_time = data%wall_time
             rows(c)%cpu_time = data%cpu_time
-            rows(c)%steps = data%steps
-            rows(c)%rhs_evals = data%rhs_evals
-            rows(c)%jac_evals = data%jac_evals
-            rows(c)%lin_setups = data%lin_setups
-            rows(c)%err_test_fails = data%err_test_fails
-            rows(c)%nonlin_iters = data%nonlin_iters
-            rows(c)%nonlin_conv_fails = data%nonlin_conv_fails
+            rows(c)%counters = data%counters
             if (data%records > 0) rows(c)%t_reached = data%time(data%records)
         end do
 
@@ -215,26 +213,29 @@ contains
         do v = 1, size(sweep%vary_keys)
             line = line//','//sweep%vary_keys(v)%s
         end do
-        line = line//',t_end,t_reached,wall_time,cpu_time,steps,rhs_evals,jac_evals,' &
-            //'lin_setups,err_test_fails,nonlin_iters,nonlin_conv_fails,reference,' &
-            //'tip_error_final,tip_error_max,position_error_max,energy_error_final,' &
-            //'energy_error_max,file,reason'
+        line = line//',t_end,t_reached,wall_time,cpu_time'
+        do v = 1, size(COUNTER_NAMES)
+            line = line//','//trim(COUNTER_NAMES(v))
+        end do
+        line = line//',reference,tip_error_final,tip_error_max,position_error_max,' &
+            //'energy_error_final,energy_error_max,file,reason'
         write (unit, '(a)', iostat=ios, iomsg=msg) line
         do c = 1, size(rows)
             if (ios /= 0) exit
             associate (r => rows(c), s => sweep%cases(c)%scene)
                 line = int_text(r%id)//','//r%status//','//csv_text(trim(s%model%kind))// &
                     ','//int_text(s%model%elements)//','//csv_text(trim(s%solver%method))// &
-                    ','//int_text(s%solver%max_order)//','//real_text(s%solver%rtol, compact=.true.)//','// &
+                    ','//int_text(s%solver%max_order)//','// &
+                    real_text(s%solver%rtol, compact=.true.)//','// &
                     real_text(s%solver%atol, compact=.true.)
                 do v = 1, size(sweep%vary_keys)
                     line = line//','//csv_text(sweep%cases(c)%vary_values(v)%s)
                 end do
-                line = line//','//real_text(s%solver%t_end, compact=.true.)//','//num(r%t_reached)//','// &
-                    num(r%wall_time)//','//num(r%cpu_time)//','//count_text(r%steps)//','// &
-                    count_text(r%rhs_evals)//','//count_text(r%jac_evals)//','// &
-                    count_text(r%lin_setups)//','//count_text(r%err_test_fails)//','// &
-                    count_text(r%nonlin_iters)//','//count_text(r%nonlin_conv_fails)//','
+                line = line//','//real_text(s%solver%t_end, compact=.true.)//','// &
+                    num(r%t_reached)//','//num(r%wall_time)//','//num(r%cpu_time)//','
+                do v = 1, size(COUNTER_NAMES)
+                    line = line//count_text(r%counters(v))//','
+                end do
                 if (r%reference > 0) line = line//int_text(r%reference)
                 line = line//','//num(r%tip_error_final)//','//num(r%tip_error_max)//','// &
                     num(r%position_error_max)//','//num(r%energy_error_final)//','// &
@@ -275,20 +276,11 @@ contains
     pure function csv_text(text) result(s)
         character(len=*), intent(in) :: text
         character(len=:), allocatable :: s
-        integer :: i
         if (scan(text, ',"'//new_line('a')) == 0) then
             s = text
-            return
+        else
+            s = enclosed(text, '"', '""')
         end if
-        s = '"'
-        do i = 1, len(text)
-            if (text(i:i) == '"') then
-                s = s//'""'
-            else
-                s = s//text(i:i)
-            end if
-        end do
-        s = s//'"'
     end function csv_text
 
     !> Newlines replaced by blanks.
@@ -311,128 +303,71 @@ contains
         type(case_row_t), intent(in) :: rows(:)
         type(error_t), allocatable, intent(out) :: err
         character(len=:), allocatable :: path
-        integer(hid_t) :: file_id
-        integer :: hdferr, n, c, v
-        type(text_t), allocatable :: strings(:)
-        real(wp), allocatable :: rv(:)
-        integer(i8), allocatable :: iv(:)
+        type(h5_file_t) :: h5
+        type(error_t), allocatable :: close_err
+        integer :: n, c, k
+        real(wp), allocatable :: measures(:, :)
+        integer(i8), allocatable :: counts(:, :)
 
         path = sweep%output_dir//'/summary.h5'
         n = size(rows)
-        allocate (strings(n))
-        call h5open_f(hdferr)
-        call h5eset_auto_f(0, hdferr)
-        call h5fcreate_f(path, H5F_ACC_TRUNC_F, file_id, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, path//': cannot create file')
-            return
-        end if
+        measures = reshape([rows%t_reached, rows%wall_time, rows%cpu_time, &
+                            rows%tip_error_final, rows%tip_error_max, rows%position_error_max, &
+                            rows%energy_error_final, rows%energy_error_max], [n, 8])
+        counts = transpose(reshape([(rows(c)%counters, c=1, n)], [size(COUNTER_NAMES), n]))
+        call h5%create(path, err)
+        if (allocated(err)) return
         steps: block
-            call int_column('case', int([(rows(c)%id, c=1, n)], i8), '1')
+            call h5%write('/case', int([(rows(c)%id, c=1, n)], i8), '1', err)
             if (allocated(err)) exit steps
-            do c = 1, n
-                strings(c)%s = rows(c)%status
-            end do
-            call text_column('status', strings)
+            call text_column('status')
             if (allocated(err)) exit steps
-            do c = 1, n
-                strings(c)%s = trim(sweep%cases(c)%scene%model%kind)
-            end do
-            call text_column('model', strings)
+            call text_column('model')
             if (allocated(err)) exit steps
-            call int_column('elements', int([(sweep%cases(c)%scene%model%elements, c=1, n)], &
-                i8), '1')
+            call h5%write('/elements', int([(sweep%cases(c)%scene%model%elements, c=1, n)], &
+                i8), '1', err)
             if (allocated(err)) exit steps
-            do c = 1, n
-                strings(c)%s = trim(sweep%cases(c)%scene%solver%method)
-            end do
-            call text_column('method', strings)
+            call text_column('method')
             if (allocated(err)) exit steps
-            call int_column('max_order', int([(sweep%cases(c)%scene%solver%max_order, c=1, n)], &
-                i8), '1')
+            call h5%write('/max_order', int([(sweep%cases(c)%scene%solver%max_order, &
+                c=1, n)], i8), '1', err)
             if (allocated(err)) exit steps
-            call real_column('rtol', [(sweep%cases(c)%scene%solver%rtol, c=1, n)], '1')
+            call h5%write('/rtol', [(sweep%cases(c)%scene%solver%rtol, c=1, n)], '1', err)
             if (allocated(err)) exit steps
-            call real_column('atol', [(sweep%cases(c)%scene%solver%atol, c=1, n)], &
-                'state units (m, rad, m/s, rad/s)')
+            call h5%write('/atol', [(sweep%cases(c)%scene%solver%atol, c=1, n)], &
+                'state units (m, rad, m/s, rad/s)', err)
             if (allocated(err)) exit steps
-            do v = 1, size(sweep%vary_keys)
-                do c = 1, n
-                    strings(c)%s = sweep%cases(c)%vary_values(v)%s
-                end do
-                call text_column(sweep%vary_keys(v)%s, strings)
+            do k = 1, size(sweep%vary_keys)
+                call text_column(sweep%vary_keys(k)%s, k)
                 if (allocated(err)) exit steps
             end do
-            call real_column('t_end', [(sweep%cases(c)%scene%solver%t_end, c=1, n)], 's')
+            call h5%write('/t_end', [(sweep%cases(c)%scene%solver%t_end, c=1, n)], 's', err)
             if (allocated(err)) exit steps
-            rv = rows%t_reached
-            call real_column('t_reached', rv, 's')
-            if (allocated(err)) exit steps
-            rv = rows%wall_time
-            call real_column('wall_time', rv, 's')
-            if (allocated(err)) exit steps
-            rv = rows%cpu_time
-            call real_column('cpu_time', rv, 's')
-            if (allocated(err)) exit steps
-            iv = rows%steps
-            call int_column('steps', iv, '1')
-            if (allocated(err)) exit steps
-            iv = rows%rhs_evals
-            call int_column('rhs_evals', iv, '1')
-            if (allocated(err)) exit steps
-            iv = rows%jac_evals
-            call int_column('jac_evals', iv, '1')
-            if (allocated(err)) exit steps
-            iv = rows%lin_setups
-            call int_column('lin_setups', iv, '1')
-            if (allocated(err)) exit steps
-            iv = rows%err_test_fails
-            call int_column('err_test_fails', iv, '1')
-            if (allocated(err)) exit steps
-            iv = rows%nonlin_iters
-            call int_column('nonlin_iters', iv, '1')
-            if (allocated(err)) exit steps
-            iv = rows%nonlin_conv_fails
-            call int_column('nonlin_conv_fails', iv, '1')
-            if (allocated(err)) exit steps
-            call int_column('reference', int(rows%reference, i8), '1')
-            if (allocated(err)) exit steps
-            rv = rows%tip_error_final
-            call real_column('tip_error_final', rv, 'm')
-            if (allocated(err)) exit steps
-            rv = rows%tip_error_max
-            call real_column('tip_error_max', rv, 'm')
-            if (allocated(err)) exit steps
-            rv = rows%position_error_max
-            call real_column('position_error_max', rv, 'm')
-            if (allocated(err)) exit steps
-            rv = rows%energy_error_final
-            call real_column('energy_error_final', rv, 'J')
-            if (allocated(err)) exit steps
-            rv = rows%energy_error_max
-            call real_column('energy_error_max', rv, 'J')
-            if (allocated(err)) exit steps
-            do c = 1, n
-                strings(c)%s = sweep%cases(c)%file
+            do k = 1, size(MEASURED, 2)
+                call h5%write('/'//trim(MEASURED(1, k)), measures(:, k), trim(MEASURED(2, k)), &
+                              err)
+                if (allocated(err)) exit steps
             end do
-            call text_column('file', strings)
-            if (allocated(err)) exit steps
-            do c = 1, n
-                strings(c)%s = rows(c)%reason
+            do k = 1, size(COUNTER_NAMES)
+                call h5%write('/'//trim(COUNTER_NAMES(k)), counts(:, k), '1', err)
+                if (allocated(err)) exit steps
             end do
-            call text_column('reason', strings)
+            call h5%write('/reference', int(rows%reference, i8), '1', err)
             if (allocated(err)) exit steps
-            call write_text_attribute(path, file_id, '/', 'sweep', sweep%path, err)
+            call text_column('file')
             if (allocated(err)) exit steps
-            call write_text_attribute(path, file_id, '/', 'base', sweep%base, err)
+            call text_column('reason')
             if (allocated(err)) exit steps
-            call write_text_attribute(path, file_id, '/', 'reference', reference_text(), err)
+            call h5%attribute('/', 'sweep', sweep%path, err)
             if (allocated(err)) exit steps
-            call write_text_attribute(path, file_id, '/', 'version', version_string, err)
+            call h5%attribute('/', 'base', sweep%base, err)
+            if (allocated(err)) exit steps
+            call h5%attribute('/', 'reference', reference_text(), err)
+            if (allocated(err)) exit steps
+            call h5%attribute('/', 'version', version_string, err)
         end block steps
-        call h5fclose_f(file_id, hdferr)
-        if (hdferr < 0 .and. .not. allocated(err)) &
-            call make_error(err, ERR_IO, path//': cannot close file')
+        call h5%close(close_err)
+        if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
     contains
         function reference_text() result(text)
             character(len=:), allocatable :: text
@@ -446,96 +381,49 @@ contains
             end select
         end function reference_text
 
-        subroutine real_column(name, values, units)
-            character(len=*), intent(in) :: name, units
-            real(wp), intent(in) :: values(:)
-            integer(hid_t) :: type_id
-            real(wp), allocatable :: contiguous_values(:)
-            contiguous_values = values
-            type_id = h5kind_to_type(wp, H5_REAL_KIND)
-            call numeric_column(name, type_id, units, rvalues=contiguous_values)
-        end subroutine real_column
-
-        subroutine int_column(name, values, units)
-            character(len=*), intent(in) :: name, units
-            integer(i8), intent(in) :: values(:)
-            integer(hid_t) :: type_id
-            integer(i8), allocatable :: contiguous_values(:)
-            contiguous_values = values
-            type_id = h5kind_to_type(i8, H5_INTEGER_KIND)
-            call numeric_column(name, type_id, units, ivalues=contiguous_values)
-        end subroutine int_column
-
-        subroutine numeric_column(name, type_id, units, rvalues, ivalues)
-            character(len=*), intent(in) :: name, units
-            integer(hid_t), intent(in) :: type_id
-            real(wp), intent(in), optional :: rvalues(:)
-            integer(i8), intent(in), optional :: ivalues(:)
-            integer(hid_t) :: space_id, dset_id
-            integer(hsize_t) :: dims(1)
-            integer :: rc
-            dims = int(n, hsize_t)
-            call h5screate_simple_f(1, dims, space_id, rc)
-            if (rc < 0) then
-                call make_error(err, ERR_IO, path//': /'//name//': cannot create dataspace')
-                return
-            end if
-            call h5dcreate_f(file_id, name, type_id, space_id, dset_id, rc)
-            call h5sclose_f(space_id, hdferr)
-            if (rc < 0) then
-                call make_error(err, ERR_IO, path//': /'//name//': cannot create dataset')
-                return
-            end if
-            if (present(rvalues)) then
-                call h5dwrite_f(dset_id, type_id, rvalues, dims, rc)
-            else
-                call h5dwrite_f(dset_id, type_id, ivalues, dims, rc)
-            end if
-            if (rc < 0) then
-                call make_error(err, ERR_IO, path//': /'//name//': cannot write dataset')
-            else
-                call write_text_attribute(path, dset_id, '/'//name, 'units', units, err)
-            end if
-            call h5dclose_f(dset_id, hdferr)
-        end subroutine numeric_column
-
-        subroutine text_column(name, values)
+        !> The column `name` of strings (a varied key's with its index `vary`), null-padded
+        !! to the longest entry (at least one character).
+        subroutine text_column(name, vary)
             character(len=*), intent(in) :: name
-            type(text_t), intent(in) :: values(:)
-            integer(hid_t) :: space_id, dset_id, type_id
-            integer(hsize_t) :: dims(1)
-            integer :: rc, width, k
-            character(len=:), allocatable :: buffer(:)
+            integer, intent(in), optional :: vary
+            integer :: width, j
+            character(len=:), allocatable :: buffer(:), text
             width = 1
-            do k = 1, size(values)
-                width = max(width, len(values(k)%s))
+            do j = 1, n
+                width = max(width, len(cell(name, j, vary)))
             end do
-            allocate (character(len=width) :: buffer(size(values)))
-            do k = 1, size(values)
-                buffer(k) = values(k)%s   ! blank-padded; stored null-padded below
-                if (len(values(k)%s) < width) buffer(k)(len(values(k)%s) + 1:) = &
-                    repeat(achar(0), width - len(values(k)%s))
+            allocate (character(len=width) :: buffer(n))
+            do j = 1, n
+                text = cell(name, j, vary)
+                buffer(j) = text   ! blank-padded; NUL-padded below
+                if (len(text) < width) buffer(j)(len(text) + 1:) = &
+                    repeat(achar(0), width - len(text))
             end do
-            dims = int(size(values), hsize_t)
-            call h5tcopy_f(H5T_NATIVE_CHARACTER, type_id, rc)
-            call h5tset_size_f(type_id, int(width, size_t), rc)
-            call h5tset_strpad_f(type_id, H5T_STR_NULLPAD_F, rc)
-            call h5screate_simple_f(1, dims, space_id, rc)
-            call h5dcreate_f(file_id, name, type_id, space_id, dset_id, rc)
-            call h5sclose_f(space_id, hdferr)
-            if (rc < 0) then
-                call make_error(err, ERR_IO, path//': /'//name//': cannot create dataset')
-                call h5tclose_f(type_id, hdferr)
+            call h5%write_text('/'//name, buffer, '', err)
+        end subroutine text_column
+
+        !> Case j's entry of the text column `name` (of varied key number `vary`).
+        function cell(name, j, vary) result(value)
+            character(len=*), intent(in) :: name
+            integer, intent(in) :: j
+            integer, intent(in), optional :: vary
+            character(len=:), allocatable :: value
+            if (present(vary)) then
+                value = sweep%cases(j)%vary_values(vary)%s
                 return
             end if
-            call h5dwrite_f(dset_id, type_id, buffer, dims, rc)
-            if (rc < 0) then
-                call make_error(err, ERR_IO, path//': /'//name//': cannot write dataset')
-            else
-                call write_text_attribute(path, dset_id, '/'//name, 'units', '', err)
-            end if
-            call h5dclose_f(dset_id, hdferr)
-            call h5tclose_f(type_id, hdferr)
-        end subroutine text_column
+            select case (name)
+            case ('status')
+                value = rows(j)%status
+            case ('model')
+                value = trim(sweep%cases(j)%scene%model%kind)
+            case ('method')
+                value = trim(sweep%cases(j)%scene%solver%method)
+            case ('file')
+                value = sweep%cases(j)%file
+            case default
+                value = rows(j)%reason
+            end select
+        end function cell
     end subroutine write_h5
 end module ropedyn_sweep_summary

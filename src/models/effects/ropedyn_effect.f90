@@ -18,6 +18,7 @@ module ropedyn_effect
     implicit none
     private
     public :: body_effect_t, effect_box_t, bodies_t, point_force_block
+    public :: add_forces_of, add_jacobians_of, add_energies_of, add_powers_of
 
     !> Kinematics of all bodies of a model at one instant.
     type :: bodies_t
@@ -94,6 +95,55 @@ contains
         class(body_effect_t), intent(in) :: self
         does = .false.
     end function effect_does_work
+
+    !> Add the forces f(2, n) (N) and moments m(n) (N m) of all `effects` at time t.
+    pure subroutine add_forces_of(effects, t, b, f, m)
+        type(effect_box_t), intent(in) :: effects(:)
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp), intent(inout) :: f(:, :), m(:)
+        integer :: k
+        do k = 1, size(effects)
+            call effects(k)%e%add_forces(t, b, f, m)
+        end do
+    end subroutine add_forces_of
+
+    !> Add the Jacobian blocks jac(3, 6, n) of all `effects` at time t.
+    pure subroutine add_jacobians_of(effects, t, b, jac)
+        type(effect_box_t), intent(in) :: effects(:)
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp), intent(inout) :: jac(:, :, :)
+        integer :: k
+        do k = 1, size(effects)
+            call effects(k)%e%add_jacobian(t, b, jac)
+        end do
+    end subroutine add_jacobians_of
+
+    !> Add the potential energies of all `effects` at time t to `energy`, J (one by one, in
+    !! their order).
+    pure subroutine add_energies_of(effects, t, b, energy)
+        type(effect_box_t), intent(in) :: effects(:)
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp), intent(inout) :: energy
+        integer :: k
+        do k = 1, size(effects)
+            energy = energy + effects(k)%e%energy(t, b)
+        end do
+    end subroutine add_energies_of
+
+    !> Add the dissipation rates and external powers (W) of all `effects` at time t.
+    pure subroutine add_powers_of(effects, t, b, dissipation, work)
+        type(effect_box_t), intent(in) :: effects(:)
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp), intent(inout) :: dissipation, work
+        integer :: k
+        do k = 1, size(effects)
+            call effects(k)%e%power(t, b, dissipation, work)
+        end do
+    end subroutine add_powers_of
 
     !> Block (3, 6) of a force F acting at the point X = c + r e of a body, with velocity
     !! V = v + r w n, for the force's derivatives dfdx = dF/dX and dfdv = dF/dV (2, 2):

@@ -60,19 +60,30 @@ contains
         does = self%current
     end function drag_does_work
 
-    !> Force and moment of body i.
-    pure subroutine body_drag(self, b, i, f, m)
+    !> Length l of body i, its axis e and normal nv, and the components a (along e) and bb
+    !! (along nv) of its centre's velocity relative to the fluid.
+    pure subroutine relative_motion(self, b, i, l, e, nv, a, bb)
         class(drag_effect_t), intent(in) :: self
         type(bodies_t), intent(in) :: b
         integer, intent(in) :: i
-        real(wp), intent(out) :: f(2), m
-        real(wp) :: e(2), nv(2), vr(2), a, bb, l
+        real(wp), intent(out) :: l, e(2), nv(2), a, bb
+        real(wp) :: vr(2)
         l = b%l(i)
         e = [cos(b%phi(i)), sin(b%phi(i))]
         nv = [-e(2), e(1)]
         vr = b%v(:, i) - self%u
         a = dot_product(e, vr)
         bb = dot_product(nv, vr)
+    end subroutine relative_motion
+
+    !> Force and moment of body i.
+    pure subroutine body_drag(self, b, i, f, m)
+        class(drag_effect_t), intent(in) :: self
+        type(bodies_t), intent(in) :: b
+        integer, intent(in) :: i
+        real(wp), intent(out) :: f(2), m
+        real(wp) :: e(2), nv(2), a, bb, l
+        call relative_motion(self, b, i, l, e, nv, a, bb)
         f = 0.0_wp
         m = 0.0_wp
         if (self%quadratic) then
@@ -104,15 +115,10 @@ contains
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: jac(:, :, :)
-        real(wp) :: e(2), nv(2), vr(2), a, bb, l, kn, kt, dfdv(2, 2), dfdphi(2), dmdw
+        real(wp) :: e(2), nv(2), a, bb, l, kn, kt, dfdv(2, 2), dfdphi(2), dmdw
         integer :: i, p
         do i = 1, b%n
-            l = b%l(i)
-            e = [cos(b%phi(i)), sin(b%phi(i))]
-            nv = [-e(2), e(1)]
-            vr = b%v(:, i) - self%u
-            a = dot_product(e, vr)
-            bb = dot_product(nv, vr)
+            call relative_motion(self, b, i, l, e, nv, a, bb)
             dfdv = 0.0_wp
             dfdphi = 0.0_wp
             dmdw = 0.0_wp

@@ -35,6 +35,17 @@ module ropedyn_effect_ground
         procedure :: total_normal_force => ground_total_normal_force
     end type ground_effect_t
 
+    !> The contact at one end point of a body (all zero but r and delta when not in contact).
+    type :: contact_t
+        real(wp) :: r = 0.0_wp        !< offset of the point from the body's centre, m
+        real(wp) :: delta = 0.0_wp    !< penetration, m
+        real(wp) :: ddelta = 0.0_wp   !< its rate, m/s
+        real(wp) :: fn = 0.0_wp       !< normal force, N
+        real(wp) :: vt = 0.0_wp       !< tangential speed, m/s
+        real(wp) :: th = 0.0_wp       !< tanh(vt / v_reg)
+        real(wp) :: f(2) = 0.0_wp     !< force on the body, N
+    end type contact_t
+
 contains
 
     !> Ground through point p0 (m) with normal `normal` (any length > 0, towards the free
@@ -58,54 +69,50 @@ contains
         name = 'ground'
     end function ground_name
 
-    !> Contact at the point of body i at offset r: penetration, its rate, normal force,
-    !! tangential speed and the force vector (zero when not in contact).
-    pure subroutine contact(self, b, i, r, delta, ddelta, fn, vt, th, f)
+    !> Contact at end s (-1: A, +1: B) of body i, the point at offset r = s l/2 from the
+    !! centre: penetration, its rate, normal force, tangential speed, tanh(v_t / v_reg) and
+    !! the force vector (zero when not in contact).
+    pure function contact(self, b, i, s) result(c)
         class(ground_effect_t), intent(in) :: self
         type(bodies_t), intent(in) :: b
-        integer, intent(in) :: i
-        real(wp), intent(in) :: r
-        real(wp), intent(out) :: delta, ddelta, fn, vt, th, f(2)
+        integer, intent(in) :: i, s
+        type(contact_t) :: c
         real(wp) :: e(2), nv(2), x(2), v(2), kp, cp
+        c%r = 0.5_wp*real(s, wp)*b%l(i)
         e = [cos(b%phi(i)), sin(b%phi(i))]
         nv = [-e(2), e(1)]
-        x = b%c(:, i) + r*e
-        delta = -dot_product(x - self%p0, self%ng)
-        fn = 0.0_wp
-        ddelta = 0.0_wp
-        vt = 0.0_wp
-        th = 0.0_wp
-        f = 0.0_wp
-        if (delta <= 0.0_wp) return
-        v = b%v(:, i) + r*b%w(i)*nv
-        ddelta = -dot_product(v, self%ng)
+        x = b%c(:, i) + c%r*e
+        c%delta = -dot_product(x - self%p0, self%ng)
+        if (c%delta <= 0.0_wp) return
+        v = b%v(:, i) + c%r*b%w(i)*nv
+        c%ddelta = -dot_product(v, self%ng)
         kp = 0.5_wp*self%k*b%l(i)
         cp = 0.5_wp*self%c*b%l(i)
-        fn = kp*delta + cp*ddelta
-        if (fn <= 0.0_wp) then
-            fn = 0.0_wp
+        c%fn = kp*c%delta + cp*c%ddelta
+        if (c%fn <= 0.0_wp) then
+            c%fn = 0.0_wp
             return
         end if
-        vt = dot_product(v, self%tg)
-        th = tanh(vt/self%v_reg)
-        f = fn*(self%ng - self%mu*th*self%tg)
-    end subroutine contact
+        c%vt = dot_product(v, self%tg)
+        c%th = tanh(c%vt/self%v_reg)
+        c%f = c%fn*(self%ng - self%mu*c%th*self%tg)
+    end function contact
 
     pure subroutine ground_add_forces(self, t, b, f, m)
         class(ground_effect_t), intent(in) :: self
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: f(:, :), m(:)
-        real(wp) :: delta, ddelta, fn, vt, th, fp(2), r, e(2)
+        type(contact_t) :: c
+        real(wp) :: e(2)
         integer :: i, s
         do i = 1, b%n
             do s = -1, 1, 2
-                r = 0.5_wp*real(s, wp)*b%l(i)
-                call contact(self, b, i, r, delta, ddelta, fn, vt, th, fp)
-                if (fn <= 0.0_wp) cycle
+                c = contact(self, b, i, s)
+                if (c%fn <= 0.0_wp) cycle
                 e = [cos(b%phi(i)), sin(b%phi(i))]
-                f(:, i) = f(:, i) + fp
-                m(i) = m(i) + r*(e(1)*fp(2) - e(2)*fp(1))
+                f(:, i) = f(:, i) + c%f
+                m(i) = m(i) + c%r*(e(1)*c%f(2) - e(2)*c%f(1))
             end do
         end do
     end subroutine ground_add_forces
@@ -115,23 +122,23 @@ contains
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: jac(:, :, :)
-        real(wp) :: delta, ddelta, fn, vt, th, fp(2), r, kp, cp, dir(2), dfdx(2, 2), dfdv(2, 2)
+        type(contact_t) :: c
+        real(wp) :: kp, cp, dir(2), dfdx(2, 2), dfdv(2, 2)
         integer :: i, s, p
         do i = 1, b%n
             do s = -1, 1, 2
-                r = 0.5_wp*real(s, wp)*b%l(i)
-                call contact(self, b, i, r, delta, ddelta, fn, vt, th, fp)
-                if (fn <= 0.0_wp) cycle
+                c = contact(self, b, i, s)
+                if (c%fn <= 0.0_wp) cycle
                 kp = 0.5_wp*self%k*b%l(i)
                 cp = 0.5_wp*self%c*b%l(i)
-                dir = self%ng - self%mu*th*self%tg
+                dir = self%ng - self%mu*c%th*self%tg
                 ! dF_N/dX = -k_p n_g, dF_N/dV = -c_p n_g; d tanh/dV = (1 - th^2)/v_reg t_g
                 do p = 1, 2
                     dfdx(:, p) = -kp*dir*self%ng(p)
-                    dfdv(:, p) = -cp*dir*self%ng(p) - self%mu*fn*(1.0_wp - th**2)/self%v_reg &
+                    dfdv(:, p) = -cp*dir*self%ng(p) - self%mu*c%fn*(1.0_wp - c%th**2)/self%v_reg &
                                  *self%tg*self%tg(p)
                 end do
-                jac(:, :, i) = jac(:, :, i) + point_force_block(r, b%phi(i), b%w(i), fp, &
+                jac(:, :, i) = jac(:, :, i) + point_force_block(c%r, b%phi(i), b%w(i), c%f, &
                                                                 dfdx, dfdv)
             end do
         end do
@@ -159,17 +166,16 @@ contains
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: dissipation, work
-        real(wp) :: delta, ddelta, fn, vt, th, fp(2), r
+        type(contact_t) :: c
         integer :: i, s
         do i = 1, b%n
             do s = -1, 1, 2
-                r = 0.5_wp*real(s, wp)*b%l(i)
-                call contact(self, b, i, r, delta, ddelta, fn, vt, th, fp)
-                if (delta <= 0.0_wp) cycle
+                c = contact(self, b, i, s)
+                if (c%delta <= 0.0_wp) cycle
                 ! F_N = 0 when separating faster than the spring relaxes: then the spring's
                 ! energy still falls at -k_p delta delta' > 0 (th = 0 there)
-                dissipation = dissipation + (fn - 0.5_wp*self%k*b%l(i)*delta)*ddelta &
-                              + self%mu*fn*th*vt
+                dissipation = dissipation + (c%fn - 0.5_wp*self%k*b%l(i)*c%delta)*c%ddelta &
+                              + self%mu*c%fn*c%th*c%vt
             end do
         end do
     end subroutine ground_power
@@ -178,14 +184,13 @@ contains
     pure real(wp) function ground_total_normal_force(self, b) result(total)
         class(ground_effect_t), intent(in) :: self
         type(bodies_t), intent(in) :: b
-        real(wp) :: delta, ddelta, fn, vt, th, fp(2)
+        type(contact_t) :: c
         integer :: i, s
         total = 0.0_wp
         do i = 1, b%n
             do s = -1, 1, 2
-                call contact(self, b, i, 0.5_wp*real(s, wp)*b%l(i), delta, ddelta, fn, vt, &
-                             th, fp)
-                total = total + fn
+                c = contact(self, b, i, s)
+                total = total + c%fn
             end do
         end do
     end function ground_total_normal_force

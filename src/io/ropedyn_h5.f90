@@ -1,0 +1,412 @@
+!> The one place that calls HDF5: a file object (create or open, groups, datasets of rank 0
+!! to 3 with a `units` attribute and an optional `description`, columns of strings, string
+!! attributes, the readers of run files, close) and extendible series for step-by-step
+!! output. Every HDF5 return code is checked; errors are `ERR_IO` (a record of the wrong
+!! size: `ERR_INTERNAL`) with messages naming the file and the object. h5py sees every
+!! shape reversed, so time, the last Fortran axis of a series, is its first axis.
+!!
+!!     type(h5_file_t) :: h5
+!!     call h5%create('out/x.h5', err)
+!!     call h5%write('/modes/omega', omega, 'rad/s', err, 'natural angular frequencies')
+!!     call h5%attribute('/', 'version', version_string, err)
+!!     call h5%close(err)
+!!
+!! Values of any rank go to HDF5 through one pointer-based call per operation; the typed
+!! procedures only pick the HDF5 type. Scalars get a scalar dataspace, strings are
+!! fixed-length and null-padded (an empty string is one NUL byte, which readers see as '').
+!! The library is opened with `h5open_f` (idempotent), HDF5's own error printing silenced,
+!! and never closed here: no module state, other HDF5 users undisturbed (HDF5 closes itself
+!! at exit). An open `h5_file_t` or `h5_series_t` must not be copied (the copies would
+!! share ids); series are closed by their owner before the file.
+!!
+!! Files and groups are here; attributes, datasets and readers in the submodule
+!! ropedyn_h5_data, series in ropedyn_h5_series.
+module ropedyn_h5
+    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr
+    use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5eset_auto_f, &
+        h5fcreate_f, h5fopen_f, h5fclose_f, h5fflush_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, &
+        H5F_ACC_RDWR_F, H5F_SCOPE_GLOBAL_F, h5gcreate_f, h5gclose_f, h5lexists_f, &
+        h5oopen_f, h5oclose_f, h5screate_f, h5screate_simple_f, h5sclose_f, &
+        h5sselect_hyperslab_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, &
+        H5S_SCALAR_F, H5S_UNLIMITED_F, H5S_SELECT_SET_F, &
+        h5pcreate_f, h5pclose_f, h5pset_chunk_f, H5P_DATASET_CREATE_F, H5P_DEFAULT_F, &
+        h5dcreate_f, h5dopen_f, h5dclose_f, h5dwrite_f, h5dread_f, h5dset_extent_f, &
+        h5dget_space_f, h5acreate_f, h5aopen_f, h5aclose_f, h5awrite_f, h5aread_f, &
+        h5aexists_f, h5adelete_f, h5aget_type_f, h5tcopy_f, h5tclose_f, h5tset_size_f, &
+        h5tget_size_f, h5tset_strpad_f, H5T_NATIVE_CHARACTER, H5T_STR_NULLPAD_F, &
+        h5kind_to_type, H5_REAL_KIND, H5_INTEGER_KIND
+    use ropedyn_kinds, only: wp, i8
+    use ropedyn_text, only: int_text
+    use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INTERNAL
+    implicit none
+    private
+
+    !> Target size of one chunk of a series, bytes.
+    integer, parameter :: CHUNK_BYTES = 16384
+    !> Most records in one chunk.
+    integer, parameter :: MAX_CHUNK_RECORDS = 512
+
+    !> One HDF5 file.
+    type, public :: h5_file_t
+        private
+        character(len=:), allocatable :: path   !< as given to create/open
+        integer(hid_t) :: id = -1
+        logical :: is_open = .false.
+    contains
+        procedure :: create => h5_create
+        procedure :: open => h5_open
+        procedure :: close => h5_close
+        procedure :: flush => h5_flush
+        procedure :: file_name => h5_file_name
+        procedure :: group => h5_group
+        procedure :: exists => h5_exists
+        procedure :: attribute => h5_attribute
+        procedure :: read_attribute => h5_read_attribute
+        procedure, private :: write_real, write_int64
+        generic :: write => write_real, write_int64
+        procedure :: write_text => h5_write_text
+        procedure, private :: read_real_scalar, read_int64_scalar
+        generic :: read_scalar => read_real_scalar, read_int64_scalar
+        procedure :: read_reals => h5_read_reals
+        procedure :: create_series => h5_create_series
+        final :: h5_final
+    end type h5_file_t
+
+    !> An extendible, chunked dataset with time on its last Fortran axis, open while the
+    !! run writes it (real(wp) or default-integer records).
+    type, public :: h5_series_t
+        private
+        character(len=:), allocatable :: path     !< its file, for messages
+        character(len=:), allocatable :: name     !< absolute path in the file
+        integer(hid_t) :: id = -1
+        integer :: rank = 1                       !< Fortran rank including the time axis
+        integer(hsize_t) :: record_dims(2) = 1    !< extents of one record (first rank-1 used)
+    contains
+        procedure, private :: append_real, append_integer
+        generic :: append => append_real, append_integer
+        procedure :: close => series_close
+    end type h5_series_t
+
+    interface
+        !> Create the empty series `name` whose records have extents `record_dims` (none for a
+        !! scalar time series; at most 2), of real(wp) values or, with `is_integer`, default
+        !! integers; write its units (and `columns`, if not empty). The series stays open.
+        module subroutine h5_create_series(self, series, name, record_dims, is_integer, units, &
+                                           columns, err)
+            class(h5_file_t), intent(inout) :: self
+            type(h5_series_t), intent(inout) :: series
+            character(len=*), intent(in) :: name
+            integer(hsize_t), intent(in) :: record_dims(:)
+            logical, intent(in) :: is_integer
+            character(len=*), intent(in) :: units
+            character(len=*), intent(in) :: columns
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine h5_create_series
+
+        !> Close the series' dataset (nothing to do when it is not open).
+        module subroutine series_close(self, err)
+            class(h5_series_t), intent(inout) :: self
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine series_close
+
+        !> Write record number `record` (1-based; the series is extended to `record` records):
+        !! `values` is the record in Fortran order.
+        module subroutine append_real(self, record, values, err)
+            class(h5_series_t), intent(inout) :: self
+            integer(hsize_t), intent(in) :: record
+            real(wp), intent(in), target :: values(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine append_real
+
+        !> Write record number `record` of an integer series, as `append_real`.
+        module subroutine append_integer(self, record, values, err)
+            class(h5_series_t), intent(inout) :: self
+            integer(hsize_t), intent(in) :: record
+            integer, intent(in), target :: values(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine append_integer
+
+        !> A fixed-length, null-padded string type of `width` characters (at least 1).
+        module subroutine string_type(width, type_id, hdferr)
+            integer, intent(in) :: width
+            integer(hid_t), intent(out) :: type_id
+            integer, intent(out) :: hdferr
+        end subroutine string_type
+
+        !> Write (or replace) a scalar string attribute `name` on the open object `loc_id`
+        !! (`where` names the object in messages).
+        module subroutine string_attribute(path, loc_id, where, name, value, err)
+            character(len=*), intent(in) :: path
+            integer(hid_t), intent(in) :: loc_id
+            character(len=*), intent(in) :: where, name, value
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine string_attribute
+
+        !> Real dataset `name` (rank 0 to 3, Fortran shape) with its units and a description
+        !! (none when absent or ''). An existing dataset of that name is overwritten (its
+        !! attributes are kept).
+        module subroutine write_real(self, name, values, units, err, description)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name, units
+            real(wp), intent(in), target :: values(..)
+            type(error_t), allocatable, intent(out) :: err
+            character(len=*), intent(in), optional :: description
+        end subroutine write_real
+
+        !> 64-bit integer dataset `name` (rank 0 to 3), as `write_real`.
+        module subroutine write_int64(self, name, values, units, err, description)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name, units
+            integer(i8), intent(in), target :: values(..)
+            type(error_t), allocatable, intent(out) :: err
+            character(len=*), intent(in), optional :: description
+        end subroutine write_int64
+
+        !> A column of strings: a 1-d fixed-length, null-padded string dataset of width
+        !! len(values) >= 1 (shorter entries NUL-padded by the caller: trailing blanks are kept).
+        module subroutine h5_write_text(self, name, values, units, err)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name, units
+            character(len=*), intent(in), target :: values(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine h5_write_text
+
+        !> Create dataset `name` of `type_id` with Fortran extents `dims` (none: scalar); with
+        !! `max_dims` and `chunk` extendible and chunked. `dset_id` is open only on success.
+        module subroutine new_dataset(self, name, type_id, dims, dset_id, err, max_dims, chunk)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            integer(hid_t), intent(in) :: type_id
+            integer(hsize_t), intent(in) :: dims(:)
+            integer(hid_t), intent(out) :: dset_id
+            type(error_t), allocatable, intent(out) :: err
+            integer(hsize_t), intent(in), optional :: max_dims(:), chunk(:)
+        end subroutine new_dataset
+
+        !> A scalar string attribute of the root group, NULs removed ('' when missing). Without
+        !! `found` a missing attribute is an error.
+        module subroutine h5_read_attribute(self, name, value, err, found)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            character(len=:), allocatable, intent(out) :: value
+            type(error_t), allocatable, intent(out) :: err
+            logical, intent(out), optional :: found
+        end subroutine h5_read_attribute
+
+        !> A scalar real dataset; `value` is unchanged when it is absent.
+        module subroutine read_real_scalar(self, name, value, err)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            real(wp), intent(inout), target :: value
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine read_real_scalar
+
+        !> A scalar 64-bit integer dataset; `value` is unchanged when it is absent.
+        module subroutine read_int64_scalar(self, name, value, err)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            integer(i8), intent(inout), target :: value
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine read_int64_scalar
+
+        !> A real dataset of rank size(dims) >= 1: its values in Fortran order and its Fortran
+        !! extents `dims` (a missing dataset reads as empty, extents 0).
+        module subroutine h5_read_reals(self, name, values, dims, err)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            real(wp), allocatable, target, intent(out) :: values(:)
+            integer(hsize_t), intent(out) :: dims(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine h5_read_reals
+    end interface
+
+contains
+
+    ! ---------------------------------------------------------------------------------------
+    ! Library and file life cycle
+    ! ---------------------------------------------------------------------------------------
+
+    !> Open the HDF5 library (idempotent) and silence HDF5's own error printing.
+    subroutine library_acquire(path, err)
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: err
+        integer :: hdferr
+        call h5open_f(hdferr)
+        if (hdferr < 0) then
+            call make_error(err, ERR_IO, path//': cannot initialize the HDF5 library')
+            return
+        end if
+        call h5eset_auto_f(0, hdferr)
+        if (hdferr < 0) call make_error(err, ERR_IO, path//': cannot silence HDF5 error printing')
+    end subroutine library_acquire
+
+    !> Create (or overwrite) the file `path`; its directory must exist. A file still open in
+    !! this object is closed first.
+    subroutine h5_create(self, path, err)
+        class(h5_file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: err
+        integer :: hdferr
+        call self%close(err)
+        if (allocated(err)) return
+        call library_acquire(path, err)
+        if (allocated(err)) return
+        call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%id, hdferr)
+        if (hdferr < 0) then
+            self%id = -1
+            if (directory_exists(path)) then
+                call make_error(err, ERR_IO, path//': cannot create file (is it open in this '// &
+                                'or another program, or is the directory read-only?)')
+            else
+                call make_error(err, ERR_IO, path// &
+                                ': cannot create file (does the directory exist?)')
+            end if
+            return
+        end if
+        self%path = path
+        self%is_open = .true.
+    end subroutine h5_create
+
+    !> Open the existing file `path`, read-only unless `writable`.
+    subroutine h5_open(self, path, err, writable)
+        class(h5_file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: err
+        logical, intent(in), optional :: writable
+        logical :: rw
+        integer :: hdferr
+        call self%close(err)
+        if (allocated(err)) return
+        call library_acquire(path, err)
+        if (allocated(err)) return
+        rw = .false.
+        if (present(writable)) rw = writable
+        if (rw) then
+            call h5fopen_f(path, H5F_ACC_RDWR_F, self%id, hdferr)
+        else
+            call h5fopen_f(path, H5F_ACC_RDONLY_F, self%id, hdferr)
+        end if
+        if (hdferr < 0) then
+            self%id = -1
+            if (rw) then
+                call make_error(err, ERR_IO, path//': cannot open for writing')
+            else
+                call make_error(err, ERR_IO, path//': cannot open as HDF5 file')
+            end if
+            return
+        end if
+        self%path = path
+        self%is_open = .true.
+    end subroutine h5_open
+
+    !> Close the file (nothing to do when it is not open). Its series must be closed first.
+    subroutine h5_close(self, err)
+        class(h5_file_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: err
+        integer :: hdferr
+        if (.not. self%is_open) return
+        call h5fclose_f(self%id, hdferr)
+        self%is_open = .false.
+        self%id = -1
+        if (hdferr < 0) call make_error(err, ERR_IO, self%path//': cannot close file')
+    end subroutine h5_close
+
+    !> Close a file left open (no error can be reported here).
+    impure elemental subroutine h5_final(self)
+        type(h5_file_t), intent(inout) :: self
+        integer :: hdferr
+        if (self%is_open) call h5fclose_f(self%id, hdferr)
+        self%is_open = .false.
+    end subroutine h5_final
+
+    !> Write everything buffered to disk.
+    subroutine h5_flush(self, err)
+        class(h5_file_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: err
+        integer :: hdferr
+        call h5fflush_f(self%id, H5F_SCOPE_GLOBAL_F, hdferr)
+        if (hdferr < 0) call make_error(err, ERR_IO, self%path//': cannot flush file')
+    end subroutine h5_flush
+
+    !> The path given to the last successful create/open ('' if none).
+    pure function h5_file_name(self) result(path)
+        class(h5_file_t), intent(in) :: self
+        character(len=:), allocatable :: path
+        path = ''
+        if (allocated(self%path)) path = self%path
+    end function h5_file_name
+
+    !> Whether the directory part of `path` exists (gfortran's INQUIRE accepts directories;
+    !! a compiler that does not merely gives the 'does the directory exist?' hint).
+    function directory_exists(path) result(exists)
+        character(len=*), intent(in) :: path
+        logical :: exists
+        integer :: slash, ios
+        slash = index(path, '/', back=.true.)
+        if (slash == 0) then
+            inquire (file='.', exist=exists, iostat=ios)
+        else if (slash == 1) then
+            inquire (file='/', exist=exists, iostat=ios)
+        else
+            inquire (file=path(1:slash - 1), exist=exists, iostat=ios)
+        end if
+        if (ios /= 0) exists = .false.
+    end function directory_exists
+
+    ! ---------------------------------------------------------------------------------------
+    ! Groups and objects
+    ! ---------------------------------------------------------------------------------------
+
+    !> Create group `name` (its parent must exist).
+    subroutine h5_group(self, name, err)
+        class(h5_file_t), intent(inout) :: self
+        character(len=*), intent(in) :: name
+        type(error_t), allocatable, intent(out) :: err
+        integer(hid_t) :: group_id
+        integer :: hdferr
+        call h5gcreate_f(self%id, name, group_id, hdferr)
+        if (hdferr < 0) then
+            call make_error(err, ERR_IO, self%path//': '//name//': cannot create group')
+            return
+        end if
+        call h5gclose_f(group_id, hdferr)
+        if (hdferr < 0) call make_error(err, ERR_IO, self%path//': '//name// &
+                                        ': cannot close group')
+    end subroutine h5_group
+
+    !> Whether the object `name` exists (its parents are asked about first, as HDF5
+    !! requires); an HDF5 failure counts as absent.
+    logical function h5_exists(self, name) result(exists)
+        class(h5_file_t), intent(in) :: self
+        character(len=*), intent(in) :: name
+        integer :: hdferr, k
+        exists = .false.
+        if (.not. self%is_open) return
+        do k = 2, len(name) - 1
+            if (name(k:k) /= '/') cycle
+            call h5lexists_f(self%id, name(:k - 1), exists, hdferr)
+            if (hdferr < 0 .or. .not. exists) then
+                exists = .false.
+                return
+            end if
+        end do
+        call h5lexists_f(self%id, name, exists, hdferr)
+        if (hdferr < 0) exists = .false.
+    end function h5_exists
+
+    !> String attribute `name` on the object `where` ('/' for the root), replacing an old one.
+    subroutine h5_attribute(self, where, name, value, err)
+        class(h5_file_t), intent(inout) :: self
+        character(len=*), intent(in) :: where, name, value
+        type(error_t), allocatable, intent(out) :: err
+        integer(hid_t) :: obj
+        integer :: hdferr
+        call h5oopen_f(self%id, where, obj, hdferr)
+        if (hdferr < 0) then
+            call make_error(err, ERR_IO, self%path//': '//where//': cannot open object')
+            return
+        end if
+        call string_attribute(self%path, obj, where, name, value, err)
+        call h5oclose_f(obj, hdferr)
+    end subroutine h5_attribute
+end module ropedyn_h5
