@@ -29,6 +29,12 @@
 !!   spring with force M g, energy (M g)^2/(2 C), C = EA/dl; released, that energy leaves
 !!   the books (the balance steps by it), and the free rope's centre of mass falls as
 !!   g (t - t_r)^2/2 from rest.
+!! - Ground contact (RFEM): a rope lying on the ground at rest. Each element of length l
+!!   rests on its two end points, each a spring k l/2 carrying half its weight lambda l g/2,
+!!   so every point sinks delta = lambda g/k below the plane, whatever the element length.
+!! - Motion table between its rows (MPP, whose top joint is the anchor): the documented C1
+!!   cubic, Hermite on each interval with three-point slopes inside
+!!   ((h1 (y_k - y_k-1)/h0 + h0 (y_k+1 - y_k)/h1)/(h0 + h1)) and zero slopes at the ends.
 !! - Release (MPP bottom): an inextensible rope hanging straight, its tip held by the bottom
 !!   spring (k = EA/l) at an anchor delta below the tip: the spring stores k delta^2/2, which
 !!   leaves the books at the release; the rope stays at rest.
@@ -58,6 +64,7 @@ program test_effect_anchors
     call harmonic_support('mpp')
     call table_support('rfem')
     call table_support('mpp')
+    call ground_sink()
     call rfem_top_release()
     call mpp_bottom_release()
     call suite%finish()
@@ -259,7 +266,64 @@ contains
                             'table rows')
         call suite%check_le(dpsi, 6.0e-4_wp, kind//': the top element turns to the table '// &
                             'rows (degrees)')
+        if (kind /= 'mpp') return
+        dp = 0.0_wp
+        do k = 1, run%last()
+            p = run%points(k)
+            dp = max(dp, norm2(p(:, 1) - hermite(rows, run%t(k))))
+        end do
+        write (*, '(a, es10.2, a)') '  mpp table top between the rows: worst deviation', dp, ' m'
+        call suite%check_le(dp, 1.0e-15_wp, kind//': between the rows the anchor follows '// &
+                            'the C1 cubic with three-point slopes')
     end subroutine table_support
+
+    !> The documented table interpolation of (dx, dy) at t: Hermite cubic on the interval,
+    !! three-point slopes inside, zero slopes at the first and last rows, at rest outside.
+    function hermite(rows, t) result(v)
+        real(wp), intent(in) :: rows(:, :), t
+        real(wp) :: v(2), slope(2, size(rows, 2)), h, u, h0, h1
+        integer :: k, m
+        m = size(rows, 2)
+        slope = 0.0_wp
+        do k = 2, m - 1
+            h0 = rows(1, k) - rows(1, k - 1)
+            h1 = rows(1, k + 1) - rows(1, k)
+            slope(:, k) = (h1*(rows(2:3, k) - rows(2:3, k - 1))/h0 &
+                           + h0*(rows(2:3, k + 1) - rows(2:3, k))/h1)/(h0 + h1)
+        end do
+        if (t >= rows(1, m)) then
+            v = rows(2:3, m)
+            return
+        end if
+        k = 1
+        do while (rows(1, k + 1) <= t)
+            k = k + 1
+        end do
+        h = rows(1, k + 1) - rows(1, k)
+        u = (t - rows(1, k))/h
+        v = (2*u**3 - 3*u**2 + 1)*rows(2:3, k) + (u**3 - 2*u**2 + u)*h*slope(:, k) &
+            + (-2*u**3 + 3*u**2)*rows(2:3, k + 1) + (u**3 - u**2)*h*slope(:, k + 1)
+    end function hermite
+
+    !> A rope (n = 10) laid flat on the ground (stiffness 1e5 N/m^2, damping 200 N s/m^2),
+    !! at rest after 0.2 s: every element centre lambda g/k below the plane, level.
+    subroutine ground_sink()
+        type(run_t) :: run
+        real(wp) :: q(3, 10), qd(3, 10), sink, dx, tilt
+        call simulate([character(len=SET_LEN) :: 'model.elements=10', 'supports.top=free', &
+            'supports.top_anchor=1.0, 0.0', 'initial.angle_deg=90', 'effects.ground=.true.', &
+            'ground.point=1.0, 0.0', 'ground.stiffness=1e5', 'ground.damping=200'], &
+            0.2_wp, 0.05_wp, 1.0e-9_wp, run)
+        if (.not. completed(run, 'ground sink')) return
+        call run%model%fields(run%y(:, run%last()), q, qd)
+        sink = lam*g/1.0e5_wp
+        dx = maxval(abs(q(1, :) - (1.0_wp + sink)))
+        tilt = maxval(abs(q(3, :) - 0.5_wp*pi))
+        write (*, '(a, 2es14.6, a)') '  ground: sink', q(1, 5) - 1.0_wp, sink, ' m'
+        call suite%check_le(dx/sink, 1.0e-10_wp, &
+            'ground: a resting rope sinks lambda g/k at every point (k l/2 per end point)')
+        call suite%check_le(tilt, 1.0e-13_wp, 'ground: the resting rope lies level')
+    end subroutine ground_sink
 
     !> RFEM, n = 10, at rest in its static equilibrium, top released at 0.1 s: the balance
     !! steps by (M g)^2/(2 C), C = EA/dl, and the centre of mass then falls freely.
