@@ -10,6 +10,11 @@
 !! - point mass: a tip mass lowers the swing frequency to the value of a heavy chain with
 !!   a tip mass (Bessel functions) and of a compound-pendulum estimate (RFEM and MPP);
 !! - all effects at once: T + V + dissipated - external work = E0 over a run.
+!! Bounds are about three times the larger of the values measured with the Debug and the
+!! Release build (CVODE at the rtol given; printed by each check): e.g. the drag balances
+!! 8.0e-9 and 3.9e-8 J, the every-effect balance 3.1e-8 (RFEM, Release 8.0e-8) and 6.5e-8 of
+!! the energy moved (docs/testing.md). Without the quadratures' error control the drag
+!! balances reach 4.1e-8 and 2.3e-7 J and fail.
 program test_effects_physics
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t
@@ -145,10 +150,10 @@ contains
         call fields_at(run, ubound(run%t, 1), q, qdot)
         v_term = sqrt(2.0_wp*lam*g/(1000.0_wp*1.2_wp*0.005_wp))
         write (*, '(a, 2f12.7, a)') '  drag: speed', maxval(qdot(1, :)), v_term, ' m/s'
-        call suite%check_le(maxval(abs(qdot(1, :) - v_term))/v_term, 1.0e-5_wp, &
+        call suite%check_le(maxval(abs(qdot(1, :) - v_term))/v_term, 5.0e-8_wp, &
                             'drag: terminal speed = sqrt(2 lambda g/(rho C_n d))')
         call suite%check_le(abs(run%e(ubound(run%e, 1))%balance() - run%e(0)%balance()), &
-                            1.0e-6_wp, 'drag: energy balance')
+                            3.0e-8_wp, 'drag: energy balance')
 
         call simulate([character(len=64) :: base, 'fluid.density = 0', &
             'fluid.linear_normal_drag = 2.0', 'fluid.linear_tangential_drag = 2.0', &
@@ -157,12 +162,12 @@ contains
         call fields_at(run, ubound(run%t, 1), q, qdot)
         write (*, '(a, 2f12.7, a)') '  linear drag: velocity', sum(qdot(1:2, :), 2)/size(q, 2), &
             ' m/s'
-        call suite%check_le(maxval(abs(qdot(1, :) - lam*g/2.0_wp)), 1.0e-5_wp, &
+        call suite%check_le(maxval(abs(qdot(1, :) - lam*g/2.0_wp)), 1.0e-7_wp, &
                             'linear drag: terminal speed = lambda g / c_n')
-        call suite%check_le(maxval(abs(qdot(2, :) - 0.3_wp)), 1.0e-5_wp, &
+        call suite%check_le(maxval(abs(qdot(2, :) - 0.3_wp)), 5.0e-8_wp, &
                             'linear drag: the rope drifts with the current')
         call suite%check_le(abs(run%e(ubound(run%e, 1))%balance() - run%e(0)%balance()), &
-                            1.0e-6_wp, 'linear drag with current: T + V + dissipated - W = E0')
+                            1.5e-7_wp, 'linear drag with current: T + V + dissipated - W = E0')
     end subroutine drag_terminal_speed
 
     !> A rope lying on the ground slides along its length at 1 m/s: Coulomb friction stops
@@ -191,9 +196,9 @@ contains
         slide = sum(mass*(q(2, :) - q0(2, :)))/sum(mass)
         expected = 1.0_wp/(2.0_wp*mu*g)
         write (*, '(a, 2f12.7, a)') '  ground: slide', slide, expected, ' m'
-        call suite%check_close(slide, expected, 1.0e-3_wp, 0.0_wp, &
+        call suite%check_close(slide, expected, 1.0e-4_wp, 0.0_wp, &
                                'ground: sliding distance = v0^2/(2 mu g)')
-        call suite%check_le(maxval(abs(qdot(1:2, :))), 1.0e-6_wp, 'ground: the rope comes to rest')
+        call suite%check_le(maxval(abs(qdot(1:2, :))), 1.0e-13_wp, 'ground: the rope comes to rest')
         ground = ground_effect([1.0_wp, 0.0_wp], [-1.0_wp, 0.0_wp], 1.0e5_wp, 200.0_wp, mu, &
                                1.0e-3_wp)
         b%n = n
@@ -205,9 +210,9 @@ contains
         normal_force = ground%total_normal_force(b)
         weight = sum(mass)*g
         write (*, '(a, 2f12.8, a)') '  ground: contact force, weight', normal_force, weight, ' N'
-        call suite%check_close(normal_force, weight, 1.0e-6_wp, 0.0_wp, &
+        call suite%check_close(normal_force, weight, 5.0e-11_wp, 0.0_wp, &
                                'ground: the contact forces carry the weight')
-        call suite%check_le(abs(run%e(last)%balance() - run%e(0)%balance()), 1.0e-6_wp, &
+        call suite%check_le(abs(run%e(last)%balance() - run%e(0)%balance()), 1.5e-9_wp, &
                             'ground: T + V + dissipated = E0 (friction and contact damping)')
     end subroutine ground_friction
 
@@ -234,7 +239,8 @@ contains
             run%e(ubound(run%e, 1))%total() - run%e(0)%total(), &
             run%e(ubound(run%e, 1))%support_work, worst, ' J'
         call suite%check_true(work > 1.0e-3_wp, kind//': the shaken top does work')
-        call suite%check_le(worst/work, 1.0e-4_wp, kind//': support work = change of T + V '// &
+        call suite%check_le(worst/work, merge(1.0e-5_wp, 5.0e-8_wp, kind == 'rfem'), &
+                            kind//': support work = change of T + V '// &
                             '(undamped, shaken top)')
     end subroutine shaken_top
 
@@ -256,15 +262,15 @@ contains
         end do
         write (*, '(a, 3f10.5, a)') '  folded: tip fall at 0.1, 0.2, 0.3 s', x(20), x(40), &
             x(60), ' m (theory 0.04947, 0.20363, 0.48980)'
-        call suite%check_close(x(20), 0.04947_wp, 0.02_wp, 0.0_wp, 'folded: fall at 0.1 s')
-        call suite%check_close(x(40), 0.20363_wp, 0.02_wp, 0.0_wp, 'folded: fall at 0.2 s')
-        call suite%check_close(x(60), 0.48980_wp, 0.03_wp, 0.0_wp, 'folded: fall at 0.3 s')
+        call suite%check_close(x(20), 0.04947_wp, 0.01_wp, 0.0_wp, 'folded: fall at 0.1 s')
+        call suite%check_close(x(40), 0.20363_wp, 0.01_wp, 0.0_wp, 'folded: fall at 0.2 s')
+        call suite%check_close(x(60), 0.48980_wp, 0.02_wp, 0.0_wp, 'folded: fall at 0.3 s')
         a_rel = (x(42) - 2.0_wp*x(40) + x(38))/(0.01_wp**2*g)
         write (*, '(a, f8.4, a)') '  folded: a/g at 0.2 s', a_rel, ' (theory 1.288)'
         call suite%check_true(a_rel > 1.15_wp, 'folded: tip acceleration > g')
         call suite%check_true(x(60) > 0.5_wp*g*0.3_wp**2, 'folded: faster than free fall')
         call suite%check_le(abs(run%e(60)%balance() - run%e(0)%balance()), &
-                            1.0e-5_wp, 'folded: T + V + dissipated = E0')
+                            2.0e-8_wp, 'folded: T + V + dissipated = E0')
     end subroutine folded_fall
 
     !> A tip mass equal to the rope's mass: the small-swing frequency against the heavy
@@ -378,7 +384,7 @@ contains
         call suite%check_true(run%e(ubound(run%e, 1))%dissipated > 0.0_wp .and. &
                               abs(run%e(ubound(run%e, 1))%support_work) > 0.0_wp, &
                               kind//': every effect: energy is dissipated and work is done')
-        call suite%check_le(worst, 1.0e-5_wp*scale, kind//': every effect: T + V + '// &
+        call suite%check_le(worst, 2.5e-7_wp*scale, kind//': every effect: T + V + '// &
                             'dissipated - work = E0')
     end subroutine every_effect_balance
 end program test_effects_physics

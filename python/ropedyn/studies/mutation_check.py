@@ -229,7 +229,7 @@ MUTATIONS = [
              "c%tq = real(k + 1, wp)*sum([(1.0_wp/real(j, wp), j=1, k)])",
              "c%tq = real(k + 2, wp)*sum([(1.0_wp/real(j, wp), j=1, k)])",
              "MEBDF error normalization (k+2) instead of (k+1)",
-             ctest=("test_mebdf",)),
+             ctest=("test_mebdf", "test_rope_solvers")),
     Mutation("cvode-rtol-loosened", "solvers/cvode/ropedyn_cvode.f90",
              "flag = FCVodeSStolerances(self%mem, real(options%rtol, c_double), &",
              "flag = FCVodeSStolerances(self%mem, real(10*options%rtol, c_double), &",
@@ -239,7 +239,7 @@ MUTATIONS = [
              "flag = FCVodeSetQuadErrCon(self%mem, 1_c_int)",
              "flag = FCVodeSetQuadErrCon(self%mem, 0_c_int)",
              "dissipated energy and work integrated without error control",
-             ctest=("test_rfem_physics", "test_effects_physics")),
+             ctest=("test_effects_physics",)),
     # --- input handling and statics -------------------------------------------------------
     Mutation("eq13-inverted", "src/io/ropedyn_scene.f90",
              "r%tangential_damping = r%normal_damping*r%shear_modulus/r%young_modulus",
@@ -380,7 +380,9 @@ class Runner:
             (self.pytest(m.pytest) if m.pytest else None)
 
     def full(self):
-        return self.ctest() or self.pytest()
+        # the list's own check fails for every mutation (its snippet is gone): not a catch
+        return self.ctest() or self.pytest(("tests/e2e", "tests/hard", "--ignore",
+                                            "tests/e2e/test_mutation_list.py"))
 
 
 def apply(tree, m):
