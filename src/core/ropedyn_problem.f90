@@ -10,7 +10,17 @@
 !! - a linearly implicit form M(t, y) y' = F(t, y) (`has_mass_matrix`): `implicit_rhs`
 !!   gives F, `mass_matrix` gives M, `implicit_jacobian` gives dF/dy. `rhs` must still give
 !!   y' = M^{-1} F for integrators that only take explicit systems. Without a mass matrix
-!!   the implicit form is the explicit one with M = I. The band (ml, mu) covers M too.
+!!   the implicit form is the explicit one with M = I. The band (ml, mu) covers M too;
+!! - second-order structure (`has_second_order`): the unknowns are coordinates q = y(pos)
+!!   and their rates v = y(vel) with q' = v exactly, and the rate equations are
+!!   M(q) v' = F_v(t, q, v) (M = I in the explicit form). Integrators then solve their
+!!   Newton systems on the reduced matrix M - g C - g^2 K of size(pos) unknowns
+!!   (K = dF_v/dq, C = dF_v/dv, g the Newton matrix's multiple of the Jacobian) instead
+!!   of the first-order one of twice that size: (I - g J) (dq, dv) = (r_q, r_v) becomes
+!!   (M - g C - g^2 K) dv = r_v + g K r_q, dq = r_q + g dv (for the implicit form with
+!!   r_v the residual of the rate rows, M dv - ...). `second_order_blocks` gives K, C, M in
+!!   band storage (default: taken from the first-order Jacobian, so every problem with a
+!!   Jacobian can use the reduced path; models override it with a direct assembly).
 module ropedyn_problem
     use ropedyn_kinds, only: wp
     implicit none
@@ -37,6 +47,9 @@ module ropedyn_problem
         procedure :: implicit_rhs => problem_implicit_rhs
         procedure :: has_implicit_jacobian => problem_has_implicit_jacobian
         procedure :: implicit_jacobian => problem_implicit_jacobian
+        procedure :: has_second_order => problem_has_second_order
+        procedure :: second_order_layout => problem_second_order_layout
+        procedure :: second_order_blocks => problem_second_order_blocks
     end type problem_t
 
     abstract interface
@@ -147,4 +160,87 @@ contains
         yqdot = 0.0_wp
         status = STATUS_OK
     end subroutine problem_quad_rhs
+
+    !> True when the problem has the second-order structure described in the module header
+    !! (none unless a problem overrides this).
+    pure logical function problem_has_second_order(self) result(has)
+        class(problem_t), intent(in) :: self
+        has = .false.
+    end function problem_has_second_order
+
+    !> Where the coordinates and their rates are in y (y(pos(k)) is q_k, y(vel(k)) its rate)
+    !! and the lower and upper bandwidths kl, ku of the reduced blocks K, C, M (matrices of
+    !! size(pos) rows and columns, in the order of pos). Only called when
+    !! `has_second_order()`; the default has no coordinates.
+    pure subroutine problem_second_order_layout(self, pos, vel, kl, ku)
+        class(problem_t), intent(in) :: self
+        integer, allocatable, intent(out) :: pos(:), vel(:)
+        integer, intent(out) :: kl, ku
+        allocate (pos(0), vel(0))
+        kl = 0
+        ku = 0
+    end subroutine problem_second_order_layout
+
+    !> Add the blocks of the rate rows into band storage (entry (i, j) of a block goes to
+    !! b(offset + i - j, j), offset >= ku + 1, size(b, 1) >= offset + kl; the caller zeroes
+    !! them): K = dF_v/dq into kb, C = dF_v/dv into cb and the mass block into mb. With
+    !! `implicit_form` false they are the rows of the explicit system y' = f (M^{-1} applied;
+    !! the mass block is I); true: of the implicit form M(t, y) y' = F. The default takes them
+    !! from the first-order (implicit) Jacobian and mass matrix, and reports STATUS_FATAL when
+    !! the problem has no analytic one (integrators then keep the first-order path).
+    subroutine problem_second_order_blocks(self, t, y, implicit_form, kb, cb, mb, offset, &
+                                           status)
+        class(problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        logical, intent(in) :: implicit_form
+        real(wp), intent(inout) :: kb(:, :), cb(:, :), mb(:, :)
+        integer, intent(in) :: offset
+        integer, intent(out) :: status
+        integer, allocatable :: pos(:), vel(:)
+        real(wp), allocatable :: jb(:, :), massb(:, :)
+        integer :: ml, mu, kl, ku, a, b, joff
+        logical :: with_mass
+
+        call self%second_order_layout(pos, vel, kl, ku)
+        call self%bandwidths(ml, mu)
+        joff = mu + 1
+        allocate (jb(ml + mu + 1, self%size()))
+        jb = 0.0_wp
+        with_mass = implicit_form .and. self%has_mass_matrix()
+        status = STATUS_FATAL
+        if (with_mass .and. .not. self%has_implicit_jacobian()) return
+        if (.not. with_mass .and. .not. self%has_jacobian()) return
+        if (with_mass) then
+            call self%implicit_jacobian(t, y, jb, joff, status)
+        else
+            call self%jacobian(t, y, jb, joff, status)
+        end if
+        if (status /= STATUS_OK) return
+        if (with_mass) then
+            allocate (massb(ml + mu + 1, self%size()))
+            massb = 0.0_wp
+            call self%mass_matrix(t, y, massb, joff, status)
+            if (status /= STATUS_OK) return
+        end if
+        do b = 1, size(pos)
+            do a = max(1, b - ku), min(size(pos), b + kl)
+                kb(offset + a - b, b) = kb(offset + a - b, b) + entry(jb, vel(a), pos(b))
+                cb(offset + a - b, b) = cb(offset + a - b, b) + entry(jb, vel(a), vel(b))
+                if (with_mass) then
+                    mb(offset + a - b, b) = mb(offset + a - b, b) + entry(massb, vel(a), vel(b))
+                else if (a == b) then
+                    mb(offset, b) = mb(offset, b) + 1.0_wp
+                end if
+            end do
+        end do
+    contains
+        !> Entry (i, j) of a first-order band matrix, zero outside the band.
+        pure real(wp) function entry(band, i, j) result(x)
+            real(wp), intent(in) :: band(:, :)
+            integer, intent(in) :: i, j
+            x = 0.0_wp
+            if (i - j <= ml .and. j - i <= mu) x = band(joff + i - j, j)
+        end function entry
+    end subroutine problem_second_order_blocks
 end module ropedyn_problem

@@ -32,6 +32,8 @@ module ropedyn_rope_model
         procedure(element_data_i), deferred :: element_data
         procedure(coordinates_i), deferred :: coordinates
         procedure(coordinate_mass_i), deferred :: coordinate_mass
+        procedure :: has_second_order => rope_has_second_order
+        procedure :: second_order_layout => rope_second_order_layout
     end type rope_model_t
 
     abstract interface
@@ -110,6 +112,23 @@ module ropedyn_rope_model
         end subroutine coordinate_mass_i
     end interface
 contains
+
+    !> Every rope model is mechanical: coordinates and their rates, q' = v.
+    pure logical function rope_has_second_order(self) result(has)
+        class(rope_model_t), intent(in) :: self
+        has = .true.
+    end function rope_has_second_order
+
+    !> The generalized coordinates (`coordinates`); the reduced blocks are dense unless a
+    !! model knows better.
+    pure subroutine rope_second_order_layout(self, pos, vel, kl, ku)
+        class(rope_model_t), intent(in) :: self
+        integer, allocatable, intent(out) :: pos(:), vel(:)
+        integer, intent(out) :: kl, ku
+        call self%coordinates(pos, vel)
+        kl = size(pos) - 1
+        ku = kl
+    end subroutine rope_second_order_layout
 
     !> T + V (kinetic + elastic + gravity), J.
     pure real(wp) function energy_total(self) result(e)

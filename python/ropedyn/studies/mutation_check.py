@@ -241,7 +241,7 @@ MUTATIONS = [
              "dissipated energy and work integrated without error control",
              ctest=("test_effects_physics",)),
     # --- input handling and statics -------------------------------------------------------
-    Mutation("eq13-inverted", "src/io/ropedyn_scene.f90",
+    Mutation("eq13-inverted", "src/io/ropedyn_scene_checks.f90",
              "r%tangential_damping = r%normal_damping*r%shear_modulus/r%young_modulus",
              "r%tangential_damping = r%normal_damping*r%young_modulus/r%shear_modulus",
              "default tangential damping eta E/G instead of eta G/E (paper, eq. 13)",

@@ -113,6 +113,7 @@ module ropedyn_rfem
         procedure :: polyline => rfem_polyline
         procedure :: element_data => rfem_element_data
         procedure :: coordinates => rfem_coordinates
+        procedure :: second_order_layout => rfem_second_order_layout
         procedure :: coordinate_mass => rfem_coordinate_mass
         procedure :: generalized_forces => rfem_generalized_forces
         procedure :: potential_energy => rfem_potential_energy
@@ -536,6 +537,17 @@ contains
             end do
         end do
     end subroutine rfem_coordinates
+
+    !> The coordinates; element i couples to i-1 and i+1 only, so the reduced blocks have
+    !! three 3x3 blocks a row: bandwidths 5 and 5.
+    pure subroutine rfem_second_order_layout(self, pos, vel, kl, ku)
+        class(rfem_t), intent(in) :: self
+        integer, allocatable, intent(out) :: pos(:), vel(:)
+        integer, intent(out) :: kl, ku
+        call self%coordinates(pos, vel)
+        kl = min(5, size(pos) - 1)
+        ku = kl
+    end subroutine rfem_second_order_layout
 
     !> The mass matrix of the coordinates: diag(m_i, m_i, J_i), plus the translation-rotation
     !! coupling s n_i of elements with point masses off their centre.
