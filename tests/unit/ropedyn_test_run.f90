@@ -15,9 +15,10 @@ module ropedyn_test_run
     use ropedyn_modes, only: equilibrium_initial_state
     use ropedyn_integrator, only: integrator_t, solver_options_t
     use ropedyn_solvers, only: new_integrator
+    use ropedyn_assert, only: test_suite_t
     implicit none
     private
-    public :: run_t, simulate, SET_LEN
+    public :: run_t, simulate, completed, kind_set, SET_LEN
 
     integer, parameter :: SET_LEN = 80   !< length of one override text
 
@@ -111,6 +112,23 @@ contains
         run%ok = .true.
         run%message = ''
     end subroutine simulate
+
+    !> 'model.kind=<kind>' (built apart: gfortran mis-sizes a concatenation inside a typed
+    !! character array constructor).
+    function kind_set(kind) result(set)
+        character(len=*), intent(in) :: kind
+        character(len=SET_LEN) :: set
+        set = 'model.kind='//kind
+    end function kind_set
+
+    !> Whether the run completed, recorded as a check of the suite (with the reason if not).
+    logical function completed(suite, run, label)
+        type(test_suite_t), intent(inout) :: suite
+        type(run_t), intent(in) :: run
+        character(len=*), intent(in) :: label
+        completed = run%ok
+        call suite%check_true(run%ok, label//': run completes '//run%message)
+    end function completed
 
     !> Index of the last record.
     pure integer function run_last(self)

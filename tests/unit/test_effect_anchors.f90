@@ -43,7 +43,7 @@
 program test_effect_anchors
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t
-    use ropedyn_test_run, only: run_t, simulate, SET_LEN
+    use ropedyn_test_run, only: run_t, simulate, completed, kind_set, SET_LEN
     use ropedyn_analysis, only: support_forces
     use ropedyn_assert, only: test_suite_t
     implicit none
@@ -71,20 +71,7 @@ program test_effect_anchors
 
 contains
 
-    !> 'model.kind=rfem' (built apart: gfortran mis-sizes a concatenation inside a typed
-    !! character array constructor).
-    function kind_key(kind) result(key)
-        character(len=*), intent(in) :: kind
-        character(len=SET_LEN) :: key
-        key = 'model.kind='//kind
-    end function kind_key
 
-    logical function completed(run, label)
-        type(run_t), intent(in) :: run
-        character(len=*), intent(in) :: label
-        completed = run%ok
-        call suite%check_true(run%ok, label//': run completes '//run%message)
-    end function completed
 
     !> Linear drag c_n = 2, c_t = 0.5 N s/m^2 on a free rope at 45 deg: both components of
     !! the terminal velocity (reached to exp(-c_t t/lambda) = 6e-10 at 5 s), no rotation.
@@ -96,7 +83,7 @@ contains
             'initial.angle_deg=45', 'effects.drag=.true.', 'fluid.density=0', &
             'fluid.linear_normal_drag=2.0', 'fluid.linear_tangential_drag=0.5'], &
             5.0_wp, 0.5_wp, 1.0e-8_wp, run)
-        if (.not. completed(run, 'drag at 45 deg')) return
+        if (.not. completed(suite, run, 'drag at 45 deg')) return
         call run%model%fields(run%y(:, run%last()), q, qd)
         expected = 0.5_wp*lam*g*[1.0_wp/ct + 1.0_wp/cn, 1.0_wp/ct - 1.0_wp/cn]
         worst = maxval(abs(qd(1, :) - expected(1))) + maxval(abs(qd(2, :) - expected(2)))
@@ -115,11 +102,11 @@ contains
         character(len=*), intent(in) :: kind
         type(run_t) :: run
         real(wp) :: q(3, 8), qd(3, 8), theta
-        call simulate([character(len=SET_LEN) :: kind_key(kind), 'model.elements=8', &
+        call simulate([character(len=SET_LEN) :: kind_set(kind), 'model.elements=8', &
             'initial.shape=hanging', 'effects.drag=.true.', 'fluid.density=0', &
             'fluid.linear_normal_drag=0.9', 'fluid.linear_tangential_drag=0.3', &
             'fluid.current=0.0, 0.6'], 6.0_wp, 0.5_wp, 1.0e-8_wp, run)
-        if (.not. completed(run, kind//' drag in a current')) return
+        if (.not. completed(suite, run, kind//' drag in a current')) return
         call run%model%fields(run%y(:, run%last()), q, qd, run%t(run%last()))
         theta = atan(0.9_wp*0.6_wp/(lam*g))
         write (*, '(a, 2f12.8, a)') '  '//kind//' current: angles (top, bottom)', &
@@ -142,7 +129,7 @@ contains
             'attachments.load_force_y=-0.05', 'attachments.load_amplitude_x=0.2', &
             'attachments.load_amplitude_y=0.3', 'attachments.load_frequency=2.0', &
             'attachments.load_phase_deg=30'], 1.0_wp, 0.05_wp, 1.0e-9_wp, run)
-        if (.not. completed(run, 'point load')) return
+        if (.not. completed(suite, run, 'point load')) return
         w = 2.0_wp*pi*2.0_wp
         phi = 30.0_wp*deg
         com0 = run%centre_of_mass(0)
@@ -174,7 +161,7 @@ contains
             'attachments.load_positions=1.0', 'attachments.load_force_y=0.2', &
             'attachments.load_amplitude_y=0.4', 'attachments.load_frequency=1.0', &
             'attachments.load_phase_deg=30'], 0.01_wp, 0.01_wp, 1.0e-8_wp, run)
-        if (.not. completed(run, 'mpp tip load')) return
+        if (.not. completed(suite, run, 'mpp tip load')) return
         call run%model%fields(run%y(:, 0), q, qd, 0.0_wp)
         force = 0.2_wp + 0.4_wp*sin(30.0_wp*deg)
         m = rope_mass/real(n, wp)
@@ -199,13 +186,13 @@ contains
         real(wp), allocatable :: p(:, :), q(:, :), qd(:, :)
         real(wp) :: w, anchor(2), psi, dp, dpsi
         integer :: k, n
-        call simulate([character(len=SET_LEN) :: kind_key(kind), 'model.elements=8', &
+        call simulate([character(len=SET_LEN) :: kind_set(kind), 'model.elements=8', &
             'initial.shape=hanging', 'supports.top=clamped', &
             'supports.support_stiffness_factor=1e4', 'supports.top_motion=harmonic', &
             'supports.top_amplitude=0.01, 0.02', 'supports.top_frequency=2', &
             'supports.top_phase_deg=180, 0', 'supports.top_angle_amplitude_deg=5', &
             'supports.top_angle_phase_deg=180'], 0.5_wp, 0.01_wp, 1.0e-8_wp, run)
-        if (.not. completed(run, kind//' harmonic support')) return
+        if (.not. completed(suite, run, kind//' harmonic support')) return
         n = run%model%n_elements()
         allocate (q(3, n), qd(3, n))
         w = 2.0_wp*pi*2.0_wp
@@ -244,11 +231,11 @@ contains
             write (unit, '(4es24.16)') rows(:, r)
         end do
         close (unit)
-        call simulate([character(len=SET_LEN) :: kind_key(kind), 'model.elements=8', &
+        call simulate([character(len=SET_LEN) :: kind_set(kind), 'model.elements=8', &
             'initial.shape=hanging', 'supports.top=clamped', &
             'supports.support_stiffness_factor=1e4', 'supports.top_motion=table', &
             'supports.top_table=test_anchor_table.dat'], 0.5_wp, 0.05_wp, 1.0e-8_wp, run)
-        if (.not. completed(run, kind//' table support')) return
+        if (.not. completed(suite, run, kind//' table support')) return
         n = run%model%n_elements()
         allocate (q(3, n), qd(3, n))
         dp = 0.0_wp
@@ -314,7 +301,7 @@ contains
             'supports.top_anchor=1.0, 0.0', 'initial.angle_deg=90', 'effects.ground=.true.', &
             'ground.point=1.0, 0.0', 'ground.stiffness=1e5', 'ground.damping=200'], &
             0.2_wp, 0.05_wp, 1.0e-9_wp, run)
-        if (.not. completed(run, 'ground sink')) return
+        if (.not. completed(suite, run, 'ground sink')) return
         call run%model%fields(run%y(:, run%last()), q, qd)
         sink = lam*g/1.0e5_wp
         dx = maxval(abs(q(1, :) - (1.0_wp + sink)))
@@ -334,7 +321,7 @@ contains
         call simulate([character(len=SET_LEN) :: 'model.elements=10', &
             'initial.shape=equilibrium', 'initial.angle_deg=0', &
             'supports.top_release_time=0.1'], 0.4_wp, 0.05_wp, 1.0e-9_wp, run)
-        if (.not. completed(run, 'rfem release')) return
+        if (.not. completed(suite, run, 'rfem release')) return
         step = run%e(2)%balance() - run%e(1)%balance()
         expected = -(rope_mass*g)**2/(2.0_wp*ea*9.0_wp)
         com_r = run%centre_of_mass(2)
@@ -363,7 +350,7 @@ contains
             'effects.tension=.false.', 'initial.shape=hanging', 'supports.bottom=pinned', &
             'supports.bottom_anchor=1.01, 0.0', 'supports.bottom_release_time=0.1'], &
             0.2_wp, 0.05_wp, 1.0e-9_wp, run)
-        if (.not. completed(run, 'mpp release')) return
+        if (.not. completed(suite, run, 'mpp release')) return
         step = run%e(2)%balance() - run%e(1)%balance()
         expected = -0.5_wp*ea*8.0_wp*0.01_wp**2
         moving = maxval(abs(run%y(size(run%y, 1)/2 + 1:, :)))

@@ -17,13 +17,7 @@
 !! balances reach 4.1e-8 and 2.3e-7 J and fail.
 program test_effects_physics
     use ropedyn_kinds, only: wp
-    use ropedyn_error, only: error_t
-    use ropedyn_rope_model, only: energy_t
-    use ropedyn_scene, only: scene_t, read_scene
-    use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_simulation, only: create_model
-    use ropedyn_integrator, only: integrator_t, solver_options_t
-    use ropedyn_solvers, only: new_integrator
+    use ropedyn_test_run, only: run_t, simulate_scene => simulate, kind_set, SET_LEN
     use ropedyn_effect, only: bodies_t
     use ropedyn_effect_ground, only: ground_effect_t, ground_effect
     use ropedyn_assert, only: test_suite_t
@@ -33,14 +27,6 @@ program test_effects_physics
     real(wp), parameter :: pi = acos(-1.0_wp), g = 9.81_wp
     !> weight per length of the paper's rope, N/m, and its mass, kg
     real(wp), parameter :: lam = 6000.0_wp*pi*0.005_wp**2/4.0_wp, rope_mass = lam
-
-    !> One run: output times, states, quadratures, energies.
-    type :: run_t
-        real(wp), allocatable :: t(:), y(:, :)
-        type(energy_t), allocatable :: e(:)
-        class(rope_model_t), allocatable :: model
-        logical :: ok = .false.
-    end type run_t
 
     suite%name = 'effects_physics'
     call drag_terminal_speed()
@@ -56,65 +42,15 @@ program test_effects_physics
 
 contains
 
-    !> Build the scene (defaults = the paper's rope, plus overrides) and integrate it with
-    !! CVODE to t_end, recording every dt.
+    !> The scene of defaults (the paper's rope) plus `sets`, integrated with CVODE to t_end
+    !! and recorded every dt (ropedyn_test_run); a failure is a failed check.
     subroutine simulate(sets, t_end, dt, rtol, run)
         character(len=*), intent(in) :: sets(:)
         real(wp), intent(in) :: t_end, dt, rtol
         type(run_t), intent(out) :: run
-        type(scene_t) :: scene
-        type(error_t), allocatable :: err
-        class(integrator_t), allocatable :: solver
-        type(solver_options_t) :: options
-        real(wp), allocatable :: y(:), yq(:)
-        real(wp) :: t
-        integer :: k, nout, unit
-        open (newunit=unit, file='test_effects_physics.nml', status='replace', action='write')
-        write (unit, '(a)') '&model /'
-        close (unit)
-        call read_scene('test_effects_physics.nml', sets, scene, err)
-        if (.not. allocated(err)) call create_model(scene%rope_spec_t, run%model, err)
-        if (.not. allocated(err)) call new_integrator('cvode', solver, err)
-        if (allocated(err)) then
-            call suite%check_true(.false., 'setup: '//err%message)
-            return
-        end if
-        allocate (y(run%model%size()), yq(run%model%quad_size()))
-        call run%model%initial_state(y)
-        yq = 0.0_wp
-        options%rtol = rtol
-        options%atol = 1.0e-2_wp*rtol
-        call solver%init(run%model, 0.0_wp, y, yq, options, err)
-        if (allocated(err)) then
-            call suite%check_true(.false., 'init: '//err%message)
-            return
-        end if
-        nout = nint(t_end/dt)
-        allocate (run%t(0:nout), run%y(size(y), 0:nout), run%e(0:nout))
-        run%t(0) = 0.0_wp
-        run%y(:, 0) = y
-        run%e(0) = run%model%energy(0.0_wp, y, yq)
-        do k = 1, nout
-            call solver%advance_to(real(k, wp)*dt, t, y, yq, err)
-            if (allocated(err)) then
-                call suite%check_true(.false., 'integration: '//err%message)
-                return
-            end if
-            run%t(k) = t
-            run%y(:, k) = y
-            run%e(k) = run%model%energy(t, y, yq)
-        end do
-        call solver%finalize()
-        run%ok = .true.
+        call simulate_scene(sets, t_end, dt, rtol, run, scene_file='test_effects_physics.nml')
+        if (.not. run%ok) call suite%check_true(.false., run%message)
     end subroutine simulate
-
-    !> 'model.kind = "rfem"' (built apart: gfortran mis-sizes a concatenation inside a typed
-    !! character array constructor).
-    function kind_key(kind) result(key)
-        character(len=*), intent(in) :: kind
-        character(len=64) :: key
-        key = 'model.kind = "'//kind//'"'
-    end function kind_key
 
     !> Element fields (centre x, y, angle and rates) of record k.
     subroutine fields_at(run, k, q, qdot)
@@ -223,7 +159,7 @@ contains
         type(run_t) :: run
         real(wp) :: worst, work, de
         integer :: k
-        call simulate([character(len=64) :: kind_key(kind), 'model.elements = 8', &
+        call simulate([character(len=SET_LEN) :: kind_set(kind), 'model.elements = 8', &
             'initial.shape = "hanging"', 'effects.damping = .false.', &
             'supports.top_motion = "harmonic"', 'supports.top_amplitude = 0.01, 0.02', &
             'supports.top_frequency = 2.0'], 1.0_wp, 0.02_wp, 1.0e-8_wp, run)
@@ -284,7 +220,7 @@ contains
         integer :: k, nc
         character(len=64) :: mass_key
         write (mass_key, '(a, es24.16)') 'attachments.masses = ', rope_mass
-        call simulate([character(len=64) :: kind_key(kind), 'model.elements = 10', &
+        call simulate([character(len=SET_LEN) :: kind_set(kind), 'model.elements = 10', &
             'initial.angle_deg = 2', 'attachments.mass_positions = 1.0', mass_key], &
             5.5_wp, 0.005_wp, 1.0e-7_wp, run)
         if (.not. run%ok) return
@@ -357,7 +293,7 @@ contains
         type(run_t) :: run
         real(wp) :: worst, scale
         integer :: k
-        call simulate([character(len=64) :: kind_key(kind), 'model.elements = 7', &
+        call simulate([character(len=SET_LEN) :: kind_set(kind), 'model.elements = 7', &
             'effects.drag = .true.', 'effects.ground = .true.', 'fluid.density = 1000', &
             'fluid.current = 0.1, -0.2', 'ground.point = 0.2, 0.0', &
             'ground.normal = -1.0, 0.2', 'ground.stiffness = 1e4', &

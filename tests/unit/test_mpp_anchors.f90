@@ -23,7 +23,7 @@
 !! each check and listed in docs/testing.md).
 program test_mpp_anchors
     use ropedyn_kinds, only: wp
-    use ropedyn_test_run, only: run_t, simulate, SET_LEN
+    use ropedyn_test_run, only: run_t, simulate, completed, kind_set, SET_LEN
     use ropedyn_assert, only: test_suite_t
     implicit none
 
@@ -43,18 +43,7 @@ program test_mpp_anchors
 
 contains
 
-    logical function completed(run, label)
-        type(run_t), intent(in) :: run
-        character(len=*), intent(in) :: label
-        completed = run%ok
-        call suite%check_true(run%ok, label//': run completes '//run%message)
-    end function completed
 
-    function kind_key(kind) result(key)
-        character(len=*), intent(in) :: kind
-        character(len=SET_LEN) :: key
-        key = 'model.kind='//kind
-    end function kind_key
 
     !> Decay rate and angular frequency of a decaying oscillation s(t) (mean zero) from its
     !! maxima after t_from: parabolic peaks, a least-squares line through log(peak), and
@@ -100,7 +89,7 @@ contains
             'effects.bending=.false.', 'initial.shape=hanging', 'rope.normal_damping=1e4', &
             'model.mpp_axial_damping_factor=2.0'], 1.3_wp, 5.0e-4_wp, 1.0e-9_wp, run, &
             atol=1.0e-12_wp)
-        if (.not. completed(run, 'mpp axial decay')) return
+        if (.not. completed(suite, run, 'mpp axial decay')) return
         x_static = 1.0_wp + rope_mass*g*(n + 1)/(2.0_wp*n*ea)
         do k = 0, run%last()
             p = run%points(k)
@@ -132,7 +121,7 @@ contains
             'rope.normal_damping=1e7', 'model.mpp_bending_damping_factor=3.0', &
             'initial.shape=hanging'], 4.0_wp, 2.0e-3_wp, 1.0e-10_wp, run, atol=1.0e-13_wp, &
             y0=y0)
-        if (.not. completed(run, 'mpp bending decay')) return
+        if (.not. completed(suite, run, 'mpp bending decay')) return
         do k = 0, run%last()
             s(k) = run%y(2, k) - run%y(1, k)
         end do
@@ -160,10 +149,10 @@ contains
         character(len=*), intent(in) :: kind
         type(run_t) :: run
         real(wp) :: p(2, 20), expected
-        call simulate([character(len=SET_LEN) :: kind_key(kind), 'model.elements=10', &
+        call simulate([character(len=SET_LEN) :: kind_set(kind), 'model.elements=10', &
             'initial.shape=equilibrium', 'initial.angle_deg=0'], 0.01_wp, 0.01_wp, &
             1.0e-8_wp, run)
-        if (.not. completed(run, kind//' static stretch')) return
+        if (.not. completed(suite, run, kind//' static stretch')) return
         p = run%points(0)
         if (kind == 'mpp') then
             expected = rope_mass*g*11.0_wp/(2.0_wp*10.0_wp*ea)
@@ -193,12 +182,12 @@ contains
             elements = 'model.elements=5'
             tension = 'effects.tension=.true.'
         end if
-        call simulate([character(len=SET_LEN) :: kind_key(kind), elements, tension, &
+        call simulate([character(len=SET_LEN) :: kind_set(kind), elements, tension, &
             'rope.young_modulus=35e12', 'rope.shear_modulus=14e12', 'rope.normal_damping=1e9', &
             'initial.angle_deg=2', 'attachments.mass_positions=0.6', 'attachments.masses=0.1'], &
             3.8_wp, 2.0e-3_wp, &
             1.0e-9_wp, run)
-        if (.not. completed(run, kind//' rigid pendulum')) return
+        if (.not. completed(suite, run, kind//' rigid pendulum')) return
         n = run%model%n_elements()
         nc = 0
         p(:, 1:2*n) = run%points(0)
