@@ -22,7 +22,7 @@
 !! stiffness for a bottom anchor far from the start. Derivation and limits:
 !! docs/statics-modes.md.
 module ropedyn_statics
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: STATUS_OK
@@ -133,11 +133,11 @@ contains
         v = 0.0_wp
         if (.not. spec%effects%point_loads) return
         associate (a => spec%attachments)
-            if (all(a%load_positions /= a%load_positions)) return
+            if (all(ieee_is_nan(a%load_positions))) return
             call model%element_data(lengths, masses)
             call model%fields(y, q, qdot, 0.0_wp)
             do k = 1, N_ATTACH
-                if (a%load_positions(k) /= a%load_positions(k)) cycle
+                if (ieee_is_nan(a%load_positions(k))) cycle
                 call locate_on_bodies(lengths, a%load_positions(k), body, r)
                 force = [a%load_force_x(k), a%load_force_y(k)] + [a%load_amplitude_x(k), &
                     a%load_amplitude_y(k)]*sin(a%load_phase_deg(k)*PI/180.0_wp)

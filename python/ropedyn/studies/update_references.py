@@ -106,12 +106,15 @@ def main(argv=None):
             scene = REFERENCE / f"{name}.nml"
             if not scene.is_file():
                 parser.error(f"no reference scene {scene}")
-            if args.check:
-                candidate = REFERENCE / f"{name}.h5"
-            else:
-                candidate = pathlib.Path(workdir) / f"{name}.h5"
-                produce(exe, scene, candidate)
-            reasons = guard(exe, scene, candidate, workdir)
+            try:
+                if args.check:
+                    candidate = REFERENCE / f"{name}.h5"
+                else:
+                    candidate = pathlib.Path(workdir) / f"{name}.h5"
+                    produce(exe, scene, candidate)
+                reasons = guard(exe, scene, candidate, workdir)
+            except RuntimeError as failure:
+                reasons = [str(failure)]
             if reasons:
                 refused.append(name)
                 print(f"update_references: REFUSED {name}: {'; '.join(reasons)}")
