@@ -141,7 +141,8 @@ contains
         if (present(pin)) pin = -wsum
 
         ! Member springs and dampers.
-        if (self%nu > 0) r(n + 1:nd) = r(n + 1:nd) - self%ks*y(n + 1:nd) - self%ds*y(nd + n + 1:2*nd)
+        if (self%nu > 0) r(n + 1:nd) = r(n + 1:nd) - self%ks*y(n + 1:nd) &
+                                       - self%ds*y(nd + n + 1:2*nd)
         ! Joint bending springs and dampers between members.
         if (self%cb > 0.0_wp .or. self%db > 0.0_wp) then
             do k = 2, n
@@ -243,7 +244,8 @@ contains
             dw = -self%mbar(k)*sh_a
             dmom = -self%pm_s1(k)*(-self%cs(2, k)*sh_a(1) + self%cs(1, k)*sh_a(2))
             if (effects) then
-                dw = dw + matmul(self%ejac(1:2, 1:2, k), sh_p) + matmul(self%ejac(1:2, 4:5, k), sh_v)
+                dw = dw + matmul(self%ejac(1:2, 1:2, k), sh_p) &
+                     + matmul(self%ejac(1:2, 4:5, k), sh_v)
                 dmom = dmom + dot_product(self%ejac(3, 1:2, k), sh_p) &
                        + dot_product(self%ejac(3, 4:5, k), sh_v)
             end if
@@ -762,7 +764,8 @@ contains
             if (self%bottom == 2) then
                 power = power + self%d_rot*(y(nd + n) - bottom%rate)**2
                 if (self%moving(2)) work = work - (self%c_rot*(y(n) - bottom%angle) &
-                                                   + self%d_rot*(y(nd + n) - bottom%rate))*bottom%rate
+                                                   + self%d_rot*(y(nd + n) - bottom%rate)) &
+                                                  *bottom%rate
             end if
         end if
         call angles(self, y)
