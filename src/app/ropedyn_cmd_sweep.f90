@@ -116,18 +116,8 @@ contains
                 call cli%int_value(opt%task, 1, err)
                 if (allocated(err)) return
             case default
-                if (len(cli%arg) == 0) then
-                    call cli%usage_error('empty argument', err)
-                    return
-                else if (cli%arg(1:1) == '-') then
-                    call cli%usage_error('unknown option "'//cli%arg//'"', err)
-                    return
-                else if (allocated(opt%path)) then
-                    call cli%usage_error('more than one sweep file: "'//opt%path//'", "' &
-                        //cli%arg//'"', err)
-                    return
-                end if
-                opt%path = cli%arg
+                call cli%positional('sweep file', opt%path, err)
+                if (allocated(err)) return
             end select
         end do
         if (.not. allocated(opt%path)) then

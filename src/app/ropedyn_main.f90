@@ -9,6 +9,7 @@
 !!                   [--force] [--quiet] [--output-dir DIR]   (docs/sweeps.md)
 !!   ropedyn statics SCENE.nml [--set ...] [-o FILE.h5] [--max-iterations N]
 !!   ropedyn modes SCENE.nml [--count K] [--set ...] [-o FILE.h5]  (docs/statics-modes.md)
+!!   ropedyn keys              (every key of a scene file with its default; docs/input.md)
 !!   ropedyn --version | --help
 !!
 !! Exit codes: 0 success, 2 bad input or command line, 3 integration failed,
@@ -23,6 +24,7 @@ program ropedyn_main
     use ropedyn_cmd_sweep, only: sweep_command
     use ropedyn_cmd_statics, only: statics_command
     use ropedyn_cmd_modes, only: modes_command
+    use ropedyn_cmd_keys, only: keys_command
     implicit none
 
     type(cli_t) :: cli
@@ -49,6 +51,8 @@ program ropedyn_main
         call statics_command(cli, err)
     case ('modes')
         call modes_command(cli, err)
+    case ('keys')
+        call keys_command(cli, err)
     case default
         call make_error(err, ERR_USAGE, 'unknown command "'//cli%command// &
                         '" (see ropedyn --help)')
@@ -73,6 +77,7 @@ contains
         write (unit, '(a)') '       ropedyn statics SCENE.nml [--set ...] [-o FILE.h5] '// &
             '[--max-iterations N]'
         write (unit, '(a)') '       ropedyn modes SCENE.nml [--count K] [--set ...] [-o FILE.h5]'
+        write (unit, '(a)') '       ropedyn keys   (every key of a scene file with its default)'
         write (unit, '(a)') '       ropedyn --version | --help;  ropedyn COMMAND --help'
         write (unit, '(a)') 'exit codes: 0 ok, 2 bad input, 3 integration failed, '// &
             '4 output error, 5 internal error'

@@ -7,7 +7,7 @@ module ropedyn_os
     implicit none
     private
     public :: make_dirs, make_parent_dirs, current_dir, is_terminal, sleep_microseconds, &
-              processor_count, absolute_path, utc_timestamp
+              processor_count, absolute_path, utc_timestamp, unwritable_dir
 
     interface
         integer(c_int) function c_mkdir(path, mode) bind(C, name='mkdir')
@@ -32,6 +32,11 @@ module ropedyn_os
         integer(c_int) function c_get_nprocs() bind(C, name='get_nprocs')
             import :: c_int
         end function c_get_nprocs
+        integer(c_int) function c_access(path, mode) bind(C, name='access')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int), value :: mode
+        end function c_access
     end interface
 
 contains
@@ -106,6 +111,39 @@ contains
         cwd = current_dir()
         if (len(cwd) > 0) full = cwd//'/'//full
     end function absolute_path
+
+    !> Why `dir` could not be created or written by `make_dirs` and the files in it: '' when
+    !! it is a writable directory or its nearest existing ancestor is one, else the reason
+    !! (creates nothing).
+    function unwritable_dir(dir) result(reason)
+        character(len=*), intent(in) :: dir
+        character(len=:), allocatable :: reason, path
+        integer(c_int), parameter :: W_OK = 2, X_OK = 1
+        logical :: exists, is_dir
+        integer :: slash
+        path = trim(dir)
+        if (len(path) == 0) path = '.'
+        do
+            inquire (file=path//'/.', exist=is_dir)
+            if (is_dir) exit
+            inquire (file=path, exist=exists)
+            if (exists) then
+                reason = '"'//path//'" is not a directory'
+                return
+            end if
+            slash = index(path, '/', back=.true.)
+            if (slash == 0) then
+                path = '.'
+            else if (slash == 1) then
+                path = '/'
+            else
+                path = path(:slash - 1)
+            end if
+        end do
+        reason = ''
+        if (c_access(path//c_null_char, W_OK + X_OK) /= 0) reason = 'the directory "'// &
+            path//'" is not writable'
+    end function unwritable_dir
 
     !> True when the file descriptor (0 stdin, 1 stdout, 2 stderr) is a terminal.
     logical function is_terminal(fd)

@@ -3,6 +3,7 @@
 module ropedyn_simulation
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp, i8
+    use ropedyn_text, only: real_text
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_IO, ERR_SOLVER
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
@@ -113,6 +114,15 @@ contains
         t = 0.0_wp
         summary%file = trim(scene%output%file)
         summary%initial_energy = model%energy(t, y, yq)
+        ! the scene's limits keep the start finite; should a value still make it not, that is
+        ! bad input: say so before any file is created
+        if (.not. (all(ieee_is_finite(y)) .and. &
+                   ieee_is_finite(summary%initial_energy%balance()))) then
+            call make_error(err, ERR_INPUT, scene%path//': the initial state or its energy '// &
+                'is not finite (energy '//real_text(summary%initial_energy%balance())// &
+                ' J): a value of the scene is too large or too small (docs/input.md, Limits)')
+            return
+        end if
 
         call make_parent_dirs(summary%file, err)
         if (allocated(err)) return

@@ -279,8 +279,8 @@ contains
         integer :: k
 
         model%n = spec%model%elements
-        if (model%n < 1) then
-            call make_error(err, ERR_INPUT, 'mpp: elements must be >= 1')
+        if (model%n < 2) then
+            call make_error(err, ERR_INPUT, 'mpp: elements must be >= 2')
             return
         end if
         if (spec%supports%top == 'free') then
