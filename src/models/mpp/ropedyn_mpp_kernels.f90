@@ -768,7 +768,7 @@ contains
                                                   *bottom%rate
             end if
         end if
-        call angles(self, y)
+        if (size(self%effects) > 0 .or. self%moving(1)) call angles(self, y)
         if (size(self%effects) > 0) then
             ! the residual at zero accelerations fills the rods as bodies
             a = 0.0_wp

@@ -32,51 +32,6 @@ contains
         end do
     end subroutine angles
 
-    !> Tension and shear strains dwx, dwy (m) of internal SDE j, and cos, sin of the angle
-    !! between its elements (self%cs must hold the angles of y).
-    pure subroutine sde_geometry(self, y, j, dwx, dwy, cd, sd)
-        class(rfem_t), intent(in) :: self
-        real(wp), intent(in) :: y(:)
-        integer, intent(in) :: j
-        real(wp), intent(out) :: dwx, dwy, cd, sd
-        real(wp) :: ca, sa, cb, sb, dx, dy
-        integer :: ka, kb
-        ka = 6*(j - 2)
-        kb = ka + 6
-        ca = self%cs(1, j - 1)
-        sa = self%cs(2, j - 1)
-        cb = self%cs(1, j)
-        sb = self%cs(2, j)
-        dx = y(kb + 1) - self%half(j)*cb - y(ka + 1) - self%half(j - 1)*ca
-        dy = y(kb + 2) - self%half(j)*sb - y(ka + 2) - self%half(j - 1)*sa
-        dwx = ca*dx + sa*dy
-        dwy = -sa*dx + ca*dy
-        cd = ca*cb + sa*sb
-        sd = ca*sb - sa*cb
-    end subroutine sde_geometry
-
-    !> Rates of the tension, shear (m/s) and bending (rad/s) strains of internal SDE j.
-    pure subroutine sde_rates(self, y, j, dwx, dwy, cd, sd, rx, ry, rp)
-        class(rfem_t), intent(in) :: self
-        real(wp), intent(in) :: y(:)
-        integer, intent(in) :: j
-        real(wp), intent(in) :: dwx, dwy, cd, sd
-        real(wp), intent(out) :: rx, ry, rp
-        real(wp) :: ca, sa, dvx, dvy, wa, wb
-        integer :: ka, kb
-        ka = 6*(j - 2)
-        kb = ka + 6
-        ca = self%cs(1, j - 1)
-        sa = self%cs(2, j - 1)
-        dvx = y(kb + 4) - y(ka + 4)
-        dvy = y(kb + 5) - y(ka + 5)
-        wa = y(ka + 6)
-        wb = y(kb + 6)
-        rx = ca*dvx + sa*dvy + dwy*wa + self%half(j)*sd*wb
-        ry = -sa*dvx + ca*dvy - (dwx + self%half(j - 1))*wa - self%half(j)*cd*wb
-        rp = wb - wa
-    end subroutine sde_rates
-
     !> Add the generalized force of support k (translational spring and damper on d, and
     !! for a clamp the rotational one) to f(3), the force on its element; with `energy`
     !! its spring energy to e_el.
@@ -261,7 +216,7 @@ contains
         c = 0.0_wp
         if (self%sup(1)%active) call support_force(self, 1, y, c, energy, e_el)
         do j = 2, n
-            ! the geometry of sde_geometry and the rates of sde_rates, written out here
+            ! geometry and rates of SDE j (the module header's formulas, written out)
             ka = 6*(j - 2)
             kb = ka + 6
             ca = self%cs(1, j - 1)
@@ -371,7 +326,7 @@ contains
         dfy = 0.0_wp
         dfp = 0.0_wp
         do j = 2, n
-            ! the geometry of sde_geometry and the rates of sde_rates, written out here
+            ! geometry and rates of SDE j (the module header's formulas, written out)
             ka = 6*(j - 2)
             kb = ka + 6
             ca = self%cs(1, j - 1)
@@ -630,20 +585,51 @@ contains
         if (self%with_work .and. size(yq) >= 2) e%support_work = yq(2)
     end procedure rfem_energy
 
+    !> Add the dissipation power sum B s'^2 of the internal SDEs (self%cs holding the
+    !! angles of y; the module header's geometry and rates).
+    subroutine internal_power(self, y, power)
+        class(rfem_t), intent(in) :: self
+        real(wp), intent(in) :: y(6*self%n)
+        real(wp), intent(inout) :: power
+        real(wp) :: ca, sa, cb, sb, ha, hb, dx, dy, dwx, dwy, cd, sd, dvx, dvy, wa, wb
+        real(wp) :: rx, ry, rp
+        integer :: j, ka, kb
+        do j = 2, self%n
+            ka = 6*(j - 2)
+            kb = ka + 6
+            ca = self%cs(1, j - 1)
+            sa = self%cs(2, j - 1)
+            cb = self%cs(1, j)
+            sb = self%cs(2, j)
+            ha = self%half(j - 1)
+            hb = self%half(j)
+            dx = y(kb + 1) - hb*cb - y(ka + 1) - ha*ca
+            dy = y(kb + 2) - hb*sb - y(ka + 2) - ha*sa
+            dwx = ca*dx + sa*dy
+            dwy = -sa*dx + ca*dy
+            cd = ca*cb + sa*sb
+            sd = ca*sb - sa*cb
+            dvx = y(kb + 4) - y(ka + 4)
+            dvy = y(kb + 5) - y(ka + 5)
+            wa = y(ka + 6)
+            wb = y(kb + 6)
+            rx = ca*dvx + sa*dvy + dwy*wa + hb*sd*wb
+            ry = -sa*dvx + ca*dvy - (dwx + ha)*wa - hb*cd*wb
+            rp = wb - wa
+            power = power + (self%bx*rx**2 + self%by*ry**2 + self%bp*rp**2)
+        end do
+    end subroutine internal_power
+
     module procedure rfem_quad_rhs
-        real(wp) :: power, work, dwx, dwy, cd, sd, rx, ry, rp
-        integer :: j, k
+        real(wp) :: power, work
+        integer :: k
         call self%set_time(t)
         ! only the damped strains and the supports: no spring forces, no gravity, no scatter
         power = 0.0_wp
         work = 0.0_wp
         if (self%damped) then
             call angles(self, y)
-            do j = 2, self%n
-                call sde_geometry(self, y, j, dwx, dwy, cd, sd)
-                call sde_rates(self, y, j, dwx, dwy, cd, sd, rx, ry, rp)
-                power = power + (self%bx*rx**2 + self%by*ry**2 + self%bp*rp**2)
-            end do
+            call internal_power(self, y, power)
         end if
         do k = 1, 2
             if (self%sup(k)%active) call support_power(self, k, y, power, work)
