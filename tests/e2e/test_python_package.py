@@ -29,6 +29,8 @@ COMMANDS = {
     "work_precision": "ropedyn.studies.work_precision",
     "work_precision_testset": "ropedyn.studies.work_precision_testset",
     "stability_report": "ropedyn.studies.stability_report",
+    "update_references": "ropedyn.studies.update_references",
+    "mutation_check": "ropedyn.studies.mutation_check",
 }
 # Python files under scripts/ that the README and docs/ call by path
 SHIMS = {"plot_energy.py": "ropedyn.plot.energy",
