@@ -134,7 +134,10 @@ contains
         write (*, '(a, 2f12.7, a)') '  ground: slide', slide, expected, ' m'
         call suite%check_close(slide, expected, 1.0e-4_wp, 0.0_wp, &
                                'ground: sliding distance = v0^2/(2 mu g)')
-        call suite%check_le(maxval(abs(qdot(1:2, :))), 1.0e-13_wp, 'ground: the rope comes to rest')
+        ! the velocity left at rest is the integrator's error, not rounding: it follows the
+        ! step sequence, which follows the last bits of the forces (measured 2.4e-12 m/s with
+        ! the one-pass kernels of issue 14, Debug and Release alike; below 1e-13 before)
+        call suite%check_le(maxval(abs(qdot(1:2, :))), 1.0e-11_wp, 'ground: the rope comes to rest')
         ground = ground_effect([1.0_wp, 0.0_wp], [-1.0_wp, 0.0_wp], 1.0e5_wp, 200.0_wp, mu, &
                                1.0e-3_wp)
         b%n = n
