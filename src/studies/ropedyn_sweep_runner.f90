@@ -150,7 +150,7 @@ contains
         type(text_t), allocatable :: warnings(:)
         type(case_state_t) :: state
         integer, allocatable :: todo(:), slot(:), pid(:), elsewhere(:)
-        character(len=:), allocatable :: base_args(:)
+        character(len=:), allocatable :: args(:)
         integer :: n, c, next, finished, failed, rc, s, width, sig
         integer(int64) :: start, now, rate, last_draw
         logical :: tty, redraw
@@ -181,9 +181,15 @@ contains
                 ' --status names the writers)'
         end if
 
-        base_args = [character(len=max(len(exe), len(sweep%path), len(sweep%output_dir), 16)) &
-            :: exe, 'sweep', sweep%path, '--quiet', '--output-dir', sweep%output_dir]
-        if (opt%force) base_args = [character(len=len(base_args)) :: base_args, '--force']
+        ! a worker's arguments: exe sweep SWEEP --quiet --output-dir DIR [--force] --task K
+        allocate (character(len=max(len(exe), len(sweep%path), len(sweep%output_dir), 16)) :: &
+            args(merge(9, 8, opt%force)))
+        args(:6) = [character(len=12) :: '', 'sweep', '', '--quiet', '--output-dir', '']
+        args(1) = exe
+        args(3) = sweep%path
+        args(6) = sweep%output_dir
+        if (opt%force) args(7) = '--force'
+        args(size(args) - 1) = '--task'
         call catch_signals(err)
         if (allocated(err)) return
         allocate (slot(opt%jobs), pid(opt%jobs), source=0)
@@ -199,8 +205,8 @@ contains
             do s = 1, size(slot)
                 if (slot(s) /= 0 .or. next > size(todo)) cycle
                 c = todo(next)
-                call spawn([character(len=len(base_args)) :: base_args, '--task', &
-                           int_text(c)], log_path(c), pid(s), err)
+                args(size(args)) = int_text(c)
+                call spawn(args, log_path(c), pid(s), err)
                 if (allocated(err)) then
                     err%message = 'sweep: case '//zero_padded(c, width)//': '//err%message
                     call stop_workers(SIGKILL)
