@@ -208,7 +208,7 @@ contains
         type(sweep_file_t), intent(inout) :: sweep
         type(error_t), allocatable, intent(out) :: err
         type(case_data_t) :: data
-        character(len=:), allocatable :: value
+        character(len=:), allocatable :: value, hint
         value = 'tightest'
         if (raw%n > 0) value = trim(adjustl(raw%text(1)%s))
         select case (lower(value))
@@ -231,6 +231,10 @@ contains
                 call make_error(err, ERR_INPUT, where//'reference = "'//value//'": no such ' &
                     //'file ('//sweep%reference_file//'; expected ''tightest'', ' &
                     //'''tightest_per_method'', ''none'' or a ropedyn run file)')
+                ! a misspelt keyword rather than a file?
+                hint = name_hint([text_t('tightest'), text_t('tightest_per_method'), &
+                                  text_t('none')], value)
+                if (hint(1:3) == '; d') err%message = err%message//hint
             else if (data%status /= 'complete' .or. data%records < 1) then
                 call make_error(err, ERR_INPUT, where//'reference = "'//value//'": not a ' &
                     //'complete run (status '//data%status//', '//int_text(data%records)// &
