@@ -6,6 +6,7 @@
 !!
 !!     ropedyn sweep case lock
 !!     host=node12
+!!     boot=8a3c...             (/proc/sys/kernel/random/boot_id: this machine since its boot)
 !!     pid=4711
 !!     start_ticks=123456        (the process's start, /proc/PID/stat; tells a reused pid)
 !!     started=2024-05-01T12:34:56Z
@@ -16,9 +17,9 @@
 !! file is in place. A lock is *live* while its writer runs and *abandoned* when it is gone:
 !!
 !! - it records a signal: abandoned (the writer ended right after writing it);
-!! - on this host (same host name): live while process `pid` exists with the same start
-!!   time, abandoned as soon as it does not;
-!! - on another host: live while its heartbeat is at most LOCK_ABANDONED_AFTER s old (the
+!! - on this machine (the same host name and boot id): live while process `pid` exists
+!!   with the same start time, abandoned as soon as it does not;
+!! - on another machine: live while its heartbeat is at most LOCK_ABANDONED_AFTER s old (the
 !!   file's modification time against this host's clock: clocks must agree within that).
 !!
 !! A second writer finds a live lock and gives up with a message naming the holder; an
@@ -45,7 +46,7 @@ module ropedyn_sweep_lock
         logical :: exists = .false.
         logical :: live = .false.      !< its writer runs (or may run: see the rule)
         logical :: mine = .false.      !< held by this process
-        character(len=:), allocatable :: host, job, started
+        character(len=:), allocatable :: host, boot, job, started
         integer :: pid = 0
         integer(int64) :: start_ticks = 0
         integer :: signal = 0          !< the signal that ended the writer (0: none recorded)
@@ -67,6 +68,7 @@ contains
         integer(int64) :: ticks
 
         lock%host = ''
+        lock%boot = ''
         lock%job = ''
         lock%started = ''
         ! open first: on NFS, an open revalidates the attributes (close-to-open)
@@ -81,6 +83,8 @@ contains
             select case (line(:eq - 1))
             case ('host')
                 lock%host = trim(line(eq + 1:))
+            case ('boot')
+                lock%boot = trim(line(eq + 1:))
             case ('job')
                 lock%job = trim(line(eq + 1:))
             case ('started')
@@ -105,7 +109,7 @@ contains
         else if (lock%pid <= 0) then
             ! not written yet (just created) or damaged: live while young
             lock%live = lock%age <= LOCK_ABANDONED_AFTER
-        else if (lock%host == host_name()) then
+        else if (this_machine(lock)) then
             ticks = process_start(lock%pid)
             lock%live = ticks >= 0
             if (ticks > 0 .and. lock%start_ticks > 0) lock%live = ticks == lock%start_ticks
@@ -114,6 +118,31 @@ contains
             lock%live = lock%age <= LOCK_ABANDONED_AFTER
         end if
     end subroutine read_lock
+
+    !> Whether the lock was written on this machine: the same host name and, when both are
+    !! known, the same boot id (two machines with one host name are told apart).
+    logical function this_machine(lock)
+        type(lock_t), intent(in) :: lock
+        character(len=:), allocatable :: boot
+        this_machine = len(lock%host) > 0 .and. lock%host == host_name()
+        if (.not. this_machine .or. len(lock%boot) == 0) return
+        boot = boot_id()
+        if (len(boot) > 0) this_machine = lock%boot == boot
+    end function this_machine
+
+    !> This machine's boot id ('' where there is none).
+    function boot_id() result(id)
+        character(len=:), allocatable :: id
+        character(len=64) :: line
+        integer :: unit, ios
+        id = ''
+        open (newunit=unit, file='/proc/sys/kernel/random/boot_id', status='old', &
+              action='read', iostat=ios)
+        if (ios /= 0) return
+        read (unit, '(a)', iostat=ios) line
+        close (unit)
+        if (ios == 0) id = trim(line)
+    end function boot_id
 
     !> 'host H, pid P, Slurm job J, since T' (what is known of it).
     function lock_holder(self) result(text)
@@ -132,7 +161,7 @@ contains
         if (self%signal > 0) then
             text = 'stopped by '//signal_name(self%signal)//' at '//utc_text(self%changed)// &
                 ' ('//self%holder()//')'
-        else if (len(self%host) > 0 .and. self%host == host_name()) then
+        else if (this_machine(self)) then
             text = 'its writer ended without finishing: killed or crashed ('// &
                 self%holder()//'; that process is gone)'
         else
@@ -244,7 +273,8 @@ contains
         open (newunit=unit, file=path, status='old', action='write', position='append', &
               iostat=ios, iomsg=msg)
         if (ios == 0) write (unit, '(a)', iostat=ios, iomsg=msg) 'ropedyn sweep case lock'// &
-            new_line('a')//'host='//host_name()//new_line('a')//'pid='// &
+            new_line('a')//'host='//host_name()//new_line('a')//'boot='//boot_id()// &
+            new_line('a')//'pid='// &
             int_text(process_id())//new_line('a')//'start_ticks='// &
             ticks_text(process_start(0))//new_line('a')//'started='//utc_timestamp()// &
             new_line('a')//'job='//trim(job)

@@ -101,6 +101,14 @@ contains
         call write_lines(PATH, lines(:3))
         call read_lock(PATH, lock)
         call suite%check_true(.not. lock%live, 'reused pid: abandoned')
+        ! the same host name on another machine (another boot id): the heartbeat decides
+        lines = ''
+        lines(1) = 'host='//host_name()
+        lines(2) = 'boot=00000000-0000-0000-0000-000000000000'
+        lines(3) = 'pid=2147483000'
+        call write_lines(PATH, lines(:3))
+        call read_lock(PATH, lock)
+        call suite%check_true(lock%live, 'same host name, another boot id: fresh, live')
         ! a recorded signal
         lines = ''
         lines(1) = 'host=elsewhere'
