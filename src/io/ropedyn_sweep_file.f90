@@ -16,7 +16,7 @@
 !!         atol_per_rtol = 0.01               ! atol = 0.01 rtol (else the scene's atol)
 !!         set = 'solver.t_end=2', 'solver.output_interval=0.01'
 !!         vary = 'rope.normal_damping = 1e3; 0.1'
-!!         reference = 'tightest'             ! 'none' or an HDF5 run file
+!!         reference = 'tightest'             ! 'tightest_per_method', 'none' or a run file
 !!     /
 module ropedyn_sweep_file
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -33,10 +33,11 @@ module ropedyn_sweep_file
     implicit none
     private
     public :: sweep_file_t, dimension_t, read_sweep_file, without_set
-    public :: MAX_LIST, MAX_VARY, MAX_CASES, REF_NONE, REF_TIGHTEST, REF_FILE
+    public :: MAX_LIST, MAX_VARY, MAX_CASES, REF_NONE, REF_TIGHTEST, REF_FILE, &
+        REF_TIGHTEST_PER_METHOD
 
     !> How the errors of the summary are measured.
-    integer, parameter :: REF_NONE = 0, REF_TIGHTEST = 1, REF_FILE = 2
+    integer, parameter :: REF_NONE = 0, REF_TIGHTEST = 1, REF_FILE = 2, REF_TIGHTEST_PER_METHOD = 3
 
     !> The keys of a sweep file: name, type ('s' string, 'i' integer, 'r' real), most values.
     type :: sweep_key_t
@@ -198,19 +199,23 @@ contains
         if (path(1:1) /= '/') path = dir//path
     end function relative_to
 
-    !> 'tightest' (the default), 'none' (or ''), or a run file that can be read.
+    !> 'tightest' (the default), 'tightest_per_method', 'none' (or ''), or a run file that
+    !! can be read and holds a complete run (that it suits every case is checked with the
+    !! cases, by ropedyn_sweep).
     subroutine read_reference(where, dir, raw, sweep, err)
         character(len=*), intent(in) :: where, dir
         type(raw_t), intent(in) :: raw
         type(sweep_file_t), intent(inout) :: sweep
         type(error_t), allocatable, intent(out) :: err
         type(case_data_t) :: data
-        character(len=:), allocatable :: value
+        character(len=:), allocatable :: value, hint
         value = 'tightest'
         if (raw%n > 0) value = trim(adjustl(raw%text(1)%s))
         select case (lower(value))
         case ('tightest')
             sweep%reference = REF_TIGHTEST
+        case ('tightest_per_method')
+            sweep%reference = REF_TIGHTEST_PER_METHOD
         case ('none', '')
             sweep%reference = REF_NONE
         case default
@@ -220,11 +225,16 @@ contains
             if (allocated(err)) then
                 err%code = ERR_INPUT
                 err%message = where//'reference = "'//value//'": '//err%message// &
-                    ' (expected ''tightest'', ''none'' or a ropedyn run file)'
+                    ' (expected ''tightest'', ''tightest_per_method'', ''none'' or a ropedyn ' &
+                    //'run file)'
             else if (.not. data%exists) then
                 call make_error(err, ERR_INPUT, where//'reference = "'//value//'": no such ' &
-                    //'file ('//sweep%reference_file//'; expected ''tightest'', ''none'' or ' &
-                    //'a ropedyn run file)')
+                    //'file ('//sweep%reference_file//'; expected ''tightest'', ' &
+                    //'''tightest_per_method'', ''none'' or a ropedyn run file)')
+                ! a misspelt keyword rather than a file?
+                hint = name_hint([text_t('tightest'), text_t('tightest_per_method'), &
+                                  text_t('none')], value)
+                if (hint(1:3) == '; d') err%message = err%message//hint
             else if (data%status /= 'complete' .or. data%records < 1) then
                 call make_error(err, ERR_INPUT, where//'reference = "'//value//'": not a ' &
                     //'complete run (status '//data%status//', '//int_text(data%records)// &

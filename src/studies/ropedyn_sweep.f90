@@ -8,14 +8,16 @@
 !! sweep file, the case and its overrides.
 module ropedyn_sweep
     use ropedyn_text, only: int_text, real_text, text_t, append_text, text_array
-    use ropedyn_error, only: error_t
+    use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_scene, only: scene_t, read_scene
+    use ropedyn_kinds, only: wp
+    use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_sweep_file, only: sweep_file_t, read_sweep_file, without_set, MAX_LIST, &
-        MAX_VARY, REF_NONE, REF_TIGHTEST, REF_FILE
+        MAX_VARY, REF_NONE, REF_TIGHTEST, REF_FILE, REF_TIGHTEST_PER_METHOD
     implicit none
     private
     public :: text_t, sweep_case_t, sweep_t, read_sweep, case_name
-    public :: MAX_LIST, MAX_VARY, REF_NONE, REF_TIGHTEST, REF_FILE
+    public :: MAX_LIST, MAX_VARY, REF_NONE, REF_TIGHTEST, REF_FILE, REF_TIGHTEST_PER_METHOD
 
     !> One case: its overrides of the base scene and the effective scene they give.
     type :: sweep_case_t
@@ -45,7 +47,59 @@ contains
         call read_sweep_file(path, sweep%sweep_file_t, err, output_dir)
         if (allocated(err)) return
         call expand(sweep, err)
+        if (allocated(err)) return
+        if (sweep%reference == REF_FILE) call check_reference_file(sweep, err)
     end subroutine read_sweep
+
+    !> A reference file serves every case: the same number of elements, and the case's
+    !! output times (0, dt, 2 dt, ..., t_end, as the run driver writes them) are its first.
+    subroutine check_reference_file(sweep, err)
+        type(sweep_t), intent(in) :: sweep
+        type(error_t), allocatable, intent(out) :: err
+        type(case_data_t) :: ref
+        real(wp), allocatable :: times(:)
+        real(wp) :: dt, t_end
+        integer :: c, k, n_out, n_ref
+        character(len=:), allocatable :: where
+
+        where = sweep%path//': &sweep: reference = "'//sweep%reference_file//'": '
+        call read_case_file(sweep%reference_file, ref, err, series=.true.)
+        if (allocated(err)) then
+            err%code = ERR_INPUT
+            err%message = where//err%message
+            return
+        end if
+        n_ref = size(ref%points, 2)/2
+        do c = 1, size(sweep%cases)
+            associate (s => sweep%cases(c)%scene)
+                if (s%model%elements /= n_ref) then
+                    call make_error(err, ERR_INPUT, where//'it has '//int_text(n_ref)// &
+                        ' elements, case '//int_text(c)//' ('//join(sweep%cases(c)%overrides) &
+                        //') '//int_text(s%model%elements)//': a reference file serves ' &
+                        //'cases of its element count only')
+                    return
+                end if
+                dt = s%solver%output_interval
+                t_end = s%solver%t_end
+                n_out = max(1, ceiling(t_end/dt*(1.0_wp - 1.0e-12_wp)))
+                times = [(min(real(k, wp)*dt, t_end), k=0, n_out)]
+                times(n_out + 1) = t_end
+                if (ref%records < size(times)) then
+                    call make_error(err, ERR_INPUT, where//'it ends at t = '// &
+                        real_text(ref%time(ref%records), compact=.true.)//' s, case '// &
+                        int_text(c)//' at '//real_text(t_end, compact=.true.)//' s')
+                    return
+                end if
+                if (maxval(abs(times - ref%time(:size(times)))) > &
+                    1.0e-9_wp*(1.0_wp + t_end)) then
+                    call make_error(err, ERR_INPUT, where//'its output times are not those ' &
+                        //'of case '//int_text(c)//' (every '//real_text(dt, compact=.true.)// &
+                        ' s up to '//real_text(t_end, compact=.true.)//' s)')
+                    return
+                end if
+            end associate
+        end do
+    end subroutine check_reference_file
 
     !> The file name of case `id` in a sweep of `n` cases: case_0007.h5 (at least 4 digits).
     pure function case_name(id, n) result(name)
@@ -87,6 +141,13 @@ contains
                         call append_text(own, dims(i)%target//'='//dims(i)%values(digit(i))%s)
                     end do
                     cs%file = sweep%output_dir//'/'//case_name(c, n_cases)
+                    if (len(cs%file) + 6 > len(cs%scene%output%file)) then
+                        call make_error(err, ERR_INPUT, sweep%path//': &sweep: output_dir = "' &
+                            //sweep%output_dir//'": too long for the case files (at most '// &
+                            int_text(len(cs%scene%output%file) - 6 - len(case_name(c, &
+                            n_cases)))//' characters)')
+                        return
+                    end if
                     call move_alloc(own, cs%overrides)
                     label = join(cs%overrides)
                     if (len(label) == 0) label = '(the base scene)'

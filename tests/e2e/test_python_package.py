@@ -21,6 +21,7 @@ COMMANDS = {
     "fig5": "ropedyn.studies.fig5",
     "calibrate": "ropedyn.studies.calibrate",
     "bench_effects": "ropedyn.studies.bench_effects",
+    "bench_kernels": "ropedyn.studies.bench_kernels",
     "bench_models": "ropedyn.studies.bench_models",
     "bench_rfem": "ropedyn.studies.bench_rfem",
     "bench_sweep": "ropedyn.studies.bench_sweep",
