@@ -3,7 +3,7 @@
 module ropedyn_cli
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_USAGE
-    use ropedyn_text, only: int_text, text_t
+    use ropedyn_text, only: int_text, text_t, append_text
     implicit none
     private
     public :: cli_t, cli_from_command_line
@@ -25,6 +25,8 @@ module ropedyn_cli
         procedure :: int_value => cli_int_value
         procedure :: count => cli_count
         procedure :: positional => cli_positional
+        procedure :: scene_argument => cli_scene_argument
+        procedure :: require => cli_require
     end type cli_t
 
 contains
@@ -121,6 +123,31 @@ contains
             path = self%arg
         end if
     end subroutine cli_positional
+
+    !> The arguments of a command that reads a scene, other than its own options:
+    !! `--set group.key=value` (appended to `overrides`) or the scene file.
+    subroutine cli_scene_argument(self, overrides, scene_path, err)
+        class(cli_t), intent(inout) :: self
+        type(text_t), allocatable, intent(inout) :: overrides(:)
+        character(len=:), allocatable, intent(inout) :: scene_path
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: value
+        if (self%option == '--set') then
+            call self%take_value(value, err)
+            if (.not. allocated(err)) call append_text(overrides, value)
+        else
+            call self%positional('scene file', scene_path, err)
+        end if
+    end subroutine cli_scene_argument
+
+    !> A usage error 'needs WHAT' unless `path` was given.
+    subroutine cli_require(self, path, what, err)
+        class(cli_t), intent(in) :: self
+        character(len=:), allocatable, intent(in) :: path
+        character(len=*), intent(in) :: what
+        type(error_t), allocatable, intent(out) :: err
+        if (.not. allocated(path)) call self%usage_error('needs '//what, err)
+    end subroutine cli_require
 
     !> The current option's value as a real number.
     subroutine cli_real_value(self, x, err)

@@ -5,6 +5,7 @@ module ropedyn_cmd_keys
     use, intrinsic :: iso_fortran_env, only: output_unit
     use ropedyn_error, only: error_t
     use ropedyn_cli, only: cli_t
+    use ropedyn_help, only: print_help
     use ropedyn_text, only: text_t
     use ropedyn_scene, only: scene_key_listing
     implicit none
@@ -21,10 +22,7 @@ contains
         do while (cli%next())
             select case (cli%option)
             case ('--help', '-h')
-                write (output_unit, '(a)') 'usage: ropedyn keys'
-                write (output_unit, '(a)') 'Lists every key of a scene file: group, key, '// &
-                    'type, unit, default, allowed values, meaning'
-                write (output_unit, '(a)') '(tab-separated; the reference is docs/input.md).'
+                call print_help('keys', output_unit)
                 return
             case default
                 call cli%usage_error('unexpected argument "'//cli%arg//'"', err)

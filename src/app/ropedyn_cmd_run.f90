@@ -4,56 +4,36 @@ module ropedyn_cmd_run
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t
     use ropedyn_cli, only: cli_t
-    use ropedyn_text, only: text_t, append_text, text_array
+    use ropedyn_help, only: print_help
+    use ropedyn_text, only: text_t, text_array
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_simulation, only: run_summary_t, run_scene
     use ropedyn_version, only: version_string
     implicit none
     private
-    public :: run_command, run_usage
+    public :: run_command
 
 contains
-
-    subroutine run_usage(unit)
-        integer, intent(in) :: unit
-        write (unit, '(a)') 'usage: ropedyn run SCENE.nml [--set group.key=value ...]'
-        write (unit, '(a)') 'Integrates the scene and writes its HDF5 file (&output file); '// &
-            'prints a summary.'
-        write (unit, '(a)') '  --set group.key=value   override a key of the scene file '// &
-            '(repeatable)'
-        write (unit, '(a)') 'exit codes: 0 ok, 2 bad input, 3 integration failed, '// &
-            '4 output error'
-        write (unit, '(a)') 'input reference: docs/input.md'
-    end subroutine run_usage
 
     subroutine run_command(cli, err)
         type(cli_t), intent(inout) :: cli
         type(error_t), allocatable, intent(out) :: err
         type(text_t), allocatable :: overrides(:)
-        character(len=:), allocatable :: scene_path, value
+        character(len=:), allocatable :: scene_path
         type(scene_t) :: scene
         type(run_summary_t) :: summary
 
         allocate (overrides(0))
         do while (cli%next())
-            select case (cli%option)
-            case ('--help', '-h')
-                call run_usage(output_unit)
+            if (cli%option == '--help' .or. cli%option == '-h') then
+                call print_help('run', output_unit)
                 return
-            case ('--set')
-                call cli%take_value(value, err)
-                if (allocated(err)) return
-                call append_text(overrides, value)
-            case default
-                call cli%positional('scene file', scene_path, err)
-                if (allocated(err)) return
-            end select
+            end if
+            call cli%scene_argument(overrides, scene_path, err)
+            if (allocated(err)) return
         end do
-        if (.not. allocated(scene_path)) then
-            call cli%usage_error('needs a scene file', err)
-            return
-        end if
-
+        call cli%require(scene_path, 'a scene file', err)
+        if (allocated(err)) return
         call read_scene(scene_path, text_array(overrides), scene, err)
         if (allocated(err)) return
         call run_scene(scene, summary, err)

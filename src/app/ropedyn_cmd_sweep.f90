@@ -10,48 +10,16 @@ module ropedyn_cmd_sweep
     use ropedyn_text, only: int_text
     use ropedyn_os, only: processor_count
     use ropedyn_cli, only: cli_t
+    use ropedyn_help, only: print_help
     use ropedyn_sweep, only: sweep_t, read_sweep
     use ropedyn_sweep_runner, only: sweep_options_t, list_cases, status_report, run_local, &
         summarize
     use ropedyn_sweep_task, only: run_cases
     implicit none
     private
-    public :: sweep_command, sweep_usage
+    public :: sweep_command
 
 contains
-
-    subroutine sweep_usage(unit)
-        integer, intent(in) :: unit
-        write (unit, '(a)') 'usage: ropedyn sweep SWEEP.nml [--jobs N] [--force] [--quiet] '// &
-            '[--output-dir DIR]'
-        write (unit, '(a)') '       ropedyn sweep SWEEP.nml --list | --count | --status'
-        write (unit, '(a)') '       ropedyn sweep SWEEP.nml --task LIST [--force] [--quiet] '// &
-            '[--output-dir DIR]'
-        write (unit, '(a)') '       ropedyn sweep SWEEP.nml --summary [--output-dir DIR]'
-        write (unit, '(a)') 'Runs every case of a sweep file (a base scene and lists of '// &
-            'models, elements,'
-        write (unit, '(a)') 'methods, max_orders, rtols and any group.key) and writes '// &
-            '<output_dir>/case_<id>.h5'
-        write (unit, '(a)') 'and summary.csv / summary.h5 (docs/sweeps.md).'
-        write (unit, '(a)') '  --jobs N        worker processes (default: the number of cores)'
-        write (unit, '(a)') '  --list          print the cases: id, status of its file, overrides'
-        write (unit, '(a)') '  --count         print the number of cases'
-        write (unit, '(a)') '  --status        count the cases by status, with ids and reasons'// &
-            ' (exit 3: not all complete)'
-        write (unit, '(a)') '  --task LIST     run these cases only (K, K-L, or a comma-'// &
-            'separated list; a Slurm'
-        write (unit, '(a)') '                  array task), one after the other; no summary'
-        write (unit, '(a)') '  --summary       rebuild the summary from the case files that exist'
-        write (unit, '(a)') '  --force         run cases again even if their output is complete'
-        write (unit, '(a)') '  --quiet         no progress and no per-case lines'
-        write (unit, '(a)') '  --output-dir D  case files and summary in D (instead of output_dir)'
-        write (unit, '(a)') 'A case whose file is complete and holds the same scene is skipped;'// &
-            ' a case being'
-        write (unit, '(a)') 'written by another process is not run twice (docs/sweeps.md).'
-        write (unit, '(a)') 'exit codes: 0 ok, 2 bad input, 3 a case not complete, 4 output '// &
-            'error or case'
-        write (unit, '(a)') 'taken by another writer, 130 stopped by SIGINT or SIGTERM'
-    end subroutine sweep_usage
 
     !> `ropedyn sweep ARGS`: `cli` holds the arguments after `sweep`; `exe` is how this
     !! program was started (argument 0), used to start the workers.
@@ -101,7 +69,7 @@ contains
         do while (cli%next())
             select case (cli%option)
             case ('--help', '-h')
-                call sweep_usage(output_unit)
+                call print_help('sweep', output_unit)
                 return
             case ('--list')
                 opt%list = .true.
@@ -141,10 +109,8 @@ contains
                 if (allocated(err)) return
             end select
         end do
-        if (.not. allocated(opt%path)) then
-            call cli%usage_error('needs a sweep file', err)
-            return
-        end if
+        call cli%require(opt%path, 'a sweep file', err)
+        if (allocated(err)) return
         if (.not. allocated(opt%output_dir)) opt%output_dir = ''
         modes = count([opt%list, opt%count, opt%summary, opt%status, size(opt%tasks) > 0])
         if (modes > 1) then

@@ -4,43 +4,18 @@ module ropedyn_cmd_testset
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, real_text, fixed_text
     use ropedyn_methods, only: method_index, method_list
     use ropedyn_cli, only: cli_t
+    use ropedyn_help, only: print_help
     use ropedyn_testset, only: testset_problem_t, new_testset_problem, testset_names, &
                                testset_name_list
     use ropedyn_testset_driver, only: testset_run_t, run_testset, DEFAULT_REPEAT_TIME
     implicit none
     private
-    public :: testset_command, testset_usage
+    public :: testset_command
 
 contains
-
-    subroutine testset_usage(unit)
-        integer, intent(in) :: unit
-        write (unit, '(a)') 'usage: ropedyn testset PROBLEM|all [options]   '// &
-            '(ropedyn testset --list: the problems)'
-        write (unit, '(a)') 'Solves a stiff problem of the Bari Test Set for IVP Solvers '// &
-            'from t0 to t_end'
-        write (unit, '(a)') 'and compares with its reference solution (docs/testset.md).'
-        write (unit, '(a)') '  --method M          integrator: cvode (default) or mebdf'
-        write (unit, '(a)') '  --rtol R            relative tolerance, 0 < R < 1 '// &
-            '(default 1e-6)'
-        write (unit, '(a)') '  --atol A            absolute tolerance, A > 0 (default: '// &
-            'the test-set rule:'
-        write (unit, '(a)') '                      atol = rtol; ROBER atol = 1e-6 rtol; '// &
-            'E5 atol = 1.7e-24)'
-        write (unit, '(a)') '  --max-order K       highest order (0 = method default: '// &
-            'cvode 5, mebdf 4)'
-        write (unit, '(a, f3.1, a)') '  --repeat-time S     repeat until S s of CPU time '// &
-            '(default ', DEFAULT_REPEAT_TIME, '; 0: one run);'
-        write (unit, '(a)') '                      the median CPU time per run is reported'
-        write (unit, '(a)') '  --csv               one header line and one line per problem'
-        write (unit, '(a)') 'Accuracy: scd = -log10 max |y - yref|/|yref| (|yref| >= 1e-200), '// &
-            'mescd = -log10 max'
-        write (unit, '(a)') '|y - yref|/(atol/rtol + |yref|); E5 is judged by mescd.'
-        write (unit, '(a)') 'exit codes: 0 ok, 2 bad arguments, 3 integration failed'
-    end subroutine testset_usage
 
     !> ropedyn testset PROBLEM|all [options] | --list
     subroutine testset_command(cli, err)
@@ -65,7 +40,8 @@ contains
         do while (cli%next())
             select case (cli%option)
             case ('--help', '-h')
-                call testset_usage(output_unit)
+                call print_help('testset', output_unit, 'default_repeat_time', &
+                                real_text(DEFAULT_REPEAT_TIME, compact=.true.))
                 return
             case ('--list')
                 list = .true.
@@ -243,8 +219,8 @@ contains
         type(testset_run_t), intent(in) :: r
         character(len=400) :: line
         write (line, '(9(a, ","), 8(i0, ","), es12.5, ",", i0)') r%problem, &
-            r%method, number(r%rtol), atol_text(r), int_text(r%max_order), decimal(r%scd), &
-            decimal(r%mescd), merge('mescd', 'scd  ', r%use_mescd), decimal(r%accuracy()), &
+            r%method, number(r%rtol), atol_text(r), int_text(r%max_order), fixed_text(r%scd, 4), &
+            fixed_text(r%mescd, 4), merge('mescd', 'scd  ', r%use_mescd), fixed_text(r%accuracy(), 4), &
             r%stats%steps, r%stats%err_test_fails, r%stats%rhs_evals, r%stats%jac_rhs_evals, &
             r%stats%jac_evals, r%stats%lin_setups, r%stats%nonlin_iters, &
             r%stats%nonlin_conv_fails, r%cpu_time, r%runs
@@ -290,21 +266,6 @@ contains
         character(len=max(width, len(text) + 1)) :: field
         field = text
     end function pad
-
-    !> A real with 4 decimals: 2.5125, 0.5813, -0.1200.
-    function decimal(x) result(text)
-        real(wp), intent(in) :: x
-        character(len=:), allocatable :: text
-        character(len=32) :: buffer
-        write (buffer, '(f0.4)') x
-        text = trim(adjustl(buffer))
-        if (text(1:1) == '.') then
-            text = '0'//text
-        else if (text(1:min(2, len(text))) == '-.') then
-            text = '-0'//text(2:)
-        end if
-    end function decimal
-
 
     pure function remove_blanks(text) result(out)
         character(len=*), intent(in) :: text

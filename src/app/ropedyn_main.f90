@@ -22,7 +22,8 @@ program ropedyn_main
     use ropedyn_cmd_run, only: run_command
     use ropedyn_cmd_testset, only: testset_command
     use ropedyn_cmd_sweep, only: sweep_command
-    use ropedyn_cmd_statics, only: statics_command
+    use ropedyn_help, only: print_help
+    use ropedyn_cmd_statics, only: analysis_command
     use ropedyn_cmd_modes, only: modes_command
     use ropedyn_cmd_keys, only: keys_command
     implicit none
@@ -34,12 +35,12 @@ program ropedyn_main
     cli = cli_from_command_line()
     select case (cli%command)
     case ('')
-        call usage(error_unit)
+        call print_help('ropedyn', error_unit)
         call make_error(err, ERR_USAGE, 'no command given (see ropedyn --help)')
     case ('--version', 'version')
         write (output_unit, '(a)') 'ropedyn '//version_string
     case ('--help', '-h', 'help')
-        call usage(output_unit)
+        call print_help('ropedyn', output_unit)
     case ('run')
         call run_command(cli, err)
     case ('testset')
@@ -48,7 +49,7 @@ program ropedyn_main
         call get_command_argument(0, exe)
         call sweep_command(cli, trim(exe), err)
     case ('statics')
-        call statics_command(cli, err)
+        call analysis_command('statics', cli, err)
     case ('modes')
         call modes_command(cli, err)
     case ('keys')
@@ -61,27 +62,4 @@ program ropedyn_main
         write (error_unit, '(a)') 'ropedyn: error: '//err%message
         stop exit_code_of(err%code), quiet=.true.
     end if
-
-contains
-
-    subroutine usage(unit)
-        integer, intent(in) :: unit
-        write (unit, '(a)') 'usage: ropedyn run SCENE.nml [--set group.key=value ...]'
-        write (unit, '(a)') '       ropedyn testset PROBLEM|all [--method cvode|mebdf] '// &
-            '[--rtol R] [--atol A]'
-        write (unit, '(a)') '                       [--max-order K] [--repeat-time SECONDS] '// &
-            '[--csv]'
-        write (unit, '(a)') '       ropedyn testset --list'
-        write (unit, '(a)') '       ropedyn sweep SWEEP.nml [--jobs N | --task LIST | '// &
-            '--summary | --list | --count | --status] ...'
-        write (unit, '(a)') '       ropedyn statics SCENE.nml [--set ...] [-o FILE.h5] '// &
-            '[--max-iterations N]'
-        write (unit, '(a)') '       ropedyn modes SCENE.nml [--count K] [--set ...] [-o FILE.h5]'
-        write (unit, '(a)') '       ropedyn keys   (every key of a scene file with its default)'
-        write (unit, '(a)') '       ropedyn --version | --help;  ropedyn COMMAND --help'
-        write (unit, '(a)') 'exit codes: 0 ok, 2 bad input, 3 integration failed, '// &
-            '4 output error, 5 internal error, 130 stopped by a signal'
-        write (unit, '(a)') 'input reference: docs/input.md; test problems: docs/testset.md '// &
-            '(ropedyn testset --help)'
-    end subroutine usage
 end program ropedyn_main

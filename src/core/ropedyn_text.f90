@@ -105,7 +105,8 @@ contains
         if (negative) s = '-'//s
     end function real_text
 
-    !> x with `decimals` digits after the point ('12.3' for decimals = 1).
+    !> x with `decimals` digits after the point and a digit before it ('12.3', '0.5000',
+    !! '-0.1200').
     function fixed_text(x, decimals) result(s)
         real(wp), intent(in) :: x
         integer, intent(in) :: decimals
@@ -114,7 +115,12 @@ contains
         character(len=16) :: fmt
         write (fmt, '(a, i0, a)') '(f0.', decimals, ')'
         write (buf, fmt) x
-        s = trim(buf)
+        s = trim(adjustl(buf))
+        if (s(1:1) == '.') then
+            s = '0'//s
+        else if (s(1:min(2, len(s))) == '-.') then
+            s = '-0'//s(2:)
+        end if
     end function fixed_text
 
     !> 'x, y' of a pair, each as `real_text`.

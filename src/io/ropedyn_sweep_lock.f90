@@ -276,17 +276,9 @@ contains
             new_line('a')//'host='//host_name()//new_line('a')//'boot='//boot_id()// &
             new_line('a')//'pid='// &
             int_text(process_id())//new_line('a')//'start_ticks='// &
-            ticks_text(process_start(0))//new_line('a')//'started='//utc_timestamp()// &
+            int_text(process_start(0))//new_line('a')//'started='//utc_timestamp()// &
             new_line('a')//'job='//trim(job)
         if (ios == 0) close (unit, iostat=ios, iomsg=msg)
         if (ios /= 0) call make_error(err, ERR_IO, path//': cannot write: '//trim(msg))
-    contains
-        pure function ticks_text(t) result(s)
-            integer(int64), intent(in) :: t
-            character(len=:), allocatable :: s
-            character(len=24) :: buf
-            write (buf, '(i0)') t
-            s = trim(buf)
-        end function ticks_text
     end subroutine write_holder
 end module ropedyn_sweep_lock

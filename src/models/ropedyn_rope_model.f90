@@ -22,9 +22,12 @@ module ropedyn_rope_model
     end type energy_t
 
     type, abstract, extends(problem_t) :: rope_model_t
+        integer :: n = 0                   !< number of elements (RFEM) or members (MPP)
+        logical :: with_work = .false.     !< external work is quadrature 2
     contains
         procedure(energy_i), deferred :: energy
-        procedure(n_elements_i), deferred :: n_elements
+        procedure :: n_elements => rope_n_elements
+        procedure :: quad_size => rope_quad_size
         procedure(model_name_i), deferred :: model_name
         procedure(initial_state_i), deferred :: initial_state
         procedure(fields_i), deferred :: fields
@@ -48,11 +51,6 @@ module ropedyn_rope_model
         end function energy_i
 
         !> Number of bodies (rigid elements or pendulum members).
-        pure integer function n_elements_i(self)
-            import :: rope_model_t
-            class(rope_model_t), intent(in) :: self
-        end function n_elements_i
-
         !> 'rfem' or 'mpp'.
         pure function model_name_i(self) result(name)
             import :: rope_model_t
@@ -112,6 +110,17 @@ module ropedyn_rope_model
         end subroutine coordinate_mass_i
     end interface
 contains
+
+    pure integer function rope_n_elements(self)
+        class(rope_model_t), intent(in) :: self
+        rope_n_elements = self%n
+    end function rope_n_elements
+
+    !> 1: the dissipated energy; 2 (when supports move or effects do work): external work.
+    pure integer function rope_quad_size(self)
+        class(rope_model_t), intent(in) :: self
+        rope_quad_size = merge(2, 1, self%with_work)
+    end function rope_quad_size
 
     !> Every rope model is mechanical: coordinates and their rates, q' = v.
     pure logical function rope_has_second_order(self) result(has)

@@ -17,7 +17,7 @@
 module ropedyn_sweep_task
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
     use ropedyn_kinds, only: wp
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, fixed_text
     use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INPUT, ERR_INTERRUPTED
     use ropedyn_os, only: make_dirs, rename_file, delete_file
     use ropedyn_process, only: catch_signals, release_signals, signal_received, note_signals, &
@@ -165,7 +165,7 @@ contains
                 end if
                 if (.not. quiet) write (output_unit, '(a)') label//': complete: '// &
                     int_text(int(summary%stats%steps))//' steps, cpu '// &
-                    seconds_text(summary%cpu_time)//', wall '//seconds_text(wall)//' -> '// &
+                    fixed_text(summary%cpu_time, 3)//' s, wall '//fixed_text(wall, 3)//' s -> '// &
                     c%file
             end block locked
             call note_signals('', lerr)
@@ -199,14 +199,4 @@ contains
         if (.not. allocated(err)) call rename_file(part, c%file, err)
         if (allocated(err)) removed = delete_file(part)
     end subroutine put_in_place
-
-    function seconds_text(x) result(s)
-        real(wp), intent(in) :: x
-        character(len=:), allocatable :: s
-        character(len=16) :: buf
-        write (buf, '(f0.3)') x
-        s = trim(adjustl(buf))
-        if (s(1:1) == '.') s = '0'//s
-        s = s//' s'
-    end function seconds_text
 end module ropedyn_sweep_task

@@ -46,7 +46,6 @@ module ropedyn_mpp
 
     type, extends(rope_model_t) :: mpp_t
         private
-        integer :: n = 0            !< members
         integer :: nu = 0           !< spring coordinates (n or 0)
         integer :: ndof = 0         !< n + nu
         real(wp) :: l = 0.0_wp      !< member length, m
@@ -67,7 +66,6 @@ module ropedyn_mpp
         type(support_motion_t) :: motion(2)
         logical :: moving(2) = .false.
         real(wp) :: bottom_release = huge(1.0_wp)  !< s
-        logical :: with_work = .false.   !< external work is quadrature 2
         type(effect_box_t), allocatable :: effects(:)
         ! point masses: rod, offset from the rod's centre along it (m), mass (kg)
         integer, allocatable :: pm_body(:)
@@ -101,9 +99,7 @@ module ropedyn_mpp
         procedure :: mass_matrix => mpp_mass_matrix
         procedure :: implicit_rhs => mpp_implicit_rhs
         procedure :: energy => mpp_energy
-        procedure :: quad_size => mpp_quad_size
         procedure :: quad_rhs => mpp_quad_rhs
-        procedure :: n_elements => mpp_n_elements
         procedure :: model_name => mpp_model_name
         procedure :: initial_state => mpp_initial_state
         procedure :: fields => mpp_fields
@@ -426,17 +422,6 @@ contains
         ml = 2*self%ndof - 1
         mu = 2*self%ndof - 1
     end subroutine mpp_bandwidths
-
-    !> 1: the dissipated energy; 2 (moving supports, working effects): external work.
-    pure integer function mpp_quad_size(self)
-        class(mpp_t), intent(in) :: self
-        mpp_quad_size = merge(2, 1, self%with_work)
-    end function mpp_quad_size
-
-    pure integer function mpp_n_elements(self)
-        class(mpp_t), intent(in) :: self
-        mpp_n_elements = self%n
-    end function mpp_n_elements
 
     pure function mpp_model_name(self) result(name)
         class(mpp_t), intent(in) :: self

@@ -67,7 +67,6 @@ module ropedyn_rfem
 
     type, extends(rope_model_t) :: rfem_t
         private
-        integer :: n = 0                       !< number of rigid elements
         real(wp), allocatable :: len(:)        !< element lengths, m
         real(wp), allocatable :: mass(:)       !< element masses, kg
         real(wp), allocatable :: inertia(:)    !< central moments of inertia, kg m^2
@@ -91,7 +90,6 @@ module ropedyn_rfem
         logical :: moving(2) = .false.
         real(wp) :: release(2) = huge(1.0_wp)  !< release times, s
         logical :: timed = .false.             !< the supports depend on time
-        logical :: with_work = .false.         !< external work is quadrature 2
         ! external effects (only those enabled) and their workspace
         type(effect_box_t), allocatable :: effects(:)
         type(bodies_t) :: bodies
@@ -115,9 +113,7 @@ module ropedyn_rfem
         procedure :: has_jacobian => rfem_has_jacobian
         procedure :: jacobian => rfem_jacobian
         procedure :: energy => rfem_energy
-        procedure :: quad_size => rfem_quad_size
         procedure :: quad_rhs => rfem_quad_rhs
-        procedure :: n_elements => rfem_n_elements
         procedure :: model_name => rfem_model_name
         procedure :: initial_state => rfem_initial_state
         procedure :: fields => rfem_fields
@@ -440,17 +436,6 @@ contains
         ml = min(11, 6*self%n - 1)
         mu = min(8, 6*self%n - 1)
     end subroutine rfem_bandwidths
-
-    !> 1: the dissipated energy; 2 (when supports move or effects do work): external work.
-    pure integer function rfem_quad_size(self)
-        class(rfem_t), intent(in) :: self
-        rfem_quad_size = merge(2, 1, self%with_work)
-    end function rfem_quad_size
-
-    pure integer function rfem_n_elements(self)
-        class(rfem_t), intent(in) :: self
-        rfem_n_elements = self%n
-    end function rfem_n_elements
 
     pure function rfem_model_name(self) result(name)
         class(rfem_t), intent(in) :: self
