@@ -90,6 +90,11 @@ module ropedyn_cvode
     integer, parameter :: EVAL_RHS = 1, EVAL_QUAD = 2
 
     interface
+        !> Our compiled vector operations for a serial N_Vector (ropedyn_nvector_ops.c).
+        integer(c_int) function nvector_fast_ops(v) bind(C, name='ropedyn_nvector_fast_ops')
+            import :: c_int, N_Vector
+            type(N_Vector) :: v
+        end function nvector_fast_ops
         pure integer(c_size_t) function c_strlen(s) bind(C, name='strlen')
             import :: c_ptr, c_size_t
             type(c_ptr), value, intent(in) :: s
@@ -140,6 +145,9 @@ contains
             call make_error(err, ERR_SOLVER, 'cvode: cannot create the state vector')
             return
         end if
+        ! CVODE clones all its vectors from this one: they inherit the compiled operations.
+        flag = nvector_fast_ops(self%nv_y)
+        if (check(flag, 'ropedyn_nvector_fast_ops')) return
         self%mem = FCVodeCreate(CV_BDF, self%sunctx)
         if (.not. c_associated(self%mem)) then
             call make_error(err, ERR_SOLVER, 'cvode: FCVodeCreate failed')
@@ -154,6 +162,7 @@ contains
         if (allocated(options%atol_vector)) then
             atol = options%atol_vector
             nv_atol => FN_VMake_Serial(int(self%n, c_int64_t), atol, self%sunctx)
+            flag = nvector_fast_ops(nv_atol)
             flag = FCVodeSVtolerances(self%mem, real(options%rtol, c_double), nv_atol)
             call FN_VDestroy(nv_atol)
             if (check(flag, 'FCVodeSVtolerances')) return
@@ -182,6 +191,8 @@ contains
 
         if (self%nq > 0) then
             self%nv_q => FN_VMake_Serial(int(self%nq, c_int64_t), self%yq, self%sunctx)
+            flag = nvector_fast_ops(self%nv_q)
+            if (check(flag, 'ropedyn_nvector_fast_ops')) return
             flag = FCVodeQuadInit(self%mem, c_funloc(cv_quad), self%nv_q)
             if (check(flag, 'FCVodeQuadInit')) return
             flag = FCVodeQuadSStolerances(self%mem, real(options%rtol, c_double), &
