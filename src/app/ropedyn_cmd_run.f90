@@ -74,6 +74,14 @@ contains
             s%stats%steps, '   rhs evals ', s%stats%rhs_evals, '   jacobians ', &
             s%stats%jac_evals, '   error-test fails ', s%stats%err_test_fails
         write (output_unit, '(a, f10.4, a)') '  cpu time        ', s%cpu_time, ' s'
+        write (output_unit, '(a, i0, a)') '  newton          '// &
+            trim(merge('reduced (second-order) matrix', 'first-order matrix           ', &
+                       s%stats%reduced_newton))//', ', s%stats%lin_setups, ' factorizations'
+        if (scene%solver%profile) write (output_unit, '(a, 5(a, f9.4))') &
+            '  time split (s) ', ' rhs ', s%stats%time_rhs, '  jacobian ', s%stats%time_jac, &
+            '  factor ', s%stats%time_factor, '  solve ', s%stats%time_solve, '  rest ', &
+            s%stats%time_advance - (s%stats%time_rhs + s%stats%time_jac + &
+                                    s%stats%time_factor + s%stats%time_solve)
         write (output_unit, '(a, 5(es13.5))') '  energy (J)      kinetic, elastic, '// &
             'gravity, dissipated, total:'
         write (output_unit, '(a, 5(es13.5))') '                  ', s%final_energy%kinetic, &

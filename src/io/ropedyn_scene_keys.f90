@@ -127,6 +127,10 @@ contains
                 'time between output records; at most a limit of records')
             call add_logical(G_SOLVER, 'stability_limit_detection', &
                 v%stability_limit_detection, "cvode only: CVODE's stability-limit detection")
+            call add_logical(G_SOLVER, 'first_order_newton', v%first_order_newton, &
+                'Newton systems on the first-order matrix, not the reduced second-order one')
+            call add_logical(G_SOLVER, 'profile', v%profile, &
+                'time the right-hand side, Jacobian, factorizations and solves')
             call add_real(G_SOLVER, 'fault_nan_after', v%fault_nan_after, R_FINITE, 's', &
                 'testing aid: NaN right-hand side after this time; < 0: off')
 

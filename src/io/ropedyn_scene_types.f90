@@ -22,6 +22,12 @@ module ropedyn_scene_types
         !> CVODE only: BDF stability-limit detection (lowers the order near the stability
         !! boundary of lightly damped oscillatory modes)
         logical :: stability_limit_detection = .false.
+        !> Newton systems on the first-order matrix of all unknowns instead of the reduced
+        !! second-order one (half the size; the default for the rope models)
+        logical :: first_order_newton = .false.
+        !> time the parts of the integration (right-hand side, Jacobian, factorizations,
+        !! solves): printed and written to /solver (costs a few % on small ropes)
+        logical :: profile = .false.
         !> testing aid: the right-hand side returns NaN for t > this time [s]; < 0: off
         real(wp) :: fault_nan_after = -1.0_wp
     end type solver_params_t

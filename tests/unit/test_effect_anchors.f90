@@ -336,7 +336,11 @@ contains
         call suite%check_close(step, expected, 1.0e-9_wp, 0.0_wp, &
             'rfem release: the balance steps by the support energy (M g)^2/(2 C)')
         call suite%check_le(still, 1.0e-12_wp, 'rfem release: at rest before the release')
-        call suite%check_le(worst, 1.0e-12_wp, &
+        ! the internal forces cancel in the centre of mass up to rounding, but the
+        ! integrator's steps after the release (their order and sizes follow the last bits
+        ! of the forces) leave their error on the free fall in it (measured 1.35e-12 m with
+        ! the one-pass kernels of issue 14, Debug and Release alike; below 1e-12 before)
+        call suite%check_le(worst, 5.0e-12_wp, &
             'rfem release: the centre of mass then falls g (t - t_r)^2/2')
     end subroutine rfem_top_release
 

@@ -134,7 +134,12 @@ contains
         write (*, '(a, 2f12.7, a)') '  ground: slide', slide, expected, ' m'
         call suite%check_close(slide, expected, 1.0e-4_wp, 0.0_wp, &
                                'ground: sliding distance = v0^2/(2 mu g)')
-        call suite%check_le(maxval(abs(qdot(1:2, :))), 1.0e-13_wp, 'ground: the rope comes to rest')
+        ! at rest to the tolerance (atol 1e-9 m/s): what is left is the integrator's error,
+        ! which follows the step sequence and so the last bits of the forces and the Newton
+        ! path: 5.4e-15 m/s (first-order Newton) and 7.0e-12 m/s (reduced) with the old
+        ! kernels, 2.4e-12 m/s with the one-pass kernels (first-order Newton); the bound is
+        ! about 3 times the largest measured
+        call suite%check_le(maxval(abs(qdot(1:2, :))), 2.0e-11_wp, 'ground: the rope comes to rest')
         ground = ground_effect([1.0_wp, 0.0_wp], [-1.0_wp, 0.0_wp], 1.0e5_wp, 200.0_wp, mu, &
                                1.0e-3_wp)
         b%n = n
