@@ -47,6 +47,9 @@ static pthread_t beat_thread;
 static void on_signal(int sig)
 {
     if (received && second_ends) {
+        static const char msg[] = "\nropedyn: a second signal: ending at once\n";
+        ssize_t rc = write(2, msg, sizeof msg - 1);
+        (void)rc;
         signal(sig, SIG_DFL);
         raise(sig);
         return;

@@ -344,11 +344,14 @@ contains
     end subroutine append_state
 
     !> Write the solver counters and the CPU time (also for a failed run); may be repeated.
-    subroutine output_write_stats(self, stats, cpu_time, err)
+    !! With `t_reached`, also /solver/t_reached: the time the integration got to (s; for an
+    !! interrupted or failed run, where it stopped).
+    subroutine output_write_stats(self, stats, cpu_time, err, t_reached)
         class(output_file_t), intent(inout) :: self
         type(solver_stats_t), intent(in) :: stats  !< counters of the integration
         real(wp), intent(in) :: cpu_time           !< CPU time of the run, s
         type(error_t), allocatable, intent(out) :: err
+        real(wp), intent(in), optional :: t_reached
         integer(i8) :: counters(size(COUNTER_NAMES))
         real(wp) :: times(size(TIMER_NAMES))
         integer :: k
@@ -373,6 +376,10 @@ contains
         call self%file%write('/solver/reduced_newton', merge(1_i8, 0_i8, stats%reduced_newton), &
                              '1', err)
         if (allocated(err)) return
+        if (present(t_reached)) then
+            call self%file%write('/solver/t_reached', t_reached, 's', err)
+            if (allocated(err)) return
+        end if
 
         call self%file%flush(err)
     end subroutine output_write_stats
@@ -434,14 +441,16 @@ contains
 
     !> Open the run file `path`, written by `create` with restart data, to continue it:
     !! every series open for `append` after its last complete record (longer series, from a
-    !! record cut short, are cut back to the length of /time), the status 'running' again and
-    !! its old reason removed. The file must be for `n_elements` elements and the given state
+    !! record cut short, are cut back to the length of /time, or to `keep` records), the
+    !! status 'running' again and its old reason removed. The file must be for `n_elements` elements and the given state
     !! and quadrature sizes.
-    subroutine output_reopen(self, path, n_elements, state_size, quad_size, err)
+    subroutine output_reopen(self, path, n_elements, state_size, quad_size, err, keep)
         class(output_file_t), intent(inout) :: self
         character(len=*), intent(in) :: path
         integer, intent(in) :: n_elements, state_size, quad_size
         type(error_t), allocatable, intent(out) :: err
+        !> keep only the first `keep` records (fewer than the file has: the others are cut)
+        integer, intent(in), optional :: keep
         integer :: expected, k
 
         if (self%is_open) call shutdown(self)
@@ -484,6 +493,8 @@ contains
                 end if
             end do
             self%n_records = self%series(S_TIME)%length()
+            if (present(keep)) self%n_records = max(0_hsize_t, min(self%n_records, &
+                                                                int(keep, hsize_t)))
             if (self%state(1)%length() < self%n_records .or. &
                 self%state(2)%length() < self%n_records) then
                 call make_error(err, ERR_IO, path//': /state/y: fewer records than /time')

@@ -10,7 +10,7 @@
 !! `--set` argument), the group, the key and the value.
 module ropedyn_scene
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
-    use ropedyn_text, only: int_text, lower, line_quote, printable, text_t, clip
+    use ropedyn_text, only: int_text, lower, line_quote, printable, text_t, clip, append_text
     use ropedyn_namelist_file, only: nml_file_t, nml_value_t, read_namelist_file, &
         parse_namelist_lines, parse_values, V_STRING
     use ropedyn_scene_types, only: scene_t, solver_params_t, output_params_t
@@ -98,7 +98,7 @@ contains
         do while (start <= len(text))
             nl = index(text(start:), new_line('a'))
             if (nl == 0) nl = len(text) - start + 2
-            lines = [lines, text_t(text(start:start + nl - 2))]
+            call append_text(lines, text(start:start + nl - 2))
             start = start + nl
         end do
         call parse_namelist_lines(origin, lines, GROUP_NAMES, file, err)
@@ -130,6 +130,10 @@ contains
                 call apply_override(ov(i), keys, err)
                 if (allocated(err)) return
             end do
+        end do
+        do i = 1, size(keys)
+            if (keys(i)%group == group_index('output') .and. keys(i)%name == 'progress') &
+                scene%output%progress_given = keys(i)%given
         end do
         call check_scene(keys, scene, err)
     end subroutine store_scene
@@ -300,7 +304,14 @@ contains
             if (g > 1) text = text//NL
             text = text//'&'//trim(GROUP_NAMES(g))//NL
             do k = 1, size(keys)
-                if (keys(k)%group == g) text = text//keys(k)%echo()
+                if (keys(k)%group /= g) cycle
+                if (keys(k)%name == 'progress' .and. trim(GROUP_NAMES(g)) == 'output' .and. &
+                    .not. scene%output%progress_given) then
+                    ! not given: a comment, so that reading the echo back keeps it unset
+                    text = text//'    ! progress: not set (on when stderr is a terminal)'//NL
+                else
+                    text = text//keys(k)%echo()
+                end if
             end do
             text = text//'/'
         end do
