@@ -3,6 +3,12 @@
 !! Life cycle: `init` (problem, initial state, options) -> `advance_to` (repeatedly, with
 !! increasing output times; the state is returned exactly at tout) -> `stats` -> `finalize`.
 !! An integrator keeps all its state in the object: two integrators never interfere.
+!!
+!! Stopping early: with `options%stop_requested` set, an integrator asks it after every
+!! accepted step and, when it says .true., returns from `advance_to` at once with t < tout
+!! and the state at t (no error). The run driver uses it to end a run at the next step after
+!! a signal (docs/output.md, "Interrupts"). An integrator that does not ask simply returns at
+!! tout; the driver then stops there.
 module ropedyn_integrator
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
@@ -12,6 +18,7 @@ module ropedyn_integrator
     implicit none
     private
     public :: integrator_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT, clock_seconds
+    public :: stop_query_i, stop_now
 
     !> No integrator here goes beyond this order of accuracy.
     integer, parameter :: MAX_ORDER_LIMIT = 7
@@ -31,6 +38,9 @@ module ropedyn_integrator
         !> CVODE's BDF stability-limit detection (order reduction when a lightly damped
         !! oscillatory mode nears the stability boundary); other methods reject .true.
         logical :: stab_lim_det = .false.
+        !> asked after every accepted step: .true. ends `advance_to` there (t < tout, no
+        !! error); not associated: never
+        procedure(stop_query_i), pointer, nopass :: stop_requested => null()
         !> solve the Newton systems on the first-order matrix even when the problem has
         !! second-order structure (the reduced matrix M - g C - g^2 K of half the size is
         !! the default then; ropedyn_iteration_matrix)
@@ -83,6 +93,10 @@ module ropedyn_integrator
     end type integrator_t
 
     abstract interface
+        !> Whether the integration should stop at the step just taken.
+        logical function stop_query_i()
+        end function stop_query_i
+
         !> Prepare to integrate `problem` from (t0, y0, yq0). The problem must outlive the
         !! integrator (it is referenced, not copied).
         subroutine init_i(self, problem, t0, y0, yq0, options, err)
@@ -130,6 +144,13 @@ module ropedyn_integrator
         end function name_i
     end interface
 contains
+
+    !> Whether `options` asks to stop now (`stop_requested` set and .true.).
+    logical function stop_now(options)
+        type(solver_options_t), intent(in) :: options
+        stop_now = .false.
+        if (associated(options%stop_requested)) stop_now = options%stop_requested()
+    end function stop_now
 
     !> Seconds on the monotonic clock (for the time split of options%profile).
     real(wp) function clock_seconds() result(s)

@@ -22,7 +22,8 @@ module ropedyn_cvode
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK
-    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, clock_seconds
+    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, clock_seconds, &
+        stop_now
     use ropedyn_iteration_matrix, only: iteration_matrix_t
     use fsundials_context_mod, only: FSUNContext_Create, FSUNContext_Free
     use fsundials_nvector_mod, only: N_Vector, FN_VDestroy, FN_VGetArrayPointer
@@ -288,7 +289,8 @@ contains
     !! each step, then the solution is interpolated at tout (what CV_NORMAL does inside;
     !! the steps taken are the same). CVODE by itself accepts steps with t + h == t: a run
     !! that runs into a region where f keeps failing (a NaN ahead) would crawl there until
-    !! max_steps.
+    !! max_steps. With `options%stop_requested` saying so after a step, it returns there
+    !! (t = the step's end < tout; the quadratures at that time).
     subroutine cvode_advance_to(self, tout, t, y, yq, err)
         class(cvode_t), intent(inout) :: self
         real(wp), intent(in) :: tout
@@ -326,6 +328,18 @@ contains
                 if (self%ctx%recoverable > 0) cause = cause//' after repeated recoverable '// &
                     'errors of the right-hand side (e.g. a NaN or Inf in the forces)'
                 exit
+            end if
+            if (self%tn < tout .and. stop_now(self%options)) then
+                ! stopped early on request: the state at the end of this step
+                self%t = self%tn
+                y = self%y
+                if (self%nq > 0) then
+                    tret = self%tn
+                    qflag = FCVodeGetQuad(self%mem, tret, self%nv_q)
+                    yq(1:self%nq) = self%yq(1:self%nq)
+                end if
+                t = self%t
+                return
             end if
         end do
 

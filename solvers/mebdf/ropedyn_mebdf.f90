@@ -29,7 +29,8 @@ module ropedyn_mebdf
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
-    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, clock_seconds
+    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, clock_seconds, &
+        stop_now
     use ropedyn_mebdf_coefficients, only: mebdf_coefficients_t, mebdf_coefficients, KMAX_MEBDF
     use ropedyn_iteration_matrix, only: iteration_matrix_t
     implicit none
@@ -340,6 +341,13 @@ contains
         do while (self%t < tout)
             call self%try_step(err)
             if (allocated(err)) then
+                t = self%t
+                y = self%dif(1:self%n, 0)
+                if (self%nq > 0) yq(1:self%nq) = self%dif(self%n + 1:, 0)
+                return
+            end if
+            if (self%t < tout .and. stop_now(self%options)) then
+                ! stopped early on request (options%stop_requested): the state of this step
                 t = self%t
                 y = self%dif(1:self%n, 0)
                 if (self%nq > 0) yq(1:self%nq) = self%dif(self%n + 1:, 0)

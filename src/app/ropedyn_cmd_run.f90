@@ -2,11 +2,12 @@
 module ropedyn_cmd_run
     use, intrinsic :: iso_fortran_env, only: output_unit
     use ropedyn_kinds, only: wp
-    use ropedyn_error, only: error_t
+    use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_INTERRUPTED
     use ropedyn_cli, only: cli_t
     use ropedyn_help, only: print_help
     use ropedyn_text, only: text_t, text_array
-    use ropedyn_scene, only: scene_t, read_scene
+    use ropedyn_scene, only: scene_t, read_scene, read_scene_text
+    use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_simulation, only: run_summary_t, run_scene
     use ropedyn_version, only: version_string
     implicit none
@@ -19,26 +20,85 @@ contains
         type(cli_t), intent(inout) :: cli
         type(error_t), allocatable, intent(out) :: err
         type(text_t), allocatable :: overrides(:)
-        character(len=:), allocatable :: scene_path
+        character(len=:), allocatable :: scene_path, resume_path
         type(scene_t) :: scene
         type(run_summary_t) :: summary
 
         allocate (overrides(0))
         do while (cli%next())
-            if (cli%option == '--help' .or. cli%option == '-h') then
+            select case (cli%option)
+            case ('--help', '-h')
                 call print_help('run', output_unit)
                 return
-            end if
-            call cli%scene_argument(overrides, scene_path, err)
-            if (allocated(err)) return
+            case ('--resume')
+                if (allocated(resume_path)) then
+                    call cli%usage_error('--resume is given twice', err)
+                    return
+                end if
+                call cli%take_value(resume_path, err)
+                if (allocated(err)) return
+            case default
+                call cli%scene_argument(overrides, scene_path, err)
+                if (allocated(err)) return
+            end select
         end do
-        call cli%require(scene_path, 'a scene file', err)
-        if (allocated(err)) return
-        call read_scene(scene_path, text_array(overrides), scene, err)
-        if (allocated(err)) return
-        call run_scene(scene, summary, err)
+        if (allocated(resume_path)) then
+            if (allocated(scene_path)) then
+                call cli%usage_error('--resume takes the scene from FILE.h5: give no scene '// &
+                                     'file ('//scene_path//')', err)
+                return
+            end if
+            call resume_scene(resume_path, text_array(overrides), scene, err)
+            if (allocated(err)) return
+            call run_scene(scene, summary, err, resume=.true.)
+        else
+            call cli%require(scene_path, 'a scene file', err)
+            if (allocated(err)) return
+            call read_scene(scene_path, text_array(overrides), scene, err)
+            if (allocated(err)) return
+            call run_scene(scene, summary, err)
+        end if
         if (summary%records > 0) call print_summary(scene, summary)
+        if (allocated(err)) then
+            if (err%code == ERR_INTERRUPTED) err%message = err%message// &
+                '; continue with: ropedyn run --resume '//trim(scene%output%file)
+        end if
     end subroutine run_command
+
+    !> The scene of the run file `path` (its `scene` attribute) with `overrides`, its output
+    !! going to `path` again.
+    subroutine resume_scene(path, overrides, scene, err)
+        character(len=*), intent(in) :: path
+        character(len=*), intent(in) :: overrides(:)
+        type(scene_t), intent(out) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        type(case_data_t) :: data
+        integer :: k
+        do k = 1, size(overrides)
+            if (index(overrides(k), 'output.file') == 1) then
+                call make_error(err, ERR_INPUT, '--set '//trim(overrides(k))//': --resume '// &
+                                'appends to '//path//'; output.file cannot be set')
+                return
+            end if
+        end do
+        call read_case_file(path, data, err)
+        if (allocated(err)) return
+        if (.not. data%exists) then
+            call make_error(err, ERR_INPUT, path//': no such file (--resume)')
+            return
+        end if
+        if (len(data%scene) == 0) then
+            call make_error(err, ERR_INPUT, path//': no scene attribute: not a ropedyn run file')
+            return
+        end if
+        call read_scene_text(path//': scene', data%scene, overrides, scene, err)
+        if (allocated(err)) return
+        if (len(path) > len(scene%output%file)) then
+            call make_error(err, ERR_INPUT, path//': the file name is too long (--resume)')
+            return
+        end if
+        scene%output%file = path
+    end subroutine resume_scene
 
     subroutine print_summary(scene, s)
         type(scene_t), intent(in) :: scene

@@ -1,10 +1,13 @@
 /* The POSIX calls Fortran cannot make on its own (signal handlers, posix_spawn, waitpid's
  * status macros, a thread): glue for ropedyn_process.f90, which is the only caller.
  *
- * - Signals: SIGINT and SIGTERM set a flag that the program polls (the local sweep runner).
- *   With a lock file given (a sweep case being written), the handler instead appends
- *   "signal=N" to that file and ends the process by the same signal (default action), so
- *   the case's lock records why its writer stopped (docs/sweeps.md, "Locks").
+ * - Signals: SIGINT and SIGTERM set a flag that the program polls (the run driver between
+ *   integration steps, the local sweep runner). Catching nests: every catch is matched by a
+ *   release, and the handlers go with the last release. With "second ends" on, a signal
+ *   that arrives when one was caught already ends the process at once by that signal (a
+ *   second Ctrl-C). With a lock file given, the handler instead appends "signal=N" to that
+ *   file and ends the process by the same signal (default action), so that a lock records
+ *   why its writer stopped (docs/sweeps.md, "Locks").
  * - A lock's heartbeat: a thread that touches the lock file every few seconds, so that a
  *   reader on another host can tell a live writer from one that is gone.
  * - Worker processes: spawned in their own process group with stdout and stderr in a log
@@ -31,8 +34,9 @@ extern char **environ;
 
 static const int CAUGHT[2] = {SIGINT, SIGTERM};
 static struct sigaction saved[2];
-static int installed = 0;
+static int installed = 0;   /* catches not yet released */
 static volatile sig_atomic_t received = 0;
+static volatile sig_atomic_t second_ends = 0;
 static volatile int note_fd = -1;
 
 static int beat_fd = -1;
@@ -42,6 +46,14 @@ static pthread_t beat_thread;
 
 static void on_signal(int sig)
 {
+    if (received && second_ends) {
+        static const char msg[] = "\nropedyn: a second signal: ending at once\n";
+        ssize_t rc = write(2, msg, sizeof msg - 1);
+        (void)rc;
+        signal(sig, SIG_DFL);
+        raise(sig);
+        return;
+    }
     if (!received) received = sig;
     if (note_fd >= 0) {
         char line[32] = "signal=";
@@ -62,12 +74,15 @@ static void on_signal(int sig)
 }
 
 /* Catch SIGINT and SIGTERM: the handler sets the flag (a signal ignored at start stays
- * ignored). Returns 0, or errno. */
+ * ignored). Nested calls only count (each needs its release). Returns 0, or errno. */
 int ropedyn_catch_signals(void)
 {
     struct sigaction sa;
     int k;
-    if (installed) return 0;
+    if (installed) {
+        installed++;
+        return 0;
+    }
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
     sigemptyset(&sa.sa_mask);
@@ -80,6 +95,10 @@ int ropedyn_catch_signals(void)
     installed = 1;
     return 0;
 }
+
+/* on != 0: a signal caught while the flag is set already ends the process at once (by that
+ * signal); 0: it only keeps the flag. */
+void ropedyn_second_signal_ends(int on) { second_ends = on ? 1 : 0; }
 
 /* With `path` not empty: from now on a caught signal is appended to that file and ends the
  * process (by the same signal). With "": back to setting the flag only. Returns 0, or
@@ -97,14 +116,20 @@ int ropedyn_signal_note(const char *path)
     return 0;
 }
 
-/* Back to the dispositions before ropedyn_catch_signals; forget the note file. */
+/* Undo one ropedyn_catch_signals; the last one restores the dispositions from before the
+ * first, forgets the note file and switches "second ends" off. The flag stays. */
 void ropedyn_release_signals(void)
 {
     int k;
+    if (installed > 1) {
+        installed--;
+        return;
+    }
     if (installed) {
         for (k = 0; k < 2; k++) sigaction(CAUGHT[k], &saved[k], NULL);
         installed = 0;
     }
+    second_ends = 0;
     ropedyn_signal_note("");
 }
 

@@ -1,8 +1,10 @@
 !> Processes and signals, through the C glue `ropedyn_process.c` (and a few libc calls):
-!! catching SIGINT/SIGTERM as a flag (or, while a sweep case is written, as a note in its
-!! lock file followed by the end of the process), a lock file's heartbeat, worker processes
-!! in their own process group (spawn, reap, signal), process ids, start times, the host
-!! name, file times and the clock. Used by the sweep runner (docs/sweeps.md).
+!! catching SIGINT/SIGTERM as a flag that the program polls (nested catches count; a second
+!! signal may end the process at once; or a note in a lock file followed by the end of the
+!! process), a lock file's heartbeat, worker processes in their own process group (spawn,
+!! reap, signal), process ids, start times, the host name, the Slurm job, file times and
+!! the clock. Used by the run driver (docs/output.md, "Interrupts") and the sweep runner
+!! (docs/sweeps.md).
 module ropedyn_process
     use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long_long, c_null_char, c_size_t
     use, intrinsic :: iso_fortran_env, only: int64
@@ -11,6 +13,7 @@ module ropedyn_process
     implicit none
     private
     public :: catch_signals, release_signals, signal_received, note_signals, signal_name
+    public :: end_on_second_signal, slurm_job, process_text
     public :: start_heartbeat, stop_heartbeat
     public :: spawn, reap, signal_group, process_id, process_start, host_name
     public :: file_mtime, unix_time
@@ -25,6 +28,10 @@ module ropedyn_process
         end function c_catch_signals
         subroutine release_signals() bind(C, name='ropedyn_release_signals')
         end subroutine release_signals
+        subroutine c_second_signal_ends(on) bind(C, name='ropedyn_second_signal_ends')
+            import :: c_int
+            integer(c_int), value :: on
+        end subroutine c_second_signal_ends
         integer(c_int) function c_signal_received() bind(C, name='ropedyn_signal_received')
             import :: c_int
         end function c_signal_received
@@ -86,6 +93,13 @@ contains
         if (rc /= 0) call make_error(err, ERR_IO, 'cannot install signal handlers (errno '// &
             int_text(int(rc))//')')
     end subroutine catch_signals
+
+    !> With `on`, a SIGINT or SIGTERM that arrives after one was caught ends the process at
+    !! once, by that signal (exit status 128 + N); off again with the last `release_signals`.
+    subroutine end_on_second_signal(on)
+        logical, intent(in) :: on
+        call c_second_signal_ends(merge(1_c_int, 0_c_int, on))
+    end subroutine end_on_second_signal
 
     !> The first SIGINT or SIGTERM caught since `catch_signals` (its number), or 0.
     integer function signal_received()
@@ -183,6 +197,31 @@ contains
         integer, intent(in) :: pid
         process_start = int(c_process_start(int(pid, c_int)), int64)
     end function process_start
+
+    !> The Slurm job this process runs in: 'ARRAYJOB_TASK' for an array task, else the job
+    !! id; '' outside Slurm.
+    function slurm_job() result(job)
+        character(len=:), allocatable :: job
+        character(len=64) :: array_job, array_task, id
+        integer :: n1, n2, n3
+        call get_environment_variable('SLURM_ARRAY_JOB_ID', array_job, n1)
+        call get_environment_variable('SLURM_ARRAY_TASK_ID', array_task, n2)
+        call get_environment_variable('SLURM_JOB_ID', id, n3)
+        if (n1 > 0 .and. n2 > 0) then
+            job = trim(array_job)//'_'//trim(array_task)
+        else if (n3 > 0) then
+            job = trim(id)
+        else
+            job = ''
+        end if
+    end function slurm_job
+
+    !> 'host H, pid P' and ', Slurm job J' inside Slurm: who this process is, for messages.
+    function process_text() result(text)
+        character(len=:), allocatable :: text
+        text = 'host '//host_name()//', pid '//int_text(process_id())
+        if (len(slurm_job()) > 0) text = text//', Slurm job '//slurm_job()
+    end function process_text
 
     !> This host's name ('unknown' if it cannot be had).
     function host_name() result(name)

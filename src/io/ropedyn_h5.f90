@@ -34,7 +34,8 @@ module ropedyn_h5
         h5dget_space_f, h5acreate_f, h5aopen_f, h5aclose_f, h5awrite_f, h5aread_f, &
         h5aexists_f, h5adelete_f, h5aget_type_f, h5tcopy_f, h5tclose_f, h5tset_size_f, &
         h5tget_size_f, h5tset_strpad_f, H5T_NATIVE_CHARACTER, H5T_STR_NULLPAD_F, &
-        h5kind_to_type, H5_REAL_KIND, H5_INTEGER_KIND
+        h5kind_to_type, H5_REAL_KIND, H5_INTEGER_KIND, h5dget_type_f, h5tget_class_f, &
+        H5T_STRING_F
     use ropedyn_kinds, only: wp, i8
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INTERNAL
@@ -68,7 +69,11 @@ module ropedyn_h5
         procedure, private :: read_real_scalar, read_int64_scalar
         generic :: read_scalar => read_real_scalar, read_int64_scalar
         procedure :: read_reals => h5_read_reals
+        procedure :: read_record => h5_read_record
         procedure :: create_series => h5_create_series
+        procedure :: create_text_series => h5_create_text_series
+        procedure :: open_series => h5_open_series
+        procedure :: delete_attribute => h5_delete_attribute
         final :: h5_final
     end type h5_file_t
 
@@ -81,9 +86,14 @@ module ropedyn_h5
         integer(hid_t) :: id = -1
         integer :: rank = 1                       !< Fortran rank including the time axis
         integer(hsize_t) :: record_dims(2) = 1    !< extents of one record (first rank-1 used)
+        integer :: text_width = 0                 !< a series of strings: their width, else 0
     contains
         procedure, private :: append_real, append_integer
         generic :: append => append_real, append_integer
+        procedure :: append_text => series_append_text
+        procedure :: length => series_length
+        procedure :: record_size => series_record_size
+        procedure :: truncate => series_truncate
         procedure :: close => series_close
     end type h5_series_t
 
@@ -102,6 +112,64 @@ module ropedyn_h5
             character(len=*), intent(in) :: columns
             type(error_t), allocatable, intent(out) :: err
         end subroutine h5_create_series
+
+        !> Create the empty series `name` of strings of `width` characters (one per record),
+        !! with its units. The series stays open.
+        module subroutine h5_create_text_series(self, series, name, width, units, err)
+            class(h5_file_t), intent(inout) :: self
+            type(h5_series_t), intent(inout) :: series
+            character(len=*), intent(in) :: name
+            integer, intent(in) :: width
+            character(len=*), intent(in) :: units
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine h5_create_text_series
+
+        !> Open the existing series `name` (an extendible dataset written by a series, of
+        !! numbers or strings) to append to it. The series stays open.
+        module subroutine h5_open_series(self, series, name, err)
+            class(h5_file_t), intent(inout) :: self
+            type(h5_series_t), intent(inout) :: series
+            character(len=*), intent(in) :: name
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine h5_open_series
+
+        !> Number of records of an open series (-1 if it cannot be had).
+        module function series_length(self) result(records)
+            class(h5_series_t), intent(in) :: self
+            integer(hsize_t) :: records
+        end function series_length
+
+        !> Number of values in one record of a series.
+        pure module function series_record_size(self) result(n)
+            class(h5_series_t), intent(in) :: self
+            integer :: n
+        end function series_record_size
+
+        !> Cut an open series to its first `records` records (nothing when it has no more).
+        module subroutine series_truncate(self, records, err)
+            class(h5_series_t), intent(inout) :: self
+            integer(hsize_t), intent(in) :: records
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine series_truncate
+
+        !> Write record number `record` of a series of strings (`value` clipped or padded to
+        !! the width).
+        module subroutine series_append_text(self, record, value, err)
+            class(h5_series_t), intent(inout) :: self
+            integer(hsize_t), intent(in) :: record
+            character(len=*), intent(in) :: value
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine series_append_text
+
+        !> Read record `record` (1-based) of the real series `name` (a dataset whose last
+        !! Fortran axis is time): its values in Fortran order.
+        module subroutine h5_read_record(self, name, record, values, err)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            integer(hsize_t), intent(in) :: record
+            real(wp), allocatable, target, intent(out) :: values(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine h5_read_record
 
         !> Close the series' dataset (nothing to do when it is not open).
         module subroutine series_close(self, err)
@@ -393,6 +461,26 @@ contains
         call h5lexists_f(self%id, name, exists, hdferr)
         if (hdferr < 0) exists = .false.
     end function h5_exists
+
+    !> Remove the attribute `name` of the object `where` ('/' for the root), if it has one.
+    subroutine h5_delete_attribute(self, where, name, err)
+        class(h5_file_t), intent(inout) :: self
+        character(len=*), intent(in) :: where, name
+        type(error_t), allocatable, intent(out) :: err
+        integer(hid_t) :: obj
+        integer :: hdferr
+        logical :: exists
+        call h5oopen_f(self%id, where, obj, hdferr)
+        if (hdferr < 0) then
+            call make_error(err, ERR_IO, self%path//': '//where//': cannot open object')
+            return
+        end if
+        call h5aexists_f(obj, name, exists, hdferr)
+        if (hdferr >= 0 .and. exists) call h5adelete_f(obj, name, hdferr)
+        if (hdferr < 0) call make_error(err, ERR_IO, self%path//': '//where//' attribute '// &
+                                        name//': cannot delete')
+        call h5oclose_f(obj, hdferr)
+    end subroutine h5_delete_attribute
 
     !> String attribute `name` on the object `where` ('/' for the root), replacing an old one.
     subroutine h5_attribute(self, where, name, value, err)

@@ -40,6 +40,190 @@ contains
             call string_attribute(self%path, series%id, name, 'columns', columns, err)
     end procedure h5_create_series
 
+    module procedure h5_create_text_series
+        integer(hsize_t) :: dims(1), max_dims(1), chunk(1)
+        integer(hid_t) :: type_id
+        integer :: hdferr
+
+        series%path = self%path
+        series%name = name
+        series%rank = 1
+        series%record_dims = 1
+        series%text_width = max(1, width)
+        call string_type(series%text_width, type_id, hdferr)
+        if (hdferr < 0) then
+            call make_error(err, ERR_IO, self%path//': '//name//': cannot set up the string type')
+            return
+        end if
+        dims = 0
+        max_dims = H5S_UNLIMITED_F
+        chunk = max(1, min(MAX_CHUNK_RECORDS, CHUNK_BYTES/series%text_width))
+        call new_dataset(self, name, type_id, dims, series%id, err, max_dims, chunk)
+        call h5tclose_f(type_id, hdferr)
+        if (allocated(err)) return
+        call string_attribute(self%path, series%id, name, 'units', units, err)
+    end procedure h5_create_text_series
+
+    module procedure h5_open_series
+        integer(hid_t) :: space_id, type_id
+        integer(hsize_t) :: dims(3), max_dims(3)
+        integer(size_t) :: width
+        integer :: rank, hdferr, ierr, class
+        rank = 0
+
+        series%path = self%path
+        series%name = name
+        call h5dopen_f(self%id, name, series%id, hdferr)
+        if (hdferr < 0) then
+            series%id = -1
+            call make_error(err, ERR_IO, self%path//': '//name//': cannot open dataset')
+            return
+        end if
+        call h5dget_space_f(series%id, space_id, hdferr)
+        if (hdferr < 0) then
+            call make_error(err, ERR_IO, self%path//': '//name//': cannot get dataspace')
+            return
+        end if
+        call h5sget_simple_extent_ndims_f(space_id, rank, hdferr)
+        if (hdferr >= 0 .and. rank >= 1 .and. rank <= 3) &
+            call h5sget_simple_extent_dims_f(space_id, dims(1:rank), max_dims(1:rank), hdferr)
+        call h5sclose_f(space_id, ierr)
+        if (hdferr < 0 .or. rank < 1 .or. rank > 3) then
+            call make_error(err, ERR_IO, self%path//': '//name//': not a series (rank '// &
+                            int_text(rank)//')')
+            return
+        end if
+        series%rank = rank
+        series%record_dims = 1
+        series%record_dims(1:rank - 1) = dims(1:rank - 1)
+        series%text_width = 0
+        call h5dget_type_f(series%id, type_id, hdferr)
+        if (hdferr < 0) then
+            call make_error(err, ERR_IO, self%path//': '//name//': cannot get its type')
+            return
+        end if
+        call h5tget_class_f(type_id, class, hdferr)
+        if (hdferr >= 0 .and. class == H5T_STRING_F) then
+            call h5tget_size_f(type_id, width, hdferr)
+            series%text_width = int(width)
+        end if
+        call h5tclose_f(type_id, hdferr)
+    end procedure h5_open_series
+
+    module procedure series_length
+        integer(hid_t) :: space_id
+        integer(hsize_t) :: dims(3), max_dims(3)
+        integer :: hdferr
+        records = -1
+        if (self%id < 0) return
+        call h5dget_space_f(self%id, space_id, hdferr)
+        if (hdferr < 0) return
+        call h5sget_simple_extent_dims_f(space_id, dims(1:self%rank), max_dims(1:self%rank), &
+                                         hdferr)
+        if (hdferr >= 0) records = dims(self%rank)
+        call h5sclose_f(space_id, hdferr)
+    end procedure series_length
+
+    module procedure series_record_size
+        n = int(product(self%record_dims(1:self%rank - 1)))
+    end procedure series_record_size
+
+    module procedure series_truncate
+        integer(hsize_t) :: dims(3)
+        integer :: hdferr
+        if (self%length() <= records) return
+        dims(1:self%rank - 1) = self%record_dims(1:self%rank - 1)
+        dims(self%rank) = records
+        call h5dset_extent_f(self%id, dims(1:self%rank), hdferr)
+        if (hdferr < 0) call make_error(err, ERR_IO, self%path//': '//self%name// &
+                                        ': cannot cut to '//int_text(int(records))//' records')
+    end procedure series_truncate
+
+    module procedure series_append_text
+        character(len=:), allocatable, target :: padded
+        integer(hid_t) :: type_id
+        integer :: hdferr
+        if (self%text_width < 1) then
+            call make_error(err, ERR_INTERNAL, self%path//': '//self%name// &
+                            ': not a series of strings')
+            return
+        end if
+        allocate (character(len=self%text_width) :: padded)
+        padded = repeat(achar(0), self%text_width)
+        padded(1:min(len(value), self%text_width)) = value(1:min(len(value), self%text_width))
+        call string_type(self%text_width, type_id, hdferr)
+        if (hdferr < 0) then
+            call make_error(err, ERR_IO, self%path//': '//self%name// &
+                            ': cannot set up the string type')
+            return
+        end if
+        call write_record(self, record, 1, type_id, c_loc(padded), .true., err)
+        call h5tclose_f(type_id, hdferr)
+    end procedure series_append_text
+
+    module procedure h5_read_record
+        integer(hid_t) :: dset_id, file_space, mem_space
+        integer(hsize_t) :: dims(3), max_dims(3), start(3), count(3)
+        integer :: rank, hdferr
+        character(len=:), allocatable :: label
+        type(c_ptr) :: buffer
+
+        label = self%path//': '//name
+        allocate (values(0))
+        call h5dopen_f(self%id, name, dset_id, hdferr)
+        if (hdferr < 0) then
+            call make_error(err, ERR_IO, label//': cannot open dataset')
+            return
+        end if
+        file_space = -1
+        mem_space = -1
+        steps: block
+            call h5dget_space_f(dset_id, file_space, hdferr)
+            if (hdferr < 0) then
+                file_space = -1
+                call make_error(err, ERR_IO, label//': cannot get dataspace')
+                exit steps
+            end if
+            call h5sget_simple_extent_ndims_f(file_space, rank, hdferr)
+            if (hdferr < 0 .or. rank < 1 .or. rank > 3) then
+                call make_error(err, ERR_IO, label//': not a series')
+                exit steps
+            end if
+            call h5sget_simple_extent_dims_f(file_space, dims(1:rank), max_dims(1:rank), hdferr)
+            if (hdferr < 0 .or. record < 1 .or. record > dims(rank)) then
+                call make_error(err, ERR_IO, label//': no record '//int_text(int(record)))
+                exit steps
+            end if
+            start = 0
+            start(rank) = record - 1
+            count(1:rank - 1) = dims(1:rank - 1)
+            count(rank) = 1
+            call h5sselect_hyperslab_f(file_space, H5S_SELECT_SET_F, start(1:rank), &
+                                       count(1:rank), hdferr)
+            if (hdferr < 0) then
+                call make_error(err, ERR_IO, label//': cannot select record '// &
+                                int_text(int(record)))
+                exit steps
+            end if
+            deallocate (values)
+            allocate (values(product(count(1:rank))))
+            call h5screate_simple_f(1, [size(values, kind=hsize_t)], mem_space, hdferr)
+            if (hdferr < 0) then
+                mem_space = -1
+                call make_error(err, ERR_IO, label//': cannot create memory dataspace')
+                exit steps
+            end if
+            buffer = c_loc(values)
+            if (size(values) > 0) call h5dread_f(dset_id, h5kind_to_type(wp, H5_REAL_KIND), &
+                buffer, hdferr, mem_space_id=mem_space, file_space_id=file_space)
+            if (hdferr < 0) call make_error(err, ERR_IO, label//': cannot read record '// &
+                                            int_text(int(record)))
+        end block steps
+        if (mem_space >= 0) call h5sclose_f(mem_space, hdferr)
+        if (file_space >= 0) call h5sclose_f(file_space, hdferr)
+        call h5dclose_f(dset_id, hdferr)
+    end procedure h5_read_record
+
     module procedure series_close
         integer :: hdferr
         if (self%id < 0) return

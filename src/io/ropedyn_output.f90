@@ -18,9 +18,14 @@
 !!              time in the integrator and where it went (&solver profile = .true.; else 0)
 !!     /solver/reduced_newton () int64 1: 1 when the Newton systems were solved on the
 !!              reduced second-order matrix
+!!     /state/y                (times, state size)    SI            restart data (with the
+!!     /state/yq               (times, quadratures)   J             state sizes at create)
+!!     /solver/restarts/{time, record, steps, cpu_time, wall_clock, previous_status,
+!!              previous_reason} (restarts,)   one entry per resume (add_restart)
 !!
-!! Root attributes: status ('running' | 'complete' | 'failed'), reason (failed only),
-!! version, model, method, scene, created, units_convention. See docs/output.md.
+!! Root attributes: status ('running' | 'complete' | 'failed' | 'interrupted'), reason
+!! (failed and interrupted), version, model, method, scene, created, units_convention.
+!! See docs/output.md. A file is continued (`ropedyn run --resume`) by `reopen`.
 !!
 !! The file is flushed after every `append`, so a run that crashes leaves readable data up to
 !! its last output time with status 'running'. `/time` is written last in each record, so
@@ -33,7 +38,7 @@ module ropedyn_output
     use ropedyn_kinds, only: wp, i8
     use ropedyn_os, only: utc_timestamp
     use ropedyn_text, only: int_text
-    use ropedyn_error, only: error_t, make_error, ERR_INTERNAL
+    use ropedyn_error, only: error_t, make_error, ERR_INTERNAL, ERR_IO
     use ropedyn_rope_model, only: energy_t
     use ropedyn_integrator, only: solver_stats_t
     use ropedyn_h5, only: h5_file_t, h5_series_t
@@ -65,6 +70,24 @@ module ropedyn_output
     integer, parameter :: RECORD_ROWS(N_SERIES) = [0, 3, 3, 2, 0, 0, 0, 0, 0, 0, 0, 0]
     integer, parameter :: RECORD_PER_ELEMENT(N_SERIES) = [0, 1, 1, 2, 0, 0, 0, 0, 0, 0, 0, 0]
 
+    !> The restart data: the model's ODE state y and its quadratures at every record (what a
+    !! run needs to continue from a record; ropedyn_run_record reads it back).
+    character(len=*), parameter :: STATE_NAME(2) = [character(len=9) :: '/state/y', '/state/yq']
+    character(len=*), parameter :: STATE_UNITS(2) = [character(len=2) :: 'SI', 'J']
+    character(len=*), parameter :: STATE_DESCRIPTION(2) = [character(len=160) :: &
+        "the model's ODE state y (rfem: x, y, phi, xdot, ydot, phidot of each element; mpp: " &
+        //'the coordinates q, then their rates): m, rad, m/s, rad/s', &
+        'the quadratures: dissipated energy, then (when supports move or effects do work) ' &
+        //'the external work']
+
+    !> The entries of /solver/restarts (one per resume): name, units, width of a string
+    !! (0: a number; integer for record and steps).
+    character(len=*), parameter :: RESTART_NAME(7) = [character(len=15) :: 'time', 'record', &
+        'steps', 'cpu_time', 'wall_clock', 'previous_status', 'previous_reason']
+    character(len=*), parameter :: RESTART_UNITS(7) = [character(len=1) :: 's', '1', '1', &
+        's', '', '', '']
+    integer, parameter :: RESTART_WIDTH(7) = [0, 0, 0, 0, 20, 16, 512]
+
     !> The solver counters of `write_stats` (/solver/<name>, int64, units 1), in the order
     !! of `counter_values`.
     character(len=*), parameter :: COUNTER_NAMES(7) = [character(len=17) :: 'steps', &
@@ -84,11 +107,18 @@ module ropedyn_output
         integer :: n_elements = 0                 !< elements of the rope
         integer(hsize_t) :: n_records = 0         !< complete records (length of /time)
         type(h5_series_t) :: series(N_SERIES)     !< the step-by-step datasets
+        !> restart data /state/y, /state/yq (when `restart_data`) and their record sizes
+        type(h5_series_t) :: state(2)
+        logical :: restart_data = .false.
+        integer :: state_size(2) = 0
     contains
         procedure :: create => output_create
         procedure :: append => output_append
         procedure :: write_stats => output_write_stats
         procedure :: close_run => output_close_run
+        procedure :: reopen => output_reopen
+        procedure :: records => output_records
+        procedure :: add_restart => output_add_restart
         final :: output_final
     end type output_file_t
 
@@ -96,9 +126,10 @@ contains
 
     !> Create (or overwrite) the file `path` and write the run's fixed data; status 'running'.
     !! The directory of `path` must exist. An object that is still open is closed first
-    !! (its file keeps status 'running').
+    !! (its file keeps status 'running'). With `state_size` and `quad_size` (the model's),
+    !! every record also holds the restart data /state/y, /state/yq (`append`'s y, yq).
     subroutine output_create(self, path, n_elements, element_length, element_mass, model, &
-                             method, version, scene_text, err)
+                             method, version, scene_text, err, state_size, quad_size)
         class(output_file_t), intent(inout) :: self
         character(len=*), intent(in) :: path              !< e.g. out/run.h5
         integer, intent(in) :: n_elements                 !< elements of the rope
@@ -109,6 +140,8 @@ contains
         character(len=*), intent(in) :: version           !< code version
         character(len=*), intent(in) :: scene_text        !< effective namelist text
         type(error_t), allocatable, intent(out) :: err
+        integer, intent(in), optional :: state_size       !< unknowns of the ODE state
+        integer, intent(in), optional :: quad_size        !< quadrature variables
 
         if (self%is_open) call shutdown(self)
 
@@ -130,6 +163,8 @@ contains
         self%is_open = .true.
         self%n_elements = n_elements
         self%n_records = 0
+        self%restart_data = present(state_size) .and. present(quad_size)
+        if (self%restart_data) self%state_size = [state_size, quad_size]
 
         call write_contents()
         if (allocated(err)) call shutdown(self)
@@ -170,10 +205,28 @@ contains
             if (allocated(err)) return
             call self%file%write('/rope/element_mass', element_mass, 'kg', err)
             if (allocated(err)) return
+            if (self%restart_data) call create_state_series(self, err)
+            if (allocated(err)) return
 
             call self%file%flush(err)
         end subroutine write_contents
     end subroutine output_create
+
+    !> The restart data series /state/y and /state/yq of an open file (`self%state_size`).
+    subroutine create_state_series(self, err)
+        type(output_file_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: err
+        integer :: k
+        do k = 1, 2
+            call self%file%create_series(self%state(k), trim(STATE_NAME(k)), &
+                                         [int(max(1, self%state_size(k)), hsize_t)], .false., &
+                                         trim(STATE_UNITS(k)), '', err)
+            if (allocated(err)) return
+            call self%file%attribute(trim(STATE_NAME(k)), 'description', &
+                                     trim(STATE_DESCRIPTION(k)), err)
+            if (allocated(err)) return
+        end do
+    end subroutine create_state_series
 
     !> The root attributes every ropedyn HDF5 file carries so that it can be re-run and
     !! read: version, model, scene (the effective namelist text), created (UTC) and
@@ -195,8 +248,9 @@ contains
         call file%attribute('/', 'units_convention', units_convention, err)
     end subroutine write_provenance
 
-    !> Append one output time and flush the file.
-    subroutine output_append(self, t, q, qdot, points, energy, step_size, order, err)
+    !> Append one output time and flush the file. A file with restart data needs the ODE
+    !! state `y` and quadratures `yq` of the record too.
+    subroutine output_append(self, t, q, qdot, points, energy, step_size, order, err, y, yq)
         class(output_file_t), intent(inout) :: self
         real(wp), intent(in) :: t                 !< time, s
         real(wp), intent(in) :: q(:, :)           !< (3, n) x, y (m), phi (rad) per element
@@ -206,6 +260,8 @@ contains
         real(wp), intent(in) :: step_size         !< last step size, s
         integer, intent(in) :: order              !< last order
         type(error_t), allocatable, intent(out) :: err
+        real(wp), intent(in), optional :: y(:)    !< the model's ODE state (restart data)
+        real(wp), intent(in), optional :: yq(:)   !< its quadratures, J (restart data)
         real(wp) :: scalars(S_KINETIC:S_STEP_SIZE)
         integer(hsize_t) :: record
         integer :: n, k
@@ -237,6 +293,8 @@ contains
         end do
         call self%series(S_ORDER)%append(record, [order], err)
         if (allocated(err)) return
+        if (self%restart_data) call append_state(self, record, y, yq, err)
+        if (allocated(err)) return
         ! /time last: its length counts the complete records
         call self%series(S_TIME)%append(record, [t], err)
         if (allocated(err)) return
@@ -259,12 +317,41 @@ contains
         end subroutine check_shape
     end subroutine output_append
 
+    !> Record `record` of the restart data: y and yq of the sizes given at create.
+    subroutine append_state(self, record, y, yq, err)
+        type(output_file_t), intent(inout) :: self
+        integer(hsize_t), intent(in) :: record
+        real(wp), intent(in), optional :: y(:), yq(:)
+        type(error_t), allocatable, intent(out) :: err
+        real(wp) :: padded(max(1, self%state_size(2)))
+        if (.not. (present(y) .and. present(yq))) then
+            call make_error(err, ERR_INTERNAL, self%file%file_name()//': append: the file '// &
+                            'holds restart data: y and yq are needed')
+            return
+        end if
+        if (size(y) /= self%state_size(1) .or. size(yq) < self%state_size(2)) then
+            call make_error(err, ERR_INTERNAL, self%file%file_name()//': append: y has '// &
+                            int_text(size(y))//' and yq '//int_text(size(yq))// &
+                            ' values, expected '//int_text(self%state_size(1))//' and '// &
+                            int_text(self%state_size(2)))
+            return
+        end if
+        call self%state(1)%append(record, y, err)
+        if (allocated(err)) return
+        padded = 0.0_wp
+        padded(1:self%state_size(2)) = yq(1:self%state_size(2))
+        call self%state(2)%append(record, padded, err)
+    end subroutine append_state
+
     !> Write the solver counters and the CPU time (also for a failed run); may be repeated.
-    subroutine output_write_stats(self, stats, cpu_time, err)
+    !! With `t_reached`, also /solver/t_reached: the time the integration got to (s; for an
+    !! interrupted or failed run, where it stopped).
+    subroutine output_write_stats(self, stats, cpu_time, err, t_reached)
         class(output_file_t), intent(inout) :: self
         type(solver_stats_t), intent(in) :: stats  !< counters of the integration
         real(wp), intent(in) :: cpu_time           !< CPU time of the run, s
         type(error_t), allocatable, intent(out) :: err
+        real(wp), intent(in), optional :: t_reached
         integer(i8) :: counters(size(COUNTER_NAMES))
         real(wp) :: times(size(TIMER_NAMES))
         integer :: k
@@ -289,6 +376,10 @@ contains
         call self%file%write('/solver/reduced_newton', merge(1_i8, 0_i8, stats%reduced_newton), &
                              '1', err)
         if (allocated(err)) return
+        if (present(t_reached)) then
+            call self%file%write('/solver/t_reached', t_reached, 's', err)
+            if (allocated(err)) return
+        end if
 
         call self%file%flush(err)
     end subroutine output_write_stats
@@ -309,26 +400,26 @@ contains
                     stats%err_test_fails, stats%nonlin_iters, stats%nonlin_conv_fails]
     end function counter_values
 
-    !> Set the root status ('complete' or 'failed', with `reason` if failed) and close
+    !> Set the root status ('complete', or 'failed' or 'interrupted' with `reason`) and close
     !! everything. The file is closed even when writing the status fails.
     subroutine output_close_run(self, status, reason, err)
         class(output_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: status            !< 'complete' or 'failed'
-        character(len=*), intent(in), optional :: reason  !< error message (failed runs)
+        character(len=*), intent(in) :: status            !< complete, failed, interrupted
+        character(len=*), intent(in), optional :: reason  !< why it failed or stopped
         type(error_t), allocatable, intent(out) :: err
 
         if (.not. self%is_open) then
             call make_error(err, ERR_INTERNAL, file_label(self)//': close_run: file is not open')
             return
         end if
-        if (status /= 'complete' .and. status /= 'failed') then
+        if (status /= 'complete' .and. status /= 'failed' .and. status /= 'interrupted') then
             call make_error(err, ERR_INTERNAL, self%file%file_name()//': close_run: status "'// &
-                            status//'" is not one of complete, failed')
+                            status//'" is not one of complete, failed, interrupted')
             return
         end if
 
         call self%file%attribute('/', 'status', trim(status), err)
-        if (.not. allocated(err) .and. status == 'failed') then
+        if (.not. allocated(err) .and. status /= 'complete') then
             if (present(reason)) then
                 if (len_trim(reason) > 0) then
                     call self%file%attribute('/', 'reason', trim(reason), err)
@@ -348,6 +439,147 @@ contains
         end if
     end subroutine output_close_run
 
+    !> Open the run file `path`, written by `create` with restart data, to continue it:
+    !! every series open for `append` after its last complete record (longer series, from a
+    !! record cut short, are cut back to the length of /time, or to `keep` records), the
+    !! status 'running' again and its old reason removed. The file must be for `n_elements` elements and the given state
+    !! and quadrature sizes.
+    subroutine output_reopen(self, path, n_elements, state_size, quad_size, err, keep)
+        class(output_file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: n_elements, state_size, quad_size
+        type(error_t), allocatable, intent(out) :: err
+        !> keep only the first `keep` records (fewer than the file has: the others are cut)
+        integer, intent(in), optional :: keep
+        integer :: expected, k
+
+        if (self%is_open) call shutdown(self)
+        call self%file%open(path, err, writable=.true.)
+        if (allocated(err)) return
+        self%is_open = .true.
+        self%n_elements = n_elements
+        self%restart_data = .true.
+        self%state_size = [state_size, quad_size]
+        steps: block
+            do k = 1, N_SERIES
+                call self%file%open_series(self%series(k), trim(SERIES_NAME(k)), err)
+                if (allocated(err)) exit steps
+            end do
+            do k = 1, 2
+                if (.not. self%file%exists(trim(STATE_NAME(k)))) then
+                    call make_error(err, ERR_IO, path//': '//trim(STATE_NAME(k))// &
+                        ': missing (a file without restart data cannot be continued)')
+                    exit steps
+                end if
+                call self%file%open_series(self%state(k), trim(STATE_NAME(k)), err)
+                if (allocated(err)) exit steps
+            end do
+            do k = 1, N_SERIES
+                expected = max(1, RECORD_ROWS(k)*RECORD_PER_ELEMENT(k)*n_elements)
+                if (self%series(k)%record_size() /= expected) then
+                    call make_error(err, ERR_IO, path//': '//trim(SERIES_NAME(k))// &
+                        ': records of '//int_text(self%series(k)%record_size())// &
+                        ' values, expected '//int_text(expected)//' for '// &
+                        int_text(n_elements)//' elements')
+                    exit steps
+                end if
+            end do
+            do k = 1, 2
+                if (self%state(k)%record_size() /= max(1, self%state_size(k))) then
+                    call make_error(err, ERR_IO, path//': '//trim(STATE_NAME(k))// &
+                        ': records of '//int_text(self%state(k)%record_size())// &
+                        ' values, the model has '//int_text(self%state_size(k)))
+                    exit steps
+                end if
+            end do
+            self%n_records = self%series(S_TIME)%length()
+            if (present(keep)) self%n_records = max(0_hsize_t, min(self%n_records, &
+                                                                int(keep, hsize_t)))
+            if (self%state(1)%length() < self%n_records .or. &
+                self%state(2)%length() < self%n_records) then
+                call make_error(err, ERR_IO, path//': /state/y: fewer records than /time')
+                exit steps
+            end if
+            do k = 1, N_SERIES
+                call self%series(k)%truncate(self%n_records, err)
+                if (allocated(err)) exit steps
+            end do
+            do k = 1, 2
+                call self%state(k)%truncate(self%n_records, err)
+                if (allocated(err)) exit steps
+            end do
+            call self%file%attribute('/', 'status', 'running', err)
+            if (allocated(err)) exit steps
+            call self%file%delete_attribute('/', 'reason', err)
+            if (allocated(err)) exit steps
+            call self%file%flush(err)
+        end block steps
+        if (allocated(err)) call shutdown(self)
+    end subroutine output_reopen
+
+    !> Complete records written so far (the length of /time).
+    pure integer function output_records(self) result(records)
+        class(output_file_t), intent(in) :: self
+        records = int(self%n_records)
+    end function output_records
+
+    !> Add an entry to /solver/restarts: the run continues from record `record` (0-based, as
+    !! h5py counts) at time `t`; the file's status and reason before, and the solver steps
+    !! and CPU time of the run so far.
+    subroutine output_add_restart(self, record, t, previous_status, previous_reason, steps, &
+                                  cpu_time, err)
+        class(output_file_t), intent(inout) :: self
+        integer, intent(in) :: record
+        real(wp), intent(in) :: t                         !< s
+        character(len=*), intent(in) :: previous_status, previous_reason
+        integer(i8), intent(in) :: steps
+        real(wp), intent(in) :: cpu_time                  !< s
+        type(error_t), allocatable, intent(out) :: err
+        type(h5_series_t) :: entry(size(RESTART_NAME))
+        type(error_t), allocatable :: close_err
+        integer(hsize_t) :: n
+        integer :: k
+        character(len=:), allocatable :: name
+
+        if (.not. self%is_open) then
+            call make_error(err, ERR_INTERNAL, file_label(self)//': add_restart: file is not open')
+            return
+        end if
+        steps_: block
+            if (.not. self%file%exists('/solver/restarts')) then
+                call self%file%group('/solver/restarts', err)
+                if (allocated(err)) exit steps_
+            end if
+            do k = 1, size(RESTART_NAME)
+                name = '/solver/restarts/'//trim(RESTART_NAME(k))
+                if (self%file%exists(name)) then
+                    call self%file%open_series(entry(k), name, err)
+                else if (RESTART_WIDTH(k) > 0) then
+                    call self%file%create_text_series(entry(k), name, RESTART_WIDTH(k), '', err)
+                else
+                    call self%file%create_series(entry(k), name, [integer(hsize_t) ::], &
+                                                 k == 2 .or. k == 3, trim(RESTART_UNITS(k)), &
+                                                 '', err)
+                end if
+                if (allocated(err)) exit steps_
+            end do
+            n = entry(1)%length() + 1
+            call entry(1)%append(n, [t], err)
+            if (.not. allocated(err)) call entry(2)%append(n, [record], err)
+            if (.not. allocated(err)) call entry(3)%append(n, [int(min(steps, &
+                int(huge(1), i8)))], err)
+            if (.not. allocated(err)) call entry(4)%append(n, [cpu_time], err)
+            if (.not. allocated(err)) call entry(5)%append_text(n, utc_timestamp(), err)
+            if (.not. allocated(err)) call entry(6)%append_text(n, previous_status, err)
+            if (.not. allocated(err)) call entry(7)%append_text(n, previous_reason, err)
+        end block steps_
+        do k = 1, size(entry)
+            call entry(k)%close(close_err)
+            if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
+        end do
+        if (.not. allocated(err)) call self%file%flush(err)
+    end subroutine output_add_restart
+
     !> Close the file if still open; its status stays 'running'.
     impure elemental subroutine output_final(self)
         type(output_file_t), intent(inout) :: self
@@ -365,6 +597,10 @@ contains
         if (.not. self%is_open) return
         do k = 1, N_SERIES
             call self%series(k)%close(e)
+            if (allocated(e) .and. .not. allocated(first)) call move_alloc(e, first)
+        end do
+        do k = 1, 2
+            call self%state(k)%close(e)
             if (allocated(e) .and. .not. allocated(first)) call move_alloc(e, first)
         end do
         call self%file%close(e)

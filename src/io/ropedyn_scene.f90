@@ -10,9 +10,9 @@
 !! `--set` argument), the group, the key and the value.
 module ropedyn_scene
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
-    use ropedyn_text, only: int_text, lower, line_quote, printable, text_t, clip
+    use ropedyn_text, only: int_text, lower, line_quote, printable, text_t, clip, append_text
     use ropedyn_namelist_file, only: nml_file_t, nml_value_t, read_namelist_file, &
-        parse_values, V_STRING
+        parse_namelist_lines, parse_values, V_STRING
     use ropedyn_scene_types, only: scene_t, solver_params_t, output_params_t
     use ropedyn_scene_key, only: scene_key_t, T_NAME, T_PATH
     use ropedyn_scene_keys, only: bind_keys, find_key, key_hint, group_index, group_list, &
@@ -21,7 +21,8 @@ module ropedyn_scene
     implicit none
     private
     public :: solver_params_t, output_params_t, scene_t
-    public :: read_scene, scene_namelist_text, scene_key_listing, check_override_value
+    public :: read_scene, read_scene_text, scene_namelist_text, scene_key_listing, &
+        check_override_value
 
     !> One `--set group.key=value` argument, parsed.
     type :: override_t
@@ -50,7 +51,7 @@ contains
         type(scene_key_t), allocatable :: keys(:)
         type(override_t), allocatable :: ov(:)
         type(nml_file_t) :: file
-        integer :: i, g, k
+        integer :: i
 
         scene%path = trim(path)
         if (printable(scene%path) /= scene%path) then
@@ -67,7 +68,57 @@ contains
         call read_namelist_file(scene%path, GROUP_NAMES, file, err, required='model', &
             not_what='not a scene file (a scene needs at least &model)')
         if (allocated(err)) return
+        call store_scene(file, ov, keys, scene, err)
+    end subroutine read_scene
 
+    !> Read a scene from namelist text (e.g. the `scene` attribute of a run file, the echo of
+    !! `scene_namelist_text`) as `read_scene` reads a file; `origin` names the text in
+    !! messages (and becomes the scene's path).
+    subroutine read_scene_text(origin, text, overrides, scene, err)
+        character(len=*), intent(in) :: origin        !< e.g. 'out/run.h5: scene'
+        character(len=*), intent(in) :: text          !< lines separated by new lines
+        character(len=*), intent(in) :: overrides(:)  !< 'group.key=value', may be empty
+        type(scene_t), target, intent(out) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        type(scene_key_t), allocatable :: keys(:)
+        type(override_t), allocatable :: ov(:)
+        type(nml_file_t) :: file
+        type(text_t), allocatable :: lines(:)
+        integer :: i, start, nl
+
+        scene%path = origin
+        call bind_keys(scene, keys)
+        allocate (ov(size(overrides)))
+        do i = 1, size(overrides)
+            call parse_override(overrides(i), keys, ov(i), err)
+            if (allocated(err)) return
+        end do
+        allocate (lines(0))
+        start = 1
+        do while (start <= len(text))
+            nl = index(text(start:), new_line('a'))
+            if (nl == 0) nl = len(text) - start + 2
+            call append_text(lines, text(start:start + nl - 2))
+            start = start + nl
+        end do
+        call parse_namelist_lines(origin, lines, GROUP_NAMES, file, err)
+        if (allocated(err)) return
+        if (file%find('model') == 0) then
+            call make_error(err, ERR_INPUT, origin//': no &model group: not a scene')
+            return
+        end if
+        call store_scene(file, ov, keys, scene, err)
+    end subroutine read_scene_text
+
+    !> The groups of a parsed file and the overrides, group by group, into the scene; then
+    !! the checks of the whole scene.
+    subroutine store_scene(file, ov, keys, scene, err)
+        type(nml_file_t), intent(in) :: file
+        type(override_t), intent(in) :: ov(:)
+        type(scene_key_t), intent(inout) :: keys(:)
+        type(scene_t), intent(inout) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        integer :: i, g, k
         do g = 1, N_GROUPS
             k = file%find(trim(GROUP_NAMES(g)))
             if (k > 0) then
@@ -80,8 +131,12 @@ contains
                 if (allocated(err)) return
             end do
         end do
+        do i = 1, size(keys)
+            if (keys(i)%group == group_index('output') .and. keys(i)%name == 'progress') &
+                scene%output%progress_given = keys(i)%given
+        end do
         call check_scene(keys, scene, err)
-    end subroutine read_scene
+    end subroutine store_scene
 
     !> Store the assignments of group k of the file (scene group g) through the key table.
     subroutine store_group(file, k, g, keys, err)
@@ -249,7 +304,14 @@ contains
             if (g > 1) text = text//NL
             text = text//'&'//trim(GROUP_NAMES(g))//NL
             do k = 1, size(keys)
-                if (keys(k)%group == g) text = text//keys(k)%echo()
+                if (keys(k)%group /= g) cycle
+                if (keys(k)%name == 'progress' .and. trim(GROUP_NAMES(g)) == 'output' .and. &
+                    .not. scene%output%progress_given) then
+                    ! not given: a comment, so that reading the echo back keeps it unset
+                    text = text//'    ! progress: not set (on when stderr is a terminal)'//NL
+                else
+                    text = text//keys(k)%echo()
+                end if
             end do
             text = text//'/'
         end do

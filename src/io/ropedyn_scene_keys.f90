@@ -135,7 +135,8 @@ contains
                 'testing aid: NaN right-hand side after this time; < 0: off')
 
             call add_path(G_OUTPUT, 'file', o%file, "HDF5 result file ('': out/<scene>.h5)")
-            call add_logical(G_OUTPUT, 'progress', o%progress, 'print the progress')
+            call add_logical(G_OUTPUT, 'progress', o%progress, &
+                'progress on stderr (not given: on when stderr is a terminal)')
 
             call add_real(G_FLUID, 'density', f%density, R_NONNEGATIVE, 'kg/m^3', &
                 'density of the fluid')

@@ -36,7 +36,10 @@ module ropedyn_scene_types
     type :: output_params_t
         !> HDF5 file; resolved by `read_scene` ('' in the file: out/<scene name>.h5)
         character(len=PATH_LEN) :: file = ''
-        logical :: progress = .false.         !< print progress while integrating
+        !> print progress while integrating (when `progress_given`; else: on when stderr
+        !! is a terminal)
+        logical :: progress = .false.
+        logical :: progress_given = .false.   !< the file or a --set gives `progress`
     end type output_params_t
 
     !> A complete scene: the rope models' parameters (the parent `rope_spec_t`, whose

@@ -32,7 +32,7 @@ module ropedyn_sweep_lock
     use ropedyn_text, only: int_text
     use ropedyn_os, only: delete_file, utc_timestamp, utc_text
     use ropedyn_process, only: process_id, process_start, host_name, file_mtime, unix_time, &
-        start_heartbeat, stop_heartbeat, signal_name
+        start_heartbeat, stop_heartbeat, signal_name, slurm_job
     implicit none
     private
     public :: lock_t, read_lock, take_lock, drop_lock, LOCK_BEAT, LOCK_ABANDONED_AFTER
@@ -259,17 +259,8 @@ contains
     subroutine write_holder(path, err)
         character(len=*), intent(in) :: path
         type(error_t), allocatable, intent(out) :: err
-        character(len=64) :: array_job, array_task, job
         character(len=256) :: msg
-        integer :: unit, ios, n1, n2, n3
-        call get_environment_variable('SLURM_ARRAY_JOB_ID', array_job, n1)
-        call get_environment_variable('SLURM_ARRAY_TASK_ID', array_task, n2)
-        call get_environment_variable('SLURM_JOB_ID', job, n3)
-        if (n1 > 0 .and. n2 > 0) then
-            job = trim(array_job)//'_'//trim(array_task)
-        else if (n3 == 0) then
-            job = ''
-        end if
+        integer :: unit, ios
         open (newunit=unit, file=path, status='old', action='write', position='append', &
               iostat=ios, iomsg=msg)
         if (ios == 0) write (unit, '(a)', iostat=ios, iomsg=msg) 'ropedyn sweep case lock'// &
@@ -277,7 +268,7 @@ contains
             new_line('a')//'pid='// &
             int_text(process_id())//new_line('a')//'start_ticks='// &
             int_text(process_start(0))//new_line('a')//'started='//utc_timestamp()// &
-            new_line('a')//'job='//trim(job)
+            new_line('a')//'job='//slurm_job()
         if (ios == 0) close (unit, iostat=ios, iomsg=msg)
         if (ios /= 0) call make_error(err, ERR_IO, path//': cannot write: '//trim(msg))
     end subroutine write_holder

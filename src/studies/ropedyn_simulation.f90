@@ -3,8 +3,11 @@
 module ropedyn_simulation
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_text, only: real_text
-    use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_IO, ERR_SOLVER
+    use, intrinsic :: iso_fortran_env, only: error_unit
+    use ropedyn_text, only: real_text, int_text
+    use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_IO, ERR_SOLVER, ERR_INTERRUPTED
+    use ropedyn_process, only: catch_signals, release_signals, signal_received, signal_name, &
+        end_on_second_signal
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, clock_seconds
     use ropedyn_solvers, only: new_integrator
@@ -14,6 +17,8 @@ module ropedyn_simulation
     use ropedyn_scene, only: scene_t, scene_namelist_text
     use ropedyn_os, only: make_parent_dirs
     use ropedyn_output, only: output_file_t
+    use ropedyn_case_file, only: case_data_t, read_case_file
+    use ropedyn_run_record, only: run_record_t, read_run_record, check_record_fits, LAST_RECORD
     use ropedyn_progress, only: progress_t
     use ropedyn_fault, only: fault_problem_t, fault_wrap
     use ropedyn_version, only: version_string
@@ -80,93 +85,165 @@ contains
         options%profile = scene%solver%profile
     end function solver_options_of
 
+    !> Whether the run should stop at the step just taken: a SIGINT or SIGTERM was caught
+    !! (the integrators ask it after every accepted step; options%stop_requested).
+    logical function stop_on_signal()
+        stop_on_signal = signal_received() /= 0
+    end function stop_on_signal
+
     !> Run a validated scene. The output file is written as the run goes; a failed
     !! integration leaves the data up to the failure and status 'failed'. No record with a
     !! NaN or Inf is ever written: a non-finite state or energy ends the run as a failed
     !! integration (ERR_SOLVER) before it reaches the file.
-    subroutine run_scene(scene, summary, err)
+    !!
+    !! Signals: SIGINT and SIGTERM are caught while the run integrates; the integrator stops
+    !! at the end of its current step, that state is written as a last record (off the output
+    !! grid when between two output times), with the counters, status 'interrupted' and a
+    !! reason naming the signal and the time reached; the error is ERR_INTERRUPTED (exit
+    !! 130). A second signal ends the process at once (by that signal).
+    !!
+    !! With `resume`, `scene%output%file` is a run file to continue (`ropedyn run --resume`,
+    !! docs/output.md "Resume"): from its last record (ropedyn_run_record) to the scene's
+    !! t_end, appending to the file. A last record off the output grid (where an interrupted
+    !! or failed run stopped) is the starting point but is replaced by the grid records that
+    !! follow, so that the file ends with the records of an uninterrupted run. The restart is
+    !! recorded in /solver/restarts; the solver counters and the CPU time add up.
+    subroutine run_scene(scene, summary, err, resume)
         type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(out) :: summary
         type(error_t), allocatable, intent(out) :: err
+        logical, intent(in), optional :: resume
+        logical :: resuming, caught
+        resuming = .false.
+        if (present(resume)) resuming = resume
+        call integrate_scene(scene, summary, err, resuming, caught)
+        if (caught) call release_signals()
+    end subroutine run_scene
+
+    !> run_scene's work; `caught`: signals are caught (to be released by the caller).
+    subroutine integrate_scene(scene, summary, err, resuming, caught)
+        type(scene_t), intent(in) :: scene
+        type(run_summary_t), intent(out) :: summary
+        type(error_t), allocatable, intent(out) :: err
+        logical, intent(in) :: resuming
+        logical, intent(out) :: caught
         class(rope_model_t), allocatable, target :: model
         class(integrator_t), allocatable :: integrator
         type(fault_problem_t), target :: faulty
         type(output_file_t) :: out
         type(progress_t) :: progress
         type(error_t), allocatable :: io_err
+        type(solver_options_t) :: options
+        type(case_data_t) :: before          ! resume: the file as it was
         real(wp), allocatable :: y(:), yq(:), q(:, :), qdot(:, :), points(:, :)
         real(wp), allocatable :: lengths(:), masses(:)
-        real(wp) :: t, tout, cpu_start, cpu_now, dt, t_end
+        real(wp) :: t, t0, tout, cpu_start, cpu_now, dt, t_end, t_last
         real(wp) :: clock_start, time_advance   ! &solver profile: time in advance_to, s
-        integer :: n, k, n_out
+        real(wp) :: cpu_before                   ! resume: CPU time of the earlier parts, s
+        integer(i8) :: counters_before(7)       ! resume: counters of the earlier parts
+        integer :: n, k, n_out, k_first, nq, sig
         type(solver_stats_t) :: stats
 
+        caught = .false.
+        cpu_before = 0.0_wp
+        counters_before = 0
         call create_model(scene%rope_spec_t, model, err)
         if (allocated(err)) return
         call create_integrator(scene, integrator, err)
         if (allocated(err)) return
 
         n = model%n_elements()
-        allocate (y(model%size()), yq(max(1, model%quad_size())))
+        nq = model%quad_size()
+        allocate (y(model%size()), yq(max(1, nq)))
         allocate (q(3, n), qdot(3, n), points(2, 2*n), lengths(n), masses(n))
-        call model%initial_state(y)
-        ! &initial shape = 'equilibrium' or 'mode': statics (and modes) first
-        call equilibrium_initial_state(model, scene%rope_spec_t, y, err, create_model)
-        if (allocated(err)) return
-        yq = 0.0_wp
-        t = 0.0_wp
+        dt = scene%solver%output_interval
+        t_end = scene%solver%t_end
+        n_out = max(1, ceiling(t_end/dt*(1.0_wp - 1.0e-12_wp)))
         summary%file = trim(scene%output%file)
-        summary%initial_energy = model%energy(t, y, yq)
-        ! the scene's limits keep the start finite; should a value still make it not, that is
-        ! bad input: say so before any file is created
-        if (.not. (all(ieee_is_finite(y)) .and. &
-                   ieee_is_finite(summary%initial_energy%balance()))) then
-            call make_error(err, ERR_INPUT, scene%path//': the initial state or its energy '// &
-                'is not finite (energy '//real_text(summary%initial_energy%balance())// &
-                ' J): a value of the scene is too large or too small (docs/input.md, Limits)')
-            return
+        k_first = 1
+        if (resuming) then
+            call start_from_file(err)
+            if (allocated(err)) return
+        else
+            call model%initial_state(y)
+            ! &initial shape = 'equilibrium' or 'mode': statics (and modes) first
+            call equilibrium_initial_state(model, scene%rope_spec_t, y, err, create_model)
+            if (allocated(err)) return
+            yq = 0.0_wp
+            t = 0.0_wp
+            summary%initial_energy = model%energy(t, y, yq)
+            ! the scene's limits keep the start finite; should a value still make it not,
+            ! that is bad input: say so before any file is created
+            if (.not. (all(ieee_is_finite(y)) .and. &
+                       ieee_is_finite(summary%initial_energy%balance()))) then
+                call make_error(err, ERR_INPUT, scene%path//': the initial state or its '// &
+                    'energy is not finite (energy '// &
+                    real_text(summary%initial_energy%balance())//' J): a value of the '// &
+                    'scene is too large or too small (docs/input.md, Limits)')
+                return
+            end if
+            call make_parent_dirs(summary%file, err)
+            if (allocated(err)) return
+            call model%element_data(lengths, masses)
+            call out%create(summary%file, n, lengths, masses, model%model_name(), &
+                            integrator%name(), version_string, scene_namelist_text(scene), &
+                            err, state_size=model%size(), quad_size=nq)
+            if (allocated(err)) return
+            call write_record(err)
+            if (allocated(err)) return
         end if
-
-        call make_parent_dirs(summary%file, err)
-        if (allocated(err)) return
-        call model%element_data(lengths, masses)
-        call out%create(summary%file, n, lengths, masses, model%model_name(), &
-                        integrator%name(), version_string, scene_namelist_text(scene), err)
-        if (allocated(err)) return
-        call write_record(err)
-        if (allocated(err)) return
+        t0 = t
+        t_last = t
 
         call cpu_time(cpu_start)
         time_advance = 0.0_wp
+        options = solver_options_of(scene)
+        options%stop_requested => stop_on_signal
+        call catch_signals(err)
+        if (allocated(err)) then
+            call finish('failed', err%message)
+            return
+        end if
+        caught = .true.
+        call end_on_second_signal(.true.)
         if (scene%solver%fault_nan_after >= 0.0_wp) then
             ! testing aid (docs/input.md): the integrator sees a NaN right-hand side later on
             call fault_wrap(faulty, model, scene%solver%fault_nan_after)
-            call integrator%init(faulty, t, y, yq(1:model%quad_size()), &
-                                 solver_options_of(scene), err)
+            call integrator%init(faulty, t, y, yq(1:nq), options, err)
         else
-            call integrator%init(model, t, y, yq(1:model%quad_size()), &
-                                 solver_options_of(scene), err)
+            call integrator%init(model, t, y, yq(1:nq), options, err)
         end if
         if (allocated(err)) then
             call finish('failed', err%message)
             return
         end if
-        dt = scene%solver%output_interval
-        t_end = scene%solver%t_end
-        n_out = max(1, ceiling(t_end/dt*(1.0_wp - 1.0e-12_wp)))
-        call progress%start_run(t_end, scene%output%progress)
-        do k = 1, n_out
-            tout = min(real(k, wp)*dt, t_end)
-            if (k == n_out) tout = t_end
+        call progress%start_run(t0, t_end, scene%output%progress, scene%output%progress_given)
+        do k = k_first, n_out
+            tout = output_time(k)
             if (scene%solver%profile) clock_start = clock_seconds()
-            call integrator%advance_to(tout, t, y, yq(1:model%quad_size()), err)
+            call integrator%advance_to(tout, t, y, yq(1:nq), err)
             if (scene%solver%profile) time_advance = time_advance + &
                                                      (clock_seconds() - clock_start)
             if (allocated(err)) then
                 call progress%done()
                 ! keep the last good state if the solver got past the previous record
-                if (t > real(k - 1, wp)*dt) call write_record(io_err)
+                if (t > t_last) call write_record(io_err)
                 call finish('failed', err%message)
+                return
+            end if
+            sig = signal_received()
+            if (t < tout .or. sig /= 0) then
+                ! stopped at a step boundary on a signal: that state is the last record
+                call progress%done()
+                if (t > t_last) call write_record(err)
+                if (allocated(err)) then
+                    if (err%code == ERR_SOLVER) call finish('failed', err%message)
+                    return
+                end if
+                call make_error(err, ERR_INTERRUPTED, summary%file//': interrupted by '// &
+                    signal_name(max(sig, signal_received()))//' at t = '//real_text(t)// &
+                    ' s of '//real_text(t_end)//' s (its last record)')
+                call finish('interrupted', err%message)
                 return
             end if
             call write_record(err)  ! also refreshes `stats`
@@ -180,6 +257,76 @@ contains
         call progress%done()
         call finish('complete', '')
     contains
+        !> Output time k (k = 0: the start; n_out: t_end).
+        pure real(wp) function output_time(k) result(tk)
+            integer, intent(in) :: k
+            tk = min(real(k, wp)*dt, t_end)
+            if (k >= n_out) tk = t_end
+        end function output_time
+
+        !> Resume: the last record of the file as the starting point, the file reopened
+        !! (an off-grid last record cut), the restart recorded.
+        subroutine start_from_file(serr)
+            type(error_t), allocatable, intent(out) :: serr
+            type(run_record_t) :: rec, first
+            real(wp) :: tol
+            integer :: keep, j
+            call read_run_record(summary%file, LAST_RECORD, rec, serr)
+            if (allocated(serr)) return
+            call check_record_fits(rec, model%model_name(), model%size(), nq, serr)
+            if (allocated(serr)) return
+            call read_case_file(summary%file, before, serr)
+            if (allocated(serr)) return
+            if (before%status == 'running') then
+                call make_error(serr, ERR_INPUT, summary%file//': status running: the run '// &
+                    'may still be going on (a run that was killed outright keeps this '// &
+                    'status; to continue it, set its status: h5py '// &
+                    'f.attrs["status"] = "interrupted")')
+                return
+            end if
+            tol = 1.0e-12_wp*max(abs(rec%t), dt)
+            if (rec%t >= t_end - tol) then
+                call make_error(serr, ERR_INPUT, summary%file//': nothing to continue: its '// &
+                    'last record is at t = '//real_text(rec%t)//' s, t_end is '// &
+                    real_text(t_end)//' s (status '//before%status//'; a longer run: '// &
+                    '--set solver.t_end=...)')
+                return
+            end if
+            call read_run_record(summary%file, 0, first, serr)
+            if (allocated(serr)) return
+            summary%initial_energy = first%energy
+            t = rec%t
+            y = rec%y
+            yq = 0.0_wp
+            yq(1:nq) = rec%yq(1:nq)
+            ! the first output time after t; an off-grid last record is replaced
+            k_first = n_out
+            do j = 1, n_out
+                if (output_time(j) > t + tol) then
+                    k_first = j
+                    exit
+                end if
+            end do
+            keep = rec%records
+            if (rec%record > 0 .and. abs(output_time(k_first - 1) - t) > tol) keep = keep - 1
+            do j = 1, size(counters_before)
+                counters_before(j) = max(0_i8, before%counters(j))
+            end do
+            if (ieee_is_finite(before%cpu_time)) cpu_before = before%cpu_time
+            call out%reopen(summary%file, n, model%size(), nq, serr, keep=keep)
+            if (allocated(serr)) return
+            call out%add_restart(rec%record, t, before%status, before%reason, &
+                                 counters_before(1), cpu_before, serr)
+            if (allocated(serr)) return
+            summary%records = keep
+            summary%t_reached = t
+            summary%final_energy = rec%energy
+            if (keep < rec%records) write (error_unit, '(a)') 'ropedyn: '//summary%file// &
+                ': continuing from t = '//real_text(t)//' s (record '// &
+                int_text(rec%record)//', off the output grid: replaced by the records '// &
+                'that follow)'
+        end subroutine start_from_file
+
         subroutine write_record(werr)
             type(error_t), allocatable, intent(out) :: werr
             type(energy_t) :: e
@@ -204,23 +351,41 @@ contains
                                 '): not written to the output')
                 return
             end if
-            call out%append(t, q, qdot, points, e, h, order, werr)
+            call out%append(t, q, qdot, points, e, h, order, werr, y=y, yq=yq)
             summary%records = summary%records + 1
             summary%final_energy = e
             summary%t_reached = t
+            t_last = t
         end subroutine write_record
 
         subroutine finish(status, reason)
             character(len=*), intent(in) :: status, reason
             type(error_t), allocatable :: ferr
             call cpu_time(cpu_now)
-            summary%cpu_time = cpu_now - cpu_start
+            summary%cpu_time = cpu_before + (cpu_now - cpu_start)
             summary%stats = integrator%stats()
             summary%stats%time_advance = time_advance
-            call out%write_stats(summary%stats, summary%cpu_time, ferr)
+            call add_counters(summary%stats, counters_before)
+            summary%t_reached = max(summary%t_reached, t)
+            call out%write_stats(summary%stats, summary%cpu_time, ferr, t_reached=t)
             call out%close_run(status, reason, ferr)
             if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
             call integrator%finalize()
         end subroutine finish
-    end subroutine run_scene
+    end subroutine integrate_scene
+
+    !> The counters of earlier parts of a resumed run added (in ropedyn_output's
+    !! COUNTER_NAMES order: steps, rhs_evals, jac_evals, lin_setups, err_test_fails,
+    !! nonlin_iters, nonlin_conv_fails).
+    pure subroutine add_counters(stats, before)
+        type(solver_stats_t), intent(inout) :: stats
+        integer(i8), intent(in) :: before(7)
+        stats%steps = stats%steps + before(1)
+        stats%rhs_evals = stats%rhs_evals + before(2)
+        stats%jac_evals = stats%jac_evals + before(3)
+        stats%lin_setups = stats%lin_setups + before(4)
+        stats%err_test_fails = stats%err_test_fails + before(5)
+        stats%nonlin_iters = stats%nonlin_iters + before(6)
+        stats%nonlin_conv_fails = stats%nonlin_conv_fails + before(7)
+    end subroutine add_counters
 end module ropedyn_simulation

@@ -8,20 +8,22 @@
 !! failed, with the reason); remove the lock. A reader therefore never sees a case file
 !! being written, and a file in place is always a finished run.
 !!
-!! Signals: SIGINT and SIGTERM are caught. While a case runs, the run driver does not stop
-!! on its own (`run_scene` does not poll), so the handler appends the signal to the case's
-!! lock and ends the process: the case reads as `interrupted` with that reason, its partial
-!! output stays in the `.part` file. Between cases a signal only stops the loop. (When the
-!! run driver stops itself on a signal and writes status `interrupted`, `note_signals`
-!! goes and the interrupted file is renamed into place like a failed one.)
+!! Signals: SIGINT and SIGTERM are caught. While a case runs, the run driver stops at the
+!! end of its current step, writes that state, the counters and status `interrupted` with
+!! the reason, and the interrupted file is renamed into place like a failed one; the task
+!! then ends (ERR_INTERRUPTED, exit 130) before its next case. A second signal ends the
+!! process at once (the case then keeps its lock, which reads as abandoned, and its .part).
+!!
+!! Resume: a case whose file says `interrupted` is continued from its last record (the file
+!! is moved back to its .part name under the lock, `run_scene(..., resume=.true.)` appends
+!! to it, and it is renamed into place again), unless forced, which runs it anew.
 module ropedyn_sweep_task
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
     use ropedyn_kinds, only: wp
     use ropedyn_text, only: int_text, fixed_text
     use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INPUT, ERR_INTERRUPTED
     use ropedyn_os, only: make_dirs, rename_file, delete_file
-    use ropedyn_process, only: catch_signals, release_signals, signal_received, note_signals, &
-        signal_name
+    use ropedyn_process, only: catch_signals, release_signals, signal_received, signal_name
     use ropedyn_scene, only: scene_t, scene_namelist_text
     use ropedyn_simulation, only: run_summary_t, run_scene
     use ropedyn_case_file, only: case_data_t, read_case_file, finish_case_file
@@ -105,11 +107,11 @@ contains
         type(run_summary_t) :: summary
         type(case_state_t) :: state
         type(scene_t) :: scene
-        type(error_t), allocatable :: ferr, lerr
+        type(error_t), allocatable :: ferr
         character(len=:), allocatable :: label, lock, part
         integer(int64) :: start, finish, rate
         real(wp) :: wall
-        logical :: removed
+        logical :: removed, resume
 
         label = case_label(sweep, k)
         associate (c => sweep%cases(k))
@@ -135,8 +137,6 @@ contains
                 return
             end if
             locked: block
-                call note_signals(lock, err)
-                if (allocated(err)) exit locked
                 if (signal_received() /= 0) then
                     call make_error(err, ERR_INTERRUPTED, label//': not run: stopped by '// &
                         signal_name(signal_received()))
@@ -153,14 +153,29 @@ contains
                 removed = delete_file(part)
                 scene = c%scene
                 scene%output%file = part
+                ! an interrupted case continues from its last record
+                resume = .false.
+                if (.not. force) then
+                    call case_state(c, state)
+                    resume = state%status == 'interrupted' .and. file_status(c%file) == &
+                             'interrupted'
+                end if
+                if (resume) then
+                    call rename_file(c%file, part, err)
+                    if (allocated(err)) exit locked
+                    if (.not. quiet) write (output_unit, '(a)') label//': interrupted '// &
+                        'before: continuing it from its last record'
+                end if
                 call system_clock(start, rate)
-                call run_scene(scene, summary, err)
+                call run_scene(scene, summary, err, resume=resume)
                 call system_clock(finish)
                 wall = real(finish - start, wp)/real(rate, wp)
                 call put_in_place(c, part, wall, ferr)
                 if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
                 if (allocated(err)) then
                     err%message = label//' ('//c%file//'): '//err%message
+                    if (err%code == ERR_INTERRUPTED) err%message = err%message// &
+                        '; running the sweep again continues it'
                     exit locked
                 end if
                 if (.not. quiet) write (output_unit, '(a)') label//': complete: '// &
@@ -168,7 +183,6 @@ contains
                     fixed_text(summary%cpu_time, 3)//' s, wall '//fixed_text(wall, 3)//' s -> '// &
                     c%file
             end block locked
-            call note_signals('', lerr)
             call drop_lock(lock)
         end associate
     contains
@@ -199,4 +213,16 @@ contains
         if (.not. allocated(err)) call rename_file(part, c%file, err)
         if (allocated(err)) removed = delete_file(part)
     end subroutine put_in_place
+
+    !> The status attribute of the run file `path` ('' when it cannot be read).
+    function file_status(path) result(status)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: status
+        type(case_data_t) :: data
+        type(error_t), allocatable :: err
+        call read_case_file(path, data, err)
+        status = ''
+        if (.not. allocated(err) .and. data%exists .and. allocated(data%status)) &
+            status = data%status
+    end function file_status
 end module ropedyn_sweep_task

@@ -1,0 +1,156 @@
+!> One record of a run file as a starting point: the time, the model's native ODE state y
+!! and its quadratures yq of a record (the restart data /state/y and /state/yq that
+!! `ropedyn_output` writes with every record; docs/output.md, "Restart data"), with what is
+!! needed to check that a model can start from it.
+!!
+!! API (io layer; no model is built here):
+!!   call read_run_record(path, record, rec, err)   record k (0-based, as h5py counts), or
+!!                                                  LAST_RECORD (-1): the last complete one
+!!   call check_record_fits(rec, model, state_size, quad_size, err)
+!!                                                  the record suits a model of that kind and
+!!                                                  size (ERR_INPUT naming the file if not)
+!!   rec%t, rec%y(1:state_size), rec%yq(1:quad_size)    the starting point
+!!
+!! Users: `ropedyn run --resume FILE` (ropedyn_simulation continues a run from its last
+!! record) and the sweep runner resuming interrupted cases; meant for `&initial shape =
+!! 'state'` (start from a record of another run's file) as well.
+module ropedyn_run_record
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use hdf5, only: hsize_t
+    use ropedyn_kinds, only: wp
+    use ropedyn_text, only: int_text, real_text
+    use ropedyn_error, only: error_t, make_error, ERR_INPUT
+    use ropedyn_h5, only: h5_file_t
+    use ropedyn_rope_model, only: energy_t
+    implicit none
+    private
+    public :: run_record_t, read_run_record, check_record_fits, LAST_RECORD
+
+    !> `record` argument of read_run_record: the last complete record.
+    integer, parameter :: LAST_RECORD = -1
+
+    !> A record of a run file.
+    type :: run_record_t
+        character(len=:), allocatable :: path  !< the file
+        character(len=:), allocatable :: model !< the file's model kind (root attribute)
+        character(len=:), allocatable :: status !< the file's status (root attribute)
+        integer :: n_elements = 0              !< elements of the file's rope
+        integer :: record = -1                 !< its index, 0-based as h5py counts
+        integer :: records = 0                 !< complete records in the file
+        real(wp) :: t = 0.0_wp                 !< its time, s
+        real(wp), allocatable :: y(:)          !< the model's ODE state
+        !> its quadratures, J (at least one value: a model without quadratures has a 0 here)
+        real(wp), allocatable :: yq(:)
+        type(energy_t) :: energy               !< the energies written with it, J
+    end type run_record_t
+
+    !> The energy datasets, in the order of energy_t's components.
+    character(len=*), parameter :: ENERGY_NAMES(5) = [character(len=12) :: 'kinetic', &
+        'elastic', 'gravity', 'dissipated', 'support_work']
+
+contains
+
+    !> Record `record` (0-based; LAST_RECORD: the last complete one) of the run file `path`.
+    !! Errors (ERR_INPUT: the file is not a starting point; ERR_IO: it cannot be read) name
+    !! the file and what is wrong: no such file, no restart data (written by an older
+    !! version), no complete record, no such record, a state that is not finite.
+    subroutine read_run_record(path, record, rec, err)
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: record
+        type(run_record_t), intent(out) :: rec
+        type(error_t), allocatable, intent(out) :: err
+        type(h5_file_t) :: h5
+        type(error_t), allocatable :: close_err
+        real(wp), allocatable :: time(:), values(:)
+        integer(hsize_t) :: dims1(1), k
+        logical :: exists
+        real(wp) :: e(size(ENERGY_NAMES))
+        integer :: j
+
+        rec%path = path
+        rec%model = ''
+        rec%status = ''
+        inquire (file=path, exist=exists)
+        if (.not. exists) then
+            call make_error(err, ERR_INPUT, path//': no such file')
+            return
+        end if
+        call h5%open(path, err)
+        if (allocated(err)) return
+        steps: block
+            call h5%read_attribute('model', rec%model, err)
+            if (allocated(err)) exit steps
+            call h5%read_attribute('status', rec%status, err)
+            if (allocated(err)) exit steps
+            if (.not. (h5%exists('/state/y') .and. h5%exists('/state/yq'))) then
+                call make_error(err, ERR_INPUT, path//': no restart data (/state/y, /state/yq'// &
+                    ' missing: written by an older version of ropedyn, or not a run file)')
+                exit steps
+            end if
+            call h5%read_reals('/rope/element_length', values, dims1, err)
+            if (allocated(err)) exit steps
+            rec%n_elements = size(values)
+            call h5%read_reals('/time', time, dims1, err)
+            if (allocated(err)) exit steps
+            rec%records = size(time)
+            if (rec%records == 0) then
+                call make_error(err, ERR_INPUT, path//': no complete record')
+                exit steps
+            end if
+            rec%record = record
+            if (record == LAST_RECORD) rec%record = rec%records - 1
+            if (rec%record < 0 .or. rec%record >= rec%records) then
+                call make_error(err, ERR_INPUT, path//': no record '//int_text(record)// &
+                    ' (the file has records 0 .. '//int_text(rec%records - 1)//')')
+                exit steps
+            end if
+            k = int(rec%record + 1, hsize_t)
+            rec%t = time(k)
+            call h5%read_record('/state/y', k, rec%y, err)
+            if (allocated(err)) exit steps
+            call h5%read_record('/state/yq', k, rec%yq, err)
+            if (allocated(err)) exit steps
+            do j = 1, size(ENERGY_NAMES)
+                call h5%read_record('/energy/'//trim(ENERGY_NAMES(j)), k, values, err)
+                if (allocated(err)) exit steps
+                e(j) = values(1)
+            end do
+            rec%energy = energy_t(kinetic=e(1), elastic=e(2), gravity=e(3), dissipated=e(4), &
+                                  support_work=e(5))
+            if (.not. (all(ieee_is_finite(rec%y)) .and. all(ieee_is_finite(rec%yq)) .and. &
+                       ieee_is_finite(rec%t))) then
+                call make_error(err, ERR_INPUT, path//': record '//int_text(rec%record)// &
+                    ': the state is not finite')
+                exit steps
+            end if
+        end block steps
+        call h5%close(close_err)
+        if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
+        if (.not. allocated(rec%y)) allocate (rec%y(0))
+        if (.not. allocated(rec%yq)) allocate (rec%yq(0))
+    end subroutine read_run_record
+
+    !> Whether a model of kind `model` ('rfem', 'mpp') with `state_size` unknowns and
+    !! `quad_size` quadratures can start from `rec`; if not, an ERR_INPUT error naming the
+    !! file, the record and the difference.
+    subroutine check_record_fits(rec, model, state_size, quad_size, err)
+        type(run_record_t), intent(in) :: rec
+        character(len=*), intent(in) :: model
+        integer, intent(in) :: state_size, quad_size
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: where
+        where = rec%path//': record '//int_text(rec%record)//' (t = '//real_text(rec%t)//' s)'
+        if (rec%model /= model) then
+            call make_error(err, ERR_INPUT, where//': written by the '//rec%model// &
+                ' model, the scene uses '//model)
+        else if (size(rec%y) /= state_size) then
+            call make_error(err, ERR_INPUT, where//': a state of '//int_text(size(rec%y))// &
+                ' values ('//int_text(rec%n_elements)//' elements), the scene''s model has '// &
+                int_text(state_size))
+        else if (size(rec%yq) < quad_size .or. (size(rec%yq) > max(1, quad_size))) then
+            call make_error(err, ERR_INPUT, where//': '//int_text(size(rec%yq))// &
+                ' quadrature values, the scene''s model has '//int_text(quad_size)// &
+                ' (its effects or supports differ)')
+        end if
+    end subroutine check_record_fits
+end module ropedyn_run_record
