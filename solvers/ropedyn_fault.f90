@@ -33,6 +33,9 @@ module ropedyn_fault
         procedure :: implicit_rhs => fault_implicit_rhs
         procedure :: has_implicit_jacobian => fault_has_implicit_jacobian
         procedure :: implicit_jacobian => fault_implicit_jacobian
+        procedure :: has_second_order => fault_has_second_order
+        procedure :: second_order_layout => fault_second_order_layout
+        procedure :: second_order_blocks => fault_second_order_blocks
     end type fault_problem_t
 
 contains
@@ -146,4 +149,27 @@ contains
         integer, intent(out) :: status
         call self%inner%implicit_jacobian(t, y, jb, offset, status)
     end subroutine fault_implicit_jacobian
+
+    pure logical function fault_has_second_order(self) result(has)
+        class(fault_problem_t), intent(in) :: self
+        has = self%inner%has_second_order()
+    end function fault_has_second_order
+
+    pure subroutine fault_second_order_layout(self, pos, vel, kl, ku)
+        class(fault_problem_t), intent(in) :: self
+        integer, allocatable, intent(out) :: pos(:), vel(:)
+        integer, intent(out) :: kl, ku
+        call self%inner%second_order_layout(pos, vel, kl, ku)
+    end subroutine fault_second_order_layout
+
+    subroutine fault_second_order_blocks(self, t, y, implicit_form, kb, cb, mb, offset, status)
+        class(fault_problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        logical, intent(in) :: implicit_form
+        real(wp), intent(inout) :: kb(:, :), cb(:, :), mb(:, :)
+        integer, intent(in) :: offset
+        integer, intent(out) :: status
+        call self%inner%second_order_blocks(t, y, implicit_form, kb, cb, mb, offset, status)
+    end subroutine fault_second_order_blocks
 end module ropedyn_fault

@@ -12,7 +12,8 @@ module ropedyn_integrator
     use ropedyn_switch_log, only: switch_event_t
     implicit none
     private
-    public :: integrator_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT, STIFF_STEP_RATE
+    public :: integrator_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT, STIFF_STEP_RATE, &
+        clock_seconds
 
     !> No integrator here goes beyond this order of accuracy.
     integer, parameter :: MAX_ORDER_LIMIT = 7
@@ -37,6 +38,14 @@ module ropedyn_integrator
         !> CVODE's BDF stability-limit detection (order reduction when a lightly damped
         !! oscillatory mode nears the stability boundary); other methods reject .true.
         logical :: stab_lim_det = .false.
+        !> solve the Newton systems on the first-order matrix even when the problem has
+        !! second-order structure (the reduced matrix M - g C - g^2 K of half the size is
+        !! the default then; ropedyn_iteration_matrix)
+        logical :: first_order_newton = .false.
+        !> time the parts of a step (right-hand side, Jacobian, factorizations, solves) into
+        !! the stats' time_* fields (a clock reading costs about 30 ns: a few % of a step of a
+        !! small rope, so it is off unless asked for)
+        logical :: profile = .false.
     end type solver_options_t
 
     !> Counters of an integration so far.
@@ -53,6 +62,18 @@ module ropedyn_integrator
         integer :: last_order = 0             !< order of the last step taken
         !> accepted steps taken at each order of accuracy (zero when a method does not say)
         integer(i8) :: order_steps(MAX_ORDER_LIMIT) = 0
+        !> Where the time went (s, monotonic clock; with options%profile only, else 0):
+        !! right-hand side evaluations (f, F and M v of a mass matrix, quadratures),
+        !! Jacobians (or the reduced blocks), factorizations of the Newton matrix, and the
+        !! linear solves, out of the whole time spent in `advance_to` (time_advance, measured
+        !! by the caller: ropedyn_simulation); the rest of that is the integrator's own work.
+        real(wp) :: time_advance = 0.0_wp
+        real(wp) :: time_rhs = 0.0_wp
+        real(wp) :: time_jac = 0.0_wp
+        real(wp) :: time_factor = 0.0_wp
+        real(wp) :: time_solve = 0.0_wp
+        !> the Newton systems were solved on the reduced second-order matrix
+        logical :: reduced_newton = .false.
     end type solver_stats_t
 
     type, abstract :: integrator_t
@@ -117,6 +138,13 @@ module ropedyn_integrator
         end function name_i
     end interface
 contains
+
+    !> Seconds on the monotonic clock (for the time split of options%profile).
+    real(wp) function clock_seconds() result(s)
+        integer(i8) :: count, rate
+        call system_clock(count, rate)
+        s = real(count, wp)/real(rate, wp)
+    end function clock_seconds
 
     !> The order limit used when options%max_order is 0, chosen to be safe for lightly
     !! damped stiff oscillations (ropedyn_methods says why, per method).

@@ -17,7 +17,8 @@ from ropedyn.namelist import parse_namelist
 ENERGY_NAMES = ("kinetic", "elastic", "gravity", "dissipated", "support_work", "total")
 #: Scalar solver statistics written at the end of a run (/solver/NAME).
 SOLVER_STATS = ("steps", "rhs_evals", "jac_evals", "lin_setups", "err_test_fails",
-                "nonlin_iters", "nonlin_conv_fails", "cpu_time")
+                "nonlin_iters", "nonlin_conv_fails", "cpu_time", "time_advance", "time_rhs", "time_jacobian",
+                "time_factor", "time_solve", "reduced_newton")
 
 
 def text(value):

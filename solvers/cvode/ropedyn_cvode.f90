@@ -1,6 +1,16 @@
 !> CVODE (BDF, Newton, band linear solver with the problem's analytic Jacobian) behind
 !! the integrator interface.
 !!
+!! For a problem with second-order structure (ropedyn_problem) the Newton systems are solved
+!! on the reduced matrix I - gamma C - gamma^2 K of the coordinates (ropedyn_iteration_matrix)
+!! by a linear solver of our own: a direct SUNLinearSolver with an empty SUNMatrix and our
+!! linear-system function (CVodeSetLinSysFn). CVODE keeps all its own rules that way: when to
+!! set up (gamma changed by > 30 %, every 20 steps, after failures), when the Jacobian is
+!! stale (jok: every 51 steps, after a convergence failure with an old one), the scaling of
+!! the correction by 2/(1 + gamma/gamma_setup) for a lagged setup, its counters; the linear
+!! system function evaluates the blocks when CVODE asks for a new Jacobian, the solver's
+!! setup factors the reduced matrix for CVODE's gamma, its solve does the reduction.
+!!
 !! We link CVODES, CVODE's superset from the same SUNDIALS release, for its quadrature
 !! feature: the problem's quadrature variables (dissipated energy, support work) are then
 !! integrated with error control but outside the Newton system. Every SUNDIALS-version
@@ -12,12 +22,15 @@ module ropedyn_cvode
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK
-    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
+    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, clock_seconds
+    use ropedyn_iteration_matrix, only: iteration_matrix_t
     use ropedyn_switch_log, only: switch_log_t, switch_event_t
     use fsundials_context_mod, only: FSUNContext_Create, FSUNContext_Free
     use fsundials_nvector_mod, only: N_Vector, FN_VDestroy, FN_VGetArrayPointer
-    use fsundials_matrix_mod, only: SUNMatrix, FSUNMatDestroy
-    use fsundials_linearsolver_mod, only: SUNLinearSolver, FSUNLinSolFree
+    use fsundials_matrix_mod, only: SUNMatrix, FSUNMatDestroy, FSUNMatNewEmpty
+    use fsundials_linearsolver_mod, only: SUNLinearSolver, FSUNLinSolFree, SUNLinearSolver_Ops, &
+                                          FSUNLinSolNewEmpty, FSUNLinSolFreeEmpty, &
+                                          SUNLinearSolver_Type, SUNLINEARSOLVER_DIRECT
     use fnvector_serial_mod, only: FN_VMake_Serial
     use fsunmatrix_band_mod, only: FSUNBandMatrix, FSUNBandMatrix_Data, FSUNBandMatrix_LDim, &
                                    FSUNBandMatrix_StoredUpperBandwidth, FSUNBandMatrix_Columns
@@ -42,6 +55,15 @@ module ropedyn_cvode
         integer :: ml = 0, mu = 0                 !< the problem's bandwidths
         !> band work array for a dense Jacobian (the problem writes band storage)
         real(wp), allocatable :: band(:, :)
+        !> the reduced Newton matrix (when `reduced`)
+        logical :: reduced = .false.
+        type(iteration_matrix_t) :: newton
+        real(wp) :: gamma = 0.0_wp                !< CVODE's gamma of the last set-up
+        real(wp), allocatable :: ones(:)          !< unit weights (the blocks need none)
+        !> time split (options%profile): rhs, Jacobian, factorization, solves, s
+        logical :: profile = .false.
+        real(wp) :: time_rhs = 0.0_wp, time_jac = 0.0_wp, time_factor = 0.0_wp, &
+                    time_solve = 0.0_wp
     end type cvode_context_t
 
     !> What the stepping loop watches to tell a stability-limited crawl at high BDF order
@@ -99,6 +121,7 @@ module ropedyn_cvode
         procedure :: switch_log => cvode_switch_log
         procedure, private :: watch => cvode_watch
         procedure, private :: restart => cvode_restart
+        procedure, private :: attach_linear_solver
         final :: cvode_destroy
     end type cvode_t
 
@@ -177,8 +200,7 @@ contains
         real(wp), intent(in) :: yq0(:)
         type(solver_options_t), intent(in) :: options
         type(error_t), allocatable, intent(out) :: err
-        integer :: ml, mu, max_order
-        logical :: dense
+        integer :: max_order
         integer(c_int) :: flag
         type(N_Vector), pointer :: nv_atol
         real(c_double), allocatable, target :: atol(:)
@@ -246,33 +268,9 @@ contains
         flag = FCVodeSetMaxHnilWarns(self%mem, -1_c_int)
         if (check(flag, 'FCVodeSetMaxHnilWarns')) return
 
-        call problem%bandwidths(ml, mu)
-        ml = min(ml, self%n - 1)
-        mu = min(mu, self%n - 1)
-        self%ctx%ml = ml
-        self%ctx%mu = mu
-        ! A nearly full band: dense LU (LAPACK-style, blocked) beats the band LU.
-        dense = 2*ml + mu + 1 >= self%n
-        if (dense) then
-            self%matrix => FSUNDenseMatrix(int(self%n, c_int64_t), int(self%n, c_int64_t), &
-                                           self%sunctx)
-            self%solver => FSUNLinSol_Dense(self%nv_y, self%matrix, self%sunctx)
-            allocate (self%ctx%band(ml + mu + 1, self%n))
-        else
-            self%matrix => FSUNBandMatrix(int(self%n, c_int64_t), int(mu, c_int64_t), &
-                                          int(ml, c_int64_t), self%sunctx)
-            self%solver => FSUNLinSol_Band(self%nv_y, self%matrix, self%sunctx)
-        end if
-        if (.not. (associated(self%matrix) .and. associated(self%solver))) then
-            call make_error(err, ERR_SOLVER, 'cvode: cannot create the linear solver')
-            return
-        end if
-        flag = FCVodeSetLinearSolver(self%mem, self%solver, self%matrix)
-        if (check(flag, 'FCVodeSetLinearSolver')) return
-        if (problem%has_jacobian() .and. .not. options%fd_jacobian) then
-            flag = FCVodeSetJacFn(self%mem, c_funloc(cv_jacobian))
-            if (check(flag, 'FCVodeSetJacFn')) return
-        end if
+        self%ctx%profile = options%profile
+        call self%attach_linear_solver(problem, options, err)
+        if (allocated(err)) return
 
         if (self%nq > 0) then
             self%nv_q => FN_VMake_Serial(int(self%nq, c_int64_t), self%yq, self%sunctx)
@@ -305,6 +303,77 @@ contains
         end function check
     end subroutine cvode_init
 
+    !> The linear solver: our reduced second-order one when the problem allows it, else
+    !! SUNDIALS' band (dense for a nearly full band) LU with the problem's analytic Jacobian
+    !! (CVODE's difference quotients without one).
+    subroutine attach_linear_solver(self, problem, options, err)
+        class(cvode_t), intent(inout) :: self
+        class(problem_t), intent(inout), target :: problem
+        type(solver_options_t), intent(in) :: options
+        type(error_t), allocatable, intent(out) :: err
+        integer :: ml, mu
+        logical :: dense
+        integer(c_int) :: flag
+
+        if (problem%has_second_order() .and. problem%has_jacobian() .and. &
+            .not. (options%first_order_newton .or. options%fd_jacobian)) then
+            call self%ctx%newton%setup(problem, implicit_form=.false., first_order=.false., &
+                                       fd_jacobian=.false.)
+            self%ctx%reduced = self%ctx%newton%is_reduced()
+        end if
+        if (self%ctx%reduced) then
+            allocate (self%ctx%ones(self%n))
+            self%ctx%ones = 1.0_wp
+            self%matrix => FSUNMatNewEmpty(self%sunctx)
+            self%solver => reduced_solver(self%ctx, self%sunctx)
+            if (.not. (associated(self%matrix) .and. associated(self%solver))) then
+                call make_error(err, ERR_SOLVER, 'cvode: cannot create the linear solver')
+                return
+            end if
+            flag = FCVodeSetLinearSolver(self%mem, self%solver, self%matrix)
+            if (check(flag, 'FCVodeSetLinearSolver')) return
+            flag = FCVodeSetLinSysFn(self%mem, c_funloc(cv_linsys))
+            if (check(flag, 'FCVodeSetLinSysFn')) return
+            return
+        end if
+
+        call problem%bandwidths(ml, mu)
+        ml = min(ml, self%n - 1)
+        mu = min(mu, self%n - 1)
+        self%ctx%ml = ml
+        self%ctx%mu = mu
+        ! A nearly full band: dense LU (LAPACK-style, blocked) beats the band LU.
+        dense = 2*ml + mu + 1 >= self%n
+        if (dense) then
+            self%matrix => FSUNDenseMatrix(int(self%n, c_int64_t), int(self%n, c_int64_t), &
+                                           self%sunctx)
+            self%solver => FSUNLinSol_Dense(self%nv_y, self%matrix, self%sunctx)
+            allocate (self%ctx%band(ml + mu + 1, self%n))
+        else
+            self%matrix => FSUNBandMatrix(int(self%n, c_int64_t), int(mu, c_int64_t), &
+                                          int(ml, c_int64_t), self%sunctx)
+            self%solver => FSUNLinSol_Band(self%nv_y, self%matrix, self%sunctx)
+        end if
+        if (.not. (associated(self%matrix) .and. associated(self%solver))) then
+            call make_error(err, ERR_SOLVER, 'cvode: cannot create the linear solver')
+            return
+        end if
+        flag = FCVodeSetLinearSolver(self%mem, self%solver, self%matrix)
+        if (check(flag, 'FCVodeSetLinearSolver')) return
+        if (problem%has_jacobian() .and. .not. options%fd_jacobian) then
+            flag = FCVodeSetJacFn(self%mem, c_funloc(cv_jacobian))
+            if (check(flag, 'FCVodeSetJacFn')) return
+        end if
+    contains
+        logical function check(flag, what)
+            integer(c_int), intent(in) :: flag
+            character(len=*), intent(in) :: what
+            check = flag < 0
+            if (check) call make_error(err, ERR_SOLVER, 'cvode: '//what//' failed: '// &
+                                       flag_name(flag)//' '//self%ctx%message)
+        end function check
+    end subroutine attach_linear_solver
+
     function cvode_stats(self) result(stats)
         class(cvode_t), intent(in) :: self
         type(solver_stats_t) :: stats
@@ -330,6 +399,11 @@ contains
         stats%jac_evals = self%base%jac_evals + v(1)
         flag = FCVodeGetNumLinRhsEvals(self%mem, v)
         stats%jac_rhs_evals = self%base%jac_rhs_evals + v(1)
+        stats%reduced_newton = self%ctx%reduced
+        stats%time_rhs = self%ctx%time_rhs
+        stats%time_jac = self%ctx%time_jac
+        stats%time_factor = self%ctx%time_factor
+        stats%time_solve = self%ctx%time_solve
     end function cvode_stats
 
     subroutine cvode_finalize(self)
@@ -385,14 +459,17 @@ contains
         type(cvode_context_t), pointer :: ctx
         real(c_double), pointer :: y(:), f(:)
         integer :: status
+        real(wp) :: start
         call c_f_pointer(user_data, ctx)
         y => FN_VGetArrayPointer(nv_y)
         f => FN_VGetArrayPointer(nv_f)
+        if (ctx%profile) start = clock_seconds()
         if (what == EVAL_RHS) then
             call ctx%problem%rhs(t, y, f, status)
         else
             call ctx%problem%quad_rhs(t, y, f, status)
         end if
+        if (ctx%profile) ctx%time_rhs = ctx%time_rhs + (clock_seconds() - start)
         ctx%last_status = status
         if (status > 0) ctx%recoverable = ctx%recoverable + 1
         ierr = int(status, c_int)
@@ -411,7 +488,9 @@ contains
         type(cvode_context_t), pointer :: ctx
         real(c_double), pointer :: y(:), data1(:), jb(:, :), a(:, :)
         integer :: status, ldim, ncols, smu, n, i, j
+        real(wp) :: start
         call c_f_pointer(user_data, ctx)
+        if (ctx%profile) start = clock_seconds()
         y => FN_VGetArrayPointer(nv_y)
         if (allocated(ctx%band)) then
             n = size(y)
@@ -439,9 +518,105 @@ contains
             jb = 0.0_c_double
             call ctx%problem%jacobian(t, y, jb, smu + 1, status)
         end if
+        if (ctx%profile) ctx%time_jac = ctx%time_jac + (clock_seconds() - start)
         ctx%last_status = status
         ierr = int(status, c_int)
     end function cv_jacobian
+
+    ! ---- the reduced second-order linear solver --------------------------------------
+
+    !> A direct SUNLinearSolver whose content is the context (set-up: factor the reduced
+    !! matrix for the gamma of the last linear-system call; solve: the reduction).
+    function reduced_solver(ctx, sunctx) result(ls)
+        type(cvode_context_t), pointer, intent(in) :: ctx
+        type(c_ptr), intent(in) :: sunctx
+        type(SUNLinearSolver), pointer :: ls
+        type(SUNLinearSolver_Ops), pointer :: ops
+        ls => FSUNLinSolNewEmpty(sunctx)
+        if (.not. associated(ls)) return
+        ls%content = c_loc(ctx)
+        call c_f_pointer(ls%ops, ops)
+        ops%gettype = c_funloc(ls_type)
+        ops%setup = c_funloc(ls_setup)
+        ops%solve = c_funloc(ls_solve)
+        ops%free = c_funloc(ls_free)
+    end function reduced_solver
+
+    integer(SUNLinearSolver_Type) function ls_type(ls) result(kind) bind(C)
+        type(SUNLinearSolver) :: ls
+        kind = SUNLINEARSOLVER_DIRECT
+    end function ls_type
+
+    !> CVODE's linear-system function: new blocks at (t, y) unless CVODE says the old ones
+    !! will do (jok); the factorization follows in ls_setup with this gamma.
+    integer(c_int) function cv_linsys(t, nv_y, nv_f, mat, jok, jcur, gamma, user_data, &
+                                      tmp1, tmp2, tmp3) result(ierr) bind(C)
+        real(c_double), value :: t
+        type(N_Vector) :: nv_y, nv_f
+        type(SUNMatrix) :: mat
+        integer(c_int), value :: jok
+        integer(c_int) :: jcur
+        real(c_double), value :: gamma
+        type(c_ptr), value :: user_data
+        type(N_Vector) :: tmp1, tmp2, tmp3
+        type(cvode_context_t), pointer :: ctx
+        real(c_double), pointer :: y(:)
+        integer(i8) :: nevals
+        integer :: status
+        real(wp) :: start
+        call c_f_pointer(user_data, ctx)
+        ctx%gamma = gamma
+        jcur = 0_c_int
+        ierr = 0_c_int
+        if (jok /= 0_c_int) return
+        if (ctx%profile) start = clock_seconds()
+        y => FN_VGetArrayPointer(nv_y)
+        nevals = 0
+        call ctx%newton%evaluate_jacobian(ctx%problem, t, y, ctx%ones, 0.0_wp, status, nevals)
+        if (ctx%profile) ctx%time_jac = ctx%time_jac + (clock_seconds() - start)
+        ctx%last_status = status
+        jcur = 1_c_int
+        ierr = int(status, c_int)
+    end function cv_linsys
+
+    integer(c_int) function ls_setup(ls, mat) result(ierr) bind(C)
+        type(SUNLinearSolver) :: ls
+        type(SUNMatrix) :: mat
+        type(cvode_context_t), pointer :: ctx
+        integer :: status
+        real(wp) :: start
+        call c_f_pointer(ls%content, ctx)
+        if (ctx%profile) start = clock_seconds()
+        call ctx%newton%factor(ctx%problem, 0.0_wp, ctx%ones, ctx%gamma, status)
+        if (ctx%profile) ctx%time_factor = ctx%time_factor + (clock_seconds() - start)
+        ierr = int(status, c_int)   ! a singular matrix is recoverable (CVODE cuts h)
+    end function ls_setup
+
+    integer(c_int) function ls_solve(ls, mat, nv_x, nv_b, tol) result(ierr) bind(C)
+        type(SUNLinearSolver) :: ls
+        type(SUNMatrix) :: mat
+        type(N_Vector) :: nv_x, nv_b
+        real(c_double), value :: tol
+        type(cvode_context_t), pointer :: ctx
+        real(c_double), pointer :: x(:), b(:)
+        real(wp) :: start
+        call c_f_pointer(ls%content, ctx)
+        if (ctx%profile) start = clock_seconds()
+        x => FN_VGetArrayPointer(nv_x)
+        b => FN_VGetArrayPointer(nv_b)
+        x = b
+        call ctx%newton%solve(x)
+        if (ctx%profile) ctx%time_solve = ctx%time_solve + (clock_seconds() - start)
+        ierr = 0_c_int
+    end function ls_solve
+
+    !> The content is the context, owned by cvode_t: only the solver object goes.
+    integer(c_int) function ls_free(ls) result(ierr) bind(C)
+        type(SUNLinearSolver), target :: ls
+        ls%content = c_null_ptr
+        call FSUNLinSolFreeEmpty(ls)
+        ierr = 0_c_int
+    end function ls_free
 
     !> Keeps CVODE's messages for our error text instead of printing them.
     subroutine cv_error_handler(code, module, function, msg, user_data) bind(C)

@@ -23,11 +23,9 @@ contains
             call self%problem%implicit_rhs(t, z(1:self%n), slope(1:self%n), status)
             self%counters%rhs_evals = self%counters%rhs_evals + 1
             if (status /= STATUS_OK) return
-            call self%matrix%factor(self%problem, t, z(1:self%n), 0.0_wp, status)
+            call self%matrix%solve_mass(self%problem, t, z(1:self%n), slope(1:self%n), status)
             self%counters%lin_setups = self%counters%lin_setups + 1
             if (status /= STATUS_OK) return
-            call self%matrix%solve(slope(1:self%n))
-            self%matrix%factored = .false.
         else
             call self%problem%rhs(t, z(1:self%n), slope(1:self%n), status)
             self%counters%rhs_evals = self%counters%rhs_evals + 1

@@ -7,14 +7,16 @@ contains
 
     module procedure prepare_matrix
         logical :: new_jacobian
+        real(wp) :: start
         status = STATUS_OK
         new_jacobian = refresh .or. self%jacobian_age >= JACOBIAN_MAX_AGE .or. &
                        self%counters%jac_evals == 0
         if (new_jacobian .and. .not. self%jacobian_current) then
+            if (self%options%profile) start = clock_seconds()
             call self%matrix%evaluate_jacobian(self%problem, self%t, self%dif(1:self%n, 0), &
-                self%w, self%h, self%options%fd_jacobian .or. &
-                .not. self%problem%has_implicit_jacobian(), status, &
-                self%counters%jac_rhs_evals)
+                self%w, self%h, status, self%counters%jac_rhs_evals)
+            if (self%options%profile) self%counters%time_jac = self%counters%time_jac + &
+                                                               (clock_seconds() - start)
             self%counters%jac_evals = self%counters%jac_evals + 1
             if (status /= STATUS_OK) return
             self%jacobian_age = 0
@@ -23,22 +25,27 @@ contains
         end if
         if (.not. self%matrix%factored .or. &
             abs(hbeta - self%matrix%hbeta) > REFACTOR_CHANGE*abs(self%matrix%hbeta)) then
+            if (self%options%profile) start = clock_seconds()
             call self%matrix%factor(self%problem, self%t, self%dif(1:self%n, 0), hbeta, status)
+            if (self%options%profile) self%counters%time_factor = self%counters%time_factor + &
+                                                                  (clock_seconds() - start)
             self%counters%lin_setups = self%counters%lin_setups + 1
             self%crate = 1.0_wp
         end if
     end procedure prepare_matrix
 
     module procedure stage
-        real(wp) :: dnorm, dnorm_old, dcon
+        real(wp) :: dnorm, dnorm_old, dcon, start
         integer :: iter, status, n
-        logical :: mass
+        logical :: mass, profile
 
         n = self%n
         mass = self%problem%has_mass_matrix()
+        profile = self%options%profile
         outcome = STAGE_NO_CONVERGENCE
         dnorm_old = 0.0_wp
         do iter = 1, MAX_NEWTON_ITERS
+            if (profile) start = clock_seconds()
             call self%problem%implicit_rhs(tn, z(1:n), self%f, status)
             self%counters%rhs_evals = self%counters%rhs_evals + 1
             if (status /= STATUS_OK) then
@@ -56,7 +63,13 @@ contains
             else
                 self%r = hbeta*self%f - (z(1:n) - c(1:n))
             end if
+            if (profile) then
+                self%counters%time_rhs = self%counters%time_rhs + (clock_seconds() - start)
+                start = clock_seconds()
+            end if
             call self%matrix%solve(self%r)
+            if (profile) self%counters%time_solve = self%counters%time_solve + &
+                                                    (clock_seconds() - start)
             self%counters%nonlin_iters = self%counters%nonlin_iters + 1
             if (.not. all(ieee_is_finite(self%r))) return
             z(1:n) = z(1:n) + self%r
@@ -74,7 +87,10 @@ contains
         end do
         if (outcome /= STAGE_OK) return
         if (self%nq > 0) then
+            if (profile) start = clock_seconds()
             call self%problem%quad_rhs(tn, z(1:n), self%gq, status)
+            if (profile) self%counters%time_rhs = self%counters%time_rhs + &
+                                                  (clock_seconds() - start)
             if (status /= STATUS_OK) then
                 outcome = merge(STAGE_FATAL, STAGE_RHS_FAILED, status == STATUS_FATAL)
                 return

@@ -3,14 +3,10 @@
 module ropedyn_cli
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_USAGE
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, text_t
     implicit none
     private
     public :: cli_t, cli_from_command_line
-
-    type :: text_t
-        character(len=:), allocatable :: s
-    end type text_t
 
     type :: cli_t
         character(len=:), allocatable :: command  !< the subcommand, for messages
@@ -28,6 +24,7 @@ module ropedyn_cli
         procedure :: real_value => cli_real_value
         procedure :: int_value => cli_int_value
         procedure :: count => cli_count
+        procedure :: positional => cli_positional
     end type cli_t
 
 contains
@@ -104,6 +101,26 @@ contains
         call make_error(err, ERR_USAGE, self%command//': '//message//' (see ropedyn '// &
                         self%command//' --help)')
     end subroutine cli_usage_error
+
+    !> The current argument as the one file the subcommand takes (`what`, e.g. 'scene
+    !! file'): an empty argument, an option the subcommand does not know or a second file is
+    !! a usage error.
+    subroutine cli_positional(self, what, path, err)
+        class(cli_t), intent(in) :: self
+        character(len=*), intent(in) :: what
+        character(len=:), allocatable, intent(inout) :: path
+        type(error_t), allocatable, intent(out) :: err
+        if (len(self%arg) == 0) then
+            call self%usage_error('empty argument', err)
+        else if (self%arg(1:1) == '-') then
+            call self%usage_error('unknown option "'//self%arg//'"', err)
+        else if (allocated(path)) then
+            call self%usage_error('more than one '//what//': "'//path//'", "'//self%arg//'"', &
+                                  err)
+        else
+            path = self%arg
+        end if
+    end subroutine cli_positional
 
     !> The current option's value as a real number.
     subroutine cli_real_value(self, x, err)

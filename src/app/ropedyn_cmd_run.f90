@@ -4,6 +4,7 @@ module ropedyn_cmd_run
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t
     use ropedyn_cli, only: cli_t
+    use ropedyn_text, only: text_t, append_text, text_array
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_simulation, only: run_summary_t, run_scene
     use ropedyn_version, only: version_string
@@ -28,14 +29,12 @@ contains
     subroutine run_command(cli, err)
         type(cli_t), intent(inout) :: cli
         type(error_t), allocatable, intent(out) :: err
-        character(len=1024), allocatable :: overrides(:)
+        type(text_t), allocatable :: overrides(:)
         character(len=:), allocatable :: scene_path, value
         type(scene_t) :: scene
         type(run_summary_t) :: summary
-        integer :: n_over
 
-        allocate (overrides(cli%count()))
-        n_over = 0
+        allocate (overrides(0))
         do while (cli%next())
             select case (cli%option)
             case ('--help', '-h')
@@ -44,19 +43,10 @@ contains
             case ('--set')
                 call cli%take_value(value, err)
                 if (allocated(err)) return
-                n_over = n_over + 1
-                overrides(n_over) = value
+                call append_text(overrides, value)
             case default
-                if (cli%arg(1:min(1, len(cli%arg))) == '-') then
-                    call cli%usage_error('unknown option "'//cli%arg//'"', err)
-                    return
-                end if
-                if (allocated(scene_path)) then
-                    call cli%usage_error('more than one scene file: "'//scene_path//'", "'// &
-                                         cli%arg//'"', err)
-                    return
-                end if
-                scene_path = cli%arg
+                call cli%positional('scene file', scene_path, err)
+                if (allocated(err)) return
             end select
         end do
         if (.not. allocated(scene_path)) then
@@ -64,7 +54,7 @@ contains
             return
         end if
 
-        call read_scene(scene_path, overrides(1:n_over), scene, err)
+        call read_scene(scene_path, text_array(overrides), scene, err)
         if (allocated(err)) return
         call run_scene(scene, summary, err)
         if (summary%records > 0) call print_summary(scene, summary)
@@ -84,6 +74,14 @@ contains
             s%stats%steps, '   rhs evals ', s%stats%rhs_evals, '   jacobians ', &
             s%stats%jac_evals, '   error-test fails ', s%stats%err_test_fails
         write (output_unit, '(a, f10.4, a)') '  cpu time        ', s%cpu_time, ' s'
+        write (output_unit, '(a, i0, a)') '  newton          '// &
+            trim(merge('reduced (second-order) matrix', 'first-order matrix           ', &
+                       s%stats%reduced_newton))//', ', s%stats%lin_setups, ' factorizations'
+        if (scene%solver%profile) write (output_unit, '(a, 5(a, f9.4))') &
+            '  time split (s) ', ' rhs ', s%stats%time_rhs, '  jacobian ', s%stats%time_jac, &
+            '  factor ', s%stats%time_factor, '  solve ', s%stats%time_solve, '  rest ', &
+            s%stats%time_advance - (s%stats%time_rhs + s%stats%time_jac + &
+                                    s%stats%time_factor + s%stats%time_solve)
         write (output_unit, '(a, 5(es13.5))') '  energy (J)      kinetic, elastic, '// &
             'gravity, dissipated, total:'
         write (output_unit, '(a, 5(es13.5))') '                  ', s%final_energy%kinetic, &

@@ -6,6 +6,7 @@ module ropedyn_cmd_statics
     use, intrinsic :: iso_fortran_env, only: output_unit
     use ropedyn_error, only: error_t
     use ropedyn_cli, only: cli_t
+    use ropedyn_text, only: text_t, append_text, text_array
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_statics, only: statics_options_t
     use ropedyn_analysis, only: run_analysis, DEFAULT_MODE_COUNT
@@ -26,14 +27,13 @@ contains
         character(len=*), intent(in) :: command   !< 'statics' or 'modes'
         type(cli_t), intent(inout) :: cli
         type(error_t), allocatable, intent(out) :: err
-        character(len=1024), allocatable :: overrides(:)
+        type(text_t), allocatable :: overrides(:)
         character(len=:), allocatable :: scene_path, out_path, value
         type(statics_options_t) :: options
         type(scene_t) :: scene
-        integer :: n_over, count
+        integer :: count
 
-        allocate (overrides(cli%count()))
-        n_over = 0
+        allocate (overrides(0))
         count = DEFAULT_MODE_COUNT
         out_path = ''
         do while (cli%next())
@@ -46,8 +46,7 @@ contains
             case ('--set')
                 call cli%take_value(value, err)
                 if (allocated(err)) return
-                n_over = n_over + 1
-                overrides(n_over) = value
+                call append_text(overrides, value)
             case ('-o', '--output')
                 call cli%take_value(out_path, err)
                 if (allocated(err)) return
@@ -62,27 +61,15 @@ contains
                 call cli%int_value(options%max_iterations, 1, err)
                 if (allocated(err)) return
             case default
-                if (len(cli%arg) == 0) then
-                    call cli%usage_error('empty argument', err)
-                    return
-                end if
-                if (cli%arg(1:1) == '-') then
-                    call cli%usage_error('unknown option "'//cli%arg//'"', err)
-                    return
-                end if
-                if (allocated(scene_path)) then
-                    call cli%usage_error('more than one scene file: "'//scene_path//'", "'// &
-                                         cli%arg//'"', err)
-                    return
-                end if
-                scene_path = cli%arg
+                call cli%positional('scene file', scene_path, err)
+                if (allocated(err)) return
             end select
         end do
         if (.not. allocated(scene_path)) then
             call cli%usage_error('needs a scene file', err)
             return
         end if
-        call read_scene(scene_path, overrides(1:n_over), scene, err)
+        call read_scene(scene_path, text_array(overrides), scene, err)
         if (allocated(err)) return
         call run_analysis(command, scene, options, count, out_path, err)
     end subroutine analysis_command

@@ -1,8 +1,8 @@
 !> `ropedyn sweep SWEEP.nml [options]`: list, run and summarize a sweep (docs/sweeps.md).
 !!
 !!     ropedyn sweep SWEEP.nml [--jobs N] [--force] [--quiet] [--output-dir DIR]
-!!     ropedyn sweep SWEEP.nml --list | --count
-!!     ropedyn sweep SWEEP.nml --task K [--force] [--quiet] [--output-dir DIR]
+!!     ropedyn sweep SWEEP.nml --list | --count | --status
+!!     ropedyn sweep SWEEP.nml --task LIST [--force] [--quiet] [--output-dir DIR]
 !!     ropedyn sweep SWEEP.nml --summary [--output-dir DIR]
 module ropedyn_cmd_sweep
     use, intrinsic :: iso_fortran_env, only: output_unit
@@ -11,7 +11,9 @@ module ropedyn_cmd_sweep
     use ropedyn_os, only: processor_count
     use ropedyn_cli, only: cli_t
     use ropedyn_sweep, only: sweep_t, read_sweep
-    use ropedyn_sweep_runner, only: sweep_options_t, list_cases, run_task, run_local, summarize
+    use ropedyn_sweep_runner, only: sweep_options_t, list_cases, status_report, run_local, &
+        summarize
+    use ropedyn_sweep_task, only: run_cases
     implicit none
     private
     public :: sweep_command, sweep_usage
@@ -22,8 +24,8 @@ contains
         integer, intent(in) :: unit
         write (unit, '(a)') 'usage: ropedyn sweep SWEEP.nml [--jobs N] [--force] [--quiet] '// &
             '[--output-dir DIR]'
-        write (unit, '(a)') '       ropedyn sweep SWEEP.nml --list | --count'
-        write (unit, '(a)') '       ropedyn sweep SWEEP.nml --task K [--force] [--quiet] '// &
+        write (unit, '(a)') '       ropedyn sweep SWEEP.nml --list | --count | --status'
+        write (unit, '(a)') '       ropedyn sweep SWEEP.nml --task LIST [--force] [--quiet] '// &
             '[--output-dir DIR]'
         write (unit, '(a)') '       ropedyn sweep SWEEP.nml --summary [--output-dir DIR]'
         write (unit, '(a)') 'Runs every case of a sweep file (a base scene and lists of '// &
@@ -34,13 +36,21 @@ contains
         write (unit, '(a)') '  --jobs N        worker processes (default: the number of cores)'
         write (unit, '(a)') '  --list          print the cases: id, status of its file, overrides'
         write (unit, '(a)') '  --count         print the number of cases'
-        write (unit, '(a)') '  --task K        run case K only (a Slurm array task); no summary'
+        write (unit, '(a)') '  --status        count the cases by status, with ids and reasons'// &
+            ' (exit 3: not all complete)'
+        write (unit, '(a)') '  --task LIST     run these cases only (K, K-L, or a comma-'// &
+            'separated list; a Slurm'
+        write (unit, '(a)') '                  array task), one after the other; no summary'
         write (unit, '(a)') '  --summary       rebuild the summary from the case files that exist'
         write (unit, '(a)') '  --force         run cases again even if their output is complete'
         write (unit, '(a)') '  --quiet         no progress and no per-case lines'
         write (unit, '(a)') '  --output-dir D  case files and summary in D (instead of output_dir)'
-        write (unit, '(a)') 'A case whose file is complete and holds the same scene is skipped.'
-        write (unit, '(a)') 'exit codes: 0 ok, 2 bad input, 3 a case failed, 4 output error'
+        write (unit, '(a)') 'A case whose file is complete and holds the same scene is skipped;'// &
+            ' a case being'
+        write (unit, '(a)') 'written by another process is not run twice (docs/sweeps.md).'
+        write (unit, '(a)') 'exit codes: 0 ok, 2 bad input, 3 a case not complete, 4 output '// &
+            'error or case'
+        write (unit, '(a)') 'taken by another writer, 130 stopped by SIGINT or SIGTERM'
     end subroutine sweep_usage
 
     !> `ropedyn sweep ARGS`: `cli` holds the arguments after `sweep`; `exe` is how this
@@ -60,15 +70,17 @@ contains
         if (opt%count) then
             write (output_unit, '(i0)') size(sweep%cases)
         else if (opt%list) then
-            call list_cases(sweep, err)
-        else if (opt%task > 0) then
-            if (opt%task > size(sweep%cases)) then
-                call make_error(err, ERR_USAGE, 'sweep: --task '//int_text(opt%task)// &
+            call list_cases(sweep)
+        else if (opt%status) then
+            call status_report(sweep, err)
+        else if (size(opt%tasks) > 0) then
+            if (maxval(opt%tasks) > size(sweep%cases)) then
+                call make_error(err, ERR_USAGE, 'sweep: --task '//int_text(maxval(opt%tasks))// &
                     ': no such case ('//opt%path//' has '//int_text(size(sweep%cases))// &
                     ' cases, 1 .. '//int_text(size(sweep%cases))//')')
                 return
             end if
-            call run_task(sweep, opt%task, opt%force, opt%quiet, err)
+            call run_cases(sweep, opt%tasks, opt%force, opt%quiet, err)
         else if (opt%summary) then
             call summarize(sweep, opt%quiet, err)
         else
@@ -82,9 +94,10 @@ contains
         type(error_t), allocatable, intent(out) :: err
         character(len=:), allocatable :: value
         integer :: modes
-        logical :: have_jobs
+        logical :: have_jobs, ok
 
         have_jobs = .false.
+        allocate (opt%tasks(0))
         do while (cli%next())
             select case (cli%option)
             case ('--help', '-h')
@@ -96,6 +109,8 @@ contains
                 opt%count = .true.
             case ('--summary')
                 opt%summary = .true.
+            case ('--status')
+                opt%status = .true.
             case ('--force')
                 opt%force = .true.
             case ('--quiet')
@@ -113,21 +128,17 @@ contains
                 if (allocated(err)) return
                 have_jobs = .true.
             case ('--task')
-                call cli%int_value(opt%task, 1, err)
+                call cli%take_value(value, err)
                 if (allocated(err)) return
-            case default
-                if (len(cli%arg) == 0) then
-                    call cli%usage_error('empty argument', err)
-                    return
-                else if (cli%arg(1:1) == '-') then
-                    call cli%usage_error('unknown option "'//cli%arg//'"', err)
-                    return
-                else if (allocated(opt%path)) then
-                    call cli%usage_error('more than one sweep file: "'//opt%path//'", "' &
-                        //cli%arg//'"', err)
+                call parse_ids(value, opt%tasks, ok)
+                if (.not. ok) then
+                    call cli%usage_error('--task "'//value//'": expected a whole number >= '// &
+                        '1, a range K-L or a comma-separated list of them', err)
                     return
                 end if
-                opt%path = cli%arg
+            case default
+                call cli%positional('sweep file', opt%path, err)
+                if (allocated(err)) return
             end select
         end do
         if (.not. allocated(opt%path)) then
@@ -135,15 +146,60 @@ contains
             return
         end if
         if (.not. allocated(opt%output_dir)) opt%output_dir = ''
-        modes = count([opt%list, opt%count, opt%summary, opt%task > 0])
+        modes = count([opt%list, opt%count, opt%summary, opt%status, size(opt%tasks) > 0])
         if (modes > 1) then
-            call cli%usage_error('--list, --count, --summary and --task exclude each other', &
-                err)
+            call cli%usage_error('--list, --count, --status, --summary and --task exclude '// &
+                'each other', err)
         else if (have_jobs .and. modes > 0) then
             call cli%usage_error('--jobs is for running the whole sweep', err)
-        else if (opt%force .and. (opt%list .or. opt%count .or. opt%summary)) then
+        else if (opt%force .and. (opt%list .or. opt%count .or. opt%summary .or. opt%status)) &
+            then
             call cli%usage_error('--force is for running cases', err)
         end if
         if (.not. have_jobs) opt%jobs = processor_count()
     end subroutine parse_options
+
+    !> Case ids from '7', '3-5' or '1,3-5,9' (each >= 1; at most 100000 of them), in the
+    !! order given.
+    subroutine parse_ids(text, ids, ok)
+        character(len=*), intent(in) :: text
+        integer, allocatable, intent(out) :: ids(:)
+        logical, intent(out) :: ok
+        integer, parameter :: MOST = 100000
+        integer :: start, comma, dash, first, last, ios, k, n
+        integer, allocatable :: buffer(:)
+        allocate (buffer(16))
+        n = 0
+        ok = len(text) > 0 .and. text(len(text):) /= ','
+        start = 1
+        do while (ok .and. start <= len(text))
+            comma = index(text(start:), ',')
+            if (comma == 0) comma = len(text) - start + 2
+            associate (item => text(start:start + comma - 2))
+                dash = index(item, '-')
+                ok = len(item) > 0 .and. len(item) < 20 .and. &
+                    verify(item, '0123456789-') == 0 .and. dash /= 1 .and. &
+                    dash /= len(item) .and. index(item(dash + 1:), '-') == 0
+                if (.not. ok) exit
+                if (dash == 0) then
+                    read (item, *, iostat=ios) first
+                    last = first
+                else
+                    read (item(:dash - 1), *, iostat=ios) first
+                    if (ios == 0) read (item(dash + 1:), *, iostat=ios) last
+                end if
+                ok = ios == 0
+                if (ok) ok = first >= 1 .and. last >= first .and. last - first < MOST - n
+                if (.not. ok) exit
+                do while (n + last - first + 1 > size(buffer))
+                    buffer = [buffer, buffer]
+                end do
+                buffer(n + 1:n + last - first + 1) = [(k, k=first, last)]
+                n = n + last - first + 1
+            end associate
+            start = start + comma
+        end do
+        ids = buffer(:n)
+        if (.not. ok) ids = buffer(:0)
+    end subroutine parse_ids
 end module ropedyn_cmd_sweep

@@ -5,14 +5,15 @@
 !!   ropedyn testset PROBLEM|all [--method M] [--rtol R] [--atol A] [--max-order K]
 !!                   [--repeat-time S] [--csv]      (docs/testset.md)
 !!   ropedyn testset --list
-!!   ropedyn sweep SWEEP.nml [--jobs N | --task K | --summary | --list | --count]
+!!   ropedyn sweep SWEEP.nml [--jobs N | --task LIST | --summary | --list | --count | --status]
 !!                   [--force] [--quiet] [--output-dir DIR]   (docs/sweeps.md)
 !!   ropedyn statics SCENE.nml [--set ...] [-o FILE.h5] [--max-iterations N]
 !!   ropedyn modes SCENE.nml [--count K] [--set ...] [-o FILE.h5]  (docs/statics-modes.md)
+!!   ropedyn keys              (every key of a scene file with its default; docs/input.md)
 !!   ropedyn --version | --help
 !!
 !! Exit codes: 0 success, 2 bad input or command line, 3 integration failed,
-!! 4 output could not be written, 5 internal error.
+!! 4 output could not be written, 5 internal error, 130 stopped by SIGINT/SIGTERM.
 program ropedyn_main
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use ropedyn_error, only: error_t, make_error, ERR_USAGE, exit_code_of
@@ -23,6 +24,7 @@ program ropedyn_main
     use ropedyn_cmd_sweep, only: sweep_command
     use ropedyn_cmd_statics, only: statics_command
     use ropedyn_cmd_modes, only: modes_command
+    use ropedyn_cmd_keys, only: keys_command
     implicit none
 
     type(cli_t) :: cli
@@ -49,6 +51,8 @@ program ropedyn_main
         call statics_command(cli, err)
     case ('modes')
         call modes_command(cli, err)
+    case ('keys')
+        call keys_command(cli, err)
     case default
         call make_error(err, ERR_USAGE, 'unknown command "'//cli%command// &
                         '" (see ropedyn --help)')
@@ -68,14 +72,15 @@ contains
         write (unit, '(a)') '                       [--max-order K] [--repeat-time SECONDS] '// &
             '[--csv]'
         write (unit, '(a)') '       ropedyn testset --list'
-        write (unit, '(a)') '       ropedyn sweep SWEEP.nml [--jobs N | --task K | --summary '// &
-            '| --list | --count] ...'
+        write (unit, '(a)') '       ropedyn sweep SWEEP.nml [--jobs N | --task LIST | '// &
+            '--summary | --list | --count | --status] ...'
         write (unit, '(a)') '       ropedyn statics SCENE.nml [--set ...] [-o FILE.h5] '// &
             '[--max-iterations N]'
         write (unit, '(a)') '       ropedyn modes SCENE.nml [--count K] [--set ...] [-o FILE.h5]'
+        write (unit, '(a)') '       ropedyn keys   (every key of a scene file with its default)'
         write (unit, '(a)') '       ropedyn --version | --help;  ropedyn COMMAND --help'
         write (unit, '(a)') 'exit codes: 0 ok, 2 bad input, 3 integration failed, '// &
-            '4 output error, 5 internal error'
+            '4 output error, 5 internal error, 130 stopped by a signal'
         write (unit, '(a)') 'input reference: docs/input.md; test problems: docs/testset.md '// &
             '(ropedyn testset --help)'
     end subroutine usage

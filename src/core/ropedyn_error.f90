@@ -7,7 +7,7 @@ module ropedyn_error
     implicit none
     private
     public :: error_t, make_error
-    public :: ERR_USAGE, ERR_INPUT, ERR_SOLVER, ERR_IO, ERR_INTERNAL
+    public :: ERR_USAGE, ERR_INPUT, ERR_SOLVER, ERR_IO, ERR_INTERNAL, ERR_INTERRUPTED
     public :: exit_code_of
 
     !> Error classes. The exit codes of `ropedyn` are documented in docs/input.md.
@@ -16,6 +16,7 @@ module ropedyn_error
     integer, parameter :: ERR_SOLVER = 3    !< integration failed
     integer, parameter :: ERR_IO = 4        !< output could not be written
     integer, parameter :: ERR_INTERNAL = 5  !< a bug: an invariant did not hold
+    integer, parameter :: ERR_INTERRUPTED = 6  !< stopped by SIGINT or SIGTERM (exit 130)
 
     type :: error_t
         integer :: code = ERR_INTERNAL          !< one of the ERR_* classes
@@ -44,6 +45,8 @@ contains
             exit_code = 3
         case (ERR_IO)
             exit_code = 4
+        case (ERR_INTERRUPTED)
+            exit_code = 130
         case default
             exit_code = 5
         end select

@@ -1,13 +1,16 @@
 !> The operating-system services ropedyn needs, through POSIX: directories, the working
-!! directory, whether a stream is a terminal, sleeping, the number of processors.
+!! directory, renaming and removing files, whether a stream is a terminal, sleeping, the
+!! number of processors.
 module ropedyn_os
     use, intrinsic :: iso_c_binding, only: c_char, c_int, c_size_t, c_ptr, c_null_char, &
                                            c_associated
+    use, intrinsic :: iso_fortran_env, only: int64
     use ropedyn_error, only: error_t, make_error, ERR_IO
     implicit none
     private
     public :: make_dirs, make_parent_dirs, current_dir, is_terminal, sleep_microseconds, &
-              processor_count, absolute_path, utc_timestamp
+              processor_count, absolute_path, utc_timestamp, unwritable_dir, rename_file, &
+              delete_file, utc_text
 
     interface
         integer(c_int) function c_mkdir(path, mode) bind(C, name='mkdir')
@@ -32,6 +35,19 @@ module ropedyn_os
         integer(c_int) function c_get_nprocs() bind(C, name='get_nprocs')
             import :: c_int
         end function c_get_nprocs
+        integer(c_int) function c_rename(old, new) bind(C, name='rename')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: old(*), new(*)
+        end function c_rename
+        integer(c_int) function c_unlink(path) bind(C, name='unlink')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+        end function c_unlink
+        integer(c_int) function c_access(path, mode) bind(C, name='access')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int), value :: mode
+        end function c_access
     end interface
 
 contains
@@ -107,6 +123,54 @@ contains
         if (len(cwd) > 0) full = cwd//'/'//full
     end function absolute_path
 
+    !> Why `dir` could not be created or written by `make_dirs` and the files in it: '' when
+    !! it is a writable directory or its nearest existing ancestor is one, else the reason
+    !! (creates nothing).
+    function unwritable_dir(dir) result(reason)
+        character(len=*), intent(in) :: dir
+        character(len=:), allocatable :: reason, path
+        integer(c_int), parameter :: W_OK = 2, X_OK = 1
+        logical :: exists, is_dir
+        integer :: slash
+        path = trim(dir)
+        if (len(path) == 0) path = '.'
+        do
+            inquire (file=path//'/.', exist=is_dir)
+            if (is_dir) exit
+            inquire (file=path, exist=exists)
+            if (exists) then
+                reason = '"'//path//'" is not a directory'
+                return
+            end if
+            slash = index(path, '/', back=.true.)
+            if (slash == 0) then
+                path = '.'
+            else if (slash == 1) then
+                path = '/'
+            else
+                path = path(:slash - 1)
+            end if
+        end do
+        reason = ''
+        if (c_access(path//c_null_char, W_OK + X_OK) /= 0) reason = 'the directory "'// &
+            path//'" is not writable'
+    end function unwritable_dir
+
+    !> rename(2): `old` becomes `new` in one step (replacing `new`; both in the same file
+    !! system).
+    subroutine rename_file(old, new, err)
+        character(len=*), intent(in) :: old, new
+        type(error_t), allocatable, intent(out) :: err
+        if (c_rename(old//c_null_char, new//c_null_char) /= 0) call make_error(err, ERR_IO, &
+            'cannot rename "'//old//'" to "'//new//'"')
+    end subroutine rename_file
+
+    !> Remove the file `path`; true if it was removed (false also when it did not exist).
+    logical function delete_file(path) result(removed)
+        character(len=*), intent(in) :: path
+        removed = c_unlink(path//c_null_char) == 0
+    end function delete_file
+
     !> True when the file descriptor (0 stdin, 1 stdout, 2 stderr) is a terminal.
     logical function is_terminal(fd)
         integer, intent(in) :: fd
@@ -139,6 +203,24 @@ contains
         write (text, '(i4.4, "-", i2.2, "-", i2.2, "T", i2.2, ":", i2.2, ":", i2.2, "Z")') &
             year, month, day, minutes/60, modulo(minutes, 60), values(7)
     end function utc_timestamp
+
+    !> A time in s since 1970 as ISO 8601 UTC, e.g. 2024-05-01T12:34:56Z.
+    function utc_text(seconds) result(text)
+        integer(int64), intent(in) :: seconds
+        character(len=20) :: text
+        integer :: year, month, day, second_of_day
+        call civil_from_days(int(floor_div64(seconds, 86400_int64)), year, month, day)
+        second_of_day = int(seconds - floor_div64(seconds, 86400_int64)*86400_int64)
+        write (text, '(i4.4, "-", i2.2, "-", i2.2, "T", i2.2, ":", i2.2, ":", i2.2, "Z")') &
+            year, month, day, second_of_day/3600, mod(second_of_day, 3600)/60, &
+            mod(second_of_day, 60)
+    end function utc_text
+
+    pure integer(int64) function floor_div64(a, b) result(q)
+        integer(int64), intent(in) :: a, b
+        q = a/b
+        if (mod(a, b) /= 0 .and. a < 0) q = q - 1
+    end function floor_div64
 
     !> Days since 1970-01-01 of a proleptic Gregorian date (H. Hinnant's algorithm).
     pure integer function days_from_civil(year, month, day) result(days)

@@ -7,6 +7,12 @@ module ropedyn_text
     private
     public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, enclosed
     public :: lower, line_quote
+    public :: text_t, append_text, text_array, printable, clip, name_hint
+
+    !> A string of any length, for lists of strings of different lengths.
+    type :: text_t
+        character(len=:), allocatable :: s
+    end type text_t
 
     !> Decimal text of an integer (default or 64-bit kind).
     interface int_text
@@ -128,11 +134,17 @@ contains
         end if
     end function logical_text
 
-    !> A Fortran string literal: 'text', with embedded quotes doubled.
-    pure function quoted(text) result(s)
+    !> A Fortran string literal: 'text', with embedded quotes doubled; with `escape`, each
+    !! embedded quote is written as `escape` instead (a shell word: escape = "'\''").
+    pure function quoted(text, escape) result(s)
         character(len=*), intent(in) :: text
+        character(len=*), intent(in), optional :: escape
         character(len=:), allocatable :: s
-        s = enclosed(text, "'", "''")
+        if (present(escape)) then
+            s = enclosed(text, "'", escape)
+        else
+            s = enclosed(text, "'", "''")
+        end if
     end function quoted
 
     !> `text` between two `mark` characters, each `mark` inside it written as `escape`
@@ -166,14 +178,128 @@ contains
         end do
     end function lower
 
-    !> A line for a message: in double quotes, trailing blanks removed, long lines shortened.
+    !> A line for a message: in double quotes, trailing blanks removed, long lines shortened,
+    !! control characters shown as `printable` does.
     pure function line_quote(line) result(s)
         character(len=*), intent(in) :: line
         character(len=:), allocatable :: s
         if (len_trim(line) > 80) then
-            s = '"'//line(:77)//'..."'
+            s = '"'//printable(line(:77))//'..."'
         else
-            s = '"'//trim(line)//'"'
+            s = '"'//printable(trim(line))//'"'
         end if
     end function line_quote
+
+    !> Text safe to print: a control character (byte < 32 except tab, or 127) as `\xNN`.
+    pure function printable(text) result(s)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: s
+        character(len=*), parameter :: HEX = '0123456789abcdef'
+        character(len=:), allocatable :: buf
+        integer :: i, c, n
+        allocate (character(len=4*len(text)) :: buf)
+        n = 0
+        do i = 1, len(text)
+            c = iachar(text(i:i))
+            if ((c < 32 .and. c /= 9) .or. c == 127) then
+                buf(n + 1:n + 4) = '\x'//HEX(c/16 + 1:c/16 + 1)//HEX(mod(c, 16) + 1:mod(c, 16) + 1)
+                n = n + 4
+            else
+                buf(n + 1:n + 1) = text(i:i)
+                n = n + 1
+            end if
+        end do
+        s = buf(:n)
+    end function printable
+
+    !> A value for a message: at most 60 characters (a longer one as its first 40 and '...').
+    pure function clip(text) result(s)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: s
+        if (len(text) > 60) then
+            s = text(:40)//'...'
+        else
+            s = text
+        end if
+    end function clip
+
+    !> A list of strings as a character array (as long as the longest, at least 1).
+    pure function text_array(list) result(arr)
+        type(text_t), intent(in) :: list(:)
+        character(len=:), allocatable :: arr(:)
+        integer :: k, width
+        width = 1
+        do k = 1, size(list)
+            width = max(width, len(list(k)%s))
+        end do
+        allocate (character(len=width) :: arr(size(list)))
+        do k = 1, size(list)
+            arr(k) = list(k)%s
+        end do
+    end function text_array
+
+    !> Append one string to a list (grown by one).
+    pure subroutine append_text(list, value)
+        type(text_t), allocatable, intent(inout) :: list(:)
+        character(len=*), intent(in) :: value
+        type(text_t), allocatable :: grown(:)
+        integer :: k, n
+        if (.not. allocated(list)) allocate (list(0))
+        n = size(list)
+        allocate (grown(n + 1))
+        do k = 1, n
+            call move_alloc(list(k)%s, grown(k)%s)
+        end do
+        grown(n + 1)%s = value
+        call move_alloc(grown, list)
+    end subroutine append_text
+    !> '; did you mean "x"?' for a near miss of one of `names`, else '; keys: ' and the list.
+    function name_hint(names, key) result(text)
+        type(text_t), intent(in) :: names(:)
+        character(len=*), intent(in) :: key
+        character(len=:), allocatable :: text
+        integer :: k, d, best, best_k
+        best = huge(1)
+        best_k = 0
+        text = ''
+        do k = 1, size(names)
+            d = huge(1)
+            if (len(key) <= 64) d = edit_distance(lower(key), names(k)%s)
+            if (d < best) then
+                best = d
+                best_k = k
+            end if
+            if (k > 1) text = text//', '
+            text = text//names(k)%s
+        end do
+        if (best_k > 0 .and. best <= 2) then
+            text = '; did you mean "'//names(best_k)%s//'"?'
+        else
+            text = '; keys: '//text
+        end if
+    end function name_hint
+
+    !> Optimal string alignment distance (Levenshtein with transpositions).
+    pure integer function edit_distance(a, b) result(dist)
+        character(len=*), intent(in) :: a, b
+        integer :: d(0:len(a), 0:len(b)), i, j, cost
+        do i = 0, len(a)
+            d(i, 0) = i
+        end do
+        do j = 0, len(b)
+            d(0, j) = j
+        end do
+        do j = 1, len(b)
+            do i = 1, len(a)
+                cost = merge(0, 1, a(i:i) == b(j:j))
+                d(i, j) = min(d(i - 1, j) + 1, d(i, j - 1) + 1, d(i - 1, j - 1) + cost)
+                if (i > 1 .and. j > 1) then
+                    if (a(i:i) == b(j - 1:j - 1) .and. a(i - 1:i - 1) == b(j:j)) then
+                        d(i, j) = min(d(i, j), d(max(i - 2, 0), max(j - 2, 0)) + 1)
+                    end if
+                end if
+            end do
+        end do
+        dist = d(len(a), len(b))
+    end function edit_distance
 end module ropedyn_text

@@ -1,6 +1,7 @@
 !> Reading back a run file written by `ropedyn_output` (the case files of a sweep): the
 !! root attributes, the solver counters and, on request, the time series needed for
-!! error measures. Also adds the wall-clock time of a sweep case (`/solver/wall_time`).
+!! error measures. Also finishes a sweep case's file before it is renamed into place: its
+!! wall-clock time (`/solver/wall_time`) and the case's scene (`finish_case_file`).
 !!
 !! The HDF5 calls are those of `ropedyn_h5`; failures are `ERR_IO` errors naming the file
 !! and the object.
@@ -13,7 +14,7 @@ module ropedyn_case_file
     use ropedyn_output, only: COUNTER_NAMES
     implicit none
     private
-    public :: case_data_t, read_case_file, write_wall_time
+    public :: case_data_t, read_case_file, finish_case_file
 
     !> What a run file holds (the counters are -1 and the times NaN when absent).
     type :: case_data_t
@@ -123,10 +124,13 @@ contains
         end subroutine read_counters
     end subroutine read_case_file
 
-    !> Write (or overwrite) the scalar `/solver/wall_time` (s) of a closed run file.
-    subroutine write_wall_time(path, seconds, err)
+    !> Finish a case file written under a temporary name: write (or overwrite) the scalar
+    !! `/solver/wall_time` (s) and set the root attribute `scene` to `scene_text`, the
+    !! case's scene (the run saw the temporary file name as its output file).
+    subroutine finish_case_file(path, seconds, scene_text, err)
         character(len=*), intent(in) :: path
         real(wp), intent(in) :: seconds
+        character(len=*), intent(in) :: scene_text
         type(error_t), allocatable, intent(out) :: err
         type(h5_file_t) :: h5
         type(error_t), allocatable :: close_err
@@ -138,7 +142,8 @@ contains
         else
             call h5%write('/solver/wall_time', seconds, 's', err)
         end if
+        if (.not. allocated(err)) call h5%attribute('/', 'scene', scene_text, err)
         call h5%close(close_err)
         if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
-    end subroutine write_wall_time
+    end subroutine finish_case_file
 end module ropedyn_case_file

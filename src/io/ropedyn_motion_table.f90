@@ -2,7 +2,8 @@
 !! rows t (s), dx, dy (m), dangle (deg), read into the rows a `support_motion_t` takes.
 module ropedyn_motion_table
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, i8
+    use ropedyn_namelist_file, only: MAX_FILE_BYTES
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_text, only: int_text
     implicit none
@@ -28,6 +29,7 @@ contains
         real(wp) :: r(4), extra
         character(len=1024) :: line, msg
         integer :: unit, ios, m, lineno, lead, i, ios2
+        integer(i8) :: bytes
 
         allocate (rows(4, 64))
         m = 0
@@ -36,6 +38,14 @@ contains
               iostat=ios, iomsg=msg)
         if (ios /= 0) then
             call make_error(err, ERR_INPUT, where//' = "'//path//'": cannot open: '//trim(msg))
+            return
+        end if
+        inquire (unit=unit, size=bytes)
+        if (bytes > MAX_FILE_BYTES) then
+            call make_error(err, ERR_INPUT, where//' = "'//path//'": '//int_text(bytes)// &
+                ' bytes: too large for an input file (at most '//int_text(MAX_FILE_BYTES)// &
+                ' bytes)')
+            close (unit)
             return
         end if
         lineno = 0

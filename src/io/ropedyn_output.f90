@@ -14,6 +14,10 @@
 !!     /solver/order           (times,)               1
 !!     /solver/{steps, rhs_evals, jac_evals, lin_setups, err_test_fails, nonlin_iters,
 !!              nonlin_conv_fails} () int64 1;  /solver/cpu_time () s   (write_stats)
+!!     /solver/{time_advance, time_rhs, time_jacobian, time_factor, time_solve} () s: the
+!!              time in the integrator and where it went (&solver profile = .true.; else 0)
+!!     /solver/reduced_newton () int64 1: 1 when the Newton systems were solved on the
+!!              reduced second-order matrix
 !!
 !! Root attributes: status ('running' | 'complete' | 'failed'), reason (failed only),
 !! version, model, method, scene, created, units_convention. See docs/output.md.
@@ -35,7 +39,7 @@ module ropedyn_output
     use ropedyn_h5, only: h5_file_t, h5_series_t
     implicit none
     private
-    public :: output_file_t, write_provenance, COUNTER_NAMES, counter_values
+    public :: output_file_t, write_provenance, COUNTER_NAMES, counter_values, TIMER_NAMES
 
     !> The convention written into every file (root attribute `units_convention`).
     character(len=*), parameter :: units_convention = &
@@ -66,6 +70,11 @@ module ropedyn_output
     character(len=*), parameter :: COUNTER_NAMES(7) = [character(len=17) :: 'steps', &
         'rhs_evals', 'jac_evals', 'lin_setups', 'err_test_fails', 'nonlin_iters', &
         'nonlin_conv_fails']
+
+    !> The time split of `write_stats` (/solver/<name>, s; solver_stats_t's time_* fields,
+    !! measured with &solver profile = .true.), in the order of `timer_values`.
+    character(len=*), parameter :: TIMER_NAMES(5) = [character(len=13) :: 'time_advance', &
+        'time_rhs', 'time_jacobian', 'time_factor', 'time_solve']
 
     !> One HDF5 file of one simulation run.
     type, public :: output_file_t
@@ -257,6 +266,7 @@ contains
         real(wp), intent(in) :: cpu_time           !< CPU time of the run, s
         type(error_t), allocatable, intent(out) :: err
         integer(i8) :: counters(size(COUNTER_NAMES))
+        real(wp) :: times(size(TIMER_NAMES))
         integer :: k
 
         if (.not. self%is_open) then
@@ -271,9 +281,25 @@ contains
         end do
         call self%file%write('/solver/cpu_time', cpu_time, 's', err)
         if (allocated(err)) return
+        times = timer_values(stats)
+        do k = 1, size(TIMER_NAMES)
+            call self%file%write('/solver/'//trim(TIMER_NAMES(k)), times(k), 's', err)
+            if (allocated(err)) return
+        end do
+        call self%file%write('/solver/reduced_newton', merge(1_i8, 0_i8, stats%reduced_newton), &
+                             '1', err)
+        if (allocated(err)) return
 
         call self%file%flush(err)
     end subroutine output_write_stats
+
+    !> The time split of `stats` named in TIMER_NAMES, in that order (s).
+    pure function timer_values(stats) result(times)
+        type(solver_stats_t), intent(in) :: stats
+        real(wp) :: times(size(TIMER_NAMES))
+        times = [stats%time_advance, stats%time_rhs, stats%time_jac, stats%time_factor, &
+                 stats%time_solve]
+    end function timer_values
 
     !> The counters of `stats` named in COUNTER_NAMES, in that order.
     pure function counter_values(stats) result(counters)

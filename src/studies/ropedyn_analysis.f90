@@ -247,7 +247,8 @@ contains
     !> Forces of the supports on the rope at the equilibrium y, N: R = dV/d(anchor) with
     !! the coordinates held fixed (virtual work), by central differences of the potential
     !! energy of models rebuilt with the anchor moved by +-h (V is quadratic in the anchor
-    !! of a pinned support: exact up to rounding). Zero for a free end.
+    !! of a pinned support: exact up to rounding), point loads included (their potential at
+    !! t = 0: an MPP's ideal pin carries them). Zero for a free end.
     subroutine support_forces(scene, model, y, top, bottom, err)
         type(rope_spec_t), intent(in) :: scene
         class(rope_model_t), intent(inout) :: model
@@ -273,8 +274,8 @@ contains
         end if
         call create_model(base, probe, err)
         if (allocated(err)) return
-        v0 = potential_energy(model, y)
-        if (abs(potential_energy(probe, y) - v0) > 1.0e-12_wp*(abs(v0) + 1.0_wp)) then
+        v0 = potential_energy(model, y, base)
+        if (abs(potential_energy(probe, y, base) - v0) > 1.0e-12_wp*(abs(v0) + 1.0_wp)) then
             call make_error(err, ERR_INTERNAL, scene%path//': support forces: cannot '// &
                             'reproduce the default bottom anchor')
             return
@@ -288,12 +289,12 @@ contains
                 call shift(moved, s, c, h)
                 call create_model(moved, probe, err)
                 if (allocated(err)) return
-                vp = potential_energy(probe, y)
+                vp = potential_energy(probe, y, moved)
                 moved = base
                 call shift(moved, s, c, -h)
                 call create_model(moved, probe, err)
                 if (allocated(err)) return
-                vm = potential_energy(probe, y)
+                vm = potential_energy(probe, y, moved)
                 if (s == 1) then
                     top(c) = (vp - vm)/(2*h)
                 else

@@ -3,9 +3,10 @@
 module ropedyn_simulation
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp, i8
+    use ropedyn_text, only: real_text
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_IO, ERR_SOLVER
     use ropedyn_rope_model, only: rope_model_t, energy_t
-    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
+    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, clock_seconds
     use ropedyn_solvers, only: new_integrator
     use ropedyn_rfem, only: rfem_t, rfem_create
     use ropedyn_mpp, only: mpp_t, mpp_create
@@ -75,6 +76,8 @@ contains
         options%max_order = scene%solver%max_order
         options%max_steps = int(scene%solver%max_steps, i8)
         options%stab_lim_det = scene%solver%stability_limit_detection
+        options%first_order_newton = scene%solver%first_order_newton
+        options%profile = scene%solver%profile
     end function solver_options_of
 
     !> Run a validated scene. The output file is written as the run goes; a failed
@@ -94,6 +97,7 @@ contains
         real(wp), allocatable :: y(:), yq(:), q(:, :), qdot(:, :), points(:, :)
         real(wp), allocatable :: lengths(:), masses(:)
         real(wp) :: t, tout, cpu_start, cpu_now, dt, t_end
+        real(wp) :: clock_start, time_advance   ! &solver profile: time in advance_to, s
         integer :: n, k, n_out
         type(solver_stats_t) :: stats
 
@@ -113,6 +117,15 @@ contains
         t = 0.0_wp
         summary%file = trim(scene%output%file)
         summary%initial_energy = model%energy(t, y, yq)
+        ! the scene's limits keep the start finite; should a value still make it not, that is
+        ! bad input: say so before any file is created
+        if (.not. (all(ieee_is_finite(y)) .and. &
+                   ieee_is_finite(summary%initial_energy%balance()))) then
+            call make_error(err, ERR_INPUT, scene%path//': the initial state or its energy '// &
+                'is not finite (energy '//real_text(summary%initial_energy%balance())// &
+                ' J): a value of the scene is too large or too small (docs/input.md, Limits)')
+            return
+        end if
 
         call make_parent_dirs(summary%file, err)
         if (allocated(err)) return
@@ -124,6 +137,7 @@ contains
         if (allocated(err)) return
 
         call cpu_time(cpu_start)
+        time_advance = 0.0_wp
         if (scene%solver%fault_nan_after >= 0.0_wp) then
             ! testing aid (docs/input.md): the integrator sees a NaN right-hand side later on
             call fault_wrap(faulty, model, scene%solver%fault_nan_after)
@@ -144,7 +158,10 @@ contains
         do k = 1, n_out
             tout = min(real(k, wp)*dt, t_end)
             if (k == n_out) tout = t_end
+            if (scene%solver%profile) clock_start = clock_seconds()
             call integrator%advance_to(tout, t, y, yq(1:model%quad_size()), err)
+            if (scene%solver%profile) time_advance = time_advance + &
+                                                     (clock_seconds() - clock_start)
             if (allocated(err)) then
                 call progress%done()
                 ! keep the last good state if the solver got past the previous record
@@ -199,6 +216,7 @@ contains
             call cpu_time(cpu_now)
             summary%cpu_time = cpu_now - cpu_start
             summary%stats = integrator%stats()
+            summary%stats%time_advance = time_advance
             call out%write_stats(summary%stats, summary%cpu_time, ferr)
             call out%close_run(status, reason, ferr)
             if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)

@@ -22,13 +22,14 @@
 !! stiffness for a bottom anchor far from the start. Derivation and limits:
 !! docs/statics-modes.md.
 module ropedyn_statics
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: STATUS_OK
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_text, only: int_text, fixed_text
-    use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
+    use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given, N_ATTACH
+    use ropedyn_effect_factory, only: locate_on_bodies
     use ropedyn_ldl, only: ldl_t, ldl_factor, ldl_solve, bandwidth
     implicit none
     private
@@ -105,15 +106,45 @@ contains
     end function total_weight
 
     !> Potential energy V = elastic + gravity of state y (velocities are ignored by both), J.
-    real(wp) function potential_energy(model, y) result(v)
+    !! With `spec`, V also holds the potential -F.X of the spec's point loads frozen at
+    !! t = 0 (the statics' loads; in a run their work is external work, not part of V).
+    real(wp) function potential_energy(model, y, spec) result(v)
         class(rope_model_t), intent(inout) :: model
         real(wp), intent(in) :: y(:)
+        type(rope_spec_t), intent(in), optional :: spec
         type(energy_t) :: e
         real(wp) :: yq(max(1, model%quad_size()))
         yq = 0.0_wp
         e = model%energy(0.0_wp, y, yq)
         v = e%elastic + e%gravity
+        if (present(spec)) v = v + load_potential(model, spec, y)
     end function potential_energy
+
+    !> Potential -sum F_k(0).X_k of the point loads of a spec (none when `&effects
+    !! point_loads` is off), X_k = c + r e the load's point on its element, J. A load of
+    !! fixed direction frozen at its t = 0 value F0 + A sin(phase) is conservative.
+    real(wp) function load_potential(model, spec, y) result(v)
+        class(rope_model_t), intent(in) :: model
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(in) :: y(:)
+        real(wp) :: lengths(model%n_elements()), masses(model%n_elements()), r, force(2)
+        real(wp) :: q(3, model%n_elements()), qdot(3, model%n_elements())
+        integer :: k, body
+        v = 0.0_wp
+        if (.not. spec%effects%point_loads) return
+        associate (a => spec%attachments)
+            if (all(ieee_is_nan(a%load_positions))) return
+            call model%element_data(lengths, masses)
+            call model%fields(y, q, qdot, 0.0_wp)
+            do k = 1, N_ATTACH
+                if (ieee_is_nan(a%load_positions(k))) cycle
+                call locate_on_bodies(lengths, a%load_positions(k), body, r)
+                force = [a%load_force_x(k), a%load_force_y(k)] + [a%load_amplitude_x(k), &
+                    a%load_amplitude_y(k)]*sin(a%load_phase_deg(k)*PI/180.0_wp)
+                v = v - dot_product(force, q(1:2, body) + r*[cos(q(3, body)), sin(q(3, body))])
+            end do
+        end associate
+    end function load_potential
 
     !> Generalized force f = M(q) q'' of state y (at rest: -dV/dq), N or N m.
     subroutine generalized_force(model, y, pos, vel, f, status)
@@ -360,11 +391,11 @@ contains
             moved%supports%bottom_anchor = target + h*u
             call factory(moved, probe, err)
             if (allocated(err)) return
-            vp = potential_energy(probe, y)
+            vp = potential_energy(probe, y, moved)
             moved%supports%bottom_anchor = target - h*u
             call factory(moved, probe, err)
             if (allocated(err)) return
-            vm = potential_energy(probe, y)
+            vm = potential_energy(probe, y, moved)
             r = abs(vp - vm)/(2*h)
         end function anchor_pull
     end subroutine find_equilibrium
@@ -408,7 +439,7 @@ contains
                             'in the starting configuration')
             return
         end if
-        v_old = potential_energy(model, y)
+        v_old = potential_energy(model, y, spec)
         call model%coordinate_mass(y, mm)
         mdiag = [(mm(k, k), k = 1, nd)]
         ! shift scale: a step of the freest coordinate of L/10 (explicit estimate); the
@@ -552,7 +583,7 @@ contains
             y_new(pos) = y(pos) + dq
             call generalized_force(model, y_new, pos, vel, f_new, status)
             if (status /= STATUS_OK) return
-            v_new = potential_energy(model, y_new)
+            v_new = potential_energy(model, y_new, spec)
             if (.not. ieee_is_finite(v_new)) then
                 status = -1
                 return

@@ -1,39 +1,47 @@
-!> Running a sweep (docs/sweeps.md): list its cases, run them locally with N worker
-!! processes or one case for a Slurm array task, and summarize (the command line is
-!! src/app/ropedyn_cmd_sweep.f90).
+!> Running a sweep (docs/sweeps.md): list its cases and their status, run them locally with
+!! N worker processes, and summarize (the command line is src/app/ropedyn_cmd_sweep.f90;
+!! one case in one process is ropedyn_sweep_task).
 !!
 !! Parallel runs are processes, not threads (the HDF5 library is not thread-safe, and a
 !! crashing case must not take the others down): the local runner starts each case as
-!! `sh -c '<this executable> sweep SWEEP --task K --quiet ... >case.log 2>&1;
-!! echo $? >.case.rc.tmp && mv .case.rc.tmp .case.rc'` with
-!! `execute_command_line(wait=.false.)`, keeps at most N of them running, and polls for the
-!! `.rc` files, which carry each worker's exit status (including a crash's: the shell
-!! writes 128 + signal). The summary is built from the case files only, so the Slurm array
-!! and the local runner produce the same summary, and `--summary` can rebuild it at any time.
+!! `<this executable> sweep SWEEP --task K --quiet --output-dir DIR` in a process group of
+!! its own with stdout and stderr in `case_<id>.log`, keeps at most N of them running, and
+!! reaps them (waitpid) for their exit status. SIGINT and SIGTERM are forwarded to every
+!! worker's group; the runner waits for them (SIGKILL after STOP_GRACE s), removes their
+!! empty logs and stops with ERR_INTERRUPTED (exit 130). The summary is built from the case
+!! files only, so the Slurm array and the local runner produce the same summary, and
+!! `--summary` can rebuild it at any time.
 module ropedyn_sweep_runner
 
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
     use ropedyn_kinds, only: wp
-    use ropedyn_os, only: make_dirs, is_terminal, sleep_microseconds, processor_count
-    use ropedyn_error, only: error_t, make_error, ERR_USAGE, ERR_SOLVER, ERR_IO
-    use ropedyn_simulation, only: run_summary_t, run_scene
-    use ropedyn_sweep, only: sweep_t
-    use ropedyn_text, only: int_text, enclosed
-    use ropedyn_sweep_summary, only: case_row_t, case_status, build_summary
-    use ropedyn_case_file, only: write_wall_time
+    use ropedyn_os, only: make_dirs, is_terminal, sleep_microseconds, delete_file
+    use ropedyn_process, only: catch_signals, release_signals, signal_received, signal_name, &
+        spawn, reap, signal_group, SIGKILL
+    use ropedyn_error, only: error_t, make_error, ERR_SOLVER, ERR_INTERRUPTED
+    use ropedyn_sweep, only: sweep_t, text_t
+    use ropedyn_text, only: int_text
+    use ropedyn_sweep_status, only: case_state_t, case_state, STATUS_NAMES
+    use ropedyn_sweep_summary, only: case_row_t, build_summary, reference_setting
+    use ropedyn_sweep_task, only: case_label
     implicit none
     private
-    public :: sweep_options_t, list_cases, run_task, run_local, summarize
+    public :: sweep_options_t, list_cases, status_report, run_local, summarize
 
     !> Poll interval of the local runner, microseconds.
     integer, parameter :: POLL_US = 50000
+    !> s a stopped worker has to end after the forwarded signal, before SIGKILL.
+    integer, parameter :: STOP_GRACE = 10
+    !> Reasons shown per status by --status (the summary holds them all).
+    integer, parameter :: MAX_REASONS = 10
 
     !> The options of one `ropedyn sweep` command line.
     type :: sweep_options_t
         character(len=:), allocatable :: path, output_dir
         logical :: list = .false., count = .false., summary = .false., force = .false., &
-            quiet = .false.
-        integer :: jobs = 0, task = 0
+            quiet = .false., status = .false.
+        integer :: jobs = 0
+        integer, allocatable :: tasks(:)    !< --task LIST: the case ids (empty: none)
     end type sweep_options_t
 
 contains
@@ -44,20 +52,21 @@ contains
         logical, intent(in) :: quiet
         type(error_t), allocatable, intent(out) :: err
         type(case_row_t), allocatable :: rows(:)
+        type(text_t), allocatable :: warnings(:)
         call make_dirs(sweep%output_dir, err, 'sweep')
         if (allocated(err)) return
-        call build_summary(sweep, rows, err)
+        call build_summary(sweep, rows, warnings, err)
         if (allocated(err)) return
-        call report_summary(sweep, rows, quiet, err)
+        call report_summary(sweep, rows, warnings, quiet, err)
     end subroutine summarize
 
-    !> --list: one line per case: id, status of its file, overrides.
-    subroutine list_cases(sweep, err)
+    !> --list: one line per case: id, status, overrides.
+    subroutine list_cases(sweep)
         type(sweep_t), intent(in) :: sweep
-        type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: status, reason, line
+        type(case_state_t) :: state
+        character(len=:), allocatable :: line
         integer :: c, k, width
-        width = max(4, len(int_text(size(sweep%cases))))
+        width = id_width(sweep)
         write (output_unit, '(a)') 'sweep '//sweep%path//': '//int_text(size(sweep%cases))// &
             ' cases; base '//sweep%base//'; output '//sweep%output_dir
         line = ''
@@ -65,143 +74,159 @@ contains
             line = line//' '//sweep%set(k)%s
         end do
         if (len(line) > 0) write (output_unit, '(a)') 'every case:'//line
-        write (output_unit, '(a)') pad('case', width)//'  '//pad('status', 10)//'  overrides'
+        write (output_unit, '(a)') pad('case', width)//'  '//pad('status', 11)//'  overrides'
         do c = 1, size(sweep%cases)
-            call case_status(sweep%cases(c), status, reason, err)
-            if (allocated(err)) deallocate (err)
+            call case_state(sweep%cases(c), state)
             line = ''
             do k = 1, size(sweep%cases(c)%overrides)
                 line = line//' '//sweep%cases(c)%overrides(k)%s
             end do
-            write (output_unit, '(a)') pad(zero_padded(c, width), width)//'  '// &
-                pad(status, 10)//' '//line
+            write (output_unit, '(a)') zero_padded(c, width)//'  '//pad(state%status, 11)// &
+                ' '//line
         end do
     end subroutine list_cases
 
-    !> Run one case (an array task, or a worker of the local runner).
-    subroutine run_task(sweep, k, force, quiet, err)
+    !> --status: the cases counted by status, with their ids and reasons; an error
+    !! (ERR_SOLVER, exit 3) when a case is not complete.
+    subroutine status_report(sweep, err)
         type(sweep_t), intent(in) :: sweep
-        integer, intent(in) :: k
-        logical, intent(in) :: force, quiet
         type(error_t), allocatable, intent(out) :: err
-        type(run_summary_t) :: summary
-        type(error_t), allocatable :: werr
-        character(len=:), allocatable :: status, reason, label
-        integer(int64) :: start, finish, rate
-        real(wp) :: wall
-        logical :: exists
+        type(case_state_t) :: state
+        type(text_t), allocatable :: status(:), reason(:)
+        character(len=:), allocatable :: ids
+        integer :: c, k, n, shown, width, not_done
 
-        label = 'sweep: case '//zero_padded(k, max(4, len(int_text(size(sweep%cases)))))
-        associate (c => sweep%cases(k))
-            if (.not. force) then
-                call case_status(c, status, reason, werr)
-                if (status == 'complete') then
-                    if (.not. quiet) write (output_unit, '(a)') label//': complete already ('// &
-                        c%file//'), skipped'
-                    return
-                end if
-            end if
-            call make_dirs(sweep%output_dir, err, 'sweep')
-            if (allocated(err)) return
-            call system_clock(start, rate)
-            call run_scene(c%scene, summary, err)
-            call system_clock(finish)
-            wall = real(finish - start, wp)/real(rate, wp)
-            inquire (file=c%file, exist=exists)
-            if (exists .and. summary%records > 0) then
-                call write_wall_time(c%file, wall, werr)
-                if (allocated(werr) .and. .not. allocated(err)) call move_alloc(werr, err)
-            end if
-            if (allocated(err)) then
-                err%message = label//' ('//c%file//'): '//err%message
-                return
-            end if
-            if (.not. quiet) write (output_unit, '(a)') label//': complete: '// &
-                int_text(int(summary%stats%steps))//' steps, cpu '// &
-                seconds_text(summary%cpu_time)//', wall '//seconds_text(wall)//' -> '//c%file
-        end associate
-    end subroutine run_task
+        n = size(sweep%cases)
+        width = id_width(sweep)
+        allocate (status(n), reason(n))
+        do c = 1, n
+            call case_state(sweep%cases(c), state)
+            status(c)%s = state%status
+            reason(c)%s = state%reason
+        end do
+        write (output_unit, '(a)') 'sweep '//sweep%path//': '//int_text(n)//' cases; output '// &
+            sweep%output_dir
+        not_done = 0
+        do k = 1, size(STATUS_NAMES)
+            ids = ''
+            shown = 0
+            do c = 1, n
+                if (status(c)%s /= trim(STATUS_NAMES(k))) cycle
+                shown = shown + 1
+                if (k == 1) cycle
+                if (shown == 1) ids = ' '
+                if (shown <= 20) ids = ids//' '//zero_padded(c, width)
+            end do
+            if (shown > 20) ids = ids//' ... ('//int_text(shown - 20)//' more)'
+            if (k > 1) not_done = not_done + shown
+            write (output_unit, '(a)') '  '//pad(trim(STATUS_NAMES(k)), 11)// &
+                repeat(' ', max(1, 7 - len(int_text(shown))))//int_text(shown)//ids
+        end do
+        do k = 2, size(STATUS_NAMES)
+            shown = 0
+            do c = 1, n
+                if (status(c)%s /= trim(STATUS_NAMES(k)) .or. len(reason(c)%s) == 0) cycle
+                shown = shown + 1
+                if (shown > MAX_REASONS) cycle
+                write (output_unit, '(a)') zero_padded(c, width)//' '//status(c)%s//': '// &
+                    reason(c)%s
+            end do
+            if (shown > MAX_REASONS) write (output_unit, '(a)') '... and '// &
+                int_text(shown - MAX_REASONS)//' more '//trim(STATUS_NAMES(k))// &
+                ' (every reason: --summary, column reason of summary.csv)'
+        end do
+        if (not_done > 0) call make_error(err, ERR_SOLVER, 'sweep: '//int_text(not_done)// &
+            ' of '//int_text(n)//' cases not complete')
+    end subroutine status_report
 
-    !> The local runner: every case not complete yet, at most opt%jobs at a time, each in
-    !! its own process; then the summary.
+    !> The local runner: every case not complete yet (and not being written by another
+    !! process), at most opt%jobs at a time, each in its own process; then the summary.
     subroutine run_local(sweep, opt, exe, err)
         type(sweep_t), intent(in) :: sweep
         type(sweep_options_t), intent(in) :: opt
         character(len=*), intent(in) :: exe
         type(error_t), allocatable, intent(out) :: err
-        type(error_t), allocatable :: serr
         type(case_row_t), allocatable :: rows(:)
-        integer, allocatable :: todo(:), slot(:)
-        character(len=:), allocatable :: status, reason, base_cmd, rc_file
-        integer :: n, c, next, running, finished, failed, rc, s, width, cmdstat
+        type(text_t), allocatable :: warnings(:)
+        type(case_state_t) :: state
+        integer, allocatable :: todo(:), slot(:), pid(:), elsewhere(:)
+        character(len=:), allocatable :: args(:)
+        integer :: n, c, next, finished, failed, rc, s, width, sig
         integer(int64) :: start, now, rate, last_draw
-        logical :: tty, exists, redraw
-        character(len=256) :: cmdmsg
+        logical :: tty, redraw
 
         n = size(sweep%cases)
-        width = max(4, len(int_text(n)))
-        allocate (todo(0))
+        width = id_width(sweep)
+        allocate (todo(0), elsewhere(0))
         do c = 1, n
-            if (.not. opt%force) then
-                call case_status(sweep%cases(c), status, reason, serr)
-                if (status == 'complete') cycle
+            call case_state(sweep%cases(c), state)
+            if (state%status == 'running') then
+                elsewhere = [elsewhere, c]
+                cycle
             end if
+            if (state%status == 'complete' .and. .not. opt%force) cycle
             todo = [todo, c]
         end do
         call make_dirs(sweep%output_dir, err, 'sweep')
         if (allocated(err)) return
         tty = is_terminal(2) .and. .not. opt%quiet
-        if (.not. opt%quiet) write (error_unit, '(a)') 'sweep '//sweep%path//': '// &
-            int_text(n)//' cases, '//int_text(n - size(todo))//' complete already, '// &
-            'running '//int_text(size(todo))//' with '//int_text(min(opt%jobs, &
-            max(1, size(todo))))//' worker(s) -> '//sweep%output_dir
+        if (.not. opt%quiet) then
+            write (error_unit, '(a)') 'sweep '//sweep%path//': '//int_text(n)//' cases, '// &
+                int_text(n - size(todo) - size(elsewhere))//' complete already, running '// &
+                int_text(size(todo))//' with '//int_text(min(opt%jobs, max(1, size(todo))))// &
+                ' worker(s) -> '//sweep%output_dir
+            if (size(elsewhere) > 0) write (error_unit, '(a)') 'sweep: '// &
+                int_text(size(elsewhere))//' case(s) being written by another process, not ' &
+                //'started here: '//id_text(elsewhere)//' (ropedyn sweep '//sweep%path// &
+                ' --status names the writers)'
+        end if
 
-        base_cmd = quote(exe)//' sweep '//quote(sweep%path)//' --quiet --output-dir '// &
-            quote(sweep%output_dir)
-        if (opt%force) base_cmd = base_cmd//' --force'
-        allocate (slot(opt%jobs), source=0)
+        ! a worker's arguments: exe sweep SWEEP --quiet --output-dir DIR [--force] --task K
+        allocate (character(len=max(len(exe), len(sweep%path), len(sweep%output_dir), 16)) :: &
+            args(merge(9, 8, opt%force)))
+        args(:6) = [character(len=12) :: '', 'sweep', '', '--quiet', '--output-dir', '']
+        args(1) = exe
+        args(3) = sweep%path
+        args(6) = sweep%output_dir
+        if (opt%force) args(7) = '--force'
+        args(size(args) - 1) = '--task'
+        call catch_signals(err)
+        if (allocated(err)) return
+        allocate (slot(opt%jobs), pid(opt%jobs), source=0)
         next = 1
-        running = 0
         finished = 0
         failed = 0
         call system_clock(start, rate)
         last_draw = start
         do while (finished < size(todo))
+            sig = signal_received()
+            if (sig /= 0) exit
             ! start workers
             do s = 1, size(slot)
                 if (slot(s) /= 0 .or. next > size(todo)) cycle
                 c = todo(next)
-                next = next + 1
-                rc_file = rc_path(c)
-                call remove_file(rc_file)
-                call execute_command_line(base_cmd//' --task '//int_text(c)//' >'// &
-                    quote(log_path(c))//' 2>&1; echo $? >'//quote(rc_file//'.tmp')// &
-                    ' && mv -f '//quote(rc_file//'.tmp')//' '//quote(rc_file), &
-                    wait=.false., cmdstat=cmdstat, cmdmsg=cmdmsg)
-                if (cmdstat /= 0) then
-                    call make_error(err, ERR_IO, 'sweep: cannot start case '//int_text(c)// &
-                        ': '//trim(cmdmsg))
+                args(size(args)) = int_text(c)
+                call spawn(args, log_path(c), pid(s), err)
+                if (allocated(err)) then
+                    err%message = 'sweep: case '//zero_padded(c, width)//': '//err%message
+                    call stop_workers(SIGKILL)
+                    call release_signals()
                     return
                 end if
+                next = next + 1
                 slot(s) = c
-                running = running + 1
             end do
             call sleep_microseconds(POLL_US)
             ! collect finished workers
             redraw = .false.
             do s = 1, size(slot)
                 if (slot(s) == 0) cycle
+                if (.not. reap(pid(s), rc)) cycle
                 c = slot(s)
-                rc_file = rc_path(c)
-                inquire (file=rc_file, exist=exists)
-                if (.not. exists) cycle
-                rc = read_exit_code(rc_file)
-                call remove_file(rc_file)
                 slot(s) = 0
-                running = running - 1
                 finished = finished + 1
                 if (rc /= 0) failed = failed + 1
-                if (rc == 0) call remove_if_empty(log_path(c))
+                call remove_if_empty(log_path(c))
                 call system_clock(now)
                 if (.not. opt%quiet) then
                     if (tty) write (error_unit, '(a)', advance='no') achar(13)//repeat(' ', 78) &
@@ -223,22 +248,77 @@ contains
             end if
         end do
         if (tty) write (error_unit, '(a)') ''
+        sig = signal_received()
+        if (sig /= 0) then
+            call stop_workers(sig)
+            call release_signals()
+            call make_error(err, ERR_INTERRUPTED, 'sweep: stopped by '//signal_name(sig)// &
+                ': '//int_text(finished)//' of '//int_text(size(todo))//' cases ended, '// &
+                int_text(count(slot /= 0))//' interrupted'//stopped_text()//', '// &
+                int_text(size(todo) - next + 1)//' not started; no summary written (ropedyn ' &
+                //'sweep '//sweep%path//' --status tells each case''s status; running the ' &
+                //'sweep again goes on from there)')
+            return
+        end if
+        call release_signals()
 
-        call build_summary(sweep, rows, err)
+        call build_summary(sweep, rows, warnings, err)
         if (allocated(err)) return
-        call report_summary(sweep, rows, opt%quiet, err)
+        call report_summary(sweep, rows, warnings, opt%quiet, err)
     contains
-        function rc_path(id) result(path)
-            integer, intent(in) :: id
-            character(len=:), allocatable :: path
-            path = sweep%output_dir//'/.case_'//zero_padded(id, width)//'.rc'
-        end function rc_path
-
         function log_path(id) result(path)
             integer, intent(in) :: id
             character(len=:), allocatable :: path
             path = sweep%output_dir//'/case_'//zero_padded(id, width)//'.log'
         end function log_path
+
+        !> Forward `signal` to every running worker's process group and wait for them (at
+        !! most STOP_GRACE s, then SIGKILL); their empty logs go. `slot` keeps the cases of
+        !! the workers that were running.
+        subroutine stop_workers(signal)
+            integer, intent(in) :: signal
+            integer :: waited, code, k
+            logical :: sent, all_ended
+            logical :: ended(size(slot))
+            ended = slot == 0
+            do k = 1, size(slot)
+                if (.not. ended(k)) sent = signal_group(pid(k), signal)
+            end do
+            do waited = 1, STOP_GRACE*1000000/POLL_US + 40
+                if (waited == STOP_GRACE*1000000/POLL_US) then
+                    do k = 1, size(slot)
+                        if (.not. ended(k)) sent = signal_group(pid(k), SIGKILL)
+                    end do
+                end if
+                all_ended = .true.
+                do k = 1, size(slot)
+                    if (ended(k)) cycle
+                    ended(k) = reap(pid(k), code)
+                    if (ended(k)) call remove_if_empty(log_path(slot(k)))
+                    all_ended = all_ended .and. ended(k)
+                end do
+                if (all_ended) exit
+                call sleep_microseconds(POLL_US)
+            end do
+        end subroutine stop_workers
+
+        function stopped_text() result(text)
+            character(len=:), allocatable :: text
+            text = ''
+            if (count(slot /= 0) > 0) text = ' ('//id_text(pack(slot, slot /= 0))//')'
+        end function stopped_text
+
+        function id_text(ids) result(text)
+            integer, intent(in) :: ids(:)
+            character(len=:), allocatable :: text
+            integer :: k
+            text = ''
+            do k = 1, min(size(ids), 20)
+                if (k > 1) text = text//' '
+                text = text//zero_padded(ids(k), width)
+            end do
+            if (size(ids) > 20) text = text//' ...'
+        end function id_text
 
         function outcome(code, id) result(text)
             integer, intent(in) :: code, id
@@ -246,7 +326,7 @@ contains
             if (code == 0) then
                 text = 'complete'
             else if (code > 128) then
-                text = 'crashed (signal '//int_text(code - 128)//'; see '//log_path(id)//')'
+                text = 'ended by '//signal_name(code - 128)//' (see '//log_path(id)//')'
             else
                 text = 'failed (exit '//int_text(code)//'; see '//log_path(id)//')'
             end if
@@ -268,63 +348,62 @@ contains
         end function progress_text
     end subroutine run_local
 
-    !> Print the outcome of the summary; an error (ERR_SOLVER) if a case is not complete.
-    subroutine report_summary(sweep, rows, quiet, err)
+    !> Print the outcome of the summary: the reference fallbacks as warnings, the cases not
+    !! complete with their reasons; an error (ERR_SOLVER) if a case is not complete.
+    subroutine report_summary(sweep, rows, warnings, quiet, err)
         type(sweep_t), intent(in) :: sweep
         type(case_row_t), intent(in) :: rows(:)
+        type(text_t), intent(in) :: warnings(:)
         logical, intent(in) :: quiet
         type(error_t), allocatable, intent(out) :: err
-        integer :: complete, bad
-        complete = count([(rows(bad)%status == 'complete', bad=1, size(rows))])
+        integer :: complete, bad, c, shown
+        do c = 1, size(warnings)
+            write (error_unit, '(a)') 'sweep: warning: '//warnings(c)%s
+        end do
+        complete = count([(rows(c)%status == 'complete', c=1, size(rows))])
         bad = size(rows) - complete
         if (.not. quiet) write (error_unit, '(a)') 'sweep: '//int_text(complete)//' of '// &
             int_text(size(rows))//' cases complete; summary: '//sweep%output_dir// &
-            '/summary.csv, summary.h5'
-        if (bad > 0) call make_error(err, ERR_SOLVER, 'sweep: '//int_text(bad)//' of '// &
-            int_text(size(rows))//' cases not complete (failed, missing or stale; reasons in '// &
-            sweep%output_dir//'/summary.csv)')
+            '/summary.csv, summary.h5 (reference: '//reference_setting(sweep)//')'
+        if (bad == 0) return
+        shown = 0
+        do c = 1, size(rows)
+            if (rows(c)%status == 'complete') cycle
+            shown = shown + 1
+            if (shown > 20) exit
+            write (error_unit, '(a)') case_label(sweep, c)//': '//rows(c)%status// &
+                reason_text(rows(c)%reason)
+        end do
+        if (bad > 20) write (error_unit, '(a)') 'sweep: ... and '//int_text(bad - 20)// &
+            ' more (summary.csv)'
+        call make_error(err, ERR_SOLVER, 'sweep: '//int_text(bad)//' of '// &
+            int_text(size(rows))//' cases not complete (reasons in '//sweep%output_dir// &
+            '/summary.csv)')
+    contains
+        function reason_text(reason) result(text)
+            character(len=*), intent(in) :: reason
+            character(len=:), allocatable :: text
+            text = ''
+            if (len(reason) > 0) text = ': '//reason
+        end function reason_text
     end subroutine report_summary
+
+    integer function id_width(sweep)
+        type(sweep_t), intent(in) :: sweep
+        id_width = max(4, len(int_text(size(sweep%cases))))
+    end function id_width
 
     ! ------------------------------------------------------------------------------------
     ! Files and text
     ! ------------------------------------------------------------------------------------
-
-    subroutine remove_file(path)
-        character(len=*), intent(in) :: path
-        integer :: unit, ios
-        logical :: exists
-        inquire (file=path, exist=exists)
-        if (.not. exists) return
-        open (newunit=unit, file=path, status='old', iostat=ios)
-        if (ios == 0) close (unit, status='delete', iostat=ios)
-    end subroutine remove_file
 
     subroutine remove_if_empty(path)
         character(len=*), intent(in) :: path
         integer :: size_bytes
         logical :: exists
         inquire (file=path, exist=exists, size=size_bytes)
-        if (exists .and. size_bytes == 0) call remove_file(path)
+        if (exists .and. size_bytes == 0) exists = .not. delete_file(path)
     end subroutine remove_if_empty
-
-    !> The exit status a worker's shell wrote; 255 if unreadable.
-    integer function read_exit_code(path) result(code)
-        character(len=*), intent(in) :: path
-        integer :: unit, ios
-        code = 255
-        open (newunit=unit, file=path, status='old', action='read', iostat=ios)
-        if (ios /= 0) return
-        read (unit, *, iostat=ios) code
-        if (ios /= 0) code = 255
-        close (unit)
-    end function read_exit_code
-
-    !> A shell word: 'text' with embedded single quotes as '\''.
-    pure function quote(text) result(s)
-        character(len=*), intent(in) :: text
-        character(len=:), allocatable :: s
-        s = enclosed(text, "'", "'\''")
-    end function quote
 
     pure function zero_padded(n, width) result(s)
         integer, intent(in) :: n, width
@@ -340,16 +419,6 @@ contains
         character(len=max(width, len(text))) :: s
         s = text
     end function pad
-
-    function seconds_text(x) result(s)
-        real(wp), intent(in) :: x
-        character(len=:), allocatable :: s
-        character(len=16) :: buf
-        write (buf, '(f0.3)') x
-        s = trim(adjustl(buf))
-        if (s(1:1) == '.') s = '0'//s
-        s = s//' s'
-    end function seconds_text
 
     !> 42 s, 3m05s, 2h03m.
     function clock_text(x) result(s)

@@ -2,21 +2,26 @@
 !! parameters, status, cost counters, errors against the reference and energy-balance
 !! error, written as `<output_dir>/summary.csv` and `<output_dir>/summary.h5`
 !! (docs/sweeps.md lists the columns).
+!!
+!! The reference of a row is named (`reference`: the case id; `reference_kind`: how it
+!! relates to the row), and when the tightest case of a reference group is not complete,
+!! the looser case used instead is a warning in the row and in `warnings` (printed by the
+!! caller).
 module ropedyn_sweep_summary
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_text, only: int_text, real_text, enclosed
+    use ropedyn_text, only: int_text, real_text, enclosed, text_t, append_text
     use ropedyn_error, only: error_t, make_error, ERR_IO
-    use ropedyn_scene, only: scene_namelist_text
-    use ropedyn_sweep, only: sweep_t, sweep_case_t, REF_NONE, &
-        REF_TIGHTEST, REF_FILE
+    use ropedyn_sweep, only: sweep_t, sweep_case_t, REF_NONE, REF_TIGHTEST, &
+        REF_TIGHTEST_PER_METHOD, REF_FILE
+    use ropedyn_sweep_status, only: case_state_t, case_state
     use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_h5, only: h5_file_t
     use ropedyn_output, only: COUNTER_NAMES
     use ropedyn_version, only: version_string
     implicit none
     private
-    public :: case_row_t, case_status, build_summary
+    public :: case_row_t, build_summary, reference_setting
 
     !> Columns of summary.h5 measured per case: name and units (docs/sweeps.md).
     character(len=*), parameter :: MEASURED(2, 8) = reshape([character(len=18) :: &
@@ -27,61 +32,56 @@ module ropedyn_sweep_summary
     !> One row of the summary.
     type :: case_row_t
         integer :: id = 0
-        character(len=:), allocatable :: status  !< complete|failed|running|stale|missing
+        character(len=:), allocatable :: status  !< one of STATUS_NAMES (ropedyn_sweep_status)
         character(len=:), allocatable :: reason
         real(wp) :: t_reached, wall_time, cpu_time                     !< s (NaN: absent)
         !> the solver counters named in ropedyn_output's COUNTER_NAMES (-1: absent)
         integer(i8) :: counters(size(COUNTER_NAMES)) = -1
         integer :: reference = 0                 !< case id of the reference (0: none)
+        !> tighter | same_rtol | self | file | none (docs/sweeps.md)
+        character(len=:), allocatable :: reference_kind
+        character(len=:), allocatable :: warning  !< about the reference ('' if none)
         real(wp) :: tip_error_final, tip_error_max, position_error_max  !< m
         real(wp) :: energy_error_final, energy_error_max                !< J
     end type case_row_t
 
 contains
 
-    !> Status of a case from its file: 'missing' (no file), 'stale' (a file of another
-    !! scene: the sweep changed), else the file's status (complete, failed, running).
-    subroutine case_status(c, status, reason, err, data, series)
-        type(sweep_case_t), intent(in) :: c
-        character(len=:), allocatable, intent(out) :: status, reason
-        type(error_t), allocatable, intent(out) :: err
-        type(case_data_t), intent(out), optional :: data
-        logical, intent(in), optional :: series
-        type(case_data_t) :: d
-        reason = ''
-        call read_case_file(c%file, d, err, series)
-        if (allocated(err)) then
-            status = 'unreadable'
-            reason = err%message
-        else if (.not. d%exists) then
-            status = 'missing'
-        else if (d%scene /= scene_namelist_text(c%scene)) then
-            status = 'stale'
-            reason = 'the file holds another scene than this case (the sweep changed); ' &
-                //'run the sweep again'
-        else
-            status = d%status
-            if (status == 'failed') reason = d%reason
-            if (status == 'running') reason = 'the run did not finish (crashed, killed or ' &
-                //'still running)'
-        end if
-        if (present(data)) data = d
-    end subroutine case_status
+    !> The sweep's `reference` setting as written in summary.h5 and on the terminal.
+    function reference_setting(sweep) result(text)
+        type(sweep_t), intent(in) :: sweep
+        character(len=:), allocatable :: text
+        select case (sweep%reference)
+        case (REF_NONE)
+            text = 'none'
+        case (REF_TIGHTEST)
+            text = 'tightest'
+        case (REF_TIGHTEST_PER_METHOD)
+            text = 'tightest_per_method'
+        case default
+            text = sweep%reference_file
+        end select
+    end function reference_setting
 
     !> Build the rows from the case files and write summary.csv and summary.h5.
-    subroutine build_summary(sweep, rows, err)
+    !! `warnings`: one line per reference group whose reference fell back to a looser case.
+    subroutine build_summary(sweep, rows, warnings, err)
         type(sweep_t), intent(in) :: sweep
         type(case_row_t), allocatable, intent(out) :: rows(:)
+        type(text_t), allocatable, intent(out) :: warnings(:)
         type(error_t), allocatable, intent(out) :: err
         type(case_data_t) :: data, ref_data
-        type(error_t), allocatable :: case_err
+        type(case_state_t) :: state
         real(wp) :: nan
-        integer :: c, g, best
-        logical :: have_file_ref
+        integer :: c, j, best, tightest, n
+        integer, allocatable :: members(:)
+        logical, allocatable :: done(:)
+        character(len=:), allocatable :: warning
 
         nan = ieee_value(1.0_wp, ieee_quiet_nan)
-        allocate (rows(size(sweep%cases)))
-        do c = 1, size(sweep%cases)
+        n = size(sweep%cases)
+        allocate (rows(n), warnings(0), done(n))
+        do c = 1, n
             rows(c)%id = c
             rows(c)%t_reached = nan
             rows(c)%wall_time = nan
@@ -91,17 +91,24 @@ contains
             rows(c)%position_error_max = nan
             rows(c)%energy_error_final = nan
             rows(c)%energy_error_max = nan
-            call case_status(sweep%cases(c), rows(c)%status, rows(c)%reason, case_err, data)
-            if (rows(c)%status == 'missing' .or. rows(c)%status == 'unreadable' .or. &
+            rows(c)%reference_kind = ''
+            rows(c)%warning = ''
+            call case_state(sweep%cases(c), state)
+            rows(c)%status = state%status
+            rows(c)%reason = state%reason
+            done(c) = rows(c)%status /= 'complete'
+            if (.not. state%data%exists .or. rows(c)%status == 'unreadable' .or. &
                 rows(c)%status == 'stale') cycle
-            rows(c)%wall_time = data%wall_time
-            rows(c)%cpu_time = data%cpu_time
-            rows(c)%counters = data%counters
-            if (data%records > 0) rows(c)%t_reached = data%time(data%records)
+            ! interrupted by an abandoned lock: the file is an older run's
+            if (rows(c)%status == 'interrupted' .and. state%data%status /= 'interrupted' .and. &
+                state%data%status /= 'running') cycle
+            rows(c)%wall_time = state%data%wall_time
+            rows(c)%cpu_time = state%data%cpu_time
+            rows(c)%counters = state%data%counters
+            if (state%data%records > 0) rows(c)%t_reached = state%data%time(state%data%records)
+            if (rows(c)%status == 'complete') call energy_errors(state%data, rows(c))
         end do
 
-        ! errors against the reference
-        have_file_ref = .false.
         if (sweep%reference == REF_FILE) then
             call read_case_file(sweep%reference_file, ref_data, err, series=.true.)
             if (allocated(err)) return
@@ -110,50 +117,120 @@ contains
                     sweep%reference_file//'": no such file')
                 return
             end if
-            have_file_ref = .true.
         end if
-        do g = 1, sweep%n_groups
-            best = 0
-            if (sweep%reference == REF_TIGHTEST) then
-                do c = 1, size(sweep%cases)
-                    if (sweep%cases(c)%group /= g .or. rows(c)%status /= 'complete') cycle
-                    if (best == 0) then
-                        best = c
-                    else if (sweep%cases(c)%scene%solver%rtol < &
-                             sweep%cases(best)%scene%solver%rtol) then
-                        best = c
-                    end if
+        ! the reference sets: the cases of one group (and method, per method)
+        done = .false.
+        do c = 1, n
+            if (done(c)) cycle
+            members = pack([(j, j=1, n)], [(same_set(c, j), j=1, n)])
+            done(members) = .true.
+            if (sweep%reference == REF_NONE) then
+                do j = 1, size(members)
+                    if (rows(members(j))%status == 'complete') &
+                        rows(members(j))%reference_kind = 'none'
                 end do
-                if (best == 0) cycle
-                call read_case_file(sweep%cases(best)%file, ref_data, err, series=.true.)
-                if (allocated(err)) return
-            else if (.not. have_file_ref) then
                 cycle
             end if
-            do c = 1, size(sweep%cases)
-                if (sweep%cases(c)%group /= g .or. rows(c)%status /= 'complete') cycle
-                call read_case_file(sweep%cases(c)%file, data, err, series=.true.)
-                if (allocated(err)) return
-                call energy_errors(data, rows(c))
-                if (c == best) cycle
-                rows(c)%reference = best
-                call position_errors(data, ref_data, rows(c))
+            if (sweep%reference == REF_FILE) then
+                do j = 1, size(members)
+                    associate (m => members(j))
+                        if (rows(m)%status /= 'complete') cycle
+                        rows(m)%reference_kind = 'file'
+                        call compare(m)
+                        if (allocated(err)) return
+                    end associate
+                end do
+                cycle
+            end if
+            ! the tightest case of the set, and the tightest complete one (ties: lowest id)
+            tightest = members(1)
+            best = 0
+            do j = 1, size(members)
+                associate (m => members(j))
+                    if (rtol(m) < rtol(tightest)) tightest = m
+                    if (rows(m)%status /= 'complete') cycle
+                    if (best == 0) then
+                        best = m
+                    else if (rtol(m) < rtol(best)) then
+                        best = m
+                    end if
+                end associate
+            end do
+            warning = ''
+            if (best == 0) then
+                cycle
+            else if (rtol(best) > rtol(tightest)) then
+                warning = 'reference falls back to case '//int_text(best)//' (rtol '// &
+                    real_text(rtol(best), compact=.true.)//'): the tightest case '// &
+                    int_text(tightest)//' (rtol '//real_text(rtol(tightest), compact=.true.)// &
+                    ') is not complete ('//rows(tightest)%status//')'
+                call append_text(warnings, 'cases '//id_list(members)//': '//warning)
+            end if
+            call read_case_file(sweep%cases(best)%file, ref_data, err, series=.true.)
+            if (allocated(err)) return
+            do j = 1, size(members)
+                associate (m => members(j))
+                    if (rows(m)%status /= 'complete') cycle
+                    rows(m)%warning = warning
+                    if (m == best) then
+                        rows(m)%reference_kind = 'self'
+                        cycle
+                    end if
+                    rows(m)%reference = best
+                    rows(m)%reference_kind = 'tighter'
+                    if (rtol(best) >= rtol(m)) rows(m)%reference_kind = 'same_rtol'
+                    call compare(m)
+                    if (allocated(err)) return
+                end associate
             end do
         end do
-        ! energy errors of complete cases that had no reference group pass
-        if (sweep%reference == REF_NONE) then
-            do c = 1, size(sweep%cases)
-                if (rows(c)%status /= 'complete') cycle
-                call read_case_file(sweep%cases(c)%file, data, err, series=.true.)
-                if (allocated(err)) return
-                call energy_errors(data, rows(c))
-            end do
-        end if
 
         call write_csv(sweep, rows, err)
         if (allocated(err)) return
         call write_h5(sweep, rows, err)
+    contains
+        real(wp) function rtol(k)
+            integer, intent(in) :: k
+            rtol = sweep%cases(k)%scene%solver%rtol
+        end function rtol
+
+        !> Whether cases a and b share a reference.
+        logical function same_set(a, b)
+            integer, intent(in) :: a, b
+            same_set = sweep%cases(a)%group == sweep%cases(b)%group
+            if (sweep%reference == REF_TIGHTEST_PER_METHOD) same_set = same_set .and. &
+                sweep%cases(a)%scene%solver%method == sweep%cases(b)%scene%solver%method
+        end function same_set
+
+        !> Position errors of complete case k against ref_data.
+        subroutine compare(k)
+            integer, intent(in) :: k
+            logical :: matched
+            call read_case_file(sweep%cases(k)%file, data, err, series=.true.)
+            if (allocated(err)) return
+            call position_errors(data, ref_data, rows(k), matched)
+            if (.not. matched) then
+                if (len(rows(k)%warning) > 0) rows(k)%warning = rows(k)%warning//'; '
+                rows(k)%warning = rows(k)%warning//'no position errors: the output times or ' &
+                    //'the element count differ from the reference''s'
+            end if
+        end subroutine compare
     end subroutine build_summary
+
+    !> '1-4' or '1, 3, 5' for a sorted list of ids.
+    function id_list(ids) result(text)
+        integer, intent(in) :: ids(:)
+        character(len=:), allocatable :: text
+        integer :: k
+        text = int_text(ids(1))
+        if (ids(size(ids)) - ids(1) == size(ids) - 1) then
+            if (size(ids) > 1) text = text//'-'//int_text(ids(size(ids)))
+            return
+        end if
+        do k = 2, size(ids)
+            text = text//', '//int_text(ids(k))
+        end do
+    end function id_list
 
     !> |B(t_end) - B(0)| and max |B(t) - B(0)|, B = T + V + dissipated - support work.
     subroutine energy_errors(data, row)
@@ -165,17 +242,21 @@ contains
     end subroutine energy_errors
 
     !> Tip and all-point position errors against a reference with the same output times
-    !! (the case's times must be the first times of the reference); NaN otherwise.
-    subroutine position_errors(data, ref, row)
+    !! (the case's times must be the first times of the reference); NaN otherwise
+    !! (`matched` false).
+    subroutine position_errors(data, ref, row, matched)
         type(case_data_t), intent(in) :: data, ref
         type(case_row_t), intent(inout) :: row
+        logical, intent(out) :: matched
         integer :: m, np, k, j
         real(wp) :: tip, worst
         m = data%records
         np = size(data%points, 2)
+        matched = .false.
         if (m < 1 .or. ref%records < m .or. size(ref%points, 2) /= np) return
         if (maxval(abs(data%time - ref%time(:m))) > 1.0e-9_wp*(1.0_wp + abs(data%time(m)))) &
             return
+        matched = .true.
         row%tip_error_max = 0.0_wp
         row%position_error_max = 0.0_wp
         do k = 1, m
@@ -217,8 +298,8 @@ contains
         do v = 1, size(COUNTER_NAMES)
             line = line//','//trim(COUNTER_NAMES(v))
         end do
-        line = line//',reference,tip_error_final,tip_error_max,position_error_max,' &
-            //'energy_error_final,energy_error_max,file,reason'
+        line = line//',reference,reference_kind,tip_error_final,tip_error_max,' &
+            //'position_error_max,energy_error_final,energy_error_max,file,reason,warning'
         write (unit, '(a)', iostat=ios, iomsg=msg) line
         do c = 1, size(rows)
             if (ios /= 0) exit
@@ -237,10 +318,11 @@ contains
                     line = line//count_text(r%counters(v))//','
                 end do
                 if (r%reference > 0) line = line//int_text(r%reference)
-                line = line//','//num(r%tip_error_final)//','//num(r%tip_error_max)//','// &
-                    num(r%position_error_max)//','//num(r%energy_error_final)//','// &
-                    num(r%energy_error_max)//','//csv_text(sweep%cases(c)%file)//','// &
-                    csv_text(one_line(r%reason))
+                line = line//','//r%reference_kind//','//num(r%tip_error_final)//','// &
+                    num(r%tip_error_max)//','//num(r%position_error_max)//','// &
+                    num(r%energy_error_final)//','//num(r%energy_error_max)//','// &
+                    csv_text(sweep%cases(c)%file)//','//csv_text(one_line(r%reason))//','// &
+                    csv_text(one_line(r%warning))
             end associate
             write (unit, '(a)', iostat=ios, iomsg=msg) line
         end do
@@ -354,33 +436,25 @@ contains
             end do
             call h5%write('/reference', int(rows%reference, i8), '1', err)
             if (allocated(err)) exit steps
+            call text_column('reference_kind')
+            if (allocated(err)) exit steps
             call text_column('file')
             if (allocated(err)) exit steps
             call text_column('reason')
+            if (allocated(err)) exit steps
+            call text_column('warning')
             if (allocated(err)) exit steps
             call h5%attribute('/', 'sweep', sweep%path, err)
             if (allocated(err)) exit steps
             call h5%attribute('/', 'base', sweep%base, err)
             if (allocated(err)) exit steps
-            call h5%attribute('/', 'reference', reference_text(), err)
+            call h5%attribute('/', 'reference', reference_setting(sweep), err)
             if (allocated(err)) exit steps
             call h5%attribute('/', 'version', version_string, err)
         end block steps
         call h5%close(close_err)
         if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
     contains
-        function reference_text() result(text)
-            character(len=:), allocatable :: text
-            select case (sweep%reference)
-            case (REF_NONE)
-                text = 'none'
-            case (REF_TIGHTEST)
-                text = 'tightest'
-            case default
-                text = sweep%reference_file
-            end select
-        end function reference_text
-
         !> The column `name` of strings (a varied key's with its index `vary`), null-padded
         !! to the longest entry (at least one character).
         subroutine text_column(name, vary)
@@ -421,6 +495,10 @@ contains
                 value = trim(sweep%cases(j)%scene%solver%method)
             case ('file')
                 value = sweep%cases(j)%file
+            case ('reference_kind')
+                value = rows(j)%reference_kind
+            case ('warning')
+                value = rows(j)%warning
             case default
                 value = rows(j)%reason
             end select

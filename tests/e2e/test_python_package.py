@@ -21,13 +21,17 @@ COMMANDS = {
     "fig5": "ropedyn.studies.fig5",
     "calibrate": "ropedyn.studies.calibrate",
     "bench_effects": "ropedyn.studies.bench_effects",
+    "bench_kernels": "ropedyn.studies.bench_kernels",
     "bench_models": "ropedyn.studies.bench_models",
     "bench_rfem": "ropedyn.studies.bench_rfem",
     "bench_sweep": "ropedyn.studies.bench_sweep",
+    "profile_step": "ropedyn.studies.profile_step",
     "validation": "ropedyn.studies.validation",
     "work_precision": "ropedyn.studies.work_precision",
     "work_precision_testset": "ropedyn.studies.work_precision_testset",
     "stability_report": "ropedyn.studies.stability_report",
+    "update_references": "ropedyn.studies.update_references",
+    "mutation_check": "ropedyn.studies.mutation_check",
 }
 # Python files under scripts/ that the README and docs/ call by path
 SHIMS = {"plot_energy.py": "ropedyn.plot.energy",

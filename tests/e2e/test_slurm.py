@@ -1,6 +1,11 @@
-"""A sweep on a real single-node Slurm cluster: scripts/slurm/submit queues the job array and
-the dependent summary job; the summary must equal the local runner's (same cases, same
-results up to floating-point reproducibility; times differ).
+"""Sweeps on a real single-node Slurm cluster, started once for this module:
+scripts/slurm/submit queues the job arrays (several cases per task; split at the cluster's
+MaxArraySize, 6 here) and the dependent summary job; the summary must equal the local
+runner's (same cases, same results up to floating-point reproducibility; times differ).
+Also: two submissions of one sweep at once (one writer per case; the second is warned, the
+task that finds its case taken fails and its summary job says so), `submit --missing`
+(queues only the cases not complete, keeps the earlier logs), a cancelled task (its case is
+`interrupted`, the summary job names the CANCELLED task).
 
 The test starts its own cluster on localhost, as root: munged (own key, socket and files in
 a temporary directory), slurmctld and slurmd in the foreground (-D) as child processes,
@@ -40,6 +45,14 @@ SWEEP = """&sweep
 
 # columns that hold timings (differ between runs) or the case file name (differs by dir)
 VOLATILE = {"wall_time", "cpu_time", "file"}
+
+# one case of a few seconds (Debug build), to be caught while it runs
+LONG = """&sweep
+    base = 'base.nml'
+    set = 'solver.t_end={t_end}', 'model.elements=20'
+    rtols = {rtols}
+/
+"""
 
 
 def _missing_tools():
@@ -122,7 +135,7 @@ SlurmdParameters=config_overrides
 JobCompType=jobcomp/none
 AccountingStorageType=accounting_storage/none
 JobAcctGatherType=jobacct_gather/none
-MaxArraySize=1001
+MaxArraySize=6
 MinJobAge=600
 NodeName=localhost NodeAddr=127.0.0.1 CPUs=2 State=UNKNOWN
 PartitionName=test Nodes=localhost Default=YES MaxTime=INFINITE State=UP
@@ -190,6 +203,25 @@ def read_rows(path):
         return list(csv.DictReader(f))
 
 
+def submit(slurm, cwd, exe, *args, timeout=300):
+    return subprocess.run([str(SUBMIT), *args, "--exe", str(exe)], cwd=cwd, env=slurm.env,
+                          capture_output=True, text=True, timeout=timeout)
+
+
+def sweep_status(exe, cwd, sweep):
+    return subprocess.run([str(exe), "sweep", sweep, "--status"], cwd=cwd, capture_output=True,
+                          text=True)
+
+
+def wait_for(predicate, timeout=60, what="condition"):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return
+        time.sleep(0.05)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
 def test_slurm_array_summary_equals_local(slurm, ropedyn_exe, tmp_path):
     (tmp_path / "base.nml").write_text(BASE)
     (tmp_path / "sw.nml").write_text(SWEEP)
@@ -198,22 +230,35 @@ def test_slurm_array_summary_equals_local(slurm, ropedyn_exe, tmp_path):
     assert n == 16
 
     start = time.monotonic()
-    result = subprocess.run([str(SUBMIT), "sw.nml", "--exe", str(ropedyn_exe), "--output-dir",
-                             "out/slurm", "--throttle", "2", "--wait"], cwd=tmp_path,
-                            env=slurm.env, capture_output=True, text=True, timeout=300)
+    result = submit(slurm, tmp_path, ropedyn_exe, "sw.nml", "--output-dir", "out/slurm",
+                    "--throttle", "2", "--wait")
     elapsed = time.monotonic() - start
     # 8 cases fail on purpose (max_steps = 20): the summary job exits 3
     assert result.returncode == 3, result.stderr + slurm.log_tail()
-    array_id, summary_id = result.stdout.split()
+    arrays, summary_id = result.stdout.split()
+    arrays = arrays.split(",")
+    # --throttle 2: 4 tasks per slot, 8 tasks of 2 cases; MaxArraySize 6: arrays of 5 and 3
+    assert "16 case(s) in 8 task(s) of up to 2 (auto" in result.stderr
+    assert "8 tasks > MaxArraySize - 1 = 5: 2 arrays" in result.stderr
+    assert len(arrays) == 2
     out = tmp_path / "out" / "slurm"
     assert (out / "summary.csv").exists(), result.stderr + slurm.log_tail()
-    summary_log = (out / "slurm" / "summary.out").read_text()
+    [task_file] = (out / "slurm").glob("tasks_*.txt")
+    assert task_file.read_text().split() == ["1-2", "3-4", "5-6", "7-8", "9-10", "11-12",
+                                             "13-14", "15-16"]
+    logs = sorted(p.name for p in (out / "slurm").glob("task_*.out"))
+    assert logs == sorted([f"task_{arrays[0]}_{k}.out" for k in range(1, 6)]
+                          + [f"task_{arrays[1]}_{k}.out" for k in range(1, 4)])
+    summary_log = (out / "slurm" / f"summary_{summary_id}.out").read_text()
     assert "8 of 16 cases complete" in summary_log, summary_log
-    assert len(list((out / "slurm").glob("case_*.out"))) == n
+    # the tasks of the failing cases 5-8 and 13-16 are named with their cases
+    assert f"summary: task {arrays[0]}_3 (cases 5-6) ended FAILED, exit code 3:0" in summary_log
+    assert f"summary: task {arrays[1]}_3 (cases 15-16) ended FAILED" in summary_log
+    assert "summary: 4 array task(s) did not end COMPLETED" in summary_log
     # nothing left in the queue
     queue = subprocess.run(["squeue", "-h"], env=slurm.env, capture_output=True, text=True)
     assert queue.stdout.strip() == ""
-    print(f"slurm: array {array_id} + summary {summary_id}: {elapsed:.1f} s")
+    print(f"slurm: arrays {arrays} + summary {summary_id}: {elapsed:.1f} s")
 
     local = subprocess.run([str(ropedyn_exe), "sweep", "sw.nml", "--output-dir", "out/local",
                             "--jobs", "2"], cwd=tmp_path, capture_output=True, text=True)
@@ -227,7 +272,7 @@ def test_slurm_array_summary_equals_local(slurm, ropedyn_exe, tmp_path):
         for key in a:
             if key in VOLATILE:
                 continue
-            if key == "reason":
+            if key in ("reason", "reference_kind", "warning"):
                 assert a[key] == b[key], (a["case"], key)
             elif a[key] and b[key] and key not in ("status", "model", "method", "reference"):
                 np.testing.assert_allclose(float(a[key]), float(b[key]), rtol=1e-12,
@@ -239,3 +284,98 @@ def test_slurm_array_summary_equals_local(slurm, ropedyn_exe, tmp_path):
         assert sorted(fa) == sorted(fb)
         np.testing.assert_array_equal(fa["steps"][:], fb["steps"][:])
         np.testing.assert_allclose(fa["tip_error_max"][:], fb["tip_error_max"][:], rtol=1e-12)
+
+
+def test_double_submission_one_writer_per_case(slurm, ropedyn_exe, tmp_path):
+    """The same sweep submitted twice while the first array runs: each case is written by
+    one task; a task that finds its case being written fails (exit 4) and its summary job
+    says so; every case ends complete and readable."""
+    (tmp_path / "base.nml").write_text(BASE)
+    (tmp_path / "dbl.nml").write_text(LONG.format(t_end=7, rtols="1e-8, 1e-9"))
+    args = ("dbl.nml", "--throttle", "1", "--cases-per-task", "1", "--wait")
+    first = subprocess.Popen([str(SUBMIT), *args, "--exe", str(ropedyn_exe)], cwd=tmp_path,
+                             env=slurm.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+    out = tmp_path / "out" / "sweep_dbl"
+    try:
+        wait_for(lambda: (out / ".case_0001.lock").exists(), what="the first array's case 1")
+        second = submit(slurm, tmp_path, ropedyn_exe, *args)
+    finally:
+        stdout, stderr = first.communicate(timeout=300)
+    assert "submit: warning: jobs for out/sweep_dbl are still queued or running:" \
+        in second.stderr
+    assert {first.returncode, second.returncode} <= {0, 3}, stderr + second.stderr
+    logs = {p.name: p.read_text() for p in (out / "slurm").glob("task_*.out")}
+    assert len(logs) == 4, logs.keys()
+    taken = [name for name, text in logs.items() if "not run: being written by host" in text]
+    assert taken, logs
+    for name, text in logs.items():
+        assert ": complete:" in text or "complete already" in text or name in taken, text
+    # the summary job of an array with a taken task fails and names it
+    summaries = [p.read_text() for p in (out / "slurm").glob("summary_*.out")]
+    assert any("ended FAILED, exit code 4:0" in text for text in summaries), summaries
+    assert 3 in (first.returncode, second.returncode)
+    status = sweep_status(ropedyn_exe, tmp_path, "dbl.nml")
+    assert status.returncode == 0, status.stdout
+    for k in (1, 2):
+        with h5py.File(out / f"case_000{k}.h5") as f:
+            assert f.attrs["status"] == b"complete"
+            assert f["rope/points"].shape[0] == f["time"].shape[0] == 701
+    assert not list(out.glob(".case_*"))
+
+
+def test_missing_queues_only_what_is_not_complete(slurm, ropedyn_exe, tmp_path):
+    (tmp_path / "base.nml").write_text(BASE)
+    (tmp_path / "m.nml").write_text("&sweep base = 'base.nml'\n"
+                                    "  vary = 'solver.max_steps = 100000; 20'\n"
+                                    "  methods = 'cvode', 'mebdf'\n/\n")
+    first = submit(slurm, tmp_path, ropedyn_exe, "m.nml", "--wait")
+    assert first.returncode == 3, first.stderr
+    out = tmp_path / "out" / "sweep_m"
+    mtime = (out / "case_0002.h5").stat().st_mtime_ns
+    (out / "case_0001.h5").unlink()
+    dry = submit(slurm, tmp_path, ropedyn_exe, "m.nml", "--missing", "--dry-run")
+    assert dry.returncode == 0 and dry.stdout.split() == ["1", "3", "4"]
+    second = submit(slurm, tmp_path, ropedyn_exe, "m.nml", "--missing", "--wait")
+    assert second.returncode == 3, second.stderr
+    assert "submit: --missing: 3 of 4 cases not complete: 1 (missing); 3 4 (failed)" \
+        in second.stderr
+    assert "3 case(s) in 3 task(s) of up to 1" in second.stderr
+    task_files = sorted((out / "slurm").glob("tasks_*.txt"))
+    assert [f.read_text().split() for f in task_files] == [["1", "2", "3", "4"],
+                                                           ["1", "3", "4"]]
+    # both attempts' logs are kept
+    arrays = {p.name.split("_")[1] for p in (out / "slurm").glob("task_*.out")}
+    assert len(arrays) == 2 and len(list((out / "slurm").glob("task_*.out"))) == 7
+    assert (out / "case_0002.h5").stat().st_mtime_ns == mtime
+    status = sweep_status(ropedyn_exe, tmp_path, "m.nml")
+    assert "  complete         2" in status.stdout and "  failed           2" in status.stdout
+    # every case complete: nothing to queue
+    (tmp_path / "ok.nml").write_text("&sweep base = 'base.nml'\n  methods = 'cvode'\n/\n")
+    assert submit(slurm, tmp_path, ropedyn_exe, "ok.nml", "--wait").returncode == 0
+    none = submit(slurm, tmp_path, ropedyn_exe, "ok.nml", "--missing")
+    assert none.returncode == 0 and "submit: nothing to queue" in none.stderr
+
+
+def test_cancelled_task_is_interrupted(slurm, ropedyn_exe, tmp_path):
+    (tmp_path / "base.nml").write_text(BASE)
+    (tmp_path / "c.nml").write_text(LONG.format(t_end=30, rtols="1e-8"))
+    job = subprocess.Popen([str(SUBMIT), "c.nml", "--wait", "--exe", str(ropedyn_exe)],
+                           cwd=tmp_path, env=slurm.env, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True)
+    out = tmp_path / "out" / "sweep_c"
+    try:
+        wait_for(lambda: (out / ".case_0001.lock").exists(), what="the case to start")
+        [task_file] = (out / "slurm").glob("tasks_*.txt")
+        array = next((out / "slurm").glob("task_*_1.out")).name.split("_")[1]
+        subprocess.run(["scancel", f"{array}_1"], env=slurm.env, check=True)
+    finally:
+        stdout, stderr = job.communicate(timeout=120)
+    assert job.returncode == 3, stderr
+    summary = next((out / "slurm").glob("summary_*.out")).read_text()
+    assert f"summary: task {array}_1 (cases 1) ended CANCELLED" in summary, summary
+    assert "sweep: case 0001: interrupted: stopped by SIGTERM at " in summary
+    status = sweep_status(ropedyn_exe, tmp_path, "c.nml")
+    assert status.returncode == 3
+    assert f"0001 interrupted: stopped by SIGTERM at " in status.stdout
+    assert f"Slurm job {array}_1" in status.stdout

@@ -1,8 +1,15 @@
 """ropedyn sweep: case list and ids, the local runner (parallel workers, summary), skip-if-done,
 a failing case recorded while the others finish, --task equal to the same case run alone,
---summary rebuilding the table from the case files."""
+--summary rebuilding the table from the case files; one writer per case (two writers, the
+lock rules, SIGTERM to the runner), complete only when the data reads back, task lists,
+the reference named in the summary and its fallback warned about."""
 import csv
+import os
 import pathlib
+import signal
+import socket
+import subprocess
+import time
 
 import h5py
 import numpy as np
@@ -171,3 +178,269 @@ def test_task_equals_case_run_alone(run, sweep_dir):
     assert result.returncode == 3
     rows = read_csv(out / "summary.csv")
     assert [r["status"] for r in rows] == ["missing"] * 6 + ["complete", "missing"]
+
+
+# ---------------------------------------------------------------------------------------
+# One writer per case, status, signals (docs/sweeps.md, "One writer per case")
+# ---------------------------------------------------------------------------------------
+
+# cases of one to two seconds each (Debug build): long enough to be caught while running
+LONG = """&sweep
+    base = 'scenes/base.nml'
+    output_dir = 'out/long'
+    set = 'solver.t_end=4', 'model.elements=20'
+    rtols = {rtols}
+/
+"""
+
+
+def wait_for(predicate, timeout=30, what="condition"):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return
+        time.sleep(0.02)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+def processes_mentioning(text):
+    """Pids of live processes whose command line holds `text`."""
+    pids = []
+    for proc in pathlib.Path("/proc").iterdir():
+        if not proc.name.isdigit():
+            continue
+        try:
+            cmdline = (proc / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+        except OSError:
+            continue
+        if text in cmdline and int(proc.name) != os.getpid():
+            pids.append(int(proc.name))
+    return pids
+
+
+def status_lines(run, sweep):
+    result = run("sweep", sweep, "--status")
+    counts = {}
+    for line in result.stdout.splitlines()[1:8]:
+        fields = line.split()
+        counts[fields[0]] = int(fields[1])
+    return result, counts
+
+
+def test_two_writers_of_one_case(run, ropedyn_exe, sweep_dir):
+    # one case of about 3 s: the checks below take about one
+    (sweep_dir / "long.nml").write_text(LONG.format(rtols="1e-9").replace("=4'", "=7'"))
+    out = sweep_dir / "out" / "long"
+    lock, part, final = out / ".case_0001.lock", out / ".case_0001.h5.part", out / "case_0001.h5"
+    first = subprocess.Popen([str(ropedyn_exe), "sweep", "long.nml", "--task", "1"],
+                             cwd=sweep_dir, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+    try:
+        wait_for(lambda: part.exists() and f"pid={first.pid}" in lock.read_text(),
+                 what="the first writer's lock and .part file")
+        # the case is not in place while it is written; it reads as running, named
+        assert not final.exists()
+        result, counts = status_lines(run, "long.nml")
+        assert counts["running"] == 1 and result.returncode == 3, result.stdout
+        assert f"0001 running: being written by host {socket.gethostname()}, " \
+               f"pid {first.pid}" in result.stdout
+        assert "0001  running" in run("sweep", "long.nml", "--list").stdout
+        # the second writer (forced, too) finds it taken
+        for extra in ([], ["--force"]):
+            second = run("sweep", "long.nml", "--task", "1", *extra)
+            assert second.returncode == 4, second.stderr
+            assert f"not run: being written by host {socket.gethostname()}, pid {first.pid}" \
+                   in second.stderr
+            assert "a case is written by one process at a time" in second.stderr
+        # the local runner does not start it either
+        runner = run("sweep", "long.nml", "--jobs", "1")
+        assert "being written by another process, not started here: 0001" in runner.stderr
+        assert first.poll() is None, "the case ended before the checks: make it longer"
+    finally:
+        stdout, stderr = first.communicate(timeout=120)
+    assert first.returncode == 0, stderr
+    assert "case 0001: complete" in stdout
+    assert not lock.exists() and not part.exists()
+    with h5py.File(final) as f:
+        assert f.attrs["status"] == b"complete"
+        assert "out/long/case_0001.h5" in f.attrs["scene"].decode()
+        assert f["time"].shape[0] == f["rope/points"].shape[0] == 701
+    assert status_lines(run, "long.nml")[1]["complete"] == 1
+
+
+def test_sigterm_to_runner_stops_its_workers(run, ropedyn_exe, sweep_dir):
+    (sweep_dir / "long.nml").write_text(LONG.format(rtols="1e-6, 1e-7, 1e-8"))
+    out = sweep_dir / "out" / "long"
+    runner = subprocess.Popen([str(ropedyn_exe), "sweep", "long.nml", "--jobs", "2"],
+                              cwd=sweep_dir, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True)
+    try:
+        wait_for(lambda: len(list(out.glob(".case_*.h5.part"))) == 2, what="two workers")
+        workers = [p for p in processes_mentioning("long.nml --quiet")]
+        assert len(workers) == 2
+        runner.send_signal(signal.SIGTERM)
+        _, stderr = runner.communicate(timeout=60)
+    finally:
+        if runner.poll() is None:
+            runner.kill()
+    assert runner.returncode == 130, stderr
+    assert "stopped by SIGTERM: 0 of 3 cases ended, 2 interrupted (0001 0002), " \
+           "1 not started" in stderr
+    # no worker left, no runner file left: the interrupted cases keep their lock (with the
+    # signal) and their partial output, which the next run replaces
+    assert processes_mentioning(str(sweep_dir)) == [] and processes_mentioning("long.nml") == []
+    names = sorted(p.name for p in out.iterdir())
+    assert names == [".case_0001.h5.part", ".case_0001.lock", ".case_0002.h5.part",
+                     ".case_0002.lock"], names
+    assert "signal=15" in (out / ".case_0001.lock").read_text()
+    result, counts = status_lines(run, "long.nml")
+    assert result.returncode == 3
+    assert counts == {"complete": 0, "failed": 0, "interrupted": 2, "running": 0, "stale": 0,
+                      "unreadable": 0, "missing": 1}, result.stdout
+    assert "0001 interrupted: stopped by SIGTERM at " in result.stdout
+    assert "partial output in out/long/.case_0001.h5.part" in result.stdout
+    # running again takes over the abandoned lock and finishes
+    again = run("sweep", "long.nml", "--task", "1")
+    assert again.returncode == 0, again.stderr
+    assert sorted(p.name for p in out.iterdir()) == [
+        ".case_0002.h5.part", ".case_0002.lock", "case_0001.h5"]
+
+
+def test_lock_rules(run, sweep_dir):
+    """A lock of another host is live while its heartbeat is fresh; one of this host while
+    its process lives; one that recorded a signal is abandoned; an abandoned lock is taken
+    over."""
+    out = sweep_dir / "out" / "sw"
+    out.mkdir(parents=True)
+    lock = out / ".case_0001.lock"
+    text = "ropedyn sweep case lock\nhost=elsewhere\npid=4711\nstarted=2024-01-01T00:00:00Z\n" \
+           "job=77_1\n"
+    lock.write_text(text)
+    result = run("sweep", "sw.nml", "--status")
+    assert "0001 running: being written by host elsewhere, pid 4711, Slurm job 77_1" \
+           in result.stdout
+    taken = run("sweep", "sw.nml", "--task", "1")
+    assert taken.returncode == 4 and "being written by host elsewhere" in taken.stderr
+    # no heartbeat for 200 s: abandoned (another host: after 120 s)
+    old = time.time() - 200
+    os.utime(lock, (old, old))
+    result = run("sweep", "sw.nml", "--status")
+    assert "0001 interrupted: its writer ended without finishing: killed, crashed or its " \
+           "node failed (host elsewhere, pid 4711, Slurm job 77_1" in result.stdout
+    assert "no heartbeat for 2" in result.stdout
+    took = run("sweep", "sw.nml", "--task", "1")
+    assert took.returncode == 0, took.stderr
+    assert not lock.exists() and (out / "case_0001.h5").exists()
+    # this host: a process that is gone
+    gone = subprocess.Popen(["true"])
+    gone.wait()
+    lock2 = out / ".case_0002.lock"
+    lock2.write_text(f"ropedyn sweep case lock\nhost={socket.gethostname()}\npid={gone.pid}\n")
+    result = run("sweep", "sw.nml", "--status")
+    assert f"0002 interrupted: its writer ended without finishing: killed or crashed " \
+           f"(host {socket.gethostname()}, pid {gone.pid}; that process is gone)" in result.stdout
+    # a recorded signal
+    lock2.write_text(f"host={socket.gethostname()}\npid={os.getpid()}\nsignal=2\n")
+    assert "0002 interrupted: stopped by SIGINT at" in run("sweep", "sw.nml", "--status").stdout
+    assert run("sweep", "sw.nml", "--task", "2").returncode == 0
+    assert not lock2.exists()
+
+
+def test_complete_only_if_it_reads_back(run, sweep_dir):
+    assert run("sweep", "sw.nml", "--task", "1-3").returncode == 0
+    out = sweep_dir / "out" / "sw"
+    # a damaged file: unreadable, not complete, runs again
+    data = (out / "case_0001.h5").read_bytes()
+    (out / "case_0001.h5").write_bytes(data[: len(data) // 2])
+    # a file whose run was interrupted (as the run driver will write it): not complete
+    with h5py.File(out / "case_0002.h5", "r+") as f:
+        f.attrs["status"] = np.bytes_("interrupted")     # fixed-length, as ropedyn writes
+        f.attrs["reason"] = np.bytes_("SIGTERM at t = 0.05 s")
+    listing = run("sweep", "sw.nml", "--list").stdout
+    assert "0001  unreadable" in listing and "0002  interrupted" in listing
+    assert "0003  complete" in listing
+    result = run("sweep", "sw.nml", "--status")
+    assert "0002 interrupted: SIGTERM at t = 0.05 s" in result.stdout
+    summary = run("sweep", "sw.nml", "--summary")
+    assert summary.returncode == 3
+    assert "case 0001: unreadable: " in summary.stderr
+    assert "case 0002: interrupted: SIGTERM at t = 0.05 s" in summary.stderr
+    rerun = run("sweep", "sw.nml", "--task", "1-3")
+    assert rerun.returncode == 0, rerun.stderr
+    assert rerun.stdout.count(": complete: ") == 2 and "0003: complete already" in rerun.stdout
+
+
+def test_task_list_runs_on_after_a_failure(run, sweep_dir):
+    result = run("sweep", "fail.nml", "--task", "1,3-4,2")
+    assert result.returncode == 3
+    assert result.stdout.count(": complete: ") == 2
+    assert result.stderr.count("max_steps") == 2
+    assert "sweep: 2 of 4 cases of this task not complete: 0001, 0002" in result.stderr
+
+
+FALLBACK = """&sweep
+    base = 'scenes/base.nml'
+    output_dir = 'out/fb'
+    set = 'solver.max_steps=300'
+    methods = 'cvode', 'mebdf'
+    rtols = 1e-3, 1e-4, 1e-8
+    reference = '{reference}'
+/
+"""
+
+
+def test_reference_named_and_fallback_warned(run, sweep_dir):
+    # with 300 steps, rtol 1e-8 fails for both methods, mebdf fails at 1e-4 too
+    (sweep_dir / "fb.nml").write_text(FALLBACK.format(reference="tightest"))
+    result = run("sweep", "fb.nml")
+    assert result.returncode == 3
+    rows = read_csv(sweep_dir / "out" / "fb" / "summary.csv")
+    assert [r["status"] for r in rows] == ["complete", "complete", "failed", "complete",
+                                           "failed", "failed"]
+    warning = ("reference falls back to case 2 (rtol 1e-4): the tightest case 3 (rtol 1e-8) "
+               "is not complete (failed)")
+    assert f"sweep: warning: cases 1-6: {warning}" in result.stderr
+    assert [r["reference"] for r in rows] == ["2", "", "", "2", "", ""]
+    assert [r["reference_kind"] for r in rows] == ["tighter", "self", "", "tighter", "", ""]
+    assert rows[0]["warning"] == warning and rows[2]["warning"] == ""
+    assert float(rows[3]["tip_error_max"]) > 0
+    # per method: mebdf is measured against its own tightest complete case (itself here)
+    (sweep_dir / "fb.nml").write_text(FALLBACK.format(reference="tightest_per_method"))
+    result = run("sweep", "fb.nml", "--summary")
+    rows = read_csv(sweep_dir / "out" / "fb" / "summary.csv")
+    assert [r["reference"] for r in rows] == ["2", "", "", "", "", ""]
+    assert [r["reference_kind"] for r in rows] == ["tighter", "self", "", "self", "", ""]
+    assert "sweep: warning: cases 4-6: reference falls back to case 4 (rtol 0.001)" \
+           in result.stderr
+    with h5py.File(sweep_dir / "out" / "fb" / "summary.h5") as f:
+        assert f.attrs["reference"] == b"tightest_per_method"
+        assert [s.decode() for s in f["reference_kind"][:2]] == ["tighter", "self"]
+    # equal tolerances of two methods: the error is their disagreement, labelled so
+    (sweep_dir / "eq.nml").write_text("&sweep base = 'scenes/base.nml'\n output_dir = 'out/eq'"
+                                      "\n methods = 'cvode', 'mebdf'\n/\n")
+    assert run("sweep", "eq.nml").returncode == 0
+    rows = read_csv(sweep_dir / "out" / "eq" / "summary.csv")
+    assert [r["reference_kind"] for r in rows] == ["self", "same_rtol"]
+    assert [r["reference"] for r in rows] == ["", "1"]
+
+
+def test_reference_file_checked_against_cases(run, sweep_dir):
+    result = run("run", "scenes/base.nml", "--set", "output.file=ref.h5")
+    assert result.returncode == 0, result.stderr
+    body = "&sweep base = 'scenes/base.nml'\n output_dir = 'out/r'\n {} reference = 'ref.h5'\n/\n"
+    (sweep_dir / "r1.nml").write_text(body.format("elements = 4, 5\n"))
+    result = run("sweep", "r1.nml", "--count")
+    assert result.returncode == 2
+    assert 'r1.nml: &sweep: reference = "ref.h5": it has 4 elements, case 2 ' \
+           '(model.elements=5) 5: a reference file serves cases of its element count only' \
+           in result.stderr
+    (sweep_dir / "r2.nml").write_text(body.format("set = 'solver.output_interval=0.02'\n"))
+    result = run("sweep", "r2.nml", "--list")
+    assert result.returncode == 2
+    assert "its output times are not those of case 1 (every 0.02 s up to 0.1 s)" \
+           in result.stderr
+    (sweep_dir / "r3.nml").write_text(body.format("rtols = 1e-4, 1e-5\n"))
+    assert run("sweep", "r3.nml").returncode == 0
+    rows = read_csv(sweep_dir / "out" / "r" / "summary.csv")
+    assert [r["reference_kind"] for r in rows] == ["file", "file"]
+    assert all(float(r["tip_error_max"]) > 0 for r in rows)

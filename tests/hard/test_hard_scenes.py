@@ -4,18 +4,19 @@ keeps the guarantees of docs/stability.md:
 1. it completes within its step budget (`&solver max_steps`), or it fails with exit code 3,
    status 'failed' and a reason naming the time, the step size and the cause;
 2. no NaN or Inf reaches the output (every float dataset is finite);
-3. energy balance: |T + V + dissipated - support work - E0| <= C_E rtol S at every record;
-4. the two solvers agree on the tip position within C_X rtol L over the horizon;
-5. with damping on (and fixed supports) T + V never rises by more than C_E rtol S, and the
+3. energy balance: |T + V + dissipated - support work - E0| <= B_E rtol S at every record;
+4. the two solvers agree on the tip position within B_X rtol L over the horizon;
+5. with damping on (and fixed supports) T + V never rises by more than B_E rtol S, and the
    dissipated energy never falls by more than that.
 
 S is the energy scale of the run (ropedyn.studies.stability_metrics: max T + max elastic +
-gravity range + dissipated) and L the rope length. The constants and their reasons are in
-docs/stability.md ("The guarantees"): C_E = 20 (measured: error / (rtol S) <= 0.4 on these
-horizons, <= 3.2 for the whip at rtol 1e-5 .. 1e-8, while CVODE at orders 3-4 gains 50-600
-rtol S on the undamped rope), C_X = 10 (measured: the solvers differ by <= 0.15 rtol L).
-The whip is also run at rtol 1e-8, so that the energy bound is seen to follow the
-tolerance.
+gravity range + dissipated) and L the rope length. B_E (per scene and solver) and B_X (per
+scene) are three times the larger of the values measured with the Debug and the Release
+build, rounded up to one digit (docs/stability.md, "The guarantees"; measured values in the
+comments of ENERGY_BOUND and TIP_BOUND, regenerate them with the measurement described
+there). Forces that are not the gradient of their energy make errors of order S (1e6 rtol S),
+far beyond every bound; a solver whose error control loosens shows in the bounds too. The
+whip is also run at rtol 1e-8, so that the energy bound is seen to follow the tolerance.
 
 Horizons are short so that the suite stays within about half a minute of a Debug build on
 two cores; the long runs are in scripts/stability_report.
@@ -30,9 +31,53 @@ from ropedyn.studies import stability_metrics
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 HARD = ROOT / "input" / "hard"
 
-C_E = 20.0
-C_X = 10.0
 TIGHT = 1e-8        # the tolerance-proportionality case (whip)
+
+#: B_E: bound on balance error / (rtol S), per case; comment: measured Debug / Release
+ENERGY_BOUND = {
+    "steel_wire_cvode": 3e-4,   # 8.8e-05 / 8.8e-05
+    "steel_wire_mebdf": 3e-4,   # 6.8e-05 / 6.8e-05
+    "undamped_cvode": 4e-3,   # 0.0012 / 0.0012
+    "undamped_mebdf": 2e-4,   # 3.5e-05 / 3.5e-05
+    "light_damping_cvode": 4e-3,   # 0.0011 / 0.0011
+    "light_damping_mebdf": 1e-4,   # 3.2e-05 / 3.2e-05
+    "no_bending_cvode": 2e-2,   # 0.004 / 0.0011
+    "no_bending_mebdf": 6e-3,   # 0.0019 / 0.0019
+    "thin_thread_cvode": 6e-3,   # 0.0016 / 0.0017
+    "thin_thread_mebdf": 3e-3,   # 0.00097 / 0.00097
+    "long_rope_cvode": 2e-3,   # 0.00028 / 0.00034
+    "long_rope_mebdf": 4e-5,   # 1.2e-05 / 1.2e-05
+    "whip_cvode": 2,   # 0.14 / 0.54
+    "whip_mebdf": 2,   # 0.36 / 0.43
+    "clamped_taut_cvode": 8e-3,   # 0.0019 / 0.0025
+    "clamped_taut_mebdf": 4e-3,   # 0.0011 / 0.0011
+    "mpp_light_damping_cvode": 9e-2,   # 0.028 / 0.028
+    "mpp_light_damping_mebdf": 6e-3,   # 0.0019 / 0.0019
+    "elements_1000_cvode": 4e-4,   # 0.00012 / 0.00012
+    "elements_1000_mebdf": 8e-5,   # 2.6e-05 / 2.6e-05
+    "shaken_support_cvode": 5,   # 1.6 / 1.6
+    "shaken_support_mebdf": 3e-1,   # 0.1 / 0.1
+    "folded_release_cvode": 8e-1,   # 0.12 / 0.24
+    "folded_release_mebdf": 2e-1,   # 0.049 / 0.043
+    "tight_cvode": 10,   # 3.2 / 1.5
+    "tight_mebdf": 6e-1,   # 0.2 / 0.2
+}
+#: B_X: bound on max |tip_cvode - tip_mebdf| / (rtol L), per scene (at least 1e-6, far
+#: above the round-off of a tip position); comment: measured Debug / Release
+TIP_BOUND = {
+    "steel_wire": 6e-5,   # 1.9e-05 / 1.9e-05
+    "undamped": 4e-3,   # 0.0013 / 0.0013
+    "light_damping": 4e-3,   # 0.0012 / 0.0012
+    "no_bending": 3e-2,   # 0.0068 / 0.0068
+    "thin_thread": 2e-2,   # 0.0062 / 0.0062
+    "long_rope": 9e-6,   # 2.9e-06 / 2.9e-06
+    "whip": 2,   # 0.15 / 0.36
+    "clamped_taut": 3e-3,   # 0.00071 / 0.00069
+    "mpp_light_damping": 6e-2,   # 0.018 / 0.018
+    "elements_1000": 1e-6,   # 1.8e-08 / 1.8e-08
+    "shaken_support": 3e-2,   # 0.0051 / 0.0084
+    "folded_release": 2e-1,   # 0.028 / 0.041
+}
 
 # scene: (horizon in s, step budget max_steps, damping on, rope length in m)
 SCENES = {
@@ -116,7 +161,7 @@ def test_output_finite(runs, scene, method):
 @pytest.mark.parametrize("scene,method", CASES)
 def test_energy_balance(runs, scene, method):
     _, m, _ = runs[case_key(scene, method)]
-    bound = C_E * m["rtol"] * m["energy_scale"]
+    bound = ENERGY_BOUND[case_key(scene, method)] * m["rtol"] * m["energy_scale"]
     assert m["balance_error"] <= bound, (m["balance_error"], bound)
 
 
@@ -126,14 +171,14 @@ def test_energy_balance_follows_tolerance(runs, method):
     assert proc.returncode == 0 and m["status"] == "complete", proc.stderr
     assert stability_metrics.all_finite(out) == []
     assert m["rtol"] == TIGHT
-    bound = C_E * TIGHT * m["energy_scale"]
+    bound = ENERGY_BOUND[f"tight_{method}"] * TIGHT * m["energy_scale"]
     assert m["balance_error"] <= bound, (m["balance_error"], bound)
 
 
 @pytest.mark.parametrize("scene,method", [c for c in CASES if SCENES[c[0]][2]])
 def test_no_energy_growth_with_damping(runs, scene, method):
     _, m, _ = runs[case_key(scene, method)]
-    slack = C_E * m["rtol"] * m["energy_scale"]
+    slack = ENERGY_BOUND[case_key(scene, method)] * m["rtol"] * m["energy_scale"]
     assert np.all(np.diff(m["mech"]) <= slack), np.diff(m["mech"]).max()
     assert m["energy_growth"] <= slack, (m["energy_growth"], slack)
     assert np.all(np.diff(m["dissipated"]) >= -slack)
@@ -146,5 +191,5 @@ def test_solvers_agree(runs, scene):
     assert np.array_equal(a["time"], b["time"])
     diff = np.abs(a["tip"] - b["tip"]).max()
     assert a["rtol"] == b["rtol"]
-    bound = C_X * a["rtol"] * SCENES[scene][3]
+    bound = TIP_BOUND[scene] * a["rtol"] * SCENES[scene][3]
     assert diff <= bound, (diff, bound)

@@ -10,15 +10,14 @@
 !! - point mass: a tip mass lowers the swing frequency to the value of a heavy chain with
 !!   a tip mass (Bessel functions) and of a compound-pendulum estimate (RFEM and MPP);
 !! - all effects at once: T + V + dissipated - external work = E0 over a run.
+!! Bounds are about three times the larger of the values measured with the Debug and the
+!! Release build (CVODE at the rtol given; printed by each check): e.g. the drag balances
+!! 8.0e-9 and 3.9e-8 J, the every-effect balance 3.1e-8 (RFEM, Release 8.0e-8) and 6.5e-8 of
+!! the energy moved (docs/testing.md). Without the quadratures' error control the drag
+!! balances reach 4.1e-8 and 2.3e-7 J and fail.
 program test_effects_physics
     use ropedyn_kinds, only: wp
-    use ropedyn_error, only: error_t
-    use ropedyn_rope_model, only: energy_t
-    use ropedyn_scene, only: scene_t, read_scene
-    use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_simulation, only: create_model
-    use ropedyn_integrator, only: integrator_t, solver_options_t
-    use ropedyn_solvers, only: new_integrator
+    use ropedyn_test_run, only: run_t, simulate_scene => simulate, kind_set, SET_LEN
     use ropedyn_effect, only: bodies_t
     use ropedyn_effect_ground, only: ground_effect_t, ground_effect
     use ropedyn_assert, only: test_suite_t
@@ -28,14 +27,6 @@ program test_effects_physics
     real(wp), parameter :: pi = acos(-1.0_wp), g = 9.81_wp
     !> weight per length of the paper's rope, N/m, and its mass, kg
     real(wp), parameter :: lam = 6000.0_wp*pi*0.005_wp**2/4.0_wp, rope_mass = lam
-
-    !> One run: output times, states, quadratures, energies.
-    type :: run_t
-        real(wp), allocatable :: t(:), y(:, :)
-        type(energy_t), allocatable :: e(:)
-        class(rope_model_t), allocatable :: model
-        logical :: ok = .false.
-    end type run_t
 
     suite%name = 'effects_physics'
     call drag_terminal_speed()
@@ -51,65 +42,15 @@ program test_effects_physics
 
 contains
 
-    !> Build the scene (defaults = the paper's rope, plus overrides) and integrate it with
-    !! CVODE to t_end, recording every dt.
+    !> The scene of defaults (the paper's rope) plus `sets`, integrated with CVODE to t_end
+    !! and recorded every dt (ropedyn_test_run); a failure is a failed check.
     subroutine simulate(sets, t_end, dt, rtol, run)
         character(len=*), intent(in) :: sets(:)
         real(wp), intent(in) :: t_end, dt, rtol
         type(run_t), intent(out) :: run
-        type(scene_t) :: scene
-        type(error_t), allocatable :: err
-        class(integrator_t), allocatable :: solver
-        type(solver_options_t) :: options
-        real(wp), allocatable :: y(:), yq(:)
-        real(wp) :: t
-        integer :: k, nout, unit
-        open (newunit=unit, file='test_effects_physics.nml', status='replace', action='write')
-        write (unit, '(a)') '&model /'
-        close (unit)
-        call read_scene('test_effects_physics.nml', sets, scene, err)
-        if (.not. allocated(err)) call create_model(scene%rope_spec_t, run%model, err)
-        if (.not. allocated(err)) call new_integrator('cvode', solver, err)
-        if (allocated(err)) then
-            call suite%check_true(.false., 'setup: '//err%message)
-            return
-        end if
-        allocate (y(run%model%size()), yq(run%model%quad_size()))
-        call run%model%initial_state(y)
-        yq = 0.0_wp
-        options%rtol = rtol
-        options%atol = 1.0e-2_wp*rtol
-        call solver%init(run%model, 0.0_wp, y, yq, options, err)
-        if (allocated(err)) then
-            call suite%check_true(.false., 'init: '//err%message)
-            return
-        end if
-        nout = nint(t_end/dt)
-        allocate (run%t(0:nout), run%y(size(y), 0:nout), run%e(0:nout))
-        run%t(0) = 0.0_wp
-        run%y(:, 0) = y
-        run%e(0) = run%model%energy(0.0_wp, y, yq)
-        do k = 1, nout
-            call solver%advance_to(real(k, wp)*dt, t, y, yq, err)
-            if (allocated(err)) then
-                call suite%check_true(.false., 'integration: '//err%message)
-                return
-            end if
-            run%t(k) = t
-            run%y(:, k) = y
-            run%e(k) = run%model%energy(t, y, yq)
-        end do
-        call solver%finalize()
-        run%ok = .true.
+        call simulate_scene(sets, t_end, dt, rtol, run, scene_file='test_effects_physics.nml')
+        if (.not. run%ok) call suite%check_true(.false., run%message)
     end subroutine simulate
-
-    !> 'model.kind = "rfem"' (built apart: gfortran mis-sizes a concatenation inside a typed
-    !! character array constructor).
-    function kind_key(kind) result(key)
-        character(len=*), intent(in) :: kind
-        character(len=64) :: key
-        key = 'model.kind = "'//kind//'"'
-    end function kind_key
 
     !> Element fields (centre x, y, angle and rates) of record k.
     subroutine fields_at(run, k, q, qdot)
@@ -145,10 +86,10 @@ contains
         call fields_at(run, ubound(run%t, 1), q, qdot)
         v_term = sqrt(2.0_wp*lam*g/(1000.0_wp*1.2_wp*0.005_wp))
         write (*, '(a, 2f12.7, a)') '  drag: speed', maxval(qdot(1, :)), v_term, ' m/s'
-        call suite%check_le(maxval(abs(qdot(1, :) - v_term))/v_term, 1.0e-5_wp, &
+        call suite%check_le(maxval(abs(qdot(1, :) - v_term))/v_term, 5.0e-8_wp, &
                             'drag: terminal speed = sqrt(2 lambda g/(rho C_n d))')
-        call suite%check_le(run%e(ubound(run%e, 1))%balance() - run%e(0)%balance(), &
-                            1.0e-6_wp, 'drag: energy balance')
+        call suite%check_le(abs(run%e(ubound(run%e, 1))%balance() - run%e(0)%balance()), &
+                            3.0e-8_wp, 'drag: energy balance')
 
         call simulate([character(len=64) :: base, 'fluid.density = 0', &
             'fluid.linear_normal_drag = 2.0', 'fluid.linear_tangential_drag = 2.0', &
@@ -157,12 +98,12 @@ contains
         call fields_at(run, ubound(run%t, 1), q, qdot)
         write (*, '(a, 2f12.7, a)') '  linear drag: velocity', sum(qdot(1:2, :), 2)/size(q, 2), &
             ' m/s'
-        call suite%check_le(maxval(abs(qdot(1, :) - lam*g/2.0_wp)), 1.0e-5_wp, &
+        call suite%check_le(maxval(abs(qdot(1, :) - lam*g/2.0_wp)), 1.0e-7_wp, &
                             'linear drag: terminal speed = lambda g / c_n')
-        call suite%check_le(maxval(abs(qdot(2, :) - 0.3_wp)), 1.0e-5_wp, &
+        call suite%check_le(maxval(abs(qdot(2, :) - 0.3_wp)), 5.0e-8_wp, &
                             'linear drag: the rope drifts with the current')
         call suite%check_le(abs(run%e(ubound(run%e, 1))%balance() - run%e(0)%balance()), &
-                            1.0e-6_wp, 'linear drag with current: T + V + dissipated - W = E0')
+                            1.5e-7_wp, 'linear drag with current: T + V + dissipated - W = E0')
     end subroutine drag_terminal_speed
 
     !> A rope lying on the ground slides along its length at 1 m/s: Coulomb friction stops
@@ -191,9 +132,14 @@ contains
         slide = sum(mass*(q(2, :) - q0(2, :)))/sum(mass)
         expected = 1.0_wp/(2.0_wp*mu*g)
         write (*, '(a, 2f12.7, a)') '  ground: slide', slide, expected, ' m'
-        call suite%check_close(slide, expected, 1.0e-3_wp, 0.0_wp, &
+        call suite%check_close(slide, expected, 1.0e-4_wp, 0.0_wp, &
                                'ground: sliding distance = v0^2/(2 mu g)')
-        call suite%check_le(maxval(abs(qdot(1:2, :))), 1.0e-6_wp, 'ground: the rope comes to rest')
+        ! at rest to the tolerance (atol 1e-9 m/s): what is left is the integrator's error,
+        ! which follows the step sequence and so the last bits of the forces and the Newton
+        ! path: 5.4e-15 m/s (first-order Newton) and 7.0e-12 m/s (reduced) with the old
+        ! kernels, 2.4e-12 m/s with the one-pass kernels (first-order Newton); the bound is
+        ! about 3 times the largest measured
+        call suite%check_le(maxval(abs(qdot(1:2, :))), 2.0e-11_wp, 'ground: the rope comes to rest')
         ground = ground_effect([1.0_wp, 0.0_wp], [-1.0_wp, 0.0_wp], 1.0e5_wp, 200.0_wp, mu, &
                                1.0e-3_wp)
         b%n = n
@@ -205,9 +151,9 @@ contains
         normal_force = ground%total_normal_force(b)
         weight = sum(mass)*g
         write (*, '(a, 2f12.8, a)') '  ground: contact force, weight', normal_force, weight, ' N'
-        call suite%check_close(normal_force, weight, 1.0e-6_wp, 0.0_wp, &
+        call suite%check_close(normal_force, weight, 5.0e-11_wp, 0.0_wp, &
                                'ground: the contact forces carry the weight')
-        call suite%check_le(abs(run%e(last)%balance() - run%e(0)%balance()), 1.0e-6_wp, &
+        call suite%check_le(abs(run%e(last)%balance() - run%e(0)%balance()), 1.5e-9_wp, &
                             'ground: T + V + dissipated = E0 (friction and contact damping)')
     end subroutine ground_friction
 
@@ -218,7 +164,7 @@ contains
         type(run_t) :: run
         real(wp) :: worst, work, de
         integer :: k
-        call simulate([character(len=64) :: kind_key(kind), 'model.elements = 8', &
+        call simulate([character(len=SET_LEN) :: kind_set(kind), 'model.elements = 8', &
             'initial.shape = "hanging"', 'effects.damping = .false.', &
             'supports.top_motion = "harmonic"', 'supports.top_amplitude = 0.01, 0.02', &
             'supports.top_frequency = 2.0'], 1.0_wp, 0.02_wp, 1.0e-8_wp, run)
@@ -234,7 +180,8 @@ contains
             run%e(ubound(run%e, 1))%total() - run%e(0)%total(), &
             run%e(ubound(run%e, 1))%support_work, worst, ' J'
         call suite%check_true(work > 1.0e-3_wp, kind//': the shaken top does work')
-        call suite%check_le(worst/work, 1.0e-4_wp, kind//': support work = change of T + V '// &
+        call suite%check_le(worst/work, merge(1.0e-5_wp, 5.0e-8_wp, kind == 'rfem'), &
+                            kind//': support work = change of T + V '// &
                             '(undamped, shaken top)')
     end subroutine shaken_top
 
@@ -256,15 +203,15 @@ contains
         end do
         write (*, '(a, 3f10.5, a)') '  folded: tip fall at 0.1, 0.2, 0.3 s', x(20), x(40), &
             x(60), ' m (theory 0.04947, 0.20363, 0.48980)'
-        call suite%check_close(x(20), 0.04947_wp, 0.02_wp, 0.0_wp, 'folded: fall at 0.1 s')
-        call suite%check_close(x(40), 0.20363_wp, 0.02_wp, 0.0_wp, 'folded: fall at 0.2 s')
-        call suite%check_close(x(60), 0.48980_wp, 0.03_wp, 0.0_wp, 'folded: fall at 0.3 s')
+        call suite%check_close(x(20), 0.04947_wp, 0.01_wp, 0.0_wp, 'folded: fall at 0.1 s')
+        call suite%check_close(x(40), 0.20363_wp, 0.01_wp, 0.0_wp, 'folded: fall at 0.2 s')
+        call suite%check_close(x(60), 0.48980_wp, 0.02_wp, 0.0_wp, 'folded: fall at 0.3 s')
         a_rel = (x(42) - 2.0_wp*x(40) + x(38))/(0.01_wp**2*g)
         write (*, '(a, f8.4, a)') '  folded: a/g at 0.2 s', a_rel, ' (theory 1.288)'
         call suite%check_true(a_rel > 1.15_wp, 'folded: tip acceleration > g')
         call suite%check_true(x(60) > 0.5_wp*g*0.3_wp**2, 'folded: faster than free fall')
         call suite%check_le(abs(run%e(60)%balance() - run%e(0)%balance()), &
-                            1.0e-5_wp, 'folded: T + V + dissipated = E0')
+                            2.0e-8_wp, 'folded: T + V + dissipated = E0')
     end subroutine folded_fall
 
     !> A tip mass equal to the rope's mass: the small-swing frequency against the heavy
@@ -278,7 +225,7 @@ contains
         integer :: k, nc
         character(len=64) :: mass_key
         write (mass_key, '(a, es24.16)') 'attachments.masses = ', rope_mass
-        call simulate([character(len=64) :: kind_key(kind), 'model.elements = 10', &
+        call simulate([character(len=SET_LEN) :: kind_set(kind), 'model.elements = 10', &
             'initial.angle_deg = 2', 'attachments.mass_positions = 1.0', mass_key], &
             5.5_wp, 0.005_wp, 1.0e-7_wp, run)
         if (.not. run%ok) return
@@ -351,7 +298,7 @@ contains
         type(run_t) :: run
         real(wp) :: worst, scale
         integer :: k
-        call simulate([character(len=64) :: kind_key(kind), 'model.elements = 7', &
+        call simulate([character(len=SET_LEN) :: kind_set(kind), 'model.elements = 7', &
             'effects.drag = .true.', 'effects.ground = .true.', 'fluid.density = 1000', &
             'fluid.current = 0.1, -0.2', 'ground.point = 0.2, 0.0', &
             'ground.normal = -1.0, 0.2', 'ground.stiffness = 1e4', &
@@ -378,7 +325,7 @@ contains
         call suite%check_true(run%e(ubound(run%e, 1))%dissipated > 0.0_wp .and. &
                               abs(run%e(ubound(run%e, 1))%support_work) > 0.0_wp, &
                               kind//': every effect: energy is dissipated and work is done')
-        call suite%check_le(worst, 1.0e-5_wp*scale, kind//': every effect: T + V + '// &
+        call suite%check_le(worst, 2.5e-7_wp*scale, kind//': every effect: T + V + '// &
                             'dissipated - work = E0')
     end subroutine every_effect_balance
 end program test_effects_physics

@@ -374,8 +374,12 @@ contains
         end do
     end subroutine test_observed_order
 
-    !> Adaptive runs on the stiff linear problem: error within a small multiple of rtol,
-    !! shrinking with rtol; the max_order limit is respected.
+    !> Adaptive runs on the stiff linear problem: the error is proportional to rtol with the
+    !! same factor at every tolerance (measured: 2.41, 2.29, 2.18 rtol at rtol 1e-4, 1e-7,
+    !! 1e-10, Debug and Release alike: within 5 % of 2.3), checked to +-15 % of 2.3. The
+    !! band is narrow on purpose: it guards the scale of the error estimate (halved, the
+    !! error doubles to 4.4 rtol; normalized by (k+2) sum 1/j instead of (k+1) sum 1/j it
+    !! grows to 2.83 rtol); the max_order limit is respected.
     subroutine test_adaptive_accuracy()
         type(linear_t), target :: p
         type(mebdf_t) :: integ
@@ -403,7 +407,8 @@ contains
             st = integ%stats()
             write (label, '(a, es8.1, a, es9.2, a, i0, a)') 'adaptive rtol ', rtols(m), &
                 ': max error at 20 output times ', e(m), ' (', st%steps, ' steps)'
-            call suite%check_le(e(m), 10.0_wp*rtols(m), trim(label))
+            call suite%check_close(e(m)/rtols(m), 2.3_wp, 0.15_wp, 0.0_wp, trim(label)// &
+                                   ': error/rtol = 2.3 +- 15 % (the error estimate''s scale)')
             call suite%check_true(all(st%order_steps(5:) == 0) .and. st%order_steps(4) > 0, &
                                   'default max_order 4 is used and respected')
             call suite%check_true(t == tout, 'output time hit exactly')

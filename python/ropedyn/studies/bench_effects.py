@@ -69,10 +69,15 @@ def build_baseline(rev, workdir):
     subprocess.run(["tar", "-x", "-C", str(src)], input=archive.stdout, check=True)
     (src / "tests" / "bench").mkdir(exist_ok=True)
     shutil.copy(ROOT / "tests" / "bench" / "bench_rhs.f90", src / "tests" / "bench")
-    with open(src / "tests" / "CMakeLists.txt", "a") as f:
-        f.write("\nadd_executable(bench_rhs bench/bench_rhs.f90)\n"
-                "ropedyn_fortran_target(bench_rhs)\n"
-                "target_link_libraries(bench_rhs PRIVATE ropedyn_lib)\n")
+    tests_cmake = src / "tests" / "CMakeLists.txt"
+    if "bench_rhs" not in tests_cmake.read_text():
+        # revisions before bench_rhs existed: one library (ropedyn_lib) or the layers
+        lib = "ropedyn_app" if "ropedyn_app" in (src / "CMakeLists.txt").read_text() \
+            else "ropedyn_lib"
+        with open(tests_cmake, "a") as f:
+            f.write("\nadd_executable(bench_rhs bench/bench_rhs.f90)\n"
+                    "ropedyn_fortran_target(bench_rhs)\n"
+                    f"target_link_libraries(bench_rhs PRIVATE {lib})\n")
     build = workdir / "build"
     log = workdir / "build.log"
     with open(log, "w") as f:

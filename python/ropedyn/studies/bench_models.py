@@ -5,7 +5,8 @@ numerically more efficient only for small n". This runs input/paper.nml (75 deg 
 Table 1 damping) for a short horizon at a fixed tolerance for every (model, solver, n),
 skipping the larger n of a (model, solver) once one case exceeds the time budget, and
 writes a table (between the bench_models markers in docs/benchmarks.md) and
-docs/figures/cost_vs_n.png. The crossover n where RFEM becomes cheaper is printed.
+docs/figures/cost_vs_n.png. The crossover n where RFEM becomes cheaper is printed. The runs
+have `&solver profile = .true.`: the table gives the CPU time per step and where it went.
 The code of scripts/bench_models (python -m ropedyn.studies.bench_models).
 """
 import argparse
@@ -21,7 +22,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from ropedyn import io  # noqa: E402
 from ropedyn.run import DOCS, PAPER, add_exe_argument, exe_or_build, set_args  # noqa: E402
-from ropedyn.studies.common import machine, update_doc, utc_stamp  # noqa: E402
+from ropedyn.studies.common import (SPLIT_HEADER, machine, time_split,  # noqa: E402
+                                    update_doc, utc_stamp)
 
 BEGIN = "<!-- bench_models:begin -->"
 END = "<!-- bench_models:end -->"
@@ -32,7 +34,7 @@ def run_case(exe, model, method, n, t_end, rtol, workdir, timeout):
     cmd = [str(exe), "run", str(PAPER), *set_args([
         f'model.kind="{model}"', f"model.elements={n}", f'solver.method="{method}"',
         f"solver.rtol={rtol}", f"solver.t_end={t_end}", f'output.file="{out}"',
-        "solver.output_interval=0.1"])]
+        "solver.output_interval=0.1", "solver.profile=.true."])]
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
@@ -43,7 +45,7 @@ def run_case(exe, model, method, n, t_end, rtol, workdir, timeout):
     total, dissipated = run.energy["total"], run.energy["dissipated"]
     return {"status": "complete", "cpu": float(run.stats["cpu_time"]),
             "steps": run.stats["steps"], "rhs": run.stats["rhs_evals"],
-            "jac": run.stats["jac_evals"],
+            "jac": run.stats["jac_evals"], "split": time_split(run.stats),
             "balance": float(abs(total + dissipated - total[0]).max())}
 
 
@@ -61,7 +63,8 @@ def main(argv=None):
     ns = [int(x) for x in args.elements.split()]
     settings = [("rfem", "cvode"), ("rfem", "mebdf"), ("mpp", "cvode"), ("mpp", "mebdf")]
     results = {}
-    header = "| model | solver | n | steps | RHS evals | Jacobians | CPU (s) | balance error (J) |"
+    header = ("| model | solver | n | steps | RHS evals | Jacobians | CPU (s) | CPU per step (ms) "
+              f"| {SPLIT_HEADER} | balance error (J) |")
     print(header, flush=True)
     with tempfile.TemporaryDirectory() as tmp:
         for model, method in settings:
@@ -120,7 +123,7 @@ def main(argv=None):
              f"\"{args.elements}\"` (input/paper.nml, rtol {args.rtol:g}, atol 1e-8, default "
              f"max orders: CVODE 5, MEBDF 4). Machine: {machine()}. Run: {stamp}.",
              "", "![cost versus n](figures/cost_vs_n.png)", "", header,
-             "|---|---|---|---|---|---|---|---|"]
+             "|---|---|---|---|---|---|---|---|---|---|"]
     lines += [line(m, s, n, results[(m, s, n)]) for m, s in settings for n in ns]
     lines += ["", *(f"Crossover with {m}: RFEM cheaper than MPP from n = {n}."
                     for m, n in crossover.items()),
@@ -134,9 +137,10 @@ def main(argv=None):
 
 def line(model, method, n, r):
     if r.get("status") != "complete":
-        return f"| {model} | {method} | {n} | {r.get('status')} |  |  |  |  |"
+        return f"| {model} | {method} | {n} | {r.get('status')} |  |  |  |  |  |  |"
     return (f"| {model} | {method} | {n} | {r['steps']} | {r['rhs']} | {r['jac']} | "
-            f"{r['cpu']:.3f} | {r['balance']:.1e} |")
+            f"{r['cpu']:.3f} | {1e3 * r['cpu'] / r['steps']:.3f} | {r['split']} | "
+            f"{r['balance']:.1e} |")
 
 
 if __name__ == "__main__":

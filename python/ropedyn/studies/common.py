@@ -43,3 +43,21 @@ def update_doc(path, begin, end, block, heading="", strip=None, default=None):
     if new is None:
         new = text.rstrip(strip) + "\n\n" + heading + block + "\n"
     path.write_text(new)
+
+
+#: The parts of the time split of a run (&solver profile = .true.; /solver/time_*).
+SPLIT_PARTS = ("time_rhs", "time_jacobian", "time_factor", "time_solve")
+SPLIT_HEADER = "split RHS / Jacobian / factor / solve / rest (%)"
+
+
+def time_split(stats):
+    """'a / b / c / d / e' percentages of the time in the integrator (/solver/time_advance)
+    spent in the right-hand side, Jacobians, factorizations, solves and the rest (the
+    integrator's own work); all measured inside the run with the monotonic clock. '' when
+    the run was not profiled."""
+    total = stats.get("time_advance", 0.0)
+    parts = [stats.get(k) for k in SPLIT_PARTS]
+    if not total or any(p is None for p in parts):
+        return ""
+    rest = max(total - sum(parts), 0.0)
+    return " / ".join(f"{100 * p / total:.0f}" for p in [*parts, rest])

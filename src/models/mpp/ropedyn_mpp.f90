@@ -10,9 +10,12 @@
 !!
 !! The whole dynamics is one O(n) routine, the Lagrange residual
 !!     r(q, q', q'') = Q(q, q') - sum_i m J_i^T C_i'' - J phi'' ,   J_i = dC_i/dq,
-!! so that f = r(q, q', 0) and M q'' = f - r(q, q', q''). M(q) itself (dense) is
-!! assembled in O(n^2) for the solve (Cholesky, LAPACK dpotrf/dpotrs), which makes the
-!! explicit right-hand side O(n^3): the paper's reason RFEM wins at large n.
+!! so that f = r(q, q', 0) and M q'' = f - r(q, q', q''). The explicit right-hand side
+!! solves M(q) q'' = f in O(n) as well: M is the mass matrix of a chain whose members hang
+!! from the previous joint by a translation only (the angles are absolute), so the tip-to-
+!! root recursion of articulated-body inertias (2x2 per joint) factors it and two sweeps
+!! solve (mass_factor, ab_solve; docs/physics-mpp.md). The dense M(q) is assembled (O(n^2),
+!! cos/sin of each angle once) only for the implicit form and the modal analysis.
 !!
 !! External effects (drag, ground contact, point loads; ropedyn_effect) act on the rods as
 !! bodies: w_i gains the body force, r[phi_i] the body moment. Point masses sit at their
@@ -69,6 +72,25 @@ module ropedyn_mpp
         ! point masses: rod, offset from the rod's centre along it (m), mass (kg)
         integer, allocatable :: pm_body(:)
         real(wp), allocatable :: pm_r(:), pm_m(:)
+        ! per rod with its point masses: mass (kg), first and second moment of the point
+        ! masses about the rod's centre (kg m, kg m^2)
+        real(wp), allocatable :: mbar(:), pm_s1(:), pm_s2(:)
+        ! workspace, allocated once (no state is kept between calls)
+        real(wp), allocatable :: cs(:, :)     !< cos, sin of the angles (2, n)
+        real(wp), allocatable :: w(:, :)      !< applied-minus-inertial force on the rods (2, n)
+        real(wp), allocatable :: cacc(:, :)   !< rod centre accelerations (2, n)
+        real(wp), allocatable :: mom(:)       !< moments on the rods (n)
+        !> suffix sums sum_{i>=k} w_i + F_b (2, n+1), column n+1 the bottom support's force
+        real(wp), allocatable :: wsum(:, :)
+        type(bodies_t) :: bodies              !< the rods as bodies for the effects
+        real(wp), allocatable :: ejac(:, :, :)  !< the effects' blocks (3, 6, n)
+        !> factors of M(q) (mass_factor): per member the 2x2 blocks G, H = D^{-1} G^T,
+        !! D^{-1} (rows and columns: angle, elongation) and the member length lambda
+        real(wp), allocatable :: ab_g(:, :, :), ab_h(:, :, :), ab_dinv(:, :, :), ab_lam(:)
+        real(wp), allocatable :: acc(:)       !< accelerations M^{-1} f (ndof)
+        real(wp), allocatable :: r0(:)        !< the residual at them (ndof)
+        real(wp), allocatable :: dr(:, :)     !< d r(q, q', acc)/d(q, q') (ndof, 2 ndof)
+        real(wp), allocatable :: mm(:, :)     !< M(q) (ndof, ndof)
     contains
         procedure :: size => mpp_size
         procedure :: bandwidths => mpp_bandwidths
@@ -91,27 +113,14 @@ module ropedyn_mpp
         procedure :: mass_dense => mpp_mass_dense
         procedure :: coordinates => mpp_coordinates
         procedure :: coordinate_mass => mpp_coordinate_mass
+        procedure :: second_order_blocks => mpp_second_order_blocks
         procedure, private :: positions
         procedure, private :: supports_at
+        procedure, private :: residual_core
+        procedure, private :: residual_column
+        procedure, private :: mass_factor
+        procedure, private :: derivatives
     end type mpp_t
-
-    interface
-        subroutine dpotrf(uplo, n, a, lda, info)
-            import :: wp
-            character, intent(in) :: uplo
-            integer, intent(in) :: n, lda
-            real(wp), intent(inout) :: a(lda, *)
-            integer, intent(out) :: info
-        end subroutine dpotrf
-        subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
-            import :: wp
-            character, intent(in) :: uplo
-            integer, intent(in) :: n, nrhs, lda, ldb
-            real(wp), intent(in) :: a(lda, *)
-            real(wp), intent(inout) :: b(ldb, *)
-            integer, intent(out) :: info
-        end subroutine dpotrs
-    end interface
 
     interface
         !> Split y into angles, elongations and their rates (elongations 0 if inextensible).
@@ -125,14 +134,56 @@ module ropedyn_mpp
         !! (and the point masses' inertia) for the generalized accelerations qacc (size ndof)
         !! at time t (default 0), O(n). `pin`: the force of the top joint on the rope (N),
         !! meaningful when qacc are the true accelerations.
-        module pure subroutine mpp_residual(self, y, qacc, r, t, pin)
-            class(mpp_t), intent(in) :: self
+        module subroutine mpp_residual(self, y, qacc, r, t, pin)
+            class(mpp_t), intent(inout) :: self
             real(wp), intent(in) :: y(:)
             real(wp), intent(in) :: qacc(:)
             real(wp), intent(out) :: r(:)
             real(wp), intent(in), optional :: t
             real(wp), intent(out), optional :: pin(2)
         end subroutine mpp_residual
+
+        !> The residual with self%cs holding cos and sin of the angles of y (mpp_residual
+        !! without that step; the Jacobian's difference quotients update one angle at a time).
+        module subroutine residual_core(self, t, y, qacc, r, pin)
+            class(mpp_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(in) :: qacc(:)
+            real(wp), intent(out) :: r(:)
+            real(wp), intent(out), optional :: pin(2)
+        end subroutine residual_core
+
+        !> Column j of d r(q, q', qacc)/d(q, q') (j <= ndof: coordinate j, else rate j - ndof),
+        !! exact: the tangent of residual_core, O(n), from the quantities its last call left
+        !! (self%w, mom, cacc, wsum, bodies) and the effects' blocks self%ejac.
+        module subroutine residual_column(self, t, y, qacc, j, col)
+            class(mpp_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(in) :: qacc(:)
+            integer, intent(in) :: j
+            real(wp), intent(out) :: col(:)
+        end subroutine residual_column
+
+        !> Factor M(q) (self%cs holding the angles of y): the articulated-body recursion from
+        !! the tip into self%ab_*; ab_solve then solves M x = b in O(n). status is
+        !! STATUS_RECOVERABLE when a pivot is not positive (an impossible configuration).
+        module subroutine mass_factor(self, y, status)
+            class(mpp_t), intent(inout) :: self
+            real(wp), intent(in) :: y(:)
+            integer, intent(out) :: status
+        end subroutine mass_factor
+
+        !> At (t, y): cos/sin, the factors of M, the accelerations self%acc = M^{-1} f, the
+        !! residual self%r0 there and self%dr = d r(q, q', acc)/d(q, q'), exact (the tangent
+        !! of the O(n) residual, column by column: O(n^2)).
+        module subroutine derivatives(self, t, y, status)
+            class(mpp_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            integer, intent(out) :: status
+        end subroutine derivatives
 
         !> The dense mass matrix M(q) (ndof x ndof), O(n^2).
         module pure subroutine mpp_mass_dense(self, y, mm)
@@ -141,7 +192,7 @@ module ropedyn_mpp
             real(wp), intent(out) :: mm(:, :)
         end subroutine mpp_mass_dense
 
-        !> y' = (q', M^{-1} f): f = r(q, q', 0), solved by Cholesky.
+        !> y' = (q', M^{-1} f): f = r(q, q', 0), solved in O(n) (mass_factor, ab_solve).
         module subroutine mpp_rhs(self, t, y, ydot, status)
             class(mpp_t), intent(inout) :: self
             real(wp), intent(in) :: t
@@ -171,7 +222,7 @@ module ropedyn_mpp
 
         !> Jacobian of y' = (q', a), a = M^{-1} f. With a0 = a(y) held fixed, M a = f gives
         !! da/dz = M^{-1} d r(q, q', a0)/dz (z = q or q'), exact: the residual's difference
-        !! quotients are O(n) each, then one Cholesky solve with 2 ndof right-hand sides.
+        !! quotients are O(n) each, then an O(n) solve per column: O(n^2) in all.
         module subroutine mpp_jacobian(self, t, y, jb, offset, status)
             class(mpp_t), intent(inout) :: self
             real(wp), intent(in) :: t
@@ -180,6 +231,22 @@ module ropedyn_mpp
             integer, intent(in) :: offset
             integer, intent(out) :: status
         end subroutine mpp_jacobian
+
+        !> The blocks of the rate rows (dense, kl = ku = ndof - 1). Explicit form: the rows of
+        !! the Jacobian, K = M^{-1} dr/dq, C = M^{-1} dr/dq', mass block I. Implicit form
+        !! (M(q) q'' = f): K = dr(q, q', a)/dq = df/dq - d(M(q) a)/dq at the current
+        !! accelerations a = M^{-1} f, C = df/dq', and M(q), so that M - g C - g^2 K is the
+        !! exact reduced Newton matrix of the implicit form.
+        module subroutine mpp_second_order_blocks(self, t, y, implicit_form, kb, cb, mb, &
+                                                  offset, status)
+            class(mpp_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            logical, intent(in) :: implicit_form
+            real(wp), intent(inout) :: kb(:, :), cb(:, :), mb(:, :)
+            integer, intent(in) :: offset
+            integer, intent(out) :: status
+        end subroutine mpp_second_order_blocks
 
         module function mpp_energy(self, t, y, yq) result(en)
             class(mpp_t), intent(inout) :: self
@@ -212,8 +279,8 @@ contains
         integer :: k
 
         model%n = spec%model%elements
-        if (model%n < 1) then
-            call make_error(err, ERR_INPUT, 'mpp: elements must be >= 1')
+        if (model%n < 2) then
+            call make_error(err, ERR_INPUT, 'mpp: elements must be >= 2')
             return
         end if
         if (spec%supports%top == 'free') then
@@ -271,7 +338,24 @@ contains
 
         call attached_masses(spec, [(model%l, k = 1, model%n)], model%pm_body, model%pm_r, &
                              model%pm_m)
+        allocate (model%mbar(model%n), model%pm_s1(model%n), model%pm_s2(model%n))
+        model%mbar = model%m
+        model%pm_s1 = 0.0_wp
+        model%pm_s2 = 0.0_wp
+        do k = 1, size(model%pm_body)
+            associate (i => model%pm_body(k))
+                model%mbar(i) = model%mbar(i) + model%pm_m(k)
+                model%pm_s1(i) = model%pm_s1(i) + model%pm_m(k)*model%pm_r(k)
+                model%pm_s2(i) = model%pm_s2(i) + model%pm_m(k)*model%pm_r(k)**2
+            end associate
+        end do
         call build_body_effects(spec, [(model%l, k = 1, model%n)], model%effects)
+        if (size(model%effects) > 0) then
+            model%bodies%n = model%n
+            allocate (model%bodies%c(2, model%n), model%bodies%v(2, model%n), &
+                      model%bodies%phi(model%n), model%bodies%w(model%n))
+            model%bodies%l = [(model%l, k = 1, model%n)]
+        end if
         model%motion(1)%p0 = model%top_anchor
         model%motion(1)%angle0 = model%top_angle
         model%motion(2)%p0 = model%bottom_anchor
@@ -285,6 +369,27 @@ contains
             call configure_motions(spec, [.true., model%bottom > 0], model%motion, model%moving)
         end if
         model%with_work = any_does_work(model%moving, model%effects)
+
+        associate (n => model%n, nd => model%ndof)
+            allocate (model%cs(2, n), model%w(2, n), model%cacc(2, n), model%mom(n), &
+                      model%ab_g(2, 2, n), model%ab_h(2, 2, n), model%ab_dinv(2, 2, n), &
+                      model%ab_lam(n), model%acc(nd), model%r0(nd), model%dr(nd, 2*nd), &
+                      model%mm(nd, nd), model%wsum(2, n + 1), model%ejac(3, 6, n))
+        end associate
+        model%cs = 0.0_wp
+        model%w = 0.0_wp
+        model%cacc = 0.0_wp
+        model%mom = 0.0_wp
+        model%ab_g = 0.0_wp
+        model%ab_h = 0.0_wp
+        model%ab_dinv = 0.0_wp
+        model%ab_lam = 0.0_wp
+        model%acc = 0.0_wp
+        model%r0 = 0.0_wp
+        model%dr = 0.0_wp
+        model%mm = 0.0_wp
+        model%wsum = 0.0_wp
+        model%ejac = 0.0_wp
     end subroutine mpp_create
 
     !> The supports at time t: top joint, bottom anchor (motion states) and whether the

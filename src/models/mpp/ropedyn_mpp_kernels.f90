@@ -1,5 +1,11 @@
-!> The MPP kernels: the O(n) Lagrange residual, the dense mass matrix, right-hand side,
-!! Jacobian, energies and powers (the derivation is in docs/physics-mpp.md).
+!> The MPP kernels: the O(n) Lagrange residual, the O(n) solve of M(q) q'' = f by the
+!! articulated-body recursion, the dense mass matrix (O(n^2)), the Jacobian and the
+!! second-order blocks (O(n^2): a difference quotient of the residual and a solve per
+!! column), energies and powers. The derivation is in docs/physics-mpp.md.
+!!
+!! Work arrays are held by the model (allocated at creation): cos and sin of every angle
+!! once per call (self%cs), the rods' forces, the factors of M and the residual's
+!! derivatives. No allocation per call.
 submodule (ropedyn_mpp) ropedyn_mpp_kernels
     implicit none
 
@@ -19,64 +25,98 @@ contains
         end if
     end procedure unpack
 
+    !> cos and sin of every angle of y into self%cs, once per call.
+    subroutine angles(self, y)
+        class(mpp_t), intent(inout) :: self
+        real(wp), intent(in) :: y(:)
+        integer :: k
+        do k = 1, self%n
+            self%cs(1, k) = cos(y(k))
+            self%cs(2, k) = sin(y(k))
+        end do
+    end subroutine angles
+
     module procedure mpp_residual
-        real(wp), dimension(self%n) :: phi, u, phid, ud, phidd, udd, hk, lk, mom
-        real(wp) :: e(2, self%n), nv(2, self%n), pacc(2), cacc(2, self%n), w(2, self%n)
-        real(wp) :: wsum(2), fb(2), pn(2), pnd(2), d, dd, tt, fp(2), pv(2)
+        real(wp) :: tt
+        tt = 0.0_wp
+        if (present(t)) tt = t
+        call angles(self, y)
+        call self%residual_core(tt, y, qacc, r, pin)
+    end procedure mpp_residual
+
+    module procedure residual_core
+        real(wp) :: pacc(2), pn(2), pnd(2), wsum(2), fb(2), fp(2), pv(2)
+        real(wp) :: c, s, u, ud, phd, pdd, udd, hk, lk, a1, a2, d, dd
         type(motion_state_t) :: top, bottom
-        type(bodies_t) :: b
-        logical :: bottom_on
+        logical :: bottom_on, effects
         integer :: k, n, nd, i
 
         n = self%n
         nd = self%ndof
-        tt = 0.0_wp
-        if (present(t)) tt = t
-        call self%supports_at(tt, top, bottom, bottom_on)
-        call unpack(self, y, phi, u, phid, ud)
-        phidd = qacc(1:n)
+        effects = size(self%effects) > 0
+        call self%supports_at(t, top, bottom, bottom_on)
+        u = 0.0_wp
+        ud = 0.0_wp
         udd = 0.0_wp
-        if (self%nu > 0) udd = qacc(n + 1:nd)
-        hk = u + 0.5_wp*self%l
-        lk = u + self%l
-        e(1, :) = cos(phi)
-        e(2, :) = sin(phi)
-        nv(1, :) = -e(2, :)
-        nv(2, :) = e(1, :)
 
         ! Accelerations of the joints (prefix sums, from the top joint's) and the
-        ! applied-minus-inertial force on each rod: w_i = m g x - m C_i''.
+        ! applied-minus-inertial force on each rod: w_k = m g x - m C_k''.
         pacc = top%a
         pn = top%p
         pnd = top%v
         do k = 1, n
-            cacc(:, k) = pacc + (hk(k)*phidd(k) + 2.0_wp*ud(k)*phid(k))*nv(:, k) &
-                         + (udd(k) - hk(k)*phid(k)**2)*e(:, k)
-            pacc = pacc + (lk(k)*phidd(k) + 2.0_wp*ud(k)*phid(k))*nv(:, k) &
-                   + (udd(k) - lk(k)*phid(k)**2)*e(:, k)
-            w(:, k) = -self%m*cacc(:, k)
-            w(1, k) = w(1, k) + self%m*self%g
-            pn = pn + lk(k)*e(:, k)
-            pnd = pnd + lk(k)*phid(k)*nv(:, k) + ud(k)*e(:, k)
+            c = self%cs(1, k)
+            s = self%cs(2, k)
+            phd = y(nd + k)
+            pdd = qacc(k)
+            if (self%nu > 0) then
+                u = y(n + k)
+                ud = y(nd + n + k)
+                udd = qacc(n + k)
+            end if
+            hk = u + 0.5_wp*self%l
+            lk = u + self%l
+            ! along n_k = (-s, c) and e_k = (c, s)
+            a1 = hk*pdd + 2.0_wp*ud*phd
+            a2 = udd - hk*phd**2
+            self%cacc(1, k) = pacc(1) - a1*s + a2*c
+            self%cacc(2, k) = pacc(2) + a1*c + a2*s
+            self%w(1, k) = -self%m*self%cacc(1, k) + self%m*self%g
+            self%w(2, k) = -self%m*self%cacc(2, k)
+            a1 = lk*pdd + 2.0_wp*ud*phd
+            a2 = udd - lk*phd**2
+            pacc(1) = pacc(1) - a1*s + a2*c
+            pacc(2) = pacc(2) + a1*c + a2*s
+            if (effects) then
+                self%bodies%c(1, k) = pn(1) + hk*c
+                self%bodies%c(2, k) = pn(2) + hk*s
+                self%bodies%v(1, k) = pnd(1) - hk*phd*s + ud*c
+                self%bodies%v(2, k) = pnd(2) + hk*phd*c + ud*s
+                self%bodies%phi(k) = y(k)
+                self%bodies%w(k) = phd
+            end if
+            pn(1) = pn(1) + lk*c
+            pn(2) = pn(2) + lk*s
+            pnd(1) = pnd(1) - lk*phd*s + ud*c
+            pnd(2) = pnd(2) + lk*phd*c + ud*s
         end do
-        mom = 0.0_wp
+        self%mom = 0.0_wp
 
         ! Point masses at P = C_i + r e_i: their applied-minus-inertial force joins w_i,
         ! its moment r e_i x f about the centre joins the rod's moment.
         do k = 1, size(self%pm_body)
             i = self%pm_body(k)
-            pv = cacc(:, i) + self%pm_r(k)*(phidd(i)*nv(:, i) - phid(i)**2*e(:, i))
+            c = self%cs(1, i)
+            s = self%cs(2, i)
+            pv = self%cacc(:, i) + self%pm_r(k)*(qacc(i)*[-s, c] - y(nd + i)**2*[c, s])
             fp = -self%pm_m(k)*pv
             fp(1) = fp(1) + self%pm_m(k)*self%g
-            w(:, i) = w(:, i) + fp
-            mom(i) = mom(i) + self%pm_r(k)*dot_product(nv(:, i), fp)
+            self%w(:, i) = self%w(:, i) + fp
+            self%mom(i) = self%mom(i) + self%pm_r(k)*(-s*fp(1) + c*fp(2))
         end do
 
         ! External effects on the rods as bodies.
-        if (size(self%effects) > 0) then
-            call rod_bodies(self, y, top, b)
-            call add_forces_of(self%effects, tt, b, w, mom)
-        end if
+        if (effects) call add_forces_of(self%effects, t, self%bodies, self%w, self%mom)
 
         ! Force of the bottom support on the tip P_n.
         fb = 0.0_wp
@@ -85,34 +125,209 @@ contains
         ! Generalized forces by suffix sums: Q[phi_k] = n_k . (h_k w_k + l_k sum_{i>k} w_i
         ! + l_k F_b) + M_k, Q[u_k] = e_k . (sum_{i>=k} w_i + F_b).
         wsum = fb
+        self%wsum(:, n + 1) = fb
         do k = n, 1, -1
-            r(k) = dot_product(nv(:, k), hk(k)*w(:, k) + lk(k)*wsum) + mom(k)
-            wsum = wsum + w(:, k)
-            if (self%nu > 0) r(n + k) = dot_product(e(:, k), wsum)
+            c = self%cs(1, k)
+            s = self%cs(2, k)
+            if (self%nu > 0) u = y(n + k)
+            hk = u + 0.5_wp*self%l
+            lk = u + self%l
+            r(k) = -s*(hk*self%w(1, k) + lk*wsum(1)) + c*(hk*self%w(2, k) + lk*wsum(2)) &
+                   + self%mom(k) - self%inertia*qacc(k)
+            wsum = wsum + self%w(:, k)
+            self%wsum(:, k) = wsum
+            if (self%nu > 0) r(n + k) = c*wsum(1) + s*wsum(2)
         end do
         if (present(pin)) pin = -wsum
-        r(1:n) = r(1:n) - self%inertia*phidd
 
         ! Member springs and dampers.
-        if (self%nu > 0) r(n + 1:nd) = r(n + 1:nd) - self%ks*u - self%ds*ud
+        if (self%nu > 0) r(n + 1:nd) = r(n + 1:nd) - self%ks*y(n + 1:nd) &
+                                       - self%ds*y(nd + n + 1:2*nd)
         ! Joint bending springs and dampers between members.
         if (self%cb > 0.0_wp .or. self%db > 0.0_wp) then
             do k = 2, n
-                d = self%cb*(phi(k) - phi(k - 1)) + self%db*(phid(k) - phid(k - 1))
+                d = self%cb*(y(k) - y(k - 1)) + self%db*(y(nd + k) - y(nd + k - 1))
                 r(k) = r(k) - d
                 r(k - 1) = r(k - 1) + d
             end do
         end if
         ! Rotational springs of clamped supports.
         if (self%top_clamped) then
-            dd = self%c_rot*(phi(1) - top%angle) + self%d_rot*(phid(1) - top%rate)
+            dd = self%c_rot*(y(1) - top%angle) + self%d_rot*(y(nd + 1) - top%rate)
             r(1) = r(1) - dd
         end if
         if (self%bottom == 2 .and. bottom_on) then
-            dd = self%c_rot*(phi(n) - bottom%angle) + self%d_rot*(phid(n) - bottom%rate)
+            dd = self%c_rot*(y(n) - bottom%angle) + self%d_rot*(y(nd + n) - bottom%rate)
             r(n) = r(n) - dd
         end if
-    end procedure mpp_residual
+    end procedure residual_core
+
+    module procedure residual_column
+        real(wp) :: c, s, e(2), nv(2), de(2), dn(2), u, ud, phd, pdd, udd, hk, lk
+        real(wp) :: dhk, dlk, dphd, dud, dphi, a1, a2, da1, da2, dcacc(2), sh_a(2), sh_p(2), sh_v(2)
+        real(wp) :: dcb(2), dvb(2), dw(2), dmom, dws(2), fp(2), dfp(2), pv(2), cb, db
+        type(motion_state_t) :: top, bottom
+        logical :: bottom_on, effects
+        integer :: n, nd, m, kind, k, p
+
+        n = self%n
+        nd = self%ndof
+        effects = size(self%effects) > 0
+        ! the member m and which of its variables (1 angle, 2 elongation, 3 and 4 their rates)
+        if (j <= nd) then
+            kind = merge(1, 2, j <= n)
+            m = merge(j, j - n, j <= n)
+        else
+            kind = merge(3, 4, j - nd <= n)
+            m = merge(j - nd, j - nd - n, j - nd <= n)
+        end if
+        c = self%cs(1, m)
+        s = self%cs(2, m)
+        e = [c, s]
+        nv = [-s, c]
+        u = 0.0_wp
+        ud = 0.0_wp
+        udd = 0.0_wp
+        if (self%nu > 0) then
+            u = y(n + m)
+            ud = y(nd + n + m)
+            udd = qacc(n + m)
+        end if
+        phd = y(nd + m)
+        pdd = qacc(m)
+        hk = u + 0.5_wp*self%l
+        lk = u + self%l
+        de = 0.0_wp
+        dn = 0.0_wp
+        dhk = 0.0_wp
+        dphd = 0.0_wp
+        dud = 0.0_wp
+        dphi = 0.0_wp
+        select case (kind)
+        case (1)
+            de = nv
+            dn = -e
+            dphi = 1.0_wp
+        case (2)
+            dhk = 1.0_wp
+        case (3)
+            dphd = 1.0_wp
+        case (4)
+            dud = 1.0_wp
+        end select
+        dlk = dhk
+        ! member m: its centre's acceleration, position and velocity, and the shifts sh_a, sh_p,
+        ! sh_v of every joint and centre below it
+        a1 = hk*pdd + 2.0_wp*ud*phd
+        a2 = udd - hk*phd**2
+        da1 = dhk*pdd + 2.0_wp*(dud*phd + ud*dphd)
+        da2 = -dhk*phd**2 - 2.0_wp*hk*phd*dphd
+        dcacc = da1*nv + a1*dn + da2*e + a2*de
+        a1 = lk*pdd + 2.0_wp*ud*phd
+        a2 = udd - lk*phd**2
+        da1 = dlk*pdd + 2.0_wp*(dud*phd + ud*dphd)
+        da2 = -dlk*phd**2 - 2.0_wp*lk*phd*dphd
+        sh_a = da1*nv + a1*dn + da2*e + a2*de
+        dcb = dhk*e + hk*de
+        dvb = (dhk*phd + hk*dphd)*nv + hk*phd*dn + dud*e + ud*de
+        sh_p = dlk*e + lk*de
+        sh_v = (dlk*phd + lk*dphd)*nv + lk*phd*dn + dud*e + ud*de
+
+        ! the bottom support's force on the tip
+        call self%supports_at(t, top, bottom, bottom_on)
+        dws = 0.0_wp
+        if (bottom_on) dws = -self%k_sup*sh_p - self%d_sup*sh_v
+
+        ! members below m: w_k shifts by -m_k sh_a and the effects' response to sh_p, sh_v
+        col = 0.0_wp
+        do k = n, m + 1, -1
+            dw = -self%mbar(k)*sh_a
+            dmom = -self%pm_s1(k)*(-self%cs(2, k)*sh_a(1) + self%cs(1, k)*sh_a(2))
+            if (effects) then
+                dw = dw + matmul(self%ejac(1:2, 1:2, k), sh_p) &
+                     + matmul(self%ejac(1:2, 4:5, k), sh_v)
+                dmom = dmom + dot_product(self%ejac(3, 1:2, k), sh_p) &
+                       + dot_product(self%ejac(3, 4:5, k), sh_v)
+            end if
+            call suffix_step(k, dw, dmom)
+        end do
+
+        ! member m itself
+        dw = -self%m*dcacc
+        dmom = 0.0_wp
+        do p = 1, size(self%pm_body)
+            if (self%pm_body(p) /= m) cycle
+            pv = self%cacc(:, m) + self%pm_r(p)*(pdd*nv - phd**2*e)
+            fp = -self%pm_m(p)*pv
+            fp(1) = fp(1) + self%pm_m(p)*self%g
+            dfp = -self%pm_m(p)*(dcacc + self%pm_r(p)*(pdd*dn - 2.0_wp*phd*dphd*e - phd**2*de))
+            dw = dw + dfp
+            dmom = dmom + self%pm_r(p)*(dot_product(dn, fp) + dot_product(nv, dfp))
+        end do
+        if (effects) then
+            dw = dw + matmul(self%ejac(1:2, 1:2, m), dcb) + self%ejac(1:2, 3, m)*dphi &
+                 + matmul(self%ejac(1:2, 4:5, m), dvb) + self%ejac(1:2, 6, m)*dphd
+            dmom = dmom + dot_product(self%ejac(3, 1:2, m), dcb) + self%ejac(3, 3, m)*dphi &
+                   + dot_product(self%ejac(3, 4:5, m), dvb) + self%ejac(3, 6, m)*dphd
+        end if
+        ! r[phi_m] = n.(h w_m + l ws_{m+1}) + ..., r[u_m] = e.ws_m: their own variables
+        col(m) = dot_product(dn, hk*self%w(:, m) + lk*self%wsum(:, m + 1)) &
+                 + dot_product(nv, dhk*self%w(:, m) + dlk*self%wsum(:, m + 1))
+        if (self%nu > 0) col(n + m) = dot_product(de, self%wsum(:, m))
+        call suffix_step(m, dw, dmom)
+
+        ! members above m: only the suffix sums change
+        do k = m - 1, 1, -1
+            c = self%cs(1, k)
+            s = self%cs(2, k)
+            lk = self%l
+            if (self%nu > 0) lk = lk + y(n + k)
+            col(k) = lk*(-s*dws(1) + c*dws(2))
+            if (self%nu > 0) col(n + k) = c*dws(1) + s*dws(2)
+        end do
+
+        ! springs, dampers and clamps on member m's own variables
+        select case (kind)
+        case (2)
+            col(n + m) = col(n + m) - self%ks
+        case (4)
+            col(n + m) = col(n + m) - self%ds
+        case (1, 3)
+            cb = merge(self%cb, self%db, kind == 1)
+            if (m >= 2) then
+                col(m) = col(m) - cb
+                col(m - 1) = col(m - 1) + cb
+            end if
+            if (m < n) then
+                col(m + 1) = col(m + 1) + cb
+                col(m) = col(m) - cb
+            end if
+            db = 0.0_wp
+            if (m == 1 .and. self%top_clamped) db = merge(self%c_rot, self%d_rot, kind == 1)
+            if (m == n .and. self%bottom == 2 .and. bottom_on) &
+                db = db + merge(self%c_rot, self%d_rot, kind == 1)
+            col(m) = col(m) - db
+        end select
+    contains
+        !> Member k's rows from its force change dw, moment change dmom and the suffix sum
+        !! of the changes below it (dws, then including dw).
+        subroutine suffix_step(k, dw, dmom)
+            integer, intent(in) :: k
+            real(wp), intent(in) :: dw(2), dmom
+            real(wp) :: ck, sk, hkk, lkk
+            ck = self%cs(1, k)
+            sk = self%cs(2, k)
+            hkk = 0.5_wp*self%l
+            lkk = self%l
+            if (self%nu > 0) then
+                hkk = hkk + y(n + k)
+                lkk = lkk + y(n + k)
+            end if
+            col(k) = col(k) - sk*(hkk*dw(1) + lkk*dws(1)) + ck*(hkk*dw(2) + lkk*dws(2)) + dmom
+            dws = dws + dw
+            if (self%nu > 0) col(n + k) = col(n + k) + ck*dws(1) + sk*dws(2)
+        end subroutine suffix_step
+    end procedure residual_column
 
     !> The rods as bodies (centre, angle, their rates, length l) for the effects.
     pure subroutine rod_bodies(self, y, top, b)
@@ -141,77 +356,233 @@ contains
         end do
     end subroutine rod_bodies
 
-    module procedure mpp_mass_dense
-        real(wp), dimension(self%n) :: phi, u, phid, ud, hk, lk
-        real(wp) :: cjk, sjk, s, jp(2, self%ndof), e(2), nv(2)
-        integer :: k, j, n, p, i
+    !> The articulated-body recursion, from the tip (docs/physics-mpp.md, "Solving
+    !! M q'' = f in O(n)"). The members k .. n, hanging from joint P_{k-1}, exert on it the
+    !! force S_k = I_k A + z_k for its acceleration A, with a 2x2 articulated inertia I_k
+    !! (I_{n+1} = 0: the tip is free of inertia; springs are forces, not inertia). With
+    !! I' = I_{k+1}, member k's unknowns x = (phi_k'', u_k'') satisfy D x = c - G^T A:
+    !!     D11 = m eta^2 + 2 s1 eta + s2 + J + lambda^2 n.I'n,  D12 = lambda e.I'n,
+    !!     D22 = m + e.I'e,  G = [(m eta + s1) n + lambda I'n, m e + I'e],
+    !! and I_k = m I + I' - G D^{-1} G^T (m the member's mass with its point masses, s1, s2
+    !! their first and second moments about the rod's centre). Inextensible members keep
+    !! the angle row only.
+    module procedure mass_factor
+        real(wp) :: ixx, ixy, iyy, inx, iny, iex, iey, c, s, u, eta, lam, mb, s1, s2
+        real(wp) :: d11, d12, d22, det, g1(2), g2(2), h1(2), h2(2)
+        integer :: k, n
+
         n = self%n
-        call unpack(self, y, phi, u, phid, ud)
-        hk = u + 0.5_wp*self%l
-        lk = u + self%l
-        mm = 0.0_wp
+        status = STATUS_OK
+        ixx = 0.0_wp
+        ixy = 0.0_wp
+        iyy = 0.0_wp
+        u = 0.0_wp
+        do k = n, 1, -1
+            c = self%cs(1, k)
+            s = self%cs(2, k)
+            if (self%nu > 0) u = y(n + k)
+            eta = u + 0.5_wp*self%l
+            lam = u + self%l
+            mb = self%mbar(k)
+            s1 = self%pm_s1(k)
+            s2 = self%pm_s2(k)
+            ! I' n and I' e, n = (-s, c), e = (c, s)
+            inx = -ixx*s + ixy*c
+            iny = -ixy*s + iyy*c
+            iex = ixx*c + ixy*s
+            iey = ixy*c + iyy*s
+            d11 = mb*eta**2 + 2.0_wp*s1*eta + s2 + self%inertia + lam**2*(-s*inx + c*iny)
+            g1(1) = -(mb*eta + s1)*s + lam*inx
+            g1(2) = (mb*eta + s1)*c + lam*iny
+            if (self%nu > 0) then
+                d12 = lam*(c*inx + s*iny)
+                d22 = mb + c*iex + s*iey
+                g2(1) = mb*c + iex
+                g2(2) = mb*s + iey
+                det = d11*d22 - d12**2
+                if (.not. (d11 > 0.0_wp .and. det > 0.0_wp)) then
+                    status = STATUS_RECOVERABLE
+                    return
+                end if
+                self%ab_dinv(1, 1, k) = d22/det
+                self%ab_dinv(1, 2, k) = -d12/det
+                self%ab_dinv(2, 1, k) = -d12/det
+                self%ab_dinv(2, 2, k) = d11/det
+                ! H = D^{-1} G^T: row 1 the angle's, row 2 the elongation's
+                h1 = self%ab_dinv(1, 1, k)*g1 + self%ab_dinv(1, 2, k)*g2
+                h2 = self%ab_dinv(2, 1, k)*g1 + self%ab_dinv(2, 2, k)*g2
+            else
+                if (.not. d11 > 0.0_wp) then
+                    status = STATUS_RECOVERABLE
+                    return
+                end if
+                self%ab_dinv(:, :, k) = 0.0_wp
+                self%ab_dinv(1, 1, k) = 1.0_wp/d11
+                g2 = 0.0_wp
+                h1 = g1/d11
+                h2 = 0.0_wp
+            end if
+            self%ab_g(:, 1, k) = g1
+            self%ab_g(:, 2, k) = g2
+            self%ab_h(1, :, k) = h1
+            self%ab_h(2, :, k) = h2
+            self%ab_lam(k) = lam
+            ! I_k = m I + I' - G H
+            ixx = mb + ixx - (g1(1)*h1(1) + g2(1)*h2(1))
+            ixy = ixy - (g1(1)*h1(2) + g2(1)*h2(2))
+            iyy = mb + iyy - (g1(2)*h1(2) + g2(2)*h2(2))
+        end do
+    end procedure mass_factor
+
+    !> Solve M x = b with the factors of mass_factor (b in, x out), O(n): from the tip the
+    !! bias forces z_k = z_{k+1} + G x0_k with x0_k = D^{-1} (b_k - (lambda n.z', e.z')), then
+    !! from the top joint (acceleration 0) x_k = x0_k - H A_{k-1}, A_k = A_{k-1} + lambda
+    !! phi_k'' n + u_k'' e.
+    pure subroutine ab_solve(n, nu, cs, g, h, dinv, lam, b)
+        integer, intent(in) :: n, nu
+        real(wp), intent(in) :: cs(:, :), g(:, :, :), h(:, :, :), dinv(:, :, :), lam(:)
+        real(wp), intent(inout) :: b(:)
+        real(wp) :: x0(2, n), zx, zy, ax, ay, c1, c2, c, s, al, be
+        integer :: k
+        zx = 0.0_wp
+        zy = 0.0_wp
+        c2 = 0.0_wp
+        do k = n, 1, -1
+            c = cs(1, k)
+            s = cs(2, k)
+            c1 = b(k) - lam(k)*(-s*zx + c*zy)
+            if (nu > 0) c2 = b(n + k) - (c*zx + s*zy)
+            x0(1, k) = dinv(1, 1, k)*c1 + dinv(1, 2, k)*c2
+            x0(2, k) = dinv(2, 1, k)*c1 + dinv(2, 2, k)*c2
+            zx = zx + g(1, 1, k)*x0(1, k) + g(1, 2, k)*x0(2, k)
+            zy = zy + g(2, 1, k)*x0(1, k) + g(2, 2, k)*x0(2, k)
+        end do
+        ax = 0.0_wp
+        ay = 0.0_wp
+        do k = 1, n
+            c = cs(1, k)
+            s = cs(2, k)
+            al = x0(1, k) - (h(1, 1, k)*ax + h(1, 2, k)*ay)
+            be = x0(2, k) - (h(2, 1, k)*ax + h(2, 2, k)*ay)
+            b(k) = al
+            if (nu > 0) b(n + k) = be
+            ax = ax - lam(k)*al*s + be*c
+            ay = ay + lam(k)*al*c + be*s
+        end do
+    end subroutine ab_solve
+
+    !> Solve M x = b in place with the model's current factors.
+    subroutine mass_solve(self, b)
+        class(mpp_t), intent(in) :: self
+        real(wp), intent(inout) :: b(:)
+        call ab_solve(self%n, self%nu, self%cs, self%ab_g, self%ab_h, self%ab_dinv, &
+                      self%ab_lam, b)
+    end subroutine mass_solve
+
+    !> The dense M(q) from cos/sin of the angles and the elongations u (zero when
+    !! inextensible), O(n^2): for k <= j, c = cos(phi_j - phi_k) = c_k c_j + s_k s_j,
+    !! s = sin(phi_j - phi_k) = s_j c_k - c_j s_k (docs/physics-mpp.md, the table), then the
+    !! point masses m_p J_p^T J_p.
+    pure subroutine assemble_mass(n, nu, m, inertia, l, cs, u, pm_body, pm_r, pm_m, mm)
+        integer, intent(in) :: n, nu, pm_body(:)
+        real(wp), intent(in) :: m, inertia, l, cs(:, :), u(:), pm_r(:), pm_m(:)
+        real(wp), intent(out) :: mm(:, :)
+        real(wp) :: hk(n), lk(n), aj, bj, cjk, sjk, ak, al
+        integer :: j, k, p, i
+        hk = u + 0.5_wp*l
+        lk = u + l
         do j = 1, n
-            do k = 1, j
-                cjk = cos(phi(k) - phi(j))
-                sjk = sin(phi(j) - phi(k))     ! n_k . e_j
-                if (k < j) then
-                    s = lk(k)*(hk(j) + real(n - j, wp)*lk(j))
-                else
-                    s = hk(k)**2 + real(n - k, wp)*lk(k)**2
-                end if
-                mm(k, j) = self%m*cjk*s
+            aj = hk(j) + real(n - j, wp)*lk(j)
+            bj = real(n - j + 1, wp)
+            do k = 1, j - 1
+                cjk = cs(1, k)*cs(1, j) + cs(2, k)*cs(2, j)
+                sjk = cs(2, j)*cs(1, k) - cs(1, j)*cs(2, k)
+                mm(k, j) = m*cjk*(lk(k)*aj)
                 mm(j, k) = mm(k, j)
-                if (self%nu > 0) then
-                    mm(n + k, n + j) = self%m*cjk*real(n - j + 1, wp)
+                if (nu > 0) then
+                    mm(n + k, n + j) = m*cjk*bj
                     mm(n + j, n + k) = mm(n + k, n + j)
-                    ! (phi_k, u_j), k <= j
-                    if (k < j) then
-                        s = real(n - j + 1, wp)*lk(k)
-                    else
-                        s = hk(k) + real(n - k, wp)*lk(k)
-                    end if
-                    mm(k, n + j) = self%m*sjk*s
+                    mm(k, n + j) = m*sjk*(bj*lk(k))
                     mm(n + j, k) = mm(k, n + j)
-                    ! (phi_j, u_k), k < j: n_j . e_k = -sjk
-                    if (k < j) then
-                        mm(j, n + k) = -self%m*sjk*(hk(j) + real(n - j, wp)*lk(j))
-                        mm(n + k, j) = mm(j, n + k)
+                    mm(j, n + k) = -m*sjk*aj
+                    mm(n + k, j) = mm(j, n + k)
+                end if
+            end do
+            mm(j, j) = m*(hk(j)**2 + real(n - j, wp)*lk(j)**2) + inertia
+            if (nu > 0) then
+                mm(n + j, n + j) = m*bj
+                mm(j, n + j) = 0.0_wp
+                mm(n + j, j) = 0.0_wp
+            end if
+        end do
+        ! point masses: m_p J_p^T J_p with J_p = dP/dq, P = C_i + r e_i: columns a_k n_k on
+        ! phi_k (a_k = lambda_k for k < i, eta_i + r for k = i) and e_k on u_k, k <= i
+        do p = 1, size(pm_body)
+            i = pm_body(p)
+            do j = 1, i
+                al = merge(hk(i) + pm_r(p), lk(j), j == i)
+                do k = 1, i
+                    ak = merge(hk(i) + pm_r(p), lk(k), k == i)
+                    cjk = cs(1, k)*cs(1, j) + cs(2, k)*cs(2, j)
+                    sjk = cs(2, j)*cs(1, k) - cs(1, j)*cs(2, k)
+                    if (k <= j) then
+                        ! the symmetric pairs once, mirrored: M stays exactly symmetric
+                        aj = pm_m(p)*cjk*(ak*al)
+                        mm(k, j) = mm(k, j) + aj
+                        if (k < j) mm(j, k) = mm(j, k) + aj
+                        if (nu > 0) then
+                            bj = pm_m(p)*cjk
+                            mm(n + k, n + j) = mm(n + k, n + j) + bj
+                            if (k < j) mm(n + j, n + k) = mm(n + j, n + k) + bj
+                        end if
                     end if
-                end if
+                    if (nu > 0) then
+                        ! (phi_k, u_j): a_k n_k . e_j = a_k sin(phi_j - phi_k)
+                        mm(k, n + j) = mm(k, n + j) + pm_m(p)*ak*sjk
+                        mm(n + j, k) = mm(n + j, k) + pm_m(p)*ak*sjk
+                    end if
+                end do
             end do
-            mm(j, j) = mm(j, j) + self%inertia
         end do
-        ! point masses: m_p J_p^T J_p with J_p = dP/dq, P = C_i + r e_i
-        do p = 1, size(self%pm_body)
-            i = self%pm_body(p)
-            jp = 0.0_wp
-            do k = 1, i
-                e = [cos(phi(k)), sin(phi(k))]
-                nv = [-e(2), e(1)]
-                if (k < i) then
-                    jp(:, k) = lk(k)*nv
-                else
-                    jp(:, k) = (hk(k) + self%pm_r(p))*nv
-                end if
-                if (self%nu > 0) jp(:, n + k) = e
-            end do
-            mm = mm + self%pm_m(p)*matmul(transpose(jp), jp)
+    end subroutine assemble_mass
+
+    module procedure mpp_mass_dense
+        real(wp) :: cs(2, self%n), u(self%n)
+        integer :: k
+        do k = 1, self%n
+            cs(1, k) = cos(y(k))
+            cs(2, k) = sin(y(k))
         end do
+        u = 0.0_wp
+        if (self%nu > 0) u = y(self%n + 1:self%ndof)
+        call assemble_mass(self%n, self%nu, self%m, self%inertia, self%l, cs, u, &
+                           self%pm_body, self%pm_r, self%pm_m, mm)
     end procedure mpp_mass_dense
 
+    !> M(q) into self%mm (self%cs holding the angles of y).
+    subroutine assemble_mass_work(self, y)
+        class(mpp_t), intent(inout) :: self
+        real(wp), intent(in) :: y(:)
+        real(wp) :: u(self%n)
+        u = 0.0_wp
+        if (self%nu > 0) u = y(self%n + 1:self%ndof)
+        call assemble_mass(self%n, self%nu, self%m, self%inertia, self%l, self%cs, u, &
+                           self%pm_body, self%pm_r, self%pm_m, self%mm)
+    end subroutine assemble_mass_work
+
     module procedure mpp_rhs
-        real(wp) :: mm(self%ndof, self%ndof), f(self%ndof, 1), zero(self%ndof)
-        integer :: nd, info
+        real(wp) :: zero(self%ndof)
+        integer :: nd
         nd = self%ndof
         zero = 0.0_wp
-        call self%residual(y, zero, f(:, 1), t)
-        call self%mass_dense(y, mm)
-        call dpotrf('L', nd, mm, nd, info)
-        if (info == 0) call dpotrs('L', nd, 1, mm, nd, f, nd, info)
+        call angles(self, y)
+        call self%residual_core(t, y, zero, ydot(nd + 1:2*nd))
+        call self%mass_factor(y, status)
+        if (status /= STATUS_OK) return
+        call mass_solve(self, ydot(nd + 1:2*nd))
         ydot(1:nd) = y(nd + 1:2*nd)
-        ydot(nd + 1:2*nd) = f(:, 1)
         status = STATUS_OK
-        if (info /= 0 .or. .not. all(ieee_is_finite(f))) status = STATUS_RECOVERABLE
+        if (.not. all(ieee_is_finite(ydot(nd + 1:2*nd)))) status = STATUS_RECOVERABLE
     end procedure mpp_rhs
 
     module procedure mpp_implicit_rhs
@@ -220,60 +591,107 @@ contains
         nd = self%ndof
         zero = 0.0_wp
         f(1:nd) = y(nd + 1:2*nd)
-        call self%residual(y, zero, f(nd + 1:2*nd), t)
+        call angles(self, y)
+        call self%residual_core(t, y, zero, f(nd + 1:2*nd))
         status = STATUS_OK
         if (.not. all(ieee_is_finite(f))) status = STATUS_RECOVERABLE
     end procedure mpp_implicit_rhs
 
     module procedure mpp_mass_matrix
-        real(wp) :: mm(self%ndof, self%ndof)
-        integer :: i, j, nd
+        integer :: j, nd
         nd = self%ndof
-        call self%mass_dense(y, mm)
+        call angles(self, y)
+        call assemble_mass_work(self, y)
         do j = 1, nd
             mb(offset, j) = mb(offset, j) + 1.0_wp
-            do i = 1, nd
-                mb(offset + i - j, nd + j) = mb(offset + i - j, nd + j) + mm(i, j)
-            end do
         end do
+        call add_to_band(mb, size(mb, 1), offset, self%mm, nd, nd)
         status = STATUS_OK
     end procedure mpp_mass_matrix
 
-    module procedure mpp_jacobian
-        real(wp) :: mm(self%ndof, self%ndof), a0(self%ndof, 1), r0(self%ndof)
-        real(wp) :: dr(self%ndof, 2*self%ndof), yp(size(y)), zero(self%ndof), inc
-        integer :: nd, j, i, info
+    module procedure derivatives
+        real(wp) :: a(self%ndof), r0(self%ndof), col(self%ndof)
+        integer :: nd, j
+
         nd = self%ndof
-        zero = 0.0_wp
-        call self%residual(y, zero, a0(:, 1), t)
-        call self%mass_dense(y, mm)
-        call dpotrf('L', nd, mm, nd, info)
-        if (info /= 0) then
-            status = STATUS_RECOVERABLE
-            return
+        call angles(self, y)
+        a = 0.0_wp
+        call self%residual_core(t, y, a, r0)
+        call self%mass_factor(y, status)
+        if (status /= STATUS_OK) return
+        a = r0
+        call mass_solve(self, a)
+        call self%residual_core(t, y, a, r0)
+        self%acc = a
+        self%r0 = r0
+        ! the effects' blocks at the bodies the residual left
+        if (size(self%effects) > 0) then
+            self%ejac = 0.0_wp
+            call add_jacobians_of(self%effects, t, self%bodies, self%ejac)
         end if
-        call dpotrs('L', nd, 1, mm, nd, a0, nd, info)
-        call self%residual(y, a0(:, 1), r0, t)
         do j = 1, 2*nd
-            yp = y
-            inc = sqrt(epsilon(1.0_wp))*max(abs(y(j)), 1.0e-3_wp)
-            yp(j) = y(j) + inc
-            call self%residual(yp, a0(:, 1), dr(:, j), t)
-            dr(:, j) = (dr(:, j) - r0)/inc
-        end do
-        call dpotrs('L', nd, 2*nd, mm, nd, dr, nd, info)
-        ! rows 1..nd: dq'/dv = I; rows nd+1..2nd: da/dy
-        do j = 1, nd
-            jb(offset + j - (nd + j), nd + j) = jb(offset + j - (nd + j), nd + j) + 1.0_wp
-        end do
-        do j = 1, 2*nd
-            do i = 1, nd
-                jb(offset + nd + i - j, j) = jb(offset + nd + i - j, j) + dr(i, j)
-            end do
+            call self%residual_column(t, y, a, j, col)
+            self%dr(:, j) = col
         end do
         status = STATUS_OK
-        if (.not. all(ieee_is_finite(dr))) status = STATUS_RECOVERABLE
+        if (.not. all(ieee_is_finite(self%dr))) status = STATUS_RECOVERABLE
+    end procedure derivatives
+
+    !> Add the dense a(nr, nc) into band storage b(ld, *) (entry (i, j) at row
+    !! offset + i - j) at rows i0 + 1 .. i0 + nr and columns j0 + 1 .. j0 + nc.
+    pure subroutine add_to_band(b, ld, offset, a, i0, j0)
+        integer, intent(in) :: ld, offset, i0, j0
+        real(wp), intent(inout) :: b(ld, *)
+        real(wp), intent(in) :: a(:, :)
+        integer :: i, j, p
+        do j = 1, size(a, 2)
+            p = offset + i0 - j0 - j
+            do i = 1, size(a, 1)
+                b(p + i, j0 + j) = b(p + i, j0 + j) + a(i, j)
+            end do
+        end do
+    end subroutine add_to_band
+
+    module procedure mpp_jacobian
+        integer :: nd, j
+
+        nd = self%ndof
+        call self%derivatives(t, y, status)
+        if (status /= STATUS_OK) return
+        ! rows 1..nd: dq'/dv = I; rows nd+1..2nd: da/dy = M^{-1} dr/dy
+        do j = 1, nd
+            jb(offset - nd, nd + j) = jb(offset - nd, nd + j) + 1.0_wp
+        end do
+        do j = 1, 2*nd
+            call ab_solve(self%n, self%nu, self%cs, self%ab_g, self%ab_h, self%ab_dinv, &
+                          self%ab_lam, self%dr(:, j))
+        end do
+        call add_to_band(jb, size(jb, 1), offset, self%dr, nd, 0)
+        status = STATUS_OK
+        if (.not. all(ieee_is_finite(self%dr))) status = STATUS_RECOVERABLE
     end procedure mpp_jacobian
+
+    module procedure mpp_second_order_blocks
+        integer :: nd, j
+
+        nd = self%ndof
+        call self%derivatives(t, y, status)
+        if (status /= STATUS_OK) return
+        if (implicit_form) then
+            call assemble_mass_work(self, y)
+            call add_to_band(mb, size(mb, 1), offset, self%mm, 0, 0)
+        else
+            do j = 1, 2*nd
+                call ab_solve(self%n, self%nu, self%cs, self%ab_g, self%ab_h, self%ab_dinv, &
+                              self%ab_lam, self%dr(:, j))
+            end do
+            mb(offset, 1:nd) = mb(offset, 1:nd) + 1.0_wp
+        end if
+        call add_to_band(kb, size(kb, 1), offset, self%dr(:, 1:nd), 0, 0)
+        call add_to_band(cb, size(cb, 1), offset, self%dr(:, nd + 1:2*nd), 0, 0)
+        status = STATUS_OK
+        if (.not. all(ieee_is_finite(self%dr))) status = STATUS_RECOVERABLE
+    end procedure mpp_second_order_blocks
 
     module procedure mpp_energy
         real(wp) :: p(2, 0:self%n), c(2, self%n), pd(2, 0:self%n), cd(2, self%n)
@@ -318,26 +736,24 @@ contains
     end procedure mpp_energy
 
     module procedure mpp_quad_rhs
-        real(wp), dimension(self%n) :: phi, u, phid, ud
         real(wp) :: p(2, 0:self%n), c(2, self%n), pd(2, 0:self%n), cd(2, self%n)
-        real(wp) :: power, work, rel(2), pin(2), mm(self%ndof, self%ndof), a(self%ndof, 1)
-        real(wp) :: r(self%ndof), zero(self%ndof)
+        real(wp) :: power, work, rel(2), pin(2), a(self%ndof), r(self%ndof)
         type(motion_state_t) :: top, bottom
-        type(bodies_t) :: b
         logical :: bottom_on
-        integer :: k, n, info
+        integer :: k, n, nd
         n = self%n
-        call unpack(self, y, phi, u, phid, ud)
+        nd = self%ndof
         call self%supports_at(t, top, bottom, bottom_on)
-        power = self%ds*sum(ud**2)
+        power = 0.0_wp
+        if (self%nu > 0) power = self%ds*sum(y(nd + n + 1:2*nd)**2)
         work = 0.0_wp
         do k = 2, n
-            power = power + self%db*(phid(k) - phid(k - 1))**2
+            power = power + self%db*(y(nd + k) - y(nd + k - 1))**2
         end do
         if (self%top_clamped) then
-            power = power + self%d_rot*(phid(1) - top%rate)**2
-            if (self%moving(1)) work = work - (self%c_rot*(phi(1) - top%angle) &
-                                                 + self%d_rot*(phid(1) - top%rate))*top%rate
+            power = power + self%d_rot*(y(nd + 1) - top%rate)**2
+            if (self%moving(1)) work = work - (self%c_rot*(y(1) - top%angle) &
+                                                 + self%d_rot*(y(nd + 1) - top%rate))*top%rate
         end if
         if (bottom_on) then
             call self%positions(y, p, c, pd, cd, t)
@@ -346,26 +762,31 @@ contains
             if (self%moving(2)) work = work + dot_product(-self%k_sup*(p(:, n) - bottom%p) &
                                                           - self%d_sup*rel, bottom%v)
             if (self%bottom == 2) then
-                power = power + self%d_rot*(phid(n) - bottom%rate)**2
-                if (self%moving(2)) work = work - (self%c_rot*(phi(n) - bottom%angle) &
-                                                   + self%d_rot*(phid(n) - bottom%rate))*bottom%rate
+                power = power + self%d_rot*(y(nd + n) - bottom%rate)**2
+                if (self%moving(2)) work = work - (self%c_rot*(y(n) - bottom%angle) &
+                                                   + self%d_rot*(y(nd + n) - bottom%rate)) &
+                                                  *bottom%rate
             end if
         end if
+        if (size(self%effects) > 0 .or. self%moving(1)) call angles(self, y)
         if (size(self%effects) > 0) then
-            call rod_bodies(self, y, top, b)
-            call add_powers_of(self%effects, t, b, power, work)
+            ! the residual at zero accelerations fills the rods as bodies
+            a = 0.0_wp
+            call self%residual_core(t, y, a, r)
+            call add_powers_of(self%effects, t, self%bodies, power, work)
         end if
         status = STATUS_OK
         if (self%moving(1)) then
             ! the pin force needs the accelerations: a = M^{-1} f, then r(q, q', a) gives it
-            zero = 0.0_wp
-            call self%residual(y, zero, a(:, 1), t)
-            call self%mass_dense(y, mm)
-            call dpotrf('L', self%ndof, mm, self%ndof, info)
-            if (info == 0) call dpotrs('L', self%ndof, 1, mm, self%ndof, a, self%ndof, info)
-            if (info /= 0) status = STATUS_RECOVERABLE
-            call self%residual(y, a(:, 1), r, t, pin)
-            work = work + dot_product(pin, top%v)
+            a = 0.0_wp
+            call self%residual_core(t, y, a, r)
+            call self%mass_factor(y, status)
+            if (status == STATUS_OK) then
+                a = r
+                call mass_solve(self, a)
+                call self%residual_core(t, y, a, r, pin)
+                work = work + dot_product(pin, top%v)
+            end if
         end if
         yqdot(1) = power
         if (self%with_work) yqdot(2) = work

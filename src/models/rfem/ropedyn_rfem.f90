@@ -7,15 +7,18 @@
 !! The derivation (forces, the analytic Jacobian) is in docs/physics-rfem.md.
 !!
 !! Every deformation measure ("strain") s(q) enters as energy C s^2/2 and dissipation
-!! B (ds/dt)^2/2, so its generalized force is -(C s + B s') grad s. Strains of one kind
-!! form a family; a family exists only when its effect is on in &effects, and damping
-!! terms are evaluated only when damping is on. Nothing is computed for an effect that is
-!! off.
+!! B (ds/dt)^2/2, so its generalized force is -(C s + B s') grad s. A strain kind exists
+!! only when its effect is on in &effects, and damping terms are evaluated only when
+!! damping is on. The kernels (ropedyn_rfem_kernels) make one pass over the internal SDEs
+!! per call, with the cosine and sine of every angle computed once per call into a work
+!! array, all three strains of an SDE and their rates together, and the Jacobian directly
+!! as 3x3 blocks of element pairs; supports and effects are small separate steps, taken
+!! only when present.
 !!
 !! External effects (drag, ground contact, point loads; ropedyn_effect) act on the elements
 !! as bodies and exist only when the spec enables them. Supports may move (their anchor
 !! and angle are functions of time, evaluated once per call) or be released at a time
-!! (their families are then off). Point masses sit at their true place on an element, which
+!! (their SDEs are then off). Point masses sit at their true place on an element, which
 !! makes that element's 3x3 mass block non-diagonal; it is solved locally.
 !!
 !! State y (size 6n), element by element: x_i, y_i, phi_i, x_i', y_i', phi_i'.
@@ -41,22 +44,26 @@ module ropedyn_rfem
 
     real(wp), parameter :: pi = acos(-1.0_wp)
 
-    !> Strain families.
-    integer, parameter :: FAM_TENSION = 1, FAM_SHEAR = 2, FAM_BEND = 3
-    integer, parameter :: FAM_TOP_X = 4, FAM_TOP_Y = 5, FAM_TOP_ROT = 6
-    integer, parameter :: FAM_BOTTOM_X = 7, FAM_BOTTOM_Y = 8, FAM_BOTTOM_ROT = 9
-
-    !> A set of SDE strains of one kind with common stiffness and damping.
-    type :: family_t
-        integer :: kind = 0
-        integer :: first = 0, last = -1  !< SDE range
-        real(wp) :: c = 0.0_wp           !< stiffness (N/m or N m/rad)
-        real(wp) :: b = 0.0_wp           !< damping (N s/m or N m s/rad)
-        logical :: damped = .false.
-        integer :: end = 0               !< 0 internal, 1 top support, 2 bottom support
-        logical :: active = .true.       !< false once its support is released
-        real(wp) :: st = 0.0_wp          !< explicit rate ds/dt of a moving support's strain
-    end type family_t
+    !> A support's SDE (1 top: d = A_1 - P, 2 bottom: d = P - B_n, P the anchor): an
+    !! isotropic translational spring and damper on d (pinned or clamped) and a rotational
+    !! one on s = sgn (phi - psi) (clamped), psi the clamp angle. With sgn = +1 (top) or -1
+    !! (bottom) and h half the element's length, d = sgn (c - P) - h e.
+    type :: support_t
+        logical :: translational = .false.  !< pinned or clamped (and not released at t <= 0)
+        logical :: rotational = .false.     !< clamped
+        real(wp) :: ct = 0.0_wp             !< translational stiffness, N/m
+        real(wp) :: bt = 0.0_wp             !< translational damping, N s/m
+        real(wp) :: cr = 0.0_wp             !< rotational stiffness, N m/rad
+        real(wp) :: br = 0.0_wp             !< rotational damping, N m s/rad
+        logical :: damped_t = .false., damped_r = .false.
+        logical :: active = .true.          !< false once the support is released
+        real(wp) :: sgn = 1.0_wp            !< +1 top, -1 bottom
+        integer :: elem = 1                 !< the element it holds (1 or n)
+        real(wp) :: anchor(2) = 0.0_wp      !< anchor P at the time of the current call, m
+        real(wp) :: angle = 0.0_wp          !< clamp angle psi at that time, rad
+        real(wp) :: anchor_vel(2) = 0.0_wp  !< P', m/s
+        real(wp) :: angle_rate = 0.0_wp     !< psi', rad/s
+    end type support_t
 
     type, extends(rope_model_t) :: rfem_t
         private
@@ -64,13 +71,17 @@ module ropedyn_rfem
         real(wp), allocatable :: len(:)        !< element lengths, m
         real(wp), allocatable :: mass(:)       !< element masses, kg
         real(wp), allocatable :: inertia(:)    !< central moments of inertia, kg m^2
+        real(wp), allocatable :: half(:)       !< half lengths l_i/2, m
+        real(wp), allocatable :: weight(:)     !< m_i g (zero when gravity is off), N
         real(wp) :: g = 0.0_wp                 !< gravity, m/s^2
         logical :: gravity_on = .false.
-        type(family_t), allocatable :: families(:)
-        real(wp) :: top_anchor(2) = 0.0_wp     !< m
-        real(wp) :: bottom_anchor(2) = 0.0_wp  !< m
-        real(wp) :: top_angle = 0.0_wp         !< clamp angle, rad
-        real(wp) :: bottom_angle = 0.0_wp      !< clamp angle, rad
+        ! internal SDEs 2 .. n: the strains that exist, stiffness (N/m, N/m, N m/rad) and
+        ! damping (N s/m, N s/m, N m s/rad), zero for a strain that is off or undamped
+        logical :: tension = .false., shear = .false., bending = .false.
+        logical :: damped = .false.            !< damping on (some internal B > 0)
+        real(wp) :: cx = 0.0_wp, cy = 0.0_wp, cp = 0.0_wp
+        real(wp) :: bx = 0.0_wp, by = 0.0_wp, bp = 0.0_wp
+        type(support_t) :: sup(2)              !< top, bottom
         real(wp) :: init_angle = 0.0_wp        !< angle of the straight initial state, rad
         real(wp) :: init_velocity(2) = 0.0_wp  !< initial velocity of every element, m/s
         logical :: folded = .false.            !< initial shape 'folded'
@@ -80,23 +91,23 @@ module ropedyn_rfem
         logical :: moving(2) = .false.
         real(wp) :: release(2) = huge(1.0_wp)  !< release times, s
         logical :: timed = .false.             !< the supports depend on time
-        real(wp) :: anchor_vel(2, 2) = 0.0_wp  !< anchor velocities (top, bottom), m/s
-        real(wp) :: angle_rate(2) = 0.0_wp     !< support angle rates, rad/s
         logical :: with_work = .false.         !< external work is quadrature 2
         ! external effects (only those enabled) and their workspace
         type(effect_box_t), allocatable :: effects(:)
         type(bodies_t) :: bodies
-        real(wp), allocatable :: ejac(:, :, :)  !< (3, 6, n)
         ! point masses: elements carrying them and their first moment sum m r (kg m);
         ! mass and inertia above include them
         integer, allocatable :: pm_elem(:)
         real(wp), allocatable :: pm_moment(:)
         real(wp), allocatable :: rowscale(:, :)  !< (3, n): 1/m, 1/m, 1/J; 1 on pm elements
-        ! workspace (no state is kept between calls)
-        real(wp), allocatable :: s(:)          !< strains of the current family
-        real(wp), allocatable :: grad(:, :)    !< their gradients, (6, n+1)
-        real(wp), allocatable :: force(:)      !< C s + B s' per SDE
+        ! workspace, allocated once (no state is kept between calls)
+        real(wp), allocatable :: cs(:, :)      !< cos, sin of every angle, (2, n)
         real(wp), allocatable :: gen(:, :)     !< generalized forces, (3, n)
+        !> Jacobian blocks (3, 6, -1:1, n): blk(r, l, o, i) is the derivative of row r of
+        !! element i (force x, y, moment; times rowscale(r, i) its acceleration, and after
+        !! `point_mass_rows` the acceleration on elements with point masses) with respect
+        !! to coordinate l (x, y, phi, x', y', phi') of element i + o
+        real(wp), allocatable :: blk(:, :, :, :)
     contains
         procedure :: size => rfem_size
         procedure :: bandwidths => rfem_bandwidths
@@ -115,33 +126,45 @@ module ropedyn_rfem
         procedure :: coordinates => rfem_coordinates
         procedure :: second_order_layout => rfem_second_order_layout
         procedure :: coordinate_mass => rfem_coordinate_mass
+        procedure :: second_order_blocks => rfem_second_order_blocks
         procedure :: generalized_forces => rfem_generalized_forces
         procedure :: potential_energy => rfem_potential_energy
-        procedure, private :: strain
-        procedure, private :: local_rates
+        procedure, private :: forces
+        procedure, private :: jacobian_blocks
+        procedure, private :: point_mass_rows
         procedure, private :: set_time
         procedure, private :: fill_bodies
         procedure, private :: point_mass_accelerations
     end type rfem_t
 
     interface
-        !> Strain s and gradient g (local dofs: x, y, phi of element j-1, then of element j)
-        !! of SDE j in family `kind`; optionally the Hessian h.
-        module pure subroutine strain(self, kind, j, y, s, g, h)
-            class(rfem_t), intent(in) :: self
-            integer, intent(in) :: kind, j
-            real(wp), intent(in) :: y(:)
-            real(wp), intent(out) :: s, g(6)
-            real(wp), intent(out), optional :: h(6, 6)
-        end subroutine strain
+        !> The generalized forces (3, n) of everything at time t and state y into self%gen
+        !! (one pass over the SDEs); optionally the elastic energy (J, springs and the
+        !! effects' potential energy).
+        module subroutine forces(self, t, y, elastic)
+            class(rfem_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(6*self%n)
+            real(wp), intent(out), optional :: elastic
+        end subroutine forces
 
-        !> Velocities of the local dofs of SDE j (zero for a support).
-        module pure function local_rates(self, j, y) result(v)
-            class(rfem_t), intent(in) :: self
-            integer, intent(in) :: j
+        !> The derivatives of the generalized forces with respect to the coordinates and
+        !! their rates, as 3x6 blocks of element pairs, into self%blk (one pass over the
+        !! SDEs; effects added on the diagonal blocks).
+        module subroutine jacobian_blocks(self, t, y)
+            class(rfem_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(6*self%n)
+        end subroutine jacobian_blocks
+
+        !> The rows of self%blk of elements with point masses from force rows to
+        !! acceleration rows: multiplied by the inverse of their mass block, with the
+        !! derivatives of the mass block and of the centripetal and weight terms.
+        module subroutine point_mass_rows(self, t, y)
+            class(rfem_t), intent(inout) :: self
+            real(wp), intent(in) :: t
             real(wp), intent(in) :: y(:)
-            real(wp) :: v(6)
-        end function local_rates
+        end subroutine point_mass_rows
 
         !> Element kinematics for the effects.
         module subroutine fill_bodies(self, y)
@@ -193,6 +216,21 @@ module ropedyn_rfem
             integer, intent(out) :: status
         end subroutine rfem_jacobian
 
+        !> K = d(acceleration)/dq, C = d(acceleration)/dq' (the velocity rows of the
+        !! Jacobian) and the identity mass block, in band storage with kl = ku = 5, from the
+        !! same blocks as the Jacobian. RFEM has no mass matrix: the implicit form is the
+        !! explicit one.
+        module subroutine rfem_second_order_blocks(self, t, y, implicit_form, kb, cb, mb, &
+                                                   offset, status)
+            class(rfem_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            logical, intent(in) :: implicit_form
+            real(wp), intent(inout) :: kb(:, :), cb(:, :), mb(:, :)
+            integer, intent(in) :: offset
+            integer, intent(out) :: status
+        end subroutine rfem_second_order_blocks
+
         !> Potential energy V = elastic + gravity, J (used by the gradient test).
         module function rfem_potential_energy(self, y) result(v)
             class(rfem_t), intent(inout) :: self
@@ -228,11 +266,11 @@ contains
         type(rfem_t), intent(out) :: model
         type(rope_spec_t), intent(in) :: spec
         type(error_t), allocatable, intent(out) :: err
-        integer :: n, nf, k, i
+        integer :: n, k, i
         real(wp) :: area, second_moment, dl, total_mass, cx, cy, cphi, bx, by, bphi, factor
         real(wp) :: angles(2)
-        type(family_t) :: fams(9)
         logical :: damped
+        character(len=:), allocatable :: kinds(:)
         integer, allocatable :: pm_body(:)
         real(wp), allocatable :: pm_r(:), pm_m(:), y0(:)
 
@@ -270,42 +308,49 @@ contains
             end associate
         end if
 
-        nf = 0
-        if (spec%effects%tension) call add(FAM_TENSION, 2, n, cx, bx)
-        if (spec%effects%shear) call add(FAM_SHEAR, 2, n, cy, by)
-        if (spec%effects%bending) call add(FAM_BEND, 2, n, cphi, bphi)
-        ! a support released at t <= 0 is free from the start: no family at all
-        if (model%release(1) > 0.0_wp) then
-            select case (spec%supports%top)
-            case ('pinned')
-                call add(FAM_TOP_X, 1, 1, factor*cx, factor*bx, 1)
-                call add(FAM_TOP_Y, 1, 1, factor*cx, factor*bx, 1)
-            case ('clamped')
-                call add(FAM_TOP_X, 1, 1, factor*cx, factor*bx, 1)
-                call add(FAM_TOP_Y, 1, 1, factor*cx, factor*bx, 1)
-                call add(FAM_TOP_ROT, 1, 1, factor*cphi, factor*bphi, 1)
-            end select
+        ! internal SDEs: a strain exists only when its effect is on, its damping only when
+        ! damping is on
+        model%tension = spec%effects%tension
+        model%shear = spec%effects%shear
+        model%bending = spec%effects%bending
+        if (model%tension) model%cx = cx
+        if (model%shear) model%cy = cy
+        if (model%bending) model%cp = cphi
+        if (damped) then
+            if (model%tension) model%bx = bx
+            if (model%shear) model%by = by
+            if (model%bending) model%bp = bphi
         end if
-        if (model%release(2) > 0.0_wp) then
-            select case (spec%supports%bottom)
-            case ('pinned')
-                call add(FAM_BOTTOM_X, n + 1, n + 1, factor*cx, factor*bx, 2)
-                call add(FAM_BOTTOM_Y, n + 1, n + 1, factor*cx, factor*bx, 2)
-            case ('clamped')
-                call add(FAM_BOTTOM_X, n + 1, n + 1, factor*cx, factor*bx, 2)
-                call add(FAM_BOTTOM_Y, n + 1, n + 1, factor*cx, factor*bx, 2)
-                call add(FAM_BOTTOM_ROT, n + 1, n + 1, factor*cphi, factor*bphi, 2)
-            end select
-        end if
-        model%families = fams(1:nf)
+        model%damped = model%bx > 0.0_wp .or. model%by > 0.0_wp .or. model%bp > 0.0_wp
+        ! supports: a support released at t <= 0 is free from the start (no SDE at all)
+        kinds = [character(len=8) :: spec%supports%top, spec%supports%bottom]
+        do k = 1, 2
+            associate (sup => model%sup(k))
+                sup%sgn = merge(1.0_wp, -1.0_wp, k == 1)
+                sup%elem = merge(1, n, k == 1)
+                if (.not. model%release(k) > 0.0_wp) cycle
+                sup%translational = kinds(k) == 'pinned' .or. kinds(k) == 'clamped'
+                sup%rotational = kinds(k) == 'clamped'
+                if (sup%translational) then
+                    sup%ct = factor*cx
+                    sup%bt = factor*bx
+                    sup%damped_t = damped .and. sup%bt > 0.0_wp
+                end if
+                if (sup%rotational) then
+                    sup%cr = factor*cphi
+                    sup%br = factor*bphi
+                    sup%damped_r = damped .and. sup%br > 0.0_wp
+                end if
+            end associate
+        end do
 
         model%init_angle = initial_angle(spec)
         model%folded = spec%initial%shape == 'folded'
         model%init_velocity = spec%initial%velocity
-        model%top_anchor = spec%supports%top_anchor
+        model%sup(1)%anchor = spec%supports%top_anchor
         angles = clamp_angles(spec)
-        model%top_angle = angles(1)
-        model%bottom_angle = angles(2)
+        model%sup(1)%angle = angles(1)
+        model%sup(2)%angle = angles(2)
 
         ! point masses at their place on the elements: mass, inertia about the centre and
         ! the first moment m r that couples translation and rotation
@@ -332,23 +377,23 @@ contains
             model%bodies%n = n
             model%bodies%l = model%len
             allocate (model%bodies%c(2, n), model%bodies%phi(n), model%bodies%v(2, n), &
-                      model%bodies%w(n), model%ejac(3, 6, n))
+                      model%bodies%w(n))
         end if
 
         ! supports: base anchor and angle, prescribed motion
-        model%motion(1)%p0 = model%top_anchor
-        model%motion(1)%angle0 = model%top_angle
+        model%motion(1)%p0 = model%sup(1)%anchor
+        model%motion(1)%angle0 = model%sup(1)%angle
         if (bottom_anchor_given(spec)) then
-            model%bottom_anchor = spec%supports%bottom_anchor
+            model%sup(2)%anchor = spec%supports%bottom_anchor
         else
             ! the rope's lower end in its initial state
             allocate (y0(6*n))
             call model%initial_state(y0)
-            model%bottom_anchor = y0(6*n - 5:6*n - 4) + 0.5_wp*model%len(n)* &
+            model%sup(2)%anchor = y0(6*n - 5:6*n - 4) + 0.5_wp*model%len(n)* &
                                   [cos(y0(6*n - 3)), sin(y0(6*n - 3))]
         end if
-        model%motion(2)%p0 = model%bottom_anchor
-        model%motion(2)%angle0 = model%bottom_angle
+        model%motion(2)%p0 = model%sup(2)%anchor
+        model%motion(2)%angle0 = model%sup(2)%angle
         ! a free or released support has no motion
         if (spec%effects%support_motion) call configure_motions(spec, &
             [spec%supports%top /= 'free', spec%supports%bottom /= 'free'] .and. &
@@ -356,66 +401,30 @@ contains
         model%timed = any(model%moving) .or. any(model%release < huge(1.0_wp))
         model%with_work = any_does_work(model%moving, model%effects)
 
-        allocate (model%s(n + 1), model%grad(6, n + 1), model%force(n + 1), model%gen(3, n))
-        model%s = 0.0_wp
-        model%grad = 0.0_wp
-        model%force = 0.0_wp
+        model%half = 0.5_wp*model%len
+        model%weight = merge(model%mass*model%g, 0.0_wp*model%mass, model%gravity_on)
+        allocate (model%cs(2, n), model%gen(3, n), model%blk(3, 6, -1:1, n))
+        model%cs = 0.0_wp
         model%gen = 0.0_wp
-    contains
-        subroutine add(kind, first, last, c, b, end)
-            integer, intent(in) :: kind, first, last
-            real(wp), intent(in) :: c, b
-            integer, intent(in), optional :: end
-            nf = nf + 1
-            fams(nf) = family_t(kind=kind, first=first, last=last, c=c, b=b, &
-                                damped=damped .and. b > 0.0_wp)
-            if (present(end)) fams(nf)%end = end
-        end subroutine add
+        model%blk = 0.0_wp
     end subroutine rfem_create
 
-    !> Supports at time t: anchors, angles and their rates from the prescribed motions; the
-    !! families of released supports switched off. Once per call, never per element.
+    !> Supports at time t: anchors, angles and their rates from the prescribed motions;
+    !! released supports switched off. Once per call, never per element.
     subroutine set_time(self, t)
         class(rfem_t), intent(inout) :: self
         real(wp), intent(in) :: t
         type(motion_state_t) :: ms
-        integer :: f, k
+        integer :: k
         if (.not. self%timed) return
         do k = 1, 2
+            self%sup(k)%active = t < self%release(k)
             if (.not. self%moving(k)) cycle
             ms = self%motion(k)%state(t)
-            if (k == 1) then
-                self%top_anchor = ms%p
-                self%top_angle = ms%angle
-            else
-                self%bottom_anchor = ms%p
-                self%bottom_angle = ms%angle
-            end if
-            self%anchor_vel(:, k) = ms%v
-            self%angle_rate(k) = ms%rate
-        end do
-        do f = 1, size(self%families)
-            associate (fam => self%families(f))
-                if (fam%end == 0) cycle
-                fam%active = t < self%release(fam%end)
-                if (.not. self%moving(fam%end)) cycle
-                ! ds/dt at fixed q: top strains are u . (A_1 - P), phi_1 - psi; bottom
-                ! strains u . (P - B_n), psi - phi_n
-                select case (fam%kind)
-                case (FAM_TOP_X)
-                    fam%st = -self%anchor_vel(1, 1)
-                case (FAM_TOP_Y)
-                    fam%st = -self%anchor_vel(2, 1)
-                case (FAM_TOP_ROT)
-                    fam%st = -self%angle_rate(1)
-                case (FAM_BOTTOM_X)
-                    fam%st = self%anchor_vel(1, 2)
-                case (FAM_BOTTOM_Y)
-                    fam%st = self%anchor_vel(2, 2)
-                case (FAM_BOTTOM_ROT)
-                    fam%st = self%angle_rate(2)
-                end select
-            end associate
+            self%sup(k)%anchor = ms%p
+            self%sup(k)%angle = ms%angle
+            self%sup(k)%anchor_vel = ms%v
+            self%sup(k)%angle_rate = ms%rate
         end do
     end subroutine set_time
 

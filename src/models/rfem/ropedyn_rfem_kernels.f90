@@ -1,103 +1,166 @@
-!> The RFEM kernels: strains, generalized forces, right-hand side, analytic Jacobian,
-!! energies and dissipation power (the derivation is in docs/physics-rfem.md).
+!> The RFEM kernels: generalized forces, right-hand side, analytic Jacobian (as blocks of
+!! element pairs, for the first-order band and for the second-order blocks), energies and
+!! the dissipation and external power (the derivation is in docs/physics-rfem.md).
+!!
+!! Each kernel makes one pass over the internal SDEs j = 2 .. n (elements a = j-1, b = j),
+!! with cos and sin of every angle computed once per call (self%cs):
+!!     d = c_b - h_b e_b - c_a - h_a e_a,  dwx = e_a.d (tension),  dwy = n_a.d (shear),
+!!     cd = e_a.e_b = cos(phi_b - phi_a),  sd = n_a.e_b = sin(phi_b - phi_a),
+!! the strain rates (only when damping is on)
+!!     rx = e_a.(v_b - v_a) + dwy w_a + h_b sd w_b,
+!!     ry = n_a.(v_b - v_a) - (dwx + h_a) w_a - h_b cd w_b,   rp = w_b - w_a,
+!! the SDE forces fx = Cx dwx + Bx rx, fy = Cy dwy + By ry, fp = Cp (phi_b - phi_a) + Bp rp
+!! (each only when its strain is on) and, with F = fx e_a + fy n_a, the generalized forces
+!!     element a: (F, fy (dwx + h_a) - fx dwy + fp),   element b: (-F, -h_b (fx sd - fy cd) - fp).
+!! The Jacobian differentiates these expressions directly (rows of element a and b with
+!! respect to the 12 coordinates and rates of both), which is the per-strain formula
+!! dF/dq = -C g g^T - (C s + B s') H - B g (H q')^T, dF/dq' = -B g g^T summed over the
+!! three strains. Supports and effects are separate small steps, only when present.
 submodule (ropedyn_rfem) ropedyn_rfem_kernels
     implicit none
 
 contains
 
-    module procedure strain
-        integer :: ka, kb
-        real(wp) :: ea(2), na(2), eb(2), nb(2), d(2), u(2), la, lb, dwx, dwy
+    !> cos and sin of every element angle into self%cs, once per call.
+    subroutine angles(self, y)
+        class(rfem_t), intent(inout) :: self
+        real(wp), intent(in) :: y(:)
+        integer :: i
+        do i = 1, self%n
+            self%cs(1, i) = cos(y(6*i - 3))
+            self%cs(2, i) = sin(y(6*i - 3))
+        end do
+    end subroutine angles
 
-        g = 0.0_wp
-        if (present(h)) h = 0.0_wp
-        select case (kind)
-        case (FAM_TENSION, FAM_SHEAR)
-            ka = 6*(j - 2)
-            kb = 6*(j - 1)
-            la = self%len(j - 1)
-            lb = self%len(j)
-            ea = [cos(y(ka + 3)), sin(y(ka + 3))]
-            na = [-ea(2), ea(1)]
-            eb = [cos(y(kb + 3)), sin(y(kb + 3))]
-            nb = [-eb(2), eb(1)]
-            d = y(kb + 1:kb + 2) - 0.5_wp*lb*eb - y(ka + 1:ka + 2) - 0.5_wp*la*ea
-            dwx = dot_product(ea, d)
-            dwy = dot_product(na, d)
-            if (kind == FAM_TENSION) then
-                s = dwx
-                g = [-ea(1), -ea(2), dwy, ea(1), ea(2), -0.5_wp*lb*dot_product(ea, nb)]
-                if (present(h)) then
-                    call sym(h, 3, 1, -na(1))
-                    call sym(h, 3, 2, -na(2))
-                    call sym(h, 3, 4, na(1))
-                    call sym(h, 3, 5, na(2))
-                    call sym(h, 6, 3, -0.5_wp*lb*dot_product(na, nb))
-                    h(3, 3) = -dwx - 0.5_wp*la
-                    h(6, 6) = 0.5_wp*lb*dot_product(ea, eb)
+    !> Add the generalized force of support k (translational spring and damper on d, and
+    !! for a clamp the rotational one) to f(3), the force on its element; with `energy`
+    !! its spring energy to e_el.
+    pure subroutine support_force(self, k, y, f, energy, e_el)
+        class(rfem_t), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(inout) :: f(3)
+        logical, intent(in) :: energy
+        real(wp), intent(inout) :: e_el
+        real(wp) :: h, co, si, d(2), fs(2), s, fr
+        integer :: m
+        associate (sp => self%sup(k))
+            m = 6*(sp%elem - 1)
+            h = self%half(sp%elem)
+            co = cos(y(m + 3))
+            si = sin(y(m + 3))
+            if (sp%translational) then
+                ! d = sgn (c - P) - h e, d' = sgn (v - P') - h w n
+                d(1) = sp%sgn*(y(m + 1) - sp%anchor(1)) - h*co
+                d(2) = sp%sgn*(y(m + 2) - sp%anchor(2)) - h*si
+                fs = sp%ct*d
+                if (energy) e_el = e_el + 0.5_wp*sp%ct*(d(1)**2 + d(2)**2)
+                if (sp%damped_t) then
+                    fs(1) = fs(1) + sp%bt*(sp%sgn*(y(m + 4) - sp%anchor_vel(1)) + h*y(m + 6)*si)
+                    fs(2) = fs(2) + sp%bt*(sp%sgn*(y(m + 5) - sp%anchor_vel(2)) - h*y(m + 6)*co)
                 end if
-            else
-                s = dwy
-                g = [-na(1), -na(2), -dwx - 0.5_wp*la, na(1), na(2), -0.5_wp*lb*dot_product(na, nb)]
-                if (present(h)) then
-                    call sym(h, 3, 1, ea(1))
-                    call sym(h, 3, 2, ea(2))
-                    call sym(h, 3, 4, -ea(1))
-                    call sym(h, 3, 5, -ea(2))
-                    call sym(h, 6, 3, 0.5_wp*lb*dot_product(ea, nb))
-                    h(3, 3) = -dwy
-                    h(6, 6) = 0.5_wp*lb*dot_product(na, eb)
-                end if
+                f(1:2) = f(1:2) - sp%sgn*fs
+                f(3) = f(3) + h*(co*fs(2) - si*fs(1))
             end if
-        case (FAM_BEND)
-            s = y(6*(j - 1) + 3) - y(6*(j - 2) + 3)
-            g(3) = -1.0_wp
-            g(6) = 1.0_wp
-        case (FAM_TOP_X, FAM_TOP_Y)
-            ! d = A_1 - P_top, strain along a fixed global axis u
-            u = merge([1.0_wp, 0.0_wp], [0.0_wp, 1.0_wp], kind == FAM_TOP_X)
-            lb = self%len(1)
-            eb = [cos(y(3)), sin(y(3))]
-            nb = [-eb(2), eb(1)]
-            d = y(1:2) - 0.5_wp*lb*eb - self%top_anchor
-            s = dot_product(u, d)
-            g(4:6) = [u(1), u(2), -0.5_wp*lb*dot_product(u, nb)]
-            if (present(h)) h(6, 6) = 0.5_wp*lb*dot_product(u, eb)
-        case (FAM_TOP_ROT)
-            s = y(3) - self%top_angle
-            g(6) = 1.0_wp
-        case (FAM_BOTTOM_X, FAM_BOTTOM_Y)
-            ! d = P_bottom - B_n
-            u = merge([1.0_wp, 0.0_wp], [0.0_wp, 1.0_wp], kind == FAM_BOTTOM_X)
-            ka = 6*(self%n - 1)
-            la = self%len(self%n)
-            ea = [cos(y(ka + 3)), sin(y(ka + 3))]
-            na = [-ea(2), ea(1)]
-            d = self%bottom_anchor - y(ka + 1:ka + 2) - 0.5_wp*la*ea
-            s = dot_product(u, d)
-            g(1:3) = [-u(1), -u(2), -0.5_wp*la*dot_product(u, na)]
-            if (present(h)) h(3, 3) = 0.5_wp*la*dot_product(u, ea)
-        case (FAM_BOTTOM_ROT)
-            s = self%bottom_angle - y(6*(self%n - 1) + 3)
-            g(3) = -1.0_wp
-        case default
-            s = 0.0_wp
-        end select
-    contains
-        pure subroutine sym(a, r, c, v)
-            real(wp), intent(inout) :: a(6, 6)
-            integer, intent(in) :: r, c
-            real(wp), intent(in) :: v
-            a(r, c) = v
-            a(c, r) = v
-        end subroutine sym
-    end procedure strain
+            if (sp%rotational) then
+                s = sp%sgn*(y(m + 3) - sp%angle)
+                fr = sp%cr*s
+                if (energy) e_el = e_el + 0.5_wp*sp%cr*s**2
+                if (sp%damped_r) fr = fr + sp%br*sp%sgn*(y(m + 6) - sp%angle_rate)
+                f(3) = f(3) - sp%sgn*fr
+            end if
+        end associate
+    end subroutine support_force
 
-    module procedure local_rates
-        v = 0.0_wp
-        if (j >= 2) v(1:3) = y(6*(j - 2) + 4:6*(j - 2) + 6)
-        if (j <= self%n) v(4:6) = y(6*(j - 1) + 4:6*(j - 1) + 6)
-    end procedure local_rates
+    !> Add the derivatives of support k's generalized force with respect to its element's
+    !! (x, y, phi, x', y', phi') to blk(3, 6).
+    pure subroutine support_jacobian(self, k, y, blk)
+        class(rfem_t), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(inout) :: blk(3, 6)
+        real(wp) :: h, co, si, w, d(2), fs(2), sg
+        integer :: m
+        associate (sp => self%sup(k))
+            m = 6*(sp%elem - 1)
+            h = self%half(sp%elem)
+            co = cos(y(m + 3))
+            si = sin(y(m + 3))
+            w = y(m + 6)
+            sg = sp%sgn
+            if (sp%translational) then
+                ! F = Ct d + Bt d' acts as -sgn F on the centre and h n.F as moment
+                d(1) = sg*(y(m + 1) - sp%anchor(1)) - h*co
+                d(2) = sg*(y(m + 2) - sp%anchor(2)) - h*si
+                fs = sp%ct*d
+                blk(1, 1) = blk(1, 1) - sp%ct
+                blk(2, 2) = blk(2, 2) - sp%ct
+                blk(1, 3) = blk(1, 3) - sg*h*sp%ct*si
+                blk(2, 3) = blk(2, 3) + sg*h*sp%ct*co
+                blk(3, 1) = blk(3, 1) - sg*h*sp%ct*si
+                blk(3, 2) = blk(3, 2) + sg*h*sp%ct*co
+                if (sp%damped_t) then
+                    fs(1) = fs(1) + sp%bt*(sg*(y(m + 4) - sp%anchor_vel(1)) + h*w*si)
+                    fs(2) = fs(2) + sp%bt*(sg*(y(m + 5) - sp%anchor_vel(2)) - h*w*co)
+                    blk(1, 3) = blk(1, 3) - sg*h*sp%bt*w*co
+                    blk(2, 3) = blk(2, 3) - sg*h*sp%bt*w*si
+                    blk(1, 4) = blk(1, 4) - sp%bt
+                    blk(2, 5) = blk(2, 5) - sp%bt
+                    blk(1, 6) = blk(1, 6) - sg*h*sp%bt*si
+                    blk(2, 6) = blk(2, 6) + sg*h*sp%bt*co
+                    blk(3, 4) = blk(3, 4) - sg*h*sp%bt*si
+                    blk(3, 5) = blk(3, 5) + sg*h*sp%bt*co
+                    blk(3, 6) = blk(3, 6) - sp%bt*h**2
+                end if
+                blk(3, 3) = blk(3, 3) - h*(co*fs(1) + si*fs(2)) - sp%ct*h**2
+            end if
+            if (sp%rotational) then
+                blk(3, 3) = blk(3, 3) - sp%cr
+                if (sp%damped_r) blk(3, 6) = blk(3, 6) - sp%br
+            end if
+        end associate
+    end subroutine support_jacobian
+
+    !> Power of support k: its dissipation (W) and, when it moves, the work rate of its
+    !! anchor on the rope (W): the force of the support times -sgn P', the moment times
+    !! -sgn psi' (the strain rate's explicit part).
+    pure subroutine support_power(self, k, y, power, work)
+        class(rfem_t), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(inout) :: power, work
+        real(wp) :: h, co, si, d(2), dd(2), fs(2), s, sd, fr
+        integer :: m
+        associate (sp => self%sup(k))
+            m = 6*(sp%elem - 1)
+            h = self%half(sp%elem)
+            co = cos(y(m + 3))
+            si = sin(y(m + 3))
+            if (sp%translational) then
+                d(1) = sp%sgn*(y(m + 1) - sp%anchor(1)) - h*co
+                d(2) = sp%sgn*(y(m + 2) - sp%anchor(2)) - h*si
+                dd(1) = sp%sgn*(y(m + 4) - sp%anchor_vel(1)) + h*y(m + 6)*si
+                dd(2) = sp%sgn*(y(m + 5) - sp%anchor_vel(2)) - h*y(m + 6)*co
+                fs = sp%ct*d
+                if (sp%damped_t) then
+                    fs = fs + sp%bt*dd
+                    power = power + sp%bt*(dd(1)**2 + dd(2)**2)
+                end if
+                if (self%moving(k)) work = work - sp%sgn*(fs(1)*sp%anchor_vel(1) &
+                                                          + fs(2)*sp%anchor_vel(2))
+            end if
+            if (sp%rotational) then
+                s = sp%sgn*(y(m + 3) - sp%angle)
+                sd = sp%sgn*(y(m + 6) - sp%angle_rate)
+                fr = sp%cr*s
+                if (sp%damped_r) then
+                    fr = fr + sp%br*sd
+                    power = power + sp%br*sd**2
+                end if
+                if (self%moving(k)) work = work - sp%sgn*fr*sp%angle_rate
+            end if
+        end associate
+    end subroutine support_power
 
     module procedure fill_bodies
         integer :: i, k
@@ -110,82 +173,130 @@ contains
         end do
     end procedure fill_bodies
 
+    !> Accelerations (x'', y'', phi'') of the element carrying point-mass group p, from its
+    !! generalized force g (3).
+    pure function pm_acceleration(self, p, y, g) result(a)
+        class(rfem_t), intent(in) :: self
+        integer, intent(in) :: p
+        real(wp), intent(in) :: y(:), g(3)
+        real(wp) :: a(3)
+        integer :: i, k
+        real(wp) :: e(2), nv(2), f(2), sm
+        i = self%pm_elem(p)
+        k = 6*(i - 1)
+        sm = self%pm_moment(p)
+        e = [cos(y(k + 3)), sin(y(k + 3))]
+        nv = [-e(2), e(1)]
+        f = g(1:2) + sm*y(k + 6)**2*e
+        a(3) = (g(3) - sm*dot_product(nv, f)/self%mass(i)) &
+               /(self%inertia(i) - sm**2/self%mass(i))
+        a(1:2) = (f - sm*nv*a(3))/self%mass(i)
+    end function pm_acceleration
+
     module procedure point_mass_accelerations
-        integer :: p, i, k
-        real(wp) :: e(2), nv(2), g(3), sm, z3
+        integer :: p, k
         do p = 1, size(self%pm_elem)
-            i = self%pm_elem(p)
-            k = 6*(i - 1)
-            sm = self%pm_moment(p)
-            e = [cos(y(k + 3)), sin(y(k + 3))]
-            nv = [-e(2), e(1)]
-            g = gen(:, i)
-            g(1:2) = g(1:2) + sm*y(k + 6)**2*e
-            z3 = (g(3) - sm*dot_product(nv, g(1:2))/self%mass(i)) &
-                 /(self%inertia(i) - sm**2/self%mass(i))
-            ydot(k + 4:k + 5) = (g(1:2) - sm*nv*z3)/self%mass(i)
-            ydot(k + 6) = z3
+            k = 6*(self%pm_elem(p) - 1)
+            ydot(k + 4:k + 6) = pm_acceleration(self, p, y, gen(:, self%pm_elem(p)))
         end do
     end procedure point_mass_accelerations
 
-    module procedure rfem_generalized_forces
-        integer :: f, j, p
-        real(wp) :: sd, tt
+    module procedure forces
+        integer :: j, ka, kb, n, p, i
+        real(wp) :: dwx, dwy, cd, sd, rx, ry, rp, fx, fy, fp, ffx, ffy, c(3), e_el
+        real(wp) :: ca, sa, cb, sb, ha, hb, dx, dy, dvx, dvy, wa, wb
+        logical :: energy
 
-        tt = 0.0_wp
-        if (present(t)) tt = t
-        call self%set_time(tt)
-        gen = 0.0_wp
-        if (present(elastic)) elastic = 0.0_wp
+        n = self%n
+        energy = present(elastic)
+        e_el = 0.0_wp
+        call self%set_time(t)
+        call angles(self, y)
+        ! c: the force of the previous SDE on its element b (first: the top support's)
+        c = 0.0_wp
+        if (self%sup(1)%active) call support_force(self, 1, y, c, energy, e_el)
+        do j = 2, n
+            ! geometry and rates of SDE j (the module header's formulas, written out)
+            ka = 6*(j - 2)
+            kb = ka + 6
+            ca = self%cs(1, j - 1)
+            sa = self%cs(2, j - 1)
+            cb = self%cs(1, j)
+            sb = self%cs(2, j)
+            ha = self%half(j - 1)
+            hb = self%half(j)
+            dx = y(kb + 1) - hb*cb - y(ka + 1) - ha*ca
+            dy = y(kb + 2) - hb*sb - y(ka + 2) - ha*sa
+            dwx = ca*dx + sa*dy
+            dwy = -sa*dx + ca*dy
+            cd = ca*cb + sa*sb
+            sd = ca*sb - sa*cb
+            fx = 0.0_wp
+            fy = 0.0_wp
+            fp = 0.0_wp
+            if (self%tension) fx = self%cx*dwx
+            if (self%shear) fy = self%cy*dwy
+            if (self%bending) fp = self%cp*(y(kb + 3) - y(ka + 3))
+            if (energy) e_el = e_el + 0.5_wp*(fx*dwx + fy*dwy + fp*(y(kb + 3) - y(ka + 3)))
+            if (self%damped) then
+                dvx = y(kb + 4) - y(ka + 4)
+                dvy = y(kb + 5) - y(ka + 5)
+                wa = y(ka + 6)
+                wb = y(kb + 6)
+                rx = ca*dvx + sa*dvy + dwy*wa + hb*sd*wb
+                ry = -sa*dvx + ca*dvy - (dwx + ha)*wa - hb*cd*wb
+                rp = wb - wa
+                fx = fx + self%bx*rx
+                fy = fy + self%by*ry
+                fp = fp + self%bp*rp
+            end if
+            ffx = fx*ca - fy*sa
+            ffy = fx*sa + fy*ca
+            self%gen(1, j - 1) = c(1) + ffx + self%weight(j - 1)
+            self%gen(2, j - 1) = c(2) + ffy
+            self%gen(3, j - 1) = c(3) + (fy*(dwx + ha) - fx*dwy + fp)
+            c(1) = -ffx
+            c(2) = -ffy
+            c(3) = -hb*(fx*sd - fy*cd) - fp
+        end do
+        if (self%sup(2)%active) call support_force(self, 2, y, c, energy, e_el)
+        self%gen(1, n) = c(1) + self%weight(n)
+        self%gen(2:3, n) = c(2:3)
+        ! moment of the point masses' weight about their element's centre
         if (self%gravity_on) then
-            gen(1, :) = self%mass*self%g
-            ! moment of the point masses' weight about their element's centre
             do p = 1, size(self%pm_elem)
-                gen(3, self%pm_elem(p)) = gen(3, self%pm_elem(p)) &
-                    - self%g*self%pm_moment(p)*sin(y(6*self%pm_elem(p) - 3))
+                i = self%pm_elem(p)
+                self%gen(3, i) = self%gen(3, i) - self%g*self%pm_moment(p)*self%cs(2, i)
             end do
         end if
-        do f = 1, size(self%families)
-            associate (fam => self%families(f))
-                if (.not. fam%active) cycle
-                do j = fam%first, fam%last
-                    call self%strain(fam%kind, j, y, self%s(j), self%grad(:, j))
-                end do
-                self%force(fam%first:fam%last) = fam%c*self%s(fam%first:fam%last)
-                if (present(elastic)) elastic = elastic + &
-                    0.5_wp*fam%c*sum(self%s(fam%first:fam%last)**2)
-                if (fam%damped) then
-                    do j = fam%first, fam%last
-                        sd = dot_product(self%grad(:, j), self%local_rates(j, y))
-                        self%force(j) = self%force(j) + fam%b*sd
-                    end do
-                    ! a moving support's strain rate has the part ds/dt at fixed q
-                    if (fam%end > 0) self%force(fam%first:fam%last) = &
-                        self%force(fam%first:fam%last) + fam%b*fam%st
-                end if
-                do j = fam%first, fam%last
-                    if (j >= 2) gen(:, j - 1) = gen(:, j - 1) - self%force(j)*self%grad(1:3, j)
-                    if (j <= self%n) gen(:, j) = gen(:, j) - self%force(j)*self%grad(4:6, j)
-                end do
-            end associate
-        end do
         if (size(self%effects) > 0) then
             call self%fill_bodies(y)
-            call add_forces_of(self%effects, tt, self%bodies, gen(1:2, :), gen(3, :))
-            if (present(elastic)) call add_energies_of(self%effects, tt, self%bodies, elastic)
+            call add_forces_of(self%effects, t, self%bodies, self%gen(1:2, :), self%gen(3, :))
+            if (energy) call add_energies_of(self%effects, t, self%bodies, e_el)
         end if
+        if (energy) elastic = e_el
+    end procedure forces
+
+    module procedure rfem_generalized_forces
+        real(wp) :: tt
+        tt = 0.0_wp
+        if (present(t)) tt = t
+        call self%forces(tt, y, elastic)
+        gen = self%gen
     end procedure rfem_generalized_forces
 
     module procedure rfem_rhs
         integer :: i, k
 
-        call self%generalized_forces(y, self%gen, t=t)
+        call self%forces(t, y)
         do i = 1, self%n
             k = 6*(i - 1)
-            ydot(k + 1:k + 3) = y(k + 4:k + 6)
-            ydot(k + 4) = self%gen(1, i)/self%mass(i)
-            ydot(k + 5) = self%gen(2, i)/self%mass(i)
-            ydot(k + 6) = self%gen(3, i)/self%inertia(i)
+            ydot(k + 1) = y(k + 4)
+            ydot(k + 2) = y(k + 5)
+            ydot(k + 3) = y(k + 6)
+            ydot(k + 4) = self%gen(1, i)*self%rowscale(1, i)
+            ydot(k + 5) = self%gen(2, i)*self%rowscale(2, i)
+            ydot(k + 6) = self%gen(3, i)*self%rowscale(3, i)
         end do
         if (size(self%pm_elem) > 0) call self%point_mass_accelerations(y, self%gen, ydot)
         status = STATUS_OK
@@ -196,119 +307,250 @@ contains
         has = .true.
     end procedure rfem_has_jacobian
 
-    module procedure rfem_jacobian
-        integer :: i, c, f, j, r, l, row, col_q, col_v, er, el
-        real(wp) :: s, g(6), h(6, 6), v(6), hv(6), sd, coef, kq(6, 6), kv(6, 6), inv_m(6)
+    module procedure jacobian_blocks
+        integer :: j, ka, kb, n
+        real(wp) :: dwx, dwy, cd, sd, rx, ry, rp, fx, fy, fp, t6
+        real(wp) :: ca, sa, cb, sb, ha, hb, dx, dy, dvx, dvy, wa, wb
+        ! local coordinates of an SDE: (x, y, phi, x', y', phi') of element a, then of b
+        real(wp) :: gx(12), gy(12), dfx(12), dfy(12), dfp(12), r1(12), r2(12), carry(3, 6)
 
+        n = self%n
         call self%set_time(t)
-        ! d(position)/dt = velocity
-        do i = 1, self%n
-            do c = 1, 3
-                row = 6*(i - 1) + c
-                jb(offset - 3, row + 3) = jb(offset - 3, row + 3) + 1.0_wp
-            end do
+        call angles(self, y)
+        ! carry: the diagonal block of element b of the previous SDE (first: the top support)
+        carry = 0.0_wp
+        if (self%sup(1)%active) call support_jacobian(self, 1, y, carry)
+        gx = 0.0_wp
+        gy = 0.0_wp
+        dfx = 0.0_wp
+        dfy = 0.0_wp
+        dfp = 0.0_wp
+        do j = 2, n
+            ! geometry and rates of SDE j (the module header's formulas, written out)
+            ka = 6*(j - 2)
+            kb = ka + 6
+            ca = self%cs(1, j - 1)
+            sa = self%cs(2, j - 1)
+            cb = self%cs(1, j)
+            sb = self%cs(2, j)
+            ha = self%half(j - 1)
+            hb = self%half(j)
+            dx = y(kb + 1) - hb*cb - y(ka + 1) - ha*ca
+            dy = y(kb + 2) - hb*sb - y(ka + 2) - ha*sa
+            dwx = ca*dx + sa*dy
+            dwy = -sa*dx + ca*dy
+            cd = ca*cb + sa*sb
+            sd = ca*sb - sa*cb
+            ! gradients of the tension and shear strains (zero on the rates)
+            gx(1) = -ca
+            gx(2) = -sa
+            gx(3) = dwy
+            gx(7) = ca
+            gx(8) = sa
+            gx(9) = hb*sd
+            gy(1) = sa
+            gy(2) = -ca
+            gy(3) = -(dwx + ha)
+            gy(7) = -sa
+            gy(8) = ca
+            gy(9) = -hb*cd
+            ! forces fx, fy, fp and their derivatives
+            fx = 0.0_wp
+            fy = 0.0_wp
+            fp = 0.0_wp
+            if (self%tension) then
+                fx = self%cx*dwx
+                dfx = self%cx*gx
+            end if
+            if (self%shear) then
+                fy = self%cy*dwy
+                dfy = self%cy*gy
+            end if
+            if (self%bending) then
+                fp = self%cp*(y(kb + 3) - y(ka + 3))
+                dfp(3) = -self%cp
+                dfp(9) = self%cp
+            end if
+            if (self%damped) then
+                dvx = y(kb + 4) - y(ka + 4)
+                dvy = y(kb + 5) - y(ka + 5)
+                wa = y(ka + 6)
+                wb = y(kb + 6)
+                rx = ca*dvx + sa*dvy + dwy*wa + hb*sd*wb
+                ry = -sa*dvx + ca*dvy - (dwx + ha)*wa - hb*cd*wb
+                rp = wb - wa
+                ! d(rate)/dq = H q' (ry and -rx on phi_a), d(rate)/dq' = the gradient
+                if (self%tension) then
+                    fx = fx + self%bx*rx
+                    dfx(1) = dfx(1) + self%bx*sa*wa
+                    dfx(2) = dfx(2) - self%bx*ca*wa
+                    dfx(3) = dfx(3) + self%bx*ry
+                    dfx(7) = dfx(7) - self%bx*sa*wa
+                    dfx(8) = dfx(8) + self%bx*ca*wa
+                    dfx(9) = dfx(9) + self%bx*hb*cd*(wb - wa)
+                    dfx(4:6) = self%bx*gx(1:3)
+                    dfx(10:12) = self%bx*gx(7:9)
+                end if
+                if (self%shear) then
+                    fy = fy + self%by*ry
+                    dfy(1) = dfy(1) + self%by*ca*wa
+                    dfy(2) = dfy(2) + self%by*sa*wa
+                    dfy(3) = dfy(3) - self%by*rx
+                    dfy(7) = dfy(7) - self%by*ca*wa
+                    dfy(8) = dfy(8) - self%by*sa*wa
+                    dfy(9) = dfy(9) + self%by*hb*sd*(wb - wa)
+                    dfy(4:6) = self%by*gy(1:3)
+                    dfy(10:12) = self%by*gy(7:9)
+                end if
+                if (self%bending) then
+                    fp = fp + self%bp*rp
+                    dfp(6) = -self%bp
+                    dfp(12) = self%bp
+                end if
+            end if
+            ! rows of element a: d(F, fy (dwx + h_a) - fx dwy + fp); of element b:
+            ! d(-F, -h_b (fx sd - fy cd) - fp); columns: a's coordinates, then b's
+            r1 = ca*dfx - sa*dfy
+            r2 = sa*dfx + ca*dfy
+            r1(3) = r1(3) - fx*sa - fy*ca
+            r2(3) = r2(3) + fx*ca - fy*sa
+            self%blk(1, :, 0, j - 1) = carry(1, :) + r1(1:6)
+            self%blk(2, :, 0, j - 1) = carry(2, :) + r2(1:6)
+            self%blk(3, :, 0, j - 1) = carry(3, :) + (dwx + ha)*dfy(1:6) - dwy*dfx(1:6) &
+                                       + dfp(1:6) + fy*gx(1:6) - fx*gy(1:6)
+            self%blk(1, :, 1, j - 1) = r1(7:12)
+            self%blk(2, :, 1, j - 1) = r2(7:12)
+            self%blk(3, :, 1, j - 1) = (dwx + ha)*dfy(7:12) - dwy*dfx(7:12) + dfp(7:12) &
+                                       + fy*gx(7:12) - fx*gy(7:12)
+            t6 = hb*(fx*cd + fy*sd)
+            self%blk(1, :, -1, j) = -r1(1:6)
+            self%blk(2, :, -1, j) = -r2(1:6)
+            self%blk(3, :, -1, j) = -hb*(sd*dfx(1:6) - cd*dfy(1:6)) - dfp(1:6)
+            self%blk(3, 3, -1, j) = self%blk(3, 3, -1, j) + t6
+            carry(1, :) = -r1(7:12)
+            carry(2, :) = -r2(7:12)
+            carry(3, :) = -hb*(sd*dfx(7:12) - cd*dfy(7:12)) - dfp(7:12)
+            carry(3, 3) = carry(3, 3) - t6
         end do
-        do f = 1, size(self%families)
-            associate (fam => self%families(f))
-                if (.not. fam%active) cycle
-                do j = fam%first, fam%last
-                    call self%strain(fam%kind, j, y, s, g, h)
-                    coef = fam%c*s
-                    kq = -fam%c*outer(g, g)
-                    if (fam%damped) then
-                        v = self%local_rates(j, y)
-                        sd = dot_product(g, v) + fam%st
-                        hv = matmul(h, v)
-                        coef = coef + fam%b*sd
-                        kq = kq - fam%b*outer(g, hv)
-                        kv = -fam%b*outer(g, g)
-                    end if
-                    kq = kq - coef*h
-                    ! scatter: local dof r belongs to element er = j-1 (r <= 3) or j (r > 3)
-                    inv_m = 0.0_wp
-                    if (j >= 2) inv_m(1:3) = self%rowscale(:, j - 1)
-                    if (j <= self%n) inv_m(4:6) = self%rowscale(:, j)
-                    do r = 1, 6
-                        if (inv_m(r) == 0.0_wp) cycle
-                        er = j - 1 + (r - 1)/3
-                        row = 6*(er - 1) + 3 + mod(r - 1, 3) + 1
-                        do l = 1, 6
-                            if (inv_m(l) == 0.0_wp) cycle
-                            el = j - 1 + (l - 1)/3
-                            col_q = 6*(el - 1) + mod(l - 1, 3) + 1
-                            col_v = col_q + 3
-                            jb(offset + row - col_q, col_q) = jb(offset + row - col_q, col_q) &
-                                                              + kq(r, l)*inv_m(r)
-                            if (fam%damped) jb(offset + row - col_v, col_v) = &
-                                jb(offset + row - col_v, col_v) + kv(r, l)*inv_m(r)
-                        end do
-                    end do
-                end do
-            end associate
-        end do
-        ! external effects: 3x6 blocks on each element's own columns
+        if (self%sup(2)%active) call support_jacobian(self, 2, y, carry)
+        self%blk(:, :, 0, n) = carry
+        ! external effects: 3x6 blocks on each element's own coordinates
         if (size(self%effects) > 0) then
             call self%fill_bodies(y)
-            self%ejac = 0.0_wp
-            call add_jacobians_of(self%effects, t, self%bodies, self%ejac)
-            do i = 1, self%n
-                do r = 1, 3
-                    row = 6*(i - 1) + 3 + r
-                    do l = 1, 6
-                        col_q = 6*(i - 1) + l
-                        jb(offset + row - col_q, col_q) = jb(offset + row - col_q, col_q) &
-                                                          + self%ejac(r, l, i)*self%rowscale(r, i)
-                    end do
-                end do
-            end do
+            call add_jacobians_of(self%effects, t, self%bodies, self%blk(:, :, 0, :))
         end if
-        if (size(self%pm_elem) > 0) call point_mass_rows()
-        status = STATUS_OK
-    contains
-        !> Rows of the point-mass elements hold dG/dy so far (unscaled); add the terms of the
-        !! weight's moment and the centripetal force, subtract (dA/dphi) a, and multiply by
-        !! the inverse of the element's mass block A.
-        subroutine point_mass_rows()
-            real(wp) :: acc(6*self%n), raw(3), e(2), nv(2), sm, a(3), z3
-            integer :: p, col, k0, c1, c2
-            call self%generalized_forces(y, self%gen, t=t)
-            call self%point_mass_accelerations(y, self%gen, acc)
-            do p = 1, size(self%pm_elem)
-                i = self%pm_elem(p)
-                k0 = 6*(i - 1)
-                sm = self%pm_moment(p)
-                e = [cos(y(k0 + 3)), sin(y(k0 + 3))]
-                nv = [-e(2), e(1)]
-                a = acc(k0 + 4:k0 + 6)
-                c1 = max(1, k0 - 5)
-                c2 = min(6*self%n, k0 + 12)
-                do col = c1, c2
-                    raw = jb(offset + k0 + 4 - col:offset + k0 + 6 - col, col)
-                    if (col == k0 + 3) then
-                        raw(1:2) = raw(1:2) + sm*y(k0 + 6)**2*nv
-                        if (self%gravity_on) raw(3) = raw(3) - self%g*sm*cos(y(k0 + 3))
+    end procedure jacobian_blocks
+
+    module procedure point_mass_rows
+        integer :: i, o, l, p, k0
+        real(wp) :: raw(3), a(3), e(2), nv(2), sm, w
+
+        ! Their rows hold dG/dy (rowscale 1): add the terms of the weight's moment and the
+        ! centripetal force, subtract (dA/dphi) a, and multiply by the inverse of the
+        ! element's mass block A.
+        call self%forces(t, y)
+        do p = 1, size(self%pm_elem)
+            i = self%pm_elem(p)
+            k0 = 6*(i - 1)
+            sm = self%pm_moment(p)
+            e = [cos(y(k0 + 3)), sin(y(k0 + 3))]
+            nv = [-e(2), e(1)]
+            w = y(k0 + 6)
+            a = pm_acceleration(self, p, y, self%gen(:, i))
+            do o = max(-1, 1 - i), min(1, self%n - i)
+                do l = 1, 6
+                    raw = self%blk(:, l, o, i)
+                    if (o == 0 .and. l == 3) then
+                        raw(1:2) = raw(1:2) + sm*w**2*nv
+                        if (self%gravity_on) raw(3) = raw(3) - self%g*sm*e(1)
                         raw = raw + sm*[e(1)*a(3), e(2)*a(3), dot_product(e, a(1:2))]
-                    else if (col == k0 + 6) then
-                        raw(1:2) = raw(1:2) + 2.0_wp*sm*y(k0 + 6)*e
+                    else if (o == 0 .and. l == 6) then
+                        raw(1:2) = raw(1:2) + 2.0_wp*sm*w*e
                     end if
-                    z3 = (raw(3) - sm*dot_product(nv, raw(1:2))/self%mass(i)) &
-                         /(self%inertia(i) - sm**2/self%mass(i))
-                    raw(1:2) = (raw(1:2) - sm*nv*z3)/self%mass(i)
-                    raw(3) = z3
-                    jb(offset + k0 + 4 - col:offset + k0 + 6 - col, col) = raw
+                    raw(3) = (raw(3) - sm*dot_product(nv, raw(1:2))/self%mass(i)) &
+                             /(self%inertia(i) - sm**2/self%mass(i))
+                    raw(1:2) = (raw(1:2) - sm*nv*raw(3))/self%mass(i)
+                    self%blk(:, l, o, i) = raw
                 end do
             end do
-        end subroutine point_mass_rows
+        end do
+    end procedure point_mass_rows
 
-        pure function outer(a, b) result(m)
-            real(wp), intent(in) :: a(6), b(6)
-            real(wp) :: m(6, 6)
-            integer :: p
-            do p = 1, 6
-                m(:, p) = a*b(p)
+    !> Add the Jacobian of the first-order system into band storage jb(ld, 6n) (entry (i, j)
+    !! at row offset + i - j): the identity of the position rows and the velocity rows from
+    !! the blocks times the row scales.
+    subroutine write_first_order(self, jb, ld, offset)
+        class(rfem_t), intent(in) :: self
+        integer, intent(in) :: ld, offset
+        real(wp), intent(inout) :: jb(ld, 6*self%n)
+        integer :: i, k, c, o, l, col, p
+        real(wp) :: s1, s2, s3
+        do i = 1, self%n
+            k = 6*(i - 1)
+            ! d(position)/dt = velocity
+            do c = 1, 3
+                jb(offset - 3, k + c + 3) = jb(offset - 3, k + c + 3) + 1.0_wp
             end do
-        end function outer
+            s1 = self%rowscale(1, i)
+            s2 = self%rowscale(2, i)
+            s3 = self%rowscale(3, i)
+            ! rows k+4 .. k+6 from the blocks of elements i-1, i, i+1
+            do o = max(-1, 1 - i), min(1, self%n - i)
+                do l = 1, 6
+                    col = 6*(i + o - 1) + l
+                    p = offset + k + 4 - col
+                    jb(p, col) = jb(p, col) + s1*self%blk(1, l, o, i)
+                    jb(p + 1, col) = jb(p + 1, col) + s2*self%blk(2, l, o, i)
+                    jb(p + 2, col) = jb(p + 2, col) + s3*self%blk(3, l, o, i)
+                end do
+            end do
+        end do
+    end subroutine write_first_order
+
+    !> Add K (the blocks' coordinate columns), C (their rate columns), both times the row
+    !! scales, and the identity mass block into band storage (ld, 3n).
+    subroutine write_second_order(self, kb, cb, mb, ld, offset)
+        class(rfem_t), intent(in) :: self
+        integer, intent(in) :: ld, offset
+        real(wp), intent(inout) :: kb(ld, 3*self%n), cb(ld, 3*self%n), mb(ld, 3*self%n)
+        integer :: i, k, c, o, l, col, p
+        real(wp) :: s1, s2, s3
+        do i = 1, self%n
+            k = 3*(i - 1)
+            do c = 1, 3
+                mb(offset, k + c) = mb(offset, k + c) + 1.0_wp
+            end do
+            s1 = self%rowscale(1, i)
+            s2 = self%rowscale(2, i)
+            s3 = self%rowscale(3, i)
+            do o = max(-1, 1 - i), min(1, self%n - i)
+                do l = 1, 3
+                    col = 3*(i + o - 1) + l
+                    p = offset + k + 1 - col
+                    kb(p, col) = kb(p, col) + s1*self%blk(1, l, o, i)
+                    kb(p + 1, col) = kb(p + 1, col) + s2*self%blk(2, l, o, i)
+                    kb(p + 2, col) = kb(p + 2, col) + s3*self%blk(3, l, o, i)
+                    cb(p, col) = cb(p, col) + s1*self%blk(1, l + 3, o, i)
+                    cb(p + 1, col) = cb(p + 1, col) + s2*self%blk(2, l + 3, o, i)
+                    cb(p + 2, col) = cb(p + 2, col) + s3*self%blk(3, l + 3, o, i)
+                end do
+            end do
+        end do
+    end subroutine write_second_order
+
+    module procedure rfem_jacobian
+        call self%jacobian_blocks(t, y)
+        if (size(self%pm_elem) > 0) call self%point_mass_rows(t, y)
+        call write_first_order(self, jb, size(jb, 1), offset)
+        status = STATUS_OK
     end procedure rfem_jacobian
+
+    module procedure rfem_second_order_blocks
+        call self%jacobian_blocks(t, y)
+        if (size(self%pm_elem) > 0) call self%point_mass_rows(t, y)
+        call write_second_order(self, kb, cb, mb, size(kb, 1), offset)
+        status = STATUS_OK
+    end procedure rfem_second_order_blocks
 
     module procedure rfem_potential_energy
         type(energy_t) :: e
@@ -317,8 +559,7 @@ contains
     end procedure rfem_potential_energy
 
     module procedure rfem_energy
-        integer :: i, k, f, j, p
-        real(wp) :: s, g(6)
+        integer :: i, k, p
 
         call self%set_time(t)
         e%kinetic = 0.0_wp
@@ -336,48 +577,62 @@ contains
                         (-y(k + 4)*sin(y(k + 3)) + y(k + 5)*cos(y(k + 3)))
             if (self%gravity_on) e%gravity = e%gravity - self%g*self%pm_moment(p)*cos(y(k + 3))
         end do
-        e%elastic = 0.0_wp
-        do f = 1, size(self%families)
-            if (.not. self%families(f)%active) cycle
-            do j = self%families(f)%first, self%families(f)%last
-                call self%strain(self%families(f)%kind, j, y, s, g)
-                e%elastic = e%elastic + 0.5_wp*self%families(f)%c*s**2
-            end do
-        end do
-        if (size(self%effects) > 0) then
-            call self%fill_bodies(y)
-            call add_energies_of(self%effects, t, self%bodies, e%elastic)
-        end if
+        ! the springs' and the effects' potential energy
+        call self%forces(t, y, e%elastic)
         e%dissipated = 0.0_wp
         if (size(yq) >= 1) e%dissipated = yq(1)
         e%support_work = 0.0_wp  ! fixed supports and no loads: no external work
         if (self%with_work .and. size(yq) >= 2) e%support_work = yq(2)
     end procedure rfem_energy
 
+    !> Add the dissipation power sum B s'^2 of the internal SDEs (self%cs holding the
+    !! angles of y; the module header's geometry and rates).
+    subroutine internal_power(self, y, power)
+        class(rfem_t), intent(in) :: self
+        real(wp), intent(in) :: y(6*self%n)
+        real(wp), intent(inout) :: power
+        real(wp) :: ca, sa, cb, sb, ha, hb, dx, dy, dwx, dwy, cd, sd, dvx, dvy, wa, wb
+        real(wp) :: rx, ry, rp
+        integer :: j, ka, kb
+        do j = 2, self%n
+            ka = 6*(j - 2)
+            kb = ka + 6
+            ca = self%cs(1, j - 1)
+            sa = self%cs(2, j - 1)
+            cb = self%cs(1, j)
+            sb = self%cs(2, j)
+            ha = self%half(j - 1)
+            hb = self%half(j)
+            dx = y(kb + 1) - hb*cb - y(ka + 1) - ha*ca
+            dy = y(kb + 2) - hb*sb - y(ka + 2) - ha*sa
+            dwx = ca*dx + sa*dy
+            dwy = -sa*dx + ca*dy
+            cd = ca*cb + sa*sb
+            sd = ca*sb - sa*cb
+            dvx = y(kb + 4) - y(ka + 4)
+            dvy = y(kb + 5) - y(ka + 5)
+            wa = y(ka + 6)
+            wb = y(kb + 6)
+            rx = ca*dvx + sa*dvy + dwy*wa + hb*sd*wb
+            ry = -sa*dvx + ca*dvy - (dwx + ha)*wa - hb*cd*wb
+            rp = wb - wa
+            power = power + (self%bx*rx**2 + self%by*ry**2 + self%bp*rp**2)
+        end do
+    end subroutine internal_power
+
     module procedure rfem_quad_rhs
-        real(wp) :: power, work, s, g(6), sd
-        integer :: f, j
+        real(wp) :: power, work
+        integer :: k
         call self%set_time(t)
-        ! only the damped strains: no spring forces, no gravity, no scatter
+        ! only the damped strains and the supports: no spring forces, no gravity, no scatter
         power = 0.0_wp
         work = 0.0_wp
-        do f = 1, size(self%families)
-            associate (fam => self%families(f))
-                if (.not. fam%active) cycle
-                if (fam%end > 0 .and. self%moving(max(fam%end, 1))) then
-                    do j = fam%first, fam%last
-                        call self%strain(fam%kind, j, y, s, g)
-                        sd = dot_product(g, self%local_rates(j, y)) + fam%st
-                        if (fam%damped) power = power + fam%b*sd**2
-                        work = work + (fam%c*s + merge(fam%b, 0.0_wp, fam%damped)*sd)*fam%st
-                    end do
-                else if (fam%damped) then
-                    do j = fam%first, fam%last
-                        call self%strain(fam%kind, j, y, s, g)
-                        power = power + fam%b*dot_product(g, self%local_rates(j, y))**2
-                    end do
-                end if
-            end associate
+        if (self%damped) then
+            call angles(self, y)
+            call internal_power(self, y, power)
+        end if
+        do k = 1, 2
+            if (self%sup(k)%active) call support_power(self, k, y, power, work)
         end do
         if (size(self%effects) > 0) then
             call self%fill_bodies(y)

@@ -1,0 +1,678 @@
+!> The Newton iteration matrix of implicit multistep methods, M - g J for the implicit form
+!! M(t, y) y' = F(t, y) (MEBDF) or I - g J for y' = f(t, y) (CVODE), with g = h beta (MEBDF)
+!! or CVODE's gamma, factored with LAPACK.
+!!
+!! Two paths:
+!! - **reduced** (problems with second-order structure, ropedyn_problem): the blocks
+!!   K = dF_v/dq, C = dF_v/dv and the mass block M_v are kept between Jacobian evaluations;
+!!   a new g costs the matrix M_v - g C - g^2 K of size(pos) unknowns (half the system) and
+!!   its factorization; a solve of (M - g J) x = b is
+!!       (M_v - g C - g^2 K) x_v = b_v + g K b_q,   x_q = b_q + g x_v.
+!!   The blocks are the problem's `second_order_blocks` of the form asked for. When the
+!!   problem has none for the implicit form (the MPP without an analytic implicit Jacobian:
+!!   STATUS_FATAL), they are difference quotients of the implicit F, taken as the first-order
+!!   path takes them (the term dM/dq v' is left to the chord iteration, as there), and M_v
+!!   comes from the mass matrix. Without any blocks the first-order path is taken.
+!! - **first order** (problems without that structure, the stiff test set, or on request):
+!!   J = dF/dy over all unknowns, analytic when the problem supplies it, else difference
+!!   quotients of F (a band Jacobian by column groups of width ml + mu + 1: one F evaluation
+!!   per group).
+!! Both: LAPACK band (dgbtrf/dgbtrs), or dense (dgetrf/dgetrs) when the band is nearly full.
+module ropedyn_iteration_matrix
+    use ropedyn_kinds, only: wp, i8
+    use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_RECOVERABLE, STATUS_FATAL
+    implicit none
+    private
+    public :: iteration_matrix_t
+
+    !> Where the reduced blocks come from.
+    integer, parameter :: BLOCKS_OWN_FORM = 1     !< the problem's blocks of the form used
+    integer, parameter :: BLOCKS_DIFFERENCES = 2  !< difference quotients of the implicit F
+
+    type :: iteration_matrix_t
+        private
+        integer :: n = 0, ml = 0, mu = 0
+        logical :: implicit_form = .true.     !< M - g J of M y' = F (else I - g J of y' = f)
+        logical :: mass = .false.             !< the form used has a mass matrix
+        logical :: fd_jacobian = .false.      !< difference F even with an analytic Jacobian
+        logical :: reduced = .false.          !< the reduced path is in use
+        logical :: blocks_seen = .false.      !< the blocks were evaluated successfully once
+        integer :: blocks = BLOCKS_OWN_FORM
+        ! first-order path (and the mass matrix for `solve_mass` and `mass_times`)
+        logical :: dense = .false.
+        real(wp), allocatable :: jac(:, :)    !< J in compact band storage (row mu+1+i-j)
+        real(wp), allocatable :: mb(:, :)     !< M in compact band storage (work)
+        real(wp), allocatable :: lu(:, :)     !< factors (dense n x n or band 2ml+mu+1 x n)
+        integer, allocatable :: ipiv(:)
+        real(wp), allocatable :: f0(:), f1(:), ywork(:)
+        ! reduced path: blocks of np = size(pos) unknowns, bandwidths kl, ku
+        integer :: np = 0, kl = 0, ku = 0
+        logical :: rdense = .false.
+        integer, allocatable :: pos(:), vel(:)
+        logical :: vel_contiguous = .false.   !< vel(k) = vel(1) + k - 1
+        real(wp), allocatable :: kb(:, :), cb(:, :), mk(:, :)  !< band (kl+ku+1, np), row ku+1+i-j
+        real(wp), allocatable :: rlu(:, :)    !< factors (dense np x np or band 2kl+ku+1 x np)
+        integer, allocatable :: ripiv(:)
+        real(wp), allocatable :: rq(:), rv(:)
+        logical, public :: factored = .false.
+        real(wp), public :: hbeta = 0.0_wp    !< g of the current factorization
+    contains
+        procedure :: setup => matrix_setup
+        procedure :: evaluate_jacobian => matrix_evaluate_jacobian
+        procedure :: factor => matrix_factor
+        procedure :: solve => matrix_solve
+        procedure :: solve_mass => matrix_solve_mass
+        procedure :: mass_times => matrix_mass_times
+        procedure :: is_dense => matrix_is_dense
+        procedure :: is_reduced => matrix_is_reduced
+        procedure, private :: setup_first_order
+        procedure, private :: first_order_jacobian
+        procedure, private :: reduced_blocks
+        procedure, private :: factor_first_order
+        procedure, private :: factor_reduced
+        procedure, private :: solve_first_order
+        procedure, private :: solve_reduced
+    end type iteration_matrix_t
+
+    interface
+        subroutine dgetrf(m, n, a, lda, ipiv, info)
+            import :: wp
+            integer, intent(in) :: m, n, lda
+            real(wp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine dgetrf
+        subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
+            import :: wp
+            character, intent(in) :: trans
+            integer, intent(in) :: n, nrhs, lda, ldb, ipiv(*)
+            real(wp), intent(in) :: a(lda, *)
+            real(wp), intent(inout) :: b(ldb, *)
+            integer, intent(out) :: info
+        end subroutine dgetrs
+        subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
+            import :: wp
+            integer, intent(in) :: m, n, kl, ku, ldab
+            real(wp), intent(inout) :: ab(ldab, *)
+            integer, intent(out) :: ipiv(*), info
+        end subroutine dgbtrf
+        subroutine dgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
+            import :: wp
+            character, intent(in) :: trans
+            integer, intent(in) :: n, kl, ku, nrhs, ldab, ldb, ipiv(*)
+            real(wp), intent(in) :: ab(ldab, *)
+            real(wp), intent(inout) :: b(ldb, *)
+            integer, intent(out) :: info
+        end subroutine dgbtrs
+    end interface
+
+contains
+
+    !> Storage for the problem's Newton matrix. `implicit_form`: M - g J of the implicit
+    !! form (else I - g J of the explicit one). The reduced path is taken when the problem
+    !! has second-order structure covering all unknowns, unless `first_order` or
+    !! `fd_jacobian` (the blocks are analytic) is set.
+    subroutine matrix_setup(self, problem, implicit_form, first_order, fd_jacobian)
+        class(iteration_matrix_t), intent(inout) :: self
+        class(problem_t), intent(in) :: problem
+        logical, intent(in) :: implicit_form
+        logical, intent(in) :: first_order
+        logical, intent(in) :: fd_jacobian
+        integer :: k
+        logical :: covered
+
+        self%n = problem%size()
+        call problem%bandwidths(self%ml, self%mu)
+        self%ml = min(self%ml, self%n - 1)
+        self%mu = min(self%mu, self%n - 1)
+        self%implicit_form = implicit_form
+        self%mass = implicit_form .and. problem%has_mass_matrix()
+        self%fd_jacobian = fd_jacobian
+        self%factored = .false.
+        self%blocks_seen = .false.
+        self%blocks = BLOCKS_OWN_FORM
+        self%reduced = .false.
+        if (allocated(self%pos)) deallocate (self%pos, self%vel)
+        if (.not. (first_order .or. fd_jacobian) .and. problem%has_second_order()) then
+            call problem%second_order_layout(self%pos, self%vel, self%kl, self%ku)
+            self%np = size(self%pos)
+            covered = self%np > 0 .and. 2*self%np == self%n .and. size(self%vel) == self%np
+            if (covered) then
+                ! every unknown exactly once
+                self%f0 = [(0.0_wp, k = 1, self%n)]
+                self%f0(self%pos) = self%f0(self%pos) + 1.0_wp
+                self%f0(self%vel) = self%f0(self%vel) + 1.0_wp
+                covered = all(self%f0 == 1.0_wp)
+            end if
+            self%reduced = covered
+            if (covered) self%vel_contiguous = all(self%vel == [(self%vel(1) + k - 1, &
+                                                                 k = 1, self%np)])
+        end if
+        if (allocated(self%kb)) deallocate (self%kb, self%cb, self%mk, self%rlu, self%ripiv, &
+                                            self%rq, self%rv)
+        if (self%reduced) then
+            self%kl = min(max(self%kl, 0), self%np - 1)
+            self%ku = min(max(self%ku, 0), self%np - 1)
+            self%rdense = 2*self%kl + self%ku + 1 >= self%np
+            associate (rows => self%kl + self%ku + 1, np => self%np)
+                allocate (self%kb(rows, np), self%cb(rows, np), self%mk(rows, np))
+                if (self%rdense) then
+                    allocate (self%rlu(np, np))
+                else
+                    allocate (self%rlu(2*self%kl + self%ku + 1, np))
+                end if
+                allocate (self%ripiv(np), self%rq(np), self%rv(np))
+            end associate
+            self%kb = 0.0_wp
+            self%cb = 0.0_wp
+            self%mk = 0.0_wp
+        end if
+        ! first-order storage: its path, or the mass matrix of the implicit form
+        call self%setup_first_order(.not. self%reduced .or. self%mass)
+    end subroutine matrix_setup
+
+    !> (Re)allocate the first-order storage (empty unless `needed`).
+    subroutine setup_first_order(self, needed)
+        class(iteration_matrix_t), intent(inout) :: self
+        logical, intent(in) :: needed
+        integer :: n
+        n = self%n
+        if (allocated(self%jac)) deallocate (self%jac, self%lu, self%ipiv, self%ywork, self%f1)
+        if (allocated(self%mb)) deallocate (self%mb)
+        if (.not. needed) n = 0
+        self%dense = 2*self%ml + self%mu + 1 >= self%n
+        allocate (self%jac(self%ml + self%mu + 1, n))
+        if (self%mass) then
+            allocate (self%mb(self%ml + self%mu + 1, n))
+            self%mb = 0.0_wp
+        end if
+        if (self%dense) then
+            allocate (self%lu(n, n))
+        else
+            allocate (self%lu(2*self%ml + self%mu + 1, n))
+        end if
+        allocate (self%ipiv(n), self%f1(n), self%ywork(n))
+        if (allocated(self%f0)) deallocate (self%f0)
+        allocate (self%f0(n))
+        self%jac = 0.0_wp
+    end subroutine setup_first_order
+
+    pure logical function matrix_is_dense(self)
+        class(iteration_matrix_t), intent(in) :: self
+        matrix_is_dense = merge(self%rdense, self%dense, self%reduced)
+    end function matrix_is_dense
+
+    !> True when the reduced path is in use.
+    pure logical function matrix_is_reduced(self)
+        class(iteration_matrix_t), intent(in) :: self
+        matrix_is_reduced = self%reduced
+    end function matrix_is_reduced
+
+    !> The Jacobian at (t, y): the reduced blocks, or J = dF/dy (analytic, or by difference
+    !! quotients when the problem has no analytic one or fd_jacobian was asked for). w are the
+    !! error weights (rtol |y| + atol), h the step size (they scale the increments as in
+    !! CVODE's difference-quotient Jacobian). nevals counts the F evaluations spent.
+    subroutine matrix_evaluate_jacobian(self, problem, t, y, w, h, status, nevals)
+        class(iteration_matrix_t), intent(inout) :: self
+        class(problem_t), intent(inout) :: problem
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(in) :: w(:)
+        real(wp), intent(in) :: h
+        integer, intent(out) :: status
+        integer(i8), intent(inout) :: nevals
+
+        self%factored = .false.
+        if (self%reduced) then
+            call self%reduced_blocks(problem, t, y, w, h, status, nevals)
+            if (status /= STATUS_FATAL .or. self%blocks_seen) return
+            ! no blocks at all: the first-order path from now on
+            self%reduced = .false.
+            call self%setup_first_order(.true.)
+        end if
+        call self%first_order_jacobian(problem, t, y, w, h, status, nevals)
+    end subroutine matrix_evaluate_jacobian
+
+    !> K, C, M_v at (t, y) (see the module header); on the first evaluation a problem
+    !! without implicit-form blocks switches to difference quotients.
+    subroutine reduced_blocks(self, problem, t, y, w, h, status, nevals)
+        class(iteration_matrix_t), intent(inout) :: self
+        class(problem_t), intent(inout) :: problem
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(in) :: w(:)
+        real(wp), intent(in) :: h
+        integer, intent(out) :: status
+        integer(i8), intent(inout) :: nevals
+        integer :: a, b, np, off, ml, mu
+
+        np = self%np
+        off = self%ku + 1
+        self%kb = 0.0_wp
+        self%cb = 0.0_wp
+        self%mk = 0.0_wp
+        if (self%blocks == BLOCKS_OWN_FORM) then
+            call problem%second_order_blocks(t, y, self%implicit_form, self%kb, self%cb, &
+                                             self%mk, off, status)
+            if (status == STATUS_OK) self%blocks_seen = .true.
+            if (status /= STATUS_FATAL .or. self%blocks_seen .or. .not. self%mass) return
+            self%blocks = BLOCKS_DIFFERENCES
+        end if
+        ! difference quotients of the implicit F over all unknowns, then the rate rows
+        call self%first_order_jacobian(problem, t, y, w, h, status, nevals, differences=.true.)
+        if (status /= STATUS_OK) return
+        self%mb = 0.0_wp
+        call problem%mass_matrix(t, y, self%mb, self%mu + 1, status)
+        if (status /= STATUS_OK) return
+        self%blocks_seen = .true.
+        ml = self%ml
+        mu = self%mu
+        do b = 1, np
+            do a = max(1, b - self%ku), min(np, b + self%kl)
+                self%kb(off + a - b, b) = full_entry(self%jac, ml, mu, self%vel(a), self%pos(b))
+                self%cb(off + a - b, b) = full_entry(self%jac, ml, mu, self%vel(a), self%vel(b))
+                self%mk(off + a - b, b) = full_entry(self%mb, ml, mu, self%vel(a), self%vel(b))
+            end do
+        end do
+    end subroutine reduced_blocks
+
+    !> J = dF/dy over all unknowns (first-order path).
+    subroutine first_order_jacobian(self, problem, t, y, w, h, status, nevals, differences)
+        class(iteration_matrix_t), intent(inout) :: self
+        class(problem_t), intent(inout) :: problem
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(in) :: w(:)
+        real(wp), intent(in) :: h
+        integer, intent(out) :: status
+        integer(i8), intent(inout) :: nevals
+        logical, intent(in), optional :: differences   !< difference quotients in any case
+        real(wp) :: inc(self%n), fnorm, min_inc
+        integer :: width, group, j, i, n
+        logical :: analytic
+
+        self%jac = 0.0_wp
+        if (self%implicit_form) then
+            analytic = problem%has_implicit_jacobian()
+        else
+            analytic = problem%has_jacobian()
+        end if
+        if (present(differences)) analytic = analytic .and. .not. differences
+        if (analytic .and. .not. self%fd_jacobian) then
+            if (self%implicit_form) then
+                call problem%implicit_jacobian(t, y, self%jac, self%mu + 1, status)
+            else
+                call problem%jacobian(t, y, self%jac, self%mu + 1, status)
+            end if
+            return
+        end if
+        n = self%n
+        call form_rhs(y, self%f0)
+        nevals = nevals + 1
+        if (status /= STATUS_OK) return
+        fnorm = sqrt(sum((self%f0/w(1:n))**2)/real(n, wp))
+        if (fnorm > 0.0_wp) then
+            min_inc = 1000.0_wp*abs(h)*epsilon(1.0_wp)*real(n, wp)*fnorm
+        else
+            min_inc = 1.0_wp
+        end if
+        do j = 1, n
+            inc(j) = max(sqrt(epsilon(1.0_wp))*abs(y(j)), min_inc*w(j))
+        end do
+        width = min(self%ml + self%mu + 1, n)
+        do group = 1, width
+            self%ywork = y(1:n)
+            do j = group, n, width
+                self%ywork(j) = y(j) + inc(j)
+            end do
+            call form_rhs(self%ywork, self%f1)
+            nevals = nevals + 1
+            if (status /= STATUS_OK) return
+            do j = group, n, width
+                do i = max(1, j - self%mu), min(n, j + self%ml)
+                    self%jac(self%mu + 1 + i - j, j) = (self%f1(i) - self%f0(i))/inc(j)
+                end do
+            end do
+        end do
+        status = STATUS_OK
+    contains
+        subroutine form_rhs(yy, ff)
+            real(wp), intent(in) :: yy(:)
+            real(wp), intent(out) :: ff(:)
+            if (self%implicit_form) then
+                call problem%implicit_rhs(t, yy, ff, status)
+            else
+                call problem%rhs(t, yy, ff, status)
+            end if
+        end subroutine form_rhs
+    end subroutine first_order_jacobian
+
+    !> Factor the Newton matrix for g = hbeta (M - g J; M = I without a mass matrix).
+    !! status is STATUS_RECOVERABLE when the matrix is singular.
+    subroutine matrix_factor(self, problem, t, y, hbeta, status)
+        class(iteration_matrix_t), intent(inout) :: self
+        class(problem_t), intent(inout) :: problem
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(in) :: hbeta
+        integer, intent(out) :: status
+        self%factored = .false.
+        if (self%reduced) then
+            call self%factor_reduced(hbeta, status)
+        else
+            call self%factor_first_order(problem, t, y, hbeta, status)
+        end if
+        if (status /= STATUS_OK) return
+        self%factored = .true.
+        self%hbeta = hbeta
+    end subroutine matrix_factor
+
+    !> M_v - g C - g^2 K from the kept blocks, factored.
+    subroutine factor_reduced(self, g, status)
+        class(iteration_matrix_t), intent(inout) :: self
+        real(wp), intent(in) :: g
+        integer, intent(out) :: status
+        integer :: i, j, info, np, kl, ku
+        real(wp) :: g2
+
+        np = self%np
+        kl = self%kl
+        ku = self%ku
+        g2 = g*g
+        if (self%rdense) then
+            do j = 1, np
+                self%rlu(1:max(1, j - ku) - 1, j) = 0.0_wp
+                do i = max(1, j - ku), min(np, j + kl)
+                    self%rlu(i, j) = self%mk(ku + 1 + i - j, j) - g*self%cb(ku + 1 + i - j, j) &
+                                     - g2*self%kb(ku + 1 + i - j, j)
+                end do
+                self%rlu(min(np, j + kl) + 1:np, j) = 0.0_wp
+            end do
+            call dgetrf(np, np, self%rlu, np, self%ripiv, info)
+        else
+            ! dgbtrf storage: (i, j) at row kl + ku + 1 + i - j of 2 kl + ku + 1 rows
+            self%rlu(1:kl, :) = 0.0_wp
+            self%rlu(kl + 1:, :) = self%mk - g*self%cb - g2*self%kb
+            call band_lu_factor(np, kl, ku, self%rlu, self%ripiv, info)
+        end if
+        status = merge(STATUS_OK, STATUS_RECOVERABLE, info == 0)
+    end subroutine factor_reduced
+
+    !> The first-order matrix M(t, y) - g J, factored.
+    subroutine factor_first_order(self, problem, t, y, hbeta, status)
+        class(iteration_matrix_t), intent(inout) :: self
+        class(problem_t), intent(inout) :: problem
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(in) :: hbeta
+        integer, intent(out) :: status
+        integer :: i, j, info, n, ml, mu
+
+        n = self%n
+        ml = self%ml
+        mu = self%mu
+        status = STATUS_OK
+        if (self%mass) then
+            self%mb = 0.0_wp
+            call problem%mass_matrix(t, y, self%mb, mu + 1, status)
+            if (status /= STATUS_OK) return
+        end if
+        self%lu = 0.0_wp
+        if (self%dense) then
+            do j = 1, n
+                do i = max(1, j - mu), min(n, j + ml)
+                    self%lu(i, j) = -hbeta*self%jac(mu + 1 + i - j, j)
+                    if (self%mass) self%lu(i, j) = self%lu(i, j) + self%mb(mu + 1 + i - j, j)
+                end do
+                if (.not. self%mass) self%lu(j, j) = self%lu(j, j) + 1.0_wp
+            end do
+            call dgetrf(n, n, self%lu, n, self%ipiv, info)
+        else
+            ! dgbtrf storage: (i, j) at row ml + mu + 1 + i - j of 2 ml + mu + 1 rows.
+            self%lu(ml + 1:2*ml + mu + 1, :) = -hbeta*self%jac
+            if (self%mass) then
+                self%lu(ml + 1:2*ml + mu + 1, :) = self%lu(ml + 1:2*ml + mu + 1, :) + self%mb
+            else
+                self%lu(ml + mu + 1, :) = self%lu(ml + mu + 1, :) + 1.0_wp
+            end if
+            call dgbtrf(n, n, ml, mu, self%lu, 2*ml + mu + 1, self%ipiv, info)
+        end if
+        if (info /= 0) status = STATUS_RECOVERABLE
+    end subroutine factor_first_order
+
+    !> b <- (M - g J)^{-1} b with the current factors.
+    subroutine matrix_solve(self, b)
+        class(iteration_matrix_t), intent(inout) :: self
+        real(wp), intent(inout) :: b(:)
+        if (self%reduced) then
+            call self%solve_reduced(b)
+        else
+            call self%solve_first_order(b)
+        end if
+    end subroutine matrix_solve
+
+    subroutine solve_first_order(self, b)
+        class(iteration_matrix_t), intent(inout) :: self
+        real(wp), intent(inout) :: b(:)
+        integer :: info
+        if (self%dense) then
+            call dgetrs('N', self%n, 1, self%lu, self%n, self%ipiv, b, self%n, info)
+        else
+            call dgbtrs('N', self%n, self%ml, self%mu, 1, self%lu, 2*self%ml + self%mu + 1, &
+                        self%ipiv, b, self%n, info)
+        end if
+    end subroutine solve_first_order
+
+    !> (M_v - g C - g^2 K) x_v = b_v + g K b_q, x_q = b_q + g x_v.
+    subroutine solve_reduced(self, b)
+        class(iteration_matrix_t), intent(inout) :: self
+        real(wp), intent(inout) :: b(:)
+        integer :: i, j, info, np, kl, ku
+        real(wp) :: g, x
+
+        np = self%np
+        kl = self%kl
+        ku = self%ku
+        g = self%hbeta
+        do i = 1, np
+            self%rq(i) = b(self%pos(i))
+            self%rv(i) = b(self%vel(i))
+        end do
+        call band_add_product(np, kl, ku, self%kb, g, self%rq, self%rv)
+        if (self%rdense) then
+            call dgetrs('N', np, 1, self%rlu, np, self%ripiv, self%rv, np, info)
+        else
+            call band_lu_solve(np, kl, ku, self%rlu, self%ripiv, self%rv)
+        end if
+        do i = 1, np
+            b(self%vel(i)) = self%rv(i)
+            b(self%pos(i)) = self%rq(i) + g*self%rv(i)
+        end do
+    end subroutine solve_reduced
+
+    !> b <- M(t, y)^{-1} b (the implicit form's mass matrix, first-order storage); the
+    !! Newton matrix must be factored again afterwards. status: STATUS_RECOVERABLE when M
+    !! is singular.
+    subroutine matrix_solve_mass(self, problem, t, y, b, status)
+        class(iteration_matrix_t), intent(inout) :: self
+        class(problem_t), intent(inout) :: problem
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(inout) :: b(:)
+        integer, intent(out) :: status
+        self%factored = .false.
+        call self%factor_first_order(problem, t, y, 0.0_wp, status)
+        if (status /= STATUS_OK) return
+        call self%solve_first_order(b)
+    end subroutine matrix_solve_mass
+
+    !> mv = M(t, y) v. With second-order structure M = blockdiag(I, M_v) (the coordinate
+    !! rows are q' = v): only the entries of M_v and the coordinates' diagonal are cleared,
+    !! filled and used (for the dense MPP a quarter of the full matrix).
+    subroutine matrix_mass_times(self, problem, t, y, v, mv, status)
+        class(iteration_matrix_t), intent(inout) :: self
+        class(problem_t), intent(inout) :: problem
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(in) :: v(:)
+        real(wp), intent(out) :: mv(:)
+        integer, intent(out) :: status
+        integer :: i, j, b, v0, lo, hi
+        real(wp) :: x
+        if (.not. self%mass) then
+            mv = v(1:self%n)
+            status = STATUS_OK
+            return
+        end if
+        if (self%reduced .and. self%vel_contiguous) then
+            ! the rates are y(v0 + 1 .. v0 + np): M_v's column b is a slice of band column
+            ! v0 + b (M_v is within the first-order band: the problem's bandwidths cover M)
+            v0 = self%vel(1) - 1
+            do b = 1, self%np
+                self%mb(self%mu + 1, self%pos(b)) = 0.0_wp
+                lo = max(1, b - self%ku)
+                hi = min(self%np, b + self%kl)
+                self%mb(self%mu + 1 + lo - b:self%mu + 1 + hi - b, v0 + b) = 0.0_wp
+            end do
+            call problem%mass_matrix(t, y, self%mb, self%mu + 1, status)
+            if (status /= STATUS_OK) return
+            do b = 1, self%np
+                i = self%pos(b)
+                mv(i) = self%mb(self%mu + 1, i)*v(i)
+            end do
+            mv(v0 + 1:v0 + self%np) = 0.0_wp
+            do b = 1, self%np
+                x = v(v0 + b)
+                lo = max(1, b - self%ku)
+                hi = min(self%np, b + self%kl)
+                mv(v0 + lo:v0 + hi) = mv(v0 + lo:v0 + hi) + &
+                    self%mb(self%mu + 1 + lo - b:self%mu + 1 + hi - b, v0 + b)*x
+            end do
+            return
+        end if
+        self%mb = 0.0_wp
+        call problem%mass_matrix(t, y, self%mb, self%mu + 1, status)
+        if (status /= STATUS_OK) return
+        mv = 0.0_wp
+        do j = 1, self%n
+            do i = max(1, j - self%mu), min(self%n, j + self%ml)
+                mv(i) = mv(i) + self%mb(self%mu + 1 + i - j, j)*v(j)
+            end do
+        end do
+    end subroutine matrix_mass_times
+
+    !> LU factorization with partial pivoting of a band matrix in LAPACK's dgbtrf storage
+    !! (entry (i, j) at row kl + ku + 1 + i - j of 2 kl + ku + 1 rows; rows 1 .. kl are
+    !! the fill-in and must be zero on entry): dgbtf2's algorithm and output, written out
+    !! as loops, except that the diagonal of U is stored inverted (the solve multiplies).
+    !! For the small bandwidths of the reduced rope matrices (5/5) LAPACK's BLAS calls per
+    !! column cost more than their arithmetic. info = j > 0: U(j, j) = 0.
+    pure subroutine band_lu_factor(n, kl, ku, ab, ipiv, info)
+        integer, intent(in) :: n, kl, ku
+        real(wp), intent(inout) :: ab(2*kl + ku + 1, n)
+        integer, intent(out) :: ipiv(n)
+        integer, intent(out) :: info
+        integer :: kv, j, jp, km, ju, i, c
+        real(wp) :: pivot, big, x, u
+
+        kv = kl + ku
+        info = 0
+        ju = 1
+        do j = 1, n
+            km = min(kl, n - j)
+            ! pivot: largest |A(i, j)|, i = j .. j + km (row kv + 1 + i - j)
+            jp = 1
+            big = abs(ab(kv + 1, j))
+            do i = 2, km + 1
+                if (abs(ab(kv + i, j)) > big) then
+                    big = abs(ab(kv + i, j))
+                    jp = i
+                end if
+            end do
+            ipiv(j) = jp + j - 1
+            if (ab(kv + jp, j) == 0.0_wp) then
+                if (info == 0) info = j
+                cycle
+            end if
+            ju = max(ju, min(j + ku + jp - 1, n))
+            if (jp /= 1) then
+                ! swap rows j and j + jp - 1 in columns j .. ju
+                do c = j, ju
+                    x = ab(kv + jp - (c - j), c)
+                    ab(kv + jp - (c - j), c) = ab(kv + 1 - (c - j), c)
+                    ab(kv + 1 - (c - j), c) = x
+                end do
+            end if
+            pivot = 1.0_wp/ab(kv + 1, j)
+            ab(kv + 1, j) = pivot
+            ab(kv + 2:kv + 1 + km, j) = ab(kv + 2:kv + 1 + km, j)*pivot
+            ! A(j+1 : j+km, c) -= l * A(j, c) for c = j+1 .. ju
+            do c = j + 1, ju
+                u = ab(kv + 1 + j - c, c)
+                if (u /= 0.0_wp) then
+                    do i = 1, km
+                        ab(kv + 1 + j + i - c, c) = ab(kv + 1 + j + i - c, c) - ab(kv + 1 + i, j)*u
+                    end do
+                end if
+            end do
+        end do
+    end subroutine band_lu_factor
+
+    !> b <- A^{-1} b with the factors of band_lu_factor (dgbtrs's algorithm).
+    pure subroutine band_lu_solve(n, kl, ku, ab, ipiv, b)
+        integer, intent(in) :: n, kl, ku
+        real(wp), intent(in) :: ab(2*kl + ku + 1, n)
+        integer, intent(in) :: ipiv(n)
+        real(wp), intent(inout) :: b(n)
+        integer :: kv, j, km, l, i
+        real(wp) :: x
+
+        kv = kl + ku
+        ! L y = P b
+        do j = 1, n - 1
+            km = min(kl, n - j)
+            l = ipiv(j)
+            x = b(l)
+            if (l /= j) then
+                b(l) = b(j)
+                b(j) = x
+            end if
+            do i = 1, km
+                b(j + i) = b(j + i) - ab(kv + 1 + i, j)*x
+            end do
+        end do
+        ! U x = y (U has kv super-diagonals; its diagonal is stored inverted)
+        do j = n, 1, -1
+            x = b(j)*ab(kv + 1, j)
+            b(j) = x
+            do i = max(1, j - kv), j - 1
+                b(i) = b(i) - ab(kv + 1 + i - j, j)*x
+            end do
+        end do
+    end subroutine band_lu_solve
+
+    !> y <- y + g A x for A in compact band storage (row ku + 1 + i - j).
+    pure subroutine band_add_product(n, kl, ku, a, g, x, y)
+        integer, intent(in) :: n, kl, ku
+        real(wp), intent(in) :: a(kl + ku + 1, n)
+        real(wp), intent(in) :: g
+        real(wp), intent(in) :: x(n)
+        real(wp), intent(inout) :: y(n)
+        integer :: i, j
+        real(wp) :: gx
+        do j = 1, n
+            gx = g*x(j)
+            do i = max(1, j - ku), min(n, j + kl)
+                y(i) = y(i) + a(ku + 1 + i - j, j)*gx
+            end do
+        end do
+    end subroutine band_add_product
+
+    !> Entry (i, j) of a matrix in compact band storage (row mu + 1 + i - j), 0 off the band.
+    pure real(wp) function full_entry(band, ml, mu, i, j) result(x)
+        real(wp), intent(in) :: band(:, :)
+        integer, intent(in) :: ml, mu, i, j
+        x = 0.0_wp
+        if (i - j <= ml .and. j - i <= mu) x = band(mu + 1 + i - j, j)
+    end function full_entry
+
+end module ropedyn_iteration_matrix

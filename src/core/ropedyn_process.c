@@ -1,0 +1,261 @@
+/* The POSIX calls Fortran cannot make on its own (signal handlers, posix_spawn, waitpid's
+ * status macros, a thread): glue for ropedyn_process.f90, which is the only caller.
+ *
+ * - Signals: SIGINT and SIGTERM set a flag that the program polls (the local sweep runner).
+ *   With a lock file given (a sweep case being written), the handler instead appends
+ *   "signal=N" to that file and ends the process by the same signal (default action), so
+ *   the case's lock records why its writer stopped (docs/sweeps.md, "Locks").
+ * - A lock's heartbeat: a thread that touches the lock file every few seconds, so that a
+ *   reader on another host can tell a live writer from one that is gone.
+ * - Worker processes: spawned in their own process group with stdout and stderr in a log
+ *   file; reaped without blocking; signalled as a group.
+ * - Process start times (/proc/PID/stat), to tell a live PID from a reused one.
+ *
+ * Only async-signal-safe calls (write, signal, raise) happen in the handler. */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <fcntl.h>
+#include <pthread.h>
+#include <signal.h>
+#include <spawn.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+extern char **environ;
+
+static const int CAUGHT[2] = {SIGINT, SIGTERM};
+static struct sigaction saved[2];
+static int installed = 0;
+static volatile sig_atomic_t received = 0;
+static volatile int note_fd = -1;
+
+static int beat_fd = -1;
+static int beat_seconds = 10;
+static int beat_running = 0;
+static pthread_t beat_thread;
+
+static void on_signal(int sig)
+{
+    if (!received) received = sig;
+    if (note_fd >= 0) {
+        char line[32] = "signal=";
+        int n = 7, d = sig;
+        char digits[8];
+        int k = 0;
+        do {
+            digits[k++] = (char)('0' + d % 10);
+            d /= 10;
+        } while (d > 0 && k < 8);
+        while (k > 0) line[n++] = digits[--k];
+        line[n++] = '\n';
+        ssize_t rc = write(note_fd, line, (size_t)n);
+        (void)rc;
+        signal(sig, SIG_DFL);
+        raise(sig);
+    }
+}
+
+/* Catch SIGINT and SIGTERM: the handler sets the flag (a signal ignored at start stays
+ * ignored). Returns 0, or errno. */
+int ropedyn_catch_signals(void)
+{
+    struct sigaction sa;
+    int k;
+    if (installed) return 0;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESTART;
+    for (k = 0; k < 2; k++) {
+        if (sigaction(CAUGHT[k], NULL, &saved[k]) != 0) return errno;
+        if (saved[k].sa_handler == SIG_IGN) continue;
+        if (sigaction(CAUGHT[k], &sa, NULL) != 0) return errno;
+    }
+    installed = 1;
+    return 0;
+}
+
+/* With `path` not empty: from now on a caught signal is appended to that file and ends the
+ * process (by the same signal). With "": back to setting the flag only. Returns 0, or
+ * errno. */
+int ropedyn_signal_note(const char *path)
+{
+    int fd = -1, old;
+    if (path[0] != '\0') {
+        fd = open(path, O_WRONLY | O_APPEND | O_CLOEXEC);
+        if (fd < 0) return errno;
+    }
+    old = note_fd;
+    note_fd = fd;
+    if (old >= 0) close(old);
+    return 0;
+}
+
+/* Back to the dispositions before ropedyn_catch_signals; forget the note file. */
+void ropedyn_release_signals(void)
+{
+    int k;
+    if (installed) {
+        for (k = 0; k < 2; k++) sigaction(CAUGHT[k], &saved[k], NULL);
+        installed = 0;
+    }
+    ropedyn_signal_note("");
+}
+
+/* The first signal caught (its number), or 0. */
+int ropedyn_signal_received(void) { return (int)received; }
+
+static void *beat(void *unused)
+{
+    (void)unused;
+    for (;;) {
+        sleep((unsigned)beat_seconds);   /* a cancellation point */
+        futimens(beat_fd, NULL);
+    }
+    return NULL;
+}
+
+/* Touch `path` now and every `seconds` s from a thread (which blocks every signal) until
+ * ropedyn_stop_heartbeat. Returns 0, or errno. */
+int ropedyn_start_heartbeat(const char *path, int seconds)
+{
+    sigset_t all, old;
+    int rc;
+    if (beat_running) return EBUSY;
+    beat_fd = open(path, O_WRONLY | O_CLOEXEC);
+    if (beat_fd < 0) return errno;
+    futimens(beat_fd, NULL);
+    beat_seconds = seconds > 0 ? seconds : 1;
+    sigfillset(&all);
+    pthread_sigmask(SIG_SETMASK, &all, &old);
+    rc = pthread_create(&beat_thread, NULL, beat, NULL);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    if (rc != 0) {
+        close(beat_fd);
+        beat_fd = -1;
+        return rc;
+    }
+    beat_running = 1;
+    return 0;
+}
+
+void ropedyn_stop_heartbeat(void)
+{
+    if (!beat_running) return;
+    pthread_cancel(beat_thread);
+    pthread_join(beat_thread, NULL);
+    close(beat_fd);
+    beat_fd = -1;
+    beat_running = 0;
+}
+
+/* Start `nargs` NUL-separated arguments (the first is the program, looked up in PATH
+ * when it holds no '/') in a new process group, stdin from /dev/null, stdout and stderr
+ * to `log` (truncated), SIGINT and SIGTERM at their default action. Returns 0 and the
+ * child's pid, or errno. */
+int ropedyn_spawn(const char *args, int nargs, const char *log, int *pid)
+{
+    posix_spawn_file_actions_t actions;
+    posix_spawnattr_t attr;
+    sigset_t defaults, none;
+    char **argv;
+    const char *p = args;
+    pid_t child;
+    int k, rc;
+
+    argv = calloc((size_t)nargs + 1, sizeof *argv);
+    if (!argv) return ENOMEM;
+    for (k = 0; k < nargs; k++) {
+        argv[k] = (char *)p;
+        p += strlen(p) + 1;
+    }
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 1, log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, 1, 2);
+    posix_spawnattr_init(&attr);
+    sigemptyset(&defaults);
+    sigaddset(&defaults, SIGINT);
+    sigaddset(&defaults, SIGTERM);
+    sigemptyset(&none);
+    posix_spawnattr_setpgroup(&attr, 0);
+    posix_spawnattr_setsigdefault(&attr, &defaults);
+    posix_spawnattr_setsigmask(&attr, &none);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGDEF |
+                                        POSIX_SPAWN_SETSIGMASK);
+    rc = posix_spawnp(&child, argv[0], &actions, &attr, argv, environ);
+    posix_spawnattr_destroy(&attr);
+    posix_spawn_file_actions_destroy(&actions);
+    free(argv);
+    if (rc == 0) *pid = (int)child;
+    return rc;
+}
+
+/* 1 when child `pid` has ended (`code`: its exit status, or 128 + the signal that ended
+ * it), 0 while it runs, -1 on error (errno in `code`). Does not block. */
+int ropedyn_reap(int pid, int *code)
+{
+    int status;
+    pid_t rc = waitpid((pid_t)pid, &status, WNOHANG);
+    if (rc == 0) return 0;
+    if (rc < 0) {
+        *code = errno;
+        return -1;
+    }
+    *code = WIFEXITED(status) ? WEXITSTATUS(status)
+                              : (WIFSIGNALED(status) ? 128 + WTERMSIG(status) : 255);
+    return 1;
+}
+
+/* Send `sig` to the process group `pgid`. Returns 0, or errno. */
+int ropedyn_signal_group(int pgid, int sig)
+{
+    return killpg((pid_t)pgid, sig) == 0 ? 0 : errno;
+}
+
+/* The start time of process `pid` (clock ticks after boot, /proc/PID/stat field 22; 0 for
+ * this process is its own pid), 0 when the process exists but /proc cannot tell, -1 when
+ * there is no such process. */
+long long ropedyn_process_start(int pid)
+{
+    char path[64], buf[1024];
+    char *p;
+    unsigned long long ticks;
+    ssize_t n;
+    int fd, field;
+
+    if (pid == 0) pid = (int)getpid();
+    snprintf(path, sizeof path, "/proc/%d/stat", pid);
+    fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0) {
+        if (kill((pid_t)pid, 0) == 0 || errno == EPERM) return 0;
+        return -1;
+    }
+    n = read(fd, buf, sizeof buf - 1);
+    close(fd);
+    if (n <= 0) return 0;
+    buf[n] = '\0';
+    /* the command name (field 2) is in parentheses and may hold blanks */
+    p = strrchr(buf, ')');
+    if (!p) return 0;
+    for (field = 2; field < 22 && p; field++) p = strchr(p + 1, ' ');
+    if (!p || sscanf(p + 1, "%llu", &ticks) != 1) return 0;
+    return (long long)ticks;
+}
+
+/* The modification time of `path` (s since 1970), or -1 when it does not exist. */
+long long ropedyn_file_mtime(const char *path)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) return -1;
+    return (long long)st.st_mtime;
+}
+
+/* The time now, s since 1970. */
+long long ropedyn_unix_time(void) { return (long long)time(NULL); }

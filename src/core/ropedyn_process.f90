@@ -1,0 +1,209 @@
+!> Processes and signals, through the C glue `ropedyn_process.c` (and a few libc calls):
+!! catching SIGINT/SIGTERM as a flag (or, while a sweep case is written, as a note in its
+!! lock file followed by the end of the process), a lock file's heartbeat, worker processes
+!! in their own process group (spawn, reap, signal), process ids, start times, the host
+!! name, file times and the clock. Used by the sweep runner (docs/sweeps.md).
+module ropedyn_process
+    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long_long, c_null_char, c_size_t
+    use, intrinsic :: iso_fortran_env, only: int64
+    use ropedyn_error, only: error_t, make_error, ERR_IO
+    use ropedyn_text, only: int_text
+    implicit none
+    private
+    public :: catch_signals, release_signals, signal_received, note_signals, signal_name
+    public :: start_heartbeat, stop_heartbeat
+    public :: spawn, reap, signal_group, process_id, process_start, host_name
+    public :: file_mtime, unix_time
+    public :: SIGINT, SIGKILL, SIGTERM
+
+    !> Signal numbers (the same on every POSIX system ropedyn runs on).
+    integer, parameter :: SIGINT = 2, SIGKILL = 9, SIGTERM = 15
+
+    interface
+        integer(c_int) function c_catch_signals() bind(C, name='ropedyn_catch_signals')
+            import :: c_int
+        end function c_catch_signals
+        subroutine release_signals() bind(C, name='ropedyn_release_signals')
+        end subroutine release_signals
+        integer(c_int) function c_signal_received() bind(C, name='ropedyn_signal_received')
+            import :: c_int
+        end function c_signal_received
+        integer(c_int) function c_signal_note(path) bind(C, name='ropedyn_signal_note')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+        end function c_signal_note
+        integer(c_int) function c_start_heartbeat(path, seconds) &
+                bind(C, name='ropedyn_start_heartbeat')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int), value :: seconds
+        end function c_start_heartbeat
+        subroutine stop_heartbeat() bind(C, name='ropedyn_stop_heartbeat')
+        end subroutine stop_heartbeat
+        integer(c_int) function c_spawn(args, nargs, log, pid) bind(C, name='ropedyn_spawn')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: args(*), log(*)
+            integer(c_int), value :: nargs
+            integer(c_int), intent(out) :: pid
+        end function c_spawn
+        integer(c_int) function c_reap(pid, code) bind(C, name='ropedyn_reap')
+            import :: c_int
+            integer(c_int), value :: pid
+            integer(c_int), intent(out) :: code
+        end function c_reap
+        integer(c_int) function c_signal_group(pgid, sig) bind(C, name='ropedyn_signal_group')
+            import :: c_int
+            integer(c_int), value :: pgid, sig
+        end function c_signal_group
+        integer(c_long_long) function c_process_start(pid) bind(C, name='ropedyn_process_start')
+            import :: c_int, c_long_long
+            integer(c_int), value :: pid
+        end function c_process_start
+        integer(c_long_long) function c_file_mtime(path) bind(C, name='ropedyn_file_mtime')
+            import :: c_char, c_long_long
+            character(kind=c_char), intent(in) :: path(*)
+        end function c_file_mtime
+        integer(c_long_long) function c_unix_time() bind(C, name='ropedyn_unix_time')
+            import :: c_long_long
+        end function c_unix_time
+        integer(c_int) function c_getpid() bind(C, name='getpid')
+            import :: c_int
+        end function c_getpid
+        integer(c_int) function c_gethostname(name, size) bind(C, name='gethostname')
+            import :: c_char, c_int, c_size_t
+            character(kind=c_char), intent(out) :: name(*)
+            integer(c_size_t), value :: size
+        end function c_gethostname
+    end interface
+
+contains
+
+    !> Catch SIGINT and SIGTERM from now on: `signal_received()` tells which came first.
+    subroutine catch_signals(err)
+        type(error_t), allocatable, intent(out) :: err
+        integer(c_int) :: rc
+        rc = c_catch_signals()
+        if (rc /= 0) call make_error(err, ERR_IO, 'cannot install signal handlers (errno '// &
+            int_text(int(rc))//')')
+    end subroutine catch_signals
+
+    !> The first SIGINT or SIGTERM caught since `catch_signals` (its number), or 0.
+    integer function signal_received()
+        signal_received = int(c_signal_received())
+    end function signal_received
+
+    !> With `path`: a signal caught from now on is appended to the file `path` as
+    !! "signal=N" and ends the process by that signal (for a writer that cannot stop on its
+    !! own). With '': a signal only sets the flag again.
+    subroutine note_signals(path, err)
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: err
+        integer(c_int) :: rc
+        rc = c_signal_note(path//c_null_char)
+        if (rc /= 0) call make_error(err, ERR_IO, path//': cannot open to record signals '// &
+            '(errno '//int_text(int(rc))//')')
+    end subroutine note_signals
+
+    !> 'SIGTERM', 'SIGINT', else 'signal N'.
+    pure function signal_name(sig) result(name)
+        integer, intent(in) :: sig
+        character(len=:), allocatable :: name
+        select case (sig)
+        case (SIGINT)
+            name = 'SIGINT'
+        case (SIGTERM)
+            name = 'SIGTERM'
+        case (SIGKILL)
+            name = 'SIGKILL'
+        case default
+            name = 'signal '//int_text(sig)
+        end select
+    end function signal_name
+
+    !> Touch the file `path` now and every `seconds` s (from a thread) until stop_heartbeat.
+    subroutine start_heartbeat(path, seconds, err)
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: seconds
+        type(error_t), allocatable, intent(out) :: err
+        integer(c_int) :: rc
+        rc = c_start_heartbeat(path//c_null_char, int(seconds, c_int))
+        if (rc /= 0) call make_error(err, ERR_IO, path//': cannot start its heartbeat (errno ' &
+            //int_text(int(rc))//')')
+    end subroutine start_heartbeat
+
+    !> Start `args(1)` (looked up in PATH when it has no '/') with the other arguments in a
+    !! process group of its own, stdin from /dev/null, stdout and stderr to the file `log`.
+    subroutine spawn(args, log, pid, err)
+        character(len=*), intent(in) :: args(:)
+        character(len=*), intent(in) :: log
+        integer, intent(out) :: pid
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: packed
+        integer(c_int) :: rc, cpid
+        integer :: k
+        packed = ''
+        do k = 1, size(args)
+            packed = packed//trim(args(k))//c_null_char
+        end do
+        pid = 0
+        rc = c_spawn(packed, int(size(args), c_int), log//c_null_char, cpid)
+        if (rc /= 0) then
+            call make_error(err, ERR_IO, 'cannot start '//trim(args(1))//' (errno '// &
+                int_text(int(rc))//')')
+            return
+        end if
+        pid = int(cpid)
+    end subroutine spawn
+
+    !> Whether child `pid` has ended; if so `code` is its exit status or 128 + the signal
+    !! that ended it (255 if it cannot be told). Does not wait.
+    logical function reap(pid, code) result(ended)
+        integer, intent(in) :: pid
+        integer, intent(out) :: code
+        integer(c_int) :: rc, c
+        rc = c_reap(int(pid, c_int), c)
+        ended = rc /= 0
+        code = int(c)
+        if (rc < 0) code = 255
+    end function reap
+
+    !> Send `sig` to the process group `pgid` (a spawned worker's pid); false if it is gone.
+    logical function signal_group(pgid, sig) result(sent)
+        integer, intent(in) :: pgid, sig
+        sent = c_signal_group(int(pgid, c_int), int(sig, c_int)) == 0
+    end function signal_group
+
+    integer function process_id()
+        process_id = int(c_getpid())
+    end function process_id
+
+    !> Start time of process `pid` (0: this process) in clock ticks after boot; 0 when the
+    !! process exists but its start time is unknown; -1 when there is no such process.
+    integer(int64) function process_start(pid)
+        integer, intent(in) :: pid
+        process_start = int(c_process_start(int(pid, c_int)), int64)
+    end function process_start
+
+    !> This host's name ('unknown' if it cannot be had).
+    function host_name() result(name)
+        character(len=:), allocatable :: name
+        character(kind=c_char, len=256) :: buf
+        integer :: k
+        buf = repeat(c_null_char, len(buf))
+        name = 'unknown'
+        if (c_gethostname(buf, int(len(buf) - 1, c_size_t)) /= 0) return
+        k = index(buf, c_null_char)
+        if (k > 1) name = buf(:k - 1)
+    end function host_name
+
+    !> Modification time of `path` in s since 1970; -1 when it does not exist.
+    integer(int64) function file_mtime(path)
+        character(len=*), intent(in) :: path
+        file_mtime = int(c_file_mtime(path//c_null_char), int64)
+    end function file_mtime
+
+    !> The time now, s since 1970.
+    integer(int64) function unix_time()
+        unix_time = int(c_unix_time(), int64)
+    end function unix_time
+end module ropedyn_process

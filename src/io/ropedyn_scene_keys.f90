@@ -1,0 +1,350 @@
+!> The key table of scene files: one entry per key with its group, name, type, rule, unit and
+!! one-line meaning, bound at run time to the component of a `scene_t` that holds its value.
+!! The component's default initialization is the key's default. The table drives reading
+!! and type conversion (`assign`), `--set`, the per-key checks (`check`), the echo (`echo`)
+!! and the listing `ropedyn keys`, which tests/e2e/test_keys.py compares with
+!! docs/input.md. Checks that involve several keys are in `ropedyn_scene_checks`.
+module ropedyn_scene_keys
+    use ropedyn_kinds, only: wp
+    use ropedyn_methods, only: method_list
+    use ropedyn_scene_types, only: scene_t
+    use ropedyn_scene_key, only: scene_key_t, T_REAL, T_INT, T_LOGICAL, T_NAME, T_PATH, &
+        T_PAIR, T_LIST, R_NONE, R_FINITE, R_POSITIVE, R_NONNEGATIVE, R_UNIT, R_AT_LEAST, &
+        R_NAMES
+    use ropedyn_text, only: text_t, append_text, name_hint
+    use ropedyn_error, only: error_t, make_error, ERR_INPUT
+    implicit none
+    private
+    public :: bind_keys, find_key, fail, key_hint, group_index, group_list
+    public :: GROUP_NAMES, N_GROUPS, G_ROPE, G_MODEL, G_SUPPORTS, G_INITIAL, G_EFFECTS, &
+        G_SOLVER, G_OUTPUT, G_FLUID, G_GROUND, G_ATTACHMENTS
+
+    !> Groups, in the order they are read, checked and written.
+    integer, parameter :: G_ROPE = 1, G_MODEL = 2, G_SUPPORTS = 3, G_INITIAL = 4, &
+        G_EFFECTS = 5, G_SOLVER = 6, G_OUTPUT = 7, G_FLUID = 8, G_GROUND = 9, &
+        G_ATTACHMENTS = 10, N_GROUPS = 10
+    character(len=*), parameter :: GROUP_NAMES(N_GROUPS) = [character(len=11) :: &
+        'rope', 'model', 'supports', 'initial', 'effects', 'solver', 'output', 'fluid', &
+        'ground', 'attachments']
+
+    character(len=*), parameter :: SUPPORTS = 'pinned, clamped, free'
+    character(len=*), parameter :: NSM2 = 'N s/m^2'
+
+contains
+
+    !> The table, bound to the components of `scene` (which must outlive `keys`).
+    subroutine bind_keys(scene, keys)
+        type(scene_t), target, intent(inout) :: scene
+        type(scene_key_t), allocatable, intent(out) :: keys(:)
+        integer :: n
+
+        allocate (keys(96))
+        n = 0
+        associate (r => scene%rope, m => scene%model, s => scene%supports, &
+                i => scene%initial, e => scene%effects, v => scene%solver, o => scene%output, &
+                f => scene%fluid, g => scene%ground, a => scene%attachments)
+            call add_real(G_ROPE, 'length', r%length, R_POSITIVE, 'm', &
+                'unstretched length L of the rope')
+            call add_real(G_ROPE, 'density', r%density, R_POSITIVE, 'kg/m^3', 'mass density')
+            call add_real(G_ROPE, 'diameter', r%diameter, R_POSITIVE, 'm', &
+                'diameter d of the circular cross-section')
+            call add_real(G_ROPE, 'young_modulus', r%young_modulus, R_POSITIVE, 'Pa', &
+                "Young's modulus E")
+            call add_real(G_ROPE, 'shear_modulus', r%shear_modulus, R_POSITIVE, 'Pa', &
+                'shear modulus G')
+            call add_real(G_ROPE, 'normal_damping', r%normal_damping, R_NONNEGATIVE, NSM2, &
+                'material damping eta of the axial and bending dampers')
+            call add_real(G_ROPE, 'tangential_damping', r%tangential_damping, R_NONNEGATIVE, &
+                NSM2, 'damping of the shear dampers; when not given eta G/E (eq. 13)')
+            call add_real(G_ROPE, 'shape_factor', r%shape_factor, R_POSITIVE, '-', &
+                'shear shape factor chi (10/9 for a circle)')
+            call add_real(G_ROPE, 'gravity', r%gravity, R_NONNEGATIVE, 'm/s^2', &
+                'gravitational acceleration, along +x (down)')
+
+            call add_name(G_MODEL, 'kind', m%kind, 'rfem, mpp', 'the discretisation')
+            call add_int(G_MODEL, 'elements', m%elements, R_AT_LEAST, 2, &
+                'number of elements n (mpp: members); at most a memory limit')
+            call add_real(G_MODEL, 'mpp_axial_damping_factor', m%mpp_axial_damping_factor, &
+                R_NONNEGATIVE, '-', "mpp: factor on the member springs' damping")
+            call add_real(G_MODEL, 'mpp_bending_damping_factor', m%mpp_bending_damping_factor, &
+                R_NONNEGATIVE, '-', "mpp: factor on the joints' bending damping")
+
+            call add_name(G_SUPPORTS, 'top', s%top, SUPPORTS, 'support of the upper end')
+            call add_name(G_SUPPORTS, 'bottom', s%bottom, SUPPORTS, 'support of the lower end')
+            call add_pair(G_SUPPORTS, 'top_anchor', s%top_anchor, R_FINITE, 'm', &
+                'point (x, y) the top support holds the upper end to')
+            call add_pair(G_SUPPORTS, 'bottom_anchor', s%bottom_anchor, R_NONE, 'm', &
+                'point the bottom support holds the lower end to', &
+                "not set: the rope's lower end in its initial state", 'finite, both or neither')
+            call add_real(G_SUPPORTS, 'top_angle_deg', s%top_angle_deg, R_FINITE, 'deg', &
+                'clamp angle of the top support from down x')
+            call add_real(G_SUPPORTS, 'bottom_angle_deg', s%bottom_angle_deg, R_FINITE, 'deg', &
+                'clamp angle of the bottom support from down x')
+            call add_real(G_SUPPORTS, 'support_stiffness_factor', s%support_stiffness_factor, &
+                R_POSITIVE, '-', 'factor on the support springs and dampers')
+            call add_motion('top', s%top_motion, s%top_amplitude, s%top_frequency, &
+                s%top_phase_deg, s%top_angle_amplitude_deg, s%top_angle_phase_deg, &
+                s%top_table, s%top_release_time)
+            call add_motion('bottom', s%bottom_motion, s%bottom_amplitude, &
+                s%bottom_frequency, s%bottom_phase_deg, s%bottom_angle_amplitude_deg, &
+                s%bottom_angle_phase_deg, s%bottom_table, s%bottom_release_time)
+
+            call add_name(G_INITIAL, 'shape', i%shape, &
+                'straight, hanging, equilibrium, mode, folded', 'initial shape of the rope')
+            call add_real(G_INITIAL, 'angle_deg', i%angle_deg, R_FINITE, 'deg', &
+                'angle of the straight initial rope from down x')
+            call add_int(G_INITIAL, 'mode', i%mode, R_AT_LEAST, 1, &
+                "shape 'mode': which mode (1 = lowest)")
+            call add_real(G_INITIAL, 'mode_amplitude', i%mode_amplitude, R_FINITE, 'm', &
+                "shape 'mode': largest displacement")
+            call add_pair(G_INITIAL, 'velocity', i%velocity, R_FINITE, 'm/s', &
+                'initial velocity (x, y) of every element')
+
+            call add_logical(G_EFFECTS, 'gravity', e%gravity, 'the weight of the rope')
+            call add_logical(G_EFFECTS, 'tension', e%tension, 'the axial springs')
+            call add_logical(G_EFFECTS, 'shear', e%shear, 'the shear springs')
+            call add_logical(G_EFFECTS, 'bending', e%bending, 'the rotational springs')
+            call add_logical(G_EFFECTS, 'damping', e%damping, 'the dampers')
+            call add_logical(G_EFFECTS, 'drag', e%drag, 'drag of the fluid (&fluid)')
+            call add_logical(G_EFFECTS, 'ground', e%ground, 'contact with a ground (&ground)')
+            call add_logical(G_EFFECTS, 'support_motion', e%support_motion, &
+                'the motions and releases of &supports')
+            call add_logical(G_EFFECTS, 'point_masses', e%point_masses, &
+                'the point masses of &attachments')
+            call add_logical(G_EFFECTS, 'point_loads', e%point_loads, &
+                'the point loads of &attachments')
+
+            call add_name(G_SOLVER, 'method', v%method, method_list(), 'the integrator')
+            call add_real(G_SOLVER, 'rtol', v%rtol, R_UNIT, '-', 'relative tolerance')
+            call add_real(G_SOLVER, 'atol', v%atol, R_POSITIVE, 'state units', &
+                'absolute tolerance')
+            call add_int(G_SOLVER, 'max_order', v%max_order, R_NONE, 0, &
+                "highest order (0: the method's default)", 'the method''s range, or 0')
+            call add_int(G_SOLVER, 'max_steps', v%max_steps, R_AT_LEAST, 1, &
+                'step budget of the whole run')
+            call add_real(G_SOLVER, 't_end', v%t_end, R_POSITIVE, 's', 'end time')
+            call add_real(G_SOLVER, 'output_interval', v%output_interval, R_POSITIVE, 's', &
+                'time between output records; at most a limit of records')
+            call add_logical(G_SOLVER, 'stability_limit_detection', &
+                v%stability_limit_detection, "cvode only: CVODE's stability-limit detection")
+            call add_logical(G_SOLVER, 'first_order_newton', v%first_order_newton, &
+                'Newton systems on the first-order matrix, not the reduced second-order one')
+            call add_logical(G_SOLVER, 'profile', v%profile, &
+                'time the right-hand side, Jacobian, factorizations and solves')
+            call add_real(G_SOLVER, 'fault_nan_after', v%fault_nan_after, R_FINITE, 's', &
+                'testing aid: NaN right-hand side after this time; < 0: off')
+
+            call add_path(G_OUTPUT, 'file', o%file, "HDF5 result file ('': out/<scene>.h5)")
+            call add_logical(G_OUTPUT, 'progress', o%progress, 'print the progress')
+
+            call add_real(G_FLUID, 'density', f%density, R_NONNEGATIVE, 'kg/m^3', &
+                'density of the fluid')
+            call add_real(G_FLUID, 'normal_drag_coefficient', f%normal_drag_coefficient, &
+                R_NONNEGATIVE, '-', 'C_n on d l')
+            call add_real(G_FLUID, 'tangential_drag_coefficient', &
+                f%tangential_drag_coefficient, R_NONNEGATIVE, '-', 'C_t on pi d l')
+            call add_real(G_FLUID, 'linear_normal_drag', f%linear_normal_drag, R_NONNEGATIVE, &
+                NSM2, 'linear normal drag per metre')
+            call add_real(G_FLUID, 'linear_tangential_drag', f%linear_tangential_drag, &
+                R_NONNEGATIVE, NSM2, 'linear tangential drag per metre')
+            call add_pair(G_FLUID, 'current', f%current, R_FINITE, 'm/s', &
+                'velocity (x, y) of the fluid')
+
+            call add_pair(G_GROUND, 'point', g%point, R_FINITE, 'm', 'a point of the plane')
+            call add_pair(G_GROUND, 'normal', g%normal, R_NONE, '-', &
+                'normal of the plane towards the free side', allowed='finite, non-zero')
+            call add_real(G_GROUND, 'stiffness', g%stiffness, R_POSITIVE, 'N/m^2', &
+                'penalty stiffness per metre of rope')
+            call add_real(G_GROUND, 'damping', g%damping, R_NONNEGATIVE, NSM2, &
+                'contact damping per metre of rope')
+            call add_real(G_GROUND, 'friction_coefficient', g%friction_coefficient, &
+                R_NONNEGATIVE, '-', 'Coulomb mu')
+            call add_real(G_GROUND, 'friction_regularization_speed', &
+                g%friction_regularization_speed, R_POSITIVE, 'm/s', 'v_reg of the friction law')
+
+            call add_list('mass_positions', a%mass_positions, a%mass_positions, 'm', &
+                'where the point masses sit (arc length from the top)', '0 .. length')
+            call add_list('masses', a%masses, a%mass_positions, 'kg', 'the point masses', &
+                '> 0 where a position is given')
+            call add_list('load_positions', a%load_positions, a%load_positions, 'm', &
+                'where the point loads act', '0 .. length')
+            call add_list('load_force_x', a%load_force_x, a%load_positions, 'N', &
+                'constant part of each load, x')
+            call add_list('load_force_y', a%load_force_y, a%load_positions, 'N', &
+                'constant part of each load, y')
+            call add_list('load_amplitude_x', a%load_amplitude_x, a%load_positions, 'N', &
+                'harmonic part of each load, x')
+            call add_list('load_amplitude_y', a%load_amplitude_y, a%load_positions, 'N', &
+                'harmonic part of each load, y')
+            call add_list('load_frequency', a%load_frequency, a%load_positions, 'Hz', &
+                'frequency of the harmonic part', '>= 0')
+            call add_list('load_phase_deg', a%load_phase_deg, a%load_positions, 'deg', &
+                'phase of the harmonic part')
+        end associate
+        keys = keys(:n)
+        if (allocated(scene%path)) then
+            do n = 1, size(keys)
+                keys(n)%origin = scene%path
+            end do
+        end if
+
+    contains
+
+        subroutine add(group, name, type, rule, unit, doc)
+            integer, intent(in) :: group, type, rule
+            character(len=*), intent(in) :: name, unit, doc
+            n = n + 1
+            keys(n) = scene_key_t(group=group, name=name, type=type, rule=rule, unit=unit, &
+                doc=doc, allowed='', unset='')
+        end subroutine add
+
+        subroutine add_real(group, name, x, rule, unit, doc)
+            integer, intent(in) :: group, rule
+            character(len=*), intent(in) :: name, unit, doc
+            real(wp), target, intent(inout) :: x
+            call add(group, name, T_REAL, rule, unit, doc)
+            keys(n)%r => x
+        end subroutine add_real
+
+        subroutine add_int(group, name, x, rule, lowest, doc, allowed)
+            integer, intent(in) :: group, rule, lowest
+            character(len=*), intent(in) :: name, doc
+            integer, target, intent(inout) :: x
+            character(len=*), intent(in), optional :: allowed
+            call add(group, name, T_INT, rule, '-', doc)
+            keys(n)%i => x
+            keys(n)%lowest = lowest
+            if (present(allowed)) keys(n)%allowed = allowed
+        end subroutine add_int
+
+        subroutine add_logical(group, name, x, doc)
+            integer, intent(in) :: group
+            character(len=*), intent(in) :: name, doc
+            logical, target, intent(inout) :: x
+            call add(group, name, T_LOGICAL, R_NONE, '-', doc)
+            keys(n)%l => x
+        end subroutine add_logical
+
+        subroutine add_name(group, name, x, allowed, doc)
+            integer, intent(in) :: group
+            character(len=*), intent(in) :: name, allowed, doc
+            character(len=*), target, intent(inout) :: x
+            call add(group, name, T_NAME, R_NAMES, '-', doc)
+            keys(n)%s => x
+            keys(n)%allowed = allowed
+        end subroutine add_name
+
+        subroutine add_path(group, name, x, doc)
+            integer, intent(in) :: group
+            character(len=*), intent(in) :: name, doc
+            character(len=*), target, intent(inout) :: x
+            call add(group, name, T_PATH, R_NONE, '-', doc)
+            keys(n)%s => x
+        end subroutine add_path
+
+        subroutine add_pair(group, name, x, rule, unit, doc, unset, allowed)
+            integer, intent(in) :: group, rule
+            character(len=*), intent(in) :: name, unit, doc
+            real(wp), target, intent(inout) :: x(:)
+            character(len=*), intent(in), optional :: unset, allowed
+            call add(group, name, T_PAIR, rule, unit, doc)
+            keys(n)%v => x
+            if (present(unset)) keys(n)%unset = unset
+            if (present(allowed)) keys(n)%allowed = allowed
+        end subroutine add_pair
+
+        subroutine add_list(name, x, used, unit, doc, allowed)
+            character(len=*), intent(in) :: name, unit, doc
+            real(wp), target, intent(inout) :: x(:), used(:)
+            character(len=*), intent(in), optional :: allowed
+            call add(G_ATTACHMENTS, name, T_LIST, R_NONE, unit, doc)
+            keys(n)%v => x
+            keys(n)%used => used
+            keys(n)%allowed = 'finite'
+            if (present(allowed)) keys(n)%allowed = allowed
+        end subroutine add_list
+
+        !> The motion and release keys of one support, 'top' or 'bottom'.
+        subroutine add_motion(end, motion, amplitude, frequency, phase_deg, &
+                angle_amplitude_deg, angle_phase_deg, table, release_time)
+            character(len=*), intent(in) :: end
+            character(len=*), target, intent(inout) :: motion, table
+            real(wp), target, intent(inout) :: amplitude(:), frequency, phase_deg(:), &
+                angle_amplitude_deg, angle_phase_deg, release_time
+            call add_name(G_SUPPORTS, end//'_motion', motion, 'fixed, harmonic, table', &
+                'prescribed motion of the '//end//' support')
+            call add_pair(G_SUPPORTS, end//'_amplitude', amplitude, R_FINITE, 'm', &
+                'harmonic: amplitudes (x, y) of the anchor')
+            call add_real(G_SUPPORTS, end//'_frequency', frequency, R_NONNEGATIVE, 'Hz', &
+                'harmonic: frequency (> 0 for harmonic)')
+            call add_pair(G_SUPPORTS, end//'_phase_deg', phase_deg, R_FINITE, 'deg', &
+                'harmonic: phases (x, y)')
+            call add_real(G_SUPPORTS, end//'_angle_amplitude_deg', angle_amplitude_deg, &
+                R_FINITE, 'deg', 'harmonic: amplitude of the clamp angle (clamped only)')
+            call add_real(G_SUPPORTS, end//'_angle_phase_deg', angle_phase_deg, R_FINITE, &
+                'deg', 'harmonic: phase of the clamp angle')
+            call add_path(G_SUPPORTS, end//'_table', table, &
+                'table: file of rows t dx dy dangle_deg (relative to the scene file)')
+            call add_real(G_SUPPORTS, end//'_release_time', release_time, R_FINITE, 's', &
+                'time at which the support lets go; < 0: never')
+        end subroutine add_motion
+    end subroutine bind_keys
+
+    !> Index of key `name` (lower case, no index) of group g in `keys`, 0 if there is none.
+    pure integer function find_key(keys, g, name) result(k)
+        type(scene_key_t), intent(in) :: keys(:)
+        integer, intent(in) :: g
+        character(len=*), intent(in) :: name
+        do k = 1, size(keys)
+            if (keys(k)%group == g .and. keys(k)%name == name) return
+        end do
+        k = 0
+    end function find_key
+
+    !> The error of a key whose value is wrong: 'origin: &group: key = value: reason', the
+    !! origin being the file or the last `--set` of the key. `key` may carry an index.
+    subroutine fail(keys, g, key, value, reason, err)
+        type(scene_key_t), intent(in) :: keys(:)
+        integer, intent(in) :: g
+        character(len=*), intent(in) :: key, value, reason
+        type(error_t), allocatable, intent(out) :: err
+        integer :: k, paren
+        paren = index(key, '(')
+        if (paren == 0) paren = len(key) + 1
+        k = max(find_key(keys, g, key(:paren - 1)), 1)
+        call make_error(err, ERR_INPUT, keys(k)%origin//': &'//trim(GROUP_NAMES(g))//': ' &
+            //key//' = '//value//': '//reason)
+    end subroutine fail
+
+    pure integer function group_index(name) result(g)
+        character(len=*), intent(in) :: name
+        do g = 1, N_GROUPS
+            if (GROUP_NAMES(g) == name) return
+        end do
+        g = 0
+    end function group_index
+
+    pure function group_list() result(list)
+        character(len=:), allocatable :: list
+        integer :: g
+        list = trim(GROUP_NAMES(1))
+        do g = 2, N_GROUPS
+            list = list//', '//trim(GROUP_NAMES(g))
+        end do
+    end function group_list
+
+    !> '; did you mean "x"?' for a near miss, else the list of keys of the group.
+    function key_hint(keys, g, key) result(text)
+        type(scene_key_t), intent(in) :: keys(:)
+        integer, intent(in) :: g
+        character(len=*), intent(in) :: key
+        character(len=:), allocatable :: text
+        type(text_t), allocatable :: names(:)
+        integer :: k
+        allocate (names(0))
+        do k = 1, size(keys)
+            if (keys(k)%group == g) call append_text(names, keys(k)%name)
+        end do
+        text = name_hint(names, key)
+    end function key_hint
+end module ropedyn_scene_keys

@@ -1,0 +1,48 @@
+!> The scene: the rope models' parameters (`rope_spec_t`, src/models) plus the solver and the
+!! output. Every component's default initialization is its key's default; the key table
+!! (`ropedyn_scene_keys`) names each component once, with its rule, unit and meaning.
+module ropedyn_scene_types
+    use ropedyn_kinds, only: wp
+    use ropedyn_rope_spec, only: rope_spec_t, NAME_LEN, PATH_LEN
+    implicit none
+    private
+    public :: solver_params_t, output_params_t, scene_t
+
+    !> `&solver`: time integration.
+    type :: solver_params_t
+        character(len=NAME_LEN) :: method = 'cvode'  !< 'cvode' | 'mebdf'
+        real(wp) :: rtol = 1.0e-6_wp          !< relative tolerance [-]
+        real(wp) :: atol = 1.0e-8_wp          !< absolute tolerance [state units]
+        !> highest order of accuracy; 0 in the file: the method's default (resolved by
+        !! `read_scene`: 5 for cvode, 4 for mebdf)
+        integer :: max_order = 0
+        integer :: max_steps = 1000000        !< step budget for the whole run [-]
+        real(wp) :: t_end = 30.0_wp           !< end time [s]
+        real(wp) :: output_interval = 0.01_wp !< time between output records [s]
+        !> CVODE only: BDF stability-limit detection (lowers the order near the stability
+        !! boundary of lightly damped oscillatory modes)
+        logical :: stability_limit_detection = .false.
+        !> Newton systems on the first-order matrix of all unknowns instead of the reduced
+        !! second-order one (half the size; the default for the rope models)
+        logical :: first_order_newton = .false.
+        !> time the parts of the integration (right-hand side, Jacobian, factorizations,
+        !! solves): printed and written to /solver (costs a few % on small ropes)
+        logical :: profile = .false.
+        !> testing aid: the right-hand side returns NaN for t > this time [s]; < 0: off
+        real(wp) :: fault_nan_after = -1.0_wp
+    end type solver_params_t
+
+    !> `&output`: where results go.
+    type :: output_params_t
+        !> HDF5 file; resolved by `read_scene` ('' in the file: out/<scene name>.h5)
+        character(len=PATH_LEN) :: file = ''
+        logical :: progress = .false.         !< print progress while integrating
+    end type output_params_t
+
+    !> A complete scene: the rope models' parameters (the parent `rope_spec_t`, whose
+    !! `path` is the file the scene was read from), the solver and the output.
+    type, extends(rope_spec_t) :: scene_t
+        type(solver_params_t) :: solver
+        type(output_params_t) :: output
+    end type scene_t
+end module ropedyn_scene_types

@@ -1,0 +1,292 @@
+!> The lock of a sweep case: one writer per case (docs/sweeps.md, "One writer per case").
+!!
+!! A writer creates `<output_dir>/.case_<id>.lock` exclusively (`open(status='new')`:
+!! O_CREAT|O_EXCL, atomic on local file systems and on NFS v3 and later) and writes who it
+!! is into it:
+!!
+!!     ropedyn sweep case lock
+!!     host=node12
+!!     boot=8a3c...             (/proc/sys/kernel/random/boot_id: this machine since its boot)
+!!     pid=4711
+!!     start_ticks=123456        (the process's start, /proc/PID/stat; tells a reused pid)
+!!     started=2024-05-01T12:34:56Z
+!!     job=8812_3                (SLURM_ARRAY_JOB_ID_SLURM_ARRAY_TASK_ID, or SLURM_JOB_ID)
+!!
+!! A thread touches the file every LOCK_BEAT s (its heartbeat) while the case runs; a signal
+!! that ends the writer is appended as `signal=15`. The writer removes the lock when the case
+!! file is in place. A lock is *live* while its writer runs and *abandoned* when it is gone:
+!!
+!! - it records a signal: abandoned (the writer ended right after writing it);
+!! - on this machine (the same host name and boot id): live while process `pid` exists
+!!   with the same start time, abandoned as soon as it does not;
+!! - on another machine: live while its heartbeat is at most LOCK_ABANDONED_AFTER s old (the
+!!   file's modification time against this host's clock: clocks must agree within that).
+!!
+!! A second writer finds a live lock and gives up with a message naming the holder; an
+!! abandoned lock is taken over under a second exclusive lock, `<lock>.break`, so that of
+!! two writers finding the same abandoned lock only one takes it (a `.break` older than
+!! BREAK_ABANDONED_AFTER s is left by a writer that died while breaking, and is removed).
+module ropedyn_sweep_lock
+    use, intrinsic :: iso_fortran_env, only: int64
+    use ropedyn_error, only: error_t, make_error, ERR_IO
+    use ropedyn_text, only: int_text
+    use ropedyn_os, only: delete_file, utc_timestamp, utc_text
+    use ropedyn_process, only: process_id, process_start, host_name, file_mtime, unix_time, &
+        start_heartbeat, stop_heartbeat, signal_name
+    implicit none
+    private
+    public :: lock_t, read_lock, take_lock, drop_lock, LOCK_BEAT, LOCK_ABANDONED_AFTER
+
+    integer, parameter :: LOCK_BEAT = 15                !< s between heartbeats
+    integer, parameter :: LOCK_ABANDONED_AFTER = 120    !< s: a lock of another host is gone
+    integer, parameter :: BREAK_ABANDONED_AFTER = 30    !< s: a .break lock is gone
+
+    !> What a lock file says, and whether its writer runs.
+    type :: lock_t
+        logical :: exists = .false.
+        logical :: live = .false.      !< its writer runs (or may run: see the rule)
+        logical :: mine = .false.      !< held by this process
+        character(len=:), allocatable :: host, boot, job, started
+        integer :: pid = 0
+        integer(int64) :: start_ticks = 0
+        integer :: signal = 0          !< the signal that ended the writer (0: none recorded)
+        integer(int64) :: changed = 0  !< last heartbeat (or the signal), s since 1970
+        integer(int64) :: age = 0      !< s since then
+    contains
+        procedure :: holder => lock_holder
+        procedure :: gone => lock_gone
+    end type lock_t
+
+contains
+
+    !> Read the lock file `path` and decide whether its writer runs.
+    subroutine read_lock(path, lock)
+        character(len=*), intent(in) :: path
+        type(lock_t), intent(out) :: lock
+        character(len=512) :: line
+        integer :: unit, ios, eq
+        integer(int64) :: ticks
+
+        lock%host = ''
+        lock%boot = ''
+        lock%job = ''
+        lock%started = ''
+        ! open first: on NFS, an open revalidates the attributes (close-to-open)
+        open (newunit=unit, file=path, status='old', action='read', iostat=ios)
+        if (ios /= 0) return
+        lock%exists = .true.
+        do
+            read (unit, '(a)', iostat=ios) line
+            if (ios /= 0) exit
+            eq = index(line, '=')
+            if (eq < 2) cycle
+            select case (line(:eq - 1))
+            case ('host')
+                lock%host = trim(line(eq + 1:))
+            case ('boot')
+                lock%boot = trim(line(eq + 1:))
+            case ('job')
+                lock%job = trim(line(eq + 1:))
+            case ('started')
+                lock%started = trim(line(eq + 1:))
+            case ('pid')
+                read (line(eq + 1:), *, iostat=ios) lock%pid
+            case ('start_ticks')
+                read (line(eq + 1:), *, iostat=ios) lock%start_ticks
+            case ('signal')
+                read (line(eq + 1:), *, iostat=ios) lock%signal
+            end select
+        end do
+        close (unit)
+        lock%changed = file_mtime(path)
+        if (lock%changed < 0) then   ! removed meanwhile
+            lock%exists = .false.
+            return
+        end if
+        lock%age = max(0_int64, unix_time() - lock%changed)
+        if (lock%signal > 0) then
+            lock%live = .false.
+        else if (lock%pid <= 0) then
+            ! not written yet (just created) or damaged: live while young
+            lock%live = lock%age <= LOCK_ABANDONED_AFTER
+        else if (this_machine(lock)) then
+            ticks = process_start(lock%pid)
+            lock%live = ticks >= 0
+            if (ticks > 0 .and. lock%start_ticks > 0) lock%live = ticks == lock%start_ticks
+            lock%mine = lock%live .and. lock%pid == process_id()
+        else
+            lock%live = lock%age <= LOCK_ABANDONED_AFTER
+        end if
+    end subroutine read_lock
+
+    !> Whether the lock was written on this machine: the same host name and, when both are
+    !! known, the same boot id (two machines with one host name are told apart).
+    logical function this_machine(lock)
+        type(lock_t), intent(in) :: lock
+        character(len=:), allocatable :: boot
+        this_machine = len(lock%host) > 0 .and. lock%host == host_name()
+        if (.not. this_machine .or. len(lock%boot) == 0) return
+        boot = boot_id()
+        if (len(boot) > 0) this_machine = lock%boot == boot
+    end function this_machine
+
+    !> This machine's boot id ('' where there is none).
+    function boot_id() result(id)
+        character(len=:), allocatable :: id
+        character(len=64) :: line
+        integer :: unit, ios
+        id = ''
+        open (newunit=unit, file='/proc/sys/kernel/random/boot_id', status='old', &
+              action='read', iostat=ios)
+        if (ios /= 0) return
+        read (unit, '(a)', iostat=ios) line
+        close (unit)
+        if (ios == 0) id = trim(line)
+    end function boot_id
+
+    !> 'host H, pid P, Slurm job J, since T' (what is known of it).
+    function lock_holder(self) result(text)
+        class(lock_t), intent(in) :: self
+        character(len=:), allocatable :: text
+        text = 'host '//self%host//', pid '//int_text(self%pid)
+        if (len(self%host) == 0) text = 'a writer that has not said who it is yet'
+        if (len(self%job) > 0) text = text//', Slurm job '//self%job
+        if (len(self%started) > 0) text = text//', since '//self%started
+    end function lock_holder
+
+    !> Why an abandoned lock's writer is gone, for the reason of an interrupted case.
+    function lock_gone(self) result(text)
+        class(lock_t), intent(in) :: self
+        character(len=:), allocatable :: text
+        if (self%signal > 0) then
+            text = 'stopped by '//signal_name(self%signal)//' at '//utc_text(self%changed)// &
+                ' ('//self%holder()//')'
+        else if (this_machine(self)) then
+            text = 'its writer ended without finishing: killed or crashed ('// &
+                self%holder()//'; that process is gone)'
+        else
+            text = 'its writer ended without finishing: killed, crashed or its node failed ('// &
+                self%holder()//'; no heartbeat for '//int_text(int(self%age))//' s)'
+        end if
+    end function lock_gone
+
+    !> Take the lock `path` for this process (and start its heartbeat): create it, or take
+    !! over an abandoned one. A live lock is an ERR_IO error naming its holder.
+    subroutine take_lock(path, err)
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: err
+        type(lock_t) :: lock
+        logical :: created, removed
+        integer :: attempt
+
+        do attempt = 1, 2
+            call create_exclusive(path, created, err)
+            if (allocated(err)) return
+            if (created) exit
+            call read_lock(path, lock)
+            if (.not. lock%exists) cycle        ! removed meanwhile: try again
+            if (lock%live) then
+                call make_error(err, ERR_IO, 'being written by '//lock%holder()//' (lock '// &
+                    path//'): a case is written by one process at a time')
+                return
+            end if
+            ! abandoned: break it under the lock <path>.break
+            call create_exclusive(path//'.break', created, err)
+            if (allocated(err)) return
+            if (.not. created) then
+                if (unix_time() - file_mtime(path//'.break') > BREAK_ABANDONED_AFTER) then
+                    removed = delete_file(path//'.break')
+                    cycle
+                end if
+                call make_error(err, ERR_IO, 'another process is taking over the abandoned ' &
+                    //'lock '//path)
+                return
+            end if
+            call read_lock(path, lock)
+            if (lock%exists .and. lock%live) then
+                removed = delete_file(path//'.break')
+                call make_error(err, ERR_IO, 'being written by '//lock%holder()//' (lock '// &
+                    path//'): a case is written by one process at a time')
+                return
+            end if
+            if (lock%exists) removed = delete_file(path)
+            call create_exclusive(path, created, err)
+            removed = delete_file(path//'.break')
+            if (allocated(err)) return
+            if (.not. created) then
+                call make_error(err, ERR_IO, 'being written by another process (lock '// &
+                    path//' was taken meanwhile)')
+                return
+            end if
+            exit
+        end do
+        if (.not. created) then
+            call make_error(err, ERR_IO, path//': cannot take the lock')
+            return
+        end if
+        call write_holder(path, err)
+        if (allocated(err)) return
+        call start_heartbeat(path, LOCK_BEAT, err)
+    end subroutine take_lock
+
+    !> Stop the heartbeat and remove the lock.
+    subroutine drop_lock(path)
+        character(len=*), intent(in) :: path
+        logical :: removed
+        call stop_heartbeat()
+        removed = delete_file(path)
+    end subroutine drop_lock
+
+    !> Create `path` if it does not exist (O_CREAT|O_EXCL); `created` false if it existed.
+    subroutine create_exclusive(path, created, err)
+        character(len=*), intent(in) :: path
+        logical, intent(out) :: created
+        type(error_t), allocatable, intent(out) :: err
+        integer :: unit, ios
+        logical :: exists
+        character(len=256) :: msg
+        open (newunit=unit, file=path, status='new', action='write', iostat=ios, iomsg=msg)
+        created = ios == 0
+        if (created) then
+            close (unit)
+            return
+        end if
+        inquire (file=path, exist=exists)
+        if (.not. exists) call make_error(err, ERR_IO, path//': cannot create: '//trim(msg))
+    end subroutine create_exclusive
+
+    !> Write who holds the lock into it.
+    subroutine write_holder(path, err)
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: err
+        character(len=64) :: array_job, array_task, job
+        character(len=256) :: msg
+        integer :: unit, ios, n1, n2, n3
+        call get_environment_variable('SLURM_ARRAY_JOB_ID', array_job, n1)
+        call get_environment_variable('SLURM_ARRAY_TASK_ID', array_task, n2)
+        call get_environment_variable('SLURM_JOB_ID', job, n3)
+        if (n1 > 0 .and. n2 > 0) then
+            job = trim(array_job)//'_'//trim(array_task)
+        else if (n3 == 0) then
+            job = ''
+        end if
+        open (newunit=unit, file=path, status='old', action='write', position='append', &
+              iostat=ios, iomsg=msg)
+        if (ios == 0) write (unit, '(a)', iostat=ios, iomsg=msg) 'ropedyn sweep case lock'// &
+            new_line('a')//'host='//host_name()//new_line('a')//'boot='//boot_id()// &
+            new_line('a')//'pid='// &
+            int_text(process_id())//new_line('a')//'start_ticks='// &
+            ticks_text(process_start(0))//new_line('a')//'started='//utc_timestamp()// &
+            new_line('a')//'job='//trim(job)
+        if (ios == 0) close (unit, iostat=ios, iomsg=msg)
+        if (ios /= 0) call make_error(err, ERR_IO, path//': cannot write: '//trim(msg))
+    contains
+        pure function ticks_text(t) result(s)
+            integer(int64), intent(in) :: t
+            character(len=:), allocatable :: s
+            character(len=24) :: buf
+            write (buf, '(i0)') t
+            s = trim(buf)
+        end function ticks_text
+    end subroutine write_holder
+end module ropedyn_sweep_lock

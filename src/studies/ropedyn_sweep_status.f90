@@ -1,0 +1,121 @@
+!> The status of a sweep case, from its lock (src/io/ropedyn_sweep_lock.f90) and its file
+!! (docs/sweeps.md, "Status of a case"):
+!!
+!! - running: its lock is live: a writer is at it (here or on another host);
+!! - complete: its file holds this case's scene, status complete, and its data reads back;
+!! - failed: its file says the run failed (with the reason);
+!! - interrupted: its writer stopped before the end: a signal (Ctrl-C, scancel, a time
+!!   limit), a kill, a crash or a node failure (an abandoned lock), or a file with status
+!!   interrupted;
+!! - stale: its file holds another scene: the sweep changed;
+!! - unreadable: its file is there but does not read back (the reason says what failed);
+!! - missing: no file, no lock.
+!!
+!! Only `complete` counts as done; every other status runs again (`running` only once its
+!! writer is gone).
+module ropedyn_sweep_status
+    use ropedyn_error, only: error_t
+    use ropedyn_scene, only: scene_namelist_text
+    use ropedyn_case_file, only: case_data_t, read_case_file
+    use ropedyn_sweep_lock, only: lock_t, read_lock
+    use ropedyn_sweep, only: sweep_case_t
+    implicit none
+    private
+    public :: case_state_t, case_state, lock_path, part_path, STATUS_NAMES
+
+    !> Every status, in the order of `--status`.
+    character(len=*), parameter :: STATUS_NAMES(7) = [character(len=11) :: 'complete', &
+        'failed', 'interrupted', 'running', 'stale', 'unreadable', 'missing']
+
+    !> A case's status, why (empty for complete and missing), its lock and what its file
+    !! holds (the series too, for a complete case).
+    type :: case_state_t
+        character(len=:), allocatable :: status
+        character(len=:), allocatable :: reason
+        type(lock_t) :: lock
+        type(case_data_t) :: data
+    end type case_state_t
+
+contains
+
+    !> `<output_dir>/.case_<id>.lock`, the lock of the case file `file`.
+    pure function lock_path(file) result(path)
+        character(len=*), intent(in) :: file
+        character(len=:), allocatable :: path
+        path = hidden(file)
+        path = path(:len(path) - 3)//'.lock'
+    end function lock_path
+
+    !> `<output_dir>/.case_<id>.h5.part`, the file a writer writes before it is complete.
+    pure function part_path(file) result(path)
+        character(len=*), intent(in) :: file
+        character(len=:), allocatable :: path
+        path = hidden(file)//'.part'
+    end function part_path
+
+    !> The case's status. A lock held by this very process does not make it `running`.
+    subroutine case_state(c, state)
+        type(sweep_case_t), intent(in) :: c
+        type(case_state_t), intent(out) :: state
+        type(error_t), allocatable :: err
+        logical :: partial
+
+        state%reason = ''
+        call read_lock(lock_path(c%file), state%lock)
+        associate (lock => state%lock)
+            if (lock%live .and. .not. lock%mine) then
+                state%status = 'running'
+                state%reason = 'being written by '//lock%holder()
+                return
+            end if
+            call read_case_file(c%file, state%data, err, series=.true.)
+            if (allocated(err)) then
+                state%status = 'unreadable'
+                state%reason = err%message
+            else if (.not. state%data%exists) then
+                state%status = 'missing'
+            else if (state%data%scene /= scene_namelist_text(c%scene)) then
+                state%status = 'stale'
+                state%reason = 'the file holds another scene than this case (the sweep ' &
+                    //'changed); run the sweep again'
+            else
+                select case (state%data%status)
+                case ('complete')
+                    state%status = 'complete'
+                    if (state%data%records < 1) then
+                        state%status = 'unreadable'
+                        state%reason = c%file//': status complete but no output record'
+                    end if
+                case ('failed')
+                    state%status = 'failed'
+                    state%reason = state%data%reason
+                case ('interrupted')
+                    state%status = 'interrupted'
+                    state%reason = state%data%reason
+                case default
+                    state%status = 'interrupted'
+                    state%reason = 'the run in the file did not finish (status "'// &
+                        state%data%status//'": its writer was killed or crashed)'
+                end select
+            end if
+            ! an abandoned lock: the latest attempt stopped; what the file holds is older
+            if (lock%exists .and. .not. lock%live .and. .not. lock%mine .and. &
+                state%status /= 'complete') then
+                state%status = 'interrupted'
+                state%reason = lock%gone()
+                inquire (file=part_path(c%file), exist=partial)
+                if (partial) state%reason = state%reason//'; partial output in '// &
+                    part_path(c%file)
+            end if
+        end associate
+    end subroutine case_state
+
+    !> `dir/.name` for `dir/name`.
+    pure function hidden(file) result(path)
+        character(len=*), intent(in) :: file
+        character(len=:), allocatable :: path
+        integer :: slash
+        slash = index(file, '/', back=.true.)
+        path = file(:slash)//'.'//file(slash + 1:)
+    end function hidden
+end module ropedyn_sweep_status

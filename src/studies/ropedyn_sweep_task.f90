@@ -1,0 +1,212 @@
+!> Running sweep cases in this process: `ropedyn sweep SWEEP --task LIST`, what every local
+!! worker and every Slurm array task runs (docs/sweeps.md, "One writer per case").
+!!
+!! For each case: skip it when it is complete (unless forced); take its lock (a live lock
+!! of another writer: the case is not run, with a message naming that writer); run the
+!! scene with its output going to `.case_<id>.h5.part`; finish that file (wall time, the
+!! case's scene) and rename it to `case_<id>.h5` once its status is final (complete or
+!! failed, with the reason); remove the lock. A reader therefore never sees a case file
+!! being written, and a file in place is always a finished run.
+!!
+!! Signals: SIGINT and SIGTERM are caught. While a case runs, the run driver does not stop
+!! on its own (`run_scene` does not poll), so the handler appends the signal to the case's
+!! lock and ends the process: the case reads as `interrupted` with that reason, its partial
+!! output stays in the `.part` file. Between cases a signal only stops the loop. (When the
+!! run driver stops itself on a signal and writes status `interrupted`, `note_signals`
+!! goes and the interrupted file is renamed into place like a failed one.)
+module ropedyn_sweep_task
+    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
+    use ropedyn_kinds, only: wp
+    use ropedyn_text, only: int_text
+    use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INPUT, ERR_INTERRUPTED
+    use ropedyn_os, only: make_dirs, rename_file, delete_file
+    use ropedyn_process, only: catch_signals, release_signals, signal_received, note_signals, &
+        signal_name
+    use ropedyn_scene, only: scene_t, scene_namelist_text
+    use ropedyn_simulation, only: run_summary_t, run_scene
+    use ropedyn_case_file, only: case_data_t, read_case_file, finish_case_file
+    use ropedyn_sweep_lock, only: take_lock, drop_lock
+    use ropedyn_sweep, only: sweep_t, sweep_case_t
+    use ropedyn_sweep_status, only: case_state_t, case_state, lock_path, part_path
+    implicit none
+    private
+    public :: run_cases, case_label, case_id
+
+contains
+
+    !> 'sweep: case 0007'.
+    function case_label(sweep, k) result(label)
+        type(sweep_t), intent(in) :: sweep
+        integer, intent(in) :: k
+        character(len=:), allocatable :: label
+        label = 'sweep: case '//case_id(sweep, k)
+    end function case_label
+
+    !> '0007': the id as in the case's file name.
+    function case_id(sweep, k) result(id)
+        type(sweep_t), intent(in) :: sweep
+        integer, intent(in) :: k
+        character(len=:), allocatable :: id
+        character(len=16) :: buf
+        write (buf, '(i0.'//int_text(max(4, len(int_text(size(sweep%cases)))))//')') k
+        id = trim(buf)
+    end function case_id
+
+    !> Run the cases `ids` one after the other. A case that fails does not stop the others;
+    !! its message goes to stderr at once when there are several. The error: the case's
+    !! own when there is one case, else a list of the cases not complete (the class: the
+    !! highest of theirs); ERR_INTERRUPTED when a signal stopped the loop.
+    subroutine run_cases(sweep, ids, force, quiet, err)
+        type(sweep_t), intent(in) :: sweep
+        integer, intent(in) :: ids(:)
+        logical, intent(in) :: force, quiet
+        type(error_t), allocatable, intent(out) :: err
+        type(error_t), allocatable :: case_err
+        character(len=:), allocatable :: failures
+        integer :: k, bad, code
+
+        call catch_signals(err)
+        if (allocated(err)) return
+        failures = ''
+        bad = 0
+        code = 0
+        do k = 1, size(ids)
+            if (signal_received() /= 0) then
+                call make_error(err, ERR_INTERRUPTED, 'sweep: stopped by '// &
+                    signal_name(signal_received())//' before '// &
+                    'case '//case_id(sweep, ids(k))//' ('//int_text(size(ids) - k + 1)// &
+                    ' case(s) of this task not run)')
+                exit
+            end if
+            call run_one(sweep, ids(k), force, quiet, case_err)
+            if (.not. allocated(case_err)) cycle
+            if (size(ids) == 1) then
+                call move_alloc(case_err, err)
+                exit
+            end if
+            write (error_unit, '(a)') 'ropedyn: error: '//case_err%message
+            bad = bad + 1
+            code = max(code, case_err%code)
+            if (len(failures) > 0) failures = failures//', '
+            failures = failures//case_id(sweep, ids(k))
+        end do
+        call release_signals()
+        if (bad > 0 .and. .not. allocated(err)) call make_error(err, code, 'sweep: '// &
+            int_text(bad)//' of '//int_text(size(ids))//' cases of this task not complete: '// &
+            failures)
+    end subroutine run_cases
+
+    !> One case: skip if complete, lock, run into the .part file, finish, rename, unlock.
+    subroutine run_one(sweep, k, force, quiet, err)
+        type(sweep_t), intent(in) :: sweep
+        integer, intent(in) :: k
+        logical, intent(in) :: force, quiet
+        type(error_t), allocatable, intent(out) :: err
+        type(run_summary_t) :: summary
+        type(case_state_t) :: state
+        type(scene_t) :: scene
+        type(error_t), allocatable :: ferr, lerr
+        character(len=:), allocatable :: label, lock, part
+        integer(int64) :: start, finish, rate
+        real(wp) :: wall
+        logical :: removed
+
+        label = case_label(sweep, k)
+        associate (c => sweep%cases(k))
+            lock = lock_path(c%file)
+            part = part_path(c%file)
+            if (len(part) > len(scene%output%file)) then
+                call make_error(err, ERR_INPUT, label//': '//part//': the file name is too ' &
+                    //'long (at most '//int_text(len(scene%output%file))//' characters)')
+                return
+            end if
+            if (.not. force) then
+                call case_state(c, state)
+                if (state%status == 'complete') then
+                    call skipped()
+                    return
+                end if
+            end if
+            call make_dirs(sweep%output_dir, err, 'sweep')
+            if (allocated(err)) return
+            call take_lock(lock, err)
+            if (allocated(err)) then
+                err%message = label//' ('//c%file//'): not run: '//err%message
+                return
+            end if
+            locked: block
+                call note_signals(lock, err)
+                if (allocated(err)) exit locked
+                if (signal_received() /= 0) then
+                    call make_error(err, ERR_INTERRUPTED, label//': not run: stopped by '// &
+                        signal_name(signal_received()))
+                    exit locked
+                end if
+                ! complete meanwhile (a writer that finished just before this one locked)?
+                if (.not. force) then
+                    call case_state(c, state)
+                    if (state%status == 'complete') then
+                        call skipped()
+                        exit locked
+                    end if
+                end if
+                removed = delete_file(part)
+                scene = c%scene
+                scene%output%file = part
+                call system_clock(start, rate)
+                call run_scene(scene, summary, err)
+                call system_clock(finish)
+                wall = real(finish - start, wp)/real(rate, wp)
+                call put_in_place(c, part, wall, ferr)
+                if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
+                if (allocated(err)) then
+                    err%message = label//' ('//c%file//'): '//err%message
+                    exit locked
+                end if
+                if (.not. quiet) write (output_unit, '(a)') label//': complete: '// &
+                    int_text(int(summary%stats%steps))//' steps, cpu '// &
+                    seconds_text(summary%cpu_time)//', wall '//seconds_text(wall)//' -> '// &
+                    c%file
+            end block locked
+            call note_signals('', lerr)
+            call drop_lock(lock)
+        end associate
+    contains
+        subroutine skipped()
+            if (.not. quiet) write (output_unit, '(a)') label//': complete already ('// &
+                sweep%cases(k)%file//'), skipped'
+        end subroutine skipped
+    end subroutine run_one
+
+    !> The .part file of a finished run becomes the case file: with its wall time and the
+    !! case's scene, renamed into place. A run that did not finish its file (an error before
+    !! the file was made, or an output error) leaves no case file: its .part is removed.
+    subroutine put_in_place(c, part, wall, err)
+        type(sweep_case_t), intent(in) :: c
+        character(len=*), intent(in) :: part
+        real(wp), intent(in) :: wall
+        type(error_t), allocatable, intent(out) :: err
+        type(case_data_t) :: data
+        logical :: removed
+        call read_case_file(part, data, err)
+        if (.not. data%exists) return
+        if (allocated(err) .or. (data%status /= 'complete' .and. data%status /= 'failed' .and. &
+                                 data%status /= 'interrupted')) then
+            removed = delete_file(part)
+            return
+        end if
+        call finish_case_file(part, wall, scene_namelist_text(c%scene), err)
+        if (.not. allocated(err)) call rename_file(part, c%file, err)
+        if (allocated(err)) removed = delete_file(part)
+    end subroutine put_in_place
+
+    function seconds_text(x) result(s)
+        real(wp), intent(in) :: x
+        character(len=:), allocatable :: s
+        character(len=16) :: buf
+        write (buf, '(f0.3)') x
+        s = trim(adjustl(buf))
+        if (s(1:1) == '.') s = '0'//s
+        s = s//' s'
+    end function seconds_text
+end module ropedyn_sweep_task
