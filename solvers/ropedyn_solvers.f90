@@ -7,6 +7,7 @@ module ropedyn_solvers
     use ropedyn_cvode, only: cvode_t, adams_t
     use ropedyn_mebdf, only: mebdf_t
     use ropedyn_erk, only: erk_t
+    use ropedyn_auto, only: auto_t
     implicit none
     private
     public :: new_integrator, method_order_range
@@ -27,6 +28,8 @@ contains
             allocate (erk_t :: integrator)
         case ('adams')
             allocate (adams_t :: integrator)
+        case ('auto')
+            allocate (auto_t :: integrator)
         case default
             call make_error(err, ERR_INPUT, 'unknown integration method "'//method// &
                             '" (available: '//method_list()//')')

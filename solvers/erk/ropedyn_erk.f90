@@ -75,6 +75,7 @@ module ropedyn_erk
         real(wp) :: window_start = 0.0_wp
         real(wp) :: stiff_share = 0.0_wp  !< stability-limited share of the last window
         real(wp) :: fail_rate = STIFF_STEP_RATE  !< 0 disables the stiffness failure
+        logical :: stiff_stop = .false.  !< the last failure was the stiffness monitor's
     contains
         procedure :: init => erk_init
         procedure :: advance_to => erk_advance_to
@@ -86,6 +87,7 @@ module ropedyn_erk
         procedure :: stiff_share_of_steps => erk_stiff_share
         procedure :: set_stiff_failure => erk_set_stiff_failure
         procedure :: set_initial_step => erk_set_initial_step
+        procedure :: stopped_by_stiffness => erk_stopped_by_stiffness
         procedure, private :: attempt_step
         procedure, private :: first_step
         procedure, private :: accept_quadrature
@@ -133,6 +135,12 @@ contains
         real(wp), intent(in) :: rate
         self%fail_rate = rate
     end subroutine erk_set_stiff_failure
+
+    !> The last advance_to ended because the step was held by stability at a crawl.
+    pure logical function erk_stopped_by_stiffness(self) result(stopped)
+        class(erk_t), intent(in) :: self
+        stopped = self%stiff_stop
+    end function erk_stopped_by_stiffness
 
     !> Size of the first step (instead of the estimate from the derivatives); call after
     !! init, before the first advance_to.
@@ -195,6 +203,7 @@ contains
         self%window_start = t0
         self%stiff_share = 0.0_wp
         self%fail_rate = STIFF_STEP_RATE
+        self%stiff_stop = .false.
         self%counters = solver_stats_t()
     end subroutine erk_init
 
@@ -500,6 +509,7 @@ contains
                 'for an explicit method here: the step is held by stability (h rho = ', &
                 h*self%rho, ' with a spectral radius rho of about ', self%rho, &
                 ' 1/s), which takes ', rate, ' steps per simulated second'
+            self%stiff_stop = .true.
             call self%failure(err, trim(buffer)//'; use method = ''auto'' (it switches '// &
                               'to an implicit method where this happens) or ''mebdf''')
             return
