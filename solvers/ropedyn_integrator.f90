@@ -15,13 +15,20 @@ module ropedyn_integrator
     use ropedyn_text, only: int_text
     use ropedyn_problem, only: problem_t
     use ropedyn_methods, only: METHODS, method_index
+    use ropedyn_switch_log, only: switch_event_t
     implicit none
     private
-    public :: integrator_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT, clock_seconds
+    public :: integrator_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT, STIFF_STEP_RATE, &
+        clock_seconds
     public :: stop_query_i, stop_now
 
     !> No integrator here goes beyond this order of accuracy.
     integer, parameter :: MAX_ORDER_LIMIT = 7
+
+    !> Steps per simulated second beyond which a method held at a crawl by the problem's
+    !! stiffness gives up with a diagnosis (erk, adams) instead of running on: the step
+    !! guarantee of the hard scenes (docs/stability.md).
+    real(wp), parameter :: STIFF_STEP_RATE = 2.0e5_wp
 
     !> Options shared by all integrators (same meaning for every method).
     !! The error test of every method keeps the local error of component i near or below
@@ -90,6 +97,7 @@ module ropedyn_integrator
         procedure :: min_order => integrator_min_order
         procedure :: max_order_limit => integrator_max_order_limit
         procedure :: check_options => integrator_check_options
+        procedure :: switch_log => integrator_switch_log
     end type integrator_t
 
     abstract interface
@@ -177,6 +185,14 @@ contains
         class(integrator_t), intent(in) :: self
         order = METHODS(method_index(self%name()))%highest_order
     end function integrator_max_order_limit
+
+    !> The changes of method or order limit made during the run so far, oldest first
+    !! (ropedyn_switch_log); none for an integrator that never changes them.
+    function integrator_switch_log(self) result(events)
+        class(integrator_t), intent(in) :: self
+        type(switch_event_t), allocatable :: events(:)
+        allocate (events(0))
+    end function integrator_switch_log
 
     !> The checks every `init` starts with: the order limit to use (options%max_order, the
     !! method's default when 0) within the method's range, per-component absolute tolerances

@@ -4,8 +4,10 @@ module ropedyn_solvers
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_methods, only: METHODS, method_index, method_list
     use ropedyn_integrator, only: integrator_t
-    use ropedyn_cvode, only: cvode_t
+    use ropedyn_cvode, only: cvode_t, adams_t
     use ropedyn_mebdf, only: mebdf_t
+    use ropedyn_erk, only: erk_t
+    use ropedyn_auto, only: auto_t
     implicit none
     private
     public :: new_integrator, method_order_range
@@ -22,6 +24,12 @@ contains
             allocate (cvode_t :: integrator)
         case ('mebdf')
             allocate (mebdf_t :: integrator)
+        case ('erk')
+            allocate (erk_t :: integrator)
+        case ('adams')
+            allocate (adams_t :: integrator)
+        case ('auto')
+            allocate (auto_t :: integrator)
         case default
             call make_error(err, ERR_INPUT, 'unknown integration method "'//method// &
                             '" (available: '//method_list()//')')

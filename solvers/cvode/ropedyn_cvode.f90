@@ -25,6 +25,7 @@ module ropedyn_cvode
     use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, clock_seconds, &
         stop_now
     use ropedyn_iteration_matrix, only: iteration_matrix_t
+    use ropedyn_switch_log, only: switch_log_t, switch_event_t
     use fsundials_context_mod, only: FSUNContext_Create, FSUNContext_Free
     use fsundials_nvector_mod, only: N_Vector, FN_VDestroy, FN_VGetArrayPointer
     use fsundials_matrix_mod, only: SUNMatrix, FSUNMatDestroy, FSUNMatNewEmpty
@@ -37,10 +38,14 @@ module ropedyn_cvode
     use fsunlinsol_band_mod, only: FSUNLinSol_Band
     use fsunmatrix_dense_mod, only: FSUNDenseMatrix, FSUNDenseMatrix_Data
     use fsunlinsol_dense_mod, only: FSUNLinSol_Dense
+    use fsundials_nonlinearsolver_mod, only: SUNNonlinearSolver, FSUNNonlinSolFree
+    use fsunnonlinsol_fixedpoint_mod, only: FSUNNonlinSol_FixedPoint
     use fcvodes_mod
     implicit none
     private
-    public :: cvode_t
+    public :: cvode_t, adams_t
+    !> public only so that gfortran emits it for the submodule (it inlines private ones)
+    public :: flag_name
 
     !> What the C callbacks see through user_data (non-polymorphic, so c_loc is valid).
     type :: cvode_context_t
@@ -62,6 +67,28 @@ module ropedyn_cvode
                     time_solve = 0.0_wp
     end type cvode_context_t
 
+    !> What the stepping loop watches to tell a stability-limited crawl at high BDF order
+    !! (or a stiff problem under Adams) from steps that accuracy limits
+    !! (ropedyn_cvode_stepping explains the rule).
+    type :: cvode_monitor_t
+        integer :: qmax_user = 5          !< the order limit asked for
+        integer :: qmax = 5               !< the order limit in force
+        integer(i8) :: window_steps0 = 0  !< total steps at the window's start
+        integer(i8) :: window_fails0 = 0  !< total error-test failures at the window's start
+        real(wp) :: window_t0 = 0.0_wp    !< time at the window's start
+        !> state of the order control: 0 watching, 1 and 3 trying the low order (first
+        !! and second window), 2 at the low order (crawl confirmed)
+        integer :: mode = 0
+        real(wp) :: rate_before = 0.0_wp  !< steps per second before the trial
+        integer :: wait_windows = 0       !< windows to let pass before the next trial
+        integer :: backoff = 1            !< windows to wait after a trial that did not pay
+        integer :: stay_windows = 0       !< windows at the low order before trying again
+        integer :: stay = 16              !< windows at the low order after a confirmation
+        integer :: stiff_windows = 0      !< consecutive windows above STIFF_STEP_RATE
+        integer :: trial_windows = 0      !< windows of the current trial so far
+        logical :: warned = .false.       !< the crawl warning is in the log
+    end type cvode_monitor_t
+
     type, extends(integrator_t) :: cvode_t
         private
         type(c_ptr) :: sunctx = c_null_ptr
@@ -77,18 +104,66 @@ module ropedyn_cvode
         integer :: n = 0, nq = 0
         real(wp) :: t = 0.0_wp    !< time of the state last returned (the last tout)
         real(wp) :: tn = 0.0_wp   !< CVODE's internal time (end of its last step), >= t
+        !> Adams-Moulton with fixed-point iteration (adams_t) instead of BDF with Newton
+        logical :: adams = .false.
+        type(SUNNonlinearSolver), pointer :: nls => null()  !< the fixed-point solver (Adams)
+        !> the stepping loop's watch on crawling (ropedyn_cvode_stepping)
+        type(cvode_monitor_t) :: monitor
+        !> counters of the integration before CVODE was last re-initialized (the order
+        !! control restarts CVODE, which zeroes its own counters)
+        type(solver_stats_t) :: base
+        type(switch_log_t) :: log  !< order changes made by the stepping loop
     contains
         procedure :: init => cvode_init
         procedure :: advance_to => cvode_advance_to
         procedure :: stats => cvode_stats
         procedure :: finalize => cvode_finalize
         procedure :: name => cvode_name
+        procedure :: switch_log => cvode_switch_log
+        procedure, private :: watch => cvode_watch
+        procedure, private :: restart => cvode_restart
         procedure, private :: attach_linear_solver
         final :: cvode_destroy
     end type cvode_t
 
+    !> CVODE's Adams-Moulton methods (orders 1 .. 12) with fixed-point iteration:
+    !! `method = 'adams'`.
+    type, extends(cvode_t) :: adams_t
+    contains
+        procedure :: name => adams_name
+    end type adams_t
+
     !> What `evaluate` evaluates.
     integer, parameter :: EVAL_RHS = 1, EVAL_QUAD = 2
+
+    interface
+        !> Integrate to tout one CVODE step at a time, watching for a crawl
+        !! (submodule ropedyn_cvode_stepping).
+        module subroutine cvode_advance_to(self, tout, t, y, yq, err)
+            class(cvode_t), intent(inout) :: self
+            real(wp), intent(in) :: tout
+            real(wp), intent(out) :: t
+            real(wp), intent(inout) :: y(:)
+            real(wp), intent(inout) :: yq(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine cvode_advance_to
+
+        !> After each window of steps: lower, keep or restore the maximum BDF order, or
+        !! end an Adams run that the problem's stiffness holds at a crawl (cause set).
+        module subroutine cvode_watch(self, cause)
+            class(cvode_t), intent(inout) :: self
+            character(len=:), allocatable, intent(inout) :: cause
+        end subroutine cvode_watch
+
+        !> Restart CVODE at its current state (tn, y, yq) with order limit qmax and first
+        !! step h, keeping the counters so far in self%base.
+        module subroutine cvode_restart(self, qmax, h, ok)
+            class(cvode_t), intent(inout) :: self
+            integer, intent(in) :: qmax
+            real(wp), intent(in) :: h
+            logical, intent(out) :: ok
+        end subroutine cvode_restart
+    end interface
 
     interface
         !> Our compiled vector operations for a serial N_Vector (ropedyn_nvector_ops.c).
@@ -110,6 +185,19 @@ contains
         name = 'cvode'
     end function cvode_name
 
+    pure function adams_name(self) result(name)
+        class(adams_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'adams'
+    end function adams_name
+
+    !> The order changes of the stepping loop (none unless it lowered the order).
+    function cvode_switch_log(self) result(events)
+        class(cvode_t), intent(in) :: self
+        type(switch_event_t), allocatable :: events(:)
+        events = self%log%items()
+    end function cvode_switch_log
+
     subroutine cvode_init(self, problem, t0, y0, yq0, options, err)
         class(cvode_t), intent(inout) :: self
         class(problem_t), intent(inout), target :: problem
@@ -129,6 +217,10 @@ contains
         self%nq = problem%quad_size()
         call self%check_options(options, self%n, max_order, err)
         if (allocated(err)) return
+        self%adams = self%name() == 'adams'
+        self%monitor = cvode_monitor_t(qmax_user=max_order, qmax=max_order, window_t0=t0)
+        self%base = solver_stats_t()
+        call self%log%clear()
         self%t = t0
         self%tn = t0
         allocate (self%ctx)
@@ -149,7 +241,7 @@ contains
         ! CVODE clones all its vectors from this one: they inherit the compiled operations.
         flag = nvector_fast_ops(self%nv_y)
         if (check(flag, 'ropedyn_nvector_fast_ops')) return
-        self%mem = FCVodeCreate(CV_BDF, self%sunctx)
+        self%mem = FCVodeCreate(merge(CV_ADAMS, CV_BDF, self%adams), self%sunctx)
         if (.not. c_associated(self%mem)) then
             call make_error(err, ERR_SOLVER, 'cvode: FCVodeCreate failed')
             return
@@ -201,6 +293,17 @@ contains
             if (check(flag, 'FCVodeQuadSStolerances')) return
             flag = FCVodeSetQuadErrCon(self%mem, 1_c_int)
             if (check(flag, 'FCVodeSetQuadErrCon')) return
+        end if
+        if (self%adams) then
+            ! Adams: fixed-point (functional) iteration, as for nonstiff problems; it
+            ! replaces the Newton solver, so the linear solver above is never used
+            self%nls => FSUNNonlinSol_FixedPoint(self%nv_y, 0_c_int, self%sunctx)
+            if (.not. associated(self%nls)) then
+                call make_error(err, ERR_SOLVER, 'adams: cannot create the fixed-point solver')
+                return
+            end if
+            flag = FCVodeSetNonlinearSolver(self%mem, self%nls)
+            if (check(flag, 'FCVodeSetNonlinearSolver')) return
         end if
     contains
         logical function check(flag, what)
@@ -283,113 +386,6 @@ contains
         end function check
     end subroutine attach_linear_solver
 
-
-    !> CVODE in one-step mode, so that every step is seen: the step budget and the
-    !! round-off floor (as MEBDF's: a step h < 16 eps |t| ends the run) are checked after
-    !! each step, then the solution is interpolated at tout (what CV_NORMAL does inside;
-    !! the steps taken are the same). CVODE by itself accepts steps with t + h == t: a run
-    !! that runs into a region where f keeps failing (a NaN ahead) would crawl there until
-    !! max_steps. With `options%stop_requested` saying so after a step, it returns there
-    !! (t = the step's end < tout; the quadratures at that time).
-    subroutine cvode_advance_to(self, tout, t, y, yq, err)
-        class(cvode_t), intent(inout) :: self
-        real(wp), intent(in) :: tout
-        real(wp), intent(out) :: t
-        real(wp), intent(inout) :: y(:)
-        real(wp), intent(inout) :: yq(:)
-        type(error_t), allocatable, intent(out) :: err
-        real(c_double) :: tret(1), hlast(1)
-        integer(c_long) :: nsteps(1)
-        integer(c_int) :: flag, qflag
-        character(len=:), allocatable :: cause
-
-        if (.not. c_associated(self%mem)) then
-            call make_error(err, ERR_SOLVER, 'cvode: advance_to called before init')
-            return
-        end if
-        self%ctx%message = ''
-        self%ctx%recoverable = 0
-        flag = CV_SUCCESS
-        cause = ''
-        do while (self%tn < tout)
-            qflag = FCVodeGetNumSteps(self%mem, nsteps)
-            if (int(nsteps(1), i8) >= self%options%max_steps) then
-                cause = 'max_steps exceeded ('//int_text(self%options%max_steps)//' steps)'
-                exit
-            end if
-            tret = self%tn
-            flag = FCVode(self%mem, real(tout, c_double), self%nv_y, tret, CV_ONE_STEP)
-            if (flag < 0) exit
-            self%tn = tret(1)
-            hlast = 0.0_c_double
-            qflag = FCVodeGetLastStep(self%mem, hlast)
-            if (hlast(1) < 16.0_wp*epsilon(1.0_wp)*abs(self%tn)) then
-                cause = 'step size fell below the round-off limit'
-                if (self%ctx%recoverable > 0) cause = cause//' after repeated recoverable '// &
-                    'errors of the right-hand side (e.g. a NaN or Inf in the forces)'
-                exit
-            end if
-            if (self%tn < tout .and. stop_now(self%options)) then
-                ! stopped early on request: the state at the end of this step
-                self%t = self%tn
-                y = self%y
-                if (self%nq > 0) then
-                    tret = self%tn
-                    qflag = FCVodeGetQuad(self%mem, tret, self%nv_q)
-                    yq(1:self%nq) = self%yq(1:self%nq)
-                end if
-                t = self%t
-                return
-            end if
-        end do
-
-        if (flag >= 0 .and. len(cause) == 0) then
-            ! the step that reached tout is done: interpolate there
-            flag = FCVodeGetDky(self%mem, real(tout, c_double), 0_c_int, self%nv_y)
-            if (self%nq > 0 .and. flag >= 0) &
-                flag = FCVodeGetQuadDky(self%mem, real(tout, c_double), 0_c_int, self%nv_q)
-            if (flag >= 0) then
-                self%t = tout
-                y = self%y
-                if (self%nq > 0) yq(1:self%nq) = self%yq(1:self%nq)
-                t = self%t
-                return
-            end if
-            cause = flag_name(flag)//': interpolation at tout failed '//self%ctx%message
-        end if
-
-        ! Failure: the last good state is CVODE's current one (in y after a one-step call).
-        self%t = self%tn
-        if (self%nq > 0) then
-            tret = self%tn
-            qflag = FCVodeGetQuad(self%mem, tret, self%nv_q)
-            if (qflag >= 0) yq(1:self%nq) = self%yq(1:self%nq)
-        end if
-        y = self%y
-        t = self%t
-        ! the step being attempted when CVODE gave up (the last successful one if none)
-        hlast = 0.0_c_double
-        qflag = FCVodeGetCurrentStep(self%mem, hlast)
-        if (hlast(1) == 0.0_c_double) qflag = FCVodeGetLastStep(self%mem, hlast)
-        if (len(cause) == 0) then
-            cause = flag_name(flag)//': '//self%ctx%message
-            if (flag == CV_REPTD_RHSFUNC_ERR .or. flag == CV_REPTD_QRHSFUNC_ERR) &
-                cause = cause//' (the model returned a recoverable error, e.g. a NaN or '// &
-                'Inf in the forces)'
-        end if
-        call make_error(err, ERR_SOLVER, 'cvode failed at '//where_text(t, hlast(1))// &
-                        ': '//cause)
-    end subroutine cvode_advance_to
-
-    !> 't = ... s, step size ... s' for messages.
-    function where_text(t, h) result(text)
-        real(wp), intent(in) :: t, h
-        character(len=:), allocatable :: text
-        character(len=64) :: buffer
-        write (buffer, '(a, es12.5, a, es11.3e3, a)') 't = ', t, ' s, step size ', h, ' s'
-        text = trim(buffer)
-    end function where_text
-
     function cvode_stats(self) result(stats)
         class(cvode_t), intent(in) :: self
         type(solver_stats_t) :: stats
@@ -402,19 +398,19 @@ contains
         order = 0
         flag = FCVodeGetIntegratorStats(self%mem, steps, rhs_evals, lin_setups, err_test_fails, &
                                         order, next_order, h0, h, h_next, tcur)
-        stats%steps = steps(1)
-        stats%rhs_evals = rhs_evals(1)
-        stats%lin_setups = lin_setups(1)
-        stats%err_test_fails = err_test_fails(1)
+        stats%steps = self%base%steps + steps(1)
+        stats%rhs_evals = self%base%rhs_evals + rhs_evals(1)
+        stats%lin_setups = self%base%lin_setups + lin_setups(1)
+        stats%err_test_fails = self%base%err_test_fails + err_test_fails(1)
         stats%last_step = h(1)
         stats%last_order = order(1)
         flag = FCVodeGetNonlinSolvStats(self%mem, v, w)
-        stats%nonlin_iters = v(1)
-        stats%nonlin_conv_fails = w(1)
+        stats%nonlin_iters = self%base%nonlin_iters + v(1)
+        stats%nonlin_conv_fails = self%base%nonlin_conv_fails + w(1)
         flag = FCVodeGetNumJacEvals(self%mem, v)
-        stats%jac_evals = v(1)
+        stats%jac_evals = self%base%jac_evals + v(1)
         flag = FCVodeGetNumLinRhsEvals(self%mem, v)
-        stats%jac_rhs_evals = v(1)
+        stats%jac_rhs_evals = self%base%jac_rhs_evals + v(1)
         stats%reduced_newton = self%ctx%reduced
         stats%time_rhs = self%ctx%time_rhs
         stats%time_jac = self%ctx%time_jac
@@ -427,6 +423,8 @@ contains
         integer(c_int) :: flag
         if (c_associated(self%mem)) call FCVodeFree(self%mem)
         self%mem = c_null_ptr
+        if (associated(self%nls)) flag = FSUNNonlinSolFree(self%nls)
+        self%nls => null()
         if (associated(self%solver)) flag = FSUNLinSolFree(self%solver)
         self%solver => null()
         if (associated(self%matrix)) call FSUNMatDestroy(self%matrix)

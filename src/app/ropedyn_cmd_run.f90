@@ -1,6 +1,6 @@
 !> `ropedyn run SCENE.nml [--set group.key=value ...]`: run one scene, print its summary.
 module ropedyn_cmd_run
-    use, intrinsic :: iso_fortran_env, only: output_unit
+    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_INTERRUPTED
     use ropedyn_cli, only: cli_t
@@ -122,6 +122,7 @@ contains
             '  factor ', s%stats%time_factor, '  solve ', s%stats%time_solve, '  rest ', &
             s%stats%time_advance - (s%stats%time_rhs + s%stats%time_jac + &
                                     s%stats%time_factor + s%stats%time_solve)
+        call print_switches(s)
         write (output_unit, '(a, 5(es13.5))') '  energy (J)      kinetic, elastic, '// &
             'gravity, dissipated, total:'
         write (output_unit, '(a, 5(es13.5))') '                  ', s%final_energy%kinetic, &
@@ -131,4 +132,22 @@ contains
             ' J   balance error (T+V+dissipated-E0) ', drift, ' J'
         write (output_unit, '(a)') '  output          '//s%file
     end subroutine print_summary
+
+    !> The integrator's changes of method or order limit, one line each; those that are
+    !! warnings (a crawl cured by a lower order) once more on stderr.
+    subroutine print_switches(s)
+        type(run_summary_t), intent(in) :: s
+        integer :: k
+        character(len=80) :: head
+        if (.not. allocated(s%switches)) return
+        do k = 1, size(s%switches)
+            associate (e => s%switches(k))
+                write (head, '(a, f10.4, a, i0, a)') '  switch  t = ', e%t, ' s  '// &
+                    trim(e%method)//' (max order ', e%max_order, ')'
+                write (output_unit, '(a)') trim(head)//': '//e%reason
+                if (e%warning) write (error_unit, '(a, f10.4, a)') 'warning: at t = ', e%t, &
+                    ' s: '//e%reason
+            end associate
+        end do
+    end subroutine print_switches
 end module ropedyn_cmd_run

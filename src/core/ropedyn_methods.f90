@@ -23,7 +23,10 @@ module ropedyn_methods
 
     type(method_info_t), parameter :: METHODS(*) = [ &
         method_info_t('cvode', 1, 5, 5), &
-        method_info_t('mebdf', 2, 7, 4)]
+        method_info_t('mebdf', 2, 7, 4), &
+        method_info_t('erk', 3, 5, 4), &
+        method_info_t('adams', 1, 12, 12), &
+        method_info_t('auto', 2, 7, 4)]
 
 contains
 

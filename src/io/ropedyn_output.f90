@@ -41,6 +41,7 @@ module ropedyn_output
     use ropedyn_error, only: error_t, make_error, ERR_INTERNAL, ERR_IO
     use ropedyn_rope_model, only: energy_t
     use ropedyn_integrator, only: solver_stats_t
+    use ropedyn_switch_log, only: switch_event_t
     use ropedyn_h5, only: h5_file_t, h5_series_t
     implicit none
     private
@@ -115,6 +116,7 @@ module ropedyn_output
         procedure :: create => output_create
         procedure :: append => output_append
         procedure :: write_stats => output_write_stats
+        procedure :: write_switches => output_write_switches
         procedure :: close_run => output_close_run
         procedure :: reopen => output_reopen
         procedure :: records => output_records
@@ -402,6 +404,43 @@ contains
 
     !> Set the root status ('complete', or 'failed' or 'interrupted' with `reason`) and close
     !! everything. The file is closed even when writing the status fails.
+    !> The integrator's changes of method or order limit during the run (ropedyn_switch_log)
+    !! as /solver/switch_time (s), switch_method, switch_max_order and switch_reason, one
+    !! entry per change, oldest first (nothing when there were none).
+    subroutine output_write_switches(self, events, err)
+        class(output_file_t), intent(inout) :: self
+        type(switch_event_t), intent(in) :: events(:)
+        type(error_t), allocatable, intent(out) :: err
+        character(len=16), allocatable :: methods(:)
+        character(len=:), allocatable :: reasons(:)
+        integer :: k, width
+
+        if (size(events) == 0) return
+        if (.not. self%is_open) then
+            call make_error(err, ERR_INTERNAL, &
+                            file_label(self)//': write_switches: file is not open')
+            return
+        end if
+        width = 1
+        do k = 1, size(events)
+            if (allocated(events(k)%reason)) width = max(width, len(events(k)%reason))
+        end do
+        allocate (methods(size(events)))
+        allocate (character(len=width) :: reasons(size(events)))
+        do k = 1, size(events)
+            methods(k) = events(k)%method
+            reasons(k) = ''
+            if (allocated(events(k)%reason)) reasons(k) = events(k)%reason
+        end do
+        call self%file%write('/solver/switch_time', events%t, 's', err)
+        if (allocated(err)) return
+        call self%file%write('/solver/switch_max_order', int(events%max_order, i8), '1', err)
+        if (allocated(err)) return
+        call self%file%write_text('/solver/switch_method', methods, '', err)
+        if (allocated(err)) return
+        call self%file%write_text('/solver/switch_reason', reasons, '', err)
+    end subroutine output_write_switches
+
     subroutine output_close_run(self, status, reason, err)
         class(output_file_t), intent(inout) :: self
         character(len=*), intent(in) :: status            !< complete, failed, interrupted

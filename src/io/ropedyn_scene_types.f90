@@ -10,7 +10,7 @@ module ropedyn_scene_types
 
     !> `&solver`: time integration.
     type :: solver_params_t
-        character(len=NAME_LEN) :: method = 'cvode'  !< 'cvode' | 'mebdf'
+        character(len=NAME_LEN) :: method = 'auto'  !< ropedyn_methods' names
         real(wp) :: rtol = 1.0e-6_wp          !< relative tolerance [-]
         real(wp) :: atol = 1.0e-8_wp          !< absolute tolerance [state units]
         !> highest order of accuracy; 0 in the file: the method's default (resolved by

@@ -21,6 +21,7 @@ module ropedyn_simulation
     use ropedyn_run_record, only: run_record_t, read_run_record, check_record_fits, LAST_RECORD
     use ropedyn_progress, only: progress_t
     use ropedyn_fault, only: fault_problem_t, fault_wrap
+    use ropedyn_switch_log, only: switch_event_t
     use ropedyn_version, only: version_string
     use ropedyn_modes, only: equilibrium_initial_state
     implicit none
@@ -35,6 +36,8 @@ module ropedyn_simulation
         type(energy_t) :: initial_energy
         type(energy_t) :: final_energy
         integer :: records = 0             !< output times written
+        !> the integrator's changes of method or order limit (auto, cvode's crawl watch)
+        type(switch_event_t), allocatable :: switches(:)
         character(len=:), allocatable :: file
     end type run_summary_t
 
@@ -368,6 +371,8 @@ contains
             call add_counters(summary%stats, counters_before)
             summary%t_reached = max(summary%t_reached, t)
             call out%write_stats(summary%stats, summary%cpu_time, ferr, t_reached=t)
+            summary%switches = integrator%switch_log()
+            if (.not. allocated(ferr)) call out%write_switches(summary%switches, ferr)
             call out%close_run(status, reason, ferr)
             if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
             call integrator%finalize()

@@ -1,0 +1,628 @@
+!> Adaptive explicit Runge-Kutta integration (`method = 'erk'`) behind the integrator
+!! interface: one of the embedded FSAL pairs of ropedyn_erk_tables (max_order 3, 4 or 5),
+!! a PI step-size controller, dense output, and a stiffness monitor that ends the run
+!! with a diagnosis when the step is held by stability at a crawl.
+!!
+!! Why a bundled method and not ARKODE's ERKStep: on the rope the step of every explicit
+!! method is limited by stability, so what counts is f evaluations per simulated second
+!! and the cost around each one; ARKODE adds about 2 us per f call, more than a whole
+!! RHS costs at n = 30 once the kernels are fast (docs/performance notes in
+!! docs/integrators.md).
+!!
+!! - **Error test**: the weighted RMS norm of h sum e_i k_i with weights
+!!   rtol max(|y_n|, |y_n+1|) + atol (atol per component when given) must be <= 1.
+!! - **Step size**: a PI controller (Gustafsson 1991), h_new = h fac err^-alpha
+!!   err_old^beta, which keeps the step steady where stability, not accuracy, limits it;
+!!   growth at most 5x (1x right after a rejection), reduction at most 10x.
+!! - **Quadratures** (dissipated energy, support work) are integrated from their
+!!   right-hand side g at the accepted step points only: the cubic through the last four
+!!   values of g, integrated over the step (Adams-Moulton-like, 4th order), one g per
+!!   step instead of one per stage. They do not take part in the error test.
+!! - **Stiffness**: the last two stages are both at t + h, so rho = |k_s - k_s-1| /
+!!   |Y_s - Y_s-1| estimates the spectral radius along the error for free (Hairer's
+!!   test). When most of the last 500 steps had h rho near the stability limit and they
+!!   averaged more than 2e5 steps per simulated second, the run ends (ERR_SOLVER) with a
+!!   message naming the implicit methods.
+!! - **Failures**: a recoverable status of f (e.g. NaN) cuts h by 4; below the round-off
+!!   floor 16 eps |t| or past max_steps the integration ends with the last good state.
+module ropedyn_erk
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use ropedyn_kinds, only: wp, i8
+    use ropedyn_text, only: int_text
+    use ropedyn_error, only: error_t, make_error, ERR_SOLVER
+    use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
+    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, &
+                                  STIFF_STEP_RATE, stop_now
+    use ropedyn_erk_tables, only: erk_table_t, erk_table, ERK_MAX_STAGES
+    implicit none
+    private
+    public :: erk_t
+    !> Accepted steps the stiffness monitor looks back over.
+    integer, parameter :: STIFF_WINDOW = 500
+    !> h rho above this fraction of the stability limit counts as stability-limited.
+    real(wp), parameter :: STIFF_FRACTION = 0.7_wp
+    real(wp), parameter :: SAFETY = 0.9_wp      !< step-size safety factor
+    real(wp), parameter :: GROW_MAX = 5.0_wp    !< largest growth of h per step
+    real(wp), parameter :: SHRINK_MAX = 0.1_wp  !< largest reduction of h per step
+    !> PI controller exponents, over the order of the error estimate + 1 (Gustafsson's
+    !! k_I = 0.3/k, k_P = 0.4/k: err^-(k_I + k_P) err_old^k_P)
+    real(wp), parameter :: K_I = 0.3_wp, K_P = 0.4_wp
+
+    type, extends(integrator_t) :: erk_t
+        private
+        class(problem_t), pointer :: problem => null()
+        type(solver_options_t) :: options
+        type(erk_table_t) :: tab
+        type(solver_stats_t) :: counters
+        integer :: n = 0, nq = 0, s = 0
+        real(wp) :: t = 0.0_wp          !< time of the last accepted step point
+        real(wp) :: h = 0.0_wp          !< size of the next step (0: not chosen yet)
+        real(wp) :: t_old = 0.0_wp      !< start of the last accepted step
+        real(wp) :: h_old = 0.0_wp      !< size of the last accepted step
+        real(wp) :: err_old = 1.0e-4_wp !< error norm of the last accepted step
+        logical :: started = .false.    !< k(:, 1) holds f(t, y)
+        logical :: rejected = .false.   !< the last attempt was rejected
+        real(wp), allocatable :: y(:), y_old(:), ynew(:), ytmp(:), yprev(:), k(:, :), atol(:)
+        real(wp), allocatable :: yq(:), yq_old(:)
+        !> quadrature history: g at the last four accepted step points, their times
+        real(wp), allocatable :: gq(:, :)
+        real(wp) :: tq(0:3) = 0.0_wp
+        integer :: nqh = 0              !< values in the quadrature history
+        !> stiffness monitor over the last STIFF_WINDOW accepted steps
+        real(wp) :: rho = 0.0_wp        !< last estimate of the spectral radius, 1/s
+        integer :: stiff_steps = 0      !< stability-limited steps in the current window
+        integer :: window_steps = 0     !< steps in the current window
+        real(wp) :: window_start = 0.0_wp
+        real(wp) :: stiff_share = 0.0_wp  !< stability-limited share of the last window
+        real(wp) :: fail_rate = STIFF_STEP_RATE  !< 0 disables the stiffness failure
+        logical :: stiff_stop = .false.  !< the last failure was the stiffness monitor's
+    contains
+        procedure :: init => erk_init
+        procedure :: advance_to => erk_advance_to
+        procedure :: stats => erk_stats
+        procedure :: finalize => erk_finalize
+        procedure :: name => erk_name
+        procedure :: table => erk_table_of
+        procedure :: spectral_radius => erk_spectral_radius
+        procedure :: stiff_share_of_steps => erk_stiff_share
+        procedure :: set_stiff_failure => erk_set_stiff_failure
+        procedure :: set_initial_step => erk_set_initial_step
+        procedure :: stopped_by_stiffness => erk_stopped_by_stiffness
+        procedure, private :: attempt_step
+        procedure, private :: first_step
+        procedure, private :: accept_quadrature
+        procedure, private :: quad_integral
+        procedure, private :: dense
+        procedure, private :: failure
+        procedure, private :: monitor_stiffness
+        procedure, private :: stage_state
+        procedure, private :: error_norm
+    end type erk_t
+
+contains
+
+    pure function erk_name(self) result(name)
+        class(erk_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'erk'
+    end function erk_name
+
+    !> The pair in use (after init).
+    pure function erk_table_of(self) result(tab)
+        class(erk_t), intent(in) :: self
+        type(erk_table_t) :: tab
+        tab = self%tab
+    end function erk_table_of
+
+    !> The last estimate of the spectral radius along the error (1/s; 0 before a step).
+    pure real(wp) function erk_spectral_radius(self) result(rho)
+        class(erk_t), intent(in) :: self
+        rho = self%rho
+    end function erk_spectral_radius
+
+    !> Share of the steps of the last full window (or of the current one) that were
+    !! limited by stability (h rho near the stability limit).
+    pure real(wp) function erk_stiff_share(self) result(share)
+        class(erk_t), intent(in) :: self
+        share = self%stiff_share
+        if (self%window_steps > 50) share = real(self%stiff_steps, wp)/self%window_steps
+    end function erk_stiff_share
+
+    !> Steps per simulated second above which a stability-limited run fails (default
+    !! STIFF_STEP_RATE; 0 or less: never). Call after init.
+    subroutine erk_set_stiff_failure(self, rate)
+        class(erk_t), intent(inout) :: self
+        real(wp), intent(in) :: rate
+        self%fail_rate = rate
+    end subroutine erk_set_stiff_failure
+
+    !> The last advance_to ended because the step was held by stability at a crawl.
+    pure logical function erk_stopped_by_stiffness(self) result(stopped)
+        class(erk_t), intent(in) :: self
+        stopped = self%stiff_stop
+    end function erk_stopped_by_stiffness
+
+    !> Size of the first step (instead of the estimate from the derivatives); call after
+    !! init, before the first advance_to.
+    subroutine erk_set_initial_step(self, h)
+        class(erk_t), intent(inout) :: self
+        real(wp), intent(in) :: h
+        if (h > 0.0_wp) self%h = h
+    end subroutine erk_set_initial_step
+
+    subroutine erk_init(self, problem, t0, y0, yq0, options, err)
+        class(erk_t), intent(inout) :: self
+        class(problem_t), intent(inout), target :: problem
+        real(wp), intent(in) :: t0
+        real(wp), intent(in) :: y0(:)
+        real(wp), intent(in) :: yq0(:)
+        type(solver_options_t), intent(in) :: options
+        type(error_t), allocatable, intent(out) :: err
+        integer :: max_order
+
+        call self%finalize()
+        self%problem => problem
+        self%options = options
+        self%n = problem%size()
+        self%nq = problem%quad_size()
+        call self%check_options(options, self%n, max_order, err)
+        if (allocated(err)) return
+        if (options%stab_lim_det) then
+            call make_error(err, ERR_SOLVER, 'erk: stability-limit detection is a CVODE '// &
+                            'option')
+            return
+        end if
+        if (.not. (options%rtol > 0.0_wp .and. options%atol > 0.0_wp)) then
+            call make_error(err, ERR_SOLVER, 'erk: rtol and atol must be > 0')
+            return
+        end if
+        if (size(y0) /= self%n .or. size(yq0) < self%nq) then
+            call make_error(err, ERR_SOLVER, 'erk: initial state of the wrong size')
+            return
+        end if
+        self%tab = erk_table(max_order)
+        self%s = self%tab%stages
+        allocate (self%y(self%n), self%y_old(self%n), self%ynew(self%n), self%ytmp(self%n), &
+                  self%yprev(self%n), self%k(self%n, self%s), self%atol(self%n))
+        allocate (self%yq(self%nq), self%yq_old(self%nq), self%gq(self%nq, 0:3))
+        self%atol = options%atol
+        if (allocated(options%atol_vector)) self%atol = options%atol_vector
+        self%y = y0
+        self%yq = yq0(1:self%nq)
+        self%t = t0
+        self%t_old = t0
+        self%h = 0.0_wp
+        self%h_old = 0.0_wp
+        self%err_old = 1.0e-4_wp
+        self%started = .false.
+        self%rejected = .false.
+        self%nqh = 0
+        self%rho = 0.0_wp
+        self%stiff_steps = 0
+        self%window_steps = 0
+        self%window_start = t0
+        self%stiff_share = 0.0_wp
+        self%fail_rate = STIFF_STEP_RATE
+        self%stiff_stop = .false.
+        self%counters = solver_stats_t()
+    end subroutine erk_init
+
+    subroutine erk_advance_to(self, tout, t, y, yq, err)
+        class(erk_t), intent(inout) :: self
+        real(wp), intent(in) :: tout
+        real(wp), intent(out) :: t
+        real(wp), intent(inout) :: y(:)
+        real(wp), intent(inout) :: yq(:)
+        type(error_t), allocatable, intent(out) :: err
+
+        t = self%t
+        if (.not. associated(self%problem)) then
+            call make_error(err, ERR_SOLVER, 'erk: advance_to called before init')
+            return
+        end if
+        if (.not. self%started) then
+            if (tout <= self%t) then
+                y = self%y
+                if (self%nq > 0) yq(1:self%nq) = self%yq
+                return
+            end if
+            call self%first_step(tout - self%t, err)
+            if (allocated(err)) then
+                y = self%y
+                return
+            end if
+        else if (tout < self%t_old - self%h_old*8.0_wp*epsilon(1.0_wp)) then
+            call make_error(err, ERR_SOLVER, 'erk: output time lies before the last step')
+            return
+        end if
+        do while (self%t < tout)
+            call self%attempt_step(err)
+            if (allocated(err) .or. (self%t < tout .and. stop_now(self%options))) then
+                ! failed, or stopped early on request: the state at the end of the last step
+                t = self%t
+                y = self%y
+                if (self%nq > 0) yq(1:self%nq) = self%yq
+                return
+            end if
+        end do
+        call self%dense(tout, y, yq)
+        t = tout
+    end subroutine erk_advance_to
+
+    !> f at the initial point and the first step size (Hairer's starting-step algorithm,
+    !! Solving ODEs I, II.4), bounded by the span to the first output time.
+    subroutine first_step(self, span, err)
+        class(erk_t), intent(inout) :: self
+        real(wp), intent(in) :: span
+        type(error_t), allocatable, intent(out) :: err
+        real(wp) :: d0, d1, d2, h0, h1, w(self%n)
+        integer :: status, p
+
+        call self%problem%rhs(self%t, self%y, self%k(:, 1), status)
+        self%counters%rhs_evals = self%counters%rhs_evals + 1
+        if (status /= STATUS_OK .or. .not. all(ieee_is_finite(self%k(:, 1)))) then
+            call self%failure(err, 'the right-hand side could not be evaluated at the '// &
+                              'initial state')
+            return
+        end if
+        if (self%nq > 0) then
+            call self%problem%quad_rhs(self%t, self%y, self%gq(:, 0), status)
+            if (status /= STATUS_OK) then
+                call self%failure(err, 'the quadrature right-hand side could not be '// &
+                                  'evaluated at the initial state')
+                return
+            end if
+            self%tq(0) = self%t
+            self%nqh = 1
+        end if
+        self%started = .true.
+        if (self%h > 0.0_wp) then
+            self%h = min(self%h, span)
+            return
+        end if
+        p = self%tab%order
+        w = self%options%rtol*abs(self%y) + self%atol
+        d0 = rms(self%y/w)
+        d1 = rms(self%k(:, 1)/w)
+        if (d0 < 1.0e-5_wp .or. d1 < 1.0e-5_wp) then
+            h0 = 1.0e-6_wp
+        else
+            h0 = 0.01_wp*d0/d1
+        end if
+        h0 = min(h0, span)
+        self%ytmp = self%y + h0*self%k(:, 1)
+        call self%problem%rhs(self%t + h0, self%ytmp, self%k(:, 2), status)
+        self%counters%rhs_evals = self%counters%rhs_evals + 1
+        if (status /= STATUS_OK) then
+            self%h = h0/4.0_wp
+            return
+        end if
+        d2 = rms((self%k(:, 2) - self%k(:, 1))/w)/h0
+        if (max(d1, d2) <= 1.0e-15_wp) then
+            h1 = max(1.0e-6_wp, h0*1.0e-3_wp)
+        else
+            h1 = (0.01_wp/max(d1, d2))**(1.0_wp/(p + 1))
+        end if
+        self%h = min(100.0_wp*h0, h1, span)
+    end subroutine first_step
+
+    !> Attempt steps until one is accepted; then self%t, self%y have moved on and the
+    !! stages of that step are kept for dense output.
+    subroutine attempt_step(self, err)
+        class(erk_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: err
+        real(wp) :: h, errnorm, fac, tnew
+        integer :: i, j, status, s
+        logical :: recoverable
+
+        s = self%s
+        recoverable = .false.
+        ! FSAL: the last stage of the previous step is f at this step's start (kept in
+        ! place until now for the dense output of the previous step)
+        if (self%counters%steps > 0) self%k(:, 1) = self%k(:, s)
+        attempts: do
+            if (self%counters%steps >= self%options%max_steps) then
+                call self%failure(err, 'max_steps exceeded ('// &
+                                  int_text(self%options%max_steps)//' steps)')
+                return
+            end if
+            h = self%h
+            if (h < 16.0_wp*epsilon(1.0_wp)*max(abs(self%t), tiny(1.0_wp))) then
+                if (recoverable) then
+                    call self%failure(err, 'step size fell below the round-off limit after '// &
+                                      'repeated recoverable errors of the right-hand side '// &
+                                      '(e.g. a NaN or Inf in the forces)')
+                else
+                    call self%failure(err, 'step size fell below the round-off limit')
+                end if
+                return
+            end if
+            ! stages 2 .. s (stage 1 is f at the step's start, already known); loops over
+            ! the components with the table's nonzero entries only (no array temporaries)
+            do i = 2, s
+                call self%stage_state(i, h)
+                if (i == s - 1) self%yprev(:) = self%ytmp
+                call self%problem%rhs(self%t + self%tab%c(i)*h, self%ytmp, self%k(:, i), status)
+                self%counters%rhs_evals = self%counters%rhs_evals + 1
+                if (status == STATUS_FATAL) then
+                    call self%failure(err, 'the right-hand side reported a fatal error')
+                    return
+                end if
+                if (status /= STATUS_OK) then
+                    ! recoverable (e.g. NaN): retry smaller, as CVODE does
+                    recoverable = .true.
+                    self%h = h/4.0_wp
+                    self%rejected = .true.
+                    cycle attempts
+                end if
+            end do
+            ! FSAL: the last stage was evaluated at the new solution
+            call swap(self%ynew, self%ytmp)
+            errnorm = self%error_norm(h)
+            if (.not. ieee_is_finite(errnorm)) errnorm = huge(1.0_wp)
+            if (errnorm > 1.0_wp) then
+                self%counters%err_test_fails = self%counters%err_test_fails + 1
+                fac = max(SHRINK_MAX, SAFETY*errnorm**(-1.0_wp/self%tab%order))
+                self%h = h*fac
+                self%rejected = .true.
+                cycle attempts
+            end if
+            exit attempts
+        end do attempts
+
+        ! accepted
+        tnew = self%t + h
+        self%rho = spectral_estimate(self%k(:, s), self%k(:, s - 1), self%ynew, self%yprev)
+        self%t_old = self%t
+        self%h_old = h
+        call swap(self%y_old, self%y)
+        call swap(self%y, self%ynew)
+        self%t = tnew
+        if (self%nq > 0) then
+            call self%accept_quadrature(status)
+            if (status /= STATUS_OK) then
+                call self%failure(err, 'the quadrature right-hand side could not be '// &
+                                  'evaluated (e.g. a NaN or Inf in the forces)')
+                self%t = self%t_old
+                self%y = self%y_old
+                return
+            end if
+        end if
+        self%counters%steps = self%counters%steps + 1
+        self%counters%last_step = h
+        self%counters%last_order = self%tab%order
+        self%counters%order_steps(self%tab%order) = self%counters%order_steps(self%tab%order) + 1
+        ! PI controller (order of the estimate + 1 = order of the method)
+        errnorm = max(errnorm, 1.0e-10_wp)
+        fac = SAFETY*errnorm**(-(K_I + K_P)/self%tab%order)* &
+              self%err_old**(K_P/self%tab%order)
+        fac = min(GROW_MAX, max(SHRINK_MAX, fac))
+        if (self%rejected) fac = min(1.0_wp, fac)
+        self%err_old = errnorm
+        self%rejected = .false.
+        self%h = h*fac
+        call self%monitor_stiffness(h, err)
+    end subroutine attempt_step
+
+    !> ytmp = y + h sum_j a(i, j) k(:, j): the argument of stage i (one vectorized
+    !! update per nonzero entry of the table).
+    subroutine stage_state(self, i, h)
+        class(erk_t), intent(inout) :: self
+        integer, intent(in) :: i
+        real(wp), intent(in) :: h
+        integer :: j
+        logical :: first
+        first = .true.
+        do j = 1, i - 1
+            if (self%tab%a(i, j) == 0.0_wp) cycle
+            if (first) then
+                call xpay(self%y, h*self%tab%a(i, j), self%k(:, j), self%ytmp)
+                first = .false.
+            else
+                call axpy(h*self%tab%a(i, j), self%k(:, j), self%ytmp)
+            end if
+        end do
+    end subroutine stage_state
+
+    !> Weighted RMS norm of the error estimate h sum_j e_j k(:, j), with weights
+    !! rtol max(|y|, |ynew|) + atol (uses ytmp as work).
+    real(wp) function error_norm(self, h) result(norm)
+        class(erk_t), intent(inout) :: self
+        real(wp), intent(in) :: h
+        real(wp) :: v, acc
+        integer :: j, l
+        self%ytmp(:) = 0.0_wp
+        do j = 1, self%s
+            if (self%tab%e(j) /= 0.0_wp) call axpy(h*self%tab%e(j), self%k(:, j), self%ytmp)
+        end do
+        acc = 0.0_wp
+        do l = 1, self%n
+            v = self%ytmp(l)/(self%options%rtol*max(abs(self%y(l)), abs(self%ynew(l))) &
+                              + self%atol(l))
+            acc = acc + v*v
+        end do
+        norm = sqrt(acc/max(1, self%n))
+    end function error_norm
+
+    !> z = y + a x.
+    pure subroutine xpay(y, a, x, z)
+        real(wp), intent(in), contiguous :: y(:)
+        real(wp), intent(in) :: a
+        real(wp), intent(in), contiguous :: x(:)
+        real(wp), intent(out), contiguous :: z(:)
+        z = y + a*x
+    end subroutine xpay
+
+    !> y = y + a x.
+    pure subroutine axpy(a, x, y)
+        real(wp), intent(in) :: a
+        real(wp), intent(in), contiguous :: x(:)
+        real(wp), intent(inout), contiguous :: y(:)
+        y = y + a*x
+    end subroutine axpy
+
+    !> Exchange two work arrays without copying.
+    subroutine swap(a, b)
+        real(wp), allocatable, intent(inout) :: a(:), b(:)
+        real(wp), allocatable :: tmp(:)
+        call move_alloc(a, tmp)
+        call move_alloc(b, a)
+        call move_alloc(tmp, b)
+    end subroutine swap
+
+    !> Root mean square of v.
+    pure real(wp) function rms(v)
+        real(wp), intent(in) :: v(:)
+        rms = sqrt(sum(v**2)/max(1, size(v)))
+    end function rms
+
+    !> |f1 - f2| / |y1 - y2| for two stages at the same time (0 when y1 = y2).
+    pure real(wp) function spectral_estimate(f1, f2, y1, y2) result(rho)
+        real(wp), intent(in) :: f1(:), f2(:), y1(:), y2(:)
+        real(wp) :: nf, ny
+        integer :: l
+        nf = 0.0_wp
+        ny = 0.0_wp
+        do l = 1, size(f1)
+            nf = nf + (f1(l) - f2(l))**2
+            ny = ny + (y1(l) - y2(l))**2
+        end do
+        rho = 0.0_wp
+        if (ny > 0.0_wp) rho = sqrt(nf/ny)
+    end function spectral_estimate
+
+    !> Count stability-limited steps; fail when a whole window was held at a crawl.
+    subroutine monitor_stiffness(self, h, err)
+        class(erk_t), intent(inout) :: self
+        real(wp), intent(in) :: h
+        type(error_t), allocatable, intent(out) :: err
+        real(wp) :: rate
+        character(len=160) :: buffer
+        self%window_steps = self%window_steps + 1
+        if (h*self%rho > STIFF_FRACTION*self%tab%stability_limit) &
+            self%stiff_steps = self%stiff_steps + 1
+        if (self%window_steps < STIFF_WINDOW) return
+        rate = self%window_steps/max(self%t - self%window_start, tiny(1.0_wp))
+        self%stiff_share = real(self%stiff_steps, wp)/self%window_steps
+        if (self%fail_rate > 0.0_wp .and. rate > self%fail_rate .and. &
+            self%stiff_share >= 0.5_wp) then
+            write (buffer, '(a, es9.2, a, es9.2, a, es9.2, a)') 'the problem is too stiff '// &
+                'for an explicit method here: the step is held by stability (h rho = ', &
+                h*self%rho, ' with a spectral radius rho of about ', self%rho, &
+                ' 1/s), which takes ', rate, ' steps per simulated second'
+            self%stiff_stop = .true.
+            call self%failure(err, trim(buffer)//'; use method = ''auto'' (it switches '// &
+                              'to an implicit method where this happens) or ''mebdf''')
+            return
+        end if
+        self%window_steps = 0
+        self%stiff_steps = 0
+        self%window_start = self%t
+    end subroutine monitor_stiffness
+
+    !> g at the new step point and the increment of the quadratures over the step: the
+    !! integral of the polynomial through the last (up to) four values of g.
+    subroutine accept_quadrature(self, status)
+        class(erk_t), intent(inout) :: self
+        integer, intent(out) :: status
+        integer :: j
+        if (self%nqh == 4) then
+            do j = 0, 2
+                self%gq(:, j) = self%gq(:, j + 1)
+                self%tq(j) = self%tq(j + 1)
+            end do
+            self%nqh = 3
+        end if
+        call self%problem%quad_rhs(self%t, self%y, self%gq(:, self%nqh), status)
+        if (status /= STATUS_OK .or. .not. all(ieee_is_finite(self%gq(:, self%nqh)))) then
+            if (status == STATUS_OK) status = STATUS_FATAL
+            return
+        end if
+        self%tq(self%nqh) = self%t
+        self%nqh = self%nqh + 1
+        self%yq_old = self%yq
+        self%yq = self%yq_old + self%quad_integral(self%t_old, self%t)
+    end subroutine accept_quadrature
+
+    !> Integral from a to b (within the last step) of the polynomial through the
+    !! quadrature history, by two-point Gauss-Legendre (exact for cubics).
+    function quad_integral(self, a, b) result(q)
+        class(erk_t), intent(in) :: self
+        real(wp), intent(in) :: a, b
+        real(wp) :: q(self%nq)
+        real(wp) :: x(2), lj
+        integer :: g, i, j, m
+        m = self%nqh
+        x = 0.5_wp*(a + b) + [-0.5_wp, 0.5_wp]*(b - a)/sqrt(3.0_wp)
+        q = 0.0_wp
+        do g = 1, 2
+            do j = 0, m - 1
+                lj = 1.0_wp
+                do i = 0, m - 1
+                    if (i /= j) lj = lj*(x(g) - self%tq(i))/(self%tq(j) - self%tq(i))
+                end do
+                q = q + (0.5_wp*(b - a)*lj)*self%gq(:, j)
+            end do
+        end do
+    end function quad_integral
+
+    !> The solution at tt within the last accepted step (t_old .. t).
+    subroutine dense(self, tt, y, yq)
+        class(erk_t), intent(in) :: self
+        real(wp), intent(in) :: tt
+        real(wp), intent(inout) :: y(:)
+        real(wp), intent(inout) :: yq(:)
+        real(wp) :: th, th1, h
+        integer :: j
+        if (tt >= self%t) then
+            y = self%y
+            if (self%nq > 0) yq(1:self%nq) = self%yq
+            return
+        end if
+        h = self%h_old
+        th = (tt - self%t_old)/h
+        th1 = 1.0_wp - th
+        ! y(th) = y0 + th (dy + th1 (bspl + th (dy - h f1 - bspl + th1 r5))),
+        ! dy = y1 - y0, bspl = h f0 - dy; r5 = 0 gives the cubic Hermite interpolant
+        associate (f0 => self%k(:, 1), f1 => self%k(:, self%s), y0 => self%y_old, &
+                   y1 => self%y)
+            if (self%tab%dp5_dense) then
+                y = 0.0_wp
+                do j = 1, self%s
+                    if (self%tab%d(j) /= 0.0_wp) y = y + (h*self%tab%d(j))*self%k(:, j)
+                end do
+                y = y0 + th*((y1 - y0) + th1*((h*f0 - (y1 - y0)) + th*(((y1 - y0) - h*f1 &
+                    - (h*f0 - (y1 - y0))) + th1*y)))
+            else
+                y = y0 + th*((y1 - y0) + th1*((h*f0 - (y1 - y0)) + th*((y1 - y0) - h*f1 &
+                    - (h*f0 - (y1 - y0)))))
+            end if
+        end associate
+        if (self%nq > 0) yq(1:self%nq) = self%yq_old + self%quad_integral(self%t_old, tt)
+    end subroutine dense
+
+    subroutine failure(self, err, cause)
+        class(erk_t), intent(in) :: self
+        type(error_t), allocatable, intent(out) :: err
+        character(len=*), intent(in) :: cause
+        character(len=96) :: buffer
+        write (buffer, '(a, es12.5, a, es11.3e3, a, i0)') 't = ', self%t, ' s, step size ', &
+            self%h, ' s, order ', self%tab%order
+        call make_error(err, ERR_SOLVER, 'erk failed at '//trim(buffer)//': '//cause)
+    end subroutine failure
+
+    function erk_stats(self) result(stats)
+        class(erk_t), intent(in) :: self
+        type(solver_stats_t) :: stats
+        stats = self%counters
+    end function erk_stats
+
+    subroutine erk_finalize(self)
+        class(erk_t), intent(inout) :: self
+        self%problem => null()
+        if (allocated(self%y)) deallocate (self%y, self%y_old, self%ynew, self%ytmp, &
+                                           self%yprev, self%k, self%atol)
+        if (allocated(self%yq)) deallocate (self%yq, self%yq_old, self%gq)
+        self%started = .false.
+    end subroutine erk_finalize
+end module ropedyn_erk

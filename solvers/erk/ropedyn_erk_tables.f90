@@ -1,0 +1,166 @@
+!> Butcher tables of the embedded explicit Runge-Kutta pairs behind `method = 'erk'`
+!! (docs/solvers-explicit.md says how they were chosen).
+!!
+!! Each table is first-same-as-last (FSAL): its last stage is f at the new solution and
+!! serves as the first stage of the next step, so a step costs `stages - 1` evaluations
+!! of f. The propagated solution has order `order`; the embedded one, whose difference
+!! gives the error estimate, order `order - 1`. The last two stages are both at c = 1, so
+!! their difference gives an estimate of the spectral radius along the error (Hairer's
+!! stiffness detection) at no cost.
+!!
+!! | max_order | pair | stages (f per step) | on the imaginary axis |
+!! |---|---|---|---|
+!! | 3 | Bogacki-Shampine 3(2) | 4 (3) | stable for h omega <= 1.73 |
+!! | 4 | classical RK4 with the 3rd-order estimate from f(y1) | 5 (4) | 2.83 |
+!! | 5 | Dormand-Prince 5(4) | 7 (6) | 0.997 (3.3 with the rope's damping) |
+module ropedyn_erk_tables
+    use ropedyn_kinds, only: wp
+    implicit none
+    private
+    public :: erk_table_t, erk_table, ERK_MAX_STAGES
+
+    integer, parameter :: ERK_MAX_STAGES = 7
+
+    !> One embedded pair.
+    type :: erk_table_t
+        character(len=32) :: name = ''
+        integer :: order = 0                 !< order of the propagated solution
+        integer :: stages = 0                !< stages per step, the FSAL stage included
+        real(wp) :: a(ERK_MAX_STAGES, ERK_MAX_STAGES) = 0.0_wp  !< a(i, j), j < i
+        real(wp) :: b(ERK_MAX_STAGES) = 0.0_wp   !< weights of the solution (= a(stages, :))
+        real(wp) :: c(ERK_MAX_STAGES) = 0.0_wp   !< nodes
+        real(wp) :: e(ERK_MAX_STAGES) = 0.0_wp   !< b - bhat: the error estimate is h sum e_i k_i
+        !> Hairer's continuous extension of Dormand-Prince 5(4) (4th order); without it,
+        !! the cubic Hermite interpolant of y and f at both ends of the step (3rd order)
+        logical :: dp5_dense = .false.
+        real(wp) :: d(ERK_MAX_STAGES) = 0.0_wp   !< its coefficients
+        !> h |lambda| below which every eigenvalue near the imaginary axis is stable (what
+        !! the stiffness test of the step compares h rho with)
+        real(wp) :: stability_limit = 0.0_wp
+        !> coefficients of the stability polynomial R(z) = sum_k gamma(k) z^k
+        real(wp) :: gamma(0:ERK_MAX_STAGES) = 0.0_wp
+    contains
+        procedure :: evals_per_step => table_evals_per_step
+        procedure :: amplification => table_amplification
+    end type erk_table_t
+
+contains
+
+    !> The pair of a given order (3, 4 or 5); an empty table (stages = 0) for any other.
+    pure function erk_table(order) result(tab)
+        integer, intent(in) :: order
+        type(erk_table_t) :: tab
+        select case (order)
+        case (3)
+            tab = bogacki_shampine()
+        case (4)
+            tab = rk4_fsal()
+        case (5)
+            tab = dormand_prince()
+        case default
+            return
+        end select
+        call set_gamma(tab)
+    end function erk_table
+
+    !> Evaluations of f per accepted step without rejections (the FSAL stage is reused).
+    pure integer function table_evals_per_step(self) result(evals)
+        class(erk_table_t), intent(in) :: self
+        evals = self%stages - 1
+    end function table_evals_per_step
+
+    !> |R(z)|: the amplification of one step for y' = lambda y, z = h lambda.
+    pure real(wp) function table_amplification(self, z) result(amp)
+        class(erk_table_t), intent(in) :: self
+        complex(wp), intent(in) :: z
+        complex(wp) :: r
+        integer :: k
+        r = cmplx(self%gamma(self%stages), 0.0_wp, wp)
+        do k = self%stages - 1, 0, -1
+            r = r*z + self%gamma(k)
+        end do
+        amp = abs(r)
+    end function table_amplification
+
+    !> gamma(k) = b^T A^(k-1) 1 (gamma(0) = 1): the stability polynomial of the table.
+    pure subroutine set_gamma(tab)
+        type(erk_table_t), intent(inout) :: tab
+        real(wp) :: v(ERK_MAX_STAGES)
+        integer :: k, s
+        s = tab%stages
+        tab%gamma = 0.0_wp
+        tab%gamma(0) = 1.0_wp
+        v = 0.0_wp
+        v(1:s) = 1.0_wp
+        do k = 1, s
+            tab%gamma(k) = dot_product(tab%b(1:s), v(1:s))
+            v(1:s) = matmul(tab%a(1:s, 1:s), v(1:s))
+        end do
+    end subroutine set_gamma
+
+    !> Bogacki & Shampine (1989), the 3(2) pair of MATLAB's ode23.
+    pure function bogacki_shampine() result(tab)
+        type(erk_table_t) :: tab
+        tab%name = 'Bogacki-Shampine 3(2)'
+        tab%order = 3
+        tab%stages = 4
+        tab%c(1:4) = [0.0_wp, 0.5_wp, 0.75_wp, 1.0_wp]
+        tab%a(2, 1) = 0.5_wp
+        tab%a(3, 2) = 0.75_wp
+        tab%a(4, 1:3) = [2.0_wp/9.0_wp, 1.0_wp/3.0_wp, 4.0_wp/9.0_wp]
+        tab%b(1:4) = tab%a(4, 1:4)
+        ! bhat = (7/24, 1/4, 1/3, 1/8)
+        tab%e(1:4) = tab%b(1:4) - [7.0_wp/24.0_wp, 0.25_wp, 1.0_wp/3.0_wp, 0.125_wp]
+        tab%stability_limit = sqrt(3.0_wp)
+    end function bogacki_shampine
+
+    !> The classical 4th-order method, with a fifth stage f(y1) (FSAL) that gives a
+    !! 3rd-order embedded solution bhat = (1/6, 1/3, 1/3, 0, 1/6): the stage at y0 + h k3
+    !! is replaced by the one at y1 (order conditions checked in tests/unit/test_erk.f90).
+    !! The error estimate is h (k4 - k5)/6. Its stability interval on the imaginary axis,
+    !! 2 sqrt(2) for 4 evaluations, is the longest per evaluation of the three pairs.
+    pure function rk4_fsal() result(tab)
+        type(erk_table_t) :: tab
+        tab%name = 'RK4 with 3rd-order estimate'
+        tab%order = 4
+        tab%stages = 5
+        tab%c(1:5) = [0.0_wp, 0.5_wp, 0.5_wp, 1.0_wp, 1.0_wp]
+        tab%a(2, 1) = 0.5_wp
+        tab%a(3, 2) = 0.5_wp
+        tab%a(4, 3) = 1.0_wp
+        tab%a(5, 1:4) = [1.0_wp/6.0_wp, 1.0_wp/3.0_wp, 1.0_wp/3.0_wp, 1.0_wp/6.0_wp]
+        tab%b(1:5) = tab%a(5, 1:5)
+        tab%e(4) = 1.0_wp/6.0_wp
+        tab%e(5) = -1.0_wp/6.0_wp
+        tab%stability_limit = 2.0_wp*sqrt(2.0_wp)
+    end function rk4_fsal
+
+    !> Dormand & Prince (1980), the 5(4) pair of DOPRI5 and MATLAB's ode45, with Hairer's
+    !! continuous extension (Hairer, Norsett & Wanner, Solving ODEs I, II.6).
+    pure function dormand_prince() result(tab)
+        type(erk_table_t) :: tab
+        tab%name = 'Dormand-Prince 5(4)'
+        tab%order = 5
+        tab%stages = 7
+        tab%c(1:7) = [0.0_wp, 0.2_wp, 0.3_wp, 0.8_wp, 8.0_wp/9.0_wp, 1.0_wp, 1.0_wp]
+        tab%a(2, 1) = 0.2_wp
+        tab%a(3, 1:2) = [3.0_wp/40.0_wp, 9.0_wp/40.0_wp]
+        tab%a(4, 1:3) = [44.0_wp/45.0_wp, -56.0_wp/15.0_wp, 32.0_wp/9.0_wp]
+        tab%a(5, 1:4) = [19372.0_wp/6561.0_wp, -25360.0_wp/2187.0_wp, 64448.0_wp/6561.0_wp, &
+                         -212.0_wp/729.0_wp]
+        tab%a(6, 1:5) = [9017.0_wp/3168.0_wp, -355.0_wp/33.0_wp, 46732.0_wp/5247.0_wp, &
+                         49.0_wp/176.0_wp, -5103.0_wp/18656.0_wp]
+        tab%a(7, 1:6) = [35.0_wp/384.0_wp, 0.0_wp, 500.0_wp/1113.0_wp, 125.0_wp/192.0_wp, &
+                         -2187.0_wp/6784.0_wp, 11.0_wp/84.0_wp]
+        tab%b(1:7) = tab%a(7, 1:7)
+        tab%e(1:7) = [71.0_wp/57600.0_wp, 0.0_wp, -71.0_wp/16695.0_wp, 71.0_wp/1920.0_wp, &
+                      -17253.0_wp/339200.0_wp, 22.0_wp/525.0_wp, -1.0_wp/40.0_wp]
+        tab%dp5_dense = .true.
+        tab%d(1:7) = [-12715105075.0_wp/11282082432.0_wp, 0.0_wp, &
+                      87487479700.0_wp/32700410799.0_wp, -10690763975.0_wp/1880347072.0_wp, &
+                      701980252875.0_wp/199316789632.0_wp, -1453857185.0_wp/822651844.0_wp, &
+                      69997945.0_wp/29380423.0_wp]
+        ! Hairer's stiffness test for DOPRI5 compares h rho with 3.25
+        tab%stability_limit = 3.25_wp
+    end function dormand_prince
+end module ropedyn_erk_tables

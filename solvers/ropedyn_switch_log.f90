@@ -1,0 +1,73 @@
+!> The record of what an integrator changed during a run: which method it ran from when,
+!! with which order limit, and why (`method = 'auto'` switching between an explicit and an
+!! implicit integrator, CVODE lowering and restoring its maximum order). The run driver
+!! writes it to `/solver/switch_*` and prints it in the run summary (docs/output.md).
+module ropedyn_switch_log
+    use ropedyn_kinds, only: wp
+    implicit none
+    private
+    public :: switch_event_t, switch_log_t
+
+    !> One change: from time t on, `method` runs with order limit `max_order`.
+    type :: switch_event_t
+        real(wp) :: t = 0.0_wp                   !< s
+        character(len=16) :: method = ''         !< the integrator in use from t on
+        integer :: max_order = 0                 !< its order limit from t on
+        character(len=:), allocatable :: reason  !< why, for people
+        !> the user should be told while the run goes on (printed once on stderr)
+        logical :: warning = .false.
+    end type switch_event_t
+
+    !> A growing list of events.
+    type :: switch_log_t
+        type(switch_event_t), allocatable :: events(:)
+        integer :: count = 0
+    contains
+        procedure :: add => log_add
+        procedure :: items => log_items
+        procedure :: clear => log_clear
+    end type switch_log_t
+
+contains
+
+    subroutine log_add(self, t, method, max_order, reason, warning)
+        class(switch_log_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        character(len=*), intent(in) :: method
+        integer, intent(in) :: max_order
+        character(len=*), intent(in) :: reason
+        logical, intent(in), optional :: warning
+        type(switch_event_t), allocatable :: grown(:)
+        if (.not. allocated(self%events)) allocate (self%events(8))
+        if (self%count == size(self%events)) then
+            allocate (grown(2*size(self%events)))
+            grown(1:self%count) = self%events(1:self%count)
+            call move_alloc(grown, self%events)
+        end if
+        self%count = self%count + 1
+        associate (e => self%events(self%count))
+            e%t = t
+            e%method = method
+            e%max_order = max_order
+            e%reason = reason
+            e%warning = .false.
+            if (present(warning)) e%warning = warning
+        end associate
+    end subroutine log_add
+
+    !> The events so far, oldest first.
+    function log_items(self) result(events)
+        class(switch_log_t), intent(in) :: self
+        type(switch_event_t), allocatable :: events(:)
+        if (self%count == 0) then
+            allocate (events(0))
+        else
+            events = self%events(1:self%count)
+        end if
+    end function log_items
+
+    subroutine log_clear(self)
+        class(switch_log_t), intent(inout) :: self
+        self%count = 0
+    end subroutine log_clear
+end module ropedyn_switch_log
