@@ -47,6 +47,8 @@ contains
         if (allocated(err)) return
         call check_initial_and_fluid(keys, scene, err)
         if (allocated(err)) return
+        call check_state_file(keys, scene, err)
+        if (allocated(err)) return
         call check_attachments(keys, scene, err)
         if (allocated(err)) return
         call check_solver(keys, scene, err)
@@ -133,6 +135,37 @@ contains
                 rows, err)
         end if
     end subroutine check_motion
+
+    !> `&initial shape = 'state'` needs `state_file`, an existing file (a relative path is
+    !! resolved against the scene file's directory); the record is read by the run.
+    subroutine check_state_file(keys, scene, err)
+        type(scene_key_t), intent(inout) :: keys(:)
+        type(scene_t), intent(in) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: full
+        logical :: exists
+        integer :: k
+        if (scene%initial%shape /= 'state') return
+        k = find_key(keys, G_INITIAL, 'state_file')
+        if (len_trim(keys(k)%s) == 0) then
+            call fail(keys, G_INITIAL, 'state_file', "''", 'a run file (HDF5) is needed for ' &
+                //'shape = ''state'' (and state_time: the time of its record, < 0 the last)', err)
+            return
+        end if
+        full = absolute_path(trim(keys(k)%s), scene%path)
+        if (len(full) > len(keys(k)%s)) then
+            call fail(keys, G_INITIAL, 'state_file', '"'//full(:40)//'..."', &
+                'too long (at most '//int_text(len(keys(k)%s))//' characters)', err)
+            return
+        end if
+        inquire (file=full, exist=exists)
+        if (.not. exists) then
+            call fail(keys, G_INITIAL, 'state_file', '"'//trim(keys(k)%s)//'"', 'no such file (' &
+                //full//')', err)
+            return
+        end if
+        keys(k)%s = full
+    end subroutine check_state_file
 
     subroutine check_initial_and_fluid(keys, scene, err)
         type(scene_key_t), intent(in) :: keys(:)

@@ -38,7 +38,7 @@ contains
         type(scene_key_t), allocatable, intent(out) :: keys(:)
         integer :: n
 
-        allocate (keys(96))
+        allocate (keys(98))
         n = 0
         associate (r => scene%rope, m => scene%model, s => scene%supports, &
                 i => scene%initial, e => scene%effects, v => scene%solver, o => scene%output, &
@@ -90,7 +90,7 @@ contains
                 s%bottom_angle_phase_deg, s%bottom_table, s%bottom_release_time)
 
             call add_name(G_INITIAL, 'shape', i%shape, &
-                'straight, hanging, equilibrium, mode, folded', 'initial shape of the rope')
+                'straight, hanging, equilibrium, mode, folded, state', 'initial shape of the rope')
             call add_real(G_INITIAL, 'angle_deg', i%angle_deg, R_FINITE, 'deg', &
                 'angle of the straight initial rope from down x')
             call add_int(G_INITIAL, 'mode', i%mode, R_AT_LEAST, 1, &
@@ -99,6 +99,10 @@ contains
                 "shape 'mode': largest displacement")
             call add_pair(G_INITIAL, 'velocity', i%velocity, R_FINITE, 'm/s', &
                 'initial velocity (x, y) of every element')
+            call add_path(G_INITIAL, 'state_file', i%state_file, &
+                "shape 'state': run file (HDF5) whose record starts the run")
+            call add_real(G_INITIAL, 'state_time', i%state_time, R_FINITE, 's', &
+                "shape 'state': time of the record (nearest); < 0: the last")
 
             call add_logical(G_EFFECTS, 'gravity', e%gravity, 'the weight of the rope')
             call add_logical(G_EFFECTS, 'tension', e%tension, 'the axial springs')

@@ -37,6 +37,7 @@ module ropedyn_rope_model
         procedure(coordinate_mass_i), deferred :: coordinate_mass
         procedure :: has_second_order => rope_has_second_order
         procedure :: second_order_layout => rope_second_order_layout
+        procedure :: state_from_fields => rope_state_from_fields
     end type rope_model_t
 
     abstract interface
@@ -138,6 +139,19 @@ contains
         kl = size(pos) - 1
         ku = kl
     end subroutine rope_second_order_layout
+
+    !> The ODE state y whose element fields (`fields`) at time t are q, qdot: the inverse of
+    !! `fields`, to start a run from a stored record (`&initial shape = 'state'`). `ok` is
+    !! .false. for a model that cannot do it (the default).
+    pure subroutine rope_state_from_fields(self, q, qdot, t, y, ok)
+        class(rope_model_t), intent(in) :: self
+        real(wp), intent(in) :: q(:, :), qdot(:, :)  !< (3, elements): x, y, phi and rates
+        real(wp), intent(in) :: t                    !< s
+        real(wp), intent(out) :: y(:)
+        logical, intent(out) :: ok
+        y = 0.0_wp
+        ok = .false.
+    end subroutine rope_state_from_fields
 
     !> T + V (kinetic + elastic + gravity), J.
     pure real(wp) function energy_total(self) result(e)

@@ -83,12 +83,17 @@ module ropedyn_rope_spec
     type :: initial_params_t
         !> 'straight' | 'hanging' | 'equilibrium' (static equilibrium, at rest) | 'mode'
         !! (equilibrium plus mode `mode` with largest point displacement `mode_amplitude`)
+        !! | 'folded' | 'state' (a record of an earlier run's file: `state_file`, `state_time`)
         character(len=NAME_LEN) :: shape = 'straight'
         real(wp) :: angle_deg = 75.0_wp   !< angle of the straight rope from down x [deg]
         integer :: mode = 1                      !< shape 'mode': which mode (1 = lowest) [-]
         real(wp) :: mode_amplitude = 0.01_wp     !< shape 'mode': largest displacement [m]
         !> shape 'folded': the rope doubled up from its top anchor (both ends there)
         real(wp) :: velocity(2) = 0.0_wp  !< initial velocity of every element (x, y) [m/s]
+        !> shape 'state': the run file (HDF5) whose record starts this run
+        character(len=PATH_LEN) :: state_file = ''
+        !> shape 'state': time of that record [s] (the nearest record); < 0: the last one
+        real(wp) :: state_time = -1.0_wp
     end type initial_params_t
 
     !> `&effects`: switches for the physical effects.

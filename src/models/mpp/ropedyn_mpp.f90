@@ -103,6 +103,7 @@ module ropedyn_mpp
         procedure :: model_name => mpp_model_name
         procedure :: initial_state => mpp_initial_state
         procedure :: fields => mpp_fields
+        procedure :: state_from_fields => mpp_state_from_fields
         procedure :: polyline => mpp_polyline
         procedure :: element_data => mpp_element_data
         procedure :: residual => mpp_residual
@@ -501,6 +502,40 @@ contains
         qdot(1:2, :) = cd
         qdot(3, :) = y(self%ndof + 1:self%ndof + self%n)
     end subroutine mpp_fields
+
+    !> The inverse of `mpp_fields`: phi_i and its rate are stored; the elongation follows
+    !! from the rod centre, C_i = P_{i-1} + (u_i + l/2) e_i, with P_i = C_i + (l/2) e_i and
+    !! P_0 the top joint at t, and its rate u_i' = (C_i' - P_{i-1}') . e_i (C_i - P_{i-1} is
+    !! along e_i, so e_i' = phi_i' n_i drops out), P_i' = C_i' + (l/2) phi_i' n_i.
+    pure subroutine mpp_state_from_fields(self, q, qdot, t, y, ok)
+        class(mpp_t), intent(in) :: self
+        real(wp), intent(in) :: q(:, :), qdot(:, :)
+        real(wp), intent(in) :: t  !< s: places a moving top joint
+        real(wp), intent(out) :: y(:)
+        logical, intent(out) :: ok
+        real(wp) :: p(2, 0:self%n), c(2, self%n), pd(2, 0:self%n), cd(2, self%n)
+        real(wp) :: prev(2), prevd(2), e(2), nv(2)
+        integer :: k
+        y = 0.0_wp
+        ok = size(q, 2) == self%n .and. size(qdot, 2) == self%n .and. &
+             size(y) == 2*self%ndof
+        if (.not. ok) return
+        call self%positions(y, p, c, pd, cd, t)
+        prev = p(:, 0)
+        prevd = pd(:, 0)
+        do k = 1, self%n
+            e = [cos(q(3, k)), sin(q(3, k))]
+            nv = [-e(2), e(1)]
+            y(k) = q(3, k)
+            y(self%ndof + k) = qdot(3, k)
+            if (self%nu > 0) then
+                y(self%n + k) = dot_product(q(1:2, k) - prev, e) - 0.5_wp*self%l
+                y(self%ndof + self%n + k) = dot_product(qdot(1:2, k) - prevd, e)
+            end if
+            prev = q(1:2, k) + 0.5_wp*self%l*e
+            prevd = qdot(1:2, k) + 0.5_wp*self%l*qdot(3, k)*nv
+        end do
+    end subroutine mpp_state_from_fields
 
     !> Member i drawn from joint P_{i-1} to joint P_i (spring and rod).
     subroutine mpp_polyline(self, y, points, t)

@@ -117,6 +117,7 @@ module ropedyn_rfem
         procedure :: model_name => rfem_model_name
         procedure :: initial_state => rfem_initial_state
         procedure :: fields => rfem_fields
+        procedure :: state_from_fields => rfem_state_from_fields
         procedure :: polyline => rfem_polyline
         procedure :: element_data => rfem_element_data
         procedure :: coordinates => rfem_coordinates
@@ -502,6 +503,23 @@ contains
             qdot(:, i) = y(6*(i - 1) + 4:6*(i - 1) + 6)
         end do
     end subroutine rfem_fields
+
+    !> The state holds the fields themselves: y(6(i-1)+1..3) = q(:, i), +4..6 = qdot(:, i).
+    pure subroutine rfem_state_from_fields(self, q, qdot, t, y, ok)
+        class(rfem_t), intent(in) :: self
+        real(wp), intent(in) :: q(:, :), qdot(:, :)
+        real(wp), intent(in) :: t  !< not needed
+        real(wp), intent(out) :: y(:)
+        logical, intent(out) :: ok
+        integer :: i
+        y = 0.0_wp
+        ok = size(q, 2) == self%n .and. size(qdot, 2) == self%n .and. size(y) == 6*self%n
+        if (.not. ok) return
+        do i = 1, self%n
+            y(6*(i - 1) + 1:6*(i - 1) + 3) = q(:, i)
+            y(6*(i - 1) + 4:6*(i - 1) + 6) = qdot(:, i)
+        end do
+    end subroutine rfem_state_from_fields
 
     subroutine rfem_polyline(self, y, points, t)
         class(rfem_t), intent(in) :: self

@@ -1,0 +1,158 @@
+!> One record of a run file as a starting point (`&initial shape = 'state'`): the record
+!! nearest a requested time, its element fields (/state/q, /state/qdot), the energy
+!! quadratures written with it (/energy/dissipated, /energy/support_work), and, when the file
+!! holds the model's native ODE state (/state/y, /state/yq: restart data), that state too.
+!! The model turns the fields back into its ODE state (`state_from_fields`) when there is no
+!! native state. docs/output.md, "Starting from a record".
+module ropedyn_state_record
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use hdf5, only: hsize_t
+    use ropedyn_kinds, only: wp
+    use ropedyn_text, only: int_text, real_text
+    use ropedyn_error, only: error_t, make_error, ERR_INPUT
+    use ropedyn_h5, only: h5_file_t
+    implicit none
+    private
+    public :: state_record_t, read_state_record
+
+    !> A record of a run file.
+    type, public :: state_record_t
+        integer :: record = -1                  !< its index, 0-based as h5py counts
+        integer :: records = 0                  !< complete records in the file
+        real(wp) :: t = 0.0_wp                  !< its time, s
+        character(len=:), allocatable :: model  !< root attribute `model` (rfem, mpp)
+        integer :: n = 0                        !< elements
+        real(wp), allocatable :: q(:, :)        !< (3, n): x, y (m), phi (rad) per element
+        real(wp), allocatable :: qdot(:, :)     !< (3, n): their rates
+        real(wp) :: dissipated = 0.0_wp         !< J
+        real(wp) :: support_work = 0.0_wp       !< J
+        real(wp), allocatable :: y(:)           !< native ODE state (restart data), if stored
+        real(wp), allocatable :: yq(:)          !< its quadratures, if stored
+    end type state_record_t
+
+contains
+
+    !> The record of the run file `path` whose time is nearest `state_time` (s; < 0: the
+    !! last complete record). ERR_INPUT names the file and what is wrong: no such file, not a
+    !! run file (no /time, /state/q, model attribute), no complete record, `state_time`
+    !! outside the file's times (by more than half the largest record spacing), a state
+    !! that is not finite. ERR_IO: the file cannot be read.
+    subroutine read_state_record(path, state_time, rec, err)
+        character(len=*), intent(in) :: path
+        real(wp), intent(in) :: state_time
+        type(state_record_t), intent(out) :: rec
+        type(error_t), allocatable, intent(out) :: err
+        type(h5_file_t) :: h5
+        type(error_t), allocatable :: close_err
+        real(wp), allocatable :: time(:), values(:)
+        integer(hsize_t) :: dims1(1), dims2(2), dims3(3)
+        logical :: exists, found
+        real(wp) :: slack
+        integer :: k, nt
+
+        inquire (file=path, exist=exists)
+        if (.not. exists) then
+            call make_error(err, ERR_INPUT, path//': no such file')
+            return
+        end if
+        call h5%open(path, err)
+        if (allocated(err)) then
+            err%code = ERR_INPUT  ! not an HDF5 file: bad input
+            return
+        end if
+        steps: block
+            call h5%read_attribute('model', rec%model, err, found)
+            if (allocated(err)) exit steps
+            if (.not. (found .and. h5%exists('/time') .and. h5%exists('/state/q') .and. &
+                       h5%exists('/state/qdot'))) then
+                call make_error(err, ERR_INPUT, path//': not a run file of ropedyn (it needs '// &
+                                'the root attribute model, /time, /state/q and /state/qdot)')
+                exit steps
+            end if
+            call h5%read_reals('/time', time, dims1, err)
+            if (allocated(err)) exit steps
+            ! /time is written last in a record: its length counts the complete records
+            nt = size(time)
+            rec%records = nt
+            if (nt == 0) then
+                call make_error(err, ERR_INPUT, path//': no complete record')
+                exit steps
+            end if
+            if (state_time < 0.0_wp) then
+                k = nt
+            else
+                k = minloc(abs(time - state_time), dim=1)
+                slack = 1.0e-9_wp*max(1.0_wp, abs(state_time))
+                if (nt > 1) slack = slack + 0.5_wp*maxval(time(2:) - time(:nt - 1))
+                if (abs(time(k) - state_time) > slack) then
+                    call make_error(err, ERR_INPUT, path//': no record at t = '// &
+                        real_text(state_time)//' s (the records span '//real_text(time(1))// &
+                        ' .. '//real_text(time(nt))//' s)')
+                    exit steps
+                end if
+            end if
+            rec%record = k - 1
+            rec%t = time(k)
+
+            call h5%read_reals('/state/q', values, dims3, err)
+            if (allocated(err)) exit steps
+            rec%n = int(dims3(2))
+            if (dims3(1) /= 3 .or. dims3(3) < nt) then
+                call make_error(err, ERR_INPUT, path//': /state/q: not (times, n, 3) with '// &
+                                int_text(nt)//' records')
+                exit steps
+            end if
+            rec%q = reshape(values(3*rec%n*(k - 1) + 1:3*rec%n*k), [3, rec%n])
+            call h5%read_reals('/state/qdot', values, dims3, err)
+            if (allocated(err)) exit steps
+            if (dims3(1) /= 3 .or. dims3(2) /= rec%n .or. dims3(3) < nt) then
+                call make_error(err, ERR_INPUT, path//': /state/qdot: not (times, '// &
+                                int_text(rec%n)//', 3) with '//int_text(nt)//' records')
+                exit steps
+            end if
+            rec%qdot = reshape(values(3*rec%n*(k - 1) + 1:3*rec%n*k), [3, rec%n])
+
+            call read_scalar_record('/energy/dissipated', rec%dissipated)
+            if (allocated(err)) exit steps
+            call read_scalar_record('/energy/support_work', rec%support_work)
+            if (allocated(err)) exit steps
+
+            ! the native state, where the writer stores it (restart data)
+            if (h5%exists('/state/y') .and. h5%exists('/state/yq')) then
+                call h5%read_reals('/state/y', values, dims2, err)
+                if (allocated(err)) exit steps
+                if (dims2(2) >= nt) rec%y = values(dims2(1)*(k - 1) + 1:dims2(1)*k)
+                call h5%read_reals('/state/yq', values, dims2, err)
+                if (allocated(err)) exit steps
+                if (dims2(2) >= nt) rec%yq = values(dims2(1)*(k - 1) + 1:dims2(1)*k)
+                if (.not. (allocated(rec%y) .and. allocated(rec%yq))) then
+                    if (allocated(rec%y)) deallocate (rec%y)
+                    if (allocated(rec%yq)) deallocate (rec%yq)
+                end if
+            end if
+
+            if (.not. (all(ieee_is_finite(rec%q)) .and. all(ieee_is_finite(rec%qdot)) .and. &
+                       ieee_is_finite(rec%t) .and. ieee_is_finite(rec%dissipated) .and. &
+                       ieee_is_finite(rec%support_work))) then
+                call make_error(err, ERR_INPUT, path//': record '//int_text(rec%record)// &
+                                ' (t = '//real_text(rec%t)//' s): the state is not finite')
+                exit steps
+            end if
+        end block steps
+        call h5%close(close_err)
+        if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
+    contains
+        !> Record k of a (times,) series; 0 when the file has no such dataset.
+        subroutine read_scalar_record(name, value)
+            character(len=*), intent(in) :: name
+            real(wp), intent(out) :: value
+            real(wp), allocatable :: series(:)
+            integer(hsize_t) :: d(1)
+            value = 0.0_wp
+            if (.not. h5%exists(name)) return
+            call h5%read_reals(name, series, d, err)
+            if (allocated(err)) return
+            if (size(series) >= k) value = series(k)
+        end subroutine read_scalar_record
+    end subroutine read_state_record
+end module ropedyn_state_record
