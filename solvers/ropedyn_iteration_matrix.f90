@@ -25,6 +25,11 @@ module ropedyn_iteration_matrix
     private
     public :: iteration_matrix_t
 
+    !> Bandwidths of the RFEM's reduced matrix (3 x 3 blocks, block tridiagonal): its solve
+    !! has a copy of the band loops with these as constants, whose inner loops the compiler
+    !! unrolls completely (half the instructions of the general loops at trip count 5).
+    integer, parameter :: RFEM_KL = 5
+
     !> Where the reduced blocks come from.
     integer, parameter :: BLOCKS_OWN_FORM = 1     !< the problem's blocks of the form used
     integer, parameter :: BLOCKS_DIFFERENCES = 2  !< difference quotients of the implicit F
@@ -52,6 +57,7 @@ module ropedyn_iteration_matrix
         logical :: vel_contiguous = .false.   !< vel(k) = vel(1) + k - 1
         real(wp), allocatable :: kb(:, :), cb(:, :), mk(:, :)  !< band (kl+ku+1, np), row ku+1+i-j
         real(wp), allocatable :: rlu(:, :)    !< factors (dense np x np or band 2kl+ku+1 x np)
+        integer :: rkv = 0                    !< super-diagonals of the band U actually filled
         integer, allocatable :: ripiv(:)
         real(wp), allocatable :: rq(:), rv(:)
         logical, public :: factored = .false.
@@ -392,7 +398,7 @@ contains
             ! dgbtrf storage: (i, j) at row kl + ku + 1 + i - j of 2 kl + ku + 1 rows
             self%rlu(1:kl, :) = 0.0_wp
             self%rlu(kl + 1:, :) = self%mk - g*self%cb - g2*self%kb
-            call band_lu_factor(np, kl, ku, self%rlu, self%ripiv, info)
+            call band_lu_factor(np, kl, ku, self%rlu, self%ripiv, info, self%rkv)
         end if
         status = merge(STATUS_OK, STATUS_RECOVERABLE, info == 0)
     end subroutine factor_reduced
@@ -477,11 +483,14 @@ contains
             self%rq(i) = b(self%pos(i))
             self%rv(i) = b(self%vel(i))
         end do
-        call band_add_product(np, kl, ku, self%kb, g, self%rq, self%rv)
         if (self%rdense) then
+            call band_add_product(np, kl, ku, self%kb, g, self%rq, self%rv)
             call dgetrs('N', np, 1, self%rlu, np, self%ripiv, self%rv, np, info)
+        else if (kl == RFEM_KL .and. ku == RFEM_KL .and. np > 4*RFEM_KL) then
+            call band_solve_rfem(np, self%kb, g, self%rq, self%rlu, self%ripiv, self%rv)
         else
-            call band_lu_solve(np, kl, ku, self%rlu, self%ripiv, self%rv)
+            call band_add_product(np, kl, ku, self%kb, g, self%rq, self%rv)
+            call band_lu_solve(np, kl, ku, self%rkv, self%rlu, self%ripiv, self%rv)
         end if
         do i = 1, np
             b(self%vel(i)) = self%rv(i)
@@ -565,18 +574,22 @@ contains
     !! the fill-in and must be zero on entry): dgbtf2's algorithm and output, written out
     !! as loops, except that the diagonal of U is stored inverted (the solve multiplies).
     !! For the small bandwidths of the reduced rope matrices (5/5) LAPACK's BLAS calls per
-    !! column cost more than their arithmetic. info = j > 0: U(j, j) = 0.
-    pure subroutine band_lu_factor(n, kl, ku, ab, ipiv, info)
+    !! column cost more than their arithmetic. info = j > 0: U(j, j) = 0. kvu: the number
+    !! of super-diagonals of U that hold fill (ku without row interchanges, at most kl + ku):
+    !! the solve skips the others, which are zero.
+    pure subroutine band_lu_factor(n, kl, ku, ab, ipiv, info, kvu)
         integer, intent(in) :: n, kl, ku
         real(wp), intent(inout) :: ab(2*kl + ku + 1, n)
         integer, intent(out) :: ipiv(n)
         integer, intent(out) :: info
+        integer, intent(out) :: kvu
         integer :: kv, j, jp, km, ju, i, c
         real(wp) :: pivot, big, x, u
 
         kv = kl + ku
         info = 0
         ju = 1
+        kvu = min(ku, n - 1)
         do j = 1, n
             km = min(kl, n - j)
             ! pivot: largest |A(i, j)|, i = j .. j + km (row kv + 1 + i - j)
@@ -594,6 +607,7 @@ contains
                 cycle
             end if
             ju = max(ju, min(j + ku + jp - 1, n))
+            kvu = max(kvu, ju - j)
             if (jp /= 1) then
                 ! swap rows j and j + jp - 1 in columns j .. ju
                 do c = j, ju
@@ -617,9 +631,10 @@ contains
         end do
     end subroutine band_lu_factor
 
-    !> b <- A^{-1} b with the factors of band_lu_factor (dgbtrs's algorithm).
-    pure subroutine band_lu_solve(n, kl, ku, ab, ipiv, b)
-        integer, intent(in) :: n, kl, ku
+    !> b <- A^{-1} b with the factors of band_lu_factor (dgbtrs's algorithm; U's
+    !! super-diagonals beyond kvu are zero and skipped).
+    pure subroutine band_lu_solve(n, kl, ku, kvu, ab, ipiv, b)
+        integer, intent(in) :: n, kl, ku, kvu
         real(wp), intent(in) :: ab(2*kl + ku + 1, n)
         integer, intent(in) :: ipiv(n)
         real(wp), intent(inout) :: b(n)
@@ -644,11 +659,74 @@ contains
         do j = n, 1, -1
             x = b(j)*ab(kv + 1, j)
             b(j) = x
-            do i = max(1, j - kv), j - 1
+            do i = max(1, j - kvu), j - 1
                 b(i) = b(i) - ab(kv + 1 + i - j, j)*x
             end do
         end do
     end subroutine band_lu_solve
+
+    !> band_add_product and band_lu_solve for kl = ku = RFEM_KL (n > 4 kl): y <- y + g K x,
+    !! then y <- A^{-1} y; the same operations in the same order, the interior columns
+    !! with constant trip counts (U's kl + ku super-diagonals all visited: those beyond
+    !! the fill are zero).
+    pure subroutine band_solve_rfem(n, kb, g, x, ab, ipiv, y)
+        integer, intent(in) :: n
+        real(wp), intent(in) :: kb(2*RFEM_KL + 1, n)
+        real(wp), intent(in) :: g
+        real(wp), intent(in) :: x(n)
+        real(wp), intent(in) :: ab(3*RFEM_KL + 1, n)
+        integer, intent(in) :: ipiv(n)
+        real(wp), intent(inout) :: y(n)
+        integer, parameter :: KL = RFEM_KL, KU = RFEM_KL, KV = 2*RFEM_KL
+        integer :: i, j, l
+        real(wp) :: gx, t
+
+        ! y <- y + g K x (column j touches rows j - ku .. j + kl)
+        do j = 1, n
+            gx = g*x(j)
+            if (j > KU .and. j <= n - KL) then
+                do i = -KU, KL
+                    y(j + i) = y(j + i) + kb(KU + 1 + i, j)*gx
+                end do
+            else
+                do i = max(1, j - KU), min(n, j + KL)
+                    y(i) = y(i) + kb(KU + 1 + i - j, j)*gx
+                end do
+            end if
+        end do
+        ! L z = P y
+        do j = 1, n - 1
+            l = ipiv(j)
+            t = y(l)
+            if (l /= j) then
+                y(l) = y(j)
+                y(j) = t
+            end if
+            if (j <= n - KL) then
+                do i = 1, KL
+                    y(j + i) = y(j + i) - ab(KV + 1 + i, j)*t
+                end do
+            else
+                do i = 1, n - j
+                    y(j + i) = y(j + i) - ab(KV + 1 + i, j)*t
+                end do
+            end if
+        end do
+        ! U x = z (diagonal stored inverted)
+        do j = n, 1, -1
+            t = y(j)*ab(KV + 1, j)
+            y(j) = t
+            if (j > KV) then
+                do i = -KV, -1
+                    y(j + i) = y(j + i) - ab(KV + 1 + i, j)*t
+                end do
+            else
+                do i = 1, j - 1
+                    y(i) = y(i) - ab(KV + 1 + i - j, j)*t
+                end do
+            end if
+        end do
+    end subroutine band_solve_rfem
 
     !> y <- y + g A x for A in compact band storage (row ku + 1 + i - j).
     pure subroutine band_add_product(n, kl, ku, a, g, x, y)

@@ -35,8 +35,8 @@ contains
     end procedure prepare_matrix
 
     module procedure stage
-        real(wp) :: dnorm, dnorm_old, dcon, start
-        integer :: iter, status, n
+        real(wp) :: dnorm, dnorm_old, dcon, start, ri
+        integer :: iter, status, n, i
         logical :: mass, profile
 
         n = self%n
@@ -61,7 +61,9 @@ contains
                 end if
                 self%r = hbeta*self%f - self%mv
             else
-                self%r = hbeta*self%f - (z(1:n) - c(1:n))
+                do i = 1, n
+                    self%r(i) = hbeta*self%f(i) - (z(i) - c(i))
+                end do
             end if
             if (profile) then
                 self%counters%time_rhs = self%counters%time_rhs + (clock_seconds() - start)
@@ -71,9 +73,16 @@ contains
             if (profile) self%counters%time_solve = self%counters%time_solve + &
                                                     (clock_seconds() - start)
             self%counters%nonlin_iters = self%counters%nonlin_iters + 1
-            if (.not. all(ieee_is_finite(self%r))) return
-            z(1:n) = z(1:n) + self%r
-            dnorm = sqrt(sum((self%r/self%w(1:n))**2)/real(n, wp))
+            ! one pass: the correction and its norm; a NaN or Inf in it (or a norm beyond
+            ! the floating-point range) fails the stage, whose z is then thrown away
+            dnorm = 0.0_wp
+            do i = 1, n
+                ri = self%r(i)
+                z(i) = z(i) + ri
+                dnorm = dnorm + (ri/self%w(i))**2
+            end do
+            if (.not. ieee_is_finite(dnorm)) return
+            dnorm = sqrt(dnorm/real(n, wp))
             if (iter > 1) then
                 if (dnorm > 2.0_wp*dnorm_old) return
                 self%crate = max(0.3_wp*self%crate, dnorm/dnorm_old)
@@ -151,7 +160,10 @@ contains
             end if
 
             ! Stage 1: k-step BDF to t_n + h.
-            pred = sum(self%dif(:, 0:k), dim=2)
+            pred = self%dif(:, 0)
+            do j = 1, k
+                pred = pred + self%dif(:, j)
+            end do
             psi = 0.0_wp
             do j = 1, k
                 psi = psi + gam(j)*self%dif(:, j)
@@ -233,7 +245,11 @@ contains
         if (k < self%kmax .and. self%steps_at_h >= k + 1) then
             errkp1 = self%wnorm(d1 - self%dif(:, k + 1))/self%coef(k + 1)%tq
         end if
-        d1 = y3 - sum(self%dif(:, 0:k), dim=2)
+        p2 = self%dif(:, 0)
+        do j = 1, k
+            p2 = p2 + self%dif(:, j)
+        end do
+        d1 = y3 - p2
         self%dif(:, k + 2) = d1 - self%dif(:, k + 1)
         self%dif(:, k + 1) = d1
         do j = k, 0, -1

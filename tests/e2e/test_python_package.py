@@ -24,6 +24,7 @@ COMMANDS = {
     "bench_kernels": "ropedyn.studies.bench_kernels",
     "bench_models": "ropedyn.studies.bench_models",
     "bench_rfem": "ropedyn.studies.bench_rfem",
+    "bench_step": "ropedyn.studies.bench_step",
     "bench_sweep": "ropedyn.studies.bench_sweep",
     "profile_step": "ropedyn.studies.profile_step",
     "validation": "ropedyn.studies.validation",

@@ -64,7 +64,7 @@ def main(argv=None):
     settings = [("rfem", "cvode"), ("rfem", "mebdf"), ("mpp", "cvode"), ("mpp", "mebdf")]
     results = {}
     header = ("| model | solver | n | steps | RHS evals | Jacobians | CPU (s) | CPU per step (ms) "
-              f"| {SPLIT_HEADER} | balance error (J) |")
+              f"| CPU per step per element (us) | {SPLIT_HEADER} | balance error (J) |")
     print(header, flush=True)
     with tempfile.TemporaryDirectory() as tmp:
         for model, method in settings:
@@ -123,7 +123,7 @@ def main(argv=None):
              f"\"{args.elements}\"` (input/paper.nml, rtol {args.rtol:g}, atol 1e-8, default "
              f"max orders: CVODE 5, MEBDF 4). Machine: {machine()}. Run: {stamp}.",
              "", "![cost versus n](figures/cost_vs_n.png)", "", header,
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     lines += [line(m, s, n, results[(m, s, n)]) for m, s in settings for n in ns]
     lines += ["", *(f"Crossover with {m}: RFEM cheaper than MPP from n = {n}."
                     for m, n in crossover.items()),
@@ -137,10 +137,10 @@ def main(argv=None):
 
 def line(model, method, n, r):
     if r.get("status") != "complete":
-        return f"| {model} | {method} | {n} | {r.get('status')} |  |  |  |  |  |  |"
+        return f"| {model} | {method} | {n} | {r.get('status')} |  |  |  |  |  |  |  |"
     return (f"| {model} | {method} | {n} | {r['steps']} | {r['rhs']} | {r['jac']} | "
-            f"{r['cpu']:.3f} | {1e3 * r['cpu'] / r['steps']:.3f} | {r['split']} | "
-            f"{r['balance']:.1e} |")
+            f"{r['cpu']:.3f} | {1e3 * r['cpu'] / r['steps']:.3f} | "
+            f"{1e6 * r['cpu'] / r['steps'] / n:.2f} | {r['split']} | {r['balance']:.1e} |")
 
 
 if __name__ == "__main__":
