@@ -18,7 +18,9 @@ module ropedyn_methods
         character(len=8) :: name = ''
         integer :: lowest_order = 1     !< smallest allowed max_order
         integer :: highest_order = 1    !< largest allowed max_order
-        integer :: default_order = 1    !< the max_order used when max_order = 0
+        !> the max_order used when max_order = 0 (0 for auto: it chooses MEBDF's limit
+        !! from the damping of the scene's fast modes, ropedyn_auto)
+        integer :: default_order = 1
     end type method_info_t
 
     type(method_info_t), parameter :: METHODS(*) = [ &
@@ -26,7 +28,7 @@ module ropedyn_methods
         method_info_t('mebdf', 2, 7, 4), &
         method_info_t('erk', 3, 5, 4), &
         method_info_t('adams', 1, 12, 12), &
-        method_info_t('auto', 2, 7, 4)]
+        method_info_t('auto', 2, 7, 0)]
 
 contains
 

@@ -413,6 +413,8 @@ contains
         type(error_t), allocatable, intent(out) :: err
         character(len=16), allocatable :: methods(:)
         character(len=:), allocatable :: reasons(:)
+        real(wp), allocatable :: times(:)
+        integer(i8), allocatable :: orders(:)
         integer :: k, width
 
         if (size(events) == 0) return
@@ -432,9 +434,11 @@ contains
             reasons(k) = ''
             if (allocated(events(k)%reason)) reasons(k) = events(k)%reason
         end do
-        call self%file%write('/solver/switch_time', events%t, 's', err)
+        times = events%t
+        orders = int(events%max_order, i8)
+        call self%file%write('/solver/switch_time', times, 's', err)
         if (allocated(err)) return
-        call self%file%write('/solver/switch_max_order', int(events%max_order, i8), '1', err)
+        call self%file%write('/solver/switch_max_order', orders, '1', err)
         if (allocated(err)) return
         call self%file%write_text('/solver/switch_method', methods, '', err)
         if (allocated(err)) return

@@ -272,7 +272,9 @@ contains
         type(error_t), allocatable, intent(out) :: err
         associate (v => scene%solver, m => METHODS(method_index(scene%solver%method)))
             if (v%max_order == 0) v%max_order = m%default_order
-            if (v%max_order < m%lowest_order .or. v%max_order > m%highest_order) then
+            if (v%max_order == 0) then
+                ! the method chooses (auto)
+            else if (v%max_order < m%lowest_order .or. v%max_order > m%highest_order) then
                 call fail(keys, G_SOLVER, 'max_order', int_text(v%max_order), &
                     'out of range for method '//trim(v%method)//' (allowed: '// &
                     int_text(m%lowest_order)//' .. '//int_text(m%highest_order)// &

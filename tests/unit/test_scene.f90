@@ -101,10 +101,10 @@ contains
         call suite%check_true(s%effects%gravity .and. s%effects%tension .and. &
             s%effects%shear .and. s%effects%bending .and. s%effects%damping, &
             'defaults: all effects on')
-        call suite%check_true(s%solver%method == 'cvode', 'defaults: method')
+        call suite%check_true(s%solver%method == 'auto', 'defaults: method')
         call suite%check_close(s%solver%rtol, 1.0e-6_wp, TIGHT, 0.0_wp, 'defaults: rtol')
         call suite%check_close(s%solver%atol, 1.0e-8_wp, TIGHT, 0.0_wp, 'defaults: atol')
-        call suite%check_true(s%solver%max_order == 5, 'defaults: max_order')
+        call suite%check_true(s%solver%max_order == 0, 'defaults: max_order')
         call suite%check_true(s%solver%max_steps == 1000000, 'defaults: max_steps')
         call suite%check_close(s%solver%t_end, 30.0_wp, TIGHT, 0.0_wp, 'defaults: t_end')
         call suite%check_close(s%solver%output_interval, 0.01_wp, TIGHT, 0.0_wp, &
@@ -434,8 +434,9 @@ contains
             NO_SET, [character(len=L) :: P//'rtol_big.nml: &solver: rtol = 1.5: must be < 1'])
         call expect_error('atol', [character(len=L) :: MODEL, '&solver atol = -1e-8 /'], &
             NO_SET, [character(len=L) :: P//'atol.nml: &solver: atol = -1.0e-8: must be > 0'])
-        call expect_error('max_order', [character(len=L) :: MODEL, '&solver max_order = 6 /'], &
-            NO_SET, [character(len=L) :: P//'max_order.nml: &solver: max_order = 6: ', &
+        call expect_error('max_order', [character(len=L) :: MODEL, &
+            '&solver method = ''cvode'', max_order = 6 /'], NO_SET, &
+            [character(len=L) :: P//'max_order.nml: &solver: max_order = 6: ', &
             'out of range for method cvode (allowed: 1 .. 5, or 0 for the default 5)'])
         call expect_error('max_order_mebdf', [character(len=L) :: MODEL, &
             '&solver method = ''mebdf'', max_order = 1 /'], NO_SET, [character(len=L) :: &
@@ -479,7 +480,7 @@ contains
             'mpp_axial_damping_factor = -1.0: must be >= 0'])
         call expect_error('method', [character(len=L) :: MODEL, '&solver method = ''euler'' /'], &
             NO_SET, [character(len=L) :: &
-            P//'method.nml: &solver: method = "euler": unknown (allowed: cvode, mebdf)'])
+            P//'method.nml: &solver: method = "euler": unknown (allowed: cvode, mebdf, erk, adams, auto)'])
         call expect_error('support', [character(len=L) :: MODEL, '&supports top = ''glued'' /'], &
             NO_SET, [character(len=L) :: P//'support.nml: &supports: top = "glued": ', &
             'unknown (allowed: pinned, clamped, free)'])

@@ -60,8 +60,11 @@ contains
             end if
         case (T_INT)
             call append_text(values, int_text(key%i + 1))
+            ! max_order 1 is for cvode and adams (auto's range starts at 2)
+            if (key%name == 'max_order') extra = "method = 'cvode'"
         case (T_LOGICAL)
             call append_text(values, trim(merge('.false.', '.true. ', key%l)))
+            if (key%name == 'stability_limit_detection') extra = "method = 'cvode'"
         case (T_NAME)
             if (key%name == 'top_motion') extra = 'top_frequency = 2.0'
             if (key%name == 'bottom_motion') extra = "bottom = 'pinned', bottom_frequency = 2.0"

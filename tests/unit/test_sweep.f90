@@ -17,7 +17,7 @@ program test_sweep
     call execute_command_line('mkdir -p '//DIR//'/scenes', exitstat=stat)
     call suite%check_true(stat == 0, 'create '//DIR)
     call write_file(DIR//'/scenes/base.nml', [character(len=60) :: &
-        '&model kind = ''rfem'', elements = 8 /', '&solver t_end = 0.1 /'])
+        '&model kind = ''rfem'', elements = 8 /', '&solver t_end = 0.1, method = ''cvode'' /'])
 
     call test_names()
     call test_expansion()

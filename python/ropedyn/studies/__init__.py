@@ -7,7 +7,7 @@
 | work_precision_testset | scripts/work_precision_testset | docs/benchmarks.md, testset_wp.csv, wp_*.png |
 | validation | scripts/validation | docs/validation.md |
 | stability_report | scripts/stability_report | docs/stability.md (measures: stability_metrics) |
-| bench_rfem, bench_models, bench_effects, bench_kernels, bench_step, bench_sweep | scripts/bench_* | docs/benchmarks.md |
+| bench_rfem, bench_models, bench_effects, bench_kernels, bench_step, bench_sweep, bench_peers | scripts/bench_* | docs/benchmarks.md |
 | profile_step | scripts/profile_step | docs/benchmarks.md (callgrind split of a step) |
 | fig5 | scripts/fig5 | docs/figures/fig5_energy.png, docs/data/fig5_energy.csv |
 | calibrate | scripts/calibrate | prints the fitted MPP damping factors |
