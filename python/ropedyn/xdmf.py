@@ -4,10 +4,12 @@ polylines (one line cell per element) with per-element and per-point fields.
 usage: scripts/xdmf RUN.h5 [--every K]     writes RUN.xmf and RUN_fields.h5 next to RUN.h5
        (python -m ropedyn.xdmf)
 
-The geometry is read from the run file itself (/rope/points); the derived fields (axial
-force, curvature, speed, velocity, angle; definitions in docs/visualization.md) go into the
-small sidecar RUN_fields.h5. The run file is only read, never modified. Open RUN.xmf in
-ParaView with the "XDMF Reader" (or the Xdmf3 readers). The coordinates are the run's: x
+The geometry (the run's /rope/points, one plain dataset per described record) and the
+derived fields (axial force, curvature, speed, velocity, angle; definitions in
+docs/visualization.md) go into the sidecar RUN_fields.h5. The run file is only read, never
+modified. RUN.xmf opens in ParaView with File > Open (OpenDataFile) and with each of its
+XDMF readers ("XDMF Reader", "Xdmf3 Reader S", "Xdmf3 Reader T"): the layout avoids what
+the Xdmf3 readers cannot read (a HyperSlab in a Geometry crashes them). The coordinates are the run's: x
 points down (gravity), y horizontal, z = 0.
 """
 import argparse
@@ -53,8 +55,12 @@ def derived_fields(run):
     return {"cell": cell, "point": point}, notes
 
 
-def write_fields(path, run, fields, notes):
-    """The sidecar HDF5: /connectivity, /time, /cell/*, /point/*, each with units."""
+def write_fields(path, run, fields, notes, picked, points):
+    """The sidecar HDF5: /connectivity, /time, /cell/*, /point/* (all records), each with
+    units; for each described record K, /geometry/record_K (2n, 2: the points of
+    /rope/points) and /records/record_K/{cell,point}/NAME. What RUN.xmf names is a plain
+    dataset per time, which every XDMF reader of ParaView reads: the Xdmf3 readers crash
+    on a HyperSlab in a Geometry and skip HyperSlab attributes."""
     with h5py.File(path, "w") as f:
         f.attrs["source"] = pathlib.Path(run.path).name
         f.attrs["model"] = run.model
@@ -68,6 +74,22 @@ def write_fields(path, run, fields, notes):
                                       compression="gzip", compression_opts=4, shuffle=True)
                 ds.attrs["units"] = FIELD_UNITS[name]
                 ds.attrs["definition"] = notes[name]
+        geometry = f.create_group("geometry")
+        geometry.attrs["definition"] = ("record_K: the element end points (x, y) of record K "
+                                        "of the run file's /rope/points")
+        records = f.create_group("records")
+        records.attrs["definition"] = ("record_K/{cell,point}/NAME: record K of /cell/NAME, "
+                                       "/point/NAME (what RUN.xmf names, one dataset per time)")
+        for k in picked:
+            geometry.create_dataset(_record_name(k), data=points[k]).attrs["units"] = "m"
+            for center, group in fields.items():
+                for name, values in group.items():
+                    records.create_dataset(f"{_record_name(k)}/{center}/{name}",
+                                           data=values[k])
+
+
+def _record_name(k):
+    return f"record_{k:06d}"
 
 
 def _hdf_item(parent, file_name, path, shape, number_type="Float", precision=8):
@@ -77,38 +99,9 @@ def _hdf_item(parent, file_name, path, shape, number_type="Float", precision=8):
     return item
 
 
-def _slab(parent, k, file_name, path, shape):
-    """Record k of a dataset whose first axis is time: a HyperSlab DataItem."""
-    rank = len(shape)
-    count = (1,) + tuple(shape[1:])
-    slab = ET.SubElement(parent, "DataItem", ItemType="HyperSlab",
-                         Dimensions=" ".join(map(str, count)), Type="HyperSlab")
-    select = ET.SubElement(slab, "DataItem", Dimensions=f"3 {rank}", Format="XML")
-    select.text = " ".join(map(str, (k,) + (0,) * (rank - 1) + (1,) * rank + count))
-    _hdf_item(slab, file_name, path, shape)
-    return slab
-
-
-def _whole(parent, file_name, path, shape):
-    """A whole integer dataset, written as a HyperSlab that selects all of it.
-
-    ParaView's XDMF (2) reader caches a grid's points keyed on the text of the first
-    DataItem of its Topology and Geometry. Our geometry is a HyperSlab of /rope/points, so
-    its key would be empty: the reader then logs an error and reads without the cache.
-    With the topology a HyperSlab too, the reader skips the cache silently, and every time
-    step is read from its own record."""
-    rank = len(shape)
-    slab = ET.SubElement(parent, "DataItem", ItemType="HyperSlab",
-                         Dimensions=" ".join(map(str, shape)), Type="HyperSlab")
-    select = ET.SubElement(slab, "DataItem", Dimensions=f"3 {rank}", Format="XML")
-    select.text = " ".join(map(str, (0,) * rank + (1,) * rank + tuple(shape)))
-    _hdf_item(slab, file_name, path, shape, "Int", 4)
-    return slab
-
-
 def build_xdmf(run_path, fields_path, records, points_shape, fields):
     """The XDMF tree: a temporal collection with one uniform grid per selected record."""
-    run_name, fields_name = pathlib.Path(run_path).name, pathlib.Path(fields_path).name
+    fields_name = pathlib.Path(fields_path).name
     n = points_shape[1] // 2
     root = ET.Element("Xdmf", Version="2.0")
     domain = ET.SubElement(root, "Domain")
@@ -119,15 +112,16 @@ def build_xdmf(run_path, fields_path, records, points_shape, fields):
         ET.SubElement(grid, "Time", Value=repr(float(t)))
         topo = ET.SubElement(grid, "Topology", TopologyType="Polyline", NodesPerElement="2",
                              NumberOfElements=str(n))
-        _whole(topo, fields_name, "/connectivity", (n, 2))
+        _hdf_item(topo, fields_name, "/connectivity", (n, 2), "Int", 4)
         geom = ET.SubElement(grid, "Geometry", GeometryType="XY")
-        _slab(geom, k, run_name, "/rope/points", points_shape)
+        _hdf_item(geom, fields_name, f"/geometry/{_record_name(k)}", (2 * n, 2))
         for center, group in fields.items():
             for name, values in group.items():
                 kind = "Vector" if values.ndim == 3 else "Scalar"
                 attr = ET.SubElement(grid, "Attribute", Name=name, AttributeType=kind,
                                      Center={"cell": "Cell", "point": "Node"}[center])
-                _slab(attr, k, fields_name, f"/{center}/{name}", values.shape)
+                _hdf_item(attr, fields_name, f"/records/{_record_name(k)}/{center}/{name}",
+                          values.shape[1:])
     ET.indent(root, space=" ")
     return ET.ElementTree(root)
 
@@ -150,10 +144,11 @@ def main(argv=None):
         print(f"xdmf: {run_path}: no output records", file=sys.stderr)
         return 1
     with h5py.File(run_path, "r") as f:
-        points_shape = f["rope/points"].shape  # may be one record longer than /time
-    fields, notes = derived_fields(run)
-    write_fields(fields_path, run, fields, notes)
-    picked = range(0, run.time.size, args.every)
+        points = f["rope/points"]  # may be one record longer than /time
+        points_shape = points.shape
+        picked = range(0, run.time.size, args.every)
+        fields, notes = derived_fields(run)
+        write_fields(fields_path, run, fields, notes, picked, points)
     tree = build_xdmf(run_path, fields_path, [(k, run.time[k]) for k in picked],
                       points_shape, fields)
     with open(xmf_path, "wb") as out:

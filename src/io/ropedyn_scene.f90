@@ -308,7 +308,7 @@ contains
                 if (keys(k)%name == 'progress' .and. trim(GROUP_NAMES(g)) == 'output' .and. &
                     .not. scene%output%progress_given) then
                     ! not given: a comment, so that reading the echo back keeps it unset
-                    text = text//'    ! progress: not set (on when stderr is a terminal)'//NL
+                    text = text//'    ! progress = (not set: on when stderr is a terminal)'//NL
                 else
                     text = text//keys(k)%echo()
                 end if

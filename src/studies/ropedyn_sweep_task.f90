@@ -168,6 +168,15 @@ contains
                 end if
                 call system_clock(start, rate)
                 call run_scene(scene, summary, err, resume=resume)
+                if (resume .and. allocated(err)) then
+                    ! not to be continued (nothing left, no restart data, ...): run it anew
+                    if (err%code == ERR_INPUT) then
+                        write (error_unit, '(a)') label//': cannot be continued ('// &
+                            err%message//'): running it anew'
+                        removed = delete_file(part)
+                        call run_scene(scene, summary, err)
+                    end if
+                end if
                 call system_clock(finish)
                 wall = real(finish - start, wp)/real(rate, wp)
                 call put_in_place(c, part, wall, ferr)

@@ -1,7 +1,11 @@
 """Run by pvpython (ParaView's Python; not a pytest module): open an XDMF sidecar of
-ropedyn with ParaView's XDMF reader and check what ParaView sees against EXPECTED.json.
+ropedyn with one of ParaView's ways to open it and check what ParaView sees against
+EXPECTED.json.
 
-usage: pvpython --force-offscreen-rendering pv_check_xdmf.py RUN.xmf EXPECTED.json
+usage: pvpython --force-offscreen-rendering pv_check_xdmf.py RUN.xmf EXPECTED.json [READER]
+
+READER: open (OpenDataFile: ParaView's own choice for the file, as File > Open does),
+XDMFReader (legacy "XDMF Reader", the default), Xdmf3ReaderS or Xdmf3ReaderT.
 
 EXPECTED.json: {"times": [...], "elements": n, "checks": [{"record": k, "tip": [x, y],
 "tension": [n values]}, ...]}. Checks: the time step values, the number of points (2 n)
@@ -13,7 +17,7 @@ import json
 import sys
 
 from paraview import servermanager
-from paraview.simple import XDMFReader
+from paraview import simple
 
 
 def fail(message):
@@ -57,12 +61,22 @@ def check_record(reader, steps, check, elements):
 
 
 def main(argv):
-    if len(argv) != 3:
-        fail("usage: pv_check_xdmf.py RUN.xmf EXPECTED.json")
+    if len(argv) not in (3, 4):
+        fail("usage: pv_check_xdmf.py RUN.xmf EXPECTED.json [READER]")
     with open(argv[2]) as f:
         expected = json.load(f)
-    reader = XDMFReader(registrationName="rope", FileNames=[argv[1]])
-    steps = list(reader.TimestepValues)
+    which = argv[3] if len(argv) == 4 else "XDMFReader"
+    if which == "open":
+        reader = simple.OpenDataFile(argv[1])
+    elif which == "XDMFReader":
+        reader = simple.XDMFReader(registrationName="rope", FileNames=[argv[1]])
+    elif which in ("Xdmf3ReaderS", "Xdmf3ReaderT"):
+        reader = getattr(simple, which)(registrationName="rope", FileName=[argv[1]])
+    else:
+        fail(f"unknown reader {which}")
+    print(f"reader {which}: {reader.GetXMLName()}")
+    values = reader.TimestepValues
+    steps = list(values) if hasattr(values, "__iter__") else [values]
     print(f"timesteps {len(steps)}")
     if len(steps) != len(expected["times"]):
         fail(f"{len(steps)} time steps, expected {len(expected['times'])}")

@@ -160,7 +160,7 @@ def test_task_equals_case_run_alone(run, sweep_dir):
     alone = sweep_dir / "alone.h5"
     result = run("run", "scenes/base.nml", "--set", "model.elements=5", "--set",
                  "solver.method=mebdf", "--set", "solver.rtol=1e-4", "--set",
-                 f"output.file={alone}")
+                 "output.progress=.false.", "--set", f"output.file={alone}")
     assert result.returncode == 0, result.stderr
     with h5py.File(out / "case_0007.h5") as a, h5py.File(alone) as b:
         for name in ("time", "state/q", "state/qdot", "rope/points", "energy/total",
@@ -286,24 +286,27 @@ def test_sigterm_to_runner_stops_its_workers(run, ropedyn_exe, sweep_dir):
     assert runner.returncode == 130, stderr
     assert "stopped by SIGTERM: 0 of 3 cases ended, 2 interrupted (0001 0002), " \
            "1 not started" in stderr
-    # no worker left, no runner file left: the interrupted cases keep their lock (with the
-    # signal) and their partial output, which the next run replaces
+    # no worker left; each interrupted case stopped at a step boundary, wrote that state
+    # with status interrupted and was renamed into place (no lock, no .part); its log keeps
+    # the worker's message
     assert processes_mentioning(str(sweep_dir)) == [] and processes_mentioning("long.nml") == []
     names = sorted(p.name for p in out.iterdir())
-    assert names == [".case_0001.h5.part", ".case_0001.lock", ".case_0002.h5.part",
-                     ".case_0002.lock"], names
-    assert "signal=15" in (out / ".case_0001.lock").read_text()
+    assert names == ["case_0001.h5", "case_0001.log", "case_0002.h5", "case_0002.log"], names
+    assert "interrupted by SIGTERM at t = " in (out / "case_0001.log").read_text()
     result, counts = status_lines(run, "long.nml")
     assert result.returncode == 3
     assert counts == {"complete": 0, "failed": 0, "interrupted": 2, "running": 0, "stale": 0,
                       "unreadable": 0, "missing": 1}, result.stdout
-    assert "0001 interrupted: stopped by SIGTERM at " in result.stdout
-    assert "partial output in out/long/.case_0001.h5.part" in result.stdout
-    # running again takes over the abandoned lock and finishes
+    assert "0001 interrupted: " in result.stdout
+    assert "interrupted by SIGTERM at t = " in result.stdout
+    # running again continues case 1 from its last record
     again = run("sweep", "long.nml", "--task", "1")
     assert again.returncode == 0, again.stderr
+    assert "continuing it from its last record" in again.stdout
     assert sorted(p.name for p in out.iterdir()) == [
-        ".case_0002.h5.part", ".case_0002.lock", "case_0001.h5"]
+        "case_0001.h5", "case_0001.log", "case_0002.h5", "case_0002.log"]
+    with h5py.File(out / "case_0001.h5") as f:
+        assert f.attrs["status"] == b"complete" and f["solver/restarts/time"].shape == (1,)
 
 
 def test_lock_rules(run, sweep_dir):
