@@ -76,6 +76,7 @@ module ropedyn_cvode
         integer(i8) :: window_steps0 = 0  !< total steps at the window's start
         integer(i8) :: window_fails0 = 0  !< total error-test failures at the window's start
         real(wp) :: window_t0 = 0.0_wp    !< time at the window's start
+        real(wp) :: t_start = 0.0_wp      !< time at the start of the run
         !> state of the order control: 0 watching, 1 and 3 trying the low order (first
         !! and second window), 2 at the low order (crawl confirmed)
         integer :: mode = 0
@@ -218,7 +219,8 @@ contains
         call self%check_options(options, self%n, max_order, err)
         if (allocated(err)) return
         self%adams = self%name() == 'adams'
-        self%monitor = cvode_monitor_t(qmax_user=max_order, qmax=max_order, window_t0=t0)
+        self%monitor = cvode_monitor_t(qmax_user=max_order, qmax=max_order, window_t0=t0, &
+                                       t_start=t0)
         self%base = solver_stats_t()
         call self%log%clear()
         self%t = t0

@@ -6,8 +6,8 @@
 !! is present, CVODE at order 5 either lets it grow or, more often, its error test catches
 !! the growth, rejects steps and holds h far below what the smooth motion needs: a crawl
 !! (the steel wire: 8.5e5 steps per simulated second at order 5, 9e4 at order 2). The loop
-!! looks at every window of WINDOW steps: when the window took more than CRAWL_RATE
-!! steps per simulated second, the order in use is >= 3 and at least FAIL_SHARE of the
+!! looks at every window of WINDOW steps: when the window and the whole run so far took
+!! more than CRAWL_RATE steps per simulated second (the run: VDPOL's fronts alone reach it), the order in use is >= 3 and at least FAIL_SHARE of the
 !! steps failed the error test (the signature of a step held by stability: on the steel
 !! wire 5 %, against under 1 % where accuracy limits the step),
 !! it tries the A-stable BDF2 for one window (CVODE re-initialized at its current state:
@@ -184,7 +184,8 @@ contains
                     if (m%wait_windows > 0) then
                         m%wait_windows = m%wait_windows - 1
                     else if (m%qmax > LOW_ORDER .and. order(1) > LOW_ORDER .and. &
-                             share >= FAIL_SHARE .and. rate >= CRAWL_RATE) then
+                             share >= FAIL_SHARE .and. rate >= CRAWL_RATE .and. &
+                             real(now%steps, wp) >= CRAWL_RATE*(self%tn - m%t_start)) then
                         ! a crawl? try the A-stable order for one window
                         m%rate_before = rate
                         call self%restart(LOW_ORDER, 8.0_wp*now%last_step, ok)
