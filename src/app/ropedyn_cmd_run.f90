@@ -82,7 +82,11 @@ contains
             end if
         end do
         call read_case_file(path, data, err)
-        if (allocated(err)) return
+        if (allocated(err)) then
+            err%code = ERR_INPUT   ! not a run file: bad input of --resume
+            err%message = err%message//' (--resume needs a ropedyn run file)'
+            return
+        end if
         if (.not. data%exists) then
             call make_error(err, ERR_INPUT, path//': no such file (--resume)')
             return

@@ -41,7 +41,8 @@ module ropedyn_scene_key
         character(len=:), allocatable :: allowed
         character(len=:), allocatable :: unit
         character(len=:), allocatable :: doc         !< one line: what the key means
-        !> a pair whose NaN value means "not set": the comment of the echo
+        !> a pair whose NaN value means "not set": the comment of the echo; a logical with
+        !! this text is tri-state (not given is a third value; listed as 'not set')
         character(len=:), allocatable :: unset
         logical :: given = .false.                   !< set by the file or a --set
         character(len=:), allocatable :: origin      !< the file or the --set argument
@@ -246,6 +247,8 @@ contains
         if (self%type == T_PAIR .or. self%type == T_LIST) then
             if (any(ieee_is_nan(self%v))) default = 'not set'
         end if
+        ! a logical with an `unset` text is tri-state: its default is "not given"
+        if (self%type == T_LOGICAL .and. len(self%unset) > 0) default = 'not set'
         select case (self%rule)
         case (R_FINITE)
             allowed = 'finite'

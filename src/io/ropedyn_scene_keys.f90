@@ -141,6 +141,8 @@ contains
             call add_path(G_OUTPUT, 'file', o%file, "HDF5 result file ('': out/<scene>.h5)")
             call add_logical(G_OUTPUT, 'progress', o%progress, &
                 'progress on stderr (not given: on when stderr is a terminal)')
+            ! tri-state: not given means "on when stderr is a terminal" (progress_given)
+            keys(n)%unset = 'not set: on when stderr is a terminal'
 
             call add_real(G_FLUID, 'density', f%density, R_NONNEGATIVE, 'kg/m^3', &
                 'density of the fluid')

@@ -7,7 +7,7 @@ module ropedyn_simulation
     use ropedyn_text, only: real_text, int_text
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_IO, ERR_SOLVER, ERR_INTERRUPTED
     use ropedyn_process, only: catch_signals, release_signals, signal_received, signal_name, &
-        end_on_second_signal
+        end_on_second_signal, process_text
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, clock_seconds
     use ropedyn_solvers, only: new_integrator
@@ -254,7 +254,7 @@ contains
                 end if
                 call make_error(err, ERR_INTERRUPTED, summary%file//': interrupted by '// &
                     signal_name(max(sig, signal_received()))//' at t = '//real_text(t)// &
-                    ' s of '//real_text(t_end)//' s (its last record)')
+                    ' s of '//real_text(t_end)//' s (its last record; '//process_text()//')')
                 call finish('interrupted', err%message)
                 return
             end if

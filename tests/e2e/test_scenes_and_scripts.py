@@ -1,5 +1,6 @@
 """Every shipped scene reads and runs; progress shows on request; the energy plot of
 scripts/run is made from an output file."""
+import os
 import pathlib
 import subprocess
 import sys
@@ -32,7 +33,36 @@ def test_progress_on_request(run, tmp_path):
         "&output progress = .true. /\n")
     result = run("run", "p.nml")
     assert result.returncode == 0, result.stderr
-    assert "ETA" in result.stderr and "100.0 %" in result.stderr
+    assert "left" in result.stderr and "100.0 %" in result.stderr and " s/s " in result.stderr
+
+
+def test_progress_forced_off_on_a_terminal(ropedyn_exe, tmp_path):
+    """Progress is on by default when stderr is a terminal; progress = .false. forces it off
+    (stderr a pseudo-terminal here)."""
+    import pty
+    import subprocess
+    (tmp_path / "t.nml").write_text("&model kind = 'rfem', elements = 4 /\n"
+                                    "&solver t_end = 0.05 /\n")
+    seen = {}
+    for label, extra in (("default", []), ("off", ["--set", "output.progress=.false."])):
+        leader, follower = pty.openpty()
+        proc = subprocess.run([str(ropedyn_exe), "run", "t.nml", *extra], cwd=tmp_path,
+                              stdout=subprocess.DEVNULL, stderr=follower, timeout=120)
+        os.close(follower)
+        chunks = []
+        while True:
+            try:
+                chunk = os.read(leader, 4096)
+            except OSError:
+                break
+            if not chunk:
+                break
+            chunks.append(chunk)
+        os.close(leader)
+        assert proc.returncode == 0
+        seen[label] = b"".join(chunks).decode(errors="replace")
+    assert "100.0 %" in seen["default"] and "left" in seen["default"], seen
+    assert seen["off"] == "", seen
 
 
 def test_silent_without_terminal(run, tmp_path):

@@ -374,8 +374,41 @@ def test_cancelled_task_is_interrupted(slurm, ropedyn_exe, tmp_path):
     assert job.returncode == 3, stderr
     summary = next((out / "slurm").glob("summary_*.out")).read_text()
     assert f"summary: task {array}_1 (cases 1) ended CANCELLED" in summary, summary
-    assert "sweep: case 0001: interrupted: stopped by SIGTERM at " in summary
+    # the run stopped itself at a step boundary and wrote status interrupted with the reason
+    assert "sweep: case 0001: interrupted: " in summary and "interrupted by SIGTERM at t = " \
+        in summary, summary
     status = sweep_status(ropedyn_exe, tmp_path, "c.nml")
     assert status.returncode == 3
-    assert f"0001 interrupted: stopped by SIGTERM at " in status.stdout
+    assert "0001 interrupted: " in status.stdout
+    assert "interrupted by SIGTERM at t = " in status.stdout
     assert f"Slurm job {array}_1" in status.stdout
+
+
+def test_time_limit_warning_requeues_and_resumes(slurm, ropedyn_exe, tmp_path):
+    """The warning signal ahead of the time limit (USR1 to the batch shell, as
+    `--signal=B:USR1@120` sends it; here by scancel) stops the case at a step boundary and
+    requeues the task, which continues the case from its last record."""
+    (tmp_path / "base.nml").write_text(BASE)
+    (tmp_path / "r.nml").write_text(LONG.format(t_end=3, rtols="1e-8"))
+    job = subprocess.Popen([str(SUBMIT), "r.nml", "--wait", "--exe", str(ropedyn_exe)],
+                           cwd=tmp_path, env=slurm.env, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True)
+    out = tmp_path / "out" / "sweep_r"
+    try:
+        wait_for(lambda: (out / ".case_0001.lock").exists(), what="the case to start")
+        time.sleep(0.5)
+        array = next((out / "slurm").glob("task_*_1.out")).name.split("_")[1]
+        subprocess.run(["scancel", "--batch", "--signal=USR1", f"{array}_1"], env=slurm.env,
+                       check=True)
+        stdout, stderr = job.communicate(timeout=300)
+    finally:
+        if job.poll() is None:
+            job.kill()
+    logs = "".join(p.read_text() for p in (out / "slurm").glob("task_*_1.out"))
+    # both attempts in the log (--open-mode=append)
+    assert "sweep.sbatch: warning signal: stopping the case and requeueing" in logs, logs
+    assert "interrupted before: continuing it from its last record" in logs, logs
+    assert job.returncode == 0, stderr + logs
+    with h5py.File(out / "case_0001.h5") as f:
+        assert f.attrs["status"] == b"complete"
+        assert f["solver/restarts/time"].shape == (1,)
