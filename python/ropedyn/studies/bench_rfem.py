@@ -82,7 +82,8 @@ def main(argv=None):
               else "reduced second-order Newton matrix")
     block = "\n".join([
         BEGIN,
-        f"Command: `scripts/bench_rfem --t-end {args.t_end:g} --elements \"{args.elements}\"` "
+        f"Command: `scripts/bench_rfem --t-end {args.t_end:g} --elements \"{args.elements}\" "
+        f"--solvers \"{args.solvers}\"` "
         f"(rtol {args.rtol:g}, atol 1e-8, default maximum orders: CVODE BDF 5, MEBDF 4; "
         f"analytic Jacobian, {newton}; `solver.profile = .true.`: the split is measured "
         "inside the run with the monotonic clock, the rest is the CPU time less the parts).",
