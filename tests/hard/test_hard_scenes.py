@@ -35,7 +35,7 @@ TIGHT = 1e-8        # the tolerance-proportionality case (whip)
 
 #: B_E: bound on balance error / (rtol S), per case; comment: measured Debug / Release
 ENERGY_BOUND = {
-    "steel_wire_cvode": 3e-4,   # 8.8e-05 / 8.8e-05
+    "steel_wire_cvode": 3e-3,   # 7.9e-04 (Debug; 8.8e-05 before the crawl watch restarts CVODE for its order-2 trials)
     "steel_wire_mebdf": 3e-4,   # 6.8e-05 / 6.8e-05
     "undamped_cvode": 4e-3,   # 0.0012 / 0.0012
     "undamped_mebdf": 2e-4,   # 3.5e-05 / 3.5e-05

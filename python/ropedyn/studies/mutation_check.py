@@ -255,7 +255,7 @@ MUTATIONS = [
              "real(wp) :: shape_factor = 9.0_wp/10.0_wp",
              "default shear shape factor 9/10 instead of 10/9",
              pytest=(ORACLE, REGRESSION)),
-    Mutation("statics-load-potential-sign", "src/studies/ropedyn_statics.f90",
+    Mutation("statics-load-potential-sign", "src/studies/ropedyn_statics_terms.f90",
              "v = v - dot_product(force, q(1:2, body)",
              "v = v + dot_product(force, q(1:2, body)",
              "statics: the loads' potential with the wrong sign",
