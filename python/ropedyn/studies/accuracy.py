@@ -339,7 +339,7 @@ def discretization(runner, args):
                   (f"{match:.0e}" if match else ("looser" if te[0] < float(row["disc_tip"])
                                                  else "tighter")) + " |")
     md += ["", "**n needed for a tip accuracy** (log-log interpolation of the discretization "
-           "error; '>' : not reached by the largest n):", "",
+           "error; '>': not reached by the largest n; '<=': reached by the smallest):", "",
            "| accuracy (m) | RFEM n | MPP n |", "|---|---|---|"]
     for target in (1e-1, 3e-2, 1e-2, 3e-3, 1e-3):
         cells = []
@@ -347,7 +347,12 @@ def discretization(runner, args):
             sel = [r for r in rows if r["model"] == model]
             x = loglog_cross([int(r["n"]) for r in sel], [float(r["disc_tip"]) for r in sel],
                              target)
-            cells.append(f"{x:.0f}" if x else f"> {sel[-1]['n']}" if sel else "-")
+            if not sel:
+                cells.append("-")
+            elif float(sel[0]["disc_tip"]) <= target:
+                cells.append(f"<= {sel[0]['n']}")
+            else:
+                cells.append(f"{x:.0f}" if x else f"> {sel[-1]['n']}")
         md.append(f"| {target:g} | " + " | ".join(cells) + " |")
     return "\n".join(md)
 
