@@ -29,6 +29,7 @@ COMMANDS = {
     "profile_step": "ropedyn.studies.profile_step",
     "validation": "ropedyn.studies.validation",
     "work_precision": "ropedyn.studies.work_precision",
+    "accuracy": "ropedyn.studies.accuracy",
     "work_precision_testset": "ropedyn.studies.work_precision_testset",
     "stability_report": "ropedyn.studies.stability_report",
     "update_references": "ropedyn.studies.update_references",

@@ -325,7 +325,9 @@ contains
         call suite%check_true(run%e(ubound(run%e, 1))%dissipated > 0.0_wp .and. &
                               abs(run%e(ubound(run%e, 1))%support_work) > 0.0_wp, &
                               kind//': every effect: energy is dissipated and work is done')
-        call suite%check_le(worst, 2.5e-7_wp*scale, kind//': every effect: T + V + '// &
+        ! the balance error is the integrator's (rtol 1e-8): measured 2.6e-7 of `scale` (mpp,
+        ! since the clamp's rotational spring is 2 EI/l: a stiffer turning clamp), bound ~4x
+        call suite%check_le(worst, 1.0e-6_wp*scale, kind//': every effect: T + V + '// &
                             'dissipated - work = E0')
     end subroutine every_effect_balance
 end program test_effects_physics

@@ -236,7 +236,7 @@ contains
             fp = 0.0_wp
             if (self%tension) fx = self%cx*dwx
             if (self%shear) fy = self%cy*dwy
-            if (self%bending) fp = self%cp*(y(kb + 3) - y(ka + 3))
+            if (self%bending) fp = self%cpj(j)*(y(kb + 3) - y(ka + 3))
             if (energy) e_el = e_el + 0.5_wp*(fx*dwx + fy*dwy + fp*(y(kb + 3) - y(ka + 3)))
             if (self%damped) then
                 dvx = y(kb + 4) - y(ka + 4)
@@ -248,7 +248,7 @@ contains
                 rp = wb - wa
                 fx = fx + self%bx*rx
                 fy = fy + self%by*ry
-                fp = fp + self%bp*rp
+                fp = fp + self%bpj(j)*rp
             end if
             ffx = fx*ca - fy*sa
             ffy = fx*sa + fy*ca
@@ -367,9 +367,9 @@ contains
                 dfy = self%cy*gy
             end if
             if (self%bending) then
-                fp = self%cp*(y(kb + 3) - y(ka + 3))
-                dfp(3) = -self%cp
-                dfp(9) = self%cp
+                fp = self%cpj(j)*(y(kb + 3) - y(ka + 3))
+                dfp(3) = -self%cpj(j)
+                dfp(9) = self%cpj(j)
             end if
             if (self%damped) then
                 dvx = y(kb + 4) - y(ka + 4)
@@ -403,9 +403,9 @@ contains
                     dfy(10:12) = self%by*gy(7:9)
                 end if
                 if (self%bending) then
-                    fp = fp + self%bp*rp
-                    dfp(6) = -self%bp
-                    dfp(12) = self%bp
+                    fp = fp + self%bpj(j)*rp
+                    dfp(6) = -self%bpj(j)
+                    dfp(12) = self%bpj(j)
                 end if
             end if
             ! rows of element a: d(F, fy (dwx + h_a) - fx dwy + fp); of element b:
@@ -616,7 +616,7 @@ contains
             rx = ca*dvx + sa*dvy + dwy*wa + hb*sd*wb
             ry = -sa*dvx + ca*dvy - (dwx + ha)*wa - hb*cd*wb
             rp = wb - wa
-            power = power + (self%bx*rx**2 + self%by*ry**2 + self%bp*rp**2)
+            power = power + (self%bx*rx**2 + self%by*ry**2 + self%bpj(j)*rp**2)
         end do
     end subroutine internal_power
 
