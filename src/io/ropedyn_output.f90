@@ -18,6 +18,9 @@
 !!              time in the integrator and where it went (&solver profile = .true.; else 0)
 !!     /solver/reduced_newton () int64 1: 1 when the Newton systems were solved on the
 !!              reduced second-order matrix
+!!     /solver/order_lowered_at () s, /solver/order_lowered_from, _to () int64 1,
+!!     /solver/energy_gain () J: only when the order safety lowered the order (the time
+!!              from which the run went on at the lower order, and the gain that caused it)
 !!
 !! Root attributes: status ('running' | 'complete' | 'failed'), reason (failed only),
 !! version, model, method, scene, created, units_convention. See docs/output.md.
@@ -88,6 +91,7 @@ module ropedyn_output
         procedure :: create => output_create
         procedure :: append => output_append
         procedure :: write_stats => output_write_stats
+        procedure :: write_order_lowered => output_write_order_lowered
         procedure :: close_run => output_close_run
         final :: output_final
     end type output_file_t
@@ -292,6 +296,28 @@ contains
 
         call self%file%flush(err)
     end subroutine output_write_stats
+
+    !> Record that the order safety lowered the order limit from `from` to `to` at time `t`
+    !! because the energy balance gained `gain` (docs/stability.md).
+    subroutine output_write_order_lowered(self, t, from, to, gain, err)
+        class(output_file_t), intent(inout) :: self
+        real(wp), intent(in) :: t       !< s
+        integer, intent(in) :: from, to
+        real(wp), intent(in) :: gain    !< J
+        type(error_t), allocatable, intent(out) :: err
+        if (.not. self%is_open) then
+            call make_error(err, ERR_INTERNAL, &
+                            file_label(self)//': write_order_lowered: file is not open')
+            return
+        end if
+        call self%file%write('/solver/order_lowered_at', t, 's', err)
+        if (.not. allocated(err)) &
+            call self%file%write('/solver/order_lowered_from', int(from, i8), '1', err)
+        if (.not. allocated(err)) &
+            call self%file%write('/solver/order_lowered_to', int(to, i8), '1', err)
+        if (.not. allocated(err)) call self%file%write('/solver/energy_gain', gain, 'J', err)
+        if (.not. allocated(err)) call self%file%flush(err)
+    end subroutine output_write_order_lowered
 
     !> The time split of `stats` named in TIMER_NAMES, in that order (s).
     pure function timer_values(stats) result(times)
