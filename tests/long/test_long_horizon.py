@@ -20,7 +20,8 @@ For every case:
 The order-safety cases (ORDER_CASES) show the monitor at work: MEBDF at order 7 and CVODE
 at order 4 gain energy on the undamped rope at rtol 1e-3 with the monitor off, and are
 lowered to their A-stable orders (4, 2) and keep the balance with it on; CVODE at its
-default order 5 does not gain and is left alone.
+default order 5 does not gain on the undamped rope and is left alone (on the lightly damped
+one at rtol 1e-3 it does, and is lowered too).
 
 Runs are cached in build/long (ROPEDYN_LONG_DIR): rerunning the suite after a change of
 the bounds takes seconds; a new executable or scene file reruns the cases it touches.
@@ -31,13 +32,27 @@ import pytest
 
 from ropedyn.studies import long_horizon as lh
 
-#: B_E per method: bound on balance error / (rtol S); comment: the largest measured
-BALANCE_BOUND = {"cvode": 1e4, "mebdf": 1e4}
+#: B_E per method: bound on balance error / (rtol S), three times the largest measured
+#: (82 of the 180 cases measured so far; docs/stability.md "Long horizons")
+BALANCE_BOUND = {"cvode": 4e3,   # 1120: light_damping, rtol 1e-7
+                 "mebdf": 2e2}   # 56: light_damping, rtol 1e-5
 #: G: the energy monitor's default bound (&solver energy_gain_bound), in rtol S
 GAIN_BOUND = 10.0
-#: B_X: bound on max |tip_cvode - tip_mebdf| / (rtol L) over AGREE_UNTIL s
-TIP_BOUND = 1e4
-AGREE_UNTIL = 1.0
+#: B_X: bound on max |tip_a - tip_b| / (rtol L) over AGREE_UNTIL s (per scene, default
+#: 1 s); three times the largest measured (0.068: mpp_light_damping at 1e-7)
+TIP_BOUND = 0.2
+AGREE_UNTIL = {"default": 1.0,
+               # the folded falls: up to the end of the fall (0.38 s), where the tension
+               # at the tip becomes singular and accurate solutions separate
+               "folded_release": 0.3, "folded_n301": 0.3}
+#: cases that gain more than G rtol S although every order safety acted: not an order
+#: instability (measured gain in rtol S and why)
+GAIN_EXCEPTIONS = {
+    # the end of the fall at 0.38 s (a singular whip at the tip) at rtol 1e-3: lowered to
+    # BDF2 at 0.38 s it still gains (185 rtol S): an accuracy failure of the loose tolerance
+    # at the singularity, which the order cannot cure
+    "folded_n301/cvode/0.001": 600.0,
+}
 
 MATRIX = lh.matrix_cases()
 ORDER = lh.order_cases()
@@ -90,7 +105,9 @@ def test_energy_balance(results, key):
 def test_no_energy_gain(results, key):
     r = results[key]
     print(f"{key}: largest gain {r['max_gain_ratio']:.3g} rtol S")
-    assert r["max_gain_ratio"] <= GAIN_BOUND
+    assert r["max_gain_ratio"] <= GAIN_EXCEPTIONS.get(key, GAIN_BOUND)
+    if key in GAIN_EXCEPTIONS:
+        return
     text = (lh.HARD / f"{r['scene']}.nml").read_text()
     if not lh.has_external_work(r["scene"]) and "damping = .false." not in text:
         assert r["energy_growth"] <= GAIN_BOUND * r["rtol"] * r["energy_scale"]
@@ -102,7 +119,8 @@ def test_methods_agree(results, scene, rtol):
     runs = [r for r in runs if "_series" in r]
     ref = runs[0]
     for other in runs[1:]:
-        diff = lh.tip_difference(ref, other, AGREE_UNTIL)
+        until = AGREE_UNTIL.get(scene, AGREE_UNTIL["default"])
+        diff = lh.tip_difference(ref, other, until)
         ratio = diff / (rtol * rope_length(scene))
         print(f"{scene} {rtol:g} {ref['method']} - {other['method']}: {ratio:.3g} rtol L")
         assert ratio <= TIP_BOUND
@@ -134,9 +152,15 @@ def test_order_safety_cvode(results, scene):
     on4 = order_result(results, scene, "cvode 4, lower")
     print(f"{scene}: cvode 5 gains {off5['max_gain_ratio']:.3g} rtol S, cvode 4 "
           f"{off4['max_gain_ratio']:.3g} unguarded, {on4['max_gain_ratio']:.3g} guarded")
-    # order 5 does not gain: the monitor leaves it alone (the same run)
-    assert off5["max_gain_ratio"] <= GAIN_BOUND and on5["order_lowered_at"] is None
-    assert on5["steps"] == off5["steps"]
+    # order 5: left alone where it does not gain (the same run); where it does (the lightly
+    # damped rope at rtol 1e-3, measured: lowered at 1.2 s) lowered to BDF2
+    if off5["max_gain_ratio"] <= GAIN_BOUND:
+        assert on5["order_lowered_at"] is None and on5["steps"] == off5["steps"]
+    else:
+        assert on5["order_lowered_to"] == 2
+    assert on5["max_gain_ratio"] <= GAIN_BOUND
+    if scene == "undamped":
+        assert on5["order_lowered_at"] is None
     # order 4 gains; guarded it is lowered to BDF2 and keeps the balance
     assert off4["max_gain_ratio"] > GAIN_BOUND
     assert on4["order_lowered_to"] == 2 and on4["max_gain_ratio"] <= GAIN_BOUND

@@ -88,7 +88,8 @@ def order_cases():
 
 
 def _stamp(exe, scene, overrides):
-    st = pathlib.Path(exe).stat()
+    exe = pathlib.Path(exe).resolve()
+    st = exe.stat()
     text = (HARD / f"{scene}.nml").read_text()
     key = json.dumps([str(exe), st.st_size, st.st_mtime_ns, text, overrides])
     return hashlib.sha256(key.encode()).hexdigest()
@@ -98,8 +99,9 @@ def _file_name(key):
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", key) + ".h5"
 
 
-def run_case(exe, workdir, key, scene, overrides, timeout):
-    """Run one case (unless cached); return (returncode, stderr, h5 path)."""
+def run_case(exe, workdir, key, scene, overrides, timeout, cached_only=False):
+    """Run one case (unless cached); return (returncode, stderr, h5 path); with
+    `cached_only` a case not in the cache is not run (returncode None)."""
     workdir = pathlib.Path(workdir)
     out = workdir / _file_name(key)
     meta = out.with_suffix(".json")
@@ -108,6 +110,8 @@ def run_case(exe, workdir, key, scene, overrides, timeout):
         old = json.loads(meta.read_text())
         if old.get("stamp") == stamp:
             return old["returncode"], old["stderr"], out
+    if cached_only:
+        return None, "not run (not in the cache)", workdir / "missing.h5"
     cmd = [str(exe), "run", str(HARD / f"{scene}.nml"), "--set", f"output.file={out}"]
     for o in overrides:
         cmd += ["--set", o]
@@ -126,6 +130,9 @@ def run_case(exe, workdir, key, scene, overrides, timeout):
 def measures(rc, stderr, path, scene):
     """The scalar measures of one case (JSON-able) plus the series under '_series'."""
     r = {"returncode": rc, "stderr": stderr.strip(), "scene": scene}
+    if rc is None:
+        r["outcome"] = stderr
+        return r
     if not path.exists():
         r["outcome"] = f"no output (exit {rc}): {stderr.strip()}"
         return r
@@ -160,7 +167,7 @@ def measures(rc, stderr, path, scene):
     return r
 
 
-def run_all(exe, cases, workdir, jobs=2, timeout=3000, log=print):
+def run_all(exe, cases, workdir, jobs=2, timeout=3000, log=print, cached_only=False):
     """Run `cases` [(key, scene, overrides)] two at a time (longest first when known);
     return {key: measures}; writes workdir/measures.json (without the series)."""
     workdir = pathlib.Path(workdir)
@@ -173,7 +180,8 @@ def run_all(exe, cases, workdir, jobs=2, timeout=3000, log=print):
     order = sorted(cases, key=lambda c: -walls.get(c[0], 1e9))
     results = {}
     with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
-        futures = {pool.submit(run_case, exe, workdir, key, scene, ov, timeout): (key, scene)
+        futures = {pool.submit(run_case, exe, workdir, key, scene, ov, timeout,
+                               cached_only): (key, scene)
                    for key, scene, ov in order}
         for fut in concurrent.futures.as_completed(futures):
             key, scene = futures[fut]
