@@ -8,6 +8,7 @@
 !! be resolved, and order 5 never amplified. MEBDF defaults to order 4 (k = 3), the highest
 !! at which it is A-stable and does not amplify undamped oscillations (order 5 amplifies by
 !! up to 1.027 per step on the imaginary axis, order 6 by 1.114; docs/solvers.md).
+!! The safe orders: BDF is A-stable up to order 2, MEBDF up to order 4.
 module ropedyn_methods
     implicit none
     private
@@ -21,11 +22,15 @@ module ropedyn_methods
         !> the max_order used when max_order = 0 (0 for auto: it chooses MEBDF's limit
         !! from the damping of the scene's fast modes, ropedyn_auto)
         integer :: default_order = 1
+        !> the highest order at which the method never amplifies an undamped oscillation
+        !! (A-stable; 0: none known): the order ropedyn's energy monitor lowers it to when
+        !! the energy balance shows a gain (&solver order_safety, docs/stability.md)
+        integer :: safe_order = 0
     end type method_info_t
 
     type(method_info_t), parameter :: METHODS(*) = [ &
-        method_info_t('cvode', 1, 5, 5), &
-        method_info_t('mebdf', 2, 7, 4), &
+        method_info_t('cvode', 1, 5, 5, safe_order=2), &
+        method_info_t('mebdf', 2, 7, 4, safe_order=4), &
         method_info_t('erk', 3, 5, 4), &
         method_info_t('adams', 1, 12, 12), &
         method_info_t('auto', 2, 7, 0)]

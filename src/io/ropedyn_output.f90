@@ -22,6 +22,9 @@
 !!     /state/yq               (times, quadratures)   J             state sizes at create)
 !!     /solver/restarts/{time, record, steps, cpu_time, wall_clock, previous_status,
 !!              previous_reason} (restarts,)   one entry per resume (add_restart)
+!!     /solver/order_lowered_at () s, /solver/order_lowered_from, _to () int64 1,
+!!     /solver/energy_gain () J: only when the order safety lowered the order (the time
+!!              from which the run went on at the lower order, and the gain that caused it)
 !!
 !! Root attributes: status ('running' | 'complete' | 'failed' | 'interrupted'), reason
 !! (failed and interrupted), version, model, method, scene, created, units_convention.
@@ -117,6 +120,7 @@ module ropedyn_output
         procedure :: append => output_append
         procedure :: write_stats => output_write_stats
         procedure :: write_switches => output_write_switches
+        procedure :: write_order_lowered => output_write_order_lowered
         procedure :: close_run => output_close_run
         procedure :: reopen => output_reopen
         procedure :: records => output_records
@@ -385,6 +389,28 @@ contains
 
         call self%file%flush(err)
     end subroutine output_write_stats
+
+    !> Record that the order safety lowered the order limit from `from` to `to` at time `t`
+    !! because the energy balance gained `gain` (docs/stability.md).
+    subroutine output_write_order_lowered(self, t, from, to, gain, err)
+        class(output_file_t), intent(inout) :: self
+        real(wp), intent(in) :: t       !< s
+        integer, intent(in) :: from, to
+        real(wp), intent(in) :: gain    !< J
+        type(error_t), allocatable, intent(out) :: err
+        if (.not. self%is_open) then
+            call make_error(err, ERR_INTERNAL, &
+                            file_label(self)//': write_order_lowered: file is not open')
+            return
+        end if
+        call self%file%write('/solver/order_lowered_at', t, 's', err)
+        if (.not. allocated(err)) &
+            call self%file%write('/solver/order_lowered_from', int(from, i8), '1', err)
+        if (.not. allocated(err)) &
+            call self%file%write('/solver/order_lowered_to', int(to, i8), '1', err)
+        if (.not. allocated(err)) call self%file%write('/solver/energy_gain', gain, 'J', err)
+        if (.not. allocated(err)) call self%file%flush(err)
+    end subroutine output_write_order_lowered
 
     !> The time split of `stats` named in TIMER_NAMES, in that order (s).
     pure function timer_values(stats) result(times)

@@ -30,6 +30,12 @@ module ropedyn_scene_types
         logical :: profile = .false.
         !> testing aid: the right-hand side returns NaN for t > this time [s]; < 0: off
         real(wp) :: fault_nan_after = -1.0_wp
+        !> what the run does when the energy balance gains more than energy_gain_bound:
+        !! 'lower' the order to the method's A-stable one and redo the output interval,
+        !! 'stop' (a diagnosed failure), or 'off' (no check); docs/stability.md
+        character(len=NAME_LEN) :: order_safety = 'lower'
+        !> the gain that counts, in units of rtol S (S: the energy scale of the run) [-]
+        real(wp) :: energy_gain_bound = 10.0_wp
     end type solver_params_t
 
     !> `&output`: where results go.

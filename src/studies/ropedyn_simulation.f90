@@ -24,6 +24,9 @@ module ropedyn_simulation
     use ropedyn_switch_log, only: switch_event_t
     use ropedyn_version, only: version_string
     use ropedyn_modes, only: equilibrium_initial_state
+    use ropedyn_methods, only: METHODS, method_index
+    use ropedyn_problem, only: problem_t
+    use ropedyn_energy_monitor, only: energy_monitor_t
     use ropedyn_state_record, only: state_record_t, read_state_record
     use ropedyn_text, only: int_text
     implicit none
@@ -41,6 +44,16 @@ module ropedyn_simulation
         !> the integrator's changes of method or order limit (auto, cvode's crawl watch)
         type(switch_event_t), allocatable :: switches(:)
         character(len=:), allocatable :: file
+        !> order safety (docs/stability.md): the time from which the order was lowered
+        !! (< 0: never), the order limit before and after, and the gain that caused it (J)
+        real(wp) :: order_lowered_at = -1.0_wp
+        integer :: order_before = 0
+        integer :: order_after = 0
+        real(wp) :: energy_gain = 0.0_wp
+        real(wp) :: energy_gain_bound = 0.0_wp
+        !> a gain beyond the bound that could not be cured by lowering the order (the method
+        !! was at its safe order already, or has none): the first time it was seen (< 0: never)
+        real(wp) :: gain_unresolved_at = -1.0_wp
     end type run_summary_t
 
 contains
@@ -113,6 +126,12 @@ contains
     !! or failed run stopped) is the starting point but is replaced by the grid records that
     !! follow, so that the file ends with the records of an uninterrupted run. The restart is
     !! recorded in /solver/restarts; the solver counters and the CPU time add up.
+    !!
+    !! Order safety (`&solver order_safety`, docs/stability.md): at every output time the
+    !! energy monitor compares the balance with E0; a gain above `energy_gain_bound` rtol S
+    !! with 'lower' restarts the integrator from the previous record at the method's safe
+    !! (A-stable) order and integrates the interval again (once: the order stays there), with
+    !! 'stop' ends the run as a failed integration naming the gain.
     subroutine run_scene(scene, summary, err, resume)
         type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(out) :: summary
@@ -135,6 +154,13 @@ contains
         class(rope_model_t), allocatable, target :: model
         class(integrator_t), allocatable :: integrator
         type(fault_problem_t), target :: faulty
+        class(problem_t), pointer :: problem
+        type(energy_monitor_t) :: monitor
+        type(solver_stats_t) :: stats_before   ! counters of the integrators replaced
+        real(wp), allocatable :: y_prev(:), yq_prev(:)
+        real(wp) :: t_prev
+        integer :: max_order, safe_order
+        logical :: monitoring
         type(output_file_t) :: out
         type(progress_t) :: progress
         type(error_t), allocatable :: io_err
@@ -161,6 +187,7 @@ contains
         nq = model%quad_size()
         allocate (y(model%size()), yq(max(1, nq)))
         allocate (q(3, n), qdot(3, n), points(2, 2*n), lengths(n), masses(n))
+        allocate (y_prev(size(y)), yq_prev(size(yq)))
         dt = scene%solver%output_interval
         t_end = scene%solver%t_end
         n_out = max(1, ceiling(t_end/dt*(1.0_wp - 1.0e-12_wp)))
@@ -206,6 +233,9 @@ contains
         end if
         t0 = t
         t_last = t
+        t_prev = t
+        y_prev = y
+        yq_prev = yq
 
         call cpu_time(cpu_start)
         time_advance = 0.0_wp
@@ -221,10 +251,19 @@ contains
         if (scene%solver%fault_nan_after >= 0.0_wp) then
             ! testing aid (docs/input.md): the integrator sees a NaN right-hand side later on
             call fault_wrap(faulty, model, scene%solver%fault_nan_after)
-            call integrator%init(faulty, t, y, yq(1:nq), options, err)
+            problem => faulty
         else
-            call integrator%init(model, t, y, yq(1:nq), options, err)
+            problem => model
         end if
+        max_order = scene%solver%max_order
+        if (max_order == 0) max_order = integrator%default_max_order()
+        safe_order = 0
+        if (method_index(integrator%name()) > 0) &
+            safe_order = METHODS(method_index(integrator%name()))%safe_order
+        monitoring = trim(scene%solver%order_safety) /= 'off'
+        call monitor%start(summary%initial_energy, scene%solver%rtol, &
+                           scene%solver%energy_gain_bound)
+        call start_integrator(err)
         if (allocated(err)) then
             call finish('failed', err%message)
             return
@@ -236,6 +275,7 @@ contains
             call integrator%advance_to(tout, t, y, yq(1:nq), err)
             if (scene%solver%profile) time_advance = time_advance + &
                                                      (clock_seconds() - clock_start)
+            if (.not. allocated(err) .and. monitoring .and. t >= tout) call check_energy(tout, err)
             if (allocated(err)) then
                 call progress%done()
                 ! keep the last good state if the solver got past the previous record
@@ -339,6 +379,78 @@ contains
                 'that follow)'
         end subroutine start_from_file
 
+        !> (Re)start the integrator at (t, y, yq) with the order limit `max_order` and the
+        !! step budget that the integrators before it left.
+        subroutine start_integrator(ierr)
+            type(error_t), allocatable, intent(out) :: ierr
+            type(solver_options_t) :: options
+            options = solver_options_of(scene)
+            options%stop_requested => stop_on_signal
+            options%max_order = max_order
+            options%max_steps = max(1_i8, options%max_steps - stats_before%steps)
+            call integrator%init(problem, t, y, yq(1:nq), options, ierr)
+        end subroutine start_integrator
+
+        !> The energy monitor at the output time just reached: on a gain beyond the bound,
+        !! lower the order and integrate the interval again ('lower'), or fail ('stop').
+        subroutine check_energy(tout, cerr)
+            real(wp), intent(in) :: tout
+            type(error_t), allocatable, intent(out) :: cerr
+            type(energy_t) :: e
+            character(len=200) :: what
+            e = model%energy(t, y, yq)
+            if (.not. ieee_is_finite(e%balance())) return   ! write_record says so
+            if (.not. monitor%gained(e)) then
+                call monitor%observe(e)
+                return
+            end if
+            block
+                type(energy_monitor_t) :: next
+                next = monitor
+                call next%observe(e)
+                write (what, '(a, es10.3, a, es10.3, a, es12.5, a, i0)') 'energy gain ', &
+                    next%gain(e), ' J above E0 (bound ', next%bound(), ' J) at t = ', t, &
+                    ' s, max order ', max_order
+                if (summary%gain_unresolved_at < 0.0_wp .and. &
+                    summary%order_lowered_at < 0.0_wp) then
+                    summary%energy_gain = next%gain(e)
+                    summary%energy_gain_bound = next%bound()
+                end if
+            end block
+            if (trim(scene%solver%order_safety) == 'stop') then
+                stats = integrator%stats()
+                call make_error(cerr, ERR_SOLVER, integrator%name()//' failed at t = '// &
+                    real_text(t_prev)//' s, step size '// &
+                    real_text(stats%last_step)//' s: '//trim(what)// &
+                    ': the integrator created energy (&solver '// &
+                    'order_safety = ''stop''; docs/stability.md)')
+                t = t_prev       ! the record with the gain is not written
+                y = y_prev
+                yq = yq_prev
+                return
+            end if
+            if (safe_order > 0 .and. max_order > safe_order) then
+                ! back to the previous record, on at the safe order
+                summary%order_lowered_at = t_prev
+                summary%order_before = max_order
+                summary%order_after = safe_order
+                call add_stats(stats_before, integrator%stats())
+                call integrator%finalize()
+                max_order = safe_order
+                t = t_prev
+                y = y_prev
+                yq = yq_prev
+                call start_integrator(cerr)
+                if (allocated(cerr)) return
+                call integrator%advance_to(tout, t, y, yq(1:nq), cerr)
+                if (allocated(cerr)) return
+                e = model%energy(t, y, yq)
+            else if (summary%gain_unresolved_at < 0.0_wp) then
+                summary%gain_unresolved_at = t
+            end if
+            call monitor%observe(e)
+        end subroutine check_energy
+
         subroutine write_record(werr)
             type(error_t), allocatable, intent(out) :: werr
             type(energy_t) :: e
@@ -349,6 +461,7 @@ contains
             order = 0
             if (allocated(integrator)) then
                 stats = integrator%stats()
+                call add_stats(stats, stats_before)
                 h = stats%last_step
                 order = stats%last_order
             end if
@@ -368,6 +481,9 @@ contains
             summary%final_energy = e
             summary%t_reached = t
             t_last = t
+            t_prev = t
+            y_prev = y
+            yq_prev = yq
         end subroutine write_record
 
         subroutine finish(status, reason)
@@ -376,17 +492,41 @@ contains
             call cpu_time(cpu_now)
             summary%cpu_time = cpu_before + (cpu_now - cpu_start)
             summary%stats = integrator%stats()
+            call add_stats(summary%stats, stats_before)
             summary%stats%time_advance = time_advance
             call add_counters(summary%stats, counters_before)
             summary%t_reached = max(summary%t_reached, t)
             call out%write_stats(summary%stats, summary%cpu_time, ferr, t_reached=t)
             summary%switches = integrator%switch_log()
             if (.not. allocated(ferr)) call out%write_switches(summary%switches, ferr)
+            if (.not. allocated(ferr) .and. summary%order_lowered_at >= 0.0_wp) &
+                call out%write_order_lowered(summary%order_lowered_at, summary%order_before, &
+                                             summary%order_after, summary%energy_gain, ferr)
             call out%close_run(status, reason, ferr)
             if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
             call integrator%finalize()
         end subroutine finish
     end subroutine integrate_scene
+
+    !> Add the counters of `more` (an integrator that was replaced) to `stats`; the last
+    !! step, order and Newton path stay those of `stats`.
+    pure subroutine add_stats(stats, more)
+        type(solver_stats_t), intent(inout) :: stats
+        type(solver_stats_t), intent(in) :: more
+        stats%steps = stats%steps + more%steps
+        stats%rhs_evals = stats%rhs_evals + more%rhs_evals
+        stats%jac_rhs_evals = stats%jac_rhs_evals + more%jac_rhs_evals
+        stats%jac_evals = stats%jac_evals + more%jac_evals
+        stats%lin_setups = stats%lin_setups + more%lin_setups
+        stats%err_test_fails = stats%err_test_fails + more%err_test_fails
+        stats%nonlin_iters = stats%nonlin_iters + more%nonlin_iters
+        stats%nonlin_conv_fails = stats%nonlin_conv_fails + more%nonlin_conv_fails
+        stats%order_steps = stats%order_steps + more%order_steps
+        stats%time_rhs = stats%time_rhs + more%time_rhs
+        stats%time_jac = stats%time_jac + more%time_jac
+        stats%time_factor = stats%time_factor + more%time_factor
+        stats%time_solve = stats%time_solve + more%time_solve
+    end subroutine add_stats
 
     !> The counters of earlier parts of a resumed run added (in ropedyn_output's
     !! COUNTER_NAMES order: steps, rhs_evals, jac_evals, lin_setups, err_test_fails,

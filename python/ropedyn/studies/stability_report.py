@@ -9,7 +9,12 @@ sections of docs/stability.md are rewritten between their markers; the text arou
   and undamped paper scenes (n = 30) and the steel wire at CVODE max_order 2 .. 5, with and
   without stability-limit detection, and MEBDF at its default for comparison;
 - `hard-scenes`: one table per hard scene (solver, settings, steps, CPU time, energy-balance
-  error, energy growth, max tip speed, outcome).
+  error, energy growth, max tip speed, outcome);
+- `long-horizon` (and with it `numerical-damping` and `order-safety`): the long-horizon
+  matrix of ropedyn.studies.long_horizon (every scene of input/hard to its t_end, the
+  default and every method at rtol 1e-3, 1e-5, 1e-7; the order-safety cases), the same runs
+  as the CTest label `long` and from the same cache (build/long): after `scripts/test
+  --long` this section only reads the files.
 
 Horizons are chosen so that the whole report takes under 20 minutes on 2 cores
 (`--jobs 2`, the default); `--quick` divides every horizon by 10 for a smoke run (no file written unless
@@ -24,7 +29,7 @@ import subprocess
 import tempfile
 
 from ropedyn.run import DOCS, INPUT, add_exe_argument, exe_or_build, set_args
-from ropedyn.studies import stability_metrics
+from ropedyn.studies import long_horizon, stability_metrics
 from ropedyn.studies.common import machine, splice
 
 DOC = DOCS / "stability.md"
@@ -226,15 +231,116 @@ STUDIES = {
 }
 
 
+def long_matrix_table(res):
+    lines = ["| scene | t_end (s) | run | steps | CPU (s) | balance error / (rtol S) | "
+             "largest gain / (rtol S) | B - E0 at the end (J) | orders | outcome |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for key, scene, _ in long_horizon.matrix_cases():
+        r = res[key]
+        run = key.split("/", 1)[1].replace("/", ", rtol ")
+        if "steps" not in r:
+            lines.append(f"| {scene} |  | {run} |  |  |  |  |  |  | {short(r['outcome'])} |")
+            continue
+        orders = "-".join(str(k) for k in (min(r["orders"]), max(r["orders"]))) \
+            if r["orders"] else ""
+        if r.get("order_lowered_at") is not None:
+            orders += f" (lowered to {r['order_lowered_to']} at {r['order_lowered_at']:.3g} s)"
+        lines.append(
+            f"| {scene} | {r['t_end']:g} | {run} | {r['steps']} | {fmt(r['cpu_time'], '.1f')} | "
+            f"{r['balance_ratio']:.2g} | {r['max_gain_ratio']:.2g} | {r['final_drift']:+.1e} | "
+            f"{orders} | {short(r['outcome'])} |")
+    total = sum(r.get("cpu_time") or 0.0 for r in res.values())
+    worst = {}
+    for key, _, _ in long_horizon.matrix_cases():
+        r = res[key]
+        if "steps" in r:
+            m = r["method"]
+            worst[m] = max(worst.get(m, 0.0), r["balance_ratio"])
+    lines.append("")
+    lines.append(f"Total CPU time of the matrix: {total / 60:.0f} min. Largest balance error / "
+                 "(rtol S) per method: " + ", ".join(f"{m} {v:.3g}" for m, v in
+                                                      sorted(worst.items())) + ".")
+    return "\n".join(lines)
+
+
+def damping_table(res):
+    """The energy the integrator removes per second on the undamped scenes."""
+    undamped = [s for s in long_horizon.scenes() if long_horizon.is_undamped(s)]
+    runs = [("default", None)] + [(m, t) for m in long_horizon.METHODS
+                                  for t in long_horizon.RTOLS]
+    lines = ["| scene | run | t_end (s) | E0 scale S (J) | removed per second (J/s) | "
+             "per second / S | B - E0 at the end (J) |", "|---|---|---|---|---|---|---|"]
+    for scene in undamped:
+        for method, rtol in runs:
+            key = f"{scene}/default" if rtol is None else f"{scene}/{method}/{rtol:g}"
+            r = res[key]
+            label = "default" if rtol is None else f"{method}, rtol {rtol:g}"
+            if "steps" not in r:
+                lines.append(f"| {scene} | {label} |  |  |  |  | {short(r['outcome'])} |")
+                continue
+            lines.append(f"| {scene} | {label} | {r['t_reached']:g} | "
+                         f"{r['energy_scale']:.3g} | {r['damping_rate']:.2e} | "
+                         f"{r['damping_rate'] / r['energy_scale']:.1e} | "
+                         f"{r['final_drift']:+.2e} |")
+    return "\n".join(lines)
+
+
+def order_safety_table(res):
+    lines = ["| scene | method, max order, order_safety | steps | CPU (s) | "
+             "largest gain / (rtol S) | balance error / (rtol S) | order lowered | outcome |",
+             "|---|---|---|---|---|---|---|---|"]
+    for key, scene, _ in long_horizon.order_cases():
+        r = res[key]
+        label = key.split("/", 2)[2]
+        if "steps" not in r:
+            lines.append(f"| {scene} | {label} |  |  |  |  |  | {short(r['outcome'])} |")
+            continue
+        low = "" if r.get("order_lowered_at") is None else \
+            f"to {r['order_lowered_to']} at {r['order_lowered_at']:.3g} s"
+        lines.append(f"| {scene} | {label} | {r['steps']} | {fmt(r['cpu_time'], '.1f')} | "
+                     f"{r['max_gain_ratio']:.3g} | {r['balance_ratio']:.3g} | {low} | "
+                     f"{short(r['outcome'])} |")
+    return "\n".join(lines)
+
+
+def long_sections(exe, jobs, command, stamp, cached_only=False):
+    """Run (or read from the cache) the long-horizon matrix; the three sections."""
+    cases = long_horizon.matrix_cases() + long_horizon.order_cases()
+    res = long_horizon.run_all(exe, cases, long_horizon.default_workdir(), jobs=jobs,
+                               cached_only=cached_only)
+    head = (f"{command} (Release build; the runs of `scripts/test --long`, cached in "
+            f"build/long). {stamp}\n\n")
+    methods = ", ".join(long_horizon.METHODS)
+    return {
+        "long-horizon": head + (
+            f"Every scene of `input/hard/` to its t_end: the default run (the scene's "
+            f"settings: cvode, rtol 1e-6) and {methods} at rtol 1e-3, 1e-5, 1e-7 "
+            "(atol = rtol/100). Balance error: max |T + V + dissipated - work - E0|; largest "
+            "gain: max (B - E0), positive: energy created; orders: the lowest and highest "
+            "order of the output records.\n\n") + long_matrix_table(res),
+        "numerical-damping": head + (
+            "The undamped scenes (no damper, no contact): everything the balance loses is "
+            "the integrator's numerical damping. Removed per second: -(B - E0)/t at the "
+            "end.\n\n") + damping_table(res),
+        "order-safety": head + (
+            "rtol 1e-3, atol 1e-5, 10 s. `off`: no energy monitor; `lower` (the default): "
+            "on a gain above 10 rtol S the run goes back one record and on at the "
+            "method's A-stable order.\n\n") + order_safety_table(res),
+    }
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     add_exe_argument(parser)
     parser.add_argument("--jobs", type=int, default=2, help="runs at a time (default 2)")
-    parser.add_argument("--only", choices=["cvode-order", "hard-scenes"], default=None)
+    parser.add_argument("--only", choices=["cvode-order", "hard-scenes", "long-horizon"],
+                        default=None)
     parser.add_argument("--quick", action="store_true", help="horizons / 10, no file written")
     parser.add_argument("--write", action="store_true", help="write docs/stability.md "
                         "even with --quick")
     parser.add_argument("--no-write", action="store_true", help="print only")
+    parser.add_argument("--cached-only", action="store_true", help="long-horizon: only "
+                        "the runs in the cache (build/long); the others are listed as not run")
     parser.add_argument("--timeout", type=float, default=1200.0, help="wall time per run (s)")
     args = parser.parse_args(argv)
     exe = exe_or_build(args.exe)
@@ -253,6 +359,12 @@ def main(argv=None):
         res = run_all(exe, cases(scale), args.jobs, args.timeout)
         sections[name] = f"{command} (Release build). {stamp}\n\n{intro}\n\n" + table(res, scale)
         print(sections[name])
+
+    if args.only in (None, "long-horizon") and not args.quick:
+        print("Long-horizon matrix:", flush=True)
+        if args.cached_only:
+            command = command[:-1] + " --only long-horizon --cached-only`"
+        sections.update(long_sections(exe, args.jobs, command, stamp, args.cached_only))
 
     elapsed = datetime.datetime.now(datetime.timezone.utc) - started
     print(f"elapsed: {elapsed.total_seconds():.0f} s")

@@ -1,0 +1,99 @@
+!> The energy monitor of a run (order safety, docs/stability.md): watches the energy balance
+!! B = T + V + dissipated - external work at the output times and says when B has risen
+!! above its start E0 by more than `factor` rtol S.
+!!
+!! Why: B equals E0 for the exact solution of every rope scene. An integrator that damps
+!! numerically lowers B; one that amplifies a barely damped mode (BDF at orders 3-5, MEBDF
+!! at orders 5-7: not A-stable) raises it, often where its error test does not look. A rise
+!! beyond the integration error is therefore an instability, and it is cheap to see: the
+!! models give the energies and the dissipated energy and work as quadratures.
+!!
+!! S is the energy the run moves around so far, as in `stability_metrics` (python): max T +
+!! max elastic + (max - min) of the gravity energy + the energy dissipated (J); one accepted
+!! step moves B by about rtol times the energies in play, so the bound rtol S follows the
+!! tolerance. The monitor knows nothing of integrators: the run driver
+!! (`ropedyn_simulation`) decides what a gain means (lower the order, stop).
+module ropedyn_energy_monitor
+    use ropedyn_kinds, only: wp
+    use ropedyn_rope_model, only: energy_t
+    implicit none
+    private
+    public :: energy_monitor_t
+
+    type :: energy_monitor_t
+        real(wp) :: e0 = 0.0_wp             !< B at the start, J
+        real(wp) :: rtol = 0.0_wp           !< relative tolerance of the run
+        real(wp) :: factor = 0.0_wp         !< the bound in units of rtol S
+        real(wp) :: max_kinetic = 0.0_wp    !< J
+        real(wp) :: max_elastic = 0.0_wp    !< J
+        real(wp) :: min_gravity = 0.0_wp    !< J
+        real(wp) :: max_gravity = 0.0_wp    !< J
+        real(wp) :: dissipated = 0.0_wp     !< |dissipated| at the last record, J
+    contains
+        procedure :: start => monitor_start
+        procedure :: observe => monitor_observe
+        procedure :: scale => monitor_scale
+        procedure :: bound => monitor_bound
+        procedure :: gain => monitor_gain
+        procedure :: gained => monitor_gained
+    end type energy_monitor_t
+
+contains
+
+    !> Start from the energies of the initial state.
+    pure subroutine monitor_start(self, e, rtol, factor)
+        class(energy_monitor_t), intent(inout) :: self
+        type(energy_t), intent(in) :: e
+        real(wp), intent(in) :: rtol, factor
+        self%e0 = e%balance()
+        self%rtol = rtol
+        self%factor = factor
+        self%max_kinetic = e%kinetic
+        self%max_elastic = e%elastic
+        self%min_gravity = e%gravity
+        self%max_gravity = e%gravity
+        self%dissipated = abs(e%dissipated)
+    end subroutine monitor_start
+
+    !> Take the energies of one more record into the scale S.
+    pure subroutine monitor_observe(self, e)
+        class(energy_monitor_t), intent(inout) :: self
+        type(energy_t), intent(in) :: e
+        self%max_kinetic = max(self%max_kinetic, e%kinetic)
+        self%max_elastic = max(self%max_elastic, e%elastic)
+        self%min_gravity = min(self%min_gravity, e%gravity)
+        self%max_gravity = max(self%max_gravity, e%gravity)
+        self%dissipated = abs(e%dissipated)
+    end subroutine monitor_observe
+
+    !> S, the energy scale so far (J).
+    pure real(wp) function monitor_scale(self) result(s)
+        class(energy_monitor_t), intent(in) :: self
+        s = self%max_kinetic + self%max_elastic + (self%max_gravity - self%min_gravity) + &
+            self%dissipated
+    end function monitor_scale
+
+    !> The gain that counts: factor rtol S (J).
+    pure real(wp) function monitor_bound(self) result(b)
+        class(energy_monitor_t), intent(in) :: self
+        b = self%factor*self%rtol*self%scale()
+    end function monitor_bound
+
+    !> B - E0 of a state (J; positive: energy created).
+    pure real(wp) function monitor_gain(self, e) result(g)
+        class(energy_monitor_t), intent(in) :: self
+        type(energy_t), intent(in) :: e
+        g = e%balance() - self%e0
+    end function monitor_gain
+
+    !> True when a state's balance lies above E0 by more than the bound, with its energies
+    !! counted into S first (so a record that itself moves much energy raises its own bound).
+    pure logical function monitor_gained(self, e) result(yes)
+        class(energy_monitor_t), intent(in) :: self
+        type(energy_t), intent(in) :: e
+        type(energy_monitor_t) :: next
+        next = self
+        call next%observe(e)
+        yes = next%gain(e) > next%bound()
+    end function monitor_gained
+end module ropedyn_energy_monitor

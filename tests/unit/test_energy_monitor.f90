@@ -1,0 +1,73 @@
+!> The energy monitor of the order safety (src/studies/ropedyn_energy_monitor.f90), on
+!! energies made up by hand:
+!! - S is max T + max elastic + gravity range + |dissipated| over the records seen, as
+!!   stability_metrics.analyse computes it from a file (python);
+!! - the gain is B - E0 with B = T + V + dissipated - work (external work counted: a support
+!!   that feeds energy in is no gain);
+!! - `gained` is true exactly above factor rtol S, with the record's own energies in S, and
+!!   does not change the monitor (only `observe` does);
+!! - losses (numerical damping) never count.
+!! The end-to-end part (the order lowered at a gain, 'stop', the HDF5 record) is
+!! tests/hard/test_order_safety.py; the long runs tests/long.
+program test_energy_monitor
+    use ropedyn_kinds, only: wp
+    use ropedyn_rope_model, only: energy_t
+    use ropedyn_energy_monitor, only: energy_monitor_t
+    use ropedyn_assert, only: test_suite_t
+    implicit none
+
+    type(test_suite_t) :: suite
+    type(energy_monitor_t) :: m
+    type(energy_t) :: e0, e1, e2
+    real(wp) :: x
+    real(wp), parameter :: rtol = 1.0e-4_wp, factor = 10.0_wp
+
+    suite%name = 'energy_monitor'
+    ! start: hanging at rest, some elastic energy, gravity -1 J
+    e0 = energy_t(kinetic=0.0_wp, elastic=0.1_wp, gravity=-1.0_wp, dissipated=0.0_wp, &
+                  support_work=0.0_wp)
+    call m%start(e0, rtol, factor)
+    call suite%check_close(m%scale(), 0.1_wp, 1.0e-15_wp, 0.0_wp, 'S at the start')
+    call suite%check_close(m%e0, -0.9_wp, 1.0e-15_wp, 0.0_wp, 'E0 = T + V + D - W')
+
+    ! swinging: 0.5 J kinetic from 0.5 J of gravity, 0.01 J dissipated: S = 0.5 + 0.1 + 0.51
+    ! + 0.01, balance exactly E0
+    e1 = energy_t(kinetic=0.5_wp, elastic=0.1_wp, gravity=-1.51_wp, dissipated=0.01_wp, &
+                  support_work=0.0_wp)
+    call suite%check_true(.not. m%gained(e1), 'an exact balance is no gain')
+    call suite%check_close(m%scale(), 0.1_wp, 1.0e-15_wp, 0.0_wp, 'gained does not observe')
+    call m%observe(e1)
+    call suite%check_close(m%scale(), 1.12_wp, 1.0e-14_wp, 0.0_wp, 'S after a record')
+    call suite%check_close(m%bound(), factor*rtol*1.12_wp, 1.0e-14_wp, 0.0_wp, 'bound')
+
+    ! a gain x in the dissipated energy alone: S = 1.12 + x, so it counts from
+    ! x* = factor rtol 1.12 / (1 - factor rtol) on
+    x = factor*rtol*1.12_wp/(1.0_wp - factor*rtol)
+    e2 = e1
+    e2%dissipated = e1%dissipated + 0.99_wp*x
+    call suite%check_true(.not. m%gained(e2), 'a gain below the bound')
+    e2%dissipated = e1%dissipated + 1.01_wp*x
+    call suite%check_true(m%gained(e2), 'a gain above the bound')
+    call suite%check_close(m%gain(e2), 1.01_wp*x, 1.0e-10_wp, 0.0_wp, 'gain = B - E0')
+
+    ! numerical damping: a large loss is never a gain
+    e2 = e1
+    e2%kinetic = 0.0_wp
+    call suite%check_true(.not. m%gained(e2), 'a loss is no gain')
+    call suite%check_true(m%gain(e2) < 0.0_wp, 'a loss is negative')
+
+    ! external work: the support did 2 J, the rope has them: no gain
+    e2 = e1
+    e2%kinetic = e1%kinetic + 2.0_wp
+    e2%support_work = 2.0_wp
+    call suite%check_true(.not. m%gained(e2), 'work done on the rope is no gain')
+    ! ... but 2 J of kinetic energy without the work is
+    e2%support_work = 0.0_wp
+    call suite%check_true(m%gained(e2), 'energy from nowhere is a gain')
+
+    ! the gravity range counts into S, not the gravity energy itself (its zero is arbitrary)
+    call m%start(energy_t(kinetic=0.0_wp, elastic=0.0_wp, gravity=-100.0_wp, &
+                          dissipated=0.0_wp, support_work=0.0_wp), rtol, factor)
+    call suite%check_close(m%scale(), 0.0_wp, 0.0_wp, 1.0e-300_wp, 'gravity zero arbitrary')
+    call suite%finish()
+end program test_energy_monitor
