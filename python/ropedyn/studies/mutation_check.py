@@ -50,6 +50,7 @@ class Mutation:
 
 RFEM = "src/models/rfem/ropedyn_rfem.f90"
 RFEM_K = "src/models/rfem/ropedyn_rfem_kernels.f90"
+RFEM_C = "src/models/rfem/ropedyn_rfem_create.f90"
 MPP = "src/models/mpp/ropedyn_mpp.f90"
 MPP_K = "src/models/mpp/ropedyn_mpp_kernels.f90"
 EFFECTS = "src/models/effects/"
@@ -61,22 +62,22 @@ REGRESSION = "tests/e2e/test_regression.py"
 
 MUTATIONS = [
     # --- RFEM -----------------------------------------------------------------------------
-    Mutation("rfem-shear-damping-eta", RFEM,
+    Mutation("rfem-shear-damping-eta", RFEM_C,
              "by = spec%rope%tangential_damping*area/(spec%rope%shape_factor*dl)",
              "by = spec%rope%normal_damping*area/(spec%rope%shape_factor*dl)",
              "shear damper from the normal instead of the tangential constant",
              pytest=(ORACLE, REGRESSION)),
-    Mutation("rfem-shear-factor-inverted", RFEM,
+    Mutation("rfem-shear-factor-inverted", RFEM_C,
              "cy = spec%rope%shear_modulus*area/(spec%rope%shape_factor*dl)",
              "cy = spec%rope%shear_modulus*area*spec%rope%shape_factor/dl",
              "shear stiffness GA chi/dl instead of GA/(chi dl)",
              pytest=(ORACLE, REGRESSION)),
-    Mutation("rfem-inertia-about-end", RFEM,
+    Mutation("rfem-inertia-about-end", RFEM_C,
              "model%inertia = model%mass*(model%len**2/12.0_wp",
              "model%inertia = model%mass*(model%len**2/3.0_wp",
              "element inertia about its end instead of its centre (l^2/3 for l^2/12)",
              ctest=("test_mpp_anchors", "test_mpp_physics"), pytest=(ORACLE,)),
-    Mutation("rfem-bending-stiffness-halved", RFEM,
+    Mutation("rfem-bending-stiffness-halved", RFEM_C,
              "cphi = spec%rope%young_modulus*second_moment/dl",
              "cphi = spec%rope%young_modulus*second_moment/(2.0_wp*dl)",
              "bending stiffness EI/(2 dl) instead of EI/dl",
@@ -104,7 +105,7 @@ MUTATIONS = [
              "(fy*(dwx + ha) + fp)",
              "tension without the moment of the turning frame (d x F)",
              ctest=("test_rfem_derivatives", "test_rfem_physics")),
-    Mutation("rfem-gravity-sign", RFEM,
+    Mutation("rfem-gravity-sign", RFEM_C,
              "model%weight = merge(model%mass*model%g",
              "model%weight = merge(-model%mass*model%g",
              "gravity pointing up",

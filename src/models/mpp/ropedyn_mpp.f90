@@ -151,6 +151,26 @@ module ropedyn_mpp
             real(wp), intent(out), optional :: pin(2)
         end subroutine residual_core
 
+        !> cos and sin of every angle of y into self%cs, once per call.
+        module subroutine angles(self, y)
+            class(mpp_t), intent(inout) :: self
+            real(wp), intent(in) :: y(:)
+        end subroutine angles
+
+        !> Solve M x = b in place with the model's current factors (mass_factor).
+        module subroutine mass_solve(self, b)
+            class(mpp_t), intent(in) :: self
+            real(wp), intent(inout) :: b(:)
+        end subroutine mass_solve
+
+        !> The rods as bodies (centre, angle, their rates, length l) for the effects.
+        pure module subroutine rod_bodies(self, y, top, b)
+            class(mpp_t), intent(in) :: self
+            real(wp), intent(in) :: y(:)
+            type(motion_state_t), intent(in) :: top
+            type(bodies_t), intent(out) :: b
+        end subroutine rod_bodies
+
         !> Column j of d r(q, q', qacc)/d(q, q') (j <= ndof: coordinate j, else rate j - ndof),
         !! exact: the tangent of residual_core, O(n), from the quantities its last call left
         !! (self%w, mom, cacc, wsum, bodies) and the effects' blocks self%ejac.

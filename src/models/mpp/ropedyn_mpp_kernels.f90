@@ -26,15 +26,13 @@ contains
     end procedure unpack
 
     !> cos and sin of every angle of y into self%cs, once per call.
-    subroutine angles(self, y)
-        class(mpp_t), intent(inout) :: self
-        real(wp), intent(in) :: y(:)
+    module procedure angles
         integer :: k
         do k = 1, self%n
             self%cs(1, k) = cos(y(k))
             self%cs(2, k) = sin(y(k))
         end do
-    end subroutine angles
+    end procedure angles
 
     module procedure mpp_residual
         real(wp) :: tt
@@ -162,179 +160,8 @@ contains
         end if
     end procedure residual_core
 
-    module procedure residual_column
-        real(wp) :: c, s, e(2), nv(2), de(2), dn(2), u, ud, phd, pdd, udd, hk, lk
-        real(wp) :: dhk, dlk, dphd, dud, dphi, a1, a2, da1, da2, dcacc(2), sh_a(2), sh_p(2), sh_v(2)
-        real(wp) :: dcb(2), dvb(2), dw(2), dmom, dws(2), fp(2), dfp(2), pv(2), cb, db
-        type(motion_state_t) :: top, bottom
-        logical :: bottom_on, effects
-        integer :: n, nd, m, kind, k, p
-
-        n = self%n
-        nd = self%ndof
-        effects = size(self%effects) > 0
-        ! the member m and which of its variables (1 angle, 2 elongation, 3 and 4 their rates)
-        if (j <= nd) then
-            kind = merge(1, 2, j <= n)
-            m = merge(j, j - n, j <= n)
-        else
-            kind = merge(3, 4, j - nd <= n)
-            m = merge(j - nd, j - nd - n, j - nd <= n)
-        end if
-        c = self%cs(1, m)
-        s = self%cs(2, m)
-        e = [c, s]
-        nv = [-s, c]
-        u = 0.0_wp
-        ud = 0.0_wp
-        udd = 0.0_wp
-        if (self%nu > 0) then
-            u = y(n + m)
-            ud = y(nd + n + m)
-            udd = qacc(n + m)
-        end if
-        phd = y(nd + m)
-        pdd = qacc(m)
-        hk = u + 0.5_wp*self%l
-        lk = u + self%l
-        de = 0.0_wp
-        dn = 0.0_wp
-        dhk = 0.0_wp
-        dphd = 0.0_wp
-        dud = 0.0_wp
-        dphi = 0.0_wp
-        select case (kind)
-        case (1)
-            de = nv
-            dn = -e
-            dphi = 1.0_wp
-        case (2)
-            dhk = 1.0_wp
-        case (3)
-            dphd = 1.0_wp
-        case (4)
-            dud = 1.0_wp
-        end select
-        dlk = dhk
-        ! member m: its centre's acceleration, position and velocity, and the shifts sh_a, sh_p,
-        ! sh_v of every joint and centre below it
-        a1 = hk*pdd + 2.0_wp*ud*phd
-        a2 = udd - hk*phd**2
-        da1 = dhk*pdd + 2.0_wp*(dud*phd + ud*dphd)
-        da2 = -dhk*phd**2 - 2.0_wp*hk*phd*dphd
-        dcacc = da1*nv + a1*dn + da2*e + a2*de
-        a1 = lk*pdd + 2.0_wp*ud*phd
-        a2 = udd - lk*phd**2
-        da1 = dlk*pdd + 2.0_wp*(dud*phd + ud*dphd)
-        da2 = -dlk*phd**2 - 2.0_wp*lk*phd*dphd
-        sh_a = da1*nv + a1*dn + da2*e + a2*de
-        dcb = dhk*e + hk*de
-        dvb = (dhk*phd + hk*dphd)*nv + hk*phd*dn + dud*e + ud*de
-        sh_p = dlk*e + lk*de
-        sh_v = (dlk*phd + lk*dphd)*nv + lk*phd*dn + dud*e + ud*de
-
-        ! the bottom support's force on the tip
-        call self%supports_at(t, top, bottom, bottom_on)
-        dws = 0.0_wp
-        if (bottom_on) dws = -self%k_sup*sh_p - self%d_sup*sh_v
-
-        ! members below m: w_k shifts by -m_k sh_a and the effects' response to sh_p, sh_v
-        col = 0.0_wp
-        do k = n, m + 1, -1
-            dw = -self%mbar(k)*sh_a
-            dmom = -self%pm_s1(k)*(-self%cs(2, k)*sh_a(1) + self%cs(1, k)*sh_a(2))
-            if (effects) then
-                dw = dw + matmul(self%ejac(1:2, 1:2, k), sh_p) &
-                     + matmul(self%ejac(1:2, 4:5, k), sh_v)
-                dmom = dmom + dot_product(self%ejac(3, 1:2, k), sh_p) &
-                       + dot_product(self%ejac(3, 4:5, k), sh_v)
-            end if
-            call suffix_step(k, dw, dmom)
-        end do
-
-        ! member m itself
-        dw = -self%m*dcacc
-        dmom = 0.0_wp
-        do p = 1, size(self%pm_body)
-            if (self%pm_body(p) /= m) cycle
-            pv = self%cacc(:, m) + self%pm_r(p)*(pdd*nv - phd**2*e)
-            fp = -self%pm_m(p)*pv
-            fp(1) = fp(1) + self%pm_m(p)*self%g
-            dfp = -self%pm_m(p)*(dcacc + self%pm_r(p)*(pdd*dn - 2.0_wp*phd*dphd*e - phd**2*de))
-            dw = dw + dfp
-            dmom = dmom + self%pm_r(p)*(dot_product(dn, fp) + dot_product(nv, dfp))
-        end do
-        if (effects) then
-            dw = dw + matmul(self%ejac(1:2, 1:2, m), dcb) + self%ejac(1:2, 3, m)*dphi &
-                 + matmul(self%ejac(1:2, 4:5, m), dvb) + self%ejac(1:2, 6, m)*dphd
-            dmom = dmom + dot_product(self%ejac(3, 1:2, m), dcb) + self%ejac(3, 3, m)*dphi &
-                   + dot_product(self%ejac(3, 4:5, m), dvb) + self%ejac(3, 6, m)*dphd
-        end if
-        ! r[phi_m] = n.(h w_m + l ws_{m+1}) + ..., r[u_m] = e.ws_m: their own variables
-        col(m) = dot_product(dn, hk*self%w(:, m) + lk*self%wsum(:, m + 1)) &
-                 + dot_product(nv, dhk*self%w(:, m) + dlk*self%wsum(:, m + 1))
-        if (self%nu > 0) col(n + m) = dot_product(de, self%wsum(:, m))
-        call suffix_step(m, dw, dmom)
-
-        ! members above m: only the suffix sums change
-        do k = m - 1, 1, -1
-            c = self%cs(1, k)
-            s = self%cs(2, k)
-            lk = self%l
-            if (self%nu > 0) lk = lk + y(n + k)
-            col(k) = lk*(-s*dws(1) + c*dws(2))
-            if (self%nu > 0) col(n + k) = c*dws(1) + s*dws(2)
-        end do
-
-        ! springs, dampers and clamps on member m's own variables
-        select case (kind)
-        case (2)
-            col(n + m) = col(n + m) - self%ks
-        case (4)
-            col(n + m) = col(n + m) - self%ds
-        case (1, 3)
-            cb = merge(self%cb, self%db, kind == 1)
-            if (m >= 2) then
-                col(m) = col(m) - cb
-                col(m - 1) = col(m - 1) + cb
-            end if
-            if (m < n) then
-                col(m + 1) = col(m + 1) + cb
-                col(m) = col(m) - cb
-            end if
-            db = 0.0_wp
-            if (m == 1 .and. self%top_clamped) db = merge(self%c_rot, self%d_rot, kind == 1)
-            if (m == n .and. self%bottom == 2 .and. bottom_on) &
-                db = db + merge(self%c_rot, self%d_rot, kind == 1)
-            col(m) = col(m) - db
-        end select
-    contains
-        !> Member k's rows from its force change dw, moment change dmom and the suffix sum
-        !! of the changes below it (dws, then including dw).
-        subroutine suffix_step(k, dw, dmom)
-            integer, intent(in) :: k
-            real(wp), intent(in) :: dw(2), dmom
-            real(wp) :: ck, sk, hkk, lkk
-            ck = self%cs(1, k)
-            sk = self%cs(2, k)
-            hkk = 0.5_wp*self%l
-            lkk = self%l
-            if (self%nu > 0) then
-                hkk = hkk + y(n + k)
-                lkk = lkk + y(n + k)
-            end if
-            col(k) = col(k) - sk*(hkk*dw(1) + lkk*dws(1)) + ck*(hkk*dw(2) + lkk*dws(2)) + dmom
-            dws = dws + dw
-            if (self%nu > 0) col(n + k) = col(n + k) + ck*dws(1) + sk*dws(2)
-        end subroutine suffix_step
-    end procedure residual_column
-
     !> The rods as bodies (centre, angle, their rates, length l) for the effects.
-    pure subroutine rod_bodies(self, y, top, b)
-        class(mpp_t), intent(in) :: self
-        real(wp), intent(in) :: y(:)
-        type(motion_state_t), intent(in) :: top
-        type(bodies_t), intent(out) :: b
+    module procedure rod_bodies
         real(wp), dimension(self%n) :: phi, u, phid, ud
         real(wp) :: p(2), pd(2), e(2), nv(2)
         integer :: k
@@ -354,7 +181,7 @@ contains
             p = p + (self%l + u(k))*e
             pd = pd + (self%l + u(k))*phid(k)*nv + ud(k)*e
         end do
-    end subroutine rod_bodies
+    end procedure rod_bodies
 
     !> The articulated-body recursion, from the tip (docs/physics-mpp.md, "Solving
     !! M q'' = f in O(n)"). The members k .. n, hanging from joint P_{k-1}, exert on it the
@@ -472,12 +299,10 @@ contains
     end subroutine ab_solve
 
     !> Solve M x = b in place with the model's current factors.
-    subroutine mass_solve(self, b)
-        class(mpp_t), intent(in) :: self
-        real(wp), intent(inout) :: b(:)
+    module procedure mass_solve
         call ab_solve(self%n, self%nu, self%cs, self%ab_g, self%ab_h, self%ab_dinv, &
                       self%ab_lam, b)
-    end subroutine mass_solve
+    end procedure mass_solve
 
     !> The dense M(q) from cos/sin of the angles and the elongations u (zero when
     !! inextensible), O(n^2): for k <= j, c = cos(phi_j - phi_k) = c_k c_j + s_k s_j,
@@ -692,104 +517,4 @@ contains
         status = STATUS_OK
         if (.not. all(ieee_is_finite(self%dr))) status = STATUS_RECOVERABLE
     end procedure mpp_second_order_blocks
-
-    module procedure mpp_energy
-        real(wp) :: p(2, 0:self%n), c(2, self%n), pd(2, 0:self%n), cd(2, self%n)
-        real(wp), dimension(self%n) :: phi, u, phid, ud
-        real(wp) :: e(2), nv(2)
-        type(motion_state_t) :: top, bottom
-        type(bodies_t) :: b
-        logical :: bottom_on
-        integer :: k, n, i
-        n = self%n
-        call unpack(self, y, phi, u, phid, ud)
-        call self%positions(y, p, c, pd, cd, t)
-        call self%supports_at(t, top, bottom, bottom_on)
-        en%kinetic = 0.5_wp*(self%m*sum(cd**2) + self%inertia*sum(phid**2))
-        en%gravity = -self%m*self%g*sum(c(1, :))
-        do k = 1, size(self%pm_body)
-            i = self%pm_body(k)
-            e = [cos(phi(i)), sin(phi(i))]
-            nv = [-e(2), e(1)]
-            en%kinetic = en%kinetic + 0.5_wp*self%pm_m(k)* &
-                         sum((cd(:, i) + self%pm_r(k)*phid(i)*nv)**2)
-            en%gravity = en%gravity - self%pm_m(k)*self%g*(c(1, i) + self%pm_r(k)*e(1))
-        end do
-        en%elastic = 0.5_wp*self%ks*sum(u**2)
-        do k = 2, n
-            en%elastic = en%elastic + 0.5_wp*self%cb*(phi(k) - phi(k - 1))**2
-        end do
-        if (self%top_clamped) en%elastic = en%elastic + 0.5_wp*self%c_rot* &
-                                            (phi(1) - top%angle)**2
-        if (bottom_on) en%elastic = en%elastic + 0.5_wp*self%k_sup* &
-                                    sum((p(:, n) - bottom%p)**2)
-        if (self%bottom == 2 .and. bottom_on) en%elastic = en%elastic + 0.5_wp*self%c_rot* &
-                                                          (phi(n) - bottom%angle)**2
-        if (size(self%effects) > 0) then
-            call rod_bodies(self, y, top, b)
-            call add_energies_of(self%effects, t, b, en%elastic)
-        end if
-        en%dissipated = 0.0_wp
-        if (size(yq) >= 1) en%dissipated = yq(1)
-        en%support_work = 0.0_wp
-        if (self%with_work .and. size(yq) >= 2) en%support_work = yq(2)
-    end procedure mpp_energy
-
-    module procedure mpp_quad_rhs
-        real(wp) :: p(2, 0:self%n), c(2, self%n), pd(2, 0:self%n), cd(2, self%n)
-        real(wp) :: power, work, rel(2), pin(2), a(self%ndof), r(self%ndof)
-        type(motion_state_t) :: top, bottom
-        logical :: bottom_on
-        integer :: k, n, nd
-        n = self%n
-        nd = self%ndof
-        call self%supports_at(t, top, bottom, bottom_on)
-        power = 0.0_wp
-        if (self%nu > 0) power = self%ds*sum(y(nd + n + 1:2*nd)**2)
-        work = 0.0_wp
-        do k = 2, n
-            power = power + self%db*(y(nd + k) - y(nd + k - 1))**2
-        end do
-        if (self%top_clamped) then
-            power = power + self%d_rot*(y(nd + 1) - top%rate)**2
-            if (self%moving(1)) work = work - (self%c_rot*(y(1) - top%angle) &
-                                                 + self%d_rot*(y(nd + 1) - top%rate))*top%rate
-        end if
-        if (bottom_on) then
-            call self%positions(y, p, c, pd, cd, t)
-            rel = pd(:, n) - bottom%v
-            power = power + self%d_sup*sum(rel**2)
-            if (self%moving(2)) work = work + dot_product(-self%k_sup*(p(:, n) - bottom%p) &
-                                                          - self%d_sup*rel, bottom%v)
-            if (self%bottom == 2) then
-                power = power + self%d_rot*(y(nd + n) - bottom%rate)**2
-                if (self%moving(2)) work = work - (self%c_rot*(y(n) - bottom%angle) &
-                                                   + self%d_rot*(y(nd + n) - bottom%rate)) &
-                                                  *bottom%rate
-            end if
-        end if
-        if (size(self%effects) > 0 .or. self%moving(1)) call angles(self, y)
-        if (size(self%effects) > 0) then
-            ! the residual at zero accelerations fills the rods as bodies
-            a = 0.0_wp
-            call self%residual_core(t, y, a, r)
-            call add_powers_of(self%effects, t, self%bodies, power, work)
-        end if
-        status = STATUS_OK
-        if (self%moving(1)) then
-            ! the pin force needs the accelerations: a = M^{-1} f, then r(q, q', a) gives it
-            a = 0.0_wp
-            call self%residual_core(t, y, a, r)
-            call self%mass_factor(y, status)
-            if (status == STATUS_OK) then
-                a = r
-                call mass_solve(self, a)
-                call self%residual_core(t, y, a, r, pin)
-                work = work + dot_product(pin, top%v)
-            end if
-        end if
-        yqdot(1) = power
-        if (self%with_work) yqdot(2) = work
-        if (.not. (ieee_is_finite(power) .and. ieee_is_finite(work))) status = STATUS_RECOVERABLE
-    end procedure mpp_quad_rhs
 end submodule ropedyn_mpp_kernels

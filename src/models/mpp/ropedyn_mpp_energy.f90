@@ -1,0 +1,107 @@
+!> The MPP's energies (kinetic, elastic, gravity, the effects') and the powers integrated
+!! as quadratures (dissipation, external work). docs/physics-mpp.md.
+submodule (ropedyn_mpp) ropedyn_mpp_energy
+    implicit none
+
+contains
+
+    module procedure mpp_energy
+        real(wp) :: p(2, 0:self%n), c(2, self%n), pd(2, 0:self%n), cd(2, self%n)
+        real(wp), dimension(self%n) :: phi, u, phid, ud
+        real(wp) :: e(2), nv(2)
+        type(motion_state_t) :: top, bottom
+        type(bodies_t) :: b
+        logical :: bottom_on
+        integer :: k, n, i
+        n = self%n
+        call unpack(self, y, phi, u, phid, ud)
+        call self%positions(y, p, c, pd, cd, t)
+        call self%supports_at(t, top, bottom, bottom_on)
+        en%kinetic = 0.5_wp*(self%m*sum(cd**2) + self%inertia*sum(phid**2))
+        en%gravity = -self%m*self%g*sum(c(1, :))
+        do k = 1, size(self%pm_body)
+            i = self%pm_body(k)
+            e = [cos(phi(i)), sin(phi(i))]
+            nv = [-e(2), e(1)]
+            en%kinetic = en%kinetic + 0.5_wp*self%pm_m(k)* &
+                         sum((cd(:, i) + self%pm_r(k)*phid(i)*nv)**2)
+            en%gravity = en%gravity - self%pm_m(k)*self%g*(c(1, i) + self%pm_r(k)*e(1))
+        end do
+        en%elastic = 0.5_wp*self%ks*sum(u**2)
+        do k = 2, n
+            en%elastic = en%elastic + 0.5_wp*self%cb*(phi(k) - phi(k - 1))**2
+        end do
+        if (self%top_clamped) en%elastic = en%elastic + 0.5_wp*self%c_rot* &
+                                            (phi(1) - top%angle)**2
+        if (bottom_on) en%elastic = en%elastic + 0.5_wp*self%k_sup* &
+                                    sum((p(:, n) - bottom%p)**2)
+        if (self%bottom == 2 .and. bottom_on) en%elastic = en%elastic + 0.5_wp*self%c_rot* &
+                                                          (phi(n) - bottom%angle)**2
+        if (size(self%effects) > 0) then
+            call rod_bodies(self, y, top, b)
+            call add_energies_of(self%effects, t, b, en%elastic)
+        end if
+        en%dissipated = 0.0_wp
+        if (size(yq) >= 1) en%dissipated = yq(1)
+        en%support_work = 0.0_wp
+        if (self%with_work .and. size(yq) >= 2) en%support_work = yq(2)
+    end procedure mpp_energy
+
+    module procedure mpp_quad_rhs
+        real(wp) :: p(2, 0:self%n), c(2, self%n), pd(2, 0:self%n), cd(2, self%n)
+        real(wp) :: power, work, rel(2), pin(2), a(self%ndof), r(self%ndof)
+        type(motion_state_t) :: top, bottom
+        logical :: bottom_on
+        integer :: k, n, nd
+        n = self%n
+        nd = self%ndof
+        call self%supports_at(t, top, bottom, bottom_on)
+        power = 0.0_wp
+        if (self%nu > 0) power = self%ds*sum(y(nd + n + 1:2*nd)**2)
+        work = 0.0_wp
+        do k = 2, n
+            power = power + self%db*(y(nd + k) - y(nd + k - 1))**2
+        end do
+        if (self%top_clamped) then
+            power = power + self%d_rot*(y(nd + 1) - top%rate)**2
+            if (self%moving(1)) work = work - (self%c_rot*(y(1) - top%angle) &
+                                                 + self%d_rot*(y(nd + 1) - top%rate))*top%rate
+        end if
+        if (bottom_on) then
+            call self%positions(y, p, c, pd, cd, t)
+            rel = pd(:, n) - bottom%v
+            power = power + self%d_sup*sum(rel**2)
+            if (self%moving(2)) work = work + dot_product(-self%k_sup*(p(:, n) - bottom%p) &
+                                                          - self%d_sup*rel, bottom%v)
+            if (self%bottom == 2) then
+                power = power + self%d_rot*(y(nd + n) - bottom%rate)**2
+                if (self%moving(2)) work = work - (self%c_rot*(y(n) - bottom%angle) &
+                                                   + self%d_rot*(y(nd + n) - bottom%rate)) &
+                                                  *bottom%rate
+            end if
+        end if
+        if (size(self%effects) > 0 .or. self%moving(1)) call angles(self, y)
+        if (size(self%effects) > 0) then
+            ! the residual at zero accelerations fills the rods as bodies
+            a = 0.0_wp
+            call self%residual_core(t, y, a, r)
+            call add_powers_of(self%effects, t, self%bodies, power, work)
+        end if
+        status = STATUS_OK
+        if (self%moving(1)) then
+            ! the pin force needs the accelerations: a = M^{-1} f, then r(q, q', a) gives it
+            a = 0.0_wp
+            call self%residual_core(t, y, a, r)
+            call self%mass_factor(y, status)
+            if (status == STATUS_OK) then
+                a = r
+                call mass_solve(self, a)
+                call self%residual_core(t, y, a, r, pin)
+                work = work + dot_product(pin, top%v)
+            end if
+        end if
+        yqdot(1) = power
+        if (self%with_work) yqdot(2) = work
+        if (.not. (ieee_is_finite(power) .and. ieee_is_finite(work))) status = STATUS_RECOVERABLE
+    end procedure mpp_quad_rhs
+end submodule ropedyn_mpp_energy

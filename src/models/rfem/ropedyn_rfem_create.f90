@@ -1,0 +1,175 @@
+!> Building an RFEM model from its spec: element lengths and masses, the spring-damping
+!! constants, supports, point masses and effects (docs/physics-rfem.md).
+submodule (ropedyn_rfem) ropedyn_rfem_create
+    implicit none
+
+contains
+
+    module procedure rfem_create
+        integer :: n, k, i
+        real(wp) :: area, second_moment, dl, total_mass, cx, cy, cphi, bx, by, bphi, factor
+        real(wp) :: angles(2)
+        logical :: damped
+        character(len=:), allocatable :: kinds(:)
+        integer, allocatable :: pm_body(:)
+        real(wp), allocatable :: pm_r(:), pm_m(:), y0(:)
+
+        n = spec%model%elements
+        if (n < 2) then
+            call make_error(err, ERR_INPUT, 'rfem: elements must be >= 2')
+            return
+        end if
+        model%n = n
+        call cross_section(spec, area, second_moment)
+        dl = spec%rope%length/real(n - 1, wp)
+        total_mass = spec%rope%density*area*spec%rope%length
+        allocate (model%len(n), model%mass(n), model%inertia(n))
+        model%len = dl
+        model%len(1) = dl/2.0_wp
+        model%len(n) = dl/2.0_wp
+        model%mass = total_mass*model%len/spec%rope%length
+        model%inertia = model%mass*(model%len**2/12.0_wp + spec%rope%diameter**2/16.0_wp)
+
+        model%g = spec%rope%gravity
+        model%gravity_on = spec%effects%gravity
+        damped = spec%effects%damping
+
+        cx = spec%rope%young_modulus*area/dl
+        cy = spec%rope%shear_modulus*area/(spec%rope%shape_factor*dl)
+        cphi = spec%rope%young_modulus*second_moment/dl
+        bx = spec%rope%normal_damping*area/dl
+        by = spec%rope%tangential_damping*area/(spec%rope%shape_factor*dl)
+        bphi = spec%rope%normal_damping*second_moment/dl
+        factor = spec%supports%support_stiffness_factor
+        if (spec%effects%support_motion) then
+            associate (s => spec%supports)
+                if (s%top_release_time >= 0.0_wp) model%release(1) = s%top_release_time
+                if (s%bottom_release_time >= 0.0_wp) model%release(2) = s%bottom_release_time
+            end associate
+        end if
+
+        ! internal SDEs: a strain exists only when its effect is on, its damping only when
+        ! damping is on
+        model%tension = spec%effects%tension
+        model%shear = spec%effects%shear
+        model%bending = spec%effects%bending
+        if (model%tension) model%cx = cx
+        if (model%shear) model%cy = cy
+        if (model%bending) model%cp = cphi
+        if (damped) then
+            if (model%tension) model%bx = bx
+            if (model%shear) model%by = by
+            if (model%bending) model%bp = bphi
+        end if
+        model%damped = model%bx > 0.0_wp .or. model%by > 0.0_wp .or. model%bp > 0.0_wp
+        ! supports: a support released at t <= 0 is free from the start (no SDE at all)
+        kinds = [character(len=8) :: spec%supports%top, spec%supports%bottom]
+        do k = 1, 2
+            associate (sup => model%sup(k))
+                sup%sgn = merge(1.0_wp, -1.0_wp, k == 1)
+                sup%elem = merge(1, n, k == 1)
+                if (.not. model%release(k) > 0.0_wp) cycle
+                sup%translational = kinds(k) == 'pinned' .or. kinds(k) == 'clamped'
+                sup%rotational = kinds(k) == 'clamped'
+                if (sup%translational) then
+                    sup%ct = factor*cx
+                    sup%bt = factor*bx
+                    sup%damped_t = damped .and. sup%bt > 0.0_wp
+                end if
+                if (sup%rotational) then
+                    sup%cr = factor*cphi
+                    sup%br = factor*bphi
+                    sup%damped_r = damped .and. sup%br > 0.0_wp
+                end if
+            end associate
+        end do
+        ! Bending next to a clamp. SDE j (between elements j-1 and j, at s = (j - 3/2) dl)
+        ! lumps the bending of the primary section [(j-2) dl, (j-1) dl] (EI/dl): the
+        ! internal SDEs alone cover the whole rope [0, L]. A clamp's rotational SDE at s = 0
+        ! on top of them would add one section's compliance dl/EI, an O(dl) error that at
+        ! these n is still in its pre-asymptotic range (the clamp's boundary layer
+        ! sqrt(EI/T) = 3 cm is resolved only from n ~ 100: observed order 0.6, -0.2 % at
+        ! n = 300). Instead the first section is split between the clamp and its neighbour:
+        ! [0, dl/2] lumped at the clamp, [dl/2, dl] at SDE 2, each 2 EI/dl (damping alike),
+        ! so the compliance adds up to L/EI and each half is lumped at its end (an O(dl^2)
+        ! error). Likewise at a clamped bottom. n = 2 with both ends clamped keeps EI/dl.
+        allocate (model%cpj(2:n), model%bpj(2:n))
+        model%cpj = model%cp
+        model%bpj = model%bp
+        if (n > 2 .or. .not. all(model%sup%rotational)) then
+            do k = 1, 2
+                ! (a clamp released later leaves its neighbour at 2 EI/dl)
+                if (.not. model%sup(k)%rotational) cycle
+                model%sup(k)%cr = 2.0_wp*model%sup(k)%cr
+                model%sup(k)%br = 2.0_wp*model%sup(k)%br
+                i = merge(2, n, k == 1)
+                model%cpj(i) = 2.0_wp*model%cpj(i)
+                model%bpj(i) = 2.0_wp*model%bpj(i)
+            end do
+        end if
+
+        model%init_angle = initial_angle(spec)
+        model%folded = spec%initial%shape == 'folded'
+        model%init_velocity = spec%initial%velocity
+        model%sup(1)%anchor = spec%supports%top_anchor
+        angles = clamp_angles(spec)
+        model%sup(1)%angle = angles(1)
+        model%sup(2)%angle = angles(2)
+
+        ! point masses at their place on the elements: mass, inertia about the centre and
+        ! the first moment m r that couples translation and rotation
+        call attached_masses(spec, model%len, pm_body, pm_r, pm_m)
+        allocate (model%pm_elem(0), model%pm_moment(0))
+        do k = 1, size(pm_body)
+            i = pm_body(k)
+            model%mass(i) = model%mass(i) + pm_m(k)
+            model%inertia(i) = model%inertia(i) + pm_m(k)*pm_r(k)**2
+            if (.not. any(model%pm_elem == i)) then
+                model%pm_elem = [model%pm_elem, i]
+                model%pm_moment = [model%pm_moment, 0.0_wp]
+            end if
+            where (model%pm_elem == i) model%pm_moment = model%pm_moment + pm_m(k)*pm_r(k)
+        end do
+        allocate (model%rowscale(3, n))
+        model%rowscale(1, :) = 1.0_wp/model%mass
+        model%rowscale(2, :) = 1.0_wp/model%mass
+        model%rowscale(3, :) = 1.0_wp/model%inertia
+        model%rowscale(:, model%pm_elem) = 1.0_wp
+
+        call build_body_effects(spec, model%len, model%effects)
+        if (size(model%effects) > 0) then
+            model%bodies%n = n
+            model%bodies%l = model%len
+            allocate (model%bodies%c(2, n), model%bodies%phi(n), model%bodies%v(2, n), &
+                      model%bodies%w(n))
+        end if
+
+        ! supports: base anchor and angle, prescribed motion
+        model%motion(1)%p0 = model%sup(1)%anchor
+        model%motion(1)%angle0 = model%sup(1)%angle
+        if (bottom_anchor_given(spec)) then
+            model%sup(2)%anchor = spec%supports%bottom_anchor
+        else
+            ! the rope's lower end in its initial state
+            allocate (y0(6*n))
+            call model%initial_state(y0)
+            model%sup(2)%anchor = y0(6*n - 5:6*n - 4) + 0.5_wp*model%len(n)* &
+                                  [cos(y0(6*n - 3)), sin(y0(6*n - 3))]
+        end if
+        model%motion(2)%p0 = model%sup(2)%anchor
+        model%motion(2)%angle0 = model%sup(2)%angle
+        ! a free or released support has no motion
+        if (spec%effects%support_motion) call configure_motions(spec, &
+            [spec%supports%top /= 'free', spec%supports%bottom /= 'free'] .and. &
+            model%release > 0.0_wp, model%motion, model%moving)
+        model%timed = any(model%moving) .or. any(model%release < huge(1.0_wp))
+        model%with_work = any_does_work(model%moving, model%effects)
+
+        model%half = 0.5_wp*model%len
+        model%weight = merge(model%mass*model%g, 0.0_wp*model%mass, model%gravity_on)
+        allocate (model%cs(2, n), model%gen(3, n), model%blk(3, 6, -1:1, n))
+        model%cs = 0.0_wp
+        model%gen = 0.0_wp
+        model%blk = 0.0_wp
+    end procedure rfem_create
+end submodule ropedyn_rfem_create
