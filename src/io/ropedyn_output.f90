@@ -128,6 +128,49 @@ module ropedyn_output
         final :: output_final
     end type output_file_t
 
+    interface
+        !> Open the run file `path`, written by `create` with restart data, to continue it:
+        !! every series open for `append` after its last complete record (longer series, from a
+        !! record cut short, are cut back to the length of /time, or to `keep` records), the
+        !! status 'running' again and its old reason removed. The file must be for
+        !! `n_elements` elements and the given state and quadrature sizes.
+        module subroutine output_reopen(self, path, n_elements, state_size, quad_size, err, keep)
+            class(output_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: path
+            integer, intent(in) :: n_elements, state_size, quad_size
+            type(error_t), allocatable, intent(out) :: err
+            !> keep only the first `keep` records (fewer than the file has: the others are cut)
+            integer, intent(in), optional :: keep
+        end subroutine output_reopen
+
+        !> Add an entry to /solver/restarts: the run continues from record `record` (0-based, as
+        !! h5py counts) at time `t`; the file's status and reason before, and the solver steps
+        !! and CPU time of the run so far.
+        module subroutine output_add_restart(self, record, t, previous_status, &
+                                             previous_reason, steps, cpu_time, err)
+            class(output_file_t), intent(inout) :: self
+            integer, intent(in) :: record
+            real(wp), intent(in) :: t                         !< s
+            character(len=*), intent(in) :: previous_status, previous_reason
+            integer(i8), intent(in) :: steps
+            real(wp), intent(in) :: cpu_time                  !< s
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine output_add_restart
+
+        !> Close all datasets and the file and mark `self` closed.
+        !! Reports the first failure in `err` if present; closes everything regardless.
+        module subroutine shutdown(self, err)
+            type(output_file_t), intent(inout) :: self
+            type(error_t), allocatable, intent(out), optional :: err
+        end subroutine shutdown
+
+        !> The path of the file, or a placeholder if create never succeeded.
+        module function file_label(self) result(label)
+            type(output_file_t), intent(in) :: self
+            character(len=:), allocatable :: label
+        end function file_label
+    end interface
+
 contains
 
     !> Create (or overwrite) the file `path` and write the run's fixed data; status 'running'.
@@ -508,181 +551,15 @@ contains
         end if
     end subroutine output_close_run
 
-    !> Open the run file `path`, written by `create` with restart data, to continue it:
-    !! every series open for `append` after its last complete record (longer series, from a
-    !! record cut short, are cut back to the length of /time, or to `keep` records), the
-    !! status 'running' again and its old reason removed. The file must be for `n_elements` elements and the given state
-    !! and quadrature sizes.
-    subroutine output_reopen(self, path, n_elements, state_size, quad_size, err, keep)
-        class(output_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        integer, intent(in) :: n_elements, state_size, quad_size
-        type(error_t), allocatable, intent(out) :: err
-        !> keep only the first `keep` records (fewer than the file has: the others are cut)
-        integer, intent(in), optional :: keep
-        integer :: expected, k
-
-        if (self%is_open) call shutdown(self)
-        call self%file%open(path, err, writable=.true.)
-        if (allocated(err)) return
-        self%is_open = .true.
-        self%n_elements = n_elements
-        self%restart_data = .true.
-        self%state_size = [state_size, quad_size]
-        steps: block
-            do k = 1, N_SERIES
-                call self%file%open_series(self%series(k), trim(SERIES_NAME(k)), err)
-                if (allocated(err)) exit steps
-            end do
-            do k = 1, 2
-                if (.not. self%file%exists(trim(STATE_NAME(k)))) then
-                    call make_error(err, ERR_IO, path//': '//trim(STATE_NAME(k))// &
-                        ': missing (a file without restart data cannot be continued)')
-                    exit steps
-                end if
-                call self%file%open_series(self%state(k), trim(STATE_NAME(k)), err)
-                if (allocated(err)) exit steps
-            end do
-            do k = 1, N_SERIES
-                expected = max(1, RECORD_ROWS(k)*RECORD_PER_ELEMENT(k)*n_elements)
-                if (self%series(k)%record_size() /= expected) then
-                    call make_error(err, ERR_IO, path//': '//trim(SERIES_NAME(k))// &
-                        ': records of '//int_text(self%series(k)%record_size())// &
-                        ' values, expected '//int_text(expected)//' for '// &
-                        int_text(n_elements)//' elements')
-                    exit steps
-                end if
-            end do
-            do k = 1, 2
-                if (self%state(k)%record_size() /= max(1, self%state_size(k))) then
-                    call make_error(err, ERR_IO, path//': '//trim(STATE_NAME(k))// &
-                        ': records of '//int_text(self%state(k)%record_size())// &
-                        ' values, the model has '//int_text(self%state_size(k)))
-                    exit steps
-                end if
-            end do
-            self%n_records = self%series(S_TIME)%length()
-            if (present(keep)) self%n_records = max(0_hsize_t, min(self%n_records, &
-                                                                int(keep, hsize_t)))
-            if (self%state(1)%length() < self%n_records .or. &
-                self%state(2)%length() < self%n_records) then
-                call make_error(err, ERR_IO, path//': /state/y: fewer records than /time')
-                exit steps
-            end if
-            do k = 1, N_SERIES
-                call self%series(k)%truncate(self%n_records, err)
-                if (allocated(err)) exit steps
-            end do
-            do k = 1, 2
-                call self%state(k)%truncate(self%n_records, err)
-                if (allocated(err)) exit steps
-            end do
-            call self%file%attribute('/', 'status', 'running', err)
-            if (allocated(err)) exit steps
-            call self%file%delete_attribute('/', 'reason', err)
-            if (allocated(err)) exit steps
-            call self%file%flush(err)
-        end block steps
-        if (allocated(err)) call shutdown(self)
-    end subroutine output_reopen
-
     !> Complete records written so far (the length of /time).
     pure integer function output_records(self) result(records)
         class(output_file_t), intent(in) :: self
         records = int(self%n_records)
     end function output_records
 
-    !> Add an entry to /solver/restarts: the run continues from record `record` (0-based, as
-    !! h5py counts) at time `t`; the file's status and reason before, and the solver steps
-    !! and CPU time of the run so far.
-    subroutine output_add_restart(self, record, t, previous_status, previous_reason, steps, &
-                                  cpu_time, err)
-        class(output_file_t), intent(inout) :: self
-        integer, intent(in) :: record
-        real(wp), intent(in) :: t                         !< s
-        character(len=*), intent(in) :: previous_status, previous_reason
-        integer(i8), intent(in) :: steps
-        real(wp), intent(in) :: cpu_time                  !< s
-        type(error_t), allocatable, intent(out) :: err
-        type(h5_series_t) :: entry(size(RESTART_NAME))
-        type(error_t), allocatable :: close_err
-        integer(hsize_t) :: n
-        integer :: k
-        character(len=:), allocatable :: name
-
-        if (.not. self%is_open) then
-            call make_error(err, ERR_INTERNAL, file_label(self)//': add_restart: file is not open')
-            return
-        end if
-        steps_: block
-            if (.not. self%file%exists('/solver/restarts')) then
-                call self%file%group('/solver/restarts', err)
-                if (allocated(err)) exit steps_
-            end if
-            do k = 1, size(RESTART_NAME)
-                name = '/solver/restarts/'//trim(RESTART_NAME(k))
-                if (self%file%exists(name)) then
-                    call self%file%open_series(entry(k), name, err)
-                else if (RESTART_WIDTH(k) > 0) then
-                    call self%file%create_text_series(entry(k), name, RESTART_WIDTH(k), '', err)
-                else
-                    call self%file%create_series(entry(k), name, [integer(hsize_t) ::], &
-                                                 k == 2 .or. k == 3, trim(RESTART_UNITS(k)), &
-                                                 '', err)
-                end if
-                if (allocated(err)) exit steps_
-            end do
-            n = entry(1)%length() + 1
-            call entry(1)%append(n, [t], err)
-            if (.not. allocated(err)) call entry(2)%append(n, [record], err)
-            if (.not. allocated(err)) call entry(3)%append(n, [int(min(steps, &
-                int(huge(1), i8)))], err)
-            if (.not. allocated(err)) call entry(4)%append(n, [cpu_time], err)
-            if (.not. allocated(err)) call entry(5)%append_text(n, utc_timestamp(), err)
-            if (.not. allocated(err)) call entry(6)%append_text(n, previous_status, err)
-            if (.not. allocated(err)) call entry(7)%append_text(n, previous_reason, err)
-        end block steps_
-        do k = 1, size(entry)
-            call entry(k)%close(close_err)
-            if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
-        end do
-        if (.not. allocated(err)) call self%file%flush(err)
-    end subroutine output_add_restart
-
     !> Close the file if still open; its status stays 'running'.
     impure elemental subroutine output_final(self)
         type(output_file_t), intent(inout) :: self
         if (self%is_open) call shutdown(self)
     end subroutine output_final
-
-    !> Close all datasets and the file and mark `self` closed.
-    !! Reports the first failure in `err` if present; closes everything regardless.
-    subroutine shutdown(self, err)
-        type(output_file_t), intent(inout) :: self
-        type(error_t), allocatable, intent(out), optional :: err
-        type(error_t), allocatable :: first, e
-        integer :: k
-
-        if (.not. self%is_open) return
-        do k = 1, N_SERIES
-            call self%series(k)%close(e)
-            if (allocated(e) .and. .not. allocated(first)) call move_alloc(e, first)
-        end do
-        do k = 1, 2
-            call self%state(k)%close(e)
-            if (allocated(e) .and. .not. allocated(first)) call move_alloc(e, first)
-        end do
-        call self%file%close(e)
-        if (allocated(e) .and. .not. allocated(first)) call move_alloc(e, first)
-        self%is_open = .false.
-        if (present(err) .and. allocated(first)) call move_alloc(first, err)
-    end subroutine shutdown
-
-    !> The path of the file, or a placeholder if create never succeeded.
-    function file_label(self) result(label)
-        type(output_file_t), intent(in) :: self
-        character(len=:), allocatable :: label
-        label = self%file%file_name()
-        if (len(label) == 0) label = '(output file never created)'
-    end function file_label
 end module ropedyn_output

@@ -27,8 +27,7 @@ module ropedyn_simulation
     use ropedyn_methods, only: METHODS, method_index
     use ropedyn_problem, only: problem_t
     use ropedyn_energy_monitor, only: energy_monitor_t
-    use ropedyn_state_record, only: state_record_t, read_state_record
-    use ropedyn_text, only: int_text
+    use ropedyn_state_start, only: state_initial_state
     implicit none
     private
     public :: run_summary_t, run_scene, create_model, create_integrator, solver_options_of
@@ -542,64 +541,4 @@ contains
         stats%nonlin_iters = stats%nonlin_iters + before(6)
         stats%nonlin_conv_fails = stats%nonlin_conv_fails + before(7)
     end subroutine add_counters
-
-    !> The start of `&initial shape = 'state'`: the record of `state_file` nearest
-    !! `state_time` (the last for < 0) gives the time t, the model's ODE state y (stored, or
-    !! rebuilt from the element fields) and the quadratures yq (dissipated energy, external
-    !! work). The file must hold a run of the same model kind and number of elements.
-    subroutine state_initial_state(scene, model, t, y, yq, err)
-        type(scene_t), intent(in) :: scene
-        class(rope_model_t), intent(in) :: model
-        real(wp), intent(out) :: t
-        real(wp), intent(inout) :: y(:), yq(:)
-        type(error_t), allocatable, intent(out) :: err
-        type(state_record_t) :: rec
-        character(len=:), allocatable :: where
-        logical :: ok
-        integer :: nq
-
-        where = scene%path//': &initial: state_file = "'//trim(scene%initial%state_file)//'"'
-        t = 0.0_wp
-        call read_state_record(trim(scene%initial%state_file), scene%initial%state_time, &
-                               rec, err)
-        if (allocated(err)) then
-            err%message = where//', state_time = '//real_text(scene%initial%state_time)// &
-                          ': '//err%message
-            return
-        end if
-        if (rec%model /= model%model_name() .or. rec%n /= model%n_elements()) then
-            call make_error(err, ERR_INPUT, where//': the file holds a run of the '//rec%model// &
-                ' model with '//int_text(rec%n)//' elements; the scene is '// &
-                model%model_name()//' with '//int_text(model%n_elements())// &
-                ' (&model kind, elements must match)')
-            return
-        end if
-        if (.not. rec%t < scene%solver%t_end) then
-            call make_error(err, ERR_INPUT, where//': its record '//int_text(rec%record)// &
-                ' is at t = '//real_text(rec%t)//' s, not before &solver t_end = '// &
-                real_text(scene%solver%t_end)//' s')
-            return
-        end if
-        nq = model%quad_size()
-        ok = .false.
-        if (allocated(rec%y)) then
-            ! the native state (restart data), when its sizes are the model's
-            if (size(rec%y) == size(y) .and. size(rec%yq) >= nq) then
-                y = rec%y
-                yq(1:nq) = rec%yq(1:nq)
-                ok = .true.
-            end if
-        end if
-        if (.not. ok) then
-            call model%state_from_fields(rec%q, rec%qdot, rec%t, y, ok)
-            if (.not. ok) then
-                call make_error(err, ERR_INPUT, where//': the '//model%model_name()// &
-                    ' model cannot rebuild its state from the stored fields')
-                return
-            end if
-            if (nq >= 1) yq(1) = rec%dissipated
-            if (nq >= 2) yq(2) = rec%support_work
-        end if
-        t = rec%t
-    end subroutine state_initial_state
 end module ropedyn_simulation
