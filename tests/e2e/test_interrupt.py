@@ -102,9 +102,13 @@ def test_interrupted_and_resumed_matches_the_uninterrupted_run(run, ropedyn_exe,
         print(f"{method}: restart at {t_reached:.4f} s, end difference {diff:.2e} m "
               f"(bound {bound:.1e})")
         assert diff <= bound
-        # the quadrature (dissipated energy) carried over, not restarted at 0
+        # the quadrature (dissipated energy) carried over, not restarted at 0: it never
+        # decreases across the restart, and it ends where the uninterrupted run's ends within
+        # the quadrature's own tolerance (CVODES and MEBDF control it with rtol and atol; a
+        # difference of 3e-9 J on 1.6e-4 J was seen, beyond rtol alone)
         dissipated = a["energy/dissipated"][-1]
-        assert abs(b["energy/dissipated"][-1] - dissipated) <= 10 * RTOL * dissipated + 1e-9
+        assert np.all(np.diff(b["energy/dissipated"][:]) >= -ATOL)
+        assert abs(b["energy/dissipated"][-1] - dissipated) <= 10 * (RTOL * dissipated + ATOL)
         # records before the restart are the interrupted run's, untouched
         k = int(np.searchsorted(a["time"][:], t_reached)) - 1
         assert np.array_equal(a["state/q"][:k + 1], b["state/q"][:k + 1])
