@@ -18,8 +18,8 @@ module ropedyn_integrator
     use ropedyn_switch_log, only: switch_event_t
     implicit none
     private
-    public :: integrator_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT, STIFF_STEP_RATE, &
-        clock_seconds
+    public :: integrator_t, start_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT, &
+        STIFF_STEP_RATE, clock_seconds
     public :: stop_query_i, stop_now
 
     !> No integrator here goes beyond this order of accuracy.
@@ -86,9 +86,28 @@ module ropedyn_integrator
         logical :: reduced_newton = .false.
     end type solver_stats_t
 
+    !> The start of an integration as `init` hands it to a method's `start`, checked:
+    !! the initial state and the order limit to use.
+    type :: start_t
+        real(wp) :: t0 = 0.0_wp
+        real(wp), allocatable :: y0(:)   !< state (problem%size())
+        real(wp), allocatable :: yq0(:)  !< quadratures (problem%quad_size())
+        !> options%max_order within the method's range, or the method's default when 0
+        !! (0 for auto when none was asked: it chooses)
+        integer :: max_order = 0
+    end type start_t
+
+    !> What every integrator does and holds. `init` (here, for all) checks the options and
+    !! the initial state against the problem, sets the components below and calls the
+    !! method's `start`; a method reads them but never sets them.
     type, abstract :: integrator_t
+        class(problem_t), pointer :: problem => null()  !< referenced, not copied
+        type(solver_options_t) :: options
+        integer :: n = 0   !< unknowns of the state
+        integer :: nq = 0  !< quadrature variables
     contains
-        procedure(init_i), deferred :: init
+        procedure :: init => integrator_init
+        procedure(start_i), deferred :: start
         procedure(advance_to_i), deferred :: advance_to
         procedure(stats_i), deferred :: stats
         procedure(finalize_i), deferred :: finalize
@@ -96,7 +115,6 @@ module ropedyn_integrator
         procedure :: default_max_order => integrator_default_max_order
         procedure :: min_order => integrator_min_order
         procedure :: max_order_limit => integrator_max_order_limit
-        procedure :: check_options => integrator_check_options
         procedure :: switch_log => integrator_switch_log
     end type integrator_t
 
@@ -105,18 +123,13 @@ module ropedyn_integrator
         logical function stop_query_i()
         end function stop_query_i
 
-        !> Prepare to integrate `problem` from (t0, y0, yq0). The problem must outlive the
-        !! integrator (it is referenced, not copied).
-        subroutine init_i(self, problem, t0, y0, yq0, options, err)
-            import :: integrator_t, problem_t, wp, solver_options_t, error_t
+        !> The method's own preparation, after `init` has set problem, options, n, nq.
+        subroutine start_i(self, start, err)
+            import :: integrator_t, start_t, error_t
             class(integrator_t), intent(inout) :: self
-            class(problem_t), intent(inout), target :: problem
-            real(wp), intent(in) :: t0
-            real(wp), intent(in) :: y0(:)
-            real(wp), intent(in) :: yq0(:)
-            type(solver_options_t), intent(in) :: options
+            type(start_t), intent(in) :: start
             type(error_t), allocatable, intent(out) :: err
-        end subroutine init_i
+        end subroutine start_i
 
         !> Integrate to tout and return the state there. On failure `err` says the
         !! simulated time, the last step size and the cause; y, yq then hold the last
@@ -194,25 +207,49 @@ contains
         allocate (events(0))
     end function integrator_switch_log
 
-    !> The checks every `init` starts with: the order limit to use (options%max_order, the
-    !! method's default when 0) within the method's range, per-component absolute tolerances
-    !! for the `n` unknowns of the state.
-    subroutine integrator_check_options(self, options, n, max_order, err)
-        class(integrator_t), intent(in) :: self
+    !> Prepare to integrate `problem` from (t0, y0, yq0). The problem must outlive the
+    !! integrator (it is referenced, not copied). The checks every method shares: the order
+    !! limit (options%max_order, the method's default when 0) within the method's range,
+    !! tolerances > 0, stability-limit detection only for CVODE, the sizes of the initial
+    !! state and of per-component absolute tolerances.
+    subroutine integrator_init(self, problem, t0, y0, yq0, options, err)
+        class(integrator_t), intent(inout) :: self
+        class(problem_t), intent(inout), target :: problem
+        real(wp), intent(in) :: t0
+        real(wp), intent(in) :: y0(:)
+        real(wp), intent(in) :: yq0(:)
         type(solver_options_t), intent(in) :: options
-        integer, intent(in) :: n                 !< unknowns of the state
-        integer, intent(out) :: max_order        !< the order limit to use
         type(error_t), allocatable, intent(out) :: err
-        max_order = options%max_order
-        if (max_order == 0) max_order = self%default_max_order()
-        if (max_order < self%min_order() .or. max_order > self%max_order_limit()) then
-            call make_error(err, ERR_SOLVER, self%name()//': max_order must be '// &
+        type(start_t) :: start
+        character(len=:), allocatable :: name
+
+        call self%finalize()
+        name = self%name()
+        self%problem => problem
+        self%options = options
+        self%n = problem%size()
+        self%nq = problem%quad_size()
+        start%max_order = options%max_order
+        if (start%max_order == 0) start%max_order = self%default_max_order()
+        if (start%max_order /= 0 .and. (start%max_order < self%min_order() .or. &
+                                        start%max_order > self%max_order_limit())) then
+            call make_error(err, ERR_SOLVER, name//': max_order must be '// &
                             int_text(self%min_order())//' .. '//int_text(self%max_order_limit()))
-            return
+        else if (options%stab_lim_det .and. all(name /= ['cvode', 'adams'])) then
+            call make_error(err, ERR_SOLVER, name//': stability-limit detection is a CVODE '// &
+                            'option (method = ''cvode'')')
+        else if (.not. (options%rtol > 0.0_wp .and. options%atol > 0.0_wp)) then
+            call make_error(err, ERR_SOLVER, name//': rtol and atol must be > 0')
+        else if (size(y0) /= self%n .or. size(yq0) < self%nq) then
+            call make_error(err, ERR_SOLVER, name//': initial state of the wrong size')
+        else if (allocated(options%atol_vector)) then
+            if (size(options%atol_vector) /= self%n) &
+                call make_error(err, ERR_SOLVER, name//': atol_vector has the wrong size')
         end if
-        if (allocated(options%atol_vector)) then
-            if (size(options%atol_vector) /= n) &
-                call make_error(err, ERR_SOLVER, self%name()//': atol_vector has the wrong size')
-        end if
-    end subroutine integrator_check_options
+        if (allocated(err)) return
+        start%t0 = t0
+        start%y0 = y0
+        start%yq0 = yq0(1:self%nq)
+        call self%start(start, err)
+    end subroutine integrator_init
 end module ropedyn_integrator

@@ -29,7 +29,7 @@ module ropedyn_auto
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t
-    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, &
+    use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, &
                                   STIFF_STEP_RATE, stop_now
     use ropedyn_erk, only: erk_t
     use ropedyn_mebdf, only: mebdf_t
@@ -55,8 +55,6 @@ module ropedyn_auto
 
     type, extends(integrator_t) :: auto_t
         private
-        class(problem_t), pointer :: problem => null()
-        type(solver_options_t) :: options
         type(erk_t) :: erk
         type(mebdf_t) :: mebdf
         type(erk_table_t) :: tab
@@ -65,7 +63,6 @@ module ropedyn_auto
         integer :: user_order = 0          !< max_order given (0: from the damping)
         type(solver_stats_t) :: done       !< counters of the finished segments
         type(switch_log_t) :: log
-        integer :: n = 0, nq = 0
         real(wp) :: t = 0.0_wp
         real(wp), allocatable :: y(:), yq(:)
         ! the window of the method in use
@@ -80,7 +77,7 @@ module ropedyn_auto
         integer :: backoff = 1
         logical :: initialized = .false.
     contains
-        procedure :: init => auto_init
+        procedure :: start => auto_start
         procedure :: advance_to => auto_advance_to
         procedure :: stats => auto_stats
         procedure :: finalize => auto_finalize
@@ -106,41 +103,18 @@ contains
         events = self%log%items()
     end function auto_switch_log
 
-    subroutine auto_init(self, problem, t0, y0, yq0, options, err)
+    subroutine auto_start(self, start, err)
         class(auto_t), intent(inout) :: self
-        class(problem_t), intent(inout), target :: problem
-        real(wp), intent(in) :: t0
-        real(wp), intent(in) :: y0(:)
-        real(wp), intent(in) :: yq0(:)
-        type(solver_options_t), intent(in) :: options
+        type(start_t), intent(in) :: start
         type(error_t), allocatable, intent(out) :: err
         type(spectrum_t) :: spec
-        integer :: max_order
         real(wp) :: h_e, rate
         character(len=200) :: text
 
-        call self%finalize()
-        self%problem => problem
-        self%options = options
-        self%n = problem%size()
-        self%nq = problem%quad_size()
-        self%user_order = options%max_order
-        if (options%max_order /= 0) then
-            call self%check_options(options, self%n, max_order, err)
-            if (allocated(err)) return
-        end if
-        if (options%stab_lim_det) then
-            call make_error(err, ERR_SOLVER, 'auto: stability-limit detection is a CVODE '// &
-                            'option (method = ''cvode'')')
-            return
-        end if
-        if (size(y0) /= self%n .or. size(yq0) < self%nq) then
-            call make_error(err, ERR_SOLVER, 'auto: initial state of the wrong size')
-            return
-        end if
-        self%y = y0
-        self%yq = yq0(1:self%nq)
-        self%t = t0
+        self%user_order = start%max_order
+        self%y = start%y0
+        self%yq = start%yq0
+        self%t = start%t0
         self%tab = erk_table(ERK_ORDER)
         self%done = solver_stats_t()
         call self%log%clear()
@@ -150,7 +124,7 @@ contains
         self%wait = 0
         self%backoff = 1
 
-        call estimate_spectrum(problem, t0, y0, spec)
+        call estimate_spectrum(self%problem, start%t0, start%y0, spec)
         self%mebdf_order = mebdf_order_for(spec%fast_damping)
         if (self%user_order /= 0) self%mebdf_order = min(self%mebdf_order, self%user_order)
         h_e = erk_stable_step(self%tab, spec)
@@ -170,7 +144,7 @@ contains
         end if
         if (allocated(err)) return
         self%initialized = .true.
-    end subroutine auto_init
+    end subroutine auto_start
 
     !> MEBDF's maximum order for fast modes damped by `zeta` (clipped at 0).
     pure integer function mebdf_order_for(zeta) result(order)

@@ -22,8 +22,8 @@ module ropedyn_cvode
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK
-    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, clock_seconds, &
-        stop_now
+    use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, &
+        clock_seconds, stop_now
     use ropedyn_iteration_matrix, only: iteration_matrix_t
     use ropedyn_switch_log, only: switch_log_t, switch_event_t
     use fsundials_context_mod, only: FSUNContext_Create, FSUNContext_Free
@@ -101,8 +101,6 @@ module ropedyn_cvode
         real(c_double), pointer, contiguous :: y(:) => null()   !< storage wrapped by nv_y
         real(c_double), pointer, contiguous :: yq(:) => null()  !< storage wrapped by nv_q
         type(cvode_context_t), pointer :: ctx => null()
-        type(solver_options_t) :: options
-        integer :: n = 0, nq = 0
         real(wp) :: t = 0.0_wp    !< time of the state last returned (the last tout)
         real(wp) :: tn = 0.0_wp   !< CVODE's internal time (end of its last step), >= t
         !> Adams-Moulton with fixed-point iteration (adams_t) instead of BDF with Newton
@@ -115,7 +113,7 @@ module ropedyn_cvode
         type(solver_stats_t) :: base
         type(switch_log_t) :: log  !< order changes made by the stepping loop
     contains
-        procedure :: init => cvode_init
+        procedure :: start => cvode_start
         procedure :: advance_to => cvode_advance_to
         procedure :: stats => cvode_stats
         procedure :: finalize => cvode_finalize
@@ -199,42 +197,31 @@ contains
         events = self%log%items()
     end function cvode_switch_log
 
-    subroutine cvode_init(self, problem, t0, y0, yq0, options, err)
+    subroutine cvode_start(self, start, err)
         class(cvode_t), intent(inout) :: self
-        class(problem_t), intent(inout), target :: problem
-        real(wp), intent(in) :: t0
-        real(wp), intent(in) :: y0(:)
-        real(wp), intent(in) :: yq0(:)
-        type(solver_options_t), intent(in) :: options
+        type(start_t), intent(in) :: start
         type(error_t), allocatable, intent(out) :: err
-        integer :: max_order
         integer(c_int) :: flag
         type(N_Vector), pointer :: nv_atol
         real(c_double), allocatable, target :: atol(:)
 
-        call self%finalize()
-        self%options = options
-        self%n = problem%size()
-        self%nq = problem%quad_size()
-        call self%check_options(options, self%n, max_order, err)
-        if (allocated(err)) return
         self%adams = self%name() == 'adams'
-        self%monitor = cvode_monitor_t(qmax_user=max_order, qmax=max_order, window_t0=t0, &
-                                       t_start=t0)
+        self%monitor = cvode_monitor_t(qmax_user=start%max_order, qmax=start%max_order, &
+                                       window_t0=start%t0, t_start=start%t0)
         self%base = solver_stats_t()
         call self%log%clear()
-        self%t = t0
-        self%tn = t0
+        self%t = start%t0
+        self%tn = start%t0
         allocate (self%ctx)
-        self%ctx%problem => problem
+        self%ctx%problem => self%problem
         self%ctx%message = ''
         allocate (self%y(self%n), self%yq(max(self%nq, 1)))
-        self%y = y0
+        self%y = start%y0
         self%yq = 0.0_wp
-        if (self%nq > 0) self%yq(1:self%nq) = yq0(1:self%nq)
+        if (self%nq > 0) self%yq(1:self%nq) = start%yq0
 
         flag = FSUNContext_Create(c_null_ptr, self%sunctx)
-        if (check(flag, 'FSUNContext_Create')) return
+        if (failed(self, flag, err, 'FSUNContext_Create')) return
         self%nv_y => FN_VMake_Serial(int(self%n, c_int64_t), self%y, self%sunctx)
         if (.not. associated(self%nv_y)) then
             call make_error(err, ERR_SOLVER, 'cvode: cannot create the state vector')
@@ -242,59 +229,59 @@ contains
         end if
         ! CVODE clones all its vectors from this one: they inherit the compiled operations.
         flag = nvector_fast_ops(self%nv_y)
-        if (check(flag, 'ropedyn_nvector_fast_ops')) return
+        if (failed(self, flag, err, 'ropedyn_nvector_fast_ops')) return
         self%mem = FCVodeCreate(merge(CV_ADAMS, CV_BDF, self%adams), self%sunctx)
         if (.not. c_associated(self%mem)) then
             call make_error(err, ERR_SOLVER, 'cvode: FCVodeCreate failed')
             return
         end if
         flag = FCVodeSetErrHandlerFn(self%mem, c_funloc(cv_error_handler), c_loc(self%ctx))
-        if (check(flag, 'FCVodeSetErrHandlerFn')) return
-        flag = FCVodeInit(self%mem, c_funloc(cv_rhs), real(t0, c_double), self%nv_y)
-        if (check(flag, 'FCVodeInit')) return
+        if (failed(self, flag, err, 'FCVodeSetErrHandlerFn')) return
+        flag = FCVodeInit(self%mem, c_funloc(cv_rhs), real(start%t0, c_double), self%nv_y)
+        if (failed(self, flag, err, 'FCVodeInit')) return
         flag = FCVodeSetUserData(self%mem, c_loc(self%ctx))
-        if (check(flag, 'FCVodeSetUserData')) return
-        if (allocated(options%atol_vector)) then
-            atol = options%atol_vector
+        if (failed(self, flag, err, 'FCVodeSetUserData')) return
+        if (allocated(self%options%atol_vector)) then
+            atol = self%options%atol_vector
             nv_atol => FN_VMake_Serial(int(self%n, c_int64_t), atol, self%sunctx)
             flag = nvector_fast_ops(nv_atol)
-            flag = FCVodeSVtolerances(self%mem, real(options%rtol, c_double), nv_atol)
+            flag = FCVodeSVtolerances(self%mem, real(self%options%rtol, c_double), nv_atol)
             call FN_VDestroy(nv_atol)
-            if (check(flag, 'FCVodeSVtolerances')) return
+            if (failed(self, flag, err, 'FCVodeSVtolerances')) return
         else
-            flag = FCVodeSStolerances(self%mem, real(options%rtol, c_double), &
-                                      real(options%atol, c_double))
-            if (check(flag, 'FCVodeSStolerances')) return
+            flag = FCVodeSStolerances(self%mem, real(self%options%rtol, c_double), &
+                                      real(self%options%atol, c_double))
+            if (failed(self, flag, err, 'FCVodeSStolerances')) return
         end if
-        flag = FCVodeSetMaxOrd(self%mem, int(max_order, c_int))
-        if (check(flag, 'FCVodeSetMaxOrd')) return
+        flag = FCVodeSetMaxOrd(self%mem, int(start%max_order, c_int))
+        if (failed(self, flag, err, 'FCVodeSetMaxOrd')) return
         ! Stability-limit detection: CVODE watches the BDF error history at orders >= 3
         ! and lowers the order when a mode approaches the stability boundary.
-        flag = FCVodeSetStabLimDet(self%mem, merge(1_c_int, 0_c_int, options%stab_lim_det))
-        if (check(flag, 'FCVodeSetStabLimDet')) return
+        flag = FCVodeSetStabLimDet(self%mem, merge(1_c_int, 0_c_int, self%options%stab_lim_det))
+        if (failed(self, flag, err, 'FCVodeSetStabLimDet')) return
         ! CVODE's default of 7 error-test failures in one step stops it at the steep fronts
         ! of OREGO and E5 at loose tolerances; MEBDF allows the same 7 but restarts at low
         ! order after 3. 20 lets CVODE through (measured by the test-set sweep).
         flag = FCVodeSetMaxErrTestFails(self%mem, 20_c_int)
-        if (check(flag, 'FCVodeSetMaxErrTestFails')) return
+        if (failed(self, flag, err, 'FCVodeSetMaxErrTestFails')) return
         flag = FCVodeSetMaxHnilWarns(self%mem, -1_c_int)
-        if (check(flag, 'FCVodeSetMaxHnilWarns')) return
+        if (failed(self, flag, err, 'FCVodeSetMaxHnilWarns')) return
 
-        self%ctx%profile = options%profile
-        call self%attach_linear_solver(problem, options, err)
+        self%ctx%profile = self%options%profile
+        call self%attach_linear_solver(err)
         if (allocated(err)) return
 
         if (self%nq > 0) then
             self%nv_q => FN_VMake_Serial(int(self%nq, c_int64_t), self%yq, self%sunctx)
             flag = nvector_fast_ops(self%nv_q)
-            if (check(flag, 'ropedyn_nvector_fast_ops')) return
+            if (failed(self, flag, err, 'ropedyn_nvector_fast_ops')) return
             flag = FCVodeQuadInit(self%mem, c_funloc(cv_quad), self%nv_q)
-            if (check(flag, 'FCVodeQuadInit')) return
-            flag = FCVodeQuadSStolerances(self%mem, real(options%rtol, c_double), &
-                                          real(options%atol, c_double))
-            if (check(flag, 'FCVodeQuadSStolerances')) return
+            if (failed(self, flag, err, 'FCVodeQuadInit')) return
+            flag = FCVodeQuadSStolerances(self%mem, real(self%options%rtol, c_double), &
+                                          real(self%options%atol, c_double))
+            if (failed(self, flag, err, 'FCVodeQuadSStolerances')) return
             flag = FCVodeSetQuadErrCon(self%mem, 1_c_int)
-            if (check(flag, 'FCVodeSetQuadErrCon')) return
+            if (failed(self, flag, err, 'FCVodeSetQuadErrCon')) return
         end if
         if (self%adams) then
             ! Adams: fixed-point (functional) iteration, as for nonstiff problems; it
@@ -305,33 +292,35 @@ contains
                 return
             end if
             flag = FCVodeSetNonlinearSolver(self%mem, self%nls)
-            if (check(flag, 'FCVodeSetNonlinearSolver')) return
+            if (failed(self, flag, err, 'FCVodeSetNonlinearSolver')) return
         end if
-    contains
-        logical function check(flag, what)
-            integer(c_int), intent(in) :: flag
-            character(len=*), intent(in) :: what
-            check = flag < 0
-            if (check) call make_error(err, ERR_SOLVER, 'cvode: '//what//' failed: '// &
-                                       flag_name(flag)//' '//self%ctx%message)
-        end function check
-    end subroutine cvode_init
+    end subroutine cvode_start
+
+    !> Whether a SUNDIALS call returned a failure flag; then err says which call, the flag
+    !! and CVODE's own message.
+    logical function failed(self, flag, err, what)
+        class(cvode_t), intent(in) :: self
+        integer(c_int), intent(in) :: flag
+        type(error_t), allocatable, intent(inout) :: err
+        character(len=*), intent(in) :: what
+        failed = flag < 0
+        if (failed) call make_error(err, ERR_SOLVER, 'cvode: '//what//' failed: '// &
+                                    flag_name(flag)//' '//self%ctx%message)
+    end function failed
 
     !> The linear solver: our reduced second-order one when the problem allows it, else
     !! SUNDIALS' band (dense for a nearly full band) LU with the problem's analytic Jacobian
     !! (CVODE's difference quotients without one).
-    subroutine attach_linear_solver(self, problem, options, err)
+    subroutine attach_linear_solver(self, err)
         class(cvode_t), intent(inout) :: self
-        class(problem_t), intent(inout), target :: problem
-        type(solver_options_t), intent(in) :: options
         type(error_t), allocatable, intent(out) :: err
         integer :: ml, mu
         logical :: dense
         integer(c_int) :: flag
 
-        if (problem%has_second_order() .and. problem%has_jacobian() .and. &
-            .not. (options%first_order_newton .or. options%fd_jacobian)) then
-            call self%ctx%newton%setup(problem, implicit_form=.false., first_order=.false., &
+        if (self%problem%has_second_order() .and. self%problem%has_jacobian() .and. &
+            .not. (self%options%first_order_newton .or. self%options%fd_jacobian)) then
+            call self%ctx%newton%setup(self%problem, implicit_form=.false., first_order=.false., &
                                        fd_jacobian=.false.)
             self%ctx%reduced = self%ctx%newton%is_reduced()
         end if
@@ -345,13 +334,13 @@ contains
                 return
             end if
             flag = FCVodeSetLinearSolver(self%mem, self%solver, self%matrix)
-            if (check(flag, 'FCVodeSetLinearSolver')) return
+            if (failed(self, flag, err, 'FCVodeSetLinearSolver')) return
             flag = FCVodeSetLinSysFn(self%mem, c_funloc(cv_linsys))
-            if (check(flag, 'FCVodeSetLinSysFn')) return
+            if (failed(self, flag, err, 'FCVodeSetLinSysFn')) return
             return
         end if
 
-        call problem%bandwidths(ml, mu)
+        call self%problem%bandwidths(ml, mu)
         ml = min(ml, self%n - 1)
         mu = min(mu, self%n - 1)
         self%ctx%ml = ml
@@ -373,19 +362,11 @@ contains
             return
         end if
         flag = FCVodeSetLinearSolver(self%mem, self%solver, self%matrix)
-        if (check(flag, 'FCVodeSetLinearSolver')) return
-        if (problem%has_jacobian() .and. .not. options%fd_jacobian) then
+        if (failed(self, flag, err, 'FCVodeSetLinearSolver')) return
+        if (self%problem%has_jacobian() .and. .not. self%options%fd_jacobian) then
             flag = FCVodeSetJacFn(self%mem, c_funloc(cv_jacobian))
-            if (check(flag, 'FCVodeSetJacFn')) return
+            if (failed(self, flag, err, 'FCVodeSetJacFn')) return
         end if
-    contains
-        logical function check(flag, what)
-            integer(c_int), intent(in) :: flag
-            character(len=*), intent(in) :: what
-            check = flag < 0
-            if (check) call make_error(err, ERR_SOLVER, 'cvode: '//what//' failed: '// &
-                                       flag_name(flag)//' '//self%ctx%message)
-        end function check
     end subroutine attach_linear_solver
 
     function cvode_stats(self) result(stats)

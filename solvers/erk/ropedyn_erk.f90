@@ -31,7 +31,7 @@ module ropedyn_erk
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
-    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, &
+    use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, &
                                   STIFF_STEP_RATE, stop_now
     use ropedyn_erk_tables, only: erk_table_t, erk_table, ERK_MAX_STAGES
     implicit none
@@ -50,11 +50,9 @@ module ropedyn_erk
 
     type, extends(integrator_t) :: erk_t
         private
-        class(problem_t), pointer :: problem => null()
-        type(solver_options_t) :: options
         type(erk_table_t) :: tab
         type(solver_stats_t) :: counters
-        integer :: n = 0, nq = 0, s = 0
+        integer :: s = 0
         real(wp) :: t = 0.0_wp          !< time of the last accepted step point
         real(wp) :: h = 0.0_wp          !< size of the next step (0: not chosen yet)
         real(wp) :: t_old = 0.0_wp      !< start of the last accepted step
@@ -77,7 +75,7 @@ module ropedyn_erk
         real(wp) :: fail_rate = STIFF_STEP_RATE  !< 0 disables the stiffness failure
         logical :: stiff_stop = .false.  !< the last failure was the stiffness monitor's
     contains
-        procedure :: init => erk_init
+        procedure :: start => erk_start
         procedure :: advance_to => erk_advance_to
         procedure :: stats => erk_stats
         procedure :: finalize => erk_finalize
@@ -150,47 +148,22 @@ contains
         if (h > 0.0_wp) self%h = h
     end subroutine erk_set_initial_step
 
-    subroutine erk_init(self, problem, t0, y0, yq0, options, err)
+    subroutine erk_start(self, start, err)
         class(erk_t), intent(inout) :: self
-        class(problem_t), intent(inout), target :: problem
-        real(wp), intent(in) :: t0
-        real(wp), intent(in) :: y0(:)
-        real(wp), intent(in) :: yq0(:)
-        type(solver_options_t), intent(in) :: options
+        type(start_t), intent(in) :: start
         type(error_t), allocatable, intent(out) :: err
-        integer :: max_order
 
-        call self%finalize()
-        self%problem => problem
-        self%options = options
-        self%n = problem%size()
-        self%nq = problem%quad_size()
-        call self%check_options(options, self%n, max_order, err)
-        if (allocated(err)) return
-        if (options%stab_lim_det) then
-            call make_error(err, ERR_SOLVER, 'erk: stability-limit detection is a CVODE '// &
-                            'option')
-            return
-        end if
-        if (.not. (options%rtol > 0.0_wp .and. options%atol > 0.0_wp)) then
-            call make_error(err, ERR_SOLVER, 'erk: rtol and atol must be > 0')
-            return
-        end if
-        if (size(y0) /= self%n .or. size(yq0) < self%nq) then
-            call make_error(err, ERR_SOLVER, 'erk: initial state of the wrong size')
-            return
-        end if
-        self%tab = erk_table(max_order)
+        self%tab = erk_table(start%max_order)
         self%s = self%tab%stages
         allocate (self%y(self%n), self%y_old(self%n), self%ynew(self%n), self%ytmp(self%n), &
                   self%yprev(self%n), self%k(self%n, self%s), self%atol(self%n))
         allocate (self%yq(self%nq), self%yq_old(self%nq), self%gq(self%nq, 0:3))
-        self%atol = options%atol
-        if (allocated(options%atol_vector)) self%atol = options%atol_vector
-        self%y = y0
-        self%yq = yq0(1:self%nq)
-        self%t = t0
-        self%t_old = t0
+        self%atol = self%options%atol
+        if (allocated(self%options%atol_vector)) self%atol = self%options%atol_vector
+        self%y = start%y0
+        self%yq = start%yq0
+        self%t = start%t0
+        self%t_old = start%t0
         self%h = 0.0_wp
         self%h_old = 0.0_wp
         self%err_old = 1.0e-4_wp
@@ -200,12 +173,12 @@ contains
         self%rho = 0.0_wp
         self%stiff_steps = 0
         self%window_steps = 0
-        self%window_start = t0
+        self%window_start = start%t0
         self%stiff_share = 0.0_wp
         self%fail_rate = STIFF_STEP_RATE
         self%stiff_stop = .false.
         self%counters = solver_stats_t()
-    end subroutine erk_init
+    end subroutine erk_start
 
     subroutine erk_advance_to(self, tout, t, y, yq, err)
         class(erk_t), intent(inout) :: self

@@ -29,8 +29,8 @@ module ropedyn_mebdf
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
-    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, clock_seconds, &
-        stop_now
+    use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, &
+        clock_seconds, stop_now
     use ropedyn_mebdf_coefficients, only: mebdf_coefficients_t, mebdf_coefficients, KMAX_MEBDF
     use ropedyn_iteration_matrix, only: iteration_matrix_t
     implicit none
@@ -63,13 +63,9 @@ module ropedyn_mebdf
 
     type, extends(integrator_t) :: mebdf_t
         private
-        class(problem_t), pointer :: problem => null()
-        type(solver_options_t) :: options
         type(iteration_matrix_t) :: matrix
         type(mebdf_coefficients_t) :: coef(KMAX_MEBDF)
         type(solver_stats_t) :: counters
-        integer :: n = 0           !< unknowns of the Newton system
-        integer :: nq = 0          !< quadrature variables
         integer :: nt = 0          !< n + nq
         integer :: kmax = 0        !< highest number of steps (max_order - 1)
         integer :: k = 1           !< current number of steps (order k + 1)
@@ -94,7 +90,7 @@ module ropedyn_mebdf
         real(wp), allocatable :: f(:), mv(:), r(:)  !< work (n)
         real(wp), allocatable :: gq(:)    !< quadrature rhs (nq)
     contains
-        procedure :: init => mebdf_init
+        procedure :: start => mebdf_start
         procedure :: advance_to => mebdf_advance_to
         procedure :: stats => mebdf_stats
         procedure :: finalize => mebdf_finalize
@@ -194,49 +190,25 @@ contains
         name = 'mebdf'
     end function mebdf_name
 
-    subroutine mebdf_init(self, problem, t0, y0, yq0, options, err)
+    subroutine mebdf_start(self, start, err)
         class(mebdf_t), intent(inout) :: self
-        class(problem_t), intent(inout), target :: problem
-        real(wp), intent(in) :: t0
-        real(wp), intent(in) :: y0(:)
-        real(wp), intent(in) :: yq0(:)
-        type(solver_options_t), intent(in) :: options
+        type(start_t), intent(in) :: start
         type(error_t), allocatable, intent(out) :: err
-        integer :: max_order, j
+        integer :: j
 
-        call self%finalize()
-        self%problem => problem
-        self%options = options
-        self%n = problem%size()
-        self%nq = problem%quad_size()
         self%nt = self%n + self%nq
-        call self%check_options(options, self%n, max_order, err)
-        if (allocated(err)) return
-        if (options%stab_lim_det) then
-            call make_error(err, ERR_SOLVER, 'mebdf: stability-limit detection is a CVODE ' &
-                            //'option (MEBDF up to order 4 is A-stable: use max_order)')
-            return
-        end if
-        if (.not. (options%rtol > 0.0_wp .and. options%atol > 0.0_wp)) then
-            call make_error(err, ERR_SOLVER, 'mebdf: rtol and atol must be > 0')
-            return
-        end if
-        if (size(y0) /= self%n .or. size(yq0) < self%nq) then
-            call make_error(err, ERR_SOLVER, 'mebdf: initial state of the wrong size')
-            return
-        end if
-        self%kmax = max_order - 1
+        self%kmax = start%max_order - 1
         do j = 1, KMAX_MEBDF
             self%coef(j) = mebdf_coefficients(j)
         end do
         allocate (self%dif(self%nt, 0:KMAX_MEBDF + 2), self%atol(self%nt), self%w(self%nt))
         allocate (self%f(self%n), self%mv(self%n), self%r(self%n), self%gq(max(self%nq, 1)))
-        self%atol = options%atol
-        if (allocated(options%atol_vector)) self%atol(1:self%n) = options%atol_vector
+        self%atol = self%options%atol
+        if (allocated(self%options%atol_vector)) self%atol(1:self%n) = self%options%atol_vector
         self%dif = 0.0_wp
-        self%dif(1:self%n, 0) = y0
-        if (self%nq > 0) self%dif(self%n + 1:, 0) = yq0(1:self%nq)
-        self%t = t0
+        self%dif(1:self%n, 0) = start%y0
+        if (self%nq > 0) self%dif(self%n + 1:, 0) = start%yq0
+        self%t = start%t0
         self%k = 1
         self%started = .false.
         self%pending = .false.
@@ -248,10 +220,10 @@ contains
         self%fixed = .false.
         self%crate = 1.0_wp
         self%counters = solver_stats_t()
-        call self%matrix%setup(problem, implicit_form=.true., &
-                               first_order=options%first_order_newton, &
-                               fd_jacobian=options%fd_jacobian)
-    end subroutine mebdf_init
+        call self%matrix%setup(self%problem, implicit_form=.true., &
+                               first_order=self%options%first_order_newton, &
+                               fd_jacobian=self%options%fd_jacobian)
+    end subroutine mebdf_start
 
     !> Switch an initialized integrator to constant step h and constant k (order k + 1)
     !! without error test, starting from the exact past values past(:, i) = y(t0 - i h),
