@@ -135,8 +135,8 @@ contains
                 'Newton systems on the first-order matrix, not the reduced second-order one')
             call add_logical(G_SOLVER, 'profile', v%profile, &
                 'time the right-hand side, Jacobian, factorizations and solves')
-            call add_real(G_SOLVER, 'fault_nan_after', v%fault_nan_after, R_FINITE, 's', &
-                'testing aid: NaN right-hand side after this time; < 0: off')
+            call add_real(G_SOLVER, 'fault_nan_after', e%fault_nan_after, R_FINITE, 's', &
+                'testing aid: NaN forces after this time; < 0: off')
             call add_name(G_SOLVER, 'order_safety', v%order_safety, 'lower, stop, off', &
                 'on an energy gain: lower the order to the A-stable one, stop, or off')
             call add_real(G_SOLVER, 'energy_gain_bound', v%energy_gain_bound, R_POSITIVE, &

@@ -28,8 +28,6 @@ module ropedyn_scene_types
         !> time the parts of the integration (right-hand side, Jacobian, factorizations,
         !! solves): printed and written to /solver (costs a few % on small ropes)
         logical :: profile = .false.
-        !> testing aid: the right-hand side returns NaN for t > this time [s]; < 0: off
-        real(wp) :: fault_nan_after = -1.0_wp
         !> what the run does when the energy balance gains more than energy_gain_bound:
         !! 'lower' the order to the method's A-stable one and redo the output interval,
         !! 'stop' (a diagnosed failure), or 'off' (no check); docs/stability.md

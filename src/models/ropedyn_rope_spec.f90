@@ -108,6 +108,9 @@ module ropedyn_rope_spec
         logical :: support_motion = .true.  !< the motions and releases given in &supports
         logical :: point_masses = .true.    !< the point masses given in &attachments
         logical :: point_loads = .true.     !< the point loads given in &attachments
+        !> testing aid (read from `&solver fault_nan_after`): NaN forces on every body for
+        !! t > this time, s; < 0: off (ropedyn_effect_fault)
+        real(wp) :: fault_nan_after = -1.0_wp
     end type effects_params_t
 
     !> `&fluid`: the surrounding fluid (used with `&effects drag = .true.`).

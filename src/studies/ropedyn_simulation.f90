@@ -20,12 +20,10 @@ module ropedyn_simulation
     use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_run_record, only: run_record_t, read_run_record, check_record_fits, LAST_RECORD
     use ropedyn_progress, only: progress_t
-    use ropedyn_fault, only: fault_problem_t, fault_wrap
     use ropedyn_switch_log, only: switch_event_t
     use ropedyn_version, only: version_string
     use ropedyn_modes, only: equilibrium_initial_state
     use ropedyn_methods, only: METHODS, method_index
-    use ropedyn_problem, only: problem_t
     use ropedyn_energy_monitor, only: energy_monitor_t
     use ropedyn_state_start, only: state_initial_state
     implicit none
@@ -152,8 +150,6 @@ contains
         logical, intent(out) :: caught
         class(rope_model_t), allocatable, target :: model
         class(integrator_t), allocatable :: integrator
-        type(fault_problem_t), target :: faulty
-        class(problem_t), pointer :: problem
         type(energy_monitor_t) :: monitor
         type(solver_stats_t) :: stats_before   ! counters of the integrators replaced
         real(wp), allocatable :: y_prev(:), yq_prev(:)
@@ -247,13 +243,6 @@ contains
         end if
         caught = .true.
         call end_on_second_signal(.true.)
-        if (scene%solver%fault_nan_after >= 0.0_wp) then
-            ! testing aid (docs/input.md): the integrator sees a NaN right-hand side later on
-            call fault_wrap(faulty, model, scene%solver%fault_nan_after)
-            problem => faulty
-        else
-            problem => model
-        end if
         max_order = scene%solver%max_order
         if (max_order == 0) max_order = integrator%default_max_order()
         safe_order = 0
@@ -387,7 +376,7 @@ contains
             options%stop_requested => stop_on_signal
             options%max_order = max_order
             options%max_steps = max(1_i8, options%max_steps - stats_before%steps)
-            call integrator%init(problem, t, y, yq(1:nq), options, ierr)
+            call integrator%init(model, t, y, yq(1:nq), options, ierr)
         end subroutine start_integrator
 
         !> The energy monitor at the output time just reached: on a gain beyond the bound,

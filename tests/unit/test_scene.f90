@@ -111,7 +111,7 @@ contains
             'defaults: output_interval')
         call suite%check_true(.not. s%solver%stability_limit_detection, &
             'defaults: stability_limit_detection off')
-        call suite%check_true(s%solver%fault_nan_after < 0.0_wp, 'defaults: fault_nan_after off')
+        call suite%check_true(s%effects%fault_nan_after < 0.0_wp, 'defaults: fault_nan_after off')
         call suite%check_true(index(scene_namelist_text(s), &
             'stability_limit_detection = .false.') > 0, &
             'defaults: echo of stability_limit_detection')
@@ -194,7 +194,7 @@ contains
             'values: output_interval')
         call suite%check_true(s%solver%stability_limit_detection, &
             'values: stability_limit_detection')
-        call suite%check_close(s%solver%fault_nan_after, 1.5_wp, TIGHT, 0.0_wp, &
+        call suite%check_close(s%effects%fault_nan_after, 1.5_wp, TIGHT, 0.0_wp, &
             'values: fault_nan_after')
         call suite%check_true(s%output%file == 'results/run 1.h5', 'values: file')
         call suite%check_true(s%output%progress, 'values: progress')
@@ -313,7 +313,7 @@ contains
             .and. eq(a%solver%t_end, b%solver%t_end) &
             .and. eq(a%solver%output_interval, b%solver%output_interval) &
             .and. (a%solver%stability_limit_detection .eqv. b%solver%stability_limit_detection) &
-            .and. eq(a%solver%fault_nan_after, b%solver%fault_nan_after) &
+            .and. eq(a%effects%fault_nan_after, b%effects%fault_nan_after) &
             .and. a%output%file == b%output%file &
             .and. (a%output%progress .eqv. b%output%progress)
         if (bottom_anchor_given(a) .and. bottom_anchor_given(b)) then

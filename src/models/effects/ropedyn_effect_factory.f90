@@ -9,6 +9,7 @@ module ropedyn_effect_factory
     use ropedyn_effect_drag, only: drag_effect
     use ropedyn_effect_ground, only: ground_effect
     use ropedyn_effect_loads, only: loads_effect_t, point_load_t
+    use ropedyn_effect_fault, only: fault_effect_t
     implicit none
     private
     public :: build_body_effects, locate_on_bodies, attached_masses
@@ -40,19 +41,20 @@ contains
     end subroutine locate_on_bodies
 
     !> The effects of a spec acting on bodies of the given lengths (m): drag, ground contact,
-    !! point loads, each only when enabled and given.
+    !! point loads, each only when enabled and given, and the testing aid's NaN forces.
     subroutine build_body_effects(spec, lengths, effects)
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(in) :: lengths(:)
         type(effect_box_t), allocatable, intent(out) :: effects(:)
         type(loads_effect_t) :: loads
-        integer :: n_eff, k, m
+        integer :: n_eff, k, m, j
         logical :: with_loads
 
         with_loads = .false.
         if (spec%effects%point_loads) &
             with_loads = any(.not. ieee_is_nan(spec%attachments%load_positions))
-        n_eff = count([spec%effects%drag, spec%effects%ground, with_loads])
+        n_eff = count([spec%effects%drag, spec%effects%ground, with_loads, &
+                       spec%effects%fault_nan_after >= 0.0_wp])
         allocate (effects(n_eff))
         k = 0
         if (spec%effects%drag) then
@@ -76,19 +78,21 @@ contains
             associate (a => spec%attachments)
                 allocate (loads%loads(count(.not. ieee_is_nan(a%load_positions))))
                 m = 0
-                do k = 1, N_ATTACH
-                    if (ieee_is_nan(a%load_positions(k))) cycle
+                do j = 1, N_ATTACH
+                    if (ieee_is_nan(a%load_positions(j))) cycle
                     m = m + 1
-                    call locate_on_bodies(lengths, a%load_positions(k), loads%loads(m)%body, &
+                    call locate_on_bodies(lengths, a%load_positions(j), loads%loads(m)%body, &
                                           loads%loads(m)%r)
-                    loads%loads(m)%f0 = [a%load_force_x(k), a%load_force_y(k)]
-                    loads%loads(m)%amplitude = [a%load_amplitude_x(k), a%load_amplitude_y(k)]
-                    loads%loads(m)%omega = 2.0_wp*pi*a%load_frequency(k)
-                    loads%loads(m)%phase = a%load_phase_deg(k)*pi/180.0_wp
+                    loads%loads(m)%f0 = [a%load_force_x(j), a%load_force_y(j)]
+                    loads%loads(m)%amplitude = [a%load_amplitude_x(j), a%load_amplitude_y(j)]
+                    loads%loads(m)%omega = 2.0_wp*pi*a%load_frequency(j)
+                    loads%loads(m)%phase = a%load_phase_deg(j)*pi/180.0_wp
                 end do
             end associate
-            allocate (effects(n_eff)%e, source=loads)
+            allocate (effects(k)%e, source=loads)
         end if
+        if (spec%effects%fault_nan_after >= 0.0_wp) &
+            allocate (effects(n_eff)%e, source=fault_effect_t(spec%effects%fault_nan_after))
     end subroutine build_body_effects
 
     !> The point masses of a spec (none when `&effects point_masses` is off): for each, the
