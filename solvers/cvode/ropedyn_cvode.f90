@@ -329,33 +329,24 @@ contains
             self%ctx%ones = 1.0_wp
             self%matrix => FSUNMatNewEmpty(self%sunctx)
             self%solver => reduced_solver(self%ctx, self%sunctx)
-            if (.not. (associated(self%matrix) .and. associated(self%solver))) then
-                call make_error(err, ERR_SOLVER, 'cvode: cannot create the linear solver')
-                return
-            end if
-            flag = FCVodeSetLinearSolver(self%mem, self%solver, self%matrix)
-            if (failed(self, flag, err, 'FCVodeSetLinearSolver')) return
-            flag = FCVodeSetLinSysFn(self%mem, c_funloc(cv_linsys))
-            if (failed(self, flag, err, 'FCVodeSetLinSysFn')) return
-            return
-        end if
-
-        call self%problem%bandwidths(ml, mu)
-        ml = min(ml, self%n - 1)
-        mu = min(mu, self%n - 1)
-        self%ctx%ml = ml
-        self%ctx%mu = mu
-        ! A nearly full band: dense LU (LAPACK-style, blocked) beats the band LU.
-        dense = 2*ml + mu + 1 >= self%n
-        if (dense) then
-            self%matrix => FSUNDenseMatrix(int(self%n, c_int64_t), int(self%n, c_int64_t), &
-                                           self%sunctx)
-            self%solver => FSUNLinSol_Dense(self%nv_y, self%matrix, self%sunctx)
-            allocate (self%ctx%band(ml + mu + 1, self%n))
         else
-            self%matrix => FSUNBandMatrix(int(self%n, c_int64_t), int(mu, c_int64_t), &
-                                          int(ml, c_int64_t), self%sunctx)
-            self%solver => FSUNLinSol_Band(self%nv_y, self%matrix, self%sunctx)
+            call self%problem%bandwidths(ml, mu)
+            ml = min(ml, self%n - 1)
+            mu = min(mu, self%n - 1)
+            self%ctx%ml = ml
+            self%ctx%mu = mu
+            ! A nearly full band: dense LU (LAPACK-style, blocked) beats the band LU.
+            dense = 2*ml + mu + 1 >= self%n
+            if (dense) then
+                self%matrix => FSUNDenseMatrix(int(self%n, c_int64_t), &
+                                               int(self%n, c_int64_t), self%sunctx)
+                self%solver => FSUNLinSol_Dense(self%nv_y, self%matrix, self%sunctx)
+                allocate (self%ctx%band(ml + mu + 1, self%n))
+            else
+                self%matrix => FSUNBandMatrix(int(self%n, c_int64_t), int(mu, c_int64_t), &
+                                              int(ml, c_int64_t), self%sunctx)
+                self%solver => FSUNLinSol_Band(self%nv_y, self%matrix, self%sunctx)
+            end if
         end if
         if (.not. (associated(self%matrix) .and. associated(self%solver))) then
             call make_error(err, ERR_SOLVER, 'cvode: cannot create the linear solver')
@@ -363,7 +354,10 @@ contains
         end if
         flag = FCVodeSetLinearSolver(self%mem, self%solver, self%matrix)
         if (failed(self, flag, err, 'FCVodeSetLinearSolver')) return
-        if (self%problem%has_jacobian() .and. .not. self%options%fd_jacobian) then
+        if (self%ctx%reduced) then
+            flag = FCVodeSetLinSysFn(self%mem, c_funloc(cv_linsys))
+            if (failed(self, flag, err, 'FCVodeSetLinSysFn')) return
+        else if (self%problem%has_jacobian() .and. .not. self%options%fd_jacobian) then
             flag = FCVodeSetJacFn(self%mem, c_funloc(cv_jacobian))
             if (failed(self, flag, err, 'FCVodeSetJacFn')) return
         end if

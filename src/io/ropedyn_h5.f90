@@ -38,7 +38,7 @@ module ropedyn_h5
         H5T_STRING_F
     use ropedyn_kinds, only: wp, i8
     use ropedyn_text, only: int_text
-    use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INTERNAL
+    use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INPUT, ERR_INTERNAL
     implicit none
     private
 
@@ -335,16 +335,22 @@ contains
         self%is_open = .true.
     end subroutine h5_create
 
-    !> Open the existing file `path`, read-only unless `writable`.
+    !> Open the existing file `path`, read-only unless `writable`; a missing file is bad
+    !! input (ERR_INPUT: the user named it), one that cannot be opened an I/O error.
     subroutine h5_open(self, path, err, writable)
         class(h5_file_t), intent(inout) :: self
         character(len=*), intent(in) :: path
         type(error_t), allocatable, intent(out) :: err
         logical, intent(in), optional :: writable
-        logical :: rw
+        logical :: rw, exists
         integer :: hdferr
         call self%close(err)
         if (allocated(err)) return
+        inquire (file=path, exist=exists)
+        if (.not. exists) then
+            call make_error(err, ERR_INPUT, path//': no such file')
+            return
+        end if
         call library_acquire(path, err)
         if (allocated(err)) return
         rw = .false.

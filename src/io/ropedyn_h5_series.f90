@@ -163,7 +163,7 @@ contains
 
     module procedure h5_read_record
         integer(hid_t) :: dset_id, file_space, mem_space
-        integer(hsize_t) :: dims(3), max_dims(3), start(3), count(3)
+        integer(hsize_t) :: dims(3), max_dims(3)
         integer :: rank, hdferr
         character(len=:), allocatable :: label
         type(c_ptr) :: buffer
@@ -194,25 +194,10 @@ contains
                 call make_error(err, ERR_IO, label//': no record '//int_text(int(record)))
                 exit steps
             end if
-            start = 0
-            start(rank) = record - 1
-            count(1:rank - 1) = dims(1:rank - 1)
-            count(rank) = 1
-            call h5sselect_hyperslab_f(file_space, H5S_SELECT_SET_F, start(1:rank), &
-                                       count(1:rank), hdferr)
-            if (hdferr < 0) then
-                call make_error(err, ERR_IO, label//': cannot select record '// &
-                                int_text(int(record)))
-                exit steps
-            end if
             deallocate (values)
-            allocate (values(product(count(1:rank))))
-            call h5screate_simple_f(1, [size(values, kind=hsize_t)], mem_space, hdferr)
-            if (hdferr < 0) then
-                mem_space = -1
-                call make_error(err, ERR_IO, label//': cannot create memory dataspace')
-                exit steps
-            end if
+            allocate (values(product(dims(1:rank - 1))))
+            call select_record(file_space, dims(1:rank - 1), record, label, mem_space, err)
+            if (allocated(err)) exit steps
             buffer = c_loc(values)
             if (size(values) > 0) call h5dread_f(dset_id, h5kind_to_type(wp, H5_REAL_KIND), &
                 buffer, hdferr, mem_space_id=mem_space, file_space_id=file_space)
@@ -253,7 +238,7 @@ contains
         type(c_ptr), intent(in) :: buffer
         logical, intent(in) :: packed
         type(error_t), allocatable, intent(out) :: err
-        integer(hsize_t) :: dims(3), start(3), count(3)
+        integer(hsize_t) :: dims(3)
         integer(hid_t) :: file_space, mem_space
         integer :: rank, hdferr
         character(len=:), allocatable :: label
@@ -282,25 +267,10 @@ contains
             call make_error(err, ERR_IO, label//': cannot get dataspace')
             return
         end if
-        start = 0
-        start(rank) = record - 1
-        count(1:rank - 1) = self%record_dims(1:rank - 1)
-        count(rank) = 1
-        mem_space = -1
         steps: block
-            call h5sselect_hyperslab_f(file_space, H5S_SELECT_SET_F, start(1:rank), &
-                                       count(1:rank), hdferr)
-            if (hdferr < 0) then
-                call make_error(err, ERR_IO, label//': cannot select record '// &
-                                int_text(int(record)))
-                exit steps
-            end if
-            call h5screate_simple_f(1, [int(n_values, hsize_t)], mem_space, hdferr)
-            if (hdferr < 0) then
-                mem_space = -1
-                call make_error(err, ERR_IO, label//': cannot create memory dataspace')
-                exit steps
-            end if
+            call select_record(file_space, self%record_dims(1:rank - 1), record, label, &
+                               mem_space, err)
+            if (allocated(err)) exit steps
             call h5dwrite_f(self%id, type_id, buffer, hdferr, mem_space_id=mem_space, &
                             file_space_id=file_space)
             if (hdferr < 0) call make_error(err, ERR_IO, label//': cannot write record '// &
@@ -309,4 +279,32 @@ contains
         if (mem_space >= 0) call h5sclose_f(mem_space, hdferr)
         call h5sclose_f(file_space, hdferr)
     end subroutine write_record
+
+    !> Select record `record` (the last dimension, from 1) of a series with records of the
+    !! dimensions `record_dims` in `file_space`, and create the memory dataspace of its
+    !! values (mem_space = -1 on failure).
+    subroutine select_record(file_space, record_dims, record, label, mem_space, err)
+        integer(hid_t), intent(in) :: file_space
+        integer(hsize_t), intent(in) :: record_dims(:)
+        integer(hsize_t), intent(in) :: record
+        character(len=*), intent(in) :: label
+        integer(hid_t), intent(out) :: mem_space
+        type(error_t), allocatable, intent(out) :: err
+        integer(hsize_t) :: start(size(record_dims) + 1)
+        integer :: hdferr
+        mem_space = -1
+        start = 0
+        start(size(start)) = record - 1
+        call h5sselect_hyperslab_f(file_space, H5S_SELECT_SET_F, start, &
+                                   [record_dims, 1_hsize_t], hdferr)
+        if (hdferr < 0) then
+            call make_error(err, ERR_IO, label//': cannot select record '//int_text(int(record)))
+            return
+        end if
+        call h5screate_simple_f(1, [product(record_dims)], mem_space, hdferr)
+        if (hdferr < 0) then
+            mem_space = -1
+            call make_error(err, ERR_IO, label//': cannot create memory dataspace')
+        end if
+    end subroutine select_record
 end submodule ropedyn_h5_series

@@ -63,18 +63,12 @@ contains
         type(error_t), allocatable :: close_err
         real(wp), allocatable :: time(:), values(:)
         integer(hsize_t) :: dims1(1), k
-        logical :: exists
         real(wp) :: e(size(ENERGY_NAMES))
         integer :: j
 
         rec%path = path
         rec%model = ''
         rec%status = ''
-        inquire (file=path, exist=exists)
-        if (.not. exists) then
-            call make_error(err, ERR_INPUT, path//': no such file')
-            return
-        end if
         call h5%open(path, err)
         if (allocated(err)) return
         steps: block

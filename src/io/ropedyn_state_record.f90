@@ -46,18 +46,13 @@ contains
         type(error_t), allocatable :: close_err
         real(wp), allocatable :: time(:), values(:)
         integer(hsize_t) :: dims1(1), dims2(2), dims3(3)
-        logical :: exists, found
+        logical :: found
         real(wp) :: slack
         integer :: k, nt
 
-        inquire (file=path, exist=exists)
-        if (.not. exists) then
-            call make_error(err, ERR_INPUT, path//': no such file')
-            return
-        end if
         call h5%open(path, err)
         if (allocated(err)) then
-            err%code = ERR_INPUT  ! not an HDF5 file: bad input
+            err%code = ERR_INPUT  ! missing or not an HDF5 file: bad input
             return
         end if
         steps: block
