@@ -7,9 +7,8 @@
 !! linear-system function (CVodeSetLinSysFn). CVODE keeps all its own rules that way: when to
 !! set up (gamma changed by > 30 %, every 20 steps, after failures), when the Jacobian is
 !! stale (jok: every 51 steps, after a convergence failure with an old one), the scaling of
-!! the correction by 2/(1 + gamma/gamma_setup) for a lagged setup, its counters; the linear
-!! system function evaluates the blocks when CVODE asks for a new Jacobian, the solver's
-!! setup factors the reduced matrix for CVODE's gamma, its solve does the reduction.
+!! the correction by 2/(1 + gamma/gamma_setup) for a lagged setup, its counters (submodule
+!! ropedyn_cvode_linsol).
 !!
 !! We link CVODES, CVODE's superset from the same SUNDIALS release, for its quadrature
 !! feature: the problem's quadrature variables (dissipated energy, support work) are then
@@ -29,9 +28,7 @@ module ropedyn_cvode
     use fsundials_context_mod, only: FSUNContext_Create, FSUNContext_Free
     use fsundials_nvector_mod, only: N_Vector, FN_VDestroy, FN_VGetArrayPointer
     use fsundials_matrix_mod, only: SUNMatrix, FSUNMatDestroy, FSUNMatNewEmpty
-    use fsundials_linearsolver_mod, only: SUNLinearSolver, FSUNLinSolFree, SUNLinearSolver_Ops, &
-                                          FSUNLinSolNewEmpty, FSUNLinSolFreeEmpty, &
-                                          SUNLinearSolver_Type, SUNLINEARSOLVER_DIRECT
+    use fsundials_linearsolver_mod, only: SUNLinearSolver, FSUNLinSolFree
     use fnvector_serial_mod, only: FN_VMake_Serial
     use fsunmatrix_band_mod, only: FSUNBandMatrix, FSUNBandMatrix_Data, FSUNBandMatrix_LDim, &
                                    FSUNBandMatrix_StoredUpperBandwidth, FSUNBandMatrix_Columns
@@ -162,6 +159,31 @@ module ropedyn_cvode
             real(wp), intent(in) :: h
             logical, intent(out) :: ok
         end subroutine cvode_restart
+
+        !> A direct SUNLinearSolver whose content is the context (set-up: factor the
+        !! reduced matrix for the gamma of the last linear-system call; solve: the
+        !! reduction); submodule ropedyn_cvode_linsol.
+        module function reduced_solver(ctx, sunctx) result(ls)
+            type(cvode_context_t), pointer, intent(in) :: ctx
+            type(c_ptr), intent(in) :: sunctx
+            type(SUNLinearSolver), pointer :: ls
+        end function reduced_solver
+
+        !> CVODE's linear-system function: new blocks at (t, y) unless CVODE says the old
+        !! ones will do (jok); the factorization follows in the solver's set-up with this
+        !! gamma.
+        module function cv_linsys(t, nv_y, nv_f, mat, jok, jcur, gamma, user_data, tmp1, &
+                                  tmp2, tmp3) result(ierr) bind(C)
+            real(c_double), value :: t
+            type(N_Vector) :: nv_y, nv_f
+            type(SUNMatrix) :: mat
+            integer(c_int), value :: jok
+            integer(c_int) :: jcur
+            real(c_double), value :: gamma
+            type(c_ptr), value :: user_data
+            type(N_Vector) :: tmp1, tmp2, tmp3
+            integer(c_int) :: ierr
+        end function cv_linsys
     end interface
 
     interface
@@ -511,101 +533,6 @@ contains
         ctx%last_status = status
         ierr = int(status, c_int)
     end function cv_jacobian
-
-    ! ---- the reduced second-order linear solver --------------------------------------
-
-    !> A direct SUNLinearSolver whose content is the context (set-up: factor the reduced
-    !! matrix for the gamma of the last linear-system call; solve: the reduction).
-    function reduced_solver(ctx, sunctx) result(ls)
-        type(cvode_context_t), pointer, intent(in) :: ctx
-        type(c_ptr), intent(in) :: sunctx
-        type(SUNLinearSolver), pointer :: ls
-        type(SUNLinearSolver_Ops), pointer :: ops
-        ls => FSUNLinSolNewEmpty(sunctx)
-        if (.not. associated(ls)) return
-        ls%content = c_loc(ctx)
-        call c_f_pointer(ls%ops, ops)
-        ops%gettype = c_funloc(ls_type)
-        ops%setup = c_funloc(ls_setup)
-        ops%solve = c_funloc(ls_solve)
-        ops%free = c_funloc(ls_free)
-    end function reduced_solver
-
-    integer(SUNLinearSolver_Type) function ls_type(ls) result(kind) bind(C)
-        type(SUNLinearSolver) :: ls
-        kind = SUNLINEARSOLVER_DIRECT
-    end function ls_type
-
-    !> CVODE's linear-system function: new blocks at (t, y) unless CVODE says the old ones
-    !! will do (jok); the factorization follows in ls_setup with this gamma.
-    integer(c_int) function cv_linsys(t, nv_y, nv_f, mat, jok, jcur, gamma, user_data, &
-                                      tmp1, tmp2, tmp3) result(ierr) bind(C)
-        real(c_double), value :: t
-        type(N_Vector) :: nv_y, nv_f
-        type(SUNMatrix) :: mat
-        integer(c_int), value :: jok
-        integer(c_int) :: jcur
-        real(c_double), value :: gamma
-        type(c_ptr), value :: user_data
-        type(N_Vector) :: tmp1, tmp2, tmp3
-        type(cvode_context_t), pointer :: ctx
-        real(c_double), pointer :: y(:)
-        integer(i8) :: nevals
-        integer :: status
-        real(wp) :: start
-        call c_f_pointer(user_data, ctx)
-        ctx%gamma = gamma
-        jcur = 0_c_int
-        ierr = 0_c_int
-        if (jok /= 0_c_int) return
-        if (ctx%profile) start = clock_seconds()
-        y => FN_VGetArrayPointer(nv_y)
-        nevals = 0
-        call ctx%newton%evaluate_jacobian(ctx%problem, t, y, ctx%ones, 0.0_wp, status, nevals)
-        if (ctx%profile) ctx%time_jac = ctx%time_jac + (clock_seconds() - start)
-        ctx%last_status = status
-        jcur = 1_c_int
-        ierr = int(status, c_int)
-    end function cv_linsys
-
-    integer(c_int) function ls_setup(ls, mat) result(ierr) bind(C)
-        type(SUNLinearSolver) :: ls
-        type(SUNMatrix) :: mat
-        type(cvode_context_t), pointer :: ctx
-        integer :: status
-        real(wp) :: start
-        call c_f_pointer(ls%content, ctx)
-        if (ctx%profile) start = clock_seconds()
-        call ctx%newton%factor(ctx%problem, 0.0_wp, ctx%ones, ctx%gamma, status)
-        if (ctx%profile) ctx%time_factor = ctx%time_factor + (clock_seconds() - start)
-        ierr = int(status, c_int)   ! a singular matrix is recoverable (CVODE cuts h)
-    end function ls_setup
-
-    integer(c_int) function ls_solve(ls, mat, nv_x, nv_b, tol) result(ierr) bind(C)
-        type(SUNLinearSolver) :: ls
-        type(SUNMatrix) :: mat
-        type(N_Vector) :: nv_x, nv_b
-        real(c_double), value :: tol
-        type(cvode_context_t), pointer :: ctx
-        real(c_double), pointer :: x(:), b(:)
-        real(wp) :: start
-        call c_f_pointer(ls%content, ctx)
-        if (ctx%profile) start = clock_seconds()
-        x => FN_VGetArrayPointer(nv_x)
-        b => FN_VGetArrayPointer(nv_b)
-        x = b
-        call ctx%newton%solve(x)
-        if (ctx%profile) ctx%time_solve = ctx%time_solve + (clock_seconds() - start)
-        ierr = 0_c_int
-    end function ls_solve
-
-    !> The content is the context, owned by cvode_t: only the solver object goes.
-    integer(c_int) function ls_free(ls) result(ierr) bind(C)
-        type(SUNLinearSolver), target :: ls
-        ls%content = c_null_ptr
-        call FSUNLinSolFreeEmpty(ls)
-        ierr = 0_c_int
-    end function ls_free
 
     !> Keeps CVODE's messages for our error text instead of printing them.
     subroutine cv_error_handler(code, module, function, msg, user_data) bind(C)
