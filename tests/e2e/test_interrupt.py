@@ -37,7 +37,7 @@ def start(ropedyn_exe, cwd, *args):
 
 
 def wait_for_records(path, count, proc, timeout=60):
-    """Until the run file (flushed after every record) has `count` records."""
+    """Until the run file (flushed every 0.1 s of wall clock) has `count` records."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         assert proc.poll() is None, "the run ended before the signal: make it longer"
