@@ -211,8 +211,9 @@ contains
     !! integrator (it is referenced, not copied). The checks every method shares: the order
     !! limit (options%max_order, the method's default when 0) within the method's range,
     !! tolerances > 0, stability-limit detection only for CVODE, the sizes of the initial
-    !! state and of per-component absolute tolerances.
-    subroutine integrator_init(self, problem, t0, y0, yq0, options, err)
+    !! state and of per-component absolute tolerances. Recursive: auto's `start` initializes
+    !! the method it runs through this same `init`.
+    recursive subroutine integrator_init(self, problem, t0, y0, yq0, options, err)
         class(integrator_t), intent(inout) :: self
         class(problem_t), intent(inout), target :: problem
         real(wp), intent(in) :: t0

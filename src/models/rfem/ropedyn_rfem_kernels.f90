@@ -17,17 +17,14 @@
 !! dF/dq = -C g g^T - (C s + B s') H - B g (H q')^T, dF/dq' = -B g g^T summed over the
 !! three strains. Supports and effects are separate small steps, only when present.
 submodule (ropedyn_rfem) ropedyn_rfem_kernels
+    use ropedyn_trig, only: cos_sin
     implicit none
 
 contains
 
     !> cos and sin of every element angle into self%cs, once per call.
     module procedure angles
-        integer :: i
-        do i = 1, self%n
-            self%cs(1, i) = cos(y(6*i - 3))
-            self%cs(2, i) = sin(y(6*i - 3))
-        end do
+        call cos_sin(y(3:6*self%n:6), self%cs)
     end procedure angles
 
     !> Add the generalized force of support k (translational spring and damper on d, and
