@@ -22,6 +22,9 @@ module ropedyn_trig
     real(wp), parameter :: PIO2_1 = 1.57079632673412561417e+00_wp
     real(wp), parameter :: PIO2_2 = 6.07710050630396597660e-11_wp
     real(wp), parameter :: PIO2_3 = 2.02226624871116645580e-21_wp
+    !> 1.5 2^52: (z + SHIFTER) - SHIFTER rounds z to the nearest integer (|z| < 2^51)
+    !! without a library call, so that the loop vectorizes
+    real(wp), parameter :: SHIFTER = 6755399441055744.0_wp
     !> largest |x| reduced here (k < 2^19)
     real(wp), parameter :: REDUCE_LIMIT = 8.0e5_wp
     !> sin r = r + r^3 (S1 + r^2 (S2 + ... )) on [-pi/4, pi/4] (fdlibm __kernel_sin)
@@ -43,8 +46,8 @@ contains
 
     !> cs(1, i) = cos(x(i)), cs(2, i) = sin(x(i)).
     pure subroutine cos_sin(x, cs)
-        real(wp), intent(in) :: x(:)
-        real(wp), intent(inout) :: cs(:, :)   !< (2, size(x)) at least
+        real(wp), contiguous, intent(in) :: x(:)
+        real(wp), contiguous, intent(inout) :: cs(:, :)   !< (2, size(x)) at least
         real(wp) :: fk, r, z, sr, cr, hz, w
         integer :: i, q
 
@@ -56,7 +59,7 @@ contains
             return
         end if
         do i = 1, size(x)
-            fk = anint(x(i)*TWO_OVER_PI)
+            fk = (x(i)*TWO_OVER_PI + SHIFTER) - SHIFTER
             r = ((x(i) - fk*PIO2_1) - fk*PIO2_2) - fk*PIO2_3
             z = r*r
             sr = r + r*z*(S1 + z*(S2 + z*(S3 + z*(S4 + z*(S5 + z*S6)))))

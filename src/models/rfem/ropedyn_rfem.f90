@@ -104,6 +104,7 @@ module ropedyn_rfem
         real(wp), allocatable :: rowscale(:, :)  !< (3, n): 1/m, 1/m, 1/J; 1 on pm elements
         ! workspace, allocated once (no state is kept between calls)
         real(wp), allocatable :: cs(:, :)      !< cos, sin of every angle, (2, n)
+        real(wp), allocatable :: phi(:)        !< every angle, gathered from y (n)
         real(wp), allocatable :: gen(:, :)     !< generalized forces, (3, n)
         !> Jacobian blocks (3, 6, -1:1, n): blk(r, l, o, i) is the derivative of row r of
         !! element i (force x, y, moment; times rowscale(r, i) its acceleration, and after

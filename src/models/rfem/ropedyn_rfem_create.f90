@@ -167,7 +167,7 @@ contains
 
         model%half = 0.5_wp*model%len
         model%weight = merge(model%mass*model%g, 0.0_wp*model%mass, model%gravity_on)
-        allocate (model%cs(2, n), model%gen(3, n), model%blk(3, 6, -1:1, n))
+        allocate (model%cs(2, n), model%phi(n), model%gen(3, n), model%blk(3, 6, -1:1, n))
         model%cs = 0.0_wp
         model%gen = 0.0_wp
         model%blk = 0.0_wp

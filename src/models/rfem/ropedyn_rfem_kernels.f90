@@ -24,7 +24,11 @@ contains
 
     !> cos and sin of every element angle into self%cs, once per call.
     module procedure angles
-        call cos_sin(y(3:6*self%n:6), self%cs)
+        integer :: i
+        do i = 1, self%n
+            self%phi(i) = y(6*i - 3)
+        end do
+        call cos_sin(self%phi, self%cs)
     end procedure angles
 
     !> Add the generalized force of support k (translational spring and damper on d, and
