@@ -6,7 +6,7 @@ module ropedyn_band_lu
     implicit none
     private
     public :: RFEM_KL, band_lu_factor, band_lu_solve, band_solve_rfem, band_add_product, &
-              full_entry
+              band_product_rfem, full_entry
 
     !> Bandwidths of the RFEM's reduced matrix (3 x 3 blocks, block tridiagonal): its solve
     !! has a copy of the band loops with these as constants, whose inner loops the compiler
@@ -111,10 +111,10 @@ contains
         end do
     end subroutine band_lu_solve
 
-    !> band_add_product and band_lu_solve for kl = ku = RFEM_KL (n > 4 kl): y <- y + g K x,
-    !! then y <- A^{-1} y; the same operations in the same order, the interior columns
-    !! with constant trip counts (U's kl + ku super-diagonals all visited: those beyond
-    !! the fill are zero).
+    !> band_product_rfem and band_lu_solve for kl = ku = RFEM_KL (n > 4 kl): y <- y + g K x,
+    !! then y <- A^{-1} y; the solve's operations in band_lu_solve's order, the interior
+    !! columns with constant trip counts (U's kl + ku super-diagonals all visited: those
+    !! beyond the fill are zero).
     pure subroutine band_solve_rfem(n, kb, g, x, ab, ipiv, y)
         integer, intent(in) :: n
         real(wp), intent(in) :: kb(2*RFEM_KL + 1, n)
@@ -123,23 +123,11 @@ contains
         real(wp), intent(in) :: ab(3*RFEM_KL + 1, n)
         integer, intent(in) :: ipiv(n)
         real(wp), intent(inout) :: y(n)
-        integer, parameter :: KL = RFEM_KL, KU = RFEM_KL, KV = 2*RFEM_KL
+        integer, parameter :: KL = RFEM_KL, KV = 2*RFEM_KL
         integer :: i, j, l
-        real(wp) :: gx, t
+        real(wp) :: t
 
-        ! y <- y + g K x (column j touches rows j - ku .. j + kl)
-        do j = 1, n
-            gx = g*x(j)
-            if (j > KU .and. j <= n - KL) then
-                do i = -KU, KL
-                    y(j + i) = y(j + i) + kb(KU + 1 + i, j)*gx
-                end do
-            else
-                do i = max(1, j - KU), min(n, j + KL)
-                    y(i) = y(i) + kb(KU + 1 + i - j, j)*gx
-                end do
-            end if
-        end do
+        call band_product_rfem(n, kb, g, x, y)
         ! L z = P y
         do j = 1, n - 1
             l = ipiv(j)
@@ -173,6 +161,34 @@ contains
             end if
         end do
     end subroutine band_solve_rfem
+
+    !> y <- y + g K x for kl = ku = RFEM_KL (n > 2 kl), row by row: each y(i) gets one dot
+    !! product of constant length in the interior (independent rows, where the column
+    !! order of band_add_product chains every update of y through memory).
+    pure subroutine band_product_rfem(n, kb, g, x, y)
+        integer, intent(in) :: n
+        real(wp), intent(in) :: kb(2*RFEM_KL + 1, n)
+        real(wp), intent(in) :: g
+        real(wp), intent(in) :: x(n)
+        real(wp), intent(inout) :: y(n)
+        integer, parameter :: KL = RFEM_KL, KU = RFEM_KL
+        integer :: i, j
+        real(wp) :: acc
+        ! row i holds columns i - kl .. i + ku, entry (i, j) at kb(ku + 1 + i - j, j)
+        do i = 1, n
+            acc = 0.0_wp
+            if (i > KL .and. i <= n - KU) then
+                do j = -KL, KU
+                    acc = acc + kb(KU + 1 - j, i + j)*x(i + j)
+                end do
+            else
+                do j = max(1, i - KL), min(n, i + KU)
+                    acc = acc + kb(KU + 1 + i - j, j)*x(j)
+                end do
+            end if
+            y(i) = y(i) + g*acc
+        end do
+    end subroutine band_product_rfem
 
     !> y <- y + g A x for A in compact band storage (row ku + 1 + i - j).
     pure subroutine band_add_product(n, kl, ku, a, g, x, y)

@@ -21,6 +21,7 @@
 module ropedyn_iteration_matrix
     use ropedyn_kinds, only: wp, i8
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_RECOVERABLE, STATUS_FATAL
+    use ropedyn_block3, only: block3_t
     use ropedyn_band_lu, only: RFEM_KL, band_lu_factor, band_lu_solve, band_solve_rfem, &
                                band_add_product, full_entry
     implicit none
@@ -55,6 +56,11 @@ module ropedyn_iteration_matrix
         real(wp), allocatable :: kb(:, :), cb(:, :), mk(:, :)  !< band (kl+ku+1, np), row ku+1+i-j
         real(wp), allocatable :: rlu(:, :)    !< factors (dense np x np or band 2kl+ku+1 x np)
         integer :: rkv = 0                    !< super-diagonals of the band U actually filled
+        !> RFEM (kl = ku = RFEM_KL): the block-tridiagonal factors, used when `use_block3`
+        !! (else the band LU: a matrix that is not block tridiagonal, or a singular block)
+        type(block3_t) :: blk3
+        logical :: use_block3 = .false.
+        real(wp), allocatable :: ra(:, :)     !< M_v - g C - g^2 K (kl+ku+1, np) for blk3
         integer, allocatable :: ripiv(:)
         real(wp), allocatable :: rq(:), rv(:)
         logical, public :: factored = .false.
@@ -152,6 +158,7 @@ contains
         end if
         if (allocated(self%kb)) deallocate (self%kb, self%cb, self%mk, self%rlu, self%ripiv, &
                                             self%rq, self%rv)
+        if (allocated(self%ra)) deallocate (self%ra)
         if (self%reduced) then
             self%kl = min(max(self%kl, 0), self%np - 1)
             self%ku = min(max(self%ku, 0), self%np - 1)
@@ -392,10 +399,19 @@ contains
             end do
             call dgetrf(np, np, self%rlu, np, self%ripiv, info)
         else
-            ! dgbtrf storage: (i, j) at row kl + ku + 1 + i - j of 2 kl + ku + 1 rows
-            self%rlu(1:kl, :) = 0.0_wp
-            self%rlu(kl + 1:, :) = self%mk - g*self%cb - g2*self%kb
-            call band_lu_factor(np, kl, ku, self%rlu, self%ripiv, info, self%rkv)
+            self%use_block3 = .false.
+            if (kl == RFEM_KL .and. ku == RFEM_KL) then
+                if (.not. allocated(self%ra)) allocate (self%ra(kl + ku + 1, np))
+                self%ra = self%mk - g*self%cb - g2*self%kb
+                call self%blk3%factor(np, self%ra, self%kb, info)
+                self%use_block3 = info == 0
+            end if
+            if (.not. self%use_block3) then
+                ! dgbtrf storage: (i, j) at row kl + ku + 1 + i - j of 2 kl + ku + 1 rows
+                self%rlu(1:kl, :) = 0.0_wp
+                self%rlu(kl + 1:, :) = self%mk - g*self%cb - g2*self%kb
+                call band_lu_factor(np, kl, ku, self%rlu, self%ripiv, info, self%rkv)
+            end if
         end if
         status = merge(STATUS_OK, STATUS_RECOVERABLE, info == 0)
     end subroutine factor_reduced
@@ -469,8 +485,8 @@ contains
     subroutine solve_reduced(self, b)
         class(iteration_matrix_t), intent(inout) :: self
         real(wp), intent(inout) :: b(:)
-        integer :: i, j, info, np, kl, ku
-        real(wp) :: g, x
+        integer :: i, info, np, kl, ku
+        real(wp) :: g
 
         np = self%np
         kl = self%kl
@@ -483,6 +499,8 @@ contains
         if (self%rdense) then
             call band_add_product(np, kl, ku, self%kb, g, self%rq, self%rv)
             call dgetrs('N', np, 1, self%rlu, np, self%ripiv, self%rv, np, info)
+        else if (self%use_block3) then
+            call self%blk3%solve_plus_product(g, self%rq, self%rv)
         else if (kl == RFEM_KL .and. ku == RFEM_KL .and. np > 4*RFEM_KL) then
             call band_solve_rfem(np, self%kb, g, self%rq, self%rlu, self%ripiv, self%rv)
         else

@@ -109,10 +109,11 @@ contains
     end procedure stage
 
     module procedure try_step
-        real(wp), dimension(self%nt) :: pred, psi, c, ybar1, ybar2, y3, d1, hg1, hg2, p2
+        real(wp), dimension(self%nt) :: pred, c, ybar1, ybar2, y3, d1, hg1, hg2
+        real(wp) :: sp, sq, s2
         real(wp) :: gam(KMAX_MEBDF), hmin, tn, err1, errkm1, errkp1, beta, hbeta
-        real(wp) :: ratio, r_same, r_down, r_up, binom
-        integer :: k, j, i, outcome, status, error_fails, conv_fails, knew
+        real(wp) :: ratio, r_same, r_down, r_up, binom, wd(0:KMAX_MEBDF)
+        integer :: k, j, i, l, outcome, status, error_fails, conv_fails, knew
         logical :: refresh
         character(len=:), allocatable :: last_cause
 
@@ -160,17 +161,19 @@ contains
             end if
 
             ! Stage 1: k-step BDF to t_n + h.
-            pred = self%dif(:, 0)
-            do j = 1, k
-                pred = pred + self%dif(:, j)
-            end do
-            psi = 0.0_wp
-            do j = 1, k
-                psi = psi + gam(j)*self%dif(:, j)
-            end do
-            ! With P_j = sum_{i>=j} dif_i (the predictor's differences), psi above is
+            ! pred = sum_{j=0..k} dif_j, psi = sum_{j=1..k} gam_j dif_j (one pass). With
+            ! P_j = sum_{i>=j} dif_i (the predictor's differences), psi is
             ! sum_{j=1..k} (1/j) P_j, the BDF's known part.
-            c = pred - beta*psi
+            do l = 1, self%nt
+                sp = self%dif(l, 0)
+                sq = 0.0_wp
+                do j = 1, k
+                    sp = sp + self%dif(l, j)
+                    sq = sq + gam(j)*self%dif(l, j)
+                end do
+                pred(l) = sp
+                c(l) = sp - beta*sq
+            end do
             ybar1 = pred
             call self%stage(tn, hbeta, c, ybar1, outcome)
             if (outcome /= STAGE_OK) then
@@ -191,15 +194,18 @@ contains
             ! Stage 2: the same BDF one step further, ybar1 joining the history. With
             ! P_j = sum_{i=j..k} dif_i, the differences of ybar1 are P_j + d1; the
             ! predictor is their sum and psi = sum_{i=1..k} gam(i) (P_i + d1).
-            pred = ybar1
-            psi = 0.0_wp
-            p2 = 0.0_wp
-            do i = k, 1, -1
-                p2 = p2 + self%dif(:, i)
-                pred = pred + p2 + d1
-                psi = psi + gam(i)*(p2 + d1)
+            do l = 1, self%nt
+                sp = ybar1(l)
+                sq = 0.0_wp
+                s2 = 0.0_wp
+                do i = k, 1, -1
+                    s2 = s2 + self%dif(l, i)
+                    sp = sp + s2 + d1(l)
+                    sq = sq + gam(i)*(s2 + d1(l))
+                end do
+                pred(l) = sp
+                c(l) = sp - beta*sq
             end do
-            c = pred - beta*psi
             ybar2 = pred
             call self%stage(tn + self%h, hbeta, c, ybar2, outcome)
             if (outcome /= STAGE_OK) then
@@ -211,16 +217,20 @@ contains
 
             ! Stage 3: the modified extended corrector. Old values y_{n-i} from the
             ! differences: y_{n-i} = sum_{j=0..i} (-1)^j binom(i, j) dif_j.
-            c = (self%coef(k)%bhat_k - beta)*hg1 + self%coef(k)%bhat_k1*hg2
+            ! c = ... - sum_i ahat(k-1-i) y_{n-i} = ... + sum_j wd(j) dif_j: the weights of
+            ! the differences first (scalars), then one pass per difference
+            wd = 0.0_wp
             do i = 0, k - 1
                 ! point n - i has index k - 1 - i in the corrector's numbering
-                p2 = 0.0_wp
                 binom = 1.0_wp
                 do j = 0, i
-                    p2 = p2 + binom*self%dif(:, j)
+                    wd(j) = wd(j) - self%coef(k)%ahat(k - 1 - i)*binom
                     binom = -binom*real(i - j, wp)/real(j + 1, wp)
                 end do
-                c = c - self%coef(k)%ahat(k - 1 - i)*p2
+            end do
+            c = (self%coef(k)%bhat_k - beta)*hg1 + self%coef(k)%bhat_k1*hg2
+            do j = 0, k - 1
+                c = c + wd(j)*self%dif(:, j)
             end do
             y3 = ybar1
             call self%stage(tn, hbeta, c, y3, outcome)
@@ -245,15 +255,17 @@ contains
         if (k < self%kmax .and. self%steps_at_h >= k + 1) then
             errkp1 = self%wnorm(d1 - self%dif(:, k + 1))/self%coef(k + 1)%tq
         end if
-        p2 = self%dif(:, 0)
-        do j = 1, k
-            p2 = p2 + self%dif(:, j)
-        end do
-        d1 = y3 - p2
-        self%dif(:, k + 2) = d1 - self%dif(:, k + 1)
-        self%dif(:, k + 1) = d1
-        do j = k, 0, -1
-            self%dif(:, j) = self%dif(:, j) + self%dif(:, j + 1)
+        do l = 1, self%nt
+            sp = self%dif(l, 0)
+            do j = 1, k
+                sp = sp + self%dif(l, j)
+            end do
+            sq = y3(l) - sp
+            self%dif(l, k + 2) = sq - self%dif(l, k + 1)
+            self%dif(l, k + 1) = sq
+            do j = k, 0, -1
+                self%dif(l, j) = self%dif(l, j) + self%dif(l, j + 1)
+            end do
         end do
         self%t = tn
         self%h_used = self%h

@@ -65,7 +65,11 @@ ENERGY_BOUND = {
 #: B_X: bound on max |tip_cvode - tip_mebdf| / (rtol L), per scene (at least 1e-6, far
 #: above the round-off of a tip position); comment: measured Debug / Release
 TIP_BOUND = {
-    "steel_wire": 6e-5,   # 1.9e-05 / 1.9e-05
+    # the CVODE run changes its max order (the crawl watch: a decision on a count of
+    # error-test failures), so its tip moves with any round-off-level change of the Newton
+    # solves: 1.9e-05 with the band LU, 2.5e-04 / 7.9e-05 with the block-tridiagonal LU
+    # (CVODE's own error against rtol 1e-10: 5.7e-05 and 8.4e-05 rtol L, Release)
+    "steel_wire": 8e-4,
     "undamped": 4e-3,   # 0.0013 / 0.0013
     "light_damping": 4e-3,   # 0.0012 / 0.0012
     "no_bending": 3e-2,   # 0.0068 / 0.0068

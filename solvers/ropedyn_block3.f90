@@ -1,0 +1,242 @@
+!> Block LU of a block-tridiagonal matrix with 3 x 3 blocks: the RFEM's reduced Newton
+!! matrix M - g C - g^2 K (three unknowns x, y, phi per element, coupled to the
+!! neighbouring elements only).
+!!
+!! The matrix comes in compact band storage with kl = ku = 5 (entry (i, j) at row
+!! 6 + i - j), the storage of ropedyn_iteration_matrix. Factorization (block Thomas):
+!!     D'_1 = D_1,  L'_i = L_i D'_{i-1}^{-1},  D'_i = D_i - L'_i U_{i-1},
+!! keeping D'_i^{-1} (Gauss-Jordan with partial pivoting within the block, which takes
+!! care of the different scales of the translational and rotational rows). Solve:
+!!     z_i = b_i - L'_i z_{i-1},  x_i = D'_i^{-1} (z_i - U_i x_{i+1}).
+!! 27 multiply-adds per block row in the solve against 3 (2 kl + ku + 1) = 78 for the band
+!! LU with partial pivoting (whose row interchanges fill U to kl + ku super-diagonals on
+!! the rope), and the 3 x 3 products are independent operations instead of a chain.
+!!
+!! Without pivoting between blocks the factorization needs nonsingular D'_i; it is stable
+!! for the block diagonally dominant or positive definite matrices of a rope (the mass
+!! blocks dominate for small g, the stiffness's discrete Laplacian for large g). A
+!! singular or non-finite D'_i is reported (info = block), and a matrix with entries
+!! outside the block-tridiagonal pattern is refused (info = -1): the caller then uses the
+!! band LU with partial pivoting.
+module ropedyn_block3
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use ropedyn_kinds, only: wp
+    implicit none
+    private
+    public :: block3_t
+
+    !> The factors of a block-tridiagonal matrix of nb block rows.
+    type :: block3_t
+        integer :: nb = 0
+        real(wp), allocatable :: dinv(:, :, :)   !< D'_i^{-1} (3, 3, nb)
+        real(wp), allocatable :: lfac(:, :, :)   !< L'_i (3, 3, nb), i >= 2
+        real(wp), allocatable :: ublk(:, :, :)   !< U_i (3, 3, nb), i <= nb - 1
+        !> blocks of a second block-tridiagonal matrix K (3, 3, -1:1, nb): (i, i-1), (i, i),
+        !! (i, i+1), for solve_plus_product
+        real(wp), allocatable :: kblk(:, :, :, :)
+    contains
+        procedure :: factor => block3_factor
+        procedure :: solve => block3_solve
+        procedure :: solve_plus_product => block3_solve_plus_product
+    end type block3_t
+
+contains
+
+    !> Factor the n x n matrix a (compact band storage, kl = ku = 5, n = 3 nb), and keep
+    !! the blocks of k (same storage) for solve_plus_product. info = 0: done; j > 0: D'_j
+    !! singular or not finite; -1: a or k not block tridiagonal (or n not a multiple of 3).
+    pure subroutine block3_factor(self, n, a, k, info)
+        class(block3_t), intent(inout) :: self
+        integer, intent(in) :: n
+        real(wp), intent(in) :: a(11, n)
+        real(wp), intent(in) :: k(11, n)
+        integer, intent(out) :: info
+        real(wp) :: d(3, 3), lb(3, 3)
+        integer :: nb, ib, r, c, j0, o
+        logical :: ok
+
+        info = -1
+        if (mod(n, 3) /= 0 .or. n < 3) return
+        if (.not. (block_tridiagonal(n, a) .and. block_tridiagonal(n, k))) return
+        nb = n/3
+        if (self%nb /= nb) then
+            if (allocated(self%dinv)) deallocate (self%dinv, self%lfac, self%ublk, self%kblk)
+            allocate (self%dinv(3, 3, nb), self%lfac(3, 3, nb), self%ublk(3, 3, nb), &
+                      self%kblk(3, 3, -1:1, nb))
+            self%nb = nb
+        end if
+        self%kblk = 0.0_wp
+        do ib = 1, nb
+            j0 = 3*(ib - 1)
+            do o = max(-1, 1 - ib), min(1, nb - ib)
+                do c = 1, 3
+                    do r = 1, 3
+                        self%kblk(r, c, o, ib) = k(6 + r - (c + 3*o), j0 + 3*o + c)
+                    end do
+                end do
+            end do
+        end do
+        info = 0
+        do ib = 1, nb
+            j0 = 3*(ib - 1)
+            do c = 1, 3
+                do r = 1, 3
+                    d(r, c) = a(6 + r - c, j0 + c)
+                end do
+            end do
+            if (ib < nb) then
+                do c = 1, 3
+                    do r = 1, 3
+                        self%ublk(r, c, ib) = a(6 + r - (c + 3), j0 + 3 + c)
+                    end do
+                end do
+            end if
+            if (ib > 1) then
+                do c = 1, 3
+                    do r = 1, 3
+                        lb(r, c) = a(6 + (r + 3) - c, j0 - 3 + c)
+                    end do
+                end do
+                self%lfac(:, :, ib) = matmul(lb, self%dinv(:, :, ib - 1))
+                d = d - matmul(self%lfac(:, :, ib), self%ublk(:, :, ib - 1))
+            end if
+            call invert3(d, self%dinv(:, :, ib), ok)
+            if (.not. ok) then
+                info = ib
+                return
+            end if
+        end do
+    end subroutine block3_factor
+
+    !> No entry of the band matrix a outside the block tridiagonal: row i of block I
+    !! against column j of block I +- 2 (within 5 of the diagonal).
+    pure logical function block_tridiagonal(n, a) result(yes)
+        integer, intent(in) :: n
+        real(wp), intent(in) :: a(11, n)
+        integer :: j0, c, r
+        yes = .false.
+        do j0 = 0, n - 1, 3
+            do c = 1, 3
+                do r = max(1, j0 + c - 5), j0 - 3
+                    if (a(6 + r - (j0 + c), j0 + c) /= 0.0_wp) return
+                end do
+                do r = j0 + 7, min(n, j0 + c + 5)
+                    if (a(6 + r - (j0 + c), j0 + c) /= 0.0_wp) return
+                end do
+            end do
+        end do
+        yes = .true.
+    end function block_tridiagonal
+
+    !> b <- A^{-1} b with the factors of block3_factor.
+    pure subroutine block3_solve(self, b)
+        class(block3_t), intent(in) :: self
+        real(wp), intent(inout) :: b(:)
+        real(wp) :: z1, z2, z3
+        integer :: ib, k
+        ! forward: z_i = b_i - L'_i z_{i-1}
+        do ib = 2, self%nb
+            k = 3*(ib - 1)
+            associate (l => self%lfac(:, :, ib))
+                z1 = b(k - 2)
+                z2 = b(k - 1)
+                z3 = b(k)
+                b(k + 1) = b(k + 1) - (l(1, 1)*z1 + l(1, 2)*z2 + l(1, 3)*z3)
+                b(k + 2) = b(k + 2) - (l(2, 1)*z1 + l(2, 2)*z2 + l(2, 3)*z3)
+                b(k + 3) = b(k + 3) - (l(3, 1)*z1 + l(3, 2)*z2 + l(3, 3)*z3)
+            end associate
+        end do
+        call backward(self, b)
+    end subroutine block3_solve
+
+    !> The backward sweep: x_i = D'_i^{-1} (z_i - U_i x_{i+1}), b holding z on entry.
+    pure subroutine backward(self, b)
+        class(block3_t), intent(in) :: self
+        real(wp), intent(inout) :: b(:)
+        real(wp) :: z1, z2, z3
+        integer :: ib, k
+        do ib = self%nb, 1, -1
+            k = 3*(ib - 1)
+            z1 = b(k + 1)
+            z2 = b(k + 2)
+            z3 = b(k + 3)
+            if (ib < self%nb) then
+                associate (u => self%ublk(:, :, ib))
+                    z1 = z1 - (u(1, 1)*b(k + 4) + u(1, 2)*b(k + 5) + u(1, 3)*b(k + 6))
+                    z2 = z2 - (u(2, 1)*b(k + 4) + u(2, 2)*b(k + 5) + u(2, 3)*b(k + 6))
+                    z3 = z3 - (u(3, 1)*b(k + 4) + u(3, 2)*b(k + 5) + u(3, 3)*b(k + 6))
+                end associate
+            end if
+            associate (v => self%dinv(:, :, ib))
+                b(k + 1) = v(1, 1)*z1 + v(1, 2)*z2 + v(1, 3)*z3
+                b(k + 2) = v(2, 1)*z1 + v(2, 2)*z2 + v(2, 3)*z3
+                b(k + 3) = v(3, 1)*z1 + v(3, 2)*z2 + v(3, 3)*z3
+            end associate
+        end do
+    end subroutine backward
+
+    !> b <- A^{-1} (b + g K x) with the factors and the K blocks of block3_factor: the
+    !! product folded into the forward sweep (one pass over b instead of two).
+    pure subroutine block3_solve_plus_product(self, g, x, b)
+        class(block3_t), intent(in) :: self
+        real(wp), intent(in) :: g
+        real(wp), intent(in) :: x(:)
+        real(wp), intent(inout) :: b(:)
+        real(wp) :: p(3)
+        integer :: ib, k, o, nb
+        nb = self%nb
+        do ib = 1, nb
+            k = 3*(ib - 1)
+            p = 0.0_wp
+            do o = max(-1, 1 - ib), min(1, nb - ib)
+                associate (a => self%kblk(:, :, o, ib), j => k + 3*o)
+                    p(1) = p(1) + (a(1, 1)*x(j + 1) + a(1, 2)*x(j + 2) + a(1, 3)*x(j + 3))
+                    p(2) = p(2) + (a(2, 1)*x(j + 1) + a(2, 2)*x(j + 2) + a(2, 3)*x(j + 3))
+                    p(3) = p(3) + (a(3, 1)*x(j + 1) + a(3, 2)*x(j + 2) + a(3, 3)*x(j + 3))
+                end associate
+            end do
+            b(k + 1:k + 3) = b(k + 1:k + 3) + g*p
+            if (ib > 1) then
+                associate (l => self%lfac(:, :, ib))
+                    b(k + 1) = b(k + 1) - (l(1, 1)*b(k - 2) + l(1, 2)*b(k - 1) + l(1, 3)*b(k))
+                    b(k + 2) = b(k + 2) - (l(2, 1)*b(k - 2) + l(2, 2)*b(k - 1) + l(2, 3)*b(k))
+                    b(k + 3) = b(k + 3) - (l(3, 1)*b(k - 2) + l(3, 2)*b(k - 1) + l(3, 3)*b(k))
+                end associate
+            end if
+        end do
+        call backward(self, b)
+    end subroutine block3_solve_plus_product
+
+    !> ainv = a^{-1} by Gauss-Jordan elimination with partial pivoting; ok = .false. when a
+    !! is singular or the inverse is not finite.
+    pure subroutine invert3(a, ainv, ok)
+        real(wp), intent(in) :: a(3, 3)
+        real(wp), intent(out) :: ainv(3, 3)
+        logical, intent(out) :: ok
+        real(wp) :: w(3, 6), row(6), f
+        integer :: c, r, p
+        w(:, 1:3) = a
+        w(:, 4:6) = 0.0_wp
+        w(1, 4) = 1.0_wp
+        w(2, 5) = 1.0_wp
+        w(3, 6) = 1.0_wp
+        ok = .false.
+        do c = 1, 3
+            p = c - 1 + maxloc(abs(w(c:3, c)), dim=1)
+            if (w(p, c) == 0.0_wp) return
+            if (p /= c) then
+                row = w(c, :)
+                w(c, :) = w(p, :)
+                w(p, :) = row
+            end if
+            w(c, :) = w(c, :)/w(c, c)
+            do r = 1, 3
+                if (r == c) cycle
+                f = w(r, c)
+                w(r, :) = w(r, :) - f*w(c, :)
+            end do
+        end do
+        ainv = w(:, 4:6)
+        ok = all(ieee_is_finite(ainv))
+    end subroutine invert3
+end module ropedyn_block3
