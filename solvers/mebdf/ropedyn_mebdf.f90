@@ -87,6 +87,7 @@ module ropedyn_mebdf
         real(wp), allocatable :: dif(:, :)
         real(wp), allocatable :: atol(:)  !< absolute tolerance per component (nt)
         real(wp), allocatable :: w(:)     !< error weights rtol |y| + atol (nt)
+        real(wp), allocatable :: wi(:)    !< their inverses (the norms multiply)
         real(wp), allocatable :: f(:), mv(:), r(:)  !< work (n)
         real(wp), allocatable :: gq(:)    !< quadrature rhs (nq)
     contains
@@ -201,7 +202,8 @@ contains
         do j = 1, KMAX_MEBDF
             self%coef(j) = mebdf_coefficients(j)
         end do
-        allocate (self%dif(self%nt, 0:KMAX_MEBDF + 2), self%atol(self%nt), self%w(self%nt))
+        allocate (self%dif(self%nt, 0:KMAX_MEBDF + 2), self%atol(self%nt), self%w(self%nt), &
+                  self%wi(self%nt))
         allocate (self%f(self%n), self%mv(self%n), self%r(self%n), self%gq(max(self%nq, 1)))
         self%atol = self%options%atol
         if (allocated(self%options%atol_vector)) self%atol(1:self%n) = self%options%atol_vector
@@ -277,7 +279,7 @@ contains
         self%problem => null()
         if (allocated(self%dif)) deallocate (self%dif)
         if (allocated(self%atol)) deallocate (self%atol)
-        if (allocated(self%w)) deallocate (self%w)
+        if (allocated(self%w)) deallocate (self%w, self%wi)
         if (allocated(self%f)) deallocate (self%f, self%mv, self%r)
         if (allocated(self%gq)) deallocate (self%gq)
     end subroutine mebdf_finalize

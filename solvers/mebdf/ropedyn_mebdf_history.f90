@@ -47,6 +47,7 @@ contains
             return
         end if
         self%w = self%options%rtol*abs(y0) + self%atol
+        self%wi = 1.0_wp/self%w
         ypnorm = self%wnorm(yp0)
         hlb = 100.0_wp*epsilon(1.0_wp)*max(abs(self%t), abs(self%t + span))
         hub = 0.1_wp*span
@@ -88,9 +89,9 @@ contains
     end procedure initial_step
 
     module procedure wnorm
-        wnorm = sqrt(sum((v(1:self%n)/self%w(1:self%n))**2)/real(self%n, wp))
-        if (self%nq > 0) wnorm = max(wnorm, sqrt(sum((v(self%n + 1:self%nt)/ &
-                                                       self%w(self%n + 1:self%nt))**2)/ &
+        wnorm = sqrt(sum((v(1:self%n)*self%wi(1:self%n))**2)/real(self%n, wp))
+        if (self%nq > 0) wnorm = max(wnorm, sqrt(sum((v(self%n + 1:self%nt)* &
+                                                       self%wi(self%n + 1:self%nt))**2)/ &
                                                   real(self%nq, wp)))
     end procedure wnorm
 

@@ -79,7 +79,7 @@ contains
             do i = 1, n
                 ri = self%r(i)
                 z(i) = z(i) + ri
-                dnorm = dnorm + (ri/self%w(i))**2
+                dnorm = dnorm + (ri*self%wi(i))**2
             end do
             if (.not. ieee_is_finite(dnorm)) return
             dnorm = sqrt(dnorm/real(n, wp))
@@ -147,6 +147,7 @@ contains
                 return
             end if
             self%w = self%options%rtol*abs(self%dif(:, 0)) + self%atol
+            self%wi = 1.0_wp/self%w
 
             call self%prepare_matrix(hbeta, refresh, status)
             refresh = .false.
@@ -181,7 +182,7 @@ contains
                 if (allocated(err)) return
                 cycle attempts
             end if
-            hg1 = (ybar1 - c)/beta
+            hg1 = (ybar1 - c)*(1.0_wp/beta)
             d1 = ybar1 - pred
             err1 = self%wnorm(d1)/self%coef(k)%tq
             if (self%fixed) err1 = 0.0_wp
@@ -213,7 +214,7 @@ contains
                 if (allocated(err)) return
                 cycle attempts
             end if
-            hg2 = (ybar2 - c)/beta
+            hg2 = (ybar2 - c)*(1.0_wp/beta)
 
             ! Stage 3: the modified extended corrector. Old values y_{n-i} from the
             ! differences: y_{n-i} = sum_{j=0..i} (-1)^j binom(i, j) dif_j.
