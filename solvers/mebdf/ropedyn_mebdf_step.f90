@@ -264,8 +264,10 @@ contains
             sq = y3(l) - sp
             self%dif(l, k + 2) = sq - self%dif(l, k + 1)
             self%dif(l, k + 1) = sq
+            ! dif_j <- dif_j + dif_{j+1} (the new one), carried in a register
             do j = k, 0, -1
-                self%dif(l, j) = self%dif(l, j) + self%dif(l, j + 1)
+                sq = self%dif(l, j) + sq
+                self%dif(l, j) = sq
             end do
         end do
         self%t = tn
