@@ -23,7 +23,7 @@ module ropedyn_block3
     use ropedyn_kinds, only: wp
     implicit none
     private
-    public :: block3_t
+    public :: block3_t, block_tridiagonal
 
     !> The factors of a block-tridiagonal matrix of nb block rows.
     type :: block3_t
@@ -35,6 +35,7 @@ module ropedyn_block3
         !! (i, i+1), for solve_plus_product
         real(wp), allocatable :: kblk(:, :, :, :)
     contains
+        procedure :: set_k => block3_set_k
         procedure :: factor => block3_factor
         procedure :: solve => block3_solve
         procedure :: solve_plus_product => block3_solve_plus_product
@@ -42,22 +43,19 @@ module ropedyn_block3
 
 contains
 
-    !> Factor the n x n matrix a (compact band storage, kl = ku = 5, n = 3 nb), and keep
-    !! the blocks of k (same storage) for solve_plus_product. info = 0: done; j > 0: D'_j
-    !! singular or not finite; -1: a or k not block tridiagonal (or n not a multiple of 3).
-    pure subroutine block3_factor(self, n, a, k, info)
+    !> Keep the blocks of K (compact band storage, kl = ku = 5, n = 3 nb) for
+    !! solve_plus_product; once per Jacobian. ok = .false.: K is not block tridiagonal (or
+    !! n not a multiple of 3).
+    pure subroutine block3_set_k(self, n, k, ok)
         class(block3_t), intent(inout) :: self
         integer, intent(in) :: n
-        real(wp), intent(in) :: a(11, n)
         real(wp), intent(in) :: k(11, n)
-        integer, intent(out) :: info
-        real(wp) :: d(3, 3), lb(3, 3)
+        logical, intent(out) :: ok
         integer :: nb, ib, r, c, j0, o
-        logical :: ok
-
-        info = -1
-        if (mod(n, 3) /= 0 .or. n < 3) return
-        if (.not. (block_tridiagonal(n, a) .and. block_tridiagonal(n, k))) return
+        ok = mod(n, 3) == 0 .and. n >= 3
+        if (.not. ok) return
+        ok = block_tridiagonal(n, k)
+        if (.not. ok) return
         nb = n/3
         if (self%nb /= nb) then
             if (allocated(self%dinv)) deallocate (self%dinv, self%lfac, self%ublk, self%kblk)
@@ -76,6 +74,21 @@ contains
                 end do
             end do
         end do
+    end subroutine block3_set_k
+
+    !> Factor the n x n matrix a (compact band storage, kl = ku = 5, n = 3 nb), which the
+    !! caller has found block tridiagonal (block_tridiagonal), after set_k for the same n.
+    !! info = 0: done; j > 0: D'_j singular or not finite.
+    pure subroutine block3_factor(self, n, a, info)
+        class(block3_t), intent(inout) :: self
+        integer, intent(in) :: n
+        real(wp), intent(in) :: a(11, n)
+        integer, intent(out) :: info
+        real(wp) :: d(3, 3), lb(3, 3)
+        integer :: nb, ib, r, c, j0
+        logical :: ok
+
+        nb = n/3
         info = 0
         do ib = 1, nb
             j0 = 3*(ib - 1)
@@ -108,8 +121,9 @@ contains
         end do
     end subroutine block3_factor
 
-    !> No entry of the band matrix a outside the block tridiagonal: row i of block I
-    !! against column j of block I +- 2 (within 5 of the diagonal).
+    !> No entry of the band matrix a (compact band storage, kl = ku = 5) outside the block
+    !! tridiagonal of 3 x 3 blocks: row i of block I against column j of block I +- 2
+    !! (within 5 of the diagonal).
     pure logical function block_tridiagonal(n, a) result(yes)
         integer, intent(in) :: n
         real(wp), intent(in) :: a(11, n)

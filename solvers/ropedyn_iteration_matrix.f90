@@ -21,7 +21,7 @@
 module ropedyn_iteration_matrix
     use ropedyn_kinds, only: wp, i8
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_RECOVERABLE, STATUS_FATAL
-    use ropedyn_block3, only: block3_t
+    use ropedyn_block3, only: block3_t, block_tridiagonal
     use ropedyn_band_lu, only: RFEM_KL, band_lu_factor, band_lu_solve, band_solve_rfem, &
                                band_add_product, full_entry
     implicit none
@@ -59,6 +59,7 @@ module ropedyn_iteration_matrix
         !> RFEM (kl = ku = RFEM_KL): the block-tridiagonal factors, used when `use_block3`
         !! (else the band LU: a matrix that is not block tridiagonal, or a singular block)
         type(block3_t) :: blk3
+        logical :: block3_pattern = .false.   !< K, C, M_v block tridiagonal (per Jacobian)
         logical :: use_block3 = .false.
         real(wp), allocatable :: ra(:, :)     !< M_v - g C - g^2 K (kl+ku+1, np) for blk3
         integer, allocatable :: ripiv(:)
@@ -234,6 +235,14 @@ contains
         self%factored = .false.
         if (self%reduced) then
             call self%reduced_blocks(problem, t, y, w, h, status, nevals)
+            self%block3_pattern = .false.
+            if (status == STATUS_OK .and. .not. self%rdense .and. self%kl == RFEM_KL .and. &
+                self%ku == RFEM_KL) then
+                call self%blk3%set_k(self%np, self%kb, self%block3_pattern)
+                self%block3_pattern = self%block3_pattern .and. &
+                                      block_tridiagonal(self%np, self%cb) .and. &
+                                      block_tridiagonal(self%np, self%mk)
+            end if
             if (status /= STATUS_FATAL .or. self%blocks_seen) return
             ! no blocks at all: the first-order path from now on
             self%reduced = .false.
@@ -400,10 +409,10 @@ contains
             call dgetrf(np, np, self%rlu, np, self%ripiv, info)
         else
             self%use_block3 = .false.
-            if (kl == RFEM_KL .and. ku == RFEM_KL) then
+            if (self%block3_pattern) then
                 if (.not. allocated(self%ra)) allocate (self%ra(kl + ku + 1, np))
                 self%ra = self%mk - g*self%cb - g2*self%kb
-                call self%blk3%factor(np, self%ra, self%kb, info)
+                call self%blk3%factor(np, self%ra, info)
                 self%use_block3 = info == 0
             end if
             if (.not. self%use_block3) then

@@ -4,11 +4,12 @@
 !! - a random block-tridiagonal matrix with 3 x 3 blocks, rows scaled like the rope's (the
 !!   rotational rows 1e-4 of the translational ones), solve_plus_product: A^{-1} (b + g K x)
 !!   for a second random block-tridiagonal K;
-!! - an entry outside the block-tridiagonal pattern (within the band) is refused (info = -1)
-!!   and a singular diagonal block reported (info > 0), so that the caller falls back.
+!! - an entry outside the block-tridiagonal pattern (within the band) is found, K's refused
+!!   by set_k, and a singular diagonal block reported (info > 0), so that the caller falls
+!!   back to the band LU.
 program test_block3
     use ropedyn_kinds, only: wp
-    use ropedyn_block3, only: block3_t
+    use ropedyn_block3, only: block3_t, block_tridiagonal
     use ropedyn_band_lu, only: band_lu_factor, band_solve_rfem
     use ropedyn_assert, only: test_suite_t
     implicit none
@@ -19,6 +20,7 @@ program test_block3
     real(wp) :: a(11, N), k(11, N), dense(N, N), kd(N, N), x(N), b(N), ref(N), y(N)
     real(wp) :: ab(16, N), scale(N), g
     integer :: i, info, ipiv(N), kvu, piv(N)
+    logical :: ok
 
     suite%name = 'block3'
     call random_seed(put=[(12345 + i, i = 1, 64)])
@@ -33,7 +35,9 @@ program test_block3
     call dgesv(N, 1, dense, N, piv, ref, N, info)
     call suite%check_true(info == 0, 'dgesv of the reference')
 
-    call f%factor(N, a, k, info)
+    call f%set_k(N, k, ok)
+    call suite%check_true(ok .and. block_tridiagonal(N, a), 'A and K block tridiagonal')
+    call f%factor(N, a, info)
     call suite%check_true(info == 0, 'block-tridiagonal matrix factored (info = 0)')
     y = b
     call f%solve_plus_product(g, x, y)
@@ -54,19 +58,17 @@ program test_block3
                         'band LU fallback (band_solve_rfem) against dgesv')
 
     ! refusals
-    a(6 - 4, 8) = 1.0e-3_wp    ! entry (4, 8): block 2 against block 3 is fine ...
-    call f%factor(N, a, k, info)
-    call suite%check_true(info == 0, 'entry (4, 8) is within the block tridiagonal')
+    a(6 + 4 - 8, 8) = 1.0e-3_wp    ! entry (4, 8): block 2 against block 3 is fine ...
+    call suite%check_true(block_tridiagonal(N, a), 'entry (4, 8) is within the pattern')
     a(6 + 3 - 8, 8) = 1.0e-3_wp    ! ... entry (3, 8): block 1 against block 3 is not
-    call f%factor(N, a, k, info)
-    call suite%check_true(info == -1, 'entry (3, 8) outside the pattern: info = -1')
-    a(6 + 3 - 8, 8) = 0.0_wp
+    call suite%check_true(.not. block_tridiagonal(N, a), 'entry (3, 8) is outside')
     k(6 + 8 - 3, 3) = 1.0_wp       ! K entry (8, 3): block 3 against block 1
-    call f%factor(N, a, k, info)
-    call suite%check_true(info == -1, 'K entry (8, 3) outside the pattern: info = -1')
-    k(6 + 8 - 3, 3) = 0.0_wp
+    call f%set_k(N, k, ok)
+    call suite%check_true(.not. ok, 'K entry (8, 3) outside the pattern: set_k refuses')
+    call f%set_k(N - 1, k(:, 1:N - 1), ok)
+    call suite%check_true(.not. ok, 'n not a multiple of 3: set_k refuses')
     a(:, 1:3) = 0.0_wp             ! first diagonal block (and the block below it) zero
-    call f%factor(N, a, k, info)
+    call f%factor(N, a, info)
     call suite%check_true(info == 1, 'singular first block: info = 1')
     call suite%finish()
 
