@@ -21,11 +21,19 @@ submodule (ropedyn_rfem) ropedyn_rfem_kernels
 
 contains
 
-    !> cos and sin of every element angle into self%cs, once per call.
+    !> cos and sin of every element angle into self%cs, once per call. Two loops that
+    !! the compiler vectorizes (the directive: also at -O2) with glibc's vector cos and
+    !! sin (libmvec, within 4 ulp; measured here within 3.3e-16 of the scalar ones):
+    !! at n = 30 they take 180 ns against 330 ns for 30 scalar sincos calls, which were a
+    !! quarter of the instructions of a paper run with erk (callgrind).
     module procedure angles
         integer :: i
+        !GCC$ vector
         do i = 1, self%n
             self%cs(1, i) = cos(y(6*i - 3))
+        end do
+        !GCC$ vector
+        do i = 1, self%n
             self%cs(2, i) = sin(y(6*i - 3))
         end do
     end procedure angles
