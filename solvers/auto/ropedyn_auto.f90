@@ -1,13 +1,14 @@
-!> `method = 'auto'` (the default): an explicit or an implicit integrator, whichever is
-!! cheaper on the scene at the time, switched during the run as LSODA switches Adams and
-!! BDF.
+!> `method = 'auto'` (the default): an explicit, an Adams or an implicit integrator,
+!! whichever is cheaper on the scene at the time, switched during the run as LSODA switches
+!! Adams and BDF.
 !!
-!! - **The two**: `erk` (ropedyn_erk, RK4 with a 3rd-order estimate: the longest stability
-!!   interval on the imaginary axis per evaluation of f of the bundled pairs) and an
-!!   implicit method: `mebdf` when the fastest modes are barely damped (below BDF_DAMPING:
-!!   its order 4 is A-stable, BDF's orders 3 .. 5 are not), else `cvode` (BDF up to order 5,
-!!   a cheaper step: on the elements_1000 .. 10000 scenes, fast modes damped by >= 12 %,
-!!   CVODE took 1.5 .. 2.8 times less CPU than MEBDF at the order auto chose for it).
+!! - **The methods**: `erk` (ropedyn_erk, RK4 with a 3rd-order estimate: the longest
+!!   stability interval on the imaginary axis per evaluation of f of the bundled pairs),
+!!   `adams` (below) and an implicit method: `mebdf` when the fastest modes are barely
+!!   damped (below BDF_DAMPING: its order 4 is A-stable, BDF's orders 3 .. 5 are not and
+!!   can amplify such modes), else `cvode` (BDF up to order 5, a cheaper step: on the
+!!   elements_1000 .. 10000 scenes, fast modes damped by >= 12 %, CVODE took 1.5 .. 2.8
+!!   times less CPU than MEBDF at the order auto chose for it).
 !! - **Start**: a few Arnoldi steps on the Jacobian at the initial state
 !!   (ropedyn_spectrum) give the spectral radius and the damping of the fastest modes. The
 !!   explicit pair's stability-limited step h_e follows from them; the run starts explicit

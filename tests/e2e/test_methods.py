@@ -80,8 +80,8 @@ def test_erk_on_the_steel_wire_within_the_guarantee_or_diagnosed(run, tmp_path):
 
 def test_auto_takes_cvode_where_the_fast_modes_are_damped(run, tmp_path):
     """n = 1000: the fastest modes are damped by far more than 12 % (the segment damping
-    ratio grows with n), so BDF's orders 3 .. 5 cannot amplify them and auto's implicit
-    method is cvode, not mebdf."""
+    ratio grows with n); the A-stable MEBDF order 4 is not needed for them, and auto's
+    implicit method is cvode (a cheaper step), not mebdf."""
     scene = ROOT / "input" / "hard" / "elements_1000.nml"
     proc, out = run_scene(run, tmp_path, scene, "n1000", "solver.t_end=1e-4",
                           "solver.output_interval=1e-4")
