@@ -31,8 +31,12 @@
 !!   implicit method that does not pay (judged on its second window) goes back at once.
 !!   A switch that is undone within two windows doubles the wait before the next one.
 !! - **Adams** (CVODE's Adams-Moulton, fixed-point iteration) for the explicit method's
-!!   other weakness: a step held by accuracy, not stability, where f is costly (the MPP's
-!!   mass matrix): Adams takes about one evaluation of f per step against erk's four.
+!!   other weakness: a step held by accuracy, not stability, where f is costly: Adams takes
+!!   about one evaluation of f per step against erk's four, but CVODE's own work per step
+!!   (about 2.7 us at n = 30) costs more than that saves where f is cheap. Counted costs
+!!   cannot tell (an RFEM f costs 1.0 us at n = 30, an MPP f 2.6 us), so Adams is tried
+!!   only for problems with a mass matrix (the MPP: f solves with it); on the RFEM scenes
+!!   where it was tried it kept Adams at up to twice erk's CPU (table_motion).
 !!   When most steps of an explicit window were not held by stability, auto tries Adams
 !!   (once; a trial, judged on its second window against the explicit cost, goes back
 !!   at once unless it is cheaper by GAIN) and later switches to it when its measured
@@ -355,8 +359,9 @@ contains
             if (self%wait > 0) return
             if (share < 0.5_wp) then
                 ! held by accuracy: Adams may need fewer evaluations of f (judged on the
-                ! explicit method's second window on: the first includes its start)
-                if (self%windows < 2) return
+                ! explicit method's second window on: the first includes its start), which
+                ! pays only where f is costly: a problem with a mass matrix (f solves with it)
+                if (self%windows < 2 .or. .not. self%problem%has_mass_matrix()) return
                 if (self%rate_adams > 0.0_wp .and. GAIN*self%rate_adams >= rate) return
                 write (text, '(a, i0, a, es9.2, a)') 'explicit step held by accuracy (', &
                     nint(100*(1 - share)), ' % of the steps; cost ', rate, ' f per second)'
