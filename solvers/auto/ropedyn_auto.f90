@@ -1,21 +1,27 @@
-!> `method = 'auto'` (the default): an explicit or an implicit integrator, whichever is
-!! cheaper on the scene at the time, switched during the run as LSODA switches Adams and
-!! BDF.
+!> `method = 'auto'` (the default): an explicit, an Adams or an implicit integrator,
+!! whichever is cheaper on the scene at the time, switched during the run as LSODA switches
+!! Adams and BDF.
 !!
-!! - **The two**: `erk` (ropedyn_erk, RK4 with a 3rd-order estimate: the longest stability
-!!   interval on the imaginary axis per evaluation of f of the bundled pairs) and `mebdf`.
+!! - **The methods**: `erk` (ropedyn_erk, RK4 with a 3rd-order estimate: the longest
+!!   stability interval on the imaginary axis per evaluation of f of the bundled pairs),
+!!   `adams` (below) and an implicit method: `mebdf` when the fastest modes are barely
+!!   damped (below BDF_DAMPING: its order 4 is A-stable, BDF's orders 3 .. 5 are not and
+!!   can amplify such modes), else `cvode` (BDF up to order 5, a cheaper step: on the
+!!   elements_1000 .. 10000 scenes, fast modes damped by >= 12 %, CVODE took 1.5 .. 2.8
+!!   times less CPU than MEBDF at the order auto chose for it).
 !! - **Start**: a few Arnoldi steps on the Jacobian at the initial state
 !!   (ropedyn_spectrum) give the spectral radius and the damping of the fastest modes. The
 !!   explicit pair's stability-limited step h_e follows from them; the run starts explicit
 !!   unless that step would take more than START_RATE steps per simulated second. MEBDF's
 !!   maximum order follows from the damping of the fast modes (A(alpha) of MEBDF,
 !!   docs/solvers.md): order 4, A-stable, when a fast mode is damped by less than 3 %, order
-!!   5 (A(88.4 deg)) up to 12 %, order 6 (A(83.1 deg)) above. `max_order` given by the user
-!!   caps it.
+!!   5 (A(88.4 deg)) up to BDF_DAMPING = 12 %; above, CVODE's BDF at up to order 5.
+!!   `max_order` given by the user caps either.
 !! - **Cost**: counted, not timed (runs stay reproducible): explicit, the evaluations of f;
-!!   implicit, those plus IMPLICIT_STEP_COST per step for the Newton matrices, solves and
-!!   vector work and JACOBIAN_COST per Jacobian (calibrated on the paper's rope, n = 30:
-!!   an MEBDF step costs its 4.1 evaluations of f plus about 6 more in the rest).
+!!   implicit, those plus IMPLICIT_STEP_COST (MEBDF) or BDF_STEP_COST (CVODE) per step
+!!   for the Newton matrices, solves and vector work and JACOBIAN_COST per Jacobian
+!!   (calibrated on the paper's rope, n = 30: an MEBDF step costs its 4.1 evaluations of f
+!!   plus about 6 more in the rest, a CVODE step its 1.2 plus about 5).
 !! - **Switching** (looked at every WINDOW steps of the method in use): explicit ->
 !!   implicit when most steps of the window were held by stability (erk's own estimate of
 !!   h rho) and either the implicit method's last measured cost per simulated second was
@@ -24,6 +30,21 @@
 !!   step / h_e) is lower than the implicit method's measured cost by GAIN; a trial of the
 !!   implicit method that does not pay (judged on its second window) goes back at once.
 !!   A switch that is undone within two windows doubles the wait before the next one.
+!! - **Adams** (CVODE's Adams-Moulton, fixed-point iteration) for the explicit method's
+!!   other weakness: a step held by accuracy, not stability, where f is costly: Adams takes
+!!   about one evaluation of f per step against erk's four, but CVODE's own work per step
+!!   (about 2.7 us at n = 30) costs more than that saves where f is cheap. Counted costs
+!!   cannot tell (an RFEM f costs 1.0 us at n = 30, an MPP f 2.6 us), so Adams is tried
+!!   only for problems with a mass matrix (the MPP: f solves with it); on the RFEM scenes
+!!   where it was tried it kept Adams at up to twice erk's CPU (table_motion).
+!!   When most steps of an explicit window were not held by stability, auto tries Adams
+!!   (once; a trial, judged on its second window against the explicit cost, goes back
+!!   at once unless it is cheaper by GAIN) and later switches to it when its measured
+!!   cost is lower by GAIN; from Adams it goes back to erk when erk's last measured cost is lower
+!!   by GAIN, or at once when Adams fails (e.g. the fixed-point iteration does not
+!!   converge: the problem has become stiff). Adams' cost: its evaluations of f plus
+!!   ADAMS_STEP_COST per step (CVODE's vector work per step: measured about 2 f on the
+!!   paper's rope at n = 30, where f is cheap, and about 1.2 f on the MPP at n = 30).
 !! Every switch (time, method, order limit, reason) goes into the switch log.
 module ropedyn_auto
     use ropedyn_kinds, only: wp, i8
@@ -33,6 +54,7 @@ module ropedyn_auto
                                   STIFF_STEP_RATE, stop_now
     use ropedyn_erk, only: erk_t
     use ropedyn_mebdf, only: mebdf_t
+    use ropedyn_cvode, only: cvode_t, adams_t
     use ropedyn_erk_tables, only: erk_table_t, erk_table
     use ropedyn_spectrum, only: spectrum_t, estimate_spectrum, erk_stable_step
     use ropedyn_switch_log, only: switch_log_t, switch_event_t
@@ -40,13 +62,20 @@ module ropedyn_auto
     private
     public :: auto_t
 
-    integer, parameter :: EXPLICIT = 1, IMPLICIT = 2
+    integer, parameter :: EXPLICIT = 1, IMPLICIT = 2, ADAMS = 3
     integer, parameter :: ERK_ORDER = 4            !< the explicit pair (RK4, 3rd-order estimate)
     integer, parameter :: WINDOW = 400             !< steps between looks
     real(wp), parameter :: GAIN = 1.3_wp           !< hysteresis of a switch
     !> explicit steps per simulated second above which a run starts implicit
     real(wp), parameter :: START_RATE = 0.25_wp*STIFF_STEP_RATE
-    real(wp), parameter :: IMPLICIT_STEP_COST = 6.0_wp  !< f-equivalents per implicit step
+    real(wp), parameter :: IMPLICIT_STEP_COST = 6.0_wp  !< f-equivalents per MEBDF step
+    real(wp), parameter :: BDF_STEP_COST = 5.0_wp       !< f-equivalents per CVODE step
+    real(wp), parameter :: ADAMS_STEP_COST = 1.0_wp     !< f-equivalents per Adams step
+    !> Adams' order limit (CVODE's own; a user's max_order caps only the implicit method)
+    integer, parameter :: ADAMS_ORDER = 12
+    !> damping ratio of the fastest modes from which the implicit method is CVODE's BDF
+    real(wp), parameter :: BDF_DAMPING = 0.12_wp
+    integer, parameter :: BDF_ORDER = 5                 !< CVODE's order limit (its own)
     real(wp), parameter :: JACOBIAN_COST = 4.0_wp       !< f-equivalents per Jacobian
     !> the explicit cost predicted from the stability limit, times this (rejected steps,
     !! steps below the limit)
@@ -57,6 +86,9 @@ module ropedyn_auto
         private
         type(erk_t) :: erk
         type(mebdf_t) :: mebdf
+        type(cvode_t) :: bdf
+        type(adams_t) :: am
+        logical :: use_bdf = .false.       !< the implicit method is cvode (else mebdf)
         type(erk_table_t) :: tab
         integer :: active = 0
         integer :: mebdf_order = 4
@@ -72,6 +104,7 @@ module ropedyn_auto
         integer :: windows = 0             !< windows since the last switch
         real(wp) :: rate_explicit = -1.0_wp  !< measured cost per simulated second (< 0: none)
         real(wp) :: rate_implicit = -1.0_wp
+        real(wp) :: rate_adams = -1.0_wp
         logical :: trial = .false.         !< the implicit method is on trial
         integer :: wait = 0                !< windows to let pass before the next switch
         integer :: backoff = 1
@@ -87,6 +120,7 @@ module ropedyn_auto
         procedure, private :: watch
         procedure, private :: current_stats
         procedure, private :: cost
+        procedure, private :: implicit_name
     end type auto_t
 
 contains
@@ -120,12 +154,15 @@ contains
         call self%log%clear()
         self%rate_explicit = -1.0_wp
         self%rate_implicit = -1.0_wp
+        self%rate_adams = -1.0_wp
         self%trial = .false.
         self%wait = 0
         self%backoff = 1
 
         call estimate_spectrum(self%problem, start%t0, start%y0, spec)
+        self%use_bdf = spec%valid .and. spec%fast_damping >= BDF_DAMPING
         self%mebdf_order = mebdf_order_for(spec%fast_damping)
+        if (self%use_bdf) self%mebdf_order = BDF_ORDER
         if (self%user_order /= 0) self%mebdf_order = min(self%mebdf_order, self%user_order)
         h_e = erk_stable_step(self%tab, spec)
         if (spec%valid .and. h_e > 0.0_wp) then
@@ -172,7 +209,11 @@ contains
             call add_counters(self%done, old)
         end if
         if (self%active == EXPLICIT) call self%erk%finalize()
-        if (self%active == IMPLICIT) call self%mebdf%finalize()
+        if (self%active == ADAMS) call self%am%finalize()
+        if (self%active == IMPLICIT) then
+            call self%mebdf%finalize()
+            call self%bdf%finalize()
+        end if
         opts = self%options
         opts%max_steps = max(1_i8, self%options%max_steps - self%done%steps)
         if (which == EXPLICIT) then
@@ -184,11 +225,22 @@ contains
                 if (h_first > 0.0_wp) call self%erk%set_initial_step(0.5_wp*h_first)
             end if
             call self%log%add(self%t, 'erk', ERK_ORDER, reason)
+        else if (which == ADAMS) then
+            opts%max_order = ADAMS_ORDER
+            call self%am%init(self%problem, self%t, self%y, self%yq, opts, err)
+            if (allocated(err)) return
+            call self%log%add(self%t, 'adams', ADAMS_ORDER, reason)
         else
             opts%max_order = self%mebdf_order
-            call self%mebdf%init(self%problem, self%t, self%y, self%yq, opts, err)
-            if (allocated(err)) return
-            call self%log%add(self%t, 'mebdf', self%mebdf_order, reason)
+            if (self%use_bdf) then
+                call self%bdf%init(self%problem, self%t, self%y, self%yq, opts, err)
+                if (allocated(err)) return
+                call self%log%add(self%t, 'cvode', self%mebdf_order, reason)
+            else
+                call self%mebdf%init(self%problem, self%t, self%y, self%yq, opts, err)
+                if (allocated(err)) return
+                call self%log%add(self%t, 'mebdf', self%mebdf_order, reason)
+            end if
         end if
         self%active = which
         self%windows = 0
@@ -219,6 +271,23 @@ contains
             if (now%last_step > 0.0_wp) target = min(tout, self%t + 0.25_wp*WINDOW*now%last_step)
             if (self%active == EXPLICIT) then
                 call self%erk%advance_to(target, self%t, self%y, self%yq, err)
+            else if (self%active == ADAMS) then
+                call self%am%advance_to(target, self%t, self%y, self%yq, err)
+                if (allocated(err)) then
+                    ! Adams gave up (e.g. no convergence: stiff); on with erk unless the
+                    ! step budget is spent
+                    now = self%stats()
+                    if (now%steps < self%options%max_steps) then
+                        self%rate_adams = huge(1.0_wp)
+                        call self%start_method(EXPLICIT, 'adams failed: '// &
+                                               trim(err%message(1:min(160, len(err%message)))), &
+                                               err)
+                        if (allocated(err)) exit
+                        cycle
+                    end if
+                end if
+            else if (self%use_bdf) then
+                call self%bdf%advance_to(target, self%t, self%y, self%yq, err)
             else
                 call self%mebdf%advance_to(target, self%t, self%y, self%yq, err)
             end if
@@ -261,15 +330,51 @@ contains
         if (self%active == EXPLICIT) then
             self%rate_explicit = rate
             share = self%erk%stiff_share_of_steps()
-            if (share < 0.5_wp .or. self%wait > 0) return
+            if (self%wait > 0) return
+            if (share < 0.5_wp) then
+                ! held by accuracy: Adams may need fewer evaluations of f (judged on the
+                ! explicit method's second window on: the first includes its start), which
+                ! pays only where f is costly: a problem with a mass matrix (f solves with it)
+                if (self%windows < 2 .or. .not. self%problem%has_mass_matrix()) return
+                if (self%rate_adams > 0.0_wp .and. GAIN*self%rate_adams >= rate) return
+                write (text, '(a, i0, a, es9.2, a)') 'explicit step held by accuracy (', &
+                    nint(100*(1 - share)), ' % of the steps; cost ', rate, ' f per second)'
+                self%trial = self%rate_adams <= 0.0_wp
+                if (self%trial) text = trim(text)//': trying adams'
+                if (self%windows <= 2) call back_off()
+                call self%start_method(ADAMS, trim(text), err)
+                return
+            end if
             if (self%rate_implicit > 0.0_wp .and. GAIN*self%rate_implicit >= rate) return
             write (text, '(a, i0, a, es9.2, a, es9.2, a)') 'explicit step held by stability (', &
                 nint(100*share), ' % of the steps; spectral radius about ', &
                 self%erk%spectral_radius(), ' 1/s; cost ', rate, ' f per second)'
             self%trial = self%rate_implicit <= 0.0_wp
-            if (self%trial) text = trim(text)//': trying mebdf'
+            if (self%trial) text = trim(text)//': trying '//self%implicit_name()
             if (self%windows <= 2) call back_off()
             call self%start_method(IMPLICIT, trim(text), err)
+        else if (self%active == ADAMS) then
+            if (self%windows < 2) return
+            self%rate_adams = rate
+            if (self%trial) then
+                ! kept only when cheaper by GAIN: its counted cost misses CVODE's fixed
+                ! work per step, which weighs most where f is cheap (the RFEM at small n)
+                self%trial = .false.
+                if (self%rate_explicit > 0.0_wp .and. GAIN*rate > self%rate_explicit) then
+                    write (text, '(a, es9.2, a, es9.2, a)') 'adams was not cheaper by 1.3 (', &
+                        rate, ' against ', self%rate_explicit, ' f per second)'
+                    call back_off()
+                    call self%start_method(EXPLICIT, trim(text), err)
+                    return
+                end if
+            end if
+            if (self%wait > 0) return
+            if (self%rate_explicit > 0.0_wp .and. GAIN*self%rate_explicit < rate) then
+                write (text, '(a, es9.2, a, es9.2, a)') 'erk was cheaper (', &
+                    self%rate_explicit, ' against ', rate, ' f per second for adams)'
+                if (self%windows <= 2) call back_off()
+                call self%start_method(EXPLICIT, trim(text), err)
+            end if
         else
             ! judge the implicit method on its second window on (the first includes its
             ! start at order 1 with small steps)
@@ -278,7 +383,8 @@ contains
             if (self%trial) then
                 self%trial = .false.
                 if (self%rate_explicit > 0.0_wp .and. rate > self%rate_explicit) then
-                    write (text, '(a, es9.2, a, es9.2, a)') 'mebdf was not cheaper (', &
+                    write (text, '(a, es9.2, a, es9.2, a)') self%implicit_name()// &
+                        ' was not cheaper (', &
                         rate, ' against ', self%rate_explicit, ' f per second)'
                     call back_off()
                     call self%start_method(EXPLICIT, trim(text), err)
@@ -293,7 +399,7 @@ contains
             if (GAIN*predicted < rate) then
                 write (text, '(a, es9.2, a, es9.2, a, es9.2, a)') 'explicit stable step ', h_e, &
                     ' s: predicted cost ', predicted, ' f per second against ', rate, &
-                    ' for mebdf'
+                    ' for '//self%implicit_name()
                 if (self%windows <= 2) call back_off()
                 call self%start_method(EXPLICIT, trim(text), err, h_e)
             end if
@@ -306,13 +412,28 @@ contains
         end subroutine back_off
     end subroutine watch
 
+    !> Name of the implicit method of this run.
+    pure function implicit_name(self) result(name)
+        class(auto_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'mebdf'
+        if (self%use_bdf) name = 'cvode'
+    end function implicit_name
+
     !> Cost of the work counted in `s` by the method in use, in evaluations of f.
     pure real(wp) function cost(self, s)
         class(auto_t), intent(in) :: self
         type(solver_stats_t), intent(in) :: s
         cost = real(s%rhs_evals + s%jac_rhs_evals, wp)
-        if (self%active == IMPLICIT) cost = cost + IMPLICIT_STEP_COST*real(s%steps, wp) + &
-                                            JACOBIAN_COST*real(s%jac_evals, wp)
+        if (self%active == ADAMS) cost = cost + ADAMS_STEP_COST*real(s%steps, wp)
+        if (self%active == IMPLICIT) then
+            if (self%use_bdf) then
+                cost = cost + BDF_STEP_COST*real(s%steps, wp)
+            else
+                cost = cost + IMPLICIT_STEP_COST*real(s%steps, wp)
+            end if
+            cost = cost + JACOBIAN_COST*real(s%jac_evals, wp)
+        end if
     end function cost
 
     !> Counters of the segment in progress.
@@ -322,8 +443,14 @@ contains
         select case (self%active)
         case (EXPLICIT)
             s = self%erk%stats()
+        case (ADAMS)
+            s = self%am%stats()
         case (IMPLICIT)
-            s = self%mebdf%stats()
+            if (self%use_bdf) then
+                s = self%bdf%stats()
+            else
+                s = self%mebdf%stats()
+            end if
         end select
     end function current_stats
 
@@ -360,6 +487,8 @@ contains
         class(auto_t), intent(inout) :: self
         call self%erk%finalize()
         call self%mebdf%finalize()
+        call self%bdf%finalize()
+        call self%am%finalize()
         self%active = 0
         self%initialized = .false.
         self%problem => null()

@@ -46,8 +46,10 @@ def test_auto_records_its_choice(run, tmp_path):
         methods = [m.decode().strip() for m in f["/solver/switch_method"][()]]
         times = f["/solver/switch_time"][()]
         reasons = [r.decode() for r in f["/solver/switch_reason"][()]]
-    # the soft rope is not stiff for an explicit method: it starts (and stays) explicit
+    # the soft rope is not stiff for an explicit method: it starts (and stays) explicit;
+    # no Adams for the RFEM (f is cheap: CVODE's work per step would outweigh it)
     assert methods[0] == "erk" and times[0] == 0.0
+    assert "adams" not in methods
     assert "spectral radius" in reasons[0]
     assert "switch  t =     0.0000 s  erk" in proc.stdout
 
@@ -76,3 +78,38 @@ def test_erk_on_the_steel_wire_within_the_guarantee_or_diagnosed(run, tmp_path):
     else:
         assert proc.returncode == 3, proc.stderr
         assert "erk failed" in proc.stderr and "mebdf" in proc.stderr
+
+
+def test_auto_takes_cvode_where_the_fast_modes_are_damped(run, tmp_path):
+    """n = 1000: the fastest modes are damped by far more than 12 % (the segment damping
+    ratio grows with n); the A-stable MEBDF order 4 is not needed for them, and auto's
+    implicit method is cvode (a cheaper step), not mebdf."""
+    scene = ROOT / "input" / "hard" / "elements_1000.nml"
+    proc, out = run_scene(run, tmp_path, scene, "n1000", "solver.t_end=1e-4",
+                          "solver.output_interval=1e-4")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods = [m.decode().strip() for m in f["/solver/switch_method"][()]]
+        orders = f["/solver/switch_max_order"][()]
+    assert methods[0] == "cvode" and orders[0] == 5
+
+
+def test_auto_tries_adams_where_the_explicit_step_is_held_by_accuracy(run, tmp_path):
+    """The lightly damped MPP (n = 10): erk's steps are held by accuracy, not stability, and
+    f is costly; auto tries adams, keeps it (it needs about a quarter of the evaluations),
+    and the run agrees with cvode at a tight tolerance."""
+    scene = ROOT / "input" / "hard" / "mpp_light_damping.nml"
+    common = ["solver.t_end=1.0", "solver.output_interval=0.1"]
+    proc, out = run_scene(run, tmp_path, scene, "auto", *common)
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods = [m.decode().strip() for m in f["/solver/switch_method"][()]]
+        reasons = [r.decode() for r in f["/solver/switch_reason"][()]]
+        q = f["/state/q"][()]
+    assert methods[:2] == ["erk", "adams"], methods
+    assert "held by accuracy" in reasons[1]
+    ref, ref_out = run_scene(run, tmp_path, scene, "cvode", "solver.method='cvode'",
+                             "solver.rtol=1e-9", "solver.atol=1e-11", *common)
+    assert ref.returncode == 0, ref.stderr
+    with h5py.File(ref_out, "r") as f:
+        assert np.max(np.abs(f["/state/q"][()] - q)) < 1e-3

@@ -26,6 +26,8 @@ COMMANDS = {
     "bench_rfem": "ropedyn.studies.bench_rfem",
     "bench_step": "ropedyn.studies.bench_step",
     "bench_sweep": "ropedyn.studies.bench_sweep",
+    "bench_peers": "ropedyn.studies.bench_peers",
+    "auto_table": "ropedyn.studies.auto_table",
     "profile_step": "ropedyn.studies.profile_step",
     "validation": "ropedyn.studies.validation",
     "work_precision": "ropedyn.studies.work_precision",

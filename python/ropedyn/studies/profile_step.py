@@ -15,6 +15,9 @@ split by the inclusive cost of the functions that do each part:
 - solves: SUNLinSolSolve (CVODE, either linear solver), MEBDF's matrix_solve;
 - the rest of the integrator (CVode, mebdf_advance_to less the parts above): vector
   operations, error tests, step-size control.
+`--methods erk` profiles the explicit method instead (no Jacobian, factorization or solves:
+RHS and the rest of erk_advance_to: stages, error norm, step control, quadratures' history)
+into its own table (the profile_step erk markers).
 The table goes into docs/benchmarks.md between the profile_step markers.
 """
 import argparse
@@ -55,6 +58,9 @@ def total_of(costs, *names):
 def split(costs, method):
     """Instructions of the parts (PARTS order) and the integrator's total."""
     rhs = total_of(costs, "_MOD_rfem_rhs", "_MOD_rfem_quad_rhs")
+    if method == "erk":
+        total = total_of(costs, "_MOD_erk_advance_to")
+        return [rhs, 0, 0, 0, total - rhs], total
     if method == "cvode":
         total = total_of(costs, "CVode")
         jac = total_of(costs, "cv_jacobian", "cv_linsys")
@@ -117,6 +123,8 @@ def main(argv=None):
     parser.add_argument("--t-end", type=float, default=1.0)
     parser.add_argument("--baseline", default=None,
                         help="git revision to profile as 'before' (e.g. main)")
+    parser.add_argument("--methods", default="cvode mebdf",
+                        help="integrators to profile: 'cvode mebdf' (default) or 'erk'")
     parser.add_argument("--no-write", action="store_true", help="print only")
     args = parser.parse_args(argv)
     if shutil.which("valgrind") is None:
@@ -138,7 +146,7 @@ def main(argv=None):
             builds.append((f"{args.baseline} ({rev})", build_baseline(args.baseline, tmp)))
         builds.append(("this tree", exe))
         for label, path in builds:
-            for method in ("cvode", "mebdf"):
+            for method in args.methods.split():
                 steps, parts, total = profile(path, method, args.t_end, tmp,
                                               re.sub(r"\W", "_", label))
                 rows.append(row(label, method, steps, parts, total))
@@ -147,16 +155,21 @@ def main(argv=None):
         return 0
     command = "scripts/profile_step" + (f" --baseline {args.baseline}" if args.baseline
                                         else "") + f" --t-end {args.t_end:g}"
+    begin, end, heading = BEGIN, END, "## Profile of a step (callgrind)\n\n"
+    if args.methods.split() != ["cvode", "mebdf"]:
+        command += f" --methods \"{args.methods}\""
+        tag = "+".join(args.methods.split())
+        begin, end = f"<!-- profile_step {tag}:begin -->", f"<!-- profile_step {tag}:end -->"
+        heading = f"### Profile of a step: {tag} (callgrind)\n\n"
     block = "\n".join([
-        BEGIN,
+        begin,
         f"Command: `{command}` (valgrind callgrind, input/paper.nml, n = 30, "
         f"{args.t_end:g} s, rtol 1e-6, default orders; instruction counts, inclusive, per "
         "accepted step; see python/ropedyn/studies/profile_step.py for the functions that "
         "make each part).",
         f"Machine: {machine()}. Run: {utc_stamp()}.",
-        "", header, rule, *rows, END])
-    update_doc(DOCS / "benchmarks.md", BEGIN, END, block,
-               heading="## Profile of a step (callgrind)\n\n")
+        "", header, rule, *rows, end])
+    update_doc(DOCS / "benchmarks.md", begin, end, block, heading=heading)
     print(f"profile_step: table written to {DOCS / 'benchmarks.md'}")
     return 0
 

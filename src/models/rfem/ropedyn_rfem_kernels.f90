@@ -22,7 +22,8 @@ submodule (ropedyn_rfem) ropedyn_rfem_kernels
 
 contains
 
-    !> cos and sin of every element angle into self%cs, once per call.
+    !> cos and sin of every element angle into self%cs, once per call (gathered, then
+    !! ropedyn_trig's vectorizing routine).
     module procedure angles
         integer :: i
         do i = 1, self%n
