@@ -361,10 +361,7 @@ contains
                 ! work per step, which weighs most where f is cheap (the RFEM at small n)
                 self%trial = .false.
                 if (self%rate_explicit > 0.0_wp .and. GAIN*rate > self%rate_explicit) then
-                    write (text, '(a, es9.2, a, es9.2, a)') 'adams was not cheaper by 1.3 (', &
-                        rate, ' against ', self%rate_explicit, ' f per second)'
-                    call back_off()
-                    call self%start_method(EXPLICIT, trim(text), err)
+                    call trial_failed('adams was not cheaper by 1.3')
                     return
                 end if
             end if
@@ -383,11 +380,7 @@ contains
             if (self%trial) then
                 self%trial = .false.
                 if (self%rate_explicit > 0.0_wp .and. rate > self%rate_explicit) then
-                    write (text, '(a, es9.2, a, es9.2, a)') self%implicit_name()// &
-                        ' was not cheaper (', &
-                        rate, ' against ', self%rate_explicit, ' f per second)'
-                    call back_off()
-                    call self%start_method(EXPLICIT, trim(text), err)
+                    call trial_failed(self%implicit_name()//' was not cheaper')
                     return
                 end if
             end if
@@ -410,6 +403,15 @@ contains
             self%wait = self%backoff
             self%backoff = min(MAX_WAIT, 2*self%backoff)
         end subroutine back_off
+
+        !> The method on trial cost more than erk: back to erk, and wait longer.
+        subroutine trial_failed(what)
+            character(len=*), intent(in) :: what
+            write (text, '(a, es9.2, a, es9.2, a)') what//' (', rate, ' against ', &
+                self%rate_explicit, ' f per second)'
+            call back_off()
+            call self%start_method(EXPLICIT, trim(text), err)
+        end subroutine trial_failed
     end subroutine watch
 
     !> Name of the implicit method of this run.
