@@ -31,7 +31,7 @@ from ropedyn.studies import stability_metrics
 HARD = INPUT / "hard"
 
 #: the methods of the matrix (each at every tolerance); a new method is one more name here
-METHODS = ["cvode", "mebdf"]
+METHODS = ["cvode", "mebdf", "adams", "erk"]
 #: the tolerances of the matrix; atol = rtol * ATOL_RATIO
 RTOLS = [1e-3, 1e-5, 1e-7]
 ATOL_RATIO = 1e-2
