@@ -76,3 +76,24 @@ def test_erk_on_the_steel_wire_within_the_guarantee_or_diagnosed(run, tmp_path):
     else:
         assert proc.returncode == 3, proc.stderr
         assert "erk failed" in proc.stderr and "mebdf" in proc.stderr
+
+
+def test_erk_stops_with_a_diagnosis_on_1000_elements(run, tmp_path):
+    """1000 elements (modes up to 7.5e5 1/s): erk is held by stability at 2.8e5 steps per
+    simulated second, above the hard scenes' 2e5, and must stop after one window (500
+    steps, 1.8 ms) with exit code 3 and the full message naming rho and the implicit
+    methods. (The message once overran its 160-character buffer: a Fortran runtime error,
+    exit code 2, on every such stop: the long-horizon suite's erk runs on elements_1000,
+    3000, 10000 and the MPP whip on the ground.)"""
+    ELEMENTS = ROOT / "input" / "hard" / "elements_1000.nml"
+    proc, out = run_scene(run, tmp_path, ELEMENTS, "erk", "solver.method='erk'",
+                          "solver.t_end=0.01")
+    assert proc.returncode == 3, proc.stderr
+    assert "erk failed" in proc.stderr and "too stiff for an explicit method" in proc.stderr
+    assert "steps per simulated second; use method = 'auto'" in proc.stderr
+    assert "'mebdf'" in proc.stderr
+    with h5py.File(out, "r") as f:
+        status = f.attrs["status"]
+        status = status.decode() if isinstance(status, bytes) else str(status)
+        assert status.strip() == "failed"
+        assert int(f["/solver/steps"][()]) <= 1000

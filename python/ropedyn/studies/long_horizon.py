@@ -190,7 +190,7 @@ def run_all(exe, cases, workdir, jobs=2, timeout=3000, log=print, cached_only=Fa
             r = results[key]
             if log:
                 log(f"  {key}: {r['outcome'][:120]}"
-                    + (f", {r['steps']} steps, {r['cpu_time']:.1f} s, balance "
+                    + (f", {r['steps']} steps, {r['cpu_time'] or 0.0:.1f} s, balance "
                        f"{r['balance_ratio']:.3g} rtol S, gain {r['max_gain_ratio']:.3g}"
                        if "steps" in r else ""))
     saved = {k: {a: b for a, b in v.items() if a != "_series"} for k, v in results.items()}
