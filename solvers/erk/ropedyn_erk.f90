@@ -496,7 +496,7 @@ contains
         real(wp), intent(in) :: h
         type(error_t), allocatable, intent(out) :: err
         real(wp) :: rate
-        character(len=160) :: buffer
+        character(len=320) :: buffer
         self%window_steps = self%window_steps + 1
         if (h*self%rho > STIFF_FRACTION*self%tab%stability_limit) &
             self%stiff_steps = self%stiff_steps + 1

@@ -113,3 +113,24 @@ def test_auto_tries_adams_where_the_explicit_step_is_held_by_accuracy(run, tmp_p
     assert ref.returncode == 0, ref.stderr
     with h5py.File(ref_out, "r") as f:
         assert np.max(np.abs(f["/state/q"][()] - q)) < 1e-3
+
+
+def test_erk_stops_with_a_diagnosis_on_1000_elements(run, tmp_path):
+    """1000 elements (modes up to 7.5e5 1/s): erk is held by stability at 2.8e5 steps per
+    simulated second, above the hard scenes' 2e5, and must stop after one window (500
+    steps, 1.8 ms) with exit code 3 and the full message naming rho and the implicit
+    methods. (The message once overran its 160-character buffer: a Fortran runtime error,
+    exit code 2, on every such stop: the long-horizon suite's erk runs on elements_1000,
+    3000, 10000 and the MPP whip on the ground.)"""
+    ELEMENTS = ROOT / "input" / "hard" / "elements_1000.nml"
+    proc, out = run_scene(run, tmp_path, ELEMENTS, "erk", "solver.method='erk'",
+                          "solver.t_end=0.01")
+    assert proc.returncode == 3, proc.stderr
+    assert "erk failed" in proc.stderr and "too stiff for an explicit method" in proc.stderr
+    assert "steps per simulated second; use method = 'auto'" in proc.stderr
+    assert "'mebdf'" in proc.stderr
+    with h5py.File(out, "r") as f:
+        status = f.attrs["status"]
+        status = status.decode() if isinstance(status, bytes) else str(status)
+        assert status.strip() == "failed"
+        assert int(f["/solver/steps"][()]) <= 1000

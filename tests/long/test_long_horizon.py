@@ -1,21 +1,31 @@
 """Long-horizon guarantees (issue 18; docs/stability.md, "Long horizons"): every hard scene
 of input/hard to its full t_end, with the default method and with every method of
 ropedyn.studies.long_horizon.METHODS at rtol 1e-3, 1e-5 and 1e-7 (atol = rtol/100), in the
-Release build. CTest label `long` (`scripts/test --long`, about 40 minutes on two cores);
-not part of the normal suite.
+Release build: 311 runs (METHODS = cvode, mebdf, adams, erk). CTest label `long`
+(`scripts/test --long`, about half an hour of CPU, see docs/stability.md); not part of the
+normal suite.
 
 For every case:
-1. it completes, or fails with exit code 3 and a reason naming time, step size and cause;
+1. it completes, or fails with exit code 3 and a reason naming time, step size and cause,
+   and the failure is one the suite knows and explains: a case of ACCEPTED_FAILURES (with
+   the text its reason must contain), or an explicit method (erk, adams) stopped quickly
+   on a stiff scene by its crawl watch, naming the implicit methods (STIFF_STOP); any other
+   failure fails the test;
 2. no NaN or Inf reaches the output;
 3. energy balance: max |T + V + dissipated - work - E0| <= B_E rtol S (S the run's energy
-   scale, stability_metrics), B_E per method (three times the largest value measured over
-   all scenes and tolerances, BALANCE_BOUND);
+   scale, stability_metrics), B_E per method (about three times the largest value measured
+   over all scenes and tolerances, BALANCE_BOUND);
 4. no energy gain: T + V + dissipated - work never lies above E0 by more than G rtol S,
    G = the order-safety bound `&solver energy_gain_bound` (10): what the energy monitor
    guarantees; on scenes with damping and without external work T + V also never rises by
    more than that;
-5. the methods agree: at each tolerance, max |tip_a - tip_b| over the first AGREE_UNTIL
-   seconds (before the motion from 75 degrees turns chaotic) <= B_X rtol L.
+5. the methods agree: at each tolerance, max |tip_cvode - tip_m| over the first
+   AGREE_UNTIL seconds (before the motion from 75 degrees turns chaotic) <= B_X rtol L
+   (B_X per method, TIP_BOUND).
+
+Known defects (KNOWN_DEFECTS: ERK's dissipated energy at impacts, ADAMS's energy gain on
+barely damped modes) are strict expected failures of checks 3 and 4: diagnosed, listed
+with their cause, and flagged when a fix makes them pass.
 
 The order-safety cases (ORDER_CASES) show the monitor at work: MEBDF at order 7 and CVODE
 at order 4 gain energy on the undamped rope at rtol 1e-3 with the monitor off, and are
@@ -32,26 +42,97 @@ import pytest
 
 from ropedyn.studies import long_horizon as lh
 
-#: B_E per method: bound on balance error / (rtol S), three times the largest measured
-#: (82 of the 180 cases measured so far; docs/stability.md "Long horizons")
-BALANCE_BOUND = {"cvode": 4e3,   # 1120: light_damping, rtol 1e-7
-                 "mebdf": 2e2}   # 56: light_damping, rtol 1e-5
+#: B_E per method: bound on balance error / (rtol S), about three times the largest measured
+#: over all scenes and tolerances outside KNOWN_DEFECTS (docs/stability.md "Long horizons")
+BALANCE_BOUND = {"cvode": 6e3,   # 1871: undamped, rtol 1e-7
+                 "mebdf": 2e2,   # 58: undamped, rtol 1e-5
+                 "auto": 15.0,   # 4.2: light_damping (the default runs, rtol 1e-6)
+                 "adams": 5e2,   # 159: undamped, rtol 1e-7 (numerical damping, no gain)
+                 "erk": 1e2}     # 34: undamped, rtol 1e-3
 #: G: the energy monitor's default bound (&solver energy_gain_bound), in rtol S
 GAIN_BOUND = 10.0
 #: B_X: bound on max |tip_a - tip_b| / (rtol L) over AGREE_UNTIL s (per scene, default
-#: 1 s); three times the largest measured (0.068: mpp_light_damping at 1e-7)
-TIP_BOUND = 0.2
+#: 1 s) against cvode at the same tolerance; about three times the largest measured
+TIP_BOUND = {"mebdf": 25.0,   # 7.7: steel_wire at 1e-3
+             "adams": 20.0,   # 6.1: shaken_support at 1e-7
+             "erk": 25.0}     # 7.9: steel_wire at 1e-3
 AGREE_UNTIL = {"default": 1.0,
                # the folded falls: up to the end of the fall (0.38 s), where the tension
                # at the tip becomes singular and accurate solutions separate
-               "folded_release": 0.3, "folded_n301": 0.3}
+               "folded_release": 0.3, "folded_n301": 0.3,
+               # the whips: up to their crack at 0.556 s (the tip speed peaks, the step
+               # halves; over 1 s cvode and mebdf differ by up to 129 rtol L at 1e-7)
+               "whip": 0.5, "whip_ground": 0.5, "whip_ground_mpp": 0.5}
 #: cases that gain more than G rtol S although every order safety acted: not an order
 #: instability (measured gain in rtol S and why)
 GAIN_EXCEPTIONS = {
-    # the end of the fall at 0.38 s (a singular whip at the tip) at rtol 1e-3: lowered to
-    # BDF2 at 0.38 s it still gains (185 rtol S): an accuracy failure of the loose tolerance
-    # at the singularity, which the order cannot cure
+    # CVODE at rtol 1e-3 on the folded fall at n = 301 (0.19 J, 186 rtol S at 0.6 s): the
+    # monitor lowers it to BDF2 at 0.38 s (the end of the fall), and the gain then grows
+    # steadily over 0.48 ... 0.6 s while the chain rings after the snap. It lies in the
+    # dissipated energy (0.34 J against 0.160 J of an rtol 1e-7 run), not in the motion (T
+    # + V ends 6 mJ from that run): the dissipation power weighs the velocity errors of the
+    # stiffest axial modes (overdamped at dl = 3.3 mm) by tau omega^2, so it grows with the
+    # square of the tolerance: BDF2 from the start gains 0.115 J at rtol 1e-3 and 2.0e-3 J
+    # at 1e-4; orders 3-5 unguarded 0.025 J; MEBDF at 1e-3 loses 9.5e-4 J. An accuracy
+    # limit of rtol 1e-3 on this scene, not an order instability.
     "folded_n301/cvode/0.001": 600.0,
+}
+#: diagnosed failures the suite accepts: key -> text the reason must contain. The step
+#: budget (max_steps 1e6) runs out on the barely damped scenes at rtol 1e-7, at the
+#: method's A-stable or explicit order: accuracy-limited, not unstable (the axial modes up
+#: to 4.4e3 rad/s, rung by the release and barely damped, are followed by the error
+#: test: MEBDF's steps per second on light_damping 2.0e4, 6.5e4, 1.6e5 at rtol 1e-3, 1e-5,
+#: 1e-7, the rtol^(-1/5) of order 4; 10 s would need 1.6e6 steps). Raise max_steps, or
+#: use cvode (580 000 steps for 10 s at 1e-7), for such runs.
+ACCEPTED_FAILURES = {
+    "undamped/mebdf/1e-07": "max_steps exceeded",              # at 6.29 s, h 4.7e-6 s
+    "light_damping/mebdf/1e-07": "max_steps exceeded",         # at 6.30 s, h 4.5e-6 s
+    "mpp_undamped/mebdf/1e-07": "max_steps exceeded",          # at 8.19 s, h 3.6e-6 s
+    "mpp_light_damping_n30/mebdf/1e-07": "max_steps exceeded",  # at 8.24 s, h 5.3e-6 s
+    "undamped/erk/1e-07": "max_steps exceeded",                # at 9.71 s, h 7.3e-6 s
+    "light_damping/erk/1e-07": "max_steps exceeded",           # at 9.70 s, h 8.9e-6 s
+}
+#: the explicit methods give up on stiff scenes: the reason names the cause and the
+#: implicit methods ('mebdf'), within STIFF_STOP_CPU seconds
+STIFF_STOP = {"erk": "too stiff for an explicit method", "adams": "the problem is stiff here"}
+STIFF_STOP_CPU = 10.0   # measured at most 2.1 s (adams on elements_10000)
+#: balance and gain bound, in rtol S, of a run the stiffness watch stopped: held at its
+#: stability limit the explicit method may amplify the fastest modes until the watch acts,
+#: within the first microseconds, whose energy scale S is tiny (measured: adams 569 rtol S
+#: on elements_10000 at rtol 1e-3 over 16 us, erk 209 over 17 us; erk's 309 on
+#: whip_ground_mpp at 1e-5 is its quadrature defect, below)
+STIFF_STOP_BOUND = 2e3
+#: known defects, diagnosed but not fixed: {test: {key: why}}; these cases are expected to
+#: fail that test (strict: a fix makes them pass, and the entry must go)
+ERK_QUADRATURE = ("erk (and auto, which runs erk on the whip scenes) integrates the "
+                  "dissipated energy from its step points only, outside the error test: "
+                  "at the impacts on the ground it misses 1 % of the 0.73 J dissipated "
+                  "(7.7e-3 J at rtol 1e-6, 2.2e-2 at 1e-4, 6.6e-4 at 1e-8: not following "
+                  "rtol), while T + V agree with mebdf to 4e-5 J")
+ADAMS_GAIN = ("adams (Adams-Moulton up to order 12, not A-stable above order 2) creates "
+              "energy on barely damped modes, and the order safety knows no safe order for "
+              "it (the methods table): it only reports the gain")
+KNOWN_DEFECTS = {
+    "balance": {
+        **{k: ERK_QUADRATURE for k in (
+            "whip_ground/default",         # 3275 rtol S (auto runs erk throughout)
+            "whip_ground_mpp/default",     # 1334
+            "whip_ground/erk/1e-05",       # 367
+            "whip_ground/erk/1e-07",       # 10852
+            "whip_ground_mpp/erk/1e-07")},  # 4993
+        **{k: ADAMS_GAIN for k in ("undamped/adams/0.001",        # 791
+                                   "light_damping/adams/0.001")},  # 771
+    },
+    # measured gain / (rtol S) at rtol 1e-3, 1e-5 (1e-7 for the moving supports)
+    "gain": {k: ADAMS_GAIN for k in (
+        "undamped/adams/0.001", "undamped/adams/1e-05",                    # 791, 337
+        "light_damping/adams/0.001", "light_damping/adams/1e-05",          # 771, 297
+        "mpp_undamped/adams/0.001", "mpp_undamped/adams/1e-05",            # 465, 150
+        "mpp_light_damping/adams/0.001", "mpp_light_damping/adams/1e-05",  # 108, 237
+        "mpp_light_damping_n30/adams/0.001",                               # 460
+        "mpp_light_damping_n30/adams/1e-05",                               # 152
+        "shaken_support/adams/1e-05", "shaken_support/adams/1e-07",        # 22, 13
+        "snap_load/adams/1e-07")},                                          # 26
 }
 
 MATRIX = lh.matrix_cases()
@@ -68,6 +149,16 @@ def diagnosis_ok(r):
             and "t =" in r["reason"] and "step size" in r["reason"])
 
 
+def case_method(key):
+    return key.split("/")[1]
+
+
+def stiff_stop(key, r):
+    """The run was ended by an explicit method's stiffness watch."""
+    return (r["returncode"] == 3 and case_method(key) in STIFF_STOP
+            and STIFF_STOP[case_method(key)] in r.get("reason", ""))
+
+
 def rope_length(scene):
     m = re.search(r"^\s*&rope[^/]*length\s*=\s*([0-9.eE+-]+)",
                   (lh.HARD / f"{scene}.nml").read_text(), re.M)
@@ -75,6 +166,13 @@ def rope_length(scene):
 
 
 KEYS = [key for key, _, _ in MATRIX]
+
+
+def keys_for(test):
+    """KEYS, those with a known defect in `test` marked as expected failures (strict)."""
+    defects = KNOWN_DEFECTS.get(test, {})
+    return [pytest.param(k, marks=pytest.mark.xfail(reason=defects[k], strict=True))
+            if k in defects else k for k in KEYS]
 
 
 @pytest.mark.parametrize("key", KEYS)
@@ -86,6 +184,14 @@ def test_completes_or_diagnosed(results, key):
         assert r["t_reached"] == pytest.approx(r["t_end"], rel=1e-12)
     else:
         assert diagnosis_ok(r), (r["returncode"], r["stderr"])
+        print(f"{key}: {r['reason']} ({r['steps']} steps, {r['cpu_time']:.1f} s)")
+        if key in ACCEPTED_FAILURES:
+            assert ACCEPTED_FAILURES[key] in r["reason"]
+        elif case_method(key) in STIFF_STOP:
+            assert STIFF_STOP[case_method(key)] in r["reason"] and "'mebdf'" in r["reason"]
+            assert r["cpu_time"] <= STIFF_STOP_CPU
+        else:
+            pytest.fail(f"{key}: a failure the suite does not know: {r['reason']}")
 
 
 @pytest.mark.parametrize("key", KEYS)
@@ -93,18 +199,21 @@ def test_output_finite(results, key):
     assert results[key].get("nonfinite") == []
 
 
-@pytest.mark.parametrize("key", KEYS)
+@pytest.mark.parametrize("key", keys_for("balance"))
 def test_energy_balance(results, key):
     r = results[key]
-    bound = BALANCE_BOUND[r["method"]]
+    bound = STIFF_STOP_BOUND if stiff_stop(key, r) else BALANCE_BOUND[r["method"]]
     print(f"{key}: balance {r['balance_ratio']:.3g} rtol S (bound {bound})")
     assert r["balance_ratio"] <= bound
 
 
-@pytest.mark.parametrize("key", KEYS)
+@pytest.mark.parametrize("key", keys_for("gain"))
 def test_no_energy_gain(results, key):
     r = results[key]
     print(f"{key}: largest gain {r['max_gain_ratio']:.3g} rtol S")
+    if stiff_stop(key, r):
+        assert r["max_gain_ratio"] <= STIFF_STOP_BOUND
+        return
     assert r["max_gain_ratio"] <= GAIN_EXCEPTIONS.get(key, GAIN_BOUND)
     if key in GAIN_EXCEPTIONS:
         return
@@ -123,7 +232,7 @@ def test_methods_agree(results, scene, rtol):
         diff = lh.tip_difference(ref, other, until)
         ratio = diff / (rtol * rope_length(scene))
         print(f"{scene} {rtol:g} {ref['method']} - {other['method']}: {ratio:.3g} rtol L")
-        assert ratio <= TIP_BOUND
+        assert ratio <= TIP_BOUND[other["method"]]
 
 
 def order_result(results, scene, label):
