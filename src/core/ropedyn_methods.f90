@@ -32,7 +32,7 @@ module ropedyn_methods
         method_info_t('cvode', 1, 5, 5, safe_order=2), &
         method_info_t('mebdf', 2, 7, 4, safe_order=4), &
         method_info_t('erk', 3, 5, 4), &
-        method_info_t('adams', 1, 12, 12), &
+        method_info_t('adams', 1, 12, 12, safe_order=2), &
         method_info_t('auto', 2, 7, 0)]
 
 contains
