@@ -110,8 +110,9 @@ contains
                         lb(r, c) = a(6 + (r + 3) - c, j0 - 3 + c)
                     end do
                 end do
-                self%lfac(:, :, ib) = matmul(lb, self%dinv(:, :, ib - 1))
-                d = d - matmul(self%lfac(:, :, ib), self%ublk(:, :, ib - 1))
+                call mul3(lb, self%dinv(:, :, ib - 1), self%lfac(:, :, ib))
+                call mul3(self%lfac(:, :, ib), self%ublk(:, :, ib - 1), lb)
+                d = d - lb
             end if
             call invert3(d, self%dinv(:, :, ib), ok)
             if (.not. ok) then
@@ -197,29 +198,44 @@ contains
         real(wp), intent(in) :: x(:)
         real(wp), intent(inout) :: b(:)
         real(wp) :: p(3)
-        integer :: ib, k, o, nb
+        integer :: ib, k, nb
         nb = self%nb
         do ib = 1, nb
             k = 3*(ib - 1)
-            p = 0.0_wp
-            do o = max(-1, 1 - ib), min(1, nb - ib)
-                associate (a => self%kblk(:, :, o, ib), j => k + 3*o)
-                    p(1) = p(1) + (a(1, 1)*x(j + 1) + a(1, 2)*x(j + 2) + a(1, 3)*x(j + 3))
-                    p(2) = p(2) + (a(2, 1)*x(j + 1) + a(2, 2)*x(j + 2) + a(2, 3)*x(j + 3))
-                    p(3) = p(3) + (a(3, 1)*x(j + 1) + a(3, 2)*x(j + 2) + a(3, 3)*x(j + 3))
+            ! p = K_{i,i-1} x_{i-1} + K_ii x_i + K_{i,i+1} x_{i+1}
+            associate (a => self%kblk(:, :, 0, ib))
+                p = a(:, 1)*x(k + 1) + a(:, 2)*x(k + 2) + a(:, 3)*x(k + 3)
+            end associate
+            if (ib > 1) then
+                associate (a => self%kblk(:, :, -1, ib))
+                    p = p + (a(:, 1)*x(k - 2) + a(:, 2)*x(k - 1) + a(:, 3)*x(k))
                 end associate
-            end do
+            end if
+            if (ib < nb) then
+                associate (a => self%kblk(:, :, 1, ib))
+                    p = p + (a(:, 1)*x(k + 4) + a(:, 2)*x(k + 5) + a(:, 3)*x(k + 6))
+                end associate
+            end if
             b(k + 1:k + 3) = b(k + 1:k + 3) + g*p
             if (ib > 1) then
                 associate (l => self%lfac(:, :, ib))
-                    b(k + 1) = b(k + 1) - (l(1, 1)*b(k - 2) + l(1, 2)*b(k - 1) + l(1, 3)*b(k))
-                    b(k + 2) = b(k + 2) - (l(2, 1)*b(k - 2) + l(2, 2)*b(k - 1) + l(2, 3)*b(k))
-                    b(k + 3) = b(k + 3) - (l(3, 1)*b(k - 2) + l(3, 2)*b(k - 1) + l(3, 3)*b(k))
+                    b(k + 1:k + 3) = b(k + 1:k + 3) - (l(:, 1)*b(k - 2) + l(:, 2)*b(k - 1) &
+                                                       + l(:, 3)*b(k))
                 end associate
             end if
         end do
         call backward(self, b)
     end subroutine block3_solve_plus_product
+
+    !> c = a b for 3 x 3 matrices, written out.
+    pure subroutine mul3(a, b, c)
+        real(wp), intent(in) :: a(3, 3), b(3, 3)
+        real(wp), intent(out) :: c(3, 3)
+        integer :: j
+        do j = 1, 3
+            c(:, j) = a(:, 1)*b(1, j) + a(:, 2)*b(2, j) + a(:, 3)*b(3, j)
+        end do
+    end subroutine mul3
 
     !> ainv = a^{-1} by Gauss-Jordan elimination with partial pivoting; ok = .false. when a
     !! is singular or the inverse is not finite.

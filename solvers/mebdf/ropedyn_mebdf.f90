@@ -89,6 +89,11 @@ module ropedyn_mebdf
         real(wp), allocatable :: w(:)     !< error weights rtol |y| + atol (nt)
         real(wp), allocatable :: wi(:)    !< their inverses (the norms multiply)
         real(wp), allocatable :: f(:), mv(:), r(:)  !< work (n)
+        !> work of a step (nt), allocated once: the predictor, a stage's known part c, the
+        !! stage solutions ybar1, ybar2, y3, ybar1's correction d1 and the slopes h g of
+        !! stages 1 and 2, and a temporary for norms
+        real(wp), allocatable :: pred(:), c(:), ybar1(:), ybar2(:), y3(:), d1(:), hg1(:), &
+                                 hg2(:), tmp(:)
         real(wp), allocatable :: gq(:)    !< quadrature rhs (nq)
     contains
         procedure :: start => mebdf_start
@@ -205,6 +210,9 @@ contains
         allocate (self%dif(self%nt, 0:KMAX_MEBDF + 2), self%atol(self%nt), self%w(self%nt), &
                   self%wi(self%nt))
         allocate (self%f(self%n), self%mv(self%n), self%r(self%n), self%gq(max(self%nq, 1)))
+        allocate (self%pred(self%nt), self%c(self%nt), self%ybar1(self%nt), &
+                  self%ybar2(self%nt), self%y3(self%nt), self%d1(self%nt), self%hg1(self%nt), &
+                  self%hg2(self%nt), self%tmp(self%nt))
         self%atol = self%options%atol
         if (allocated(self%options%atol_vector)) self%atol(1:self%n) = self%options%atol_vector
         self%dif = 0.0_wp
@@ -282,6 +290,8 @@ contains
         if (allocated(self%w)) deallocate (self%w, self%wi)
         if (allocated(self%f)) deallocate (self%f, self%mv, self%r)
         if (allocated(self%gq)) deallocate (self%gq)
+        if (allocated(self%pred)) deallocate (self%pred, self%c, self%ybar1, self%ybar2, &
+                                              self%y3, self%d1, self%hg1, self%hg2, self%tmp)
     end subroutine mebdf_finalize
 
     subroutine mebdf_advance_to(self, tout, t, y, yq, err)

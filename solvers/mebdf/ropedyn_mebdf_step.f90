@@ -109,7 +109,6 @@ contains
     end procedure stage
 
     module procedure try_step
-        real(wp), dimension(self%nt) :: pred, c, ybar1, ybar2, y3, d1, hg1, hg2
         real(wp) :: sp, sq, s2
         real(wp) :: gam(KMAX_MEBDF), hmin, tn, err1, errkm1, errkp1, beta, hbeta
         real(wp) :: ratio, r_same, r_down, r_up, binom, wd(0:KMAX_MEBDF)
@@ -172,19 +171,19 @@ contains
                     sp = sp + self%dif(l, j)
                     sq = sq + gam(j)*self%dif(l, j)
                 end do
-                pred(l) = sp
-                c(l) = sp - beta*sq
+                self%pred(l) = sp
+                self%c(l) = sp - beta*sq
             end do
-            ybar1 = pred
-            call self%stage(tn, hbeta, c, ybar1, outcome)
+            self%ybar1 = self%pred
+            call self%stage(tn, hbeta, self%c, self%ybar1, outcome)
             if (outcome /= STAGE_OK) then
                 call newton_failed(outcome)
                 if (allocated(err)) return
                 cycle attempts
             end if
-            hg1 = (ybar1 - c)*(1.0_wp/beta)
-            d1 = ybar1 - pred
-            err1 = self%wnorm(d1)/self%coef(k)%tq
+            self%hg1 = (self%ybar1 - self%c)*(1.0_wp/beta)
+            self%d1 = self%ybar1 - self%pred
+            err1 = self%wnorm(self%d1)/self%coef(k)%tq
             if (self%fixed) err1 = 0.0_wp
             if (.not. (err1 <= 1.0_wp)) then
                 call error_failed(err1)
@@ -196,25 +195,25 @@ contains
             ! P_j = sum_{i=j..k} dif_i, the differences of ybar1 are P_j + d1; the
             ! predictor is their sum and psi = sum_{i=1..k} gam(i) (P_i + d1).
             do l = 1, self%nt
-                sp = ybar1(l)
+                sp = self%ybar1(l)
                 sq = 0.0_wp
                 s2 = 0.0_wp
                 do i = k, 1, -1
                     s2 = s2 + self%dif(l, i)
-                    sp = sp + s2 + d1(l)
-                    sq = sq + gam(i)*(s2 + d1(l))
+                    sp = sp + s2 + self%d1(l)
+                    sq = sq + gam(i)*(s2 + self%d1(l))
                 end do
-                pred(l) = sp
-                c(l) = sp - beta*sq
+                self%pred(l) = sp
+                self%c(l) = sp - beta*sq
             end do
-            ybar2 = pred
-            call self%stage(tn + self%h, hbeta, c, ybar2, outcome)
+            self%ybar2 = self%pred
+            call self%stage(tn + self%h, hbeta, self%c, self%ybar2, outcome)
             if (outcome /= STAGE_OK) then
                 call newton_failed(outcome)
                 if (allocated(err)) return
                 cycle attempts
             end if
-            hg2 = (ybar2 - c)*(1.0_wp/beta)
+            self%hg2 = (self%ybar2 - self%c)*(1.0_wp/beta)
 
             ! Stage 3: the modified extended corrector. Old values y_{n-i} from the
             ! differences: y_{n-i} = sum_{j=0..i} (-1)^j binom(i, j) dif_j.
@@ -229,18 +228,19 @@ contains
                     binom = -binom*real(i - j, wp)/real(j + 1, wp)
                 end do
             end do
-            c = (self%coef(k)%bhat_k - beta)*hg1 + self%coef(k)%bhat_k1*hg2
+            self%c = (self%coef(k)%bhat_k - beta)*self%hg1 + self%coef(k)%bhat_k1*self%hg2
             do j = 0, k - 1
-                c = c + wd(j)*self%dif(:, j)
+                self%c = self%c + wd(j)*self%dif(:, j)
             end do
-            y3 = ybar1
-            call self%stage(tn, hbeta, c, y3, outcome)
+            self%y3 = self%ybar1
+            call self%stage(tn, hbeta, self%c, self%y3, outcome)
             if (outcome /= STAGE_OK) then
                 call newton_failed(outcome)
                 if (allocated(err)) return
                 cycle attempts
             end if
-            if (.not. (self%wnorm(y3 - ybar1) <= EXTRA_CHECK .or. self%fixed)) then
+            self%tmp = self%y3 - self%ybar1
+            if (.not. (self%wnorm(self%tmp) <= EXTRA_CHECK .or. self%fixed)) then
                 call error_failed(max(err1, 1.01_wp))
                 if (allocated(err)) return
                 cycle attempts
@@ -252,16 +252,20 @@ contains
         ! differences; then the history moves to t_n + h with the MEBDF value.
         errkm1 = huge(1.0_wp)
         errkp1 = huge(1.0_wp)
-        if (k > 1) errkm1 = self%wnorm(self%dif(:, k) + d1)/self%coef(k - 1)%tq
+        if (k > 1) then
+            self%tmp = self%dif(:, k) + self%d1
+            errkm1 = self%wnorm(self%tmp)/self%coef(k - 1)%tq
+        end if
         if (k < self%kmax .and. self%steps_at_h >= k + 1) then
-            errkp1 = self%wnorm(d1 - self%dif(:, k + 1))/self%coef(k + 1)%tq
+            self%tmp = self%d1 - self%dif(:, k + 1)
+            errkp1 = self%wnorm(self%tmp)/self%coef(k + 1)%tq
         end if
         do l = 1, self%nt
             sp = self%dif(l, 0)
             do j = 1, k
                 sp = sp + self%dif(l, j)
             end do
-            sq = y3(l) - sp
+            sq = self%y3(l) - sp
             self%dif(l, k + 2) = sq - self%dif(l, k + 1)
             self%dif(l, k + 1) = sq
             ! dif_j <- dif_j + dif_{j+1} (the new one), carried in a register
@@ -371,7 +375,8 @@ contains
             self%pending_ratio = min(max(r, merge(1.0e-3_wp, 0.1_wp, &
                                                   self%counters%steps == 0)), 0.9_wp)
             if (self%k > 1) then
-                errkm1 = self%wnorm(self%dif(:, self%k) + d1)/self%coef(self%k - 1)%tq
+                self%tmp = self%dif(:, self%k) + self%d1
+                errkm1 = self%wnorm(self%tmp)/self%coef(self%k - 1)%tq
                 if (errkm1 < e) then
                     self%pending_k = self%k - 1
                     r = 1.0_wp/(SAFETY_FAILED*max(errkm1, 1.0e-10_wp)** &
