@@ -6,7 +6,7 @@ module ropedyn_band_lu
     implicit none
     private
     public :: RFEM_KL, band_lu_factor, band_lu_solve, band_solve_rfem, band_add_product, &
-              band_product_rfem, full_entry
+              full_entry
 
     !> Bandwidths of the RFEM's reduced matrix (3 x 3 blocks, block tridiagonal): its solve
     !! has a copy of the band loops with these as constants, whose inner loops the compiler

@@ -15,9 +15,9 @@
 !! Without pivoting between blocks the factorization needs nonsingular D'_i; it is stable
 !! for the block diagonally dominant or positive definite matrices of a rope (the mass
 !! blocks dominate for small g, the stiffness's discrete Laplacian for large g). A
-!! singular or non-finite D'_i is reported (info = block), and a matrix with entries
-!! outside the block-tridiagonal pattern is refused (info = -1): the caller then uses the
-!! band LU with partial pivoting.
+!! singular or non-finite D'_i is reported (info = block); the caller checks the pattern
+!! first (`block_tridiagonal`, and `set_k` for K, once per Jacobian) and uses the band LU
+!! with partial pivoting for a matrix outside it or a singular block.
 module ropedyn_block3
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp

@@ -10,6 +10,14 @@ PAPER = ROOT / "input" / "paper.nml"
 STEEL = ROOT / "input" / "hard" / "steel_wire.nml"
 
 
+def switch_log(f):
+    """The run's switches from /solver (open h5py file): methods, times, order limits,
+    reasons."""
+    methods = [m.decode().strip() for m in f["/solver/switch_method"][()]]
+    reasons = [r.decode() for r in f["/solver/switch_reason"][()]]
+    return methods, f["/solver/switch_time"][()], f["/solver/switch_max_order"][()], reasons
+
+
 def run_scene(run, tmp_path, scene, name, *sets):
     out = tmp_path / f"{name}.h5"
     args = ["run", scene, "--set", f"output.file='{out}'"]
@@ -43,9 +51,7 @@ def test_auto_records_its_choice(run, tmp_path):
                           "solver.t_end=0.2")
     assert proc.returncode == 0, proc.stderr
     with h5py.File(out, "r") as f:
-        methods = [m.decode().strip() for m in f["/solver/switch_method"][()]]
-        times = f["/solver/switch_time"][()]
-        reasons = [r.decode() for r in f["/solver/switch_reason"][()]]
+        methods, times, _, reasons = switch_log(f)
     # the soft rope is not stiff for an explicit method: it starts (and stays) explicit;
     # no Adams for the RFEM (f is cheap: CVODE's work per step would outweigh it)
     assert methods[0] == "erk" and times[0] == 0.0
@@ -59,8 +65,7 @@ def test_auto_starts_implicit_on_the_steel_wire(run, tmp_path):
                           "solver.output_interval=0.001")
     assert proc.returncode == 0, proc.stderr
     with h5py.File(out, "r") as f:
-        methods = [m.decode().strip() for m in f["/solver/switch_method"][()]]
-        orders = f["/solver/switch_max_order"][()]
+        methods, _, orders, _ = switch_log(f)
     assert methods[0] == "mebdf" and orders[0] == 4   # barely damped fast modes: A-stable
 
 
@@ -89,8 +94,7 @@ def test_auto_takes_cvode_where_the_fast_modes_are_damped(run, tmp_path):
                           "solver.output_interval=1e-4")
     assert proc.returncode == 0, proc.stderr
     with h5py.File(out, "r") as f:
-        methods = [m.decode().strip() for m in f["/solver/switch_method"][()]]
-        orders = f["/solver/switch_max_order"][()]
+        methods, _, orders, _ = switch_log(f)
     assert methods[0] == "cvode" and orders[0] == 5
 
 
@@ -103,8 +107,7 @@ def test_auto_tries_adams_where_the_explicit_step_is_held_by_accuracy(run, tmp_p
     proc, out = run_scene(run, tmp_path, scene, "auto", *common)
     assert proc.returncode == 0, proc.stderr
     with h5py.File(out, "r") as f:
-        methods = [m.decode().strip() for m in f["/solver/switch_method"][()]]
-        reasons = [r.decode() for r in f["/solver/switch_reason"][()]]
+        methods, _, _, reasons = switch_log(f)
         q = f["/state/q"][()]
     assert methods[:2] == ["erk", "adams"], methods
     assert "held by accuracy" in reasons[1]
