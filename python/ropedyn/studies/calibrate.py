@@ -14,11 +14,14 @@ sensitive (nearly chaotic) and its fast exchange between kinetic and elastic ene
 not what the damping constants should be fitted to; the windowed loss is.
 
 by Nelder-Mead on (log a, log b), and prints the fitted values, the residual RMS and the
-residual of the default rule (a = b = 1). Use the printed `--set` line in a scene.
+residual of the default rule (a = b = 1). Use the printed `--set` line in a scene. The fit
+is also written to docs/data/mpp_damping_fit.csv (with --data), which `scripts/fig5`
+reads for its calibrated MPP runs.
 
     scripts/calibrate [SCENE.nml] [--elements N] [--t-fit SECONDS] [--set g.k=v ...]
 """
 import argparse
+import csv
 import math
 import subprocess
 import sys
@@ -27,7 +30,20 @@ import tempfile
 import numpy as np
 
 from ropedyn import io
-from ropedyn.run import PAPER, add_exe_argument, exe_or_build, set_args
+from ropedyn.run import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
+
+#: where the fit is written (and scripts/fig5 reads it)
+FIT_DATA = DOCS / "data" / "mpp_damping_fit.csv"
+
+
+def read_fit(path=FIT_DATA):
+    """The last fit written by calibrate: dict with a, b, rms_default, rms_fit, ... (None
+    when there is none)."""
+    if not path.exists():
+        return None
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return rows[-1] if rows else None
 
 
 def energy_history(exe, scene, sets, out):
@@ -84,7 +100,9 @@ def main(argv=None):
     add_exe_argument(parser)
     parser.add_argument("--elements", type=int, default=10)
     parser.add_argument("--t-fit", type=float, default=5.0, help="fitted time span (s)")
-    parser.add_argument("--method", default="mebdf")
+    parser.add_argument("--method", default="auto")
+    parser.add_argument("--data", default=str(FIT_DATA),
+                        help="CSV the fit is written to ('' for none)")
     parser.add_argument("--max-evals", type=int, default=30)
     parser.add_argument("--window", type=float, default=0.5,
                         help="averaging window of the energy histories (s)")
@@ -131,6 +149,16 @@ def main(argv=None):
     print(f"  fitted  a = {a:.4g}, b = {b:.4g}: rms {math.sqrt(s_fit / n):.4e} J")
     print(f"  use: --set model.mpp_axial_damping_factor={a:.4g} "
           f"--set model.mpp_bending_damping_factor={b:.4g}")
+    if args.data:
+        with open(args.data, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["scene", "elements", "t_fit_s", "window_s", "method", "mpp_runs",
+                        "a", "b", "rms_default_J", "rms_fit_J", "rfem_energy_loss_J"])
+            w.writerow([args.scene.split("/")[-1], args.elements, args.t_fit, args.window,
+                        args.method, evals, f"{a:.4g}", f"{b:.4g}",
+                        f"{math.sqrt(s_default / n):.4e}", f"{math.sqrt(s_fit / n):.4e}",
+                        f"{drop:.4e}"])
+        print(f"calibrate: wrote {args.data}")
     return 0
 
 
