@@ -395,22 +395,13 @@ contains
                            self%pm_body, self%pm_r, self%pm_m, self%mm)
     end subroutine assemble_mass_work
 
-    module procedure mpp_rhs
-        real(wp) :: zero(self%ndof)
-        integer :: nd
-        nd = self%ndof
-        zero = 0.0_wp
-        call angles(self, y)
-        call self%residual_core(t, y, zero, ydot(nd + 1:2*nd))
-        call self%mass_factor(y, status)
-        if (status /= STATUS_OK) return
-        call mass_solve(self, ydot(nd + 1:2*nd))
-        ydot(1:nd) = y(nd + 1:2*nd)
-        status = STATUS_OK
-        if (.not. all(ieee_is_finite(ydot(nd + 1:2*nd)))) status = STATUS_RECOVERABLE
-    end procedure mpp_rhs
-
-    module procedure mpp_implicit_rhs
+    !> F of the implicit form M(q) y' = F: (q', r(t, q, q', 0)), the residual at zero
+    !! accelerations (self%cs set to the angles of y on the way).
+    subroutine implicit_form_rhs(self, t, y, f)
+        class(mpp_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: f(:)
         real(wp) :: zero(self%ndof)
         integer :: nd
         nd = self%ndof
@@ -418,6 +409,21 @@ contains
         f(1:nd) = y(nd + 1:2*nd)
         call angles(self, y)
         call self%residual_core(t, y, zero, f(nd + 1:2*nd))
+    end subroutine implicit_form_rhs
+
+    module procedure mpp_rhs
+        integer :: nd
+        nd = self%ndof
+        call implicit_form_rhs(self, t, y, ydot)
+        call self%mass_factor(y, status)
+        if (status /= STATUS_OK) return
+        call mass_solve(self, ydot(nd + 1:2*nd))
+        status = STATUS_OK
+        if (.not. all(ieee_is_finite(ydot(nd + 1:2*nd)))) status = STATUS_RECOVERABLE
+    end procedure mpp_rhs
+
+    module procedure mpp_implicit_rhs
+        call implicit_form_rhs(self, t, y, f)
         status = STATUS_OK
         if (.not. all(ieee_is_finite(f))) status = STATUS_RECOVERABLE
     end procedure mpp_implicit_rhs
