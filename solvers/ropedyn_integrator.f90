@@ -84,6 +84,8 @@ module ropedyn_integrator
         real(wp) :: time_solve = 0.0_wp
         !> the Newton systems were solved on the reduced second-order matrix
         logical :: reduced_newton = .false.
+    contains
+        procedure :: add => stats_add
     end type solver_stats_t
 
     !> The start of an integration as `init` hands it to a method's `start`, checked:
@@ -172,6 +174,27 @@ contains
         stop_now = .false.
         if (associated(options%stop_requested)) stop_now = options%stop_requested()
     end function stop_now
+
+    !> Add the counters and times of `part` (another integration, or an earlier part of this
+    !! one) to `self`; time_advance, the last step and order and the Newton path stay
+    !! those of `self`.
+    pure subroutine stats_add(self, part)
+        class(solver_stats_t), intent(inout) :: self
+        type(solver_stats_t), intent(in) :: part
+        self%steps = self%steps + part%steps
+        self%rhs_evals = self%rhs_evals + part%rhs_evals
+        self%jac_rhs_evals = self%jac_rhs_evals + part%jac_rhs_evals
+        self%jac_evals = self%jac_evals + part%jac_evals
+        self%lin_setups = self%lin_setups + part%lin_setups
+        self%err_test_fails = self%err_test_fails + part%err_test_fails
+        self%nonlin_iters = self%nonlin_iters + part%nonlin_iters
+        self%nonlin_conv_fails = self%nonlin_conv_fails + part%nonlin_conv_fails
+        self%order_steps = self%order_steps + part%order_steps
+        self%time_rhs = self%time_rhs + part%time_rhs
+        self%time_jac = self%time_jac + part%time_jac
+        self%time_factor = self%time_factor + part%time_factor
+        self%time_solve = self%time_solve + part%time_solve
+    end subroutine stats_add
 
     !> Seconds on the monotonic clock (for the time split of options%profile).
     real(wp) function clock_seconds() result(s)

@@ -456,23 +456,12 @@ contains
         end select
     end function current_stats
 
-    !> total += part (counters; the last step and order are the part's).
+    !> total += part (counters; the last step and order are the part's, the reduced Newton
+    !! path counts when either part used it).
     subroutine add_counters(total, part)
         type(solver_stats_t), intent(inout) :: total
         type(solver_stats_t), intent(in) :: part
-        total%steps = total%steps + part%steps
-        total%rhs_evals = total%rhs_evals + part%rhs_evals
-        total%jac_rhs_evals = total%jac_rhs_evals + part%jac_rhs_evals
-        total%jac_evals = total%jac_evals + part%jac_evals
-        total%lin_setups = total%lin_setups + part%lin_setups
-        total%err_test_fails = total%err_test_fails + part%err_test_fails
-        total%nonlin_iters = total%nonlin_iters + part%nonlin_iters
-        total%nonlin_conv_fails = total%nonlin_conv_fails + part%nonlin_conv_fails
-        total%order_steps = total%order_steps + part%order_steps
-        total%time_rhs = total%time_rhs + part%time_rhs
-        total%time_jac = total%time_jac + part%time_jac
-        total%time_factor = total%time_factor + part%time_factor
-        total%time_solve = total%time_solve + part%time_solve
+        call total%add(part)
         total%reduced_newton = total%reduced_newton .or. part%reduced_newton
         total%last_step = part%last_step
         total%last_order = part%last_order

@@ -3,7 +3,7 @@
 module ropedyn_cli
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_USAGE
-    use ropedyn_text, only: int_text, text_t, append_text
+    use ropedyn_text, only: int_text, text_t, append_text, text_array
     implicit none
     private
     public :: cli_t, cli_from_command_line
@@ -17,6 +17,10 @@ module ropedyn_cli
         character(len=:), allocatable :: inline   !< the '=value' part of '--option=value'
         logical :: has_inline = .false.
         character(len=:), allocatable :: value    !< the value taken last (`take_value`)
+        !> what `scene_argument` took: the scene file (not allocated until given) and the
+        !! `--set group.key=value` overrides in the order given
+        character(len=:), allocatable :: scene_path
+        type(text_t), allocatable :: overrides(:)
     contains
         procedure :: next => cli_next
         procedure :: take_value => cli_take_value
@@ -26,6 +30,7 @@ module ropedyn_cli
         procedure :: count => cli_count
         procedure :: positional => cli_positional
         procedure :: scene_argument => cli_scene_argument
+        procedure :: scene_overrides => cli_scene_overrides
         procedure :: require => cli_require
     end type cli_t
 
@@ -125,20 +130,30 @@ contains
     end subroutine cli_positional
 
     !> The arguments of a command that reads a scene, other than its own options:
-    !! `--set group.key=value` (appended to `overrides`) or the scene file.
-    subroutine cli_scene_argument(self, overrides, scene_path, err)
+    !! `--set group.key=value` (appended to self%overrides) or the scene file
+    !! (self%scene_path).
+    subroutine cli_scene_argument(self, err)
         class(cli_t), intent(inout) :: self
-        type(text_t), allocatable, intent(inout) :: overrides(:)
-        character(len=:), allocatable, intent(inout) :: scene_path
         type(error_t), allocatable, intent(out) :: err
         character(len=:), allocatable :: value
         if (self%option == '--set') then
             call self%take_value(value, err)
-            if (.not. allocated(err)) call append_text(overrides, value)
+            if (.not. allocated(err)) call append_text(self%overrides, value)
         else
-            call self%positional('scene file', scene_path, err)
+            call self%positional('scene file', self%scene_path, err)
         end if
     end subroutine cli_scene_argument
+
+    !> The `--set` overrides taken so far, in order (none: an empty list).
+    pure function cli_scene_overrides(self) result(list)
+        class(cli_t), intent(in) :: self
+        character(len=:), allocatable :: list(:)
+        if (allocated(self%overrides)) then
+            list = text_array(self%overrides)
+        else
+            allocate (character(len=1) :: list(0))
+        end if
+    end function cli_scene_overrides
 
     !> A usage error 'needs WHAT' unless `path` was given.
     subroutine cli_require(self, path, what, err)

@@ -5,7 +5,6 @@ module ropedyn_cmd_run
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_INTERRUPTED
     use ropedyn_cli, only: cli_t
     use ropedyn_help, only: print_help
-    use ropedyn_text, only: text_t, text_array
     use ropedyn_scene, only: scene_t, read_scene, read_scene_text
     use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_simulation, only: run_summary_t, run_scene
@@ -19,12 +18,10 @@ contains
     subroutine run_command(cli, err)
         type(cli_t), intent(inout) :: cli
         type(error_t), allocatable, intent(out) :: err
-        type(text_t), allocatable :: overrides(:)
-        character(len=:), allocatable :: scene_path, resume_path
+        character(len=:), allocatable :: resume_path
         type(scene_t) :: scene
         type(run_summary_t) :: summary
 
-        allocate (overrides(0))
         do while (cli%next())
             select case (cli%option)
             case ('--help', '-h')
@@ -38,23 +35,23 @@ contains
                 call cli%take_value(resume_path, err)
                 if (allocated(err)) return
             case default
-                call cli%scene_argument(overrides, scene_path, err)
+                call cli%scene_argument(err)
                 if (allocated(err)) return
             end select
         end do
         if (allocated(resume_path)) then
-            if (allocated(scene_path)) then
+            if (allocated(cli%scene_path)) then
                 call cli%usage_error('--resume takes the scene from FILE.h5: give no scene '// &
-                                     'file ('//scene_path//')', err)
+                                     'file ('//cli%scene_path//')', err)
                 return
             end if
-            call resume_scene(resume_path, text_array(overrides), scene, err)
+            call resume_scene(resume_path, cli%scene_overrides(), scene, err)
             if (allocated(err)) return
             call run_scene(scene, summary, err, resume=.true.)
         else
-            call cli%require(scene_path, 'a scene file', err)
+            call cli%require(cli%scene_path, 'a scene file', err)
             if (allocated(err)) return
-            call read_scene(scene_path, text_array(overrides), scene, err)
+            call read_scene(cli%scene_path, cli%scene_overrides(), scene, err)
             if (allocated(err)) return
             call run_scene(scene, summary, err)
         end if

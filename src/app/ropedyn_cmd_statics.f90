@@ -7,7 +7,6 @@ module ropedyn_cmd_statics
     use ropedyn_error, only: error_t
     use ropedyn_cli, only: cli_t
     use ropedyn_help, only: print_help
-    use ropedyn_text, only: text_t, text_array
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_statics, only: statics_options_t
     use ropedyn_analysis, only: run_analysis, DEFAULT_MODE_COUNT
@@ -22,13 +21,11 @@ contains
         character(len=*), intent(in) :: command   !< 'statics' or 'modes'
         type(cli_t), intent(inout) :: cli
         type(error_t), allocatable, intent(out) :: err
-        type(text_t), allocatable :: overrides(:)
-        character(len=:), allocatable :: scene_path, out_path
+        character(len=:), allocatable :: out_path
         type(statics_options_t) :: options
         type(scene_t) :: scene
         integer :: count
 
-        allocate (overrides(0))
         count = DEFAULT_MODE_COUNT
         out_path = ''
         do while (cli%next())
@@ -52,13 +49,13 @@ contains
                 call cli%int_value(options%max_iterations, 1, err)
                 if (allocated(err)) return
             case default
-                call cli%scene_argument(overrides, scene_path, err)
+                call cli%scene_argument(err)
                 if (allocated(err)) return
             end select
         end do
-        call cli%require(scene_path, 'a scene file', err)
+        call cli%require(cli%scene_path, 'a scene file', err)
         if (allocated(err)) return
-        call read_scene(scene_path, text_array(overrides), scene, err)
+        call read_scene(cli%scene_path, cli%scene_overrides(), scene, err)
         if (allocated(err)) return
         call run_analysis(command, scene, options, count, out_path, err)
     end subroutine analysis_command

@@ -24,7 +24,7 @@ module ropedyn_run_record
     use ropedyn_rope_model, only: energy_t
     implicit none
     private
-    public :: run_record_t, read_run_record, check_record_fits, LAST_RECORD
+    public :: run_record_t, read_run_record, check_record_fits, read_record_times, LAST_RECORD
 
     !> `record` argument of read_run_record: the last complete record.
     integer, parameter :: LAST_RECORD = -1
@@ -84,13 +84,9 @@ contains
             call h5%read_reals('/rope/element_length', values, dims1, err)
             if (allocated(err)) exit steps
             rec%n_elements = size(values)
-            call h5%read_reals('/time', time, dims1, err)
+            call read_record_times(h5, path, time, err)
             if (allocated(err)) exit steps
             rec%records = size(time)
-            if (rec%records == 0) then
-                call make_error(err, ERR_INPUT, path//': no complete record')
-                exit steps
-            end if
             rec%record = record
             if (record == LAST_RECORD) rec%record = rec%records - 1
             if (rec%record < 0 .or. rec%record >= rec%records) then
@@ -123,6 +119,20 @@ contains
         if (.not. allocated(rec%y)) allocate (rec%y(0))
         if (.not. allocated(rec%yq)) allocate (rec%yq(0))
     end subroutine read_run_record
+
+    !> The times of the complete records of the run file `path`, open as h5: /time, which
+    !! the writer extends last in a record, so that its length counts the complete records.
+    !! ERR_INPUT when there is none.
+    subroutine read_record_times(h5, path, time, err)
+        type(h5_file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: path
+        real(wp), allocatable, intent(out) :: time(:)
+        type(error_t), allocatable, intent(out) :: err
+        integer(hsize_t) :: dims1(1)
+        call h5%read_reals('/time', time, dims1, err)
+        if (allocated(err)) return
+        if (size(time) == 0) call make_error(err, ERR_INPUT, path//': no complete record')
+    end subroutine read_record_times
 
     !> Whether a model of kind `model` ('rfem', 'mpp') with `state_size` unknowns and
     !! `quad_size` quadratures can start from `rec`; if not, an ERR_INPUT error naming the

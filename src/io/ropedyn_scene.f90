@@ -48,10 +48,6 @@ contains
         character(len=*), intent(in) :: overrides(:)  !< 'group.key=value', may be empty
         type(scene_t), target, intent(out) :: scene
         type(error_t), allocatable, intent(out) :: err
-        type(scene_key_t), allocatable :: keys(:)
-        type(override_t), allocatable :: ov(:)
-        type(nml_file_t) :: file
-        integer :: i
 
         scene%path = trim(path)
         if (printable(scene%path) /= scene%path) then
@@ -59,16 +55,7 @@ contains
                 //'the file name')
             return
         end if
-        call bind_keys(scene, keys)
-        allocate (ov(size(overrides)))
-        do i = 1, size(overrides)
-            call parse_override(overrides(i), keys, ov(i), err)
-            if (allocated(err)) return
-        end do
-        call read_namelist_file(scene%path, GROUP_NAMES, file, err, required='model', &
-            not_what='not a scene file (a scene needs at least &model)')
-        if (allocated(err)) return
-        call store_scene(file, ov, keys, scene, err)
+        call load_scene(overrides, scene, err)
     end subroutine read_scene
 
     !> Read a scene from namelist text (e.g. the `scene` attribute of a run file, the echo of
@@ -80,35 +67,53 @@ contains
         character(len=*), intent(in) :: overrides(:)  !< 'group.key=value', may be empty
         type(scene_t), target, intent(out) :: scene
         type(error_t), allocatable, intent(out) :: err
+
+        scene%path = origin
+        call load_scene(overrides, scene, err, text)
+    end subroutine read_scene_text
+
+    !> The steps of `read_scene` and `read_scene_text` after scene%path is set: the
+    !! overrides parsed against the scene's keys, then the namelist read (from `text` when
+    !! present, else from the file scene%path), stored and checked.
+    subroutine load_scene(overrides, scene, err, text)
+        character(len=*), intent(in) :: overrides(:)
+        type(scene_t), target, intent(inout) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        character(len=*), intent(in), optional :: text
         type(scene_key_t), allocatable :: keys(:)
         type(override_t), allocatable :: ov(:)
         type(nml_file_t) :: file
         type(text_t), allocatable :: lines(:)
         integer :: i, start, nl
 
-        scene%path = origin
         call bind_keys(scene, keys)
         allocate (ov(size(overrides)))
         do i = 1, size(overrides)
             call parse_override(overrides(i), keys, ov(i), err)
             if (allocated(err)) return
         end do
-        allocate (lines(0))
-        start = 1
-        do while (start <= len(text))
-            nl = index(text(start:), new_line('a'))
-            if (nl == 0) nl = len(text) - start + 2
-            call append_text(lines, text(start:start + nl - 2))
-            start = start + nl
-        end do
-        call parse_namelist_lines(origin, lines, GROUP_NAMES, file, err)
-        if (allocated(err)) return
-        if (file%find('model') == 0) then
-            call make_error(err, ERR_INPUT, origin//': no &model group: not a scene')
-            return
+        if (present(text)) then
+            allocate (lines(0))
+            start = 1
+            do while (start <= len(text))
+                nl = index(text(start:), new_line('a'))
+                if (nl == 0) nl = len(text) - start + 2
+                call append_text(lines, text(start:start + nl - 2))
+                start = start + nl
+            end do
+            call parse_namelist_lines(scene%path, lines, GROUP_NAMES, file, err)
+            if (allocated(err)) return
+            if (file%find('model') == 0) then
+                call make_error(err, ERR_INPUT, scene%path//': no &model group: not a scene')
+                return
+            end if
+        else
+            call read_namelist_file(scene%path, GROUP_NAMES, file, err, required='model', &
+                not_what='not a scene file (a scene needs at least &model)')
+            if (allocated(err)) return
         end if
         call store_scene(file, ov, keys, scene, err)
-    end subroutine read_scene_text
+    end subroutine load_scene
 
     !> The groups of a parsed file and the overrides, group by group, into the scene; then
     !! the checks of the whole scene.

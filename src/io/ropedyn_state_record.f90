@@ -11,6 +11,7 @@ module ropedyn_state_record
     use ropedyn_text, only: int_text, real_text
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_h5, only: h5_file_t
+    use ropedyn_run_record, only: read_record_times
     implicit none
     private
     public :: state_record_t, read_state_record
@@ -45,7 +46,7 @@ contains
         type(h5_file_t) :: h5
         type(error_t), allocatable :: close_err
         real(wp), allocatable :: time(:), values(:)
-        integer(hsize_t) :: dims1(1), dims2(2), dims3(3)
+        integer(hsize_t) :: dims2(2), dims3(3)
         logical :: found
         real(wp) :: slack
         integer :: k, nt
@@ -64,15 +65,10 @@ contains
                                 'the root attribute model, /time, /state/q and /state/qdot)')
                 exit steps
             end if
-            call h5%read_reals('/time', time, dims1, err)
+            call read_record_times(h5, path, time, err)
             if (allocated(err)) exit steps
-            ! /time is written last in a record: its length counts the complete records
             nt = size(time)
             rec%records = nt
-            if (nt == 0) then
-                call make_error(err, ERR_INPUT, path//': no complete record')
-                exit steps
-            end if
             if (state_time < 0.0_wp) then
                 k = nt
             else

@@ -38,6 +38,9 @@ module ropedyn_sweep_file
 
     !> How the errors of the summary are measured.
     integer, parameter :: REF_NONE = 0, REF_TIGHTEST = 1, REF_FILE = 2, REF_TIGHTEST_PER_METHOD = 3
+    !> The `reference` keyword of each REF_* value (REF_FILE has none: a run file's name).
+    character(len=*), parameter :: REFERENCE_KEYWORDS(0:3) = [character(len=19) :: 'none', &
+        'tightest', '', 'tightest_per_method']
 
     !> The keys of a sweep file: name, type ('s' string, 'i' integer, 'r' real), most values.
     type :: sweep_key_t
@@ -77,6 +80,8 @@ module ropedyn_sweep_file
         type(dimension_t), allocatable :: dims(:)
         logical :: atol_given = .false.
         real(wp) :: atol_per_rtol = 0.0_wp           !< when atol_given
+    contains
+        procedure :: reference_setting => sweep_reference_setting
     end type sweep_file_t
 
 contains
@@ -209,17 +214,16 @@ contains
         type(error_t), allocatable, intent(out) :: err
         type(case_data_t) :: data
         character(len=:), allocatable :: value, hint
+        integer :: k
         value = 'tightest'
         if (raw%n > 0) value = trim(adjustl(raw%text(1)%s))
-        select case (lower(value))
-        case ('tightest')
-            sweep%reference = REF_TIGHTEST
-        case ('tightest_per_method')
-            sweep%reference = REF_TIGHTEST_PER_METHOD
-        case ('none', '')
-            sweep%reference = REF_NONE
-        case default
-            sweep%reference = REF_FILE
+        sweep%reference = REF_FILE
+        if (len(value) == 0) sweep%reference = REF_NONE
+        do k = lbound(REFERENCE_KEYWORDS, 1), ubound(REFERENCE_KEYWORDS, 1)
+            if (k /= REF_FILE .and. lower(value) == trim(REFERENCE_KEYWORDS(k))) &
+                sweep%reference = k
+        end do
+        if (sweep%reference == REF_FILE) then
             sweep%reference_file = relative_to(dir, value)
             call read_case_file(sweep%reference_file, data, err, series=.true.)
             if (allocated(err)) then
@@ -240,8 +244,20 @@ contains
                     //'complete run (status '//data%status//', '//int_text(data%records)// &
                     ' records)')
             end if
-        end select
+        end if
     end subroutine read_reference
+
+    !> The `reference` setting as the sweep file gives it (its keyword, or the run file), as
+    !! written in summary.h5 and on the terminal.
+    function sweep_reference_setting(self) result(text)
+        class(sweep_file_t), intent(in) :: self
+        character(len=:), allocatable :: text
+        if (self%reference == REF_FILE) then
+            text = self%reference_file
+        else
+            text = trim(REFERENCE_KEYWORDS(self%reference))
+        end if
+    end function sweep_reference_setting
 
     !> The &sweep group, its values by key (typed, without gaps).
     subroutine read_raw(path, raw, err)

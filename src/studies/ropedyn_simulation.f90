@@ -422,7 +422,7 @@ contains
                 summary%order_lowered_at = t_prev
                 summary%order_before = max_order
                 summary%order_after = safe_order
-                call add_stats(stats_before, integrator%stats())
+                call stats_before%add(integrator%stats())
                 call integrator%finalize()
                 max_order = safe_order
                 t = t_prev
@@ -449,7 +449,7 @@ contains
             order = 0
             if (allocated(integrator)) then
                 stats = integrator%stats()
-                call add_stats(stats, stats_before)
+                call stats%add(stats_before)
                 h = stats%last_step
                 order = stats%last_order
             end if
@@ -480,7 +480,7 @@ contains
             call cpu_time(cpu_now)
             summary%cpu_time = cpu_before + (cpu_now - cpu_start)
             summary%stats = integrator%stats()
-            call add_stats(summary%stats, stats_before)
+            call summary%stats%add(stats_before)
             summary%stats%time_advance = time_advance
             call add_counters(summary%stats, counters_before)
             summary%t_reached = max(summary%t_reached, t)
@@ -495,26 +495,6 @@ contains
             call integrator%finalize()
         end subroutine finish
     end subroutine integrate_scene
-
-    !> Add the counters of `more` (an integrator that was replaced) to `stats`; the last
-    !! step, order and Newton path stay those of `stats`.
-    pure subroutine add_stats(stats, more)
-        type(solver_stats_t), intent(inout) :: stats
-        type(solver_stats_t), intent(in) :: more
-        stats%steps = stats%steps + more%steps
-        stats%rhs_evals = stats%rhs_evals + more%rhs_evals
-        stats%jac_rhs_evals = stats%jac_rhs_evals + more%jac_rhs_evals
-        stats%jac_evals = stats%jac_evals + more%jac_evals
-        stats%lin_setups = stats%lin_setups + more%lin_setups
-        stats%err_test_fails = stats%err_test_fails + more%err_test_fails
-        stats%nonlin_iters = stats%nonlin_iters + more%nonlin_iters
-        stats%nonlin_conv_fails = stats%nonlin_conv_fails + more%nonlin_conv_fails
-        stats%order_steps = stats%order_steps + more%order_steps
-        stats%time_rhs = stats%time_rhs + more%time_rhs
-        stats%time_jac = stats%time_jac + more%time_jac
-        stats%time_factor = stats%time_factor + more%time_factor
-        stats%time_solve = stats%time_solve + more%time_solve
-    end subroutine add_stats
 
     !> The counters of earlier parts of a resumed run added (in ropedyn_output's
     !! COUNTER_NAMES order: steps, rhs_evals, jac_evals, lin_setups, err_test_fails,

@@ -22,7 +22,7 @@ module ropedyn_sweep_runner
     use ropedyn_sweep, only: sweep_t, text_t
     use ropedyn_text, only: int_text
     use ropedyn_sweep_status, only: case_state_t, case_state, STATUS_NAMES
-    use ropedyn_sweep_summary, only: case_row_t, build_summary, reference_setting
+    use ropedyn_sweep_summary, only: case_row_t, build_summary
     use ropedyn_sweep_task, only: case_label
     implicit none
     private
@@ -364,7 +364,7 @@ contains
         bad = size(rows) - complete
         if (.not. quiet) write (error_unit, '(a)') 'sweep: '//int_text(complete)//' of '// &
             int_text(size(rows))//' cases complete; summary: '//sweep%output_dir// &
-            '/summary.csv, summary.h5 (reference: '//reference_setting(sweep)//')'
+            '/summary.csv, summary.h5 (reference: '//sweep%reference_setting()//')'
         if (bad == 0) return
         shown = 0
         do c = 1, size(rows)

@@ -12,7 +12,7 @@ module ropedyn_sweep_summary
     use ropedyn_kinds, only: wp, i8
     use ropedyn_text, only: int_text, real_text, enclosed, text_t, append_text
     use ropedyn_error, only: error_t, make_error, ERR_IO
-    use ropedyn_sweep, only: sweep_t, sweep_case_t, REF_NONE, REF_TIGHTEST, &
+    use ropedyn_sweep, only: sweep_t, sweep_case_t, REF_NONE, &
         REF_TIGHTEST_PER_METHOD, REF_FILE
     use ropedyn_sweep_status, only: case_state_t, case_state
     use ropedyn_case_file, only: case_data_t, read_case_file
@@ -21,7 +21,7 @@ module ropedyn_sweep_summary
     use ropedyn_version, only: version_string
     implicit none
     private
-    public :: case_row_t, build_summary, reference_setting
+    public :: case_row_t, build_summary
 
     !> Columns of summary.h5 measured per case: name and units (docs/sweeps.md).
     character(len=*), parameter :: MEASURED(2, 8) = reshape([character(len=18) :: &
@@ -46,22 +46,6 @@ module ropedyn_sweep_summary
     end type case_row_t
 
 contains
-
-    !> The sweep's `reference` setting as written in summary.h5 and on the terminal.
-    function reference_setting(sweep) result(text)
-        type(sweep_t), intent(in) :: sweep
-        character(len=:), allocatable :: text
-        select case (sweep%reference)
-        case (REF_NONE)
-            text = 'none'
-        case (REF_TIGHTEST)
-            text = 'tightest'
-        case (REF_TIGHTEST_PER_METHOD)
-            text = 'tightest_per_method'
-        case default
-            text = sweep%reference_file
-        end select
-    end function reference_setting
 
     !> Build the rows from the case files and write summary.csv and summary.h5.
     !! `warnings`: one line per reference group whose reference fell back to a looser case.
@@ -448,7 +432,7 @@ contains
             if (allocated(err)) exit steps
             call h5%attribute('/', 'base', sweep%base, err)
             if (allocated(err)) exit steps
-            call h5%attribute('/', 'reference', reference_setting(sweep), err)
+            call h5%attribute('/', 'reference', sweep%reference_setting(), err)
             if (allocated(err)) exit steps
             call h5%attribute('/', 'version', version_string, err)
         end block steps

@@ -194,11 +194,14 @@ module ropedyn_mpp
 
         !> At (t, y): cos/sin, the factors of M, the accelerations self%acc = M^{-1} f, the
         !! residual self%r0 there and self%dr = d r(q, q', acc)/d(q, q'), exact (the tangent
-        !! of the O(n) residual, column by column: O(n^2)).
-        module subroutine derivatives(self, t, y, status)
+        !! of the O(n) residual, column by column: O(n^2)); with `solved`, M^{-1} applied to
+        !! its columns (da/d(q, q'), the explicit system's rows). STATUS_RECOVERABLE when a
+        !! factor or a column is not finite.
+        module subroutine derivatives(self, t, y, solved, status)
             class(mpp_t), intent(inout) :: self
             real(wp), intent(in) :: t
             real(wp), intent(in) :: y(:)
+            logical, intent(in) :: solved
             integer, intent(out) :: status
         end subroutine derivatives
 

@@ -395,22 +395,13 @@ contains
                            self%pm_body, self%pm_r, self%pm_m, self%mm)
     end subroutine assemble_mass_work
 
-    module procedure mpp_rhs
-        real(wp) :: zero(self%ndof)
-        integer :: nd
-        nd = self%ndof
-        zero = 0.0_wp
-        call angles(self, y)
-        call self%residual_core(t, y, zero, ydot(nd + 1:2*nd))
-        call self%mass_factor(y, status)
-        if (status /= STATUS_OK) return
-        call mass_solve(self, ydot(nd + 1:2*nd))
-        ydot(1:nd) = y(nd + 1:2*nd)
-        status = STATUS_OK
-        if (.not. all(ieee_is_finite(ydot(nd + 1:2*nd)))) status = STATUS_RECOVERABLE
-    end procedure mpp_rhs
-
-    module procedure mpp_implicit_rhs
+    !> F of the implicit form M(q) y' = F: (q', r(t, q, q', 0)), the residual at zero
+    !! accelerations (self%cs set to the angles of y on the way).
+    subroutine implicit_form_rhs(self, t, y, f)
+        class(mpp_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: f(:)
         real(wp) :: zero(self%ndof)
         integer :: nd
         nd = self%ndof
@@ -418,6 +409,21 @@ contains
         f(1:nd) = y(nd + 1:2*nd)
         call angles(self, y)
         call self%residual_core(t, y, zero, f(nd + 1:2*nd))
+    end subroutine implicit_form_rhs
+
+    module procedure mpp_rhs
+        integer :: nd
+        nd = self%ndof
+        call implicit_form_rhs(self, t, y, ydot)
+        call self%mass_factor(y, status)
+        if (status /= STATUS_OK) return
+        call mass_solve(self, ydot(nd + 1:2*nd))
+        status = STATUS_OK
+        if (.not. all(ieee_is_finite(ydot(nd + 1:2*nd)))) status = STATUS_RECOVERABLE
+    end procedure mpp_rhs
+
+    module procedure mpp_implicit_rhs
+        call implicit_form_rhs(self, t, y, f)
         status = STATUS_OK
         if (.not. all(ieee_is_finite(f))) status = STATUS_RECOVERABLE
     end procedure mpp_implicit_rhs
@@ -460,6 +466,12 @@ contains
         end do
         status = STATUS_OK
         if (.not. all(ieee_is_finite(self%dr))) status = STATUS_RECOVERABLE
+        if (status /= STATUS_OK .or. .not. solved) return
+        do j = 1, 2*nd
+            call ab_solve(self%n, self%nu, self%cs, self%ab_g, self%ab_h, self%ab_dinv, &
+                          self%ab_lam, self%dr(:, j))
+        end do
+        if (.not. all(ieee_is_finite(self%dr))) status = STATUS_RECOVERABLE
     end procedure derivatives
 
     !> Add the dense a(nr, nc) into band storage b(ld, *) (entry (i, j) at row
@@ -481,40 +493,28 @@ contains
         integer :: nd, j
 
         nd = self%ndof
-        call self%derivatives(t, y, status)
+        call self%derivatives(t, y, .true., status)
         if (status /= STATUS_OK) return
         ! rows 1..nd: dq'/dv = I; rows nd+1..2nd: da/dy = M^{-1} dr/dy
         do j = 1, nd
             jb(offset - nd, nd + j) = jb(offset - nd, nd + j) + 1.0_wp
         end do
-        do j = 1, 2*nd
-            call ab_solve(self%n, self%nu, self%cs, self%ab_g, self%ab_h, self%ab_dinv, &
-                          self%ab_lam, self%dr(:, j))
-        end do
         call add_to_band(jb, size(jb, 1), offset, self%dr, nd, 0)
-        status = STATUS_OK
-        if (.not. all(ieee_is_finite(self%dr))) status = STATUS_RECOVERABLE
     end procedure mpp_jacobian
 
     module procedure mpp_second_order_blocks
-        integer :: nd, j
+        integer :: nd
 
         nd = self%ndof
-        call self%derivatives(t, y, status)
+        call self%derivatives(t, y, .not. implicit_form, status)
         if (status /= STATUS_OK) return
         if (implicit_form) then
             call assemble_mass_work(self, y)
             call add_to_band(mb, size(mb, 1), offset, self%mm, 0, 0)
         else
-            do j = 1, 2*nd
-                call ab_solve(self%n, self%nu, self%cs, self%ab_g, self%ab_h, self%ab_dinv, &
-                              self%ab_lam, self%dr(:, j))
-            end do
             mb(offset, 1:nd) = mb(offset, 1:nd) + 1.0_wp
         end if
         call add_to_band(kb, size(kb, 1), offset, self%dr(:, 1:nd), 0, 0)
         call add_to_band(cb, size(cb, 1), offset, self%dr(:, nd + 1:2*nd), 0, 0)
-        status = STATUS_OK
-        if (.not. all(ieee_is_finite(self%dr))) status = STATUS_RECOVERABLE
     end procedure mpp_second_order_blocks
 end submodule ropedyn_mpp_kernels

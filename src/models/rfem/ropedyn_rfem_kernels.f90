@@ -1,9 +1,10 @@
-!> The RFEM kernels: generalized forces, right-hand side, analytic Jacobian (as blocks of
-!! element pairs, for the first-order band and for the second-order blocks), energies and
-!! the dissipation and external power (the derivation is in docs/physics-rfem.md).
+!> The RFEM kernels: generalized forces, right-hand side, the analytic Jacobian as blocks of
+!! element pairs (written into the band by ropedyn_rfem_jacobian), energies and the
+!! dissipation and external power (the derivation is in docs/physics-rfem.md).
 !!
 !! Each kernel makes one pass over the internal SDEs j = 2 .. n (elements a = j-1, b = j),
-!! with cos and sin of every angle computed once per call (self%cs):
+!! with cos and sin of every angle computed once per call (self%cs), and takes the geometry
+!! of each SDE from `sde_at` (and its rates from `sde_rates`):
 !!     d = c_b - h_b e_b - c_a - h_a e_a,  dwx = e_a.d (tension),  dwy = n_a.d (shear),
 !!     cd = e_a.e_b = cos(phi_b - phi_a),  sd = n_a.e_b = sin(phi_b - phi_a),
 !! the strain rates (only when damping is on)
@@ -20,6 +21,18 @@ submodule (ropedyn_rfem) ropedyn_rfem_kernels
     use ropedyn_trig, only: cos_sin
     implicit none
 
+    !> SDE j between elements a = j - 1 and b = j at a state y (the module header's
+    !! formulas; self%cs holding the angles of y): where a's and b's coordinates start in y
+    !! (ka, kb: x at ka + 1), cos, sin and half length of both, the tension and shear
+    !! strains dwx, dwy and cos, sin of phi_b - phi_a (cd, sd); after `sde_rates` also the
+    !! angular velocities wa, wb and the strain rates rx, ry, rp.
+    type :: sde_t
+        integer :: ka, kb
+        real(wp) :: ca, sa, cb, sb, ha, hb
+        real(wp) :: dwx, dwy, cd, sd
+        real(wp) :: wa, wb, rx, ry, rp
+    end type sde_t
+
 contains
 
     !> cos and sin of every element angle into self%cs, once per call (gathered, then
@@ -31,6 +44,43 @@ contains
         end do
         call cos_sin(self%phi, self%cs)
     end procedure angles
+
+    !> The geometry of SDE j at y (sde_t), computed once for every kernel's pass.
+    pure function sde_at(self, y, j) result(s)
+        class(rfem_t), intent(in) :: self
+        real(wp), intent(in) :: y(:)
+        integer, intent(in) :: j
+        type(sde_t) :: s
+        real(wp) :: dx, dy
+        s%ka = 6*(j - 2)
+        s%kb = s%ka + 6
+        s%ca = self%cs(1, j - 1)
+        s%sa = self%cs(2, j - 1)
+        s%cb = self%cs(1, j)
+        s%sb = self%cs(2, j)
+        s%ha = self%half(j - 1)
+        s%hb = self%half(j)
+        dx = y(s%kb + 1) - s%hb*s%cb - y(s%ka + 1) - s%ha*s%ca
+        dy = y(s%kb + 2) - s%hb*s%sb - y(s%ka + 2) - s%ha*s%sa
+        s%dwx = s%ca*dx + s%sa*dy
+        s%dwy = -s%sa*dx + s%ca*dy
+        s%cd = s%ca*s%cb + s%sa*s%sb
+        s%sd = s%ca*s%sb - s%sa*s%cb
+    end function sde_at
+
+    !> The rates of SDE s at y: angular velocities and strain rates (only when damping is on).
+    pure subroutine sde_rates(s, y)
+        type(sde_t), intent(inout) :: s
+        real(wp), intent(in) :: y(:)
+        real(wp) :: dvx, dvy
+        dvx = y(s%kb + 4) - y(s%ka + 4)
+        dvy = y(s%kb + 5) - y(s%ka + 5)
+        s%wa = y(s%ka + 6)
+        s%wb = y(s%kb + 6)
+        s%rx = s%ca*dvx + s%sa*dvy + s%dwy*s%wa + s%hb*s%sd*s%wb
+        s%ry = -s%sa*dvx + s%ca*dvy - (s%dwx + s%ha)*s%wa - s%hb*s%cd*s%wb
+        s%rp = s%wb - s%wa
+    end subroutine sde_rates
 
     !> Add the generalized force of support k (translational spring and damper on d, and
     !! for a clamp the rotational one) to f(3), the force on its element; with `energy`
@@ -113,6 +163,61 @@ contains
         end associate
     end subroutine support_power
 
+    !> Add -k G^T G, G = [[sg, 0, h si], [0, sg, -h co]] the gradient of a support's
+    !! displacement d (or of d' with respect to the rates), to the 3x3 block b, except its
+    !! (3, 3) entry -k h^2, which the caller adds (for the spring together with the moment
+    !! of the force, as the force's other phi terms). sh = sg h.
+    pure subroutine add_spring(b, k, sh, co, si)
+        real(wp), intent(inout) :: b(3, 3)
+        real(wp), intent(in) :: k, sh, co, si
+        b(1, 1) = b(1, 1) - k
+        b(2, 2) = b(2, 2) - k
+        b(1, 3) = b(1, 3) - sh*k*si
+        b(2, 3) = b(2, 3) + sh*k*co
+        b(3, 1) = b(3, 1) - sh*k*si
+        b(3, 2) = b(3, 2) + sh*k*co
+    end subroutine add_spring
+
+    !> Add the derivatives of support k's generalized force with respect to its element's
+    !! (x, y, phi, x', y', phi') to blk(3, 6).
+    pure subroutine support_jacobian(self, k, y, blk)
+        class(rfem_t), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(inout) :: blk(3, 6)
+        real(wp) :: h, co, si, w, d(2), fs(2), sg
+        integer :: m
+        associate (sp => self%sup(k))
+            m = 6*(sp%elem - 1)
+            h = self%half(sp%elem)
+            co = cos(y(m + 3))
+            si = sin(y(m + 3))
+            w = y(m + 6)
+            sg = sp%sgn
+            if (sp%translational) then
+                ! F = Ct d + Bt d' acts as -sgn F on the centre and h n.F as moment; d and d'
+                ! have the same gradient G with respect to (x, y, phi) and (x', y', phi'),
+                ! so the spring's block and the damper's have one pattern (add_spring)
+                d(1) = sg*(y(m + 1) - sp%anchor(1)) - h*co
+                d(2) = sg*(y(m + 2) - sp%anchor(2)) - h*si
+                fs = sp%ct*d
+                call add_spring(blk(:, 1:3), sp%ct, sg*h, co, si)
+                if (sp%damped_t) then
+                    fs(1) = fs(1) + sp%bt*(sg*(y(m + 4) - sp%anchor_vel(1)) + h*w*si)
+                    fs(2) = fs(2) + sp%bt*(sg*(y(m + 5) - sp%anchor_vel(2)) - h*w*co)
+                    blk(1, 3) = blk(1, 3) - sg*h*sp%bt*w*co
+                    blk(2, 3) = blk(2, 3) - sg*h*sp%bt*w*si
+                    call add_spring(blk(:, 4:6), sp%bt, sg*h, co, si)
+                    blk(3, 6) = blk(3, 6) - sp%bt*h**2
+                end if
+                blk(3, 3) = blk(3, 3) - h*(co*fs(1) + si*fs(2)) - sp%ct*h**2
+            end if
+            if (sp%rotational) then
+                blk(3, 3) = blk(3, 3) - sp%cr
+                if (sp%damped_r) blk(3, 6) = blk(3, 6) - sp%br
+            end if
+        end associate
+    end subroutine support_jacobian
     module procedure fill_bodies
         integer :: i, k
         do i = 1, self%n
@@ -124,38 +229,10 @@ contains
         end do
     end procedure fill_bodies
 
-    !> Accelerations (x'', y'', phi'') of the element carrying point-mass group p, from its
-    !! generalized force g (3).
-    pure function pm_acceleration(self, p, y, g) result(a)
-        class(rfem_t), intent(in) :: self
-        integer, intent(in) :: p
-        real(wp), intent(in) :: y(:), g(3)
-        real(wp) :: a(3)
-        integer :: i, k
-        real(wp) :: e(2), nv(2), f(2), sm
-        i = self%pm_elem(p)
-        k = 6*(i - 1)
-        sm = self%pm_moment(p)
-        e = [cos(y(k + 3)), sin(y(k + 3))]
-        nv = [-e(2), e(1)]
-        f = g(1:2) + sm*y(k + 6)**2*e
-        a(3) = (g(3) - sm*dot_product(nv, f)/self%mass(i)) &
-               /(self%inertia(i) - sm**2/self%mass(i))
-        a(1:2) = (f - sm*nv*a(3))/self%mass(i)
-    end function pm_acceleration
-
-    module procedure point_mass_accelerations
-        integer :: p, k
-        do p = 1, size(self%pm_elem)
-            k = 6*(self%pm_elem(p) - 1)
-            ydot(k + 4:k + 6) = pm_acceleration(self, p, y, gen(:, self%pm_elem(p)))
-        end do
-    end procedure point_mass_accelerations
-
     module procedure forces
-        integer :: j, ka, kb, n, p, i
-        real(wp) :: dwx, dwy, cd, sd, rx, ry, rp, fx, fy, fp, ffx, ffy, c(3), e_el
-        real(wp) :: ca, sa, cb, sb, ha, hb, dx, dy, dvx, dvy, wa, wb, p_in
+        integer :: j, n, p, i
+        real(wp) :: fx, fy, fp, ffx, ffy, c(3), e_el, p_in
+        type(sde_t) :: s
         logical :: energy, with_power
 
         n = self%n
@@ -169,50 +246,31 @@ contains
         c = 0.0_wp
         if (self%sup(1)%active) call support_force(self, 1, y, c, energy, e_el)
         do j = 2, n
-            ! geometry and rates of SDE j (the module header's formulas, written out)
-            ka = 6*(j - 2)
-            kb = ka + 6
-            ca = self%cs(1, j - 1)
-            sa = self%cs(2, j - 1)
-            cb = self%cs(1, j)
-            sb = self%cs(2, j)
-            ha = self%half(j - 1)
-            hb = self%half(j)
-            dx = y(kb + 1) - hb*cb - y(ka + 1) - ha*ca
-            dy = y(kb + 2) - hb*sb - y(ka + 2) - ha*sa
-            dwx = ca*dx + sa*dy
-            dwy = -sa*dx + ca*dy
-            cd = ca*cb + sa*sb
-            sd = ca*sb - sa*cb
+            s = sde_at(self, y, j)
             fx = 0.0_wp
             fy = 0.0_wp
             fp = 0.0_wp
-            if (self%tension) fx = self%cx*dwx
-            if (self%shear) fy = self%cy*dwy
-            if (self%bending) fp = self%cpj(j)*(y(kb + 3) - y(ka + 3))
-            if (energy) e_el = e_el + 0.5_wp*(fx*dwx + fy*dwy + fp*(y(kb + 3) - y(ka + 3)))
+            if (self%tension) fx = self%cx*s%dwx
+            if (self%shear) fy = self%cy*s%dwy
+            if (self%bending) fp = self%cpj(j)*(y(s%kb + 3) - y(s%ka + 3))
+            if (energy) e_el = e_el + 0.5_wp*(fx*s%dwx + fy*s%dwy &
+                                              + fp*(y(s%kb + 3) - y(s%ka + 3)))
             if (self%damped) then
-                dvx = y(kb + 4) - y(ka + 4)
-                dvy = y(kb + 5) - y(ka + 5)
-                wa = y(ka + 6)
-                wb = y(kb + 6)
-                rx = ca*dvx + sa*dvy + dwy*wa + hb*sd*wb
-                ry = -sa*dvx + ca*dvy - (dwx + ha)*wa - hb*cd*wb
-                rp = wb - wa
-                fx = fx + self%bx*rx
-                fy = fy + self%by*ry
-                fp = fp + self%bpj(j)*rp
-                if (with_power) p_in = p_in + (self%bx*rx**2 + self%by*ry**2 + &
-                                               self%bpj(j)*rp**2)
+                call sde_rates(s, y)
+                fx = fx + self%bx*s%rx
+                fy = fy + self%by*s%ry
+                fp = fp + self%bpj(j)*s%rp
+                if (with_power) p_in = p_in + (self%bx*s%rx**2 + self%by*s%ry**2 + &
+                                               self%bpj(j)*s%rp**2)
             end if
-            ffx = fx*ca - fy*sa
-            ffy = fx*sa + fy*ca
+            ffx = fx*s%ca - fy*s%sa
+            ffy = fx*s%sa + fy*s%ca
             self%gen(1, j - 1) = c(1) + ffx + self%weight(j - 1)
             self%gen(2, j - 1) = c(2) + ffy
-            self%gen(3, j - 1) = c(3) + (fy*(dwx + ha) - fx*dwy + fp)
+            self%gen(3, j - 1) = c(3) + (fy*(s%dwx + s%ha) - fx*s%dwy + fp)
             c(1) = -ffx
             c(2) = -ffy
-            c(3) = -hb*(fx*sd - fy*cd) - fp
+            c(3) = -s%hb*(fx*s%sd - fy*s%cd) - fp
         end do
         if (self%sup(2)%active) call support_force(self, 2, y, c, energy, e_el)
         self%gen(1, n) = c(1) + self%weight(n)
@@ -294,116 +352,119 @@ contains
         has = .true.
     end procedure rfem_has_jacobian
 
-    module procedure point_mass_rows
-        integer :: i, o, l, p, k0
-        real(wp) :: raw(3), a(3), e(2), nv(2), sm, w
+    module procedure jacobian_blocks
+        integer :: j, n
+        real(wp) :: fx, fy, fp, t6
+        type(sde_t) :: s
+        ! local coordinates of an SDE: (x, y, phi, x', y', phi') of element a, then of b
+        real(wp) :: gx(12), gy(12), dfx(12), dfy(12), dfp(12), r1(12), r2(12), carry(3, 6)
 
-        ! Their rows hold dG/dy (rowscale 1): add the terms of the weight's moment and the
-        ! centripetal force, subtract (dA/dphi) a, and multiply by the inverse of the
-        ! element's mass block A.
-        call self%forces(t, y)
-        do p = 1, size(self%pm_elem)
-            i = self%pm_elem(p)
-            k0 = 6*(i - 1)
-            sm = self%pm_moment(p)
-            e = [cos(y(k0 + 3)), sin(y(k0 + 3))]
-            nv = [-e(2), e(1)]
-            w = y(k0 + 6)
-            a = pm_acceleration(self, p, y, self%gen(:, i))
-            do o = max(-1, 1 - i), min(1, self%n - i)
-                do l = 1, 6
-                    raw = self%blk(:, l, o, i)
-                    if (o == 0 .and. l == 3) then
-                        raw(1:2) = raw(1:2) + sm*w**2*nv
-                        if (self%gravity_on) raw(3) = raw(3) - self%g*sm*e(1)
-                        raw = raw + sm*[e(1)*a(3), e(2)*a(3), dot_product(e, a(1:2))]
-                    else if (o == 0 .and. l == 6) then
-                        raw(1:2) = raw(1:2) + 2.0_wp*sm*w*e
-                    end if
-                    raw(3) = (raw(3) - sm*dot_product(nv, raw(1:2))/self%mass(i)) &
-                             /(self%inertia(i) - sm**2/self%mass(i))
-                    raw(1:2) = (raw(1:2) - sm*nv*raw(3))/self%mass(i)
-                    self%blk(:, l, o, i) = raw
-                end do
-            end do
+        n = self%n
+        call self%set_time(t)
+        call angles(self, y)
+        ! carry: the diagonal block of element b of the previous SDE (first: the top support)
+        carry = 0.0_wp
+        if (self%sup(1)%active) call support_jacobian(self, 1, y, carry)
+        gx = 0.0_wp
+        gy = 0.0_wp
+        dfx = 0.0_wp
+        dfy = 0.0_wp
+        dfp = 0.0_wp
+        do j = 2, n
+            s = sde_at(self, y, j)
+            ! gradients of the tension and shear strains (zero on the rates)
+            gx(1) = -s%ca
+            gx(2) = -s%sa
+            gx(3) = s%dwy
+            gx(7) = s%ca
+            gx(8) = s%sa
+            gx(9) = s%hb*s%sd
+            gy(1) = s%sa
+            gy(2) = -s%ca
+            gy(3) = -(s%dwx + s%ha)
+            gy(7) = -s%sa
+            gy(8) = s%ca
+            gy(9) = -s%hb*s%cd
+            ! forces fx, fy, fp and their derivatives
+            fx = 0.0_wp
+            fy = 0.0_wp
+            fp = 0.0_wp
+            if (self%tension) then
+                fx = self%cx*s%dwx
+                dfx = self%cx*gx
+            end if
+            if (self%shear) then
+                fy = self%cy*s%dwy
+                dfy = self%cy*gy
+            end if
+            if (self%bending) then
+                fp = self%cpj(j)*(y(s%kb + 3) - y(s%ka + 3))
+                dfp(3) = -self%cpj(j)
+                dfp(9) = self%cpj(j)
+            end if
+            if (self%damped) then
+                call sde_rates(s, y)
+                ! d(rate)/dq = H q' (ry and -rx on phi_a), d(rate)/dq' = the gradient
+                if (self%tension) then
+                    fx = fx + self%bx*s%rx
+                    dfx(1) = dfx(1) + self%bx*s%sa*s%wa
+                    dfx(2) = dfx(2) - self%bx*s%ca*s%wa
+                    dfx(3) = dfx(3) + self%bx*s%ry
+                    dfx(7) = dfx(7) - self%bx*s%sa*s%wa
+                    dfx(8) = dfx(8) + self%bx*s%ca*s%wa
+                    dfx(9) = dfx(9) + self%bx*s%hb*s%cd*(s%wb - s%wa)
+                    dfx(4:6) = self%bx*gx(1:3)
+                    dfx(10:12) = self%bx*gx(7:9)
+                end if
+                if (self%shear) then
+                    fy = fy + self%by*s%ry
+                    dfy(1) = dfy(1) + self%by*s%ca*s%wa
+                    dfy(2) = dfy(2) + self%by*s%sa*s%wa
+                    dfy(3) = dfy(3) - self%by*s%rx
+                    dfy(7) = dfy(7) - self%by*s%ca*s%wa
+                    dfy(8) = dfy(8) - self%by*s%sa*s%wa
+                    dfy(9) = dfy(9) + self%by*s%hb*s%sd*(s%wb - s%wa)
+                    dfy(4:6) = self%by*gy(1:3)
+                    dfy(10:12) = self%by*gy(7:9)
+                end if
+                if (self%bending) then
+                    fp = fp + self%bpj(j)*s%rp
+                    dfp(6) = -self%bpj(j)
+                    dfp(12) = self%bpj(j)
+                end if
+            end if
+            ! rows of element a: d(F, fy (dwx + h_a) - fx dwy + fp); of element b:
+            ! d(-F, -h_b (fx sd - fy cd) - fp); columns: a's coordinates, then b's
+            r1 = s%ca*dfx - s%sa*dfy
+            r2 = s%sa*dfx + s%ca*dfy
+            r1(3) = r1(3) - fx*s%sa - fy*s%ca
+            r2(3) = r2(3) + fx*s%ca - fy*s%sa
+            self%blk(1, :, 0, j - 1) = carry(1, :) + r1(1:6)
+            self%blk(2, :, 0, j - 1) = carry(2, :) + r2(1:6)
+            self%blk(3, :, 0, j - 1) = carry(3, :) + (s%dwx + s%ha)*dfy(1:6) - s%dwy*dfx(1:6) &
+                                       + dfp(1:6) + fy*gx(1:6) - fx*gy(1:6)
+            self%blk(1, :, 1, j - 1) = r1(7:12)
+            self%blk(2, :, 1, j - 1) = r2(7:12)
+            self%blk(3, :, 1, j - 1) = (s%dwx + s%ha)*dfy(7:12) - s%dwy*dfx(7:12) + dfp(7:12) &
+                                       + fy*gx(7:12) - fx*gy(7:12)
+            t6 = s%hb*(fx*s%cd + fy*s%sd)
+            self%blk(1, :, -1, j) = -r1(1:6)
+            self%blk(2, :, -1, j) = -r2(1:6)
+            self%blk(3, :, -1, j) = -s%hb*(s%sd*dfx(1:6) - s%cd*dfy(1:6)) - dfp(1:6)
+            self%blk(3, 3, -1, j) = self%blk(3, 3, -1, j) + t6
+            carry(1, :) = -r1(7:12)
+            carry(2, :) = -r2(7:12)
+            carry(3, :) = -s%hb*(s%sd*dfx(7:12) - s%cd*dfy(7:12)) - dfp(7:12)
+            carry(3, 3) = carry(3, 3) - t6
         end do
-    end procedure point_mass_rows
-
-    !> Add the Jacobian of the first-order system into band storage jb(ld, 6n) (entry (i, j)
-    !! at row offset + i - j): the identity of the position rows and the velocity rows from
-    !! the blocks times the row scales.
-    subroutine write_first_order(self, jb, ld, offset)
-        class(rfem_t), intent(in) :: self
-        integer, intent(in) :: ld, offset
-        real(wp), intent(inout) :: jb(ld, 6*self%n)
-        integer :: i, k, c, o, l, col, p
-        real(wp) :: s1, s2, s3
-        do i = 1, self%n
-            k = 6*(i - 1)
-            ! d(position)/dt = velocity
-            do c = 1, 3
-                jb(offset - 3, k + c + 3) = jb(offset - 3, k + c + 3) + 1.0_wp
-            end do
-            s1 = self%rowscale(1, i)
-            s2 = self%rowscale(2, i)
-            s3 = self%rowscale(3, i)
-            ! rows k+4 .. k+6 from the blocks of elements i-1, i, i+1
-            do o = max(-1, 1 - i), min(1, self%n - i)
-                do l = 1, 6
-                    col = 6*(i + o - 1) + l
-                    p = offset + k + 4 - col
-                    jb(p, col) = jb(p, col) + s1*self%blk(1, l, o, i)
-                    jb(p + 1, col) = jb(p + 1, col) + s2*self%blk(2, l, o, i)
-                    jb(p + 2, col) = jb(p + 2, col) + s3*self%blk(3, l, o, i)
-                end do
-            end do
-        end do
-    end subroutine write_first_order
-
-    !> Add K (the blocks' coordinate columns), C (their rate columns), both times the row
-    !! scales, and the identity mass block into band storage (ld, 3n).
-    subroutine write_second_order(self, kb, cb, mb, ld, offset)
-        class(rfem_t), intent(in) :: self
-        integer, intent(in) :: ld, offset
-        real(wp), intent(inout) :: kb(ld, 3*self%n), cb(ld, 3*self%n), mb(ld, 3*self%n)
-        integer :: i, k, c, o, l, col, p
-        real(wp) :: s1, s2, s3
-        do i = 1, self%n
-            k = 3*(i - 1)
-            do c = 1, 3
-                mb(offset, k + c) = mb(offset, k + c) + 1.0_wp
-            end do
-            s1 = self%rowscale(1, i)
-            s2 = self%rowscale(2, i)
-            s3 = self%rowscale(3, i)
-            do o = max(-1, 1 - i), min(1, self%n - i)
-                do l = 1, 3
-                    col = 3*(i + o - 1) + l
-                    p = offset + k + 1 - col
-                    kb(p, col) = kb(p, col) + s1*self%blk(1, l, o, i)
-                    kb(p + 1, col) = kb(p + 1, col) + s2*self%blk(2, l, o, i)
-                    kb(p + 2, col) = kb(p + 2, col) + s3*self%blk(3, l, o, i)
-                    cb(p, col) = cb(p, col) + s1*self%blk(1, l + 3, o, i)
-                    cb(p + 1, col) = cb(p + 1, col) + s2*self%blk(2, l + 3, o, i)
-                    cb(p + 2, col) = cb(p + 2, col) + s3*self%blk(3, l + 3, o, i)
-                end do
-            end do
-        end do
-    end subroutine write_second_order
-
-    module procedure rfem_jacobian
-        call self%jacobian_blocks(t, y)
-        if (size(self%pm_elem) > 0) call self%point_mass_rows(t, y)
-        call write_first_order(self, jb, size(jb, 1), offset)
-        status = STATUS_OK
-    end procedure rfem_jacobian
-
-    module procedure rfem_second_order_blocks
-        call self%jacobian_blocks(t, y)
-        if (size(self%pm_elem) > 0) call self%point_mass_rows(t, y)
-        call write_second_order(self, kb, cb, mb, size(kb, 1), offset)
-        status = STATUS_OK
-    end procedure rfem_second_order_blocks
+        if (self%sup(2)%active) call support_jacobian(self, 2, y, carry)
+        self%blk(:, :, 0, n) = carry
+        ! external effects: 3x6 blocks on each element's own coordinates
+        if (size(self%effects) > 0) then
+            call self%fill_bodies(y)
+            call add_jacobians_of(self%effects, t, self%bodies, self%blk(:, :, 0, :))
+        end if
+    end procedure jacobian_blocks
 
     module procedure rfem_potential_energy
         type(energy_t) :: e
@@ -444,32 +505,12 @@ contains
         class(rfem_t), intent(in) :: self
         real(wp), intent(in) :: y(6*self%n)
         real(wp), intent(inout) :: power
-        real(wp) :: ca, sa, cb, sb, ha, hb, dx, dy, dwx, dwy, cd, sd, dvx, dvy, wa, wb
-        real(wp) :: rx, ry, rp
-        integer :: j, ka, kb
+        type(sde_t) :: s
+        integer :: j
         do j = 2, self%n
-            ka = 6*(j - 2)
-            kb = ka + 6
-            ca = self%cs(1, j - 1)
-            sa = self%cs(2, j - 1)
-            cb = self%cs(1, j)
-            sb = self%cs(2, j)
-            ha = self%half(j - 1)
-            hb = self%half(j)
-            dx = y(kb + 1) - hb*cb - y(ka + 1) - ha*ca
-            dy = y(kb + 2) - hb*sb - y(ka + 2) - ha*sa
-            dwx = ca*dx + sa*dy
-            dwy = -sa*dx + ca*dy
-            cd = ca*cb + sa*sb
-            sd = ca*sb - sa*cb
-            dvx = y(kb + 4) - y(ka + 4)
-            dvy = y(kb + 5) - y(ka + 5)
-            wa = y(ka + 6)
-            wb = y(kb + 6)
-            rx = ca*dvx + sa*dvy + dwy*wa + hb*sd*wb
-            ry = -sa*dvx + ca*dvy - (dwx + ha)*wa - hb*cd*wb
-            rp = wb - wa
-            power = power + (self%bx*rx**2 + self%by*ry**2 + self%bpj(j)*rp**2)
+            s = sde_at(self, y, j)
+            call sde_rates(s, y)
+            power = power + (self%bx*s%rx**2 + self%by*s%ry**2 + self%bpj(j)*s%rp**2)
         end do
     end subroutine internal_power
 
