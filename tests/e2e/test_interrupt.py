@@ -63,9 +63,12 @@ def test_interrupted_and_resumed_matches_the_uninterrupted_run(run, ropedyn_exe,
     full = run("run", scene, "--set", f"solver.method='{method}'", "--set",
                "output.file='full.h5'")
     assert full.returncode == 0, full.stderr
-    # interrupted after a random number of records (and a random part of a step)
+    # interrupted after a random number of records (and a random part of a step); at most
+    # 150 of the 401: the file shows its records only when flushed (every 0.1 s of wall
+    # clock, some 70 records here), so the run must have time left after the flush that
+    # shows them for the signal to find it still running
     rng = random.Random()
-    records = rng.randint(2, 250)
+    records = rng.randint(2, 150)
     print(f"signal after {records} records")
     proc = start(ropedyn_exe, tmp_path, "run", scene, "--set", f"solver.method='{method}'",
                  "--set", "output.file='part.h5'")
@@ -122,24 +125,32 @@ def test_interrupted_and_resumed_matches_the_uninterrupted_run(run, ropedyn_exe,
 
 def test_second_signal_ends_at_once(ropedyn_exe, tmp_path, scene):
     # a big rope and an implicit method: a step takes long enough for the second signal to
-    # arrive within it
-    proc = start(ropedyn_exe, tmp_path, "run", scene, "--set", "model.elements=3000",
-                 "--set", "solver.method='mebdf'", "--set", "output.file='big.h5'")
-    try:
-        wait_for_records(tmp_path / "big.h5", 1, proc)
-        time.sleep(0.2)
-        # two different signals, back to back: the same signal twice may be merged into
-        # one while pending, and a pause between them may let the first end the run
-        proc.send_signal(signal.SIGTERM)
-        proc.send_signal(signal.SIGINT)
-        _, stderr = proc.communicate(timeout=60)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
+    # arrive within it. On a loaded machine the test itself may be descheduled between the
+    # two signals for longer than the step, and the first then ends the run gracefully
+    # (exit 130): try again, up to three times
+    for attempt in range(3):
+        out = f"big{attempt}.h5"
+        proc = start(ropedyn_exe, tmp_path, "run", scene, "--set", "model.elements=3000",
+                     "--set", "solver.method='mebdf'", "--set", f"output.file='{out}'")
+        try:
+            wait_for_records(tmp_path / out, 1, proc)
+            time.sleep(0.2)
+            # two different signals, back to back: the same signal twice may be merged
+            # into one while pending, and a pause between them may let the first end the
+            # run
+            proc.send_signal(signal.SIGTERM)
+            proc.send_signal(signal.SIGINT)
+            _, stderr = proc.communicate(timeout=60)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+        if proc.returncode == 130 and "a second signal" not in stderr:
+            continue   # the second signal came after the run had ended (see above)
+        break
     # ended by whichever of the two was delivered second (pending signals go lowest first)
     assert proc.returncode in (-signal.SIGTERM, -signal.SIGINT), stderr
     assert "a second signal: ending at once" in stderr
-    with h5py.File(tmp_path / "big.h5") as f:
+    with h5py.File(tmp_path / out) as f:
         assert attr(f, "status") == "running"
 
 
