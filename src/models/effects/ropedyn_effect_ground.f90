@@ -71,15 +71,16 @@ contains
 
     !> Contact at end s (-1: A, +1: B) of body i, the point at offset r = s l/2 from the
     !! centre: penetration, its rate, normal force, tangential speed, tanh(v_t / v_reg) and
-    !! the force vector (zero when not in contact).
-    pure function contact(self, b, i, s) result(c)
+    !! the force vector (zero when not in contact). e: the body's axis (cos phi, sin phi),
+    !! computed once per body by the caller for both ends.
+    pure function contact(self, b, i, s, e) result(c)
         class(ground_effect_t), intent(in) :: self
         type(bodies_t), intent(in) :: b
         integer, intent(in) :: i, s
+        real(wp), intent(in) :: e(2)
         type(contact_t) :: c
-        real(wp) :: e(2), nv(2), x(2), v(2), kp, cp
+        real(wp) :: nv(2), x(2), v(2), kp, cp
         c%r = 0.5_wp*real(s, wp)*b%l(i)
-        e = [cos(b%phi(i)), sin(b%phi(i))]
         nv = [-e(2), e(1)]
         x = b%c(:, i) + c%r*e
         c%delta = -dot_product(x - self%p0, self%ng)
@@ -107,10 +108,10 @@ contains
         real(wp) :: e(2)
         integer :: i, s
         do i = 1, b%n
+            e = [cos(b%phi(i)), sin(b%phi(i))]
             do s = -1, 1, 2
-                c = contact(self, b, i, s)
+                c = contact(self, b, i, s, e)
                 if (c%fn <= 0.0_wp) cycle
-                e = [cos(b%phi(i)), sin(b%phi(i))]
                 f(:, i) = f(:, i) + c%f
                 m(i) = m(i) + c%r*(e(1)*c%f(2) - e(2)*c%f(1))
             end do
@@ -123,11 +124,12 @@ contains
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: jac(:, :, :)
         type(contact_t) :: c
-        real(wp) :: kp, cp, dir(2), dfdx(2, 2), dfdv(2, 2)
+        real(wp) :: kp, cp, dir(2), dfdx(2, 2), dfdv(2, 2), e(2)
         integer :: i, s, p
         do i = 1, b%n
+            e = [cos(b%phi(i)), sin(b%phi(i))]
             do s = -1, 1, 2
-                c = contact(self, b, i, s)
+                c = contact(self, b, i, s, e)
                 if (c%fn <= 0.0_wp) cycle
                 kp = 0.5_wp*self%k*b%l(i)
                 cp = 0.5_wp*self%c*b%l(i)
@@ -167,10 +169,12 @@ contains
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: dissipation, work
         type(contact_t) :: c
+        real(wp) :: e(2)
         integer :: i, s
         do i = 1, b%n
+            e = [cos(b%phi(i)), sin(b%phi(i))]
             do s = -1, 1, 2
-                c = contact(self, b, i, s)
+                c = contact(self, b, i, s, e)
                 if (c%delta <= 0.0_wp) cycle
                 ! F_N = 0 when separating faster than the spring relaxes: then the spring's
                 ! energy still falls at -k_p delta delta' > 0 (th = 0 there)
@@ -185,11 +189,13 @@ contains
         class(ground_effect_t), intent(in) :: self
         type(bodies_t), intent(in) :: b
         type(contact_t) :: c
+        real(wp) :: e(2)
         integer :: i, s
         total = 0.0_wp
         do i = 1, b%n
+            e = [cos(b%phi(i)), sin(b%phi(i))]
             do s = -1, 1, 2
-                c = contact(self, b, i, s)
+                c = contact(self, b, i, s, e)
                 total = total + c%fn
             end do
         end do
