@@ -14,10 +14,14 @@
 !! - **Step size**: a PI controller (Gustafsson 1991), h_new = h fac err^-alpha
 !!   err_old^beta, which keeps the step steady where stability, not accuracy, limits it;
 !!   growth at most 5x (1x right after a rejection), reduction at most 10x.
-!! - **Quadratures** (dissipated energy, support work) are integrated from their
-!!   right-hand side g at the accepted step points only: the cubic through the last four
-!!   values of g, integrated over the step (Adams-Moulton-like, 4th order), one g per
-!!   step instead of one per stage. They do not take part in the error test.
+!! - **Quadratures** (dissipated energy, support work) are integrated by the same pair
+!!   from their right-hand side g at every stage, yq += h sum b_i g_i, with its error
+!!   estimate h sum e_i g_i in the error test (weights rtol |yq| + atol, the norm the
+!!   larger of the state's and the quadratures'), as CVODE does with its quadratures.
+!!   The quadratures are then the pair's solution of the augmented system, so the
+!!   energy balance T + V + dissipated = E0 holds to the pair's accuracy even where g is
+!!   rough (impacts, stick-slip), where g at the step points alone aliases the
+!!   element-scale oscillations that a stability-held step does not resolve.
 !! - **Stiffness**: the last two stages are both at t + h, so rho = |k_s - k_s-1| /
 !!   |Y_s - Y_s-1| estimates the spectral radius along the error for free (Hairer's
 !!   test). When most of the last 500 steps had h rho near the stability limit and they
@@ -62,10 +66,8 @@ module ropedyn_erk
         logical :: rejected = .false.   !< the last attempt was rejected
         real(wp), allocatable :: y(:), y_old(:), ynew(:), ytmp(:), yprev(:), k(:, :), atol(:)
         real(wp), allocatable :: yq(:), yq_old(:)
-        !> quadrature history: g at the last four accepted step points, their times
-        real(wp), allocatable :: gq(:, :)
-        real(wp) :: tq(0:3) = 0.0_wp
-        integer :: nqh = 0              !< values in the quadrature history
+        !> the quadratures' right-hand side g at the stages of the current step (FSAL as k)
+        real(wp), allocatable :: gk(:, :)
         !> stiffness monitor over the last STIFF_WINDOW accepted steps
         real(wp) :: rho = 0.0_wp        !< last estimate of the spectral radius, 1/s
         integer :: stiff_steps = 0      !< stability-limited steps in the current window
@@ -88,8 +90,7 @@ module ropedyn_erk
         procedure :: stopped_by_stiffness => erk_stopped_by_stiffness
         procedure, private :: attempt_step
         procedure, private :: first_step
-        procedure, private :: accept_quadrature
-        procedure, private :: quad_integral
+        procedure, private :: quad_step
         procedure, private :: dense
         procedure, private :: failure
         procedure, private :: monitor_stiffness
@@ -98,21 +99,14 @@ module ropedyn_erk
     end type erk_t
 
     interface
-        !> g at the new step point and the increment of the quadratures over the step: the
-        !! integral of the polynomial through the last (up to) four values of g
-        !! (submodule ropedyn_erk_dense, as the two below).
-        module subroutine accept_quadrature(self, status)
-            class(erk_t), intent(inout) :: self
-            integer, intent(out) :: status
-        end subroutine accept_quadrature
-
-        !> Integral from a to b (within the last step) of the polynomial through the
-        !! quadrature history.
-        module function quad_integral(self, a, b) result(q)
+        !> The quadratures' increment over the step just computed and the weighted norm
+        !! of its error estimate (submodule ropedyn_erk_dense, as dense).
+        module subroutine quad_step(self, h, dq, errq)
             class(erk_t), intent(in) :: self
-            real(wp), intent(in) :: a, b
-            real(wp) :: q(self%nq)
-        end function quad_integral
+            real(wp), intent(in) :: h
+            real(wp), intent(out) :: dq(:)
+            real(wp), intent(out) :: errq
+        end subroutine quad_step
 
         !> The solution at tt within the last accepted step (t_old .. t).
         module subroutine dense(self, tt, y, yq)
@@ -183,7 +177,7 @@ contains
         self%s = self%tab%stages
         allocate (self%y(self%n), self%y_old(self%n), self%ynew(self%n), self%ytmp(self%n), &
                   self%yprev(self%n), self%k(self%n, self%s), self%atol(self%n))
-        allocate (self%yq(self%nq), self%yq_old(self%nq), self%gq(self%nq, 0:3))
+        allocate (self%yq(self%nq), self%yq_old(self%nq), self%gk(self%nq, self%s))
         self%atol = self%options%atol
         if (allocated(self%options%atol_vector)) self%atol = self%options%atol_vector
         self%y = start%y0
@@ -195,7 +189,6 @@ contains
         self%err_old = 1.0e-4_wp
         self%started = .false.
         self%rejected = .false.
-        self%nqh = 0
         self%rho = 0.0_wp
         self%stiff_steps = 0
         self%window_steps = 0
@@ -265,14 +258,12 @@ contains
             return
         end if
         if (self%nq > 0) then
-            call self%problem%quad_rhs(self%t, self%y, self%gq(:, 0), status)
-            if (status /= STATUS_OK) then
+            call self%problem%quad_rhs(self%t, self%y, self%gk(:, 1), status)
+            if (status /= STATUS_OK .or. .not. all(ieee_is_finite(self%gk(:, 1)))) then
                 call self%failure(err, 'the quadrature right-hand side could not be '// &
                                   'evaluated at the initial state')
                 return
             end if
-            self%tq(0) = self%t
-            self%nqh = 1
         end if
         self%started = .true.
         if (self%h > 0.0_wp) then
@@ -310,7 +301,7 @@ contains
     subroutine attempt_step(self, err)
         class(erk_t), intent(inout) :: self
         type(error_t), allocatable, intent(out) :: err
-        real(wp) :: h, errnorm, fac, tnew
+        real(wp) :: h, errnorm, errq, fac, tnew, dq(self%nq)
         integer :: i, status, s
         logical :: recoverable
 
@@ -318,7 +309,10 @@ contains
         recoverable = .false.
         ! FSAL: the last stage of the previous step is f at this step's start (kept in
         ! place until now for the dense output of the previous step)
-        if (self%counters%steps > 0) self%k(:, 1) = self%k(:, s)
+        if (self%counters%steps > 0) then
+            self%k(:, 1) = self%k(:, s)
+            if (self%nq > 0) self%gk(:, 1) = self%gk(:, s)
+        end if
         attempts: do
             if (self%counters%steps >= self%options%max_steps) then
                 call self%failure(err, 'max_steps exceeded ('// &
@@ -341,7 +335,14 @@ contains
             do i = 2, s
                 call self%stage_state(i, h)
                 if (i == s - 1) self%yprev(:) = self%ytmp
-                call self%problem%rhs(self%t + self%tab%c(i)*h, self%ytmp, self%k(:, i), status)
+                if (self%nq > 0) then
+                    ! with the quadratures' right-hand side at the same stage
+                    call self%problem%rhs_quad(self%t + self%tab%c(i)*h, self%ytmp, &
+                                               self%k(:, i), self%gk(:, i), status)
+                else
+                    call self%problem%rhs(self%t + self%tab%c(i)*h, self%ytmp, &
+                                          self%k(:, i), status)
+                end if
                 self%counters%rhs_evals = self%counters%rhs_evals + 1
                 if (status == STATUS_FATAL) then
                     call self%failure(err, 'the right-hand side reported a fatal error')
@@ -358,6 +359,10 @@ contains
             ! FSAL: the last stage was evaluated at the new solution
             call swap(self%ynew, self%ytmp)
             errnorm = self%error_norm(h)
+            if (self%nq > 0) then
+                call self%quad_step(h, dq, errq)
+                errnorm = max(errnorm, errq)
+            end if
             if (.not. ieee_is_finite(errnorm)) errnorm = huge(1.0_wp)
             if (errnorm > 1.0_wp) then
                 self%counters%err_test_fails = self%counters%err_test_fails + 1
@@ -378,14 +383,8 @@ contains
         call swap(self%y, self%ynew)
         self%t = tnew
         if (self%nq > 0) then
-            call self%accept_quadrature(status)
-            if (status /= STATUS_OK) then
-                call self%failure(err, 'the quadrature right-hand side could not be '// &
-                                  'evaluated (e.g. a NaN or Inf in the forces)')
-                self%t = self%t_old
-                self%y = self%y_old
-                return
-            end if
+            self%yq_old = self%yq
+            self%yq = self%yq + dq
         end if
         self%counters%steps = self%counters%steps + 1
         self%counters%last_step = h
@@ -540,7 +539,7 @@ contains
         self%problem => null()
         if (allocated(self%y)) deallocate (self%y, self%y_old, self%ynew, self%ytmp, &
                                            self%yprev, self%k, self%atol)
-        if (allocated(self%yq)) deallocate (self%yq, self%yq_old, self%gq)
+        if (allocated(self%yq)) deallocate (self%yq, self%yq_old, self%gk)
         self%started = .false.
     end subroutine erk_finalize
 end module ropedyn_erk

@@ -1,53 +1,27 @@
 !> Dense output and quadratures of the explicit Runge-Kutta integration (ropedyn_erk): the
 !! solution between step points (the pair's own continuous extension, or the cubic Hermite
-!! interpolant), and the quadratures integrated from their right-hand side g at the
-!! accepted step points only (the cubic through the last four values of g, integrated by
-!! two-point Gauss-Legendre).
+!! interpolant), and the quadratures' increment and error estimate over a step from
+!! their right-hand side g at the stages.
 submodule (ropedyn_erk) ropedyn_erk_dense
     implicit none
 
 contains
 
-    !> g at the new step point and the increment of the quadratures over the step: the
-    !! integral of the polynomial through the last (up to) four values of g.
-    module procedure accept_quadrature
+    !> The quadratures' increment over the step just computed, dq = h sum b_i g_i, and
+    !! the weighted RMS norm of its error estimate h sum e_i g_i (weights rtol
+    !! max(|yq|, |yq + dq|) + atol, as CVODE's for its quadratures).
+    module procedure quad_step
+        real(wp) :: eq(self%nq)
         integer :: j
-        if (self%nqh == 4) then
-            do j = 0, 2
-                self%gq(:, j) = self%gq(:, j + 1)
-                self%tq(j) = self%tq(j + 1)
-            end do
-            self%nqh = 3
-        end if
-        call self%problem%quad_rhs(self%t, self%y, self%gq(:, self%nqh), status)
-        if (status /= STATUS_OK .or. .not. all(ieee_is_finite(self%gq(:, self%nqh)))) then
-            if (status == STATUS_OK) status = STATUS_FATAL
-            return
-        end if
-        self%tq(self%nqh) = self%t
-        self%nqh = self%nqh + 1
-        self%yq_old = self%yq
-        self%yq = self%yq_old + self%quad_integral(self%t_old, self%t)
-    end procedure accept_quadrature
-
-    !> Integral from a to b (within the last step) of the polynomial through the
-    !! quadrature history, by two-point Gauss-Legendre (exact for cubics).
-    module procedure quad_integral
-        real(wp) :: x(2), lj
-        integer :: g, i, j, m
-        m = self%nqh
-        x = 0.5_wp*(a + b) + [-0.5_wp, 0.5_wp]*(b - a)/sqrt(3.0_wp)
-        q = 0.0_wp
-        do g = 1, 2
-            do j = 0, m - 1
-                lj = 1.0_wp
-                do i = 0, m - 1
-                    if (i /= j) lj = lj*(x(g) - self%tq(i))/(self%tq(j) - self%tq(i))
-                end do
-                q = q + (0.5_wp*(b - a)*lj)*self%gq(:, j)
-            end do
+        dq = 0.0_wp
+        eq = 0.0_wp
+        do j = 1, self%s
+            if (self%tab%b(j) /= 0.0_wp) dq = dq + (h*self%tab%b(j))*self%gk(:, j)
+            if (self%tab%e(j) /= 0.0_wp) eq = eq + (h*self%tab%e(j))*self%gk(:, j)
         end do
-    end procedure quad_integral
+        errq = sqrt(sum((eq/(self%options%rtol*max(abs(self%yq), abs(self%yq + dq)) &
+                             + self%options%atol))**2)/self%nq)
+    end procedure quad_step
 
     !> The solution at tt within the last accepted step (t_old .. t).
     module procedure dense
@@ -77,6 +51,13 @@ contains
                     - (h*f0 - (y1 - y0)))))
             end if
         end associate
-        if (self%nq > 0) yq(1:self%nq) = self%yq_old + self%quad_integral(self%t_old, tt)
+        ! the quadratures: the cubic Hermite interpolant of yq and g at both ends
+        if (self%nq > 0) then
+            associate (dq => self%yq - self%yq_old, g0 => self%gk(:, 1), &
+                       g1 => self%gk(:, self%s))
+                yq(1:self%nq) = self%yq_old + th*(dq + th1*((h*g0 - dq) + th*(dq - h*g1 &
+                                - (h*g0 - dq))))
+            end associate
+        end if
     end procedure dense
 end submodule ropedyn_erk_dense

@@ -42,6 +42,7 @@ module ropedyn_problem
         procedure :: jacobian => problem_jacobian
         procedure :: quad_size => problem_quad_size
         procedure :: quad_rhs => problem_quad_rhs
+        procedure :: rhs_quad => problem_rhs_quad
         procedure :: has_mass_matrix => problem_has_mass_matrix
         procedure :: mass_matrix => problem_mass_matrix
         procedure :: implicit_rhs => problem_implicit_rhs
@@ -160,6 +161,21 @@ contains
         yqdot = 0.0_wp
         status = STATUS_OK
     end subroutine problem_quad_rhs
+
+    !> ydot = f(t, y) and yqdot = g(t, y) in one call, for integrators that need both at
+    !! every stage (the explicit Runge-Kutta pairs); a problem whose g falls out of f's
+    !! evaluation overrides this to share the work.
+    subroutine problem_rhs_quad(self, t, y, ydot, yqdot, status)
+        class(problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: ydot(:)
+        real(wp), intent(out) :: yqdot(:)
+        integer, intent(out) :: status
+        call self%rhs(t, y, ydot, status)
+        if (status /= STATUS_OK) return
+        call self%quad_rhs(t, y, yqdot, status)
+    end subroutine problem_rhs_quad
 
     !> True when the problem has the second-order structure described in the module header
     !! (none unless a problem overrides this).

@@ -23,9 +23,9 @@ For every case:
    AGREE_UNTIL seconds (before the motion from 75 degrees turns chaotic) <= B_X rtol L
    (B_X per method, TIP_BOUND).
 
-Known defects (KNOWN_DEFECTS: ERK's dissipated energy at impacts) are strict expected
-failures of check 3: diagnosed, listed with their cause, and flagged when a fix makes them
-pass. (ADAMS's energy gain on barely damped modes, up to 791 rtol S, was one until ADAMS got
+Known defects (KNOWN_DEFECTS, none now) are strict expected failures: diagnosed, listed
+with their cause, and flagged when a fix makes them pass (ERK's dissipated energy at
+impacts was one until erk integrated its quadratures with its stages and error test). (ADAMS's energy gain on barely damped modes, up to 791 rtol S, was one until ADAMS got
 a safe order, 2: the monitor now lowers it there, and the gains stay below G; where order
 2 then needs steps too short, the run stops with the stiffness watch's diagnosis.)
 
@@ -108,26 +108,15 @@ STIFF_STOP_CPU = 10.0   # measured at most 2.1 s (adams on elements_10000)
 #: balance and gain bound, in rtol S, of a run the stiffness watch stopped: held at its
 #: stability limit the explicit method may amplify the fastest modes until the watch acts,
 #: within the first microseconds, whose energy scale S is tiny (measured: adams 569 rtol S
-#: on elements_10000 at rtol 1e-3 over 16 us, erk 209 over 17 us; erk's 309 on
-#: whip_ground_mpp at 1e-5 is its quadrature defect, below)
+#: on elements_10000 at rtol 1e-3 over 16 us, erk 209 over 17 us)
 STIFF_STOP_BOUND = 2e3
 #: known defects, diagnosed but not fixed: {test: {key: why}}; these cases are expected to
 #: fail that test (strict: a fix makes them pass, and the entry must go)
-ERK_QUADRATURE = ("erk (and auto, which runs erk on the whip scenes) integrates the "
-                  "dissipated energy from its step points only, outside the error test: "
-                  "at the impacts on the ground it misses 1 % of the 0.73 J dissipated "
-                  "(7.7e-3 J at rtol 1e-6, 2.2e-2 at 1e-4, 6.6e-4 at 1e-8: not following "
-                  "rtol), while T + V agree with mebdf to 4e-5 J")
-KNOWN_DEFECTS = {
-    "balance": {
-        **{k: ERK_QUADRATURE for k in (
-            "whip_ground/default",         # 3275 rtol S (auto runs erk throughout)
-            "whip_ground_mpp/default",     # 1334
-            "whip_ground/erk/1e-05",       # 367
-            "whip_ground/erk/1e-07",       # 10852
-            "whip_ground_mpp/erk/1e-07")},  # 4993
-    },
-}
+KNOWN_DEFECTS = {}
+# (ERK's dissipated energy at impacts was one: integrated from g at the step points only,
+# outside the error test, it missed 1 % of the dissipation on whip_ground, up to 10852
+# rtol S; now integrated with the pair's stages and error test.)
+
 
 MATRIX = lh.matrix_cases()
 ORDER = lh.order_cases()

@@ -14,6 +14,7 @@ program test_effects_derivatives
     use ropedyn_rfem, only: rfem_t, rfem_create
     use ropedyn_mpp, only: mpp_t, mpp_create
     use ropedyn_assert, only: test_suite_t
+    use ropedyn_problem, only: STATUS_OK
     implicit none
 
     type(test_suite_t) :: suite
@@ -203,6 +204,17 @@ contains
         call suite%check_le(abs(dedt - (rates(2) - rates(1)))/scale, 1.0e-6_wp, &
                             label//': d(T+V)/dt = work - dissipation'//trim(tag))
         call suite%check_true(rates(1) > 0.0_wp, label//': dissipation positive')
+        ! the one-call form the explicit pairs use at every stage gives the same f and g
+        ! (the RFEM sums the dissipation power inside its force pass)
+        block
+            real(wp) :: f2(size(y)), g2(2)
+            g2 = 0.0_wp
+            call model%rhs_quad(t, y, f2, g2(1:model%quad_size()), status)
+            call suite%check_true(status == STATUS_OK .and. &
+                                  maxval(abs(f2 - ydot)) == 0.0_wp .and. &
+                                  maxval(abs(g2 - rates)) <= 1.0e-14_wp*maxval(abs(rates)), &
+                                  label//': rhs_quad = rhs and quad_rhs')
+        end block
     end subroutine power_balance
 
     !> Conservative forces (zero velocity, no current and no loads: drag and friction vanish)

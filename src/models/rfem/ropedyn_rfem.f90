@@ -119,6 +119,7 @@ module ropedyn_rfem
         procedure :: jacobian => rfem_jacobian
         procedure :: energy => rfem_energy
         procedure :: quad_rhs => rfem_quad_rhs
+        procedure :: rhs_quad => rfem_rhs_quad
         procedure :: model_name => rfem_model_name
         procedure :: initial_state => rfem_initial_state
         procedure :: fields => rfem_fields
@@ -143,11 +144,13 @@ module ropedyn_rfem
         !> The generalized forces (3, n) of everything at time t and state y into self%gen
         !! (one pass over the SDEs); optionally the elastic energy (J, springs and the
         !! effects' potential energy).
-        module subroutine forces(self, t, y, elastic)
+        module subroutine forces(self, t, y, elastic, power)
             class(rfem_t), intent(inout) :: self
             real(wp), intent(in) :: t
             real(wp), intent(in) :: y(6*self%n)
             real(wp), intent(out), optional :: elastic
+            !> when present: the internal SDEs' dissipation power sum B s'^2
+            real(wp), intent(out), optional :: power
         end subroutine forces
 
         !> The derivatives of the generalized forces with respect to the coordinates and
@@ -259,6 +262,17 @@ module ropedyn_rfem
             real(wp), intent(out) :: yqdot(:)
             integer, intent(out) :: status
         end subroutine rfem_quad_rhs
+
+        !> rfem_rhs and rfem_quad_rhs in one pass: the internal SDEs' dissipation power
+        !! is summed where their damping forces are formed (same values, same order).
+        module subroutine rfem_rhs_quad(self, t, y, ydot, yqdot, status)
+            class(rfem_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(out) :: ydot(:)
+            real(wp), intent(out) :: yqdot(:)
+            integer, intent(out) :: status
+        end subroutine rfem_rhs_quad
         !> Build the model of a spec (its values are already validated; submodule
         !! ropedyn_rfem_create).
         module subroutine rfem_create(model, spec, err)

@@ -155,12 +155,14 @@ contains
     module procedure forces
         integer :: j, ka, kb, n, p, i
         real(wp) :: dwx, dwy, cd, sd, rx, ry, rp, fx, fy, fp, ffx, ffy, c(3), e_el
-        real(wp) :: ca, sa, cb, sb, ha, hb, dx, dy, dvx, dvy, wa, wb
-        logical :: energy
+        real(wp) :: ca, sa, cb, sb, ha, hb, dx, dy, dvx, dvy, wa, wb, p_in
+        logical :: energy, with_power
 
         n = self%n
         energy = present(elastic)
+        with_power = present(power)
         e_el = 0.0_wp
+        p_in = 0.0_wp
         call self%set_time(t)
         call angles(self, y)
         ! c: the force of the previous SDE on its element b (first: the top support's)
@@ -200,6 +202,8 @@ contains
                 fx = fx + self%bx*rx
                 fy = fy + self%by*ry
                 fp = fp + self%bpj(j)*rp
+                if (with_power) p_in = p_in + (self%bx*rx**2 + self%by*ry**2 + &
+                                               self%bpj(j)*rp**2)
             end if
             ffx = fx*ca - fy*sa
             ffy = fx*sa + fy*ca
@@ -226,6 +230,7 @@ contains
             if (energy) call add_energies_of(self%effects, t, self%bodies, e_el)
         end if
         if (energy) elastic = e_el
+        if (with_power) power = p_in
     end procedure forces
 
     module procedure rfem_generalized_forces
@@ -237,9 +242,42 @@ contains
     end procedure rfem_generalized_forces
 
     module procedure rfem_rhs
-        integer :: i, k
-
         call self%forces(t, y)
+        call accelerations(self, y, ydot)
+        status = STATUS_OK
+        if (.not. all(ieee_is_finite(ydot))) status = STATUS_RECOVERABLE
+    end procedure rfem_rhs
+
+    module procedure rfem_rhs_quad
+        real(wp) :: power, work
+        integer :: k
+        ! the order of the sums as in rfem_quad_rhs: internal SDEs, supports, effects
+        power = 0.0_wp
+        if (self%damped) then
+            call self%forces(t, y, power=power)
+        else
+            call self%forces(t, y)
+        end if
+        call accelerations(self, y, ydot)
+        work = 0.0_wp
+        do k = 1, 2
+            if (self%sup(k)%active) call support_power(self, k, y, power, work)
+        end do
+        ! forces filled the bodies of the effects
+        if (size(self%effects) > 0) call add_powers_of(self%effects, t, self%bodies, power, work)
+        yqdot(1) = power
+        if (self%with_work) yqdot(2) = work
+        status = STATUS_OK
+        if (.not. (all(ieee_is_finite(ydot)) .and. ieee_is_finite(power) .and. &
+                   ieee_is_finite(work))) status = STATUS_RECOVERABLE
+    end procedure rfem_rhs_quad
+
+    !> ydot from y and the generalized forces in self%gen.
+    subroutine accelerations(self, y, ydot)
+        class(rfem_t), intent(inout) :: self
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: ydot(:)
+        integer :: i, k
         do i = 1, self%n
             k = 6*(i - 1)
             ydot(k + 1) = y(k + 4)
@@ -250,9 +288,7 @@ contains
             ydot(k + 6) = self%gen(3, i)*self%rowscale(3, i)
         end do
         if (size(self%pm_elem) > 0) call self%point_mass_accelerations(y, self%gen, ydot)
-        status = STATUS_OK
-        if (.not. all(ieee_is_finite(ydot))) status = STATUS_RECOVERABLE
-    end procedure rfem_rhs
+    end subroutine accelerations
 
     module procedure rfem_has_jacobian
         has = .true.
