@@ -1,0 +1,47 @@
+"""The analysis of scripts/accuracy (python/ropedyn/studies/accuracy.py) on small made-up
+data: the choices docs/choosing.md states come out of these functions, so each must pick
+what its description says."""
+import math
+
+from ropedyn.studies import accuracy as acc
+
+
+def window_row(method, rtol, tip, cpu, t0=0.0, model="rfem", n=30):
+    return dict(model=model, n=str(n), t0=str(t0), method=method, rtol=str(rtol),
+                tip=str(tip), cpu=str(cpu), status="ok")
+
+
+def test_cheapest_in_windows_takes_each_methods_loosest_rtol_that_reaches_the_target():
+    win = [window_row("a", 1e-2, 5e-3, 0.1), window_row("a", 1e-3, 5e-4, 0.2),
+           window_row("a", 1e-4, 5e-5, 0.4),
+           window_row("b", 1e-2, 8e-4, 0.3), window_row("b", 1e-3, 8e-5, 0.5)]
+    best = acc.cheapest_in_windows(win, "rfem", 30, 1e-3)
+    # a reaches 1e-3 only at rtol 1e-3 (0.2 s), b already at 1e-2 (0.3 s)
+    assert [(m, rtol) for _, m, rtol in best] == [("a", 1e-3), ("b", 1e-2)]
+    assert acc.cheapest_in_windows(win, "rfem", 30, 1e-5) == []
+    # another model or n is not mixed in
+    assert acc.cheapest_in_windows(win, "mpp", 30, 1e-3) == []
+
+
+def test_later_over_first_is_the_ratio_of_later_windows_to_the_first():
+    win = [window_row("a", r, tip, 0.1, t0) for r in (1e-3, 1e-4)
+           for t0, tip in ((0.0, 1e-6 * r / 1e-4), (5.0, 4e-6 * r / 1e-4),
+                           (10.0, 4e-6 * r / 1e-4))]
+    (m, median, p90), = acc.later_over_first(win)
+    assert m == "a" and math.isclose(median, 4.0) and math.isclose(p90, 4.0)
+
+
+def chaos_row(method, rtol, mean, spread, starts=8):
+    return dict(method=method, rtol=str(rtol), starts=str(starts), mean=str(mean),
+                spread=str(spread), cpu="1")
+
+
+def test_chaos_z_measures_the_difference_in_standard_errors():
+    rows = [chaos_row("tight", 1e-8, 3.0e-3, 4e-4),
+            chaos_row("same", 1e-3, 3.1e-3, 4e-4),      # 0.1e-3 apart: within the noise
+            chaos_row("shifted", 1e-3, 4.0e-3, 4e-4)]   # 1e-3 apart: far outside
+    z = acc.chaos_z(rows)
+    se = 4e-4 * math.sqrt(8 / 7) / math.sqrt(8)
+    assert z[0] == 0.0
+    assert math.isclose(z[1], 0.1e-3 / math.hypot(se, se), rel_tol=1e-9) and z[1] < 2
+    assert z[2] > 2
