@@ -47,17 +47,21 @@ contains
                 y = y0 + th*((y1 - y0) + th1*((h*f0 - (y1 - y0)) + th*(((y1 - y0) - h*f1 &
                     - (h*f0 - (y1 - y0))) + th1*y)))
             else
-                y = y0 + th*((y1 - y0) + th1*((h*f0 - (y1 - y0)) + th*((y1 - y0) - h*f1 &
-                    - (h*f0 - (y1 - y0)))))
+                y = hermite(y0, y1, f0, f1, h, th)
             end if
         end associate
         ! the quadratures: the cubic Hermite interpolant of yq and g at both ends
-        if (self%nq > 0) then
-            associate (dq => self%yq - self%yq_old, g0 => self%gk(:, 1), &
-                       g1 => self%gk(:, self%s))
-                yq(1:self%nq) = self%yq_old + th*(dq + th1*((h*g0 - dq) + th*(dq - h*g1 &
-                                - (h*g0 - dq))))
-            end associate
-        end if
+        if (self%nq > 0) yq(1:self%nq) = hermite(self%yq_old, self%yq, self%gk(:, 1), &
+                                                 self%gk(:, self%s), h, th)
     end procedure dense
+
+    !> The cubic Hermite interpolant at th (0 .. 1) of a step of size h from a0 to a1 with
+    !! slopes f0 and f1 at its ends.
+    elemental real(wp) function hermite(a0, a1, f0, f1, h, th) result(a)
+        real(wp), intent(in) :: a0, a1, f0, f1, h, th
+        real(wp) :: th1
+        th1 = 1.0_wp - th
+        a = a0 + th*((a1 - a0) + th1*((h*f0 - (a1 - a0)) + th*((a1 - a0) - h*f1 &
+            - (h*f0 - (a1 - a0)))))
+    end function hermite
 end submodule ropedyn_erk_dense

@@ -307,8 +307,7 @@ contains
     end procedure rfem_rhs
 
     module procedure rfem_rhs_quad
-        real(wp) :: power, work
-        integer :: k
+        real(wp) :: power
         ! the order of the sums as in rfem_quad_rhs: internal SDEs, supports, effects
         power = 0.0_wp
         if (self%damped) then
@@ -317,17 +316,9 @@ contains
             call self%forces(t, y)
         end if
         call accelerations(self, y, ydot)
-        work = 0.0_wp
-        do k = 1, 2
-            if (self%sup(k)%active) call support_power(self, k, y, power, work)
-        end do
         ! forces filled the bodies of the effects
-        if (size(self%effects) > 0) call add_powers_of(self%effects, t, self%bodies, power, work)
-        yqdot(1) = power
-        if (self%with_work) yqdot(2) = work
-        status = STATUS_OK
-        if (.not. (all(ieee_is_finite(ydot)) .and. ieee_is_finite(power) .and. &
-                   ieee_is_finite(work))) status = STATUS_RECOVERABLE
+        call store_powers(self, t, y, power, yqdot, status)
+        if (.not. all(ieee_is_finite(ydot))) status = STATUS_RECOVERABLE
     end procedure rfem_rhs_quad
 
     !> ydot from y and the generalized forces in self%gen.
@@ -515,26 +506,38 @@ contains
     end subroutine internal_power
 
     module procedure rfem_quad_rhs
-        real(wp) :: power, work
-        integer :: k
+        real(wp) :: power
         call self%set_time(t)
         ! only the damped strains and the supports: no spring forces, no gravity, no scatter
         power = 0.0_wp
-        work = 0.0_wp
         if (self%damped) then
             call angles(self, y)
             call internal_power(self, y, power)
         end if
+        if (size(self%effects) > 0) call self%fill_bodies(y)
+        call store_powers(self, t, y, power, yqdot, status)
+    end procedure rfem_quad_rhs
+
+    !> Add the supports' and the effects' dissipation to power (the internal SDEs' share;
+    !! self%bodies filled) and their external work rate, and store both as the quadratures'
+    !! rates; STATUS_RECOVERABLE when either is not finite.
+    subroutine store_powers(self, t, y, power, yqdot, status)
+        class(rfem_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(inout) :: power
+        real(wp), intent(out) :: yqdot(:)
+        integer, intent(out) :: status
+        real(wp) :: work
+        integer :: k
+        work = 0.0_wp
         do k = 1, 2
             if (self%sup(k)%active) call support_power(self, k, y, power, work)
         end do
-        if (size(self%effects) > 0) then
-            call self%fill_bodies(y)
-            call add_powers_of(self%effects, t, self%bodies, power, work)
-        end if
+        if (size(self%effects) > 0) call add_powers_of(self%effects, t, self%bodies, power, work)
         yqdot(1) = power
         if (self%with_work) yqdot(2) = work
         status = STATUS_OK
         if (.not. (ieee_is_finite(power) .and. ieee_is_finite(work))) status = STATUS_RECOVERABLE
-    end procedure rfem_quad_rhs
+    end subroutine store_powers
 end submodule ropedyn_rfem_kernels
