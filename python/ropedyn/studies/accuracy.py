@@ -302,6 +302,19 @@ def window_table(rows, rtols):
     return out
 
 
+def window_medians(win, model, n, method):
+    """{rtol: (median tip error, median CPU)} over the windows t0 of one model, n and
+    method (completed runs only), loosest rtol first."""
+    sel = [r for r in win if r["model"] == model and int(r["n"]) == n and
+           r["method"] == method and r["status"] == "ok"]
+    out = {}
+    for rtol in sorted(set(float(r["rtol"]) for r in sel), reverse=True):
+        rs = [r for r in sel if float(r["rtol"]) == rtol]
+        out[rtol] = (float(np.median([float(r["tip"]) for r in rs])),
+                     float(np.median([float(r["cpu"]) for r in rs])))
+    return out
+
+
 def figure_windows(rows):
     import matplotlib
     matplotlib.use("Agg")
@@ -311,12 +324,9 @@ def figure_windows(rows):
     for ax, model in zip(axes[0], models):
         for (n, m) in dict.fromkeys((int(r["n"]), r["method"]) for r in rows
                                     if r["model"] == model):
-            sel = [r for r in rows if r["model"] == model and int(r["n"]) == n and
-                   r["method"] == m and r["status"] == "ok"]
-            rt = sorted(set(float(r["rtol"]) for r in sel), reverse=True)
-            cpu = [np.median([float(r["cpu"]) for r in sel if float(r["rtol"]) == x]) for x in rt]
-            err = [np.median([float(r["tip"]) for r in sel if float(r["rtol"]) == x]) for x in rt]
-            ax.loglog(cpu, err, "o-", label=f"n={n} {m}")
+            med = window_medians(rows, model, n, m)
+            ax.loglog([c for _, c in med.values()], [e for e, _ in med.values()], "o-",
+                      label=f"n={n} {m}")
         ax.set_xlabel("CPU per 0.5 s window (s)")
         ax.set_ylabel("tip L2 error (m)")
         ax.set_title(model)
@@ -562,11 +572,8 @@ def chosen_rtol(win, model, method, target):
     if not sel:
         return None
     nmax = max(int(r["n"]) for r in sel)
-    good = []
-    for rtol in sorted(set(float(r["rtol"]) for r in sel), reverse=True):
-        tips = [float(r["tip"]) for r in sel if int(r["n"]) == nmax and float(r["rtol"]) == rtol]
-        if tips and np.median(tips) < target:
-            good.append(rtol)
+    good = [rtol for rtol, (tip, _) in window_medians(win, model, nmax, method).items()
+            if tip < target]
     return max(good) if good else None
 
 
@@ -708,13 +715,8 @@ def cheapest_in_windows(win, model, n, target):
     median windowed tip error is below target, cheapest first."""
     best = []
     for m in dict.fromkeys(r["method"] for r in win):
-        sel = [r for r in win if r["model"] == model and int(r["n"]) == n and
-               r["method"] == m and r["status"] == "ok"]
-        opts = []
-        for rtol in set(float(r["rtol"]) for r in sel):
-            rs = [r for r in sel if float(r["rtol"]) == rtol]
-            if np.median([float(r["tip"]) for r in rs]) < target:
-                opts.append((float(np.median([float(r["cpu"]) for r in rs])), rtol))
+        opts = [(cpu, rtol) for rtol, (tip, cpu) in window_medians(win, model, n, m).items()
+                if tip < target]
         if opts:
             cpu, rtol = min(opts)
             best.append((cpu, m, rtol))
@@ -733,10 +735,8 @@ def headline(win, disc, f4, chaos_rows):
             continue
         e = float(d[0]["disc_tip"])
         # the loosest rtol at which auto's windowed tip error is below a tenth of it
-        w = [r for r in win if r["model"] == model and int(r["n"]) == n and
-             r["method"] == "auto" and r["status"] == "ok"]
-        ok = [rt for rt in sorted(set(float(r["rtol"]) for r in w), reverse=True)
-              if np.median([float(r["tip"]) for r in w if float(r["rtol"]) == rt]) < e / 10]
+        ok = [rt for rt, (tip, _) in window_medians(win, model, n, "auto").items()
+              if tip < e / 10]
         runs = [r for r in f4 if r["model"] == model and int(r["n"]) == n and
                 r["status"] == "ok" and r["cpu"]]
         au = [r for r in runs if r["method"] == "auto"]
@@ -786,10 +786,9 @@ def headline(win, disc, f4, chaos_rows):
     below = []
     for model, n in dict.fromkeys((r["model"], int(r["n"])) for r in win):
         d = [r for r in disc if r["model"] == model and int(r["n"]) == n]
-        w = [float(r["tip"]) for r in win if r["model"] == model and int(r["n"]) == n and
-             r["method"] == "auto" and float(r["rtol"]) == 1e-3 and r["status"] == "ok"]
+        w = window_medians(win, model, n, "auto").get(1e-3)
         if d and w:
-            below.append((model, n, float(np.median(w)) < float(d[0]["disc_tip"])))
+            below.append((model, n, w[0] < float(d[0]["disc_tip"])))
     if below:
         good = [f"{m.upper()} n = {n}" for m, n, b in below if b]
         bad = [f"{m.upper()} n = {n}" for m, n, b in below if not b]
