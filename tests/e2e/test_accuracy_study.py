@@ -45,3 +45,12 @@ def test_chaos_z_measures_the_difference_in_standard_errors():
     assert z[0] == 0.0
     assert math.isclose(z[1], 0.1e-3 / math.hypot(se, se), rel_tol=1e-9) and z[1] < 2
     assert z[2] > 2
+
+
+def test_cases_option_names_a_bad_value():
+    import argparse
+    import pytest
+    assert acc.model_cases("mpp:100,rfem:30") == [("mpp", 100), ("rfem", 30)]
+    for bad in ("mpp100", "beam:10", "rfem:1", "rfem:x"):
+        with pytest.raises(argparse.ArgumentTypeError, match=bad):
+            acc.model_cases(bad)

@@ -191,7 +191,7 @@ def windows(runner, args):
          ("mpp", 10), ("mpp", 30), ("mpp", 100)]
     if args.cases:
         # only these cases; the other cases' rows are kept from the CSV files
-        cases = [(c.split(":")[0], int(c.split(":")[1])) for c in args.cases.split(",")]
+        cases = args.cases
     t_end = 6.0 if q else 30.0
     t0s = [0.0, 5.0] if q else [0.0, 5.0, 10.0, 20.0]
     width = 0.5
@@ -810,6 +810,18 @@ DEFAULT_METHODS = ["cvode", "cvode:2", "adams", "erk", "mebdf:4", "mebdf:7", "au
 STUDIES = {"windows": windows, "discretization": discretization, "chaos": chaos, "fig4": fig4}
 
 
+def model_cases(text):
+    """--cases: 'model:n,...' -> [(model, n)], model rfem or mpp, n >= 2."""
+    cases = []
+    for item in text.split(","):
+        model, _, n = item.strip().partition(":")
+        if model not in ("rfem", "mpp") or not n.isdigit() or int(n) < 2:
+            raise argparse.ArgumentTypeError(
+                f"'{item}': expected model:n with model rfem or mpp and n >= 2 (e.g. mpp:100)")
+        cases.append((model, int(n)))
+    return cases
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("study", choices=[*STUDIES, "choosing", "all"])
@@ -817,8 +829,9 @@ def main(argv=None):
     parser.add_argument("--quick", action="store_true", help="smoke test: small n, short")
     parser.add_argument("--methods", default=",".join(DEFAULT_METHODS),
                         help="comma list of method[:max_order] (any &solver method)")
-    parser.add_argument("--cases", default="",
-                        help="windows: only these model:n (comma list), merged into the CSVs")
+    parser.add_argument("--cases", default=[], type=model_cases,
+                        help="windows: only these model:n (comma list, e.g. mpp:100), merged "
+                        "into the CSVs")
     parser.add_argument("--render", action="store_true",
                         help="chaos: rewrite the section from its CSV without running")
     parser.add_argument("--timeout", type=float, default=600.0,
@@ -838,7 +851,8 @@ def main(argv=None):
             body = STUDIES[name](Runner(exe, tmp, args.timeout), args)
         command = "scripts/accuracy " + name + (" --quick" if args.quick else "") + \
             (" --render" if args.render and name == "chaos" else "") + \
-            (f" --cases {args.cases}` (the other cases' rows from the CSV files of the "
+            (f" --cases {','.join(f'{m}:{n}' for m, n in args.cases)}` (the other cases' "
+             "rows from the CSV files of the "
              "previous full run), `" if args.cases and name == "windows" else "") + \
             ("" if args.methods == DEFAULT_METHODS
              else " --methods " + ",".join(args.methods))
