@@ -429,9 +429,16 @@ contains
         real(wp), intent(in) :: h
         real(wp) :: v, acc
         integer :: j, l
-        self%ytmp(:) = 0.0_wp
+        logical :: first
+        first = .true.
         do j = 1, self%s
-            if (self%tab%e(j) /= 0.0_wp) call axpy(h*self%tab%e(j), self%k(:, j), self%ytmp)
+            if (self%tab%e(j) == 0.0_wp) cycle
+            if (first) then
+                self%ytmp(:) = (h*self%tab%e(j))*self%k(:, j)
+                first = .false.
+            else
+                call axpy(h*self%tab%e(j), self%k(:, j), self%ytmp)
+            end if
         end do
         acc = 0.0_wp
         do l = 1, self%n

@@ -178,7 +178,8 @@ module ropedyn_h5
         end subroutine series_close
 
         !> Write record number `record` (1-based; the series is extended to `record` records):
-        !! `values` is the record in Fortran order.
+        !! `values` is the record in Fortran order; or several records at once, `values` the
+        !! records `record`, `record` + 1, ... one after the other (one HDF5 write for all).
         module subroutine append_real(self, record, values, err)
             class(h5_series_t), intent(inout) :: self
             integer(hsize_t), intent(in) :: record

@@ -228,8 +228,8 @@ contains
                           c_loc(values), is_contiguous(values), err)
     end procedure append_integer
 
-    !> Extend the series to `record` records and write the `n_values` values at `buffer`
-    !! (`packed`: one block) as that record.
+    !> Write the `n_values` values at `buffer` (`packed`: one block) as the records `record`,
+    !! `record` + 1, ... (as many as they fill), extending the series to the last of them.
     subroutine write_record(self, record, n_values, type_id, buffer, packed, err)
         class(h5_series_t), intent(inout) :: self
         integer(hsize_t), intent(in) :: record
@@ -238,9 +238,9 @@ contains
         type(c_ptr), intent(in) :: buffer
         logical, intent(in) :: packed
         type(error_t), allocatable, intent(out) :: err
-        integer(hsize_t) :: dims(3)
+        integer(hsize_t) :: dims(3), count
         integer(hid_t) :: file_space, mem_space
-        integer :: rank, hdferr
+        integer :: rank, hdferr, record_size
         character(len=:), allocatable :: label
 
         label = self%path//': '//self%name
@@ -249,14 +249,16 @@ contains
             call make_error(err, ERR_INTERNAL, label//': record not contiguous')
             return
         end if
-        if (int(product(self%record_dims(1:rank - 1))) /= n_values) then
-            call make_error(err, ERR_INTERNAL, label//': record of '//int_text(n_values)// &
-                            ' values, expected '// &
-                            int_text(int(product(self%record_dims(1:rank - 1)))))
+        record_size = int(product(self%record_dims(1:rank - 1)))
+        if (n_values < record_size .or. mod(n_values, max(record_size, 1)) /= 0) then
+            call make_error(err, ERR_INTERNAL, label//': '//int_text(n_values)// &
+                            ' values, not a whole number of records of '// &
+                            int_text(record_size))
             return
         end if
+        count = int(n_values/record_size, hsize_t)
         dims(1:rank - 1) = self%record_dims(1:rank - 1)
-        dims(rank) = record
+        dims(rank) = record + count - 1
         call h5dset_extent_f(self%id, dims(1:rank), hdferr)
         if (hdferr < 0) then
             call make_error(err, ERR_IO, label//': cannot extend dataset')
@@ -269,7 +271,7 @@ contains
         end if
         steps: block
             call select_record(file_space, self%record_dims(1:rank - 1), record, label, &
-                               mem_space, err)
+                               mem_space, err, count)
             if (allocated(err)) exit steps
             call h5dwrite_f(self%id, type_id, buffer, hdferr, mem_space_id=mem_space, &
                             file_space_id=file_space)
@@ -280,28 +282,31 @@ contains
         call h5sclose_f(file_space, hdferr)
     end subroutine write_record
 
-    !> Select record `record` (the last dimension, from 1) of a series with records of the
-    !! dimensions `record_dims` in `file_space`, and create the memory dataspace of its
-    !! values (mem_space = -1 on failure).
-    subroutine select_record(file_space, record_dims, record, label, mem_space, err)
+    !> Select record `record` (the last dimension, from 1), or `count` records from it, of a
+    !! series with records of the dimensions `record_dims` in `file_space`, and create the
+    !! memory dataspace of its values (mem_space = -1 on failure).
+    subroutine select_record(file_space, record_dims, record, label, mem_space, err, count)
         integer(hid_t), intent(in) :: file_space
         integer(hsize_t), intent(in) :: record_dims(:)
         integer(hsize_t), intent(in) :: record
         character(len=*), intent(in) :: label
         integer(hid_t), intent(out) :: mem_space
         type(error_t), allocatable, intent(out) :: err
-        integer(hsize_t) :: start(size(record_dims) + 1)
+        integer(hsize_t), intent(in), optional :: count
+        integer(hsize_t) :: start(size(record_dims) + 1), records
         integer :: hdferr
         mem_space = -1
+        records = 1
+        if (present(count)) records = count
         start = 0
         start(size(start)) = record - 1
         call h5sselect_hyperslab_f(file_space, H5S_SELECT_SET_F, start, &
-                                   [record_dims, 1_hsize_t], hdferr)
+                                   [record_dims, records], hdferr)
         if (hdferr < 0) then
             call make_error(err, ERR_IO, label//': cannot select record '//int_text(int(record)))
             return
         end if
-        call h5screate_simple_f(1, [product(record_dims)], mem_space, hdferr)
+        call h5screate_simple_f(1, [product(record_dims)*records], mem_space, hdferr)
         if (hdferr < 0) then
             mem_space = -1
             call make_error(err, ERR_IO, label//': cannot create memory dataspace')

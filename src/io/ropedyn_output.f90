@@ -109,6 +109,16 @@ module ropedyn_output
     character(len=*), parameter :: TIMER_NAMES(5) = [character(len=13) :: 'time_advance', &
         'time_rhs', 'time_jacobian', 'time_factor', 'time_solve']
 
+    !> Records held in memory before they are written: about this many bytes, and at most
+    !! MAX_PENDING records. One HDF5 write per series and record cost a tenth of the paper
+    !! run's time (12 datasets); a block of records costs one write per series.
+    integer, parameter :: PENDING_BYTES = 2**20, MAX_PENDING = 512
+
+    !> The values of a series' pending records, one after the other.
+    type :: block_t
+        real(wp), allocatable :: v(:)
+    end type block_t
+
     !> One HDF5 file of one simulation run.
     type, public :: output_file_t
         private
@@ -123,6 +133,14 @@ module ropedyn_output
         type(h5_series_t) :: state(2)
         logical :: restart_data = .false.
         integer :: state_size(2) = 0
+        !> records appended but not yet written: record m of series k (the state's two
+        !! after the N_SERIES) at pending(k)%v((m - 1) r + 1 : m r), r its record size;
+        !! written as one block per series when `capacity` are held, when FLUSH_PERIOD has
+        !! passed, and before the file is finished or closed (write_pending)
+        type(block_t) :: pending(N_SERIES + 2)
+        integer, allocatable :: pending_order(:)
+        integer :: n_pending = 0
+        integer :: capacity = 1
     contains
         procedure :: create => output_create
         procedure :: append => output_append
@@ -171,6 +189,35 @@ module ropedyn_output
             type(output_file_t), intent(inout) :: self
             type(error_t), allocatable, intent(out), optional :: err
         end subroutine shutdown
+
+        !> Append one output time (held in memory and written in blocks, see `pending`);
+        !! flush the file when FLUSH_PERIOD has passed since the last flush. A file with
+        !! restart data needs the ODE state `y` and quadratures `yq` of the record too.
+        module subroutine output_append(self, t, q, qdot, points, energy, step_size, order, &
+                                        err, y, yq)
+            class(output_file_t), intent(inout) :: self
+            real(wp), intent(in) :: t                 !< time, s
+            real(wp), intent(in) :: q(:, :)           !< (3, n) x, y (m), phi (rad) per element
+            real(wp), intent(in) :: qdot(:, :)        !< (3, n) rates: m/s, m/s, rad/s
+            real(wp), intent(in) :: points(:, :)      !< (2, 2n) element end points, m
+            type(energy_t), intent(in) :: energy      !< energies at t, J
+            real(wp), intent(in) :: step_size         !< last step size, s
+            integer, intent(in) :: order              !< last order
+            type(error_t), allocatable, intent(out) :: err
+            real(wp), intent(in), optional :: y(:)    !< the model's ODE state (restart data)
+            real(wp), intent(in), optional :: yq(:)   !< its quadratures, J (restart data)
+        end subroutine output_append
+
+        !> The buffers of the pending records for the series of an open file (none held).
+        module subroutine allocate_pending(self)
+            type(output_file_t), intent(inout) :: self
+        end subroutine allocate_pending
+
+        !> Write the pending records, one block per series, /time last.
+        module subroutine write_pending(self, err)
+            type(output_file_t), intent(inout) :: self
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine write_pending
 
         !> The path of the file, or a placeholder if create never succeeded.
         module function file_label(self) result(label)
@@ -224,7 +271,11 @@ contains
         if (self%restart_data) self%state_size = [state_size, quad_size]
 
         call write_contents()
-        if (allocated(err)) call shutdown(self)
+        if (allocated(err)) then
+            call shutdown(self)
+        else
+            call allocate_pending(self)
+        end if
 
     contains
 
@@ -305,107 +356,6 @@ contains
         call file%attribute('/', 'units_convention', units_convention, err)
     end subroutine write_provenance
 
-    !> Append one output time; flush the file when FLUSH_PERIOD has passed since the last
-    !! flush. A file with restart data needs the ODE state `y` and quadratures `yq` of the
-    !! record too.
-    subroutine output_append(self, t, q, qdot, points, energy, step_size, order, err, y, yq)
-        class(output_file_t), intent(inout) :: self
-        real(wp), intent(in) :: t                 !< time, s
-        real(wp), intent(in) :: q(:, :)           !< (3, n) x, y (m), phi (rad) per element
-        real(wp), intent(in) :: qdot(:, :)        !< (3, n) rates: m/s, m/s, rad/s
-        real(wp), intent(in) :: points(:, :)      !< (2, 2n) element end points A_1, B_1, ..., m
-        type(energy_t), intent(in) :: energy      !< energies at t, J
-        real(wp), intent(in) :: step_size         !< last step size, s
-        integer, intent(in) :: order              !< last order
-        type(error_t), allocatable, intent(out) :: err
-        real(wp), intent(in), optional :: y(:)    !< the model's ODE state (restart data)
-        real(wp), intent(in), optional :: yq(:)   !< its quadratures, J (restart data)
-        real(wp) :: scalars(S_KINETIC:S_STEP_SIZE)
-        integer(hsize_t) :: record
-        integer(i8) :: now, rate
-        integer :: n, k
-
-        if (.not. self%is_open) then
-            call make_error(err, ERR_INTERNAL, file_label(self)//': append: file is not open')
-            return
-        end if
-        n = self%n_elements
-        call check_shape(q, '/state/q', 3, n)
-        if (allocated(err)) return
-        call check_shape(qdot, '/state/qdot', 3, n)
-        if (allocated(err)) return
-        call check_shape(points, '/rope/points', 2, 2*n)
-        if (allocated(err)) return
-
-        record = self%n_records + 1
-        call self%series(S_Q)%append(record, reshape(q, [size(q)]), err)
-        if (allocated(err)) return
-        call self%series(S_QDOT)%append(record, reshape(qdot, [size(qdot)]), err)
-        if (allocated(err)) return
-        call self%series(S_POINTS)%append(record, reshape(points, [size(points)]), err)
-        if (allocated(err)) return
-        scalars = [energy%kinetic, energy%elastic, energy%gravity, energy%dissipated, &
-                   energy%support_work, energy%total(), step_size]
-        do k = S_KINETIC, S_STEP_SIZE
-            call self%series(k)%append(record, scalars(k:k), err)
-            if (allocated(err)) return
-        end do
-        call self%series(S_ORDER)%append(record, [order], err)
-        if (allocated(err)) return
-        if (self%restart_data) call append_state(self, record, y, yq, err)
-        if (allocated(err)) return
-        ! /time last: its length counts the complete records
-        call self%series(S_TIME)%append(record, [t], err)
-        if (allocated(err)) return
-        self%n_records = record
-
-        call system_clock(now, rate)
-        if (record == 1 .or. real(now - self%last_flush, wp) >= FLUSH_PERIOD*real(rate, wp)) then
-            call self%file%flush(err)
-            self%last_flush = now
-        end if
-
-    contains
-
-        !> ERR_INTERNAL unless the record `a` of dataset `name` has the shape (rows, cols).
-        subroutine check_shape(a, name, rows, cols)
-            real(wp), intent(in) :: a(:, :)
-            character(len=*), intent(in) :: name
-            integer, intent(in) :: rows, cols
-            if (size(a, 1) /= rows .or. size(a, 2) /= cols) &
-                call make_error(err, ERR_INTERNAL, self%file%file_name()//': '//name// &
-                                ': record has shape ('//int_text(size(a, 1))//', '// &
-                                int_text(size(a, 2))//'), expected ('//int_text(rows)//', '// &
-                                int_text(cols)//')')
-        end subroutine check_shape
-    end subroutine output_append
-
-    !> Record `record` of the restart data: y and yq of the sizes given at create.
-    subroutine append_state(self, record, y, yq, err)
-        type(output_file_t), intent(inout) :: self
-        integer(hsize_t), intent(in) :: record
-        real(wp), intent(in), optional :: y(:), yq(:)
-        type(error_t), allocatable, intent(out) :: err
-        real(wp) :: padded(max(1, self%state_size(2)))
-        if (.not. (present(y) .and. present(yq))) then
-            call make_error(err, ERR_INTERNAL, self%file%file_name()//': append: the file '// &
-                            'holds restart data: y and yq are needed')
-            return
-        end if
-        if (size(y) /= self%state_size(1) .or. size(yq) < self%state_size(2)) then
-            call make_error(err, ERR_INTERNAL, self%file%file_name()//': append: y has '// &
-                            int_text(size(y))//' and yq '//int_text(size(yq))// &
-                            ' values, expected '//int_text(self%state_size(1))//' and '// &
-                            int_text(self%state_size(2)))
-            return
-        end if
-        call self%state(1)%append(record, y, err)
-        if (allocated(err)) return
-        padded = 0.0_wp
-        padded(1:self%state_size(2)) = yq(1:self%state_size(2))
-        call self%state(2)%append(record, padded, err)
-    end subroutine append_state
-
     !> Write the solver counters and the CPU time (also for a failed run); may be repeated.
     !! With `t_reached`, also /solver/t_reached: the time the integration got to (s; for an
     !! interrupted or failed run, where it stopped).
@@ -424,6 +374,8 @@ contains
                             file_label(self)//': write_stats: file is not open')
             return
         end if
+        call write_pending(self, err)
+        if (allocated(err)) return
         counters = counter_values(stats)
         do k = 1, size(COUNTER_NAMES)
             call self%file%write('/solver/'//trim(COUNTER_NAMES(k)), counters(k), '1', err)
@@ -544,7 +496,9 @@ contains
             return
         end if
 
-        call self%file%attribute('/', 'status', trim(status), err)
+        ! the records first: a file says 'complete' only when it holds all of them
+        call write_pending(self, err)
+        if (.not. allocated(err)) call self%file%attribute('/', 'status', trim(status), err)
         if (.not. allocated(err) .and. status /= 'complete') then
             if (present(reason)) then
                 if (len_trim(reason) > 0) then
@@ -565,10 +519,11 @@ contains
         end if
     end subroutine output_close_run
 
-    !> Complete records written so far (the length of /time).
+    !> Records appended so far (written, or pending and written at the latest when the file
+    !! is flushed, finished or closed).
     pure integer function output_records(self) result(records)
         class(output_file_t), intent(in) :: self
-        records = int(self%n_records)
+        records = int(self%n_records) + self%n_pending
     end function output_records
 
     !> Close the file if still open; its status stays 'running'.

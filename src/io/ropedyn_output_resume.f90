@@ -70,7 +70,11 @@ contains
             if (allocated(err)) exit steps
             call self%file%flush(err)
         end block steps
-        if (allocated(err)) call shutdown(self)
+        if (allocated(err)) then
+            call shutdown(self)
+        else
+            call allocate_pending(self)
+        end if
     end procedure output_reopen
 
     module procedure output_add_restart
@@ -124,6 +128,8 @@ contains
         integer :: k
 
         if (.not. self%is_open) return
+        call write_pending(self, e)
+        if (allocated(e)) call move_alloc(e, first)
         do k = 1, N_SERIES
             call self%series(k)%close(e)
             if (allocated(e) .and. .not. allocated(first)) call move_alloc(e, first)
@@ -134,6 +140,7 @@ contains
         end do
         call self%file%close(e)
         if (allocated(e) .and. .not. allocated(first)) call move_alloc(e, first)
+        self%n_pending = 0
         self%is_open = .false.
         if (present(err) .and. allocated(first)) call move_alloc(first, err)
     end procedure shutdown

@@ -113,6 +113,9 @@ program test_output
     ! --- two files open at once ------------------------------------------------------------
     call two_files_at_once()
 
+    ! --- many records: held in memory and written in blocks ---------------------------------
+    call many_records()
+
     ! --- a directory that does not exist -----------------------------------------------------
     call out%create(missing_path, n, element_length, element_mass, 'rfem', 'bdf', '0.0.0-test', &
                     scene, err)
@@ -335,6 +338,63 @@ contains
         if (.not. allocated(e)) ok = ok + 1
         call suite%check_true(ok == 6, 'two files open at once'//error_text(e))
     end subroutine two_files_at_once
+
+    !> 1,300 records (more than two blocks of pending records for this small rope): every
+    !! record of every series in its place, the last block written by close_run before
+    !! the file says 'complete'.
+    subroutine many_records()
+        integer, parameter :: records = 1300
+        character(len=*), parameter :: path = 'test_output_blocks.h5'
+        type(output_file_t) :: run
+        type(error_t), allocatable :: e
+        integer(hid_t) :: file_id
+        real(wp), allocatable :: times(:), q(:, :, :), qdot(:, :, :), points(:, :, :), &
+                                 kinetic(:)
+        integer, allocatable :: orders(:)
+        integer :: j, bad, hdferr
+        call run%create(path, n, element_length, element_mass, 'rfem', 'bdf', '0.0.0-test', &
+                        scene, e)
+        call suite%check_true(.not. allocated(e), 'create '//path//error_text(e))
+        if (allocated(e)) return
+        do j = 1, records
+            call run%append(time_of(j), q_of(j), qdot_of(j), points_of(j), energy_of(j), &
+                            0.001_wp*j, mod(j, 7), e)
+            if (allocated(e)) exit
+        end do
+        call suite%check_true(.not. allocated(e), 'append 1300 records'//error_text(e))
+        call suite%check_true(run%records() == records, 'records() counts the pending ones')
+        call run%close_run('complete', '', e)
+        call suite%check_true(.not. allocated(e), 'close_run after 1300'//error_text(e))
+
+        call h5open_f(hdferr)
+        call h5fopen_f(path, H5F_ACC_RDONLY_F, file_id, hdferr)
+        call suite%check_true(hdferr >= 0, 'reopen '//path)
+        if (hdferr < 0) return
+        call suite%check_true(string_attribute(file_id, '/', 'status') == 'complete', &
+                              path//' complete')
+        call read_real_1d(file_id, '/time', times)
+        call read_real_1d(file_id, '/energy/kinetic', kinetic)
+        call read_int_1d(file_id, '/solver/order', orders)
+        call suite%check_true(size(times) == records .and. size(kinetic) == records .and. &
+                              size(orders) == records, 'every series has 1300 records')
+        allocate (q(3, n, records), qdot(3, n, records), points(2, 2*n, records))
+        call read_real_3d(file_id, '/state/q', q)
+        call read_real_3d(file_id, '/state/qdot', qdot)
+        call read_real_3d(file_id, '/rope/points', points)
+        bad = 0
+        if (size(times) == records .and. size(kinetic) == records .and. &
+            size(orders) == records) then
+            do j = 1, records
+                if (times(j) /= time_of(j) .or. kinetic(j) /= 1.0_wp*j .or. &
+                    orders(j) /= mod(j, 7) .or. any(q(:, :, j) /= q_of(j)) .or. &
+                    any(qdot(:, :, j) /= qdot_of(j)) .or. &
+                    any(points(:, :, j) /= points_of(j))) bad = bad + 1
+            end do
+        end if
+        call suite%check_true(bad == 0, 'every record of 1300 in its place')
+        call h5fclose_f(file_id, hdferr)
+        call h5close_f(hdferr)
+    end subroutine many_records
 
     ! HDF5 reading helpers (failures give empty results, which the checks then catch) ------
 

@@ -1,0 +1,144 @@
+!> Appending records to a run file: each record is held in memory and the records are
+!! written in blocks, one HDF5 write per series and block (`pending` of output_file_t).
+!! What a crash can lose is unchanged: pending records are written, and the file flushed,
+!! whenever FLUSH_PERIOD has passed, and before the file is finished or closed.
+submodule (ropedyn_output) ropedyn_output_pending
+    implicit none
+
+contains
+
+    module procedure output_append
+        real(wp) :: scalars(S_KINETIC:S_STEP_SIZE)
+        integer(i8) :: now, rate
+        integer :: n, k, m
+        logical :: due
+
+        if (.not. self%is_open) then
+            call make_error(err, ERR_INTERNAL, file_label(self)//': append: file is not open')
+            return
+        end if
+        n = self%n_elements
+        call check_shape(q, '/state/q', 3, n)
+        if (allocated(err)) return
+        call check_shape(qdot, '/state/qdot', 3, n)
+        if (allocated(err)) return
+        call check_shape(points, '/rope/points', 2, 2*n)
+        if (allocated(err)) return
+        if (self%restart_data) call check_state()
+        if (allocated(err)) return
+
+        m = self%n_pending + 1
+        call put(S_TIME, [t])
+        call put(S_Q, reshape(q, [size(q)]))
+        call put(S_QDOT, reshape(qdot, [size(qdot)]))
+        call put(S_POINTS, reshape(points, [size(points)]))
+        scalars = [energy%kinetic, energy%elastic, energy%gravity, energy%dissipated, &
+                   energy%support_work, energy%total(), step_size]
+        do k = S_KINETIC, S_STEP_SIZE
+            call put(k, scalars(k:k))
+        end do
+        self%pending_order(m) = order
+        if (self%restart_data) then
+            call put(N_SERIES + 1, y)
+            call put(N_SERIES + 2, [yq(1:self%state_size(2)), &
+                                    spread(0.0_wp, 1, max(1, self%state_size(2)) &
+                                           - self%state_size(2))])
+        end if
+        self%n_pending = m
+
+        call system_clock(now, rate)
+        due = self%n_records + m == 1 .or. &
+              real(now - self%last_flush, wp) >= FLUSH_PERIOD*real(rate, wp)
+        if (due .or. m == self%capacity) then
+            call write_pending(self, err)
+            if (allocated(err)) return
+        end if
+        if (due) then
+            call self%file%flush(err)
+            self%last_flush = now
+        end if
+
+    contains
+
+        !> Record m of series k.
+        subroutine put(k, values)
+            integer, intent(in) :: k
+            real(wp), intent(in) :: values(:)
+            integer :: r
+            r = size(values)
+            self%pending(k)%v((m - 1)*r + 1:m*r) = values
+        end subroutine put
+
+        !> ERR_INTERNAL unless the record `a` of dataset `name` has the shape (rows, cols).
+        subroutine check_shape(a, name, rows, cols)
+            real(wp), intent(in) :: a(:, :)
+            character(len=*), intent(in) :: name
+            integer, intent(in) :: rows, cols
+            if (size(a, 1) /= rows .or. size(a, 2) /= cols) &
+                call make_error(err, ERR_INTERNAL, self%file%file_name()//': '//name// &
+                                ': record has shape ('//int_text(size(a, 1))//', '// &
+                                int_text(size(a, 2))//'), expected ('//int_text(rows)//', '// &
+                                int_text(cols)//')')
+        end subroutine check_shape
+
+        !> ERR_INTERNAL unless y and yq are present with the sizes given at create.
+        subroutine check_state()
+            if (.not. (present(y) .and. present(yq))) then
+                call make_error(err, ERR_INTERNAL, self%file%file_name()//': append: the '// &
+                                'file holds restart data: y and yq are needed')
+            else if (size(y) /= self%state_size(1) .or. size(yq) < self%state_size(2)) then
+                call make_error(err, ERR_INTERNAL, self%file%file_name()//': append: y has '// &
+                                int_text(size(y))//' and yq '//int_text(size(yq))// &
+                                ' values, expected '//int_text(self%state_size(1))//' and '// &
+                                int_text(self%state_size(2)))
+            end if
+        end subroutine check_state
+    end procedure output_append
+
+    module procedure allocate_pending
+        integer :: sizes(N_SERIES + 2), k
+        do k = 1, N_SERIES
+            sizes(k) = max(1, RECORD_ROWS(k)*RECORD_PER_ELEMENT(k)*self%n_elements)
+        end do
+        sizes(N_SERIES + 1:) = 0
+        if (self%restart_data) sizes(N_SERIES + 1:) = max(1, self%state_size)
+        self%capacity = max(1, min(MAX_PENDING, PENDING_BYTES/(8*sum(sizes))))
+        do k = 1, N_SERIES + 2
+            if (allocated(self%pending(k)%v)) deallocate (self%pending(k)%v)
+            allocate (self%pending(k)%v(sizes(k)*self%capacity))
+        end do
+        if (allocated(self%pending_order)) deallocate (self%pending_order)
+        allocate (self%pending_order(self%capacity))
+        self%n_pending = 0
+    end procedure allocate_pending
+
+    module procedure write_pending
+        integer(hsize_t) :: first
+        integer :: k, m, r
+
+        m = self%n_pending
+        if (m == 0 .or. .not. self%is_open) return
+        first = self%n_records + 1
+        do k = 2, N_SERIES
+            if (k == S_ORDER) then
+                call self%series(k)%append(first, self%pending_order(1:m), err)
+            else
+                r = size(self%pending(k)%v)/self%capacity
+                call self%series(k)%append(first, self%pending(k)%v(1:m*r), err)
+            end if
+            if (allocated(err)) return
+        end do
+        if (self%restart_data) then
+            do k = 1, 2
+                r = size(self%pending(N_SERIES + k)%v)/self%capacity
+                call self%state(k)%append(first, self%pending(N_SERIES + k)%v(1:m*r), err)
+                if (allocated(err)) return
+            end do
+        end if
+        ! /time last: its length counts the complete records
+        call self%series(S_TIME)%append(first, self%pending(S_TIME)%v(1:m), err)
+        if (allocated(err)) return
+        self%n_records = self%n_records + int(m, hsize_t)
+        self%n_pending = 0
+    end procedure write_pending
+end submodule ropedyn_output_pending
