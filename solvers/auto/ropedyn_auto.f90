@@ -21,7 +21,17 @@
 !!   implicit, those plus IMPLICIT_STEP_COST (MEBDF) or BDF_STEP_COST (CVODE) per step
 !!   for the Newton matrices, solves and vector work and JACOBIAN_COST per Jacobian
 !!   (calibrated on the paper's rope, n = 30: an MEBDF step costs its 4.1 evaluations of f
-!!   plus about 6 more in the rest, a CVODE step its 1.2 plus about 5).
+!!   plus about 6 more in the rest, a CVODE step its 1.2 plus about 5). These hold for a
+!!   Newton matrix of the RFEM's row width (11, block tridiagonal); a wider one (the MPP's
+!!   is dense: width = its np rows) costs more against f, which stays O(n): with
+!!   lambda = width / 11 (at least 1), a step costs SOLVE_COST (lambda - 1) more for its
+!!   solves, a factorization FACTOR_COST (lambda^2 - 1), a Jacobian JACOBIAN_COST lambda,
+!!   and an MEBDF evaluation of a problem with a mass matrix 1 + MASS_COST width (its
+!!   Newton residual multiplies by M(q), assembled in O(width) per row). Calibrated on the
+!!   MPP, n = 30 / 100 / 200 (MEBDF, solver.profile, f the explicit one of erk: 2.3 / 7.4 /
+!!   14.6 us): a residual with M(q) v costs 4.4 / 10.3 / 16.6 f, the solves and vector work
+!!   of a step 11 / 27 / 45 f, a factorization 29 / 225 / 664 f, a Jacobian 26 / 92 /
+!!   149 f. At lambda = 1 and no mass matrix the counts are those of the RFEM above.
 !! - **Switching** (looked at every WINDOW steps of the method in use): explicit ->
 !!   implicit when most steps of the window were held by stability (erk's own estimate of
 !!   h rho) and either the implicit method's last measured cost per simulated second was
@@ -77,6 +87,14 @@ module ropedyn_auto
     real(wp), parameter :: BDF_DAMPING = 0.12_wp
     integer, parameter :: BDF_ORDER = 5                 !< CVODE's order limit (its own)
     real(wp), parameter :: JACOBIAN_COST = 4.0_wp       !< f-equivalents per Jacobian
+    !> the width scaling of the Newton matrix's costs (see Cost above): the RFEM's row width,
+    !! f-equivalents per step and unit of lambda - 1 for MEBDF's solves (about 3.5 per step)
+    !! and CVODE's (about 1.3), per factorization and unit of lambda^2 - 1, and per entry of
+    !! a row of M(q) in an MEBDF evaluation of f
+    real(wp), parameter :: REFERENCE_WIDTH = 11.0_wp
+    real(wp), parameter :: SOLVE_COST = 1.2_wp, BDF_SOLVE_COST = 0.45_wp
+    real(wp), parameter :: FACTOR_COST = 0.6_wp
+    real(wp), parameter :: MASS_COST = 0.045_wp
     !> the explicit cost predicted from the stability limit, times this (rejected steps,
     !! steps below the limit)
     real(wp), parameter :: EXPLICIT_MARGIN = 1.15_wp
@@ -109,6 +127,10 @@ module ropedyn_auto
         integer :: wait = 0                !< windows to let pass before the next switch
         integer :: backoff = 1
         logical :: initialized = .false.
+        !> the Newton matrix's width over the RFEM's (>= 1), and the cost of one MEBDF
+        !! evaluation of f in evaluations of the explicit f (see Cost)
+        real(wp) :: lambda = 1.0_wp
+        real(wp) :: mebdf_eval_cost = 1.0_wp
     contains
         procedure :: start => auto_start
         procedure :: advance_to => auto_advance_to
@@ -159,6 +181,7 @@ contains
         self%wait = 0
         self%backoff = 1
 
+        call newton_widths(self%problem, self%lambda, self%mebdf_eval_cost)
         call estimate_spectrum(self%problem, start%t0, start%y0, spec)
         self%use_bdf = spec%valid .and. spec%fast_damping >= BDF_DAMPING
         self%mebdf_order = mebdf_order_for(spec%fast_damping)
@@ -182,6 +205,30 @@ contains
         if (allocated(err)) return
         self%initialized = .true.
     end subroutine auto_start
+
+    !> The width of the implicit methods' Newton matrix (the reduced second-order one when
+    !! the problem has the structure, else the first-order one; dense: all its rows) over
+    !! the RFEM's, at least 1; and the cost of an MEBDF evaluation of f, which for a problem
+    !! with a mass matrix includes M(q) v (see Cost).
+    subroutine newton_widths(problem, lambda, eval_cost)
+        class(problem_t), intent(in) :: problem
+        real(wp), intent(out) :: lambda, eval_cost
+        integer, allocatable :: pos(:), vel(:)
+        integer :: np, kl, ku, width
+        call problem%second_order_layout(pos, vel, kl, ku)
+        np = size(pos)
+        if (np == 0) then
+            np = problem%size()
+            call problem%bandwidths(kl, ku)
+        end if
+        kl = min(max(kl, 0), np - 1)
+        ku = min(max(ku, 0), np - 1)
+        width = kl + ku + 1
+        if (2*kl + ku + 1 >= np) width = np     ! factored dense (ropedyn_iteration_matrix)
+        lambda = max(1.0_wp, real(width, wp)/REFERENCE_WIDTH)
+        eval_cost = 1.0_wp
+        if (problem%has_mass_matrix()) eval_cost = 1.0_wp + MASS_COST*real(width, wp)
+    end subroutine newton_widths
 
     !> MEBDF's maximum order for fast modes damped by `zeta` (clipped at 0).
     pure integer function mebdf_order_for(zeta) result(order)
@@ -429,12 +476,17 @@ contains
         cost = real(s%rhs_evals + s%jac_rhs_evals, wp)
         if (self%active == ADAMS) cost = cost + ADAMS_STEP_COST*real(s%steps, wp)
         if (self%active == IMPLICIT) then
-            if (self%use_bdf) then
-                cost = cost + BDF_STEP_COST*real(s%steps, wp)
-            else
-                cost = cost + IMPLICIT_STEP_COST*real(s%steps, wp)
-            end if
-            cost = cost + JACOBIAN_COST*real(s%jac_evals, wp)
+            associate (lambda => self%lambda)
+                if (self%use_bdf) then
+                    cost = cost + (BDF_STEP_COST + BDF_SOLVE_COST*(lambda - 1.0_wp))* &
+                           real(s%steps, wp)
+                else
+                    cost = self%mebdf_eval_cost*cost + (IMPLICIT_STEP_COST + SOLVE_COST* &
+                                                        (lambda - 1.0_wp))*real(s%steps, wp)
+                end if
+                cost = cost + FACTOR_COST*(lambda**2 - 1.0_wp)*real(s%lin_setups, wp) &
+                       + JACOBIAN_COST*lambda*real(s%jac_evals, wp)
+            end associate
         end if
     end function cost
 

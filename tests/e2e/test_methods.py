@@ -118,6 +118,32 @@ def test_auto_tries_adams_where_the_explicit_step_is_held_by_accuracy(run, tmp_p
         assert np.max(np.abs(f["/state/q"][()] - q)) < 1e-3
 
 
+def test_auto_weighs_the_dense_newton_matrix_of_the_mpp(run, tmp_path):
+    """The MPP at n = 70, rtol 1e-2: erk's step is held by stability, so auto tries MEBDF;
+    its Newton matrix is dense (140 rows against the RFEM's band of 11) and its residual
+    multiplies by the dense M(q), so a step costs some 40-90 evaluations of erk's f
+    (measured with solver.profile). Counted as on the RFEM (6 per step) MEBDF looked
+    cheaper and ran on at 4-5x erk's CPU (the accuracy study's miss on the MPP at
+    n >= 200: 12-20x); weighed by the matrix's width, the trial is not cheaper and auto
+    goes back to erk after it."""
+    proc, out = run_scene(run, tmp_path, PAPER, "mpp70", "model.kind='mpp'",
+                          "model.elements=70", "solver.t_end=2.5", "solver.rtol=1e-2",
+                          "solver.atol=1e-4", "solver.output_interval=0.1")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods, times, _, reasons = switch_log(f)
+    assert "mebdf" in methods, methods
+    k = methods.index("mebdf")
+    assert "held by stability" in reasons[k]
+    assert methods[k + 1] == "erk", methods
+    assert "mebdf was not cheaper" in reasons[k + 1], reasons[k + 1]
+    # the trial's counted cost against erk's (f per second), from the reason's numbers
+    counted = [float(x) for x in reasons[k + 1].split("(")[1].split(" f per")[0]
+               .split(" against ")]
+    assert counted[0] > 3 * counted[1], counted
+    assert "mebdf" not in methods[k + 1:], methods
+
+
 def test_erk_stops_with_a_diagnosis_on_1000_elements(run, tmp_path):
     """1000 elements (modes up to 7.5e5 1/s): erk is held by stability at 2.8e5 steps per
     simulated second, above the hard scenes' 2e5, and must stop after one window (500
