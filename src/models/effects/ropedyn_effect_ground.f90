@@ -13,6 +13,7 @@
 module ropedyn_effect_ground
     use ropedyn_kinds, only: wp
     use ropedyn_effect, only: body_effect_t, bodies_t, point_force_block
+    use ropedyn_trig, only: cos_sin
     implicit none
     private
     public :: ground_effect_t, ground_effect
@@ -105,10 +106,11 @@ contains
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: f(:, :), m(:)
         type(contact_t) :: c
-        real(wp) :: e(2)
+        real(wp) :: e(2), cs(2, b%n)
         integer :: i, s
+        call cos_sin(b%phi, cs)
         do i = 1, b%n
-            e = [cos(b%phi(i)), sin(b%phi(i))]
+            e = cs(:, i)
             do s = -1, 1, 2
                 c = contact(self, b, i, s, e)
                 if (c%fn <= 0.0_wp) cycle
@@ -124,10 +126,11 @@ contains
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: jac(:, :, :)
         type(contact_t) :: c
-        real(wp) :: kp, cp, dir(2), dfdx(2, 2), dfdv(2, 2), e(2)
+        real(wp) :: kp, cp, dir(2), dfdx(2, 2), dfdv(2, 2), e(2), cs(2, b%n)
         integer :: i, s, p
+        call cos_sin(b%phi, cs)
         do i = 1, b%n
-            e = [cos(b%phi(i)), sin(b%phi(i))]
+            e = cs(:, i)
             do s = -1, 1, 2
                 c = contact(self, b, i, s, e)
                 if (c%fn <= 0.0_wp) cycle
@@ -150,13 +153,14 @@ contains
         class(ground_effect_t), intent(in) :: self
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
-        real(wp) :: x(2), delta, r
+        real(wp) :: x(2), delta, r, cs(2, b%n)
         integer :: i, s
         e = 0.0_wp
+        call cos_sin(b%phi, cs)
         do i = 1, b%n
             do s = -1, 1, 2
                 r = 0.5_wp*real(s, wp)*b%l(i)
-                x = b%c(:, i) + r*[cos(b%phi(i)), sin(b%phi(i))]
+                x = b%c(:, i) + r*cs(:, i)
                 delta = -dot_product(x - self%p0, self%ng)
                 if (delta > 0.0_wp) e = e + 0.25_wp*self%k*b%l(i)*delta**2
             end do
@@ -169,10 +173,11 @@ contains
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: dissipation, work
         type(contact_t) :: c
-        real(wp) :: e(2)
+        real(wp) :: e(2), cs(2, b%n)
         integer :: i, s
+        call cos_sin(b%phi, cs)
         do i = 1, b%n
-            e = [cos(b%phi(i)), sin(b%phi(i))]
+            e = cs(:, i)
             do s = -1, 1, 2
                 c = contact(self, b, i, s, e)
                 if (c%delta <= 0.0_wp) cycle
@@ -189,11 +194,12 @@ contains
         class(ground_effect_t), intent(in) :: self
         type(bodies_t), intent(in) :: b
         type(contact_t) :: c
-        real(wp) :: e(2)
+        real(wp) :: e(2), cs(2, b%n)
         integer :: i, s
         total = 0.0_wp
+        call cos_sin(b%phi, cs)
         do i = 1, b%n
-            e = [cos(b%phi(i)), sin(b%phi(i))]
+            e = cs(:, i)
             do s = -1, 1, 2
                 c = contact(self, b, i, s, e)
                 total = total + c%fn
