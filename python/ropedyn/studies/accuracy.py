@@ -518,6 +518,16 @@ def fig4(runner, args):
                         row.update(cpu=f"{r['cpu']:.4g}", steps=r["steps"])
                     rows.append(row)
                     print(f"fig4: {row}", flush=True)
+    methods = list(args.methods)
+    if not q and methods != DEFAULT_METHODS:
+        # only these methods: the other methods' rows are kept from the CSV file
+        methods = list(dict.fromkeys(DEFAULT_METHODS + methods))
+        kept = [dict(r, target=float(r["target"]), n=int(r["n"]), rtol=float(r["rtol"]))
+                for r in read_csv(DATA / "acc_fig4.csv") if r["method"] not in args.methods]
+        order = {m: k for k, m in enumerate(methods)}
+        rows = sorted(kept + rows, key=lambda r: (FIG4_TARGETS.index(r["target"]),
+                                                  ("rfem", "mpp").index(r["model"]),
+                                                  order[r["method"]], r["n"]))
     write_csv(DATA / "acc_fig4.csv", rows)
     figure_fig4(rows, t_end)
     md = [f"CPU time of the whole motion ({t_end:g} s, output every 0.05 s) against n, each "
@@ -528,6 +538,10 @@ def fig4(runner, args):
           f"{mpp_max} ('-': not run; their dense O(n³) Newton matrix makes a 30 s run at n = "
           "300 take some 20 min each). Raw data: [data/acc_fig4.csv](data/acc_fig4.csv).",
           "", "![Figure 4 over the whole motion](figures/acc_fig4.png)"]
+    if methods != list(args.methods):
+        md[0] += (f" Rows of {', '.join(args.methods)} from this run (the rtol chosen from "
+                  "the windows data as it stands); the other methods' rows from the CSV file "
+                  "of the previous full run.")
     for target in FIG4_TARGETS:
         sel = [r for r in rows if float(r["target"]) == target]
         md += ["", f"**Target {target:g} m**", "",
@@ -543,7 +557,7 @@ def fig4(runner, args):
             md.append(f"| {key[0]}, {key[1]} ({key[2]:g}) | " + " | ".join(cells) + " |")
         # the paper: "the MPP model is numerically more efficient only for small n"
         cross = []
-        for m in args.methods:
+        for m in methods:
             cheaper = [n for n in ns if mpp_cheaper(sel, m, n)]
             dearer = [n for n in ns if mpp_cheaper(sel, m, n) is False]
             cross.append(f"{m}: MPP cheaper at n = {cheaper or 'none'}, RFEM at "

@@ -97,8 +97,8 @@ contains
         associate (sp => self%sup(k))
             m = 6*(sp%elem - 1)
             h = self%half(sp%elem)
-            co = cos(y(m + 3))
-            si = sin(y(m + 3))
+            co = self%cs(1, sp%elem)    ! cos and sin of its angle (angles, at y)
+            si = self%cs(2, sp%elem)
             if (sp%translational) then
                 ! d = sgn (c - P) - h e, d' = sgn (v - P') - h w n
                 d(1) = sp%sgn*(y(m + 1) - sp%anchor(1)) - h*co
@@ -135,8 +135,8 @@ contains
         associate (sp => self%sup(k))
             m = 6*(sp%elem - 1)
             h = self%half(sp%elem)
-            co = cos(y(m + 3))
-            si = sin(y(m + 3))
+            co = self%cs(1, sp%elem)    ! cos and sin of its angle (angles, at y)
+            si = self%cs(2, sp%elem)
             if (sp%translational) then
                 d(1) = sp%sgn*(y(m + 1) - sp%anchor(1)) - h*co
                 d(2) = sp%sgn*(y(m + 2) - sp%anchor(2)) - h*si
@@ -510,10 +510,8 @@ contains
         call self%set_time(t)
         ! only the damped strains and the supports: no spring forces, no gravity, no scatter
         power = 0.0_wp
-        if (self%damped) then
-            call angles(self, y)
-            call internal_power(self, y, power)
-        end if
+        call angles(self, y)    ! for the SDEs and the supports
+        if (self%damped) call internal_power(self, y, power)
         if (size(self%effects) > 0) call self%fill_bodies(y)
         call store_powers(self, t, y, power, yqdot, status)
     end procedure rfem_quad_rhs
