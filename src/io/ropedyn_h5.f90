@@ -195,6 +195,18 @@ module ropedyn_h5
             type(error_t), allocatable, intent(out) :: err
         end subroutine append_integer
 
+        !> Whether an HDF5 call failed (hdferr < 0); then err says `message` (ERR_IO) and `id`,
+        !! the identifier the call was to give, is marked as none (-1). The message is built
+        !! before the call, also on success: the calls made for every record (write_record,
+        !! select_record, series_append_text) test hdferr themselves.
+        module function h5_failed(hdferr, message, err, id) result(failed)
+            integer, intent(in) :: hdferr
+            character(len=*), intent(in) :: message
+            type(error_t), allocatable, intent(inout) :: err
+            integer(hid_t), intent(inout), optional :: id
+            logical :: failed
+        end function h5_failed
+
         !> A fixed-length, null-padded string type of `width` characters (at least 1).
         module subroutine string_type(width, type_id, hdferr)
             integer, intent(in) :: width
@@ -301,10 +313,7 @@ contains
         type(error_t), allocatable, intent(out) :: err
         integer :: hdferr
         call h5open_f(hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, path//': cannot initialize the HDF5 library')
-            return
-        end if
+        if (h5_failed(hdferr, path//': cannot initialize the HDF5 library', err)) return
         call h5eset_auto_f(0, hdferr)
         if (hdferr < 0) call make_error(err, ERR_IO, path//': cannot silence HDF5 error printing')
     end subroutine library_acquire
@@ -440,10 +449,7 @@ contains
         integer(hid_t) :: group_id
         integer :: hdferr
         call h5gcreate_f(self%id, name, group_id, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot create group')
-            return
-        end if
+        if (h5_failed(hdferr, self%path//': '//name//': cannot create group', err)) return
         call h5gclose_f(group_id, hdferr)
         if (hdferr < 0) call make_error(err, ERR_IO, self%path//': '//name// &
                                         ': cannot close group')
@@ -478,10 +484,7 @@ contains
         integer :: hdferr
         logical :: exists
         call h5oopen_f(self%id, where, obj, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//where//': cannot open object')
-            return
-        end if
+        if (h5_failed(hdferr, self%path//': '//where//': cannot open object', err)) return
         call h5aexists_f(obj, name, exists, hdferr)
         if (hdferr >= 0 .and. exists) call h5adelete_f(obj, name, hdferr)
         if (hdferr < 0) call make_error(err, ERR_IO, self%path//': '//where//' attribute '// &
@@ -497,10 +500,7 @@ contains
         integer(hid_t) :: obj
         integer :: hdferr
         call h5oopen_f(self%id, where, obj, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//where//': cannot open object')
-            return
-        end if
+        if (h5_failed(hdferr, self%path//': '//where//': cannot open object', err)) return
         call string_attribute(self%path, obj, where, name, value, err)
         call h5oclose_f(obj, hdferr)
     end subroutine h5_attribute

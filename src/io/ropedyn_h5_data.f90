@@ -5,6 +5,13 @@ submodule (ropedyn_h5) ropedyn_h5_data
 
 contains
 
+    module procedure h5_failed
+        failed = hdferr < 0
+        if (.not. failed) return
+        call make_error(err, ERR_IO, message)
+        if (present(id)) id = -1
+    end procedure h5_failed
+
     module procedure string_type
         call h5tcopy_f(H5T_NATIVE_CHARACTER, type_id, hdferr)
         if (hdferr < 0) then
@@ -28,34 +35,17 @@ contains
         attr_id = -1
         steps: block
             call h5aexists_f(loc_id, name, exists, hdferr)
-            if (hdferr < 0) then
-                call make_error(err, ERR_IO, label//': cannot check existence')
-                exit steps
-            end if
+            if (h5_failed(hdferr, label//': cannot check existence', err)) exit steps
             if (exists) then
                 call h5adelete_f(loc_id, name, hdferr)
-                if (hdferr < 0) then
-                    call make_error(err, ERR_IO, label//': cannot delete old value')
-                    exit steps
-                end if
+                if (h5_failed(hdferr, label//': cannot delete old value', err)) exit steps
             end if
             call string_type(len(value), type_id, hdferr)
-            if (hdferr < 0) then
-                call make_error(err, ERR_IO, label//': cannot set up the string type')
-                exit steps
-            end if
+            if (h5_failed(hdferr, label//': cannot set up the string type', err)) exit steps
             call h5screate_f(H5S_SCALAR_F, space_id, hdferr)
-            if (hdferr < 0) then
-                space_id = -1
-                call make_error(err, ERR_IO, label//': cannot create dataspace')
-                exit steps
-            end if
+            if (h5_failed(hdferr, label//': cannot create dataspace', err, space_id)) exit steps
             call h5acreate_f(loc_id, name, type_id, space_id, attr_id, hdferr)
-            if (hdferr < 0) then
-                attr_id = -1
-                call make_error(err, ERR_IO, label//': cannot create attribute')
-                exit steps
-            end if
+            if (h5_failed(hdferr, label//': cannot create attribute', err, attr_id)) exit steps
             if (len(value) > 0) then
                 call h5awrite_f(attr_id, type_id, value, dims, hdferr)
             else
@@ -132,10 +122,7 @@ contains
         exists = self%exists(name)
         if (exists) then
             call h5dopen_f(self%id, name, dset_id, hdferr)
-            if (hdferr < 0) then
-                call make_error(err, ERR_IO, self%path//': '//name//': cannot open dataset')
-                return
-            end if
+            if (h5_failed(hdferr, self%path//': '//name//': cannot open dataset', err)) return
         else
             call new_dataset(self, name, type_id, dims, dset_id, err)
             if (allocated(err)) return
@@ -171,11 +158,8 @@ contains
             else
                 call h5screate_simple_f(size(dims), dims, space_id, hdferr)
             end if
-            if (hdferr < 0) then
-                space_id = -1
-                call make_error(err, ERR_IO, self%path//': '//name//': cannot create dataspace')
-                exit steps
-            end if
+            if (h5_failed(hdferr, self%path//': '//name// &
+                                  ': cannot create dataspace', err, space_id)) exit steps
             if (present(chunk)) then
                 call h5pcreate_f(H5P_DATASET_CREATE_F, plist_id, hdferr)
                 if (hdferr < 0) then
@@ -185,11 +169,8 @@ contains
                     exit steps
                 end if
                 call h5pset_chunk_f(plist_id, size(chunk), chunk, hdferr)
-                if (hdferr < 0) then
-                    call make_error(err, ERR_IO, self%path//': '//name// &
-                                    ': cannot set chunk size')
-                    exit steps
-                end if
+                if (h5_failed(hdferr, self%path//': '//name// &
+                                      ': cannot set chunk size', err)) exit steps
             end if
             call h5dcreate_f(self%id, name, type_id, space_id, dset_id, hdferr, dcpl_id=plist_id)
             if (hdferr < 0) then
@@ -217,20 +198,14 @@ contains
         value = ''
         if (present(found)) found = .false.
         call h5aexists_f(self%id, name, exists, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, label//': cannot check existence')
-            return
-        end if
+        if (h5_failed(hdferr, label//': cannot check existence', err)) return
         if (.not. exists) then
             if (.not. present(found)) call make_error(err, ERR_IO, label//' is missing')
             return
         end if
         if (present(found)) found = .true.
         call h5aopen_f(self%id, name, attr_id, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, label//': cannot open')
-            return
-        end if
+        if (h5_failed(hdferr, label//': cannot open', err)) return
         call h5aget_type_f(attr_id, type_id, hdferr)
         if (hdferr >= 0) call h5tget_size_f(type_id, length, hdferr)
         if (hdferr < 0) then
@@ -289,10 +264,7 @@ contains
 
         if (.not. self%exists(name)) return
         call h5dopen_f(self%id, name, dset_id, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot open dataset')
-            return
-        end if
+        if (h5_failed(hdferr, self%path//': '//name//': cannot open dataset', err)) return
         steps: block
             if (present(values)) then
                 call extents(self, name, dset_id, dims, err)
@@ -321,10 +293,7 @@ contains
         integer :: hdferr, actual
         dims = 0
         call h5dget_space_f(dset_id, space_id, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot get dataspace')
-            return
-        end if
+        if (h5_failed(hdferr, self%path//': '//name//': cannot get dataspace', err)) return
         call h5sget_simple_extent_ndims_f(space_id, actual, hdferr)
         if (hdferr < 0 .or. actual /= size(dims)) then
             call make_error(err, ERR_IO, self%path//': '//name//': not of rank '// &

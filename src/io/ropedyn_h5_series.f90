@@ -51,10 +51,7 @@ contains
         series%record_dims = 1
         series%text_width = max(1, width)
         call string_type(series%text_width, type_id, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot set up the string type')
-            return
-        end if
+        if (h5_failed(hdferr, self%path//': '//name//': cannot set up the string type', err)) return
         dims = 0
         max_dims = H5S_UNLIMITED_F
         chunk = max(1, min(MAX_CHUNK_RECORDS, CHUNK_BYTES/series%text_width))
@@ -74,16 +71,10 @@ contains
         series%path = self%path
         series%name = name
         call h5dopen_f(self%id, name, series%id, hdferr)
-        if (hdferr < 0) then
-            series%id = -1
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot open dataset')
-            return
-        end if
+        if (h5_failed(hdferr, self%path//': '//name//': cannot open dataset', err, &
+                      series%id)) return
         call h5dget_space_f(series%id, space_id, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot get dataspace')
-            return
-        end if
+        if (h5_failed(hdferr, self%path//': '//name//': cannot get dataspace', err)) return
         call h5sget_simple_extent_ndims_f(space_id, rank, hdferr)
         if (hdferr >= 0 .and. rank >= 1 .and. rank <= 3) &
             call h5sget_simple_extent_dims_f(space_id, dims(1:rank), max_dims(1:rank), hdferr)
@@ -98,10 +89,7 @@ contains
         series%record_dims(1:rank - 1) = dims(1:rank - 1)
         series%text_width = 0
         call h5dget_type_f(series%id, type_id, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot get its type')
-            return
-        end if
+        if (h5_failed(hdferr, self%path//': '//name//': cannot get its type', err)) return
         call h5tget_class_f(type_id, class, hdferr)
         if (hdferr >= 0 .and. class == H5T_STRING_F) then
             call h5tget_size_f(type_id, width, hdferr)
@@ -171,19 +159,12 @@ contains
         label = self%path//': '//name
         allocate (values(0))
         call h5dopen_f(self%id, name, dset_id, hdferr)
-        if (hdferr < 0) then
-            call make_error(err, ERR_IO, label//': cannot open dataset')
-            return
-        end if
+        if (h5_failed(hdferr, label//': cannot open dataset', err)) return
         file_space = -1
         mem_space = -1
         steps: block
             call h5dget_space_f(dset_id, file_space, hdferr)
-            if (hdferr < 0) then
-                file_space = -1
-                call make_error(err, ERR_IO, label//': cannot get dataspace')
-                exit steps
-            end if
+            if (h5_failed(hdferr, label//': cannot get dataspace', err, file_space)) exit steps
             call h5sget_simple_extent_ndims_f(file_space, rank, hdferr)
             if (hdferr < 0 .or. rank < 1 .or. rank > 3) then
                 call make_error(err, ERR_IO, label//': not a series')
