@@ -40,12 +40,6 @@
 !!   step / h_e) is lower than the implicit method's measured cost by GAIN; a trial of the
 !!   implicit method that does not pay (judged on its second window) goes back at once.
 !!   A switch that is undone within two windows doubles the wait before the next one.
-!! - **The explicit pair**: RK4 (the longest stable step per evaluation of f) while the
-!!   explicit step is held by stability; where it is held by accuracy (and the problem has
-!!   no mass matrix: there Adams, below) Dormand-Prince 5(4) may take so much longer steps
-!!   that it pays for its larger vector work per step: it is tried (two windows, then RK4
-!!   again for two, the costs compared next to each other in time) and taken when it needs
-!!   GAIN fewer evaluations of f than RK4; every RECHECK windows RK4 is measured again.
 !! - **Adams** (CVODE's Adams-Moulton, fixed-point iteration) for the explicit method's
 !!   other weakness: a step held by accuracy, not stability, where f is costly: Adams takes
 !!   about one evaluation of f per step against erk's four, but CVODE's own work per step
@@ -80,10 +74,6 @@ module ropedyn_auto
 
     integer, parameter :: EXPLICIT = 1, IMPLICIT = 2, ADAMS = 3
     integer, parameter :: ERK_ORDER = 4            !< the explicit pair (RK4, 3rd-order estimate)
-    !> the explicit pair where its step is held by accuracy (Dormand-Prince 5(4))
-    integer, parameter :: ERK_ACCURATE_ORDER = 5
-    !> windows of the accurate pair before RK4 is measured again
-    integer, parameter :: RECHECK = 16
     integer, parameter :: WINDOW = 400             !< steps between looks
     real(wp), parameter :: GAIN = 1.3_wp           !< hysteresis of a switch
     !> explicit steps per simulated second above which a run starts implicit
@@ -131,11 +121,6 @@ module ropedyn_auto
         integer(i8) :: win_steps0 = 0
         integer :: windows = 0             !< windows since the last switch
         real(wp) :: rate_explicit = -1.0_wp  !< measured cost per simulated second (< 0: none)
-        !> the explicit pair in use (ERK_ORDER or ERK_ACCURATE_ORDER), the measured cost
-        !! of each, and whether the accurate pair is on trial
-        integer :: erk_order = ERK_ORDER
-        real(wp) :: rate_erk(ERK_ORDER:ERK_ACCURATE_ORDER) = -1.0_wp
-        logical :: erk_trial = .false.
         real(wp) :: rate_implicit = -1.0_wp
         real(wp) :: rate_adams = -1.0_wp
         logical :: trial = .false.         !< the implicit method is on trial
@@ -190,9 +175,6 @@ contains
         self%done = solver_stats_t()
         call self%log%clear()
         self%rate_explicit = -1.0_wp
-        self%erk_order = ERK_ORDER
-        self%rate_erk = -1.0_wp
-        self%erk_trial = .false.
         self%rate_implicit = -1.0_wp
         self%rate_adams = -1.0_wp
         self%trial = .false.
@@ -282,14 +264,14 @@ contains
         opts = self%options
         opts%max_steps = max(1_i8, self%options%max_steps - self%done%steps)
         if (which == EXPLICIT) then
-            opts%max_order = self%erk_order
+            opts%max_order = ERK_ORDER
             call self%erk%init(self%problem, self%t, self%y, self%yq, opts, err)
             if (allocated(err)) return
             call self%erk%set_stiff_failure(0.0_wp)
             if (present(h_first)) then
                 if (h_first > 0.0_wp) call self%erk%set_initial_step(0.5_wp*h_first)
             end if
-            call self%log%add(self%t, 'erk', self%erk_order, reason)
+            call self%log%add(self%t, 'erk', ERK_ORDER, reason)
         else if (which == ADAMS) then
             opts%max_order = ADAMS_ORDER
             call self%am%init(self%problem, self%t, self%y, self%yq, opts, err)
@@ -380,7 +362,6 @@ contains
         type(spectrum_t) :: spec
         real(wp) :: rate, span, h_e, predicted, share
         character(len=240) :: text
-        logical :: back
 
         now = self%current_stats()
         if (now%steps - self%win_steps0 < WINDOW) return
@@ -394,49 +375,14 @@ contains
         if (self%wait > 0) self%wait = self%wait - 1
 
         if (self%active == EXPLICIT) then
-            share = self%erk%stiff_share_of_steps()
-            ! the accurate pair is measured from its second window (the first includes its
-            ! start)
-            if (self%erk_order /= ERK_ORDER .and. self%windows < 2) return
             self%rate_explicit = rate
-            self%rate_erk(self%erk_order) = rate
-            if (self%erk_order /= ERK_ORDER) then
-                ! back to RK4 after a trial, after RECHECK windows, or when held by
-                ! stability (RK4: the longest stable step per evaluation of f); RK4's
-                ! second window then compares the two (next to each other in time: the
-                ! motion changes what either costs)
-                if (self%erk_trial .or. share >= 0.5_wp .or. self%windows >= RECHECK) then
-                    if (share >= 0.5_wp) then
-                        text = 'explicit step held by stability'
-                    else
-                        text = 'erk 5 measured: RK4 again to compare'
-                    end if
-                    back = self%erk_trial
-                    self%erk_trial = .false.
-                    call switch_pair(ERK_ORDER, trim(text), back)
-                end if
-                return
-            end if
+            share = self%erk%stiff_share_of_steps()
             if (self%wait > 0) return
-            if (share < 0.5_wp .and. .not. self%problem%has_mass_matrix()) then
-                ! held by accuracy: the higher-order pair takes longer steps for the same
-                ! error, but each costs more vector work per evaluation of f (21 stage
-                ! combinations against RK4's 7), which the count does not see: it is taken
-                ! when it saves GAIN in evaluations (the paper's rope at rtol 1e-6: as many
-                ! as RK4 and 7 % more CPU; the folded 301-element rope: half the CPU)
-                if (self%windows < 2) return
-                if (self%rate_erk(ERK_ACCURATE_ORDER) > 0.0_wp .and. &
-                    GAIN*self%rate_erk(ERK_ACCURATE_ORDER) >= rate) return
-                self%erk_trial = self%rate_erk(ERK_ACCURATE_ORDER) <= 0.0_wp
-                call switch_pair(ERK_ACCURATE_ORDER, 'explicit step held by accuracy', &
-                                 self%windows <= 2)
-                return
-            end if
             if (share < 0.5_wp) then
                 ! held by accuracy: Adams may need fewer evaluations of f (judged on the
                 ! explicit method's second window on: the first includes its start), which
                 ! pays only where f is costly: a problem with a mass matrix (f solves with it)
-                if (self%windows < 2) return
+                if (self%windows < 2 .or. .not. self%problem%has_mass_matrix()) return
                 if (self%rate_adams > 0.0_wp .and. GAIN*self%rate_adams >= rate) return
                 write (text, '(a, i0, a, es9.2, a)') 'explicit step held by accuracy (', &
                     nint(100*(1 - share)), ' % of the steps; cost ', rate, ' f per second)'
@@ -495,24 +441,10 @@ contains
                     ' s: predicted cost ', predicted, ' f per second against ', rate, &
                     ' for '//self%implicit_name()
                 if (self%windows <= 2) call back_off()
-                self%erk_order = ERK_ORDER     ! the pair h_e is for
                 call self%start_method(EXPLICIT, trim(text), err, h_e)
             end if
         end if
     contains
-        !> Go on with the explicit pair of order `order` from the current step size.
-        subroutine switch_pair(order, why, soon)
-            integer, intent(in) :: order
-            character(len=*), intent(in) :: why
-            logical, intent(in) :: soon     !< soon after the last switch: wait longer
-            write (text, '(a, i0, a, es9.2, a)') why//' (', nint(100*share), &
-                ' % of the steps held by stability; cost ', rate, ' f per second)'
-            if (self%erk_trial) text = trim(text)//': trying erk 5'
-            if (soon) call back_off()
-            self%erk_order = order
-            call self%start_method(EXPLICIT, trim(text), err, 2.0_wp*now%last_step)
-        end subroutine switch_pair
-
         !> A switch soon after the last one: wait longer before the next.
         subroutine back_off()
             self%wait = self%backoff
