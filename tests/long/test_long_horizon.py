@@ -83,6 +83,16 @@ GAIN_EXCEPTIONS = {
     # at 1e-4; orders 3-5 unguarded 0.025 J; MEBDF at 1e-3 loses 9.5e-4 J. An accuracy
     # limit of rtol 1e-3 on this scene, not an order instability.
     "folded_n301/cvode/0.001": 600.0,
+    # CVODE at rtol 1e-5 on the same fall (43 rtol S, 3.6e-4 J at 0.6 s, with the exe of
+    # fb831c0): the same snap, chaotic: runs whose only difference is round-off (the
+    # RFEM supports' cos and sin from the vectorized pass instead of libm) or rtol moved
+    # by 1e-6 .. 1e-5 of itself end with balance errors from 9e-6 to 3.6e-4 J, with and
+    # without the order safety acting (it lowered to BDF2 at 0.17 .. 0.53 s in 5 of 8);
+    # this case passed before by chance. Here BDF5 is lowered at 0.384 s, and at BDF2
+    # the gain grows from 1.8e-5 to 3.6e-4 J over 0.386 .. 0.5 s while the chain rings
+    # after the snap, as at 1e-3; BDF2 from the start gains 4.7e-5 J (5.6 rtol S), MEBDF
+    # and erk stay below 3 rtol S. An accuracy limit of CVODE through the snap.
+    "folded_n301/cvode/1e-05": 60.0,
     # ADAMS at rtol 1e-3 on the lightly damped rope: the monitor watches T + V + dissipated
     # and lowers ADAMS to order 2 when that gains 10 rtol S; T + V alone rose 10.2 rtol S
     # (the dissipated energy rose with it), just past G. Measured, after the safe order.

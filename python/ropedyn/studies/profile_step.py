@@ -18,6 +18,11 @@ split by the inclusive cost of the functions that do each part:
 `--methods erk` profiles the explicit method instead (no Jacobian, factorization or solves:
 RHS and the rest of erk_advance_to: stages, error norm, step control, quadratures' history)
 into its own table (the profile_step erk markers).
+`--whole-run` profiles the whole program on the paper scene as it ships (output every
+0.01 s, its default method unless --methods names one) into a table of its own (the
+profile_step whole-run markers): the integrator's RHS and rest as above, the output (the
+run file: output_append, and the stats and close that write the last records) and the
+remainder (start-up, the records' fields and energies, the driver); per accepted step.
 The table goes into docs/benchmarks.md between the profile_step markers.
 """
 import argparse
@@ -35,6 +40,7 @@ from ropedyn.studies.common import machine, update_doc, utc_stamp
 BEGIN = "<!-- profile_step:begin -->"
 END = "<!-- profile_step:end -->"
 PARTS = ("RHS", "Jacobian", "factorization", "solves", "rest")
+WHOLE_PARTS = ("RHS", "rest of the integrator", "output (HDF5)", "the remainder")
 
 
 def inclusive_costs(cg_file):
@@ -75,20 +81,38 @@ def split(costs, method):
     return [*parts, total - sum(parts)], total
 
 
-def profile(exe, method, t_end, workdir, tag):
+def whole_split(costs):
+    """Instructions of the WHOLE_PARTS and the program's total (any integrator)."""
+    total = total_of(costs, "MAIN__")
+    rhs = total_of(costs, "_MOD_rfem_rhs", "_MOD_rfem_quad_rhs", "_MOD_rfem_rhs_quad")
+    # the outermost integrator (auto's inclusive cost holds the one it runs)
+    integrator = next((c for c in (total_of(costs, name) for name in (
+        "_MOD_auto_advance_to", "_MOD_erk_advance_to", "CVode", "_MOD_mebdf_advance_to"))
+        if c > 0), 0)
+    output = total_of(costs, "_MOD_output_append", "_MOD_output_write_stats",
+                      "_MOD_output_close_run")
+    return [rhs, integrator - rhs, output, total - integrator - output], total
+
+
+def profile(exe, method, t_end, workdir, tag, whole=False):
     out = workdir / f"{tag}_{method}.h5"
     cg = workdir / f"{tag}_{method}.callgrind"
     log = workdir / f"{tag}_{method}.log"
+    sets = [f"solver.t_end={t_end}", f'output.file="{out}"']
+    if not whole:
+        sets.append("solver.output_interval=0.1")
+    if method != "default":
+        sets.append(f'solver.method="{method}"')
     cmd = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={cg}", str(exe), "run",
-           str(PAPER), *set_args([f'solver.method="{method}"', f"solver.t_end={t_end}",
-                                  f'output.file="{out}"', "solver.output_interval=0.1"])]
+           str(PAPER), *set_args(sets)]
     with open(log, "w") as f:
         proc = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT, text=True)
     text = log.read_text()
     if proc.returncode != 0:
         raise SystemExit(f"profile_step: {' '.join(cmd)} failed:\n{text[-2000:]}")
     steps = int(re.search(r"steps\s+(\d+)", text).group(1))
-    parts, total = split(inclusive_costs(cg), method)
+    costs = inclusive_costs(cg)
+    parts, total = whole_split(costs) if whole else split(costs, method)
     return steps, parts, total
 
 
@@ -125,14 +149,19 @@ def main(argv=None):
                         help="git revision to profile as 'before' (e.g. main)")
     parser.add_argument("--methods", default="cvode mebdf",
                         help="integrators to profile: 'cvode mebdf' (default) or 'erk'")
+    parser.add_argument("--whole-run", action="store_true",
+                        help="the whole program with the scene's output (its own table)")
     parser.add_argument("--no-write", action="store_true", help="print only")
     args = parser.parse_args(argv)
+    if args.whole_run and args.methods == "cvode mebdf":
+        args.methods = "default"
+    parts_names = WHOLE_PARTS if args.whole_run else PARTS
     if shutil.which("valgrind") is None:
         raise SystemExit("profile_step: valgrind is not installed")
     exe = exe_or_build(args.exe)
     header = ("| build | solver | steps | instructions per step (k) | "
-              + " | ".join(f"{p}: k per step (share)" for p in PARTS) + " |")
-    rule = "|---|---|---|---|" + "---|" * len(PARTS)
+              + " | ".join(f"{p}: k per step (share)" for p in parts_names) + " |")
+    rule = "|---|---|---|---|" + "---|" * len(parts_names)
     rows = []
     print(header)
     print(rule)
@@ -148,7 +177,7 @@ def main(argv=None):
         for label, path in builds:
             for method in args.methods.split():
                 steps, parts, total = profile(path, method, args.t_end, tmp,
-                                              re.sub(r"\W", "_", label))
+                                              re.sub(r"\W", "_", label), args.whole_run)
                 rows.append(row(label, method, steps, parts, total))
                 print(rows[-1], flush=True)
     if args.no_write:
@@ -156,17 +185,25 @@ def main(argv=None):
     command = "scripts/profile_step" + (f" --baseline {args.baseline}" if args.baseline
                                         else "") + f" --t-end {args.t_end:g}"
     begin, end, heading = BEGIN, END, "## Profile of a step (callgrind)\n\n"
-    if args.methods.split() != ["cvode", "mebdf"]:
+    what = (f"{args.t_end:g} s, rtol 1e-6, default orders; instruction counts, inclusive, per "
+            "accepted step")
+    if args.whole_run:
+        command += " --whole-run" + (f" --methods \"{args.methods}\""
+                                     if args.methods != "default" else "")
+        begin, end = "<!-- profile_step whole-run:begin -->", "<!-- profile_step whole-run:end -->"
+        heading = "### Profile of the whole paper run (callgrind)\n\n"
+        what = (f"{args.t_end:g} s as the scene ships it: its method (solver 'default'), rtol "
+                "1e-6, a record every 0.01 s; instruction counts of the whole program, "
+                "inclusive, per accepted step")
+    elif args.methods.split() != ["cvode", "mebdf"]:
         command += f" --methods \"{args.methods}\""
         tag = "+".join(args.methods.split())
         begin, end = f"<!-- profile_step {tag}:begin -->", f"<!-- profile_step {tag}:end -->"
         heading = f"### Profile of a step: {tag} (callgrind)\n\n"
     block = "\n".join([
         begin,
-        f"Command: `{command}` (valgrind callgrind, input/paper.nml, n = 30, "
-        f"{args.t_end:g} s, rtol 1e-6, default orders; instruction counts, inclusive, per "
-        "accepted step; see python/ropedyn/studies/profile_step.py for the functions that "
-        "make each part).",
+        f"Command: `{command}` (valgrind callgrind, input/paper.nml, n = 30, {what}; see "
+        "python/ropedyn/studies/profile_step.py for the functions that make each part).",
         f"Machine: {machine()}. Run: {utc_stamp()}.",
         "", header, rule, *rows, end])
     update_doc(DOCS / "benchmarks.md", begin, end, block, heading=heading)
