@@ -104,9 +104,22 @@ module ropedyn_erk
         module subroutine quad_step(self, h, dq, errq)
             class(erk_t), intent(in) :: self
             real(wp), intent(in) :: h
-            real(wp), intent(out) :: dq(:)
+            real(wp), intent(out), contiguous :: dq(:)
             real(wp), intent(out) :: errq
         end subroutine quad_step
+
+        !> out = base + sum_j (h c_j) k(:, j) over the nonzero c_j, left to right (without base:
+        !! the sum alone, its first term assigned, no zero fill): the argument of a stage, the
+        !! error estimate, the quadratures' increment and its estimate. One vectorized update
+        !! per nonzero entry of the table, no array temporaries.
+        !! (in submodule ropedyn_erk_dense, which uses it too)
+        pure module subroutine combine(c, h, k, out, base)
+            real(wp), intent(in) :: c(:)              !< coefficients of the first size(c) stages
+            real(wp), intent(in) :: h
+            real(wp), intent(in), contiguous :: k(:, :)
+            real(wp), intent(out), contiguous :: out(:)
+            real(wp), intent(in), contiguous, optional :: base(:)
+        end subroutine combine
 
         !> The solution at tt within the last accepted step (t_old .. t).
         module subroutine dense(self, tt, y, yq)
@@ -408,18 +421,7 @@ contains
         class(erk_t), intent(inout) :: self
         integer, intent(in) :: i
         real(wp), intent(in) :: h
-        integer :: j
-        logical :: first
-        first = .true.
-        do j = 1, i - 1
-            if (self%tab%a(i, j) == 0.0_wp) cycle
-            if (first) then
-                call xpay(self%y, h*self%tab%a(i, j), self%k(:, j), self%ytmp)
-                first = .false.
-            else
-                call axpy(h*self%tab%a(i, j), self%k(:, j), self%ytmp)
-            end if
-        end do
+        call combine(self%tab%a(i, 1:i - 1), h, self%k, self%ytmp, self%y)
     end subroutine stage_state
 
     !> Weighted RMS norm of the error estimate h sum_j e_j k(:, j), with weights
@@ -428,18 +430,8 @@ contains
         class(erk_t), intent(inout) :: self
         real(wp), intent(in) :: h
         real(wp) :: v, acc
-        integer :: j, l
-        logical :: first
-        first = .true.
-        do j = 1, self%s
-            if (self%tab%e(j) == 0.0_wp) cycle
-            if (first) then
-                self%ytmp(:) = (h*self%tab%e(j))*self%k(:, j)
-                first = .false.
-            else
-                call axpy(h*self%tab%e(j), self%k(:, j), self%ytmp)
-            end if
-        end do
+        integer :: l
+        call combine(self%tab%e(1:self%s), h, self%k, self%ytmp)
         acc = 0.0_wp
         do l = 1, self%n
             v = self%ytmp(l)/(self%options%rtol*max(abs(self%y(l)), abs(self%ynew(l))) &
@@ -449,22 +441,6 @@ contains
         norm = sqrt(acc/max(1, self%n))
     end function error_norm
 
-    !> z = y + a x.
-    pure subroutine xpay(y, a, x, z)
-        real(wp), intent(in), contiguous :: y(:)
-        real(wp), intent(in) :: a
-        real(wp), intent(in), contiguous :: x(:)
-        real(wp), intent(out), contiguous :: z(:)
-        z = y + a*x
-    end subroutine xpay
-
-    !> y = y + a x.
-    pure subroutine axpy(a, x, y)
-        real(wp), intent(in) :: a
-        real(wp), intent(in), contiguous :: x(:)
-        real(wp), intent(inout), contiguous :: y(:)
-        y = y + a*x
-    end subroutine axpy
 
     !> Exchange two work arrays without copying.
     subroutine swap(a, b)

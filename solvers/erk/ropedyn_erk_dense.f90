@@ -1,7 +1,8 @@
 !> Dense output and quadratures of the explicit Runge-Kutta integration (ropedyn_erk): the
 !! solution between step points (the pair's own continuous extension, or the cubic Hermite
 !! interpolant), and the quadratures' increment and error estimate over a step from
-!! their right-hand side g at the stages.
+!! their right-hand side g at the stages; `combine`, the sum over a table's stages that
+!! these and ropedyn_erk's stages and error estimate are made of.
 submodule (ropedyn_erk) ropedyn_erk_dense
     implicit none
 
@@ -12,16 +13,32 @@ contains
     !! max(|yq|, |yq + dq|) + atol, as CVODE's for its quadratures).
     module procedure quad_step
         real(wp) :: eq(self%nq)
-        integer :: j
-        dq = 0.0_wp
-        eq = 0.0_wp
-        do j = 1, self%s
-            if (self%tab%b(j) /= 0.0_wp) dq = dq + (h*self%tab%b(j))*self%gk(:, j)
-            if (self%tab%e(j) /= 0.0_wp) eq = eq + (h*self%tab%e(j))*self%gk(:, j)
-        end do
+        call combine(self%tab%b(1:self%s), h, self%gk, dq)
+        call combine(self%tab%e(1:self%s), h, self%gk, eq)
         errq = sqrt(sum((eq/(self%options%rtol*max(abs(self%yq), abs(self%yq + dq)) &
                              + self%options%atol))**2)/self%nq)
     end procedure quad_step
+
+    module procedure combine
+        integer :: j
+        logical :: first
+        first = .true.
+        do j = 1, size(c)
+            if (c(j) == 0.0_wp) cycle
+            if (.not. first) then
+                call axpy(h*c(j), k(:, j), out)
+            else if (present(base)) then
+                call xpay(base, h*c(j), k(:, j), out)
+            else
+                out = (h*c(j))*k(:, j)
+            end if
+            first = .false.
+        end do
+        if (first) then
+            out = 0.0_wp
+            if (present(base)) out = base
+        end if
+    end procedure combine
 
     !> The solution at tt within the last accepted step (t_old .. t).
     module procedure dense
@@ -64,4 +81,21 @@ contains
         a = a0 + th*((a1 - a0) + th1*((h*f0 - (a1 - a0)) + th*((a1 - a0) - h*f1 &
             - (h*f0 - (a1 - a0)))))
     end function hermite
+
+    !> z = y + a x.
+    pure subroutine xpay(y, a, x, z)
+        real(wp), intent(in), contiguous :: y(:)
+        real(wp), intent(in) :: a
+        real(wp), intent(in), contiguous :: x(:)
+        real(wp), intent(out), contiguous :: z(:)
+        z = y + a*x
+    end subroutine xpay
+
+    !> y = y + a x.
+    pure subroutine axpy(a, x, y)
+        real(wp), intent(in) :: a
+        real(wp), intent(in), contiguous :: x(:)
+        real(wp), intent(inout), contiguous :: y(:)
+        y = y + a*x
+    end subroutine axpy
 end submodule ropedyn_erk_dense
