@@ -5,8 +5,8 @@ module ropedyn_band_lu
     use ropedyn_kinds, only: wp
     implicit none
     private
-    public :: RFEM_KL, band_lu_factor, band_lu_solve, band_solve_rfem, band_add_product, &
-              full_entry
+    public :: RFEM_KL, factored_dense, band_lu_factor, band_lu_solve, band_solve_rfem, &
+              band_add_product, full_entry
 
     !> Bandwidths of the RFEM's reduced matrix (3 x 3 blocks, block tridiagonal): its solve
     !! has a copy of the band loops with these as constants, whose inner loops the compiler
@@ -14,6 +14,13 @@ module ropedyn_band_lu
     integer, parameter :: RFEM_KL = 5
 
 contains
+
+    !> True when a matrix of order n with bandwidths kl, ku is factored dense (dgetrf): its
+    !! band LU storage (2 kl + ku + 1 rows) would be as large.
+    pure logical function factored_dense(n, kl, ku) result(dense)
+        integer, intent(in) :: n, kl, ku
+        dense = 2*kl + ku + 1 >= n
+    end function factored_dense
 
     !> LU factorization with partial pivoting of a band matrix in LAPACK's dgbtrf storage
     !! (entry (i, j) at row kl + ku + 1 + i - j of 2 kl + ku + 1 rows; rows 1 .. kl are

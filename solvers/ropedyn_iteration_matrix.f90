@@ -22,11 +22,12 @@ module ropedyn_iteration_matrix
     use ropedyn_kinds, only: wp, i8
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_RECOVERABLE, STATUS_FATAL
     use ropedyn_block3, only: block3_t, block_tridiagonal
-    use ropedyn_band_lu, only: RFEM_KL, band_lu_factor, band_lu_solve, band_solve_rfem, &
-                               band_add_product, full_entry
+    use ropedyn_band_lu, only: RFEM_KL, factored_dense, band_lu_factor, band_lu_solve, &
+                               band_solve_rfem, band_add_product, full_entry
     implicit none
     private
     public :: iteration_matrix_t
+    public :: factored_dense   !< ropedyn_band_lu's, for the CVODE linear solver
 
     !> Where the reduced blocks come from.
     integer, parameter :: BLOCKS_OWN_FORM = 1     !< the problem's blocks of the form used
@@ -163,7 +164,7 @@ contains
         if (self%reduced) then
             self%kl = min(max(self%kl, 0), self%np - 1)
             self%ku = min(max(self%ku, 0), self%np - 1)
-            self%rdense = 2*self%kl + self%ku + 1 >= self%np
+            self%rdense = factored_dense(self%np, self%kl, self%ku)
             associate (rows => self%kl + self%ku + 1, np => self%np)
                 allocate (self%kb(rows, np), self%cb(rows, np), self%mk(rows, np))
                 if (self%rdense) then
@@ -190,7 +191,7 @@ contains
         if (allocated(self%jac)) deallocate (self%jac, self%lu, self%ipiv, self%ywork, self%f1)
         if (allocated(self%mb)) deallocate (self%mb)
         if (.not. needed) n = 0
-        self%dense = 2*self%ml + self%mu + 1 >= self%n
+        self%dense = factored_dense(self%n, self%ml, self%mu)
         allocate (self%jac(self%ml + self%mu + 1, n))
         if (self%mass) then
             allocate (self%mb(self%ml + self%mu + 1, n))

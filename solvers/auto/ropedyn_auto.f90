@@ -67,6 +67,7 @@ module ropedyn_auto
     use ropedyn_cvode, only: cvode_t, adams_t
     use ropedyn_erk_tables, only: erk_table_t, erk_table
     use ropedyn_spectrum, only: spectrum_t, estimate_spectrum, erk_stable_step
+    use ropedyn_band_lu, only: factored_dense
     use ropedyn_switch_log, only: switch_log_t, switch_event_t
     implicit none
     private
@@ -224,7 +225,7 @@ contains
         kl = min(max(kl, 0), np - 1)
         ku = min(max(ku, 0), np - 1)
         width = kl + ku + 1
-        if (2*kl + ku + 1 >= np) width = np     ! factored dense (ropedyn_iteration_matrix)
+        if (factored_dense(np, kl, ku)) width = np
         lambda = max(1.0_wp, real(width, wp)/REFERENCE_WIDTH)
         eval_cost = 1.0_wp
         if (problem%has_mass_matrix()) eval_cost = 1.0_wp + MASS_COST*real(width, wp)

@@ -23,7 +23,7 @@ module ropedyn_cvode
     use ropedyn_problem, only: problem_t, STATUS_OK
     use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, &
         clock_seconds, stop_now
-    use ropedyn_iteration_matrix, only: iteration_matrix_t
+    use ropedyn_iteration_matrix, only: iteration_matrix_t, factored_dense
     use ropedyn_switch_log, only: switch_log_t, switch_event_t
     use fsundials_context_mod, only: FSUNContext_Create, FSUNContext_Free
     use fsundials_nvector_mod, only: N_Vector, FN_VDestroy, FN_VGetArrayPointer
@@ -358,7 +358,7 @@ contains
             self%ctx%ml = ml
             self%ctx%mu = mu
             ! A nearly full band: dense LU (LAPACK-style, blocked) beats the band LU.
-            dense = 2*ml + mu + 1 >= self%n
+            dense = factored_dense(self%n, ml, mu)
             if (dense) then
                 self%matrix => FSUNDenseMatrix(int(self%n, c_int64_t), &
                                                int(self%n, c_int64_t), self%sunctx)
