@@ -28,6 +28,7 @@ COMMANDS = {
     "bench_sweep": "ropedyn.studies.bench_sweep",
     "bench_peers": "ropedyn.studies.bench_peers",
     "auto_table": "ropedyn.studies.auto_table",
+    "auto_accuracy": "ropedyn.studies.auto_accuracy",
     "profile_step": "ropedyn.studies.profile_step",
     "validation": "ropedyn.studies.validation",
     "work_precision": "ropedyn.studies.work_precision",
