@@ -43,6 +43,9 @@ module ropedyn_erk
     public :: erk_t
     !> Accepted steps the stiffness monitor looks back over.
     integer, parameter :: STIFF_WINDOW = 500
+    !> accepted steps between estimates of the spectral radius from a combination of all
+    !! stages (the tables with rho_alpha); the last estimate holds in between
+    integer, parameter :: RHO_EVERY = 4
     !> h rho above this fraction of the stability limit counts as stability-limited.
     real(wp), parameter :: STIFF_FRACTION = 0.7_wp
     real(wp), parameter :: SAFETY = 0.9_wp      !< step-size safety factor
@@ -65,6 +68,7 @@ module ropedyn_erk
         logical :: started = .false.    !< k(:, 1) holds f(t, y)
         logical :: rejected = .false.   !< the last attempt was rejected
         real(wp), allocatable :: y(:), y_old(:), ynew(:), ytmp(:), yprev(:), k(:, :), atol(:)
+        real(wp), allocatable :: dk(:), dy(:)  !< the spectral estimate's stage combinations
         real(wp), allocatable :: yq(:), yq_old(:)
         !> the quadratures' right-hand side g at the stages of the current step (FSAL as k)
         real(wp), allocatable :: gk(:, :)
@@ -189,7 +193,8 @@ contains
         self%tab = erk_table(start%max_order)
         self%s = self%tab%stages
         allocate (self%y(self%n), self%y_old(self%n), self%ynew(self%n), self%ytmp(self%n), &
-                  self%yprev(self%n), self%k(self%n, self%s), self%atol(self%n))
+                  self%yprev(self%n), self%k(self%n, self%s), self%atol(self%n), &
+                  self%dk(self%n), self%dy(self%n))
         allocate (self%yq(self%nq), self%yq_old(self%nq), self%gk(self%nq, self%s))
         self%atol = self%options%atol
         if (allocated(self%options%atol_vector)) self%atol = self%options%atol_vector
@@ -389,7 +394,15 @@ contains
 
         ! accepted
         tnew = self%t + h
-        self%rho = spectral_estimate(self%k(:, s), self%k(:, s - 1), self%ynew, self%yprev)
+        if (all(self%tab%rho_alpha == 0.0_wp)) then
+            self%rho = spectral_estimate(self%k(:, s), self%k(:, s - 1), self%ynew, self%yprev)
+        else if (mod(self%counters%steps, int(RHO_EVERY, i8)) == 0) then
+            ! a combination of all stages (ropedyn_erk_tables: rho_alpha), every RHO_EVERY
+            ! steps (two passes over the stages: 8 % of the paper run at every step)
+            call combine(self%tab%rho_alpha(1:s), 1.0_wp, self%k, self%dk)
+            call combine(self%tab%rho_beta(1:s), h, self%k, self%dy)
+            self%rho = norm_ratio(self%dk, self%dy)
+        end if
         self%t_old = self%t
         self%h_old = h
         call swap(self%y_old, self%y)
@@ -472,6 +485,21 @@ contains
         if (ny > 0.0_wp) rho = sqrt(nf/ny)
     end function spectral_estimate
 
+    !> |a| / |b| (0 when b = 0).
+    pure real(wp) function norm_ratio(a, b) result(r)
+        real(wp), intent(in) :: a(:), b(:)
+        real(wp) :: na, nb
+        integer :: l
+        na = 0.0_wp
+        nb = 0.0_wp
+        do l = 1, size(a)
+            na = na + a(l)**2
+            nb = nb + b(l)**2
+        end do
+        r = 0.0_wp
+        if (nb > 0.0_wp) r = sqrt(na/nb)
+    end function norm_ratio
+
     !> Count stability-limited steps; fail when a whole window was held at a crawl.
     subroutine monitor_stiffness(self, h, err)
         class(erk_t), intent(inout) :: self
@@ -521,7 +549,7 @@ contains
         class(erk_t), intent(inout) :: self
         self%problem => null()
         if (allocated(self%y)) deallocate (self%y, self%y_old, self%ynew, self%ytmp, &
-                                           self%yprev, self%k, self%atol)
+                                           self%yprev, self%k, self%atol, self%dk, self%dy)
         if (allocated(self%yq)) deallocate (self%yq, self%yq_old, self%gk)
         self%started = .false.
     end subroutine erk_finalize
