@@ -24,7 +24,9 @@
 !!   element-scale oscillations that a stability-held step does not resolve.
 !! - **Stiffness**: the last two stages are both at t + h, so rho = |k_s - k_s-1| /
 !!   |Y_s - Y_s-1| estimates the spectral radius along the error for free (Hairer's
-!!   test). When most of the last 500 steps had h rho near the stability limit and they
+!!   test); the order-4 pair (the 3/8 rule) takes a combination of all its stages
+!!   instead, every 4th step (ropedyn_erk_tables: rho_alpha, and why). When most of the
+!!   last 500 steps had h rho near the stability limit and they
 !!   averaged more than 2e5 steps per simulated second, the run ends (ERR_SOLVER) with a
 !!   message naming the implicit methods.
 !! - **Failures**: a recoverable status of f (e.g. NaN) cuts h by 4; below the round-off
