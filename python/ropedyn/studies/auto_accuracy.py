@@ -28,17 +28,14 @@ with a diagnosis does not count. The table goes between the auto_accuracy marker
 docs/benchmarks.md. The code of scripts/auto_accuracy.
 """
 import argparse
-import math
 import pathlib
-import resource
-import subprocess
 import sys
 import tempfile
 
-import h5py
 import numpy as np
 
-from ropedyn.run import DOCS, add_exe_argument, exe_or_build, set_args
+from ropedyn.run import DOCS, add_exe_argument, exe_or_build
+from ropedyn.studies import auto_table
 from ropedyn.studies.auto_table import FIXED, scene_t_end, scenes
 from ropedyn.studies.common import machine, update_doc, utc_stamp
 
@@ -68,42 +65,21 @@ def distance(a, b):
 
 
 def one_run(exe, scene, work, method, span, sets, cap):
-    """One run: (cpu, points, switch methods), or None when it failed or ran over its cap."""
-    out = work / f"{scene.stem}_{method}.h5"
-    args = [f"solver.t_end={span:.10g}", f'solver.method="{method}"', *sets,
-            f'output.file="{out}"']
-
-    def limit():
-        if cap is not None:
-            c = int(math.ceil(cap))
-            resource.setrlimit(resource.RLIMIT_CPU, (c, c + 1))
-
-    proc = subprocess.run([str(exe), "run", str(scene), *set_args(args)], capture_output=True,
-                          text=True, preexec_fn=limit, cwd=work)
-    if proc.returncode != 0:
+    """One run (auto_table's): (cpu, points, switch methods), or None when it failed or ran
+    over its cap."""
+    r = auto_table.run(exe, scene, work, method, span, cap, sets, points=True)
+    if r["status"] != "complete":
         return None
-    with h5py.File(out, "r") as f:
-        methods = [m.decode().strip() for m in f["solver/switch_method"][()]] \
-            if "solver/switch_method" in f else [method]
-        result = float(f["solver/cpu_time"][()]), f["rope/points"][()], methods
-    out.unlink()
-    return result
+    return r["cpu"], r["points"], [m for _, m, _ in r["switches"]] or [method]
 
 
 def measured(exe, scene, work, method, span, sets, repeat, cap, ref):
     """(cpu, error, switch methods) of `method` with `sets`: the least CPU of `repeat` runs
-    (more, up to 8, while they add up to less than 1 s); None when a run failed or ran over
-    its cap."""
-    best, spent, runs = None, 0.0, 0
-    while runs < repeat or (spent < 1.0 and runs < 8):
-        r = one_run(exe, scene, work, method, span, sets, cap)
-        if r is None:
-            return None
-        runs += 1
-        spent += r[0]
-        if best is None or r[0] < best[0]:
-            best = r
-    return best[0], distance(best[1], ref), best[2]
+    (auto_table's best_of); None when a run failed or ran over its cap."""
+    r = auto_table.best_of(exe, scene, work, method, span, repeat, cap, sets, points=True)
+    if r["status"] != "complete":
+        return None
+    return r["cpu"], distance(r["points"], ref), [m for _, m, _ in r["switches"]] or [method]
 
 
 def main(argv=None):

@@ -58,7 +58,9 @@ def round_down(x):
     return max(m * 10.0 ** k for m in ROUND if m * 10.0 ** k <= x * (1 + 1e-12))
 
 
-def run(exe, scene, work, method, t_end, cap=None, extra=()):
+def run(exe, scene, work, method, t_end, cap=None, extra=(), points=False):
+    """One run with at most `cap` s of CPU: its status, CPU, steps and switches (and with
+    `points`, /rope/points)."""
     out = work / f"{scene.stem}_{method}.h5"
     sets = [f"solver.t_end={t_end:.10g}", f'output.file="{out}"', f'solver.method="{method}"',
             *extra]
@@ -83,16 +85,18 @@ def run(exe, scene, work, method, t_end, cap=None, extra=()):
             for t, m, o in zip(f["solver/switch_time"][()], f["solver/switch_method"][()],
                                f["solver/switch_max_order"][()]):
                 switches.append((float(t), m.decode().strip(), int(o)))
+        rope = f["rope/points"][()] if points else None
     out.unlink()
-    return {"status": "complete", "cpu": cpu, "steps": steps, "switches": switches}
+    return {"status": "complete", "cpu": cpu, "steps": steps, "switches": switches,
+            "points": rope}
 
 
-def best_of(exe, scene, work, method, t_end, repeat, cap=None, extra=()):
+def best_of(exe, scene, work, method, t_end, repeat, cap=None, extra=(), points=False):
     """The run with the least CPU of `repeat` (a failed or capped run is returned at once)."""
     best, spent, runs = None, 0.0, 0
     # short runs are repeated more (up to 8 runs or 1 s of CPU): their minimum is noisy
     while runs < repeat or (spent < 1.0 and runs < 8):
-        r = run(exe, scene, work, method, t_end, cap, extra)
+        r = run(exe, scene, work, method, t_end, cap, extra, points)
         if r["status"] != "complete":
             return r
         runs += 1
