@@ -26,9 +26,9 @@
 !!   |Y_s - Y_s-1| estimates the spectral radius along the error for free (Hairer's
 !!   test); the order-4 pair (the 3/8 rule) takes a combination of all its stages
 !!   instead, every 4th step (ropedyn_erk_tables: rho_alpha, and why). When most of the
-!!   last 500 steps had h rho near the stability limit and they
-!!   averaged more than 2e5 steps per simulated second, the run ends (ERR_SOLVER) with a
-!!   message naming the implicit methods.
+!!   last 500 steps had h rho near the stability limit and they averaged more than 2e5
+!!   steps per simulated second, the run ends (ERR_SOLVER) with a message naming the
+!!   implicit methods.
 !! - **Failures**: a recoverable status of f (e.g. NaN) cuts h by 4; below the round-off
 !!   floor 16 eps |t| or past max_steps the integration ends with the last good state.
 module ropedyn_erk
@@ -71,6 +71,9 @@ module ropedyn_erk
         logical :: rejected = .false.   !< the last attempt was rejected
         real(wp), allocatable :: y(:), y_old(:), ynew(:), ytmp(:), yprev(:), k(:, :), atol(:)
         real(wp), allocatable :: dk(:), dy(:)  !< the spectral estimate's stage combinations
+        !> the table estimates rho from its last two stages (Y_s-1 kept in yprev), not
+        !! from a combination of all (rho_alpha: dk, dy)
+        logical :: rho_last_two = .true.
         real(wp), allocatable :: yq(:), yq_old(:)
         !> the quadratures' right-hand side g at the stages of the current step (FSAL as k)
         real(wp), allocatable :: gk(:, :)
@@ -194,6 +197,7 @@ contains
 
         self%tab = erk_table(start%max_order)
         self%s = self%tab%stages
+        self%rho_last_two = all(self%tab%rho_alpha == 0.0_wp)
         allocate (self%y(self%n), self%y_old(self%n), self%ynew(self%n), self%ytmp(self%n), &
                   self%yprev(self%n), self%k(self%n, self%s), self%atol(self%n), &
                   self%dk(self%n), self%dy(self%n))
@@ -354,7 +358,7 @@ contains
             ! the components with the table's nonzero entries only (no array temporaries)
             do i = 2, s
                 call self%stage_state(i, h)
-                if (i == s - 1) self%yprev(:) = self%ytmp
+                if (i == s - 1 .and. self%rho_last_two) self%yprev(:) = self%ytmp
                 if (self%nq > 0) then
                     ! with the quadratures' right-hand side at the same stage
                     call self%problem%rhs_quad(self%t + self%tab%c(i)*h, self%ytmp, &
@@ -396,7 +400,7 @@ contains
 
         ! accepted
         tnew = self%t + h
-        if (all(self%tab%rho_alpha == 0.0_wp)) then
+        if (self%rho_last_two) then
             self%rho = spectral_estimate(self%k(:, s), self%k(:, s - 1), self%ynew, self%yprev)
         else if (mod(self%counters%steps, int(RHO_EVERY, i8)) == 0) then
             ! a combination of all stages (ropedyn_erk_tables: rho_alpha), every RHO_EVERY
