@@ -37,7 +37,7 @@ import numpy as np
 from ropedyn.run import DOCS, add_exe_argument, exe_or_build
 from ropedyn.studies import auto_table
 from ropedyn.studies.auto_table import FIXED, scene_t_end, scenes
-from ropedyn.studies.common import machine, update_doc, utc_stamp
+from ropedyn.studies.common import machine, scene_number, update_doc, utc_stamp
 
 BEGIN = "<!-- auto_accuracy:begin -->"
 END = "<!-- auto_accuracy:end -->"
@@ -47,30 +47,10 @@ FACTORS = (1e3, 1e2, 1e1, 1.0, 1e-1, 1e-2, 1e-3)
 SLACK = 1.5
 
 
-def scene_tolerances(scene):
-    """The scene's rtol and atol from its text (ropedyn's defaults when absent)."""
-    import re
-    text = scene.read_text()
-    out = []
-    for key, default in (("rtol", 1e-6), ("atol", 1e-8)):
-        m = re.search(rf"^\s*{key}\s*=\s*([0-9.eEdD+-]+)", text, re.MULTILINE)
-        out.append(float(m.group(1).lower().replace("d", "e")) if m else default)
-    return out
-
-
 def distance(a, b):
     """Largest distance (m) over the records and points of two /rope/points arrays."""
     k = min(len(a), len(b))
     return float(np.max(np.linalg.norm(a[:k] - b[:k], axis=-1)))
-
-
-def one_run(exe, scene, work, method, span, sets, cap):
-    """One run (auto_table's): (cpu, points, switch methods), or None when it failed or ran
-    over its cap."""
-    r = auto_table.run(exe, scene, work, method, span, cap, sets, points=True)
-    if r["status"] != "complete":
-        return None
-    return r["cpu"], r["points"], [m for _, m, _ in r["switches"]] or [method]
 
 
 def measured(exe, scene, work, method, span, sets, repeat, cap, ref):
@@ -107,23 +87,25 @@ def main(argv=None):
         work = pathlib.Path(tmp)
         for scene in chosen:
             span = min(args.span, scene_t_end(scene))
-            rtol, atol = scene_tolerances(scene)
+            rtol, atol = scene_number(scene, "rtol", 1e-6), scene_number(scene, "atol", 1e-8)
             # the span is halved while the reference does not resolve the methods' errors
             # (a chaotic phase, or a reference that has not converged)
             for _ in range(6):
                 common = [f"solver.output_interval={span / args.records:.10g}",
                           "solver.max_steps=10000000"]
-                refs = [one_run(exe, scene, work, "cvode", span, [
-                    *common, f"solver.rtol={r:g}", f"solver.atol={r * 1e-2:g}"], None)
+                refs = [auto_table.run(exe, scene, work, "cvode", span, None, [
+                    *common, f"solver.rtol={r:g}", f"solver.atol={r * 1e-2:g}"], points=True)
                     for r in (args.ref_rtol, 10 * args.ref_rtol)]
-                auto = measured(exe, scene, work, "auto", span, common, args.repeat, None,
-                                refs[0][1]) if None not in refs else None
+                auto = None
+                if all(r["status"] == "complete" for r in refs):
+                    auto = measured(exe, scene, work, "auto", span, common, args.repeat, None,
+                                    refs[0]["points"])
                 if auto is None:
                     break
-                spread = distance(refs[0][1], refs[1][1])
+                spread = distance(refs[0]["points"], refs[1]["points"])
                 cap = max(4 * auto[0], 3.0)
                 own = {m: measured(exe, scene, work, m, span, common, args.repeat, cap,
-                                   refs[0][1]) for m in FIXED}
+                                   refs[0]["points"]) for m in FIXED}
                 largest = max([auto[1]] + [r[1] for r in own.values() if r is not None])
                 if spread <= max(0.1 * largest, args.floor):
                     break
@@ -133,7 +115,7 @@ def main(argv=None):
                             f"reference or auto failed |")
                 print(rows[-1], flush=True)
                 continue
-            ref = refs[0][1]
+            ref = refs[0]["points"]
             auto_cpu, auto_err, choice = auto
             # errors below the reference's reach (a tenth of its spread) are not resolved
             reach = max(spread / 10, args.floor)

@@ -33,7 +33,7 @@ import tempfile
 import h5py
 
 from ropedyn.run import DOCS, INPUT, add_exe_argument, exe_or_build, set_args
-from ropedyn.studies.common import machine, update_doc, utc_stamp
+from ropedyn.studies.common import machine, scene_number, update_doc, utc_stamp
 
 BEGIN = "<!-- auto_table:begin -->"
 END = "<!-- auto_table:end -->"
@@ -47,9 +47,7 @@ def scenes():
 
 def scene_t_end(path):
     """The scene's t_end (s) from its text (ropedyn's default when absent)."""
-    import re
-    m = re.search(r"\bt_end\s*=\s*([0-9.eEdD+-]+)", path.read_text())
-    return float(m.group(1).lower().replace("d", "e")) if m else 1.0
+    return scene_number(path, "t_end", 1.0)
 
 
 def round_down(x):

@@ -284,11 +284,11 @@ def main(argv=None):
                 if fine.get("ok"):
                     k = min(len(fine["tip"]), len(md["tip"]))
                     d = np.linalg.norm(md["tip"][:k] - fine["tip"][:k], axis=1)
-                    md_self = f"{float(np.sqrt(np.mean(d ** 2))):.1e}"
+                    md_time_error = float(np.sqrt(np.mean(d ** 2)))
+                    md_self = f"{md_time_error:.1e}"
                     if ref["status"] == "complete":
-                        equal_rows.append(at_equal_accuracy(
-                            exe, work, n, args.t_end, ref, md,
-                            float(np.sqrt(np.mean(d ** 2)))))
+                        equal_rows.append(at_equal_accuracy(exe, work, n, args.t_end, ref, md,
+                                                            md_time_error))
                         print(equal_rows[-1], flush=True)
             dt_text = f"{dt:.3g}" if dt else "none stable (or MoorDyn crashed)"
             row = (f"| {n} | {dt_text} | {zeta:.4f} | {md_cpu} | auto ({rd.get('methods', '')}) "

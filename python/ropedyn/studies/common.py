@@ -1,8 +1,11 @@
 """What the studies share when they write their results into docs/: the machine line, the
-time stamp and the generated section between two markers of a Markdown page."""
+time stamp and the generated section between two markers of a Markdown page; and a number
+read from a scene file's text."""
 import datetime
 import os
+import pathlib
 import platform
+import re
 
 
 def machine():
@@ -30,6 +33,19 @@ def splice(text, begin, end, block):
     if begin in text and end in text:
         return text[:text.index(begin)] + block + text[text.index(end) + len(end):]
     return None
+
+
+def scene_number(path, key, default=None):
+    """A real key's value from a scene file's text (Fortran d exponents read too), the first
+    line that sets it outside a comment; `default` when no line does (None: ValueError
+    naming the file and key)."""
+    m = re.search(rf"^[^!\n]*\b{key}\s*=\s*([0-9.eEdD+-]+)", pathlib.Path(path).read_text(),
+                  re.MULTILINE)
+    if m:
+        return float(m.group(1).lower().replace("d", "e"))
+    if default is None:
+        raise ValueError(f"{path}: no {key} = <number>")
+    return default
 
 
 def update_doc(path, begin, end, block, heading="", strip=None, default=None):

@@ -27,6 +27,7 @@ import numpy as np
 
 from ropedyn.run import INPUT
 from ropedyn.studies import stability_metrics
+from ropedyn.studies.common import scene_number
 
 HARD = INPUT / "hard"
 
@@ -54,8 +55,7 @@ def scenes():
 
 
 def scene_t_end(scene):
-    text = (HARD / f"{scene}.nml").read_text()
-    return float(re.search(r"t_end\s*=\s*([0-9.eE+-]+)", text).group(1))
+    return scene_number(HARD / f"{scene}.nml", "t_end")
 
 
 def has_external_work(scene):
