@@ -34,6 +34,15 @@ def add_exe_argument(parser, help_text="the ropedyn executable"):
                              "scripts/build and use build/release/ropedyn)")
 
 
+def add_scaling_arguments(parser, t_end, elements, rtol=1e-6):
+    """--exe, and --t-end, --rtol and --elements (n, a space-separated list) of a study
+    that runs the paper's rope at several n."""
+    add_exe_argument(parser)
+    parser.add_argument("--t-end", type=float, default=t_end)
+    parser.add_argument("--rtol", type=float, default=rtol)
+    parser.add_argument("--elements", default=elements)
+
+
 def exe_or_build(exe):
     """exe as given, or the executable of the Release build (built or updated first)."""
     return exe if exe is not None else str(build("Release") / "ropedyn")

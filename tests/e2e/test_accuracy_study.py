@@ -54,3 +54,22 @@ def test_cases_option_names_a_bad_value():
     for bad in ("mpp100", "beam:10", "rfem:1", "rfem:x"):
         with pytest.raises(argparse.ArgumentTypeError, match=bad):
             acc.model_cases(bad)
+
+
+def test_merged_replaces_only_the_cases_and_methods_that_were_run():
+    old = [window_row("erk", 1e-3, 1.0, 0.1), window_row("cvode", 1e-3, 2.0, 0.1),
+           window_row("erk", 1e-3, 3.0, 0.1, n=100), window_row("erk", 1e-3, 4.0, 0.1,
+                                                                  model="mpp")]
+    new = [window_row("erk", 1e-3, 9.0, 0.2)]
+    rows = acc.merged(old, new, [("rfem", 30)], ["erk"])
+    # rfem 30 erk replaced; rfem 30 cvode, rfem 100 erk and mpp 30 erk kept
+    assert sorted(float(r["tip"]) for r in rows) == [2.0, 3.0, 4.0, 9.0]
+    # all methods of the case: every row of rfem 30 is replaced
+    rows = acc.merged(old, new, [("rfem", 30)], ["erk", "cvode"])
+    assert sorted(float(r["tip"]) for r in rows) == [3.0, 4.0, 9.0]
+    # in the order of a full run: per case, window, method (cvode before erk), rtol
+    old = [window_row("cvode", r, 1.0, 0.1, t0) for t0 in (0.0, 5.0) for r in (1e-2, 1e-3)]
+    new = [window_row("erk", r, 2.0, 0.1, t0) for t0 in (0.0, 5.0) for r in (1e-2, 1e-3)]
+    rows = acc.merged(old, new, [("rfem", 30)], ["erk"])
+    assert [(r["t0"], r["method"], float(r["rtol"])) for r in rows] == [
+        (t0, m, r) for t0 in ("0.0", "5.0") for m in ("cvode", "erk") for r in (1e-2, 1e-3)]

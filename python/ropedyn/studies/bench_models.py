@@ -21,7 +21,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from ropedyn import io  # noqa: E402
-from ropedyn.run import DOCS, PAPER, add_exe_argument, exe_or_build, set_args  # noqa: E402
+from ropedyn.run import DOCS, PAPER, add_scaling_arguments, exe_or_build, set_args  # noqa: E402
 from ropedyn.studies.common import (SPLIT_HEADER, machine, time_split,  # noqa: E402
                                     update_doc, utc_stamp)
 
@@ -51,10 +51,7 @@ def run_case(exe, model, method, n, t_end, rtol, workdir, timeout):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    add_exe_argument(parser)
-    parser.add_argument("--t-end", type=float, default=1.0)
-    parser.add_argument("--rtol", type=float, default=1e-6)
-    parser.add_argument("--elements", default="10 20 30 50 70 100 150 200 300")
+    add_scaling_arguments(parser, t_end=1.0, elements="10 20 30 50 70 100 150 200 300")
     parser.add_argument("--budget", type=float, default=300.0,
                         help="skip larger n of a (model, solver) after a case above this (s)")
     parser.add_argument("--no-write", action="store_true")

@@ -14,7 +14,7 @@ import sys
 import tempfile
 
 from ropedyn import io
-from ropedyn.run import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
+from ropedyn.run import DOCS, PAPER, add_scaling_arguments, exe_or_build, set_args
 from ropedyn.studies.common import SPLIT_HEADER, machine, time_split, update_doc, utc_stamp
 
 BEGIN = "<!-- bench_rfem:begin -->"
@@ -52,10 +52,7 @@ def line(r):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    add_exe_argument(parser)
-    parser.add_argument("--t-end", type=float, default=30.0)
-    parser.add_argument("--rtol", type=float, default=1e-6)
-    parser.add_argument("--elements", default="10 30 100 300 1000")
+    add_scaling_arguments(parser, t_end=30.0, elements="10 30 100 300 1000")
     parser.add_argument("--solvers", default="cvode mebdf")
     parser.add_argument("--first-order-newton", action="store_true",
                         help="Newton systems on the first-order matrix (the path before the "

@@ -7,7 +7,7 @@ once with the executable built from git revision REV (git archive; the working t
 untouched). Instruction counts (not times: the machine is shared, counts are exact) are
 split by the inclusive cost of the functions that do each part:
 
-- RHS: the model's right-hand side and quadratures (rfem_rhs, rfem_quad_rhs);
+- RHS: the model's right-hand side and quadratures (rfem_rhs, rfem_quad_rhs, rfem_rhs_quad);
 - Jacobian: CVODE's Jacobian callback or linear-system function (cv_jacobian, cv_linsys),
   MEBDF's matrix_evaluate_jacobian;
 - factorization: CVODE's linear-solver setup less the Jacobian (cvLsSetup: forming
@@ -63,7 +63,8 @@ def total_of(costs, *names):
 
 def split(costs, method):
     """Instructions of the parts (PARTS order) and the integrator's total."""
-    rhs = total_of(costs, "_MOD_rfem_rhs", "_MOD_rfem_quad_rhs")
+    # erk takes f and the quadratures' g in one call (rfem_rhs_quad) at every stage
+    rhs = total_of(costs, "_MOD_rfem_rhs", "_MOD_rfem_quad_rhs", "_MOD_rfem_rhs_quad")
     if method == "erk":
         total = total_of(costs, "_MOD_erk_advance_to")
         return [rhs, 0, 0, 0, total - rhs], total
