@@ -82,28 +82,32 @@ contains
         s%rp = s%wb - s%wa
     end subroutine sde_rates
 
-    !> Support k at state y, its element's angle having cosine and sine cs: the
-    !! displacement d = sgn (c - P) - h e and its rate d' = sgn (v - P') - h w n (the
-    !! translational spring's and damper's strains), and the rotational ones, the angle
-    !! s = sgn (phi - psi) and its rate sd.
-    pure subroutine support_strain(self, k, y, cs, d, dd, s, sd)
+    !> The displacement d = sgn (c - P) - h e of translational support k at state y, its
+    !! element's angle having cosine co and sine si.
+    pure function support_offset(self, k, y, co, si) result(d)
         class(rfem_t), intent(in) :: self
         integer, intent(in) :: k
-        real(wp), intent(in) :: y(:), cs(2)
-        real(wp), intent(out) :: d(2), dd(2), s, sd
-        real(wp) :: h
-        integer :: m
-        associate (sp => self%sup(k))
-            m = 6*(sp%elem - 1)
-            h = self%half(sp%elem)
-            d(1) = sp%sgn*(y(m + 1) - sp%anchor(1)) - h*cs(1)
-            d(2) = sp%sgn*(y(m + 2) - sp%anchor(2)) - h*cs(2)
-            dd(1) = sp%sgn*(y(m + 4) - sp%anchor_vel(1)) + h*y(m + 6)*cs(2)
-            dd(2) = sp%sgn*(y(m + 5) - sp%anchor_vel(2)) - h*y(m + 6)*cs(1)
-            s = sp%sgn*(y(m + 3) - sp%angle)
-            sd = sp%sgn*(y(m + 6) - sp%angle_rate)
+        real(wp), intent(in) :: y(:), co, si
+        real(wp) :: d(2)
+        associate (sp => self%sup(k), m => 6*(self%sup(k)%elem - 1), &
+                   h => self%half(self%sup(k)%elem))
+            d(1) = sp%sgn*(y(m + 1) - sp%anchor(1)) - h*co
+            d(2) = sp%sgn*(y(m + 2) - sp%anchor(2)) - h*si
         end associate
-    end subroutine support_strain
+    end function support_offset
+
+    !> Its rate d' = sgn (v - P') - h w n.
+    pure function support_offset_rate(self, k, y, co, si) result(dd)
+        class(rfem_t), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: y(:), co, si
+        real(wp) :: dd(2)
+        associate (sp => self%sup(k), m => 6*(self%sup(k)%elem - 1), &
+                   h => self%half(self%sup(k)%elem))
+            dd(1) = sp%sgn*(y(m + 4) - sp%anchor_vel(1)) + h*y(m + 6)*si
+            dd(2) = sp%sgn*(y(m + 5) - sp%anchor_vel(2)) - h*y(m + 6)*co
+        end associate
+    end function support_offset_rate
 
     !> Add the generalized force of support k (translational spring and damper on d, and
     !! for a clamp the rotational one) to f(3), the force on its element; with `energy`
@@ -115,23 +119,26 @@ contains
         real(wp), intent(inout) :: f(3)
         logical, intent(in) :: energy
         real(wp), intent(inout) :: e_el
-        real(wp) :: h, d(2), dd(2), fs(2), s, sd, fr
-        associate (sp => self%sup(k), co => self%cs(1, self%sup(k)%elem), &
-                   si => self%cs(2, self%sup(k)%elem))
-            ! cos and sin of its element's angle (self%cs: the angles at y)
-            call support_strain(self, k, y, [co, si], d, dd, s, sd)
+        real(wp) :: h, co, si, d(2), fs(2), s, fr
+        integer :: m
+        associate (sp => self%sup(k))
+            m = 6*(sp%elem - 1)
             h = self%half(sp%elem)
+            co = self%cs(1, sp%elem)    ! cos and sin of its angle (angles, at y)
+            si = self%cs(2, sp%elem)
             if (sp%translational) then
+                d = support_offset(self, k, y, co, si)
                 fs = sp%ct*d
                 if (energy) e_el = e_el + 0.5_wp*sp%ct*(d(1)**2 + d(2)**2)
-                if (sp%damped_t) fs = fs + sp%bt*dd
+                if (sp%damped_t) fs = fs + sp%bt*support_offset_rate(self, k, y, co, si)
                 f(1:2) = f(1:2) - sp%sgn*fs
                 f(3) = f(3) + h*(co*fs(2) - si*fs(1))
             end if
             if (sp%rotational) then
+                s = sp%sgn*(y(m + 3) - sp%angle)
                 fr = sp%cr*s
                 if (energy) e_el = e_el + 0.5_wp*sp%cr*s**2
-                if (sp%damped_r) fr = fr + sp%br*sd
+                if (sp%damped_r) fr = fr + sp%br*sp%sgn*(y(m + 6) - sp%angle_rate)
                 f(3) = f(3) - sp%sgn*fr
             end if
         end associate
@@ -145,12 +152,15 @@ contains
         integer, intent(in) :: k
         real(wp), intent(in) :: y(:)
         real(wp), intent(inout) :: power, work
-        real(wp) :: d(2), dd(2), fs(2), s, sd, fr
-        associate (sp => self%sup(k))
-            call support_strain(self, k, y, self%cs(:, sp%elem), d, dd, s, sd)
+        real(wp) :: dd(2), fs(2), s, sd, fr
+        integer :: m
+        associate (sp => self%sup(k), co => self%cs(1, self%sup(k)%elem), &
+                   si => self%cs(2, self%sup(k)%elem))
+            m = 6*(sp%elem - 1)
             if (sp%translational) then
-                fs = sp%ct*d
+                fs = sp%ct*support_offset(self, k, y, co, si)
                 if (sp%damped_t) then
+                    dd = support_offset_rate(self, k, y, co, si)
                     fs = fs + sp%bt*dd
                     power = power + sp%bt*(dd(1)**2 + dd(2)**2)
                 end if
@@ -158,6 +168,8 @@ contains
                                                           + fs(2)*sp%anchor_vel(2))
             end if
             if (sp%rotational) then
+                s = sp%sgn*(y(m + 3) - sp%angle)
+                sd = sp%sgn*(y(m + 6) - sp%angle_rate)
                 fr = sp%cr*s
                 if (sp%damped_r) then
                     fr = fr + sp%br*sd
@@ -190,7 +202,7 @@ contains
         integer, intent(in) :: k
         real(wp), intent(in) :: y(:)
         real(wp), intent(inout) :: blk(3, 6)
-        real(wp) :: h, co, si, w, d(2), dd(2), fs(2), sg, s, sd
+        real(wp) :: h, co, si, w, fs(2), sg
         integer :: m
         associate (sp => self%sup(k))
             m = 6*(sp%elem - 1)
@@ -203,11 +215,10 @@ contains
                 ! F = Ct d + Bt d' acts as -sgn F on the centre and h n.F as moment; d and d'
                 ! have the same gradient G with respect to (x, y, phi) and (x', y', phi'),
                 ! so the spring's block and the damper's have one pattern (add_spring)
-                call support_strain(self, k, y, [co, si], d, dd, s, sd)
-                fs = sp%ct*d
+                fs = sp%ct*support_offset(self, k, y, co, si)
                 call add_spring(blk(:, 1:3), sp%ct, sg*h, co, si)
                 if (sp%damped_t) then
-                    fs = fs + sp%bt*dd
+                    fs = fs + sp%bt*support_offset_rate(self, k, y, co, si)
                     blk(1, 3) = blk(1, 3) - sg*h*sp%bt*w*co
                     blk(2, 3) = blk(2, 3) - sg*h*sp%bt*w*si
                     call add_spring(blk(:, 4:6), sp%bt, sg*h, co, si)
