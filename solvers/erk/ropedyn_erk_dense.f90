@@ -20,23 +20,57 @@ contains
     end procedure quad_step
 
     module procedure combine
-        integer :: j
-        logical :: first
-        first = .true.
+        real(wp) :: w(size(c))
+        integer :: idx(size(c)), j, m
+        ! the nonzero terms, each weighed by h; then one fused pass over the components
+        ! per stage (the sum kept left to right: ((base + w1 k1) + w2 k2) + ...)
+        m = 0
         do j = 1, size(c)
             if (c(j) == 0.0_wp) cycle
-            if (.not. first) then
-                call axpy(h*c(j), k(:, j), out)
-            else if (present(base)) then
-                call xpay(base, h*c(j), k(:, j), out)
-            else
-                out = (h*c(j))*k(:, j)
-            end if
-            first = .false.
+            m = m + 1
+            idx(m) = j
+            w(m) = h*c(j)
         end do
-        if (first) then
-            out = 0.0_wp
-            if (present(base)) out = base
+        if (present(base)) then
+            select case (m)
+            case (0)
+                out = base
+            case (1)
+                out = base + w(1)*k(:, idx(1))
+            case (2)
+                out = base + w(1)*k(:, idx(1)) + w(2)*k(:, idx(2))
+            case (3)
+                out = base + w(1)*k(:, idx(1)) + w(2)*k(:, idx(2)) + w(3)*k(:, idx(3))
+            case (4)
+                out = base + w(1)*k(:, idx(1)) + w(2)*k(:, idx(2)) + w(3)*k(:, idx(3)) &
+                      + w(4)*k(:, idx(4))
+            case default
+                out = base + w(1)*k(:, idx(1)) + w(2)*k(:, idx(2)) + w(3)*k(:, idx(3)) &
+                      + w(4)*k(:, idx(4))
+                do j = 5, m
+                    call axpy(w(j), k(:, idx(j)), out)
+                end do
+            end select
+        else
+            select case (m)
+            case (0)
+                out = 0.0_wp
+            case (1)
+                out = w(1)*k(:, idx(1))
+            case (2)
+                out = w(1)*k(:, idx(1)) + w(2)*k(:, idx(2))
+            case (3)
+                out = w(1)*k(:, idx(1)) + w(2)*k(:, idx(2)) + w(3)*k(:, idx(3))
+            case (4)
+                out = w(1)*k(:, idx(1)) + w(2)*k(:, idx(2)) + w(3)*k(:, idx(3)) &
+                      + w(4)*k(:, idx(4))
+            case default
+                out = w(1)*k(:, idx(1)) + w(2)*k(:, idx(2)) + w(3)*k(:, idx(3)) &
+                      + w(4)*k(:, idx(4)) + w(5)*k(:, idx(5))
+                do j = 6, m
+                    call axpy(w(j), k(:, idx(j)), out)
+                end do
+            end select
         end if
     end procedure combine
 
@@ -81,15 +115,6 @@ contains
         a = a0 + th*((a1 - a0) + th1*((h*f0 - (a1 - a0)) + th*((a1 - a0) - h*f1 &
             - (h*f0 - (a1 - a0)))))
     end function hermite
-
-    !> z = y + a x.
-    pure subroutine xpay(y, a, x, z)
-        real(wp), intent(in), contiguous :: y(:)
-        real(wp), intent(in) :: a
-        real(wp), intent(in), contiguous :: x(:)
-        real(wp), intent(out), contiguous :: z(:)
-        z = y + a*x
-    end subroutine xpay
 
     !> y = y + a x.
     pure subroutine axpy(a, x, y)
