@@ -75,6 +75,8 @@ module ropedyn_erk
         !! from a combination of all (rho_alpha: dk, dy)
         logical :: rho_last_two = .true.
         real(wp), allocatable :: yq(:), yq_old(:)
+        !> the quadratures' increment over the step just computed and its error estimate
+        real(wp), allocatable :: dq(:), eq(:)
         !> the quadratures' right-hand side g at the stages of the current step (FSAL as k)
         real(wp), allocatable :: gk(:, :)
         !> stiffness monitor over the last STIFF_WINDOW accepted steps
@@ -110,10 +112,9 @@ module ropedyn_erk
     interface
         !> The quadratures' increment over the step just computed and the weighted norm
         !! of its error estimate (submodule ropedyn_erk_dense, as dense).
-        module subroutine quad_step(self, h, dq, errq)
-            class(erk_t), intent(in) :: self
+        module subroutine quad_step(self, h, errq)
+            class(erk_t), intent(inout) :: self
             real(wp), intent(in) :: h
-            real(wp), intent(out), contiguous :: dq(:)
             real(wp), intent(out) :: errq
         end subroutine quad_step
 
@@ -201,7 +202,8 @@ contains
         allocate (self%y(self%n), self%y_old(self%n), self%ynew(self%n), self%ytmp(self%n), &
                   self%yprev(self%n), self%k(self%n, self%s), self%atol(self%n), &
                   self%dk(self%n), self%dy(self%n))
-        allocate (self%yq(self%nq), self%yq_old(self%nq), self%gk(self%nq, self%s))
+        allocate (self%yq(self%nq), self%yq_old(self%nq), self%gk(self%nq, self%s), &
+                  self%dq(self%nq), self%eq(self%nq))
         self%atol = self%options%atol
         if (allocated(self%options%atol_vector)) self%atol = self%options%atol_vector
         self%y = start%y0
@@ -325,7 +327,7 @@ contains
     subroutine attempt_step(self, err)
         class(erk_t), intent(inout) :: self
         type(error_t), allocatable, intent(out) :: err
-        real(wp) :: h, errnorm, errq, fac, tnew, dq(self%nq)
+        real(wp) :: h, errnorm, errq, fac, tnew
         integer :: i, status, s
         logical :: recoverable
 
@@ -384,7 +386,7 @@ contains
             call swap(self%ynew, self%ytmp)
             errnorm = self%error_norm(h)
             if (self%nq > 0) then
-                call self%quad_step(h, dq, errq)
+                call self%quad_step(h, errq)
                 errnorm = max(errnorm, errq)
             end if
             if (.not. ieee_is_finite(errnorm)) errnorm = huge(1.0_wp)
@@ -416,7 +418,7 @@ contains
         self%t = tnew
         if (self%nq > 0) then
             self%yq_old = self%yq
-            self%yq = self%yq + dq
+            self%yq = self%yq + self%dq
         end if
         self%counters%steps = self%counters%steps + 1
         self%counters%last_step = h
@@ -556,7 +558,7 @@ contains
         self%problem => null()
         if (allocated(self%y)) deallocate (self%y, self%y_old, self%ynew, self%ytmp, &
                                            self%yprev, self%k, self%atol, self%dk, self%dy)
-        if (allocated(self%yq)) deallocate (self%yq, self%yq_old, self%gk)
+        if (allocated(self%yq)) deallocate (self%yq, self%yq_old, self%gk, self%dq, self%eq)
         self%started = .false.
     end subroutine erk_finalize
 end module ropedyn_erk

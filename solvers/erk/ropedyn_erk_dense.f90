@@ -8,20 +8,21 @@ submodule (ropedyn_erk) ropedyn_erk_dense
 
 contains
 
-    !> The quadratures' increment over the step just computed, dq = h sum b_i g_i, and
+    !> The quadratures' increment over the step just computed, dq = h sum b_i g_i (into
+    !! self%dq; the estimate into self%eq), and
     !! the weighted RMS norm of its error estimate h sum e_i g_i (weights rtol
     !! max(|yq|, |yq + dq|) + atol, as CVODE's for its quadratures).
     module procedure quad_step
-        real(wp) :: eq(self%nq)
-        call combine(self%tab%b(1:self%s), h, self%gk, dq)
-        call combine(self%tab%e(1:self%s), h, self%gk, eq)
-        errq = sqrt(sum((eq/(self%options%rtol*max(abs(self%yq), abs(self%yq + dq)) &
-                             + self%options%atol))**2)/self%nq)
+        call combine(self%tab%b(1:self%s), h, self%gk, self%dq)
+        call combine(self%tab%e(1:self%s), h, self%gk, self%eq)
+        errq = sqrt(sum((self%eq/(self%options%rtol*max(abs(self%yq), abs(self%yq + self%dq)) &
+                                  + self%options%atol))**2)/self%nq)
     end procedure quad_step
 
     module procedure combine
-        real(wp) :: w(size(c))
-        integer :: idx(size(c)), j, m
+        ! fixed size: automatic arrays would be allocated on the heap at every call
+        real(wp) :: w(ERK_MAX_STAGES)
+        integer :: idx(ERK_MAX_STAGES), j, m
         ! the nonzero terms, each weighed by h; then one fused pass over the components
         ! per stage (the sum kept left to right: ((base + w1 k1) + w2 k2) + ...)
         m = 0
