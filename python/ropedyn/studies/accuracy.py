@@ -186,7 +186,8 @@ def loglog_cross(xs, ys, target):
 
 def merged(old, new, cases, methods):
     """The rows of old whose (model, n) is not among cases or whose method is not among
-    methods, then new: what a run of those cases and methods leaves in the CSV file."""
+    methods, and new, in the order of a full run: what a run of those cases and methods
+    leaves in the CSV file."""
     done = {(m, str(n)) for m, n in cases}
     rows = [r for r in old
             if (r["model"], str(r["n"])) not in done or r["method"] not in methods] + new
