@@ -406,7 +406,8 @@ contains
             self%rho = spectral_estimate(self%k(:, s), self%k(:, s - 1), self%ynew, self%yprev)
         else if (mod(self%counters%steps, int(RHO_EVERY, i8)) == 0) then
             ! a combination of all stages (ropedyn_erk_tables: rho_alpha), every RHO_EVERY
-            ! steps (two passes over the stages: 8 % of the paper run at every step)
+            ! steps (two more passes over the stages: 8 % of the paper run at every step,
+            ! measured before combine fused its passes)
             call combine(self%tab%rho_alpha(1:s), 1.0_wp, self%k, self%dk)
             call combine(self%tab%rho_beta(1:s), h, self%k, self%dy)
             self%rho = norm_ratio(self%dk, self%dy)
