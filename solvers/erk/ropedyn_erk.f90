@@ -12,7 +12,8 @@
 !! - **Error test**: the weighted RMS norm of h sum e_i k_i with weights
 !!   rtol max(|y_n|, |y_n+1|) + atol (atol per component when given) must be <= 1.
 !! - **Step size**: a PI controller (Gustafsson 1991), h_new = h fac err^-alpha
-!!   err_old^beta, which keeps the step steady where stability, not accuracy, limits it;
+!!   err_old^beta, which keeps the step steady where stability, not accuracy, limits it
+!!   (with gains of its own there: K_I_STABLE, K_P_STABLE);
 !!   growth at most 5x (1x right after a rejection), reduction at most 10x.
 !! - **Quadratures** (dissipated energy, support work) are integrated by the same pair
 !!   from their right-hand side g at every stage, yq += h sum b_i g_i, with its error
@@ -56,6 +57,15 @@ module ropedyn_erk
     !> PI controller exponents, over the order of the error estimate + 1 (Gustafsson's
     !! k_I = 0.3/k, k_P = 0.4/k: err^-(k_I + k_P) err_old^k_P)
     real(wp), parameter :: K_I = 0.3_wp, K_P = 0.4_wp
+    !> ... and where the step is held by stability (h rho above STABLE_CONTROL times the
+    !! stability limit): a smaller integral and a larger proportional gain, which damp the
+    !! controller's cycle of growing into the unstable region and being rejected there.
+    !! Measured with the 3/8 pair on the paper rope at rtol 1e-2, 30 s: 12 % of the
+    !! steps rejected at n = 30 with (0.3, 0.4), 4.6 % with (0.15, 0.5); f evaluations
+    !! 289,722 -> 267,566 (n = 30), 915,082 -> 860,850 (n = 100), 484,706 -> 446,302
+    !! (n = 50); the accuracy-held runs (rtol 1e-6, n = 10 and 30) take the same steps.
+    real(wp), parameter :: K_I_STABLE = 0.15_wp, K_P_STABLE = 0.5_wp
+    real(wp), parameter :: STABLE_CONTROL = 0.8_wp
 
     type, extends(integrator_t) :: erk_t
         private
@@ -425,10 +435,16 @@ contains
         self%counters%last_step = h
         self%counters%last_order = self%tab%order
         self%counters%order_steps(self%tab%order) = self%counters%order_steps(self%tab%order) + 1
-        ! PI controller (order of the estimate + 1 = order of the method)
+        ! PI controller (order of the estimate + 1 = order of the method), with the gains
+        ! for a stability-held step where h rho is near the stability limit
         errnorm = max(errnorm, 1.0e-10_wp)
-        fac = SAFETY*errnorm**(-(K_I + K_P)/self%tab%order)* &
-              self%err_old**(K_P/self%tab%order)
+        if (h*self%rho > STABLE_CONTROL*self%tab%stability_limit) then
+            fac = SAFETY*errnorm**(-(K_I_STABLE + K_P_STABLE)/self%tab%order)* &
+                  self%err_old**(K_P_STABLE/self%tab%order)
+        else
+            fac = SAFETY*errnorm**(-(K_I + K_P)/self%tab%order)* &
+                  self%err_old**(K_P/self%tab%order)
+        end if
         fac = min(GROW_MAX, max(SHRINK_MAX, fac))
         if (self%rejected) fac = min(1.0_wp, fac)
         self%err_old = errnorm
