@@ -51,7 +51,10 @@
 !!   (once; a trial, judged on its second window against the explicit cost, goes back
 !!   at once unless it is cheaper by GAIN) and later switches to it when its measured
 !!   cost is lower by GAIN; from Adams it goes back to erk when erk's last measured cost is lower
-!!   by GAIN, or at once when Adams fails (e.g. the fixed-point iteration does not
+!!   by GAIN in two windows in a row (snap_load_mpp: Adams measured once at 6.6e4 f/s in the
+!!   window of the snap sent auto back to erk, whose cost of 4.5e4 measured before the
+!!   snap then kept Adams out for the remaining 9 s: 1.36 s CPU against Adams' 0.82),
+!!   or at once when Adams fails (e.g. the fixed-point iteration does not
 !!   converge: the problem has become stiff). Adams' cost: its evaluations of f plus
 !!   ADAMS_STEP_COST per step (CVODE's vector work per step: measured about 2 f on the
 !!   paper's rope at n = 30, where f is cheap, and about 1.2 f on the MPP at n = 30).
@@ -125,6 +128,7 @@ module ropedyn_auto
         real(wp) :: rate_implicit = -1.0_wp
         real(wp) :: rate_adams = -1.0_wp
         logical :: trial = .false.         !< the implicit method is on trial
+        integer :: dearer = 0              !< windows in a row Adams cost more than erk by GAIN
         integer :: wait = 0                !< windows to let pass before the next switch
         integer :: backoff = 1
         logical :: initialized = .false.
@@ -292,6 +296,7 @@ contains
         end if
         self%active = which
         self%windows = 0
+        self%dearer = 0
         self%win_t0 = self%t
         self%win_steps0 = 0
         self%win_cost0 = 0.0_wp
@@ -414,10 +419,19 @@ contains
                 end if
             end if
             if (self%wait > 0) return
+            ! two windows in a row: one window of a transient (a snap) must not send auto
+            ! back to erk, whose cost, measured before, then keeps Adams out for the rest
+            ! of the run
             if (self%rate_explicit > 0.0_wp .and. GAIN*self%rate_explicit < rate) then
+                self%dearer = self%dearer + 1
+            else
+                self%dearer = 0
+            end if
+            if (self%dearer >= 2) then
                 write (text, '(a, es9.2, a, es9.2, a)') 'erk was cheaper (', &
-                    self%rate_explicit, ' against ', rate, ' f per second for adams)'
-                if (self%windows <= 2) call back_off()
+                    self%rate_explicit, ' against ', rate, ' f per second for adams, '// &
+                    'two windows in a row)'
+                if (self%windows <= 3) call back_off()
                 call self%start_method(EXPLICIT, trim(text), err)
             end if
         else
