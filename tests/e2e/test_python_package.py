@@ -105,3 +105,19 @@ def test_shim_answers_help(name, tmp_path):
                             cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
     assert result.stdout.startswith("usage:"), result.stdout
+
+
+def test_least_cpu_keeps_the_fastest_run_and_stops_at_a_failure():
+    """The benchmarks' timing rule (bench_peers --repeat): the least CPU of the runs, and a
+    run that did not complete is returned at once (its CPU means nothing)."""
+    from ropedyn.studies.common import least_cpu
+    runs = iter([{"cpu": 3.0}, {"cpu": 1.0}, {"cpu": 2.0}])
+    assert least_cpu(lambda: next(runs), 3) == {"cpu": 1.0}
+    calls = []
+
+    def run():
+        calls.append(1)
+        return {"cpu": 0.5 if len(calls) == 2 else 1.0, "ok": len(calls) != 2}
+    r = least_cpu(run, 3, complete=lambda x: x["ok"])
+    assert r == {"cpu": 0.5, "ok": False} and len(calls) == 2
+    assert least_cpu(lambda: {"cpu": 4.0}, 0) == {"cpu": 4.0}

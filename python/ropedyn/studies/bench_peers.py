@@ -23,7 +23,9 @@ venv) on the same rope as input/paper.nml, n segments against ropedyn's n elemen
 - Output: both write the whole rope every 0.01 s (MoorDyn its node positions to its line
   file, LineOutputs p; ropedyn its HDF5 records), and MoorDyn's tip is read every 0.01 s.
 - CPU: process time of MoorDyn's stepping loop (Create and initialisation excluded) and the
-  run's /solver/cpu_time for ropedyn (integration and output).
+  run's /solver/cpu_time for ropedyn (integration and output); each the least of
+  `--repeat` runs (3 by default: on this VM one run's ratio moved by 10 %, 2.69 / 2.93 /
+  3.02 at n = 30 in three runs of the same code).
 - Accuracy: ropedyn's tip against a tight reference (ropedyn, cvode at rtol 1e-10, atol
   1e-12) over [0, 2 s], L2 over the output times; MoorDyn's time error the same way, its
   tip against its own run at a quarter of the step (RK4: 256 times smaller error). MoorDyn's
@@ -54,7 +56,7 @@ import numpy as np
 
 from ropedyn import io
 from ropedyn.run import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
-from ropedyn.studies.common import machine, update_doc, utc_stamp
+from ropedyn.studies.common import least_cpu, machine, update_doc, utc_stamp
 
 BEGIN = "<!-- bench_peers:begin -->"
 END = "<!-- bench_peers:end -->"
@@ -215,16 +217,23 @@ def tip_l2(time, tip, ref):
 EQUAL_RTOLS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
 
 
-def at_equal_accuracy(exe, work, n, t_end, ref, md, md_error):
+def at_equal_accuracy(exe, work, n, t_end, ref, md, md_error, repeat=1):
     """ropedyn at the loosest rtol of EQUAL_RTOLS whose tip error is <= MoorDyn's time
-    error: the table row (n, MoorDyn's error, rtol, method, error, balance, CPU, ratio)."""
+    error: the table row (n, MoorDyn's error, rtol, method, error, balance, CPU (the least
+    of `repeat` runs), ratio)."""
     for rtol in EQUAL_RTOLS:
-        r = run_ropedyn(exe, work, n, t_end, name=f"rtol{rtol:g}",
-                        sets=[f"solver.rtol={rtol:g}", f"solver.atol={rtol / 100:g}"])
+        sets = [f"solver.rtol={rtol:g}", f"solver.atol={rtol / 100:g}"]
+        r = run_ropedyn(exe, work, n, t_end, name=f"rtol{rtol:g}", sets=sets)
         if r["status"] != "complete":
             continue
         err = tip_l2(r["time"], r["tip"], ref)
         if err <= md_error:
+            if repeat > 1:
+                again = least_cpu(lambda: run_ropedyn(exe, work, n, t_end, sets=sets,
+                                                      name=f"rtol{rtol:g}"), repeat - 1,
+                                  complete=lambda x: x["status"] == "complete")
+                if again["status"] == "complete" and again["cpu"] < r["cpu"]:
+                    r["cpu"] = again["cpu"]
             return (f"| {n} | {md_error:.1e} | {rtol:g} | auto ({r['methods']}) | {err:.1e} "
                     f"| {r['balance']:.1e} | {r['steps']} | {r['cpu']:.3g} | {md['cpu']:.3g} "
                     f"| {md['cpu'] / r['cpu']:.2f} |")
@@ -237,6 +246,8 @@ def main(argv=None):
     parser.add_argument("--t-end", type=float, default=30.0)
     parser.add_argument("--probe", type=float, default=5.0, help="stability probe (s)")
     parser.add_argument("--elements", default="10 30 100")
+    parser.add_argument("--repeat", type=int, default=3,
+                        help="runs of each timed run (the least CPU counts)")
     parser.add_argument("--no-write", action="store_true")
     args = parser.parse_args(argv)
     exe = exe_or_build(args.exe)
@@ -262,12 +273,15 @@ def main(argv=None):
             k = next((i for i, h in enumerate(steps)
                       if stable_and_right(py, work, n, h, args.probe)), None)
             while k is not None and k < len(steps):
-                md = run_moordyn(py, work, n, steps[k], args.t_end)
+                h = steps[k]
+                md = least_cpu(lambda: run_moordyn(py, work, n, h, args.t_end), args.repeat,
+                               complete=lambda r: r["ok"])
                 if md["ok"]:
                     dt = steps[k]
                     break
                 k += 1
-            rd = run_ropedyn(exe, work, n, args.t_end)
+            rd = least_cpu(lambda: run_ropedyn(exe, work, n, args.t_end), args.repeat,
+                           complete=lambda r: r["status"] == "complete")
             ref = run_ropedyn(exe, work, n, ACCURACY_SPAN, name="reference", sets=[
                 'solver.method="cvode"', "solver.rtol=1e-10", "solver.atol=1e-12"])
             complete = rd["status"] == "complete" and ref["status"] == "complete"
@@ -288,7 +302,7 @@ def main(argv=None):
                     md_self = f"{md_time_error:.1e}"
                     if ref["status"] == "complete":
                         equal_rows.append(at_equal_accuracy(exe, work, n, args.t_end, ref, md,
-                                                            md_time_error))
+                                                            md_time_error, args.repeat))
                         print(equal_rows[-1], flush=True)
             dt_text = f"{dt:.3g}" if dt else "none stable (or MoorDyn crashed)"
             row = (f"| {n} | {dt_text} | {zeta:.4f} | {md_cpu} | auto ({rd.get('methods', '')}) "
@@ -300,7 +314,9 @@ def main(argv=None):
         return 0
     lines = [BEGIN,
              f"Command: `scripts/bench_peers --t-end {args.t_end:g} --elements "
-             f"\"{args.elements}\"` (code: python/ropedyn/studies/bench_peers.py). MoorDyn-C "
+             f"\"{args.elements}\" --repeat {args.repeat}` (code: "
+             f"python/ropedyn/studies/bench_peers.py; CPU: the least of {args.repeat} runs "
+             f"each). MoorDyn-C "
              f"from PyPI `moordyn` in .venv-bench: RK4 at the largest step of the ladder "
              f"2e-4 (30/n) 2^(k/4) that stays finite over a {args.probe:g} s probe, agrees "
              f"there with half the step within 1 % of the length, and stays finite over the "
