@@ -337,7 +337,7 @@ contains
     subroutine attempt_step(self, err)
         class(erk_t), intent(inout) :: self
         type(error_t), allocatable, intent(out) :: err
-        real(wp) :: h, errnorm, errq, fac, tnew
+        real(wp) :: h, errnorm, errq, fac, tnew, gain_i, gain_p
         integer :: i, status, s
         logical :: recoverable
 
@@ -438,13 +438,14 @@ contains
         ! PI controller (order of the estimate + 1 = order of the method), with the gains
         ! for a stability-held step where h rho is near the stability limit
         errnorm = max(errnorm, 1.0e-10_wp)
+        gain_i = K_I
+        gain_p = K_P
         if (h*self%rho > STABLE_CONTROL*self%tab%stability_limit) then
-            fac = SAFETY*errnorm**(-(K_I_STABLE + K_P_STABLE)/self%tab%order)* &
-                  self%err_old**(K_P_STABLE/self%tab%order)
-        else
-            fac = SAFETY*errnorm**(-(K_I + K_P)/self%tab%order)* &
-                  self%err_old**(K_P/self%tab%order)
+            gain_i = K_I_STABLE
+            gain_p = K_P_STABLE
         end if
+        fac = SAFETY*errnorm**(-(gain_i + gain_p)/self%tab%order)* &
+              self%err_old**(gain_p/self%tab%order)
         fac = min(GROW_MAX, max(SHRINK_MAX, fac))
         if (self%rejected) fac = min(1.0_wp, fac)
         self%err_old = errnorm
