@@ -431,6 +431,8 @@ contains
                 write (text, '(a, es9.2, a, es9.2, a)') 'erk was cheaper (', &
                     self%rate_explicit, ' against ', rate, ' f per second for adams, '// &
                     'two windows in a row)'
+                ! windows 2 and 3 are the earliest two that can send it back (the rate is
+                ! kept from window 2 on): leaving then undoes the switch at once
                 if (self%windows <= 3) call back_off()
                 call self%start_method(EXPLICIT, trim(text), err)
             end if
