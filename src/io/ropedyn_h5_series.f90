@@ -287,7 +287,9 @@ contains
             call make_error(err, ERR_IO, label//': cannot select record '//int_text(int(record)))
             return
         end if
-        call h5screate_simple_f(1, [product(record_dims)*records], mem_space, hdferr)
+        ! the memory space has the selection's shape, so that HDF5 copies the block whole
+        ! (a flat one makes it iterate over the selection element by element)
+        call h5screate_simple_f(size(start), [record_dims, records], mem_space, hdferr)
         if (hdferr < 0) then
             mem_space = -1
             call make_error(err, ERR_IO, label//': cannot create memory dataspace')
