@@ -175,7 +175,8 @@ contains
         type(energy_t) :: e
         integer :: k
         character(len=120) :: text
-        v = [(sin(1.0_wp + 0.7_wp*k), k = 1, size(pos))]
+        ! rates in [-1, 1) from the golden-ratio sequence (no sin: see ropedyn_spectrum)
+        v = [(2.0_wp*modulo(0.6180339887498949_wp*k, 1.0_wp) - 1.0_wp, k = 1, size(pos))]
         yv = y
         yv(vel) = v
         allocate (yq(max(1, model%quad_size())))
