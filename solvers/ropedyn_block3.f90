@@ -25,13 +25,16 @@ module ropedyn_block3
     private
     public :: block3_t, block_tridiagonal
 
-    !> The factors of a block-tridiagonal matrix of nb block rows.
+    !> The factors of a block-tridiagonal matrix of nb block rows. Each 3 x 3 block is
+    !! stored with a fourth row of zeros, so that a block's column is one vector of four
+    !! doubles: the solves' block products become whole-vector operations (AVX2), each row
+    !! computed with the same operations in the same order as written out row by row.
     type :: block3_t
         integer :: nb = 0
-        real(wp), allocatable :: dinv(:, :, :)   !< D'_i^{-1} (3, 3, nb)
-        real(wp), allocatable :: lfac(:, :, :)   !< L'_i (3, 3, nb), i >= 2
-        real(wp), allocatable :: ublk(:, :, :)   !< U_i (3, 3, nb), i <= nb - 1
-        !> blocks of a second block-tridiagonal matrix K (3, 3, -1:1, nb): (i, i-1), (i, i),
+        real(wp), allocatable :: dinv(:, :, :)   !< D'_i^{-1} (4, 3, nb)
+        real(wp), allocatable :: lfac(:, :, :)   !< L'_i (4, 3, nb), i >= 2
+        real(wp), allocatable :: ublk(:, :, :)   !< U_i (4, 3, nb), i <= nb - 1
+        !> blocks of a second block-tridiagonal matrix K (4, 3, -1:1, nb): (i, i-1), (i, i),
         !! (i, i+1), for solve_plus_product
         real(wp), allocatable :: kblk(:, :, :, :)
     contains
@@ -59,8 +62,11 @@ contains
         nb = n/3
         if (self%nb /= nb) then
             if (allocated(self%dinv)) deallocate (self%dinv, self%lfac, self%ublk, self%kblk)
-            allocate (self%dinv(3, 3, nb), self%lfac(3, 3, nb), self%ublk(3, 3, nb), &
-                      self%kblk(3, 3, -1:1, nb))
+            allocate (self%dinv(4, 3, nb), self%lfac(4, 3, nb), self%ublk(4, 3, nb), &
+                      self%kblk(4, 3, -1:1, nb))
+            self%dinv = 0.0_wp
+            self%lfac = 0.0_wp
+            self%ublk = 0.0_wp
             self%nb = nb
         end if
         self%kblk = 0.0_wp
@@ -84,7 +90,7 @@ contains
         integer, intent(in) :: n
         real(wp), intent(in) :: a(11, n)
         integer, intent(out) :: info
-        real(wp) :: d(3, 3), lb(3, 3)
+        real(wp) :: d(3, 3), lb(3, 3), lf(3, 3), prev(3, 3)
         integer :: nb, ib, r, c, j0
         logical :: ok
 
@@ -110,15 +116,19 @@ contains
                         lb(r, c) = a(6 + (r + 3) - c, j0 - 3 + c)
                     end do
                 end do
-                call mul3(lb, self%dinv(:, :, ib - 1), self%lfac(:, :, ib))
-                call mul3(self%lfac(:, :, ib), self%ublk(:, :, ib - 1), lb)
+                prev = self%dinv(1:3, :, ib - 1)
+                call mul3(lb, prev, lf)
+                self%lfac(1:3, :, ib) = lf
+                prev = self%ublk(1:3, :, ib - 1)
+                call mul3(lf, prev, lb)
                 d = d - lb
             end if
-            call invert3(d, self%dinv(:, :, ib), ok)
+            call invert3(d, prev, ok)
             if (.not. ok) then
                 info = ib
                 return
             end if
+            self%dinv(1:3, :, ib) = prev
         end do
     end subroutine block3_factor
 
@@ -147,48 +157,9 @@ contains
     pure subroutine block3_solve(self, b)
         class(block3_t), intent(in) :: self
         real(wp), intent(inout) :: b(:)
-        real(wp) :: z1, z2, z3
-        integer :: ib, k
-        ! forward: z_i = b_i - L'_i z_{i-1}
-        do ib = 2, self%nb
-            k = 3*(ib - 1)
-            associate (l => self%lfac(:, :, ib))
-                z1 = b(k - 2)
-                z2 = b(k - 1)
-                z3 = b(k)
-                b(k + 1) = b(k + 1) - (l(1, 1)*z1 + l(1, 2)*z2 + l(1, 3)*z3)
-                b(k + 2) = b(k + 2) - (l(2, 1)*z1 + l(2, 2)*z2 + l(2, 3)*z3)
-                b(k + 3) = b(k + 3) - (l(3, 1)*z1 + l(3, 2)*z2 + l(3, 3)*z3)
-            end associate
-        end do
-        call backward(self, b)
+        call forward(self%nb, self%lfac, b)
+        call backward(self%nb, self%ublk, self%dinv, b)
     end subroutine block3_solve
-
-    !> The backward sweep: x_i = D'_i^{-1} (z_i - U_i x_{i+1}), b holding z on entry.
-    pure subroutine backward(self, b)
-        class(block3_t), intent(in) :: self
-        real(wp), intent(inout) :: b(:)
-        real(wp) :: z1, z2, z3
-        integer :: ib, k
-        do ib = self%nb, 1, -1
-            k = 3*(ib - 1)
-            z1 = b(k + 1)
-            z2 = b(k + 2)
-            z3 = b(k + 3)
-            if (ib < self%nb) then
-                associate (u => self%ublk(:, :, ib))
-                    z1 = z1 - (u(1, 1)*b(k + 4) + u(1, 2)*b(k + 5) + u(1, 3)*b(k + 6))
-                    z2 = z2 - (u(2, 1)*b(k + 4) + u(2, 2)*b(k + 5) + u(2, 3)*b(k + 6))
-                    z3 = z3 - (u(3, 1)*b(k + 4) + u(3, 2)*b(k + 5) + u(3, 3)*b(k + 6))
-                end associate
-            end if
-            associate (v => self%dinv(:, :, ib))
-                b(k + 1) = v(1, 1)*z1 + v(1, 2)*z2 + v(1, 3)*z3
-                b(k + 2) = v(2, 1)*z1 + v(2, 2)*z2 + v(2, 3)*z3
-                b(k + 3) = v(3, 1)*z1 + v(3, 2)*z2 + v(3, 3)*z3
-            end associate
-        end do
-    end subroutine backward
 
     !> b <- A^{-1} (b + g K x) with the factors and the K blocks of block3_factor: the
     !! product folded into the forward sweep (one pass over b instead of two).
@@ -197,35 +168,73 @@ contains
         real(wp), intent(in) :: g
         real(wp), intent(in) :: x(:)
         real(wp), intent(inout) :: b(:)
-        real(wp) :: p(3)
-        integer :: ib, k, nb
-        nb = self%nb
+        call forward_plus_product(self%nb, self%kblk, self%lfac, g, x, b)
+        call backward(self%nb, self%ublk, self%dinv, b)
+    end subroutine block3_solve_plus_product
+
+    ! The sweeps take the blocks as explicit-shape arrays (b and x as (3, nb)): their
+    ! addresses and strides then stay in registers through the loop.
+
+    !> The forward sweep: z_i = b_i - L'_i z_{i-1}.
+    pure subroutine forward(nb, lfac, b)
+        integer, intent(in) :: nb
+        real(wp), intent(in) :: lfac(4, 3, nb)
+        real(wp), intent(inout) :: b(3, nb)
+        real(wp) :: p(4)
+        integer :: ib
+        do ib = 2, nb
+            p = lfac(:, 1, ib)*b(1, ib - 1) + lfac(:, 2, ib)*b(2, ib - 1) &
+                + lfac(:, 3, ib)*b(3, ib - 1)
+            b(:, ib) = b(:, ib) - p(1:3)
+        end do
+    end subroutine forward
+
+    !> The forward sweep of b + g K x: z_i = b_i + g (K x)_i - L'_i z_{i-1}.
+    pure subroutine forward_plus_product(nb, kblk, lfac, g, x, b)
+        integer, intent(in) :: nb
+        real(wp), intent(in) :: kblk(4, 3, -1:1, nb), lfac(4, 3, nb)
+        real(wp), intent(in) :: g
+        real(wp), intent(in) :: x(3, nb)
+        real(wp), intent(inout) :: b(3, nb)
+        real(wp) :: p(4), q(4)
+        integer :: ib
         do ib = 1, nb
-            k = 3*(ib - 1)
             ! p = K_{i,i-1} x_{i-1} + K_ii x_i + K_{i,i+1} x_{i+1}
-            associate (a => self%kblk(:, :, 0, ib))
-                p = a(:, 1)*x(k + 1) + a(:, 2)*x(k + 2) + a(:, 3)*x(k + 3)
-            end associate
+            p = kblk(:, 1, 0, ib)*x(1, ib) + kblk(:, 2, 0, ib)*x(2, ib) &
+                + kblk(:, 3, 0, ib)*x(3, ib)
+            if (ib > 1) p = p + (kblk(:, 1, -1, ib)*x(1, ib - 1) &
+                                 + kblk(:, 2, -1, ib)*x(2, ib - 1) &
+                                 + kblk(:, 3, -1, ib)*x(3, ib - 1))
+            if (ib < nb) p = p + (kblk(:, 1, 1, ib)*x(1, ib + 1) &
+                                  + kblk(:, 2, 1, ib)*x(2, ib + 1) &
+                                  + kblk(:, 3, 1, ib)*x(3, ib + 1))
+            b(:, ib) = b(:, ib) + g*p(1:3)
             if (ib > 1) then
-                associate (a => self%kblk(:, :, -1, ib))
-                    p = p + (a(:, 1)*x(k - 2) + a(:, 2)*x(k - 1) + a(:, 3)*x(k))
-                end associate
-            end if
-            if (ib < nb) then
-                associate (a => self%kblk(:, :, 1, ib))
-                    p = p + (a(:, 1)*x(k + 4) + a(:, 2)*x(k + 5) + a(:, 3)*x(k + 6))
-                end associate
-            end if
-            b(k + 1:k + 3) = b(k + 1:k + 3) + g*p
-            if (ib > 1) then
-                associate (l => self%lfac(:, :, ib))
-                    b(k + 1:k + 3) = b(k + 1:k + 3) - (l(:, 1)*b(k - 2) + l(:, 2)*b(k - 1) &
-                                                       + l(:, 3)*b(k))
-                end associate
+                q = lfac(:, 1, ib)*b(1, ib - 1) + lfac(:, 2, ib)*b(2, ib - 1) &
+                    + lfac(:, 3, ib)*b(3, ib - 1)
+                b(:, ib) = b(:, ib) - q(1:3)
             end if
         end do
-        call backward(self, b)
-    end subroutine block3_solve_plus_product
+    end subroutine forward_plus_product
+
+    !> The backward sweep: x_i = D'_i^{-1} (z_i - U_i x_{i+1}), b holding z on entry.
+    pure subroutine backward(nb, ublk, dinv, b)
+        integer, intent(in) :: nb
+        real(wp), intent(in) :: ublk(4, 3, nb), dinv(4, 3, nb)
+        real(wp), intent(inout) :: b(3, nb)
+        real(wp) :: z(3), p(4)
+        integer :: ib
+        do ib = nb, 1, -1
+            z = b(:, ib)
+            if (ib < nb) then
+                p = ublk(:, 1, ib)*b(1, ib + 1) + ublk(:, 2, ib)*b(2, ib + 1) &
+                    + ublk(:, 3, ib)*b(3, ib + 1)
+                z = z - p(1:3)
+            end if
+            p = dinv(:, 1, ib)*z(1) + dinv(:, 2, ib)*z(2) + dinv(:, 3, ib)*z(3)
+            b(:, ib) = p(1:3)
+        end do
+    end subroutine backward
 
     !> c = a b for 3 x 3 matrices, written out.
     pure subroutine mul3(a, b, c)

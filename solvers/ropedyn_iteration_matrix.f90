@@ -54,6 +54,10 @@ module ropedyn_iteration_matrix
         logical :: rdense = .false.
         integer, allocatable :: pos(:), vel(:)
         logical :: vel_contiguous = .false.   !< vel(k) = vel(1) + k - 1
+        !> m > 0: y is made of blocks of m positions followed by their m rates (RFEM: x, y,
+        !! phi and their rates, element by element); m = 3 is gathered without the index
+        !! vectors pos and vel
+        integer :: interleave = 0
         real(wp), allocatable :: kb(:, :), cb(:, :), mk(:, :)  !< band (kl+ku+1, np), row ku+1+i-j
         real(wp), allocatable :: rlu(:, :)    !< factors (dense np x np or band 2kl+ku+1 x np)
         integer :: rkv = 0                    !< super-diagonals of the band U actually filled
@@ -157,6 +161,8 @@ contains
             self%reduced = covered
             if (covered) self%vel_contiguous = all(self%vel == [(self%vel(1) + k - 1, &
                                                                  k = 1, self%np)])
+            self%interleave = 0
+            if (covered) self%interleave = interleaved_blocks(self%pos, self%vel)
         end if
         if (allocated(self%kb)) deallocate (self%kb, self%cb, self%mk, self%rlu, self%ripiv, &
                                             self%rq, self%rv)
@@ -502,10 +508,14 @@ contains
         kl = self%kl
         ku = self%ku
         g = self%hbeta
-        do i = 1, np
-            self%rq(i) = b(self%pos(i))
-            self%rv(i) = b(self%vel(i))
-        end do
+        if (self%interleave == 3) then
+            call split_blocks3(np/3, b, self%rq, self%rv)
+        else
+            do i = 1, np
+                self%rq(i) = b(self%pos(i))
+                self%rv(i) = b(self%vel(i))
+            end do
+        end if
         if (self%rdense) then
             call band_add_product(np, kl, ku, self%kb, g, self%rq, self%rv)
             call dgetrs('N', np, 1, self%rlu, np, self%ripiv, self%rv, np, info)
@@ -517,11 +527,67 @@ contains
             call band_add_product(np, kl, ku, self%kb, g, self%rq, self%rv)
             call band_lu_solve(np, kl, ku, self%rkv, self%rlu, self%ripiv, self%rv)
         end if
-        do i = 1, np
-            b(self%vel(i)) = self%rv(i)
-            b(self%pos(i)) = self%rq(i) + g*self%rv(i)
-        end do
+        if (self%interleave == 3) then
+            call join_blocks3(np/3, g, self%rq, self%rv, b)
+        else
+            do i = 1, np
+                b(self%vel(i)) = self%rv(i)
+                b(self%pos(i)) = self%rq(i) + g*self%rv(i)
+            end do
+        end if
     end subroutine solve_reduced
+
+    !> m when pos and vel make y of blocks of m positions followed by their m rates
+    !! (pos(k) = 2 m (b - 1) + c, vel(k) = pos(k) + m for k = m (b - 1) + c), else 0.
+    pure integer function interleaved_blocks(pos, vel) result(m)
+        integer, intent(in) :: pos(:), vel(:)
+        integer :: k
+        m = vel(1) - pos(1)
+        if (pos(1) /= 1 .or. m < 1 .or. mod(size(pos), max(m, 1)) /= 0) then
+            m = 0
+            return
+        end if
+        do k = 1, size(pos)
+            if (pos(k) /= 2*m*((k - 1)/m) + mod(k - 1, m) + 1 .or. vel(k) /= pos(k) + m) then
+                m = 0
+                return
+            end if
+        end do
+    end function interleaved_blocks
+
+    !> rq, rv = the positions' and the rates' entries of b (nb blocks of three of each).
+    !! Written out: as loops over the three, gfortran makes each block a call of memcpy.
+    pure subroutine split_blocks3(nb, b, rq, rv)
+        integer, intent(in) :: nb
+        real(wp), intent(in) :: b(3, 2, nb)
+        real(wp), intent(out) :: rq(3, nb), rv(3, nb)
+        integer :: ib
+        do ib = 1, nb
+            rq(1, ib) = b(1, 1, ib)
+            rq(2, ib) = b(2, 1, ib)
+            rq(3, ib) = b(3, 1, ib)
+            rv(1, ib) = b(1, 2, ib)
+            rv(2, ib) = b(2, 2, ib)
+            rv(3, ib) = b(3, 2, ib)
+        end do
+    end subroutine split_blocks3
+
+    !> b = (rq + g rv, rv), block by block: the inverse of split_blocks3 for x_q = b_q + g x_v.
+    pure subroutine join_blocks3(nb, g, rq, rv, b)
+        integer, intent(in) :: nb
+        real(wp), intent(in) :: g
+        real(wp), intent(in) :: rq(3, nb), rv(3, nb)
+        real(wp), intent(out) :: b(3, 2, nb)
+        integer :: ib
+        do ib = 1, nb
+            b(1, 1, ib) = rq(1, ib) + g*rv(1, ib)
+            b(2, 1, ib) = rq(2, ib) + g*rv(2, ib)
+            b(3, 1, ib) = rq(3, ib) + g*rv(3, ib)
+            b(1, 2, ib) = rv(1, ib)
+            b(2, 2, ib) = rv(2, ib)
+            b(3, 2, ib) = rv(3, ib)
+        end do
+    end subroutine join_blocks3
 
     !> b <- M(t, y)^{-1} b (the implicit form's mass matrix, first-order storage); the
     !! Newton matrix must be factored again afterwards. status: STATUS_RECOVERABLE when M

@@ -129,8 +129,8 @@ module ropedyn_mebdf
             class(mebdf_t), intent(inout) :: self
             real(wp), intent(in) :: tn
             real(wp), intent(in) :: hbeta
-            real(wp), intent(in) :: c(:)
-            real(wp), intent(inout) :: z(:)
+            real(wp), contiguous, intent(in) :: c(:)
+            real(wp), contiguous, intent(inout) :: z(:)
             integer, intent(out) :: outcome
         end subroutine stage
 

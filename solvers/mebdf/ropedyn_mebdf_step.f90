@@ -109,10 +109,9 @@ contains
     end procedure stage
 
     module procedure try_step
-        real(wp) :: sp, sq, s2
         real(wp) :: gam(KMAX_MEBDF), hmin, tn, err1, errkm1, errkp1, beta, hbeta
         real(wp) :: ratio, r_same, r_down, r_up, binom, wd(0:KMAX_MEBDF)
-        integer :: k, j, i, l, outcome, status, error_fails, conv_fails, knew
+        integer :: k, j, i, outcome, status, error_fails, conv_fails, knew
         logical :: refresh
         character(len=:), allocatable :: last_cause
 
@@ -161,19 +160,17 @@ contains
             end if
 
             ! Stage 1: k-step BDF to t_n + h.
-            ! pred = sum_{j=0..k} dif_j, psi = sum_{j=1..k} gam_j dif_j (one pass). With
-            ! P_j = sum_{i>=j} dif_i (the predictor's differences), psi is
-            ! sum_{j=1..k} (1/j) P_j, the BDF's known part.
-            do l = 1, self%nt
-                sp = self%dif(l, 0)
-                sq = 0.0_wp
-                do j = 1, k
-                    sp = sp + self%dif(l, j)
-                    sq = sq + gam(j)*self%dif(l, j)
-                end do
-                self%pred(l) = sp
-                self%c(l) = sp - beta*sq
+            ! pred = sum_{j=0..k} dif_j, psi = sum_{j=1..k} gam_j dif_j (c holds psi until
+            ! the last line). With P_j = sum_{i>=j} dif_i (the predictor's differences), psi
+            ! is sum_{j=1..k} (1/j) P_j, the BDF's known part. The loops over the
+            ! components are innermost (vector instructions); pred stays for the history.
+            self%pred = self%dif(:, 0) + self%dif(:, 1)
+            self%c = gam(1)*self%dif(:, 1)
+            do j = 2, k
+                self%pred = self%pred + self%dif(:, j)
+                self%c = self%c + gam(j)*self%dif(:, j)
             end do
+            self%c = self%pred - beta*self%c
             self%ybar1 = self%pred
             call self%stage(tn, hbeta, self%c, self%ybar1, outcome)
             if (outcome /= STAGE_OK) then
@@ -193,20 +190,17 @@ contains
 
             ! Stage 2: the same BDF one step further, ybar1 joining the history. With
             ! P_j = sum_{i=j..k} dif_i, the differences of ybar1 are P_j + d1; the
-            ! predictor is their sum and psi = sum_{i=1..k} gam(i) (P_i + d1).
-            do l = 1, self%nt
-                sp = self%ybar1(l)
-                sq = 0.0_wp
-                s2 = 0.0_wp
-                do i = k, 1, -1
-                    s2 = s2 + self%dif(l, i)
-                    sp = sp + s2 + self%d1(l)
-                    sq = sq + gam(i)*(s2 + self%d1(l))
-                end do
-                self%pred(l) = sp
-                self%c(l) = sp - beta*sq
+            ! predictor (summed in ybar2) is their sum and psi (in c) = sum_{i=1..k} gam(i)
+            ! (P_i + d1); tmp carries P_i.
+            self%tmp = self%dif(:, k)
+            self%ybar2 = self%ybar1 + self%tmp + self%d1
+            self%c = gam(k)*(self%tmp + self%d1)
+            do i = k - 1, 1, -1
+                self%tmp = self%tmp + self%dif(:, i)
+                self%ybar2 = self%ybar2 + self%tmp + self%d1
+                self%c = self%c + gam(i)*(self%tmp + self%d1)
             end do
-            self%ybar2 = self%pred
+            self%c = self%ybar2 - beta*self%c
             call self%stage(tn + self%h, hbeta, self%c, self%ybar2, outcome)
             if (outcome /= STAGE_OK) then
                 call newton_failed(outcome)
@@ -260,19 +254,13 @@ contains
             self%tmp = self%d1 - self%dif(:, k + 1)
             errkp1 = self%wnorm(self%tmp)/self%coef(k + 1)%tq
         end if
-        do l = 1, self%nt
-            sp = self%dif(l, 0)
-            do j = 1, k
-                sp = sp + self%dif(l, j)
-            end do
-            sq = self%y3(l) - sp
-            self%dif(l, k + 2) = sq - self%dif(l, k + 1)
-            self%dif(l, k + 1) = sq
-            ! dif_j <- dif_j + dif_{j+1} (the new one), carried in a register
-            do j = k, 0, -1
-                sq = self%dif(l, j) + sq
-                self%dif(l, j) = sq
-            end do
+        ! nabla^{k+1} y_{n+1} = y3 - pred (stage 1's predictor, sum_{j=0..k} dif_j), then
+        ! dif_j <- dif_j + dif_{j+1} (the new one) from j = k down
+        self%tmp = self%y3 - self%pred
+        self%dif(:, k + 2) = self%tmp - self%dif(:, k + 1)
+        self%dif(:, k + 1) = self%tmp
+        do j = k, 0, -1
+            self%dif(:, j) = self%dif(:, j) + self%dif(:, j + 1)
         end do
         self%t = tn
         self%h_used = self%h
