@@ -5,9 +5,9 @@
 !! The matrix comes in compact band storage with kl = ku = 5 (entry (i, j) at row
 !! 6 + i - j), the storage of ropedyn_iteration_matrix. Factorization (block Thomas):
 !!     D'_1 = D_1,  L'_i = L_i D'_{i-1}^{-1},  D'_i = D_i - L'_i U_{i-1},
-!! keeping D'_i^{-1} (Gauss-Jordan with partial pivoting within the block, which takes
-!! care of the different scales of the translational and rotational rows). Solve:
-!!     z_i = b_i - L'_i z_{i-1},  x_i = D'_i^{-1} (z_i - U_i x_{i+1}).
+!! keeping D'_i^{-1} (the adjugate over the determinant: exact under the scaling of the
+!! translational and rotational rows, see invert3) and W_i = D'_i^{-1} U_i. Solve:
+!!     z_i = b_i - L'_i z_{i-1},  c_i = D'_i^{-1} z_i,  x_i = c_i - W_i x_{i+1}.
 !! 27 multiply-adds per block row in the solve against 3 (2 kl + ku + 1) = 78 for the band
 !! LU with partial pivoting (whose row interchanges fill U to kl + ku super-diagonals on
 !! the rope), and the 3 x 3 products are independent operations instead of a chain.
@@ -33,7 +33,7 @@ module ropedyn_block3
         integer :: nb = 0
         real(wp), allocatable :: dinv(:, :, :)   !< D'_i^{-1} (4, 3, nb)
         real(wp), allocatable :: lfac(:, :, :)   !< L'_i (4, 3, nb), i >= 2
-        real(wp), allocatable :: ublk(:, :, :)   !< U_i (4, 3, nb), i <= nb - 1
+        real(wp), allocatable :: wblk(:, :, :)   !< W_i = D'_i^{-1} U_i (4, 3, nb), i <= nb - 1
         !> blocks of a second block-tridiagonal matrix K (4, 3, -1:1, nb): (i, i-1), (i, i),
         !! (i, i+1), for solve_plus_product
         real(wp), allocatable :: kblk(:, :, :, :)
@@ -61,12 +61,12 @@ contains
         if (.not. ok) return
         nb = n/3
         if (self%nb /= nb) then
-            if (allocated(self%dinv)) deallocate (self%dinv, self%lfac, self%ublk, self%kblk)
-            allocate (self%dinv(4, 3, nb), self%lfac(4, 3, nb), self%ublk(4, 3, nb), &
+            if (allocated(self%dinv)) deallocate (self%dinv, self%lfac, self%wblk, self%kblk)
+            allocate (self%dinv(4, 3, nb), self%lfac(4, 3, nb), self%wblk(4, 3, nb), &
                       self%kblk(4, 3, -1:1, nb))
             self%dinv = 0.0_wp
             self%lfac = 0.0_wp
-            self%ublk = 0.0_wp
+            self%wblk = 0.0_wp
             self%nb = nb
         end if
         self%kblk = 0.0_wp
@@ -90,7 +90,7 @@ contains
         integer, intent(in) :: n
         real(wp), intent(in) :: a(11, n)
         integer, intent(out) :: info
-        real(wp) :: d(3, 3), lb(3, 3), lf(3, 3), prev(3, 3)
+        real(wp) :: d(3, 3), lb(3, 3), lf(3, 3), prev(3, 3), u(3, 3), uprev(3, 3)
         integer :: nb, ib, r, c, j0
         logical :: ok
 
@@ -106,7 +106,7 @@ contains
             if (ib < nb) then
                 do c = 1, 3
                     do r = 1, 3
-                        self%ublk(r, c, ib) = a(6 + r - (c + 3), j0 + 3 + c)
+                        u(r, c) = a(6 + r - (c + 3), j0 + 3 + c)
                     end do
                 end do
             end if
@@ -119,8 +119,7 @@ contains
                 prev = self%dinv(1:3, :, ib - 1)
                 call mul3(lb, prev, lf)
                 self%lfac(1:3, :, ib) = lf
-                prev = self%ublk(1:3, :, ib - 1)
-                call mul3(lf, prev, lb)
+                call mul3(lf, uprev, lb)
                 d = d - lb
             end if
             call invert3(d, prev, ok)
@@ -129,6 +128,11 @@ contains
                 return
             end if
             self%dinv(1:3, :, ib) = prev
+            if (ib < nb) then
+                call mul3(prev, u, lb)
+                self%wblk(1:3, :, ib) = lb
+                uprev = u
+            end if
         end do
     end subroutine block3_factor
 
@@ -157,8 +161,8 @@ contains
     pure subroutine block3_solve(self, b)
         class(block3_t), intent(in) :: self
         real(wp), intent(inout) :: b(:)
-        call forward(self%nb, self%lfac, b)
-        call backward(self%nb, self%ublk, self%dinv, b)
+        call forward(self%nb, self%lfac, self%dinv, b)
+        call backward(self%nb, self%wblk, b)
     end subroutine block3_solve
 
     !> b <- A^{-1} (b + g K x) with the factors and the K blocks of block3_factor: the
@@ -168,36 +172,45 @@ contains
         real(wp), intent(in) :: g
         real(wp), intent(in) :: x(:)
         real(wp), intent(inout) :: b(:)
-        call forward_plus_product(self%nb, self%kblk, self%lfac, g, x, b)
-        call backward(self%nb, self%ublk, self%dinv, b)
+        call forward_plus_product(self%nb, self%kblk, self%lfac, self%dinv, g, x, b)
+        call backward(self%nb, self%wblk, b)
     end subroutine block3_solve_plus_product
 
     ! The sweeps take the blocks as explicit-shape arrays (b and x as (3, nb)): their
-    ! addresses and strides then stay in registers through the loop.
+    ! addresses and strides then stay in registers through the loop. Each sweep is a chain
+    ! (block i needs block i - 1's result): the forward sweep leaves c_i = D'_i^{-1} z_i in
+    ! b (off the chain), so that a step of the backward chain is one block product,
+    ! x_i = c_i - W_i x_{i+1}, not two.
 
-    !> The forward sweep: z_i = b_i - L'_i z_{i-1}.
-    pure subroutine forward(nb, lfac, b)
+    !> The forward sweep: z_i = b_i - L'_i z_{i-1}; b_i <- D'_i^{-1} z_i.
+    pure subroutine forward(nb, lfac, dinv, b)
         integer, intent(in) :: nb
-        real(wp), intent(in) :: lfac(4, 3, nb)
+        real(wp), intent(in) :: lfac(4, 3, nb), dinv(4, 3, nb)
         real(wp), intent(inout) :: b(3, nb)
-        real(wp) :: p(4)
+        real(wp) :: z(3), p(4), q(4)
         integer :: ib
-        do ib = 2, nb
-            p = lfac(:, 1, ib)*b(1, ib - 1) + lfac(:, 2, ib)*b(2, ib - 1) &
-                + lfac(:, 3, ib)*b(3, ib - 1)
-            b(:, ib) = b(:, ib) - p(1:3)
+        z = b(:, 1)
+        do ib = 1, nb
+            if (ib > 1) then
+                q = lfac(:, 1, ib)*z(1) + lfac(:, 2, ib)*z(2) + lfac(:, 3, ib)*z(3)
+                z = b(:, ib) - q(1:3)
+            end if
+            p = dinv(:, 1, ib)*z(1) + dinv(:, 2, ib)*z(2) + dinv(:, 3, ib)*z(3)
+            b(:, ib) = p(1:3)
         end do
     end subroutine forward
 
-    !> The forward sweep of b + g K x: z_i = b_i + g (K x)_i - L'_i z_{i-1}.
-    pure subroutine forward_plus_product(nb, kblk, lfac, g, x, b)
+    !> The forward sweep of b + g K x: z_i = b_i + g (K x)_i - L'_i z_{i-1};
+    !! b_i <- D'_i^{-1} z_i.
+    pure subroutine forward_plus_product(nb, kblk, lfac, dinv, g, x, b)
         integer, intent(in) :: nb
-        real(wp), intent(in) :: kblk(4, 3, -1:1, nb), lfac(4, 3, nb)
+        real(wp), intent(in) :: kblk(4, 3, -1:1, nb), lfac(4, 3, nb), dinv(4, 3, nb)
         real(wp), intent(in) :: g
         real(wp), intent(in) :: x(3, nb)
         real(wp), intent(inout) :: b(3, nb)
-        real(wp) :: p(4), q(4)
+        real(wp) :: z(3), p(4), q(4)
         integer :: ib
+        z = 0.0_wp
         do ib = 1, nb
             ! p = K_{i,i-1} x_{i-1} + K_ii x_i + K_{i,i+1} x_{i+1}
             p = kblk(:, 1, 0, ib)*x(1, ib) + kblk(:, 2, 0, ib)*x(2, ib) &
@@ -208,31 +221,29 @@ contains
             if (ib < nb) p = p + (kblk(:, 1, 1, ib)*x(1, ib + 1) &
                                   + kblk(:, 2, 1, ib)*x(2, ib + 1) &
                                   + kblk(:, 3, 1, ib)*x(3, ib + 1))
-            b(:, ib) = b(:, ib) + g*p(1:3)
             if (ib > 1) then
-                q = lfac(:, 1, ib)*b(1, ib - 1) + lfac(:, 2, ib)*b(2, ib - 1) &
-                    + lfac(:, 3, ib)*b(3, ib - 1)
-                b(:, ib) = b(:, ib) - q(1:3)
-            end if
-        end do
-    end subroutine forward_plus_product
-
-    !> The backward sweep: x_i = D'_i^{-1} (z_i - U_i x_{i+1}), b holding z on entry.
-    pure subroutine backward(nb, ublk, dinv, b)
-        integer, intent(in) :: nb
-        real(wp), intent(in) :: ublk(4, 3, nb), dinv(4, 3, nb)
-        real(wp), intent(inout) :: b(3, nb)
-        real(wp) :: z(3), p(4)
-        integer :: ib
-        do ib = nb, 1, -1
-            z = b(:, ib)
-            if (ib < nb) then
-                p = ublk(:, 1, ib)*b(1, ib + 1) + ublk(:, 2, ib)*b(2, ib + 1) &
-                    + ublk(:, 3, ib)*b(3, ib + 1)
-                z = z - p(1:3)
+                q = lfac(:, 1, ib)*z(1) + lfac(:, 2, ib)*z(2) + lfac(:, 3, ib)*z(3)
+                z = (b(:, ib) + g*p(1:3)) - q(1:3)
+            else
+                z = b(:, ib) + g*p(1:3)
             end if
             p = dinv(:, 1, ib)*z(1) + dinv(:, 2, ib)*z(2) + dinv(:, 3, ib)*z(3)
             b(:, ib) = p(1:3)
+        end do
+    end subroutine forward_plus_product
+
+    !> The backward sweep: x_i = c_i - W_i x_{i+1}, b holding c on entry.
+    pure subroutine backward(nb, wblk, b)
+        integer, intent(in) :: nb
+        real(wp), intent(in) :: wblk(4, 3, nb)
+        real(wp), intent(inout) :: b(3, nb)
+        real(wp) :: x(3), p(4)
+        integer :: ib
+        x = b(:, nb)
+        do ib = nb - 1, 1, -1
+            p = wblk(:, 1, ib)*x(1) + wblk(:, 2, ib)*x(2) + wblk(:, 3, ib)*x(3)
+            x = b(:, ib) - p(1:3)
+            b(:, ib) = x
         end do
     end subroutine backward
 
@@ -246,36 +257,35 @@ contains
         end do
     end subroutine mul3
 
-    !> ainv = a^{-1} by Gauss-Jordan elimination with partial pivoting; ok = .false. when a
-    !! is singular or the inverse is not finite.
+    !> ainv = a^{-1} = adj(a)/det(a) (the cofactors written out); ok = .false. when det(a)
+    !! is zero or the inverse is not finite. Each cofactor and each term of det takes one
+    !! entry from each of the rows involved, so scaling a row (the rope's rotational rows are
+    !! some 1e-4 of its translational ones) scales them exactly and costs no accuracy: the
+    !! result is as good as for the equilibrated block. It is a short chain of operations
+    !! with no branch, where the factorization spent its time in Gauss-Jordan's pivot
+    !! searches and row exchanges, block after dependent block.
     pure subroutine invert3(a, ainv, ok)
         real(wp), intent(in) :: a(3, 3)
         real(wp), intent(out) :: ainv(3, 3)
         logical, intent(out) :: ok
-        real(wp) :: w(3, 6), row(6), f
-        integer :: c, r, p
-        w(:, 1:3) = a
-        w(:, 4:6) = 0.0_wp
-        w(1, 4) = 1.0_wp
-        w(2, 5) = 1.0_wp
-        w(3, 6) = 1.0_wp
+        real(wp) :: c11, c12, c13, det, r
+        c11 = a(2, 2)*a(3, 3) - a(2, 3)*a(3, 2)
+        c12 = a(2, 3)*a(3, 1) - a(2, 1)*a(3, 3)
+        c13 = a(2, 1)*a(3, 2) - a(2, 2)*a(3, 1)
+        det = a(1, 1)*c11 + a(1, 2)*c12 + a(1, 3)*c13
         ok = .false.
-        do c = 1, 3
-            p = c - 1 + maxloc(abs(w(c:3, c)), dim=1)
-            if (w(p, c) == 0.0_wp) return
-            if (p /= c) then
-                row = w(c, :)
-                w(c, :) = w(p, :)
-                w(p, :) = row
-            end if
-            w(c, :) = w(c, :)/w(c, c)
-            do r = 1, 3
-                if (r == c) cycle
-                f = w(r, c)
-                w(r, :) = w(r, :) - f*w(c, :)
-            end do
-        end do
-        ainv = w(:, 4:6)
+        ainv = 0.0_wp
+        if (.not. abs(det) > 0.0_wp) return
+        r = 1.0_wp/det
+        ainv(1, 1) = c11*r
+        ainv(2, 1) = c12*r
+        ainv(3, 1) = c13*r
+        ainv(1, 2) = (a(1, 3)*a(3, 2) - a(1, 2)*a(3, 3))*r
+        ainv(2, 2) = (a(1, 1)*a(3, 3) - a(1, 3)*a(3, 1))*r
+        ainv(3, 2) = (a(1, 2)*a(3, 1) - a(1, 1)*a(3, 2))*r
+        ainv(1, 3) = (a(1, 2)*a(2, 3) - a(1, 3)*a(2, 2))*r
+        ainv(2, 3) = (a(1, 3)*a(2, 1) - a(1, 1)*a(2, 3))*r
+        ainv(3, 3) = (a(1, 1)*a(2, 2) - a(1, 2)*a(2, 1))*r
         ok = all(ieee_is_finite(ainv))
     end subroutine invert3
 end module ropedyn_block3

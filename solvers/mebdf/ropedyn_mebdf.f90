@@ -26,6 +26,7 @@
 module ropedyn_mebdf
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp, i8
+    use ropedyn_sums, only: sum_squares
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
@@ -88,7 +89,8 @@ module ropedyn_mebdf
         real(wp), allocatable :: atol(:)  !< absolute tolerance per component (nt)
         real(wp), allocatable :: w(:)     !< error weights rtol |y| + atol (nt)
         real(wp), allocatable :: wi(:)    !< their inverses (the norms multiply)
-        real(wp), allocatable :: f(:), mv(:), r(:)  !< work (n)
+        !> work (n): F, M times the correction, the Newton correction and its weighted form
+        real(wp), allocatable :: f(:), mv(:), r(:), rw(:)
         !> work of a step (nt), allocated once: the predictor, a stage's known part c, the
         !! stage solutions ybar1, ybar2, y3, ybar1's correction d1 and the slopes h g of
         !! stages 1 and 2, and a temporary for norms
@@ -209,7 +211,8 @@ contains
         end do
         allocate (self%dif(self%nt, 0:KMAX_MEBDF + 2), self%atol(self%nt), self%w(self%nt), &
                   self%wi(self%nt))
-        allocate (self%f(self%n), self%mv(self%n), self%r(self%n), self%gq(max(self%nq, 1)))
+        allocate (self%f(self%n), self%mv(self%n), self%r(self%n), self%rw(self%n), &
+                  self%gq(max(self%nq, 1)))
         allocate (self%pred(self%nt), self%c(self%nt), self%ybar1(self%nt), &
                   self%ybar2(self%nt), self%y3(self%nt), self%d1(self%nt), self%hg1(self%nt), &
                   self%hg2(self%nt), self%tmp(self%nt))
@@ -288,7 +291,7 @@ contains
         if (allocated(self%dif)) deallocate (self%dif)
         if (allocated(self%atol)) deallocate (self%atol)
         if (allocated(self%w)) deallocate (self%w, self%wi)
-        if (allocated(self%f)) deallocate (self%f, self%mv, self%r)
+        if (allocated(self%f)) deallocate (self%f, self%mv, self%r, self%rw)
         if (allocated(self%gq)) deallocate (self%gq)
         if (allocated(self%pred)) deallocate (self%pred, self%c, self%ybar1, self%ybar2, &
                                               self%y3, self%d1, self%hg1, self%hg2, self%tmp)

@@ -89,9 +89,10 @@ contains
     end procedure initial_step
 
     module procedure wnorm
-        wnorm = sqrt(sum((v(1:self%n)*self%wi(1:self%n))**2)/real(self%n, wp))
-        if (self%nq > 0) wnorm = max(wnorm, sqrt(sum((v(self%n + 1:self%nt)* &
-                                                       self%wi(self%n + 1:self%nt))**2)/ &
+        real(wp) :: x(self%nt)
+        x = v(1:self%nt)*self%wi
+        wnorm = sqrt(sum_squares(x(1:self%n))/real(self%n, wp))
+        if (self%nq > 0) wnorm = max(wnorm, sqrt(sum_squares(x(self%n + 1:self%nt))/ &
                                                   real(self%nq, wp)))
     end procedure wnorm
 

@@ -35,7 +35,7 @@ contains
     end procedure prepare_matrix
 
     module procedure stage
-        real(wp) :: dnorm, dnorm_old, dcon, start, ri
+        real(wp) :: dnorm, dnorm_old, dcon, start
         integer :: iter, status, n, i
         logical :: mass, profile
 
@@ -73,14 +73,11 @@ contains
             if (profile) self%counters%time_solve = self%counters%time_solve + &
                                                     (clock_seconds() - start)
             self%counters%nonlin_iters = self%counters%nonlin_iters + 1
-            ! one pass: the correction and its norm; a NaN or Inf in it (or a norm beyond
-            ! the floating-point range) fails the stage, whose z is then thrown away
-            dnorm = 0.0_wp
-            do i = 1, n
-                ri = self%r(i)
-                z(i) = z(i) + ri
-                dnorm = dnorm + (ri*self%wi(i))**2
-            end do
+            ! the correction and its norm; a NaN or Inf in it (or a norm beyond the
+            ! floating-point range) fails the stage, whose z is then thrown away
+            z(1:n) = z(1:n) + self%r
+            self%rw = self%r*self%wi(1:n)
+            dnorm = sum_squares(self%rw)
             if (.not. ieee_is_finite(dnorm)) return
             dnorm = sqrt(dnorm/real(n, wp))
             if (iter > 1) then

@@ -1,0 +1,45 @@
+!> The integrators' sums of squares (src/core/ropedyn_sums.f90):
+!! - exact on integers (no rounding): every component counted once, for every length from 0
+!!   to 40 (the eight partial sums, and the tail beyond a multiple of eight);
+!! - the order the module header fixes: components i = 8 m + j in partial sum j, the eight
+!!   added pairwise; written out here for a vector where another order rounds differently
+!!   (squares 1 and nine times 2^-54: a plain sum gives 1, the module's order 1 + 2^-52);
+!! - against the plain sum on 600 random values (within rounding).
+program test_sums
+    use ropedyn_kinds, only: wp
+    use ropedyn_sums, only: sum_squares
+    use ropedyn_assert, only: test_suite_t
+    implicit none
+
+    type(test_suite_t) :: suite
+    real(wp), allocatable :: x(:)
+    real(wp) :: a(8), expected, eps
+    integer :: n, i
+    character(len=8) :: label
+
+    suite%name = 'sums'
+    do n = 0, 40
+        x = [(real(mod(7*i, 11) - 5, wp), i = 1, n)]
+        write (label, '(i0)') n
+        call suite%check_true(sum_squares(x) == sum(x**2), 'integers, length '//trim(label))
+    end do
+
+    ! squares 1 and nine times 2^-54 (exact: x = 2^-27)
+    eps = 2.0_wp**(-27)
+    x = [1.0_wp, eps, eps, eps, eps, eps, eps, eps, eps, eps]
+    a = 0.0_wp
+    do i = 1, size(x)
+        a(mod(i - 1, 8) + 1) = a(mod(i - 1, 8) + 1) + x(i)**2
+    end do
+    expected = ((a(1) + a(2)) + (a(3) + a(4))) + ((a(5) + a(6)) + (a(7) + a(8)))
+    call suite%check_true(sum_squares(x) == expected, 'the fixed order of the partial sums')
+    call suite%check_true(sum_squares(x) /= sum(x**2), '... which is not the plain order here')
+
+    deallocate (x)
+    allocate (x(600))
+    call random_number(x)
+    x = 2.0_wp*x - 1.0_wp
+    call suite%check_close(sum_squares(x), sum(x**2), 1.0e-13_wp, 0.0_wp, &
+                           '600 random values against the plain sum')
+    call suite%finish()
+end program test_sums
