@@ -90,7 +90,9 @@ contains
         integer, intent(in) :: n
         real(wp), intent(in) :: a(11, n)
         integer, intent(out) :: info
-        real(wp) :: d(3, 3), lb(3, 3), lf(3, 3), prev(3, 3), u(3, 3), uprev(3, 3)
+        ! dv: D'^{-1} of the block row in hand, kept into the next one; u, uprev: U of
+        ! this row and of the last
+        real(wp) :: d(3, 3), lb(3, 3), lf(3, 3), dv(3, 3), u(3, 3), uprev(3, 3)
         integer :: nb, ib, r, c, j0
         logical :: ok
 
@@ -116,20 +118,19 @@ contains
                         lb(r, c) = a(6 + (r + 3) - c, j0 - 3 + c)
                     end do
                 end do
-                prev = self%dinv(1:3, :, ib - 1)
-                call mul3(lb, prev, lf)
+                call mul3(lb, dv, lf)
                 self%lfac(1:3, :, ib) = lf
                 call mul3(lf, uprev, lb)
                 d = d - lb
             end if
-            call invert3(d, prev, ok)
+            call invert3(d, dv, ok)
             if (.not. ok) then
                 info = ib
                 return
             end if
-            self%dinv(1:3, :, ib) = prev
+            self%dinv(1:3, :, ib) = dv
             if (ib < nb) then
-                call mul3(prev, u, lb)
+                call mul3(dv, u, lb)
                 self%wblk(1:3, :, ib) = lb
                 uprev = u
             end if

@@ -91,9 +91,10 @@ module ropedyn_mebdf
         real(wp), allocatable :: wi(:)    !< their inverses (the norms multiply)
         !> work (n): F, M times the correction, the Newton correction and its weighted form
         real(wp), allocatable :: f(:), mv(:), r(:), rw(:)
-        !> work of a step (nt), allocated once: the predictor, a stage's known part c, the
-        !! stage solutions ybar1, ybar2, y3, ybar1's correction d1 and the slopes h g of
-        !! stages 1 and 2, and a temporary for norms
+        !> work of a step (nt), allocated once: stage 1's predictor (kept for the history
+        !! update), a stage's known part c, the stage solutions ybar1, ybar2, y3, ybar1's
+        !! correction d1 and the slopes h g of stages 1 and 2, and a temporary (stage 2's
+        !! partial sums of the differences, the new difference, the vectors of norms)
         real(wp), allocatable :: pred(:), c(:), ybar1(:), ybar2(:), y3(:), d1(:), hg1(:), &
                                  hg2(:), tmp(:)
         real(wp), allocatable :: gq(:)    !< quadrature rhs (nq)
