@@ -12,7 +12,13 @@
 !! - **Start**: a few Arnoldi steps on the Jacobian at the initial state
 !!   (ropedyn_spectrum) give the spectral radius and the damping of the fastest modes. The
 !!   explicit pair's stability-limited step h_e follows from them; the run starts explicit
-!!   unless that step would take more than START_RATE steps per simulated second. MEBDF's
+!!   unless that step would take more than START_RATE steps per simulated second, or the
+!!   motion at the start is so slow that a first-order step within the tolerance
+!!   (sqrt(2 / |y''|) in the error weights, CVODE's first-step estimate, |y''| from a
+!!   difference of f along f) is longer than START_ACCURACY = 5 explicit stable steps:
+!!   an implicit step of order >= 1 is at least that long, and costs about 2.5 explicit
+!!   steps (a rope hanging at rest, catenary: 13 x h_e; every other scene in input/ and
+!!   input/hard/ is below 1, a rope released from rest at 0.001 .. 0.5). MEBDF's
 !!   maximum order follows from the damping of the fast modes (A(alpha) of MEBDF,
 !!   docs/solvers.md): order 4, A-stable, when a fast mode is damped by less than 3 %, order
 !!   5 (A(88.4 deg)) up to BDF_DAMPING = 12 %; above, CVODE's BDF at up to order 5.
@@ -62,7 +68,7 @@
 module ropedyn_auto
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
-    use ropedyn_problem, only: problem_t
+    use ropedyn_problem, only: problem_t, STATUS_OK
     use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, &
                                   STIFF_STEP_RATE, stop_now
     use ropedyn_erk, only: erk_t
@@ -82,6 +88,9 @@ module ropedyn_auto
     real(wp), parameter :: GAIN = 1.3_wp           !< hysteresis of a switch
     !> explicit steps per simulated second above which a run starts implicit
     real(wp), parameter :: START_RATE = 0.25_wp*STIFF_STEP_RATE
+    !> ... or when a first-order step within the tolerance at the initial state is longer
+    !! than this many explicit stable steps (a rope at rest: catenary)
+    real(wp), parameter :: START_ACCURACY = 5.0_wp
     real(wp), parameter :: IMPLICIT_STEP_COST = 6.0_wp  !< f-equivalents per MEBDF step
     real(wp), parameter :: BDF_STEP_COST = 5.0_wp       !< f-equivalents per CVODE step
     real(wp), parameter :: ADAMS_STEP_COST = 1.0_wp     !< f-equivalents per Adams step
@@ -169,8 +178,9 @@ contains
         type(start_t), intent(in) :: start
         type(error_t), allocatable, intent(out) :: err
         type(spectrum_t) :: spec
-        real(wp) :: h_e, rate
+        real(wp) :: h_e, h_a, rate
         character(len=200) :: text
+        character(len=100) :: slow
 
         self%user_order = start%max_order
         self%y = start%y0
@@ -202,8 +212,15 @@ contains
             rate = 0.0_wp
             text = 'no spectrum estimate'
         end if
+        h_a = 0.0_wp
+        if (rate > 0.0_wp .and. rate <= START_RATE) &
+            h_a = accuracy_step(self%problem, start%t0, start%y0, self%options, h_e)
         if (rate > START_RATE) then
             call self%start_method(IMPLICIT, trim(text)//': explicit steps too short', err)
+        else if (h_a > START_ACCURACY*h_e) then
+            write (slow, '(a, es9.2, a)') '; a first-order step of ', h_a, &
+                ' s within the tolerance: motion too slow for explicit steps'
+            call self%start_method(IMPLICIT, trim(text)//trim(slow), err)
         else
             call self%start_method(EXPLICIT, trim(text), err, h_e)
         end if
@@ -234,6 +251,31 @@ contains
         eval_cost = 1.0_wp
         if (problem%has_mass_matrix()) eval_cost = 1.0_wp + MASS_COST*real(width, wp)
     end subroutine newton_widths
+
+    !> A step the implicit method may take at the start, by accuracy alone: sqrt(2 / |y''|)
+    !! in the error weights (|y''| from a difference of f along f over h_probe), the
+    !! step of a first-order method with a local error of one tolerance unit (CVODE's
+    !! first-step estimate). 0 when f fails; huge when y'' is 0.
+    real(wp) function accuracy_step(problem, t, y, options, h_probe) result(h)
+        class(problem_t), intent(inout) :: problem
+        real(wp), intent(in) :: t, y(:), h_probe
+        type(solver_options_t), intent(in) :: options
+        real(wp), allocatable :: w(:), f0(:), f1(:)
+        real(wp) :: d2
+        integer :: status
+        h = 0.0_wp
+        if (h_probe <= 0.0_wp) return
+        w = options%rtol*abs(y) + options%atol
+        if (allocated(options%atol_vector)) w = options%rtol*abs(y) + options%atol_vector
+        allocate (f0(size(y)), f1(size(y)))
+        call problem%rhs(t, y, f0, status)
+        if (status /= STATUS_OK) return
+        call problem%rhs(t + h_probe, y + h_probe*f0, f1, status)
+        if (status /= STATUS_OK) return
+        d2 = sqrt(sum(((f1 - f0)/w)**2)/size(y))/h_probe
+        h = huge(1.0_wp)
+        if (d2 > 0.0_wp) h = sqrt(2.0_wp/d2)
+    end function accuracy_step
 
     !> MEBDF's maximum order for fast modes damped by `zeta` (clipped at 0).
     pure integer function mebdf_order_for(zeta) result(order)

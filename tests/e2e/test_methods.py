@@ -69,6 +69,22 @@ def test_auto_starts_implicit_on_the_steel_wire(run, tmp_path):
     assert methods[0] == "mebdf" and orders[0] == 4   # barely damped fast modes: A-stable
 
 
+def test_auto_starts_implicit_on_a_rope_at_rest(run, tmp_path):
+    """The catenary hangs at rest in its equilibrium: erk's step is held by stability
+    (4.6e-5 s) while a first-order step within the tolerance is 13 times longer, and auto
+    starts with the implicit method instead of spending a window of explicit steps; it
+    takes a handful of steps for the 3 s (erk: 6e4). A rope released from rest (the paper's,
+    test_auto_records_its_choice) starts explicit."""
+    proc, out = run_scene(run, tmp_path, ROOT / "input" / "catenary.nml", "catenary")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods, times, orders, reasons = switch_log(f)
+        steps = int(f["/solver/steps"][()])
+    assert methods == ["mebdf"] and times[0] == 0.0 and orders[0] == 4, (methods, reasons)
+    assert "first-order step" in reasons[0] and "too slow for explicit steps" in reasons[0]
+    assert steps < 100, steps
+
+
 def test_erk_on_the_steel_wire_within_the_guarantee_or_diagnosed(run, tmp_path):
     """The stiff wire: erk either completes within the step guarantee of the hard scenes
     (2e5 steps per simulated second) or, held by stability above it, gives up quickly with
