@@ -35,6 +35,7 @@
 module ropedyn_erk
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp, i8
+    use ropedyn_sums, only: sum_squares
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
@@ -413,7 +414,9 @@ contains
         ! accepted
         tnew = self%t + h
         if (self%rho_last_two) then
-            self%rho = spectral_estimate(self%k(:, s), self%k(:, s - 1), self%ynew, self%yprev)
+            self%dk = self%k(:, s) - self%k(:, s - 1)
+            self%dy = self%ynew - self%yprev
+            self%rho = norm_ratio(self%dk, self%dy)
         else if (mod(self%counters%steps, int(RHO_EVERY, i8)) == 0) then
             ! a combination of all stages (ropedyn_erk_tables: rho_alpha), every RHO_EVERY
             ! steps (two more passes over the stages: 8 % of the paper run at every step,
@@ -468,16 +471,15 @@ contains
     real(wp) function error_norm(self, h) result(norm)
         class(erk_t), intent(inout) :: self
         real(wp), intent(in) :: h
-        real(wp) :: v, acc
+        real(wp) :: rtol
         integer :: l
         call combine(self%tab%e(1:self%s), h, self%k, self%ytmp)
-        acc = 0.0_wp
+        rtol = self%options%rtol
         do l = 1, self%n
-            v = self%ytmp(l)/(self%options%rtol*max(abs(self%y(l)), abs(self%ynew(l))) &
-                              + self%atol(l))
-            acc = acc + v*v
+            self%ytmp(l) = self%ytmp(l)/(rtol*max(abs(self%y(l)), abs(self%ynew(l))) &
+                                         + self%atol(l))
         end do
-        norm = sqrt(acc/max(1, self%n))
+        norm = sqrt(sum_squares(self%ytmp)/max(1, self%n))
     end function error_norm
 
 
@@ -496,32 +498,12 @@ contains
         rms = sqrt(sum(v**2)/max(1, size(v)))
     end function rms
 
-    !> |f1 - f2| / |y1 - y2| for two stages at the same time (0 when y1 = y2).
-    pure real(wp) function spectral_estimate(f1, f2, y1, y2) result(rho)
-        real(wp), intent(in) :: f1(:), f2(:), y1(:), y2(:)
-        real(wp) :: nf, ny
-        integer :: l
-        nf = 0.0_wp
-        ny = 0.0_wp
-        do l = 1, size(f1)
-            nf = nf + (f1(l) - f2(l))**2
-            ny = ny + (y1(l) - y2(l))**2
-        end do
-        rho = 0.0_wp
-        if (ny > 0.0_wp) rho = sqrt(nf/ny)
-    end function spectral_estimate
-
-    !> |a| / |b| (0 when b = 0).
+    !> |a| / |b| (0 when b = 0), the sums in ropedyn_sums' order.
     pure real(wp) function norm_ratio(a, b) result(r)
-        real(wp), intent(in) :: a(:), b(:)
+        real(wp), contiguous, intent(in) :: a(:), b(:)
         real(wp) :: na, nb
-        integer :: l
-        na = 0.0_wp
-        nb = 0.0_wp
-        do l = 1, size(a)
-            na = na + a(l)**2
-            nb = nb + b(l)**2
-        end do
+        na = sum_squares(a)
+        nb = sum_squares(b)
         r = 0.0_wp
         if (nb > 0.0_wp) r = sqrt(na/nb)
     end function norm_ratio
