@@ -59,7 +59,10 @@
 !!   cost is lower by GAIN; from Adams it goes back to erk when erk's last measured cost is lower
 !!   by GAIN in two windows in a row (snap_load_mpp: Adams measured once at 6.6e4 f/s in the
 !!   window of the snap sent auto back to erk, whose cost of 4.5e4 measured before the
-!!   snap then kept Adams out for the remaining 9 s: 1.36 s CPU against Adams' 0.82),
+!!   snap then kept Adams out for the remaining 9 s: 1.36 s CPU against Adams' 0.82);
+!!   leaving, it keeps as Adams' cost that of its last window that was not dearer, so
+!!   that a stretch longer than two windows (a contact) does not keep Adams out once it
+!!   is over (whip_ground_mpp: 3.2 s CPU on erk from 1.25 s against 2.6 s),
 !!   or at once when Adams fails (e.g. the fixed-point iteration does not
 !!   converge: the problem has become stiff). Adams' cost: its evaluations of f plus
 !!   ADAMS_STEP_COST per step (CVODE's vector work per step: measured about 2 f on the
@@ -136,6 +139,8 @@ module ropedyn_auto
         real(wp) :: rate_explicit = -1.0_wp  !< measured cost per simulated second (< 0: none)
         real(wp) :: rate_implicit = -1.0_wp
         real(wp) :: rate_adams = -1.0_wp
+        !> Adams' cost in its last window that was not dearer than erk's by GAIN (< 0: none)
+        real(wp) :: calm_adams = -1.0_wp
         logical :: trial = .false.         !< the implicit method is on trial
         integer :: dearer = 0              !< windows in a row Adams cost more than erk by GAIN
         integer :: wait = 0                !< windows to let pass before the next switch
@@ -320,6 +325,7 @@ contains
             end if
             call self%log%add(self%t, 'erk', ERK_ORDER, reason)
         else if (which == ADAMS) then
+            self%calm_adams = -1.0_wp
             opts%max_order = ADAMS_ORDER
             call self%am%init(self%problem, self%t, self%y, self%yq, opts, err)
             if (allocated(err)) return
@@ -460,6 +466,8 @@ contains
                     return
                 end if
             end if
+            if (.not. (self%rate_explicit > 0.0_wp .and. GAIN*self%rate_explicit < rate)) &
+                self%calm_adams = rate
             if (self%wait > 0) return
             ! two windows in a row: one window of a transient (a snap) must not send auto
             ! back to erk, whose cost, measured before, then keeps Adams out for the rest
@@ -476,6 +484,12 @@ contains
                 ! windows 2 and 3 are the earliest two that can send it back (the rate is
                 ! kept from window 2 on): leaving then undoes the switch at once
                 if (self%windows <= 3) call back_off()
+                ! Adams' cost in the stretch that sent it back (a contact) must not keep
+                ! it out once that stretch is over (whip_ground_mpp: 1.16e6 f per second
+                ! in a contact at 1.25 s against erk's 3.3e5 kept erk for the last 8.7 s,
+                ! 3.2 s CPU against Adams' 2.4): erk is weighed against Adams' cost in its
+                ! last window that was not dearer
+                if (self%calm_adams > 0.0_wp) self%rate_adams = self%calm_adams
                 call self%start_method(EXPLICIT, trim(text), err)
             end if
         else

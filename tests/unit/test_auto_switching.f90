@@ -7,6 +7,8 @@
 !! did before it asked for two windows in a row) sends it back to erk, whose cost measured
 !! before the burst then keeps Adams out for the rest of the run: 2.1e4 evaluations of f
 !! over 20 s against 7.5e3 (measured with a one-window rule, burst lengths 0.05-0.08 s).
+!! A second run has a burst of 1 s, which does send auto to erk: after it, auto must go
+!! back to Adams (see the program).
 module test_auto_switching_burst
     use ropedyn_kinds, only: wp
     use ropedyn_problem, only: problem_t, STATUS_OK
@@ -18,6 +20,7 @@ module test_auto_switching_burst
     real(wp), parameter :: BURST = 0.06_wp    !< s, its length
 
     type, extends(problem_t) :: burst_t
+        real(wp) :: length = BURST              !< s, the burst's length
     contains
         procedure :: size => burst_size
         procedure :: bandwidths => burst_bandwidths
@@ -54,7 +57,7 @@ contains
         integer, intent(out) :: status
         real(wp) :: w
         w = 20.0_wp
-        if (t >= T_BURST .and. t < T_BURST + BURST) w = 2000.0_wp
+        if (t >= T_BURST .and. t < T_BURST + self%length) w = 2000.0_wp
         ydot(1) = y(2)
         ydot(2) = -400.0_wp*y(1) - 0.1_wp*y(2) + w**2*cos(w*t)
         status = STATUS_OK
@@ -73,43 +76,82 @@ program test_auto_switching
 
     real(wp), parameter :: T_END = 20.0_wp
     type(test_suite_t) :: suite
-    type(burst_t), target :: problem
-    class(integrator_t), allocatable :: integ
-    type(solver_options_t) :: opts
-    type(error_t), allocatable :: err
+    type(burst_t), target :: short_burst, long_burst
     type(switch_event_t), allocatable :: events(:)
     type(solver_stats_t) :: stats
-    real(wp) :: y(2), yq(0), t
-    integer :: k, n
-    character(len=200) :: line
+    logical :: ok
+    integer :: n
 
     suite%name = 'auto_switching'
-    opts%rtol = 1.0e-6_wp
-    opts%atol = 1.0e-9_wp
-    call new_integrator('auto', integ, err)
-    if (.not. allocated(err)) call integ%init(problem, 0.0_wp, [1.0_wp, 0.0_wp], yq, opts, err)
-    ! output every 0.01 s, as a run does (auto looks at its window between outputs)
-    do k = 1, nint(100*T_END)
-        if (allocated(err)) exit
-        call integ%advance_to(0.01_wp*k, t, y, yq, err)
-    end do
-    call suite%check_true(.not. allocated(err), 'auto integrates through the burst')
-    if (allocated(err)) call suite%finish()
-    events = integ%switch_log()
-    stats = integ%stats()
+
+    call integrate(short_burst, events, stats, ok)
+    call suite%check_true(ok, 'auto integrates through the burst')
     n = size(events)
-    do k = 1, n
-        write (line, '(a, f8.4, a)') '  switch at t = ', events(k)%t, ' s: '// &
-            trim(events(k)%method)//': '//events(k)%reason(1:min(120, len(events(k)%reason)))
-        print '(a)', trim(line)
-    end do
-    print '(a, i0, a, i0)', '  steps ', stats%steps, ', f evaluations ', stats%rhs_evals
     call suite%check_true(n >= 2, 'auto tries adams')
-    if (n < 2) call suite%finish()
+    if (.not. ok .or. n < 2) call suite%finish()
     call suite%check_true(trim(events(1)%method) == 'erk' .and. &
                           trim(events(n)%method) == 'adams' .and. events(n)%t < T_BURST, &
                           'erk, then adams before the burst, kept to the end')
     call suite%check_le(real(stats%rhs_evals, wp), 1.2e4_wp, &
                         'f evaluations over 20 s (2.1e4 when the burst sends it to erk)')
+
+    ! A burst of 1 s: Adams is dearer than erk for more than two windows and auto goes to
+    ! erk (and tries mebdf in the burst, where erk's step is held by stability); once the
+    ! burst is over, erk is weighed against Adams' cost before the burst (its last window
+    ! that was not dearer), not its cost in the burst (2e4 f per second), and auto goes
+    ! back to Adams for the rest of the run (at 8.5 s, after the wait of its back-off).
+    ! With the burst's cost held against Adams, erk ran from 6.15 s to the end: 8.2e4
+    ! evaluations of f against 7.1e4.
+    long_burst%length = 1.0_wp
+    call integrate(long_burst, events, stats, ok)
+    call suite%check_true(ok, 'auto integrates through the long burst')
+    n = size(events)
+    if (.not. ok .or. n < 2) call suite%finish()
+    call suite%check_true(any(events(1:n - 1)%t > T_BURST .and. &
+                              events(1:n - 1)%method == 'erk'), 'erk in the long burst')
+    call suite%check_true(trim(events(n)%method) == 'adams' .and. &
+                          events(n)%t > T_BURST + long_burst%length .and. &
+                          events(n)%t < T_END - 5.0_wp, &
+                          'back to adams after the long burst, kept to the end')
+    call suite%check_le(real(stats%rhs_evals, wp), 7.6e4_wp, &
+                        'f evaluations over 20 s with the long burst (8.2e4 on erk)')
     call suite%finish()
+
+contains
+
+    !> auto over [0, T_END], an output every 0.01 s as a run has (auto looks at its window
+    !! between outputs); prints the switches.
+    subroutine integrate(problem, events, stats, ok)
+        type(burst_t), target, intent(inout) :: problem
+        type(switch_event_t), allocatable, intent(out) :: events(:)
+        type(solver_stats_t), intent(out) :: stats
+        logical, intent(out) :: ok
+        class(integrator_t), allocatable :: integ
+        type(solver_options_t) :: opts
+        type(error_t), allocatable :: err
+        real(wp) :: y(2), yq(0), t
+        integer :: k
+        character(len=200) :: line
+        opts%rtol = 1.0e-6_wp
+        opts%atol = 1.0e-9_wp
+        call new_integrator('auto', integ, err)
+        if (.not. allocated(err)) call integ%init(problem, 0.0_wp, [1.0_wp, 0.0_wp], yq, &
+                                                  opts, err)
+        do k = 1, nint(100*T_END)
+            if (allocated(err)) exit
+            call integ%advance_to(0.01_wp*k, t, y, yq, err)
+        end do
+        ok = .not. allocated(err)
+        allocate (events(0))
+        if (.not. ok) return
+        events = integ%switch_log()
+        stats = integ%stats()
+        print '(a, f5.2, a)', '  burst of ', problem%length, ' s:'
+        do k = 1, size(events)
+            write (line, '(a, f8.4, a)') '  switch at t = ', events(k)%t, ' s: '// &
+                trim(events(k)%method)//': '//events(k)%reason(1:min(120, len(events(k)%reason)))
+            print '(a)', trim(line)
+        end do
+        print '(a, i0, a, i0)', '  steps ', stats%steps, ', f evaluations ', stats%rhs_evals
+    end subroutine integrate
 end program test_auto_switching
