@@ -43,7 +43,8 @@ contains
     !> Read the scene (defaults plus `sets`), build its model and initial state, integrate
     !! it to `t_end` with `method` ('cvode' by default) at `rtol` (atol = rtol/100 unless
     !! given), recording every `dt`. `scene_file` names the scratch scene file (default
-    !! 'test_run.nml' in the working directory; a relative motion table is found beside it).
+    !! 'test_run_<program>.nml' in the working directory, one per test program, since CTest
+    !! runs them side by side in one directory; a relative motion table is found beside it).
     !! `y0`, when given, replaces the initial state.
     subroutine simulate(sets, t_end, dt, rtol, run, method, atol, scene_file, y0)
         character(len=*), intent(in) :: sets(:)
@@ -59,8 +60,10 @@ contains
         real(wp) :: t
         integer :: k, nout, unit
         character(len=:), allocatable :: path, name
+        character(len=256) :: program
 
-        path = 'test_run.nml'
+        call get_command_argument(0, program)
+        path = 'test_run_'//trim(program(index(program, '/', back=.true.) + 1:))//'.nml'
         if (present(scene_file)) path = scene_file
         name = 'cvode'
         if (present(method)) name = method
