@@ -415,6 +415,7 @@ contains
         type(solver_stats_t) :: now
         type(spectrum_t) :: spec
         real(wp) :: rate, span, h_e, predicted, share
+        logical :: dearer   !< Adams' window cost more than erk's last by GAIN
         character(len=240) :: text
 
         now = self%current_stats()
@@ -466,13 +467,13 @@ contains
                     return
                 end if
             end if
-            if (.not. (self%rate_explicit > 0.0_wp .and. GAIN*self%rate_explicit < rate)) &
-                self%calm_adams = rate
+            dearer = self%rate_explicit > 0.0_wp .and. GAIN*self%rate_explicit < rate
+            if (.not. dearer) self%calm_adams = rate
             if (self%wait > 0) return
             ! two windows in a row: one window of a transient (a snap) must not send auto
             ! back to erk, whose cost, measured before, then keeps Adams out for the rest
             ! of the run
-            if (self%rate_explicit > 0.0_wp .and. GAIN*self%rate_explicit < rate) then
+            if (dearer) then
                 self%dearer = self%dearer + 1
             else
                 self%dearer = 0

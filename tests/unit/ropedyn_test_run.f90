@@ -60,10 +60,10 @@ contains
         real(wp) :: t
         integer :: k, nout, unit
         character(len=:), allocatable :: path, name
-        character(len=256) :: program
+        character(len=256) :: exe
 
-        call get_command_argument(0, program)
-        path = 'test_run_'//trim(program(index(program, '/', back=.true.) + 1:))//'.nml'
+        call get_command_argument(0, exe)
+        path = 'test_run_'//trim(exe(index(exe, '/', back=.true.) + 1:))//'.nml'
         if (present(scene_file)) path = scene_file
         name = 'cvode'
         if (present(method)) name = method
