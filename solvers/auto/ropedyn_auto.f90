@@ -40,8 +40,14 @@
 !!   149 f. At lambda = 1 and no mass matrix the counts are those of the RFEM above.
 !! - **Switching** (looked at every WINDOW steps of the method in use): explicit ->
 !!   implicit when most steps of the window were held by stability (erk's own estimate of
-!!   h rho) and either the implicit method's last measured cost per simulated second was
-!!   lower by GAIN, or it has not been measured yet (a trial). Implicit -> explicit when
+!!   h rho near the limit, or h within 0.7 .. 2 times the stable step from the last
+!!   spectrum estimate: the stages' estimate misses fast modes the solution does not
+!!   excite, 1e2 .. 3e3 1/s against the Jacobian's 5.1e3 on a rope falling flat,
+!!   drag_fall) and either the implicit method's last measured cost per simulated second
+!!   was lower by GAIN, or it has not been measured yet (a trial). Before that cost is
+!!   known, erk's first window ends after EARLY_WINDOW = 100 steps when 90 % of them were
+!!   held by stability (drag_fall: mebdf from 0.1 s instead of 0.77 s, 2.9 ms CPU against
+!!   7 ms; mebdf alone 2.3 ms). Implicit -> explicit when
 !!   the explicit cost predicted from the spectrum at the current state (evaluations per
 !!   step / h_e) is lower than the implicit method's measured cost by GAIN; a trial of the
 !!   implicit method that does not pay (judged on its second window) goes back at once.
@@ -88,6 +94,10 @@ module ropedyn_auto
     integer, parameter :: EXPLICIT = 1, IMPLICIT = 2, ADAMS = 3
     integer, parameter :: ERK_ORDER = 4            !< the explicit pair (RK4, 3rd-order estimate)
     integer, parameter :: WINDOW = 400             !< steps between looks
+    !> an earlier first look at erk, before the implicit method's cost is known: after
+    !! EARLY_WINDOW steps, when at least EARLY_SHARE of them were held by stability
+    integer, parameter :: EARLY_WINDOW = 100
+    real(wp), parameter :: EARLY_SHARE = 0.9_wp
     real(wp), parameter :: GAIN = 1.3_wp           !< hysteresis of a switch
     !> explicit steps per simulated second above which a run starts implicit
     real(wp), parameter :: START_RATE = 0.25_wp*STIFF_STEP_RATE
@@ -150,6 +160,9 @@ module ropedyn_auto
         !! evaluation of f in evaluations of the explicit f (see Cost)
         real(wp) :: lambda = 1.0_wp
         real(wp) :: mebdf_eval_cost = 1.0_wp
+        !> erk's stable step when it was last started from a spectrum estimate (s; 0: none)
+        real(wp) :: h_stable = 0.0_wp
+        real(wp) :: radius = 0.0_wp        !< the last estimate's spectral radius, 1/s
     contains
         procedure :: start => auto_start
         procedure :: advance_to => auto_advance_to
@@ -200,6 +213,8 @@ contains
         self%trial = .false.
         self%wait = 0
         self%backoff = 1
+        self%h_stable = 0.0_wp
+        self%radius = 0.0_wp
 
         call newton_widths(self%problem, self%lambda, self%mebdf_eval_cost)
         call estimate_spectrum(self%problem, start%t0, start%y0, spec)
@@ -208,6 +223,7 @@ contains
         if (self%use_bdf) self%mebdf_order = BDF_ORDER
         if (self%user_order /= 0) self%mebdf_order = min(self%mebdf_order, self%user_order)
         h_e = erk_stable_step(self%tab, spec)
+        self%radius = spec%radius
         if (spec%valid .and. h_e > 0.0_wp) then
             rate = 1.0_wp/h_e
             write (text, '(a, es9.2, a, f6.3, a, es9.2, a)') 'spectral radius ', &
@@ -321,8 +337,12 @@ contains
             if (allocated(err)) return
             call self%erk%set_stiff_failure(0.0_wp)
             if (present(h_first)) then
-                if (h_first > 0.0_wp) call self%erk%set_initial_step(0.5_wp*h_first)
+                if (h_first > 0.0_wp) then
+                    call self%erk%set_initial_step(0.5_wp*h_first)
+                    self%h_stable = h_first
+                end if
             end if
+            call self%erk%set_stable_step(self%h_stable)
             call self%log%add(self%t, 'erk', ERK_ORDER, reason)
         else if (which == ADAMS) then
             self%calm_adams = -1.0_wp
@@ -419,7 +439,7 @@ contains
         character(len=240) :: text
 
         now = self%current_stats()
-        if (now%steps - self%win_steps0 < WINDOW) return
+        if (now%steps - self%win_steps0 < WINDOW .and. .not. early_look()) return
         span = self%t - self%win_t0
         if (span <= 0.0_wp) return
         rate = (self%cost(now) - self%win_cost0)/span
@@ -450,7 +470,8 @@ contains
             if (self%rate_implicit > 0.0_wp .and. GAIN*self%rate_implicit >= rate) return
             write (text, '(a, i0, a, es9.2, a, es9.2, a)') 'explicit step held by stability (', &
                 nint(100*share), ' % of the steps; spectral radius about ', &
-                self%erk%spectral_radius(), ' 1/s; cost ', rate, ' f per second)'
+                max(self%erk%spectral_radius(), self%radius), ' 1/s; cost ', rate, &
+                ' f per second)'
             self%trial = self%rate_implicit <= 0.0_wp
             if (self%trial) text = trim(text)//': trying '//self%implicit_name()
             if (self%windows <= 2) call back_off()
@@ -509,6 +530,7 @@ contains
             call estimate_spectrum(self%problem, self%t, self%y, spec)
             h_e = erk_stable_step(self%tab, spec)
             if (h_e <= 0.0_wp) return
+            self%radius = spec%radius
             predicted = EXPLICIT_MARGIN*self%tab%evals_per_step()/h_e
             if (GAIN*predicted < rate) then
                 write (text, '(a, es9.2, a, es9.2, a, es9.2, a)') 'explicit stable step ', h_e, &
@@ -533,6 +555,16 @@ contains
             call back_off()
             call self%start_method(EXPLICIT, trim(text), err)
         end subroutine trial_failed
+
+        !> erk's first window since the start, nearly every step held by stability and
+        !! the implicit method not yet tried: no need to wait for WINDOW steps (drag_fall:
+        !! 400 steps take 0.38 of its 2 s, where mebdf needs 156 steps in all)
+        logical function early_look()
+            early_look = self%active == EXPLICIT .and. self%windows == 0 .and. &
+                         self%rate_implicit < 0.0_wp .and. &
+                         now%steps - self%win_steps0 >= EARLY_WINDOW
+            if (early_look) early_look = self%erk%stiff_share_of_steps() >= EARLY_SHARE
+        end function early_look
     end subroutine watch
 
     !> Name of the implicit method of this run.

@@ -85,6 +85,24 @@ def test_auto_starts_implicit_on_a_rope_at_rest(run, tmp_path):
     assert steps < 100, steps
 
 
+def test_auto_tries_implicit_early_where_erk_sits_at_its_stable_step(run, tmp_path):
+    """drag_fall: a rope falling flat through water excites none of its fast modes, so
+    erk's estimate of the spectral radius from its last stages (1e2 .. 3e3 1/s) misses
+    them, yet its steps sit at the stable step of the Jacobian's spectrum (5.1e3 1/s,
+    9.0e-4 s) from the start. auto counts those steps as held by stability and tries
+    mebdf after its first 100 steps (it took 400 and 0.77 s before, and 849 steps in
+    all); mebdf is kept (its trial pays) and takes the remaining 1.9 s in about 100 steps."""
+    proc, out = run_scene(run, tmp_path, ROOT / "input" / "drag_fall.nml", "drag_fall")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods, times, _, reasons = switch_log(f)
+        steps = int(f["/solver/steps"][()])
+    assert methods == ["erk", "mebdf"], (methods, reasons)
+    assert times[1] < 0.15, (times, reasons)
+    assert "held by stability" in reasons[1], reasons
+    assert steps < 300, steps
+
+
 def test_erk_on_the_steel_wire_within_the_guarantee_or_diagnosed(run, tmp_path):
     """The stiff wire: erk either completes within the step guarantee of the hard scenes
     (2e5 steps per simulated second) or, held by stability above it, gives up quickly with
