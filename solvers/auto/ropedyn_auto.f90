@@ -38,41 +38,8 @@
 !!   14.6 us): a residual with M(q) v costs 4.4 / 10.3 / 16.6 f, the solves and vector work
 !!   of a step 11 / 27 / 45 f, a factorization 29 / 225 / 664 f, a Jacobian 26 / 92 /
 !!   149 f. At lambda = 1 and no mass matrix the counts are those of the RFEM above.
-!! - **Switching** (looked at every WINDOW steps of the method in use): explicit ->
-!!   implicit when most steps of the window were held by stability (erk's own estimate of
-!!   h rho near the limit, or h within 0.7 .. 2 times the stable step from the last
-!!   spectrum estimate: the stages' estimate misses fast modes the solution does not
-!!   excite, 1e2 .. 3e3 1/s against the Jacobian's 5.1e3 on a rope falling flat,
-!!   drag_fall) and either the implicit method's last measured cost per simulated second
-!!   was lower by GAIN, or it has not been measured yet (a trial). Before that cost is
-!!   known, erk's first window ends after EARLY_WINDOW = 100 steps when 90 % of them were
-!!   held by stability (drag_fall: mebdf from 0.1 s instead of 0.77 s, 2.9 ms CPU against
-!!   7 ms; mebdf alone 2.3 ms). Implicit -> explicit when
-!!   the explicit cost predicted from the spectrum at the current state (evaluations per
-!!   step / h_e) is lower than the implicit method's measured cost by GAIN; a trial of the
-!!   implicit method that does not pay (judged on its second window) goes back at once.
-!!   A switch that is undone within two windows doubles the wait before the next one.
-!! - **Adams** (CVODE's Adams-Moulton, fixed-point iteration) for the explicit method's
-!!   other weakness: a step held by accuracy, not stability, where f is costly: Adams takes
-!!   about one evaluation of f per step against erk's four, but CVODE's own work per step
-!!   (about 2.7 us at n = 30) costs more than that saves where f is cheap. Counted costs
-!!   cannot tell (an RFEM f costs 1.0 us at n = 30, an MPP f 2.6 us), so Adams is tried
-!!   only for problems with a mass matrix (the MPP: f solves with it); on the RFEM scenes
-!!   where it was tried it kept Adams at up to twice erk's CPU (table_motion).
-!!   When most steps of an explicit window were not held by stability, auto tries Adams
-!!   (once; a trial, judged on its second window against the explicit cost, goes back
-!!   at once unless it is cheaper by GAIN) and later switches to it when its measured
-!!   cost is lower by GAIN; from Adams it goes back to erk when erk's last measured cost is lower
-!!   by GAIN in two windows in a row (snap_load_mpp: Adams measured once at 6.6e4 f/s in the
-!!   window of the snap sent auto back to erk, whose cost of 4.5e4 measured before the
-!!   snap then kept Adams out for the remaining 9 s: 1.36 s CPU against Adams' 0.82);
-!!   leaving, it keeps as Adams' cost that of its last window that was not dearer, so
-!!   that a stretch longer than two windows (a contact) does not keep Adams out once it
-!!   is over (whip_ground_mpp: 3.2 s CPU on erk from 1.25 s against 2.6 s),
-!!   or at once when Adams fails (e.g. the fixed-point iteration does not
-!!   converge: the problem has become stiff). Adams' cost: its evaluations of f plus
-!!   ADAMS_STEP_COST per step (CVODE's vector work per step: measured about 2 f on the
-!!   paper's rope at n = 30, where f is cheap, and about 1.2 f on the MPP at n = 30).
+!! - **Switching** and **Adams**: the rules of `watch`, with their measurements, are in
+!!   the submodule ropedyn_auto_switching.
 !! Every switch (time, method, order limit, reason) goes into the switch log.
 module ropedyn_auto
     use ropedyn_kinds, only: wp, i8
@@ -176,6 +143,14 @@ module ropedyn_auto
         procedure, private :: cost
         procedure, private :: implicit_name
     end type auto_t
+
+    interface
+        !> At the end of a window: measure, compare, switch (submodule ropedyn_auto_switching).
+        module subroutine watch(self, err)
+            class(auto_t), intent(inout) :: self
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine watch
+    end interface
 
 contains
 
@@ -428,144 +403,6 @@ contains
         t = self%t
     end subroutine auto_advance_to
 
-    !> At the end of a window: measure, compare, switch.
-    subroutine watch(self, err)
-        class(auto_t), intent(inout) :: self
-        type(error_t), allocatable, intent(out) :: err
-        type(solver_stats_t) :: now
-        type(spectrum_t) :: spec
-        real(wp) :: rate, span, h_e, predicted, share
-        logical :: dearer   !< Adams' window cost more than erk's last by GAIN
-        character(len=240) :: text
-
-        now = self%current_stats()
-        if (now%steps - self%win_steps0 < WINDOW .and. .not. early_look()) return
-        span = self%t - self%win_t0
-        if (span <= 0.0_wp) return
-        rate = (self%cost(now) - self%win_cost0)/span
-        self%windows = self%windows + 1
-        self%win_t0 = self%t
-        self%win_steps0 = now%steps
-        self%win_cost0 = self%cost(now)
-        if (self%wait > 0) self%wait = self%wait - 1
-
-        if (self%active == EXPLICIT) then
-            self%rate_explicit = rate
-            share = self%erk%stiff_share_of_steps()
-            if (self%wait > 0) return
-            if (share < 0.5_wp) then
-                ! held by accuracy: Adams may need fewer evaluations of f (judged on the
-                ! explicit method's second window on: the first includes its start), which
-                ! pays only where f is costly: a problem with a mass matrix (f solves with it)
-                if (self%windows < 2 .or. .not. self%problem%has_mass_matrix()) return
-                if (self%rate_adams > 0.0_wp .and. GAIN*self%rate_adams >= rate) return
-                write (text, '(a, i0, a, es9.2, a)') 'explicit step held by accuracy (', &
-                    nint(100*(1 - share)), ' % of the steps; cost ', rate, ' f per second)'
-                self%trial = self%rate_adams <= 0.0_wp
-                if (self%trial) text = trim(text)//': trying adams'
-                if (self%windows <= 2) call back_off()
-                call self%start_method(ADAMS, trim(text), err)
-                return
-            end if
-            if (self%rate_implicit > 0.0_wp .and. GAIN*self%rate_implicit >= rate) return
-            write (text, '(a, i0, a, es9.2, a, es9.2, a)') 'explicit step held by stability (', &
-                nint(100*share), ' % of the steps; spectral radius about ', &
-                max(self%erk%spectral_radius(), self%radius), ' 1/s; cost ', rate, &
-                ' f per second)'
-            self%trial = self%rate_implicit <= 0.0_wp
-            if (self%trial) text = trim(text)//': trying '//self%implicit_name()
-            if (self%windows <= 2) call back_off()
-            call self%start_method(IMPLICIT, trim(text), err)
-        else if (self%active == ADAMS) then
-            if (self%windows < 2) return
-            self%rate_adams = rate
-            if (self%trial) then
-                ! kept only when cheaper by GAIN: its counted cost misses CVODE's fixed
-                ! work per step, which weighs most where f is cheap (the RFEM at small n)
-                self%trial = .false.
-                if (self%rate_explicit > 0.0_wp .and. GAIN*rate > self%rate_explicit) then
-                    call trial_failed('adams was not cheaper by 1.3')
-                    return
-                end if
-            end if
-            dearer = self%rate_explicit > 0.0_wp .and. GAIN*self%rate_explicit < rate
-            if (.not. dearer) self%calm_adams = rate
-            if (self%wait > 0) return
-            ! two windows in a row: one window of a transient (a snap) must not send auto
-            ! back to erk, whose cost, measured before, then keeps Adams out for the rest
-            ! of the run
-            if (dearer) then
-                self%dearer = self%dearer + 1
-            else
-                self%dearer = 0
-            end if
-            if (self%dearer >= 2) then
-                write (text, '(a, es9.2, a, es9.2, a)') 'erk was cheaper (', &
-                    self%rate_explicit, ' against ', rate, ' f per second for adams, '// &
-                    'two windows in a row)'
-                ! windows 2 and 3 are the earliest two that can send it back (the rate is
-                ! kept from window 2 on): leaving then undoes the switch at once
-                if (self%windows <= 3) call back_off()
-                ! Adams' cost in the stretch that sent it back (a contact) must not keep
-                ! it out once that stretch is over (whip_ground_mpp: 1.16e6 f per second
-                ! in a contact at 1.25 s against erk's 3.3e5 kept erk for the last 8.7 s,
-                ! 3.2 s CPU against Adams' 2.4): erk is weighed against Adams' cost in its
-                ! last window that was not dearer
-                if (self%calm_adams > 0.0_wp) self%rate_adams = self%calm_adams
-                call self%start_method(EXPLICIT, trim(text), err)
-            end if
-        else
-            ! judge the implicit method on its second window on (the first includes its
-            ! start at order 1 with small steps)
-            if (self%windows < 2) return
-            self%rate_implicit = rate
-            if (self%trial) then
-                self%trial = .false.
-                if (self%rate_explicit > 0.0_wp .and. rate > self%rate_explicit) then
-                    call trial_failed(self%implicit_name()//' was not cheaper')
-                    return
-                end if
-            end if
-            if (self%wait > 0) return
-            call estimate_spectrum(self%problem, self%t, self%y, spec)
-            h_e = erk_stable_step(self%tab, spec)
-            if (h_e <= 0.0_wp) return
-            self%radius = spec%radius
-            predicted = EXPLICIT_MARGIN*self%tab%evals_per_step()/h_e
-            if (GAIN*predicted < rate) then
-                write (text, '(a, es9.2, a, es9.2, a, es9.2, a)') 'explicit stable step ', h_e, &
-                    ' s: predicted cost ', predicted, ' f per second against ', rate, &
-                    ' for '//self%implicit_name()
-                if (self%windows <= 2) call back_off()
-                call self%start_method(EXPLICIT, trim(text), err, h_e)
-            end if
-        end if
-    contains
-        !> A switch soon after the last one: wait longer before the next.
-        subroutine back_off()
-            self%wait = self%backoff
-            self%backoff = min(MAX_WAIT, 2*self%backoff)
-        end subroutine back_off
-
-        !> The method on trial cost more than erk: back to erk, and wait longer.
-        subroutine trial_failed(what)
-            character(len=*), intent(in) :: what
-            write (text, '(a, es9.2, a, es9.2, a)') what//' (', rate, ' against ', &
-                self%rate_explicit, ' f per second)'
-            call back_off()
-            call self%start_method(EXPLICIT, trim(text), err)
-        end subroutine trial_failed
-
-        !> erk's first window since the start, nearly every step held by stability and
-        !! the implicit method not yet tried: no need to wait for WINDOW steps (drag_fall:
-        !! 400 steps take 0.38 of its 2 s, where mebdf needs 156 steps in all)
-        logical function early_look()
-            early_look = self%active == EXPLICIT .and. self%windows == 0 .and. &
-                         self%rate_implicit < 0.0_wp .and. &
-                         now%steps - self%win_steps0 >= EARLY_WINDOW
-            if (early_look) early_look = self%erk%stiff_share_of_steps() >= EARLY_SHARE
-        end function early_look
-    end subroutine watch
 
     !> Name of the implicit method of this run.
     pure function implicit_name(self) result(name)

@@ -23,3 +23,15 @@ def test_check_catches_an_upward_use(tmp_path, monkeypatch):
     units["ropedyn_rfem"]["uses"].discard("ropedyn_scene")
     units["ropedyn_mebdf"]["uses"].add("ropedyn_rope_model")   # solvers -> models
     assert any("ropedyn_mebdf" in v for v in arch.violations(units))
+
+
+def test_check_catches_a_file_over_600_lines():
+    """No Fortran source file is longer than 600 lines (issue 13); one that grew past it
+    is reported by file and length."""
+    from ropedyn.studies import architecture as arch
+    units = arch.scan()
+    longest = max(units.values(), key=lambda u: u["lines"])
+    assert longest["lines"] <= arch.MAX_LINES, longest["file"]
+    longest["lines"] = arch.MAX_LINES + 1
+    bad = arch.violations(units)
+    assert any(longest["file"] in v and "601 lines" in v for v in bad), bad

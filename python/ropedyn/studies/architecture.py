@@ -10,7 +10,7 @@ program, the layer of each (by folder), and every `use ropedyn_*` between them. 
 
 It checks the layering rule that CMake enforces by separate module directories: a module
 uses only its own layer and the layers below it, and `solvers` and `models` never use
-each other. `--check` only checks (the rule, and that docs/architecture.md is current)
+each other; and that no Fortran file is longer than MAX_LINES = 600 lines. `--check` only checks (the rule, and that docs/architecture.md is current)
 and exits 1 on a violation; the test suite runs it.
 
     scripts/architecture            # regenerate docs/architecture.md and the figure
@@ -39,6 +39,7 @@ LAYERS = [
     ("app", 4, ["src/app"]),
 ]
 RANK = {name: rank for name, rank, _ in LAYERS}
+MAX_LINES = 600   # lines of a Fortran source file, at most
 
 UNIT = re.compile(r"^\s*(module|submodule\s*\(\s*(\w+)\s*(?::\s*\w+)?\s*\)|program)\s+(\w+)",
                   re.I)
@@ -85,6 +86,11 @@ def scan():
 
 def violations(units):
     bad = []
+    files = {u["file"]: u["lines"] for u in units.values()}
+    for path, lines in sorted(files.items()):
+        if lines > MAX_LINES:
+            bad.append(f"{path}: {lines} lines (at most {MAX_LINES}: split it, e.g. into "
+                       "submodules)")
     for name, u in units.items():
         for dep in sorted(u["uses"]):
             if dep not in units:
@@ -176,7 +182,7 @@ def main(argv=None):
     units = scan()
     bad = violations(units)
     for b in bad:
-        print("layer violation:", b, file=sys.stderr)
+        print("architecture:", b, file=sys.stderr)
     gen = generated_markdown(units)
     doc = DOC.read_text() if DOC.exists() else ""
     if BEGIN in doc and END in doc:
@@ -206,7 +212,7 @@ def main(argv=None):
                            input=dot_source(units), text=True, check=True)
         print(f"architecture: wrote {FIGURE.relative_to(ROOT)}")
     print(f"architecture: wrote {DOC.relative_to(ROOT)} ({len(units)} units, "
-          f"{len(bad)} layer violations)")
+          f"{len(bad)} violations)")
     return 1 if bad else 0
 
 
