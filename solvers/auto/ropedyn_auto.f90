@@ -317,7 +317,9 @@ contains
                     self%h_stable = h_first
                 end if
             end if
-            call self%erk%set_stable_step(self%h_stable)
+            ! only without a mass matrix: see the submodule's header (Switching)
+            if (.not. self%problem%has_mass_matrix()) &
+                call self%erk%set_stable_step(self%h_stable)
             call self%log%add(self%t, 'erk', ERK_ORDER, reason)
         else if (which == ADAMS) then
             self%calm_adams = -1.0_wp
