@@ -217,7 +217,7 @@ contains
     !! the first unstable one, found by a scan of every STRIDE-th sample and then of the
     !! samples of the last stride one by one (a tenth of the evaluations of |R|; the same
     !! h as a scan of all, unless an unstable stretch shorter than a stride lies inside
-    !! the region: none for the bundled pairs).
+    !! the region: none for the bundled pairs, tests/unit/test_stable_step).
     real(wp) function erk_stable_step(tab, spec) result(h)
         type(erk_table_t), intent(in) :: tab
         type(spectrum_t), intent(in) :: spec
