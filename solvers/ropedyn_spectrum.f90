@@ -237,7 +237,7 @@ contains
             if (.not. stable(k*step)) exit
             k0 = k
         end do
-        if (k0 > 0) h = k0*step
+        h = k0*step
         do k = k0 + 1, min(k0 + STRIDE - 1, SAMPLES)
             if (.not. stable(k*step)) exit
             h = k*step

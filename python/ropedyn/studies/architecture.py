@@ -10,8 +10,9 @@ program, the layer of each (by folder), and every `use ropedyn_*` between them. 
 
 It checks the layering rule that CMake enforces by separate module directories: a module
 uses only its own layer and the layers below it, and `solvers` and `models` never use
-each other; and that no Fortran file is longer than MAX_LINES = 600 lines. `--check` only checks (the rule, and that docs/architecture.md is current)
-and exits 1 on a violation; the test suite runs it.
+each other; and that no Fortran file is longer than MAX_LINES = 600 lines. `--check`
+only checks (the rules, and that docs/architecture.md is current) and exits 1 on a
+violation; the test suite runs it.
 
     scripts/architecture            # regenerate docs/architecture.md and the figure
     scripts/architecture --check    # verify only
