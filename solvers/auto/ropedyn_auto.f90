@@ -92,6 +92,9 @@ module ropedyn_auto
     !! steps below the limit)
     real(wp), parameter :: EXPLICIT_MARGIN = 1.15_wp
     integer, parameter :: MAX_WAIT = 64            !< windows between switches, at most
+    !> explicit windows after which the implicit method's measured cost is stale (doubled by
+    !! each trial that does not pay)
+    integer, parameter :: STALE_WINDOWS = 8
 
     type, extends(integrator_t) :: auto_t
         private
@@ -115,6 +118,9 @@ module ropedyn_auto
         integer :: windows = 0             !< windows since the last switch
         real(wp) :: rate_explicit = -1.0_wp  !< measured cost per simulated second (< 0: none)
         real(wp) :: rate_implicit = -1.0_wp
+        !> explicit windows since rate_implicit was measured, and how many make it stale
+        integer :: implicit_age = 0
+        integer :: stale_after = STALE_WINDOWS
         real(wp) :: rate_adams = -1.0_wp
         !> Adams' cost in its last window that was not dearer than erk's by GAIN (< 0: none)
         real(wp) :: calm_adams = -1.0_wp
@@ -184,6 +190,8 @@ contains
         call self%log%clear()
         self%rate_explicit = -1.0_wp
         self%rate_implicit = -1.0_wp
+        self%implicit_age = 0
+        self%stale_after = STALE_WINDOWS
         self%rate_adams = -1.0_wp
         self%trial = .false.
         self%wait = 0

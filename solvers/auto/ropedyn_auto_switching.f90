@@ -19,6 +19,14 @@
 !!   the explicit cost predicted from the spectrum at the current state (evaluations per
 !!   step / h_e) is lower than the implicit method's measured cost by GAIN; a trial of the
 !!   implicit method that does not pay (judged on its second window) goes back at once.
+!!   The implicit method's measured cost is evidence for STALE_WINDOWS = 8 explicit windows
+!!   (doubled by each trial that does not pay); after that erk's steps held by stability
+!!   bring a new trial even where the old cost was higher. steel_wire (5 ms outputs):
+!!   mebdf's second window, at 5.4 ms, is in the ringing after the release (steps of 1e-6
+!!   s, 9.2e6 f per second) and auto rightly went to erk (0.7e6); mebdf's steps later grow
+!!   to 4e-5 s (2.3e5 f per second on its own run), but the old cost kept it out to the
+!!   end: 0.58 s CPU against mebdf's 0.41. With trials at 0.07, 0.12, 0.23 (not cheaper
+!!   yet) and 0.61 s (kept): 0.45 s.
 !!   A switch that is undone within two windows doubles the wait before the next one.
 !! - **Adams** (CVODE's Adams-Moulton, fixed-point iteration) for the explicit method's
 !!   other weakness: a step held by accuracy, not stability, where f is costly: Adams takes
@@ -52,7 +60,9 @@ contains
         type(spectrum_t) :: spec
         real(wp) :: rate, span, h_e, predicted, share
         logical :: dearer   !< Adams' window cost more than erk's last by GAIN
+        logical :: stale    !< the implicit method's measured cost is old (explicit windows)
         character(len=240) :: text
+        character(len=12) :: age
 
         now = self%current_stats()
         if (now%steps - self%win_steps0 < WINDOW .and. .not. early_look()) return
@@ -67,6 +77,7 @@ contains
 
         if (self%active == EXPLICIT) then
             self%rate_explicit = rate
+            if (self%rate_implicit > 0.0_wp) self%implicit_age = self%implicit_age + 1
             share = self%erk%stiff_share_of_steps()
             if (self%wait > 0) return
             if (share < 0.5_wp) then
@@ -83,13 +94,21 @@ contains
                 call self%start_method(ADAMS, trim(text), err)
                 return
             end if
-            if (self%rate_implicit > 0.0_wp .and. GAIN*self%rate_implicit >= rate) return
+            stale = self%rate_implicit > 0.0_wp .and. self%implicit_age >= self%stale_after
+            if (self%rate_implicit > 0.0_wp .and. GAIN*self%rate_implicit >= rate .and. &
+                .not. stale) return
             write (text, '(a, i0, a, es9.2, a, es9.2, a)') 'explicit step held by stability (', &
                 nint(100*share), ' % of the steps; spectral radius about ', &
                 max(self%erk%spectral_radius(), self%radius), ' 1/s; cost ', rate, &
                 ' f per second)'
-            self%trial = self%rate_implicit <= 0.0_wp
-            if (self%trial) text = trim(text)//': trying '//self%implicit_name()
+            self%trial = self%rate_implicit <= 0.0_wp .or. stale
+            if (stale) then
+                write (age, '(i0)') self%implicit_age
+                text = trim(text)//': trying '//self%implicit_name()// &
+                       ' again (its cost was measured '//trim(age)//' windows ago)'
+            else if (self%trial) then
+                text = trim(text)//': trying '//self%implicit_name()
+            end if
             if (self%windows <= 2) call back_off()
             call self%start_method(IMPLICIT, trim(text), err)
         else if (self%active == ADAMS) then
@@ -135,9 +154,11 @@ contains
             ! start at order 1 with small steps)
             if (self%windows < 2) return
             self%rate_implicit = rate
+            self%implicit_age = 0
             if (self%trial) then
                 self%trial = .false.
                 if (self%rate_explicit > 0.0_wp .and. rate > self%rate_explicit) then
+                    if (self%stale_after < huge(0)/2) self%stale_after = 2*self%stale_after
                     call trial_failed(self%implicit_name()//' was not cheaper')
                     return
                 end if

@@ -118,6 +118,25 @@ def test_auto_does_not_try_mebdf_early_on_the_mpp(run, tmp_path):
     assert "mebdf" not in methods, (methods, times, reasons)
 
 
+def test_auto_tries_the_implicit_method_again_when_its_cost_is_stale(run, tmp_path):
+    """The steel wire (its own output interval, 5 ms): mebdf's second window, at 5.4 ms,
+    is in the ringing after the release (steps of 1e-6 s, 9.2e6 f per second), and auto
+    rightly goes to erk (0.7e6). mebdf's steps later grow to 4e-5 s (2.3e5 f per second on
+    its own run), but that old measurement kept it out for the whole run: erk to the end,
+    0.58 s CPU against mebdf's 0.41. Now a cost measured 8 explicit windows ago (doubled
+    after each trial that does not pay) is tried again where erk's steps are held by
+    stability; the trials are few, and mebdf takes over."""
+    proc, out = run_scene(run, tmp_path, STEEL, "stale", "solver.t_end=0.7")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods, times, _, reasons = switch_log(f)
+    assert methods[:2] == ["mebdf", "erk"], (methods, reasons)
+    again = [r for r in reasons if "trying mebdf again" in r]
+    assert again, reasons
+    assert len(again) <= 5, reasons      # doubling: a few trials, not one a window
+    assert methods[-1] == "mebdf", (methods, times, reasons)
+
+
 def test_erk_on_the_steel_wire_within_the_guarantee_or_diagnosed(run, tmp_path):
     """The stiff wire: erk either completes within the step guarantee of the hard scenes
     (2e5 steps per simulated second) or, held by stability above it, gives up quickly with
