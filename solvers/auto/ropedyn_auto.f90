@@ -94,7 +94,7 @@ module ropedyn_auto
     integer, parameter :: MAX_WAIT = 64            !< windows between switches, at most
     !> explicit windows after which the implicit method's measured cost is stale (doubled by
     !! each trial that does not pay)
-    integer, parameter :: STALE_WINDOWS = 8
+    integer, parameter :: STALE_WINDOWS = 32
 
     type, extends(integrator_t) :: auto_t
         private

@@ -19,14 +19,15 @@
 !!   the explicit cost predicted from the spectrum at the current state (evaluations per
 !!   step / h_e) is lower than the implicit method's measured cost by GAIN; a trial of the
 !!   implicit method that does not pay (judged on its second window) goes back at once.
-!!   The implicit method's measured cost is evidence for STALE_WINDOWS = 8 explicit windows
-!!   (doubled by each trial that does not pay); after that erk's steps held by stability
-!!   bring a new trial even where the old cost was higher. steel_wire (5 ms outputs):
-!!   mebdf's second window, at 5.4 ms, is in the ringing after the release (steps of 1e-6
-!!   s, 9.2e6 f per second) and auto rightly went to erk (0.7e6); mebdf's steps later grow
-!!   to 4e-5 s (2.3e5 f per second on its own run), but the old cost kept it out to the
-!!   end: 0.58 s CPU against mebdf's 0.41. With trials at 0.07, 0.12, 0.23 (not cheaper
-!!   yet) and 0.61 s (kept): 0.45 s.
+!!   The implicit method's measured cost is evidence for STALE_WINDOWS = 32 explicit
+!!   windows (doubled by each trial that does not pay); after that erk's steps held by
+!!   stability bring a new trial even where the old cost was higher. steel_wire (5 ms
+!!   outputs): mebdf's second window, at 5.4 ms, is in the ringing after the release (steps
+!!   of 1e-6 s, 9.2e6 f per second) and auto rightly went to erk (0.7e6); mebdf's steps
+!!   later grow to 4e-5 s (2.3e5 f per second on its own run), but the old cost kept it out
+!!   to the end: 0.54 s CPU against mebdf's 0.36 .. 0.41. Now a trial at 0.10 s (not
+!!   cheaper yet) and one at 0.30 s (kept): 0.35 s. With 8 windows there were four trials
+!!   (0.46 s), and on the paper's rope at rtol 2.9e-4 three failed ones in 30 s, not one.
 !!   A switch that is undone within two windows doubles the wait before the next one.
 !! - **Adams** (CVODE's Adams-Moulton, fixed-point iteration) for the explicit method's
 !!   other weakness: a step held by accuracy, not stability, where f is costly: Adams takes

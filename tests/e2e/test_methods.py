@@ -123,9 +123,9 @@ def test_auto_tries_the_implicit_method_again_when_its_cost_is_stale(run, tmp_pa
     is in the ringing after the release (steps of 1e-6 s, 9.2e6 f per second), and auto
     rightly goes to erk (0.7e6). mebdf's steps later grow to 4e-5 s (2.3e5 f per second on
     its own run), but that old measurement kept it out for the whole run: erk to the end,
-    0.58 s CPU against mebdf's 0.41. Now a cost measured 8 explicit windows ago (doubled
-    after each trial that does not pay) is tried again where erk's steps are held by
-    stability; the trials are few, and mebdf takes over."""
+    0.54 s CPU against mebdf's 0.36 .. 0.41. Now a cost measured 32 explicit windows ago
+    (doubled after each trial that does not pay) is tried again where erk's steps are
+    held by stability; the trials are few, and mebdf takes over (from 0.30 s)."""
     proc, out = run_scene(run, tmp_path, STEEL, "stale", "solver.t_end=0.7")
     assert proc.returncode == 0, proc.stderr
     with h5py.File(out, "r") as f:
