@@ -29,6 +29,7 @@ COMMANDS = {
     "bench_peers": "ropedyn.studies.bench_peers",
     "auto_table": "ropedyn.studies.auto_table",
     "auto_accuracy": "ropedyn.studies.auto_accuracy",
+    "cost_model": "ropedyn.studies.cost_model",
     "profile_step": "ropedyn.studies.profile_step",
     "validation": "ropedyn.studies.validation",
     "work_precision": "ropedyn.studies.work_precision",
