@@ -25,9 +25,13 @@
 !!   `max_order` given by the user caps either.
 !! - **Cost**: counted, not timed (runs stay reproducible): explicit, the evaluations of f;
 !!   implicit, those plus IMPLICIT_STEP_COST (MEBDF) or BDF_STEP_COST (CVODE) per step
-!!   for the Newton matrices, solves and vector work and JACOBIAN_COST per Jacobian
-!!   (calibrated on the paper's rope, n = 30: an MEBDF step costs its 4.1 evaluations of f
-!!   plus about 6 more in the rest, a CVODE step its 1.2 plus about 5). These hold for a
+!!   for the Newton matrices, solves and vector work, FACTOR_BASE per factorization (both)
+!!   and JACOBIAN_COST per Jacobian (calibrated on the paper's rope, n = 30: an MEBDF step
+!!   costs its 4.1 evaluations of f plus about 6 more in the rest, a CVODE step its 1.2
+!!   plus about 5; scripts/cost_model over n = 10 .. 100 and rtol 1e-2 .. 1e-8 split
+!!   MEBDF's 6 into 5.3 per step and 5 per factorization: at rtol 1e-2 it makes 0.29 .. 0.34
+!!   factorizations per step against 0.14 at 1e-6, and was counted 17 .. 25 % too cheap
+!!   there, at n = 30 .. 100). These hold for a
 !!   Newton matrix of the RFEM's row width (11, block tridiagonal); a wider one (the MPP's
 !!   is dense: width = its np rows) costs more against f, which stays O(n): with
 !!   lambda = width / 11 (at least 1), a step costs SOLVE_COST (lambda - 1) more for its
@@ -71,7 +75,7 @@ module ropedyn_auto
     !> ... or when a first-order step within the tolerance at the initial state is longer
     !! than this many explicit stable steps (a rope at rest: catenary)
     real(wp), parameter :: START_ACCURACY = 5.0_wp
-    real(wp), parameter :: IMPLICIT_STEP_COST = 6.0_wp  !< f-equivalents per MEBDF step
+    real(wp), parameter :: IMPLICIT_STEP_COST = 5.3_wp  !< f-equivalents per MEBDF step
     real(wp), parameter :: BDF_STEP_COST = 5.0_wp       !< f-equivalents per CVODE step
     real(wp), parameter :: ADAMS_STEP_COST = 1.0_wp     !< f-equivalents per Adams step
     !> Adams' order limit (CVODE's own; a user's max_order caps only the implicit method)
@@ -87,6 +91,8 @@ module ropedyn_auto
     real(wp), parameter :: REFERENCE_WIDTH = 11.0_wp
     real(wp), parameter :: SOLVE_COST = 1.2_wp, BDF_SOLVE_COST = 0.45_wp
     real(wp), parameter :: FACTOR_COST = 0.6_wp
+    !> f-equivalents per factorization of the RFEM's band (scripts/cost_model)
+    real(wp), parameter :: FACTOR_BASE = 5.0_wp
     real(wp), parameter :: MASS_COST = 0.045_wp
     !> the explicit cost predicted from the stability limit, times this (rejected steps,
     !! steps below the limit)
@@ -437,7 +443,8 @@ contains
                     cost = self%mebdf_eval_cost*cost + (IMPLICIT_STEP_COST + SOLVE_COST* &
                                                         (lambda - 1.0_wp))*real(s%steps, wp)
                 end if
-                cost = cost + FACTOR_COST*(lambda**2 - 1.0_wp)*real(s%lin_setups, wp) &
+                cost = cost + (FACTOR_BASE + FACTOR_COST*(lambda**2 - 1.0_wp))* &
+                       real(s%lin_setups, wp) &
                        + JACOBIAN_COST*lambda*real(s%jac_evals, wp)
             end associate
         end if

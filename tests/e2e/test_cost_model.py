@@ -23,11 +23,12 @@ def test_constants_are_read_from_the_fortran_source(tmp_path):
 
 
 def test_counted_cost_is_autos_formula():
-    c = {"IMPLICIT_STEP_COST": 6.0, "BDF_STEP_COST": 5.0, "JACOBIAN_COST": 4.0}
-    stats = {"rhs_evals": 100, "steps": 10, "jac_evals": 2}
+    c = {"IMPLICIT_STEP_COST": 6.0, "BDF_STEP_COST": 5.0, "FACTOR_BASE": 3.0,
+         "JACOBIAN_COST": 4.0}
+    stats = {"rhs_evals": 100, "steps": 10, "jac_evals": 2, "lin_setups": 7}
     assert cm.counted("erk", stats, c) == 100
-    assert cm.counted("mebdf", stats, c) == 100 + 60 + 8
-    assert cm.counted("cvode", stats, c) == 100 + 50 + 8
+    assert cm.counted("mebdf", stats, c) == 100 + 60 + 21 + 8
+    assert cm.counted("cvode", stats, c) == 100 + 50 + 21 + 8
 
 
 def test_study_runs_and_prints_a_row_per_method(ropedyn_exe, capsys):

@@ -3,9 +3,9 @@ for every method?
 
 auto (solvers/auto/ropedyn_auto.f90, "Cost") compares methods by counted work, not by
 timers, so that runs stay reproducible: erk its evaluations of f; mebdf those plus
-IMPLICIT_STEP_COST per step and JACOBIAN_COST per Jacobian; cvode those plus BDF_STEP_COST
-per step and JACOBIAN_COST per Jacobian (on the RFEM's band; wider Newton matrices add more,
-not measured here). The constants were calibrated on the paper's rope at n = 30, rtol 1e-6.
+IMPLICIT_STEP_COST per step; cvode those plus BDF_STEP_COST per step; both FACTOR_BASE per
+factorization and JACOBIAN_COST per Jacobian (on the RFEM's band; wider Newton matrices add
+more, not measured here). The constants were calibrated on the paper's rope at n = 30, rtol 1e-6.
 This runs the paper's rope (RFEM) with each method over a grid of n and rtol and prints the
 CPU time per counted unit, and its ratio to erk's at the same n and rtol: 1 where the model
 is right, above 1 where it undercounts the method (auto then holds it cheaper than it is).
@@ -33,7 +33,7 @@ def auto_constants(path=AUTO_SOURCE):
     """auto's per-step and per-Jacobian costs (f-equivalents) from its Fortran source."""
     text = pathlib.Path(path).read_text()
     values = {}
-    for name in ("IMPLICIT_STEP_COST", "BDF_STEP_COST", "JACOBIAN_COST"):
+    for name in ("IMPLICIT_STEP_COST", "BDF_STEP_COST", "FACTOR_BASE", "JACOBIAN_COST"):
         m = re.search(rf"parameter\s*::\s*{name}\s*=\s*([0-9.]+)_wp", text)
         if m is None:
             raise ValueError(f"{path}: no parameter {name}")
@@ -47,7 +47,9 @@ def counted(method, stats, constants):
     if method == "erk":
         return f
     step = constants["IMPLICIT_STEP_COST" if method == "mebdf" else "BDF_STEP_COST"]
-    return f + step * float(stats["steps"]) + constants["JACOBIAN_COST"] * float(stats["jac_evals"])
+    return (f + step * float(stats["steps"])
+            + constants["FACTOR_BASE"] * float(stats.get("lin_setups", 0))
+            + constants["JACOBIAN_COST"] * float(stats["jac_evals"]))
 
 
 def run_case(exe, n, rtol, method, t_end, workdir):
@@ -120,7 +122,8 @@ def main(argv=None):
              f"\"{args.elements}\" --rtols \"{args.rtols}\" --repeat {args.repeat}` (code: "
              "python/ropedyn/studies/cost_model.py). input/paper.nml (RFEM) with each method "
              "(atol = rtol / 100); counted as auto counts on the RFEM's band (erk: evaluations "
-             f"of f; mebdf and cvode: those plus a cost per step and per Jacobian; {consts}, "
+             "of f; mebdf and cvode: those plus a cost per step, per factorization and per "
+             f"Jacobian; {consts}, "
              "read from solvers/auto/ropedyn_auto.f90); CPU: /solver/cpu_time, the least of "
              f"{args.repeat} runs. '/ erk's': CPU per counted unit over erk's at the same n and "
              "rtol (above 1: auto counts the method cheaper than it is). Machine: "
