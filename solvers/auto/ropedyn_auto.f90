@@ -98,8 +98,8 @@ module ropedyn_auto
     !! steps below the limit)
     real(wp), parameter :: EXPLICIT_MARGIN = 1.15_wp
     integer, parameter :: MAX_WAIT = 64            !< windows between switches, at most
-    !> explicit windows after which the implicit method's measured cost is stale (doubled by
-    !! each trial that does not pay)
+    !> explicit windows after which the implicit method's measured cost is stale (times the
+    !! cost ratio, at least 2, of each trial that does not pay)
     integer, parameter :: STALE_WINDOWS = 32
 
     type, extends(integrator_t) :: auto_t

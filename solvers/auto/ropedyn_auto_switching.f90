@@ -20,7 +20,10 @@
 !!   step / h_e) is lower than the implicit method's measured cost by GAIN; a trial of the
 !!   implicit method that does not pay (judged on its second window) goes back at once.
 !!   The implicit method's measured cost is evidence for STALE_WINDOWS = 32 explicit
-!!   windows (doubled by each trial that does not pay); after that erk's steps held by
+!!   windows (times the cost ratio of each trial that does not pay, at least 2: on the
+!!   MPP a trial of the dense MEBDF costs 11 times erk's, and doubling alone let its
+!!   retrials take fig4's MPP runs at rtol 1e-2 from 24 to 47 s at n = 200, 58 to 155 s at
+!!   n = 300); after that erk's steps held by
 !!   stability bring a new trial even where the old cost was higher. steel_wire (5 ms
 !!   outputs): mebdf's second window, at 5.4 ms, is in the ringing after the release (steps
 !!   of 1e-6 s, 9.2e6 f per second) and auto rightly went to erk (0.7e6); mebdf's steps
@@ -159,7 +162,11 @@ contains
             if (self%trial) then
                 self%trial = .false.
                 if (self%rate_explicit > 0.0_wp .and. rate > self%rate_explicit) then
-                    if (self%stale_after < huge(0)/2) self%stale_after = 2*self%stale_after
+                    ! the dearer the trial, the longer until the next: times the cost
+                    ! ratio, at least 2 (the MPP's dense MEBDF: 11 times erk's)
+                    self%stale_after = int(min(real(huge(0)/2, wp), self%stale_after* &
+                                               max(2.0_wp, real(ceiling(rate/ &
+                                                   self%rate_explicit), wp))))
                     call trial_failed(self%implicit_name()//' was not cheaper')
                     return
                 end if

@@ -1,6 +1,8 @@
 """The explicit and switching methods end to end (issue 15): erk and adams integrate the
 paper's rope like cvode does; auto records its choice in /solver/switch_* and the summary,
 picks the explicit method for the soft rope and the implicit one for a steel wire."""
+import re
+
 import h5py
 import numpy as np
 import pytest
@@ -135,6 +137,25 @@ def test_auto_tries_the_implicit_method_again_when_its_cost_is_stale(run, tmp_pa
     assert again, reasons
     assert len(again) <= 5, reasons      # doubling: a few trials, not one a window
     assert methods[-1] == "mebdf", (methods, times, reasons)
+
+
+def test_a_much_dearer_trial_keeps_the_implicit_method_out_for_longer(run, tmp_path):
+    """The MPP at n = 30, rtol 1e-2, 30 s: the trial of mebdf at 0.53 s costs 6.3 times
+    erk's (4.0e4 against 6.4e3 f per second: the dense Newton matrix). Doubling the wait
+    after it brought a retrial at 26.6 s that cost as much again (and on fig4's MPP runs
+    at n = 200 .. 300 several, doubling their CPU); the wait now grows by the cost ratio,
+    and no retrial comes in the 30 s."""
+    proc, out = run_scene(run, tmp_path, PAPER, "mpp_dear", "model.kind='mpp'",
+                          "model.elements=30", "solver.rtol=1e-2", "solver.atol=1e-4")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods, times, _, reasons = switch_log(f)
+    failed = [r for r in reasons if "mebdf was not cheaper" in r]
+    assert failed, (methods, reasons)
+    costs = re.findall(r"\( *([0-9.E+-]+) against +([0-9.E+-]+)", failed[0])[0]
+    a, b = (float(x) for x in costs)
+    assert a > 3 * b, failed[0]
+    assert not [r for r in reasons if "trying mebdf again" in r], (methods, times, reasons)
 
 
 def test_erk_on_the_steel_wire_within_the_guarantee_or_diagnosed(run, tmp_path):
