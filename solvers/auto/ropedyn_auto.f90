@@ -29,11 +29,11 @@
 !!   and JACOBIAN_COST per Jacobian (calibrated on the paper's rope, n = 30: an MEBDF step
 !!   costs its 4.1 evaluations of f plus about 6 more in the rest, a CVODE step its 1.2
 !!   plus about 5; scripts/cost_model over n = 10 .. 100 and rtol 1e-2 .. 1e-8 split
-!!   MEBDF's 6 into 5.3 per step and 5 per factorization: at rtol 1e-2 it makes 0.29 .. 0.34
-!!   factorizations per step against 0.14 at 1e-6, and was counted 17 .. 25 % too cheap
-!!   there, at n = 30 .. 100). These hold for a
-!!   Newton matrix of the RFEM's row width (11, block tridiagonal); a wider one (the MPP's
-!!   is dense: width = its np rows) costs more against f, which stays O(n): with
+!!   MEBDF's 6 into 5.3 per step and 5 per factorization: at rtol 1e-2 it makes 0.29 ..
+!!   0.34 factorizations per step against 0.14 at 1e-6, and was counted 17 .. 25 % too
+!!   cheap there, at n = 30 .. 100). These hold for a Newton matrix of the RFEM's row
+!!   width (11, block tridiagonal); a wider one (the MPP's is dense: width = its np rows)
+!!   costs more against f, which stays O(n): with
 !!   lambda = width / 11 (at least 1), a step costs SOLVE_COST (lambda - 1) more for its
 !!   solves, a factorization FACTOR_COST (lambda^2 - 1), a Jacobian JACOBIAN_COST lambda,
 !!   and an MEBDF evaluation of a problem with a mass matrix 1 + MASS_COST width (its
@@ -154,6 +154,7 @@ module ropedyn_auto
         procedure, private :: current_stats
         procedure, private :: cost
         procedure, private :: implicit_name
+        procedure, private :: trials_are_cheap
     end type auto_t
 
     interface
@@ -331,9 +332,7 @@ contains
                     self%h_stable = h_first
                 end if
             end if
-            ! only without a mass matrix: see the submodule's header (Switching)
-            if (.not. self%problem%has_mass_matrix()) &
-                call self%erk%set_stable_step(self%h_stable)
+            if (self%trials_are_cheap()) call self%erk%set_stable_step(self%h_stable)
             call self%log%add(self%t, 'erk', ERK_ORDER, reason)
         else if (which == ADAMS) then
             self%calm_adams = -1.0_wp
@@ -427,6 +426,16 @@ contains
         name = 'mebdf'
         if (self%use_bdf) name = 'cvode'
     end function implicit_name
+
+    !> Whether a trial of the implicit method is a cheap experiment, so that weaker evidence
+    !! may bring one: erk's steps near the stable step of the spectrum estimate, the early
+    !! first look, a measured cost gone stale. Not for a problem with a mass matrix (the
+    !! MPP: M(q) in MEBDF's residual, a dense Newton matrix; a trial there costs 6 to 12
+    !! times erk's; see the submodule's header, Switching).
+    pure logical function trials_are_cheap(self)
+        class(auto_t), intent(in) :: self
+        trials_are_cheap = .not. self%problem%has_mass_matrix()
+    end function trials_are_cheap
 
     !> Cost of the work counted in `s` by the method in use, in evaluations of f.
     pure real(wp) function cost(self, s)

@@ -21,8 +21,8 @@
 !!   implicit method that does not pay (judged on its second window) goes back at once.
 !!   The implicit method's measured cost is evidence for STALE_WINDOWS = 32 explicit
 !!   windows (times the cost ratio of each trial that does not pay, at least 2); after
-!!   that erk's steps held by
-!!   stability bring a new trial even where the old cost was higher. steel_wire (5 ms
+!!   that erk's steps held by stability bring a new trial even where the old cost was
+!!   higher. steel_wire (5 ms
 !!   outputs): mebdf's second window, at 5.4 ms, is in the ringing after the release (steps
 !!   of 1e-6 s, 9.2e6 f per second) and auto rightly went to erk (0.7e6); mebdf's steps
 !!   later grow to 4e-5 s (2.3e5 f per second on its own run), but the old cost kept it out
@@ -65,6 +65,7 @@ contains
         type(solver_stats_t) :: now
         type(spectrum_t) :: spec
         real(wp) :: rate, span, h_e, predicted, share
+        real(wp) :: growth  !< of stale_after after a trial that did not pay
         logical :: dearer   !< Adams' window cost more than erk's last by GAIN
         logical :: stale    !< the implicit method's measured cost is old (explicit windows)
         character(len=240) :: text
@@ -100,11 +101,8 @@ contains
                 call self%start_method(ADAMS, trim(text), err)
                 return
             end if
-            ! not on the MPP (a mass matrix): a trial of its dense MEBDF costs 8 to 12 times
-            ! erk's, and even waits grown by that ratio let a retrial into fig4's runs at n =
-            ! 200 (24 -> 30 s) and 300 (58 -> 82 s)
             stale = self%rate_implicit > 0.0_wp .and. self%implicit_age >= self%stale_after &
-                    .and. .not. self%problem%has_mass_matrix()
+                    .and. self%trials_are_cheap()
             if (self%rate_implicit > 0.0_wp .and. GAIN*self%rate_implicit >= rate .and. &
                 .not. stale) return
             write (text, '(a, i0, a, es9.2, a, es9.2, a)') 'explicit step held by stability (', &
@@ -169,10 +167,10 @@ contains
                 self%trial = .false.
                 if (self%rate_explicit > 0.0_wp .and. rate > self%rate_explicit) then
                     ! the dearer the trial, the longer until the next: times the cost
-                    ! ratio, at least 2 (the MPP's dense MEBDF: 11 times erk's)
-                    self%stale_after = int(min(real(huge(0)/2, wp), self%stale_after* &
-                                               max(2.0_wp, real(ceiling(rate/ &
-                                                   self%rate_explicit), wp))))
+                    ! ratio rounded up, at least 2 (capped below integer overflow)
+                    growth = max(2.0_wp, real(ceiling(min(rate/self%rate_explicit, &
+                                                          1.0e9_wp)), wp))
+                    self%stale_after = int(min(real(huge(0)/2, wp), growth*self%stale_after))
                     call trial_failed(self%implicit_name()//' was not cheaper')
                     return
                 end if
@@ -212,8 +210,7 @@ contains
         !! 400 steps take 0.38 of its 2 s, where mebdf needs 156 steps in all)
         logical function early_look()
             early_look = self%active == EXPLICIT .and. self%windows == 0 .and. &
-                         self%rate_implicit < 0.0_wp .and. &
-                         .not. self%problem%has_mass_matrix() .and. &
+                         self%rate_implicit < 0.0_wp .and. self%trials_are_cheap() .and. &
                          now%steps - self%win_steps0 >= EARLY_WINDOW
             if (early_look) early_look = self%erk%stiff_share_of_steps() >= EARLY_SHARE
         end function early_look
