@@ -40,3 +40,19 @@ def test_study_runs_and_prints_a_row_per_method(ropedyn_exe, capsys):
     assert rows[0].split("|")[-2].strip() == "1.00"      # erk over itself
     for r in rows[1:]:
         assert float(r.split("|")[-2]) > 0.0
+
+
+def test_bad_arguments_are_named(capsys):
+    """A list that is not numbers, or a value not above 0, is a usage error (exit 2)
+    naming the option and the value, before anything runs."""
+    for args, words in ((["--elements", "ten"], ["--elements", "'ten'"]),
+                        (["--rtols", "1e-3 0"], ["--rtols", "'0'"]),
+                        (["--repeat", "-1"], ["--repeat", "'-1'"])):
+        try:
+            cm.main([*args, "--exe", "/nonexistent", "--no-write"])
+        except SystemExit as e:
+            assert e.code == 2
+        else:
+            raise AssertionError(f"{args} accepted")
+        err = capsys.readouterr().err
+        assert all(w in err for w in words), err

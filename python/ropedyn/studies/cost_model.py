@@ -52,6 +52,30 @@ def counted(method, stats, constants):
             + constants["JACOBIAN_COST"] * float(stats["jac_evals"]))
 
 
+def positive(kind):
+    """An argparse type: a number of `kind` above 0."""
+    def parse(text):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+        if not value > 0:
+            raise argparse.ArgumentTypeError(f"must be above 0: {text!r}")
+        return value
+    parse.__name__ = kind.__name__
+    return parse
+
+
+def listing(item):
+    """An argparse type: a space-separated, non-empty list of `item`."""
+    def parse(text):
+        values = [item(x) for x in text.split()]
+        if not values:
+            raise argparse.ArgumentTypeError("an empty list")
+        return values
+    return parse
+
+
 def run_case(exe, n, rtol, method, t_end, workdir):
     out = workdir / f"cost_{method}_{n}_{rtol:g}.h5"
     cmd = [str(exe), "run", str(PAPER), *set_args([
@@ -92,18 +116,21 @@ def rows(results, constants):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     add_exe_argument(parser)
-    parser.add_argument("--t-end", type=float, default=10.0)
-    parser.add_argument("--elements", default="10 30 100")
-    parser.add_argument("--rtols", default="1e-2 1e-4 1e-6 1e-8")
-    parser.add_argument("--repeat", type=int, default=2, help="runs per case (least CPU)")
+    parser.add_argument("--t-end", type=positive(float), default=10.0)
+    parser.add_argument("--elements", type=listing(positive(int)), default="10 30 100",
+                        help="numbers of elements, space-separated")
+    parser.add_argument("--rtols", type=listing(positive(float)), default="1e-2 1e-4 1e-6 1e-8",
+                        help="relative tolerances, space-separated")
+    parser.add_argument("--repeat", type=positive(int), default=2,
+                        help="runs per case (least CPU)")
     parser.add_argument("--no-write", action="store_true")
     args = parser.parse_args(argv)
     exe = exe_or_build(args.exe)
     constants = auto_constants()
     results = {}
     with tempfile.TemporaryDirectory() as tmp:
-        for n in [int(x) for x in args.elements.split()]:
-            for rtol in [float(x) for x in args.rtols.split()]:
+        for n in args.elements:
+            for rtol in args.rtols:
                 results[(n, rtol)] = {
                     m: least_cpu(lambda m=m: run_case(exe, n, rtol, m, args.t_end,
                                                       pathlib.Path(tmp)),
@@ -118,8 +145,10 @@ def main(argv=None):
     if args.no_write:
         return 0
     consts = ", ".join(f"{k} = {v:g}" for k, v in constants.items())
+    elements = " ".join(str(n) for n in args.elements)
+    rtols = " ".join(f"{r:g}" for r in args.rtols)
     block = (f"{BEGIN}\nCommand: `scripts/cost_model --t-end {args.t_end:g} --elements "
-             f"\"{args.elements}\" --rtols \"{args.rtols}\" --repeat {args.repeat}` (code: "
+             f"\"{elements}\" --rtols \"{rtols}\" --repeat {args.repeat}` (code: "
              "python/ropedyn/studies/cost_model.py). input/paper.nml (RFEM) with each method "
              "(atol = rtol / 100); counted as auto counts on the RFEM's band (erk: evaluations "
              "of f; mebdf and cvode: those plus a cost per step, per factorization and per "
