@@ -20,6 +20,13 @@ def switch_log(f):
     return methods, f["/solver/switch_time"][()], f["/solver/switch_max_order"][()], reasons
 
 
+def stale_windows():
+    """STALE_WINDOWS of solvers/auto/ropedyn_auto.f90: how many explicit windows a measured
+    implicit cost counts for before a retrial."""
+    text = (ROOT / "solvers" / "auto" / "ropedyn_auto.f90").read_text()
+    return int(re.search(r"STALE_WINDOWS\s*=\s*(\d+)", text).group(1))
+
+
 def run_scene(run, tmp_path, scene, name, *sets):
     out = tmp_path / f"{name}.h5"
     args = ["run", scene, "--set", f"output.file='{out}'"]
@@ -138,6 +145,12 @@ def test_auto_tries_the_implicit_method_again_when_its_cost_is_stale(run, tmp_pa
     assert again, reasons
     assert len(again) <= 5, reasons      # growing waits: a few trials, not one a window
     assert methods[-1] == "mebdf", (methods, times, reasons)
+    # the waits: 32 windows at first; after the trial that did not pay (8.8e5 against
+    # 6.7e5 f per second, ratio 1.3) max(2, ceil(1.3)) = 2 times that
+    ages = [int(re.search(r"measured (\d+) windows ago", r).group(1)) for r in again]
+    stale = stale_windows()
+    assert stale <= ages[0] < 2 * stale, (ages, reasons)
+    assert len(ages) >= 2 and ages[1] >= 2 * stale, (ages, reasons)
 
 
 def test_no_retrial_of_mebdf_on_the_mpp(run, tmp_path):
