@@ -10,14 +10,13 @@ existed), which shows that effects that are off cost nothing. The table goes int
 docs/benchmarks.md between the markers of the section "Cost of the effects".
 """
 import argparse
-import os
 import pathlib
-import shutil
 import subprocess
 import sys
 import tempfile
 
 from ropedyn.run import DOCS, PAPER, ROOT, build, set_args
+from ropedyn.studies.bench_rhs import build_bench_rhs
 from ropedyn.studies.common import machine, update_doc, utc_stamp
 
 BEGIN = "<!-- bench_effects:begin -->"
@@ -60,37 +59,6 @@ def bench(exe, n, sets, seconds):
     return float(fields[1]), float(fields[2])
 
 
-def build_baseline(rev, workdir):
-    """Build bench_rhs from git revision `rev` (git archive: the working tree is untouched)."""
-    src = workdir / "src"
-    src.mkdir()
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev], capture_output=True,
-                             check=True)
-    subprocess.run(["tar", "-x", "-C", str(src)], input=archive.stdout, check=True)
-    (src / "tests" / "bench").mkdir(exist_ok=True)
-    shutil.copy(ROOT / "tests" / "bench" / "bench_rhs.f90", src / "tests" / "bench")
-    tests_cmake = src / "tests" / "CMakeLists.txt"
-    if "bench_rhs" not in tests_cmake.read_text():
-        # revisions before bench_rhs existed: one library (ropedyn_lib) or the layers
-        lib = "ropedyn_app" if "ropedyn_app" in (src / "CMakeLists.txt").read_text() \
-            else "ropedyn_lib"
-        with open(tests_cmake, "a") as f:
-            f.write("\nadd_executable(bench_rhs bench/bench_rhs.f90)\n"
-                    "ropedyn_fortran_target(bench_rhs)\n"
-                    f"target_link_libraries(bench_rhs PRIVATE {lib})\n")
-    build = workdir / "build"
-    log = workdir / "build.log"
-    with open(log, "w") as f:
-        ok = subprocess.run(["cmake", "-S", str(src), "-B", str(build),
-                             "-DCMAKE_BUILD_TYPE=Release"], stdout=f, stderr=f).returncode == 0
-        ok = ok and subprocess.run(["cmake", "--build", str(build), "--target", "bench_rhs",
-                                    "-j", str(os.cpu_count())], stdout=f,
-                                   stderr=f).returncode == 0
-    if not ok:
-        raise SystemExit(f"baseline build of {rev} failed; log: {log.read_text()[-3000:]}")
-    return build / "tests" / "bench_rhs"
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--build", default=None, help="Release build directory (default: "
@@ -117,7 +85,7 @@ def main(argv=None):
     baseline_line = None
     if args.baseline:
         with tempfile.TemporaryDirectory() as tmp:
-            base_exe = build_baseline(args.baseline, pathlib.Path(tmp))
+            base_exe = build_bench_rhs(args.baseline, pathlib.Path(tmp))
             rev = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", args.baseline],
                                  capture_output=True, text=True).stdout.strip()
             rhs, jac = bench(base_exe, n, [], args.seconds)

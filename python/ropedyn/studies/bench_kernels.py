@@ -13,7 +13,6 @@ the working tree is untouched) and both are reported side by side. The table goe
 docs/benchmarks.md between the markers of the section "Model kernels".
 """
 import argparse
-import os
 import pathlib
 import re
 import shutil
@@ -22,6 +21,7 @@ import sys
 import tempfile
 
 from ropedyn.run import DOCS, PAPER, ROOT, build, set_args
+from ropedyn.studies.bench_rhs import build_bench_rhs
 from ropedyn.studies.common import machine, update_doc, utc_stamp
 
 BEGIN = "<!-- bench_kernels:begin -->"
@@ -63,28 +63,6 @@ def per_call(exe, model, n, kernel, extra=3):
             - instructions(exe, model, n, kernel, 2)) / extra
 
 
-def build_baseline(rev, workdir):
-    """Build bench_rhs from git revision `rev` with this tree's bench_rhs.f90."""
-    src = workdir / "src"
-    src.mkdir()
-    archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev], capture_output=True,
-                             check=True)
-    subprocess.run(["tar", "-x", "-C", str(src)], input=archive.stdout, check=True)
-    (src / "tests" / "bench").mkdir(exist_ok=True)
-    shutil.copy(ROOT / "tests" / "bench" / "bench_rhs.f90", src / "tests" / "bench")
-    build_dir = workdir / "build"
-    log = workdir / "build.log"
-    with open(log, "w") as f:
-        ok = subprocess.run(["cmake", "-S", str(src), "-B", str(build_dir),
-                             "-DCMAKE_BUILD_TYPE=Release"], stdout=f, stderr=f).returncode == 0
-        ok = ok and subprocess.run(["cmake", "--build", str(build_dir), "--target", "bench_rhs",
-                                    "-j", str(os.cpu_count())], stdout=f,
-                                   stderr=f).returncode == 0
-    if not ok:
-        raise SystemExit(f"baseline build of {rev} failed; log: {log.read_text()[-3000:]}")
-    return build_dir / "tests" / "bench_rhs"
-
-
 def fmt(x, digits=0):
     if x is None:
         return "n/a"
@@ -117,7 +95,7 @@ def main(argv=None):
     callgrind = not args.no_callgrind and shutil.which("valgrind") is not None
 
     with tempfile.TemporaryDirectory() as tmp:
-        base_exe = build_baseline(args.baseline, pathlib.Path(tmp)) if args.baseline else None
+        base_exe = build_bench_rhs(args.baseline, pathlib.Path(tmp)) if args.baseline else None
         base_rev = None
         if args.baseline:
             base_rev = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short",
