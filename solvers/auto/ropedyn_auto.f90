@@ -142,6 +142,10 @@ module ropedyn_auto
         !> erk's stable step when it was last started from a spectrum estimate (s; 0: none)
         real(wp) :: h_stable = 0.0_wp
         real(wp) :: radius = 0.0_wp        !< the last estimate's spectral radius, 1/s
+        !> the step that sizes a segment's first chunk, before its method has stepped (s;
+        !! 0: none): the stable step h_e at the start, the step the previous method ended
+        !! with after a switch (h_e when erk is restarted from a spectrum estimate)
+        real(wp) :: h_chunk = 0.0_wp
     contains
         procedure :: start => auto_start
         procedure :: advance_to => auto_advance_to
@@ -205,6 +209,7 @@ contains
         self%backoff = 1
         self%h_stable = 0.0_wp
         self%radius = 0.0_wp
+        self%h_chunk = 0.0_wp
 
         call newton_widths(self%problem, self%lambda, self%mebdf_eval_cost)
         call estimate_spectrum(self%problem, start%t0, start%y0, spec)
@@ -214,6 +219,7 @@ contains
         if (self%user_order /= 0) self%mebdf_order = min(self%mebdf_order, self%user_order)
         h_e = erk_stable_step(self%tab, spec)
         self%radius = spec%radius
+        self%h_chunk = h_e
         if (spec%valid .and. h_e > 0.0_wp) then
             rate = 1.0_wp/h_e
             write (text, '(a, es9.2, a, f6.3, a, es9.2, a)') 'spectral radius ', &
@@ -312,6 +318,10 @@ contains
         if (self%active /= 0) then
             old = self%current_stats()
             call add_counters(self%done, old)
+            if (old%last_step > 0.0_wp) self%h_chunk = old%last_step
+        end if
+        if (present(h_first)) then
+            if (h_first > 0.0_wp) self%h_chunk = h_first
         end if
         if (self%active == EXPLICIT) call self%erk%finalize()
         if (self%active == ADAMS) call self%am%finalize()
@@ -368,7 +378,7 @@ contains
         real(wp), intent(inout) :: yq(:)
         type(error_t), allocatable, intent(out) :: err
         type(solver_stats_t) :: now
-        real(wp) :: target
+        real(wp) :: target, h_look
 
         t = self%t
         if (.not. self%initialized) then
@@ -377,9 +387,12 @@ contains
         end if
         do while (self%t < tout)
             ! look at the window after at most about WINDOW/4 steps of the method in use
+            ! (before its first step, of h_chunk): not only at the next output time
             now = self%current_stats()
+            h_look = now%last_step
+            if (h_look <= 0.0_wp) h_look = self%h_chunk
             target = tout
-            if (now%last_step > 0.0_wp) target = min(tout, self%t + 0.25_wp*WINDOW*now%last_step)
+            if (h_look > 0.0_wp) target = min(tout, self%t + 0.25_wp*WINDOW*h_look)
             if (self%active == EXPLICIT) then
                 call self%erk%advance_to(target, self%t, self%y, self%yq, err)
             else if (self%active == ADAMS) then

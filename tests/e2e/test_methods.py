@@ -112,6 +112,25 @@ def test_auto_tries_implicit_early_where_erk_sits_at_its_stable_step(run, tmp_pa
     assert steps < 300, steps
 
 
+@pytest.mark.parametrize("interval", ["0.2", "1.0"])
+def test_auto_looks_early_whatever_the_output_interval(run, tmp_path, interval):
+    """auto looks at its window every WINDOW/4 steps of the method in use; before that
+    method's first step the chunk was sized from nothing and ran to the next output time,
+    so with outputs every 1 s drag_fall's first look (and the switch to mebdf) came at
+    1.0 s, 1,088 steps. The first chunk is now sized from the stable step h_e (after a
+    switch, from the previous method's last step): the switch comes near 0.19 s and the
+    run takes the same steps whether the outputs are 0.2 or 1 s apart."""
+    proc, out = run_scene(run, tmp_path, ROOT / "input" / "drag_fall.nml", "sparse",
+                          f"solver.output_interval={interval}")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods, times, _, reasons = switch_log(f)
+        steps = int(f["/solver/steps"][()])
+    assert methods == ["erk", "mebdf"], (methods, reasons)
+    assert times[1] < 0.3, (times, reasons)
+    assert steps < 300, steps
+
+
 def test_auto_does_not_try_mebdf_early_on_the_mpp(run, tmp_path):
     """The early trial above is for problems without a mass matrix. On the MPP at rtol
     1e-2 erk's steps sit at the stable step too, but an MEBDF step there (M(q) in its
