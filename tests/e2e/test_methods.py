@@ -147,14 +147,15 @@ def test_auto_does_not_try_mebdf_early_on_the_mpp(run, tmp_path):
 
 
 def test_auto_tries_the_implicit_method_again_when_its_cost_is_stale(run, tmp_path):
-    """The steel wire (its own output interval, 5 ms): mebdf's second window, at 5.4 ms,
-    is in the ringing after the release (steps of 1e-6 s, 9.2e6 f per second), and auto
-    rightly goes to erk (0.7e6). mebdf's steps later grow to 4e-5 s (2.3e5 f per second on
-    its own run), but that old measurement kept it out for the whole run: erk to the end,
-    0.54 s CPU against mebdf's 0.36 .. 0.41. Now a cost measured 32 explicit windows ago
-    (that many times, at least twice, the cost ratio of each trial that does not pay) is
-    tried again where erk's steps are held by stability; the trials are few, and mebdf
-    takes over (from 0.30 s)."""
+    """The steel wire: mebdf's cost is measured in the ringing after the release (steps
+    of 1e-6 s, 2e7 f per second at 0.4 ms; 9.2e6 at 5.4 ms when its first window ran to
+    the first output), and auto rightly goes to erk (0.7e6). mebdf's steps later grow to
+    4e-5 s (2.3e5 f per second on its own run), but that old measurement kept it out for
+    the whole run: erk to the end, 0.54 s CPU against mebdf's 0.36 .. 0.41. Now a cost
+    measured 32 explicit windows ago (that many times, at least twice, the cost ratio of
+    each trial that does not pay) is tried again where erk's steps are held by stability;
+    the trials are few (one not cheaper yet at 0.077 s), and mebdf takes over (from
+    0.27 s)."""
     proc, out = run_scene(run, tmp_path, STEEL, "stale", "solver.t_end=0.7")
     assert proc.returncode == 0, proc.stderr
     with h5py.File(out, "r") as f:
