@@ -209,7 +209,6 @@ contains
         self%backoff = 1
         self%h_stable = 0.0_wp
         self%radius = 0.0_wp
-        self%h_chunk = 0.0_wp
 
         call newton_widths(self%problem, self%lambda, self%mebdf_eval_cost)
         call estimate_spectrum(self%problem, start%t0, start%y0, spec)
