@@ -7,6 +7,8 @@ import h5py
 import numpy as np
 import pytest
 
+from ropedyn.studies.cost_model import auto_parameter
+
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
 PAPER = ROOT / "input" / "paper.nml"
 STEEL = ROOT / "input" / "hard" / "steel_wire.nml"
@@ -18,13 +20,6 @@ def switch_log(f):
     methods = [m.decode().strip() for m in f["/solver/switch_method"][()]]
     reasons = [r.decode() for r in f["/solver/switch_reason"][()]]
     return methods, f["/solver/switch_time"][()], f["/solver/switch_max_order"][()], reasons
-
-
-def stale_windows():
-    """STALE_WINDOWS of solvers/auto/ropedyn_auto.f90: how many explicit windows a measured
-    implicit cost counts for before a retrial."""
-    text = (ROOT / "solvers" / "auto" / "ropedyn_auto.f90").read_text()
-    return int(re.search(r"STALE_WINDOWS\s*=\s*(\d+)", text).group(1))
 
 
 def run_scene(run, tmp_path, scene, name, *sets):
@@ -94,40 +89,29 @@ def test_auto_starts_implicit_on_a_rope_at_rest(run, tmp_path):
     assert steps < 100, steps
 
 
-def test_auto_tries_implicit_early_where_erk_sits_at_its_stable_step(run, tmp_path):
+@pytest.mark.parametrize("interval, switch_before", [(None, 0.15), ("0.2", 0.3), ("1.0", 0.3)])
+def test_auto_tries_implicit_early_where_erk_sits_at_its_stable_step(run, tmp_path, interval,
+                                                                     switch_before):
     """drag_fall: a rope falling flat through water excites none of its fast modes, so
     erk's estimate of the spectral radius from its last stages (1e2 .. 3e3 1/s) misses
     them, yet its steps sit at the stable step of the Jacobian's spectrum (5.1e3 1/s,
     9.0e-4 s) from the start. auto counts those steps as held by stability and tries
     mebdf after its first 100 steps (it took 400 and 0.77 s before, and 849 steps in
-    all); mebdf is kept (its trial pays) and takes the remaining 1.9 s in about 100 steps."""
-    proc, out = run_scene(run, tmp_path, ROOT / "input" / "drag_fall.nml", "drag_fall")
+    all); mebdf is kept (its trial pays) and takes the remaining 1.9 s in about 100 steps.
+    Whatever the output interval: before a method's first step auto's chunk was sized from
+    nothing and ran to the next output time, so with outputs every 1 s the first look (and
+    the switch) came at 1.0 s, 1,088 steps. The first chunk is now sized from the stable
+    step h_e (after a switch, from the previous method's last step): with outputs 0.2 or
+    1 s apart the switch comes near 0.19 s, in the same steps."""
+    sets = [f"solver.output_interval={interval}"] if interval else []
+    proc, out = run_scene(run, tmp_path, ROOT / "input" / "drag_fall.nml", "drag_fall", *sets)
     assert proc.returncode == 0, proc.stderr
     with h5py.File(out, "r") as f:
         methods, times, _, reasons = switch_log(f)
         steps = int(f["/solver/steps"][()])
     assert methods == ["erk", "mebdf"], (methods, reasons)
-    assert times[1] < 0.15, (times, reasons)
+    assert times[1] < switch_before, (times, reasons)
     assert "held by stability" in reasons[1], reasons
-    assert steps < 300, steps
-
-
-@pytest.mark.parametrize("interval", ["0.2", "1.0"])
-def test_auto_looks_early_whatever_the_output_interval(run, tmp_path, interval):
-    """auto looks at its window every WINDOW/4 steps of the method in use; before that
-    method's first step the chunk was sized from nothing and ran to the next output time,
-    so with outputs every 1 s drag_fall's first look (and the switch to mebdf) came at
-    1.0 s, 1,088 steps. The first chunk is now sized from the stable step h_e (after a
-    switch, from the previous method's last step): the switch comes near 0.19 s and the
-    run takes the same steps whether the outputs are 0.2 or 1 s apart."""
-    proc, out = run_scene(run, tmp_path, ROOT / "input" / "drag_fall.nml", "sparse",
-                          f"solver.output_interval={interval}")
-    assert proc.returncode == 0, proc.stderr
-    with h5py.File(out, "r") as f:
-        methods, times, _, reasons = switch_log(f)
-        steps = int(f["/solver/steps"][()])
-    assert methods == ["erk", "mebdf"], (methods, reasons)
-    assert times[1] < 0.3, (times, reasons)
     assert steps < 300, steps
 
 
@@ -168,7 +152,7 @@ def test_auto_tries_the_implicit_method_again_when_its_cost_is_stale(run, tmp_pa
     # the waits: 32 windows at first; after the trial that did not pay (8.8e5 against
     # 6.7e5 f per second, ratio 1.3) max(2, ceil(1.3)) = 2 times that
     ages = [int(re.search(r"measured (\d+) windows ago", r).group(1)) for r in again]
-    stale = stale_windows()
+    stale = auto_parameter("STALE_WINDOWS")   # explicit windows a measured cost counts for
     assert stale <= ages[0] < 2 * stale, (ages, reasons)
     assert len(ages) >= 2 and ages[1] >= 2 * stale, (ages, reasons)
 

@@ -29,16 +29,22 @@ AUTO_SOURCE = ROOT / "solvers" / "auto" / "ropedyn_auto.f90"
 METHODS = ("erk", "mebdf", "cvode")
 
 
+def auto_parameter(name, path=AUTO_SOURCE, text=None):
+    """The value of the Fortran parameter `name` (real `..._wp` or integer) in auto's
+    source; ValueError naming it when the source has none."""
+    text = pathlib.Path(path).read_text() if text is None else text
+    m = re.search(rf"parameter\s*::\s*{name}\s*=\s*([0-9.]+)(_wp)?\b", text)
+    if m is None:
+        raise ValueError(f"{path}: no parameter {name}")
+    return float(m.group(1)) if m.group(2) else int(m.group(1))
+
+
 def auto_constants(path=AUTO_SOURCE):
     """auto's per-step and per-Jacobian costs (f-equivalents) from its Fortran source."""
     text = pathlib.Path(path).read_text()
-    values = {}
-    for name in ("IMPLICIT_STEP_COST", "BDF_STEP_COST", "FACTOR_BASE", "JACOBIAN_COST"):
-        m = re.search(rf"parameter\s*::\s*{name}\s*=\s*([0-9.]+)_wp", text)
-        if m is None:
-            raise ValueError(f"{path}: no parameter {name}")
-        values[name] = float(m.group(1))
-    return values
+    return {name: float(auto_parameter(name, path, text))
+            for name in ("IMPLICIT_STEP_COST", "BDF_STEP_COST", "FACTOR_BASE",
+                         "JACOBIAN_COST")}
 
 
 def counted(method, stats, constants):
