@@ -108,6 +108,28 @@ def test_shim_answers_help(name, tmp_path):
     assert result.stdout.startswith("usage:"), result.stdout
 
 
+@pytest.mark.parametrize("module", ["ropedyn.studies.bench_effects",
+                                    "ropedyn.studies.bench_kernels"])
+def test_unknown_baseline_is_a_usage_error(module, capsys):
+    """--baseline naming no commit: a usage error naming the option and the value (exit 2),
+    before anything is built (it used to end in git's traceback after the Release build)."""
+    main = importlib.import_module(module).main
+    with pytest.raises(SystemExit) as stop:
+        main(["--baseline", "no-such-revision", "--build", "/nonexistent", "--no-write"])
+    assert stop.value.code == 2
+    assert "--baseline no-such-revision: not a commit" in capsys.readouterr().err
+
+
+def test_baseline_revision_names_the_commit():
+    """A revision git knows comes back as the short hash of its commit."""
+    import argparse
+    from ropedyn.studies.bench_rhs import baseline_revision
+    head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True,
+                          text=True, check=True).stdout.strip()
+    short = baseline_revision(argparse.ArgumentParser(), "HEAD")
+    assert len(short) >= 7 and head.startswith(short)
+
+
 def test_least_cpu_keeps_the_fastest_run_and_stops_at_a_failure():
     """The benchmarks' timing rule (bench_peers --repeat): the least CPU of the runs, and a
     run that did not complete is returned at once (its CPU means nothing)."""

@@ -15,8 +15,8 @@ import subprocess
 import sys
 import tempfile
 
-from ropedyn.run import DOCS, PAPER, ROOT, build, set_args
-from ropedyn.studies.bench_rhs import build_bench_rhs
+from ropedyn.run import DOCS, PAPER, build, set_args
+from ropedyn.studies.bench_rhs import baseline_revision, build_bench_rhs
 from ropedyn.studies.common import machine, update_doc, utc_stamp
 
 BEGIN = "<!-- bench_effects:begin -->"
@@ -70,6 +70,7 @@ def main(argv=None):
                         help="git revision to time 'all internal effects' at (e.g. HEAD)")
     parser.add_argument("--no-write", action="store_true", help="print only")
     args = parser.parse_args(argv)
+    rev = baseline_revision(parser, args.baseline) if args.baseline else None
     exe = pathlib.Path(args.build or build("Release")) / "tests" / "bench_rhs"
     n = args.elements
 
@@ -86,8 +87,6 @@ def main(argv=None):
     if args.baseline:
         with tempfile.TemporaryDirectory() as tmp:
             base_exe = build_bench_rhs(args.baseline, pathlib.Path(tmp))
-            rev = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", args.baseline],
-                                 capture_output=True, text=True).stdout.strip()
             rhs, jac = bench(base_exe, n, [], args.seconds)
             # the current build once more, right after, for a fair pair
             now_rhs, now_jac = bench(exe, n, [], args.seconds)

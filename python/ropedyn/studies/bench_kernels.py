@@ -20,8 +20,8 @@ import subprocess
 import sys
 import tempfile
 
-from ropedyn.run import DOCS, PAPER, ROOT, build, set_args
-from ropedyn.studies.bench_rhs import build_bench_rhs
+from ropedyn.run import DOCS, PAPER, build, set_args
+from ropedyn.studies.bench_rhs import baseline_revision, build_bench_rhs
 from ropedyn.studies.common import machine, update_doc, utc_stamp
 
 BEGIN = "<!-- bench_kernels:begin -->"
@@ -89,6 +89,7 @@ def main(argv=None):
                         help="timings only (no instruction counts)")
     parser.add_argument("--no-write", action="store_true", help="print only")
     args = parser.parse_args(argv)
+    base_rev = baseline_revision(parser, args.baseline) if args.baseline else None
     exe = pathlib.Path(args.build or build("Release")) / "tests" / "bench_rhs"
     cases = [("rfem", int(n)) for n in args.rfem_elements.split()] + \
             [("mpp", int(n)) for n in args.mpp_elements.split()]
@@ -96,11 +97,6 @@ def main(argv=None):
 
     with tempfile.TemporaryDirectory() as tmp:
         base_exe = build_bench_rhs(args.baseline, pathlib.Path(tmp)) if args.baseline else None
-        base_rev = None
-        if args.baseline:
-            base_rev = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short",
-                                       args.baseline], capture_output=True,
-                                      text=True).stdout.strip()
         rows = []
         for model, n in cases:
             # the two builds back to back, so that both see the same machine load
