@@ -144,3 +144,46 @@ def test_least_cpu_keeps_the_fastest_run_and_stops_at_a_failure():
     r = least_cpu(run, 3, complete=lambda x: x["ok"])
     assert r == {"cpu": 0.5, "ok": False} and len(calls) == 2
     assert least_cpu(lambda: {"cpu": 4.0}, 0) == {"cpu": 4.0}
+
+
+def test_long_horizon_cache_is_keyed_on_the_code(tmp_path):
+    """The long-horizon cache survives a commit that changes no code (the executable is
+    relinked for its version string only) but not a change to src/, solvers/ or
+    CMakeLists.txt, committed or not; an executable older than the code is keyed on itself."""
+    import os
+    from ropedyn.studies.long_horizon import code_fingerprint
+
+    def git(*args):
+        subprocess.run(["git", "-C", str(tmp_path), "-c", "user.name=t", "-c",
+                        "user.email=t@t", *args], check=True, capture_output=True)
+
+    for name in ("src/a.f90", "solvers/b.f90", "CMakeLists.txt", "docs/c.md"):
+        (tmp_path / name).parent.mkdir(exist_ok=True)
+        (tmp_path / name).write_text(name + "\n")
+    git("init", "-q")
+    git("add", ".")
+    git("commit", "-qm", "one")
+    exe = tmp_path / "build" / "ropedyn"
+    exe.parent.mkdir()
+
+    def relink(text):
+        exe.write_text(text)
+        later = max(p.stat().st_mtime_ns for p in tmp_path.rglob("*") if p.is_file()) + 10**9
+        os.utime(exe, ns=(later, later))
+        return code_fingerprint(exe, root=tmp_path)
+
+    first = relink("version one")
+    assert " code " in first
+    (tmp_path / "docs/c.md").write_text("changed\n")
+    git("commit", "-qam", "docs only")
+    assert relink("version two, a longer string") == first
+    (tmp_path / "src/a.f90").write_text("changed\n")
+    edited = relink("version two-dirty")
+    assert " code " in edited and edited != first
+    git("commit", "-qam", "code")
+    assert relink("version three") not in (first, edited)
+    (tmp_path / "solvers/new.f90").write_text("untracked\n")
+    untracked = relink("version three-dirty")
+    assert untracked not in (first, edited)
+    os.utime(exe, ns=(0, 0))
+    assert " exe " in code_fingerprint(exe, root=tmp_path)

@@ -10,11 +10,15 @@ scripts/stability_report (the tables of docs/stability.md).
 **A new method is one line**: append its name to METHODS.
 
 Runs are cached in a work directory (default build/long): a case is run again only when its
-command or the executable (size, modification time) changed, so that the checks and the
-report can be re-evaluated without the hour of runs. `measures.json` there holds the
+command or the code changed, so that the checks and the report can be re-evaluated without the
+hour of runs. The code is the git content of src/, solvers/ and CMakeLists.txt with any
+uncommitted change to them (`code_fingerprint`): a commit that touches only docs or scripts
+relinks the executable (its version string) but keeps the cache; an executable older than
+those files, or outside a git checkout, is keyed on its size and modification time. `measures.json` there holds the
 scalar measures of every case.
 """
 import concurrent.futures
+import functools
 import hashlib
 import json
 import os
@@ -25,7 +29,7 @@ import time
 
 import numpy as np
 
-from ropedyn.run import INPUT
+from ropedyn.run import INPUT, ROOT
 from ropedyn.studies import stability_metrics
 from ropedyn.studies.common import scene_number
 
@@ -87,11 +91,49 @@ def order_cases():
     return [(f"order/{scene}/{label}", scene, ov) for label, scene, ov in ORDER_CASES]
 
 
-def _stamp(exe, scene, overrides):
+CODE_PATHS = ("src", "solvers", "CMakeLists.txt")
+
+
+def _git(root, *args):
+    return subprocess.run(["git", "-C", str(root), *args], capture_output=True,
+                          check=True).stdout
+
+
+@functools.lru_cache(maxsize=8)
+def _fingerprint(exe, size, mtime_ns, root):
+    """See `code_fingerprint` (cached on the executable's identity)."""
+    try:
+        files = _git(root, "ls-files", "-z", "--cached", "--others", "--exclude-standard",
+                     "--", *CODE_PATHS).decode().split("\0")
+        newest = max((root / f).stat().st_mtime_ns for f in files if f and
+                     (root / f).exists())
+        if newest > mtime_ns:
+            raise ValueError("the executable is older than the code")
+        parts = [_git(root, "rev-parse", *(f"HEAD:{p}" for p in CODE_PATHS)),
+                 _git(root, "diff", "HEAD", "--binary", "--", *CODE_PATHS)]
+        untracked = _git(root, "ls-files", "-z", "--others", "--exclude-standard", "--",
+                         *CODE_PATHS).decode().split("\0")
+        parts += [f.encode() + (root / f).read_bytes() for f in sorted(untracked) if f]
+        return "code " + hashlib.sha256(b"\0".join(parts)).hexdigest()
+    except (subprocess.CalledProcessError, OSError, ValueError):
+        return f"exe {size} {mtime_ns}"
+
+
+def code_fingerprint(exe, root=ROOT):
+    """What a cached run's result depends on besides its scene and overrides: the git content
+    of CODE_PATHS under `root` (HEAD's trees plus the uncommitted diff and untracked files)
+    when the executable is no older than every one of those files, else the executable's
+    size and modification time. The executable's path is part of the key (Debug and Release
+    builds are different codes)."""
     exe = pathlib.Path(exe).resolve()
     st = exe.stat()
+    return f"{exe} " + _fingerprint(str(exe), st.st_size, st.st_mtime_ns,
+                                    pathlib.Path(root).resolve())
+
+
+def _stamp(exe, scene, overrides):
     text = (HARD / f"{scene}.nml").read_text()
-    key = json.dumps([str(exe), st.st_size, st.st_mtime_ns, text, overrides])
+    key = json.dumps([code_fingerprint(exe), text, overrides])
     return hashlib.sha256(key.encode()).hexdigest()
 
 
