@@ -38,6 +38,7 @@ COMMANDS = {
     "stability_report": "ropedyn.studies.stability_report",
     "update_references": "ropedyn.studies.update_references",
     "mutation_check": "ropedyn.studies.mutation_check",
+    "docs_status": "ropedyn.studies.docs_status",
 }
 # Python files under scripts/ that the README and docs/ call by path
 SHIMS = {"plot_energy.py": "ropedyn.plot.energy",

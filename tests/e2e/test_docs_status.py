@@ -1,0 +1,70 @@
+"""scripts/docs_status: which generated sections of docs/ predate a change of their code."""
+import os
+import subprocess
+
+from ropedyn.studies import docs_status
+
+
+def _repo(tmp_path):
+    """A scratch checkout: code committed on Jan 1, changed on Jan 2 (counts), changed again
+    on Jan 3 with a Numbers-unchanged line (does not count), docs changed on Jan 4."""
+    def commit(date, message, files):
+        for name, text in files.items():
+            (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+            (tmp_path / name).write_text(text)
+        env = dict(os.environ, GIT_COMMITTER_DATE=date, GIT_AUTHOR_DATE=date)
+        subprocess.run(["git", "-C", str(tmp_path), "add", "."], check=True, env=env)
+        subprocess.run(["git", "-C", str(tmp_path), "-c", "user.name=t", "-c",
+                        "user.email=t@t", "commit", "-qm", message], check=True, env=env)
+        return subprocess.run(["git", "-C", str(tmp_path), "rev-parse", "--short", "HEAD"],
+                              capture_output=True, text=True, check=True).stdout.strip()
+
+    subprocess.run(["git", "init", "-q", str(tmp_path)], check=True)
+    first = commit("2026-01-01T12:00:00Z", "start", {"src/a.f90": "1\n", "docs/x.md": "x\n"})
+    second = commit("2026-01-02T12:00:00Z", "change a", {"src/a.f90": "2\n"})
+    commit("2026-01-03T12:00:00Z", "comment\n\nNumbers-unchanged: a comment",
+           {"src/a.f90": "2 ! why\n"})
+    commit("2026-01-04T12:00:00Z", "docs", {"docs/y.md": "y\n"})
+    (tmp_path / "docs" / "page.md").write_text(f"""# Page
+<!-- before:begin -->
+Command: `scripts/fig5` (Release). Run: 2026-01-02 06:00 UTC.
+| a |
+<!-- before:end -->
+<!-- after:begin -->
+Written by `scripts/auto_table` (0.1 min, 2026-01-02 13:00 UTC, this machine)
+<!-- after:end -->
+<!-- by-commit:begin -->
+Last run: 2026-01-05, commit `{first}`, 3 mutations (`scripts/mutation_check`).
+<!-- by-commit:end -->
+<!-- testset:begin -->
+Command: `scripts/work_precision_testset`. Run: 2026-01-02 06:00 UTC.
+<!-- testset:end -->
+<!-- undated:begin -->
+A table someone wrote by hand.
+<!-- undated:end -->
+""")
+    return second
+
+
+def test_sections_count_the_code_commits_since_their_run(tmp_path):
+    second = _repo(tmp_path)
+    rows = {r["name"]: r for r in docs_status.status(tmp_path)}
+    assert [c[0] for c in rows["before"]["commits"]] == [second]
+    assert rows["before"]["script"] == "fig5"
+    assert rows["after"]["commits"] == []
+    # a section that names its commit is judged from the commit, not from the date
+    assert [c[0] for c in rows["by-commit"]["commits"]] == [second]
+    # the test set's numbers do not come from src/
+    assert rows["testset"]["commits"] == []
+    assert rows["undated"]["commits"] is None
+
+
+def test_check_fails_on_a_stale_section(tmp_path, capsys):
+    _repo(tmp_path)
+    assert docs_status.main(["--root", str(tmp_path)]) == 0
+    capsys.readouterr()
+    assert docs_status.main(["--root", str(tmp_path), "--check"]) == 1
+    out = capsys.readouterr().out
+    listed = [line.split(" | ")[1] for line in out.splitlines() if line.startswith("| docs")]
+    assert "before" in listed and "by-commit" in listed and "undated" in listed
+    assert "after" not in listed and "testset" not in listed
