@@ -41,7 +41,11 @@ from ropedyn.studies.common import machine, update_doc, utc_stamp
 
 BEGIN = "<!-- work-precision:begin -->"
 END = "<!-- work-precision:end -->"
-OTHER = {"cvode": "mebdf", "mebdf": "cvode"}
+#: the reference a method's runs are judged against: the other integrator's, never the code
+#: that made the run (erk and auto against CVODE's; auto may run MEBDF, never CVODE on this
+#: rope's RFEM, and the two references agree within 4e-9 m over the horizon anyway)
+OTHER = {"cvode": "mebdf", "adams": "mebdf", "mebdf": "cvode", "erk": "cvode",
+         "auto": "cvode"}
 FIELDS = ["model", "elements", "method", "max_order", "rtol", "atol", "status", "steps",
           "rhs_evals", "jac_evals", "lin_setups", "err_test_fails", "cpu_time", "runs",
           "reference_method", "horizon", "tip_final", "tip_l2", "points_final", "points_l2",
@@ -173,7 +177,8 @@ def main(argv=None):
     p.add_argument("--model-elements", action="append", default=None,
                    help="MODEL=N,N,... element counts for one model (default: mpp=10,30,70: "
                         "MPP's dense mass matrix makes n = 100 cost 100 s per 2-s run)")
-    p.add_argument("--methods", default="cvode,mebdf")
+    p.add_argument("--methods", default="cvode,mebdf,erk,auto",
+                   help="integrators to measure (default cvode,mebdf,erk,auto)")
     p.add_argument("--max-orders", default="cvode=2+5,mebdf=4+7",
                    help="METHOD=K[+K...] per method, e.g. cvode=2+5,mebdf=4+7")
     p.add_argument("--rtols", default=None, help="default 1e-3,1e-4,1e-5,1e-6 (--quick: "
@@ -263,7 +268,7 @@ def main(argv=None):
                     cpu, runs = repeat_cpu(exe, r, float(r["cpu_time"]), args.repeat_time,
                                            work)
                     row["cpu_time"], row["runs"] = cpu, runs
-                    ref_method = OTHER.get(method, method)
+                    ref_method = OTHER.get(method, "cvode")
                     run = load(r["file"])
                     e = errors(run, ref_data[(n, ref_method)][0], horizons[n])
                     row["reference_method"] = ref_method
@@ -308,6 +313,11 @@ def curves(rows, model):
     return out
 
 
+def line_label(method, k):
+    """'cvode (max order 5)', or 'erk (default)' for a method run at its default order."""
+    return f"{method} (max order {k})" if k else f"{method} (default)"
+
+
 def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz, elapsed):
     import matplotlib
     matplotlib.use("Agg")
@@ -329,7 +339,8 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
 
     markers = {r: m for r, m in zip(sorted(rtols, reverse=True), "os^Dvph*")}
     colors = {("cvode", 5): "C0", ("cvode", 2): "C9", ("cvode", 3): "C4",
-              ("mebdf", 4): "C1", ("mebdf", 7): "C3", ("mebdf", 6): "C5", ("mebdf", 2): "C6"}
+              ("mebdf", 4): "C1", ("mebdf", 7): "C3", ("mebdf", 6): "C5", ("mebdf", 2): "C6",
+              ("erk", 0): "C2", ("auto", 0): "k", ("adams", 0): "C8"}
     figures = []
     for model in models:
         lines = curves(rows, model)
@@ -346,8 +357,8 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
                         continue
                     x = [float(r["cpu_time"]) for r in rs]
                     y = [float(r[measure]) for r in rs]
-                    c = colors.get((method, k), None)
-                    ax.loglog(x, y, "-", color=c, label=f"{method} (max order {k})")
+                    c = colors.get((method, k), colors.get((method, 0)))
+                    ax.loglog(x, y, "-", color=c, label=line_label(method, k))
                     for xi, yi, r in zip(x, y, rs):
                         ax.loglog(xi, yi, markers.get(float(r["rtol"]), "o"), color=c)
                 ax.set_title(f"{model}, n = {n}")
@@ -375,7 +386,7 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
     for model, style in zip(models, ["-", "--", ":"]):
         lines = curves(rows, model)
         for method in methods:
-            for k in orders.get(method, [0]):
+            for k in sorted({key[1] for key in lines if key[0] == method}):
                 pts = []
                 for n in sorted({key[2] for key in lines}):
                     rs = lines.get((method, k, n))
@@ -387,9 +398,9 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
                     if np.isfinite(c):
                         pts.append((n, c, bound))
                 if pts:
-                    color = colors.get((method, k))
+                    color = colors.get((method, k), colors.get((method, 0)))
                     ax.loglog([q[0] for q in pts], [q[1] for q in pts], style, color=color,
-                              label=f"{model}, {method} (max order {k})")
+                              label=f"{model}, {line_label(method, k)}")
                     for q in pts:
                         ax.loglog(q[0], q[1], "v" if q[2] else "o", color=color,
                                   fillstyle="none" if q[2] else "full")
@@ -429,7 +440,8 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
              f"atol = {args.atol_per_rtol} rtol; rtol = "
              + ", ".join(f"{r:.0e}" for r in sorted(rtols, reverse=True))
              + f"; references at rtol {ref_rtol:.0e} with both integrators; errors over "
-             f"[0, horizon] against the other integrator's reference; CPU time: median over "
+             f"[0, horizon] against the other integrator's reference (MEBDF's for cvode "
+             "and adams, CVODE's for the others); CPU time: median over "
              f">= {args.repeat_time} s of repeated runs. Raw data: "
              "[data/rope_wp.csv](data/rope_wp.csv), "
              "[data/rope_references.csv](data/rope_references.csv).")
@@ -476,7 +488,7 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
         for n in ns:
             c, bound = cost.get((model, method, k, n), (float("nan"), False))
             cells.append(("≤ " if bound else "") + fmt(c))
-        b.append(f"| {model}, {method} ({k}) | " + " | ".join(cells) + " |")
+        b.append(f"| {model}, {method} ({k or 'default'}) | " + " | ".join(cells) + " |")
     b.append("")
     b.append("**Every run** (tip L2 error m / all-points L2 error m / energy-balance error J / "
              "steps / CPU s):")
@@ -485,7 +497,7 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
         ns = sorted({key[2] for key in lines})
         settings = sorted({(key[0], key[1]) for key in lines})
         b.append("")
-        b.append(f"| {model}: n, rtol | " + " | ".join(f"{m} ({k})" for m, k in settings) + " |")
+        b.append(f"| {model}: n, rtol | " + " | ".join(f"{m} ({k or 'default'})" for m, k in settings) + " |")
         b.append("|---|" + "---|" * len(settings))
         for n in ns:
             for rtol in sorted(rtols, reverse=True):
