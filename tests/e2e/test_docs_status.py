@@ -25,6 +25,13 @@ def _repo(tmp_path):
     commit("2026-01-03T12:00:00Z", "comment\n\nNumbers-unchanged: a comment",
            {"src/a.f90": "2 ! why\n"})
     commit("2026-01-04T12:00:00Z", "docs", {"docs/y.md": "y\n"})
+    # a study run on the working tree at 06:00, committed with the code it ran at 13:00;
+    # the code changes again the next day
+    with_page = commit("2026-01-05T13:00:00Z", "study and its page", {
+        "src/a.f90": "3\n",
+        "docs/committed.md": "<!-- run:begin -->\nCommand: `scripts/fig5`. "
+                             "Run: 2026-01-05 06:00 UTC.\n<!-- run:end -->\n"})
+    later = commit("2026-01-06T12:00:00Z", "change a again", {"src/a.f90": "4\n"})
     (tmp_path / "docs" / "page.md").write_text(f"""# Page
 <!-- before:begin -->
 Command: `scripts/fig5` (Release). Run: 2026-01-02 06:00 UTC.
@@ -43,20 +50,27 @@ Command: `scripts/work_precision_testset`. Run: 2026-01-02 06:00 UTC.
 A table someone wrote by hand.
 <!-- undated:end -->
 """)
-    return second
+    return second, with_page, later
 
 
 def test_sections_count_the_code_commits_since_their_run(tmp_path):
-    second = _repo(tmp_path)
+    second, with_page, later = _repo(tmp_path)
     rows = {r["name"]: r for r in docs_status.status(tmp_path)}
-    assert [c[0] for c in rows["before"]["commits"]] == [second]
+    hashes = {name: [c[0] for c in r["commits"]] for name, r in rows.items()
+              if r["commits"] is not None}
+    # page.md is not committed: judged by its runs' times (the comment-only commit of
+    # Jan 3, marked Numbers-unchanged, never counts)
+    assert hashes["before"] == [later, with_page, second]
     assert rows["before"]["script"] == "fig5"
-    assert rows["after"]["commits"] == []
+    assert hashes["after"] == [later, with_page]
     # a section that names its commit is judged from the commit, not from the date
-    assert [c[0] for c in rows["by-commit"]["commits"]] == [second]
+    assert hashes["by-commit"] == [later, with_page, second]
     # the test set's numbers do not come from src/
-    assert rows["testset"]["commits"] == []
+    assert hashes["testset"] == []
     assert rows["undated"]["commits"] is None
+    # a committed stamp is judged from the commit that wrote it: the code committed with it
+    # (after the run's time) does not count, the next day's change does
+    assert hashes["run"] == [later]
 
 
 def test_check_fails_on_a_stale_section(tmp_path, capsys):
@@ -66,5 +80,5 @@ def test_check_fails_on_a_stale_section(tmp_path, capsys):
     assert docs_status.main(["--root", str(tmp_path), "--check"]) == 1
     out = capsys.readouterr().out
     listed = [line.split(" | ")[1] for line in out.splitlines() if line.startswith("| docs")]
-    assert "before" in listed and "by-commit" in listed and "undated" in listed
-    assert "after" not in listed and "testset" not in listed
+    assert {"before", "after", "by-commit", "undated", "run"} <= set(listed)
+    assert "testset" not in listed

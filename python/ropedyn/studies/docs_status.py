@@ -3,7 +3,8 @@
 Every table or figure in docs/ stands between two markers, `<!-- NAME:begin -->` and
 `<!-- NAME:end -->`, and opens with the command that wrote it and when (a "Run:" stamp, a
 "(... min, YYYY-MM-DD HH:MM UTC)" or a "YYYY-MM-DD, commit `abc1234`" line). For each section
-this lists the commits since that run that changed the code its numbers come from: the
+this lists the commits that changed the code its numbers come from after the commit that
+wrote that stamp into the page (after the run's time while it is not committed): the
 Fortran (src/, solvers/, CMakeLists.txt), the scenes (input/) and the study's own module
 (python/ropedyn/studies/SCRIPT.py, SCRIPT read from the section's command; NARROWER lists the
 studies that read less). A commit there does not mean the numbers changed; it means the
@@ -81,10 +82,15 @@ def run_time(stamp):
     return when.replace(tzinfo=datetime.timezone.utc)
 
 
+def _git_out(root, *args):
+    return subprocess.run(["git", "-C", str(root), *args], capture_output=True, text=True,
+                          check=True).stdout.strip()
+
+
 def code_commits(root, since, paths, commit=None):
     """[(short hash, ISO date, subject)] of the commits that changed `paths` after the time
-    `since` (or, given the section's `commit`, after that commit), newest first; not those
-    whose message has a line starting with UNCHANGED."""
+    `since` (or, given `commit`, after that commit), newest first; not those whose message
+    has a line starting with UNCHANGED."""
     cmd = ["git", "-C", str(root), "log", "-z", "--format=%h%x09%cI%x09%s%x09%b"]
     if commit:
         cmd.append(f"{commit}..HEAD")
@@ -116,6 +122,12 @@ def status(root=ROOT):
             if script:
                 paths.append(f"python/ropedyn/studies/{script}.py")
             commits = None
+            if stamp and not commit:
+                # the commit that wrote this stamp into the page: the code it ran is that
+                # commit's (a study is run on the working tree and committed with the code
+                # it measured); a stamp not committed yet is judged by its time
+                commit = _git_out(root, "log", "-1", "--format=%h", "-S", stamp, "--",
+                                  str(page.relative_to(root))) or None
             if stamp or commit:
                 when = run_time(stamp) if stamp else None
                 commits = code_commits(root, when, paths, commit)
