@@ -82,3 +82,15 @@ def test_check_fails_on_a_stale_section(tmp_path, capsys):
     listed = [line.split(" | ")[1] for line in out.splitlines() if line.startswith("| docs")]
     assert {"before", "after", "by-commit", "undated", "run"} <= set(listed)
     assert "testset" not in listed
+
+
+def test_a_commit_listed_as_numbers_unchanged_does_not_count(tmp_path):
+    """docs/numbers-unchanged.txt marks a committed code change whose results were checked
+    to be the same; it counts against no section (comments after # are ignored)."""
+    second, with_page, later = _repo(tmp_path)
+    (tmp_path / "docs" / "numbers-unchanged.txt").write_text(
+        f"# commit  how it was checked\n{later}  every scene's steps identical\n")
+    rows = {r["name"]: [c[0] for c in r["commits"]] for r in docs_status.status(tmp_path)
+            if r["commits"] is not None}
+    assert rows["run"] == []
+    assert rows["before"] == [with_page, second]

@@ -10,7 +10,8 @@ Fortran (src/, solvers/, CMakeLists.txt), the scenes (input/) and the study's ow
 studies that read less). A commit there does not mean the numbers changed; it means the
 study has not been run on the code as it is, and its page should say why not or be rerun by
 its script. A commit that changes code but, checked, none of the results (a refactoring, a
-comment) says so with a line `Numbers-unchanged: how it was checked` in its message and is
+comment) says so with a line `Numbers-unchanged: how it was checked` in its message, or,
+once committed, with a line `HASH  how it was checked` in docs/numbers-unchanged.txt; it is
 not counted.
 
     scripts/docs_status            # every section, oldest first
@@ -35,6 +36,8 @@ NARROWER = {
 }
 #: the line of a commit message that keeps a code commit from counting (see above)
 UNCHANGED = "Numbers-unchanged:"
+#: commits that changed code but, checked, no result (one `HASH  how checked` a line)
+UNCHANGED_FILE = "docs/numbers-unchanged.txt"
 #: how many lines after the begin marker are searched for the command and the stamp
 HEAD_LINES = 6
 
@@ -87,11 +90,24 @@ def _git_out(root, *args):
                           check=True).stdout.strip()
 
 
-def code_commits(root, since, paths, commit=None):
+def unchanged_commits(root):
+    """The full hashes of the commits listed in root/UNCHANGED_FILE (comments: #)."""
+    path = pathlib.Path(root) / UNCHANGED_FILE
+    if not path.exists():
+        return set()
+    full = set()
+    for line in path.read_text().splitlines():
+        line = line.split("#", 1)[0].strip()
+        if line:
+            full.add(_git_out(root, "rev-parse", "--verify", line.split()[0] + "^{commit}"))
+    return full
+
+
+def code_commits(root, since, paths, commit=None, skip=frozenset()):
     """[(short hash, ISO date, subject)] of the commits that changed `paths` after the time
     `since` (or, given `commit`, after that commit), newest first; not those whose message
-    has a line starting with UNCHANGED."""
-    cmd = ["git", "-C", str(root), "log", "-z", "--format=%h%x09%cI%x09%s%x09%b"]
+    has a line starting with UNCHANGED, nor those in `skip` (full hashes)."""
+    cmd = ["git", "-C", str(root), "log", "-z", "--format=%H%x09%h%x09%cI%x09%s%x09%b"]
     if commit:
         cmd.append(f"{commit}..HEAD")
     else:
@@ -104,8 +120,8 @@ def code_commits(root, since, paths, commit=None):
     for record in out.stdout.split("\0"):
         if not record.strip():
             continue
-        rev, date, subject, body = record.strip("\n").split("\t", 3)
-        if any(line.startswith(UNCHANGED) for line in body.splitlines()):
+        full, rev, date, subject, body = record.strip("\n").split("\t", 4)
+        if full in skip or any(line.startswith(UNCHANGED) for line in body.splitlines()):
             continue
         commits.append((rev, date, subject))
     return commits
@@ -115,6 +131,7 @@ def status(root=ROOT):
     """One row per generated section of root/docs/*.md: dict(page, name, script, stamp,
     commits); commits None when the section names no run time."""
     root = pathlib.Path(root)
+    skip = unchanged_commits(root)
     rows = []
     for page in sorted((root / "docs").glob("*.md")):
         for name, script, stamp, commit in sections(page):
@@ -130,7 +147,7 @@ def status(root=ROOT):
                                   str(page.relative_to(root))) or None
             if stamp or commit:
                 when = run_time(stamp) if stamp else None
-                commits = code_commits(root, when, paths, commit)
+                commits = code_commits(root, when, paths, commit, skip)
             rows.append({"page": str(page.relative_to(root)), "name": name, "script": script,
                          "stamp": stamp, "commits": commits})
     return rows
