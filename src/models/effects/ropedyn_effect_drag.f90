@@ -11,6 +11,7 @@
 module ropedyn_effect_drag
     use ropedyn_kinds, only: wp
     use ropedyn_effect, only: body_effect_t, bodies_t
+    use ropedyn_trig, only: cos_sin
     implicit none
     private
     public :: drag_effect_t, drag_effect
@@ -60,30 +61,32 @@ contains
         does = self%current
     end function drag_does_work
 
-    !> Length l of body i, its axis e and normal nv, and the components a (along e) and bb
-    !! (along nv) of its centre's velocity relative to the fluid.
-    pure subroutine relative_motion(self, b, i, l, e, nv, a, bb)
+    !> Length l of body i, its normal nv, and the components a (along its axis e = (cos phi,
+    !! sin phi), from the caller's vectorized pass) and bb (along nv) of its centre's
+    !! velocity relative to the fluid.
+    pure subroutine relative_motion(self, b, i, e, l, nv, a, bb)
         class(drag_effect_t), intent(in) :: self
         type(bodies_t), intent(in) :: b
         integer, intent(in) :: i
-        real(wp), intent(out) :: l, e(2), nv(2), a, bb
+        real(wp), intent(in) :: e(2)
+        real(wp), intent(out) :: l, nv(2), a, bb
         real(wp) :: vr(2)
         l = b%l(i)
-        e = [cos(b%phi(i)), sin(b%phi(i))]
         nv = [-e(2), e(1)]
         vr = b%v(:, i) - self%u
         a = dot_product(e, vr)
         bb = dot_product(nv, vr)
     end subroutine relative_motion
 
-    !> Force and moment of body i.
-    pure subroutine body_drag(self, b, i, f, m)
+    !> Force and moment of body i with axis e.
+    pure subroutine body_drag(self, b, i, e, f, m)
         class(drag_effect_t), intent(in) :: self
         type(bodies_t), intent(in) :: b
         integer, intent(in) :: i
+        real(wp), intent(in) :: e(2)
         real(wp), intent(out) :: f(2), m
-        real(wp) :: e(2), nv(2), a, bb, l
-        call relative_motion(self, b, i, l, e, nv, a, bb)
+        real(wp) :: nv(2), a, bb, l
+        call relative_motion(self, b, i, e, l, nv, a, bb)
         f = 0.0_wp
         m = 0.0_wp
         if (self%quadratic) then
@@ -101,10 +104,11 @@ contains
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: f(:, :), m(:)
-        real(wp) :: fi(2), mi
+        real(wp) :: fi(2), mi, cs(2, b%n)
         integer :: i
+        call cos_sin(b%phi, cs)
         do i = 1, b%n
-            call body_drag(self, b, i, fi, mi)
+            call body_drag(self, b, i, cs(:, i), fi, mi)
             f(:, i) = f(:, i) + fi
             m(i) = m(i) + mi
         end do
@@ -115,10 +119,12 @@ contains
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: jac(:, :, :)
-        real(wp) :: e(2), nv(2), a, bb, l, kn, kt, dfdv(2, 2), dfdphi(2), dmdw
+        real(wp) :: e(2), nv(2), a, bb, l, kn, kt, dfdv(2, 2), dfdphi(2), dmdw, cs(2, b%n)
         integer :: i, p
+        call cos_sin(b%phi, cs)
         do i = 1, b%n
-            call relative_motion(self, b, i, l, e, nv, a, bb)
+            e = cs(:, i)
+            call relative_motion(self, b, i, e, l, nv, a, bb)
             dfdv = 0.0_wp
             dfdphi = 0.0_wp
             dmdw = 0.0_wp
@@ -150,10 +156,11 @@ contains
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: dissipation, work
-        real(wp) :: fi(2), mi
+        real(wp) :: fi(2), mi, cs(2, b%n)
         integer :: i
+        call cos_sin(b%phi, cs)
         do i = 1, b%n
-            call body_drag(self, b, i, fi, mi)
+            call body_drag(self, b, i, cs(:, i), fi, mi)
             dissipation = dissipation - dot_product(fi, b%v(:, i) - self%u) - mi*b%w(i)
             if (self%current) work = work + dot_product(fi, self%u)
         end do
