@@ -131,22 +131,14 @@ contains
             s%final_energy%total()
         write (output_unit, '(a, es13.5, a, es10.2, a)') '  E0              ', e0, &
             ' J   balance error (T+V+dissipated-E0) ', drift, ' J'
-        associate (safety => s%safety)
-            if (safety%lowered_at >= 0.0_wp) write (output_unit, &
-                '(a, es10.3, a, es10.3, a, i0, a, i0, a, f9.4, a)') &
-                '  order safety    energy gain ', s%energy_gain, ' J > bound ', &
-                s%energy_gain_bound, ' J: max order ', safety%order_before, ' -> ', &
-                safety%order_after, ' from t = ', safety%lowered_at, ' s'
-            if (safety%unresolved_at >= 0.0_wp) write (output_unit, '(a, es10.3, a, f9.4, a)') &
-                '  order safety    energy gain ', s%energy_gain, ' J above the bound at t = ', &
-                safety%unresolved_at, ' s at the safe order (not an order instability)'
-            if (safety%restored_at >= 0.0_wp) write (output_unit, '(a, i0, a, f9.4, a)') &
-                '  order safety    max order ', safety%order_before, ' restored from t = ', &
-                safety%restored_at, ' s (the gain persisted at the safe order)'
-            if (safety%lowered_again_at >= 0.0_wp) write (output_unit, '(a, i0, a, f9.4, a)') &
-                '  order safety    max order ', safety%order_after, ' again from t = ', &
-                safety%lowered_again_at, ' s, for good (the gain grew by another bound)'
-        end associate
+        if (s%order_lowered_at >= 0.0_wp) write (output_unit, &
+            '(a, es10.3, a, es10.3, a, i0, a, i0, a, f9.4, a)') &
+            '  order safety    energy gain ', s%energy_gain, ' J > bound ', &
+            s%energy_gain_bound, ' J: max order ', s%order_before, ' -> ', s%order_after, &
+            ' from t = ', s%order_lowered_at, ' s'
+        if (s%gain_unresolved_at >= 0.0_wp) write (output_unit, '(a, es10.3, a, f9.4, a)') &
+            '  order safety    energy gain ', s%energy_gain, ' J above the bound at t = ', &
+            s%gain_unresolved_at, ' s at the safe order (not an order instability)'
         write (output_unit, '(a)') '  output          '//s%file
     end subroutine print_summary
 

@@ -23,8 +23,6 @@
 !!     /solver/restarts/{time, record, steps, cpu_time, wall_clock, previous_status,
 !!              previous_reason} (restarts,)   one entry per resume (add_restart)
 !!     /solver/order_lowered_at () s, /solver/order_lowered_from, _to () int64 1,
-!!     /solver/order_restored_at () s (only when the order was restored),
-!!     /solver/order_lowered_again_at () s (only when it was lowered again after that),
 !!     /solver/energy_gain () J: only when the order safety lowered the order (the time
 !!              from which the run went on at the lower order, and the gain that caused it)
 !!
@@ -402,17 +400,13 @@ contains
     end subroutine output_write_stats
 
     !> Record that the order safety lowered the order limit from `from` to `to` at time `t`
-    !! because the energy balance gained `gain` (docs/stability.md), and, with `restored_at`
-    !! >= 0, that it restored `from` at that time (the gain persisted at the safe order), and
-    !! with `again_at` >= 0, that it lowered the order to `to` again, for good, at that time.
-    subroutine output_write_order_lowered(self, t, from, to, gain, err, restored_at, again_at)
+    !! because the energy balance gained `gain` (docs/stability.md).
+    subroutine output_write_order_lowered(self, t, from, to, gain, err)
         class(output_file_t), intent(inout) :: self
         real(wp), intent(in) :: t       !< s
         integer, intent(in) :: from, to
         real(wp), intent(in) :: gain    !< J
         type(error_t), allocatable, intent(out) :: err
-        real(wp), intent(in), optional :: restored_at   !< s
-        real(wp), intent(in), optional :: again_at      !< s
         if (.not. self%is_open) then
             call make_error(err, ERR_INTERNAL, &
                             file_label(self)//': write_order_lowered: file is not open')
@@ -424,14 +418,6 @@ contains
         if (.not. allocated(err)) &
             call self%file%write('/solver/order_lowered_to', int(to, i8), '1', err)
         if (.not. allocated(err)) call self%file%write('/solver/energy_gain', gain, 'J', err)
-        if (present(restored_at)) then
-            if (.not. allocated(err) .and. restored_at >= 0.0_wp) &
-                call self%file%write('/solver/order_restored_at', restored_at, 's', err)
-        end if
-        if (present(again_at)) then
-            if (.not. allocated(err) .and. again_at >= 0.0_wp) &
-                call self%file%write('/solver/order_lowered_again_at', again_at, 's', err)
-        end if
         if (.not. allocated(err)) call self%file%flush(err)
     end subroutine output_write_order_lowered
 

@@ -12,20 +12,13 @@
 !! max elastic + (max - min) of the gravity energy + the energy dissipated (J); one accepted
 !! step moves B by about rtol times the energies in play, so the bound rtol S follows the
 !! tolerance. The monitor knows nothing of integrators: the run driver
-!! (`ropedyn_simulation`) decides what a gain means (lower the order, stop), on the rules of
-!! `order_safety_t` below (orders as plain numbers).
+!! (`ropedyn_simulation`) decides what a gain means (lower the order, stop).
 module ropedyn_energy_monitor
     use ropedyn_kinds, only: wp
     use ropedyn_rope_model, only: energy_t
     implicit none
     private
-    public :: energy_monitor_t, order_safety_t
-    public :: SAFETY_KEEP, SAFETY_LOWER, SAFETY_RESTORE
-
-    !> What the order safety does at a record whose gain is beyond the bound
-    integer, parameter :: SAFETY_KEEP = 0     !< go on as it is (the gain is only reported)
-    integer, parameter :: SAFETY_LOWER = 1    !< back to the previous record, on at the safe order
-    integer, parameter :: SAFETY_RESTORE = 2  !< on from this record at the order asked for
+    public :: energy_monitor_t
 
     type :: energy_monitor_t
         real(wp) :: e0 = 0.0_wp             !< B at the start, J
@@ -45,73 +38,7 @@ module ropedyn_energy_monitor
         procedure :: gained => monitor_gained
     end type energy_monitor_t
 
-    !> The order safety's rules and what it did in a run (times in s, < 0: never). At a
-    !! gain beyond the bound: lower the order limit to the method's safe (A-stable) order
-    !! and integrate the interval again; if a gain is seen again at the safe order, it was
-    !! not an order instability (the integration error of a scene with external work at a
-    !! tight rtol): restore the order asked for, once, rather than stay at an order that may
-    !! crawl; should the gain then grow by another bound, lowering was right after all:
-    !! lower again, for good. A method without a safe order, or at it from the start, only
-    !! reports the gain.
-    type :: order_safety_t
-        real(wp) :: lowered_at = -1.0_wp        !< first lowering, from this record
-        integer :: order_before = 0             !< the order limit asked for
-        integer :: order_after = 0              !< the safe order
-        real(wp) :: unresolved_at = -1.0_wp     !< first gain at the safe order (or none)
-        real(wp) :: restored_at = -1.0_wp       !< the order asked for restored
-        real(wp) :: lowered_again_at = -1.0_wp  !< lowered again, for good
-        real(wp) :: gain_restored = 0.0_wp      !< the gain when restored, J
-    contains
-        procedure :: action => safety_action
-        procedure :: take => safety_take
-    end type order_safety_t
-
 contains
-
-    !> The action at a record whose gain (J) is beyond the bound (J), the run being at
-    !! order limit `max_order` of a method whose safe order is `safe_order` (0: none).
-    pure integer function safety_action(self, gain, bound, max_order, safe_order) &
-        result(action)
-        class(order_safety_t), intent(in) :: self
-        real(wp), intent(in) :: gain, bound
-        integer, intent(in) :: max_order, safe_order
-        action = SAFETY_KEEP
-        if (safe_order > 0 .and. max_order > safe_order) then
-            if (self%restored_at < 0.0_wp) then
-                action = SAFETY_LOWER
-            else if (self%lowered_again_at < 0.0_wp .and. &
-                     gain > self%gain_restored + bound) then
-                action = SAFETY_LOWER
-            end if
-        else if (self%lowered_at >= 0.0_wp .and. self%restored_at < 0.0_wp .and. &
-                 max_order < self%order_before) then
-            action = SAFETY_RESTORE
-        end if
-    end function safety_action
-
-    !> Remember `action`, taken at the record at time t (the previous record at t_prev).
-    pure subroutine safety_take(self, action, t_prev, t, gain, max_order, safe_order)
-        class(order_safety_t), intent(inout) :: self
-        integer, intent(in) :: action
-        real(wp), intent(in) :: t_prev, t, gain
-        integer, intent(in) :: max_order, safe_order
-        select case (action)
-        case (SAFETY_LOWER)
-            if (self%restored_at < 0.0_wp) then
-                self%lowered_at = t_prev
-                self%order_before = max_order
-                self%order_after = safe_order
-            else
-                self%lowered_again_at = t_prev
-            end if
-        case default
-            if (self%unresolved_at < 0.0_wp) self%unresolved_at = t
-            if (action == SAFETY_RESTORE) then
-                self%restored_at = t
-                self%gain_restored = gain
-            end if
-        end select
-    end subroutine safety_take
 
     !> Start from the energies of the initial state.
     pure subroutine monitor_start(self, e, rtol, factor)

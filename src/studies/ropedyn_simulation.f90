@@ -24,8 +24,7 @@ module ropedyn_simulation
     use ropedyn_version, only: version_string
     use ropedyn_modes, only: equilibrium_initial_state
     use ropedyn_methods, only: METHODS, method_index
-    use ropedyn_energy_monitor, only: energy_monitor_t, order_safety_t, SAFETY_LOWER, &
-                                      SAFETY_RESTORE
+    use ropedyn_energy_monitor, only: energy_monitor_t
     use ropedyn_state_start, only: state_initial_state
     implicit none
     private
@@ -42,11 +41,16 @@ module ropedyn_simulation
         !> the integrator's changes of method or order limit (auto, cvode's crawl watch)
         type(switch_event_t), allocatable :: switches(:)
         character(len=:), allocatable :: file
-        !> order safety (docs/stability.md): what it did (lowered, restored, ... and when),
-        !! and the first gain that made it act, with its bound (J)
-        type(order_safety_t) :: safety
+        !> order safety (docs/stability.md): the time from which the order was lowered
+        !! (< 0: never), the order limit before and after, and the gain that caused it (J)
+        real(wp) :: order_lowered_at = -1.0_wp
+        integer :: order_before = 0
+        integer :: order_after = 0
         real(wp) :: energy_gain = 0.0_wp
         real(wp) :: energy_gain_bound = 0.0_wp
+        !> a gain beyond the bound that could not be cured by lowering the order (the method
+        !! was at its safe order already, or has none): the first time it was seen (< 0: never)
+        real(wp) :: gain_unresolved_at = -1.0_wp
     end type run_summary_t
 
 contains
@@ -124,13 +128,7 @@ contains
     !! energy monitor compares the balance with E0; a gain above `energy_gain_bound` rtol S
     !! with 'lower' restarts the integrator from the previous record at the method's safe
     !! (A-stable) order and integrates the interval again (once: the order stays there), with
-    !! 'stop' ends the run as a failed integration naming the gain. If the gain is still
-    !! there at a later output time at the safe order, it was not an order instability (the
-    !! integration error of a scene with external work, at a tight rtol): the order limit
-    !! asked for is restored from there, once, rather than left at an order that may crawl
-    !! (BDF2 at rtol 1e-11 exhausted 10^6 steps in 0.14 s on every_effect_mpp_n7). Should
-    !! the gain then grow by another bound at that order, lowering was right after all: back
-    !! to the previous record and on at the safe order for good.
+    !! 'stop' ends the run as a failed integration naming the gain.
     subroutine run_scene(scene, summary, err, resume)
         type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(out) :: summary
@@ -158,7 +156,6 @@ contains
         real(wp) :: t_prev
         integer :: max_order, safe_order
         logical :: monitoring
-        logical :: restore_order   !< the order safety restores the order after this record
         type(output_file_t) :: out
         type(progress_t) :: progress
         type(error_t), allocatable :: io_err
@@ -260,7 +257,6 @@ contains
             return
         end if
         call progress%start_run(t0, t_end, scene%output%progress, scene%output%progress_given)
-        restore_order = .false.
         do k = k_first, n_out
             tout = output_time(k)
             if (scene%solver%profile) clock_start = clock_seconds()
@@ -291,14 +287,6 @@ contains
                 return
             end if
             call write_record(err)  ! also refreshes `stats`
-            if (.not. allocated(err) .and. restore_order) then
-                ! on from this record at the order limit asked for (check_energy)
-                restore_order = .false.
-                call stats_before%add(integrator%stats())
-                call integrator%finalize()
-                max_order = summary%safety%order_before
-                call start_integrator(err)
-            end if
             if (allocated(err)) then
                 call progress%done()
                 if (err%code == ERR_SOLVER) call finish('failed', err%message)
@@ -392,16 +380,12 @@ contains
         end subroutine start_integrator
 
         !> The energy monitor at the output time just reached: on a gain beyond the bound,
-        !! fail ('stop'), or act on the order safety's rules ('lower'; order_safety_t in
-        !! ropedyn_energy_monitor): lower the order and integrate the interval again, or
-        !! restore the order asked for after this record is written.
+        !! lower the order and integrate the interval again ('lower'), or fail ('stop').
         subroutine check_energy(tout, cerr)
             real(wp), intent(in) :: tout
             type(error_t), allocatable, intent(out) :: cerr
             type(energy_t) :: e
             character(len=200) :: what
-            real(wp) :: gain, bound
-            integer :: action
             e = model%energy(t, y, yq)
             if (.not. ieee_is_finite(e%balance())) return   ! write_record says so
             if (.not. monitor%gained(e)) then
@@ -412,15 +396,13 @@ contains
                 type(energy_monitor_t) :: next
                 next = monitor
                 call next%observe(e)
-                gain = next%gain(e)
-                bound = next%bound()
                 write (what, '(a, es10.3, a, es10.3, a, es12.5, a, i0)') 'energy gain ', &
-                    gain, ' J above E0 (bound ', bound, ' J) at t = ', t, &
+                    next%gain(e), ' J above E0 (bound ', next%bound(), ' J) at t = ', t, &
                     ' s, max order ', max_order
-                if (summary%safety%unresolved_at < 0.0_wp .and. &
-                    summary%safety%lowered_at < 0.0_wp) then
-                    summary%energy_gain = gain
-                    summary%energy_gain_bound = bound
+                if (summary%gain_unresolved_at < 0.0_wp .and. &
+                    summary%order_lowered_at < 0.0_wp) then
+                    summary%energy_gain = next%gain(e)
+                    summary%energy_gain_bound = next%bound()
                 end if
             end block
             if (trim(scene%solver%order_safety) == 'stop') then
@@ -435,10 +417,11 @@ contains
                 yq = yq_prev
                 return
             end if
-            action = summary%safety%action(gain, bound, max_order, safe_order)
-            call summary%safety%take(action, t_prev, t, gain, max_order, safe_order)
-            if (action == SAFETY_LOWER) then
+            if (safe_order > 0 .and. max_order > safe_order) then
                 ! back to the previous record, on at the safe order
+                summary%order_lowered_at = t_prev
+                summary%order_before = max_order
+                summary%order_after = safe_order
                 call stats_before%add(integrator%stats())
                 call integrator%finalize()
                 max_order = safe_order
@@ -450,9 +433,8 @@ contains
                 call integrator%advance_to(tout, t, y, yq(1:nq), cerr)
                 if (allocated(cerr)) return
                 e = model%energy(t, y, yq)
-            else if (action == SAFETY_RESTORE) then
-                ! on from this record (once written) at the order limit asked for
-                restore_order = .true.
+            else if (summary%gain_unresolved_at < 0.0_wp) then
+                summary%gain_unresolved_at = t
             end if
             call monitor%observe(e)
         end subroutine check_energy
@@ -505,12 +487,9 @@ contains
             call out%write_stats(summary%stats, summary%cpu_time, ferr, t_reached=t)
             summary%switches = integrator%switch_log()
             if (.not. allocated(ferr)) call out%write_switches(summary%switches, ferr)
-            if (.not. allocated(ferr) .and. summary%safety%lowered_at >= 0.0_wp) &
-                call out%write_order_lowered(summary%safety%lowered_at, &
-                                             summary%safety%order_before, &
-                                             summary%safety%order_after, summary%energy_gain, &
-                                             ferr, summary%safety%restored_at, &
-                                             summary%safety%lowered_again_at)
+            if (.not. allocated(ferr) .and. summary%order_lowered_at >= 0.0_wp) &
+                call out%write_order_lowered(summary%order_lowered_at, summary%order_before, &
+                                             summary%order_after, summary%energy_gain, ferr)
             call out%close_run(status, reason, ferr)
             if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
             call integrator%finalize()

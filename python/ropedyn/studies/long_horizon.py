@@ -202,9 +202,6 @@ def measures(rc, stderr, path, scene):
         if "order_lowered_at" in f["solver"]:
             r["order_lowered_at"] = float(f["solver/order_lowered_at"][()])
             r["order_lowered_to"] = int(f["solver/order_lowered_to"][()])
-        for name in ("order_restored_at", "order_lowered_again_at"):
-            if name in f["solver"]:
-                r[name] = float(f["solver"][name][()])
     r["outcome"] = "complete" if (m["status"] == "complete" and rc == 0) else \
         f"failed (exit {rc}) at t = {m['t_reached']:.4g} s: {m['reason']}"
     r["_series"] = {"time": t, "tip": m["tip"], "mech": m["mech"],

@@ -261,7 +261,7 @@ def long_matrix_table(res):
         orders = "-".join(str(k) for k in (min(r["orders"]), max(r["orders"]))) \
             if r["orders"] else ""
         if r.get("order_lowered_at") is not None:
-            orders += f" ({order_history(r)})"
+            orders += f" (lowered to {r['order_lowered_to']} at {r['order_lowered_at']:.3g} s)"
         lines.append(
             f"| {scene} | {r['t_end']:g} | {run} | {r['steps']} | {fmt(r['cpu_time'], '.1f')} | "
             f"{r['balance_ratio']:.2g} | {r['max_gain_ratio']:.2g} | {r['final_drift']:+.1e} | "
@@ -312,22 +312,12 @@ def order_safety_table(res):
         if "steps" not in r:
             lines.append(f"| {scene} | {label} |  |  |  |  |  | {short(r['outcome'])} |")
             continue
-        low = "" if r.get("order_lowered_at") is None else order_history(r)
+        low = "" if r.get("order_lowered_at") is None else \
+            f"to {r['order_lowered_to']} at {r['order_lowered_at']:.3g} s"
         lines.append(f"| {scene} | {label} | {r['steps']} | {fmt(r['cpu_time'], '.1f')} | "
                      f"{r['max_gain_ratio']:.3g} | {r['balance_ratio']:.3g} | {low} | "
                      f"{short(r['outcome'])} |")
     return "\n".join(lines)
-
-
-def order_history(r):
-    """What the order safety did in a long-horizon case: 'lowered to 2 at 0.384 s', then
-    ', restored at 0.388 s' and ', lowered again at ... s' when it did."""
-    text = f"lowered to {r['order_lowered_to']} at {r['order_lowered_at']:.3g} s"
-    if r.get("order_restored_at") is not None:
-        text += f", restored at {r['order_restored_at']:.3g} s"
-    if r.get("order_lowered_again_at") is not None:
-        text += f", lowered again at {r['order_lowered_again_at']:.3g} s"
-    return text
 
 
 def long_sections(exe, jobs, command, stamp, cached_only=False):
