@@ -109,14 +109,17 @@ def test_shim_answers_help(name, tmp_path):
     assert result.stdout.startswith("usage:"), result.stdout
 
 
-@pytest.mark.parametrize("module", ["ropedyn.studies.bench_effects",
-                                    "ropedyn.studies.bench_kernels"])
-def test_unknown_baseline_is_a_usage_error(module, capsys):
+@pytest.mark.parametrize("module, extra", [
+    ("ropedyn.studies.bench_effects", ["--build", "/nonexistent"]),
+    ("ropedyn.studies.bench_kernels", ["--build", "/nonexistent"]),
+    ("ropedyn.studies.profile_step", ["--exe", "/nonexistent"]),
+    ("ropedyn.studies.bench_step", ["--exe", "/nonexistent"])])
+def test_unknown_baseline_is_a_usage_error(module, extra, capsys):
     """--baseline naming no commit: a usage error naming the option and the value (exit 2),
     before anything is built (it used to end in git's traceback after the Release build)."""
     main = importlib.import_module(module).main
     with pytest.raises(SystemExit) as stop:
-        main(["--baseline", "no-such-revision", "--build", "/nonexistent", "--no-write"])
+        main(["--baseline", "no-such-revision", *extra, "--no-write"])
     assert stop.value.code == 2
     assert "--baseline no-such-revision: not a commit" in capsys.readouterr().err
 
@@ -124,7 +127,7 @@ def test_unknown_baseline_is_a_usage_error(module, capsys):
 def test_baseline_revision_names_the_commit():
     """A revision git knows comes back as the short hash of its commit."""
     import argparse
-    from ropedyn.studies.bench_rhs import baseline_revision
+    from ropedyn.studies.common import baseline_revision
     head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True,
                           text=True, check=True).stdout.strip()
     short = baseline_revision(argparse.ArgumentParser(), "HEAD")

@@ -16,8 +16,8 @@ import sys
 import tempfile
 
 from ropedyn.run import DOCS, PAPER, build, set_args
-from ropedyn.studies.bench_rhs import baseline_revision, build_bench_rhs
-from ropedyn.studies.common import machine, update_doc, utc_stamp
+from ropedyn.studies.bench_rhs import build_bench_rhs
+from ropedyn.studies.common import baseline_revision, machine, update_doc, utc_stamp
 
 BEGIN = "<!-- bench_effects:begin -->"
 END = "<!-- bench_effects:end -->"

@@ -7,16 +7,6 @@ import subprocess
 from ropedyn.run import ROOT
 
 
-def baseline_revision(parser, rev):
-    """The short hash of the commit `rev` names (a --baseline argument), or a usage error
-    naming the option and the value (exit 2) when git knows no such commit."""
-    found = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--verify", "--quiet",
-                            "--short", f"{rev}^{{commit}}"], capture_output=True, text=True)
-    if found.returncode != 0 or not found.stdout.strip():
-        parser.error(f"--baseline {rev}: not a commit of {ROOT}")
-    return found.stdout.strip()
-
-
 def build_bench_rhs(rev, workdir):
     """Build bench_rhs from git revision `rev` (git archive: the working tree is untouched)
     with this tree's bench_rhs.f90, in the folder `workdir`; the path of the executable.

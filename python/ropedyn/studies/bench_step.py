@@ -16,7 +16,7 @@ import sys
 import tempfile
 
 from ropedyn.run import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
-from ropedyn.studies.common import machine, update_doc, utc_stamp
+from ropedyn.studies.common import baseline_revision, machine, update_doc, utc_stamp
 from ropedyn.studies.profile_step import build_baseline
 
 BEGIN = "<!-- bench_step:begin -->"
@@ -60,6 +60,8 @@ def main(argv=None):
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--no-write", action="store_true", help="print only")
     args = parser.parse_args(argv)
+    if not args.baseline_exe:
+        baseline_revision(parser, args.baseline)
     exe = exe_or_build(args.exe)
     rows = []
     print(HEADER)

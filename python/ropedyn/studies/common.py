@@ -1,11 +1,31 @@
 """What the studies share when they write their results into docs/: the machine line, the
-time stamp and the generated section between two markers of a Markdown page; and a number
-read from a scene file's text."""
+time stamp and the generated section between two markers of a Markdown page; a number read
+from a scene file's text; git's answers about the checkout (`git`, `baseline_revision`)."""
 import datetime
 import os
 import pathlib
 import platform
 import re
+import subprocess
+
+
+def git(*args, root=None):
+    """stdout (bytes) of `git -C root ARGS` (root: this checkout); CalledProcessError when
+    git fails."""
+    from ropedyn.run import ROOT
+    return subprocess.run(["git", "-C", str(root or ROOT), *args], capture_output=True,
+                          check=True).stdout
+
+
+def baseline_revision(parser, rev):
+    """The short hash of the commit `rev` names (a --baseline argument), or a usage error
+    naming the option and the value (exit 2) when git knows no such commit."""
+    try:
+        return git("rev-parse", "--verify", "--quiet", "--short",
+                   f"{rev}^{{commit}}").decode().strip()
+    except subprocess.CalledProcessError:
+        from ropedyn.run import ROOT
+        parser.error(f"--baseline {rev}: not a commit of {ROOT}")
 
 
 def machine():

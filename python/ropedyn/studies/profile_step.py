@@ -35,7 +35,7 @@ import sys
 import tempfile
 
 from ropedyn.run import DOCS, PAPER, ROOT, add_exe_argument, exe_or_build, set_args
-from ropedyn.studies.common import machine, update_doc, utc_stamp
+from ropedyn.studies.common import baseline_revision, machine, update_doc, utc_stamp
 
 BEGIN = "<!-- profile_step:begin -->"
 END = "<!-- profile_step:end -->"
@@ -154,6 +154,7 @@ def main(argv=None):
                         help="the whole program with the scene's output (its own table)")
     parser.add_argument("--no-write", action="store_true", help="print only")
     args = parser.parse_args(argv)
+    rev = baseline_revision(parser, args.baseline) if args.baseline else None
     if args.whole_run and args.methods == "cvode mebdf":
         args.methods = "default"
     parts_names = WHOLE_PARTS if args.whole_run else PARTS
@@ -170,9 +171,6 @@ def main(argv=None):
         tmp = pathlib.Path(tmp)
         builds = []
         if args.baseline:
-            rev = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short",
-                                  args.baseline], capture_output=True, text=True,
-                                 check=True).stdout.strip()
             builds.append((f"{args.baseline} ({rev})", build_baseline(args.baseline, tmp)))
         builds.append(("this tree", exe))
         for label, path in builds:
