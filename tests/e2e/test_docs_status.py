@@ -2,6 +2,8 @@
 import os
 import subprocess
 
+import pytest
+
 from ropedyn.studies import docs_status
 
 
@@ -94,3 +96,15 @@ def test_a_commit_listed_as_numbers_unchanged_does_not_count(tmp_path):
             if r["commits"] is not None}
     assert rows["run"] == []
     assert rows["before"] == [with_page, second]
+
+
+def test_a_bad_line_in_numbers_unchanged_is_named(tmp_path):
+    """A line of docs/numbers-unchanged.txt that names no commit: an error naming the file,
+    the line and the word (not git's traceback)."""
+    _repo(tmp_path)
+    (tmp_path / "docs" / "numbers-unchanged.txt").write_text(
+        "# commit  how checked\n\nnot-a-commit  typed by hand\n")
+    with pytest.raises(SystemExit) as stop:
+        docs_status.status(tmp_path)
+    message = str(stop.value)
+    assert "numbers-unchanged.txt: line 3: 'not-a-commit' is not a commit" in message

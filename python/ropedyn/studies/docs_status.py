@@ -26,6 +26,7 @@ import subprocess
 import sys
 
 from ropedyn.run import ROOT
+from ropedyn.studies.common import git
 
 #: what a study's numbers come from besides its own module
 CODE_PATHS = ("src", "solvers", "CMakeLists.txt", "input")
@@ -85,21 +86,26 @@ def run_time(stamp):
     return when.replace(tzinfo=datetime.timezone.utc)
 
 
-def _git_out(root, *args):
-    return subprocess.run(["git", "-C", str(root), *args], capture_output=True, text=True,
-                          check=True).stdout.strip()
+def _git_text(root, *args):
+    return git(*args, root=root).decode().strip()
 
 
 def unchanged_commits(root):
-    """The full hashes of the commits listed in root/UNCHANGED_FILE (comments: #)."""
+    """The full hashes of the commits listed in root/UNCHANGED_FILE (comments: #); a line
+    whose first word git knows as no commit is an error naming the file, line and word."""
     path = pathlib.Path(root) / UNCHANGED_FILE
     if not path.exists():
         return set()
     full = set()
-    for line in path.read_text().splitlines():
+    for number, line in enumerate(path.read_text().splitlines(), start=1):
         line = line.split("#", 1)[0].strip()
-        if line:
-            full.add(_git_out(root, "rev-parse", "--verify", line.split()[0] + "^{commit}"))
+        if not line:
+            continue
+        rev = line.split()[0]
+        try:
+            full.add(_git_text(root, "rev-parse", "--verify", "--quiet", rev + "^{commit}"))
+        except subprocess.CalledProcessError:
+            raise SystemExit(f"docs_status: {path}: line {number}: '{rev}' is not a commit")
     return full
 
 
@@ -107,7 +113,7 @@ def code_commits(root, since, paths, commit=None, skip=frozenset()):
     """[(short hash, ISO date, subject)] of the commits that changed `paths` after the time
     `since` (or, given `commit`, after that commit), newest first; not those whose message
     has a line starting with UNCHANGED, nor those in `skip` (full hashes)."""
-    cmd = ["git", "-C", str(root), "log", "-z", "--format=%H%x09%h%x09%cI%x09%s%x09%b"]
+    cmd = ["log", "-z", "--format=%H%x09%h%x09%cI%x09%s%x09%b"]
     if commit:
         cmd.append(f"{commit}..HEAD")
     else:
@@ -115,9 +121,8 @@ def code_commits(root, since, paths, commit=None, skip=frozenset()):
     existing = [p for p in paths if (pathlib.Path(root) / p).exists()]
     if not existing:
         return []    # (a bare `git log --` would list every commit)
-    out = subprocess.run(cmd + ["--", *existing], capture_output=True, text=True, check=True)
     commits = []
-    for record in out.stdout.split("\0"):
+    for record in git(*cmd, "--", *existing, root=root).decode().split("\0"):
         if not record.strip():
             continue
         full, rev, date, subject, body = record.strip("\n").split("\t", 4)
@@ -143,7 +148,7 @@ def status(root=ROOT):
                 # the commit that wrote this stamp into the page: the code it ran is that
                 # commit's (a study is run on the working tree and committed with the code
                 # it measured); a stamp not committed yet is judged by its time
-                commit = _git_out(root, "log", "-1", "--format=%h", "-S", stamp, "--",
+                commit = _git_text(root, "log", "-1", "--format=%h", "-S", stamp, "--",
                                   str(page.relative_to(root))) or None
             if stamp or commit:
                 when = run_time(stamp) if stamp else None

@@ -10,12 +10,12 @@ scripts/stability_report (the tables of docs/stability.md).
 **A new method is one line**: append its name to METHODS.
 
 Runs are cached in a work directory (default build/long): a case is run again only when its
-command or the code changed, so that the checks and the report can be re-evaluated without the
-hour of runs. The code is the git content of src/, solvers/ and CMakeLists.txt with any
+command or the code changed, so that the checks and the report can be re-evaluated without
+the hour of runs. The code is the git content of src/, solvers/ and CMakeLists.txt with any
 uncommitted change to them (`code_fingerprint`): a commit that touches only docs or scripts
 relinks the executable (its version string) but keeps the cache; an executable older than
-those files, or outside a git checkout, is keyed on its size and modification time. `measures.json` there holds the
-scalar measures of every case.
+those files, or outside a git checkout, is keyed on its size and modification time.
+`measures.json` there holds the scalar measures of every case.
 """
 import concurrent.futures
 import functools
@@ -31,7 +31,7 @@ import numpy as np
 
 from ropedyn.run import INPUT, ROOT
 from ropedyn.studies import stability_metrics
-from ropedyn.studies.common import scene_number
+from ropedyn.studies.common import git, scene_number
 
 HARD = INPUT / "hard"
 
@@ -94,26 +94,21 @@ def order_cases():
 CODE_PATHS = ("src", "solvers", "CMakeLists.txt")
 
 
-def _git(root, *args):
-    return subprocess.run(["git", "-C", str(root), *args], capture_output=True,
-                          check=True).stdout
-
-
 @functools.lru_cache(maxsize=8)
 def _fingerprint(exe, size, mtime_ns, root):
     """See `code_fingerprint` (cached on the executable's identity)."""
     try:
-        files = _git(root, "ls-files", "-z", "--cached", "--others", "--exclude-standard",
-                     "--", *CODE_PATHS).decode().split("\0")
-        newest = max((root / f).stat().st_mtime_ns for f in files if f and
-                     (root / f).exists())
+        def listed(*which):
+            return [f for f in git("ls-files", "-z", *which, "--", *CODE_PATHS,
+                                   root=root).decode().split("\0") if f]
+        untracked = listed("--others", "--exclude-standard")
+        newest = max((root / f).stat().st_mtime_ns for f in listed("--cached") + untracked
+                     if (root / f).exists())
         if newest > mtime_ns:
             raise ValueError("the executable is older than the code")
-        parts = [_git(root, "rev-parse", *(f"HEAD:{p}" for p in CODE_PATHS)),
-                 _git(root, "diff", "HEAD", "--binary", "--", *CODE_PATHS)]
-        untracked = _git(root, "ls-files", "-z", "--others", "--exclude-standard", "--",
-                         *CODE_PATHS).decode().split("\0")
-        parts += [f.encode() + (root / f).read_bytes() for f in sorted(untracked) if f]
+        parts = [git("rev-parse", *(f"HEAD:{p}" for p in CODE_PATHS), root=root),
+                 git("diff", "HEAD", "--binary", "--", *CODE_PATHS, root=root)]
+        parts += [f.encode() + (root / f).read_bytes() for f in sorted(untracked)]
         return "code " + hashlib.sha256(b"\0".join(parts)).hexdigest()
     except (subprocess.CalledProcessError, OSError, ValueError):
         return f"exe {size} {mtime_ns}"

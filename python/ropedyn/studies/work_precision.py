@@ -318,6 +318,11 @@ def line_label(method, k):
     return f"{method} (max order {k})" if k else f"{method} (default)"
 
 
+def short_label(method, k):
+    """'cvode (5)', or 'erk (default)': the tables' column and row names."""
+    return f"{method} ({k or 'default'})"
+
+
 def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz, elapsed):
     import matplotlib
     matplotlib.use("Agg")
@@ -338,6 +343,9 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
         w.writerows(refs)
 
     markers = {r: m for r, m in zip(sorted(rtols, reverse=True), "os^Dvph*")}
+    def color(method, k):
+        return colors.get((method, k), colors.get((method, 0)))
+
     colors = {("cvode", 5): "C0", ("cvode", 2): "C9", ("cvode", 3): "C4",
               ("mebdf", 4): "C1", ("mebdf", 7): "C3", ("mebdf", 6): "C5", ("mebdf", 2): "C6",
               ("erk", 0): "C2", ("auto", 0): "k", ("adams", 0): "C8"}
@@ -357,7 +365,7 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
                         continue
                     x = [float(r["cpu_time"]) for r in rs]
                     y = [float(r[measure]) for r in rs]
-                    c = colors.get((method, k), colors.get((method, 0)))
+                    c = color(method, k)
                     ax.loglog(x, y, "-", color=c, label=line_label(method, k))
                     for xi, yi, r in zip(x, y, rs):
                         ax.loglog(xi, yi, markers.get(float(r["rtol"]), "o"), color=c)
@@ -398,11 +406,11 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
                     if np.isfinite(c):
                         pts.append((n, c, bound))
                 if pts:
-                    color = colors.get((method, k), colors.get((method, 0)))
-                    ax.loglog([q[0] for q in pts], [q[1] for q in pts], style, color=color,
+                    c = color(method, k)
+                    ax.loglog([q[0] for q in pts], [q[1] for q in pts], style, color=c,
                               label=f"{model}, {line_label(method, k)}")
                     for q in pts:
-                        ax.loglog(q[0], q[1], "v" if q[2] else "o", color=color,
+                        ax.loglog(q[0], q[1], "v" if q[2] else "o", color=c,
                                   fillstyle="none" if q[2] else "full")
     ax.set_xlabel("number of elements n")
     ax.set_ylabel("CPU time (s)")
@@ -488,7 +496,7 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
         for n in ns:
             c, bound = cost.get((model, method, k, n), (float("nan"), False))
             cells.append(("≤ " if bound else "") + fmt(c))
-        b.append(f"| {model}, {method} ({k or 'default'}) | " + " | ".join(cells) + " |")
+        b.append(f"| {model}, {short_label(method, k)} | " + " | ".join(cells) + " |")
     b.append("")
     b.append("**Every run** (tip L2 error m / all-points L2 error m / energy-balance error J / "
              "steps / CPU s):")
@@ -497,7 +505,8 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
         ns = sorted({key[2] for key in lines})
         settings = sorted({(key[0], key[1]) for key in lines})
         b.append("")
-        b.append(f"| {model}: n, rtol | " + " | ".join(f"{m} ({k or 'default'})" for m, k in settings) + " |")
+        b.append(f"| {model}: n, rtol | " + " | ".join(short_label(m, k) for m, k in settings)
+                 + " |")
         b.append("|---|" + "---|" * len(settings))
         for n in ns:
             for rtol in sorted(rtols, reverse=True):
