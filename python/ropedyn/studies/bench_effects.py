@@ -70,7 +70,7 @@ def main(argv=None):
                         help="git revision to time 'all internal effects' at (e.g. HEAD)")
     parser.add_argument("--no-write", action="store_true", help="print only")
     args = parser.parse_args(argv)
-    rev = baseline_revision(parser, args.baseline) if args.baseline else None
+    rev = baseline_revision(parser, args.baseline)
     exe = pathlib.Path(args.build or build("Release")) / "tests" / "bench_rhs"
     n = args.elements
 

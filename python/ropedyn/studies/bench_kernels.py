@@ -89,7 +89,7 @@ def main(argv=None):
                         help="timings only (no instruction counts)")
     parser.add_argument("--no-write", action="store_true", help="print only")
     args = parser.parse_args(argv)
-    base_rev = baseline_revision(parser, args.baseline) if args.baseline else None
+    base_rev = baseline_revision(parser, args.baseline)
     exe = pathlib.Path(args.build or build("Release")) / "tests" / "bench_rhs"
     cases = [("rfem", int(n)) for n in args.rfem_elements.split()] + \
             [("mpp", int(n)) for n in args.mpp_elements.split()]

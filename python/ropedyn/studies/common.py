@@ -18,8 +18,11 @@ def git(*args, root=None):
 
 
 def baseline_revision(parser, rev):
-    """The short hash of the commit `rev` names (a --baseline argument), or a usage error
-    naming the option and the value (exit 2) when git knows no such commit."""
+    """The short hash of the commit `rev` names (a --baseline argument; None when it is not
+    given), or a usage error naming the option and the value (exit 2) when git knows no
+    such commit."""
+    if not rev:
+        return None
     try:
         return git("rev-parse", "--verify", "--quiet", "--short",
                    f"{rev}^{{commit}}").decode().strip()

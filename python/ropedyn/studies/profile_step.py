@@ -154,10 +154,10 @@ def main(argv=None):
                         help="the whole program with the scene's output (its own table)")
     parser.add_argument("--no-write", action="store_true", help="print only")
     args = parser.parse_args(argv)
-    rev = baseline_revision(parser, args.baseline) if args.baseline else None
     if args.whole_run and args.methods == "cvode mebdf":
         args.methods = "default"
     parts_names = WHOLE_PARTS if args.whole_run else PARTS
+    rev = baseline_revision(parser, args.baseline)   # before the build, as every check
     if shutil.which("valgrind") is None:
         raise SystemExit("profile_step: valgrind is not installed")
     exe = exe_or_build(args.exe)
