@@ -2,6 +2,7 @@
 module ropedyn_cmd_run
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
     use ropedyn_kinds, only: wp
+    use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_INTERRUPTED
     use ropedyn_cli, only: cli_t
     use ropedyn_help, only: print_help
@@ -139,8 +140,26 @@ contains
         if (s%gain_unresolved_at >= 0.0_wp) write (output_unit, '(a, es10.3, a, f9.4, a)') &
             '  order safety    energy gain ', s%energy_gain, ' J above the bound at t = ', &
             s%gain_unresolved_at, ' s at the safe order (not an order instability)'
+        if (s%order_kept_at >= 0.0_wp) write (output_unit, '(a, es10.3, a, f9.4, a)') &
+            '  order safety    energy gain ', s%energy_gain, ' J above the bound at t = ', &
+            s%order_kept_at, ' s: '//s%order_kept_reason//': the integration error at '// &
+            'this rtol, the order kept ('//times_text(s%order_kept_count)//')'
         write (output_unit, '(a)') '  output          '//s%file
     end subroutine print_summary
+
+    !> 'once', 'twice', 'n times'.
+    pure function times_text(n) result(text)
+        integer, intent(in) :: n
+        character(len=:), allocatable :: text
+        select case (n)
+        case (1)
+            text = 'once'
+        case (2)
+            text = 'twice'
+        case default
+            text = int_text(n)//' times'
+        end select
+    end function times_text
 
     !> The integrator's changes of method or order limit, one line each; those that are
     !! warnings (a crawl cured by a lower order) once more on stderr.

@@ -25,6 +25,9 @@
 !!     /solver/order_lowered_at () s, /solver/order_lowered_from, _to () int64 1,
 !!     /solver/energy_gain () J: only when the order safety lowered the order (the time
 !!              from which the run went on at the lower order, and the gain that caused it)
+!!     /solver/order_kept_at () s, /solver/order_kept_count () int64 1, /solver/energy_gain:
+!!              only when a gain beyond the bound was not cured by the safe order (the
+!!              order asked for kept; the first time, how often, the first gain)
 !!
 !! Root attributes: status ('running' | 'complete' | 'failed' | 'interrupted'), reason
 !! (failed and interrupted), version, model, method, scene, created, units_convention.
@@ -147,6 +150,7 @@ module ropedyn_output
         procedure :: write_stats => output_write_stats
         procedure :: write_switches => output_write_switches
         procedure :: write_order_lowered => output_write_order_lowered
+        procedure :: write_order_kept => output_write_order_kept
         procedure :: close_run => output_close_run
         procedure :: reopen => output_reopen
         procedure :: records => output_records
@@ -420,6 +424,28 @@ contains
         if (.not. allocated(err)) call self%file%write('/solver/energy_gain', gain, 'J', err)
         if (.not. allocated(err)) call self%file%flush(err)
     end subroutine output_write_order_lowered
+
+    !> Record that the order safety kept the order asked for at a gain beyond the bound
+    !! (the safe order did not cure it), first at time `t`, `count` times in all; `gain`:
+    !! the first such gain (docs/stability.md).
+    subroutine output_write_order_kept(self, t, count, gain, err)
+        class(output_file_t), intent(inout) :: self
+        real(wp), intent(in) :: t       !< s
+        integer, intent(in) :: count
+        real(wp), intent(in) :: gain    !< J
+        type(error_t), allocatable, intent(out) :: err
+        if (.not. self%is_open) then
+            call make_error(err, ERR_INTERNAL, &
+                            file_label(self)//': write_order_kept: file is not open')
+            return
+        end if
+        call self%file%write('/solver/order_kept_at', t, 's', err)
+        if (.not. allocated(err)) &
+            call self%file%write('/solver/order_kept_count', int(count, i8), '1', err)
+        if (.not. allocated(err) .and. .not. self%file%exists('/solver/energy_gain')) &
+            call self%file%write('/solver/energy_gain', gain, 'J', err)
+        if (.not. allocated(err)) call self%file%flush(err)
+    end subroutine output_write_order_kept
 
     !> The time split of `stats` named in TIMER_NAMES, in that order (s).
     pure function timer_values(stats) result(times)

@@ -29,7 +29,8 @@ module ropedyn_scene_types
         !! solves): printed and written to /solver (costs a few % on small ropes)
         logical :: profile = .false.
         !> what the run does when the energy balance gains more than energy_gain_bound:
-        !! 'lower' the order to the method's A-stable one and redo the output interval,
+        !! 'lower' the order to the method's A-stable one if, over the same output interval,
+        !! that order does better (else the gain is the integration error: the order kept),
         !! 'stop' (a diagnosed failure), or 'off' (no check); docs/stability.md
         character(len=NAME_LEN) :: order_safety = 'lower'
         !> the gain that counts, in units of rtol S (S: the energy scale of the run) [-]

@@ -12,13 +12,17 @@
 !! max elastic + (max - min) of the gravity energy + the energy dissipated (J); one accepted
 !! step moves B by about rtol times the energies in play, so the bound rtol S follows the
 !! tolerance. The monitor knows nothing of integrators: the run driver
-!! (`ropedyn_simulation`) decides what a gain means (lower the order, stop).
+!! (`ropedyn_simulation`) decides what a gain means (lower the order, stop), and may
+!! `accept` a gain as the integration error of the run: gains are then counted from there.
+!!
+!! Whether a gain is the high order's (an instability) or the integration error is decided
+!! by `high_order_to_blame` from the same interval integrated at both orders.
 module ropedyn_energy_monitor
     use ropedyn_kinds, only: wp
     use ropedyn_rope_model, only: energy_t
     implicit none
     private
-    public :: energy_monitor_t
+    public :: energy_monitor_t, high_order_to_blame
 
     type :: energy_monitor_t
         real(wp) :: e0 = 0.0_wp             !< B at the start, J
@@ -29,6 +33,7 @@ module ropedyn_energy_monitor
         real(wp) :: min_gravity = 0.0_wp    !< J
         real(wp) :: max_gravity = 0.0_wp    !< J
         real(wp) :: dissipated = 0.0_wp     !< |dissipated| at the last record, J
+        real(wp) :: accepted = 0.0_wp       !< gain accepted as integration error, J
     contains
         procedure :: start => monitor_start
         procedure :: observe => monitor_observe
@@ -36,9 +41,28 @@ module ropedyn_energy_monitor
         procedure :: bound => monitor_bound
         procedure :: gain => monitor_gain
         procedure :: gained => monitor_gained
+        procedure :: accept => monitor_accept
     end type energy_monitor_t
 
 contains
+
+    !> Whether a gain beyond the bound was made by the order in use, the interval since the
+    !! previous record having been integrated again at the method's safe (A-stable) order:
+    !! true when the safe order changed the balance less over it. `change_high` and
+    !! `change_safe` are the changes of B - E0 over the interval (J). When the safe order
+    !! changes the balance as much or more (a larger integration error, often a loss), the
+    !! gain is the integration error of the run at its tolerance, not an instability.
+    pure logical function high_order_to_blame(change_high, change_safe) result(yes)
+        real(wp), intent(in) :: change_high, change_safe
+        yes = abs(change_safe) < abs(change_high)
+    end function high_order_to_blame
+
+    !> Count gains from `gain` (J, a gain beyond the bound judged the integration error) on.
+    pure subroutine monitor_accept(self, gain)
+        class(energy_monitor_t), intent(inout) :: self
+        real(wp), intent(in) :: gain
+        self%accepted = max(self%accepted, gain)
+    end subroutine monitor_accept
 
     !> Start from the energies of the initial state.
     pure subroutine monitor_start(self, e, rtol, factor)
@@ -86,14 +110,15 @@ contains
         g = e%balance() - self%e0
     end function monitor_gain
 
-    !> True when a state's balance lies above E0 by more than the bound, with its energies
-    !! counted into S first (so a record that itself moves much energy raises its own bound).
+    !> True when a state's balance lies above E0 (and above the gain accepted) by more than
+    !! the bound, with its energies counted into S first (so a record that itself moves much
+    !! energy raises its own bound).
     pure logical function monitor_gained(self, e) result(yes)
         class(energy_monitor_t), intent(in) :: self
         type(energy_t), intent(in) :: e
         type(energy_monitor_t) :: next
         next = self
         call next%observe(e)
-        yes = next%gain(e) > next%bound()
+        yes = next%gain(e) - next%accepted > next%bound()
     end function monitor_gained
 end module ropedyn_energy_monitor

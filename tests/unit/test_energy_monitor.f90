@@ -6,13 +6,17 @@
 !!   that feeds energy in is no gain);
 !! - `gained` is true exactly above factor rtol S, with the record's own energies in S, and
 !!   does not change the monitor (only `observe` does);
-!! - losses (numerical damping) never count.
+!! - losses (numerical damping) never count;
+!! - a gain accepted as integration error is counted from: the next alarm is a bound above
+!!   it (and accepting never lowers the level);
+!! - `high_order_to_blame`: the order in use made the gain exactly when the safe order,
+!!   over the same interval, changed the balance less (a gain or a loss alike).
 !! The end-to-end part (the order lowered at a gain, 'stop', the HDF5 record) is
 !! tests/hard/test_order_safety.py; the long runs tests/long.
 program test_energy_monitor
     use ropedyn_kinds, only: wp
     use ropedyn_rope_model, only: energy_t
-    use ropedyn_energy_monitor, only: energy_monitor_t
+    use ropedyn_energy_monitor, only: energy_monitor_t, high_order_to_blame
     use ropedyn_assert, only: test_suite_t
     implicit none
 
@@ -64,6 +68,29 @@ program test_energy_monitor
     ! ... but 2 J of kinetic energy without the work is
     e2%support_work = 0.0_wp
     call suite%check_true(m%gained(e2), 'energy from nowhere is a gain')
+
+    ! accepted: a gain of 1.01 x* taken as the integration error; the next alarm is one
+    ! bound above it (the bound of a record with that dissipation in S)
+    e2 = e1
+    e2%dissipated = e1%dissipated + 1.01_wp*x
+    call m%accept(m%gain(e2))
+    call suite%check_true(.not. m%gained(e2), 'an accepted gain is no alarm')
+    e2%dissipated = e1%dissipated + 1.99_wp*x
+    call suite%check_true(.not. m%gained(e2), 'below a bound above the accepted gain')
+    e2%dissipated = e1%dissipated + 2.03_wp*x
+    call suite%check_true(m%gained(e2), 'a bound above the accepted gain')
+    call m%accept(0.0_wp)
+    call suite%check_true(m%gained(e2), 'accepting less keeps the level')
+
+    ! who made the gain: the change of B - E0 over the interval at each order
+    call suite%check_true(high_order_to_blame(2.0e-3_wp, 1.0e-4_wp), &
+                          'the safe order gains less: the high order made it')
+    call suite%check_true(high_order_to_blame(2.0e-3_wp, -1.0e-4_wp), &
+                          'the safe order loses less: the high order made it')
+    call suite%check_true(.not. high_order_to_blame(2.3e-9_wp, -4.1e-8_wp), &
+                          'the safe order loses more: integration error')
+    call suite%check_true(.not. high_order_to_blame(1.0e-3_wp, 1.0e-3_wp), &
+                          'the same change: integration error')
 
     ! the gravity range counts into S, not the gravity energy itself (its zero is arbitrary)
     call m%start(energy_t(kinetic=0.0_wp, elastic=0.0_wp, gravity=-100.0_wp, &
