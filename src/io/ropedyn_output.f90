@@ -53,6 +53,7 @@ module ropedyn_output
     implicit none
     private
     public :: output_file_t, write_provenance, COUNTER_NAMES, counter_values, TIMER_NAMES
+    public :: add_counter_values
 
     !> The convention written into every file (root attribute `units_convention`).
     character(len=*), parameter :: units_convention = &
@@ -463,8 +464,20 @@ contains
                     stats%err_test_fails, stats%nonlin_iters, stats%nonlin_conv_fails]
     end function counter_values
 
-    !> Set the root status ('complete', or 'failed' or 'interrupted' with `reason`) and close
-    !! everything. The file is closed even when writing the status fails.
+    !> Add counters in COUNTER_NAMES order (those of the earlier parts of a resumed run) to
+    !! `stats`: the inverse of counter_values.
+    pure subroutine add_counter_values(stats, counters)
+        type(solver_stats_t), intent(inout) :: stats
+        integer(i8), intent(in) :: counters(size(COUNTER_NAMES))
+        stats%steps = stats%steps + counters(1)
+        stats%rhs_evals = stats%rhs_evals + counters(2)
+        stats%jac_evals = stats%jac_evals + counters(3)
+        stats%lin_setups = stats%lin_setups + counters(4)
+        stats%err_test_fails = stats%err_test_fails + counters(5)
+        stats%nonlin_iters = stats%nonlin_iters + counters(6)
+        stats%nonlin_conv_fails = stats%nonlin_conv_fails + counters(7)
+    end subroutine add_counter_values
+
     !> The integrator's changes of method or order limit during the run (ropedyn_switch_log)
     !! as /solver/switch_time (s), switch_method, switch_max_order and switch_reason, one
     !! entry per change, oldest first (nothing when there were none).
@@ -506,6 +519,8 @@ contains
         call self%file%write_text('/solver/switch_reason', reasons, '', err)
     end subroutine output_write_switches
 
+    !> Set the root status ('complete', or 'failed' or 'interrupted' with `reason`) and close
+    !! everything. The file is closed even when writing the status fails.
     subroutine output_close_run(self, status, reason, err)
         class(output_file_t), intent(inout) :: self
         character(len=*), intent(in) :: status            !< complete, failed, interrupted

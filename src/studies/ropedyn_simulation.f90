@@ -16,7 +16,7 @@ module ropedyn_simulation
     use ropedyn_rope_spec, only: rope_spec_t
     use ropedyn_scene, only: scene_t, scene_namelist_text
     use ropedyn_os, only: make_parent_dirs
-    use ropedyn_output, only: output_file_t
+    use ropedyn_output, only: output_file_t, add_counter_values
     use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_run_record, only: run_record_t, read_run_record, check_record_fits, LAST_RECORD
     use ropedyn_progress, only: progress_t
@@ -572,7 +572,7 @@ contains
             summary%stats = integrator%stats()
             call summary%stats%add(stats_before)
             summary%stats%time_advance = time_advance
-            call add_counters(summary%stats, counters_before)
+            call add_counter_values(summary%stats, counters_before)
             summary%t_reached = max(summary%t_reached, t)
             call out%write_stats(summary%stats, summary%cpu_time, ferr, t_reached=t)
             summary%switches = integrator%switch_log()
@@ -588,19 +588,4 @@ contains
             call integrator%finalize()
         end subroutine finish
     end subroutine integrate_scene
-
-    !> The counters of earlier parts of a resumed run added (in ropedyn_output's
-    !! COUNTER_NAMES order: steps, rhs_evals, jac_evals, lin_setups, err_test_fails,
-    !! nonlin_iters, nonlin_conv_fails).
-    pure subroutine add_counters(stats, before)
-        type(solver_stats_t), intent(inout) :: stats
-        integer(i8), intent(in) :: before(7)
-        stats%steps = stats%steps + before(1)
-        stats%rhs_evals = stats%rhs_evals + before(2)
-        stats%jac_evals = stats%jac_evals + before(3)
-        stats%lin_setups = stats%lin_setups + before(4)
-        stats%err_test_fails = stats%err_test_fails + before(5)
-        stats%nonlin_iters = stats%nonlin_iters + before(6)
-        stats%nonlin_conv_fails = stats%nonlin_conv_fails + before(7)
-    end subroutine add_counters
 end module ropedyn_simulation
