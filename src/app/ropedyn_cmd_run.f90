@@ -142,8 +142,8 @@ contains
             s%gain_unresolved_at, ' s at the safe order (not an order instability)'
         if (s%order_kept_at >= 0.0_wp) write (output_unit, '(a, es10.3, a, f9.4, a)') &
             '  order safety    energy gain ', s%energy_gain, ' J above the bound at t = ', &
-            s%order_kept_at, ' s: '//s%order_kept_reason//': the integration error at '// &
-            'this rtol, the order kept ('//times_text(s%order_kept_count)//')'
+            s%order_kept_at, ' s: '//s%order_kept_reason//'; the order kept ('// &
+            times_text(s%order_kept_count)//')'
         write (output_unit, '(a)') '  output          '//s%file
     end subroutine print_summary
 

@@ -24,7 +24,7 @@ module ropedyn_simulation
     use ropedyn_version, only: version_string
     use ropedyn_modes, only: equilibrium_initial_state
     use ropedyn_methods, only: METHODS, method_index
-    use ropedyn_energy_monitor, only: energy_monitor_t, high_order_to_blame
+    use ropedyn_energy_monitor, only: energy_monitor_t, high_order_to_blame, sudden_gain
     use ropedyn_state_start, only: state_initial_state
     implicit none
     private
@@ -138,14 +138,18 @@ contains
     !! Order safety (`&solver order_safety`, docs/stability.md): at every output time the
     !! energy monitor compares the balance with E0; a gain above `energy_gain_bound` rtol S
     !! with 'lower' integrates the interval since the previous record again at the method's
-    !! safe (A-stable) order, with a second integrator. If that changed the balance less, the
-    !! gain was the order's (an instability): the run goes on from there at the safe order,
-    !! for good. If it changed the balance as much or more, or could not integrate the
-    !! interval within SAFE_STEPS_FACTOR times the steps, the gain is the integration error
-    !! at this tolerance: the run goes on as it was, at the order asked for, and the monitor
-    !! counts gains from that level on (a first look that lowered on the gain alone left
-    !! every_effect_mpp_n7, rtol 1e-11, at BDF2 to crawl). With 'stop' a gain ends the run
-    !! as a failed integration naming it.
+    !! safe (A-stable) order, with a second integrator, and the run goes on from there at
+    !! the safe order, for good, when the gain was the order's (high_order_to_blame): always
+    !! for a gain gathered over earlier intervals (an amplified mode), else if the safe order
+    !! changed the balance less over the interval. If that gain of one interval is matched
+    !! by the safe order's change, it is the integration error at this tolerance: the run
+    !! goes on as it was, at the order asked for, and the monitor counts gains from that
+    !! level on (lowering on the gain alone left every_effect_mpp_n7, rtol 1e-11, at BDF2 to
+    !! crawl). If the safe order could not get through the interval within
+    !! SAFE_STEPS_FACTOR times the steps, there is no verdict: the order is kept so, once;
+    !! after that the safe order has the whole budget left (its failure is the run's, as is
+    !! that of a safe order lowered to). With 'stop' a gain ends the run as a failed
+    !! integration naming it.
     subroutine run_scene(scene, summary, err, resume)
         type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(out) :: summary
@@ -186,9 +190,11 @@ contains
         integer(i8) :: counters_before(7)       ! resume: counters of the earlier parts
         integer :: n, k, n_out, k_first, nq, sig
         integer(i8) :: steps_mark   ! the integrator's steps at the previous record
+        logical :: safe_crawled     ! a second look at the safe order ran out of its budget
         type(solver_stats_t) :: stats
 
         caught = .false.
+        safe_crawled = .false.
         cpu_before = 0.0_wp
         counters_before = 0
         call create_model(scene%rope_spec_t, model, err)
@@ -405,6 +411,7 @@ contains
             type(error_t), allocatable, intent(out) :: cerr
             type(energy_t) :: e
             character(len=200) :: what
+            real(wp) :: next_bound
             e = model%energy(t, y, yq)
             if (.not. ieee_is_finite(e%balance())) return   ! write_record says so
             if (.not. monitor%gained(e)) then
@@ -416,6 +423,7 @@ contains
                 type(energy_monitor_t) :: next
                 next = monitor
                 call next%observe(e)
+                next_bound = next%bound()
                 write (what, '(a, es10.3, a, es10.3, a, es12.5, a, i0)') 'energy gain ', &
                     next%gain(e), ' J above E0 (bound ', next%bound(), ' J) at t = ', t, &
                     ' s, max order ', max_order
@@ -438,7 +446,7 @@ contains
                 return
             end if
             if (safe_order > 0 .and. max_order > safe_order) then
-                call second_look(tout, e, cerr)
+                call second_look(tout, e, next_bound, cerr)
                 if (allocated(cerr)) return
             else if (summary%gain_unresolved_at < 0.0_wp) then
                 summary%gain_unresolved_at = t
@@ -449,12 +457,14 @@ contains
 
         !> A gain beyond the bound at the order limit in use (see run_scene): the interval
         !! [t_prev, tout] again at the safe order, by a second integrator with a step budget
-        !! of SAFE_STEPS_FACTOR times the first one's steps there. Either that integrator
-        !! and its state replace the first (lowered, for good) or they are dropped, the gain
-        !! accepted (the order kept). e: the energies of the state the run goes on from.
-        subroutine second_look(tout, e, lerr)
+        !! of SAFE_STEPS_FACTOR times the first one's steps there (after a look that ran out
+        !! of it: the whole budget). Either that integrator and its state replace the first
+        !! (lowered, for good) or they are dropped, the gain accepted (the order kept).
+        !! e: the energies of the state the run goes on from.
+        subroutine second_look(tout, e, bound, lerr)
             real(wp), intent(in) :: tout
             type(energy_t), intent(inout) :: e
+            real(wp), intent(in) :: bound   !< the monitor's bound at this record, J
             type(error_t), allocatable, intent(out) :: lerr
             class(integrator_t), allocatable :: safe
             type(solver_options_t) :: safe_options
@@ -462,10 +472,16 @@ contains
             real(wp) :: t_safe, y_safe(size(y)), yq_safe(size(yq)), gain_prev, gain_high, &
                         gain_safe
             integer(i8) :: steps_high, budget
-            character(len=160) :: why
+            logical :: full_budget
+            character(len=200) :: why
+            gain_prev = monitor%gain(model%energy(t_prev, y_prev, yq_prev))
+            gain_high = monitor%gain(e)
             steps_high = steps_taken() - steps_mark
-            budget = min(max(SAFE_STEPS_MIN, SAFE_STEPS_FACTOR*steps_high), options%max_steps - &
-                         stats_before%steps - steps_taken())
+            budget = options%max_steps - stats_before%steps - steps_taken()
+            ! a gain gathered over earlier intervals lowers the order whatever it costs
+            full_budget = safe_crawled .or. .not. sudden_gain(gain_high - gain_prev, bound)
+            if (.not. full_budget) budget = min(budget, max(SAFE_STEPS_MIN, &
+                                                            SAFE_STEPS_FACTOR*steps_high))
             call create_integrator(scene, safe, lerr)
             if (allocated(lerr)) return
             safe_options = solver_options_of(scene)
@@ -478,11 +494,10 @@ contains
             call safe%init(model, t_safe, y_safe, yq_safe(1:nq), safe_options, lerr)
             if (allocated(lerr)) return
             call safe%advance_to(tout, t_safe, y_safe, yq_safe(1:nq), safe_err)
-            gain_prev = monitor%gain(model%energy(t_prev, y_prev, yq_prev))
-            gain_high = monitor%gain(e)
             if (.not. allocated(safe_err) .and. t_safe >= tout) then
                 gain_safe = monitor%gain(model%energy(t_safe, y_safe, yq_safe))
-                if (high_order_to_blame(gain_high - gain_prev, gain_safe - gain_prev)) then
+                if (high_order_to_blame(gain_high - gain_prev, gain_safe - gain_prev, &
+                                        bound)) then
                     ! on from tout at the safe order, for good
                     summary%order_lowered_at = t_prev
                     summary%order_before = max_order
@@ -503,13 +518,26 @@ contains
                 write (why, '(a, i0, a, es10.3, a, i0, a, es10.3, a)') 'order ', safe_order, &
                     ' changed the balance by ', gain_safe - gain_prev, &
                     ' J over the same interval, order ', max_order, ' by ', &
-                    gain_high - gain_prev, ' J'
+                    gain_high - gain_prev, ' J: the integration error at this rtol'
             else if (signal_received() /= 0) then
                 why = 'the second look at the safe order was interrupted'
+            else if (full_budget) then
+                ! the safe order with the whole budget: its failure is the run's, as the
+                ! failure of any integration
+                call stats_before%add(integrator%stats())
+                call integrator%finalize()
+                call move_alloc(safe, integrator)
+                t = t_safe
+                y = y_safe
+                yq = yq_safe
+                call move_alloc(safe_err, lerr)
+                return
             else
+                ! no verdict, once: a second gain of a bound lowers the order whatever it costs
+                safe_crawled = .true.
                 write (why, '(4(a, i0), a)') 'order ', safe_order, &
                     ' did not get through the same interval in ', budget, &
-                    ' steps (order ', max_order, ' took ', steps_high, ')'
+                    ' steps (order ', max_order, ' took ', steps_high, '): no verdict'
             end if
             ! the integration error at this rtol: on at the order asked for
             call stats_before%add(safe%stats())
