@@ -132,18 +132,20 @@ contains
             s%final_energy%total()
         write (output_unit, '(a, es13.5, a, es10.2, a)') '  E0              ', e0, &
             ' J   balance error (T+V+dissipated-E0) ', drift, ' J'
-        if (s%order_lowered_at >= 0.0_wp) write (output_unit, &
-            '(a, es10.3, a, es10.3, a, i0, a, i0, a, f9.4, a)') &
-            '  order safety    energy gain ', s%energy_gain, ' J > bound ', &
-            s%energy_gain_bound, ' J: max order ', s%order_before, ' -> ', s%order_after, &
-            ' from t = ', s%order_lowered_at, ' s'
-        if (s%gain_unresolved_at >= 0.0_wp) write (output_unit, '(a, es10.3, a, f9.4, a)') &
-            '  order safety    energy gain ', s%energy_gain, ' J above the bound at t = ', &
-            s%gain_unresolved_at, ' s at the safe order (not an order instability)'
-        if (s%order_kept_at >= 0.0_wp) write (output_unit, '(a, es10.3, a, f9.4, a)') &
-            '  order safety    energy gain ', s%energy_gain, ' J above the bound at t = ', &
-            s%order_kept_at, ' s: '//s%order_kept_reason//'; the order kept ('// &
-            times_text(s%order_kept_count)//')'
+        associate (r => s%safety)
+            if (r%lowered_at >= 0.0_wp) write (output_unit, &
+                '(a, es10.3, a, es10.3, a, i0, a, i0, a, f9.4, a)') &
+                '  order safety    energy gain ', r%energy_gain, ' J > bound ', &
+                r%energy_gain_bound, ' J: max order ', r%order_before, ' -> ', r%order_after, &
+                ' from t = ', r%lowered_at, ' s'
+            if (r%unresolved_at >= 0.0_wp) write (output_unit, '(a, es10.3, a, f9.4, a)') &
+                '  order safety    energy gain ', r%energy_gain, ' J above the bound at t = ', &
+                r%unresolved_at, ' s at the safe order (not an order instability)'
+            if (r%kept_at >= 0.0_wp) write (output_unit, '(a, es10.3, a, f9.4, a)') &
+                '  order safety    energy gain ', r%energy_gain, ' J above the bound at t = ', &
+                r%kept_at, ' s: '//r%kept_reason//'; the order kept ('// &
+                times_text(r%kept_count)//')'
+        end associate
         write (output_unit, '(a)') '  output          '//s%file
     end subroutine print_summary
 

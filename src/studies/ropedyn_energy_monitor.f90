@@ -22,7 +22,7 @@ module ropedyn_energy_monitor
     use ropedyn_rope_model, only: energy_t
     implicit none
     private
-    public :: energy_monitor_t, high_order_to_blame, sudden_gain
+    public :: energy_monitor_t, safety_record_t, high_order_to_blame, sudden_gain
 
     !> the share of the bound a gain must have made in the last interval to be judged by a
     !! comparison with the safe order over that interval (high_order_to_blame)
@@ -48,7 +48,57 @@ module ropedyn_energy_monitor
         procedure :: accept => monitor_accept
     end type energy_monitor_t
 
+    !> What the order safety did in a run (docs/stability.md; times in s, < 0: never).
+    type :: safety_record_t
+        real(wp) :: energy_gain = 0.0_wp        !< the first gain beyond the bound, J
+        real(wp) :: energy_gain_bound = 0.0_wp  !< ... and its bound, J
+        real(wp) :: lowered_at = -1.0_wp        !< the order lowered from this record on
+        integer :: order_before = 0             !< ... from this order limit
+        integer :: order_after = 0              !< ... to the safe order
+        !> a gain that lowering could not cure (at the safe order, or a method without one)
+        real(wp) :: unresolved_at = -1.0_wp
+        real(wp) :: kept_at = -1.0_wp           !< a gain judged the integration error
+        integer :: kept_count = 0               !< ... how many
+        character(len=:), allocatable :: kept_reason  !< ... why, the first time
+    contains
+        procedure :: alarm => record_alarm
+        procedure :: lowered => record_lowered
+        procedure :: kept => record_kept
+    end type safety_record_t
+
 contains
+
+    !> A gain (J) beyond the bound (J): remembered if it is the first.
+    pure subroutine record_alarm(self, gain, bound)
+        class(safety_record_t), intent(inout) :: self
+        real(wp), intent(in) :: gain, bound
+        if (self%unresolved_at >= 0.0_wp .or. self%lowered_at >= 0.0_wp .or. &
+            self%kept_at >= 0.0_wp) return
+        self%energy_gain = gain
+        self%energy_gain_bound = bound
+    end subroutine record_alarm
+
+    !> The order limit lowered from `from` to `to`, from the record at time t on.
+    pure subroutine record_lowered(self, t, from, to)
+        class(safety_record_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        integer, intent(in) :: from, to
+        self%lowered_at = t
+        self%order_before = from
+        self%order_after = to
+    end subroutine record_lowered
+
+    !> The order kept at time t at a gain judged the integration error, for reason `why`.
+    pure subroutine record_kept(self, t, why)
+        class(safety_record_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        character(len=*), intent(in) :: why
+        if (self%kept_at < 0.0_wp) then
+            self%kept_at = t
+            self%kept_reason = why
+        end if
+        self%kept_count = self%kept_count + 1
+    end subroutine record_kept
 
     !> Whether a gain beyond `bound` (J) was made by the order in use, the interval since
     !! the previous record having been integrated again at the method's safe (A-stable)

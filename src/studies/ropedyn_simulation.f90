@@ -24,7 +24,8 @@ module ropedyn_simulation
     use ropedyn_version, only: version_string
     use ropedyn_modes, only: equilibrium_initial_state
     use ropedyn_methods, only: METHODS, method_index
-    use ropedyn_energy_monitor, only: energy_monitor_t, high_order_to_blame, sudden_gain
+    use ropedyn_energy_monitor, only: energy_monitor_t, safety_record_t, high_order_to_blame, &
+                                      sudden_gain
     use ropedyn_state_start, only: state_initial_state
     implicit none
     private
@@ -41,22 +42,7 @@ module ropedyn_simulation
         !> the integrator's changes of method or order limit (auto, cvode's crawl watch)
         type(switch_event_t), allocatable :: switches(:)
         character(len=:), allocatable :: file
-        !> order safety (docs/stability.md): the time from which the order was lowered
-        !! (< 0: never), the order limit before and after, and the gain that caused it (J)
-        real(wp) :: order_lowered_at = -1.0_wp
-        integer :: order_before = 0
-        integer :: order_after = 0
-        real(wp) :: energy_gain = 0.0_wp
-        real(wp) :: energy_gain_bound = 0.0_wp
-        !> a gain beyond the bound that could not be cured by lowering the order (the method
-        !! was at its safe order already, or has none): the first time it was seen (< 0: never)
-        real(wp) :: gain_unresolved_at = -1.0_wp
-        !> gains beyond the bound that the safe order did not cure (it changed the balance
-        !! as much or more over the same interval, or crawled through it): the order asked
-        !! for was kept; the first time (< 0: never), how often, and why (the first time)
-        real(wp) :: order_kept_at = -1.0_wp
-        integer :: order_kept_count = 0
-        character(len=:), allocatable :: order_kept_reason
+        type(safety_record_t) :: safety   !< what the order safety did (docs/stability.md)
     end type run_summary_t
 
     !> The order safety's second look: the safe order may take this many times the steps
@@ -137,19 +123,8 @@ contains
     !!
     !! Order safety (`&solver order_safety`, docs/stability.md): at every output time the
     !! energy monitor compares the balance with E0; a gain above `energy_gain_bound` rtol S
-    !! with 'lower' integrates the interval since the previous record again at the method's
-    !! safe (A-stable) order, with a second integrator, and the run goes on from there at
-    !! the safe order, for good, when the gain was the order's (high_order_to_blame): always
-    !! for a gain gathered over earlier intervals (an amplified mode), else if the safe order
-    !! changed the balance less over the interval. If that gain of one interval is matched
-    !! by the safe order's change, it is the integration error at this tolerance: the run
-    !! goes on as it was, at the order asked for, and the monitor counts gains from that
-    !! level on (lowering on the gain alone left every_effect_mpp_n7, rtol 1e-11, at BDF2 to
-    !! crawl). If the safe order could not get through the interval within
-    !! SAFE_STEPS_FACTOR times the steps, there is no verdict: the order is kept so, once;
-    !! after that the safe order has the whole budget left (its failure is the run's, as is
-    !! that of a safe order lowered to). With 'stop' a gain ends the run as a failed
-    !! integration naming it.
+    !! with 'lower' takes a second look at the method's safe order (second_look), with 'stop'
+    !! ends the run as a failed integration naming the gain.
     subroutine run_scene(scene, summary, err, resume)
         type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(out) :: summary
@@ -427,11 +402,7 @@ contains
                 write (what, '(a, es10.3, a, es10.3, a, es12.5, a, i0)') 'energy gain ', &
                     next%gain(e), ' J above E0 (bound ', next%bound(), ' J) at t = ', t, &
                     ' s, max order ', max_order
-                if (summary%gain_unresolved_at < 0.0_wp .and. &
-                    summary%order_lowered_at < 0.0_wp .and. summary%order_kept_at < 0.0_wp) then
-                    summary%energy_gain = next%gain(e)
-                    summary%energy_gain_bound = next%bound()
-                end if
+                call summary%safety%alarm(next%gain(e), next_bound)
             end block
             if (trim(scene%solver%order_safety) == 'stop') then
                 stats = integrator%stats()
@@ -448,18 +419,24 @@ contains
             if (safe_order > 0 .and. max_order > safe_order) then
                 call second_look(tout, e, next_bound, cerr)
                 if (allocated(cerr)) return
-            else if (summary%gain_unresolved_at < 0.0_wp) then
-                summary%gain_unresolved_at = t
+            else if (summary%safety%unresolved_at < 0.0_wp) then
+                summary%safety%unresolved_at = t
             end if
             call monitor%observe(e)
             steps_mark = steps_taken()
         end subroutine check_energy
 
-        !> A gain beyond the bound at the order limit in use (see run_scene): the interval
-        !! [t_prev, tout] again at the safe order, by a second integrator with a step budget
-        !! of SAFE_STEPS_FACTOR times the first one's steps there (after a look that ran out
-        !! of it: the whole budget). Either that integrator and its state replace the first
-        !! (lowered, for good) or they are dropped, the gain accepted (the order kept).
+        !> A gain beyond the bound at the order limit in use: the interval [t_prev, tout]
+        !! again at the safe (A-stable) order by a second integrator. When the gain is the
+        !! order's (high_order_to_blame: gathered over earlier intervals, or made in this
+        !! one and the safe order changed the balance less), the run goes on from tout at
+        !! the safe order with that integrator, for good. A gain of this interval that the
+        !! safe order matches is the integration error at this tolerance: the second
+        !! integrator is dropped, the run goes on as it was and the monitor counts gains
+        !! from that level on (lowering on the gain alone left every_effect_mpp_n7, rtol
+        !! 1e-11, at BDF2 to crawl). For such a gain the safe order has SAFE_STEPS_FACTOR
+        !! times the steps of the interval; if that is not enough, no verdict: the order is
+        !! kept so, once. Otherwise it has the whole budget left; its failure is the run's.
         !! e: the energies of the state the run goes on from.
         subroutine second_look(tout, e, bound, lerr)
             real(wp), intent(in) :: tout
@@ -499,9 +476,7 @@ contains
                 if (high_order_to_blame(gain_high - gain_prev, gain_safe - gain_prev, &
                                         bound)) then
                     ! on from tout at the safe order, for good
-                    summary%order_lowered_at = t_prev
-                    summary%order_before = max_order
-                    summary%order_after = safe_order
+                    call summary%safety%lowered(t_prev, max_order, safe_order)
                     call stats_before%add(integrator%stats())
                     call integrator%finalize()
                     call move_alloc(safe, integrator)
@@ -542,11 +517,7 @@ contains
             ! the integration error at this rtol: on at the order asked for
             call stats_before%add(safe%stats())
             call safe%finalize()
-            if (summary%order_kept_at < 0.0_wp) then
-                summary%order_kept_at = t
-                summary%order_kept_reason = trim(why)
-            end if
-            summary%order_kept_count = summary%order_kept_count + 1
+            call summary%safety%kept(t, trim(why))
             call monitor%accept(gain_high)
         end subroutine second_look
 
@@ -605,12 +576,13 @@ contains
             call out%write_stats(summary%stats, summary%cpu_time, ferr, t_reached=t)
             summary%switches = integrator%switch_log()
             if (.not. allocated(ferr)) call out%write_switches(summary%switches, ferr)
-            if (.not. allocated(ferr) .and. summary%order_lowered_at >= 0.0_wp) &
-                call out%write_order_lowered(summary%order_lowered_at, summary%order_before, &
-                                             summary%order_after, summary%energy_gain, ferr)
-            if (.not. allocated(ferr) .and. summary%order_kept_at >= 0.0_wp) &
-                call out%write_order_kept(summary%order_kept_at, summary%order_kept_count, &
-                                          summary%energy_gain, ferr)
+            associate (r => summary%safety)
+                if (.not. allocated(ferr) .and. r%lowered_at >= 0.0_wp) &
+                    call out%write_order_lowered(r%lowered_at, r%order_before, &
+                                                 r%order_after, r%energy_gain, ferr)
+                if (.not. allocated(ferr) .and. r%kept_at >= 0.0_wp) &
+                    call out%write_order_kept(r%kept_at, r%kept_count, r%energy_gain, ferr)
+            end associate
             call out%close_run(status, reason, ferr)
             if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
             call integrator%finalize()
