@@ -18,15 +18,26 @@
 !! Whether a gain is the high order's (an instability) or the integration error is decided
 !! by `high_order_to_blame` from the same interval integrated at both orders.
 module ropedyn_energy_monitor
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, i8
     use ropedyn_rope_model, only: energy_t
     implicit none
     private
     public :: energy_monitor_t, safety_record_t, high_order_to_blame, sudden_gain
+    public :: look_budget, look_action, LOOK_LOWER, LOOK_KEEP, LOOK_NO_VERDICT, LOOK_FAIL
 
     !> the share of the bound a gain must have made in the last interval to be judged by a
     !! comparison with the safe order over that interval (high_order_to_blame)
     real(wp), parameter :: SUDDEN_SHARE = 0.5_wp
+    !> The second look at a sudden gain: the safe order may take this many times the steps
+    !! that the order in use took over the interval (at least SAFE_STEPS_MIN); more is a
+    !! crawl (BDF2 at rtol 1e-11 took 20 .. 60 times BDF5's steps on every_effect_mpp_n7)
+    integer(i8), parameter :: SAFE_STEPS_FACTOR = 20, SAFE_STEPS_MIN = 500
+
+    !> What the second look decides (look_action)
+    integer, parameter :: LOOK_LOWER = 1       !< on at the safe order, for good
+    integer, parameter :: LOOK_KEEP = 2        !< the gain is the integration error: order kept
+    integer, parameter :: LOOK_NO_VERDICT = 3  !< the safe order ran out of a capped budget
+    integer, parameter :: LOOK_FAIL = 4        !< ... of the whole budget: the run fails
 
     type :: energy_monitor_t
         real(wp) :: e0 = 0.0_wp             !< B at the start, J
@@ -119,6 +130,37 @@ contains
         real(wp), intent(in) :: change_high, change_safe, bound
         yes = .not. sudden_gain(change_high, bound) .or. abs(change_safe) < abs(change_high)
     end function high_order_to_blame
+
+    !> The step budget of the safe order's second look: `left`, the run's budget left, for
+    !! a gain gathered over earlier intervals (lowered whatever it costs) or after a look
+    !! without verdict (`crawled`); for a sudden gain SAFE_STEPS_FACTOR times the
+    !! `steps_high` the order in use took over the interval (at least SAFE_STEPS_MIN).
+    pure integer(i8) function look_budget(sudden, crawled, steps_high, left) result(budget)
+        logical, intent(in) :: sudden, crawled
+        integer(i8), intent(in) :: steps_high, left
+        budget = left
+        if (sudden .and. .not. crawled) &
+            budget = min(left, max(SAFE_STEPS_MIN, SAFE_STEPS_FACTOR*steps_high))
+    end function look_budget
+
+    !> What the second look decides: the safe order `reached` the end of the interval
+    !! (then `blame`, high_order_to_blame, decides), or it stopped on a signal
+    !! (`interrupted`: the order kept, the run stops), or it ran out of its budget: with
+    !! the capped one of a sudden gain's first look no verdict, with the whole one the run
+    !! fails as any integration does.
+    pure integer function look_action(reached, interrupted, sudden, crawled, blame) &
+        result(action)
+        logical, intent(in) :: reached, interrupted, sudden, crawled, blame
+        if (reached) then
+            action = merge(LOOK_LOWER, LOOK_KEEP, blame)
+        else if (interrupted) then
+            action = LOOK_KEEP
+        else if (sudden .and. .not. crawled) then
+            action = LOOK_NO_VERDICT
+        else
+            action = LOOK_FAIL
+        end if
+    end function look_action
 
     !> True when the last interval made SUDDEN_SHARE of the bound or more (see
     !! high_order_to_blame): only then does the safe order's run of that interval decide.

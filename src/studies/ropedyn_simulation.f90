@@ -25,7 +25,8 @@ module ropedyn_simulation
     use ropedyn_modes, only: equilibrium_initial_state
     use ropedyn_methods, only: METHODS, method_index
     use ropedyn_energy_monitor, only: energy_monitor_t, safety_record_t, high_order_to_blame, &
-                                      sudden_gain
+                                      sudden_gain, look_budget, look_action, LOOK_LOWER, &
+                                      LOOK_NO_VERDICT, LOOK_FAIL
     use ropedyn_state_start, only: state_initial_state
     implicit none
     private
@@ -44,11 +45,6 @@ module ropedyn_simulation
         character(len=:), allocatable :: file
         type(safety_record_t) :: safety   !< what the order safety did (docs/stability.md)
     end type run_summary_t
-
-    !> The order safety's second look: the safe order may take this many times the steps
-    !! that the order in use took over the interval (at least SAFE_STEPS_MIN); more is a
-    !! crawl (BDF2 at rtol 1e-11 took 50 times BDF5's steps on every_effect_mpp_n7).
-    integer(i8), parameter :: SAFE_STEPS_FACTOR = 20, SAFE_STEPS_MIN = 500
 
 contains
 
@@ -446,19 +442,17 @@ contains
             class(integrator_t), allocatable :: safe
             type(solver_options_t) :: safe_options
             type(error_t), allocatable :: safe_err
-            real(wp) :: t_safe, y_safe(size(y)), yq_safe(size(yq)), gain_prev, gain_high, &
-                        gain_safe
+            real(wp) :: t_safe, y_safe(size(y)), yq_safe(size(yq)), change_high, change_safe
             integer(i8) :: steps_high, budget
-            logical :: full_budget
+            logical :: sudden, reached
+            integer :: action
             character(len=200) :: why
-            gain_prev = monitor%gain(model%energy(t_prev, y_prev, yq_prev))
-            gain_high = monitor%gain(e)
+            change_high = monitor%gain(e) - monitor%gain(model%energy(t_prev, y_prev, yq_prev))
+            change_safe = 0.0_wp
             steps_high = steps_taken() - steps_mark
-            budget = options%max_steps - stats_before%steps - steps_taken()
-            ! a gain gathered over earlier intervals lowers the order whatever it costs
-            full_budget = safe_crawled .or. .not. sudden_gain(gain_high - gain_prev, bound)
-            if (.not. full_budget) budget = min(budget, max(SAFE_STEPS_MIN, &
-                                                            SAFE_STEPS_FACTOR*steps_high))
+            sudden = sudden_gain(change_high, bound)
+            budget = look_budget(sudden, safe_crawled, steps_high, options%max_steps - &
+                                 stats_before%steps - steps_taken())
             call create_integrator(scene, safe, lerr)
             if (allocated(lerr)) return
             safe_options = solver_options_of(scene)
@@ -471,54 +465,47 @@ contains
             call safe%init(model, t_safe, y_safe, yq_safe(1:nq), safe_options, lerr)
             if (allocated(lerr)) return
             call safe%advance_to(tout, t_safe, y_safe, yq_safe(1:nq), safe_err)
-            if (.not. allocated(safe_err) .and. t_safe >= tout) then
-                gain_safe = monitor%gain(model%energy(t_safe, y_safe, yq_safe))
-                if (high_order_to_blame(gain_high - gain_prev, gain_safe - gain_prev, &
-                                        bound)) then
-                    ! on from tout at the safe order, for good
-                    call summary%safety%lowered(t_prev, max_order, safe_order)
-                    call stats_before%add(integrator%stats())
-                    call integrator%finalize()
-                    call move_alloc(safe, integrator)
-                    ! the whole budget that is left, no longer the second look's
-                    integrator%options%max_steps = max(1_i8, options%max_steps - &
-                                                       stats_before%steps)
-                    max_order = safe_order
-                    t = t_safe
-                    y = y_safe
-                    yq = yq_safe
-                    e = model%energy(t, y, yq)
-                    return
-                end if
-                write (why, '(a, i0, a, es10.3, a, i0, a, es10.3, a)') 'order ', safe_order, &
-                    ' changed the balance by ', gain_safe - gain_prev, &
-                    ' J over the same interval, order ', max_order, ' by ', &
-                    gain_high - gain_prev, ' J: the integration error at this rtol'
-            else if (signal_received() /= 0) then
-                why = 'the second look at the safe order was interrupted'
-            else if (full_budget) then
-                ! the safe order with the whole budget: its failure is the run's, as the
-                ! failure of any integration
+            reached = .not. allocated(safe_err) .and. t_safe >= tout
+            if (reached) change_safe = monitor%gain(model%energy(t_safe, y_safe, yq_safe)) - &
+                                       (monitor%gain(e) - change_high)
+            action = look_action(reached, signal_received() /= 0, sudden, safe_crawled, &
+                                 high_order_to_blame(change_high, change_safe, bound))
+            if (action == LOOK_LOWER .or. action == LOOK_FAIL) then
+                ! on from where the safe order got, with it (its failure is the run's)
+                if (action == LOOK_LOWER) call summary%safety%lowered(t_prev, max_order, &
+                                                                      safe_order)
                 call stats_before%add(integrator%stats())
                 call integrator%finalize()
                 call move_alloc(safe, integrator)
+                ! the whole budget that is left, no longer the second look's
+                integrator%options%max_steps = max(1_i8, options%max_steps - &
+                                                   stats_before%steps)
+                max_order = safe_order
                 t = t_safe
                 y = y_safe
                 yq = yq_safe
-                call move_alloc(safe_err, lerr)
+                e = model%energy(t, y, yq)
+                if (allocated(safe_err)) call move_alloc(safe_err, lerr)
                 return
-            else
-                ! no verdict, once: a second gain of a bound lowers the order whatever it costs
+            end if
+            if (action == LOOK_NO_VERDICT) then
                 safe_crawled = .true.
                 write (why, '(4(a, i0), a)') 'order ', safe_order, &
                     ' did not get through the same interval in ', budget, &
                     ' steps (order ', max_order, ' took ', steps_high, '): no verdict'
+            else if (reached) then
+                write (why, '(a, i0, a, es10.3, a, i0, a, es10.3, a)') 'order ', safe_order, &
+                    ' changed the balance by ', change_safe, ' J over the same interval, '// &
+                    'order ', max_order, ' by ', change_high, ' J: the integration error '// &
+                    'at this rtol'
+            else
+                why = 'the second look at the safe order was interrupted'
             end if
-            ! the integration error at this rtol: on at the order asked for
+            ! on at the order asked for; gains counted from this level
             call stats_before%add(safe%stats())
             call safe%finalize()
             call summary%safety%kept(t, trim(why))
-            call monitor%accept(gain_high)
+            call monitor%accept(monitor%gain(e))
         end subroutine second_look
 
         !> Steps of the integrator in use so far.

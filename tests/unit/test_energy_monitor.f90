@@ -12,13 +12,18 @@
 !! - `high_order_to_blame`: the order in use made a gain gathered over earlier intervals
 !!   (less than half the bound in the last one) whatever the safe order did; a gain of the
 !!   last interval exactly when the safe order, over the same interval, changed the balance
-!!   less (a gain or a loss alike).
+!!   less (a gain or a loss alike);
+!! - the second look's budget (20 times the interval's steps, at least 500, for a sudden
+!!   gain's first look; else all that is left) and its action in every case (lower, keep,
+!!   no verdict once, the run's failure).
 !! The end-to-end part (the order lowered at a gain, 'stop', the HDF5 record) is
 !! tests/hard/test_order_safety.py; the long runs tests/long.
 program test_energy_monitor
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, i8
     use ropedyn_rope_model, only: energy_t
-    use ropedyn_energy_monitor, only: energy_monitor_t, high_order_to_blame, sudden_gain
+    use ropedyn_energy_monitor, only: energy_monitor_t, high_order_to_blame, sudden_gain, &
+                                      look_budget, look_action, LOOK_LOWER, LOOK_KEEP, &
+                                      LOOK_NO_VERDICT, LOOK_FAIL
     use ropedyn_assert, only: test_suite_t
     implicit none
 
@@ -99,6 +104,31 @@ program test_energy_monitor
                           'a gain gathered before: the order, however the safe one does')
     call suite%check_true(sudden_gain(0.5e-3_wp, 1.0e-3_wp) .and. &
                           .not. sudden_gain(0.49e-3_wp, 1.0e-3_wp), 'sudden from half')
+
+    ! the second look's budget: capped for a sudden gain's first look, else all that is left
+    call suite%check_true(look_budget(.true., .false., 3076_i8, 10**6_i8) == 61520_i8, &
+                          'budget: 20 times the steps of the interval')
+    call suite%check_true(look_budget(.true., .false., 3_i8, 10**6_i8) == 500_i8, &
+                          'budget: at least 500')
+    call suite%check_true(look_budget(.true., .false., 3076_i8, 1000_i8) == 1000_i8, &
+                          'budget: no more than is left')
+    call suite%check_true(look_budget(.false., .false., 3076_i8, 10**6_i8) == 10**6_i8, &
+                          'budget: a gathered gain gets all that is left')
+    call suite%check_true(look_budget(.true., .true., 3076_i8, 10**6_i8) == 10**6_i8, &
+                          'budget: after a look without verdict, all that is left')
+    ! ... and its action
+    call suite%check_true(look_action(.true., .false., .true., .false., .true.) == LOOK_LOWER, &
+                          'reached, the order to blame: lower')
+    call suite%check_true(look_action(.true., .false., .true., .false., .false.) == LOOK_KEEP, &
+                          'reached, integration error: keep')
+    call suite%check_true(look_action(.false., .true., .true., .false., .true.) == LOOK_KEEP, &
+                          'interrupted: keep (the run stops)')
+    call suite%check_true(look_action(.false., .false., .true., .false., .true.) == &
+                          LOOK_NO_VERDICT, 'a sudden gain, capped budget run out: no verdict')
+    call suite%check_true(look_action(.false., .false., .true., .true., .true.) == LOOK_FAIL, &
+                          'after a look without verdict: the safe order fails the run')
+    call suite%check_true(look_action(.false., .false., .false., .false., .true.) == LOOK_FAIL, &
+                          'a gathered gain: the safe order fails the run')
 
     ! the gravity range counts into S, not the gravity energy itself (its zero is arbitrary)
     call m%start(energy_t(kinetic=0.0_wp, elastic=0.0_wp, gravity=-100.0_wp, &
