@@ -150,8 +150,7 @@ module ropedyn_output
         procedure :: append => output_append
         procedure :: write_stats => output_write_stats
         procedure :: write_switches => output_write_switches
-        procedure :: write_order_lowered => output_write_order_lowered
-        procedure :: write_order_kept => output_write_order_kept
+        procedure :: write_order_safety => output_write_order_safety
         procedure :: close_run => output_close_run
         procedure :: reopen => output_reopen
         procedure :: records => output_records
@@ -404,49 +403,40 @@ contains
         call self%file%flush(err)
     end subroutine output_write_stats
 
-    !> Record that the order safety lowered the order limit from `from` to `to` at time `t`
-    !! because the energy balance gained `gain` (docs/stability.md).
-    subroutine output_write_order_lowered(self, t, from, to, gain, err)
+    !> Record what the order safety did (docs/stability.md; times < 0: never): the order
+    !! limit lowered from `from` to `to` at time `lowered_at`; the order kept at a gain
+    !! judged the integration error, first at `kept_at`, `kept_count` times in all; `gain`,
+    !! the first gain beyond the bound. Nothing when it did neither.
+    subroutine output_write_order_safety(self, gain, lowered_at, from, to, kept_at, &
+                                         kept_count, err)
         class(output_file_t), intent(inout) :: self
-        real(wp), intent(in) :: t       !< s
-        integer, intent(in) :: from, to
-        real(wp), intent(in) :: gain    !< J
+        real(wp), intent(in) :: gain                  !< J
+        real(wp), intent(in) :: lowered_at, kept_at   !< s
+        integer, intent(in) :: from, to, kept_count
         type(error_t), allocatable, intent(out) :: err
+        if (lowered_at < 0.0_wp .and. kept_at < 0.0_wp) return
         if (.not. self%is_open) then
             call make_error(err, ERR_INTERNAL, &
-                            file_label(self)//': write_order_lowered: file is not open')
+                            file_label(self)//': write_order_safety: file is not open')
             return
         end if
-        call self%file%write('/solver/order_lowered_at', t, 's', err)
-        if (.not. allocated(err)) &
-            call self%file%write('/solver/order_lowered_from', int(from, i8), '1', err)
-        if (.not. allocated(err)) &
-            call self%file%write('/solver/order_lowered_to', int(to, i8), '1', err)
-        if (.not. allocated(err)) call self%file%write('/solver/energy_gain', gain, 'J', err)
-        if (.not. allocated(err)) call self%file%flush(err)
-    end subroutine output_write_order_lowered
-
-    !> Record that the order safety kept the order asked for at a gain beyond the bound
-    !! (the safe order did not cure it), first at time `t`, `count` times in all; `gain`:
-    !! the first such gain (docs/stability.md).
-    subroutine output_write_order_kept(self, t, count, gain, err)
-        class(output_file_t), intent(inout) :: self
-        real(wp), intent(in) :: t       !< s
-        integer, intent(in) :: count
-        real(wp), intent(in) :: gain    !< J
-        type(error_t), allocatable, intent(out) :: err
-        if (.not. self%is_open) then
-            call make_error(err, ERR_INTERNAL, &
-                            file_label(self)//': write_order_kept: file is not open')
-            return
+        call self%file%write('/solver/energy_gain', gain, 'J', err)
+        if (lowered_at >= 0.0_wp) then
+            if (.not. allocated(err)) &
+                call self%file%write('/solver/order_lowered_at', lowered_at, 's', err)
+            if (.not. allocated(err)) &
+                call self%file%write('/solver/order_lowered_from', int(from, i8), '1', err)
+            if (.not. allocated(err)) &
+                call self%file%write('/solver/order_lowered_to', int(to, i8), '1', err)
         end if
-        call self%file%write('/solver/order_kept_at', t, 's', err)
-        if (.not. allocated(err)) &
-            call self%file%write('/solver/order_kept_count', int(count, i8), '1', err)
-        if (.not. allocated(err) .and. .not. self%file%exists('/solver/energy_gain')) &
-            call self%file%write('/solver/energy_gain', gain, 'J', err)
+        if (kept_at >= 0.0_wp) then
+            if (.not. allocated(err)) &
+                call self%file%write('/solver/order_kept_at', kept_at, 's', err)
+            if (.not. allocated(err)) &
+                call self%file%write('/solver/order_kept_count', int(kept_count, i8), '1', err)
+        end if
         if (.not. allocated(err)) call self%file%flush(err)
-    end subroutine output_write_order_kept
+    end subroutine output_write_order_safety
 
     !> The time split of `stats` named in TIMER_NAMES, in that order (s).
     pure function timer_values(stats) result(times)

@@ -71,9 +71,12 @@ module ropedyn_energy_monitor
         real(wp) :: kept_at = -1.0_wp           !< a gain judged the integration error
         integer :: kept_count = 0               !< ... how many
         character(len=:), allocatable :: kept_reason  !< ... why, the first time
+        !> a second look ran out of its capped budget (no verdict): later looks get all
+        logical :: crawled = .false.
     contains
         procedure :: alarm => record_alarm
         procedure :: lowered => record_lowered
+        procedure :: unresolved => record_unresolved
         procedure :: kept => record_kept
     end type safety_record_t
 
@@ -98,6 +101,13 @@ contains
         self%order_before = from
         self%order_after = to
     end subroutine record_lowered
+
+    !> A gain at time t that lowering cannot cure: remembered if it is the first.
+    pure subroutine record_unresolved(self, t)
+        class(safety_record_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        if (self%unresolved_at < 0.0_wp) self%unresolved_at = t
+    end subroutine record_unresolved
 
     !> The order kept at time t at a gain judged the integration error, for reason `why`.
     pure subroutine record_kept(self, t, why)

@@ -161,11 +161,9 @@ contains
         integer(i8) :: counters_before(7)       ! resume: counters of the earlier parts
         integer :: n, k, n_out, k_first, nq, sig
         integer(i8) :: steps_mark   ! the integrator's steps at the previous record
-        logical :: safe_crawled     ! a second look at the safe order ran out of its budget
         type(solver_stats_t) :: stats
 
         caught = .false.
-        safe_crawled = .false.
         cpu_before = 0.0_wp
         counters_before = 0
         call create_model(scene%rope_spec_t, model, err)
@@ -396,7 +394,7 @@ contains
                 call next%observe(e)
                 next_bound = next%bound()
                 write (what, '(a, es10.3, a, es10.3, a, es12.5, a, i0)') 'energy gain ', &
-                    next%gain(e), ' J above E0 (bound ', next%bound(), ' J) at t = ', t, &
+                    next%gain(e), ' J above E0 (bound ', next_bound, ' J) at t = ', t, &
                     ' s, max order ', max_order
                 call summary%safety%alarm(next%gain(e), next_bound)
             end block
@@ -415,8 +413,8 @@ contains
             if (safe_order > 0 .and. max_order > safe_order) then
                 call second_look(tout, e, next_bound, cerr)
                 if (allocated(cerr)) return
-            else if (summary%safety%unresolved_at < 0.0_wp) then
-                summary%safety%unresolved_at = t
+            else
+                call summary%safety%unresolved(t)
             end if
             call monitor%observe(e)
             steps_mark = steps_taken()
@@ -442,16 +440,18 @@ contains
             class(integrator_t), allocatable :: safe
             type(solver_options_t) :: safe_options
             type(error_t), allocatable :: safe_err
-            real(wp) :: t_safe, y_safe(size(y)), yq_safe(size(yq)), change_high, change_safe
+            real(wp) :: t_safe, y_safe(size(y)), yq_safe(size(yq)), gain_prev, change_high, &
+                        change_safe
             integer(i8) :: steps_high, budget
             logical :: sudden, reached
             integer :: action
             character(len=200) :: why
-            change_high = monitor%gain(e) - monitor%gain(model%energy(t_prev, y_prev, yq_prev))
+            gain_prev = monitor%gain(model%energy(t_prev, y_prev, yq_prev))
+            change_high = monitor%gain(e) - gain_prev
             change_safe = 0.0_wp
             steps_high = steps_taken() - steps_mark
             sudden = sudden_gain(change_high, bound)
-            budget = look_budget(sudden, safe_crawled, steps_high, options%max_steps - &
+            budget = look_budget(sudden, summary%safety%crawled, steps_high, options%max_steps - &
                                  stats_before%steps - steps_taken())
             call create_integrator(scene, safe, lerr)
             if (allocated(lerr)) return
@@ -467,8 +467,8 @@ contains
             call safe%advance_to(tout, t_safe, y_safe, yq_safe(1:nq), safe_err)
             reached = .not. allocated(safe_err) .and. t_safe >= tout
             if (reached) change_safe = monitor%gain(model%energy(t_safe, y_safe, yq_safe)) - &
-                                       (monitor%gain(e) - change_high)
-            action = look_action(reached, signal_received() /= 0, sudden, safe_crawled, &
+                                       gain_prev
+            action = look_action(reached, signal_received() /= 0, sudden, summary%safety%crawled, &
                                  high_order_to_blame(change_high, change_safe, bound))
             if (action == LOOK_LOWER .or. action == LOOK_FAIL) then
                 ! on from where the safe order got, with it (its failure is the run's)
@@ -489,7 +489,7 @@ contains
                 return
             end if
             if (action == LOOK_NO_VERDICT) then
-                safe_crawled = .true.
+                summary%safety%crawled = .true.
                 write (why, '(4(a, i0), a)') 'order ', safe_order, &
                     ' did not get through the same interval in ', budget, &
                     ' steps (order ', max_order, ' took ', steps_high, '): no verdict'
@@ -564,11 +564,9 @@ contains
             summary%switches = integrator%switch_log()
             if (.not. allocated(ferr)) call out%write_switches(summary%switches, ferr)
             associate (r => summary%safety)
-                if (.not. allocated(ferr) .and. r%lowered_at >= 0.0_wp) &
-                    call out%write_order_lowered(r%lowered_at, r%order_before, &
-                                                 r%order_after, r%energy_gain, ferr)
-                if (.not. allocated(ferr) .and. r%kept_at >= 0.0_wp) &
-                    call out%write_order_kept(r%kept_at, r%kept_count, r%energy_gain, ferr)
+                if (.not. allocated(ferr)) &
+                    call out%write_order_safety(r%energy_gain, r%lowered_at, r%order_before, &
+                                                r%order_after, r%kept_at, r%kept_count, ferr)
             end associate
             call out%close_run(status, reason, ferr)
             if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
