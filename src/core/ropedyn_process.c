@@ -11,13 +11,18 @@
  * - A lock's heartbeat: a thread that touches the lock file every few seconds, so that a
  *   reader on another host can tell a live writer from one that is gone.
  * - Worker processes: spawned in their own process group with stdout and stderr in a log
- *   file; reaped without blocking; signalled as a group.
+ *   file; reaped without blocking; signalled as a group; waited for: while children are
+ *   watched, SIGCHLD has a handler that does nothing and is blocked except inside
+ *   ropedyn_wait_children, which sleeps until a child ends, a signal is caught or its time
+ *   is up (a child that ends between a reap and the wait leaves SIGCHLD pending, and the
+ *   wait returns at once).
  * - Process start times (/proc/PID/stat), to tell a live PID from a reused one.
  *
  * Only async-signal-safe calls (write, signal, raise) happen in the handler. */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <fcntl.h>
+#include <poll.h>
 #include <pthread.h>
 #include <signal.h>
 #include <spawn.h>
@@ -236,6 +241,57 @@ int ropedyn_reap(int pid, int *code)
     *code = WIFEXITED(status) ? WEXITSTATUS(status)
                               : (WIFSIGNALED(status) ? 128 + WTERMSIG(status) : 255);
     return 1;
+}
+
+static int watching = 0;
+static struct sigaction saved_chld;
+static sigset_t saved_mask;
+
+static void on_child(int sig) { (void)sig; }
+
+/* Watch for ended children (see the header): SIGCHLD gets a handler that does nothing and
+ * is blocked outside ropedyn_wait_children. Returns 0, or errno. */
+int ropedyn_watch_children(void)
+{
+    struct sigaction sa;
+    sigset_t chld;
+    if (watching) return 0;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_child;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESTART | SA_NOCLDSTOP;
+    sigemptyset(&chld);
+    sigaddset(&chld, SIGCHLD);
+    if (pthread_sigmask(SIG_BLOCK, &chld, &saved_mask) != 0) return EINVAL;
+    if (sigaction(SIGCHLD, &sa, &saved_chld) != 0) {
+        int rc = errno;
+        pthread_sigmask(SIG_SETMASK, &saved_mask, NULL);
+        return rc;
+    }
+    watching = 1;
+    return 0;
+}
+
+/* Undo ropedyn_watch_children: SIGCHLD's handler and this thread's mask as they were. */
+void ropedyn_unwatch_children(void)
+{
+    if (!watching) return;
+    sigaction(SIGCHLD, &saved_chld, NULL);
+    pthread_sigmask(SIG_SETMASK, &saved_mask, NULL);
+    watching = 0;
+}
+
+/* Sleep until a child ends or a signal is caught (1), or `microseconds` pass (0). Without
+ * ropedyn_watch_children only a caught signal ends the sleep early. */
+int ropedyn_wait_children(long microseconds)
+{
+    struct timespec ts;
+    sigset_t during;
+    ts.tv_sec = microseconds / 1000000;
+    ts.tv_nsec = (microseconds % 1000000) * 1000;
+    pthread_sigmask(SIG_BLOCK, NULL, &during);
+    sigdelset(&during, SIGCHLD);
+    return ppoll(NULL, 0, &ts, &during) < 0 && errno == EINTR ? 1 : 0;
 }
 
 /* Send `sig` to the process group `pgid`. Returns 0, or errno. */

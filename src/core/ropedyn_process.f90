@@ -6,7 +6,7 @@
 !! the clock. Used by the run driver (docs/output.md, "Interrupts") and the sweep runner
 !! (docs/sweeps.md).
 module ropedyn_process
-    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long_long, c_null_char, c_size_t
+    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_long_long, c_null_char, c_size_t
     use, intrinsic :: iso_fortran_env, only: int64
     use ropedyn_error, only: error_t, make_error, ERR_IO
     use ropedyn_text, only: int_text
@@ -16,6 +16,7 @@ module ropedyn_process
     public :: end_on_second_signal, slurm_job, process_text
     public :: start_heartbeat, stop_heartbeat
     public :: spawn, reap, signal_group, process_id, process_start, host_name
+    public :: watch_children, unwatch_children, wait_children
     public :: file_mtime, unix_time
     public :: SIGINT, SIGKILL, SIGTERM
 
@@ -58,6 +59,16 @@ module ropedyn_process
             integer(c_int), value :: pid
             integer(c_int), intent(out) :: code
         end function c_reap
+        integer(c_int) function c_watch_children() bind(C, name='ropedyn_watch_children')
+            import :: c_int
+        end function c_watch_children
+        subroutine unwatch_children() bind(C, name='ropedyn_unwatch_children')
+        end subroutine unwatch_children
+        integer(c_int) function c_wait_children(microseconds) &
+                bind(C, name='ropedyn_wait_children')
+            import :: c_int, c_long
+            integer(c_long), value :: microseconds
+        end function c_wait_children
         integer(c_int) function c_signal_group(pgid, sig) bind(C, name='ropedyn_signal_group')
             import :: c_int
             integer(c_int), value :: pgid, sig
@@ -180,6 +191,23 @@ contains
         code = int(c)
         if (rc < 0) code = 255
     end function reap
+
+    !> From now on until `unwatch_children`, the end of a child wakes `wait_children`
+    !! (SIGCHLD is blocked outside it, so that an end between a reap and the wait is kept).
+    subroutine watch_children(err)
+        type(error_t), allocatable, intent(out) :: err
+        integer(c_int) :: rc
+        rc = c_watch_children()
+        if (rc /= 0) call make_error(err, ERR_IO, 'cannot watch for the end of worker '// &
+            'processes (errno '//int_text(int(rc))//')')
+    end subroutine watch_children
+
+    !> Sleep until a watched child ends or a signal is caught (true), or at most
+    !! `microseconds` (false: the time passed).
+    logical function wait_children(microseconds) result(woken)
+        integer, intent(in) :: microseconds
+        woken = c_wait_children(int(microseconds, c_long)) /= 0
+    end function wait_children
 
     !> Send `sig` to the process group `pgid` (a spawned worker's pid); false if it is gone.
     logical function signal_group(pgid, sig) result(sent)

@@ -17,7 +17,7 @@ module ropedyn_sweep_runner
     use ropedyn_kinds, only: wp
     use ropedyn_os, only: make_dirs, is_terminal, sleep_microseconds, delete_file
     use ropedyn_process, only: catch_signals, release_signals, signal_received, signal_name, &
-        spawn, reap, signal_group, SIGKILL
+        spawn, reap, signal_group, SIGKILL, watch_children, unwatch_children, wait_children
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER, ERR_INTERRUPTED
     use ropedyn_sweep, only: sweep_t, text_t
     use ropedyn_text, only: int_text
@@ -28,7 +28,8 @@ module ropedyn_sweep_runner
     private
     public :: sweep_options_t, list_cases, status_report, run_local, summarize
 
-    !> Poll interval of the local runner, microseconds.
+    !> The local runner's longest wait for a worker's end (it wakes at once when one ends),
+    !! and its poll interval while it stops workers, microseconds.
     integer, parameter :: POLL_US = 50000
     !> s a stopped worker has to end after the forwarded signal, before SIGKILL.
     integer, parameter :: STOP_GRACE = 10
@@ -153,7 +154,7 @@ contains
         character(len=:), allocatable :: args(:)
         integer :: n, c, next, finished, failed, rc, s, width, sig
         integer(int64) :: start, now, rate, last_draw
-        logical :: tty, redraw
+        logical :: tty, redraw, woken
 
         n = size(sweep%cases)
         width = id_width(sweep)
@@ -192,6 +193,11 @@ contains
         args(size(args) - 1) = '--task'
         call catch_signals(err)
         if (allocated(err)) return
+        call watch_children(err)
+        if (allocated(err)) then
+            call release_signals()
+            return
+        end if
         allocate (slot(opt%jobs), pid(opt%jobs), source=0)
         next = 1
         finished = 0
@@ -210,13 +216,15 @@ contains
                 if (allocated(err)) then
                     err%message = 'sweep: case '//zero_padded(c, width)//': '//err%message
                     call stop_workers(SIGKILL)
+                    call unwatch_children()
                     call release_signals()
                     return
                 end if
                 next = next + 1
                 slot(s) = c
             end do
-            call sleep_microseconds(POLL_US)
+            ! until a worker ends (or a signal, or POLL_US for the progress line)
+            woken = wait_children(POLL_US)
             ! collect finished workers
             redraw = .false.
             do s = 1, size(slot)
@@ -251,6 +259,7 @@ contains
         sig = signal_received()
         if (sig /= 0) then
             call stop_workers(sig)
+            call unwatch_children()
             call release_signals()
             call make_error(err, ERR_INTERRUPTED, 'sweep: stopped by '//signal_name(sig)// &
                 ': '//int_text(finished)//' of '//int_text(size(todo))//' cases ended, '// &
@@ -260,6 +269,7 @@ contains
                 //'sweep again goes on from there)')
             return
         end if
+        call unwatch_children()
         call release_signals()
 
         call build_summary(sweep, rows, warnings, err)
