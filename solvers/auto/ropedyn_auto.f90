@@ -62,8 +62,12 @@ module ropedyn_auto
     private
     public :: auto_t
 
-    integer, parameter :: EXPLICIT = 1, IMPLICIT = 2, ADAMS = 3
+    !> The methods: erk's order-4 pair, the implicit method, Adams, erk's order-5 pair
+    integer, parameter :: EXPLICIT = 1, IMPLICIT = 2, ADAMS = 3, HIGH = 4
     integer, parameter :: ERK_ORDER = 4            !< the explicit pair (RK4, 3rd-order estimate)
+    !> the explicit pair for stretches held by accuracy on problems without a mass matrix
+    !! (Dormand-Prince 5(4))
+    integer, parameter :: HIGH_ORDER = 5
     integer, parameter :: WINDOW = 400             !< steps between looks
     !> an earlier first look at erk, before the implicit method's cost is known: after
     !! EARLY_WINDOW steps, when at least EARLY_SHARE of them were held by stability
@@ -105,11 +109,13 @@ module ropedyn_auto
     type, extends(integrator_t) :: auto_t
         private
         type(erk_t) :: erk
+        type(erk_t) :: erk_high            !< the order-5 pair (HIGH)
         type(mebdf_t) :: mebdf
         type(cvode_t) :: bdf
         type(adams_t) :: am
         logical :: use_bdf = .false.       !< the implicit method is cvode (else mebdf)
         type(erk_table_t) :: tab
+        type(erk_table_t) :: tab_high      !< the order-5 pair's
         integer :: active = 0
         integer :: mebdf_order = 4
         integer :: user_order = 0          !< max_order given (0: from the damping)
@@ -127,9 +133,14 @@ module ropedyn_auto
         !> explicit windows since rate_implicit was measured, and how many make it stale
         integer :: implicit_age = 0
         integer :: stale_after = STALE_WINDOWS
-        real(wp) :: rate_adams = -1.0_wp
-        !> Adams' cost in its last window that was not dearer than erk's by GAIN (< 0: none)
-        real(wp) :: calm_adams = -1.0_wp
+        !> the method for stretches where erk's step is held by accuracy: Adams where f
+        !! solves with a mass matrix, else erk's order-5 pair (HIGH)
+        integer :: accurate = ADAMS
+        real(wp) :: rate_accurate = -1.0_wp  !< its measured cost per simulated second
+        !> windows of the order-5 pair since rate_explicit was measured
+        integer :: explicit_age = 0
+        !> its cost in its last window that was not dearer than erk's by GAIN (< 0: none)
+        real(wp) :: calm_accurate = -1.0_wp
         logical :: trial = .false.         !< the implicit method is on trial
         integer :: dearer = 0              !< windows in a row Adams cost more than erk by GAIN
         integer :: wait = 0                !< windows to let pass before the next switch
@@ -141,6 +152,8 @@ module ropedyn_auto
         real(wp) :: mebdf_eval_cost = 1.0_wp
         !> erk's stable step when it was last started from a spectrum estimate (s; 0: none)
         real(wp) :: h_stable = 0.0_wp
+        !> the order-5 pair's stable step from the same estimate (s; 0: none)
+        real(wp) :: h_stable_high = 0.0_wp
         real(wp) :: radius = 0.0_wp        !< the last estimate's spectral radius, 1/s
         !> the step that sizes a segment's first chunk, before its method has stepped (s;
         !! 0: none): the stable step h_e at the start, the step the previous method ended
@@ -158,6 +171,7 @@ module ropedyn_auto
         procedure, private :: current_stats
         procedure, private :: cost
         procedure, private :: implicit_name
+        procedure, private :: accurate_name
         procedure, private :: trials_are_cheap
     end type auto_t
 
@@ -197,17 +211,21 @@ contains
         self%yq = start%yq0
         self%t = start%t0
         self%tab = erk_table(ERK_ORDER)
+        self%tab_high = erk_table(HIGH_ORDER)
         self%done = solver_stats_t()
         call self%log%clear()
         self%rate_explicit = -1.0_wp
         self%rate_implicit = -1.0_wp
         self%implicit_age = 0
         self%stale_after = STALE_WINDOWS
-        self%rate_adams = -1.0_wp
+        self%rate_accurate = -1.0_wp
+        self%accurate = merge(ADAMS, HIGH, self%problem%has_mass_matrix())
         self%trial = .false.
         self%wait = 0
         self%backoff = 1
         self%h_stable = 0.0_wp
+        self%h_stable_high = 0.0_wp
+        self%explicit_age = 0
         self%radius = 0.0_wp
 
         call newton_widths(self%problem, self%lambda, self%mebdf_eval_cost)
@@ -217,6 +235,7 @@ contains
         if (self%use_bdf) self%mebdf_order = BDF_ORDER
         if (self%user_order /= 0) self%mebdf_order = min(self%mebdf_order, self%user_order)
         h_e = erk_stable_step(self%tab, spec)
+        self%h_stable_high = erk_stable_step(self%tab_high, spec)
         self%radius = spec%radius
         self%h_chunk = h_e
         if (spec%valid .and. h_e > 0.0_wp) then
@@ -323,6 +342,7 @@ contains
             if (h_first > 0.0_wp) self%h_chunk = h_first
         end if
         if (self%active == EXPLICIT) call self%erk%finalize()
+        if (self%active == HIGH) call self%erk_high%finalize()
         if (self%active == ADAMS) call self%am%finalize()
         if (self%active == IMPLICIT) then
             call self%mebdf%finalize()
@@ -343,8 +363,19 @@ contains
             end if
             if (self%trials_are_cheap()) call self%erk%set_stable_step(self%h_stable)
             call self%log%add(self%t, 'erk', ERK_ORDER, reason)
+        else if (which == HIGH) then
+            self%calm_accurate = -1.0_wp
+            opts%max_order = HIGH_ORDER
+            call self%erk_high%init(self%problem, self%t, self%y, self%yq, opts, err)
+            if (allocated(err)) return
+            call self%erk_high%set_stiff_failure(0.0_wp)
+            ! the order-4 pair's last step, held by accuracy, is a safe first step
+            if (self%h_chunk > 0.0_wp) call self%erk_high%set_initial_step(self%h_chunk)
+            call self%erk_high%set_stable_step(self%h_stable_high)
+            self%explicit_age = 0
+            call self%log%add(self%t, 'erk', HIGH_ORDER, reason)
         else if (which == ADAMS) then
-            self%calm_adams = -1.0_wp
+            self%calm_accurate = -1.0_wp
             opts%max_order = ADAMS_ORDER
             call self%am%init(self%problem, self%t, self%y, self%yq, opts, err)
             if (allocated(err)) return
@@ -394,6 +425,8 @@ contains
             if (h_look > 0.0_wp) target = min(tout, self%t + 0.25_wp*WINDOW*h_look)
             if (self%active == EXPLICIT) then
                 call self%erk%advance_to(target, self%t, self%y, self%yq, err)
+            else if (self%active == HIGH) then
+                call self%erk_high%advance_to(target, self%t, self%y, self%yq, err)
             else if (self%active == ADAMS) then
                 call self%am%advance_to(target, self%t, self%y, self%yq, err)
                 if (allocated(err)) then
@@ -401,7 +434,7 @@ contains
                     ! step budget is spent
                     now = self%stats()
                     if (now%steps < self%options%max_steps) then
-                        self%rate_adams = huge(1.0_wp)
+                        self%rate_accurate = huge(1.0_wp)
                         call self%start_method(EXPLICIT, 'adams failed: '// &
                                                trim(err%message(1:min(160, len(err%message)))), &
                                                err)
@@ -430,6 +463,14 @@ contains
         t = self%t
     end subroutine auto_advance_to
 
+
+    !> Name of the method for stretches held by accuracy.
+    pure function accurate_name(self) result(name)
+        class(auto_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'adams'
+        if (self%accurate == HIGH) name = 'the order-5 pair'
+    end function accurate_name
 
     !> Name of the implicit method of this run.
     pure function implicit_name(self) result(name)
@@ -478,6 +519,8 @@ contains
         select case (self%active)
         case (EXPLICIT)
             s = self%erk%stats()
+        case (HIGH)
+            s = self%erk_high%stats()
         case (ADAMS)
             s = self%am%stats()
         case (IMPLICIT)
@@ -510,6 +553,7 @@ contains
     subroutine auto_finalize(self)
         class(auto_t), intent(inout) :: self
         call self%erk%finalize()
+        call self%erk_high%finalize()
         call self%mebdf%finalize()
         call self%bdf%finalize()
         call self%am%finalize()

@@ -62,6 +62,23 @@
 !!   converge: the problem has become stiff). Adams' cost: its evaluations of f plus
 !!   ADAMS_STEP_COST per step (CVODE's vector work per step: measured about 2 f on the
 !!   paper's rope at n = 30, where f is cheap, and about 1.2 f on the MPP at n = 30).
+!! - **The order-5 pair** (erk's Dormand-Prince 5(4), HIGH) is the method for a step held
+!!   by accuracy on a problem without a mass matrix (the RFEM), by the rules of Adams
+!!   above (the "accuracy method": tried once when most steps of an order-4 window were
+!!   held by accuracy, kept when cheaper by GAIN on its second window, left when the
+!!   order-4 pair was cheaper by GAIN two windows in a row). Its steps are longer where
+!!   accuracy holds them (folded_n301 at rtol 1e-6: 196,076 f against 359,070 for the
+!!   order-4 pair over 0.6 s; light_damping 1.18e6 against 2.23e6 over 10 s), but its
+!!   stable interval on the imaginary axis is a third of the 3/8 pair's per step, so on
+!!   lightly damped element modes near the limit it is the dearer one (paper: 884,876 f
+!!   against 817,662; steel_wire 1.17e6 against 0.68e6). Two more rules for it: when most
+!!   of a window's steps were held by stability (its own stable step from the same
+!!   spectrum estimate), back to the order-4 pair at once, from which the implicit
+!!   method may be tried, and the waits double (steel_wire went back and forth eight
+!!   times in 0.7 s without that); and the order-4 pair's measured cost is evidence for
+!!   STALE_WINDOWS windows of the order-5 pair, after which auto measures it again
+!!   (shaken_top: the order-5 pair paid in the first 0.03 s and then ran to the end at
+!!   1.18 times the order-4 pair's evaluations of f).
 submodule (ropedyn_auto) ropedyn_auto_switching
     implicit none
 
@@ -95,17 +112,17 @@ contains
             share = self%erk%stiff_share_of_steps()
             if (self%wait > 0) return
             if (share < 0.5_wp) then
-                ! held by accuracy: Adams may need fewer evaluations of f (judged on the
-                ! explicit method's second window on: the first includes its start), which
-                ! pays only where f is costly: a problem with a mass matrix (f solves with it)
-                if (self%windows < 2 .or. .not. self%problem%has_mass_matrix()) return
-                if (self%rate_adams > 0.0_wp .and. GAIN*self%rate_adams >= rate) return
+                ! held by accuracy: the accuracy method may need fewer evaluations of f
+                ! (judged on the explicit method's second window on: the first includes its
+                ! start)
+                if (self%windows < 2) return
+                if (self%rate_accurate > 0.0_wp .and. GAIN*self%rate_accurate >= rate) return
                 write (text, '(a, i0, a, es9.2, a)') 'explicit step held by accuracy (', &
                     nint(100*(1 - share)), ' % of the steps; cost ', rate, ' f per second)'
-                self%trial = self%rate_adams <= 0.0_wp
-                if (self%trial) text = trim(text)//': trying adams'
+                self%trial = self%rate_accurate <= 0.0_wp
+                if (self%trial) text = trim(text)//': trying '//self%accurate_name()
                 if (self%windows <= 2) call back_off()
-                call self%start_method(ADAMS, trim(text), err)
+                call self%start_method(self%accurate, trim(text), err)
                 return
             end if
             stale = self%rate_implicit > 0.0_wp .and. self%implicit_age >= self%stale_after &
@@ -126,20 +143,45 @@ contains
             end if
             if (self%windows <= 2) call back_off()
             call self%start_method(IMPLICIT, trim(text), err)
-        else if (self%active == ADAMS) then
+        else if (self%active == self%accurate) then
+            if (self%active == HIGH) then
+                ! the order-5 pair held by stability: the order-4 pair's stable step is
+                ! longer per evaluation of f, and from it auto may try the implicit method
+                share = self%erk_high%stiff_share_of_steps()
+                ! (a switch that did not pay: the waits double, against a ping-pong where
+                ! both pairs step near their limits: steel_wire)
+                if (share >= 0.5_wp) then
+                    write (text, '(a, i0, a)') 'order-5 pair held by stability (', &
+                        nint(100*share), ' % of the steps)'
+                    call back_off()
+                    call self%start_method(EXPLICIT, trim(text), err)
+                    return
+                end if
+                ! the order-4 pair's cost is evidence for STALE_WINDOWS windows: the
+                ! motion changes (shaken_top: the order-5 pair pays in the first 0.03 s,
+                ! not over the run), so then it is measured again
+                if (self%windows >= 2) self%explicit_age = self%explicit_age + 1
+                if (self%explicit_age >= STALE_WINDOWS .and. self%wait == 0) then
+                    write (text, '(a, i0, a)') 'the order-4 pair''s cost was measured ', &
+                        self%explicit_age, ' windows ago: measuring it again'
+                    call self%start_method(EXPLICIT, trim(text), err)
+                    return
+                end if
+            end if
             if (self%windows < 2) return
-            self%rate_adams = rate
+            self%rate_accurate = rate
             if (self%trial) then
-                ! kept only when cheaper by GAIN: its counted cost misses CVODE's fixed
-                ! work per step, which weighs most where f is cheap (the RFEM at small n)
+                ! kept only when cheaper by GAIN: Adams' counted cost misses CVODE's fixed
+                ! work per step, which weighs most where f is cheap (the RFEM at small n);
+                ! the order-5 pair is not worth a switch for less either
                 self%trial = .false.
                 if (self%rate_explicit > 0.0_wp .and. GAIN*rate > self%rate_explicit) then
-                    call trial_failed('adams was not cheaper by 1.3')
+                    call trial_failed(self%accurate_name()//' was not cheaper by 1.3')
                     return
                 end if
             end if
             dearer = self%rate_explicit > 0.0_wp .and. GAIN*self%rate_explicit < rate
-            if (.not. dearer) self%calm_adams = rate
+            if (.not. dearer) self%calm_accurate = rate
             if (self%wait > 0) return
             ! two windows in a row: one window of a transient (a snap) must not send auto
             ! back to erk, whose cost, measured before, then keeps Adams out for the rest
@@ -151,8 +193,8 @@ contains
             end if
             if (self%dearer >= 2) then
                 write (text, '(a, es9.2, a, es9.2, a)') 'erk was cheaper (', &
-                    self%rate_explicit, ' against ', rate, ' f per second for adams, '// &
-                    'two windows in a row)'
+                    self%rate_explicit, ' against ', rate, ' f per second for '// &
+                    self%accurate_name()//', two windows in a row)'
                 ! windows 2 and 3 are the earliest two that can send it back (the rate is
                 ! kept from window 2 on): leaving then undoes the switch at once
                 if (self%windows <= 3) call back_off()
@@ -161,7 +203,7 @@ contains
                 ! in a contact at 1.25 s against erk's 3.3e5 kept erk for the last 8.7 s,
                 ! 3.2 s CPU against Adams' 2.4): erk is weighed against Adams' cost in its
                 ! last window that was not dearer
-                if (self%calm_adams > 0.0_wp) self%rate_adams = self%calm_adams
+                if (self%calm_accurate > 0.0_wp) self%rate_accurate = self%calm_accurate
                 call self%start_method(EXPLICIT, trim(text), err)
             end if
         else
@@ -186,6 +228,7 @@ contains
             call estimate_spectrum(self%problem, self%t, self%y, spec)
             h_e = erk_stable_step(self%tab, spec)
             if (h_e <= 0.0_wp) return
+            self%h_stable_high = erk_stable_step(self%tab_high, spec)
             self%radius = spec%radius
             predicted = EXPLICIT_MARGIN*self%tab%evals_per_step()/h_e
             if (GAIN*predicted < rate) then

@@ -8,7 +8,9 @@
 !! before the burst then keeps Adams out for the rest of the run: 2.1e4 evaluations of f
 !! over 20 s against 7.5e3 (measured with a one-window rule, burst lengths 0.05-0.08 s).
 !! A second run has a burst of 1 s, which does send auto to erk: after it, auto must go
-!! back to Adams (see the program).
+!! back to Adams (see the program). A third run has no mass matrix: there auto's method
+!! for a step held by accuracy is erk's order-5 pair (Dormand-Prince 5(4)), and it must
+!! take fewer evaluations of f than the order-4 pair alone.
 module test_auto_switching_burst
     use ropedyn_kinds, only: wp
     use ropedyn_problem, only: problem_t, STATUS_OK
@@ -21,6 +23,7 @@ module test_auto_switching_burst
 
     type, extends(problem_t) :: burst_t
         real(wp) :: length = BURST              !< s, the burst's length
+        logical :: mass = .true.                !< weighed as a problem with a mass matrix
     contains
         procedure :: size => burst_size
         procedure :: bandwidths => burst_bandwidths
@@ -46,7 +49,7 @@ contains
     !! one whose f solves with a mass matrix.
     pure logical function burst_has_mass_matrix(self) result(has)
         class(burst_t), intent(in) :: self
-        has = .true.
+        has = self%mass
     end function burst_has_mass_matrix
 
     subroutine burst_rhs(self, t, y, ydot, status)
@@ -76,7 +79,8 @@ program test_auto_switching
 
     real(wp), parameter :: T_END = 20.0_wp
     type(test_suite_t) :: suite
-    type(burst_t), target :: short_burst, long_burst
+    type(burst_t), target :: short_burst, long_burst, no_mass
+    type(solver_stats_t) :: erk4
     type(switch_event_t), allocatable :: events(:)
     type(solver_stats_t) :: stats
     logical :: ok
@@ -115,17 +119,37 @@ program test_auto_switching
                           'back to adams after the long burst, kept to the end')
     call suite%check_le(real(stats%rhs_evals, wp), 7.6e4_wp, &
                         'f evaluations over 20 s with the long burst (8.2e4 on erk)')
+
+    ! No mass matrix (and no burst): the step is held by accuracy, and the order-5 pair
+    ! takes longer steps for the same tolerance than the order-4 pair; auto must find that
+    ! out and use it
+    no_mass%mass = .false.
+    no_mass%length = 0.0_wp
+    call integrate(no_mass, events, erk4, ok, 'erk')
+    call suite%check_true(ok, 'erk integrates the problem without a mass matrix')
+    call integrate(no_mass, events, stats, ok)
+    call suite%check_true(ok, 'auto integrates the problem without a mass matrix')
+    n = size(events)
+    if (.not. ok .or. n < 2) call suite%finish()
+    call suite%check_true(trim(events(1)%method) == 'erk' .and. events(1)%max_order == 4 &
+                          .and. any(events(2:)%method == 'erk' .and. events(2:)%max_order == 5), &
+                          'without a mass matrix: erk 4, then the order-5 pair')
+    call suite%check_true(all(events%method == 'erk'), &
+                          'without a mass matrix: no adams, no implicit method')
+    call suite%check_le(1.3_wp*real(stats%rhs_evals, wp), real(erk4%rhs_evals, wp), &
+                        'f evaluations: auto at least 1.3 times fewer than the order-4 pair')
     call suite%finish()
 
 contains
 
     !> auto over [0, T_END], an output every 0.01 s as a run has (auto looks at its window
     !! between outputs); prints the switches.
-    subroutine integrate(problem, events, stats, ok)
+    subroutine integrate(problem, events, stats, ok, method)
         type(burst_t), target, intent(inout) :: problem
         type(switch_event_t), allocatable, intent(out) :: events(:)
         type(solver_stats_t), intent(out) :: stats
         logical, intent(out) :: ok
+        character(len=*), intent(in), optional :: method   !< default 'auto'
         class(integrator_t), allocatable :: integ
         type(solver_options_t) :: opts
         type(error_t), allocatable :: err
@@ -134,7 +158,11 @@ contains
         character(len=200) :: line
         opts%rtol = 1.0e-6_wp
         opts%atol = 1.0e-9_wp
-        call new_integrator('auto', integ, err)
+        if (present(method)) then
+            call new_integrator(method, integ, err)
+        else
+            call new_integrator('auto', integ, err)
+        end if
         if (.not. allocated(err)) call integ%init(problem, 0.0_wp, [1.0_wp, 0.0_wp], yq, &
                                                   opts, err)
         do k = 1, nint(100*T_END)
@@ -146,7 +174,8 @@ contains
         if (.not. ok) return
         events = integ%switch_log()
         stats = integ%stats()
-        print '(a, f5.2, a)', '  burst of ', problem%length, ' s:'
+        print '(a, f5.2, a, l1, a)', '  burst of ', problem%length, ' s (mass matrix: ', &
+            problem%mass, '):'
         do k = 1, size(events)
             write (line, '(a, f8.4, a)') '  switch at t = ', events(k)%t, ' s: '// &
                 trim(events(k)%method)//': '//events(k)%reason(1:min(120, len(events(k)%reason)))
