@@ -37,7 +37,7 @@ import numpy as np
 from ropedyn.run import DOCS, add_exe_argument, exe_or_build
 from ropedyn.studies import auto_table
 from ropedyn.studies.auto_table import FIXED, scene_t_end, scenes
-from ropedyn.studies.common import machine, scene_number, update_doc, utc_stamp
+from ropedyn.studies.common import machine, method_chain, scene_number, update_doc, utc_stamp
 
 BEGIN = "<!-- auto_accuracy:begin -->"
 END = "<!-- auto_accuracy:end -->"
@@ -54,12 +54,14 @@ def distance(a, b):
 
 
 def measured(exe, scene, work, method, span, sets, repeat, cap, ref):
-    """(cpu, error, switch methods) of `method` with `sets`: the least CPU of `repeat` runs
-    (auto_table's best_of); None when a run failed or ran over its cap."""
+    """(cpu, error, switch methods: erk with its pair's order) of `method` with `sets`:
+    the least CPU of `repeat` runs (auto_table's best_of); None when a run failed or ran
+    over its cap."""
     r = auto_table.best_of(exe, scene, work, method, span, repeat, cap, sets, points=True)
     if r["status"] != "complete":
         return None
-    return r["cpu"], distance(r["points"], ref), [m for _, m, _ in r["switches"]] or [method]
+    return r["cpu"], distance(r["points"], ref), [
+        f"{m} {o}" if m == "erk" else m for _, m, o in r["switches"]] or [method]
 
 
 def main(argv=None):
@@ -135,7 +137,7 @@ def main(argv=None):
                         if best is None or got[0] < best[0]:
                             best = (got[0], f"{method} ({rtol * factor:.3g})")
                         break
-            choice = " -> ".join(choice)
+            choice = method_chain(choice)
             best_text = (f"{best[1]} | {best[0]:.3g} | {auto_cpu / best[0]:.2f}"
                          if best else "none | | ")
             rows.append(f"| {scene.relative_to(DOCS.parent)} | {span:g} | {rtol:g} | "

@@ -114,3 +114,12 @@ def least_cpu(run, repeat, complete=lambda r: True):
         if best is None or r["cpu"] < best["cpu"]:
             best = r
     return best
+
+
+def method_chain(methods, most=5):
+    """'a -> b -> c' of a run's methods in switch order; with more than `most`, the first
+    three and how many switches there were in all."""
+    methods = list(methods)
+    if len(methods) > most:
+        return " -> ".join(methods[:3]) + f" -> ... ({len(methods) - 1} switches)"
+    return " -> ".join(methods)
