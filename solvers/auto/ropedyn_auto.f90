@@ -141,8 +141,10 @@ module ropedyn_auto
         integer :: explicit_age = 0
         !> its cost in its last window that was not dearer than erk's by GAIN (< 0: none)
         real(wp) :: calm_accurate = -1.0_wp
-        logical :: trial = .false.         !< the implicit method is on trial
-        integer :: dearer = 0              !< windows in a row Adams cost more than erk by GAIN
+        !> the method just started (the implicit or the accuracy method) is on trial
+        logical :: trial = .false.
+        !> windows in a row the accuracy method cost more than erk's order-4 pair by GAIN
+        integer :: dearer = 0
         integer :: wait = 0                !< windows to let pass before the next switch
         integer :: backoff = 1
         logical :: initialized = .false.

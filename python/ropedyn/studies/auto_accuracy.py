@@ -37,7 +37,8 @@ import numpy as np
 from ropedyn.run import DOCS, add_exe_argument, exe_or_build
 from ropedyn.studies import auto_table
 from ropedyn.studies.auto_table import FIXED, scene_t_end, scenes
-from ropedyn.studies.common import machine, method_chain, scene_number, update_doc, utc_stamp
+from ropedyn.studies.common import (machine, method_chain, method_label, scene_number,
+                                    update_doc, utc_stamp)
 
 BEGIN = "<!-- auto_accuracy:begin -->"
 END = "<!-- auto_accuracy:end -->"
@@ -61,7 +62,7 @@ def measured(exe, scene, work, method, span, sets, repeat, cap, ref):
     if r["status"] != "complete":
         return None
     return r["cpu"], distance(r["points"], ref), [
-        f"{m} {o}" if m == "erk" else m for _, m, o in r["switches"]] or [method]
+        method_label(m, o) for _, m, o in r["switches"]] or [method]
 
 
 def main(argv=None):

@@ -146,31 +146,25 @@ def main(argv=None):
             if probe["status"] == "complete" and 20 * probe["cpu"] > args.budget:
                 horizon = round_down(full * args.budget / (20 * probe["cpu"]))
                 note = f" (of {full:g})"
-            extra = ()
-            auto = best_of(exe, scene, work, "auto", horizon, args.repeat,
-                           cap=4 * args.budget)
-            if out_of_steps(auto):
-                extra = ("solver.max_steps=10000000",)
-                note += ", max_steps 1e7"
+            # at the default step budget, then at 1e7 when any method ran out of it
+            for extra in ((), ("solver.max_steps=10000000",)):
                 auto = best_of(exe, scene, work, "auto", horizon, args.repeat,
                                cap=4 * args.budget, extra=extra)
+                fixed = {}
+                if auto["status"] == "complete":
+                    cap = max(args.cap_factor * auto["cpu"], args.cap_min)
+                    fixed = {m: best_of(exe, scene, work, m, horizon, args.repeat, cap=cap,
+                                        extra=extra) for m in FIXED}
+                if not any(out_of_steps(r) for r in (auto, *fixed.values())):
+                    break
+            if extra:
+                note += ", max_steps 1e7"
             if auto["status"] != "complete":
                 row = (f"| {name} | {horizon:g}{note} | auto {auto['status']}: "
                        f"{auto.get('reason', '')} | | | | | | | |")
                 rows.append(row)
                 print(row, flush=True)
                 continue
-            cap = max(args.cap_factor * auto["cpu"], args.cap_min)
-            fixed = {m: best_of(exe, scene, work, m, horizon, args.repeat, cap=cap,
-                                extra=extra) for m in FIXED}
-            if not extra and any(out_of_steps(r) for r in fixed.values()):
-                extra = ("solver.max_steps=10000000",)
-                note += ", max_steps 1e7"
-                auto = best_of(exe, scene, work, "auto", horizon, args.repeat,
-                               cap=4 * args.budget, extra=extra)
-                cap = max(args.cap_factor * auto["cpu"], args.cap_min)
-                fixed = {m: best_of(exe, scene, work, m, horizon, args.repeat, cap=cap,
-                                    extra=extra) for m in FIXED}
             cells, best = [], None
             for m, r in fixed.items():
                 if r["status"] == "complete":

@@ -56,7 +56,8 @@ import numpy as np
 
 from ropedyn import io
 from ropedyn.run import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
-from ropedyn.studies.common import least_cpu, machine, method_chain, update_doc, utc_stamp
+from ropedyn.studies.common import (least_cpu, machine, method_chain, method_label, update_doc,
+                                    utc_stamp)
 
 BEGIN = "<!-- bench_peers:begin -->"
 END = "<!-- bench_peers:end -->"
@@ -198,10 +199,8 @@ def run_ropedyn(exe, workdir, n, t_end, sets=(), name="run"):
     import h5py
     with h5py.File(out, "r") as f:
         if "/solver/switch_method" in f:
-            # erk with its pair's order (auto runs the order-4 and the order-5 pair)
             methods = method_chain(
-                f"{m.decode().strip()} {o}" if m.decode().strip() == "erk"
-                else m.decode().strip()
+                method_label(m.decode().strip(), o)
                 for m, o in zip(f["/solver/switch_method"][()],
                                 f["/solver/switch_max_order"][()]))
     return {"status": "complete", "cpu": float(run.stats["cpu_time"]),

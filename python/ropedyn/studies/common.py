@@ -116,6 +116,12 @@ def least_cpu(run, repeat, complete=lambda r: True):
     return best
 
 
+def method_label(method, order):
+    """A switch's method as the tables name it: erk with its pair's order ('erk 4',
+    'erk 5': auto runs both pairs), any other by its name."""
+    return f"{method} {order}" if method == "erk" else method
+
+
 def method_chain(methods, most=5):
     """'a -> b -> c' of a run's methods in switch order; with more than `most`, the first
     three and how many switches there were in all."""
