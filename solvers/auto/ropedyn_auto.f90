@@ -71,7 +71,7 @@ module ropedyn_auto
     integer, parameter :: WINDOW = 400             !< steps between looks
     !> an earlier first look at erk, before the implicit method's cost is known: after
     !! EARLY_WINDOW steps, when at least EARLY_SHARE of them were held by stability
-    integer, parameter :: EARLY_WINDOW = 100
+    integer, parameter :: EARLY_WINDOW = 50
     real(wp), parameter :: EARLY_SHARE = 0.9_wp
     real(wp), parameter :: GAIN = 1.3_wp           !< hysteresis of a switch
     !> explicit steps per simulated second above which a run starts implicit

@@ -13,9 +13,12 @@
 !!   excite, 1e2 .. 3e3 1/s against the Jacobian's 5.1e3 on a rope falling flat,
 !!   drag_fall) and either the implicit method's last measured cost per simulated second
 !!   was lower by GAIN, or it has not been measured yet (a trial). Before that cost is
-!!   known, erk's first window ends after EARLY_WINDOW = 100 steps when 90 % of them were
-!!   held by stability (drag_fall: mebdf from 0.1 s instead of 0.77 s, 2.9 ms CPU against
-!!   7 ms; mebdf alone 2.3 ms). Both only for problems without a mass matrix: on the
+!!   known, erk's first window ends after EARLY_WINDOW = 50 steps when 90 % of them were
+!!   held by stability, the share counted over those steps (erk's own share waits for 51):
+!!   drag_fall tries mebdf at 0.05 s (0.77 s with WINDOW, 0.1 s after 100 steps; with
+!!   outputs 1 s apart 0.09 s, 0.19 s after 100), and its CPU over mebdf alone went from
+!!   1.27 to 1.20 (min of 30 runs; the rest is the spectrum estimate at the start, about
+!!   0.2 ms of its 1.9). Both only for problems without a mass matrix: on the
 !!   MPP (M(q) in MEBDF's residual, a dense Newton matrix) an implicit step costs far
 !!   more, a trial there is no cheap experiment, and erk's own estimate decides alone.
 !!   With the stable step there, the 0.5 s windows of docs/accuracy.md at rtol 1e-2 went
@@ -92,11 +95,16 @@ contains
         real(wp) :: growth  !< of stale_after after a trial that did not pay
         logical :: dearer   !< Adams' window cost more than erk's last by GAIN
         logical :: stale    !< the implicit method's measured cost is old (explicit windows)
+        logical :: early    !< erk's early first window (early_look)
         character(len=240) :: text
         character(len=12) :: age
 
         now = self%current_stats()
-        if (now%steps - self%win_steps0 < WINDOW .and. .not. early_look()) return
+        early = .false.
+        if (now%steps - self%win_steps0 < WINDOW) then
+            early = early_look()
+            if (.not. early) return
+        end if
         span = self%t - self%win_t0
         if (span <= 0.0_wp) return
         rate = (self%cost(now) - self%win_cost0)/span
@@ -109,7 +117,11 @@ contains
         if (self%active == EXPLICIT) then
             self%rate_explicit = rate
             if (self%rate_implicit > 0.0_wp) self%implicit_age = self%implicit_age + 1
-            share = self%erk%stiff_share_of_steps()
+            if (early) then
+                share = self%erk%stiff_share_of_steps(EARLY_WINDOW)
+            else
+                share = self%erk%stiff_share_of_steps()
+            end if
             if (self%wait > 0) return
             if (share < 0.5_wp) then
                 ! held by accuracy: the accuracy method may need fewer evaluations of f
@@ -262,7 +274,8 @@ contains
             early_look = self%active == EXPLICIT .and. self%windows == 0 .and. &
                          self%rate_implicit < 0.0_wp .and. self%trials_are_cheap() .and. &
                          now%steps - self%win_steps0 >= EARLY_WINDOW
-            if (early_look) early_look = self%erk%stiff_share_of_steps() >= EARLY_SHARE
+            if (early_look) &
+                early_look = self%erk%stiff_share_of_steps(EARLY_WINDOW) >= EARLY_SHARE
         end function early_look
     end procedure watch
 end submodule ropedyn_auto_switching

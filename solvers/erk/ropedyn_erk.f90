@@ -180,12 +180,17 @@ contains
         rho = self%rho
     end function erk_spectral_radius
 
-    !> Share of the steps of the last full window (or of the current one) that were
-    !! limited by stability (h rho near the stability limit).
-    pure real(wp) function erk_stiff_share(self) result(share)
+    !> Share of the steps of the last full window (or of the current one, once it has at
+    !! least `min_steps` steps: 51 unless given) that were limited by stability (h rho
+    !! near the stability limit).
+    pure real(wp) function erk_stiff_share(self, min_steps) result(share)
         class(erk_t), intent(in) :: self
+        integer, intent(in), optional :: min_steps
+        integer :: least
+        least = 51
+        if (present(min_steps)) least = max(1, min_steps)
         share = self%stiff_share
-        if (self%window_steps > 50) share = real(self%stiff_steps, wp)/self%window_steps
+        if (self%window_steps >= least) share = real(self%stiff_steps, wp)/self%window_steps
     end function erk_stiff_share
 
     !> Steps per simulated second above which a stability-limited run fails (default
