@@ -294,14 +294,18 @@ def tracked_files(root):
 
 def sync_tree(root, tree):
     """Make tree a copy of root's files (only changed files are copied, so that the build in
-    tree stays incremental); files that root no longer has are removed."""
+    tree stays incremental); files that root no longer has are removed. A copied file gets
+    the time of the copy, not the source's: a run killed before it restored its mutation
+    (SIGKILL skips the restore) leaves a mutated file newer than the source, whose objects
+    a copy with the source's older time (copy2) would not rebuild, so the next run's
+    baseline failed on the old mutation."""
     files = tracked_files(root)
     wanted = set(files)
     for rel in files:
         src, dst = pathlib.Path(root) / rel, tree / rel
         if not dst.exists() or not filecmp.cmp(src, dst, shallow=False):
             dst.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(src, dst)
+            shutil.copy(src, dst)
     for path in tree.rglob("*"):
         rel = path.relative_to(tree).as_posix()
         if rel.split("/")[0] in ("build", ".venv") or not path.is_file():
