@@ -154,7 +154,8 @@ module ropedyn_auto
         real(wp) :: mebdf_eval_cost = 1.0_wp
         !> erk's stable step when it was last started from a spectrum estimate (s; 0: none)
         real(wp) :: h_stable = 0.0_wp
-        !> the order-5 pair's stable step from the same estimate (s; 0: none)
+        !> the order-5 pair's stable step from the same estimate, where it is the accuracy
+        !! method (s; 0: none)
         real(wp) :: h_stable_high = 0.0_wp
         real(wp) :: radius = 0.0_wp        !< the last estimate's spectral radius, 1/s
         !> the step that sizes a segment's first chunk, before its method has stepped (s;
@@ -237,7 +238,7 @@ contains
         if (self%use_bdf) self%mebdf_order = BDF_ORDER
         if (self%user_order /= 0) self%mebdf_order = min(self%mebdf_order, self%user_order)
         h_e = erk_stable_step(self%tab, spec)
-        self%h_stable_high = erk_stable_step(self%tab_high, spec)
+        if (self%accurate == HIGH) self%h_stable_high = erk_stable_step(self%tab_high, spec)
         self%radius = spec%radius
         self%h_chunk = h_e
         if (spec%valid .and. h_e > 0.0_wp) then

@@ -240,7 +240,8 @@ contains
             call estimate_spectrum(self%problem, self%t, self%y, spec)
             h_e = erk_stable_step(self%tab, spec)
             if (h_e <= 0.0_wp) return
-            self%h_stable_high = erk_stable_step(self%tab_high, spec)
+            if (self%accurate == HIGH) &
+                self%h_stable_high = erk_stable_step(self%tab_high, spec)
             self%radius = spec%radius
             predicted = EXPLICIT_MARGIN*self%tab%evals_per_step()/h_e
             if (GAIN*predicted < rate) then
