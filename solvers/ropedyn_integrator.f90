@@ -114,9 +114,10 @@ module ropedyn_integrator
         procedure(stats_i), deferred :: stats
         procedure(finalize_i), deferred :: finalize
         procedure(name_i), deferred :: name
-        procedure :: default_max_order => integrator_default_max_order
-        procedure :: min_order => integrator_min_order
-        procedure :: max_order_limit => integrator_max_order_limit
+        ! the method's order range, one statement
+        procedure :: min_order => integrator_min_order, &
+                     default_max_order => integrator_default_max_order, &
+                     max_order_limit => integrator_max_order_limit
         procedure :: switch_log => integrator_switch_log
     end type integrator_t
 

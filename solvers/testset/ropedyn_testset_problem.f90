@@ -34,10 +34,8 @@ module ropedyn_testset_problem
         procedure(dense_jacobian_i), deferred :: dense_jacobian
         procedure :: size => testset_size
         procedure :: bandwidths => testset_bandwidths
-        procedure :: has_jacobian => testset_has_jacobian
-        procedure :: jacobian => testset_jacobian
-        procedure :: recommended_atol => testset_recommended_atol
-        procedure :: atol_rule => testset_atol_rule
+        procedure :: has_jacobian => testset_has_jacobian, jacobian => testset_jacobian
+        procedure :: recommended_atol => testset_recommended_atol, atol_rule => testset_atol_rule
     end type testset_problem_t
 
     abstract interface

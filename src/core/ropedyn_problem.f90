@@ -38,19 +38,18 @@ module ropedyn_problem
         procedure(size_i), deferred :: size
         procedure(bandwidths_i), deferred :: bandwidths
         procedure(rhs_i), deferred :: rhs
-        procedure :: has_jacobian => problem_has_jacobian
-        procedure :: jacobian => problem_jacobian
-        procedure :: quad_size => problem_quad_size
-        procedure :: quad_rhs => problem_quad_rhs
-        procedure :: rhs_quad => problem_rhs_quad
-        procedure :: has_mass_matrix => problem_has_mass_matrix
-        procedure :: mass_matrix => problem_mass_matrix
-        procedure :: implicit_rhs => problem_implicit_rhs
-        procedure :: has_implicit_jacobian => problem_has_implicit_jacobian
-        procedure :: implicit_jacobian => problem_implicit_jacobian
-        procedure :: has_second_order => problem_has_second_order
-        procedure :: second_order_layout => problem_second_order_layout
-        procedure :: second_order_blocks => problem_second_order_blocks
+        ! The optional capabilities, one statement each: its query (or size) and what it
+        ! provides. The defaults say "not provided".
+        procedure :: has_jacobian => problem_has_jacobian, jacobian => problem_jacobian
+        procedure :: quad_size => problem_quad_size, quad_rhs => problem_quad_rhs, &
+                     rhs_quad => problem_rhs_quad
+        procedure :: has_mass_matrix => problem_has_mass_matrix, mass_matrix => problem_mass_matrix
+        procedure :: implicit_rhs => problem_implicit_rhs, &
+                     has_implicit_jacobian => problem_has_implicit_jacobian, &
+                     implicit_jacobian => problem_implicit_jacobian
+        procedure :: has_second_order => problem_has_second_order, &
+                     second_order_layout => problem_second_order_layout, &
+                     second_order_blocks => problem_second_order_blocks
     end type problem_t
 
     abstract interface

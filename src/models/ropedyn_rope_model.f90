@@ -26,8 +26,7 @@ module ropedyn_rope_model
         logical :: with_work = .false.     !< external work is quadrature 2
     contains
         procedure(energy_i), deferred :: energy
-        procedure :: n_elements => rope_n_elements
-        procedure :: quad_size => rope_quad_size
+        procedure :: n_elements => rope_n_elements, quad_size => rope_quad_size
         procedure(model_name_i), deferred :: model_name
         procedure(initial_state_i), deferred :: initial_state
         procedure(fields_i), deferred :: fields
@@ -35,8 +34,8 @@ module ropedyn_rope_model
         procedure(element_data_i), deferred :: element_data
         procedure(coordinates_i), deferred :: coordinates
         procedure(coordinate_mass_i), deferred :: coordinate_mass
-        procedure :: has_second_order => rope_has_second_order
-        procedure :: second_order_layout => rope_second_order_layout
+        procedure :: has_second_order => rope_has_second_order, &
+                     second_order_layout => rope_second_order_layout
         procedure :: state_from_fields => rope_state_from_fields
     end type rope_model_t
 

@@ -35,9 +35,8 @@ module ropedyn_effect
         procedure(name_i), deferred :: name
         procedure(add_forces_i), deferred :: add_forces
         procedure(add_jacobian_i), deferred :: add_jacobian
-        procedure :: energy => effect_energy
-        procedure :: power => effect_power
-        procedure :: does_work => effect_does_work
+        ! its part of the energy balance (the defaults: none)
+        procedure :: does_work => effect_does_work, energy => effect_energy, power => effect_power
     end type body_effect_t
 
     !> A container, so that a model can hold an array of different effects.
