@@ -26,8 +26,8 @@ contains
                 return
             case default
                 call cli%usage_error('unexpected argument "'//cli%arg//'"', err)
-                return
             end select
+            if (allocated(err)) return
         end do
         lines = scene_key_listing()
         do k = 1, size(lines)

@@ -31,14 +31,13 @@ contains
             case ('--resume')
                 if (allocated(resume_path)) then
                     call cli%usage_error('--resume is given twice', err)
-                    return
+                else
+                    call cli%take_value(resume_path, err)
                 end if
-                call cli%take_value(resume_path, err)
-                if (allocated(err)) return
             case default
                 call cli%scene_argument(err)
-                if (allocated(err)) return
             end select
+            if (allocated(err)) return
         end do
         if (allocated(resume_path)) then
             if (allocated(cli%scene_path)) then

@@ -37,21 +37,18 @@ contains
                 options%continuation = .false.
             case ('-o', '--output')
                 call cli%take_value(out_path, err)
-                if (allocated(err)) return
             case ('--count')
-                if (command /= 'modes') then
+                if (command == 'modes') then
+                    call cli%int_value(count, 1, err)
+                else
                     call cli%usage_error('--count is an option of "ropedyn modes"', err)
-                    return
                 end if
-                call cli%int_value(count, 1, err)
-                if (allocated(err)) return
             case ('--max-iterations')
                 call cli%int_value(options%max_iterations, 1, err)
-                if (allocated(err)) return
             case default
                 call cli%scene_argument(err)
-                if (allocated(err)) return
             end select
+            if (allocated(err)) return
         end do
         call cli%require(cli%scene_path, 'a scene file', err)
         if (allocated(err)) return

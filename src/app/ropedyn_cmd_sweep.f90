@@ -85,29 +85,24 @@ contains
                 opt%quiet = .true.
             case ('--output-dir')
                 call cli%take_value(value, err)
-                if (allocated(err)) return
-                if (len(value) == 0) then
-                    call cli%usage_error('--output-dir needs a directory', err)
-                    return
+                if (.not. allocated(err)) then
+                    opt%output_dir = value
+                    if (len(value) == 0) call cli%usage_error('--output-dir needs a directory', err)
                 end if
-                opt%output_dir = value
             case ('--jobs')
                 call cli%int_value(opt%jobs, 1, err)
-                if (allocated(err)) return
                 have_jobs = .true.
             case ('--task')
                 call cli%take_value(value, err)
-                if (allocated(err)) return
-                call parse_ids(value, opt%tasks, ok)
-                if (.not. ok) then
-                    call cli%usage_error('--task "'//value//'": expected a whole number >= '// &
-                        '1, a range K-L or a comma-separated list of them', err)
-                    return
+                if (.not. allocated(err)) then
+                    call parse_ids(value, opt%tasks, ok)
+                    if (.not. ok) call cli%usage_error('--task "'//value//'": expected a '// &
+                        'whole number >= 1, a range K-L or a comma-separated list of them', err)
                 end if
             case default
                 call cli%positional('sweep file', opt%path, err)
-                if (allocated(err)) return
             end select
+            if (allocated(err)) return
         end do
         call cli%require(opt%path, 'a sweep file', err)
         if (allocated(err)) return

@@ -49,54 +49,31 @@ contains
                 csv = .true.
             case ('--method')
                 call cli%take_value(value, err)
-                if (allocated(err)) return
-                if (method_index(value) == 0) then
-                    call cli%usage_error('--method "'//value//'": unknown method '// &
-                                         '(available: '//method_list()//')', err)
-                    return
+                if (.not. allocated(err)) then
+                    method = value
+                    if (method_index(value) == 0) call cli%usage_error('--method "'//value// &
+                        '": unknown method (available: '//method_list()//')', err)
                 end if
-                method = value
             case ('--rtol')
                 call cli%real_value(rtol, err)
-                if (allocated(err)) return
-                if (.not. (rtol > 0.0_wp .and. rtol < 1.0_wp)) then
+                if (.not. allocated(err) .and. .not. (rtol > 0.0_wp .and. rtol < 1.0_wp)) &
                     call cli%usage_error('--rtol '//cli%value//': must be > 0 and < 1', err)
-                    return
-                end if
             case ('--atol')
                 call cli%real_value(atol, err)
-                if (allocated(err)) return
-                if (.not. (atol > 0.0_wp)) then
+                if (.not. allocated(err) .and. .not. (atol > 0.0_wp)) &
                     call cli%usage_error('--atol '//cli%value//': must be > 0', err)
-                    return
-                end if
                 have_atol = .true.
             case ('--max-order')
                 call cli%int_value(max_order, 0, err)
-                if (allocated(err)) return
             case ('--repeat-time')
                 call cli%real_value(repeat_time, err)
-                if (allocated(err)) return
-                if (.not. (repeat_time >= 0.0_wp .and. repeat_time <= 3600.0_wp)) then
+                if (.not. allocated(err) .and. &
+                    .not. (repeat_time >= 0.0_wp .and. repeat_time <= 3600.0_wp)) &
                     call cli%usage_error('--repeat-time '//cli%value//': must be 0 .. 3600 s', err)
-                    return
-                end if
             case default
-                if (len(cli%arg) == 0) then
-                    call cli%usage_error('empty argument', err)
-                    return
-                end if
-                if (cli%arg(1:1) == '-') then
-                    call cli%usage_error('unknown option "'//cli%arg//'"', err)
-                    return
-                end if
-                if (allocated(problem_name)) then
-                    call cli%usage_error('more than one problem: "'//problem_name//'", "'// &
-                                         cli%arg//'"', err)
-                    return
-                end if
-                problem_name = cli%arg
+                call cli%positional('problem', problem_name, err)
             end select
+            if (allocated(err)) return
         end do
 
         if (list) then
