@@ -91,19 +91,15 @@ contains
         real(wp), intent(in) :: ab(2*kl + ku + 1, n)
         integer, intent(in) :: ipiv(n)
         real(wp), intent(inout) :: b(n)
-        integer :: kv, j, km, l, i
+        integer :: kv, j, km, i
         real(wp) :: x
 
         kv = kl + ku
         ! L y = P b
         do j = 1, n - 1
             km = min(kl, n - j)
-            l = ipiv(j)
-            x = b(l)
-            if (l /= j) then
-                b(l) = b(j)
-                b(j) = x
-            end if
+            if (ipiv(j) /= j) call interchange(b, j, ipiv(j))
+            x = b(j)
             do i = 1, km
                 b(j + i) = b(j + i) - ab(kv + 1 + i, j)*x
             end do
@@ -131,18 +127,14 @@ contains
         integer, intent(in) :: ipiv(n)
         real(wp), intent(inout) :: y(n)
         integer, parameter :: KL = RFEM_KL, KV = 2*RFEM_KL
-        integer :: i, j, l
+        integer :: i, j
         real(wp) :: t
 
         call band_product_rfem(n, kb, g, x, y)
         ! L z = P y
         do j = 1, n - 1
-            l = ipiv(j)
-            t = y(l)
-            if (l /= j) then
-                y(l) = y(j)
-                y(j) = t
-            end if
+            if (ipiv(j) /= j) call interchange(y, j, ipiv(j))
+            t = y(j)
             if (j <= n - KL) then
                 do i = 1, KL
                     y(j + i) = y(j + i) - ab(KV + 1 + i, j)*t
@@ -168,6 +160,16 @@ contains
             end if
         end do
     end subroutine band_solve_rfem
+
+    !> b(j) <-> b(l): a row interchange of the factorization's partial pivoting.
+    pure subroutine interchange(b, j, l)
+        real(wp), intent(inout) :: b(:)
+        integer, intent(in) :: j, l
+        real(wp) :: x
+        x = b(l)
+        b(l) = b(j)
+        b(j) = x
+    end subroutine interchange
 
     !> y <- y + g K x for kl = ku = RFEM_KL (n > 2 kl), row by row: each y(i) gets one dot
     !! product of constant length in the interior (independent rows, where the column

@@ -77,25 +77,18 @@ contains
         class(rfem_t), intent(in) :: self
         integer, intent(in) :: ld, offset
         real(wp), intent(inout) :: jb(ld, 6*self%n)
-        integer :: i, k, c, o, l, col, p
-        real(wp) :: s1, s2, s3
+        integer :: i, k, o, l, col, p
         do i = 1, self%n
             k = 6*(i - 1)
             ! d(position)/dt = velocity
-            do c = 1, 3
-                jb(offset - 3, k + c + 3) = jb(offset - 3, k + c + 3) + 1.0_wp
-            end do
-            s1 = self%rowscale(1, i)
-            s2 = self%rowscale(2, i)
-            s3 = self%rowscale(3, i)
-            ! rows k+4 .. k+6 from the blocks of elements i-1, i, i+1
+            jb(offset - 3, k + 4:k + 6) = jb(offset - 3, k + 4:k + 6) + 1.0_wp
+            ! rows k+4 .. k+6 (band rows p .. p+2 of column col) from the blocks of elements
+            ! i-1, i, i+1, times the row scales
             do o = max(-1, 1 - i), min(1, self%n - i)
                 do l = 1, 6
                     col = 6*(i + o - 1) + l
                     p = offset + k + 4 - col
-                    jb(p, col) = jb(p, col) + s1*self%blk(1, l, o, i)
-                    jb(p + 1, col) = jb(p + 1, col) + s2*self%blk(2, l, o, i)
-                    jb(p + 2, col) = jb(p + 2, col) + s3*self%blk(3, l, o, i)
+                    jb(p:p + 2, col) = jb(p:p + 2, col) + self%rowscale(:, i)*self%blk(:, l, o, i)
                 end do
             end do
         end do
@@ -107,26 +100,18 @@ contains
         class(rfem_t), intent(in) :: self
         integer, intent(in) :: ld, offset
         real(wp), intent(inout) :: kb(ld, 3*self%n), cb(ld, 3*self%n), mb(ld, 3*self%n)
-        integer :: i, k, c, o, l, col, p
-        real(wp) :: s1, s2, s3
+        integer :: i, k, o, l, col, p
+        real(wp) :: s(3)
         do i = 1, self%n
             k = 3*(i - 1)
-            do c = 1, 3
-                mb(offset, k + c) = mb(offset, k + c) + 1.0_wp
-            end do
-            s1 = self%rowscale(1, i)
-            s2 = self%rowscale(2, i)
-            s3 = self%rowscale(3, i)
+            mb(offset, k + 1:k + 3) = mb(offset, k + 1:k + 3) + 1.0_wp
+            s = self%rowscale(:, i)
             do o = max(-1, 1 - i), min(1, self%n - i)
                 do l = 1, 3
                     col = 3*(i + o - 1) + l
                     p = offset + k + 1 - col
-                    kb(p, col) = kb(p, col) + s1*self%blk(1, l, o, i)
-                    kb(p + 1, col) = kb(p + 1, col) + s2*self%blk(2, l, o, i)
-                    kb(p + 2, col) = kb(p + 2, col) + s3*self%blk(3, l, o, i)
-                    cb(p, col) = cb(p, col) + s1*self%blk(1, l + 3, o, i)
-                    cb(p + 1, col) = cb(p + 1, col) + s2*self%blk(2, l + 3, o, i)
-                    cb(p + 2, col) = cb(p + 2, col) + s3*self%blk(3, l + 3, o, i)
+                    kb(p:p + 2, col) = kb(p:p + 2, col) + s*self%blk(:, l, o, i)
+                    cb(p:p + 2, col) = cb(p:p + 2, col) + s*self%blk(:, l + 3, o, i)
                 end do
             end do
         end do
