@@ -36,8 +36,11 @@ module ropedyn_effect_ground
         procedure :: total_normal_force => ground_total_normal_force
     end type ground_effect_t
 
-    !> The contact at one end point of a body (all zero but r and delta when not in contact).
+    !> The contact at one end point of a body (all zero but i, e, r and delta when not in
+    !! contact).
     type :: contact_t
+        integer :: i = 0              !< the body
+        real(wp) :: e(2) = 0.0_wp     !< its axis (cos phi, sin phi)
         real(wp) :: r = 0.0_wp        !< offset of the point from the body's centre, m
         real(wp) :: delta = 0.0_wp    !< penetration, m
         real(wp) :: ddelta = 0.0_wp   !< its rate, m/s
@@ -81,6 +84,8 @@ contains
         real(wp), intent(in) :: e(2)
         type(contact_t) :: c
         real(wp) :: nv(2), x(2), v(2), kp, cp
+        c%i = i
+        c%e = e
         c%r = 0.5_wp*real(s, wp)*b%l(i)
         nv = [-e(2), e(1)]
         x = b%c(:, i) + c%r*e
@@ -100,23 +105,43 @@ contains
         c%f = c%fn*(self%ng - self%mu*c%th*self%tg)
     end function contact
 
+    !> The end points below the plane (delta > 0), body by body, end A before end B, in
+    !! cc(1:nc) (cc holds at least 2 b%n). Those separating faster than their spring relaxes
+    !! carry no force (fn = 0).
+    pure subroutine touching(self, b, cc, nc)
+        class(ground_effect_t), intent(in) :: self
+        type(bodies_t), intent(in) :: b
+        type(contact_t), intent(inout) :: cc(:)
+        integer, intent(out) :: nc
+        type(contact_t) :: c
+        real(wp) :: cs(2, b%n)
+        integer :: i, s
+        nc = 0
+        call cos_sin(b%phi, cs)
+        do i = 1, b%n
+            do s = -1, 1, 2
+                c = contact(self, b, i, s, cs(:, i))
+                if (c%delta <= 0.0_wp) cycle
+                nc = nc + 1
+                cc(nc) = c
+            end do
+        end do
+    end subroutine touching
+
     pure subroutine ground_add_forces(self, t, b, f, m)
         class(ground_effect_t), intent(in) :: self
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: f(:, :), m(:)
-        type(contact_t) :: c
-        real(wp) :: e(2), cs(2, b%n)
-        integer :: i, s
-        call cos_sin(b%phi, cs)
-        do i = 1, b%n
-            e = cs(:, i)
-            do s = -1, 1, 2
-                c = contact(self, b, i, s, e)
+        type(contact_t) :: cc(2*b%n)
+        integer :: k, nc
+        call touching(self, b, cc, nc)
+        do k = 1, nc
+            associate (c => cc(k), i => cc(k)%i)
                 if (c%fn <= 0.0_wp) cycle
                 f(:, i) = f(:, i) + c%f
-                m(i) = m(i) + c%r*(e(1)*c%f(2) - e(2)*c%f(1))
-            end do
+                m(i) = m(i) + c%r*(c%e(1)*c%f(2) - c%e(2)*c%f(1))
+            end associate
         end do
     end subroutine ground_add_forces
 
@@ -125,14 +150,12 @@ contains
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: jac(:, :, :)
-        type(contact_t) :: c
-        real(wp) :: kp, cp, dir(2), dfdx(2, 2), dfdv(2, 2), e(2), cs(2, b%n)
-        integer :: i, s, p
-        call cos_sin(b%phi, cs)
-        do i = 1, b%n
-            e = cs(:, i)
-            do s = -1, 1, 2
-                c = contact(self, b, i, s, e)
+        type(contact_t) :: cc(2*b%n)
+        real(wp) :: kp, cp, dir(2), dfdx(2, 2), dfdv(2, 2)
+        integer :: k, nc, p
+        call touching(self, b, cc, nc)
+        do k = 1, nc
+            associate (c => cc(k), i => cc(k)%i)
                 if (c%fn <= 0.0_wp) cycle
                 kp = 0.5_wp*self%k*b%l(i)
                 cp = 0.5_wp*self%c*b%l(i)
@@ -145,25 +168,21 @@ contains
                 end do
                 jac(:, :, i) = jac(:, :, i) + point_force_block(c%r, b%phi(i), b%w(i), c%f, &
                                                                 dfdx, dfdv)
-            end do
+            end associate
         end do
     end subroutine ground_add_jacobian
 
+    !> The contact springs' energy, sum k_p delta^2 / 2, J.
     pure real(wp) function ground_energy(self, t, b) result(e)
         class(ground_effect_t), intent(in) :: self
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
-        real(wp) :: x(2), delta, r, cs(2, b%n)
-        integer :: i, s
+        type(contact_t) :: cc(2*b%n)
+        integer :: k, nc
         e = 0.0_wp
-        call cos_sin(b%phi, cs)
-        do i = 1, b%n
-            do s = -1, 1, 2
-                r = 0.5_wp*real(s, wp)*b%l(i)
-                x = b%c(:, i) + r*cs(:, i)
-                delta = -dot_product(x - self%p0, self%ng)
-                if (delta > 0.0_wp) e = e + 0.25_wp*self%k*b%l(i)*delta**2
-            end do
+        call touching(self, b, cc, nc)
+        do k = 1, nc
+            e = e + 0.25_wp*self%k*b%l(cc(k)%i)*cc(k)%delta**2
         end do
     end function ground_energy
 
@@ -172,20 +191,16 @@ contains
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: dissipation, work
-        type(contact_t) :: c
-        real(wp) :: e(2), cs(2, b%n)
-        integer :: i, s
-        call cos_sin(b%phi, cs)
-        do i = 1, b%n
-            e = cs(:, i)
-            do s = -1, 1, 2
-                c = contact(self, b, i, s, e)
-                if (c%delta <= 0.0_wp) cycle
+        type(contact_t) :: cc(2*b%n)
+        integer :: k, nc
+        call touching(self, b, cc, nc)
+        do k = 1, nc
+            associate (c => cc(k))
                 ! F_N = 0 when separating faster than the spring relaxes: then the spring's
                 ! energy still falls at -k_p delta delta' > 0 (th = 0 there)
-                dissipation = dissipation + (c%fn - 0.5_wp*self%k*b%l(i)*c%delta)*c%ddelta &
+                dissipation = dissipation + (c%fn - 0.5_wp*self%k*b%l(c%i)*c%delta)*c%ddelta &
                               + self%mu*c%fn*c%th*c%vt
-            end do
+            end associate
         end do
     end subroutine ground_power
 
@@ -193,17 +208,9 @@ contains
     pure real(wp) function ground_total_normal_force(self, b) result(total)
         class(ground_effect_t), intent(in) :: self
         type(bodies_t), intent(in) :: b
-        type(contact_t) :: c
-        real(wp) :: e(2), cs(2, b%n)
-        integer :: i, s
-        total = 0.0_wp
-        call cos_sin(b%phi, cs)
-        do i = 1, b%n
-            e = cs(:, i)
-            do s = -1, 1, 2
-                c = contact(self, b, i, s, e)
-                total = total + c%fn
-            end do
-        end do
+        type(contact_t) :: cc(2*b%n)
+        integer :: nc
+        call touching(self, b, cc, nc)
+        total = sum(cc(:nc)%fn)
     end function ground_total_normal_force
 end module ropedyn_effect_ground
