@@ -39,7 +39,8 @@ module ropedyn_problem
         procedure(bandwidths_i), deferred :: bandwidths
         procedure(rhs_i), deferred :: rhs
         ! The optional capabilities, one statement each: its query (or size) and what it
-        ! provides. The defaults say "not provided".
+        ! provides. The defaults: none (no Jacobian, no quadrature, no second-order blocks),
+        ! the identity mass matrix, and the explicit form as the implicit one.
         procedure :: has_jacobian => problem_has_jacobian, jacobian => problem_jacobian
         procedure :: quad_size => problem_quad_size, quad_rhs => problem_quad_rhs, &
                      rhs_quad => problem_rhs_quad
