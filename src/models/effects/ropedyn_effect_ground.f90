@@ -37,17 +37,19 @@ module ropedyn_effect_ground
     end type ground_effect_t
 
     !> The contact at one end point of a body (all zero but i, e, r and delta when not in
-    !! contact).
+    !! contact). No default initialization: `contact` sets every component, and the lists
+    !! of contacts (automatic arrays of 2n in every caller of `touching`) would otherwise be
+    !! filled with zeros on each call before being written.
     type :: contact_t
-        integer :: i = 0              !< the body
-        real(wp) :: e(2) = 0.0_wp     !< its axis (cos phi, sin phi)
-        real(wp) :: r = 0.0_wp        !< offset of the point from the body's centre, m
-        real(wp) :: delta = 0.0_wp    !< penetration, m
-        real(wp) :: ddelta = 0.0_wp   !< its rate, m/s
-        real(wp) :: fn = 0.0_wp       !< normal force, N
-        real(wp) :: vt = 0.0_wp       !< tangential speed, m/s
-        real(wp) :: th = 0.0_wp       !< tanh(vt / v_reg)
-        real(wp) :: f(2) = 0.0_wp     !< force on the body, N
+        integer :: i                  !< the body
+        real(wp) :: e(2)              !< its axis (cos phi, sin phi)
+        real(wp) :: r                 !< offset of the point from the body's centre, m
+        real(wp) :: delta             !< penetration, m
+        real(wp) :: ddelta            !< its rate, m/s
+        real(wp) :: fn                !< normal force, N
+        real(wp) :: vt                !< tangential speed, m/s
+        real(wp) :: th                !< tanh(vt / v_reg)
+        real(wp) :: f(2)              !< force on the body, N
     end type contact_t
 
 contains
@@ -84,9 +86,8 @@ contains
         real(wp), intent(in) :: e(2)
         type(contact_t) :: c
         real(wp) :: nv(2), x(2), v(2), kp, cp
-        c%i = i
-        c%e = e
-        c%r = 0.5_wp*real(s, wp)*b%l(i)
+        c = contact_t(i=i, e=e, r=0.5_wp*real(s, wp)*b%l(i), delta=0.0_wp, ddelta=0.0_wp, &
+                      fn=0.0_wp, vt=0.0_wp, th=0.0_wp, f=0.0_wp)
         nv = [-e(2), e(1)]
         x = b%c(:, i) + c%r*e
         c%delta = -dot_product(x - self%p0, self%ng)
