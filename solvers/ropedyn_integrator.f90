@@ -19,7 +19,7 @@ module ropedyn_integrator
     implicit none
     private
     public :: integrator_t, start_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT, &
-        STIFF_STEP_RATE, clock_seconds
+        STIFF_STEP_RATE
     public :: stop_query_i, stop_now
 
     !> No integrator here goes beyond this order of accuracy.
@@ -196,13 +196,6 @@ contains
         self%time_factor = self%time_factor + part%time_factor
         self%time_solve = self%time_solve + part%time_solve
     end subroutine stats_add
-
-    !> Seconds on the monotonic clock (for the time split of options%profile).
-    real(wp) function clock_seconds() result(s)
-        integer(i8) :: count, rate
-        call system_clock(count, rate)
-        s = real(count, wp)/real(rate, wp)
-    end function clock_seconds
 
     !> The order limit used when options%max_order is 0, chosen to be safe for lightly
     !! damped stiff oscillations (ropedyn_methods says why, per method).

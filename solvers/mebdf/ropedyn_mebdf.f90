@@ -30,8 +30,8 @@ module ropedyn_mebdf
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
-    use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, &
-        clock_seconds, stop_now
+    use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, stop_now
+    use ropedyn_clock, only: clock_seconds
     use ropedyn_mebdf_coefficients, only: mebdf_coefficients_t, mebdf_coefficients, KMAX_MEBDF
     use ropedyn_iteration_matrix, only: iteration_matrix_t
     implicit none

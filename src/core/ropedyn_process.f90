@@ -1,10 +1,8 @@
-!> Processes and signals, through the C glue `ropedyn_process.c` (and a few libc calls):
-!! catching SIGINT/SIGTERM as a flag that the program polls (nested catches count; a second
-!! signal may end the process at once; or a note in a lock file followed by the end of the
-!! process), a lock file's heartbeat, worker processes in their own process group (spawn,
-!! reap, signal), process ids, start times, the host name, the Slurm job, file times and
-!! the clock. Used by the run driver (docs/output.md, "Interrupts") and the sweep runner
-!! (docs/sweeps.md).
+!> Worker processes and what identifies a process, through the C glue `ropedyn_process.c`
+!! (and a few libc calls): worker processes in their own process group (spawn, reap,
+!! signal, wait for their end), a lock file's heartbeat, process ids and start times, the
+!! host name, the Slurm job, file times. Used by the sweep runner and a sweep case's lock
+!! (the sweeps guide). Signals are ropedyn_signals', clocks ropedyn_clock's.
 module ropedyn_process
     use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_long_long, c_null_char, c_size_t
     use, intrinsic :: iso_fortran_env, only: int64
@@ -12,34 +10,13 @@ module ropedyn_process
     use ropedyn_text, only: int_text
     implicit none
     private
-    public :: catch_signals, release_signals, signal_received, note_signals, signal_name
-    public :: end_on_second_signal, slurm_job, process_text
+    public :: slurm_job, process_text
     public :: start_heartbeat, stop_heartbeat
     public :: spawn, reap, signal_group, process_id, process_start, host_name
     public :: watch_children, unwatch_children, wait_children
-    public :: file_mtime, unix_time
-    public :: SIGINT, SIGKILL, SIGTERM
-
-    !> Signal numbers (the same on every POSIX system ropedyn runs on).
-    integer, parameter :: SIGINT = 2, SIGKILL = 9, SIGTERM = 15
+    public :: file_mtime
 
     interface
-        integer(c_int) function c_catch_signals() bind(C, name='ropedyn_catch_signals')
-            import :: c_int
-        end function c_catch_signals
-        subroutine release_signals() bind(C, name='ropedyn_release_signals')
-        end subroutine release_signals
-        subroutine c_second_signal_ends(on) bind(C, name='ropedyn_second_signal_ends')
-            import :: c_int
-            integer(c_int), value :: on
-        end subroutine c_second_signal_ends
-        integer(c_int) function c_signal_received() bind(C, name='ropedyn_signal_received')
-            import :: c_int
-        end function c_signal_received
-        integer(c_int) function c_signal_note(path) bind(C, name='ropedyn_signal_note')
-            import :: c_char, c_int
-            character(kind=c_char), intent(in) :: path(*)
-        end function c_signal_note
         integer(c_int) function c_start_heartbeat(path, seconds) &
                 bind(C, name='ropedyn_start_heartbeat')
             import :: c_char, c_int
@@ -81,9 +58,6 @@ module ropedyn_process
             import :: c_char, c_long_long
             character(kind=c_char), intent(in) :: path(*)
         end function c_file_mtime
-        integer(c_long_long) function c_unix_time() bind(C, name='ropedyn_unix_time')
-            import :: c_long_long
-        end function c_unix_time
         integer(c_int) function c_getpid() bind(C, name='getpid')
             import :: c_int
         end function c_getpid
@@ -95,55 +69,6 @@ module ropedyn_process
     end interface
 
 contains
-
-    !> Catch SIGINT and SIGTERM from now on: `signal_received()` tells which came first.
-    subroutine catch_signals(err)
-        type(error_t), allocatable, intent(out) :: err
-        integer(c_int) :: rc
-        rc = c_catch_signals()
-        if (rc /= 0) call make_error(err, ERR_IO, 'cannot install signal handlers (errno '// &
-            int_text(int(rc))//')')
-    end subroutine catch_signals
-
-    !> With `on`, a SIGINT or SIGTERM that arrives after one was caught ends the process at
-    !! once, by that signal (exit status 128 + N); off again with the last `release_signals`.
-    subroutine end_on_second_signal(on)
-        logical, intent(in) :: on
-        call c_second_signal_ends(merge(1_c_int, 0_c_int, on))
-    end subroutine end_on_second_signal
-
-    !> The first SIGINT or SIGTERM caught since `catch_signals` (its number), or 0.
-    integer function signal_received()
-        signal_received = int(c_signal_received())
-    end function signal_received
-
-    !> With `path`: a signal caught from now on is appended to the file `path` as
-    !! "signal=N" and ends the process by that signal (for a writer that cannot stop on its
-    !! own). With '': a signal only sets the flag again.
-    subroutine note_signals(path, err)
-        character(len=*), intent(in) :: path
-        type(error_t), allocatable, intent(out) :: err
-        integer(c_int) :: rc
-        rc = c_signal_note(path//c_null_char)
-        if (rc /= 0) call make_error(err, ERR_IO, path//': cannot open to record signals '// &
-            '(errno '//int_text(int(rc))//')')
-    end subroutine note_signals
-
-    !> 'SIGTERM', 'SIGINT', else 'signal N'.
-    pure function signal_name(sig) result(name)
-        integer, intent(in) :: sig
-        character(len=:), allocatable :: name
-        select case (sig)
-        case (SIGINT)
-            name = 'SIGINT'
-        case (SIGTERM)
-            name = 'SIGTERM'
-        case (SIGKILL)
-            name = 'SIGKILL'
-        case default
-            name = 'signal '//int_text(sig)
-        end select
-    end function signal_name
 
     !> Touch the file `path` now and every `seconds` s (from a thread) until stop_heartbeat.
     subroutine start_heartbeat(path, seconds, err)
@@ -268,9 +193,4 @@ contains
         character(len=*), intent(in) :: path
         file_mtime = int(c_file_mtime(path//c_null_char), int64)
     end function file_mtime
-
-    !> The time now, s since 1970.
-    integer(int64) function unix_time()
-        unix_time = int(c_unix_time(), int64)
-    end function unix_time
 end module ropedyn_process

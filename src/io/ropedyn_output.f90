@@ -43,7 +43,7 @@
 module ropedyn_output
     use hdf5, only: hsize_t
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_os, only: utc_timestamp
+    use ropedyn_clock, only: utc_timestamp, clock_seconds
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_INTERNAL, ERR_IO
     use ropedyn_rope_model, only: energy_t
@@ -130,8 +130,8 @@ module ropedyn_output
         logical :: is_open = .false.              !< create succeeded and close_run not yet done
         integer :: n_elements = 0                 !< elements of the rope
         integer(hsize_t) :: n_records = 0         !< complete records (length of /time)
-        !> system_clock count of the last flush after an append (FLUSH_PERIOD)
-        integer(i8) :: last_flush = 0
+        !> the monotonic clock (s) at the last flush after an append (FLUSH_PERIOD)
+        real(wp) :: last_flush = 0.0_wp
         type(h5_series_t) :: series(N_SERIES)     !< the step-by-step datasets
         !> restart data /state/y, /state/yq (when `restart_data`) and their record sizes
         type(h5_series_t) :: state(2)

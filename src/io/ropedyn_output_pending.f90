@@ -9,7 +9,7 @@ contains
 
     module procedure output_append
         real(wp) :: scalars(S_KINETIC:S_STEP_SIZE)
-        integer(i8) :: now, rate
+        real(wp) :: now
         integer :: n, k, m
         logical :: due
 
@@ -46,9 +46,9 @@ contains
         end if
         self%n_pending = m
 
-        call system_clock(now, rate)
+        now = clock_seconds()
         due = self%n_records + m == 1 .or. &
-              real(now - self%last_flush, wp) >= FLUSH_PERIOD*real(rate, wp)
+              now - self%last_flush >= FLUSH_PERIOD
         if (due .or. m == self%capacity) then
             call write_pending(self, err)
             if (allocated(err)) return

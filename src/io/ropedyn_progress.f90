@@ -6,6 +6,7 @@
 !! 0.2 s of wall time.
 module ropedyn_progress
     use, intrinsic :: iso_fortran_env, only: error_unit, int64
+    use ropedyn_clock, only: clock_seconds
     use ropedyn_kinds, only: wp, i8
     use ropedyn_os, only: is_terminal
     implicit none
@@ -17,7 +18,7 @@ module ropedyn_progress
         logical :: enabled = .false.
         real(wp) :: t0 = 0.0_wp
         real(wp) :: t_end = 1.0_wp
-        integer(int64) :: start = 0, last = 0, rate = 1
+        real(wp) :: start = 0.0_wp, last = 0.0_wp   !< the monotonic clock, s
         logical :: drawn = .false.
     contains
         procedure :: start_run
@@ -48,7 +49,7 @@ contains
         self%enabled = progress_shown(value, given)
         self%t0 = t0
         self%t_end = t_end
-        call system_clock(self%start, self%rate)
+        self%start = clock_seconds()
         self%last = self%start
         self%drawn = .false.
     end subroutine start_run
@@ -57,14 +58,14 @@ contains
         class(progress_t), intent(inout) :: self
         real(wp), intent(in) :: t        !< simulated time reached, s
         integer(i8), intent(in) :: steps
-        integer(int64) :: now
+        real(wp) :: now
         real(wp) :: elapsed, fraction, eta, rate
         character(len=120) :: line
         if (.not. self%enabled) return
-        call system_clock(now)
-        if (real(now - self%last, wp)/real(self%rate, wp) < 0.2_wp .and. t < self%t_end) return
+        now = clock_seconds()
+        if (now - self%last < 0.2_wp .and. t < self%t_end) return
         self%last = now
-        elapsed = max(real(now - self%start, wp)/real(self%rate, wp), 1.0e-9_wp)
+        elapsed = max(now - self%start, 1.0e-9_wp)
         fraction = min(1.0_wp, max((t - self%t0)/max(self%t_end - self%t0, tiny(1.0_wp)), &
                                    1.0e-12_wp))
         eta = elapsed*(1.0_wp - fraction)/fraction

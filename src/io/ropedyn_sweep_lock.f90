@@ -30,9 +30,11 @@ module ropedyn_sweep_lock
     use, intrinsic :: iso_fortran_env, only: int64
     use ropedyn_error, only: error_t, make_error, ERR_IO
     use ropedyn_text, only: int_text
-    use ropedyn_os, only: delete_file, utc_timestamp, utc_text
-    use ropedyn_process, only: process_id, process_start, host_name, file_mtime, unix_time, &
-        start_heartbeat, stop_heartbeat, signal_name, slurm_job
+    use ropedyn_os, only: delete_file
+    use ropedyn_clock, only: utc_timestamp, utc_text, unix_time
+    use ropedyn_signals, only: signal_name
+    use ropedyn_process, only: process_id, process_start, host_name, file_mtime, &
+        start_heartbeat, stop_heartbeat, slurm_job
     implicit none
     private
     public :: lock_t, read_lock, take_lock, drop_lock, LOCK_BEAT, LOCK_ABANDONED_AFTER

@@ -6,10 +6,12 @@ module ropedyn_simulation
     use, intrinsic :: iso_fortran_env, only: error_unit
     use ropedyn_text, only: real_text, int_text
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_IO, ERR_SOLVER, ERR_INTERRUPTED
-    use ropedyn_process, only: catch_signals, release_signals, signal_received, signal_name, &
-        end_on_second_signal, process_text
+    use ropedyn_signals, only: catch_signals, release_signals, signal_received, signal_name, &
+        end_on_second_signal
+    use ropedyn_process, only: process_text
     use ropedyn_rope_model, only: rope_model_t, energy_t
-    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, clock_seconds
+    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
+    use ropedyn_clock, only: clock_seconds
     use ropedyn_solvers, only: new_integrator
     use ropedyn_rfem, only: rfem_t, rfem_create
     use ropedyn_mpp, only: mpp_t, mpp_create

@@ -13,11 +13,14 @@
 !! `--summary` can rebuild it at any time.
 module ropedyn_sweep_runner
 
-    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
+    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use ropedyn_kinds, only: wp
     use ropedyn_os, only: make_dirs, is_terminal, sleep_microseconds, delete_file
-    use ropedyn_process, only: catch_signals, release_signals, signal_received, signal_name, &
-        spawn, reap, signal_group, SIGKILL, watch_children, unwatch_children, wait_children
+    use ropedyn_clock, only: clock_seconds
+    use ropedyn_signals, only: catch_signals, release_signals, signal_received, signal_name, &
+        SIGKILL
+    use ropedyn_process, only: spawn, reap, signal_group, watch_children, unwatch_children, &
+        wait_children
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER, ERR_INTERRUPTED
     use ropedyn_sweep, only: sweep_t, text_t
     use ropedyn_text, only: int_text
@@ -153,7 +156,7 @@ contains
         integer, allocatable :: todo(:), slot(:), pid(:), elsewhere(:)
         character(len=:), allocatable :: args(:)
         integer :: n, c, next, finished, failed, rc, s, width, sig
-        integer(int64) :: start, now, rate, last_draw
+        real(wp) :: start, now, last_draw
         logical :: tty, redraw, woken
 
         n = size(sweep%cases)
@@ -202,7 +205,7 @@ contains
         next = 1
         finished = 0
         failed = 0
-        call system_clock(start, rate)
+        start = clock_seconds()
         last_draw = start
         do while (finished < size(todo))
             sig = signal_received()
@@ -235,7 +238,7 @@ contains
                 finished = finished + 1
                 if (rc /= 0) failed = failed + 1
                 call remove_if_empty(log_path(c))
-                call system_clock(now)
+                now = clock_seconds()
                 if (.not. opt%quiet) then
                     if (tty) write (error_unit, '(a)', advance='no') achar(13)//repeat(' ', 78) &
                         //achar(13)
@@ -246,8 +249,8 @@ contains
                 redraw = .true.
             end do
             if (tty) then
-                call system_clock(now)
-                if (redraw .or. real(now - last_draw, wp)/real(rate, wp) > 0.5_wp) then
+                now = clock_seconds()
+                if (redraw .or. now - last_draw > 0.5_wp) then
                     write (error_unit, '(a)', advance='no') achar(13)//'sweep: '// &
                         progress_text(now)//'   '
                     flush (error_unit)
@@ -343,10 +346,10 @@ contains
         end function outcome
 
         function progress_text(time_now) result(text)
-            integer(int64), intent(in) :: time_now
+            real(wp), intent(in) :: time_now   !< the monotonic clock, s
             character(len=:), allocatable :: text
             real(wp) :: elapsed, eta
-            elapsed = real(time_now - start, wp)/real(rate, wp)
+            elapsed = time_now - start
             ! a finished worker's slot is refilled at once: count it as running
             text = int_text(finished)//'/'//int_text(size(todo))//' done, '// &
                 int_text(min(size(slot), size(todo) - finished))//' running, '// &

@@ -18,12 +18,13 @@
 !! is moved back to its .part name under the lock, `run_scene(..., resume=.true.)` appends
 !! to it, and it is renamed into place again), unless forced, which runs it anew.
 module ropedyn_sweep_task
-    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
+    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use ropedyn_kinds, only: wp
     use ropedyn_text, only: int_text, fixed_text
     use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INPUT, ERR_INTERRUPTED
     use ropedyn_os, only: make_dirs, rename_file, delete_file
-    use ropedyn_process, only: catch_signals, release_signals, signal_received, signal_name
+    use ropedyn_clock, only: clock_seconds
+    use ropedyn_signals, only: catch_signals, release_signals, signal_received, signal_name
     use ropedyn_scene, only: scene_t, scene_namelist_text
     use ropedyn_simulation, only: run_summary_t, run_scene
     use ropedyn_case_file, only: case_data_t, read_case_file, finish_case_file
@@ -109,7 +110,7 @@ contains
         type(scene_t) :: scene
         type(error_t), allocatable :: ferr
         character(len=:), allocatable :: label, lock, part
-        integer(int64) :: start, finish, rate
+        real(wp) :: start
         real(wp) :: wall
         logical :: removed, resume
 
@@ -166,7 +167,7 @@ contains
                     if (.not. quiet) write (output_unit, '(a)') label//': interrupted '// &
                         'before: continuing it from its last record'
                 end if
-                call system_clock(start, rate)
+                start = clock_seconds()
                 call run_scene(scene, summary, err, resume=resume)
                 if (resume .and. allocated(err)) then
                     ! not to be continued (nothing left, no restart data, ...): run it anew
@@ -177,8 +178,7 @@ contains
                         call run_scene(scene, summary, err)
                     end if
                 end if
-                call system_clock(finish)
-                wall = real(finish - start, wp)/real(rate, wp)
+                wall = clock_seconds() - start
                 call put_in_place(c, part, wall, ferr)
                 if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
                 if (allocated(err)) then

@@ -5,7 +5,8 @@
 program test_sweep_lock
     use, intrinsic :: iso_fortran_env, only: int64
     use ropedyn_error, only: error_t, ERR_IO
-    use ropedyn_os, only: make_dirs, utc_text, sleep_microseconds
+    use ropedyn_os, only: make_dirs, sleep_microseconds
+    use ropedyn_clock, only: utc_text
     use ropedyn_process, only: process_id, process_start, host_name, file_mtime, &
         start_heartbeat, stop_heartbeat
     use ropedyn_sweep_lock, only: lock_t, read_lock, take_lock, drop_lock
