@@ -11,7 +11,7 @@ module ropedyn_analysis
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_os, only: make_parent_dirs
     use ropedyn_text, only: int_text
-    use ropedyn_simulation, only: create_model
+    use ropedyn_model_factory, only: create_model
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
                                potential_energy, rope_length
     use ropedyn_modes, only: modes_result_t, compute_modes
@@ -69,7 +69,7 @@ contains
         if (allocated(err)) return
         allocate (y(model%size()))
         call model%initial_state(y)
-        call find_equilibrium(model, scene%rope_spec_t, y, options, sres, err, create_model)
+        call find_equilibrium(model, scene%rope_spec_t, y, options, sres, err)
         if (allocated(err)) return
         call support_forces(scene%rope_spec_t, model, y, force_top, force_bottom, err)
         if (allocated(err)) return

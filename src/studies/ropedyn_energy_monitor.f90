@@ -12,7 +12,7 @@
 !! max elastic + (max - min) of the gravity energy + the energy dissipated (J); one accepted
 !! step moves B by about rtol times the energies in play, so the bound rtol S follows the
 !! tolerance. The monitor knows nothing of integrators: the run driver
-!! (`ropedyn_simulation`) decides what a gain means (lower the order, stop), and may
+!! (`ropedyn_run`) decides what a gain means (lower the order, stop), and may
 !! `accept` a gain as the integration error of the run: gains are then counted from there.
 !!
 !! Whether a gain is the high order's (an instability) or the integration error is decided

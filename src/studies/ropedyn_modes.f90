@@ -23,7 +23,7 @@ module ropedyn_modes
     use ropedyn_text, only: int_text
     use ropedyn_rope_spec, only: rope_spec_t
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
-                               tangent_matrices, rope_length, model_factory_i
+                               tangent_matrices, rope_length
     use ropedyn_ldl, only: bandwidth
     implicit none
     private
@@ -229,12 +229,11 @@ contains
     !! rest, found from the 'straight' start in y) or 'mode' (that equilibrium plus mode
     !! `mode` scaled so that its largest point displacement is `mode_amplitude`, at rest).
     !! Other shapes leave y unchanged.
-    subroutine equilibrium_initial_state(model, spec, y, err, factory)
+    subroutine equilibrium_initial_state(model, spec, y, err)
         class(rope_model_t), intent(inout) :: model
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(inout) :: y(:)
         type(error_t), allocatable, intent(out) :: err
-        procedure(model_factory_i), optional :: factory  !< for continuation (create_model)
         type(statics_result_t) :: sres
         type(modes_result_t) :: mres
         integer, allocatable :: pos(:), vel(:)
@@ -246,7 +245,7 @@ contains
         case default
             return
         end select
-        call find_equilibrium(model, spec, y, statics_options_t(), sres, err, factory)
+        call find_equilibrium(model, spec, y, statics_options_t(), sres, err)
         if (allocated(err)) then
             err%message = err%message//" (&initial shape = '"//trim(spec%initial%shape)//"')"
             return

@@ -27,6 +27,7 @@ module ropedyn_statics
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: STATUS_OK
     use ropedyn_rope_model, only: rope_model_t, energy_t
+    use ropedyn_model_factory, only: create_model
     use ropedyn_text, only: int_text, fixed_text
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_ldl, only: ldl_t, ldl_factor, ldl_solve
@@ -35,7 +36,7 @@ module ropedyn_statics
     implicit none
     private
     public :: statics_options_t, statics_result_t
-    public :: solve_statics, find_equilibrium, check_equilibrium_exists, model_factory_i
+    public :: solve_statics, find_equilibrium, check_equilibrium_exists
     public :: generalized_force, tangent_matrices, potential_energy, rope_length, total_weight
 
     !> Controls of `solve_statics`.
@@ -62,16 +63,6 @@ module ropedyn_statics
         character(len=:), allocatable :: criterion  !< 'newton step' or 'rounding level'
     end type statics_result_t
 
-    abstract interface
-        !> Builds the model of a spec (ropedyn_simulation's create_model).
-        subroutine model_factory_i(spec, model, err)
-            import :: rope_spec_t, rope_model_t, error_t
-            type(rope_spec_t), intent(in) :: spec
-            class(rope_model_t), allocatable, intent(out) :: model
-            type(error_t), allocatable, intent(out) :: err
-        end subroutine model_factory_i
-    end interface
-
 contains
 
     !> ERR_SOLVER when the spec cannot have an equilibrium: both ends free under gravity.
@@ -90,22 +81,21 @@ contains
     !! pinned or clamped to an anchor far (> L/1000) from the lower end of the starting
     !! configuration, the support spring starts hugely stretched: its pull (~ EA/dl times the
     !! distance) dwarfs the weight and pushes the straight rope along its axis, a saddle
-    !! (compression) where the steps must be tiny. Then (given `factory`) the solution is
+    !! (compression) where the steps must be tiny. Then the solution is
     !! first continued in `support_stiffness_factor`: from the value at which the spring pulls
     !! with 0.3 times the weight up to the spec's value in geometric stages, each started
-    !! from the previous equilibrium (models rebuilt by `factory`); a stage multiplies the
+    !! from the previous equilibrium (models rebuilt); a stage multiplies the
     !! factor by 10 at first, by 100 after an easy stage, and its step is cut by 4 after a
     !! failure. If the first stage fails or the continuation stalls (RFEM: its top support
     !! softens too and the rope drops far), it solves directly from the start, which the
     !! RFEM's Cartesian coordinates tolerate. Otherwise it is `solve_statics`.
-    subroutine find_equilibrium(model, spec, y, options, result, err, factory)
+    subroutine find_equilibrium(model, spec, y, options, result, err)
         class(rope_model_t), intent(inout) :: model
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(inout) :: y(:)
         type(statics_options_t), intent(in) :: options
         type(statics_result_t), intent(out) :: result
         type(error_t), allocatable, intent(out) :: err
-        procedure(model_factory_i), optional :: factory
         type(rope_spec_t) :: stage_spec
         class(rope_model_t), allocatable :: stage_model
         type(statics_result_t) :: stage
@@ -123,7 +113,7 @@ contains
         call check_equilibrium_exists(spec, err)
         if (allocated(err)) return
         weight = total_weight(model, spec)
-        continuation: if (present(factory) .and. options%continuation .and. &
+        continuation: if (options%continuation .and. &
                           trim(spec%supports%bottom) /= 'free' .and. &
                           bottom_anchor_given(spec) .and. weight > 0.0_wp) then
             allocate (points(2, 2*model%n_elements()))
@@ -149,7 +139,7 @@ contains
                 stage_spec = spec
                 stage_spec%supports%support_stiffness_factor = &
                     exp(log_f0 + s_try*(log_f1 - log_f0))
-                call factory(stage_spec, stage_model, err)
+                call create_model(stage_spec, stage_model, err)
                 if (allocated(err)) return
                 y_try = y
                 call solve_statics(stage_model, stage_spec, y_try, stage_options, stage, &
@@ -196,11 +186,11 @@ contains
             r = 0.0_wp
             moved = spec
             moved%supports%bottom_anchor = target + h*u
-            call factory(moved, probe, err)
+            call create_model(moved, probe, err)
             if (allocated(err)) return
             vp = potential_energy(probe, y, moved)
             moved%supports%bottom_anchor = target - h*u
-            call factory(moved, probe, err)
+            call create_model(moved, probe, err)
             if (allocated(err)) return
             vm = potential_energy(probe, y, moved)
             r = abs(vp - vm)/(2*h)

@@ -22,7 +22,7 @@ program bench_rhs
     use ropedyn_error, only: error_t
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_simulation, only: create_model
+    use ropedyn_model_factory, only: create_model
     implicit none
     integer, parameter :: K_RHS = 1, K_JAC = 2, K_BLOCKS = 3, K_BLOCKS_IMPLICIT = 4, K_QUAD = 5
     character(len=*), parameter :: KERNELS(5) = [character(len=15) :: 'rhs', 'jac', 'blocks', &

@@ -11,7 +11,7 @@ module ropedyn_test_run
     use ropedyn_error, only: error_t
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_scene, only: scene_t, read_scene
-    use ropedyn_simulation, only: create_model
+    use ropedyn_model_factory, only: create_model
     use ropedyn_modes, only: equilibrium_initial_state
     use ropedyn_integrator, only: integrator_t, solver_options_t
     use ropedyn_solvers, only: new_integrator
@@ -75,8 +75,7 @@ contains
         if (.not. allocated(err)) then
             allocate (y(run%model%size()), yq(run%model%quad_size()))
             call run%model%initial_state(y)
-            call equilibrium_initial_state(run%model, run%scene%rope_spec_t, y, err, &
-                                           create_model)
+            call equilibrium_initial_state(run%model, run%scene%rope_spec_t, y, err)
             if (present(y0)) y = y0
         end if
         if (.not. allocated(err)) call new_integrator(name, solver, err)

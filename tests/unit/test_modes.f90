@@ -10,7 +10,8 @@ program test_modes
     use ropedyn_error, only: error_t
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_simulation, only: create_model, solver_options_of
+    use ropedyn_model_factory, only: create_model
+    use ropedyn_scene_solver, only: solver_options_of
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium
     use ropedyn_modes, only: modes_result_t, compute_modes, equilibrium_initial_state
     use ropedyn_integrator, only: integrator_t
@@ -70,7 +71,7 @@ contains
         if (.not. allocated(err)) then
             allocate (y(model%size()))
             call model%initial_state(y)
-            call find_equilibrium(model, scene%rope_spec_t, y, statics_options_t(), sres, err, create_model)
+            call find_equilibrium(model, scene%rope_spec_t, y, statics_options_t(), sres, err)
         end if
         if (.not. allocated(err)) call compute_modes(model, y, count, res, err)
         if (allocated(err)) then
@@ -166,7 +167,7 @@ contains
         allocate (y(size(y_eq)), yq(model%quad_size()), p0(2, 20), p(2, 20))
         call model%polyline(y_eq, p0)
         call model%initial_state(y)
-        call equilibrium_initial_state(model, scene%rope_spec_t, y, err, create_model)
+        call equilibrium_initial_state(model, scene%rope_spec_t, y, err)
         yq = 0.0_wp
         call new_integrator('cvode', integ, err)
         call integ%init(model, 0.0_wp, y, yq, solver_options_of(scene), err)

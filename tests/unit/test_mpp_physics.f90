@@ -9,7 +9,8 @@ program test_mpp_physics
     use ropedyn_mpp, only: mpp_t, mpp_create
     use ropedyn_integrator, only: integrator_t, solver_options_t
     use ropedyn_solvers, only: new_integrator
-    use ropedyn_simulation, only: create_model, solver_options_of
+    use ropedyn_model_factory, only: create_model
+    use ropedyn_scene_solver, only: solver_options_of
     use ropedyn_assert, only: test_suite_t
     implicit none
 

@@ -132,7 +132,7 @@ program test_newton_matrix
     use ropedyn_problem, only: STATUS_OK
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_simulation, only: create_model
+    use ropedyn_model_factory, only: create_model
     use ropedyn_iteration_matrix, only: iteration_matrix_t
     use ropedyn_assert, only: test_suite_t
     use test_newton_matrix_toy, only: toy_t, TOY_KL, TOY_KU

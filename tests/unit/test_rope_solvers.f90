@@ -7,7 +7,8 @@ program test_rope_solvers
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_integrator, only: integrator_t, solver_stats_t
-    use ropedyn_simulation, only: create_model, create_integrator, solver_options_of
+    use ropedyn_model_factory, only: create_model
+    use ropedyn_scene_solver, only: create_integrator, solver_options_of
     use ropedyn_assert, only: test_suite_t
     implicit none
 

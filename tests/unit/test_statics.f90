@@ -11,7 +11,7 @@ program test_statics
     use ropedyn_error, only: error_t, ERR_SOLVER
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_simulation, only: create_model
+    use ropedyn_model_factory, only: create_model
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
                                generalized_force
     use ropedyn_modes, only: equilibrium_initial_state
@@ -66,7 +66,7 @@ contains
         end if
         allocate (y(model%size()))
         call model%initial_state(y)
-        call find_equilibrium(model, scene%rope_spec_t, y, statics_options_t(), res, err, create_model)
+        call find_equilibrium(model, scene%rope_spec_t, y, statics_options_t(), res, err)
         if (allocated(err)) then
             call suite%check_true(.false., 'equilibrium found: '//err%message)
         else
@@ -181,7 +181,7 @@ contains
         call create_model(scene%rope_spec_t, model, err)
         allocate (y(model%size()), p0(2, 40), p1(2, 40))
         call model%initial_state(y)
-        call equilibrium_initial_state(model, scene%rope_spec_t, y, err, create_model)
+        call equilibrium_initial_state(model, scene%rope_spec_t, y, err)
         call suite%check_true(.not. allocated(err), "shape = 'equilibrium': solved")
         call model%coordinates(pos, vel)
         allocate (f(size(pos)))
@@ -195,7 +195,7 @@ contains
                        'initial.mode = 1', 'initial.mode_amplitude = 0.002'], scene)
         call create_model(scene%rope_spec_t, model, err)
         call model%initial_state(y)
-        call equilibrium_initial_state(model, scene%rope_spec_t, y, err, create_model)
+        call equilibrium_initial_state(model, scene%rope_spec_t, y, err)
         call suite%check_true(.not. allocated(err), "shape = 'mode': solved")
         call model%polyline(y, p1)
         largest = maxval(norm2(p1 - p0, dim=1))
@@ -209,7 +209,7 @@ contains
         deallocate (y)
         allocate (y(model%size()))
         call model%initial_state(y)
-        call equilibrium_initial_state(model, scene%rope_spec_t, y, err, create_model)
+        call equilibrium_initial_state(model, scene%rope_spec_t, y, err)
         call suite%check_true(allocated(err), "shape = 'mode', mode = 99 > 12 modes: error")
         if (allocated(err)) call suite%check_contains(err%message, 'only 12 modes', &
                                                       'mode beyond the count')
@@ -230,7 +230,7 @@ contains
         call create_model(scene%rope_spec_t, model, err)
         allocate (y(model%size()))
         call model%initial_state(y)
-        call find_equilibrium(model, scene%rope_spec_t, y, statics_options_t(), res, err, create_model)
+        call find_equilibrium(model, scene%rope_spec_t, y, statics_options_t(), res, err)
         call suite%check_true(allocated(err), 'free-free with gravity: error')
         if (allocated(err)) then
             call suite%check_true(err%code == ERR_SOLVER, 'free-free: class ERR_SOLVER (exit 3)')
@@ -243,7 +243,7 @@ contains
                        'supports.bottom = "free"', 'effects.gravity = .false.'], scene)
         call create_model(scene%rope_spec_t, model, err)
         call model%initial_state(y)
-        call find_equilibrium(model, scene%rope_spec_t, y, statics_options_t(), res, err, create_model)
+        call find_equilibrium(model, scene%rope_spec_t, y, statics_options_t(), res, err)
         call suite%check_true(.not. allocated(err) .and. res%iterations == 0, &
                               'free-free without gravity: the start is an equilibrium')
 
@@ -253,7 +253,7 @@ contains
         allocate (y(model%size()))
         call model%initial_state(y)
         options%max_iterations = 3
-        call find_equilibrium(model, scene%rope_spec_t, y, options, res, err, create_model)
+        call find_equilibrium(model, scene%rope_spec_t, y, options, res, err)
         call suite%check_true(allocated(err), 'capped iteration: error')
         if (allocated(err)) then
             call suite%check_true(err%code == ERR_SOLVER, 'capped: class ERR_SOLVER')

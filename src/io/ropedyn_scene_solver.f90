@@ -1,0 +1,35 @@
+!> What a scene asks of the solvers: the integrator it names and the options it gives.
+module ropedyn_scene_solver
+    use ropedyn_kinds, only: i8
+    use ropedyn_error, only: error_t
+    use ropedyn_integrator, only: integrator_t, solver_options_t
+    use ropedyn_solvers, only: new_integrator
+    use ropedyn_scene_types, only: scene_t
+    implicit none
+    private
+    public :: create_integrator, solver_options_of
+
+contains
+
+    !> The integrator a scene names (its error names the scene and &solver).
+    subroutine create_integrator(scene, integrator, err)
+        type(scene_t), intent(in) :: scene
+        class(integrator_t), allocatable, intent(out) :: integrator
+        type(error_t), allocatable, intent(out) :: err
+        call new_integrator(trim(scene%solver%method), integrator, err)
+        if (allocated(err)) err%message = scene%path//': &solver: '//err%message
+    end subroutine create_integrator
+
+    !> The solver options of a scene's &solver group.
+    pure function solver_options_of(scene) result(options)
+        type(scene_t), intent(in) :: scene
+        type(solver_options_t) :: options
+        options%rtol = scene%solver%rtol
+        options%atol = scene%solver%atol
+        options%max_order = scene%solver%max_order
+        options%max_steps = int(scene%solver%max_steps, i8)
+        options%stab_lim_det = scene%solver%stability_limit_detection
+        options%first_order_newton = scene%solver%first_order_newton
+        options%profile = scene%solver%profile
+    end function solver_options_of
+end module ropedyn_scene_solver

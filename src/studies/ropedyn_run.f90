@@ -1,0 +1,426 @@
+!> One run of a scene as an object: the model, the integrator, the output file and what the
+!! run has done so far, with small type-bound steps that a driver calls in order:
+!!
+!!     call run%open(scene, err)            ! model, integrator, start state, file, record 0
+!!     call run%begin(err, stop)            ! (or open with resume = .true.: from the file)
+!!     do while (.not. run%done())
+!!         call run%step(outcome, err)      ! to the next output time, checked and recorded
+!!         if (outcome /= STEP_RECORDED) exit
+!!     end do
+!!     call run%finish(status, reason, err) ! counters, switches, the file's status, closed
+!!
+!! A step integrates to the next output time, lets the order safety look at the energy
+!! balance there (ropedyn_run_safety) and appends the record. No record with a NaN or Inf
+!! is ever written: a non-finite state or energy ends the run as a failed integration
+!! (ERR_SOLVER) before it reaches the file. A step that fails finishes the run as 'failed'
+!! itself; a step that stops early (the integrator returned before the output time, or
+!! the driver's stop query said so) writes the state it reached as the last record and
+!! leaves the finishing to the driver, which knows why it stopped (a signal).
+!!
+!! Resume (`open` with resume, submodule ropedyn_run_resume; the rules are in the output
+!! guide, "Resume"): the last record of the file is the start, the file is reopened and
+!! appended to; an off-grid last record is replaced by the grid records that follow.
+module ropedyn_run
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use ropedyn_kinds, only: wp, i8
+    use ropedyn_text, only: real_text
+    use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_SOLVER
+    use ropedyn_rope_model, only: rope_model_t, energy_t
+    use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, &
+                                  stop_query_i
+    use ropedyn_clock, only: clock_seconds
+    use ropedyn_model_factory, only: create_model
+    use ropedyn_scene, only: scene_t, scene_namelist_text
+    use ropedyn_scene_solver, only: create_integrator, solver_options_of
+    use ropedyn_os, only: make_parent_dirs
+    use ropedyn_output, only: output_file_t, add_counter_values
+    use ropedyn_progress, only: progress_t
+    use ropedyn_switch_log, only: switch_event_t
+    use ropedyn_version, only: version_string
+    use ropedyn_modes, only: equilibrium_initial_state
+    use ropedyn_methods, only: METHODS, method_index
+    use ropedyn_energy_monitor, only: energy_monitor_t, safety_record_t
+    use ropedyn_state_start, only: state_initial_state
+    implicit none
+    private
+    public :: run_t, run_summary_t, STEP_RECORDED, STEP_STOPPED, STEP_FAILED
+
+    !> What `step` did: recorded the next output time; stopped early (the last record is
+    !! the state reached; the driver finishes); failed (`err`; finished unless the error is
+    !! the output's).
+    integer, parameter :: STEP_RECORDED = 0, STEP_STOPPED = 1, STEP_FAILED = 2
+
+    !> What a run reports back to the driver.
+    type :: run_summary_t
+        type(solver_stats_t) :: stats
+        real(wp) :: cpu_time = 0.0_wp      !< s
+        real(wp) :: t_reached = 0.0_wp     !< s
+        type(energy_t) :: initial_energy
+        type(energy_t) :: final_energy
+        integer :: records = 0             !< output times written
+        !> the integrator's changes of method or order limit (auto, cvode's crawl watch)
+        type(switch_event_t), allocatable :: switches(:)
+        character(len=:), allocatable :: file
+        type(safety_record_t) :: safety    !< what the order safety did
+    end type run_summary_t
+
+    !> A run of one scene (see the module header for the order of the steps).
+    type :: run_t
+        private
+        type(scene_t) :: scene
+        class(rope_model_t), allocatable :: model
+        class(integrator_t), allocatable :: integrator
+        type(output_file_t) :: out
+        type(progress_t) :: progress
+        type(energy_monitor_t) :: monitor
+        type(run_summary_t), public :: summary
+        !> the counters of integrators replaced by the order safety
+        type(solver_stats_t) :: stats_before
+        !> resume: the counters and CPU time (s) of the earlier parts of the run
+        integer(i8) :: counters_before(7) = 0
+        real(wp) :: cpu_before = 0.0_wp
+        real(wp) :: cpu_start = 0.0_wp      !< CPU clock at `begin`, s
+        real(wp) :: time_advance = 0.0_wp   !< &solver profile: time in advance_to, s
+        integer(i8) :: steps_now = 0        !< steps of the run at the last record
+        ! the state: time (s), ODE state and quadratures; at the previous record too
+        real(wp) :: t = 0.0_wp, t_prev = 0.0_wp, t_last = 0.0_wp
+        real(wp), allocatable :: y(:), yq(:), y_prev(:), yq_prev(:)
+        ! work arrays of a record: element fields and the polyline
+        real(wp), allocatable :: q(:, :), qdot(:, :), points(:, :)
+        integer :: nq = 0                   !< quadratures of the model
+        ! the output grid: every dt up to t_end, records 0 .. n_out; the next is k_next
+        real(wp) :: dt = 1.0_wp, t_end = 0.0_wp
+        integer :: n_out = 1, k_next = 1
+        ! the order safety: the order limit in use, the method's safe one, the steps of
+        ! the integrator in use at the previous record
+        integer :: max_order = 0, safe_order = 0
+        logical :: monitoring = .false.
+        integer(i8) :: steps_mark = 0
+        procedure(stop_query_i), pointer, nopass :: stop_requested => null()
+    contains
+        procedure :: open => run_open
+        procedure :: begin => run_begin
+        procedure :: step => run_step
+        procedure :: finish => run_finish
+        procedure :: done => run_done
+        procedure :: time => run_time
+        procedure :: end_time => run_end_time
+        procedure :: output_file => run_output_file
+        procedure, private :: fresh_start, output_time, start_integrator, record, &
+                              steps_taken, keep_as_previous, asked_to_stop
+        procedure, private :: resume_from_file, check_energy, second_look
+    end type run_t
+
+    interface
+        !> Resume: the last record of the run file as the starting point, the file reopened
+        !! (an off-grid last record cut), the restart recorded (submodule
+        !! ropedyn_run_resume).
+        module subroutine resume_from_file(self, err)
+            class(run_t), intent(inout) :: self
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine resume_from_file
+
+        !> The order safety at the output time just reached (submodule ropedyn_run_safety).
+        module subroutine check_energy(self, tout, err)
+            class(run_t), intent(inout) :: self
+            real(wp), intent(in) :: tout
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine check_energy
+
+        !> The second look of the order safety (submodule ropedyn_run_safety).
+        module subroutine second_look(self, tout, e, bound, err)
+            class(run_t), intent(inout) :: self
+            real(wp), intent(in) :: tout
+            type(energy_t), intent(inout) :: e
+            real(wp), intent(in) :: bound
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine second_look
+    end interface
+
+contains
+
+    !> Build the run of a validated scene: its model and integrator, the start (the
+    !! scene's initial state, or with `resume` the last record of the run file
+    !! scene%output%file) and the output file with its first record. A failure before the
+    !! file exists leaves none; a failure after it is the caller's to finish.
+    subroutine run_open(self, scene, err, resume)
+        class(run_t), intent(inout) :: self
+        type(scene_t), intent(in) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        logical, intent(in), optional :: resume
+        integer :: n
+        self%scene = scene
+        call create_model(scene%rope_spec_t, self%model, err)
+        if (allocated(err)) return
+        call create_integrator(scene, self%integrator, err)
+        if (allocated(err)) return
+        n = self%model%n_elements()
+        self%nq = self%model%quad_size()
+        allocate (self%y(self%model%size()), self%yq(max(1, self%nq)))
+        allocate (self%q(3, n), self%qdot(3, n), self%points(2, 2*n))
+        self%dt = scene%solver%output_interval
+        self%t_end = scene%solver%t_end
+        self%n_out = max(1, ceiling(self%t_end/self%dt*(1.0_wp - 1.0e-12_wp)))
+        self%summary%file = trim(scene%output%file)
+        self%k_next = 1
+        if (present(resume)) then
+            if (resume) then
+                call self%resume_from_file(err)
+                if (.not. allocated(err)) call self%keep_as_previous()
+                return
+            end if
+        end if
+        call self%fresh_start(err)
+    end subroutine run_open
+
+    !> The scene's start: the initial state (statics and modes first for 'equilibrium' and
+    !! 'mode'; a record of an earlier run for 'state', whose output times it keeps), checked
+    !! finite; then the output file and record 0.
+    subroutine fresh_start(self, err)
+        class(run_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: err
+        real(wp), allocatable :: lengths(:), masses(:)
+        associate (scene => self%scene, model => self%model)
+            call model%initial_state(self%y)
+            call equilibrium_initial_state(model, scene%rope_spec_t, self%y, err)
+            if (allocated(err)) return
+            self%yq = 0.0_wp
+            self%t = 0.0_wp
+            if (trim(scene%initial%shape) == 'state') then
+                call state_initial_state(scene, model, self%t, self%y, self%yq, err)
+                if (allocated(err)) return
+                if (self%t > 0.0_wp) &
+                    self%k_next = floor(self%t/self%dt*(1.0_wp + 1.0e-12_wp)) + 1
+            end if
+            self%summary%initial_energy = model%energy(self%t, self%y, self%yq)
+            ! the scene's limits keep the start finite; should a value still make it not,
+            ! that is bad input: say so before any file is created
+            if (.not. (all(ieee_is_finite(self%y)) .and. &
+                       ieee_is_finite(self%summary%initial_energy%balance()))) then
+                call make_error(err, ERR_INPUT, scene%path//': the initial state or its '// &
+                    'energy is not finite (energy '// &
+                    real_text(self%summary%initial_energy%balance())//' J): a value of '// &
+                    'the scene is too large or too small (docs/input.md, Limits)')
+                return
+            end if
+            call make_parent_dirs(self%summary%file, err)
+            if (allocated(err)) return
+            allocate (lengths(model%n_elements()), masses(model%n_elements()))
+            call model%element_data(lengths, masses)
+            call self%out%create(self%summary%file, model%n_elements(), lengths, masses, &
+                                 model%model_name(), self%integrator%name(), version_string, &
+                                 scene_namelist_text(scene), err, state_size=model%size(), &
+                                 quad_size=self%nq)
+            if (allocated(err)) return
+        end associate
+        call self%record(err)
+    end subroutine fresh_start
+
+    !> Start integrating (after `open`): the CPU clock, the order safety's monitor and
+    !! limits, the integrator at the start state, the progress display. `stop`, when
+    !! given, is asked after every step (a signal caught by the driver, say): when it says
+    !! so, `step` stops there. A failure here is the caller's to finish.
+    subroutine run_begin(self, err, stop)
+        class(run_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: err
+        procedure(stop_query_i), optional :: stop
+        call cpu_time(self%cpu_start)
+        self%time_advance = 0.0_wp
+        if (present(stop)) self%stop_requested => stop
+        self%max_order = self%scene%solver%max_order
+        if (self%max_order == 0) self%max_order = self%integrator%default_max_order()
+        self%safe_order = 0
+        if (method_index(self%integrator%name()) > 0) &
+            self%safe_order = METHODS(method_index(self%integrator%name()))%safe_order
+        self%monitoring = trim(self%scene%solver%order_safety) /= 'off'
+        call self%monitor%start(self%summary%initial_energy, self%scene%solver%rtol, &
+                                self%scene%solver%energy_gain_bound)
+        call self%start_integrator(err)
+        if (allocated(err)) return
+        call self%progress%start_run(self%t, self%t_end, self%scene%output%progress, &
+                                     self%scene%output%progress_given)
+    end subroutine run_begin
+
+    !> (Re)start the integrator at the run's state with the order limit `max_order` and the
+    !! step budget that the integrators before it left.
+    subroutine start_integrator(self, err)
+        class(run_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: err
+        type(solver_options_t) :: options
+        options = solver_options_of(self%scene)
+        options%stop_requested => self%stop_requested
+        options%max_order = self%max_order
+        options%max_steps = max(1_i8, options%max_steps - self%stats_before%steps)
+        call self%integrator%init(self%model, self%t, self%y, self%yq(1:self%nq), options, err)
+        self%steps_mark = 0
+    end subroutine start_integrator
+
+    !> Integrate to the next output time, let the order safety look, and record it (see
+    !! the module header for the outcomes).
+    subroutine run_step(self, outcome, err)
+        class(run_t), intent(inout) :: self
+        integer, intent(out) :: outcome
+        type(error_t), allocatable, intent(out) :: err
+        type(error_t), allocatable :: io_err
+        real(wp) :: tout, clock_start
+        tout = self%output_time(self%k_next)
+        outcome = STEP_FAILED
+        if (self%scene%solver%profile) clock_start = clock_seconds()
+        call self%integrator%advance_to(tout, self%t, self%y, self%yq(1:self%nq), err)
+        if (self%scene%solver%profile) &
+            self%time_advance = self%time_advance + (clock_seconds() - clock_start)
+        if (.not. allocated(err) .and. self%monitoring .and. self%t >= tout) &
+            call self%check_energy(tout, err)
+        if (allocated(err)) then
+            call self%progress%done()
+            ! keep the last good state if the solver got past the previous record
+            if (self%t > self%t_last) call self%record(io_err)
+            call self%finish('failed', (err%message), err)
+            return
+        end if
+        if (self%t < tout .or. self%asked_to_stop()) then
+            ! stopped at a step boundary: that state is the last record
+            call self%progress%done()
+            if (self%t > self%t_last) call self%record(err)
+            if (allocated(err)) then
+                if (err%code == ERR_SOLVER) call self%finish('failed', (err%message), err)
+                return
+            end if
+            outcome = STEP_STOPPED
+            return
+        end if
+        call self%record(err)
+        if (allocated(err)) then
+            call self%progress%done()
+            if (err%code == ERR_SOLVER) call self%finish('failed', (err%message), err)
+            return
+        end if
+        outcome = STEP_RECORDED
+        self%k_next = self%k_next + 1
+        call self%progress%update(self%t, self%steps_now)
+    end subroutine run_step
+
+    !> Append the state at t to the file (after checking it is finite) and make it the
+    !! previous record.
+    subroutine record(self, err)
+        class(run_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: err
+        type(solver_stats_t) :: stats
+        type(energy_t) :: e
+        real(wp) :: h
+        integer :: order
+        character(len=64) :: where
+        stats = self%integrator%stats()
+        call stats%add(self%stats_before)
+        h = stats%last_step
+        order = stats%last_order
+        self%steps_now = stats%steps
+        call self%model%fields(self%y, self%q, self%qdot, self%t)
+        call self%model%polyline(self%y, self%points, self%t)
+        e = self%model%energy(self%t, self%y, self%yq)
+        if (.not. (all(ieee_is_finite(self%y)) .and. all(ieee_is_finite(self%yq)) .and. &
+                   ieee_is_finite(e%balance()) .and. all(ieee_is_finite(self%points)))) then
+            write (where, '(a, es12.5, a, es11.3e3, a)') 't = ', self%t, ' s, step size ', &
+                h, ' s'
+            call make_error(err, ERR_SOLVER, 'non-finite state or energy at '// &
+                            trim(where)//' (integrator '//self%integrator%name()// &
+                            '): not written to the output')
+            return
+        end if
+        call self%out%append(self%t, self%q, self%qdot, self%points, e, h, order, err, &
+                             y=self%y, yq=self%yq)
+        self%summary%records = self%summary%records + 1
+        self%summary%final_energy = e
+        self%summary%t_reached = self%t
+        call self%keep_as_previous()
+    end subroutine record
+
+    !> The state now is the previous record's (where the order safety looks back to).
+    subroutine keep_as_previous(self)
+        class(run_t), intent(inout) :: self
+        self%t_last = self%t
+        self%t_prev = self%t
+        self%y_prev = self%y
+        self%yq_prev = self%yq
+    end subroutine keep_as_previous
+
+    !> Whether the driver's stop query says stop.
+    logical function asked_to_stop(self)
+        class(run_t), intent(in) :: self
+        asked_to_stop = .false.
+        if (associated(self%stop_requested)) asked_to_stop = self%stop_requested()
+    end function asked_to_stop
+
+    !> End the run: the summary's counters and CPU time, the solver's statistics, switches
+    !! and order safety into the file, its status and reason, the file closed. An error of
+    !! the file goes into `err` unless it already holds one.
+    subroutine run_finish(self, status, reason, err)
+        class(run_t), intent(inout) :: self
+        character(len=*), intent(in) :: status, reason
+        type(error_t), allocatable, intent(inout) :: err
+        type(error_t), allocatable :: ferr
+        real(wp) :: cpu_now
+        call self%progress%done()
+        call cpu_time(cpu_now)
+        associate (s => self%summary)
+            s%cpu_time = self%cpu_before + (cpu_now - self%cpu_start)
+            s%stats = self%integrator%stats()
+            call s%stats%add(self%stats_before)
+            s%stats%time_advance = self%time_advance
+            call add_counter_values(s%stats, self%counters_before)
+            s%t_reached = max(s%t_reached, self%t)
+            call self%out%write_stats(s%stats, s%cpu_time, ferr, t_reached=self%t)
+            s%switches = self%integrator%switch_log()
+            if (.not. allocated(ferr)) call self%out%write_switches(s%switches, ferr)
+            associate (r => s%safety)
+                if (.not. allocated(ferr)) &
+                    call self%out%write_order_safety(r%energy_gain, r%lowered_at, &
+                        r%order_before, r%order_after, r%kept_at, r%kept_count, ferr)
+            end associate
+        end associate
+        call self%out%close_run(status, reason, ferr)
+        if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
+        call self%integrator%finalize()
+    end subroutine run_finish
+
+    !> Whether every output time has been recorded.
+    pure logical function run_done(self)
+        class(run_t), intent(in) :: self
+        run_done = self%k_next > self%n_out
+    end function run_done
+
+    !> The simulated time reached, s.
+    pure real(wp) function run_time(self)
+        class(run_t), intent(in) :: self
+        run_time = self%t
+    end function run_time
+
+    !> The scene's end time, s.
+    pure real(wp) function run_end_time(self)
+        class(run_t), intent(in) :: self
+        run_end_time = self%t_end
+    end function run_end_time
+
+    !> The run's output file.
+    pure function run_output_file(self) result(path)
+        class(run_t), intent(in) :: self
+        character(len=:), allocatable :: path
+        path = self%summary%file
+    end function run_output_file
+
+    !> Output time k (k = 0: the start; n_out: t_end).
+    pure real(wp) function output_time(self, k) result(tk)
+        class(run_t), intent(in) :: self
+        integer, intent(in) :: k
+        tk = min(real(k, wp)*self%dt, self%t_end)
+        if (k >= self%n_out) tk = self%t_end
+    end function output_time
+
+    !> Steps of the integrator in use so far.
+    integer(i8) function steps_taken(self)
+        class(run_t), intent(in) :: self
+        type(solver_stats_t) :: now
+        now = self%integrator%stats()
+        steps_taken = now%steps
+    end function steps_taken
+end module ropedyn_run

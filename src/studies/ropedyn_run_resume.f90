@@ -1,0 +1,83 @@
+!> Resuming a run from its file (`ropedyn run --resume FILE.h5`): the last record is the
+!! starting point, the file is reopened for appending, and the restart is recorded in
+!! /solver/restarts; the solver counters and the CPU time of the earlier parts add up.
+submodule (ropedyn_run) ropedyn_run_resume
+    use, intrinsic :: iso_fortran_env, only: error_unit
+    use ropedyn_text, only: int_text
+    use ropedyn_case_file, only: case_data_t, read_case_file
+    use ropedyn_run_record, only: run_record_t, read_run_record, check_record_fits, LAST_RECORD
+    implicit none
+
+contains
+
+    !> The last record of the file as the start (it must be before t_end and the file not
+    !! 'running'); the output times that follow it on the scene's grid; an off-grid last
+    !! record (where an interrupted or failed run stopped) is the start but is cut from
+    !! the file, replaced by the grid records that follow, so that the file ends with the
+    !! records of an uninterrupted run.
+    module procedure resume_from_file
+        type(run_record_t) :: rec, first
+        type(case_data_t) :: before
+        real(wp) :: tol
+        integer :: keep, j
+        associate (file => self%summary%file)
+            call read_run_record(file, LAST_RECORD, rec, err)
+            if (allocated(err)) return
+            call check_record_fits(rec, self%model%model_name(), self%model%size(), self%nq, &
+                                   err)
+            if (allocated(err)) return
+            call read_case_file(file, before, err)
+            if (allocated(err)) return
+            if (before%status == 'running') then
+                call make_error(err, ERR_INPUT, file//': status running: the run may '// &
+                    'still be going on (a run that was killed outright keeps this status; '// &
+                    'to continue it, set its status: h5py '// &
+                    'f.attrs["status"] = "interrupted")')
+                return
+            end if
+            tol = 1.0e-12_wp*max(abs(rec%t), self%dt)
+            if (rec%t >= self%t_end - tol) then
+                call make_error(err, ERR_INPUT, file//': nothing to continue: its last '// &
+                    'record is at t = '//real_text(rec%t)//' s, t_end is '// &
+                    real_text(self%t_end)//' s (status '//before%status//'; a longer '// &
+                    'run: --set solver.t_end=...)')
+                return
+            end if
+            call read_run_record(file, 0, first, err)
+            if (allocated(err)) return
+            self%summary%initial_energy = first%energy
+            self%t = rec%t
+            self%y = rec%y
+            self%yq = 0.0_wp
+            self%yq(1:self%nq) = rec%yq(1:self%nq)
+            ! the first output time after t; an off-grid last record is replaced
+            self%k_next = self%n_out
+            do j = 1, self%n_out
+                if (self%output_time(j) > self%t + tol) then
+                    self%k_next = j
+                    exit
+                end if
+            end do
+            keep = rec%records
+            if (rec%record > 0 .and. abs(self%output_time(self%k_next - 1) - self%t) > tol) &
+                keep = keep - 1
+            do j = 1, size(self%counters_before)
+                self%counters_before(j) = max(0_i8, before%counters(j))
+            end do
+            if (ieee_is_finite(before%cpu_time)) self%cpu_before = before%cpu_time
+            call self%out%reopen(file, self%model%n_elements(), self%model%size(), self%nq, &
+                                 err, keep=keep)
+            if (allocated(err)) return
+            call self%out%add_restart(rec%record, self%t, before%status, before%reason, &
+                                      self%counters_before(1), self%cpu_before, err)
+            if (allocated(err)) return
+            self%summary%records = keep
+            self%summary%t_reached = self%t
+            self%summary%final_energy = rec%energy
+            if (keep < rec%records) write (error_unit, '(a)') 'ropedyn: '//file// &
+                ': continuing from t = '//real_text(self%t)//' s (record '// &
+                int_text(rec%record)//', off the output grid: replaced by the records '// &
+                'that follow)'
+        end associate
+    end procedure resume_from_file
+end submodule ropedyn_run_resume

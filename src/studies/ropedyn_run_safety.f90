@@ -1,0 +1,140 @@
+!> The order safety of a run (`&solver order_safety`; the stability guide, "Order safety"):
+!! at every output time the energy monitor compares the balance B = T + V + dissipated -
+!! work with E0; a gain above `energy_gain_bound` rtol S takes a second look at the
+!! method's safe (A-stable) order with 'lower', and ends the run as a failed integration
+!! naming the gain with 'stop'. The monitor (ropedyn_energy_monitor) holds the rules as
+!! pure functions; this submodule carries them out on the run.
+submodule (ropedyn_run) ropedyn_run_safety
+    use ropedyn_energy_monitor, only: high_order_to_blame, sudden_gain, look_budget, &
+                                      look_action, LOOK_LOWER, LOOK_NO_VERDICT, LOOK_FAIL
+    implicit none
+
+contains
+
+    !> The energy monitor at the output time just reached: on a gain beyond the bound,
+    !! lower the order and integrate the interval again ('lower'), or fail ('stop').
+    module procedure check_energy
+        type(energy_t) :: e
+        type(energy_monitor_t) :: next
+        type(solver_stats_t) :: stats
+        character(len=200) :: what
+        real(wp) :: next_bound
+        e = self%model%energy(self%t, self%y, self%yq)
+        if (.not. ieee_is_finite(e%balance())) return   ! `record` says so
+        if (.not. self%monitor%gained(e)) then
+            call self%monitor%observe(e)
+            self%steps_mark = self%steps_taken()
+            return
+        end if
+        next = self%monitor
+        call next%observe(e)
+        next_bound = next%bound()
+        write (what, '(a, es10.3, a, es10.3, a, es12.5, a, i0)') 'energy gain ', &
+            next%gain(e), ' J above E0 (bound ', next_bound, ' J) at t = ', self%t, &
+            ' s, max order ', self%max_order
+        call self%summary%safety%alarm(next%gain(e), next_bound)
+        if (trim(self%scene%solver%order_safety) == 'stop') then
+            stats = self%integrator%stats()
+            call make_error(err, ERR_SOLVER, self%integrator%name()//' failed at t = '// &
+                real_text(self%t_prev)//' s, step size '//real_text(stats%last_step)// &
+                ' s: '//trim(what)//': the integrator created energy (&solver '// &
+                'order_safety = ''stop''; docs/stability.md)')
+            ! the record with the gain is not written
+            self%t = self%t_prev
+            self%y = self%y_prev
+            self%yq = self%yq_prev
+            return
+        end if
+        if (self%safe_order > 0 .and. self%max_order > self%safe_order) then
+            call self%second_look(tout, e, next_bound, err)
+            if (allocated(err)) return
+        else
+            call self%summary%safety%unresolved(self%t)
+        end if
+        call self%monitor%observe(e)
+        self%steps_mark = self%steps_taken()
+    end procedure check_energy
+
+    !> A gain beyond the bound at the order limit in use: the interval [t_prev, tout]
+    !! again at the safe order by a second integrator. When the gain is the order's
+    !! (high_order_to_blame: gathered over earlier intervals, or made in this one and the
+    !! safe order changed the balance less), the run goes on from tout at the safe order
+    !! with that integrator, for good. A gain of this interval that the safe order matches
+    !! is the integration error at this tolerance: the second integrator is dropped, the
+    !! run goes on as it was and the monitor counts gains from that level on. For such a
+    !! gain the safe order has a capped budget (look_budget); if that is not enough, no
+    !! verdict: the order is kept so, once. Otherwise it has the whole budget left; its
+    !! failure is the run's. e: the energies of the state the run goes on from.
+    module procedure second_look
+        class(integrator_t), allocatable :: safe
+        type(error_t), allocatable :: safe_err
+        type(solver_options_t) :: options
+        real(wp) :: t_safe, y_safe(size(self%y)), yq_safe(size(self%yq)), gain_prev, &
+                    change_high, change_safe
+        integer(i8) :: steps_high, budget, max_steps
+        logical :: sudden, reached
+        integer :: action
+        character(len=200) :: why
+        gain_prev = self%monitor%gain(self%model%energy(self%t_prev, self%y_prev, &
+                                                        self%yq_prev))
+        change_high = self%monitor%gain(e) - gain_prev
+        change_safe = 0.0_wp
+        steps_high = self%steps_taken() - self%steps_mark
+        sudden = sudden_gain(change_high, bound)
+        max_steps = int(self%scene%solver%max_steps, i8)
+        budget = look_budget(sudden, self%summary%safety%crawled, steps_high, &
+                             max_steps - self%stats_before%steps - self%steps_taken())
+        t_safe = self%t_prev
+        y_safe = self%y_prev
+        yq_safe = self%yq_prev
+        call create_integrator(self%scene, safe, err)
+        if (allocated(err)) return
+        options = solver_options_of(self%scene)
+        options%stop_requested => self%stop_requested
+        options%max_order = self%safe_order
+        options%max_steps = max(1_i8, budget)
+        call safe%init(self%model, t_safe, y_safe, yq_safe(1:self%nq), options, err)
+        if (allocated(err)) return
+        call safe%advance_to(tout, t_safe, y_safe, yq_safe(1:self%nq), safe_err)
+        reached = .not. allocated(safe_err) .and. t_safe >= tout
+        if (reached) change_safe = self%monitor%gain(self%model%energy(t_safe, y_safe, &
+                                                                        yq_safe)) - gain_prev
+        action = look_action(reached, self%asked_to_stop(), sudden, self%summary%safety%crawled, &
+                             high_order_to_blame(change_high, change_safe, bound))
+        if (action == LOOK_LOWER .or. action == LOOK_FAIL) then
+            ! on from where the safe order got, with it (its failure is the run's)
+            if (action == LOOK_LOWER) call self%summary%safety%lowered(self%t_prev, &
+                self%max_order, self%safe_order)
+            call self%stats_before%add(self%integrator%stats())
+            call self%integrator%finalize()
+            call move_alloc(safe, self%integrator)
+            ! the whole budget that is left, no longer the second look's
+            self%integrator%options%max_steps = max(1_i8, max_steps - self%stats_before%steps)
+            self%max_order = self%safe_order
+            self%t = t_safe
+            self%y = y_safe
+            self%yq = yq_safe
+            e = self%model%energy(self%t, self%y, self%yq)
+            if (allocated(safe_err)) call move_alloc(safe_err, err)
+            return
+        end if
+        if (action == LOOK_NO_VERDICT) then
+            self%summary%safety%crawled = .true.
+            write (why, '(4(a, i0), a)') 'order ', self%safe_order, &
+                ' did not get through the same interval in ', budget, &
+                ' steps (order ', self%max_order, ' took ', steps_high, '): no verdict'
+        else if (reached) then
+            write (why, '(a, i0, a, es10.3, a, i0, a, es10.3, a)') 'order ', &
+                self%safe_order, ' changed the balance by ', change_safe, ' J over the '// &
+                'same interval, order ', self%max_order, ' by ', change_high, ' J: the '// &
+                'integration error at this rtol'
+        else
+            why = 'the second look at the safe order was interrupted'
+        end if
+        ! on at the order asked for; gains counted from this level
+        call self%stats_before%add(safe%stats())
+        call safe%finalize()
+        call self%summary%safety%kept(self%t, trim(why))
+        call self%monitor%accept(self%monitor%gain(e))
+    end procedure second_look
+end submodule ropedyn_run_safety
