@@ -108,6 +108,7 @@ contains
         type(error_t), allocatable, intent(out) :: err
         character(len=*), intent(in), optional :: description
         integer(hid_t) :: dset_id
+        integer(hsize_t) :: old_dims(7)
         logical :: exists
         integer :: hdferr
 
@@ -123,7 +124,21 @@ contains
         if (exists) then
             call h5dopen_f(self%id, name, dset_id, hdferr)
             if (h5_failed(hdferr, self%path//': '//name//': cannot open dataset', err)) return
-        else
+            ! one of other extents (an earlier part of a resumed run wrote it) is replaced:
+            ! writing into it would read past the values
+            if (size(dims) > 0) then
+                call extents(self, name, dset_id, old_dims(1:size(dims)), err)
+                if (allocated(err)) deallocate (err)
+                if (any(old_dims(1:size(dims)) /= dims)) then
+                    call h5dclose_f(dset_id, hdferr)
+                    call h5ldelete_f(self%id, name, hdferr)
+                    if (h5_failed(hdferr, self%path//': '//name//': cannot replace dataset', &
+                                  err)) return
+                    exists = .false.
+                end if
+            end if
+        end if
+        if (.not. exists) then
             call new_dataset(self, name, type_id, dims, dset_id, err)
             if (allocated(err)) return
         end if

@@ -218,3 +218,24 @@ def test_sweep_continues_an_interrupted_case(run, ropedyn_exe, tmp_path, scene):
         assert attr(f, "status") == "complete"
         assert f["time"].shape[0] == 401
         assert f["solver/restarts/time"].shape == (1,)
+
+
+def test_resume_rewrites_a_longer_switch_log_whole(run, tmp_path, scene):
+    """A resumed run whose part has fewer switches than the first part's log: the switch
+    datasets hold this part's switches, every entry valid (writing a shorter log into the
+    longer dataset read past the values: times like 2e-322 s and garbage method names)."""
+    first = run("run", scene, "--set", "output.file='sw.h5'", "--set", "solver.method='auto'",
+                "--set", "solver.t_end=2.0")
+    assert first.returncode == 0, first.stderr
+    with h5py.File(tmp_path / "sw.h5") as f:
+        n_first = f["solver/switch_time"].shape[0]
+    resumed = run("run", "--resume", "sw.h5", "--set", "solver.t_end=2.05")
+    assert resumed.returncode == 0, resumed.stderr
+    with h5py.File(tmp_path / "sw.h5") as f:
+        times = f["solver/switch_time"][()]
+        methods = [m.decode().rstrip("\0 ") for m in f["solver/switch_method"][()]]
+        orders = f["solver/switch_max_order"][()]
+    assert 0 < len(times) < n_first, (len(times), n_first)
+    assert np.all((times >= 2.0) & (times <= 2.05)), times
+    assert set(methods) <= {"erk", "mebdf", "cvode", "adams"}, methods
+    assert len(orders) == len(times) and np.all((orders >= 0) & (orders <= 12)), orders
