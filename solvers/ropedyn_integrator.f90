@@ -14,13 +14,20 @@ module ropedyn_integrator
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_text, only: int_text
     use ropedyn_problem, only: problem_t
-    use ropedyn_methods, only: METHODS, method_index
+    use ropedyn_methods, only: METHODS, method_index, resolved_max_order
     use ropedyn_switch_log, only: switch_event_t
     implicit none
     private
     public :: integrator_t, start_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT, &
         STIFF_STEP_RATE
     public :: stop_query_i, stop_now
+    public :: DEFAULT_RTOL, DEFAULT_ATOL, DEFAULT_MAX_STEPS
+
+    !> The defaults of the options every method shares; the scene's &solver keys take
+    !! theirs from here.
+    real(wp), parameter :: DEFAULT_RTOL = 1.0e-6_wp      !< relative tolerance
+    real(wp), parameter :: DEFAULT_ATOL = 1.0e-8_wp      !< absolute tolerance (state units)
+    integer, parameter :: DEFAULT_MAX_STEPS = 1000000    !< step budget of a whole run
 
     !> No integrator here goes beyond this order of accuracy.
     integer, parameter :: MAX_ORDER_LIMIT = 7
@@ -34,13 +41,13 @@ module ropedyn_integrator
     !! The error test of every method keeps the local error of component i near or below
     !! rtol * |y_i| + atol_i.
     type :: solver_options_t
-        real(wp) :: rtol = 1.0e-6_wp         !< relative tolerance
-        real(wp) :: atol = 1.0e-8_wp         !< absolute tolerance (state units)
+        real(wp) :: rtol = DEFAULT_RTOL      !< relative tolerance
+        real(wp) :: atol = DEFAULT_ATOL      !< absolute tolerance (state units)
         !> per-component absolute tolerances; when allocated (size of the state) they
         !! replace `atol` for the state (quadratures keep `atol`)
         real(wp), allocatable :: atol_vector(:)
         integer :: max_order = 0             !< highest order of accuracy (0: method default)
-        integer(i8) :: max_steps = 1000000_i8 !< step budget for the whole run
+        integer(i8) :: max_steps = DEFAULT_MAX_STEPS  !< step budget for the whole run
         logical :: fd_jacobian = .false.     !< difference f even if the problem has a Jacobian
         !> CVODE's BDF stability-limit detection (order reduction when a lightly damped
         !! oscillatory mode nears the stability boundary); other methods reject .true.
@@ -116,7 +123,6 @@ module ropedyn_integrator
         procedure(name_i), deferred :: name
         ! the method's order range, one statement
         procedure :: min_order => integrator_min_order, &
-                     default_max_order => integrator_default_max_order, &
                      max_order_limit => integrator_max_order_limit
         procedure :: switch_log => integrator_switch_log
     end type integrator_t
@@ -197,13 +203,6 @@ contains
         self%time_solve = self%time_solve + part%time_solve
     end subroutine stats_add
 
-    !> The order limit used when options%max_order is 0, chosen to be safe for lightly
-    !! damped stiff oscillations (ropedyn_methods says why, per method).
-    pure integer function integrator_default_max_order(self) result(order)
-        class(integrator_t), intent(in) :: self
-        order = METHODS(method_index(self%name()))%default_order
-    end function integrator_default_max_order
-
     !> The lowest value options%max_order may take for this method.
     pure integer function integrator_min_order(self) result(order)
         class(integrator_t), intent(in) :: self
@@ -247,8 +246,7 @@ contains
         self%options = options
         self%n = problem%size()
         self%nq = problem%quad_size()
-        start%max_order = options%max_order
-        if (start%max_order == 0) start%max_order = self%default_max_order()
+        start%max_order = resolved_max_order(name, options%max_order)
         if (start%max_order /= 0 .and. (start%max_order < self%min_order() .or. &
                                         start%max_order > self%max_order_limit())) then
             call make_error(err, ERR_SOLVER, name//': max_order must be '// &

@@ -36,15 +36,14 @@ contains
         end select
     end subroutine new_integrator
 
-    !> Lowest and highest allowed max_order of a method, and its default.
-    subroutine method_order_range(method, lowest, highest, default, err)
+    !> Lowest and highest allowed max_order of a method.
+    subroutine method_order_range(method, lowest, highest, err)
         character(len=*), intent(in) :: method
-        integer, intent(out) :: lowest, highest, default
+        integer, intent(out) :: lowest, highest
         type(error_t), allocatable, intent(out) :: err
         integer :: k
         lowest = 0
         highest = 0
-        default = 0
         k = method_index(method)
         if (k == 0) then
             call make_error(err, ERR_INPUT, 'unknown integration method "'//method// &
@@ -53,6 +52,5 @@ contains
         end if
         lowest = METHODS(k)%lowest_order
         highest = METHODS(k)%highest_order
-        default = METHODS(k)%default_order
     end subroutine method_order_range
 end module ropedyn_solvers

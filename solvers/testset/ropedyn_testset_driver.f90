@@ -14,6 +14,7 @@ module ropedyn_testset_driver
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_SOLVER
     use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
     use ropedyn_solvers, only: new_integrator, method_order_range
+    use ropedyn_methods, only: resolved_max_order
     use ropedyn_testset_problem, only: testset_problem_t
     implicit none
     private
@@ -67,7 +68,7 @@ contains
         type(solver_options_t) :: options
         real(wp), allocatable :: y(:), times(:), grown(:)
         real(wp) :: yq(0), t, start, finish, budget, total
-        integer :: n, lowest, highest, default_order
+        integer :: n, lowest, highest
         character(len=120) :: buffer
         character(len=:), allocatable :: context
 
@@ -104,9 +105,9 @@ contains
             return
         end if
 
-        call method_order_range(method, lowest, highest, default_order, err)
+        call method_order_range(method, lowest, highest, err)
         if (allocated(err)) return
-        result%max_order = default_order
+        result%max_order = resolved_max_order(method, 0)
         if (present(max_order)) then
             if (max_order /= 0) then
                 if (max_order < lowest .or. max_order > highest) then

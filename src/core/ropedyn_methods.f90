@@ -12,7 +12,7 @@
 module ropedyn_methods
     implicit none
     private
-    public :: method_info_t, METHODS, method_index, method_list
+    public :: method_info_t, METHODS, method_index, method_list, resolved_max_order
 
     !> One method: its name in `&solver method` and the orders of accuracy it allows.
     type :: method_info_t
@@ -45,6 +45,16 @@ contains
         end do
         k = 0
     end function method_index
+
+    !> The order limit a method uses for `max_order`: max_order itself, or when it is 0 the
+    !! method's default (0 for auto: it chooses). The one place where 0 means the default.
+    pure integer function resolved_max_order(name, max_order) result(order)
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: max_order
+        order = max_order
+        if (order == 0 .and. method_index(name) > 0) &
+            order = METHODS(method_index(name))%default_order
+    end function resolved_max_order
 
     !> 'cvode, mebdf': the names for messages.
     pure function method_list() result(list)

@@ -9,8 +9,9 @@ module ropedyn_scene_checks
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_text, only: int_text, real_text, pair_text, lower
     use ropedyn_os, only: absolute_path
-    use ropedyn_methods, only: METHODS, method_index
+    use ropedyn_methods, only: METHODS, method_index, resolved_max_order
     use ropedyn_rope_spec, only: N_ATTACH
+    use ropedyn_rope_section, only: tangential_damping_of
     use ropedyn_motion_table, only: read_motion_table
     use ropedyn_scene_types, only: scene_t
     use ropedyn_scene_key, only: scene_key_t
@@ -271,7 +272,7 @@ contains
         type(scene_t), intent(inout) :: scene
         type(error_t), allocatable, intent(out) :: err
         associate (v => scene%solver, m => METHODS(method_index(scene%solver%method)))
-            if (v%max_order == 0) v%max_order = m%default_order
+            v%max_order = resolved_max_order(v%method, v%max_order)
             if (v%max_order == 0) then
                 ! the method chooses (auto)
             else if (v%max_order < m%lowest_order .or. v%max_order > m%highest_order) then
@@ -296,8 +297,7 @@ contains
         character(len=:), allocatable :: base
         integer :: slash
         associate (r => scene%rope)
-            if (.not. keys(find_key(keys, G_ROPE, 'tangential_damping'))%given) &
-                r%tangential_damping = r%normal_damping*r%shear_modulus/r%young_modulus
+            r%tangential_damping = tangential_damping_of(r)
         end associate
         if (len_trim(scene%output%file) == 0) then
             slash = index(scene%path, '/', back=.true.)

@@ -41,8 +41,9 @@ module ropedyn_scene_key
         character(len=:), allocatable :: allowed
         character(len=:), allocatable :: unit
         character(len=:), allocatable :: doc         !< one line: what the key means
-        !> a pair whose NaN value means "not set": the comment of the echo; a logical with
-        !! this text is tri-state (not given is a third value; listed as 'not set')
+        !> a real or pair whose NaN value means "not set": the comment of the echo (a
+        !! real not set is resolved or left out); a logical with this text is tri-state
+        !! (not given is a third value); each is listed as 'not set'
         character(len=:), allocatable :: unset
         logical :: given = .false.                   !< set by the file or a --set
         character(len=:), allocatable :: origin      !< the file or the --set argument
@@ -134,6 +135,10 @@ contains
         class(scene_key_t), intent(inout) :: self
         character(len=:), allocatable :: reason, v
         reason = ''
+        ! a real not set (NaN, not given): its rule applies once it is given
+        if (self%type == T_REAL .and. len(self%unset) > 0 .and. .not. self%given) then
+            if (ieee_is_nan(self%r)) return
+        end if
         select case (self%rule)
         case (R_FINITE)
             if (.not. all(ieee_is_finite(reals(self)))) reason = 'must be finite'
@@ -205,6 +210,10 @@ contains
         select case (self%type)
         case (T_NAME, T_PATH)
             text = I4//self%name//' = '//quoted(trim(self%s))
+        case (T_REAL)
+            text = I4//self%name//' = '//self%value_text()
+            if (len(self%unset) > 0 .and. ieee_is_nan(self%r)) text = I4//'! '//self%name// &
+                ' = ('//self%unset//')'
         case (T_PAIR)
             text = I4//self%name//' = '//pair_text(self%v)
             if (len(self%unset) > 0 .and. any(ieee_is_nan(self%v))) text = text//'  ! '// &
@@ -246,6 +255,9 @@ contains
         end select
         if (self%type == T_PAIR .or. self%type == T_LIST) then
             if (any(ieee_is_nan(self%v))) default = 'not set'
+        end if
+        if (self%type == T_REAL .and. len(self%unset) > 0) then
+            if (ieee_is_nan(self%r)) default = 'not set'
         end if
         ! a logical with an `unset` text is tri-state: its default is "not given"
         if (self%type == T_LOGICAL .and. len(self%unset) > 0) default = 'not set'

@@ -55,7 +55,7 @@ contains
             call add_real(G_ROPE, 'normal_damping', r%normal_damping, R_NONNEGATIVE, NSM2, &
                 'material damping eta of the axial and bending dampers')
             call add_real(G_ROPE, 'tangential_damping', r%tangential_damping, R_NONNEGATIVE, &
-                NSM2, 'damping of the shear dampers; when not given eta G/E (eq. 13)')
+                NSM2, 'damping of the shear dampers', unset='not set: eta G/E (eq. 13)')
             call add_real(G_ROPE, 'shape_factor', r%shape_factor, R_POSITIVE, '-', &
                 'shear shape factor chi (10/9 for a circle)')
             call add_real(G_ROPE, 'gravity', r%gravity, R_NONNEGATIVE, 'm/s^2', &
@@ -117,6 +117,8 @@ contains
                 'the point masses of &attachments')
             call add_logical(G_EFFECTS, 'point_loads', e%point_loads, &
                 'the point loads of &attachments')
+            call add_real(G_EFFECTS, 'fault_nan_after', e%fault_nan_after, R_FINITE, 's', &
+                'testing aid: NaN forces after this time; < 0: off')
 
             call add_name(G_SOLVER, 'method', v%method, method_list(), 'the integrator')
             call add_real(G_SOLVER, 'rtol', v%rtol, R_UNIT, '-', 'relative tolerance')
@@ -135,8 +137,6 @@ contains
                 'Newton systems on the first-order matrix, not the reduced second-order one')
             call add_logical(G_SOLVER, 'profile', v%profile, &
                 'time the right-hand side, Jacobian, factorizations and solves')
-            call add_real(G_SOLVER, 'fault_nan_after', e%fault_nan_after, R_FINITE, 's', &
-                'testing aid: NaN forces after this time; < 0: off')
             call add_name(G_SOLVER, 'order_safety', v%order_safety, 'lower, stop, off', &
                 'on an energy gain: lower the order to the A-stable one, stop, or off')
             call add_real(G_SOLVER, 'energy_gain_bound', v%energy_gain_bound, R_POSITIVE, &
@@ -209,12 +209,14 @@ contains
                 doc=doc, allowed='', unset='')
         end subroutine add
 
-        subroutine add_real(group, name, x, rule, unit, doc)
+        subroutine add_real(group, name, x, rule, unit, doc, unset)
             integer, intent(in) :: group, rule
             character(len=*), intent(in) :: name, unit, doc
             real(wp), target, intent(inout) :: x
+            character(len=*), intent(in), optional :: unset  !< a NaN default means this
             call add(group, name, T_REAL, rule, unit, doc)
             keys(n)%r => x
+            if (present(unset)) keys(n)%unset = unset
         end subroutine add_real
 
         subroutine add_int(group, name, x, rule, lowest, doc, allowed)

@@ -4,6 +4,7 @@
 module ropedyn_scene_types
     use ropedyn_kinds, only: wp
     use ropedyn_rope_spec, only: rope_spec_t, NAME_LEN, PATH_LEN
+    use ropedyn_integrator, only: DEFAULT_RTOL, DEFAULT_ATOL, DEFAULT_MAX_STEPS
     implicit none
     private
     public :: solver_params_t, output_params_t, scene_t
@@ -11,12 +12,12 @@ module ropedyn_scene_types
     !> `&solver`: time integration.
     type :: solver_params_t
         character(len=NAME_LEN) :: method = 'auto'  !< ropedyn_methods' names
-        real(wp) :: rtol = 1.0e-6_wp          !< relative tolerance [-]
-        real(wp) :: atol = 1.0e-8_wp          !< absolute tolerance [state units]
+        real(wp) :: rtol = DEFAULT_RTOL       !< relative tolerance [-]
+        real(wp) :: atol = DEFAULT_ATOL       !< absolute tolerance [state units]
         !> highest order of accuracy; 0 in the file: the method's default (resolved by
-        !! `read_scene`: 5 for cvode, 4 for mebdf)
+        !! `read_scene` with `resolved_max_order`, so that the stored scene says it)
         integer :: max_order = 0
-        integer :: max_steps = 1000000        !< step budget for the whole run [-]
+        integer :: max_steps = DEFAULT_MAX_STEPS  !< step budget for the whole run [-]
         real(wp) :: t_end = 30.0_wp           !< end time [s]
         real(wp) :: output_interval = 0.01_wp !< time between output records [s]
         !> CVODE only: BDF stability-limit detection (lowers the order near the stability

@@ -1,6 +1,6 @@
-!> What the rope models (RFEM, MPP) take from a spec in the same way: the cross-section,
-!! the angle of the straight initial shape, the supports' clamp angles and prescribed
-!! motions, and whether external work has to be integrated.
+!> What the rope models (RFEM, MPP) take from a spec in the same way: the angle of the
+!! straight initial shape, the supports' clamp angles and prescribed motions, and whether
+!! external work has to be integrated.
 module ropedyn_rope_setup
     use ropedyn_kinds, only: wp
     use ropedyn_rope_spec, only: rope_spec_t
@@ -8,19 +8,11 @@ module ropedyn_rope_setup
     use ropedyn_effect, only: effect_box_t
     implicit none
     private
-    public :: cross_section, initial_angle, clamp_angles, configure_motions, any_does_work
+    public :: initial_angle, clamp_angles, configure_motions, any_does_work
 
     real(wp), parameter :: pi = acos(-1.0_wp)
 
 contains
-
-    !> Area (m^2) and second moment of area (m^4) of the circular cross-section.
-    pure subroutine cross_section(spec, area, second_moment)
-        type(rope_spec_t), intent(in) :: spec
-        real(wp), intent(out) :: area, second_moment
-        area = pi*spec%rope%diameter**2/4.0_wp
-        second_moment = pi*spec%rope%diameter**4/64.0_wp
-    end subroutine cross_section
 
     !> Angle of the straight initial shape from the downward x axis, rad ('hanging' and
     !! 'folded' start from 0).

@@ -28,8 +28,9 @@ module ropedyn_rope_spec
         real(wp) :: young_modulus = 35.0e6_wp   !< Young's modulus E [Pa]
         real(wp) :: shear_modulus = 14.0e6_wp   !< shear modulus G [Pa]
         real(wp) :: normal_damping = 1.0e3_wp   !< eta [N s/m^2]
-        !> eta_bar [N s/m^2]; when not given, normal_damping*shear_modulus/young_modulus
-        real(wp) :: tangential_damping = 400.0_wp
+        !> eta_bar [N s/m^2]; not set (NaN): normal_damping*shear_modulus/young_modulus,
+        !! resolved by the scene reader
+        real(wp) :: tangential_damping = NOT_SET
         real(wp) :: shape_factor = 10.0_wp/9.0_wp  !< shear shape factor chi [-]
         real(wp) :: gravity = 9.81_wp           !< gravitational acceleration [m/s^2]
     end type rope_params_t
@@ -108,8 +109,8 @@ module ropedyn_rope_spec
         logical :: support_motion = .true.  !< the motions and releases given in &supports
         logical :: point_masses = .true.    !< the point masses given in &attachments
         logical :: point_loads = .true.     !< the point loads given in &attachments
-        !> testing aid (read from `&solver fault_nan_after`): NaN forces on every body for
-        !! t > this time, s; < 0: off (ropedyn_effect_fault)
+        !> testing aid: NaN forces on every body for t > this time, s; < 0: off
+        !! (ropedyn_effect_fault)
         real(wp) :: fault_nan_after = -1.0_wp
     end type effects_params_t
 

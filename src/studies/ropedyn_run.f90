@@ -38,7 +38,7 @@ module ropedyn_run
     use ropedyn_switch_log, only: switch_event_t
     use ropedyn_version, only: version_string
     use ropedyn_modes, only: equilibrium_initial_state
-    use ropedyn_methods, only: METHODS, method_index
+    use ropedyn_methods, only: METHODS, method_index, resolved_max_order
     use ropedyn_energy_monitor, only: energy_monitor_t, safety_record_t
     use ropedyn_state_start, only: state_initial_state
     implicit none
@@ -227,8 +227,8 @@ contains
         call cpu_time(self%cpu_start)
         self%time_advance = 0.0_wp
         if (present(stop)) self%stop_requested => stop
-        self%max_order = self%scene%solver%max_order
-        if (self%max_order == 0) self%max_order = self%integrator%default_max_order()
+        self%max_order = resolved_max_order(self%integrator%name(), &
+                                            self%scene%solver%max_order)
         self%safe_order = 0
         if (method_index(self%integrator%name()) > 0) &
             self%safe_order = METHODS(method_index(self%integrator%name()))%safe_order

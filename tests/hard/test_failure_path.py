@@ -1,5 +1,5 @@
 """The failure path end to end: a NaN in the right-hand side (the testing aid
-`&solver fault_nan_after`, docs/input.md) or an exhausted step budget ends the run with
+`&effects fault_nan_after`, docs/input.md) or an exhausted step budget ends the run with
 exit code 3 and one message naming the time, the step size and the cause; the HDF5 file is
 marked failed with that reason, holds only finite numbers, and keeps every record before
 the failure unchanged (bit for bit the records of the same run without the fault)."""
@@ -28,7 +28,7 @@ def runs(run_many, tmp_path_factory):
     for model, method in CASES:
         base = MODELS[model] + [f"solver.method={method}", "solver.t_end=0.3",
                                 f"solver.output_interval={DT}"]
-        jobs[f"{model}_{method}_fault"] = (PAPER, base + [f"solver.fault_nan_after={T_FAULT}"])
+        jobs[f"{model}_{method}_fault"] = (PAPER, base + [f"effects.fault_nan_after={T_FAULT}"])
         jobs[f"{model}_{method}_clean"] = (PAPER, base)
     for method in ("cvode", "mebdf"):
         jobs[f"budget_{method}"] = (STEEL, [f"solver.method={method}", "solver.t_end=0.05",

@@ -1,7 +1,7 @@
 !> The failure path of a non-finite right-hand side, below the executable:
 !! - both rope models return STATUS_RECOVERABLE (not OK, not fatal) when their forces are
 !!   NaN or Inf (rhs, quad_rhs, and the implicit form of the MPP);
-!! - the testing aid (`&solver fault_nan_after`, ropedyn_effect_fault) leaves a model's
+!! - the testing aid (`&effects fault_nan_after`, ropedyn_effect_fault) leaves a model's
 !!   right-hand side unchanged, bit for bit, before its time and makes the model return NaN
 !!   forces with STATUS_RECOVERABLE after it;
 !! - both integrators treat that as recoverable (cut the step), end the run soon after with
@@ -42,7 +42,7 @@ program test_fault
 contains
 
     !> The paper's scene with `kind`, n elements and `method`; NaN forces after t_fault (s)
-    !! when given (`&solver fault_nan_after`).
+    !! when given (`&effects fault_nan_after`).
     subroutine make(kind, n, method, scene, model, t_fault)
         character(len=*), intent(in) :: kind, method
         integer, intent(in) :: n
@@ -54,8 +54,8 @@ contains
         sets(1) = 'model.kind = "'//kind//'"'
         write (sets(2), '(a, i0)') 'model.elements = ', n
         sets(3) = 'solver.method = "'//method//'"'
-        sets(4) = 'solver.fault_nan_after = -1'
-        if (present(t_fault)) write (sets(4), '(a, es23.16)') 'solver.fault_nan_after = ', &
+        sets(4) = 'effects.fault_nan_after = -1'
+        if (present(t_fault)) write (sets(4), '(a, es23.16)') 'effects.fault_nan_after = ', &
             t_fault
         call read_scene(trim(source_dir)//'/input/paper.nml', sets, scene, err)
         if (.not. allocated(err)) call create_model(scene%rope_spec_t, model, err)

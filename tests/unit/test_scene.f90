@@ -152,13 +152,13 @@ contains
             '&initial shape = ''hanging'', angle_deg = 0.0 /', &
             '&effects', &
             '    gravity = .false., tension = T, shear = .false.', &
-            '    bending = F, damping = .true.', &
+            '    bending = F, damping = .true., fault_nan_after = 1.5', &
             '/', &
             '&solver', &
             '    method = ''cvode'', rtol = 1e-9, atol = 1e-12', &
             '    max_order = 3, max_steps = 5000', &
             '    t_end = 2.0, output_interval = 0.5', &
-            '    stability_limit_detection = T, fault_nan_after = 1.5', &
+            '    stability_limit_detection = T', &
             '/', &
             '&output file = ''results/run 1.h5'', progress = .true. /'])
         call read_ok(PATH, NO_SET, s, 'values')
@@ -451,8 +451,8 @@ contains
             '--set solver.stability_limit_detection=T: &solver: stability_limit_detection', &
             'only for method cvode'])
         call expect_error('fault_nan_after', [character(len=L) :: MODEL, &
-            '&solver fault_nan_after = 1e999 /'], NO_SET, [character(len=L) :: &
-            P//'fault_nan_after.nml: &solver: fault_nan_after = +Infinity: must be finite'])
+            '&effects fault_nan_after = 1e999 /'], NO_SET, [character(len=L) :: &
+            P//'fault_nan_after.nml: &effects: fault_nan_after = +Infinity: must be finite'])
         call expect_error('max_steps', [character(len=L) :: MODEL, '&solver max_steps = 0 /'], &
             NO_SET, [character(len=L) :: P//'max_steps.nml: &solver: max_steps = 0: ', &
             'must be >= 1'])

@@ -3,6 +3,7 @@
 !! value; every key is in the listing of `ropedyn keys` with the default of a fresh scene_t;
 !! the echo of the defaults lists every key. Files go to test_scene_keys_tmp/.
 program test_scene_keys
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t
     use ropedyn_text, only: text_t, int_text, real_text, append_text
@@ -53,7 +54,10 @@ contains
         allocate (values(0))
         select case (key%type)
         case (T_REAL)
-            if (key%rule == R_UNIT) then
+            if (ieee_is_nan(key%r)) then
+                ! not set by default: any value of its rule
+                call append_text(values, '0.25')
+            else if (key%rule == R_UNIT) then
                 call append_text(values, real_text(key%r/2.0_wp))
             else
                 call append_text(values, real_text(key%r*1.5_wp + 0.25_wp))

@@ -36,7 +36,8 @@ module ropedyn_mpp
                               add_energies_of, add_powers_of
     use ropedyn_effect_factory, only: build_body_effects, attached_masses
     use ropedyn_support_motion, only: support_motion_t, motion_state_t
-    use ropedyn_rope_setup, only: cross_section, initial_angle, clamp_angles, &
+    use ropedyn_rope_section, only: section_t, rope_section
+    use ropedyn_rope_setup, only: initial_angle, clamp_angles, &
                                   configure_motions, any_does_work
     implicit none
     private
@@ -295,7 +296,8 @@ contains
         type(mpp_t), intent(out) :: model
         type(rope_spec_t), intent(in) :: spec
         type(error_t), allocatable, intent(out) :: err
-        real(wp) :: area, second_moment, total_mass, factor, angles(2)
+        type(section_t) :: sec
+        real(wp) :: total_mass, factor, angles(2)
         integer :: k
 
         model%n = spec%model%elements
@@ -309,19 +311,18 @@ contains
         end if
         model%nu = merge(model%n, 0, spec%effects%tension)
         model%ndof = model%n + model%nu
-        call cross_section(spec, area, second_moment)
-        total_mass = spec%rope%density*area*spec%rope%length
+        sec = rope_section(spec%rope)
+        total_mass = sec%mass_per_length*spec%rope%length
         model%l = spec%rope%length/real(model%n, wp)
         model%m = total_mass/real(model%n, wp)
-        model%inertia = model%m*(model%l**2/12.0_wp + spec%rope%diameter**2/16.0_wp)
+        model%inertia = model%m*(model%l**2/12.0_wp + sec%diameter**2/16.0_wp)
         model%g = merge(spec%rope%gravity, 0.0_wp, spec%effects%gravity)
-        model%ks = spec%rope%young_modulus*area/model%l
-        if (spec%effects%bending) model%cb = spec%rope%young_modulus*second_moment/model%l
+        model%ks = sec%ea/model%l
+        if (spec%effects%bending) model%cb = sec%ei/model%l
         if (spec%effects%damping) then
-            model%ds = spec%model%mpp_axial_damping_factor* &
-                       spec%rope%normal_damping*area/model%l
+            model%ds = spec%model%mpp_axial_damping_factor*sec%axial_damping/model%l
             if (spec%effects%bending) model%db = spec%model%mpp_bending_damping_factor* &
-                                                  spec%rope%normal_damping*second_moment/model%l
+                                                  sec%bending_damping/model%l
         end if
         factor = spec%supports%support_stiffness_factor
         model%top_clamped = spec%supports%top == 'clamped'
@@ -334,15 +335,15 @@ contains
             model%bottom = 0
         end select
         ! Supports take the values of the rope's own springs (as in RFEM), times the factor.
-        model%k_sup = factor*spec%rope%young_modulus*area/model%l
+        model%k_sup = factor*sec%ea/model%l
         ! A clamp's rotational spring lumps the half member [0, l/2] that no joint covers
         ! (joint i, at s = i l, lumps [(i - 1/2) l, (i + 1/2) l]): 2 EI/l, so the bending
         ! compliance adds up to L/EI (EI/l would add l/(2 EI): a first-order error, -0.09 %
         ! on omega_1 at n = 300 in its pre-asymptotic range). Damping alike.
-        model%c_rot = 2.0_wp*factor*spec%rope%young_modulus*second_moment/model%l
+        model%c_rot = 2.0_wp*factor*sec%ei/model%l
         if (spec%effects%damping) then
-            model%d_sup = factor*spec%rope%normal_damping*area/model%l
-            model%d_rot = 2.0_wp*factor*spec%rope%normal_damping*second_moment/model%l
+            model%d_sup = factor*sec%axial_damping/model%l
+            model%d_rot = 2.0_wp*factor*sec%bending_damping/model%l
         end if
 
         model%init_angle = initial_angle(spec)

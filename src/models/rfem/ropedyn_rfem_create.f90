@@ -7,7 +7,8 @@ contains
 
     module procedure rfem_create
         integer :: n, k, i
-        real(wp) :: area, second_moment, dl, total_mass, cx, cy, cphi, bx, by, bphi, factor
+        type(section_t) :: sec
+        real(wp) :: dl, total_mass, cx, cy, cphi, bx, by, bphi, factor
         real(wp) :: angles(2)
         logical :: damped
         character(len=:), allocatable :: kinds(:)
@@ -20,26 +21,26 @@ contains
             return
         end if
         model%n = n
-        call cross_section(spec, area, second_moment)
+        sec = rope_section(spec%rope)
         dl = spec%rope%length/real(n - 1, wp)
-        total_mass = spec%rope%density*area*spec%rope%length
+        total_mass = sec%mass_per_length*spec%rope%length
         allocate (model%len(n), model%mass(n), model%inertia(n))
         model%len = dl
         model%len(1) = dl/2.0_wp
         model%len(n) = dl/2.0_wp
         model%mass = total_mass*model%len/spec%rope%length
-        model%inertia = model%mass*(model%len**2/12.0_wp + spec%rope%diameter**2/16.0_wp)
+        model%inertia = model%mass*(model%len**2/12.0_wp + sec%diameter**2/16.0_wp)
 
         model%g = spec%rope%gravity
         model%gravity_on = spec%effects%gravity
         damped = spec%effects%damping
 
-        cx = spec%rope%young_modulus*area/dl
-        cy = spec%rope%shear_modulus*area/(spec%rope%shape_factor*dl)
-        cphi = spec%rope%young_modulus*second_moment/dl
-        bx = spec%rope%normal_damping*area/dl
-        by = spec%rope%tangential_damping*area/(spec%rope%shape_factor*dl)
-        bphi = spec%rope%normal_damping*second_moment/dl
+        cx = sec%ea/dl
+        cy = sec%ga/(sec%shape_factor*dl)
+        cphi = sec%ei/dl
+        bx = sec%axial_damping/dl
+        by = sec%shear_damping/(sec%shape_factor*dl)
+        bphi = sec%bending_damping/dl
         factor = spec%supports%support_stiffness_factor
         if (spec%effects%support_motion) then
             associate (s => spec%supports)
