@@ -8,7 +8,7 @@ import subprocess
 import time
 
 from conftest import ROOT
-from ropedyn.studies.mutation_check import BEGIN, END, MUTATIONS, check_list, sync_tree
+from ropedyn_tools.mutation_check import BEGIN, END, MUTATIONS, check_list, sync_tree
 
 
 def test_every_snippet_occurs_once_in_its_file():
