@@ -3,21 +3,21 @@
 Reads every Fortran file under src/ and solvers/, finds the modules, submodules and the
 program, the layer of each (by folder), and every `use ropedyn_*` between them. Writes
 
-- the generated part of docs/architecture.md (between the GENERATED markers): one table
-  per layer with its folders, modules, line counts and what each uses from other layers,
-  and the layer-to-layer use counts;
+- the generated part of docs/architecture.md (between the GENERATED markers): which layers
+  each layer uses, and one table per layer with its folders, its modules and what each uses
+  from other layers (nothing that changes with every edit of a file: no line counts);
 - docs/figures/architecture.svg: the module graph, one cluster per layer (graphviz `dot`).
 
 It checks the layering rule that CMake enforces by separate module directories: a module
 uses only its own layer and the layers below it, and `solvers` and `models` never use
-each other; and that no Fortran file is longer than MAX_LINES = 600 lines. `--check`
-only checks (the rules, and that docs/architecture.md is current) and exits 1 on a
-violation; the test suite runs it.
+each other. `--check` only checks (the rule, and that docs/architecture.md is current) and
+exits 1 on a violation; the test suite runs it.
 
     scripts/architecture            # regenerate docs/architecture.md and the figure
     scripts/architecture --check    # verify only
 """
 import argparse
+import pathlib
 import re
 import shutil
 import subprocess
@@ -40,15 +40,19 @@ LAYERS = [
     ("app", 4, ["src/app"]),
 ]
 RANK = {name: rank for name, rank, _ in LAYERS}
-MAX_LINES = 600   # lines of a Fortran source file, at most
 
 UNIT = re.compile(r"^\s*(module|submodule\s*\(\s*(\w+)\s*(?::\s*\w+)?\s*\)|program)\s+(\w+)",
                   re.I)
+#: `module subroutine f`, `module pure function g`, `module procedure h`: a separate module
+#: procedure (an interface body or its submodule's definition), not a module
+MODULE_PROCEDURE = re.compile(r"^\s*module\s+(procedure|function|subroutine|pure|impure|"
+                              r"elemental|recursive|non_recursive|integer|real|logical|"
+                              r"character|complex|type)\b", re.I)
 USE = re.compile(r"^\s*use\s*(?:,\s*non_intrinsic\s*)?(?:::)?\s*(ropedyn_\w+)", re.I)
 
 
-def layer_of(path):
-    rel = path.relative_to(ROOT).as_posix()
+def layer_of(path, root=ROOT):
+    rel = path.relative_to(root).as_posix()
     best = None
     for name, _, folders in LAYERS:
         for folder in folders:
@@ -57,25 +61,25 @@ def layer_of(path):
     return best[0] if best else None
 
 
-def scan():
-    """Units: name -> dict(kind, layer, file, lines, uses set, parent)."""
+def scan(root=ROOT):
+    """Units: name -> dict(kind, layer, file, uses set, parent) of the Fortran files under
+    root/src and root/solvers."""
+    root = pathlib.Path(root)
     units = {}
-    files = sorted(list((ROOT / "src").rglob("*.f90")) + list((ROOT / "src").rglob("*.f90.in"))
-                   + list((ROOT / "solvers").rglob("*.f90")))
+    files = sorted(list((root / "src").rglob("*.f90")) + list((root / "src").rglob("*.f90.in"))
+                   + list((root / "solvers").rglob("*.f90")))
     for path in files:
-        layer = layer_of(path)
-        text = path.read_text(errors="replace").splitlines()
+        layer = layer_of(path, root)
         current = None
-        for line in text:
+        for line in path.read_text(errors="replace").splitlines():
             stripped = line.split("!")[0]
             m = UNIT.match(stripped)
-            if m and not re.match(r"^\s*module\s+procedure", stripped, re.I):
+            if m and not MODULE_PROCEDURE.match(stripped):
                 kind = m.group(1).split("(")[0].strip().lower()
                 name = m.group(3).lower()
                 current = name
-                units[name] = dict(kind=kind, layer=layer, file=path.relative_to(ROOT).as_posix(),
-                                   lines=len(text), uses=set(),
-                                   parent=(m.group(2) or "").lower() or None)
+                units[name] = dict(kind=kind, layer=layer, file=path.relative_to(root).as_posix(),
+                                   uses=set(), parent=(m.group(2) or "").lower() or None)
                 if units[name]["parent"]:
                     units[name]["uses"].add(units[name]["parent"])
                 continue
@@ -86,12 +90,9 @@ def scan():
 
 
 def violations(units):
+    """'FILE: unit (layer) uses unit (layer)' for every `use` of a higher layer or between
+    the side-by-side layers solvers and models."""
     bad = []
-    files = {u["file"]: u["lines"] for u in units.values()}
-    for path, lines in sorted(files.items()):
-        if lines > MAX_LINES:
-            bad.append(f"{path}: {lines} lines (at most {MAX_LINES}: split it, e.g. into "
-                       "submodules)")
     for name, u in units.items():
         for dep in sorted(u["uses"]):
             if dep not in units:
@@ -106,36 +107,33 @@ def violations(units):
 
 def generated_markdown(units):
     out = [BEGIN, ""]
-    cross = defaultdict(int)
+    cross = defaultdict(set)
     for u in units.values():
         for dep in u["uses"]:
             if dep in units and units[dep]["layer"] != u["layer"]:
-                cross[(u["layer"], units[dep]["layer"])] += 1
+                cross[u["layer"]].add(units[dep]["layer"])
     out.append("### Uses between layers")
     out.append("")
-    out.append("| layer | uses (number of `use` statements into each lower layer) |")
+    out.append("| layer | uses modules of |")
     out.append("|---|---|")
     for name, _, _ in LAYERS:
-        deps = [f"{b} {n}" for (a, b), n in sorted(cross.items()) if a == name]
+        deps = sorted(cross[name], key=lambda b: (RANK[b], b))
         out.append(f"| {name} | {', '.join(deps) if deps else '(nothing)'} |")
     out.append("")
     for name, _, folders in LAYERS:
         members = sorted((u["file"], n) for n, u in units.items() if u["layer"] == name)
         files = sorted({f for f, _ in members})
-        lines = sum(units[n]["lines"] for f, n in members if units[n]["kind"] != "submodule"
-                    or True) if members else 0
         out.append(f"### {name}: {', '.join('`' + f + '/`' for f in folders)}")
         out.append("")
         out.append(f"{len(members)} units in {len(files)} files.")
         out.append("")
-        out.append("| unit | file | lines | uses from lower layers |")
-        out.append("|---|---|---|---|")
+        out.append("| unit | file | uses from lower layers |")
+        out.append("|---|---|---|")
         for f, n in members:
             u = units[n]
             lower = sorted(d for d in u["uses"] if d in units and units[d]["layer"] != name)
             label = n if u["kind"] != "submodule" else f"{n} (submodule of {u['parent']})"
-            out.append(f"| `{label}` | {f} | {u['lines']} | "
-                       f"{', '.join(lower) if lower else ''} |")
+            out.append(f"| `{label}` | {f} | {', '.join(lower) if lower else ''} |")
         out.append("")
     out.append(END)
     return "\n".join(out)
