@@ -2,7 +2,7 @@
 
 usage: scripts/mutation_check [--only ID,...] [--list] [--no-write] [--full] [--workdir DIR]
 
-Each mutation of MUTATIONS replaces one exact snippet of one source file (a sign, a factor, a
+Each mutation of MUTATIONS replaces one snippet of one source file (a sign, a factor, a
 swapped coefficient, a unit conversion, a dropped term) in a scratch copy of the working tree
 (build/mutation/tree: the files git knows, copied where they differ; the working tree itself
 is never changed, and the scratch file is restored after each mutation, also on Ctrl-C).
@@ -16,8 +16,14 @@ suite passes. Before the first mutation the declared tests run once on the uncha
 --only). Takes about 10 minutes on two cores when every mutation is caught by its declared
 tests; each survivor costs a full suite run (~3 minutes). Run on demand, not part of CI.
 
-A mutation's snippet must occur exactly once in its file (tests/e2e/test_mutation_list.py
-checks that for the whole list, so the list follows the code when it moves).
+A snippet is found as Fortran, not as text (`find_anchor`): blanks, comments and
+continuation ampersands do not count, nor do blank lines, so the list survives reformatting
+(spaces changed, a statement split over continuation lines or joined); a statement's end
+(a line end without `&`) does count, and the snippet must start and end at whole names (`k`
+does not match the start of `kappa`). A snippet must occur exactly once in its file
+(tests/e2e/test_mutation_list.py checks that for the whole list, so the list follows the
+code when it moves). The replacement takes the place of the matched text, from its first to
+its last character, as it is written in the list.
 """
 import argparse
 import dataclasses
@@ -41,7 +47,7 @@ BEGIN, END = "<!-- mutation-results:begin -->", "<!-- mutation-results:end -->"
 class Mutation:
     id: str             #: short name
     file: str           #: path relative to the repository root
-    original: str       #: exact snippet, occurs once in the file
+    original: str       #: snippet, occurs once in the file (as find_anchor reads it)
     replacement: str    #: what it becomes
     breaks: str         #: the physics or numerics it breaks
     ctest: tuple = ()   #: CTest programs that should catch it
@@ -83,9 +89,9 @@ MUTATIONS = [
              "bending stiffness EI/(2 dl) instead of EI/dl",
              ctest=("test_modes",), pytest=(REGRESSION,)),
     Mutation("rfem-pin-anisotropic", RFEM_K,
-             "                fs = sp%ct*d\n"
+             "fs = sp%ct*d\n"
              "                if (energy) e_el",
-             "                fs = sp%ct*[d(1), self%cy/self%cx*d(2)]\n"
+             "fs = sp%ct*[d(1), self%cy/self%cx*d(2)]\n"
              "                if (energy) e_el",
              "pinned support with the shear stiffness sideways (not isotropic)",
              pytest=(ORACLE, REGRESSION)),
@@ -126,8 +132,8 @@ MUTATIONS = [
              "joint damper from the tangential instead of the normal constant",
              ctest=("test_mpp_anchors",)),
     Mutation("mpp-axial-factor-ignored", MPP,
-             "model%ds = spec%model%mpp_axial_damping_factor* &",
-             "model%ds = 1.0_wp* &",
+             "model%ds = spec%model%mpp_axial_damping_factor*",
+             "model%ds = 1.0_wp*",
              "mpp_axial_damping_factor ignored",
              ctest=("test_mpp_anchors",)),
     Mutation("mpp-spring-per-rope-length", MPP,
@@ -136,8 +142,8 @@ MUTATIONS = [
              "member spring EA/L instead of EA/l",
              ctest=("test_mpp_anchors", "test_mpp_physics")),
     Mutation("mpp-centripetal-dropped", MPP_K,
-             "            a2 = udd - hk*phd**2\n            self%cacc(1, k)",
-             "            a2 = udd\n            self%cacc(1, k)",
+             "a2 = udd - hk*phd**2\n            self%cacc(1, k)",
+             "a2 = udd\n            self%cacc(1, k)",
              "rod centre acceleration without its centripetal part",
              ctest=("test_mpp",)),
     Mutation("mpp-bottom-damper-sign", MPP_K,
@@ -231,8 +237,8 @@ MUTATIONS = [
              "MEBDF error normalization (k+2) instead of (k+1)",
              ctest=("test_mebdf", "test_rope_solvers")),
     Mutation("cvode-rtol-loosened", "solvers/cvode/ropedyn_cvode.f90",
-             "flag = FCVodeSStolerances(self%mem, real(self%options%rtol, c_double), &",
-             "flag = FCVodeSStolerances(self%mem, real(10*self%options%rtol, c_double), &",
+             "flag = FCVodeSStolerances(self%mem, real(self%options%rtol, c_double),",
+             "flag = FCVodeSStolerances(self%mem, real(10*self%options%rtol, c_double),",
              "CVODE given ten times the relative tolerance asked for",
              ctest=("test_rope_solvers", "test_rfem_physics"), pytest=(REGRESSION,)),
     Mutation("cvode-quadrature-unchecked", "solvers/cvode/ropedyn_cvode.f90",
@@ -264,6 +270,81 @@ MUTATIONS = [
 ]
 
 
+def normalise(text):
+    """(code, where): the Fortran text without blanks, comments (outside strings) and
+    continuation ampersands, statements separated by one newline; where[i] is the index in
+    text of code[i]. Character strings are kept as they are."""
+    code, where = [], []
+    quote = None
+    i, n = 0, len(text)
+    while i < n:
+        c = text[i]
+        if quote:                           # inside a string: every character counts
+            if c == "\n":                   # (an unclosed quote ends with its line)
+                quote = None
+            else:
+                code.append(c)
+                where.append(i)
+                if c == quote:
+                    quote = None
+                i += 1
+                continue
+        if c == "!":                        # a comment: to the end of the line
+            end = text.find("\n", i)
+            i = n if end < 0 else end
+            continue
+        if c == "&":                        # a continuation: the statement goes on at the
+            nxt = text.find("\n", i)        # next line that is not blank or a comment, at
+            while 0 <= nxt < n:             # its first character or after its &
+                nxt += 1
+                while nxt < n and text[nxt] in " \t":
+                    nxt += 1
+                if nxt < n and text[nxt] in "!\n":
+                    nxt = text.find("\n", nxt)
+                    continue
+                break
+            i = n if nxt < 0 else nxt + (nxt < n and text[nxt] == "&")
+            continue
+        if c == "\n" or c == ";":
+            if code and code[-1] != "\n":
+                code.append("\n")
+                where.append(i)
+        elif not c.isspace():
+            if c in "'\"":
+                quote = c
+            code.append(c)
+            where.append(i)
+        i += 1
+    while code and code[-1] == "\n":
+        code.pop()
+        where.pop()
+    return "".join(code), where
+
+
+def _name_char(c):
+    return c.isalnum() or c in "_%"
+
+
+def find_anchor(text, snippet):
+    """[(start, end)] of the places in text where snippet occurs as Fortran (see the module's
+    docstring: blanks, comments and continuations aside, at whole names); text[start:end] is
+    the matched text from its first to its last character."""
+    code, where = normalise(text)
+    want = normalise(snippet)[0].strip("\n")
+    spans = []
+    if not want:
+        return spans
+    k = code.find(want)
+    while k >= 0:
+        end = k + len(want)
+        inside = (k > 0 and _name_char(want[0]) and _name_char(code[k - 1])) or \
+            (end < len(code) and _name_char(want[-1]) and _name_char(code[end]))
+        if not inside:
+            spans.append((where[k], where[end - 1] + 1))
+        k = code.find(want, k + 1)
+    return spans
+
+
 def check_list(root=ROOT, mutations=MUTATIONS):
     """Problems of the list: ids not unique, snippets not exactly once, no-op replacements."""
     problems = []
@@ -274,11 +355,16 @@ def check_list(root=ROOT, mutations=MUTATIONS):
         if not path.is_file():
             problems.append(f"{m.id}: no file {m.file}")
             continue
-        count = path.read_text().count(m.original)
+        count = len(find_anchor(path.read_text(), m.original))
         if count != 1:
             problems.append(f"{m.id}: snippet found {count} times in {m.file}")
-        if m.replacement == m.original:
+        if normalise(m.replacement)[0] == normalise(m.original)[0]:
             problems.append(f"{m.id}: replacement equals the snippet")
+        for text in (m.original, m.replacement):
+            if text != text.strip(" \t\n&"):
+                problems.append(f"{m.id}: a snippet or replacement that starts or ends with a "
+                                "blank, a line end or a continuation (it would be doubled)")
+                break
         for test in m.pytest:
             if not (pathlib.Path(root) / test.split("::")[0]).is_file():
                 problems.append(f"{m.id}: no pytest file {test}")
@@ -393,9 +479,11 @@ def apply(tree, m):
     """Write the mutation into the tree's file; returns the original text."""
     path = tree / m.file
     text = path.read_text()
-    if text.count(m.original) != 1:
-        raise RuntimeError(f"{m.id}: snippet found {text.count(m.original)} times in {m.file}")
-    path.write_text(text.replace(m.original, m.replacement))
+    spans = find_anchor(text, m.original)
+    if len(spans) != 1:
+        raise RuntimeError(f"{m.id}: snippet found {len(spans)} times in {m.file}")
+    (start, end), = spans
+    path.write_text(text[:start] + m.replacement + text[end:])
     return text
 
 
