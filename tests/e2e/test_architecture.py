@@ -58,3 +58,48 @@ def test_scan_reads_the_uses_from_the_files(tmp_path):
     assert units["ropedyn_rope"]["uses"] == {"ropedyn_scene"}
     assert arch.violations(units) == [
         "src/models/ropedyn_rope.f90: ropedyn_rope (models) uses ropedyn_scene (io)"]
+
+
+def test_each_test_program_links_the_lowest_layer_it_needs(tmp_path):
+    """tests/CMakeLists.txt: a test links the lowest layer whose library holds what it uses
+    (solvers and models together: io; through a test helper: what the helper uses;
+    SUNDIALS's modules: solvers). A layer too high is reported (one too low does not
+    build), and so is SCENE_RUNS without ropedyn_test_run or the other way round."""
+    module = "module {0}\n{1}end module {0}\n"
+    program = "program {0}\n{1}end program {0}\n"
+    _tree(tmp_path, {
+        "src/core/ropedyn_kinds.f90": module.format("ropedyn_kinds", ""),
+        "solvers/ropedyn_integrator.f90": module.format("ropedyn_integrator",
+                                                        "    use ropedyn_kinds\n"),
+        "src/models/ropedyn_rope.f90": module.format("ropedyn_rope", ""),
+        "src/studies/ropedyn_simulation.f90": module.format("ropedyn_simulation", ""),
+        "tests/unit/ropedyn_test_run.f90": module.format("ropedyn_test_run",
+                                                         "    use ropedyn_simulation\n"),
+        "tests/unit/test_a.f90": program.format(
+            "test_a", "    use, intrinsic :: iso_fortran_env\n    use ropedyn_kinds\n"),
+        "tests/unit/test_b.f90": program.format(
+            "test_b", "    use ropedyn_integrator, only: x\n    use ropedyn_rope\n"),
+        "tests/unit/test_c.f90": program.format("test_c", "    use ropedyn_test_run\n"),
+        "tests/unit/test_d.f90": program.format("test_d", "    use fsundials_context_mod\n"),
+        "tests/bench/bench_x.f90": program.format("bench_x", "    use ropedyn_rope\n"),
+    })
+    cmake = tmp_path / "tests" / "CMakeLists.txt"
+
+    def report(a, b, c, d, bench):
+        cmake.write_text(f"function(ropedyn_unit_test name layer)\nendfunction()\n"
+                         f"ropedyn_unit_test(test_a {a})\nropedyn_unit_test(test_b {b})\n"
+                         f"ropedyn_unit_test(test_c {c})\nropedyn_unit_test(test_d {d})\n"
+                         f"add_executable(bench_x bench/bench_x.f90)\n"
+                         f"target_link_libraries(bench_x PRIVATE ropedyn_{bench})\n")
+        return arch.link_violations(arch.scan(tmp_path), tmp_path)
+
+    assert report("core", "io", "studies SCENE_RUNS", "solvers", "models") == []
+    where = "tests/CMakeLists.txt: "
+    assert report("app", "solvers", "studies SCENE_RUNS", "io", "app") == [
+        where + "bench_x links ropedyn_app, but what it uses is in ropedyn_models",
+        where + "test_a links ropedyn_app, but what it uses is in ropedyn_core",
+        where + "test_b links ropedyn_solvers, but what it uses is in ropedyn_io",
+        where + "test_d links ropedyn_io, but what it uses is in ropedyn_solvers"]
+    assert report("core SCENE_RUNS", "io", "studies", "solvers", "models") == [
+        where + "test_a: SCENE_RUNS without a use of ropedyn_test_run",
+        where + "test_c: SCENE_RUNS missing (it uses ropedyn_test_run)"]

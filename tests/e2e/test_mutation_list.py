@@ -107,8 +107,8 @@ def test_the_whole_list_survives_reflowing_its_files(tmp_path):
 
 
 def test_declared_ctest_programs_exist():
-    registered = set(re.findall(r"ropedyn_unit_test\((\w+)\)",
-                                (ROOT / "tests" / "CMakeLists.txt").read_text()))
+    registered = set(re.findall(r"^ropedyn_unit_test\((\w+)\s",
+                                (ROOT / "tests" / "CMakeLists.txt").read_text(), re.M))
     missing = {t for m in MUTATIONS for t in m.ctest} - registered
     assert not missing, missing
 

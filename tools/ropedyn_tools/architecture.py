@@ -10,8 +10,10 @@ program, the layer of each (by folder), and every `use ropedyn_*` between them. 
 
 It checks the layering rule that CMake enforces by separate module directories: a module
 uses only its own layer and the layers below it, and `solvers` and `models` never use
-each other. `--check` only checks (the rule, and that docs/architecture.md is current) and
-exits 1 on a violation; the test suite runs it.
+each other. And it checks that each test program of tests/CMakeLists.txt links the lowest
+layer whose library holds what it uses (`ropedyn_unit_test(NAME LAYER)`; the build fails
+on a layer too low, this reports one too high). `--check` only checks (the rules, and that
+docs/architecture.md is current) and exits 1 on a violation; the test suite runs it.
 
     scripts/architecture            # regenerate docs/architecture.md and the figure
     scripts/architecture --check    # verify only
@@ -105,6 +107,93 @@ def violations(units):
     return bad
 
 
+#: modules from outside ropedyn and the layer whose library brings them (SUNDIALS's Fortran
+#: modules come with the solvers, HDF5's with io); intrinsic modules need none
+EXTERNAL = {"fsundials": "solvers", "fnvector": "solvers", "fsunmatrix": "solvers",
+            "fsunlinsol": "solvers", "fsunnonlinsol": "solvers", "fcvode": "solvers",
+            "hdf5": "io", "h5": "io"}
+TESTS = "tests"
+#: a test program: `ropedyn_unit_test(NAME LAYER [SCENE_RUNS])` (source unit/NAME.f90)
+UNIT_TEST = re.compile(r"^\s*ropedyn_unit_test\(\s*(\w+)\s+(\w+)((?:\s+\w+)*)\s*\)", re.M)
+#: another program: `add_executable(NAME SOURCE)` and `target_link_libraries(NAME PRIVATE
+#: ropedyn_LAYER)`
+PROGRAM = re.compile(r"^\s*add_executable\(\s*(\w+)\s+([\w/]+\.f90)\s*\)", re.M)
+ANY_USE = re.compile(r"^\s*use\b\s*(,\s*(non_)?intrinsic\s*)?(::)?\s*(\w+)", re.I | re.M)
+
+
+def lowest_library(layers):
+    """The layer whose library holds modules of all `layers`: the highest of them, or the
+    layer above when the highest are side by side (solvers and models: io)."""
+    layers = set(layers)
+    if not layers:
+        return "core"
+    top = max(RANK[name] for name in layers)
+    highest = {name for name in layers if RANK[name] == top}
+    if len(highest) == 1:
+        return highest.pop()
+    return next(name for name, rank, _ in LAYERS if rank == top + 1)
+
+
+def program_links(root=ROOT):
+    """{name: (source, layer it links, whether it links ropedyn_test_run)} of the test and
+    benchmark programs of root/tests/CMakeLists.txt."""
+    tests = pathlib.Path(root) / TESTS
+    text = (tests / "CMakeLists.txt").read_text()
+    programs = {}
+    for name, layer, flags in UNIT_TEST.findall(text):
+        programs[name] = (tests / "unit" / f"{name}.f90", layer, "SCENE_RUNS" in flags.split())
+    for name, source in PROGRAM.findall(text):
+        link = re.search(rf"target_link_libraries\(\s*{name}\s+PRIVATE\s+ropedyn_(\w+)", text)
+        if link:
+            programs[name] = (tests / source, link.group(1), False)
+    return programs
+
+
+def link_violations(units, root=ROOT):
+    """'tests/CMakeLists.txt: NAME links ropedyn_X ...' for each test program that links a
+    layer other than the lowest holding what it uses (the test helpers of tests/unit count
+    with what they use), or ropedyn_test_run without using it."""
+    root = pathlib.Path(root)
+    helpers = {}
+    for path in sorted((root / TESTS / "unit").glob("ropedyn_*.f90")):
+        m = re.search(r"^\s*module\s+(\w+)", path.read_text(), re.I | re.M)
+        if m:
+            helpers[m.group(1).lower()] = path
+
+    def layers_of(path, seen):
+        found = set()
+        for m in ANY_USE.finditer(path.read_text()):
+            if m.group(1) and not m.group(2):       # use, intrinsic
+                continue
+            name = m.group(4).lower()
+            if name in units and units[name]["layer"]:
+                found.add(units[name]["layer"])
+            elif name in helpers and name not in seen:
+                seen.add(name)
+                found |= layers_of(helpers[name], seen)
+            else:
+                found |= {layer for prefix, layer in EXTERNAL.items()
+                          if name.startswith(prefix)}
+        return found
+
+    bad = []
+    for name, (source, layer, scene_runs) in sorted(program_links(root).items()):
+        if layer not in RANK:
+            bad.append(f"{TESTS}/CMakeLists.txt: {name} links ropedyn_{layer}, no layer")
+            continue
+        need = lowest_library(layers_of(source, set()))
+        if need != layer:
+            bad.append(f"{TESTS}/CMakeLists.txt: {name} links ropedyn_{layer}, but what it "
+                       f"uses is in ropedyn_{need}")
+        uses_runs = re.search(r"^\s*use\s+ropedyn_test_run\b", source.read_text(),
+                              re.I | re.M)
+        if scene_runs != bool(uses_runs):
+            bad.append(f"{TESTS}/CMakeLists.txt: {name}: SCENE_RUNS "
+                       + ("without a use of ropedyn_test_run" if scene_runs
+                          else "missing (it uses ropedyn_test_run)"))
+    return bad
+
+
 def generated_markdown(units):
     out = [BEGIN, ""]
     cross = defaultdict(set)
@@ -179,7 +268,7 @@ def main(argv=None):
                         help="check the layering and that docs/architecture.md is current")
     args = parser.parse_args(argv)
     units = scan()
-    bad = violations(units)
+    bad = violations(units) + link_violations(units)
     for b in bad:
         print("architecture:", b, file=sys.stderr)
     gen = generated_markdown(units)
