@@ -1,4 +1,4 @@
-"""Python tools around the ropedyn executable.
+"""Reading, plotting and animating what the ropedyn executable writes.
 
 Modules (each command-line module has `main(argv=None)` and runs with `python -m`):
 
@@ -6,12 +6,12 @@ Modules (each command-line module has `main(argv=None)` and runs with `python -m
 - `ropedyn.namelist`: the scene text (Fortran namelist) as a dict;
 - `ropedyn.fields`: derived fields: supports, axial force, curvature, speed;
 - `ropedyn.layout`: check a run file against the documented layout (docs/output.md);
-- `ropedyn.compare`: compare a run with a reference, quantity by quantity;
 - `ropedyn.plot`: drawing helpers; `ropedyn.plot.overview` (scripts/plot),
   `ropedyn.plot.energy` (scripts/plot_energy.py);
-- `ropedyn.animate` (scripts/animate), `ropedyn.xdmf` (scripts/xdmf);
-- `ropedyn.run`: the repository, the executable (Release build), `--set` arguments;
-- `ropedyn.studies.*`: the studies that write docs/ (scripts/work_precision, ...).
+- `ropedyn.animate` (scripts/animate), `ropedyn.xdmf` (scripts/xdmf).
+
+The studies that write docs/ and the maintenance tools of the repository are not part of
+this package: they are `ropedyn_tools` in tools/ of the source tree, run by scripts/.
 
 `import ropedyn` is light; `ropedyn.load_run` and `ropedyn.Run` are loaded on first use.
 """

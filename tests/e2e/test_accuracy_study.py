@@ -1,9 +1,9 @@
-"""The analysis of scripts/accuracy (python/ropedyn/studies/accuracy.py) on small made-up
+"""The analysis of scripts/accuracy (tools/ropedyn_tools/studies/accuracy.py) on small made-up
 data: the choices docs/choosing.md states come out of these functions, so each must pick
 what its description says."""
 import math
 
-from ropedyn.studies import accuracy as acc
+from ropedyn_tools.studies import accuracy as acc
 
 
 def window_row(method, rtol, tip, cpu, t0=0.0, model="rfem", n=30):

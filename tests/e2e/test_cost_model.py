@@ -1,9 +1,9 @@
-"""scripts/cost_model (python/ropedyn/studies/cost_model.py): auto's counted cost against CPU.
+"""scripts/cost_model (tools/ropedyn_tools/studies/cost_model.py): auto's counted cost against CPU.
 Its counts must be auto's: the constants come from the Fortran source, and a run's counted
 cost follows auto's formula on the RFEM's band."""
 import re
 
-from ropedyn.studies import cost_model as cm
+from ropedyn_tools.studies import cost_model as cm
 
 
 def test_constants_are_read_from_the_fortran_source(tmp_path):

@@ -4,7 +4,7 @@ import subprocess
 
 import pytest
 
-from ropedyn.studies import docs_status
+from ropedyn_tools import docs_status
 
 
 def _repo(tmp_path):

@@ -7,7 +7,7 @@ import h5py
 import numpy as np
 import pytest
 
-from ropedyn.studies.cost_model import auto_parameter
+from ropedyn_tools.studies.cost_model import auto_parameter
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
 PAPER = ROOT / "input" / "paper.nml"

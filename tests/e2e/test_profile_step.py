@@ -1,6 +1,6 @@
-"""The split of scripts/profile_step (python/ropedyn/studies/profile_step.py): which
+"""The split of scripts/profile_step (tools/ropedyn_tools/studies/profile_step.py): which
 inclusive costs of a callgrind profile make each part of a step."""
-from ropedyn.studies import profile_step as ps
+from ropedyn_tools.studies import profile_step as ps
 
 
 def test_erk_counts_the_combined_rhs_and_quadrature_call_as_rhs():

@@ -1,9 +1,12 @@
 """The ropedyn Python package (python/ropedyn, installed editable into .venv by
-scripts/setup) and the scripts/ commands that are thin entry points into it: the package
-imports from any directory, its reader gives a run file's arrays with their units, and every
-command answers --help (without building or running anything)."""
+scripts/setup) holds what a user imports; the studies and maintenance tools
+(tools/ropedyn_tools) are not installed and the scripts/ commands find them there. The
+package imports from any directory, its reader gives a run file's arrays with their units,
+and every command answers --help (without building or running anything)."""
 import importlib
+import os
 import pathlib
+import re
 import subprocess
 import sys
 
@@ -17,43 +20,60 @@ COMMANDS = {
     "animate": "ropedyn.animate",
     "plot": "ropedyn.plot.overview",
     "xdmf": "ropedyn.xdmf",
-    "readme_figures": "ropedyn.studies.readme_figures",
-    "fig5": "ropedyn.studies.fig5",
-    "calibrate": "ropedyn.studies.calibrate",
-    "bench_effects": "ropedyn.studies.bench_effects",
-    "bench_kernels": "ropedyn.studies.bench_kernels",
-    "bench_models": "ropedyn.studies.bench_models",
-    "bench_rfem": "ropedyn.studies.bench_rfem",
-    "bench_step": "ropedyn.studies.bench_step",
-    "bench_sweep": "ropedyn.studies.bench_sweep",
-    "bench_peers": "ropedyn.studies.bench_peers",
-    "auto_table": "ropedyn.studies.auto_table",
-    "auto_accuracy": "ropedyn.studies.auto_accuracy",
-    "cost_model": "ropedyn.studies.cost_model",
-    "profile_step": "ropedyn.studies.profile_step",
-    "validation": "ropedyn.studies.validation",
-    "work_precision": "ropedyn.studies.work_precision",
-    "accuracy": "ropedyn.studies.accuracy",
-    "work_precision_testset": "ropedyn.studies.work_precision_testset",
-    "stability_report": "ropedyn.studies.stability_report",
-    "update_references": "ropedyn.studies.update_references",
-    "mutation_check": "ropedyn.studies.mutation_check",
-    "docs_status": "ropedyn.studies.docs_status",
+    "readme_figures": "ropedyn_tools.studies.readme_figures",
+    "fig5": "ropedyn_tools.studies.fig5",
+    "calibrate": "ropedyn_tools.studies.calibrate",
+    "bench_effects": "ropedyn_tools.studies.bench_effects",
+    "bench_kernels": "ropedyn_tools.studies.bench_kernels",
+    "bench_models": "ropedyn_tools.studies.bench_models",
+    "bench_rfem": "ropedyn_tools.studies.bench_rfem",
+    "bench_step": "ropedyn_tools.studies.bench_step",
+    "bench_sweep": "ropedyn_tools.studies.bench_sweep",
+    "bench_peers": "ropedyn_tools.studies.bench_peers",
+    "auto_table": "ropedyn_tools.studies.auto_table",
+    "auto_accuracy": "ropedyn_tools.studies.auto_accuracy",
+    "cost_model": "ropedyn_tools.studies.cost_model",
+    "profile_step": "ropedyn_tools.studies.profile_step",
+    "validation": "ropedyn_tools.studies.validation",
+    "work_precision": "ropedyn_tools.studies.work_precision",
+    "accuracy": "ropedyn_tools.studies.accuracy",
+    "work_precision_testset": "ropedyn_tools.studies.work_precision_testset",
+    "stability_report": "ropedyn_tools.studies.stability_report",
+    "update_references": "ropedyn_tools.update_references",
+    "mutation_check": "ropedyn_tools.mutation_check",
+    "docs_status": "ropedyn_tools.docs_status",
 }
 # Python files under scripts/ that the README and docs/ call by path
 SHIMS = {"plot_energy.py": "ropedyn.plot.energy",
-         "mebdf_stability.py": "ropedyn.studies.mebdf_stability"}
+         "mebdf_stability.py": "ropedyn_tools.studies.mebdf_stability"}
 
 
 def test_import_from_another_directory(tmp_path):
-    """The venv's Python finds this checkout's package wherever it runs."""
-    result = subprocess.run([sys.executable, "-c", "import ropedyn, ropedyn.io, ropedyn.studies;"
+    """The venv's Python finds this checkout's package wherever it runs, and only the
+    package: the tools are not installed (without tools/ on the path they do not import)."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    result = subprocess.run([sys.executable, "-c", "import ropedyn, ropedyn.io;"
                              "print(ropedyn.__file__); print(ropedyn.load_run is ropedyn.io."
-                             "load_run)"], cwd=tmp_path, capture_output=True, text=True)
+                             "load_run)"], cwd=tmp_path, capture_output=True, text=True, env=env)
     assert result.returncode == 0, result.stderr
     path, same = result.stdout.split()
     assert pathlib.Path(path) == ROOT / "python" / "ropedyn" / "__init__.py"
     assert same == "True"
+    result = subprocess.run([sys.executable, "-c", "import ropedyn_tools"], cwd=tmp_path,
+                            capture_output=True, text=True, env=env)
+    assert "No module named 'ropedyn_tools'" in result.stderr
+
+
+def test_package_holds_no_tools():
+    """What `pip install python/` installs is the user's package: no studies, no
+    maintenance tools, no module that knows the repository's layout."""
+    files = {p.relative_to(ROOT / "python" / "ropedyn").as_posix()
+             for p in (ROOT / "python" / "ropedyn").rglob("*.py")}
+    assert not {f for f in files if f.startswith("studies/")}, files
+    assert not files & {"run.py", "compare.py", "architecture.py", "mutation_check.py"}
+    source = "\n".join((ROOT / "python" / "ropedyn" / f).read_text() for f in files)
+    assert not re.search(r"^\s*(from|import) ropedyn_tools", source, re.M)
+    assert "scripts/build" not in source
 
 
 def test_reader_gives_arrays_with_units(run, tmp_path):
@@ -110,10 +130,10 @@ def test_shim_answers_help(name, tmp_path):
 
 
 @pytest.mark.parametrize("module, extra", [
-    ("ropedyn.studies.bench_effects", ["--build", "/nonexistent"]),
-    ("ropedyn.studies.bench_kernels", ["--build", "/nonexistent"]),
-    ("ropedyn.studies.profile_step", ["--exe", "/nonexistent"]),
-    ("ropedyn.studies.bench_step", ["--exe", "/nonexistent"])])
+    ("ropedyn_tools.studies.bench_effects", ["--build", "/nonexistent"]),
+    ("ropedyn_tools.studies.bench_kernels", ["--build", "/nonexistent"]),
+    ("ropedyn_tools.studies.profile_step", ["--exe", "/nonexistent"]),
+    ("ropedyn_tools.studies.bench_step", ["--exe", "/nonexistent"])])
 def test_unknown_baseline_is_a_usage_error(module, extra, capsys):
     """--baseline naming no commit: a usage error naming the option and the value (exit 2),
     before anything is built (it used to end in git's traceback after the Release build)."""
@@ -127,7 +147,7 @@ def test_unknown_baseline_is_a_usage_error(module, extra, capsys):
 def test_baseline_revision_names_the_commit():
     """A revision git knows comes back as the short hash of its commit."""
     import argparse
-    from ropedyn.studies.common import baseline_revision
+    from ropedyn_tools.studies.common import baseline_revision
     head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True,
                           text=True, check=True).stdout.strip()
     short = baseline_revision(argparse.ArgumentParser(), "HEAD")
@@ -137,7 +157,7 @@ def test_baseline_revision_names_the_commit():
 def test_least_cpu_keeps_the_fastest_run_and_stops_at_a_failure():
     """The benchmarks' timing rule (bench_peers --repeat): the least CPU of the runs, and a
     run that did not complete is returned at once (its CPU means nothing)."""
-    from ropedyn.studies.common import least_cpu
+    from ropedyn_tools.studies.common import least_cpu
     runs = iter([{"cpu": 3.0}, {"cpu": 1.0}, {"cpu": 2.0}])
     assert least_cpu(lambda: next(runs), 3) == {"cpu": 1.0}
     calls = []
@@ -155,7 +175,7 @@ def test_long_horizon_cache_is_keyed_on_the_code(tmp_path):
     relinked for its version string only) but not a change to src/, solvers/ or
     CMakeLists.txt, committed or not; an executable older than the code is keyed on itself."""
     import os
-    from ropedyn.studies.long_horizon import code_fingerprint
+    from ropedyn_tools.studies.long_horizon import code_fingerprint
 
     def git(*args):
         subprocess.run(["git", "-C", str(tmp_path), "-c", "user.name=t", "-c",

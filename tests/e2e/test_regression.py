@@ -10,8 +10,8 @@ import shutil
 import h5py
 import pytest
 
-from ropedyn.compare import compare
-from ropedyn.studies.update_references import REFERENCE, analysis_of, command, names, tighter
+from ropedyn_tools.compare import compare
+from ropedyn_tools.update_references import REFERENCE, analysis_of, command, names, tighter
 
 SCENES = names()
 

@@ -4,11 +4,14 @@ work-precision script runs (print-only mode)."""
 import csv
 import io
 import math
+import os
 import re
 import subprocess
 import sys
 
 import pytest
+
+from conftest import ROOT
 
 COLUMNS = ["problem", "method", "rtol", "atol", "max_order", "scd", "mescd", "measure",
            "accuracy", "steps", "rejected", "rhs_evals", "jac_rhs_evals", "jac_evals",
@@ -116,10 +119,11 @@ def test_failed_integration_exits_3(run):
 
 
 def test_work_precision_script_print_only(ropedyn_exe):
-    result = subprocess.run([sys.executable, "-m", "ropedyn.studies.work_precision_testset",
+    result = subprocess.run([sys.executable, "-m", "ropedyn_tools.studies.work_precision_testset",
                              "--exe", str(ropedyn_exe), "--quick",
                              "--no-write", "--problems", "HIRES,ROBER", "--methods", "cvode",
-                             "--repeat-time", "0"], capture_output=True, text=True, timeout=300)
+                             "--repeat-time", "0"], capture_output=True, text=True, timeout=300,
+                            env=dict(os.environ, PYTHONPATH=str(ROOT / "tools")))
     assert result.returncode == 0, result.stderr
     assert "| rtol | cvode (max order 5) |" in result.stdout
     assert "**HIRES** (scd / steps / CPU ms per run)" in result.stdout

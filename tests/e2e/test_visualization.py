@@ -5,6 +5,7 @@ Small runs (5 elements, 0.2 s) are made once per module; each script runs as a u
 run it, and its picture is checked for size and for not being blank."""
 import hashlib
 import json
+import os
 import pathlib
 import shutil
 import subprocess
@@ -36,11 +37,13 @@ def ropedyn(exe, workdir, scene_text, name, *overrides):
     return out
 
 
-def script(module, *args):
-    """Run `python -m ropedyn.MODULE ARGS` (the code of scripts/animate, scripts/plot, ...)
-    with this Python; returns the CompletedProcess."""
-    return subprocess.run([sys.executable, "-m", f"ropedyn.{module}", *map(str, args)],
-                          capture_output=True, text=True, timeout=120)
+def script(module, *args, package="ropedyn"):
+    """Run `python -m PACKAGE.MODULE ARGS` (the code of scripts/animate, scripts/plot, ...)
+    with this Python, tools/ on its path as the scripts/ commands put it (for the package
+    ropedyn_tools, not installed); returns the CompletedProcess."""
+    return subprocess.run([sys.executable, "-m", f"{package}.{module}", *map(str, args)],
+                          capture_output=True, text=True, timeout=120,
+                          env=dict(os.environ, PYTHONPATH=str(ROOT / "tools")))
 
 
 def assert_picture(image, size):
@@ -238,7 +241,8 @@ def test_xdmf_for_mpp(tiny_mpp):
 # --- README figures -----------------------------------------------------------------------
 
 def test_readme_figures(tiny, tmp_path):
-    result = script("studies.readme_figures", tiny, "--outdir", tmp_path, "--strobe-end", "0.2")
+    result = script("studies.readme_figures", tiny, "--outdir", tmp_path, "--strobe-end", "0.2",
+                    package="ropedyn_tools")
     assert result.returncode == 0, result.stderr
     for name, size in (("rope_motion.png", (800, 520)), ("energy.png", (800, 450))):
         with Image.open(tmp_path / name) as image:

@@ -9,7 +9,7 @@ keeps the guarantees of docs/stability.md:
 5. with damping on (and fixed supports) T + V never rises by more than B_E rtol S, and the
    dissipated energy never falls by more than that.
 
-S is the energy scale of the run (ropedyn.studies.stability_metrics: max T + max elastic +
+S is the energy scale of the run (ropedyn_tools.studies.stability_metrics: max T + max elastic +
 gravity range + dissipated) and L the rope length. B_E (per scene and solver) and B_X (per
 scene) are three times the larger of the values measured with the Debug and the Release
 build, rounded up to one digit (docs/stability.md, "The guarantees"; measured values in the
@@ -26,7 +26,7 @@ import pathlib
 import numpy as np
 import pytest
 
-from ropedyn.studies import stability_metrics
+from ropedyn_tools.studies import stability_metrics
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 HARD = ROOT / "input" / "hard"

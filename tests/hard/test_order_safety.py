@@ -19,7 +19,7 @@ import h5py
 import numpy as np
 import pytest
 
-from ropedyn.studies import stability_metrics
+from ropedyn_tools.studies import stability_metrics
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 UNDAMPED = ROOT / "input" / "hard" / "undamped.nml"

@@ -1,6 +1,6 @@
 """Long-horizon guarantees (issue 18; docs/stability.md, "Long horizons"): every hard scene
 of input/hard to its full t_end, with the default method and with every method of
-ropedyn.studies.long_horizon.METHODS at rtol 1e-3, 1e-5 and 1e-7 (atol = rtol/100), in the
+ropedyn_tools.studies.long_horizon.METHODS at rtol 1e-3, 1e-5 and 1e-7 (atol = rtol/100), in the
 Release build: 311 runs (METHODS = cvode, mebdf, adams, erk). CTest label `long`
 (`scripts/test --long`, about half an hour of CPU, see docs/stability.md); not part of the
 normal suite.
@@ -42,7 +42,7 @@ import re
 
 import pytest
 
-from ropedyn.studies import long_horizon as lh
+from ropedyn_tools.studies import long_horizon as lh
 
 #: B_E per method: bound on balance error / (rtol S), about three times the largest measured
 #: over all scenes and tolerances outside KNOWN_DEFECTS (docs/stability.md "Long horizons")

@@ -1,0 +1,191 @@
+"""Which generated sections of docs/ were written before the code under them last changed.
+
+Every table or figure in docs/ stands between two markers, `<!-- NAME:begin -->` and
+`<!-- NAME:end -->`, and opens with the command that wrote it and when (a "Run:" stamp, a
+"(... min, YYYY-MM-DD HH:MM UTC)" or a "YYYY-MM-DD, commit `abc1234`" line). For each section
+this lists the commits that changed the code its numbers come from after the commit that
+wrote that stamp into the page (after the run's time while it is not committed): the
+Fortran (src/, solvers/, CMakeLists.txt), the scenes (input/) and the study's own module
+(tools/ropedyn_tools/studies/SCRIPT.py or tools/ropedyn_tools/SCRIPT.py, earlier
+python/ropedyn/studies/SCRIPT.py; SCRIPT read from the section's command; NARROWER lists
+the studies that read less). A commit there does not mean the numbers changed; it means the
+study has not been run on the code as it is, and its page should say why not or be rerun by
+its script. A commit that changes code but, checked, none of the results (a refactoring, a
+comment) says so with a line `Numbers-unchanged: how it was checked` in its message, or,
+once committed, with a line `HASH  how it was checked` in docs/numbers-unchanged.txt; it is
+not counted.
+
+    scripts/docs_status            # every section, oldest first
+    scripts/docs_status --stale    # only those with code commits since their run
+    scripts/docs_status --check    # as --stale, exit status 1 when any is listed
+"""
+import argparse
+import datetime
+import pathlib
+import re
+import subprocess
+import sys
+
+from ropedyn_tools.repo import ROOT
+from ropedyn_tools.studies.common import git
+
+#: where a study's own module is, and (for the runs before it moved) was
+STUDY_FOLDERS = ("tools/ropedyn_tools/studies", "tools/ropedyn_tools", "python/ropedyn/studies")
+#: what a study's numbers come from besides its own module
+CODE_PATHS = ("src", "solvers", "CMakeLists.txt", "input")
+#: studies whose numbers come from less than CODE_PATHS
+NARROWER = {
+    # the stiff test set: the integrators and their driver, no rope, no scene
+    "work_precision_testset": ("solvers", "CMakeLists.txt"),
+}
+#: the line of a commit message that keeps a code commit from counting (see above)
+UNCHANGED = "Numbers-unchanged:"
+#: commits that changed code but, checked, no result (one `HASH  how checked` a line)
+UNCHANGED_FILE = "docs/numbers-unchanged.txt"
+#: how many lines after the begin marker are searched for the command and the stamp
+HEAD_LINES = 6
+
+_BEGIN = re.compile(r"<!-- (?P<name>[^:>]+):begin -->")
+_SCRIPT = re.compile(r"scripts/(?P<script>[a-z0-9_]+)")
+_STAMP = re.compile(r"(?P<date>20\d\d-\d\d-\d\d)(?:[ T](?P<time>\d\d:\d\d)(?: ?UTC)?)?")
+_COMMIT = re.compile(r"commit `(?P<rev>[0-9a-f]{7,40})`")
+
+
+def sections(page):
+    """[(name, script or None, stamp text or None, commit or None)] of the generated
+    sections of the Markdown page at `page`, in page order."""
+    lines = pathlib.Path(page).read_text().splitlines()
+    found = []
+    for i, line in enumerate(lines):
+        m = _BEGIN.search(line)
+        if not m:
+            continue
+        name = m.group("name")
+        head = []
+        for text in lines[i + 1:]:
+            if f"<!-- {name}:end -->" in text or len(head) == HEAD_LINES:
+                break
+            if text.strip():
+                head.append(text)
+        head = "\n".join(head)
+        script = _SCRIPT.search(head)
+        stamp = _STAMP.search(head)
+        commit = _COMMIT.search(head)
+        found.append((name, script and script.group("script"),
+                      stamp and stamp.group(0), commit and commit.group("rev")))
+    return found
+
+
+def run_time(stamp):
+    """The UTC time of a stamp 'YYYY-MM-DD[ HH:MM[ UTC]]' (a date alone: the end of that
+    day, so that only the next days' commits count against it)."""
+    m = _STAMP.fullmatch(stamp.strip())
+    day = datetime.datetime.strptime(m.group("date"), "%Y-%m-%d")
+    if m.group("time"):
+        hours, minutes = map(int, m.group("time").split(":"))
+        when = day.replace(hour=hours, minute=minutes)
+    else:
+        when = day.replace(hour=23, minute=59)
+    return when.replace(tzinfo=datetime.timezone.utc)
+
+
+def _git_text(root, *args):
+    return git(*args, root=root).decode().strip()
+
+
+def unchanged_commits(root):
+    """The full hashes of the commits listed in root/UNCHANGED_FILE (comments: #); a line
+    whose first word git knows as no commit is an error naming the file, line and word."""
+    path = pathlib.Path(root) / UNCHANGED_FILE
+    if not path.exists():
+        return set()
+    full = set()
+    for number, line in enumerate(path.read_text().splitlines(), start=1):
+        line = line.split("#", 1)[0].strip()
+        if not line:
+            continue
+        rev = line.split()[0]
+        try:
+            full.add(_git_text(root, "rev-parse", "--verify", "--quiet", rev + "^{commit}"))
+        except subprocess.CalledProcessError:
+            raise SystemExit(f"docs_status: {path}: line {number}: '{rev}' is not a commit")
+    return full
+
+
+def code_commits(root, since, paths, commit=None, skip=frozenset()):
+    """[(short hash, ISO date, subject)] of the commits that changed `paths` after the time
+    `since` (or, given `commit`, after that commit), newest first; not those whose message
+    has a line starting with UNCHANGED, nor those in `skip` (full hashes)."""
+    cmd = ["log", "-z", "--format=%H%x09%h%x09%cI%x09%s%x09%b"]
+    if commit:
+        cmd.append(f"{commit}..HEAD")
+    else:
+        cmd.append(f"--since={since.isoformat()}")
+    if not any((pathlib.Path(root) / p).exists() for p in paths):
+        return []    # (a bare `git log --` would list every commit)
+    commits = []
+    # every path, also those gone (a module's earlier place), for the commits to them
+    for record in git(*cmd, "--", *paths, root=root).decode().split("\0"):
+        if not record.strip():
+            continue
+        full, rev, date, subject, body = record.strip("\n").split("\t", 4)
+        if full in skip or any(line.startswith(UNCHANGED) for line in body.splitlines()):
+            continue
+        commits.append((rev, date, subject))
+    return commits
+
+
+def status(root=ROOT):
+    """One row per generated section of root/docs/*.md: dict(page, name, script, stamp,
+    commits); commits None when the section names no run time."""
+    root = pathlib.Path(root)
+    skip = unchanged_commits(root)
+    rows = []
+    for page in sorted((root / "docs").glob("*.md")):
+        for name, script, stamp, commit in sections(page):
+            paths = list(NARROWER.get(script, CODE_PATHS))
+            if script:
+                paths += [f"{folder}/{script}.py" for folder in STUDY_FOLDERS]
+            commits = None
+            if stamp and not commit:
+                # the commit that wrote this stamp into the page: the code it ran is that
+                # commit's (a study is run on the working tree and committed with the code
+                # it measured); a stamp not committed yet is judged by its time
+                commit = _git_text(root, "log", "-1", "--format=%h", "-S", stamp, "--",
+                                  str(page.relative_to(root))) or None
+            if stamp or commit:
+                when = run_time(stamp) if stamp else None
+                commits = code_commits(root, when, paths, commit, skip)
+            rows.append({"page": str(page.relative_to(root)), "name": name, "script": script,
+                         "stamp": stamp, "commits": commits})
+    return rows
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--stale", action="store_true",
+                        help="list only the sections with code commits since their run")
+    parser.add_argument("--check", action="store_true",
+                        help="as --stale; exit status 1 when any section is listed")
+    parser.add_argument("--root", type=pathlib.Path, default=ROOT,
+                        help="the checkout whose docs/ to read (default: this one)")
+    args = parser.parse_args(argv)
+    rows = status(args.root)
+    rows.sort(key=lambda r: (r["stamp"] is not None, r["stamp"] or ""))
+    listed = [r for r in rows if not (args.stale or args.check) or r["commits"] is None
+              or r["commits"]]
+    print("| page | section | written by | run | code commits since | newest |")
+    print("|---|---|---|---|---|---|")
+    for r in listed:
+        commits = r["commits"]
+        count = "no run time" if commits is None else str(len(commits))
+        newest = f"{commits[0][0]} {commits[0][2][:60]}" if commits else ""
+        script = f"scripts/{r['script']}" if r["script"] else "?"
+        print(f"| {r['page']} | {r['name']} | {script} | {r['stamp'] or '?'} | {count} | "
+              f"{newest} |")
+    print(f"\n{len(listed)} of {len(rows)} sections listed", file=sys.stderr)
+    return 1 if args.check and listed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

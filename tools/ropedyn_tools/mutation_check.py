@@ -1,0 +1,606 @@
+"""Mutation check: does the test suite catch small deliberate bugs?
+
+usage: scripts/mutation_check [--only ID,...] [--list] [--no-write] [--full] [--workdir DIR]
+
+Each mutation of MUTATIONS replaces one snippet of one source file (a sign, a factor, a
+swapped coefficient, a unit conversion, a dropped term) in a scratch copy of the working tree
+(build/mutation/tree: the files git knows, copied where they differ; the working tree itself
+is never changed, and the scratch file is restored after each mutation, also on Ctrl-C).
+Then the copy is built incrementally (Debug, as scripts/test) and the mutation's declared
+tests run first (the CTest programs and pytest files that guard its area); when they all
+pass, the whole suite runs (CTest, then pytest tests/e2e tests/hard). A mutation is
+"caught" when a test fails (the first failing test is reported), "survived" when the whole
+suite passes. Before the first mutation the declared tests run once on the unchanged copy
+(they must pass). The result table is written into docs/testing.md between the markers
+<!-- mutation-results:begin --> and <!-- mutation-results:end --> (not with --no-write or
+--only). Takes about 10 minutes on two cores when every mutation is caught by its declared
+tests; each survivor costs a full suite run (~3 minutes). Run on demand, not part of CI.
+
+A snippet is found as Fortran, not as text (`find_anchor`): blanks, comments and
+continuation ampersands do not count, nor do blank lines, so the list survives reformatting
+(spaces changed, a statement split over continuation lines or joined); a statement's end
+(a line end without `&`) does count, and the snippet must start and end at whole names (`k`
+does not match the start of `kappa`). A snippet must occur exactly once in its file
+(tests/e2e/test_mutation_list.py checks that for the whole list, so the list follows the
+code when it moves). The replacement takes the place of the matched text, from its first to
+its last character, as it is written in the list.
+"""
+import argparse
+import dataclasses
+import datetime
+import filecmp
+import os
+import pathlib
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+from ropedyn_tools.repo import ROOT
+
+DOC = ROOT / "docs" / "testing.md"
+BEGIN, END = "<!-- mutation-results:begin -->", "<!-- mutation-results:end -->"
+
+
+@dataclasses.dataclass(frozen=True)
+class Mutation:
+    id: str             #: short name
+    file: str           #: path relative to the repository root
+    original: str       #: snippet, occurs once in the file (as find_anchor reads it)
+    replacement: str    #: what it becomes
+    breaks: str         #: the physics or numerics it breaks
+    ctest: tuple = ()   #: CTest programs that should catch it
+    pytest: tuple = ()  #: pytest files or node ids that should catch it
+
+
+RFEM = "src/models/rfem/ropedyn_rfem.f90"
+RFEM_K = "src/models/rfem/ropedyn_rfem_kernels.f90"
+RFEM_C = "src/models/rfem/ropedyn_rfem_create.f90"
+MPP = "src/models/mpp/ropedyn_mpp.f90"
+MPP_K = "src/models/mpp/ropedyn_mpp_kernels.f90"
+EFFECTS = "src/models/effects/"
+MOTION = "src/models/ropedyn_support_motion.f90"
+SETUP = "src/models/ropedyn_rope_setup.f90"
+SPEC = "src/models/ropedyn_rope_spec.f90"
+ORACLE = "tests/e2e/test_physics_anchors.py"
+REGRESSION = "tests/e2e/test_regression.py"
+
+MUTATIONS = [
+    # --- RFEM -----------------------------------------------------------------------------
+    Mutation("rfem-shear-damping-eta", RFEM_C,
+             "by = spec%rope%tangential_damping*area/(spec%rope%shape_factor*dl)",
+             "by = spec%rope%normal_damping*area/(spec%rope%shape_factor*dl)",
+             "shear damper from the normal instead of the tangential constant",
+             pytest=(ORACLE, REGRESSION)),
+    Mutation("rfem-shear-factor-inverted", RFEM_C,
+             "cy = spec%rope%shear_modulus*area/(spec%rope%shape_factor*dl)",
+             "cy = spec%rope%shear_modulus*area*spec%rope%shape_factor/dl",
+             "shear stiffness GA chi/dl instead of GA/(chi dl)",
+             pytest=(ORACLE, REGRESSION)),
+    Mutation("rfem-inertia-about-end", RFEM_C,
+             "model%inertia = model%mass*(model%len**2/12.0_wp",
+             "model%inertia = model%mass*(model%len**2/3.0_wp",
+             "element inertia about its end instead of its centre (l^2/3 for l^2/12)",
+             ctest=("test_mpp_anchors", "test_mpp_physics"), pytest=(ORACLE,)),
+    Mutation("rfem-bending-stiffness-halved", RFEM_C,
+             "cphi = spec%rope%young_modulus*second_moment/dl",
+             "cphi = spec%rope%young_modulus*second_moment/(2.0_wp*dl)",
+             "bending stiffness EI/(2 dl) instead of EI/dl",
+             ctest=("test_modes",), pytest=(REGRESSION,)),
+    Mutation("rfem-pin-anisotropic", RFEM_K,
+             "fs = sp%ct*d\n"
+             "                if (energy) e_el",
+             "fs = sp%ct*[d(1), self%cy/self%cx*d(2)]\n"
+             "                if (energy) e_el",
+             "pinned support with the shear stiffness sideways (not isotropic)",
+             pytest=(ORACLE, REGRESSION)),
+    Mutation("rfem-release-ignored", RFEM,
+             "self%sup(k)%active = t < self%release(k)",
+             "self%sup(k)%active = .true.",
+             "a released support keeps holding",
+             ctest=("test_effect_anchors", "test_effects_physics")),
+    Mutation("rfem-moving-support-rate-dropped", RFEM,
+             "self%sup(k)%anchor_vel = ms%v",
+             "self%sup(k)%anchor_vel = [0.0_wp, ms%v(2)]",
+             "the supports' dampers act on the absolute, not the relative x velocity (and x "
+             "work lost)",
+             ctest=("test_effects_physics", "test_effects_derivatives")),
+    Mutation("rfem-frame-moment-dropped", RFEM_K,
+             "(fy*(s%dwx + s%ha) - fx*s%dwy + fp)",
+             "(fy*(s%dwx + s%ha) + fp)",
+             "tension without the moment of the turning frame (d x F)",
+             ctest=("test_rfem_derivatives", "test_rfem_physics")),
+    Mutation("rfem-gravity-sign", RFEM_C,
+             "model%weight = merge(model%mass*model%g",
+             "model%weight = merge(-model%mass*model%g",
+             "gravity pointing up",
+             ctest=("test_rfem_physics",)),
+    # --- MPP ------------------------------------------------------------------------------
+    Mutation("mpp-axial-damping-eta-bar", MPP,
+             "model%ds = spec%model%mpp_axial_damping_factor* &\n"
+             "                       spec%rope%normal_damping*area/model%l",
+             "model%ds = spec%model%mpp_axial_damping_factor* &\n"
+             "                       spec%rope%tangential_damping*area/model%l",
+             "member damper from the tangential instead of the normal constant",
+             ctest=("test_mpp_anchors",)),
+    Mutation("mpp-bending-damping-eta-bar", MPP,
+             "model%db = spec%model%mpp_bending_damping_factor* &\n"
+             "                                                  spec%rope%normal_damping",
+             "model%db = spec%model%mpp_bending_damping_factor* &\n"
+             "                                                  spec%rope%tangential_damping",
+             "joint damper from the tangential instead of the normal constant",
+             ctest=("test_mpp_anchors",)),
+    Mutation("mpp-axial-factor-ignored", MPP,
+             "model%ds = spec%model%mpp_axial_damping_factor*",
+             "model%ds = 1.0_wp*",
+             "mpp_axial_damping_factor ignored",
+             ctest=("test_mpp_anchors",)),
+    Mutation("mpp-spring-per-rope-length", MPP,
+             "model%ks = spec%rope%young_modulus*area/model%l",
+             "model%ks = spec%rope%young_modulus*area/spec%rope%length",
+             "member spring EA/L instead of EA/l",
+             ctest=("test_mpp_anchors", "test_mpp_physics")),
+    Mutation("mpp-centripetal-dropped", MPP_K,
+             "a2 = udd - hk*phd**2\n            self%cacc(1, k)",
+             "a2 = udd\n            self%cacc(1, k)",
+             "rod centre acceleration without its centripetal part",
+             ctest=("test_mpp",)),
+    Mutation("mpp-bottom-damper-sign", MPP_K,
+             "fb = -self%k_sup*(pn - bottom%p) - self%d_sup*(pnd - bottom%v)",
+             "fb = -self%k_sup*(pn - bottom%p) + self%d_sup*(pnd - bottom%v)",
+             "the bottom support's damper pushes energy in",
+             ctest=("test_effects_physics", "test_effects_derivatives", "test_mpp")),
+    Mutation("mpp-release-ignored", MPP,
+             "bottom_on = self%bottom > 0 .and. t < self%bottom_release",
+             "bottom_on = self%bottom > 0",
+             "the MPP's released bottom keeps holding",
+             ctest=("test_effect_anchors", "test_effects_physics")),
+    # --- effects --------------------------------------------------------------------------
+    Mutation("drag-linear-swapped", EFFECTS + "ropedyn_effect_drag.f90",
+             "eff%cn = lin_n\n        eff%ct = lin_t",
+             "eff%cn = lin_t\n        eff%ct = lin_n",
+             "linear normal and tangential drag swapped",
+             ctest=("test_effect_anchors",)),
+    Mutation("drag-tangential-area", EFFECTS + "ropedyn_effect_drag.f90",
+             "eff%qt = 0.5_wp*rho*cd_t*pi*d",
+             "eff%qt = 0.5_wp*rho*cd_t*d",
+             "quadratic tangential drag on d l instead of the wetted area pi d l",
+             pytest=(REGRESSION,)),
+    Mutation("loads-frequency-without-2pi", EFFECTS + "ropedyn_effect_factory.f90",
+             "loads%loads(m)%omega = 2.0_wp*pi*a%load_frequency(j)",
+             "loads%loads(m)%omega = a%load_frequency(j)",
+             "point-load frequency in Hz used as rad/s",
+             ctest=("test_effect_anchors",)),
+    Mutation("loads-phase-in-degrees", EFFECTS + "ropedyn_effect_factory.f90",
+             "loads%loads(m)%phase = a%load_phase_deg(j)*pi/180.0_wp",
+             "loads%loads(m)%phase = a%load_phase_deg(j)",
+             "point-load phase left in degrees",
+             ctest=("test_effect_anchors",)),
+    Mutation("loads-moment-dropped", EFFECTS + "ropedyn_effect_loads.f90",
+             "m(i) = m(i) + self%loads(k)%r*(e(1)*fl(2) - e(2)*fl(1))",
+             "m(i) = m(i)",
+             "a load off the element centre without its moment",
+             ctest=("test_effects_derivatives", "test_effects_physics")),
+    Mutation("point-mass-halved", EFFECTS + "ropedyn_effect_factory.f90",
+             "mass(m) = spec%attachments%masses(k)",
+             "mass(m) = 0.5_wp*spec%attachments%masses(k)",
+             "point masses at half their value",
+             ctest=("test_mpp_anchors", "test_effects_physics")),
+    Mutation("ground-friction-halved", EFFECTS + "ropedyn_effect_ground.f90",
+             "eff%mu = mu",
+             "eff%mu = 0.5_wp*mu",
+             "friction coefficient halved",
+             ctest=("test_effects_physics",)),
+    Mutation("ground-stiffness-doubled", EFFECTS + "ropedyn_effect_ground.f90",
+             "eff%k = k",
+             "eff%k = 2.0_wp*k",
+             "contact stiffness per point k l instead of k l/2",
+             ctest=("test_effect_anchors",)),
+    # --- supports -------------------------------------------------------------------------
+    Mutation("support-phase-in-degrees", MOTION,
+             "self%phase = phase_deg*pi/180.0_wp",
+             "self%phase = phase_deg",
+             "harmonic support phase left in degrees",
+             ctest=("test_effect_anchors",)),
+    Mutation("support-frequency-without-2pi", MOTION,
+             "self%omega = 2.0_wp*pi*frequency",
+             "self%omega = frequency",
+             "harmonic support frequency in Hz used as rad/s",
+             ctest=("test_effect_anchors", "test_effects_physics")),
+    Mutation("table-hermite-basis", MOTION,
+             "h01 = u**2*(3.0_wp - 2.0_wp*u)",
+             "h01 = u**2*(3.0_wp - u)",
+             "motion table interpolation misses its rows",
+             ctest=("test_effect_anchors",)),
+    Mutation("table-slopes-swapped", MOTION,
+             "self%slope(:, k) = (h1*(rows(2:4, k) - rows(2:4, k - 1))/h0 + &\n"
+             "                                h0*(rows(2:4, k + 1) - rows(2:4, k))/h1)",
+             "self%slope(:, k) = (h0*(rows(2:4, k) - rows(2:4, k - 1))/h0 + &\n"
+             "                                h1*(rows(2:4, k + 1) - rows(2:4, k))/h1)",
+             "motion table slopes with the interval weights swapped (uneven rows)",
+             ctest=("test_effect_anchors",)),
+    Mutation("clamp-angle-in-degrees", SETUP,
+             "angles(1) = spec%supports%top_angle_deg*pi/180.0_wp",
+             "angles(1) = spec%supports%top_angle_deg",
+             "top clamp angle left in degrees",
+             pytest=(REGRESSION,)),
+    # --- solvers --------------------------------------------------------------------------
+    Mutation("mebdf-error-estimate-halved", "solvers/mebdf/ropedyn_mebdf_step.f90",
+             "err1 = self%wnorm(self%d1)/self%coef(k)%tq",
+             "err1 = 0.5_wp*self%wnorm(self%d1)/self%coef(k)%tq",
+             "MEBDF local error estimate halved (steps too long for the tolerance)",
+             ctest=("test_mebdf",)),
+    Mutation("mebdf-error-constant", "solvers/mebdf/ropedyn_mebdf_coefficients.f90",
+             "c%tq = real(k + 1, wp)*sum([(1.0_wp/real(j, wp), j=1, k)])",
+             "c%tq = real(k + 2, wp)*sum([(1.0_wp/real(j, wp), j=1, k)])",
+             "MEBDF error normalization (k+2) instead of (k+1)",
+             ctest=("test_mebdf", "test_rope_solvers")),
+    Mutation("cvode-rtol-loosened", "solvers/cvode/ropedyn_cvode.f90",
+             "flag = FCVodeSStolerances(self%mem, real(self%options%rtol, c_double),",
+             "flag = FCVodeSStolerances(self%mem, real(10*self%options%rtol, c_double),",
+             "CVODE given ten times the relative tolerance asked for",
+             ctest=("test_rope_solvers", "test_rfem_physics"), pytest=(REGRESSION,)),
+    Mutation("cvode-quadrature-unchecked", "solvers/cvode/ropedyn_cvode.f90",
+             "flag = FCVodeSetQuadErrCon(self%mem, 1_c_int)",
+             "flag = FCVodeSetQuadErrCon(self%mem, 0_c_int)",
+             "dissipated energy and work integrated without error control",
+             ctest=("test_effects_physics",)),
+    # --- input handling and statics -------------------------------------------------------
+    Mutation("eq13-inverted", "src/io/ropedyn_scene_checks.f90",
+             "r%tangential_damping = r%normal_damping*r%shear_modulus/r%young_modulus",
+             "r%tangential_damping = r%normal_damping*r%young_modulus/r%shear_modulus",
+             "default tangential damping eta E/G instead of eta G/E (paper, eq. 13)",
+             ctest=("test_scene",), pytest=(ORACLE, REGRESSION)),
+    Mutation("table-angle-in-degrees", "src/io/ropedyn_motion_table.f90",
+             "rows(:, m) = [r(1:3), r(4)*pi/180.0_wp]",
+             "rows(:, m) = [r(1:3), r(4)]",
+             "motion table angles left in degrees",
+             ctest=("test_effect_anchors",)),
+    Mutation("shape-factor-inverted", SPEC,
+             "real(wp) :: shape_factor = 10.0_wp/9.0_wp",
+             "real(wp) :: shape_factor = 9.0_wp/10.0_wp",
+             "default shear shape factor 9/10 instead of 10/9",
+             pytest=(ORACLE, REGRESSION)),
+    Mutation("statics-load-potential-sign", "src/studies/ropedyn_statics_terms.f90",
+             "v = v - dot_product(force, q(1:2, body)",
+             "v = v + dot_product(force, q(1:2, body)",
+             "statics: the loads' potential with the wrong sign",
+             ctest=("test_effect_anchors",)),
+]
+
+
+def normalise(text):
+    """(code, where): the Fortran text without blanks, comments (outside strings) and
+    continuation ampersands, statements separated by one newline; where[i] is the index in
+    text of code[i]. Character strings are kept as they are."""
+    code, where = [], []
+    quote = None
+    i, n = 0, len(text)
+    while i < n:
+        c = text[i]
+        if quote:                           # inside a string: every character counts
+            if c == "\n":                   # (an unclosed quote ends with its line)
+                quote = None
+            else:
+                code.append(c)
+                where.append(i)
+                if c == quote:
+                    quote = None
+                i += 1
+                continue
+        if c == "!":                        # a comment: to the end of the line
+            end = text.find("\n", i)
+            i = n if end < 0 else end
+            continue
+        if c == "&":                        # a continuation: the statement goes on at the
+            nxt = text.find("\n", i)        # next line that is not blank or a comment, at
+            while 0 <= nxt < n:             # its first character or after its &
+                nxt += 1
+                while nxt < n and text[nxt] in " \t":
+                    nxt += 1
+                if nxt < n and text[nxt] in "!\n":
+                    nxt = text.find("\n", nxt)
+                    continue
+                break
+            i = n if nxt < 0 else nxt + (nxt < n and text[nxt] == "&")
+            continue
+        if c == "\n" or c == ";":
+            if code and code[-1] != "\n":
+                code.append("\n")
+                where.append(i)
+        elif not c.isspace():
+            if c in "'\"":
+                quote = c
+            code.append(c)
+            where.append(i)
+        i += 1
+    while code and code[-1] == "\n":
+        code.pop()
+        where.pop()
+    return "".join(code), where
+
+
+def _name_char(c):
+    return c.isalnum() or c in "_%"
+
+
+def find_anchor(text, snippet):
+    """[(start, end)] of the places in text where snippet occurs as Fortran (see the module's
+    docstring: blanks, comments and continuations aside, at whole names); text[start:end] is
+    the matched text from its first to its last character."""
+    code, where = normalise(text)
+    want = normalise(snippet)[0].strip("\n")
+    spans = []
+    if not want:
+        return spans
+    k = code.find(want)
+    while k >= 0:
+        end = k + len(want)
+        inside = (k > 0 and _name_char(want[0]) and _name_char(code[k - 1])) or \
+            (end < len(code) and _name_char(want[-1]) and _name_char(code[end]))
+        if not inside:
+            spans.append((where[k], where[end - 1] + 1))
+        k = code.find(want, k + 1)
+    return spans
+
+
+def check_list(root=ROOT, mutations=MUTATIONS):
+    """Problems of the list: ids not unique, snippets not exactly once, no-op replacements."""
+    problems = []
+    ids = [m.id for m in mutations]
+    problems += [f"{i}: id used twice" for i in sorted({i for i in ids if ids.count(i) > 1})]
+    for m in mutations:
+        path = pathlib.Path(root) / m.file
+        if not path.is_file():
+            problems.append(f"{m.id}: no file {m.file}")
+            continue
+        count = len(find_anchor(path.read_text(), m.original))
+        if count != 1:
+            problems.append(f"{m.id}: snippet found {count} times in {m.file}")
+        if normalise(m.replacement)[0] == normalise(m.original)[0]:
+            problems.append(f"{m.id}: replacement equals the snippet")
+        for text in (m.original, m.replacement):
+            if text != text.strip(" \t\n&"):
+                problems.append(f"{m.id}: a snippet or replacement that starts or ends with a "
+                                "blank, a line end or a continuation (it would be doubled)")
+                break
+        for test in m.pytest:
+            if not (pathlib.Path(root) / test.split("::")[0]).is_file():
+                problems.append(f"{m.id}: no pytest file {test}")
+    return problems
+
+
+def tracked_files(root):
+    """Files of the working tree that git knows or would add (not ignored)."""
+    out = subprocess.run(["git", "ls-files", "-z", "-co", "--exclude-standard"], cwd=root,
+                         capture_output=True, check=True).stdout
+    return [p for p in out.decode().split("\0") if p and (pathlib.Path(root) / p).is_file()]
+
+
+def sync_tree(root, tree):
+    """Make tree a copy of root's files (only changed files are copied, so that the build in
+    tree stays incremental); files that root no longer has are removed. A copied file gets
+    the time of the copy, not the source's: a run killed before it restored its mutation
+    (SIGKILL skips the restore) leaves a mutated file newer than the source, whose objects
+    a copy with the source's older time (copy2) would not rebuild, so the next run's
+    baseline failed on the old mutation."""
+    files = tracked_files(root)
+    wanted = set(files)
+    for rel in files:
+        src, dst = pathlib.Path(root) / rel, tree / rel
+        if not dst.exists() or not filecmp.cmp(src, dst, shallow=False):
+            dst.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy(src, dst)
+    for path in tree.rglob("*"):
+        rel = path.relative_to(tree).as_posix()
+        if rel.split("/")[0] in ("build", ".venv") or not path.is_file():
+            continue
+        if rel not in wanted and "__pycache__" not in rel and ".pytest_cache" not in rel:
+            path.unlink()
+    venv = tree / ".venv"
+    if not venv.exists():
+        venv.symlink_to(pathlib.Path(root) / ".venv")
+
+
+class Runner:
+    """Builds and tests the scratch tree."""
+
+    def __init__(self, tree, log):
+        self.tree = tree
+        self.build = tree / "build" / "debug"
+        self.log = log
+        self.env = dict(os.environ, ROPEDYN_EXE=str(self.build / "ropedyn"),
+                        PYTHONPATH=os.pathsep.join([str(tree / "python"), str(tree / "tools")]))
+        self.python = str(pathlib.Path(ROOT) / ".venv" / "bin" / "python")
+
+    def _run(self, cmd, timeout):
+        with open(self.log, "a") as log:
+            log.write(f"\n$ {' '.join(map(str, cmd))}\n")
+            log.flush()
+            try:
+                proc = subprocess.run(cmd, cwd=self.tree, env=self.env, stdout=subprocess.PIPE,
+                                      stderr=subprocess.STDOUT, text=True, timeout=timeout)
+            except subprocess.TimeoutExpired as exc:
+                out = exc.stdout.decode() if isinstance(exc.stdout, bytes) else (exc.stdout or "")
+                log.write(out + f"\n(timeout after {timeout} s)\n")
+                return None, out
+            log.write(proc.stdout)
+        return proc.returncode, proc.stdout
+
+    def configure(self):
+        code, out = self._run(["cmake", "-S", ".", "-B", str(self.build),
+                               "-DCMAKE_BUILD_TYPE=Debug"], 600)
+        if code != 0:
+            raise RuntimeError(f"mutation_check: configure failed:\n{out[-2000:]}")
+
+    def compile(self):
+        code, _ = self._run(["cmake", "--build", str(self.build), "-j", str(os.cpu_count() or 2)],
+                            1800)
+        return code == 0
+
+    def ctest(self, names=()):
+        """None when every test passes, else the name of a failing one."""
+        cmd = ["ctest", "--test-dir", str(self.build), "--no-tests=error", "--timeout", "900",
+               "-j", str(os.cpu_count() or 2)]
+        if names:
+            cmd += ["-R", "^(" + "|".join(re.escape(n) for n in names) + ")$"]
+        code, out = self._run(cmd, 3600)
+        if code == 0:
+            return None
+        if code is None:
+            return "ctest (timeout)"
+        failed = re.findall(r"^\s*\d+ - (\S+) \(", out, re.M)
+        return failed[0] if failed else "ctest"
+
+    def pytest(self, targets=("tests/e2e", "tests/hard")):
+        """None when every test passes, else the id of the first failing one."""
+        code, out = self._run([self.python, "-m", "pytest", "-x", "-q", "-rf",
+                               "-p", "no:cacheprovider", *targets], 3600)
+        if code == 0:
+            return None
+        if code is None:
+            return "pytest (timeout)"
+        failed = re.findall(r"^FAILED (\S+)", out, re.M) or re.findall(r"^ERROR (\S+)", out, re.M)
+        return failed[0] if failed else "pytest"
+
+    def declared(self, m):
+        """First failing test among the mutation's declared tests, or None."""
+        return (self.ctest(m.ctest) if m.ctest else None) or \
+            (self.pytest(m.pytest) if m.pytest else None)
+
+    def full(self):
+        # the list's own check fails for every mutation (its snippet is gone): not a catch
+        return self.ctest() or self.pytest(("tests/e2e", "tests/hard", "--ignore",
+                                            "tests/e2e/test_mutation_list.py"))
+
+
+def apply(tree, m):
+    """Write the mutation into the tree's file; returns the original text."""
+    path = tree / m.file
+    text = path.read_text()
+    spans = find_anchor(text, m.original)
+    if len(spans) != 1:
+        raise RuntimeError(f"{m.id}: snippet found {len(spans)} times in {m.file}")
+    (start, end), = spans
+    path.write_text(text[:start] + m.replacement + text[end:])
+    return text
+
+
+def results_table(results, commit, minutes):
+    """The docs/testing.md section with the results."""
+    caught = sum(r["status"] == "caught" for r in results)
+    lines = [BEGIN, "",
+             f"Last run: {datetime.date.today().isoformat()}, commit `{commit}`, "
+             f"{len(results)} mutations, **{caught} caught**, "
+             f"{len(results) - caught} not caught; {minutes:.0f} min on two cores "
+             "(`scripts/mutation_check`).", "",
+             "| mutation | file | what it breaks | result | first failing test |",
+             "|---|---|---|---|---|"]
+    for r in results:
+        m = r["mutation"]
+        where = "declared" if r["by"] == "declared" else "full suite"
+        result = r["status"] if r["status"] != "caught" else f"caught ({where})"
+        lines.append(f"| `{m.id}` | `{m.file}` | {m.breaks} | {result} | "
+                     f"`{r['test'] or '-'}` |")
+    lines += ["", END]
+    return "\n".join(lines)
+
+
+def write_doc(section):
+    text = DOC.read_text()
+    if BEGIN not in text or END not in text:
+        raise RuntimeError(f"{DOC}: markers {BEGIN} / {END} missing")
+    head, rest = text.split(BEGIN, 1)
+    _, tail = rest.split(END, 1)
+    DOC.write_text(head + section + tail)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="mutation_check", description=__doc__.split("\n\n")[0],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--only", help="comma-separated mutation ids")
+    parser.add_argument("--list", action="store_true", help="print the mutations and exit")
+    parser.add_argument("--no-write", action="store_true", help="do not update docs/testing.md")
+    parser.add_argument("--full", action="store_true",
+                        help="run the whole suite for every mutation (not the declared tests first)")
+    parser.add_argument("--workdir", type=pathlib.Path, default=ROOT / "build" / "mutation",
+                        help="scratch directory (default build/mutation)")
+    args = parser.parse_args(argv)
+
+    problems = check_list()
+    if problems:
+        print("mutation_check: the list does not match the code:\n  " + "\n  ".join(problems))
+        return 2
+    chosen = MUTATIONS
+    if args.only:
+        ids = args.only.split(",")
+        unknown = set(ids) - {m.id for m in MUTATIONS}
+        if unknown:
+            parser.error(f"unknown mutation ids: {', '.join(sorted(unknown))}")
+        chosen = [m for m in MUTATIONS if m.id in ids]
+    if args.list:
+        for m in chosen:
+            print(f"{m.id:34s} {m.file}: {m.breaks}")
+        return 0
+
+    start = time.time()
+    tree = args.workdir / "tree"
+    tree.mkdir(parents=True, exist_ok=True)
+    log = args.workdir / "mutation_check.log"
+    log.write_text("")
+    commit = subprocess.run(["git", "describe", "--always", "--dirty"], cwd=ROOT,
+                            capture_output=True, text=True).stdout.strip()
+    print(f"mutation_check: {len(chosen)} mutations on a copy in {tree} (log: {log})")
+    sync_tree(ROOT, tree)
+    runner = Runner(tree, log)
+    runner.configure()
+    if not runner.compile():
+        print("mutation_check: the unchanged copy does not build; see the log")
+        return 2
+    declared_ctest = sorted({t for m in chosen for t in m.ctest})
+    declared_pytest = sorted({t for m in chosen for t in m.pytest})
+    baseline = (runner.ctest(declared_ctest) if declared_ctest else None) or \
+        (runner.pytest(declared_pytest) if declared_pytest else None)
+    if baseline:
+        print(f"mutation_check: {baseline} fails without any mutation; fix that first")
+        return 2
+    print(f"mutation_check: baseline ok ({time.time() - start:.0f} s)")
+
+    results = []
+    try:
+        for i, m in enumerate(chosen, 1):
+            t0 = time.time()
+            original = apply(tree, m)
+            try:
+                if not runner.compile():
+                    status, by, test = "build error", "-", None
+                else:
+                    test = None if args.full else runner.declared(m)
+                    by = "declared"
+                    if test is None:
+                        test, by = runner.full(), "full"
+                    status = "caught" if test else "SURVIVED"
+            finally:
+                (tree / m.file).write_text(original)
+            results.append({"mutation": m, "status": status, "by": by, "test": test})
+            print(f"  [{i:2d}/{len(chosen)}] {m.id:34s} {status:8s} {test or ''} "
+                  f"({time.time() - t0:.0f} s)", flush=True)
+    except KeyboardInterrupt:
+        print("\nmutation_check: interrupted; the scratch copy is restored, the working tree "
+              "was never changed")
+        return 130
+    finally:
+        runner.compile()
+    minutes = (time.time() - start) / 60
+    survived = [r["mutation"].id for r in results if r["status"] != "caught"]
+    print(f"mutation_check: {len(results) - len(survived)} of {len(results)} caught "
+          f"in {minutes:.0f} min" + (f"; not caught: {', '.join(survived)}" if survived else ""))
+    if not args.no_write and not args.only:
+        write_doc(results_table(results, commit, minutes))
+        print(f"mutation_check: wrote the table into {DOC.relative_to(ROOT)}")
+    return 1 if survived else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
