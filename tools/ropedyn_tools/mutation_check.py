@@ -63,19 +63,20 @@ EFFECTS = "src/models/effects/"
 MOTION = "src/models/ropedyn_support_motion.f90"
 SETUP = "src/models/ropedyn_rope_setup.f90"
 SPEC = "src/models/ropedyn_rope_spec.f90"
+SECTION = "src/models/ropedyn_rope_section.f90"
 ORACLE = "tests/e2e/test_physics_anchors.py"
 REGRESSION = "tests/e2e/test_regression.py"
 
 MUTATIONS = [
     # --- RFEM -----------------------------------------------------------------------------
-    Mutation("rfem-shear-damping-eta", RFEM_C,
-             "by = spec%rope%tangential_damping*area/(spec%rope%shape_factor*dl)",
-             "by = spec%rope%normal_damping*area/(spec%rope%shape_factor*dl)",
+    Mutation("rfem-shear-damping-eta", SECTION,
+             "s%shear_damping = tangential_damping_of(rope)*s%area",
+             "s%shear_damping = rope%normal_damping*s%area",
              "shear damper from the normal instead of the tangential constant",
              pytest=(ORACLE, REGRESSION)),
     Mutation("rfem-shear-factor-inverted", RFEM_C,
-             "cy = spec%rope%shear_modulus*area/(spec%rope%shape_factor*dl)",
-             "cy = spec%rope%shear_modulus*area*spec%rope%shape_factor/dl",
+             "cy = sec%ga/(sec%shape_factor*dl)",
+             "cy = sec%ga*sec%shape_factor/dl",
              "shear stiffness GA chi/dl instead of GA/(chi dl)",
              pytest=(ORACLE, REGRESSION)),
     Mutation("rfem-inertia-about-end", RFEM_C,
@@ -84,8 +85,8 @@ MUTATIONS = [
              "element inertia about its end instead of its centre (l^2/3 for l^2/12)",
              ctest=("test_mpp_anchors", "test_mpp_physics"), pytest=(ORACLE,)),
     Mutation("rfem-bending-stiffness-halved", RFEM_C,
-             "cphi = spec%rope%young_modulus*second_moment/dl",
-             "cphi = spec%rope%young_modulus*second_moment/(2.0_wp*dl)",
+             "cphi = sec%ei/dl",
+             "cphi = sec%ei/(2.0_wp*dl)",
              "bending stiffness EI/(2 dl) instead of EI/dl",
              ctest=("test_modes",), pytest=(REGRESSION,)),
     Mutation("rfem-pin-anisotropic", RFEM_K,
@@ -118,17 +119,14 @@ MUTATIONS = [
              ctest=("test_rfem_physics",)),
     # --- MPP ------------------------------------------------------------------------------
     Mutation("mpp-axial-damping-eta-bar", MPP,
-             "model%ds = spec%model%mpp_axial_damping_factor* &\n"
-             "                       spec%rope%normal_damping*area/model%l",
-             "model%ds = spec%model%mpp_axial_damping_factor* &\n"
-             "                       spec%rope%tangential_damping*area/model%l",
+             "model%ds = spec%model%mpp_axial_damping_factor*sec%axial_damping/model%l",
+             "model%ds = spec%model%mpp_axial_damping_factor*sec%shear_damping/model%l",
              "member damper from the tangential instead of the normal constant",
              ctest=("test_mpp_anchors",)),
     Mutation("mpp-bending-damping-eta-bar", MPP,
+             "model%db = spec%model%mpp_bending_damping_factor*sec%bending_damping/model%l",
              "model%db = spec%model%mpp_bending_damping_factor* &\n"
-             "                                                  spec%rope%normal_damping",
-             "model%db = spec%model%mpp_bending_damping_factor* &\n"
-             "                                                  spec%rope%tangential_damping",
+             "    sec%shear_damping/sec%area*sec%second_moment/model%l",
              "joint damper from the tangential instead of the normal constant",
              ctest=("test_mpp_anchors",)),
     Mutation("mpp-axial-factor-ignored", MPP,
@@ -137,8 +135,8 @@ MUTATIONS = [
              "mpp_axial_damping_factor ignored",
              ctest=("test_mpp_anchors",)),
     Mutation("mpp-spring-per-rope-length", MPP,
-             "model%ks = spec%rope%young_modulus*area/model%l",
-             "model%ks = spec%rope%young_modulus*area/spec%rope%length",
+             "model%ks = sec%ea/model%l",
+             "model%ks = sec%ea/spec%rope%length",
              "member spring EA/L instead of EA/l",
              ctest=("test_mpp_anchors", "test_mpp_physics")),
     Mutation("mpp-centripetal-dropped", MPP_K,
@@ -247,9 +245,9 @@ MUTATIONS = [
              "dissipated energy and work integrated without error control",
              ctest=("test_effects_physics",)),
     # --- input handling and statics -------------------------------------------------------
-    Mutation("eq13-inverted", "src/io/ropedyn_scene_checks.f90",
-             "r%tangential_damping = r%normal_damping*r%shear_modulus/r%young_modulus",
-             "r%tangential_damping = r%normal_damping*r%young_modulus/r%shear_modulus",
+    Mutation("eq13-inverted", SECTION,
+             "eta_bar = rope%normal_damping*rope%shear_modulus/rope%young_modulus",
+             "eta_bar = rope%normal_damping*rope%young_modulus/rope%shear_modulus",
              "default tangential damping eta E/G instead of eta G/E (paper, eq. 13)",
              ctest=("test_scene",), pytest=(ORACLE, REGRESSION)),
     Mutation("table-angle-in-degrees", "src/io/ropedyn_motion_table.f90",
