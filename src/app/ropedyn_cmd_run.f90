@@ -3,6 +3,7 @@ module ropedyn_cmd_run
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
     use ropedyn_kinds, only: wp
     use ropedyn_text, only: int_text
+    use ropedyn_switch_log, only: switch_event_t
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_INTERRUPTED
     use ropedyn_cli, only: cli_t
     use ropedyn_help, only: print_help
@@ -22,12 +23,16 @@ contains
         character(len=:), allocatable :: resume_path
         type(scene_t) :: scene
         type(run_summary_t) :: summary
+        logical :: verbose
 
+        verbose = .false.
         do while (cli%next())
             select case (cli%option)
             case ('--help', '-h')
                 call print_help('run', output_unit)
                 return
+            case ('--verbose', '-v')
+                verbose = .true.
             case ('--resume')
                 if (allocated(resume_path)) then
                     call cli%usage_error('--resume is given twice', err)
@@ -55,7 +60,7 @@ contains
             if (allocated(err)) return
             call run_scene(scene, summary, err)
         end if
-        if (summary%records > 0) call print_summary(scene, summary)
+        if (summary%records > 0) call print_summary(scene, summary, verbose)
         if (allocated(err)) then
             if (err%code == ERR_INTERRUPTED) err%message = err%message// &
                 '; continue with: ropedyn run --resume '//trim(scene%output%file)
@@ -101,21 +106,27 @@ contains
         scene%output%file = path
     end subroutine resume_scene
 
-    subroutine print_summary(scene, s)
+    !> The summary of a run: what ran, its cost, the methods it used, its energies and how
+    !! well they balance, the order safety's actions, the file. Counters that did not
+    !! apply (no implicit step: no Jacobians, factorizations) are left out. With `verbose`
+    !! every switch of method or order on a line of its own.
+    subroutine print_summary(scene, s, verbose)
         type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(in) :: s
-        real(wp) :: e0, drift
-        e0 = s%initial_energy%balance()
-        drift = s%final_energy%balance() - e0
+        logical, intent(in) :: verbose
+        character(len=:), allocatable :: line
         write (output_unit, '(a)') 'ropedyn '//version_string//': '//trim(scene%model%kind)// &
             ' model, '//trim(scene%solver%method)//' solver, scene '//scene%path
         write (output_unit, '(a, i0, a, es10.3, a, f9.4, a)') '  elements        ', &
             scene%model%elements, '   rtol ', scene%solver%rtol, '   t = ', s%t_reached, ' s'
-        write (output_unit, '(a, i0, a, i0, a, i0, a, i0)') '  steps           ', &
-            s%stats%steps, '   rhs evals ', s%stats%rhs_evals, '   jacobians ', &
-            s%stats%jac_evals, '   error-test fails ', s%stats%err_test_fails
+        line = '  steps           '//int_text(s%stats%steps)//'   rhs evals '// &
+            int_text(s%stats%rhs_evals)
+        if (s%stats%jac_evals > 0) line = line//'   jacobians '//int_text(s%stats%jac_evals)
+        if (s%stats%err_test_fails > 0) line = line//'   error-test fails '// &
+            int_text(s%stats%err_test_fails)
+        write (output_unit, '(a)') line
         write (output_unit, '(a, f10.4, a)') '  cpu time        ', s%cpu_time, ' s'
-        write (output_unit, '(a, i0, a)') '  newton          '// &
+        if (s%stats%lin_setups > 0) write (output_unit, '(a, i0, a)') '  newton          '// &
             trim(merge('reduced (second-order) matrix', 'first-order matrix           ', &
                        s%stats%reduced_newton))//', ', s%stats%lin_setups, ' factorizations'
         if (scene%solver%profile) write (output_unit, '(a, 5(a, f9.4))') &
@@ -123,14 +134,40 @@ contains
             '  factor ', s%stats%time_factor, '  solve ', s%stats%time_solve, '  rest ', &
             s%stats%time_advance - (s%stats%time_rhs + s%stats%time_jac + &
                                     s%stats%time_factor + s%stats%time_solve)
-        call print_switches(s)
-        write (output_unit, '(a, 5(es13.5))') '  energy (J)      kinetic, elastic, '// &
-            'gravity, dissipated, total:'
+        call print_switches(scene, s, verbose)
+        call print_energies(s)
+        call print_safety(s)
+        write (output_unit, '(a)') '  output          '//s%file
+    end subroutine print_summary
+
+    !> The energies at the end and the balance: every term it sums named, in J and in units
+    !! of m g L (the rope's weight times its length) when there is gravity.
+    subroutine print_energies(s)
+        type(run_summary_t), intent(in) :: s
+        character(len=16) :: number
+        character(len=:), allocatable :: terms
+        real(wp) :: e0, balance
+        e0 = s%initial_energy%balance()
+        balance = s%final_energy%balance() - e0
+        write (output_unit, '(a)') '  energy (J)      kinetic, elastic, gravity, dissipated, '// &
+            'external work:'
         write (output_unit, '(a, 5(es13.5))') '                  ', s%final_energy%kinetic, &
             s%final_energy%elastic, s%final_energy%gravity, s%final_energy%dissipated, &
-            s%final_energy%total()
-        write (output_unit, '(a, es13.5, a, es10.2, a)') '  E0              ', e0, &
-            ' J   balance error (T+V+dissipated-E0) ', drift, ' J'
+            s%final_energy%support_work
+        write (output_unit, '(a, es13.5, a)') '  E0              ', e0, ' J'
+        write (number, '(es10.2)') balance
+        terms = ' = kinetic + elastic + gravity + dissipated - work - E0'
+        if (s%weight_length > 0.0_wp) then
+            write (output_unit, '(a, es9.2, a)') '  balance error   '//trim(adjustl(number))// &
+                ' J (', balance/s%weight_length, ' m g L)'//terms
+        else
+            write (output_unit, '(a)') '  balance error   '//trim(adjustl(number))//' J'//terms
+        end if
+    end subroutine print_energies
+
+    !> What the order safety did, a line for each kind of action.
+    subroutine print_safety(s)
+        type(run_summary_t), intent(in) :: s
         associate (r => s%safety)
             if (r%lowered_at >= 0.0_wp) write (output_unit, &
                 '(a, es10.3, a, es10.3, a, i0, a, i0, a, f9.4, a)') &
@@ -145,8 +182,7 @@ contains
                 r%kept_at, ' s: '//r%kept_reason//'; the order kept ('// &
                 times_text(r%kept_count)//')'
         end associate
-        write (output_unit, '(a)') '  output          '//s%file
-    end subroutine print_summary
+    end subroutine print_safety
 
     !> 'once', 'twice', 'n times'.
     pure function times_text(n) result(text)
@@ -162,21 +198,58 @@ contains
         end select
     end function times_text
 
-    !> The integrator's changes of method or order limit, one line each; those that are
-    !! warnings (a crawl cured by a lower order) once more on stderr.
-    subroutine print_switches(s)
+    !> The methods the run used, as one line: 'auto: erk 4 -> erk 5 -> erk 4 (2 switches)';
+    !! with `verbose` each switch on a line with its time and reason. The switches that are
+    !! warnings (a crawl cured by a lower order) also go to stderr, once.
+    subroutine print_switches(scene, s, verbose)
+        type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(in) :: s
+        logical, intent(in) :: verbose
         integer :: k
         character(len=80) :: head
         if (.not. allocated(s%switches)) return
+        if (size(s%switches) == 0) return
+        if (verbose) then
+            do k = 1, size(s%switches)
+                associate (e => s%switches(k))
+                    write (head, '(a, f10.4, a, i0, a)') '  switch  t = ', e%t, ' s  '// &
+                        trim(e%method)//' (max order ', e%max_order, ')'
+                    write (output_unit, '(a)') trim(head)//': '//e%reason
+                end associate
+            end do
+        else
+            write (output_unit, '(a)') '  methods         '//trim(scene%solver%method)//': '// &
+                method_chain(s%switches)
+        end if
         do k = 1, size(s%switches)
-            associate (e => s%switches(k))
-                write (head, '(a, f10.4, a, i0, a)') '  switch  t = ', e%t, ' s  '// &
-                    trim(e%method)//' (max order ', e%max_order, ')'
-                write (output_unit, '(a)') trim(head)//': '//e%reason
-                if (e%warning) write (error_unit, '(a, f10.4, a)') 'warning: at t = ', e%t, &
-                    ' s: '//e%reason
-            end associate
+            if (s%switches(k)%warning) write (error_unit, '(a, f10.4, a)') 'warning: at t = ', &
+                s%switches(k)%t, ' s: '//s%switches(k)%reason
         end do
     end subroutine print_switches
+
+    !> 'erk 4 -> erk 5 -> erk 4 (2 switches; ropedyn run -v lists them)': the method and
+    !! order limit in use after each event; of a long chain the first three and the last.
+    pure function method_chain(events) result(text)
+        type(switch_event_t), intent(in) :: events(:)
+        character(len=:), allocatable :: text
+        integer, parameter :: MOST = 5
+        integer :: k, n
+        n = size(events)
+        text = label(events(1))
+        do k = 2, n
+            if (n > MOST .and. k > 3 .and. k < n) then
+                if (k == 4) text = text//' -> ...'
+                cycle
+            end if
+            text = text//' -> '//label(events(k))
+        end do
+        if (n == 2) text = text//' (1 switch; ropedyn run -v lists it)'
+        if (n > 2) text = text//' ('//int_text(n - 1)//' switches; ropedyn run -v lists them)'
+    contains
+        pure function label(e) result(t)
+            type(switch_event_t), intent(in) :: e
+            character(len=:), allocatable :: t
+            t = trim(e%method)//' '//int_text(e%max_order)
+        end function label
+    end function method_chain
 end module ropedyn_cmd_run

@@ -62,6 +62,9 @@ module ropedyn_run
         type(switch_event_t), allocatable :: switches(:)
         character(len=:), allocatable :: file
         type(safety_record_t) :: safety    !< what the order safety did
+        !> m g L: the rope's weight (with its point masses) times its length, the unit in
+        !! which the summary states the energy balance; 0 without gravity, J
+        real(wp) :: weight_length = 0.0_wp
     end type run_summary_t
 
     !> A run of one scene (see the module header for the order of the steps).
@@ -156,6 +159,7 @@ contains
         if (allocated(err)) return
         n = self%model%n_elements()
         self%nq = self%model%quad_size()
+        self%summary%weight_length = weight_length(scene, self%model)
         allocate (self%y(self%model%size()), self%yq(max(1, self%nq)))
         allocate (self%q(3, n), self%qdot(3, n), self%points(2, 2*n))
         self%dt = scene%solver%output_interval
@@ -382,6 +386,18 @@ contains
         if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
         call self%integrator%finalize()
     end subroutine run_finish
+
+    !> m g L of a scene's rope (its model's element masses), J; 0 without gravity.
+    function weight_length(scene, model) result(mgl)
+        type(scene_t), intent(in) :: scene
+        class(rope_model_t), intent(in) :: model
+        real(wp) :: mgl
+        real(wp) :: lengths(model%n_elements()), masses(model%n_elements())
+        mgl = 0.0_wp
+        if (.not. scene%effects%gravity) return
+        call model%element_data(lengths, masses)
+        mgl = sum(masses)*scene%rope%gravity*scene%rope%length
+    end function weight_length
 
     !> Whether every output time has been recorded.
     pure logical function run_done(self)

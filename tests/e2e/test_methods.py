@@ -61,7 +61,7 @@ def test_auto_records_its_choice(run, tmp_path):
     assert methods[0] == "erk" and times[0] == 0.0
     assert "adams" not in methods
     assert "spectral radius" in reasons[0]
-    assert "switch  t =     0.0000 s  erk" in proc.stdout
+    assert "methods         auto: erk 4" in proc.stdout
 
 
 def test_auto_starts_implicit_on_the_steel_wire(run, tmp_path):
@@ -348,5 +348,5 @@ def test_erk_closes_the_energy_balance_through_impacts(run, tmp_path):
                         "solver.t_end=0.8", "solver.output_interval=0.01")
     assert proc.returncode == 0, proc.stderr
     line = [x for x in proc.stdout.splitlines() if "balance error" in x][0]
-    balance = float(line.split()[-2])
+    balance = float(line.split()[2])
     assert abs(balance) <= 40 * 1e-6 * 0.5, line

@@ -1,0 +1,65 @@
+"""The run summary says what matters: the methods of a switching run on one line (every
+switch with -v), counters that applied only, the balance with every term it sums, in J and
+in units of m g L."""
+import re
+
+import h5py
+import numpy as np
+
+from conftest import ROOT
+
+PAPER = ROOT / "input" / "paper.nml"
+
+
+def summary(run, *sets, verbose=False):
+    args = ["run", PAPER, "--set", "output.file='s.h5'", "--set", "output.progress=.false."]
+    for s in sets:
+        args += ["--set", s]
+    if verbose:
+        args.append("-v")
+    proc = run(*args)
+    assert proc.returncode == 0, proc.stderr
+    return proc.stdout
+
+
+def test_switches_on_one_line_and_all_with_verbose(run, tmp_path):
+    short = summary(run, "solver.t_end=2")
+    with h5py.File(tmp_path / "s.h5") as f:
+        n = f["solver/switch_time"].shape[0]
+        first = f["solver/switch_method"][0].decode().strip("\0 ")
+    assert n > 2
+    lines = [x for x in short.splitlines() if x.startswith("  methods ")]
+    assert len(lines) == 1 and "  switch  t =" not in short
+    assert lines[0].startswith(f"  methods         auto: {first} ")
+    assert f"({n - 1} switches; ropedyn run -v lists them)" in lines[0]
+    full = summary(run, "solver.t_end=2", verbose=True)
+    assert len(re.findall(r"^  switch  t = ", full, re.M)) == n
+    assert "  methods " not in full
+
+
+def test_counters_that_did_not_apply_are_left_out(run):
+    explicit = summary(run, "solver.method='erk'", "solver.t_end=0.2")
+    assert "jacobians" not in explicit and "factorizations" not in explicit
+    assert "newton" not in explicit
+    implicit = summary(run, "solver.method='mebdf'", "solver.t_end=0.2")
+    assert re.search(r"jacobians \d+", implicit)
+    assert re.search(r"newton .*, \d+ factorizations", implicit)
+
+
+def test_balance_names_its_terms_in_joules_and_m_g_l(run, tmp_path):
+    out = summary(run, "solver.t_end=1", "solver.rtol=1e-3")
+    line = [x for x in out.splitlines() if "balance error" in x][0]
+    assert line.endswith("= kinetic + elastic + gravity + dissipated - work - E0")
+    joules = float(line.split()[2])
+    per_mgl = float(re.search(r"\(\s*(\S+) m g L\)", line).group(1))
+    with h5py.File(tmp_path / "s.h5") as f:
+        e = {k: f["energy"][k][()] for k in ("kinetic", "elastic", "gravity", "dissipated",
+                                              "support_work")}
+        balance = e["kinetic"] + e["elastic"] + e["gravity"] + e["dissipated"] \
+            - e["support_work"]
+        mgl = f["rope/element_mass"][()].sum() * 9.81 * 1.0
+    assert abs(joules - (balance[-1] - balance[0])) <= 0.01 * abs(joules) + 1e-300
+    assert abs(per_mgl - joules / mgl) <= 0.01 * abs(joules / mgl)
+    weightless = summary(run, "solver.t_end=0.1", "effects.gravity=.false.")
+    line = [x for x in weightless.splitlines() if "balance error" in x][0]
+    assert "m g L" not in line and line.split()[3] == "J"
