@@ -18,6 +18,7 @@ program ropedyn_main
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use ropedyn_error, only: error_t, make_error, ERR_USAGE, exit_code_of
     use ropedyn_version, only: version_string
+    use ropedyn_text, only: name_hint, text_t, append_text
     use ropedyn_cli, only: cli_t, cli_from_command_line
     use ropedyn_cmd_run, only: run_command
     use ropedyn_cmd_testset, only: testset_command
@@ -55,11 +56,25 @@ program ropedyn_main
     case ('keys')
         call keys_command(cli, err)
     case default
-        call make_error(err, ERR_USAGE, 'unknown command "'//cli%command// &
-                        '" (see ropedyn --help)')
+        call make_error(err, ERR_USAGE, 'unknown command "'//cli%command//'"'// &
+                        name_hint(commands(), cli%command, 'commands')//' (see ropedyn --help)')
     end select
     if (allocated(err)) then
         write (error_unit, '(a)') 'ropedyn: error: '//err%message
         stop exit_code_of(err%code), quiet=.true.
     end if
+
+contains
+
+    !> The subcommands, for a near miss's hint.
+    function commands() result(list)
+        type(text_t), allocatable :: list(:)
+        character(len=*), parameter :: NAMES(*) = [character(len=7) :: 'run', 'sweep', &
+            'statics', 'modes', 'testset', 'keys', 'version', 'help']
+        integer :: k
+        allocate (list(0))
+        do k = 1, size(NAMES)
+            call append_text(list, trim(NAMES(k)))
+        end do
+    end function commands
 end program ropedyn_main

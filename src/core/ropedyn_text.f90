@@ -6,6 +6,7 @@ module ropedyn_text
     implicit none
     private
     public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, enclosed
+    public :: significant_text
     public :: lower, line_quote
     public :: text_t, append_text, text_array, printable, clip, name_hint
 
@@ -104,6 +105,28 @@ contains
         end if
         if (negative) s = '-'//s
     end function real_text
+
+    !> x rounded to `digits` significant digits, as real_text writes that number: a
+    !! measured or derived value without the noise of its last binary digits
+    !! (0.09168699999999999 -> '0.091687' with 6).
+    function significant_text(x, digits, compact) result(s)
+        real(wp), intent(in) :: x
+        integer, intent(in) :: digits
+        logical, intent(in), optional :: compact
+        character(len=:), allocatable :: s
+        character(len=40) :: buf
+        character(len=16) :: fmt
+        real(wp) :: y
+        integer :: ios
+        y = x
+        if (ieee_is_finite(x) .and. abs(x) > 0.0_wp) then
+            write (fmt, '(a, i0, a)') '(es40.', max(digits, 1) - 1, 'e3)'
+            write (buf, fmt) x
+            read (buf, *, iostat=ios) y
+            if (ios /= 0) y = x
+        end if
+        s = real_text(y, compact)
+    end function significant_text
 
     !> x with `decimals` digits after the point and a digit before it ('12.3', '0.5000',
     !! '-0.1200').
@@ -259,10 +282,12 @@ contains
         grown(n + 1)%s = value
         call move_alloc(grown, list)
     end subroutine append_text
-    !> '; did you mean "x"?' for a near miss of one of `names`, else '; keys: ' and the list.
-    function name_hint(names, key) result(text)
+    !> '; did you mean "x"?' for a near miss of one of `names`, else '; keys: ' (or
+    !! '; WHAT: ') and the list.
+    function name_hint(names, key, what) result(text)
         type(text_t), intent(in) :: names(:)
         character(len=*), intent(in) :: key
+        character(len=*), intent(in), optional :: what
         character(len=:), allocatable :: text
         integer :: k, d, best, best_k
         best = huge(1)
@@ -280,6 +305,8 @@ contains
         end do
         if (best_k > 0 .and. best <= 2) then
             text = '; did you mean "'//names(best_k)%s//'"?'
+        else if (present(what)) then
+            text = '; '//what//': '//text
         else
             text = '; keys: '//text
         end if

@@ -323,19 +323,24 @@ contains
     end function scene_namelist_text
 
     !> The listing of `ropedyn keys`: a header and one line per key (tab-separated group,
-    !! key, type, unit, default, allowed values, meaning).
-    function scene_key_listing() result(lines)
+    !! key, type, unit, default, allowed values, meaning); with `group`, that group's keys
+    !! only (an unknown group: the header alone).
+    function scene_key_listing(group) result(lines)
+        character(len=*), intent(in), optional :: group
         type(text_t), allocatable :: lines(:)
         type(scene_t), target :: scene
         type(scene_key_t), allocatable :: keys(:)
         character(len=1), parameter :: TAB = achar(9)
         integer :: k
         call bind_keys(scene, keys)
-        allocate (lines(size(keys) + 1))
-        lines(1)%s = 'group'//TAB//'key'//TAB//'type'//TAB//'unit'//TAB//'default'//TAB// &
-            'allowed'//TAB//'meaning'
+        allocate (lines(0))
+        call append_text(lines, 'group'//TAB//'key'//TAB//'type'//TAB//'unit'//TAB// &
+                         'default'//TAB//'allowed'//TAB//'meaning')
         do k = 1, size(keys)
-            lines(k + 1)%s = keys(k)%listing(trim(GROUP_NAMES(keys(k)%group)))
+            if (present(group)) then
+                if (trim(GROUP_NAMES(keys(k)%group)) /= group) cycle
+            end if
+            call append_text(lines, keys(k)%listing(trim(GROUP_NAMES(keys(k)%group))))
         end do
     end function scene_key_listing
 end module ropedyn_scene

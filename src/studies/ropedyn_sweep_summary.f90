@@ -10,7 +10,8 @@
 module ropedyn_sweep_summary
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_text, only: int_text, real_text, enclosed, text_t, append_text
+    use ropedyn_text, only: int_text, real_text, significant_text, enclosed, text_t, &
+                            append_text
     use ropedyn_error, only: error_t, make_error, ERR_IO
     use ropedyn_sweep, only: sweep_t, sweep_case_t, REF_NONE, &
         REF_TIGHTEST_PER_METHOD, REF_FILE
@@ -314,14 +315,15 @@ contains
         close (unit)
     end subroutine write_csv
 
-    !> A real for the table: empty when NaN.
+    !> A measured or derived real for the table: six significant digits (no noise of the
+    !! last binary digits: 0.091687, not 0.09168699999999999); empty when NaN.
     function num(x) result(s)
         real(wp), intent(in) :: x
         character(len=:), allocatable :: s
         if (ieee_is_nan(x)) then
             s = ''
         else
-            s = real_text(x, compact=.true.)
+            s = significant_text(x, 6, compact=.true.)
         end if
     end function num
 

@@ -115,3 +115,23 @@ def test_unwritable_output(run, tmp_path):
     result = run("run", "w.nml")
     assert result.returncode == 4, result.stderr
     assert "blocker/run.h5" in result.stderr
+
+
+def test_a_near_miss_of_a_command_or_group_gets_a_suggestion(run):
+    near = run("runn", "x.nml")
+    assert near.returncode == 2
+    assert 'unknown command "runn"; did you mean "run"?' in near.stderr
+    far = run("frobnicate")
+    assert far.returncode == 2 and "commands: run, sweep, statics" in far.stderr
+    group = run("keys", "rop")
+    assert group.returncode == 2 and 'no group "rop"; did you mean "rope"?' in group.stderr
+
+
+def test_keys_of_one_group(run):
+    whole = run("keys").stdout.splitlines()
+    rope = run("keys", "rope")
+    assert rope.returncode == 0, rope.stderr
+    lines = rope.stdout.splitlines()
+    assert lines[0] == whole[0]
+    assert lines[1:] == [x for x in whole[1:] if x.split("\t")[0] == "rope"]
+    assert len(lines) > 5
