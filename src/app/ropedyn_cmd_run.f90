@@ -10,6 +10,7 @@ module ropedyn_cmd_run
     use ropedyn_scene, only: scene_t, read_scene, read_scene_text
     use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_simulation, only: run_summary_t, run_scene
+    use ropedyn_scene_warnings, only: print_warnings
     use ropedyn_version, only: version_string
     implicit none
     private
@@ -52,12 +53,14 @@ contains
             end if
             call resume_scene(resume_path, cli%scene_overrides(), scene, err)
             if (allocated(err)) return
+            call print_warnings(scene)
             call run_scene(scene, summary, err, resume=.true.)
         else
             call cli%require(cli%scene_path, 'a scene file', err)
             if (allocated(err)) return
             call read_scene(cli%scene_path, cli%scene_overrides(), scene, err)
             if (allocated(err)) return
+            call print_warnings(scene)
             call run_scene(scene, summary, err)
         end if
         if (summary%records > 0) call print_summary(scene, summary, verbose)

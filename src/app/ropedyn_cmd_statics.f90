@@ -8,6 +8,7 @@ module ropedyn_cmd_statics
     use ropedyn_cli, only: cli_t
     use ropedyn_help, only: print_help
     use ropedyn_scene, only: scene_t, read_scene
+    use ropedyn_scene_warnings, only: print_warnings
     use ropedyn_statics, only: statics_options_t
     use ropedyn_analysis, only: run_analysis, DEFAULT_MODE_COUNT
     implicit none
@@ -54,6 +55,7 @@ contains
         if (allocated(err)) return
         call read_scene(cli%scene_path, cli%scene_overrides(), scene, err)
         if (allocated(err)) return
+        call print_warnings(scene)
         call run_analysis(command, scene, options, count, out_path, err)
     end subroutine analysis_command
 

@@ -10,8 +10,8 @@ module ropedyn_scene_checks
     use ropedyn_text, only: int_text, real_text, pair_text, lower
     use ropedyn_os, only: absolute_path
     use ropedyn_methods, only: METHODS, method_index, resolved_max_order
-    use ropedyn_rope_spec, only: N_ATTACH
-    use ropedyn_rope_section, only: tangential_damping_of
+    use ropedyn_rope_spec, only: N_ATTACH, NOT_SET
+    use ropedyn_rope_section, only: resolved_rope, section_set_given
     use ropedyn_motion_table, only: read_motion_table
     use ropedyn_scene_types, only: scene_t
     use ropedyn_scene_key, only: scene_key_t
@@ -40,6 +40,8 @@ contains
                 return
             end if
         end do
+        call check_rope_sets(keys, scene, err)
+        if (allocated(err)) return
         call check_supports(keys, scene, err)
         if (allocated(err)) return
         call check_motion(keys, scene, 'top', scene%supports%top_table_rows, err)
@@ -58,6 +60,66 @@ contains
         if (allocated(err)) return
         call check_limits(keys, scene, err)
     end subroutine check_scene
+
+    !> &rope is given by one of its two sets (ropedyn_rope_section): a key of the solid-rod
+    !! set given with the section set is an error naming both; the section set needs its
+    !! mass per length and EA. With the section set the solid-rod values are not set (NaN),
+    !! so that the effective scene says so.
+    subroutine check_rope_sets(keys, scene, err)
+        type(scene_key_t), intent(in) :: keys(:)
+        type(scene_t), intent(inout) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        character(len=*), parameter :: SOLID(6) = [character(len=18) :: 'density', &
+            'young_modulus', 'shear_modulus', 'normal_damping', 'tangential_damping', &
+            'shape_factor']
+        character(len=*), parameter :: SECTION(7) = [character(len=17) :: 'mass_per_length', &
+            'axial_stiffness', 'bending_stiffness', 'shear_stiffness', 'axial_damping', &
+            'shear_damping', 'bending_damping']
+        integer :: a, b, ka, kb
+        if (.not. section_set_given(scene%rope)) return
+        do a = 1, size(SOLID)
+            ka = find_key(keys, G_ROPE, trim(SOLID(a)))
+            if (.not. keys(ka)%given) cycle
+            do b = 1, size(SECTION)
+                kb = find_key(keys, G_ROPE, trim(SECTION(b)))
+                if (keys(kb)%given) exit
+            end do
+            b = min(b, size(SECTION))
+            call fail(keys, G_ROPE, trim(SOLID(a)), keys(ka)%value_text(), 'a key of the '// &
+                'solid-rod set, but '//trim(SECTION(b))//' = '//keys(kb)%value_text()// &
+                ' gives the section set: give one set (solid rod: density, young_modulus, '// &
+                'shear_modulus, normal_damping, tangential_damping, shape_factor; section: '// &
+                'mass_per_length, axial_stiffness, bending_stiffness, shear_stiffness and '// &
+                'the dampings)', err)
+            return
+        end do
+        do b = 1, 2
+            kb = find_key(keys, G_ROPE, trim(SECTION(b)))
+            if (keys(kb)%given) cycle
+            call fail(keys, G_ROPE, trim(SECTION(b)), 'not set', 'needed with the section '// &
+                'set (given: '//given_section_keys()//')', err)
+            return
+        end do
+        associate (r => scene%rope)
+            r%density = NOT_SET
+            r%young_modulus = NOT_SET
+            r%shear_modulus = NOT_SET
+            r%normal_damping = NOT_SET
+            r%tangential_damping = NOT_SET
+            r%shape_factor = NOT_SET
+        end associate
+    contains
+        function given_section_keys() result(list)
+            character(len=:), allocatable :: list
+            integer :: k
+            list = ''
+            do k = 1, size(SECTION)
+                if (.not. keys(find_key(keys, G_ROPE, trim(SECTION(k))))%given) cycle
+                if (len(list) > 0) list = list//', '
+                list = list//trim(SECTION(k))
+            end do
+        end function given_section_keys
+    end subroutine check_rope_sets
 
     subroutine check_supports(keys, scene, err)
         type(scene_key_t), intent(in) :: keys(:)
@@ -288,17 +350,16 @@ contains
         end associate
     end subroutine check_solver
 
-    !> The derived defaults: tangential damping (eq. 13 of the paper) when not given, and
-    !! the output file out/<scene file name without .nml>.h5 when empty.
+    !> The derived defaults: those of the rope's set (resolved_rope: tangential damping, eq.
+    !! 13 of the paper; the section set's EI, joint shear stiffness and dampings), and the
+    !! output file out/<scene file name without .nml>.h5 when empty.
     subroutine resolve_defaults(keys, scene, err)
         type(scene_key_t), intent(in) :: keys(:)
         type(scene_t), intent(inout) :: scene
         type(error_t), allocatable, intent(out) :: err
         character(len=:), allocatable :: base
         integer :: slash
-        associate (r => scene%rope)
-            r%tangential_damping = tangential_damping_of(r)
-        end associate
+        scene%rope = resolved_rope(scene%rope)
         if (len_trim(scene%output%file) == 0) then
             slash = index(scene%path, '/', back=.true.)
             base = scene%path(slash + 1:)

@@ -29,6 +29,9 @@ module ropedyn_scene_keys
 
     character(len=*), parameter :: SUPPORTS = 'pinned, clamped, free'
     character(len=*), parameter :: NSM2 = 'N s/m^2'
+    !> The "not set" texts of the two sets of &rope.
+    character(len=*), parameter :: SECTION_GIVEN = 'not set: the section set is given'
+    character(len=*), parameter :: SOLID_ROD = 'not set: the solid-rod set is used'
 
 contains
 
@@ -38,26 +41,47 @@ contains
         type(scene_key_t), allocatable, intent(out) :: keys(:)
         integer :: n
 
-        allocate (keys(98))
+        allocate (keys(120))
         n = 0
         associate (r => scene%rope, m => scene%model, s => scene%supports, &
                 i => scene%initial, e => scene%effects, v => scene%solver, o => scene%output, &
                 f => scene%fluid, g => scene%ground, a => scene%attachments)
             call add_real(G_ROPE, 'length', r%length, R_POSITIVE, 'm', &
                 'unstretched length L of the rope')
-            call add_real(G_ROPE, 'density', r%density, R_POSITIVE, 'kg/m^3', 'mass density')
             call add_real(G_ROPE, 'diameter', r%diameter, R_POSITIVE, 'm', &
-                'diameter d of the circular cross-section')
+                'diameter d of the circular cross-section (section set: hydrodynamic)')
+            call add_real(G_ROPE, 'density', r%density, R_POSITIVE, 'kg/m^3', &
+                'solid rod: mass density', unset=SECTION_GIVEN)
             call add_real(G_ROPE, 'young_modulus', r%young_modulus, R_POSITIVE, 'Pa', &
-                "Young's modulus E")
+                "solid rod: Young's modulus E", unset=SECTION_GIVEN)
             call add_real(G_ROPE, 'shear_modulus', r%shear_modulus, R_POSITIVE, 'Pa', &
-                'shear modulus G')
+                'solid rod: shear modulus G', unset=SECTION_GIVEN)
             call add_real(G_ROPE, 'normal_damping', r%normal_damping, R_NONNEGATIVE, NSM2, &
-                'material damping eta of the axial and bending dampers')
+                'solid rod: damping eta of the axial and bending dampers', unset=SECTION_GIVEN)
             call add_real(G_ROPE, 'tangential_damping', r%tangential_damping, R_NONNEGATIVE, &
-                NSM2, 'damping of the shear dampers', unset='not set: eta G/E (eq. 13)')
+                NSM2, 'solid rod: damping of the shear dampers', &
+                unset='not set: eta G/E (eq. 13), or the section set is given')
             call add_real(G_ROPE, 'shape_factor', r%shape_factor, R_POSITIVE, '-', &
-                'shear shape factor chi (10/9 for a circle)')
+                'solid rod: shear shape factor chi (10/9 for a circle)', unset=SECTION_GIVEN)
+            call add_real(G_ROPE, 'mass_per_length', r%mass_per_length, R_POSITIVE, 'kg/m', &
+                'section set: mass per length', unset=SOLID_ROD)
+            call add_real(G_ROPE, 'axial_stiffness', r%axial_stiffness, R_POSITIVE, 'N', &
+                'section set: axial stiffness EA', unset=SOLID_ROD)
+            call add_real(G_ROPE, 'bending_stiffness', r%bending_stiffness, R_NONNEGATIVE, &
+                'N m^2', 'section set: bending stiffness EI (0: a chain)', &
+                unset='not set: 0 with the section set; else the solid-rod set')
+            call add_real(G_ROPE, 'shear_stiffness', r%shear_stiffness, R_POSITIVE, 'N', &
+                'section set: shear stiffness of the RFEM joint', &
+                unset='not set: axial_stiffness with the section set; else the solid-rod set')
+            call add_real(G_ROPE, 'axial_damping', r%axial_damping, R_NONNEGATIVE, 'N s', &
+                'section set: axial damping coefficient', &
+                unset='not set: 0 with the section set; else the solid-rod set')
+            call add_real(G_ROPE, 'shear_damping', r%shear_damping, R_NONNEGATIVE, 'N s', &
+                'section set: shear damping coefficient', &
+                unset='not set: axial_damping GA/EA with the section set; else the solid rod')
+            call add_real(G_ROPE, 'bending_damping', r%bending_damping, R_NONNEGATIVE, &
+                'N m^2 s', 'section set: bending damping coefficient', &
+                unset='not set: axial_damping EI/EA with the section set; else the solid rod')
             call add_real(G_ROPE, 'gravity', r%gravity, R_NONNEGATIVE, 'm/s^2', &
                 'gravitational acceleration, along +x (down)')
 

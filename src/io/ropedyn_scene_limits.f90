@@ -16,6 +16,7 @@ module ropedyn_scene_limits
     use ropedyn_error, only: error_t
     use ropedyn_text, only: int_text, real_text
     use ropedyn_rope_spec, only: N_ATTACH
+    use ropedyn_rope_section, only: section_t, rope_section
     use ropedyn_scene_types, only: scene_t
     use ropedyn_scene_key, only: scene_key_t, T_INT, T_REAL, T_LIST
     use ropedyn_scene_keys, only: find_key, fail, group_index, G_MODEL, G_SOLVER
@@ -30,14 +31,16 @@ module ropedyn_scene_limits
     real(wp), parameter :: pi = acos(-1.0_wp)
     integer, parameter :: KL = 40
     ! The keys each derived value depends on.
-    character(len=KL), parameter :: MASS_KEYS(3) = [character(len=KL) :: 'rope.density', &
-        'rope.diameter', 'rope.length']
-    character(len=KL), parameter :: STIFF_KEYS(6) = [character(len=KL) :: &
+    character(len=KL), parameter :: MASS_KEYS(4) = [character(len=KL) :: 'rope.density', &
+        'rope.diameter', 'rope.length', 'rope.mass_per_length']
+    character(len=KL), parameter :: STIFF_KEYS(9) = [character(len=KL) :: &
         'rope.young_modulus', 'rope.shear_modulus', 'rope.shape_factor', 'rope.diameter', &
-        'rope.length', 'supports.support_stiffness_factor']
-    character(len=KL), parameter :: DAMP_KEYS(6) = [character(len=KL) :: &
+        'rope.length', 'supports.support_stiffness_factor', 'rope.axial_stiffness', &
+        'rope.shear_stiffness', 'rope.bending_stiffness']
+    character(len=KL), parameter :: DAMP_KEYS(9) = [character(len=KL) :: &
         'rope.normal_damping', 'rope.tangential_damping', 'rope.shape_factor', &
-        'rope.diameter', 'rope.length', 'supports.support_stiffness_factor']
+        'rope.diameter', 'rope.length', 'supports.support_stiffness_factor', &
+        'rope.axial_damping', 'rope.shear_damping', 'rope.bending_damping']
     character(len=KL), parameter :: REACH_KEYS(7) = [character(len=KL) :: &
         'supports.top_anchor', 'rope.length', 'supports.bottom_anchor', 'ground.point', &
         'initial.mode_amplitude', 'supports.top_amplitude', 'supports.bottom_amplitude']
@@ -116,32 +119,31 @@ contains
         type(scene_key_t), intent(in) :: keys(:)
         type(scene_t), intent(in) :: scene
         type(error_t), allocatable, intent(out) :: err
-        real(wp) :: area, second, dl, m_e, mass, reach, speed, c, b, factor, loads, drag, &
-            motion
+        type(section_t) :: sec
+        real(wp) :: dl, m_e, mass, reach, speed, c, b, factor, loads, drag, motion
         logical :: given(N_ATTACH)
         integer :: k
 
         associate (r => scene%rope, s => scene%supports, a => scene%attachments, &
                 f => scene%fluid, g => scene%ground)
-            area = pi*r%diameter**2/4.0_wp
-            second = pi*r%diameter**4/64.0_wp
+            sec = rope_section(r)
             dl = r%length/real(max(scene%model%elements - 1, 1), wp)
             factor = max(1.0_wp, s%support_stiffness_factor)
-            m_e = r%density*area*dl/2.0_wp
+            m_e = sec%mass_per_length*dl/2.0_wp
             call bound(m_e, "an element's mass", 'kg', ELEMENT_KEYS, .true.)
             call bound(m_e*(dl**2/12.0_wp + r%diameter**2/16.0_wp), "an element's rotary " &
                 //'inertia', 'kg m^2', ELEMENT_KEYS, .true.)
             given = .not. ieee_is_nan(a%mass_positions)
-            mass = r%density*area*r%length + sum(a%masses, mask=given)
+            mass = sec%mass_per_length*r%length + sum(a%masses, mask=given)
             call bound(mass, 'the mass', 'kg', TOTAL_KEYS, .false.)
-            c = max(r%young_modulus, r%shear_modulus/r%shape_factor)*area/dl*factor
+            c = max(sec%ea, sec%ga/sec%shape_factor)/dl*factor
             call bound(c, 'a spring constant', 'N/m', SPRING_KEYS, .false.)
-            call bound(r%young_modulus*second/dl*factor, 'a bending spring constant', 'N m', &
-                SPRING_KEYS, .false.)
-            b = max(r%normal_damping, r%tangential_damping/r%shape_factor)*area/dl*factor
+            call bound(sec%ei/dl*factor, 'a bending spring constant', 'N m', SPRING_KEYS, &
+                .false.)
+            b = max(sec%axial_damping, sec%shear_damping/sec%shape_factor)/dl*factor
             call bound(b, 'a damper constant', 'N s/m', DAMPER_KEYS, .false.)
-            call bound(r%normal_damping*second/dl*factor, 'a bending damper constant', &
-                'N m s', DAMPER_KEYS, .false.)
+            call bound(sec%bending_damping/dl*factor, 'a bending damper constant', 'N m s', &
+                DAMPER_KEYS, .false.)
 
             reach = norm2(s%top_anchor) + r%length + abs(scene%initial%mode_amplitude) &
                 + norm2(s%top_amplitude) + norm2(s%bottom_amplitude)

@@ -20,11 +20,19 @@ module ropedyn_rope_spec
     !> A quiet NaN: the value of `bottom_anchor` when it is not given.
     real(wp), parameter :: NOT_SET = transfer(9221120237041090560_i8, 1.0_wp)
 
-    !> `&rope`: material and geometry of the rope (defaults: the paper's rope).
+    !> `&rope`: the rope's length and section, given by one of two sets (defaults: the
+    !! paper's rope). The solid-rod set: density, young_modulus, shear_modulus,
+    !! normal_damping, tangential_damping, shape_factor of a solid round rod of `diameter`.
+    !! The section set, as engineers give a line: mass_per_length, axial_stiffness (EA),
+    !! bending_stiffness (EI), shear_stiffness (of the RFEM joint), axial_damping,
+    !! shear_damping, bending_damping; `diameter` is then the hydrodynamic diameter. A value
+    !! not set is NaN; ropedyn_rope_section resolves the derived defaults of either set.
     type :: rope_params_t
         real(wp) :: length = 1.0_wp             !< rope length [m]
         real(wp) :: density = 6000.0_wp         !< mass density [kg/m^3]
-        real(wp) :: diameter = 0.005_wp         !< diameter of the circular cross-section [m]
+        !> diameter of the circular cross-section [m] (the section set: of the displaced
+        !! volume, for buoyancy, drag and added mass)
+        real(wp) :: diameter = 0.005_wp
         real(wp) :: young_modulus = 35.0e6_wp   !< Young's modulus E [Pa]
         real(wp) :: shear_modulus = 14.0e6_wp   !< shear modulus G [Pa]
         real(wp) :: normal_damping = 1.0e3_wp   !< eta [N s/m^2]
@@ -33,6 +41,16 @@ module ropedyn_rope_spec
         real(wp) :: tangential_damping = NOT_SET
         real(wp) :: shape_factor = 10.0_wp/9.0_wp  !< shear shape factor chi [-]
         real(wp) :: gravity = 9.81_wp           !< gravitational acceleration [m/s^2]
+        ! the section set (NaN: not given)
+        real(wp) :: mass_per_length = NOT_SET    !< [kg/m]
+        real(wp) :: axial_stiffness = NOT_SET    !< EA [N]
+        real(wp) :: bending_stiffness = NOT_SET  !< EI [N m^2]; not set: 0
+        real(wp) :: shear_stiffness = NOT_SET    !< of the RFEM joint [N]; not set: EA
+        real(wp) :: axial_damping = NOT_SET      !< [N s]; not set: 0
+        !> [N s]; not set: axial_damping times shear_stiffness/axial_stiffness
+        real(wp) :: shear_damping = NOT_SET
+        !> [N m^2 s]; not set: axial_damping times bending_stiffness/axial_stiffness
+        real(wp) :: bending_damping = NOT_SET
     end type rope_params_t
 
     !> `&model`: which discretisation and how fine.

@@ -70,7 +70,7 @@ def documented(cell, default):
 
 def test_every_key_documented_with_its_default(run):
     keys = listing(run)
-    assert len(keys) == 89
+    assert len(keys) == 96
     rows = doc_rows()
     missing, wrong = [], []
     for k in keys:

@@ -70,8 +70,8 @@ REGRESSION = "tests/e2e/test_regression.py"
 MUTATIONS = [
     # --- RFEM -----------------------------------------------------------------------------
     Mutation("rfem-shear-damping-eta", SECTION,
-             "s%shear_damping = tangential_damping_of(rope)*s%area",
-             "s%shear_damping = rope%normal_damping*s%area",
+             "s%shear_damping = r%tangential_damping*s%area",
+             "s%shear_damping = r%normal_damping*s%area",
              "shear damper from the normal instead of the tangential constant",
              pytest=(ORACLE, REGRESSION)),
     Mutation("rfem-shear-factor-inverted", RFEM_C,

@@ -1,0 +1,95 @@
+!> Warnings for a scene whose values are legal but probably a unit slip: a diameter in mm
+!! (more than a tenth of the length), a modulus or stiffness in the wrong unit (the static
+!! strain under the rope's own weight above 10 %), a damping coefficient in the wrong unit
+!! (an element's axial damping ratio below 1e-6 or above 1000), air's density for water. Each
+!! warning names the key, its value and why; a run goes ahead.
+module ropedyn_scene_warnings
+    use, intrinsic :: iso_fortran_env, only: error_unit
+    use ropedyn_kinds, only: wp
+    use ropedyn_text, only: text_t, append_text, real_text, significant_text
+    use ropedyn_rope_section, only: section_t, rope_section, section_set_given
+    use ropedyn_scene_types, only: scene_t
+    implicit none
+    private
+    public :: scene_warnings, print_warnings
+
+    !> The bounds of the checks.
+    real(wp), parameter :: MAX_DIAMETER_SHARE = 0.1_wp   !< of the length
+    real(wp), parameter :: MAX_SELF_STRAIN = 0.1_wp      !< under the rope's own weight
+    !> an element's axial damping ratio: the paper's rope, heavily damped by design, has 13 at
+    !! n = 30 and 31 at n = 70; a coefficient in N s/m^2 given as N s, or the reverse, is off
+    !! by the area, 1e4 .. 1e8 for ropes
+    real(wp), parameter :: MIN_DAMPING_RATIO = 1.0e-6_wp, MAX_DAMPING_RATIO = 1.0e3_wp
+    real(wp), parameter :: MIN_WATER_DENSITY = 100.0_wp  !< kg/m^3
+
+contains
+
+    !> Print the scene's warnings on stderr, each once: 'ropedyn: warning: ...'.
+    subroutine print_warnings(scene)
+        type(scene_t), intent(in) :: scene
+        type(text_t), allocatable :: list(:)
+        integer :: k
+        list = scene_warnings(scene)
+        do k = 1, size(list)
+            write (error_unit, '(a)') 'ropedyn: warning: '//list(k)%s
+        end do
+    end subroutine print_warnings
+
+    !> The warnings of a checked scene, each one line: 'FILE: &group: key = value: why'.
+    function scene_warnings(scene) result(list)
+        type(scene_t), intent(in) :: scene
+        type(text_t), allocatable :: list(:)
+        type(section_t) :: sec
+        character(len=:), allocatable :: where
+        real(wp) :: strain, dl, zeta
+        logical :: section
+        allocate (list(0))
+        where = scene%path//': &rope: '
+        sec = rope_section(scene%rope)
+        section = section_set_given(scene%rope)
+        if (scene%rope%diameter > MAX_DIAMETER_SHARE*scene%rope%length) &
+            call append_text(list, where//'diameter = '//real_text(scene%rope%diameter)// &
+                ': more than a tenth of the length ('//real_text(scene%rope%length)// &
+                ' m): a diameter in mm? (the unit is m)')
+        if (scene%effects%gravity .and. scene%effects%tension) then
+            strain = sec%mass_per_length*scene%rope%gravity*scene%rope%length/sec%ea
+            if (strain > MAX_SELF_STRAIN) call append_text(list, where// &
+                trim(merge('axial_stiffness', 'young_modulus  ', section))//' = '// &
+                stiffness_text()//': the rope stretches by '// &
+                significant_text(100.0_wp*strain, 3)//' % under its own weight (m g L / '// &
+                'EA): '//trim(merge('EA in kN?        ', 'a modulus in GPa?', section))// &
+                ' (the unit is '//trim(merge('N ', 'Pa', section))//')')
+        end if
+        if (scene%effects%damping .and. scene%effects%tension .and. sec%axial_damping > 0.0_wp) &
+            then
+            dl = scene%rope%length/real(max(1, scene%model%elements - 1), wp)
+            if (scene%model%kind == 'mpp') dl = scene%rope%length/real(scene%model%elements, wp)
+            ! B/(2 sqrt(K m)) of an element: B = eta_a/dl, K = EA/dl, m = mu dl
+            zeta = sec%axial_damping/(2.0_wp*dl*sqrt(sec%ea*sec%mass_per_length))
+            if (zeta < MIN_DAMPING_RATIO .or. zeta > MAX_DAMPING_RATIO) call append_text(list, &
+                where//trim(merge('axial_damping ', 'normal_damping', section))//' = '// &
+                damping_text()//": an element's axial damping ratio is "// &
+                significant_text(zeta, 3)//' (plausible: '//real_text(MIN_DAMPING_RATIO)// &
+                ' .. '//real_text(MAX_DAMPING_RATIO)//'): a coefficient in the wrong unit? '// &
+                '(the unit is '//trim(merge('N s    ', 'N s/m^2', section))//')')
+        end if
+    contains
+        function stiffness_text() result(text)
+            character(len=:), allocatable :: text
+            if (section) then
+                text = real_text(scene%rope%axial_stiffness)
+            else
+                text = real_text(scene%rope%young_modulus)
+            end if
+        end function stiffness_text
+
+        function damping_text() result(text)
+            character(len=:), allocatable :: text
+            if (section) then
+                text = real_text(scene%rope%axial_damping)
+            else
+                text = real_text(scene%rope%normal_damping)
+            end if
+        end function damping_text
+    end function scene_warnings
+end module ropedyn_scene_warnings

@@ -1,0 +1,139 @@
+"""A line given as engineers give it (&rope's section set: mass per length, EA, EI, the
+joint's shear stiffness, damping coefficients) behaves as the same line given as a solid rod,
+in both models, in a run, in statics and in modes; the two sets do not mix; a chain (EI = 0)
+hangs in both models; values that are legal but probably a unit slip get one warning each."""
+import math
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import ROOT
+
+PAPER = ROOT / "input" / "paper.nml"
+
+# the paper's rope (solid-rod set: E, G, d, rho, eta, eta_bar, chi) as a section
+E, G, D, RHO, ETA, ETA_BAR, CHI = 35.0e6, 14.0e6, 0.005, 6000.0, 1.0e3, 400.0, 10.0 / 9.0
+A, I = math.pi * D ** 2 / 4, math.pi * D ** 4 / 64
+SECTION = {"mass_per_length": RHO * A, "axial_stiffness": E * A,
+           "shear_stiffness": G * A / CHI, "bending_stiffness": E * I,
+           "axial_damping": ETA * A, "shear_damping": ETA_BAR * A / CHI,
+           "bending_damping": ETA * I}
+SOLID_KEYS = ("density", "young_modulus", "shear_modulus", "normal_damping",
+              "tangential_damping", "shape_factor")
+
+
+def section_scene(tmp_path, **extra):
+    """paper.nml with its &rope replaced by the section set (diameter kept)."""
+    text = PAPER.read_text()
+    start = text.index("&rope")
+    end = text.index("\n/", start) + 2
+    values = dict(SECTION, **extra)
+    rope = "&rope length = 1.0, diameter = 0.005, " + ", ".join(
+        f"{k} = {v!r}" for k, v in values.items()) + " /"
+    path = tmp_path / "section.nml"
+    path.write_text(text[:start] + rope + text[end:])
+    return path
+
+
+def states(run, tmp_path, scene, name, *sets):
+    args = ["run", scene, "--set", f"output.file='{name}.h5'", "--set", "output.progress=.false."]
+    for s in sets:
+        args += ["--set", s]
+    proc = run(*args)
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(tmp_path / f"{name}.h5") as f:
+        return f["state/q"][()], f.attrs["scene"].decode()
+
+
+@pytest.mark.parametrize("kind", ["rfem", "mpp"])
+def test_the_paper_rope_as_a_section_runs_as_the_solid_rod(run, tmp_path, kind):
+    sets = [f"model.kind='{kind}'", "model.elements=10", "solver.t_end=0.5",
+            "solver.method='cvode'", "solver.rtol=1e-9", "solver.atol=1e-11"]
+    solid, _ = states(run, tmp_path, PAPER, "solid", *sets)
+    section, scene = states(run, tmp_path, section_scene(tmp_path), "section", *sets)
+    # the same constants up to the rounding of their products: the same motion to the
+    # integration error
+    assert np.max(np.abs(solid - section)) < 1e-7
+    # the effective scene says which set it used
+    for key in SOLID_KEYS:
+        assert f"! {key} = (not set" in scene, key
+    assert "mass_per_length = " in scene and "! mass_per_length" not in scene
+
+
+@pytest.mark.parametrize("command,dataset", [("statics", "rope/points"), ("modes", "modes/omega")])
+def test_statics_and_modes_honour_the_section(run, tmp_path, command, dataset):
+    results = []
+    for scene in (PAPER, section_scene(tmp_path)):
+        out = tmp_path / f"{command}_{scene.stem}.h5"
+        proc = run(command, scene, "--set", "model.elements=12", "-o", out)
+        assert proc.returncode == 0, proc.stderr
+        with h5py.File(out) as f:
+            results.append(f[dataset][()])
+    assert np.allclose(results[0], results[1], rtol=1e-9, atol=1e-12)
+
+
+def test_the_two_sets_do_not_mix(run, tmp_path):
+    scene = section_scene(tmp_path)
+    mixed = run("run", scene, "--set", "rope.density=7800")
+    assert mixed.returncode == 2
+    assert ("&rope: density = 7800.0: a key of the solid-rod set, but mass_per_length = "
+            in mixed.stderr), mixed.stderr
+    (tmp_path / "half.nml").write_text("&rope mass_per_length = 0.1 /\n&model /\n")
+    half = run("run", "half.nml")
+    assert half.returncode == 2
+    assert "&rope: axial_stiffness = not set: needed with the section set" in half.stderr
+
+
+def test_derived_defaults_of_the_section_set(run, tmp_path):
+    (tmp_path / "line.nml").write_text(
+        "&rope length = 2.0, mass_per_length = 0.5, axial_stiffness = 1.0e5,"
+        " bending_stiffness = 2.0, axial_damping = 10.0, diameter = 0.01 /\n"
+        "&model elements = 6 /\n&solver t_end = 0.01 /\n")
+    assert run("run", "line.nml", "--set", "output.file='l.h5'").returncode == 0
+    with h5py.File(tmp_path / "l.h5") as f:
+        rope = f.attrs["scene"].decode().split("\n/")[0]
+    values = {line.split("=")[0].strip(): float(line.split("=")[1])
+              for line in rope.splitlines() if "=" in line and "!" not in line}
+    assert values["shear_stiffness"] == 1.0e5                  # EA
+    assert values["shear_damping"] == 10.0                     # axial_damping GA/EA
+    assert abs(values["bending_damping"] - 10.0 * 2.0 / 1.0e5) < 1e-18   # axial_damping EI/EA
+
+
+@pytest.mark.parametrize("kind", ["rfem", "mpp"])
+def test_a_chain_without_bending_stiffness_hangs(run, tmp_path, kind):
+    (tmp_path / "chain.nml").write_text(
+        "&rope length = 3.0, mass_per_length = 0.0818, axial_stiffness = 1.0e4,"
+        " bending_stiffness = 0.0, diameter = 0.003654 /\n"
+        f"&model kind = '{kind}', elements = 15 /\n"
+        "&supports bottom = 'pinned', bottom_anchor = 0.5, 2.0 /\n"
+        "&initial shape = 'hanging' /\n")
+    proc = run("statics", "chain.nml", "-o", "c.h5")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(tmp_path / "c.h5") as f:
+        assert f["statics/residual_relative"][()] < 1e-8
+        # a catenary between (0, 0) and (0.5, 2.0): the lowest point below the chord
+        points = f["rope/points"][0]
+    assert points[:, 0].max() > 0.5
+
+
+@pytest.mark.parametrize("sets,fragment", [
+    (["rope.diameter=5"], "&rope: diameter = 5.0: more than a tenth of the length"),
+    (["rope.young_modulus=200"], "&rope: young_modulus = 200.0: the rope stretches by"),
+    (["rope.normal_damping=1e9"], "&rope: normal_damping = 1.0e9: an element's axial damping"),
+    (["rope.normal_damping=1e-9"], "&rope: normal_damping = 1.0e-9: an element's axial damping"),
+])
+def test_a_probable_unit_slip_gets_one_warning(run, tmp_path, sets, fragment):
+    args = ["run", PAPER, "--set", "solver.t_end=1e-4", "--set", "solver.output_interval=1e-4",
+            "--set", "output.file='w.h5'"]
+    for s in sets:
+        args += ["--set", s]
+    proc = run(*args)
+    warnings = [x for x in proc.stderr.splitlines() if x.startswith("ropedyn: warning: ")]
+    assert len(warnings) == 1 and fragment in warnings[0], proc.stderr
+
+
+def test_the_shipped_paper_scene_has_no_warning(run, tmp_path):
+    proc = run("run", PAPER, "--set", "solver.t_end=1e-4", "--set", "solver.output_interval=1e-4",
+               "--set", "output.file='w.h5'")
+    assert proc.returncode == 0 and "warning" not in proc.stderr, proc.stderr
