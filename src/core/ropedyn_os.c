@@ -130,3 +130,34 @@ int ropedyn_try_lock(const char *path)
     close(fd);
     return rc;
 }
+
+/* Room kept on the file system for the file `path`: its blocks from offset 0 to its end
+ * (or to `end`, when that is further: the writer's idea of it) plus `bytes` allocated
+ * (fallocate, FALLOC_FL_KEEP_SIZE: its size is unchanged), so that writes there cannot fail
+ * for want of space. Returns 0, or errno: ENOSPC (or EDQUOT) when the file system has not
+ * that much room left; EOPNOTSUPP where it cannot reserve. */
+int ropedyn_reserve_space(const char *path, long long end, long long bytes)
+{
+    struct stat st;
+    off_t last;
+    int fd = open(path, O_WRONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY), rc = 0;
+    if (fd < 0) return errno;
+    if (fstat(fd, &st) != 0) rc = errno;
+    last = st.st_size > (off_t)end ? st.st_size : (off_t)end;
+    if (rc == 0 && fallocate(fd, FALLOC_FL_KEEP_SIZE, 0, last + (off_t)bytes) != 0) rc = errno;
+    close(fd);
+    return rc;
+}
+
+/* Give back the room reserved beyond the end of the file `path` (ropedyn_reserve_space).
+ * Returns 0, or errno. */
+int ropedyn_release_space(const char *path)
+{
+    struct stat st;
+    int fd = open(path, O_WRONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY), rc = 0;
+    if (fd < 0) return errno;
+    if (fstat(fd, &st) != 0) rc = errno;
+    else if (ftruncate(fd, st.st_size) != 0) rc = errno;
+    close(fd);
+    return rc;
+}

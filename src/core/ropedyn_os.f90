@@ -14,7 +14,8 @@ module ropedyn_os
               processor_count, absolute_path, utc_timestamp, unwritable_dir, rename_file, &
               delete_file, utc_text
     public :: file_kind, file_kind_name, special_file_reason, errno_text, real_path, &
-              canonical_path, same_file, output_clash, lock_holder, try_lock
+              canonical_path, same_file, output_clash, lock_holder, try_lock, &
+              reserve_space, release_space
     public :: FILE_MISSING, FILE_REGULAR, FILE_DIRECTORY, FILE_FIFO, FILE_CHAR_DEVICE, &
               FILE_BLOCK_DEVICE, FILE_SOCKET, FILE_SYMLINK, FILE_OTHER
 
@@ -23,7 +24,8 @@ module ropedyn_os
         FILE_FIFO = 3, FILE_CHAR_DEVICE = 4, FILE_BLOCK_DEVICE = 5, FILE_SOCKET = 6, &
         FILE_SYMLINK = 7, FILE_OTHER = 8
     !> errno values the callers tell apart (Linux)
-    integer, parameter, public :: ERRNO_ENOENT = 2, ERRNO_EWOULDBLOCK = 11
+    integer, parameter, public :: ERRNO_ENOENT = 2, ERRNO_EWOULDBLOCK = 11, &
+        ERRNO_EFBIG = 27, ERRNO_ENOSPC = 28, ERRNO_EDQUOT = 122
 
     interface
         integer(c_int) function c_mkdir(path, mode) bind(C, name='mkdir')
@@ -92,6 +94,16 @@ module ropedyn_os
             import :: c_char, c_int
             character(kind=c_char), intent(in) :: path(*)
         end function c_try_lock
+        integer(c_int) function c_reserve_space(path, end, bytes) &
+                bind(C, name='ropedyn_reserve_space')
+            import :: c_char, c_int, c_long_long
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_long_long), value :: end, bytes
+        end function c_reserve_space
+        integer(c_int) function c_release_space(path) bind(C, name='ropedyn_release_space')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+        end function c_release_space
     end interface
 
 contains
@@ -231,6 +243,25 @@ contains
     integer function processor_count()
         processor_count = max(1, int(c_get_nprocs()))
     end function processor_count
+
+    !> Keep room on the file system for the file `path`: its blocks to its end (or to `end`
+    !! bytes, the writer's idea of its end, when that is further) and `bytes` beyond
+    !! allocated (its size unchanged), so that writing that much more cannot fail for want
+    !! of space. 0, or the errno: ERRNO_ENOSPC / ERRNO_EDQUOT when there is not that much
+    !! room left; another (e.g. a file system that cannot reserve) when nothing is kept.
+    integer function reserve_space(path, end, bytes)
+        character(len=*), intent(in) :: path
+        integer(int64), intent(in) :: end, bytes
+        reserve_space = int(c_reserve_space(path//c_null_char, int(end, c_long_long), &
+                                            int(bytes, c_long_long)))
+    end function reserve_space
+
+    !> Give back the room that reserve_space kept beyond the end of the file `path`.
+    subroutine release_space(path)
+        character(len=*), intent(in) :: path
+        integer(c_int) :: rc
+        rc = c_release_space(path//c_null_char)
+    end subroutine release_space
 
     ! ---------------------------------------------------------------------------------------
     ! What a path is, and whether two paths are one file (ropedyn_os.c)

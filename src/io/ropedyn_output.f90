@@ -117,6 +117,10 @@ module ropedyn_output
     !! MAX_PENDING records. One HDF5 write per series and record cost a tenth of the paper
     !! run's time (12 datasets); a block of records costs one write per series.
     integer, parameter :: PENDING_BYTES = 2**20, MAX_PENDING = 512
+    !> Room kept free on the file system beyond the end of the file (ropedyn_os reserve_space,
+    !! renewed after every block of records): when it cannot be kept, the disk is all but
+    !! full, and the run stops while there is still room to close the file marked failed.
+    integer(i8), parameter :: RESERVE_BYTES = 2*int(PENDING_BYTES, i8)
 
     !> The values of a series' pending records, one after the other.
     type :: block_t
@@ -145,6 +149,11 @@ module ropedyn_output
         integer, allocatable :: pending_order(:)
         integer :: n_pending = 0
         integer :: capacity = 1
+        !> the I/O error after which the file was given up (`abandon`); later calls return it
+        character(len=:), allocatable :: broken
+        !> bytes of records written to HDF5 since the file was last flushed (held in its
+        !! chunk cache: written to disk at the flush; keep_room keeps room for them)
+        integer(i8) :: unflushed = 0
     contains
         procedure :: create => output_create
         procedure :: append => output_append
@@ -223,6 +232,39 @@ module ropedyn_output
             type(error_t), allocatable, intent(out) :: err
         end subroutine write_pending
 
+        !> After the I/O error `err` (a full disk, a failed device, ...), give the file up: the
+        !! records not written yet are dropped, the status set to 'failed' with err's message
+        !! as the reason while that can still be written, and every object closed (datasets
+        !! before the file, so that nothing is left for the library to flush at exit). err's
+        !! message then says which: '; the file is closed with status failed ...' or '; the
+        !! file is incomplete ...'. Later calls on `self` return that error.
+        module subroutine abandon(self, err)
+            type(output_file_t), intent(inout) :: self
+            type(error_t), allocatable, intent(inout) :: err
+        end subroutine abandon
+
+        !> The error of a call on a file that is not open: the I/O error it was given up
+        !! after (ERR_IO), else ERR_INTERNAL naming `what` (the call).
+        module subroutine not_open(self, what, err)
+            type(output_file_t), intent(in) :: self
+            character(len=*), intent(in) :: what
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine not_open
+
+        !> Flush the file (everything HDF5 holds goes to disk).
+        module subroutine flush_file(self, err)
+            type(output_file_t), intent(inout) :: self
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine flush_file
+
+        !> Keep room beyond the end of the file for what is not flushed yet and RESERVE_BYTES
+        !! more; ERR_IO when the file system has not that much left (nothing when it cannot
+        !! reserve at all).
+        module subroutine keep_room(self, err)
+            type(output_file_t), intent(inout) :: self
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine keep_room
+
         !> The path of the file, or a placeholder if create never succeeded.
         module function file_label(self) result(label)
             type(output_file_t), intent(in) :: self
@@ -276,7 +318,7 @@ contains
 
         call write_contents()
         if (allocated(err)) then
-            call shutdown(self)
+            call abandon(self, err)
         else
             call allocate_pending(self)
         end if
@@ -320,7 +362,8 @@ contains
             if (self%restart_data) call create_state_series(self, err)
             if (allocated(err)) return
 
-            call self%file%flush(err)
+            call flush_file(self, err)
+            if (.not. allocated(err)) call keep_room(self, err)
         end subroutine write_contents
     end subroutine output_create
 
@@ -374,33 +417,34 @@ contains
         integer :: k
 
         if (.not. self%is_open) then
-            call make_error(err, ERR_INTERNAL, &
-                            file_label(self)//': write_stats: file is not open')
+            call not_open(self, 'write_stats', err)
             return
         end if
-        call write_pending(self, err)
-        if (allocated(err)) return
-        counters = counter_values(stats)
-        do k = 1, size(COUNTER_NAMES)
-            call self%file%write('/solver/'//trim(COUNTER_NAMES(k)), counters(k), '1', err)
-            if (allocated(err)) return
-        end do
-        call self%file%write('/solver/cpu_time', cpu_time, 's', err)
-        if (allocated(err)) return
-        times = timer_values(stats)
-        do k = 1, size(TIMER_NAMES)
-            call self%file%write('/solver/'//trim(TIMER_NAMES(k)), times(k), 's', err)
-            if (allocated(err)) return
-        end do
-        call self%file%write('/solver/reduced_newton', merge(1_i8, 0_i8, stats%reduced_newton), &
-                             '1', err)
-        if (allocated(err)) return
-        if (present(t_reached)) then
-            call self%file%write('/solver/t_reached', t_reached, 's', err)
-            if (allocated(err)) return
-        end if
-
-        call self%file%flush(err)
+        steps: block
+            call write_pending(self, err)
+            if (allocated(err)) exit steps
+            counters = counter_values(stats)
+            do k = 1, size(COUNTER_NAMES)
+                call self%file%write('/solver/'//trim(COUNTER_NAMES(k)), counters(k), '1', err)
+                if (allocated(err)) exit steps
+            end do
+            call self%file%write('/solver/cpu_time', cpu_time, 's', err)
+            if (allocated(err)) exit steps
+            times = timer_values(stats)
+            do k = 1, size(TIMER_NAMES)
+                call self%file%write('/solver/'//trim(TIMER_NAMES(k)), times(k), 's', err)
+                if (allocated(err)) exit steps
+            end do
+            call self%file%write('/solver/reduced_newton', merge(1_i8, 0_i8, &
+                                 stats%reduced_newton), '1', err)
+            if (allocated(err)) exit steps
+            if (present(t_reached)) then
+                call self%file%write('/solver/t_reached', t_reached, 's', err)
+                if (allocated(err)) exit steps
+            end if
+            call flush_file(self, err)
+        end block steps
+        if (allocated(err)) call abandon(self, err)
     end subroutine output_write_stats
 
     !> Record what the order safety did (docs/stability.md; times < 0: never): the order
@@ -416,8 +460,7 @@ contains
         type(error_t), allocatable, intent(out) :: err
         if (lowered_at < 0.0_wp .and. kept_at < 0.0_wp) return
         if (.not. self%is_open) then
-            call make_error(err, ERR_INTERNAL, &
-                            file_label(self)//': write_order_safety: file is not open')
+            call not_open(self, 'write_order_safety', err)
             return
         end if
         call self%file%write('/solver/energy_gain', gain, 'J', err)
@@ -435,7 +478,8 @@ contains
             if (.not. allocated(err)) &
                 call self%file%write('/solver/order_kept_count', int(kept_count, i8), '1', err)
         end if
-        if (.not. allocated(err)) call self%file%flush(err)
+        if (.not. allocated(err)) call flush_file(self, err)
+        if (allocated(err)) call abandon(self, err)
     end subroutine output_write_order_safety
 
     !> The time split of `stats` named in TIMER_NAMES, in that order (s).
@@ -483,8 +527,7 @@ contains
 
         if (size(events) == 0) return
         if (.not. self%is_open) then
-            call make_error(err, ERR_INTERNAL, &
-                            file_label(self)//': write_switches: file is not open')
+            call not_open(self, 'write_switches', err)
             return
         end if
         width = 1
@@ -501,12 +544,13 @@ contains
         times = events%t
         orders = int(events%max_order, i8)
         call self%file%write('/solver/switch_time', times, 's', err)
-        if (allocated(err)) return
-        call self%file%write('/solver/switch_max_order', orders, '1', err)
-        if (allocated(err)) return
-        call self%file%write_text('/solver/switch_method', methods, '', err)
-        if (allocated(err)) return
-        call self%file%write_text('/solver/switch_reason', reasons, '', err)
+        if (.not. allocated(err)) call self%file%write('/solver/switch_max_order', orders, &
+                                                       '1', err)
+        if (.not. allocated(err)) call self%file%write_text('/solver/switch_method', methods, &
+                                                            '', err)
+        if (.not. allocated(err)) call self%file%write_text('/solver/switch_reason', reasons, &
+                                                            '', err)
+        if (allocated(err)) call abandon(self, err)
     end subroutine output_write_switches
 
     !> Set the root status ('complete', or 'failed' or 'interrupted' with `reason`) and close
@@ -518,7 +562,7 @@ contains
         type(error_t), allocatable, intent(out) :: err
 
         if (.not. self%is_open) then
-            call make_error(err, ERR_INTERNAL, file_label(self)//': close_run: file is not open')
+            call not_open(self, 'close_run', err)
             return
         end if
         if (status /= 'complete' .and. status /= 'failed' .and. status /= 'interrupted') then
@@ -541,10 +585,10 @@ contains
                 call self%file%attribute('/', 'reason', '(no reason given)', err)
             end if
         end if
-        if (.not. allocated(err)) call self%file%flush(err)
+        if (.not. allocated(err)) call flush_file(self, err)
 
         if (allocated(err)) then
-            call shutdown(self)
+            call abandon(self, err)
         else
             call shutdown(self, err)
         end if

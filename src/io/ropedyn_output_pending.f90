@@ -3,6 +3,7 @@
 !! What a crash can lose is unchanged: pending records are written, and the file flushed,
 !! whenever FLUSH_PERIOD has passed, and before the file is finished or closed.
 submodule (ropedyn_output) ropedyn_output_pending
+    use ropedyn_os, only: reserve_space, errno_text, ERRNO_ENOSPC, ERRNO_EDQUOT
     implicit none
 
 contains
@@ -14,7 +15,7 @@ contains
         logical :: due
 
         if (.not. self%is_open) then
-            call make_error(err, ERR_INTERNAL, file_label(self)//': append: file is not open')
+            call not_open(self, 'append', err)
             return
         end if
         n = self%n_elements
@@ -49,14 +50,12 @@ contains
         call system_clock(now, rate)
         due = self%n_records + m == 1 .or. &
               real(now - self%last_flush, wp) >= FLUSH_PERIOD*real(rate, wp)
-        if (due .or. m == self%capacity) then
-            call write_pending(self, err)
-            if (allocated(err)) return
-        end if
-        if (due) then
-            call self%file%flush(err)
+        if (due .or. m == self%capacity) call write_pending(self, err)
+        if (due .and. .not. allocated(err)) then
+            call flush_file(self, err)
             self%last_flush = now
         end if
+        if (allocated(err)) call abandon(self, err)
 
     contains
 
@@ -140,5 +139,23 @@ contains
         if (allocated(err)) return
         self%n_records = self%n_records + int(m, hsize_t)
         self%n_pending = 0
+        self%unflushed = self%unflushed + 8_i8*m*sum([(size(self%pending(k)%v), &
+                                                       k = 1, N_SERIES + 2)])/self%capacity
+        call keep_room(self, err)
     end procedure write_pending
+
+    module procedure flush_file
+        call self%file%flush(err)
+        if (.not. allocated(err)) self%unflushed = 0
+    end procedure flush_file
+
+    module procedure keep_room
+        integer :: errnum
+        errnum = reserve_space(self%file%file_name(), self%file%size(), &
+                               self%unflushed + RESERVE_BYTES)
+        if (errnum == ERRNO_ENOSPC .or. errnum == ERRNO_EDQUOT) call make_error(err, ERR_IO, &
+            self%file%file_name()//': '//errno_text(errnum)//' (less than '// &
+            int_text(int(RESERVE_BYTES/2**20))//' MiB left: the run stops while the file '// &
+            'can still be closed)')
+    end procedure keep_room
 end submodule ropedyn_output_pending

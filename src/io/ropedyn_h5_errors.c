@@ -1,0 +1,77 @@
+/* Glue for ropedyn_h5.f90, which is the only caller: why an HDF5 call failed, and the
+ * library's end at the exit of the process.
+ *
+ * Why a call failed, in the system's words (h5_reason). The Fortran interface of HDF5
+ * returns only a negative code;
+ * the library's error stack (silenced by ropedyn_h5, not cleared until the next HDF5 call)
+ * holds what happened, and for a failed system call its errno text, e.g.
+ *
+ *     file write failed: ..., errno = 28, error message = 'No space left on device', ...
+ *     unable to lock file, errno = 11, error message = 'Resource temporarily unavailable'
+ *
+ * The reason is that text when a frame has one, else the innermost frame's description. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <hdf5.h>
+
+struct reason {
+    char system[256];   /* the first "error message = '...'" found */
+    char inner[256];    /* the innermost frame's description */
+    int errnum;         /* its "errno = N", or 0 */
+};
+
+static herr_t visit(unsigned n, const H5E_error2_t *frame, void *data)
+{
+    struct reason *r = data;
+    const char *desc = frame->desc ? frame->desc : "";
+    const char *m, *e;
+    if (n == 0) snprintf(r->inner, sizeof r->inner, "%s", desc);
+    if (r->system[0]) return 0;
+    m = strstr(desc, "error message = '");
+    if (m) {
+        m += strlen("error message = '");
+        e = strchr(m, '\'');
+        snprintf(r->system, sizeof r->system, "%.*s", (int)(e ? e - m : (long)strlen(m)), m);
+        e = strstr(desc, "errno = ");
+        if (e) sscanf(e + strlen("errno = "), "%d", &r->errnum);
+    }
+    return 0;
+}
+
+/* The reason of the last failure on HDF5's default error stack in `buf` (`size` bytes,
+ * NUL-terminated; "" when the stack is empty). Returns the errno of a failed system call
+ * found on the stack, or 0. */
+int ropedyn_h5_reason(char *buf, int size)
+{
+    struct reason r;
+    memset(&r, 0, sizeof r);
+    if (size < 1) return 0;
+    H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, visit, &r);
+    snprintf(buf, (size_t)size, "%s", r.system[0] ? r.system : r.inner);
+    return r.errnum;
+}
+
+/* The library's end at exit. HDF5 closes what is still open when the process exits (its
+ * own atexit handler). After a file failed to close (its last flush failed: a full disk),
+ * that file is left half closed, and the library's handler crashed in H5F__close_cb
+ * (SIGSEGV after the error message). ropedyn_h5_prepare, called before the library is
+ * first opened, replaces that handler with one that ends the library only when no close
+ * has failed; ropedyn_h5_close_failed says one has. Without it nothing changes. */
+static int close_failed = 0;
+
+static void end_library(void)
+{
+    if (!close_failed) H5close();
+}
+
+void ropedyn_h5_prepare(void)
+{
+    static int prepared = 0;
+    if (prepared) return;
+    prepared = 1;
+    if (H5dont_atexit() >= 0) atexit(end_library);
+}
+
+void ropedyn_h5_close_failed(void) { close_failed = 1; }
