@@ -16,7 +16,7 @@
 !! fixed-length and null-padded (an empty string is one NUL byte, which readers see as '').
 !! The library is opened with `h5open_f` (idempotent), HDF5's own error printing silenced,
 !! and never closed here: no module state, other HDF5 users undisturbed (HDF5 closes itself
-!! at exit, unless a file failed to close: ropedyn_h5_errors.c). A failure's message ends
+!! at exit, unless a file failed to close: ropedyn_h5_glue.c). A failure's message ends
 !! with the reason from HDF5's error stack (the system's, e.g. 'No space left on device'). An open `h5_file_t` or `h5_series_t` must not be copied (the copies would
 !! share ids); series are closed by their owner before the file.
 !!
@@ -36,7 +36,7 @@ module ropedyn_h5
         h5aexists_f, h5adelete_f, h5aget_type_f, h5tcopy_f, h5tclose_f, h5tset_size_f, &
         h5tget_size_f, h5tset_strpad_f, H5T_NATIVE_CHARACTER, H5T_STR_NULLPAD_F, &
         h5kind_to_type, H5_REAL_KIND, H5_INTEGER_KIND, h5dget_type_f, h5tget_class_f, &
-        H5T_STRING_F, H5T_FLOAT_F, H5T_INTEGER_F
+        H5T_STRING_F, H5T_FLOAT_F, H5T_INTEGER_F, h5tis_variable_str_f
     use ropedyn_kinds, only: wp, i8
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INPUT, ERR_INTERNAL
@@ -109,14 +109,24 @@ module ropedyn_h5
     integer, parameter, public :: SERIES_REAL = 1, SERIES_INTEGER = 2, SERIES_TEXT = 3
 
     interface
-        !> Before the library is first opened: its end at exit (ropedyn_h5_errors.c).
+        !> Before the library is first opened: its end at exit (ropedyn_h5_glue.c).
         subroutine c_h5_prepare() bind(C, name='ropedyn_h5_prepare')
         end subroutine c_h5_prepare
         !> A file or dataset failed to close: the library is not ended at exit.
         subroutine c_h5_close_failed() bind(C, name='ropedyn_h5_close_failed')
         end subroutine c_h5_close_failed
 
-        !> HDF5's reason of its last failure (ropedyn_h5_errors.c).
+        !> A variable-length string attribute (ropedyn_h5_glue.c).
+        integer(c_int) function c_h5_vlen_attribute(loc, name, buf, size) &
+                bind(C, name='ropedyn_h5_vlen_attribute')
+            import :: c_char, c_int, hid_t
+            integer(hid_t), value :: loc
+            character(kind=c_char), intent(in) :: name(*)
+            character(kind=c_char), intent(out) :: buf(*)
+            integer(c_int), value :: size
+        end function c_h5_vlen_attribute
+
+        !> HDF5's reason of its last failure (ropedyn_h5_glue.c).
         integer(c_int) function c_h5_reason(buf, size) bind(C, name='ropedyn_h5_reason')
             import :: c_char, c_int
             character(kind=c_char), intent(out) :: buf(*)
@@ -147,7 +157,7 @@ module ropedyn_h5
         end subroutine h5_error
 
         !> The errno of the system call behind HDF5's last failure (0: none) and, in
-        !! `reason`, that failure in words (ropedyn_h5_errors.c); to be read before the next
+        !! `reason`, that failure in words (ropedyn_h5_glue.c); to be read before the next
         !! HDF5 call, which clears it.
         module function h5_reason(reason) result(errnum)
             character(len=:), allocatable, intent(out), optional :: reason

@@ -213,8 +213,11 @@ contains
         integer(hid_t) :: attr_id, type_id
         integer(size_t) :: length
         integer(hsize_t), parameter :: dims(1) = 1
-        logical :: exists
+        logical :: exists, vlen
         integer :: hdferr, nul, class
+        integer(c_int) :: n
+        character(kind=c_char, len=1) :: small
+        character(kind=c_char, len=:), allocatable :: whole
         character(len=:), allocatable :: label
 
         label = self%path//': attribute '//name
@@ -232,11 +235,27 @@ contains
         call h5aget_type_f(attr_id, type_id, hdferr)
         if (hdferr >= 0) call h5tget_class_f(type_id, class, hdferr)
         if (hdferr >= 0) call h5tget_size_f(type_id, length, hdferr)
+        vlen = .false.
+        if (hdferr >= 0 .and. class == H5T_STRING_F) call h5tis_variable_str_f(type_id, &
+                                                                                vlen, hdferr)
         if (hdferr < 0) then
             call h5_error(err, label//': cannot get its type')
         else if (class /= H5T_STRING_F) then
             call make_error(err, ERR_INPUT, label//': not a string (not written by ropedyn)')
             call h5tclose_f(type_id, hdferr)
+        else if (vlen) then
+            ! a string of variable length (h5py's): read by the C glue
+            call h5tclose_f(type_id, hdferr)
+            n = c_h5_vlen_attribute(self%id, name//c_null_char, small, 1_c_int)
+            if (n >= 0) then
+                allocate (character(len=n + 1) :: whole)
+                n = c_h5_vlen_attribute(self%id, name//c_null_char, whole, int(n + 1, c_int))
+            end if
+            if (n < 0) then
+                call h5_error(err, label//': cannot read')
+            else
+                value = whole(:n)
+            end if
         else
             block
                 character(len=length) :: buffer

@@ -4,7 +4,8 @@
 !! - memory: the state and Jacobian storage of the model and its integrator, estimated from
 !!   `elements` (RFEM: band storage, ~6 kB per element; MPP: dense n^2 matrices), at most
 !!   MEMORY_LIMIT bytes;
-!! - output: t_end/output_interval at most MAX_RECORDS records;
+!! - output: t_end/output_interval at most MAX_RECORDS records, t_end at most MAX_TIME (and
+!!   so the time of a record a run starts from: ropedyn_run_record);
 !! - magnitudes: the derived values of the rope (element mass and inertia, spring and damper
 !!   constants, energies and forces at the start) within MAGNITUDE_LIMIT (masses and inertias
 !!   at least 1/MAGNITUDE_LIMIT). A value beyond them would make the initial state, the energy
@@ -21,11 +22,14 @@ module ropedyn_scene_limits
     use ropedyn_scene_keys, only: find_key, fail, group_index, G_MODEL, G_SOLVER
     implicit none
     private
-    public :: check_limits, MAX_RECORDS, MEMORY_LIMIT, MAGNITUDE_LIMIT
+    public :: check_limits, MAX_RECORDS, MEMORY_LIMIT, MAGNITUDE_LIMIT, MAX_TIME
 
     integer, parameter :: MAX_RECORDS = 10000000          !< output records of one run
     real(wp), parameter :: MEMORY_LIMIT = 8.0_wp*1024.0_wp**3  !< bytes (8 GiB)
     real(wp), parameter :: MAGNITUDE_LIMIT = 1.0e100_wp   !< derived values, SI units
+    !> The latest time of a run, s (about 32 years): beyond it the round-off of t (1.2e-7 s)
+    !! is coarser than the steps of a rope's motion, and no integrator could advance t.
+    real(wp), parameter :: MAX_TIME = 1.0e9_wp
 
     real(wp), parameter :: pi = acos(-1.0_wp)
     integer, parameter :: KL = 40
@@ -109,6 +113,9 @@ contains
                 real_text(records)//' output records, more than the limit '// &
                 int_text(MAX_RECORDS)//' (docs/input.md, Limits)', err)
         end if
+        if (.not. allocated(err) .and. scene%solver%t_end > MAX_TIME) call fail(keys, G_SOLVER, &
+            't_end', real_text(scene%solver%t_end), 'out of range (at most '// &
+            real_text(MAX_TIME)//' s; docs/input.md, Limits)', err)
     end subroutine check_sizes
 
     !> The derived values of the rope within MAGNITUDE_LIMIT.

@@ -1,5 +1,6 @@
-/* Glue for ropedyn_h5.f90, which is the only caller: why an HDF5 call failed, and the
- * library's end at the exit of the process.
+/* Glue for ropedyn_h5.f90, which is the only caller: why an HDF5 call failed, the
+ * library's end at the exit of the process, and string attributes of variable length
+ * (which the Fortran interface of HDF5 1.10 does not read).
  *
  * Why a call failed, in the system's words (h5_reason). The Fortran interface of HDF5
  * returns only a negative code;
@@ -75,3 +76,34 @@ void ropedyn_h5_prepare(void)
 }
 
 void ropedyn_h5_close_failed(void) { close_failed = 1; }
+
+/* The scalar variable-length string attribute `name` of the object `loc` (as h5py writes
+ * strings) in `buf` (`size` bytes, NUL-terminated, clipped). Returns the length of the
+ * whole string (call again with a larger buffer when it did not fit), -2 when the
+ * attribute is not a variable-length string, -1 when it cannot be read. */
+int ropedyn_h5_vlen_attribute(hid_t loc, const char *name, char *buf, int size)
+{
+    hid_t attr, type, mem;
+    char *value = NULL;
+    int rc = -1;
+    if (size >= 1) buf[0] = '\0';
+    attr = H5Aopen(loc, name, H5P_DEFAULT);
+    if (attr < 0) return -1;
+    type = H5Aget_type(attr);
+    if (type >= 0 && (H5Tget_class(type) != H5T_STRING || H5Tis_variable_str(type) <= 0)) {
+        rc = -2;
+    } else if (type >= 0) {
+        mem = H5Tcopy(H5T_C_S1);
+        H5Tset_size(mem, H5T_VARIABLE);
+        H5Tset_cset(mem, H5Tget_cset(type));   /* h5py's are UTF-8: no conversion */
+        if (H5Aread(attr, mem, &value) >= 0) {
+            rc = value ? (int)strlen(value) : 0;
+            if (size >= 1) snprintf(buf, (size_t)size, "%s", value ? value : "");
+            H5free_memory(value);
+        }
+        H5Tclose(mem);
+    }
+    if (type >= 0) H5Tclose(type);
+    H5Aclose(attr);
+    return rc;
+}
