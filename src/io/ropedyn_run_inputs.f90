@@ -1,0 +1,68 @@
+!> The input files of a run and the check that an output file is none of them: a run must
+!! never write over what it reads (docs/output.md, "Inputs are never outputs").
+!!
+!! The inputs of a scene: the scene file itself, its motion tables (`&supports
+!! top_table`, `bottom_table` with motion 'table') and the run file of its starting record
+!! (`&initial state_file` with shape 'state'); a caller adds its own (a sweep file, a
+!! reference file). Two paths are one file when they have the same device and inode (links,
+!! relative paths and hard links resolved: ropedyn_os output_clash); an output not created
+!! yet is compared by its canonical name.
+!!
+!!     call check_not_input(out_path, scene, err)              ! statics -o, modes -o, run
+!!     call check_not_input(case_file, scene, err, [sweep_file], ['the sweep file'])
+module ropedyn_run_inputs
+    use ropedyn_error, only: error_t, make_error, ERR_USAGE
+    use ropedyn_os, only: output_clash
+    use ropedyn_scene_types, only: scene_t
+    implicit none
+    private
+    public :: scene_inputs, check_not_input
+
+    !> Width of an entry of the lists (the longest path a scene holds, and some).
+    integer, parameter :: W = 1100
+
+contains
+
+    !> The input files of `scene` (blank entries where it has none) and what each is.
+    subroutine scene_inputs(scene, paths, roles)
+        type(scene_t), intent(in) :: scene
+        character(len=W), intent(out) :: paths(4)
+        character(len=40), intent(out) :: roles(4)
+        paths = ''
+        roles = [character(len=40) :: 'the scene file', 'the motion table top_table', &
+                 'the motion table bottom_table', 'the state file']
+        paths(1) = scene%path
+        if (trim(scene%supports%top_motion) == 'table') paths(2) = scene%supports%top_table
+        if (trim(scene%supports%bottom_motion) == 'table') &
+            paths(3) = scene%supports%bottom_table
+        if (trim(scene%initial%shape) == 'state') paths(4) = scene%initial%state_file
+    end subroutine scene_inputs
+
+    !> ERR_USAGE (exit 2) when the file `output` is one of the inputs of `scene` or of
+    !! `extra` (described by `extra_roles`), naming both; nothing else happens.
+    subroutine check_not_input(output, scene, err, extra, extra_roles)
+        character(len=*), intent(in) :: output
+        type(scene_t), intent(in) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        character(len=*), intent(in), optional :: extra(:), extra_roles(:)
+        character(len=W) :: paths(4)
+        character(len=40) :: roles(4)
+        integer :: k
+        call scene_inputs(scene, paths, roles)
+        k = output_clash(output, paths)
+        if (k > 0) then
+            call clash(trim(roles(k)), trim(paths(k)))
+            return
+        end if
+        if (.not. present(extra)) return
+        k = output_clash(output, extra)
+        if (k > 0) call clash(trim(extra_roles(k)), trim(extra(k)))
+    contains
+        subroutine clash(role, path)
+            character(len=*), intent(in) :: role, path
+            call make_error(err, ERR_USAGE, output//': the output file is '//role//' "'// &
+                path//'" (the same file): writing it would destroy an input of this run; '// &
+                'choose another output file')
+        end subroutine clash
+    end subroutine check_not_input
+end module ropedyn_run_inputs
