@@ -148,6 +148,33 @@ module ropedyn_h5
             type(error_t), allocatable, intent(out) :: err
         end subroutine h5_create_series
 
+        !> Open the HDF5 library (idempotent) and silence HDF5's own error printing.
+        module subroutine library_acquire(path, err)
+            character(len=*), intent(in) :: path
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine library_acquire
+
+        !> Create (or overwrite) the file `path`; its directory must exist. A file still open
+        !! in this object is closed first. An existing `path` that is not a regular file (a
+        !! device, a FIFO, a link to one) is bad input and left alone; one that another
+        !! program holds open (locked) is not truncated. Errors give the system's reason.
+        module subroutine h5_create(self, path, err)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: path
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine h5_create
+
+        !> Open the existing file `path`, read-only unless `writable`; a missing file, or one
+        !! that is not a regular file, is bad input (ERR_INPUT: the user named it), one that
+        !! cannot be opened an I/O error naming the reason (the process that holds it
+        !! locked).
+        module subroutine h5_open(self, path, err, writable)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: path
+            type(error_t), allocatable, intent(out) :: err
+            logical, intent(in), optional :: writable
+        end subroutine h5_open
+
         !> An ERR_IO error (replacing one in `err`): `message` and the reason HDF5 gives for
         !! its last failure (the system's, e.g. 'No space left on device', when a system call
         !! failed).
@@ -365,120 +392,6 @@ contains
     ! ---------------------------------------------------------------------------------------
     ! Library and file life cycle
     ! ---------------------------------------------------------------------------------------
-
-    !> Open the HDF5 library (idempotent) and silence HDF5's own error printing.
-    subroutine library_acquire(path, err)
-        character(len=*), intent(in) :: path
-        type(error_t), allocatable, intent(out) :: err
-        integer :: hdferr
-        call c_h5_prepare()
-        call h5open_f(hdferr)
-        if (h5_failed(hdferr, path//': cannot initialize the HDF5 library', err)) return
-        call h5eset_auto_f(0, hdferr)
-        if (hdferr < 0) call h5_error(err, path//': cannot silence HDF5 error printing')
-    end subroutine library_acquire
-
-    !> Create (or overwrite) the file `path`; its directory must exist. A file still open in
-    !! this object is closed first. An existing `path` that is not a regular file (a device,
-    !! a FIFO, a link to one) is bad input and left alone; one that another program holds
-    !! open (locked) is not truncated. Errors give the system's reason.
-    subroutine h5_create(self, path, err)
-        class(h5_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: special
-        integer :: hdferr
-        call self%close(err)
-        if (allocated(err)) return
-        special = special_file_reason(path)
-        if (len(special) > 0) then
-            call make_error(err, ERR_INPUT, path//': cannot create file: it is '//special)
-            return
-        end if
-        if (try_lock(path) == ERRNO_EWOULDBLOCK) then
-            call make_error(err, ERR_IO, path//': cannot create file: '//locked_text(path)// &
-                            ' (left as it is)')
-            return
-        end if
-        call library_acquire(path, err)
-        if (allocated(err)) return
-        call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%id, hdferr)
-        if (hdferr < 0) then
-            self%id = -1
-            if (h5_reason() == ERRNO_EWOULDBLOCK) then
-                call make_error(err, ERR_IO, path//': cannot create file: '//locked_text(path))
-            else
-                call h5_error(err, path//': cannot create file')
-            end if
-            return
-        end if
-        self%path = path
-        self%is_open = .true.
-    end subroutine h5_create
-
-    !> Open the existing file `path`, read-only unless `writable`; a missing file, or one
-    !! that is not a regular file, is bad input (ERR_INPUT: the user named it), one that
-    !! cannot be opened an I/O error naming the reason (the process that holds it locked).
-    subroutine h5_open(self, path, err, writable)
-        class(h5_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        type(error_t), allocatable, intent(out) :: err
-        logical, intent(in), optional :: writable
-        character(len=:), allocatable :: special
-        logical :: rw, exists
-        integer :: hdferr, errnum
-        call self%close(err)
-        if (allocated(err)) return
-        inquire (file=path, exist=exists)
-        if (.not. exists) then
-            call make_error(err, ERR_INPUT, path//': no such file')
-            return
-        end if
-        special = special_file_reason(path)
-        if (len(special) > 0) then
-            call make_error(err, ERR_INPUT, path//': cannot open: '//special)
-            return
-        end if
-        call library_acquire(path, err)
-        if (allocated(err)) return
-        rw = .false.
-        if (present(writable)) rw = writable
-        if (rw) then
-            call h5fopen_f(path, H5F_ACC_RDWR_F, self%id, hdferr)
-        else
-            call h5fopen_f(path, H5F_ACC_RDONLY_F, self%id, hdferr)
-        end if
-        if (hdferr < 0) then
-            self%id = -1
-            errnum = h5_reason()
-            if (errnum == ERRNO_EWOULDBLOCK) then
-                call make_error(err, ERR_IO, path//': cannot open: '//locked_text(path))
-            else if (errnum > 0) then
-                call h5_error(err, path//': cannot open')
-            else if (rw) then
-                call make_error(err, ERR_IO, path//': cannot open for writing')
-            else
-                call make_error(err, ERR_IO, path//': cannot open as HDF5 file')
-            end if
-            return
-        end if
-        self%path = path
-        self%is_open = .true.
-    end subroutine h5_open
-
-    !> 'locked by pid N (...)': a file another process holds open with HDF5.
-    function locked_text(path) result(text)
-        character(len=*), intent(in) :: path
-        character(len=:), allocatable :: text
-        integer :: pid
-        pid = lock_holder(path)
-        if (pid > 0) then
-            text = 'locked by pid '//int_text(pid)
-        else
-            text = 'locked by another process'
-        end if
-        text = text//' (a run writing it, or a program reading it)'
-    end function locked_text
 
     !> Close the file (nothing to do when it is not open). Its series must be closed first.
     subroutine h5_close(self, err)

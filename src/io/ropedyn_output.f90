@@ -232,6 +232,28 @@ module ropedyn_output
             type(error_t), allocatable, intent(out) :: err
         end subroutine write_pending
 
+        !> Record what the order safety did (docs/stability.md; times < 0: never): the order
+        !! limit lowered from `from` to `to` at time `lowered_at`; the order kept at a gain
+        !! judged the integration error, first at `kept_at`, `kept_count` times in all; `gain`,
+        !! the first gain beyond the bound. Nothing when it did neither.
+        module subroutine output_write_order_safety(self, gain, lowered_at, from, to, &
+                                                    kept_at, kept_count, err)
+            class(output_file_t), intent(inout) :: self
+            real(wp), intent(in) :: gain                  !< J
+            real(wp), intent(in) :: lowered_at, kept_at   !< s
+            integer, intent(in) :: from, to, kept_count
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine output_write_order_safety
+
+        !> The integrator's changes of method or order limit during the run
+        !! (ropedyn_switch_log) as /solver/switch_time (s), switch_method, switch_max_order
+        !! and switch_reason, one entry per change, oldest first (nothing when none).
+        module subroutine output_write_switches(self, events, err)
+            class(output_file_t), intent(inout) :: self
+            type(switch_event_t), intent(in) :: events(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine output_write_switches
+
         !> After the I/O error `err` (a full disk, a failed device, ...), give the file up: the
         !! records not written yet are dropped, the status set to 'failed' with err's message
         !! as the reason while that can still be written, and every object closed (datasets
@@ -447,41 +469,6 @@ contains
         if (allocated(err)) call abandon(self, err)
     end subroutine output_write_stats
 
-    !> Record what the order safety did (docs/stability.md; times < 0: never): the order
-    !! limit lowered from `from` to `to` at time `lowered_at`; the order kept at a gain
-    !! judged the integration error, first at `kept_at`, `kept_count` times in all; `gain`,
-    !! the first gain beyond the bound. Nothing when it did neither.
-    subroutine output_write_order_safety(self, gain, lowered_at, from, to, kept_at, &
-                                         kept_count, err)
-        class(output_file_t), intent(inout) :: self
-        real(wp), intent(in) :: gain                  !< J
-        real(wp), intent(in) :: lowered_at, kept_at   !< s
-        integer, intent(in) :: from, to, kept_count
-        type(error_t), allocatable, intent(out) :: err
-        if (lowered_at < 0.0_wp .and. kept_at < 0.0_wp) return
-        if (.not. self%is_open) then
-            call not_open(self, 'write_order_safety', err)
-            return
-        end if
-        call self%file%write('/solver/energy_gain', gain, 'J', err)
-        if (lowered_at >= 0.0_wp) then
-            if (.not. allocated(err)) &
-                call self%file%write('/solver/order_lowered_at', lowered_at, 's', err)
-            if (.not. allocated(err)) &
-                call self%file%write('/solver/order_lowered_from', int(from, i8), '1', err)
-            if (.not. allocated(err)) &
-                call self%file%write('/solver/order_lowered_to', int(to, i8), '1', err)
-        end if
-        if (kept_at >= 0.0_wp) then
-            if (.not. allocated(err)) &
-                call self%file%write('/solver/order_kept_at', kept_at, 's', err)
-            if (.not. allocated(err)) &
-                call self%file%write('/solver/order_kept_count', int(kept_count, i8), '1', err)
-        end if
-        if (.not. allocated(err)) call flush_file(self, err)
-        if (allocated(err)) call abandon(self, err)
-    end subroutine output_write_order_safety
-
     !> The time split of `stats` named in TIMER_NAMES, in that order (s).
     pure function timer_values(stats) result(times)
         type(solver_stats_t), intent(in) :: stats
@@ -511,47 +498,6 @@ contains
         stats%nonlin_iters = stats%nonlin_iters + counters(6)
         stats%nonlin_conv_fails = stats%nonlin_conv_fails + counters(7)
     end subroutine add_counter_values
-
-    !> The integrator's changes of method or order limit during the run (ropedyn_switch_log)
-    !! as /solver/switch_time (s), switch_method, switch_max_order and switch_reason, one
-    !! entry per change, oldest first (nothing when there were none).
-    subroutine output_write_switches(self, events, err)
-        class(output_file_t), intent(inout) :: self
-        type(switch_event_t), intent(in) :: events(:)
-        type(error_t), allocatable, intent(out) :: err
-        character(len=16), allocatable :: methods(:)
-        character(len=:), allocatable :: reasons(:)
-        real(wp), allocatable :: times(:)
-        integer(i8), allocatable :: orders(:)
-        integer :: k, width
-
-        if (size(events) == 0) return
-        if (.not. self%is_open) then
-            call not_open(self, 'write_switches', err)
-            return
-        end if
-        width = 1
-        do k = 1, size(events)
-            if (allocated(events(k)%reason)) width = max(width, len(events(k)%reason))
-        end do
-        allocate (methods(size(events)))
-        allocate (character(len=width) :: reasons(size(events)))
-        do k = 1, size(events)
-            methods(k) = events(k)%method
-            reasons(k) = ''
-            if (allocated(events(k)%reason)) reasons(k) = events(k)%reason
-        end do
-        times = events%t
-        orders = int(events%max_order, i8)
-        call self%file%write('/solver/switch_time', times, 's', err)
-        if (.not. allocated(err)) call self%file%write('/solver/switch_max_order', orders, &
-                                                       '1', err)
-        if (.not. allocated(err)) call self%file%write_text('/solver/switch_method', methods, &
-                                                            '', err)
-        if (.not. allocated(err)) call self%file%write_text('/solver/switch_reason', reasons, &
-                                                            '', err)
-        if (allocated(err)) call abandon(self, err)
-    end subroutine output_write_switches
 
     !> Set the root status ('complete', or 'failed' or 'interrupted' with `reason`) and close
     !! everything. The file is closed even when writing the status fails.
