@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/file.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
 #include <sys/types.h>
@@ -44,6 +45,12 @@ int ropedyn_file_kind(const char *path, int follow, int *err)
     if (S_ISSOCK(st.st_mode)) return KIND_SOCKET;
     if (S_ISLNK(st.st_mode)) return KIND_SYMLINK;
     return KIND_OTHER;
+}
+
+/* mkdir(2) of `path` with `mode`. Returns 0, or errno. */
+int ropedyn_mkdir(const char *path, int mode)
+{
+    return mkdir(path, (mode_t)mode) == 0 ? 0 : errno;
 }
 
 /* The device and inode of `path` (links followed). Returns 0, or errno. */
@@ -135,15 +142,21 @@ int ropedyn_try_lock(const char *path)
  * (or to `end`, when that is further: the writer's idea of it) plus `bytes` allocated
  * (fallocate, FALLOC_FL_KEEP_SIZE: its size is unchanged), so that writes there cannot fail
  * for want of space. Returns 0, or errno: ENOSPC (or EDQUOT) when the file system has not
- * that much room left; EOPNOTSUPP where it cannot reserve. */
+ * that much room left, EFBIG when the process's file-size limit (RLIMIT_FSIZE) is nearer;
+ * EOPNOTSUPP where it cannot reserve. */
 int ropedyn_reserve_space(const char *path, long long end, long long bytes)
 {
     struct stat st;
+    struct rlimit limit;
     off_t last;
     int fd = open(path, O_WRONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY), rc = 0;
     if (fd < 0) return errno;
     if (fstat(fd, &st) != 0) rc = errno;
     last = st.st_size > (off_t)end ? st.st_size : (off_t)end;
+    /* a file-size limit (ulimit -f) is room that cannot be had either */
+    if (rc == 0 && getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY &&
+        (unsigned long long)(last + (off_t)bytes) > (unsigned long long)limit.rlim_cur)
+        rc = EFBIG;
     if (rc == 0 && fallocate(fd, FALLOC_FL_KEEP_SIZE, 0, last + (off_t)bytes) != 0) rc = errno;
     close(fd);
     return rc;

@@ -24,11 +24,11 @@ module ropedyn_os
         FILE_FIFO = 3, FILE_CHAR_DEVICE = 4, FILE_BLOCK_DEVICE = 5, FILE_SOCKET = 6, &
         FILE_SYMLINK = 7, FILE_OTHER = 8
     !> errno values the callers tell apart (Linux)
-    integer, parameter, public :: ERRNO_ENOENT = 2, ERRNO_EWOULDBLOCK = 11, &
-        ERRNO_EFBIG = 27, ERRNO_ENOSPC = 28, ERRNO_EDQUOT = 122
+    integer, parameter, public :: ERRNO_ENOENT = 2, ERRNO_EWOULDBLOCK = 11, ERRNO_EEXIST = 17, &
+        ERRNO_ENOTDIR = 20, ERRNO_EFBIG = 27, ERRNO_ENOSPC = 28, ERRNO_EDQUOT = 122
 
     interface
-        integer(c_int) function c_mkdir(path, mode) bind(C, name='mkdir')
+        integer(c_int) function c_mkdir(path, mode) bind(C, name='ropedyn_mkdir')
             import :: c_char, c_int
             character(kind=c_char), intent(in) :: path(*)
             integer(c_int), value :: mode
@@ -124,12 +124,14 @@ contains
             rc = c_mkdir(path(1:k - 1)//c_null_char, int(o'755', c_int))
             inquire (file=path(1:k - 1)//'/.', exist=exists)
             if (.not. exists) then
+                ! the system's reason (a file in the way, no permission, a full disk, ...)
+                if (rc == 0 .or. rc == ERRNO_EEXIST) rc = ERRNO_ENOTDIR
                 if (present(what)) then
                     call make_error(err, ERR_IO, what//': cannot create directory "'// &
-                                    path(1:k - 1)//'"')
+                                    path(1:k - 1)//'": '//errno_text(rc))
                 else
                     call make_error(err, ERR_IO, 'cannot create directory "'// &
-                                    path(1:k - 1)//'"')
+                                    path(1:k - 1)//'": '//errno_text(rc))
                 end if
                 return
             end if
@@ -248,7 +250,8 @@ contains
     !! bytes, the writer's idea of its end, when that is further) and `bytes` beyond
     !! allocated (its size unchanged), so that writing that much more cannot fail for want
     !! of space. 0, or the errno: ERRNO_ENOSPC / ERRNO_EDQUOT when there is not that much
-    !! room left; another (e.g. a file system that cannot reserve) when nothing is kept.
+    !! room left, ERRNO_EFBIG when the file-size limit (ulimit -f) is nearer; another (e.g.
+    !! a file system that cannot reserve) when nothing is kept.
     integer function reserve_space(path, end, bytes)
         character(len=*), intent(in) :: path
         integer(int64), intent(in) :: end, bytes

@@ -11,6 +11,7 @@
  *     unable to lock file, errno = 11, error message = 'Resource temporarily unavailable'
  *
  * The reason is that text when a frame has one, else the innermost frame's description. */
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -73,6 +74,10 @@ void ropedyn_h5_prepare(void)
     if (prepared) return;
     prepared = 1;
     if (H5dont_atexit() >= 0) atexit(end_library);
+    /* A file-size limit (ulimit -f) then makes a write fail with EFBIG, an I/O error the
+     * writer handles (the file closed, marked failed), instead of ending the process by
+     * SIGXFSZ with its file left 'running'. */
+    signal(SIGXFSZ, SIG_IGN);
 }
 
 void ropedyn_h5_close_failed(void) { close_failed = 1; }

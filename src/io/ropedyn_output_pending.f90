@@ -3,7 +3,7 @@
 !! What a crash can lose is unchanged: pending records are written, and the file flushed,
 !! whenever FLUSH_PERIOD has passed, and before the file is finished or closed.
 submodule (ropedyn_output) ropedyn_output_pending
-    use ropedyn_os, only: reserve_space, errno_text, ERRNO_ENOSPC, ERRNO_EDQUOT
+    use ropedyn_os, only: reserve_space, errno_text, ERRNO_ENOSPC, ERRNO_EDQUOT, ERRNO_EFBIG
     implicit none
 
 contains
@@ -153,9 +153,10 @@ contains
         integer :: errnum
         errnum = reserve_space(self%file%file_name(), self%file%size(), &
                                self%unflushed + RESERVE_BYTES)
-        if (errnum == ERRNO_ENOSPC .or. errnum == ERRNO_EDQUOT) call make_error(err, ERR_IO, &
-            self%file%file_name()//': '//errno_text(errnum)//' (less than '// &
-            int_text(int(RESERVE_BYTES/2**20))//' MiB left: the run stops while the file '// &
-            'can still be closed)')
+        if (errnum == ERRNO_ENOSPC .or. errnum == ERRNO_EDQUOT .or. errnum == ERRNO_EFBIG) &
+            call make_error(err, ERR_IO, &
+            self%file%file_name()//': '//errno_text(errnum)//' (no room for the records '// &
+            'not flushed and a reserve of '//int_text(int(RESERVE_BYTES/2**20))//' MiB: '// &
+            'the run stops while the file can still be closed)')
     end procedure keep_room
 end submodule ropedyn_output_pending
