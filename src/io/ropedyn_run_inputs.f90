@@ -10,13 +10,25 @@
 !!
 !!     call check_not_input(out_path, scene, err)              ! statics -o, modes -o, run
 !!     call check_not_input(case_file, scene, err, [sweep_file], ['the sweep file'])
+!!
+!! And whether an existing file may be replaced at all (check_replaceable): only a run file
+!! that ropedyn wrote (docs/output.md, "Write, lock and resume rules").
 module ropedyn_run_inputs
-    use ropedyn_error, only: error_t, make_error, ERR_USAGE
-    use ropedyn_os, only: output_clash
+    use ropedyn_error, only: error_t, make_error, ERR_USAGE, ERR_INPUT
+    use ropedyn_os, only: output_clash, special_file_reason
     use ropedyn_scene_types, only: scene_t
+    use ropedyn_h5, only: h5_file_t
     implicit none
     private
-    public :: scene_inputs, check_not_input
+    public :: scene_inputs, check_not_input, check_replaceable
+
+    !> The first bytes of an HDF5 file (its signature at offset 0: ropedyn writes no user
+    !! block).
+    character(len=*), parameter :: HDF5_SIGNATURE = achar(137)//'HDF'//achar(13)//achar(10)// &
+        achar(26)//achar(10)
+    !> Root attributes every file ropedyn writes has.
+    character(len=*), parameter :: OWN_ATTRIBUTES(3) = [character(len=7) :: 'version', &
+        'model', 'created']
 
     !> Width of an entry of the lists (the longest path a scene holds, and some).
     integer, parameter :: W = 1100
@@ -65,4 +77,51 @@ contains
                 'choose another output file')
         end subroutine clash
     end subroutine check_not_input
+
+    !> Whether the existing file `path` may be replaced by an output of ropedyn: ERR_USAGE
+    !! (exit 2) naming what it is when it is not a regular file, not an HDF5 file (a text
+    !! file, ...), or an HDF5 file without ropedyn's root attributes (version, model,
+    !! created); an error of the file's own (locked by a process: ERR_IO) as it is. Nothing
+    !! when `path` does not exist or is a file ropedyn wrote. For the rule that a run
+    !! replaces only what it wrote unless told to (--force).
+    subroutine check_replaceable(path, err)
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: err
+        character(len=len(HDF5_SIGNATURE)) :: head
+        character(len=:), allocatable :: value
+        type(h5_file_t) :: h5
+        type(error_t), allocatable :: close_err
+        logical :: exists, found
+        integer :: unit, ios, k
+        inquire (file=path, exist=exists)
+        if (.not. exists) return
+        if (len(special_file_reason(path)) > 0) then
+            call make_error(err, ERR_USAGE, path//': exists and is '// &
+                special_file_reason(path)//': not replaced')
+            return
+        end if
+        head = ''
+        open (newunit=unit, file=path, status='old', action='read', access='stream', &
+              form='unformatted', iostat=ios)
+        if (ios == 0) read (unit, iostat=ios) head
+        if (ios == 0) close (unit)
+        if (head /= HDF5_SIGNATURE) then
+            call make_error(err, ERR_USAGE, path//': exists and is not an HDF5 file (not '// &
+                'written by ropedyn): not replaced')
+            return
+        end if
+        call h5%open(path, err)
+        if (allocated(err)) then
+            if (err%code == ERR_INPUT) err%code = ERR_USAGE
+            return
+        end if
+        do k = 1, size(OWN_ATTRIBUTES)
+            call h5%read_attribute(trim(OWN_ATTRIBUTES(k)), value, err, found)
+            if (allocated(err) .or. .not. found) exit
+        end do
+        call h5%close(close_err)
+        if (.not. allocated(err) .and. .not. found) call make_error(err, ERR_USAGE, path// &
+            ': exists and is an HDF5 file not written by ropedyn (no root attribute '// &
+            trim(OWN_ATTRIBUTES(k))//'): not replaced')
+    end subroutine check_replaceable
 end module ropedyn_run_inputs
