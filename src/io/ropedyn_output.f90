@@ -118,8 +118,9 @@ module ropedyn_output
     !! run's time (12 datasets); a block of records costs one write per series.
     integer, parameter :: PENDING_BYTES = 2**20, MAX_PENDING = 512
     !> Room kept free on the file system beyond the end of the file (ropedyn_os reserve_space,
-    !! renewed after every block of records): when it cannot be kept, the disk is all but
-    !! full, and the run stops while there is still room to close the file marked failed.
+    !! at create and reopen and after every block of records appended): when it cannot be
+    !! kept, the disk is all but full, and the run stops while there is still room to close
+    !! the file marked failed.
     integer(i8), parameter :: RESERVE_BYTES = 2*int(PENDING_BYTES, i8)
 
     !> The values of a series' pending records, one after the other.

@@ -50,7 +50,12 @@ contains
         call system_clock(now, rate)
         due = self%n_records + m == 1 .or. &
               real(now - self%last_flush, wp) >= FLUSH_PERIOD*real(rate, wp)
-        if (due .or. m == self%capacity) call write_pending(self, err)
+        if (due .or. m == self%capacity) then
+            call write_pending(self, err)
+            ! room for what follows (not at the end: a run that got all its records written
+            ! closes its file whatever room is left)
+            if (.not. allocated(err)) call keep_room(self, err)
+        end if
         if (due .and. .not. allocated(err)) then
             call flush_file(self, err)
             self%last_flush = now
@@ -141,7 +146,6 @@ contains
         self%n_pending = 0
         self%unflushed = self%unflushed + 8_i8*m*sum([(size(self%pending(k)%v), &
                                                        k = 1, N_SERIES + 2)])/self%capacity
-        call keep_room(self, err)
     end procedure write_pending
 
     module procedure flush_file
