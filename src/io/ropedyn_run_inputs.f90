@@ -30,8 +30,9 @@ module ropedyn_run_inputs
     character(len=*), parameter :: OWN_ATTRIBUTES(3) = [character(len=7) :: 'version', &
         'model', 'created']
 
-    !> Width of an entry of the lists (the longest path a scene holds, and some).
-    integer, parameter :: W = 1100
+    !> Width of an entry of the lists: the longest path of a scene (PATH_MAX of Linux; the
+    !! scene's own keys hold at most 512 characters).
+    integer, parameter :: W = 4096
 
 contains
 
