@@ -426,6 +426,9 @@ contains
             if (h_look <= 0.0_wp) h_look = self%h_chunk
             target = tout
             if (h_look > 0.0_wp) target = min(tout, self%t + 0.25_wp*WINDOW*h_look)
+            ! a look-ahead below the round-off of t rounds back to t: the method would take
+            ! no step (and never reach its own round-off limit): on to tout instead
+            if (target <= self%t) target = tout
             if (self%active == EXPLICIT) then
                 call self%erk%advance_to(target, self%t, self%y, self%yq, err)
             else if (self%active == HIGH) then

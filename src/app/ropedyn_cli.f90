@@ -4,6 +4,7 @@ module ropedyn_cli
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_USAGE
     use ropedyn_text, only: int_text, text_t, append_text, text_array
+    use ropedyn_scene, only: override_target
     implicit none
     private
     public :: cli_t, cli_from_command_line
@@ -130,7 +131,8 @@ contains
     end subroutine cli_positional
 
     !> The arguments of a command that reads a scene, other than its own options:
-    !! `--set group.key=value` (appended to self%overrides) or the scene file
+    !! `--set group.key=value` (appended to self%overrides, its 'group.key' as the scene
+    !! reads it: `--set ' OUTPUT.File = x'` is `output.file=x`) or the scene file
     !! (self%scene_path).
     subroutine cli_scene_argument(self, err)
         class(cli_t), intent(inout) :: self
@@ -138,7 +140,11 @@ contains
         character(len=:), allocatable :: value
         if (self%option == '--set') then
             call self%take_value(value, err)
-            if (.not. allocated(err)) call append_text(self%overrides, value)
+            if (allocated(err)) return
+            ! as the scene reads it: 'group.key' in lower case, without blanks around it
+            if (len(override_target(value)) > 0) value = override_target(value)//'='// &
+                trim(adjustl(value(index(value, '=') + 1:)))
+            call append_text(self%overrides, value)
         else
             call self%positional('scene file', self%scene_path, err)
         end if

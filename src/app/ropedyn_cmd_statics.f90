@@ -37,7 +37,11 @@ contains
             case ('--no-continuation')
                 options%continuation = .false.
             case ('-o', '--output')
-                call cli%take_value(out_path, err)
+                if (len(out_path) > 0) then
+                    call cli%usage_error(cli%option//' is given twice', err)
+                else
+                    call cli%take_value(out_path, err)
+                end if
             case ('--count')
                 if (command == 'modes') then
                     call cli%int_value(count, 1, err)

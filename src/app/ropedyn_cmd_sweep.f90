@@ -84,15 +84,24 @@ contains
             case ('--quiet')
                 opt%quiet = .true.
             case ('--output-dir')
+                if (allocated(opt%output_dir)) then
+                    call cli%usage_error('--output-dir is given twice', err)
+                    return
+                end if
                 call cli%take_value(value, err)
                 if (.not. allocated(err)) then
                     opt%output_dir = value
                     if (len(value) == 0) call cli%usage_error('--output-dir needs a directory', err)
                 end if
             case ('--jobs')
-                call cli%int_value(opt%jobs, 1, err)
+                if (have_jobs) call cli%usage_error('--jobs is given twice', err)
+                if (.not. allocated(err)) call cli%int_value(opt%jobs, 1, err)
                 have_jobs = .true.
             case ('--task')
+                if (size(opt%tasks) > 0) then
+                    call cli%usage_error('--task is given twice', err)
+                    return
+                end if
                 call cli%take_value(value, err)
                 if (.not. allocated(err)) then
                     call parse_ids(value, opt%tasks, ok)

@@ -1,17 +1,33 @@
 !> The operating-system services ropedyn needs, through POSIX: directories, the working
 !! directory, renaming and removing files, whether a stream is a terminal, sleeping, the
-!! number of processors.
+!! number of processors; and, through the C glue `ropedyn_os.c`, what a path is (a regular
+!! file, a FIFO, a device, ...), whether two paths are one file (device and inode, links
+!! resolved), the system's text of an errno value and the holder of a file's lock.
 module ropedyn_os
     use, intrinsic :: iso_c_binding, only: c_char, c_int, c_size_t, c_ptr, c_null_char, &
-                                           c_associated
+                                           c_associated, c_long_long
+    use, intrinsic :: iso_fortran_env, only: int64
     use ropedyn_error, only: error_t, make_error, ERR_IO
     implicit none
     private
     public :: make_dirs, make_parent_dirs, current_dir, is_terminal, sleep_microseconds, &
               processor_count, absolute_path, unwritable_dir, rename_file, delete_file
+    public :: file_kind, file_kind_name, special_file_reason, errno_text, real_path, &
+              canonical_path, same_file, output_clash, lock_holder, try_lock, &
+              reserve_space, release_space
+    public :: FILE_MISSING, FILE_REGULAR, FILE_DIRECTORY, FILE_FIFO, FILE_CHAR_DEVICE, &
+              FILE_BLOCK_DEVICE, FILE_SOCKET, FILE_SYMLINK, FILE_OTHER
+
+    !> What a path is (`file_kind`; the numbers of ropedyn_os.c).
+    integer, parameter :: FILE_MISSING = 0, FILE_REGULAR = 1, FILE_DIRECTORY = 2, &
+        FILE_FIFO = 3, FILE_CHAR_DEVICE = 4, FILE_BLOCK_DEVICE = 5, FILE_SOCKET = 6, &
+        FILE_SYMLINK = 7, FILE_OTHER = 8
+    !> errno values the callers tell apart (Linux)
+    integer, parameter, public :: ERRNO_ENOENT = 2, ERRNO_EWOULDBLOCK = 11, ERRNO_EEXIST = 17, &
+        ERRNO_ENOTDIR = 20, ERRNO_EFBIG = 27, ERRNO_ENOSPC = 28, ERRNO_EDQUOT = 122
 
     interface
-        integer(c_int) function c_mkdir(path, mode) bind(C, name='mkdir')
+        integer(c_int) function c_mkdir(path, mode) bind(C, name='ropedyn_mkdir')
             import :: c_char, c_int
             character(kind=c_char), intent(in) :: path(*)
             integer(c_int), value :: mode
@@ -46,6 +62,47 @@ module ropedyn_os
             character(kind=c_char), intent(in) :: path(*)
             integer(c_int), value :: mode
         end function c_access
+        integer(c_int) function c_file_kind(path, follow, errnum) &
+                bind(C, name='ropedyn_file_kind')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int), value :: follow
+            integer(c_int), intent(out) :: errnum
+        end function c_file_kind
+        integer(c_int) function c_file_id(path, dev, ino) bind(C, name='ropedyn_file_id')
+            import :: c_char, c_int, c_long_long
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_long_long), intent(out) :: dev, ino
+        end function c_file_id
+        integer(c_int) function c_real_path(path, buf, size) bind(C, name='ropedyn_real_path')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            character(kind=c_char), intent(out) :: buf(*)
+            integer(c_int), value :: size
+        end function c_real_path
+        subroutine c_errno_text(errnum, buf, size) bind(C, name='ropedyn_errno_text')
+            import :: c_char, c_int
+            integer(c_int), value :: errnum, size
+            character(kind=c_char), intent(out) :: buf(*)
+        end subroutine c_errno_text
+        integer(c_int) function c_lock_holder(path) bind(C, name='ropedyn_lock_holder')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+        end function c_lock_holder
+        integer(c_int) function c_try_lock(path) bind(C, name='ropedyn_try_lock')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+        end function c_try_lock
+        integer(c_int) function c_reserve_space(path, end, bytes) &
+                bind(C, name='ropedyn_reserve_space')
+            import :: c_char, c_int, c_long_long
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_long_long), value :: end, bytes
+        end function c_reserve_space
+        integer(c_int) function c_release_space(path) bind(C, name='ropedyn_release_space')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+        end function c_release_space
     end interface
 
 contains
@@ -66,12 +123,14 @@ contains
             rc = c_mkdir(path(1:k - 1)//c_null_char, int(o'755', c_int))
             inquire (file=path(1:k - 1)//'/.', exist=exists)
             if (.not. exists) then
+                ! the system's reason (a file in the way, no permission, a full disk, ...)
+                if (rc == 0 .or. rc == ERRNO_EEXIST) rc = ERRNO_ENOTDIR
                 if (present(what)) then
                     call make_error(err, ERR_IO, what//': cannot create directory "'// &
-                                    path(1:k - 1)//'"')
+                                    path(1:k - 1)//'": '//errno_text(rc))
                 else
                     call make_error(err, ERR_IO, 'cannot create directory "'// &
-                                    path(1:k - 1)//'"')
+                                    path(1:k - 1)//'": '//errno_text(rc))
                 end if
                 return
             end if
@@ -185,4 +244,183 @@ contains
     integer function processor_count()
         processor_count = max(1, int(c_get_nprocs()))
     end function processor_count
+
+    !> Keep room on the file system for the file `path`: its blocks to its end (or to `end`
+    !! bytes, the writer's idea of its end, when that is further) and `bytes` beyond
+    !! allocated (its size unchanged), so that writing that much more cannot fail for want
+    !! of space. 0, or the errno: ERRNO_ENOSPC / ERRNO_EDQUOT when there is not that much
+    !! room left, ERRNO_EFBIG when the file-size limit (ulimit -f) is nearer; another (e.g.
+    !! a file system that cannot reserve) when nothing is kept.
+    integer function reserve_space(path, end, bytes)
+        character(len=*), intent(in) :: path
+        integer(int64), intent(in) :: end, bytes
+        reserve_space = int(c_reserve_space(path//c_null_char, int(end, c_long_long), &
+                                            int(bytes, c_long_long)))
+    end function reserve_space
+
+    !> Give back the room that reserve_space kept beyond the end of the file `path`.
+    subroutine release_space(path)
+        character(len=*), intent(in) :: path
+        integer(c_int) :: rc
+        rc = c_release_space(path//c_null_char)
+    end subroutine release_space
+
+    ! ---------------------------------------------------------------------------------------
+    ! What a path is, and whether two paths are one file (ropedyn_os.c)
+    ! ---------------------------------------------------------------------------------------
+
+    !> What `path` is (FILE_*), symbolic links followed unless `follow` is false; FILE_MISSING
+    !! when it cannot be had (`errnum`, if present: the errno, e.g. ERRNO_ENOENT).
+    integer function file_kind(path, follow, errnum) result(kind)
+        character(len=*), intent(in) :: path
+        logical, intent(in), optional :: follow
+        integer, intent(out), optional :: errnum
+        integer(c_int) :: e, f
+        f = 1
+        if (present(follow)) f = merge(1_c_int, 0_c_int, follow)
+        kind = int(c_file_kind(path//c_null_char, f, e))
+        if (present(errnum)) errnum = int(e)
+    end function file_kind
+
+    !> 'a regular file', 'a directory', 'a FIFO (named pipe)', 'a character device', ...
+    pure function file_kind_name(kind) result(name)
+        integer, intent(in) :: kind
+        character(len=:), allocatable :: name
+        select case (kind)
+        case (FILE_MISSING)
+            name = 'missing'
+        case (FILE_REGULAR)
+            name = 'a regular file'
+        case (FILE_DIRECTORY)
+            name = 'a directory'
+        case (FILE_FIFO)
+            name = 'a FIFO (named pipe)'
+        case (FILE_CHAR_DEVICE)
+            name = 'a character device'
+        case (FILE_BLOCK_DEVICE)
+            name = 'a block device'
+        case (FILE_SOCKET)
+            name = 'a socket'
+        case (FILE_SYMLINK)
+            name = 'a symbolic link'
+        case default
+            name = 'not a regular file'
+        end select
+    end function file_kind_name
+
+    !> Why `path` cannot be read as an input file although it exists: '' for a regular file
+    !! (or one that is not there, or cannot be looked at: the opener says why), else e.g.
+    !! 'a FIFO (named pipe), not a regular file'. Asked before an input is opened: a FIFO
+    !! would block its reader, a device such as /dev/zero never end.
+    function special_file_reason(path) result(reason)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: reason
+        integer :: kind
+        reason = ''
+        kind = file_kind(path)
+        if (kind == FILE_MISSING .or. kind == FILE_REGULAR) return
+        reason = file_kind_name(kind)//', not a regular file'
+        if (kind == FILE_DIRECTORY) reason = 'a directory, not a file'
+    end function special_file_reason
+
+    !> The system's text of the errno value `errnum`, e.g. 'No space left on device'.
+    function errno_text(errnum) result(text)
+        integer, intent(in) :: errnum
+        character(len=:), allocatable :: text
+        character(kind=c_char, len=256) :: buf
+        integer :: k
+        buf = repeat(c_null_char, len(buf))
+        call c_errno_text(int(errnum, c_int), buf, int(len(buf), c_int))
+        k = index(buf, c_null_char)
+        if (k == 0) k = len(buf) + 1
+        text = buf(:k - 1)
+    end function errno_text
+
+    !> realpath(3) of `path`: its absolute form with every link, '.' and '..' resolved
+    !! (`errnum` 0); '' and the errno when it does not exist or cannot be resolved.
+    function real_path(path, errnum) result(full)
+        character(len=*), intent(in) :: path
+        integer, intent(out), optional :: errnum
+        character(len=:), allocatable :: full
+        character(kind=c_char, len=4097) :: buf
+        integer(c_int) :: rc
+        integer :: k
+        full = ''
+        rc = c_real_path(path//c_null_char, buf, int(len(buf), c_int))
+        if (present(errnum)) errnum = int(rc)
+        if (rc /= 0) return
+        k = index(buf, c_null_char)
+        if (k > 0) full = buf(:k - 1)
+    end function real_path
+
+    !> The name of the file `path` refers to: its real_path when it exists, else the
+    !! real_path of its directory followed by its last part (a file not created yet, or a
+    !! dangling link's own name), else `path` made absolute.
+    function canonical_path(path) result(full)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: full, dir
+        integer :: slash
+        full = real_path(path)
+        if (len(full) > 0) return
+        slash = index(path, '/', back=.true.)
+        if (slash == 0) then
+            dir = real_path('.')
+        else if (slash == 1) then
+            dir = '/'
+        else
+            dir = real_path(path(:slash - 1))
+        end if
+        if (len(dir) == 0) then
+            full = absolute_path(path)
+        else if (dir == '/') then
+            full = '/'//path(slash + 1:)
+        else
+            full = dir//'/'//path(slash + 1:)
+        end if
+    end function canonical_path
+
+    !> Whether the paths `a` and `b` name one file: the same device and inode when both
+    !! exist (links, relative paths and hard links alike), else the same canonical_path.
+    logical function same_file(a, b)
+        character(len=*), intent(in) :: a, b
+        integer(c_long_long) :: dev_a, ino_a, dev_b, ino_b
+        integer(c_int) :: rc_a, rc_b
+        rc_a = c_file_id(trim(a)//c_null_char, dev_a, ino_a)
+        rc_b = c_file_id(trim(b)//c_null_char, dev_b, ino_b)
+        if (rc_a == 0 .and. rc_b == 0) then
+            same_file = dev_a == dev_b .and. ino_a == ino_b
+        else if (rc_a == 0 .neqv. rc_b == 0) then
+            same_file = .false.
+        else
+            same_file = canonical_path(trim(a)) == canonical_path(trim(b))
+        end if
+    end function same_file
+
+    !> The first of `inputs` (blank entries skipped; each trimmed) that is the same file
+    !! as `output` (same_file): its index, 0 when there is none. An output that does not
+    !! exist yet is compared by its canonical name (its directory resolved).
+    integer function output_clash(output, inputs) result(k)
+        character(len=*), intent(in) :: output
+        character(len=*), intent(in) :: inputs(:)
+        do k = 1, size(inputs)
+            if (len_trim(inputs(k)) == 0) cycle
+            if (same_file(output, trim(inputs(k)))) return
+        end do
+        k = 0
+    end function output_clash
+
+    !> The process that holds a lock on the file `path` (HDF5 locks the files it opens):
+    !! its pid; 0 when none does; -1 when it cannot be told.
+    integer function lock_holder(path)
+        character(len=*), intent(in) :: path
+        lock_holder = int(c_lock_holder(path//c_null_char))
+    end function lock_holder
+
+    !> Whether the existing file `path` could be locked exclusively now: 0 yes,
+    !! ERRNO_EWOULDBLOCK when another process holds a lock on it, else the errno (the file
+    !! is neither created nor truncated; a lock taken is released at once).
+    integer function try_lock(path)
+        character(len=*), intent(in) :: path
+        try_lock = int(c_try_lock(path//c_null_char))
+    end function try_lock
 end module ropedyn_os

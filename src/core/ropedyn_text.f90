@@ -8,7 +8,7 @@ module ropedyn_text
     public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, enclosed
     public :: significant_text
     public :: lower, line_quote
-    public :: text_t, append_text, text_array, printable, clip, name_hint
+    public :: text_t, append_text, text_array, printable, clip, name_hint, edit_distance
 
     !> A string of any length, for lists of strings of different lengths.
     type :: text_t
@@ -219,27 +219,94 @@ contains
         end if
     end function line_quote
 
-    !> Text safe to print: a control character (byte < 32 except tab, or 127) as `\xNN`.
+    !> Text safe to print: a control character (byte < 32 except tab, or 127) as `\xNN`; a
+    !! character that shows as nothing or as a blank (UTF-8 of a no-break space, zero-width
+    !! space, byte-order mark, soft hyphen, ...: `invisible`) as `<U+XXXX>`, so that a
+    !! message names it; bytes that are not UTF-8 as `\xNN`.
     pure function printable(text) result(s)
         character(len=*), intent(in) :: text
         character(len=:), allocatable :: s
-        character(len=*), parameter :: HEX = '0123456789abcdef'
+        character(len=*), parameter :: HEX = '0123456789abcdef', UPPER = '0123456789ABCDEF'
         character(len=:), allocatable :: buf
-        integer :: i, c, n
-        allocate (character(len=4*len(text)) :: buf)
+        integer :: i, c, n, code, length, k
+        allocate (character(len=8*len(text)) :: buf)
         n = 0
-        do i = 1, len(text)
+        i = 1
+        do while (i <= len(text))
             c = iachar(text(i:i))
-            if ((c < 32 .and. c /= 9) .or. c == 127) then
+            call utf8_at(text, i, code, length)
+            if ((c < 32 .and. c /= 9) .or. c == 127 .or. (c >= 128 .and. length == 0)) then
                 buf(n + 1:n + 4) = '\x'//HEX(c/16 + 1:c/16 + 1)//HEX(mod(c, 16) + 1:mod(c, 16) + 1)
                 n = n + 4
+                i = i + 1
+            else if (c >= 128 .and. invisible(code)) then
+                buf(n + 1:n + 3) = '<U+'
+                do k = 3, 0, -1
+                    buf(n + 7 - k:n + 7 - k) = UPPER(mod(code/16**k, 16) + 1:mod(code/16**k, 16) + 1)
+                end do
+                buf(n + 8:n + 8) = '>'
+                n = n + 8
+                i = i + length
             else
-                buf(n + 1:n + 1) = text(i:i)
-                n = n + 1
+                length = max(length, 1)
+                buf(n + 1:n + length) = text(i:i + length - 1)
+                n = n + length
+                i = i + length
             end if
         end do
         s = buf(:n)
     end function printable
+
+    !> The UTF-8 character at byte i of `text`: its code point and its length in bytes (1
+    !! for ASCII; 0 when the bytes there are not UTF-8).
+    pure subroutine utf8_at(text, i, code, length)
+        character(len=*), intent(in) :: text
+        integer, intent(in) :: i
+        integer, intent(out) :: code, length
+        integer :: c, k, b
+        c = iachar(text(i:i))
+        code = c
+        length = 1
+        if (c < 128) return
+        length = 0
+        if (c >= 194 .and. c <= 223) then
+            length = 2
+            code = c - 192
+        else if (c >= 224 .and. c <= 239) then
+            length = 3
+            code = c - 224
+        else if (c >= 240 .and. c <= 244) then
+            length = 4
+            code = c - 240
+        end if
+        if (length == 0 .or. i + length - 1 > len(text)) then
+            length = 0
+            return
+        end if
+        do k = 1, length - 1
+            b = iachar(text(i + k:i + k))
+            if (b < 128 .or. b > 191) then
+                length = 0
+                return
+            end if
+            code = code*64 + (b - 128)
+        end do
+    end subroutine utf8_at
+
+    !> Whether the code point shows as nothing or as a blank: spaces other than ' ', the
+    !! zero-width characters, the byte-order mark, the soft hyphen, joiners, marks.
+    pure logical function invisible(code)
+        integer, intent(in) :: code
+        select case (code)
+        case (int(z'A0'), int(z'AD'), int(z'34F'), int(z'61C'), int(z'115F'), int(z'1160'), &
+              int(z'17B4'), int(z'17B5'), int(z'180E'), int(z'2000'):int(z'200F'), &
+              int(z'2028'):int(z'202F'), int(z'205F'):int(z'206F'), int(z'3000'), &
+              int(z'3164'), int(z'FEFF'), int(z'FFA0'))
+            invisible = .true.
+        case default
+            invisible = .false.
+        end select
+    end function invisible
 
     !> A value for a message: at most 60 characters (a longer one as its first 40 and '...').
     pure function clip(text) result(s)

@@ -16,15 +16,16 @@
 !! fixed-length and null-padded (an empty string is one NUL byte, which readers see as '').
 !! The library is opened with `h5open_f` (idempotent), HDF5's own error printing silenced,
 !! and never closed here: no module state, other HDF5 users undisturbed (HDF5 closes itself
-!! at exit). An open `h5_file_t` or `h5_series_t` must not be copied (the copies would
+!! at exit, unless a file failed to close: ropedyn_h5_glue.c). A failure's message ends
+!! with the reason from HDF5's error stack (the system's, e.g. 'No space left on device'). An open `h5_file_t` or `h5_series_t` must not be copied (the copies would
 !! share ids); series are closed by their owner before the file.
 !!
 !! Files and groups are here; attributes, datasets and readers in the submodule
 !! ropedyn_h5_data, series in ropedyn_h5_series.
 module ropedyn_h5
-    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr
+    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr, c_char, c_int, c_null_char
     use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5eset_auto_f, &
-        h5fcreate_f, h5fopen_f, h5fclose_f, h5fflush_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, &
+        h5fcreate_f, h5fopen_f, h5fclose_f, h5fflush_f, h5fget_filesize_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, &
         H5F_ACC_RDWR_F, H5F_SCOPE_GLOBAL_F, h5gcreate_f, h5gclose_f, h5lexists_f, &
         h5oopen_f, h5oclose_f, h5screate_f, h5screate_simple_f, h5sclose_f, &
         h5sselect_hyperslab_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, &
@@ -35,10 +36,11 @@ module ropedyn_h5
         h5aexists_f, h5adelete_f, h5aget_type_f, h5tcopy_f, h5tclose_f, h5tset_size_f, &
         h5tget_size_f, h5tset_strpad_f, H5T_NATIVE_CHARACTER, H5T_STR_NULLPAD_F, &
         h5kind_to_type, H5_REAL_KIND, H5_INTEGER_KIND, h5dget_type_f, h5tget_class_f, &
-        H5T_STRING_F, h5ldelete_f
+        H5T_STRING_F, H5T_FLOAT_F, H5T_INTEGER_F, h5tis_variable_str_f, h5ldelete_f
     use ropedyn_kinds, only: wp, i8
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INPUT, ERR_INTERNAL
+    use ropedyn_os, only: special_file_reason, try_lock, lock_holder, ERRNO_EWOULDBLOCK
     implicit none
     private
 
@@ -59,6 +61,7 @@ module ropedyn_h5
         procedure :: close => h5_close
         procedure :: flush => h5_flush
         procedure :: file_name => h5_file_name
+        procedure :: size => h5_size
         procedure :: group => h5_group
         procedure :: exists => h5_exists
         procedure :: attribute => h5_attribute
@@ -87,6 +90,10 @@ module ropedyn_h5
         integer :: rank = 1                       !< Fortran rank including the time axis
         integer(hsize_t) :: record_dims(2) = 1    !< extents of one record (first rank-1 used)
         integer :: text_width = 0                 !< a series of strings: their width, else 0
+        !> what open_series found: its values (SERIES_REAL, _INTEGER, _TEXT, 0: other) and
+        !! whether it can grow along time (unlimited)
+        integer :: value_class = 0
+        logical :: extendible = .true.
     contains
         procedure, private :: append_real, append_integer
         generic :: append => append_real, append_integer
@@ -95,9 +102,37 @@ module ropedyn_h5
         procedure :: record_size => series_record_size
         procedure :: truncate => series_truncate
         procedure :: close => series_close
+        procedure :: unfit => series_unfit
     end type h5_series_t
 
+    !> The values of a series (h5_series_t%value_class).
+    integer, parameter, public :: SERIES_REAL = 1, SERIES_INTEGER = 2, SERIES_TEXT = 3
+
     interface
+        !> Before the library is first opened: its end at exit (ropedyn_h5_glue.c).
+        subroutine c_h5_prepare() bind(C, name='ropedyn_h5_prepare')
+        end subroutine c_h5_prepare
+        !> A file or dataset failed to close: the library is not ended at exit.
+        subroutine c_h5_close_failed() bind(C, name='ropedyn_h5_close_failed')
+        end subroutine c_h5_close_failed
+
+        !> A variable-length string attribute (ropedyn_h5_glue.c).
+        integer(c_int) function c_h5_vlen_attribute(loc, name, buf, size) &
+                bind(C, name='ropedyn_h5_vlen_attribute')
+            import :: c_char, c_int, hid_t
+            integer(hid_t), value :: loc
+            character(kind=c_char), intent(in) :: name(*)
+            character(kind=c_char), intent(out) :: buf(*)
+            integer(c_int), value :: size
+        end function c_h5_vlen_attribute
+
+        !> HDF5's reason of its last failure (ropedyn_h5_glue.c).
+        integer(c_int) function c_h5_reason(buf, size) bind(C, name='ropedyn_h5_reason')
+            import :: c_char, c_int
+            character(kind=c_char), intent(out) :: buf(*)
+            integer(c_int), value :: size
+        end function c_h5_reason
+
         !> Create the empty series `name` whose records have extents `record_dims` (none for a
         !! scalar time series; at most 2), of real(wp) values or, with `is_integer`, default
         !! integers; write its units (and `columns`, if not empty). The series stays open.
@@ -112,6 +147,49 @@ module ropedyn_h5
             character(len=*), intent(in) :: columns
             type(error_t), allocatable, intent(out) :: err
         end subroutine h5_create_series
+
+        !> Open the HDF5 library (idempotent) and silence HDF5's own error printing.
+        module subroutine library_acquire(path, err)
+            character(len=*), intent(in) :: path
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine library_acquire
+
+        !> Create (or overwrite) the file `path`; its directory must exist. A file still open
+        !! in this object is closed first. An existing `path` that is not a regular file (a
+        !! device, a FIFO, a link to one) is bad input and left alone; one that another
+        !! program holds open (locked) is not truncated. Errors give the system's reason.
+        module subroutine h5_create(self, path, err)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: path
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine h5_create
+
+        !> Open the existing file `path`, read-only unless `writable`; a missing file, or one
+        !! that is not a regular file, is bad input (ERR_INPUT: the user named it), one that
+        !! cannot be opened an I/O error naming the reason (the process that holds it
+        !! locked).
+        module subroutine h5_open(self, path, err, writable)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: path
+            type(error_t), allocatable, intent(out) :: err
+            logical, intent(in), optional :: writable
+        end subroutine h5_open
+
+        !> An ERR_IO error (replacing one in `err`): `message` and the reason HDF5 gives for
+        !! its last failure (the system's, e.g. 'No space left on device', when a system call
+        !! failed).
+        module subroutine h5_error(err, message)
+            type(error_t), allocatable, intent(inout) :: err
+            character(len=*), intent(in) :: message
+        end subroutine h5_error
+
+        !> The errno of the system call behind HDF5's last failure (0: none) and, in
+        !! `reason`, that failure in words (ropedyn_h5_glue.c); to be read before the next
+        !! HDF5 call, which clears it.
+        module function h5_reason(reason) result(errnum)
+            character(len=:), allocatable, intent(out), optional :: reason
+            integer :: errnum
+        end function h5_reason
 
         !> Create the empty series `name` of strings of `width` characters (one per record),
         !! with its units. The series stays open.
@@ -138,6 +216,14 @@ module ropedyn_h5
             class(h5_series_t), intent(in) :: self
             integer(hsize_t) :: records
         end function series_length
+
+        !> Why an open series cannot be continued as one of `value_class` (SERIES_*): ''
+        !! when it can, else e.g. 'not extendible (a fixed-size dataset)'.
+        module function series_unfit(self, value_class) result(reason)
+            class(h5_series_t), intent(in) :: self
+            integer, intent(in) :: value_class
+            character(len=:), allocatable :: reason
+        end function series_unfit
 
         !> Number of values in one record of a series.
         pure module function series_record_size(self) result(n)
@@ -307,82 +393,6 @@ contains
     ! Library and file life cycle
     ! ---------------------------------------------------------------------------------------
 
-    !> Open the HDF5 library (idempotent) and silence HDF5's own error printing.
-    subroutine library_acquire(path, err)
-        character(len=*), intent(in) :: path
-        type(error_t), allocatable, intent(out) :: err
-        integer :: hdferr
-        call h5open_f(hdferr)
-        if (h5_failed(hdferr, path//': cannot initialize the HDF5 library', err)) return
-        call h5eset_auto_f(0, hdferr)
-        if (hdferr < 0) call make_error(err, ERR_IO, path//': cannot silence HDF5 error printing')
-    end subroutine library_acquire
-
-    !> Create (or overwrite) the file `path`; its directory must exist. A file still open in
-    !! this object is closed first.
-    subroutine h5_create(self, path, err)
-        class(h5_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        type(error_t), allocatable, intent(out) :: err
-        integer :: hdferr
-        call self%close(err)
-        if (allocated(err)) return
-        call library_acquire(path, err)
-        if (allocated(err)) return
-        call h5fcreate_f(path, H5F_ACC_TRUNC_F, self%id, hdferr)
-        if (hdferr < 0) then
-            self%id = -1
-            if (directory_exists(path)) then
-                call make_error(err, ERR_IO, path//': cannot create file (is it open in this '// &
-                                'or another program, or is the directory read-only?)')
-            else
-                call make_error(err, ERR_IO, path// &
-                                ': cannot create file (does the directory exist?)')
-            end if
-            return
-        end if
-        self%path = path
-        self%is_open = .true.
-    end subroutine h5_create
-
-    !> Open the existing file `path`, read-only unless `writable`; a missing file is bad
-    !! input (ERR_INPUT: the user named it), one that cannot be opened an I/O error.
-    subroutine h5_open(self, path, err, writable)
-        class(h5_file_t), intent(inout) :: self
-        character(len=*), intent(in) :: path
-        type(error_t), allocatable, intent(out) :: err
-        logical, intent(in), optional :: writable
-        logical :: rw, exists
-        integer :: hdferr
-        call self%close(err)
-        if (allocated(err)) return
-        inquire (file=path, exist=exists)
-        if (.not. exists) then
-            call make_error(err, ERR_INPUT, path//': no such file')
-            return
-        end if
-        call library_acquire(path, err)
-        if (allocated(err)) return
-        rw = .false.
-        if (present(writable)) rw = writable
-        if (rw) then
-            call h5fopen_f(path, H5F_ACC_RDWR_F, self%id, hdferr)
-        else
-            call h5fopen_f(path, H5F_ACC_RDONLY_F, self%id, hdferr)
-        end if
-        if (hdferr < 0) then
-            self%id = -1
-            if (rw) then
-                call make_error(err, ERR_IO, path//': cannot open for writing')
-            else
-                call make_error(err, ERR_IO, path//': cannot open as HDF5 file')
-            end if
-            return
-        end if
-        self%path = path
-        self%is_open = .true.
-    end subroutine h5_open
-
     !> Close the file (nothing to do when it is not open). Its series must be closed first.
     subroutine h5_close(self, err)
         class(h5_file_t), intent(inout) :: self
@@ -392,7 +402,10 @@ contains
         call h5fclose_f(self%id, hdferr)
         self%is_open = .false.
         self%id = -1
-        if (hdferr < 0) call make_error(err, ERR_IO, self%path//': cannot close file')
+        if (hdferr < 0) then
+            call h5_error(err, self%path//': cannot close file')
+            call c_h5_close_failed()
+        end if
     end subroutine h5_close
 
     !> Close a file left open (no error can be reported here).
@@ -400,6 +413,7 @@ contains
         type(h5_file_t), intent(inout) :: self
         integer :: hdferr
         if (self%is_open) call h5fclose_f(self%id, hdferr)
+        if (self%is_open .and. hdferr < 0) call c_h5_close_failed()
         self%is_open = .false.
     end subroutine h5_final
 
@@ -409,8 +423,20 @@ contains
         type(error_t), allocatable, intent(out) :: err
         integer :: hdferr
         call h5fflush_f(self%id, H5F_SCOPE_GLOBAL_F, hdferr)
-        if (hdferr < 0) call make_error(err, ERR_IO, self%path//': cannot flush file')
+        if (hdferr < 0) call h5_error(err, self%path//': cannot flush file')
     end subroutine h5_flush
+
+    !> The size of the open file as HDF5 sees it (its end of allocated space, which may lie
+    !! beyond what is written yet), bytes; 0 when it cannot be had.
+    integer(i8) function h5_size(self) result(bytes)
+        class(h5_file_t), intent(in) :: self
+        integer(hsize_t) :: size
+        integer :: hdferr
+        bytes = 0
+        if (.not. self%is_open) return
+        call h5fget_filesize_f(self%id, size, hdferr)
+        if (hdferr >= 0) bytes = int(size, i8)
+    end function h5_size
 
     !> The path given to the last successful create/open ('' if none).
     pure function h5_file_name(self) result(path)
@@ -419,23 +445,6 @@ contains
         path = ''
         if (allocated(self%path)) path = self%path
     end function h5_file_name
-
-    !> Whether the directory part of `path` exists (gfortran's INQUIRE accepts directories;
-    !! a compiler that does not merely gives the 'does the directory exist?' hint).
-    function directory_exists(path) result(exists)
-        character(len=*), intent(in) :: path
-        logical :: exists
-        integer :: slash, ios
-        slash = index(path, '/', back=.true.)
-        if (slash == 0) then
-            inquire (file='.', exist=exists, iostat=ios)
-        else if (slash == 1) then
-            inquire (file='/', exist=exists, iostat=ios)
-        else
-            inquire (file=path(1:slash - 1), exist=exists, iostat=ios)
-        end if
-        if (ios /= 0) exists = .false.
-    end function directory_exists
 
     ! ---------------------------------------------------------------------------------------
     ! Groups and objects
@@ -451,7 +460,7 @@ contains
         call h5gcreate_f(self%id, name, group_id, hdferr)
         if (h5_failed(hdferr, self%path//': '//name//': cannot create group', err)) return
         call h5gclose_f(group_id, hdferr)
-        if (hdferr < 0) call make_error(err, ERR_IO, self%path//': '//name// &
+        if (hdferr < 0) call h5_error(err, self%path//': '//name// &
                                         ': cannot close group')
     end subroutine h5_group
 
@@ -487,7 +496,7 @@ contains
         if (h5_failed(hdferr, self%path//': '//where//': cannot open object', err)) return
         call h5aexists_f(obj, name, exists, hdferr)
         if (hdferr >= 0 .and. exists) call h5adelete_f(obj, name, hdferr)
-        if (hdferr < 0) call make_error(err, ERR_IO, self%path//': '//where//' attribute '// &
+        if (hdferr < 0) call h5_error(err, self%path//': '//where//' attribute '// &
                                         name//': cannot delete')
         call h5oclose_f(obj, hdferr)
     end subroutine h5_delete_attribute

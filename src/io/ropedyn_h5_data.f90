@@ -8,9 +8,32 @@ contains
     module procedure h5_failed
         failed = hdferr < 0
         if (.not. failed) return
-        call make_error(err, ERR_IO, message)
+        call h5_error(err, message)
         if (present(id)) id = -1
     end procedure h5_failed
+
+    module procedure h5_error
+        character(len=:), allocatable :: reason
+        integer :: errnum
+        errnum = h5_reason(reason)
+        if (allocated(err)) deallocate (err)
+        if (len(reason) > 0) then
+            call make_error(err, ERR_IO, message//': '//reason)
+        else
+            call make_error(err, ERR_IO, message)
+        end if
+    end procedure h5_error
+
+    module procedure h5_reason
+        character(kind=c_char, len=300) :: buf
+        integer :: k
+        buf = repeat(c_null_char, len(buf))
+        errnum = int(c_h5_reason(buf, int(len(buf), c_int)))
+        if (.not. present(reason)) return
+        k = index(buf, c_null_char)
+        if (k == 0) k = len(buf) + 1
+        reason = trim(buf(:k - 1))
+    end procedure h5_reason
 
     module procedure string_type
         call h5tcopy_f(H5T_NATIVE_CHARACTER, type_id, hdferr)
@@ -51,12 +74,12 @@ contains
             else
                 call h5awrite_f(attr_id, type_id, achar(0), dims, hdferr)
             end if
-            if (hdferr < 0) call make_error(err, ERR_IO, label//': cannot write attribute')
+            if (hdferr < 0) call h5_error(err, label//': cannot write attribute')
         end block steps
         if (attr_id >= 0) then
             call h5aclose_f(attr_id, hdferr)
             if (hdferr < 0 .and. .not. allocated(err)) &
-                call make_error(err, ERR_IO, label//': cannot close attribute')
+                call h5_error(err, label//': cannot close attribute')
         end if
         if (space_id >= 0) call h5sclose_f(space_id, hdferr)
         if (type_id >= 0) call h5tclose_f(type_id, hdferr)
@@ -86,7 +109,7 @@ contains
         if (size(values) > 0 .and. len(values) > 0) buffer = c_loc(values(1)(1:1))
         call string_type(len(values), type_id, hdferr)
         if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot set up the string type')
+            call h5_error(err, self%path//': '//name//': cannot set up the string type')
         else
             call write_data(self, name, type_id, [size(values, kind=hsize_t)], buffer, &
                             is_contiguous(values), units, err)
@@ -145,7 +168,7 @@ contains
         hdferr = 0
         if (product(dims) > 0) call h5dwrite_f(dset_id, type_id, buffer, hdferr)
         if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot write dataset')
+            call h5_error(err, self%path//': '//name//': cannot write dataset')
         else if (.not. exists) then
             call string_attribute(self%path, dset_id, name, 'units', units, err)
             if (.not. allocated(err) .and. present(description)) then
@@ -155,7 +178,7 @@ contains
         end if
         call h5dclose_f(dset_id, hdferr)
         if (hdferr < 0 .and. .not. allocated(err)) &
-            call make_error(err, ERR_IO, self%path//': '//name//': cannot close dataset')
+            call h5_error(err, self%path//': '//name//': cannot close dataset')
     end subroutine write_data
 
     module procedure new_dataset
@@ -179,7 +202,7 @@ contains
                 call h5pcreate_f(H5P_DATASET_CREATE_F, plist_id, hdferr)
                 if (hdferr < 0) then
                     plist_id = H5P_DEFAULT_F
-                    call make_error(err, ERR_IO, self%path//': '//name// &
+                    call h5_error(err, self%path//': '//name// &
                                     ': cannot create property list')
                     exit steps
                 end if
@@ -190,7 +213,7 @@ contains
             call h5dcreate_f(self%id, name, type_id, space_id, dset_id, hdferr, dcpl_id=plist_id)
             if (hdferr < 0) then
                 dset_id = -1
-                call make_error(err, ERR_IO, self%path//': '//name//': cannot create dataset')
+                call h5_error(err, self%path//': '//name//': cannot create dataset')
             end if
         end block steps
         if (plist_id /= H5P_DEFAULT_F) call h5pclose_f(plist_id, hdferr)
@@ -205,8 +228,11 @@ contains
         integer(hid_t) :: attr_id, type_id
         integer(size_t) :: length
         integer(hsize_t), parameter :: dims(1) = 1
-        logical :: exists
-        integer :: hdferr, nul
+        logical :: exists, vlen
+        integer :: hdferr, nul, class
+        integer(c_int) :: n
+        character(kind=c_char, len=1) :: small
+        character(kind=c_char, len=:), allocatable :: whole
         character(len=:), allocatable :: label
 
         label = self%path//': attribute '//name
@@ -222,16 +248,36 @@ contains
         call h5aopen_f(self%id, name, attr_id, hdferr)
         if (h5_failed(hdferr, label//': cannot open', err)) return
         call h5aget_type_f(attr_id, type_id, hdferr)
+        if (hdferr >= 0) call h5tget_class_f(type_id, class, hdferr)
         if (hdferr >= 0) call h5tget_size_f(type_id, length, hdferr)
+        vlen = .false.
+        if (hdferr >= 0 .and. class == H5T_STRING_F) call h5tis_variable_str_f(type_id, &
+                                                                                vlen, hdferr)
         if (hdferr < 0) then
-            call make_error(err, ERR_IO, label//': cannot get its type')
+            call h5_error(err, label//': cannot get its type')
+        else if (class /= H5T_STRING_F) then
+            call make_error(err, ERR_INPUT, label//': not a string (not written by ropedyn)')
+            call h5tclose_f(type_id, hdferr)
+        else if (vlen) then
+            ! a string of variable length (h5py's): read by the C glue
+            call h5tclose_f(type_id, hdferr)
+            n = c_h5_vlen_attribute(self%id, name//c_null_char, small, 1_c_int)
+            if (n >= 0) then
+                allocate (character(len=n + 1) :: whole)
+                n = c_h5_vlen_attribute(self%id, name//c_null_char, whole, int(n + 1, c_int))
+            end if
+            if (n < 0) then
+                call h5_error(err, label//': cannot read')
+            else
+                value = whole(:n)
+            end if
         else
             block
                 character(len=length) :: buffer
                 buffer = ''
                 call h5aread_f(attr_id, type_id, buffer, dims, hdferr)
                 if (hdferr < 0) then
-                    call make_error(err, ERR_IO, label//': cannot read')
+                    call h5_error(err, label//': cannot read')
                 else
                     nul = index(buffer, achar(0))
                     if (nul > 0) then
@@ -291,7 +337,7 @@ contains
                 target_ptr = buffer
             end if
             call h5dread_f(dset_id, type_id, target_ptr, hdferr)
-            if (hdferr < 0) call make_error(err, ERR_IO, self%path//': '//name//': cannot read')
+            if (hdferr < 0) call h5_error(err, self%path//': '//name//': cannot read')
         end block steps
         call h5dclose_f(dset_id, hdferr)
     end subroutine read_data
@@ -315,7 +361,7 @@ contains
                             int_text(size(dims)))
         else
             call h5sget_simple_extent_dims_f(space_id, dims, maxdims, hdferr)
-            if (hdferr < 0) call make_error(err, ERR_IO, self%path//': '//name// &
+            if (hdferr < 0) call h5_error(err, self%path//': '//name// &
                                             ': cannot get extents')
         end if
         call h5sclose_f(space_id, hdferr)

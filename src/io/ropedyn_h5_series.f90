@@ -88,15 +88,33 @@ contains
         series%record_dims = 1
         series%record_dims(1:rank - 1) = dims(1:rank - 1)
         series%text_width = 0
+        series%extendible = max_dims(rank) == H5S_UNLIMITED_F
+        series%value_class = 0
         call h5dget_type_f(series%id, type_id, hdferr)
         if (h5_failed(hdferr, self%path//': '//name//': cannot get its type', err)) return
         call h5tget_class_f(type_id, class, hdferr)
         if (hdferr >= 0 .and. class == H5T_STRING_F) then
             call h5tget_size_f(type_id, width, hdferr)
             series%text_width = int(width)
+            series%value_class = SERIES_TEXT
+        else if (hdferr >= 0 .and. class == H5T_FLOAT_F) then
+            series%value_class = SERIES_REAL
+        else if (hdferr >= 0 .and. class == H5T_INTEGER_F) then
+            series%value_class = SERIES_INTEGER
         end if
         call h5tclose_f(type_id, hdferr)
     end procedure h5_open_series
+
+    module procedure series_unfit
+        character(len=*), parameter :: NAMES(3) = [character(len=15) :: 'real numbers', &
+            'integers', 'strings']
+        reason = ''
+        if (.not. self%extendible) then
+            reason = 'not extendible (a fixed-size dataset: not written by ropedyn)'
+        else if (self%value_class /= value_class) then
+            reason = 'not a series of '//trim(NAMES(value_class))//' (not written by ropedyn)'
+        end if
+    end procedure series_unfit
 
     module procedure series_length
         integer(hid_t) :: space_id
@@ -123,7 +141,7 @@ contains
         dims(1:self%rank - 1) = self%record_dims(1:self%rank - 1)
         dims(self%rank) = records
         call h5dset_extent_f(self%id, dims(1:self%rank), hdferr)
-        if (hdferr < 0) call make_error(err, ERR_IO, self%path//': '//self%name// &
+        if (hdferr < 0) call h5_error(err, self%path//': '//self%name// &
                                         ': cannot cut to '//int_text(int(records))//' records')
     end procedure series_truncate
 
@@ -141,7 +159,7 @@ contains
         padded(1:min(len(value), self%text_width)) = value(1:min(len(value), self%text_width))
         call string_type(self%text_width, type_id, hdferr)
         if (hdferr < 0) then
-            call make_error(err, ERR_IO, self%path//': '//self%name// &
+            call h5_error(err, self%path//': '//self%name// &
                             ': cannot set up the string type')
             return
         end if
@@ -182,7 +200,7 @@ contains
             buffer = c_loc(values)
             if (size(values) > 0) call h5dread_f(dset_id, h5kind_to_type(wp, H5_REAL_KIND), &
                 buffer, hdferr, mem_space_id=mem_space, file_space_id=file_space)
-            if (hdferr < 0) call make_error(err, ERR_IO, label//': cannot read record '// &
+            if (hdferr < 0) call h5_error(err, label//': cannot read record '// &
                                             int_text(int(record)))
         end block steps
         if (mem_space >= 0) call h5sclose_f(mem_space, hdferr)
@@ -195,7 +213,8 @@ contains
         if (self%id < 0) return
         call h5dclose_f(self%id, hdferr)
         self%id = -1
-        if (hdferr < 0) call make_error(err, ERR_IO, self%path//': '//self%name// &
+        if (hdferr < 0) call c_h5_close_failed()
+        if (hdferr < 0) call h5_error(err, self%path//': '//self%name// &
                                         ': cannot close dataset')
     end procedure series_close
 
@@ -242,12 +261,12 @@ contains
         dims(rank) = record + count - 1
         call h5dset_extent_f(self%id, dims(1:rank), hdferr)
         if (hdferr < 0) then
-            call make_error(err, ERR_IO, label//': cannot extend dataset')
+            call h5_error(err, label//': cannot extend dataset')
             return
         end if
         call h5dget_space_f(self%id, file_space, hdferr)
         if (hdferr < 0) then
-            call make_error(err, ERR_IO, label//': cannot get dataspace')
+            call h5_error(err, label//': cannot get dataspace')
             return
         end if
         steps: block
@@ -256,7 +275,7 @@ contains
             if (allocated(err)) exit steps
             call h5dwrite_f(self%id, type_id, buffer, hdferr, mem_space_id=mem_space, &
                             file_space_id=file_space)
-            if (hdferr < 0) call make_error(err, ERR_IO, label//': cannot write record '// &
+            if (hdferr < 0) call h5_error(err, label//': cannot write record '// &
                                             int_text(int(record)))
         end block steps
         if (mem_space >= 0) call h5sclose_f(mem_space, hdferr)
@@ -284,7 +303,7 @@ contains
         call h5sselect_hyperslab_f(file_space, H5S_SELECT_SET_F, start, &
                                    [record_dims, records], hdferr)
         if (hdferr < 0) then
-            call make_error(err, ERR_IO, label//': cannot select record '//int_text(int(record)))
+            call h5_error(err, label//': cannot select record '//int_text(int(record)))
             return
         end if
         ! the memory space has the selection's shape, so that HDF5 copies the block whole
@@ -292,7 +311,7 @@ contains
         call h5screate_simple_f(size(start), [record_dims, records], mem_space, hdferr)
         if (hdferr < 0) then
             mem_space = -1
-            call make_error(err, ERR_IO, label//': cannot create memory dataspace')
+            call h5_error(err, label//': cannot create memory dataspace')
         end if
     end subroutine select_record
 end submodule ropedyn_h5_series

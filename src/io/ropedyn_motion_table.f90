@@ -6,6 +6,7 @@ module ropedyn_motion_table
     use ropedyn_namelist_file, only: MAX_FILE_BYTES
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_text, only: int_text
+    use ropedyn_os, only: special_file_reason
     implicit none
     private
     public :: read_motion_table
@@ -27,13 +28,22 @@ contains
         type(error_t), allocatable, intent(out) :: err
         real(wp), allocatable :: grown(:, :)
         real(wp) :: r(4), extra
-        character(len=1024) :: line, msg
+        character(len=:), allocatable :: line
+        character(len=1024) :: msg
         integer :: unit, ios, m, lineno, lead, i, ios2
         integer(i8) :: bytes
 
         allocate (rows(4, 64))
         m = 0
         msg = ''
+        line = ''
+        lineno = 0
+        ! a FIFO would block the open, a device such as /dev/zero never end
+        if (len(special_file_reason(path)) > 0) then
+            call make_error(err, ERR_INPUT, where//' = "'//path//'": cannot read: '// &
+                special_file_reason(path))
+            return
+        end if
         open (newunit=unit, file=path, status='old', action='read', form='formatted', &
               iostat=ios, iomsg=msg)
         if (ios /= 0) then
@@ -48,9 +58,8 @@ contains
             close (unit)
             return
         end if
-        lineno = 0
         do
-            read (unit, '(a)', iostat=ios, iomsg=msg) line
+            call read_line(unit, line, ios, msg)
             if (is_iostat_end(ios)) exit
             lineno = lineno + 1
             if (ios /= 0) then
@@ -106,4 +115,23 @@ contains
             close (unit)
         end subroutine fail
     end subroutine read_motion_table
+
+    !> The next line of the formatted unit, whole (however long).
+    subroutine read_line(unit, line, ios, msg)
+        integer, intent(in) :: unit
+        character(len=:), allocatable, intent(out) :: line
+        integer, intent(out) :: ios
+        character(len=*), intent(inout) :: msg
+        character(len=256) :: chunk
+        integer :: n
+        line = ''
+        do
+            read (unit, '(a)', advance='no', iostat=ios, iomsg=msg, size=n) chunk
+            line = line//chunk(:n)
+            if (ios /= 0) exit
+        end do
+        if (is_iostat_eor(ios)) ios = 0
+        ! the last line without a new line: its text, then the end on the next call
+        if (is_iostat_end(ios) .and. len(line) > 0) ios = 0
+    end subroutine read_line
 end module ropedyn_motion_table

@@ -14,7 +14,8 @@
 module ropedyn_namelist_file
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
-    use ropedyn_text, only: int_text, lower, line_quote, printable, text_t, clip
+    use ropedyn_text, only: int_text, lower, line_quote, printable, text_t, clip, edit_distance
+    use ropedyn_os, only: special_file_reason
     use ropedyn_namelist_lexer, only: token_t, lex_lines, TK_WORD, TK_STRING, TK_EQ, &
         TK_COMMA, TK_SLASH, TK_LPAREN, TK_RPAREN, TK_GROUP, TK_BAD_CHAR, TK_BAD_QUOTE
     use ropedyn_namelist_values, only: nml_value_t, value_token, parse_values, value_real, &
@@ -28,6 +29,8 @@ module ropedyn_namelist_file
 
     integer, parameter :: MAX_FILE_BYTES = 1048576  !< largest file read (1 MiB)
     integer, parameter :: MAX_ASSIGNMENTS = 1000    !< most assignments in one group
+    !> The UTF-8 byte-order mark, skipped at the start of a file.
+    character(len=*), parameter :: UTF8_BOM = achar(239)//achar(187)//achar(191)
 
     !> `key = values` or `key(index) = values`.
     type :: nml_assignment_t
@@ -94,14 +97,38 @@ contains
                     call make_error(err, ERR_INPUT, path//': no &'//required//' group (the ' &
                         //'file is empty): '//not_what)
                 else
-                    call make_error(err, ERR_INPUT, path//': no &'//required//' group: ' &
-                        //not_what)
+                    call make_error(err, ERR_INPUT, path//': no &'//required//' group'// &
+                        groups_found(tk, required)//': '//not_what)
                 end if
                 return
             end if
         end if
         call parse_namelist_lines(path, lines, allowed, file, err, hint)
     end subroutine read_namelist_file
+
+    !> ' (found &a, &b; did you mean &required?)' for the groups the tokens `tk` open (''
+    !! when none), the hint when one of them is a near miss of `required`.
+    function groups_found(tk, required) result(text)
+        type(token_t), intent(in) :: tk(:)
+        character(len=*), intent(in) :: required
+        character(len=:), allocatable :: text, hint
+        integer :: k, shown
+        text = ''
+        hint = ''
+        shown = 0
+        do k = 1, size(tk)
+            if (tk(k)%kind /= TK_GROUP .or. len(tk(k)%text) == 0) cycle
+            if (tk(k)%text == 'end') cycle
+            shown = shown + 1
+            if (shown > 5) cycle
+            if (shown > 1) text = text//', '
+            text = text//'&'//clip(printable(tk(k)%text))
+            if (len(hint) == 0 .and. edit_distance(tk(k)%text, required) <= 2) &
+                hint = '; did you mean &'//required//'?'
+        end do
+        if (shown > 5) text = text//', ...'
+        if (shown > 0) text = ' (found '//text//hint//')'
+    end function groups_found
 
     !> Index of group `name` in the file, 0 if it is not there.
     pure integer function file_find(self, name) result(k)
@@ -124,6 +151,11 @@ contains
         integer(i8) :: file_size
 
         msg = ''
+        ! a FIFO would block the open, a device such as /dev/zero read as empty or never end
+        if (len(special_file_reason(path)) > 0) then
+            call make_error(err, ERR_INPUT, path//': cannot read: '//special_file_reason(path))
+            return
+        end if
         open (newunit=unit, file=path, status='old', action='read', access='stream', &
               form='unformatted', iostat=ios, iomsg=msg)
         if (ios /= 0) then
@@ -144,6 +176,13 @@ contains
         if (ios /= 0) then
             call make_error(err, ERR_INPUT, path//': cannot read: '//trim(msg))
             return
+        end if
+        ! a UTF-8 byte-order mark (some editors write one) is not part of the text
+        if (size_bytes >= 3) then
+            if (bytes(1:3) == UTF8_BOM) then
+                bytes = bytes(4:)
+                size_bytes = size_bytes - 3
+            end if
         end if
         n = count([(bytes(k:k) == achar(10), k = 1, size_bytes)])
         if (size_bytes > 0) then

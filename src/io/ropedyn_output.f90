@@ -117,6 +117,11 @@ module ropedyn_output
     !! MAX_PENDING records. One HDF5 write per series and record cost a tenth of the paper
     !! run's time (12 datasets); a block of records costs one write per series.
     integer, parameter :: PENDING_BYTES = 2**20, MAX_PENDING = 512
+    !> Room kept free on the file system beyond the end of the file (ropedyn_os reserve_space,
+    !! at create and reopen and after every block of records appended): when it cannot be
+    !! kept, the disk is all but full, and the run stops while there is still room to close
+    !! the file marked failed.
+    integer(i8), parameter :: RESERVE_BYTES = 2*int(PENDING_BYTES, i8)
 
     !> The values of a series' pending records, one after the other.
     type :: block_t
@@ -145,6 +150,11 @@ module ropedyn_output
         integer, allocatable :: pending_order(:)
         integer :: n_pending = 0
         integer :: capacity = 1
+        !> the I/O error after which the file was given up (`abandon`); later calls return it
+        character(len=:), allocatable :: broken
+        !> bytes of records written to HDF5 since the file was last flushed (held in its
+        !! chunk cache: written to disk at the flush; keep_room keeps room for them)
+        integer(i8) :: unflushed = 0
     contains
         procedure :: create => output_create
         procedure :: append => output_append
@@ -223,6 +233,61 @@ module ropedyn_output
             type(error_t), allocatable, intent(out) :: err
         end subroutine write_pending
 
+        !> Record what the order safety did (docs/stability.md; times < 0: never): the order
+        !! limit lowered from `from` to `to` at time `lowered_at`; the order kept at a gain
+        !! judged the integration error, first at `kept_at`, `kept_count` times in all; `gain`,
+        !! the first gain beyond the bound. Nothing when it did neither.
+        module subroutine output_write_order_safety(self, gain, lowered_at, from, to, &
+                                                    kept_at, kept_count, err)
+            class(output_file_t), intent(inout) :: self
+            real(wp), intent(in) :: gain                  !< J
+            real(wp), intent(in) :: lowered_at, kept_at   !< s
+            integer, intent(in) :: from, to, kept_count
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine output_write_order_safety
+
+        !> The integrator's changes of method or order limit during the run
+        !! (ropedyn_switch_log) as /solver/switch_time (s), switch_method, switch_max_order
+        !! and switch_reason, one entry per change, oldest first (nothing when none).
+        module subroutine output_write_switches(self, events, err)
+            class(output_file_t), intent(inout) :: self
+            type(switch_event_t), intent(in) :: events(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine output_write_switches
+
+        !> After the I/O error `err` (a full disk, a failed device, ...), give the file up: the
+        !! records not written yet are dropped, the status set to 'failed' with err's message
+        !! as the reason while that can still be written, and every object closed (datasets
+        !! before the file, so that nothing is left for the library to flush at exit). err's
+        !! message then says which: '; the file is closed with status failed ...' or '; the
+        !! file is incomplete ...'. Later calls on `self` return that error.
+        module subroutine abandon(self, err)
+            type(output_file_t), intent(inout) :: self
+            type(error_t), allocatable, intent(inout) :: err
+        end subroutine abandon
+
+        !> The error of a call on a file that is not open: the I/O error it was given up
+        !! after (ERR_IO), else ERR_INTERNAL naming `what` (the call).
+        module subroutine not_open(self, what, err)
+            type(output_file_t), intent(in) :: self
+            character(len=*), intent(in) :: what
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine not_open
+
+        !> Flush the file (everything HDF5 holds goes to disk).
+        module subroutine flush_file(self, err)
+            type(output_file_t), intent(inout) :: self
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine flush_file
+
+        !> Keep room beyond the end of the file for what is not flushed yet and RESERVE_BYTES
+        !! more; ERR_IO when the file system has not that much left (nothing when it cannot
+        !! reserve at all).
+        module subroutine keep_room(self, err)
+            type(output_file_t), intent(inout) :: self
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine keep_room
+
         !> The path of the file, or a placeholder if create never succeeded.
         module function file_label(self) result(label)
             type(output_file_t), intent(in) :: self
@@ -276,7 +341,7 @@ contains
 
         call write_contents()
         if (allocated(err)) then
-            call shutdown(self)
+            call abandon(self, err)
         else
             call allocate_pending(self)
         end if
@@ -320,7 +385,8 @@ contains
             if (self%restart_data) call create_state_series(self, err)
             if (allocated(err)) return
 
-            call self%file%flush(err)
+            call flush_file(self, err)
+            if (.not. allocated(err)) call keep_room(self, err)
         end subroutine write_contents
     end subroutine output_create
 
@@ -374,69 +440,35 @@ contains
         integer :: k
 
         if (.not. self%is_open) then
-            call make_error(err, ERR_INTERNAL, &
-                            file_label(self)//': write_stats: file is not open')
+            call not_open(self, 'write_stats', err)
             return
         end if
-        call write_pending(self, err)
-        if (allocated(err)) return
-        counters = counter_values(stats)
-        do k = 1, size(COUNTER_NAMES)
-            call self%file%write('/solver/'//trim(COUNTER_NAMES(k)), counters(k), '1', err)
-            if (allocated(err)) return
-        end do
-        call self%file%write('/solver/cpu_time', cpu_time, 's', err)
-        if (allocated(err)) return
-        times = timer_values(stats)
-        do k = 1, size(TIMER_NAMES)
-            call self%file%write('/solver/'//trim(TIMER_NAMES(k)), times(k), 's', err)
-            if (allocated(err)) return
-        end do
-        call self%file%write('/solver/reduced_newton', merge(1_i8, 0_i8, stats%reduced_newton), &
-                             '1', err)
-        if (allocated(err)) return
-        if (present(t_reached)) then
-            call self%file%write('/solver/t_reached', t_reached, 's', err)
-            if (allocated(err)) return
-        end if
-
-        call self%file%flush(err)
+        steps: block
+            call write_pending(self, err)
+            if (allocated(err)) exit steps
+            counters = counter_values(stats)
+            do k = 1, size(COUNTER_NAMES)
+                call self%file%write('/solver/'//trim(COUNTER_NAMES(k)), counters(k), '1', err)
+                if (allocated(err)) exit steps
+            end do
+            call self%file%write('/solver/cpu_time', cpu_time, 's', err)
+            if (allocated(err)) exit steps
+            times = timer_values(stats)
+            do k = 1, size(TIMER_NAMES)
+                call self%file%write('/solver/'//trim(TIMER_NAMES(k)), times(k), 's', err)
+                if (allocated(err)) exit steps
+            end do
+            call self%file%write('/solver/reduced_newton', merge(1_i8, 0_i8, &
+                                 stats%reduced_newton), '1', err)
+            if (allocated(err)) exit steps
+            if (present(t_reached)) then
+                call self%file%write('/solver/t_reached', t_reached, 's', err)
+                if (allocated(err)) exit steps
+            end if
+            call flush_file(self, err)
+        end block steps
+        if (allocated(err)) call abandon(self, err)
     end subroutine output_write_stats
-
-    !> Record what the order safety did (docs/stability.md; times < 0: never): the order
-    !! limit lowered from `from` to `to` at time `lowered_at`; the order kept at a gain
-    !! judged the integration error, first at `kept_at`, `kept_count` times in all; `gain`,
-    !! the first gain beyond the bound. Nothing when it did neither.
-    subroutine output_write_order_safety(self, gain, lowered_at, from, to, kept_at, &
-                                         kept_count, err)
-        class(output_file_t), intent(inout) :: self
-        real(wp), intent(in) :: gain                  !< J
-        real(wp), intent(in) :: lowered_at, kept_at   !< s
-        integer, intent(in) :: from, to, kept_count
-        type(error_t), allocatable, intent(out) :: err
-        if (lowered_at < 0.0_wp .and. kept_at < 0.0_wp) return
-        if (.not. self%is_open) then
-            call make_error(err, ERR_INTERNAL, &
-                            file_label(self)//': write_order_safety: file is not open')
-            return
-        end if
-        call self%file%write('/solver/energy_gain', gain, 'J', err)
-        if (lowered_at >= 0.0_wp) then
-            if (.not. allocated(err)) &
-                call self%file%write('/solver/order_lowered_at', lowered_at, 's', err)
-            if (.not. allocated(err)) &
-                call self%file%write('/solver/order_lowered_from', int(from, i8), '1', err)
-            if (.not. allocated(err)) &
-                call self%file%write('/solver/order_lowered_to', int(to, i8), '1', err)
-        end if
-        if (kept_at >= 0.0_wp) then
-            if (.not. allocated(err)) &
-                call self%file%write('/solver/order_kept_at', kept_at, 's', err)
-            if (.not. allocated(err)) &
-                call self%file%write('/solver/order_kept_count', int(kept_count, i8), '1', err)
-        end if
-        if (.not. allocated(err)) call self%file%flush(err)
-    end subroutine output_write_order_safety
 
     !> The time split of `stats` named in TIMER_NAMES, in that order (s).
     pure function timer_values(stats) result(times)
@@ -468,47 +500,6 @@ contains
         stats%nonlin_conv_fails = stats%nonlin_conv_fails + counters(7)
     end subroutine add_counter_values
 
-    !> The integrator's changes of method or order limit during the run (ropedyn_switch_log)
-    !! as /solver/switch_time (s), switch_method, switch_max_order and switch_reason, one
-    !! entry per change, oldest first (nothing when there were none).
-    subroutine output_write_switches(self, events, err)
-        class(output_file_t), intent(inout) :: self
-        type(switch_event_t), intent(in) :: events(:)
-        type(error_t), allocatable, intent(out) :: err
-        character(len=16), allocatable :: methods(:)
-        character(len=:), allocatable :: reasons(:)
-        real(wp), allocatable :: times(:)
-        integer(i8), allocatable :: orders(:)
-        integer :: k, width
-
-        if (size(events) == 0) return
-        if (.not. self%is_open) then
-            call make_error(err, ERR_INTERNAL, &
-                            file_label(self)//': write_switches: file is not open')
-            return
-        end if
-        width = 1
-        do k = 1, size(events)
-            if (allocated(events(k)%reason)) width = max(width, len(events(k)%reason))
-        end do
-        allocate (methods(size(events)))
-        allocate (character(len=width) :: reasons(size(events)))
-        do k = 1, size(events)
-            methods(k) = events(k)%method
-            reasons(k) = ''
-            if (allocated(events(k)%reason)) reasons(k) = events(k)%reason
-        end do
-        times = events%t
-        orders = int(events%max_order, i8)
-        call self%file%write('/solver/switch_time', times, 's', err)
-        if (allocated(err)) return
-        call self%file%write('/solver/switch_max_order', orders, '1', err)
-        if (allocated(err)) return
-        call self%file%write_text('/solver/switch_method', methods, '', err)
-        if (allocated(err)) return
-        call self%file%write_text('/solver/switch_reason', reasons, '', err)
-    end subroutine output_write_switches
-
     !> Set the root status ('complete', or 'failed' or 'interrupted' with `reason`) and close
     !! everything. The file is closed even when writing the status fails.
     subroutine output_close_run(self, status, reason, err)
@@ -518,7 +509,7 @@ contains
         type(error_t), allocatable, intent(out) :: err
 
         if (.not. self%is_open) then
-            call make_error(err, ERR_INTERNAL, file_label(self)//': close_run: file is not open')
+            call not_open(self, 'close_run', err)
             return
         end if
         if (status /= 'complete' .and. status /= 'failed' .and. status /= 'interrupted') then
@@ -541,10 +532,10 @@ contains
                 call self%file%attribute('/', 'reason', '(no reason given)', err)
             end if
         end if
-        if (.not. allocated(err)) call self%file%flush(err)
+        if (.not. allocated(err)) call flush_file(self, err)
 
         if (allocated(err)) then
-            call shutdown(self)
+            call abandon(self, err)
         else
             call shutdown(self, err)
         end if

@@ -3,6 +3,7 @@
 !! What a crash can lose is unchanged: pending records are written, and the file flushed,
 !! whenever FLUSH_PERIOD has passed, and before the file is finished or closed.
 submodule (ropedyn_output) ropedyn_output_pending
+    use ropedyn_os, only: reserve_space, errno_text, ERRNO_ENOSPC, ERRNO_EDQUOT, ERRNO_EFBIG
     implicit none
 
 contains
@@ -14,7 +15,7 @@ contains
         logical :: due
 
         if (.not. self%is_open) then
-            call make_error(err, ERR_INTERNAL, file_label(self)//': append: file is not open')
+            call not_open(self, 'append', err)
             return
         end if
         n = self%n_elements
@@ -51,12 +52,15 @@ contains
               now - self%last_flush >= FLUSH_PERIOD
         if (due .or. m == self%capacity) then
             call write_pending(self, err)
-            if (allocated(err)) return
+            ! room for what follows (not at the end: a run that got all its records written
+            ! closes its file whatever room is left)
+            if (.not. allocated(err)) call keep_room(self, err)
         end if
-        if (due) then
-            call self%file%flush(err)
+        if (due .and. .not. allocated(err)) then
+            call flush_file(self, err)
             self%last_flush = now
         end if
+        if (allocated(err)) call abandon(self, err)
 
     contains
 
@@ -140,5 +144,23 @@ contains
         if (allocated(err)) return
         self%n_records = self%n_records + int(m, hsize_t)
         self%n_pending = 0
+        self%unflushed = self%unflushed + 8_i8*m*sum([(size(self%pending(k)%v), &
+                                                       k = 1, N_SERIES + 2)])/self%capacity
     end procedure write_pending
+
+    module procedure flush_file
+        call self%file%flush(err)
+        if (.not. allocated(err)) self%unflushed = 0
+    end procedure flush_file
+
+    module procedure keep_room
+        integer :: errnum
+        errnum = reserve_space(self%file%file_name(), self%file%size(), &
+                               self%unflushed + RESERVE_BYTES)
+        if (errnum == ERRNO_ENOSPC .or. errnum == ERRNO_EDQUOT .or. errnum == ERRNO_EFBIG) &
+            call make_error(err, ERR_IO, &
+            self%file%file_name()//': '//errno_text(errnum)//' (no room for the records '// &
+            'not flushed and a reserve of '//int_text(int(RESERVE_BYTES/2**20))//' MiB: '// &
+            'the run stops while the file can still be closed)')
+    end procedure keep_room
 end submodule ropedyn_output_pending

@@ -1,13 +1,19 @@
-!> Continuing a run file (`ropedyn run --resume`, the sweep runner's resume): reopening it
-!! after its last complete record and recording the restart in /solver/restarts; and
-!! closing a file (shutdown, shared with the module's close and finalizer).
+!> Continuing a run file (`ropedyn run --resume`, the sweep runner's resume): checking that
+!! it can be continued (before anything in it changes), reopening it after its last
+!! complete record and recording the restart in /solver/restarts; and closing a file
+!! (shutdown, shared with the module's close and finalizer; abandon, after an I/O error).
 submodule (ropedyn_output) ropedyn_output_resume
+    use ropedyn_text, only: real_text
+    use ropedyn_error, only: ERR_INPUT
+    use ropedyn_h5, only: SERIES_REAL, SERIES_INTEGER, SERIES_TEXT
+    use ropedyn_scene, only: scene_t, read_scene_text
+    use ropedyn_os, only: release_space
     implicit none
 
 contains
 
     module procedure output_reopen
-        integer :: expected, k
+        integer :: k
 
         if (self%is_open) call shutdown(self)
         call self%file%open(path, err, writable=.true.)
@@ -16,46 +22,17 @@ contains
         self%n_elements = n_elements
         self%restart_data = .true.
         self%state_size = [state_size, quad_size]
+        ! first every check, with nothing changed: a file that cannot be continued is left
+        ! as it was (its status, its reason, its records)
+        call open_checked(self, path, err)
+        if (.not. allocated(err) .and. present(keep)) call check_cut(self, path, keep, err)
+        if (allocated(err)) then
+            call shutdown(self)
+            return
+        end if
+        if (present(keep)) self%n_records = max(0_hsize_t, min(self%n_records, &
+                                                               int(keep, hsize_t)))
         steps: block
-            do k = 1, N_SERIES
-                call self%file%open_series(self%series(k), trim(SERIES_NAME(k)), err)
-                if (allocated(err)) exit steps
-            end do
-            do k = 1, 2
-                if (.not. self%file%exists(trim(STATE_NAME(k)))) then
-                    call make_error(err, ERR_IO, path//': '//trim(STATE_NAME(k))// &
-                        ': missing (a file without restart data cannot be continued)')
-                    exit steps
-                end if
-                call self%file%open_series(self%state(k), trim(STATE_NAME(k)), err)
-                if (allocated(err)) exit steps
-            end do
-            do k = 1, N_SERIES
-                expected = max(1, RECORD_ROWS(k)*RECORD_PER_ELEMENT(k)*n_elements)
-                if (self%series(k)%record_size() /= expected) then
-                    call make_error(err, ERR_IO, path//': '//trim(SERIES_NAME(k))// &
-                        ': records of '//int_text(self%series(k)%record_size())// &
-                        ' values, expected '//int_text(expected)//' for '// &
-                        int_text(n_elements)//' elements')
-                    exit steps
-                end if
-            end do
-            do k = 1, 2
-                if (self%state(k)%record_size() /= max(1, self%state_size(k))) then
-                    call make_error(err, ERR_IO, path//': '//trim(STATE_NAME(k))// &
-                        ': records of '//int_text(self%state(k)%record_size())// &
-                        ' values, the model has '//int_text(self%state_size(k)))
-                    exit steps
-                end if
-            end do
-            self%n_records = self%series(S_TIME)%length()
-            if (present(keep)) self%n_records = max(0_hsize_t, min(self%n_records, &
-                                                                int(keep, hsize_t)))
-            if (self%state(1)%length() < self%n_records .or. &
-                self%state(2)%length() < self%n_records) then
-                call make_error(err, ERR_IO, path//': /state/y: fewer records than /time')
-                exit steps
-            end if
             do k = 1, N_SERIES
                 call self%series(k)%truncate(self%n_records, err)
                 if (allocated(err)) exit steps
@@ -68,14 +45,137 @@ contains
             if (allocated(err)) exit steps
             call self%file%delete_attribute('/', 'reason', err)
             if (allocated(err)) exit steps
-            call self%file%flush(err)
+            call flush_file(self, err)
+            if (allocated(err)) exit steps
+            call keep_room(self, err)
         end block steps
         if (allocated(err)) then
-            call shutdown(self)
+            call abandon(self, err)
         else
             call allocate_pending(self)
         end if
     end procedure output_reopen
+
+    !> Open every series of a file being continued and check it (nothing is written): each
+    !! one there, extendible, of its kind of values and record size, with at least as many
+    !! records as /time; the restart entries (if any) likewise. self%n_records: the
+    !! length of /time. Errors are ERR_INPUT naming the dataset: the file was changed by
+    !! something else than ropedyn.
+    subroutine open_checked(self, path, err)
+        type(output_file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: err
+        type(h5_series_t) :: entry
+        type(error_t), allocatable :: close_err
+        character(len=:), allocatable :: name
+        integer(hsize_t) :: n
+        integer :: expected, k, kind
+
+        do k = 1, N_SERIES + 2
+            if (k <= N_SERIES) then
+                name = trim(SERIES_NAME(k))
+                expected = max(1, RECORD_ROWS(k)*RECORD_PER_ELEMENT(k)*self%n_elements)
+                kind = merge(SERIES_INTEGER, SERIES_REAL, k == S_ORDER)
+                call open_one(self%series(k))
+            else
+                name = trim(STATE_NAME(k - N_SERIES))
+                expected = max(1, self%state_size(k - N_SERIES))
+                kind = SERIES_REAL
+                call open_one(self%state(k - N_SERIES))
+            end if
+            if (allocated(err)) return
+        end do
+        self%n_records = self%series(S_TIME)%length()
+        do k = 1, N_SERIES + 2
+            if (k <= N_SERIES) then
+                n = self%series(k)%length()
+                name = trim(SERIES_NAME(k))
+            else
+                n = self%state(k - N_SERIES)%length()
+                name = trim(STATE_NAME(k - N_SERIES))
+            end if
+            if (n < self%n_records) then
+                call make_error(err, ERR_INPUT, path//': '//name//': '//int_text(int(n))// &
+                    ' records, fewer than /time ('//int_text(int(self%n_records))// &
+                    '): the file cannot be continued')
+                return
+            end if
+        end do
+        if (.not. self%file%exists('/solver/restarts')) return
+        do k = 1, size(RESTART_NAME)
+            name = '/solver/restarts/'//trim(RESTART_NAME(k))
+            kind = SERIES_REAL
+            if (k == 2 .or. k == 3) kind = SERIES_INTEGER
+            if (RESTART_WIDTH(k) > 0) kind = SERIES_TEXT
+            expected = 1
+            call open_one(entry)
+            if (.not. allocated(err) .and. k == 1) n = entry%length()
+            if (.not. allocated(err) .and. entry%length() /= n) call make_error(err, &
+                ERR_INPUT, path//': '//name//': '//int_text(int(entry%length()))// &
+                ' entries, /solver/restarts/time has '//int_text(int(n))// &
+                ': the file cannot be continued')
+            call entry%close(close_err)
+            if (allocated(err)) return
+        end do
+    contains
+        !> Open series `name` (not there, unfit: an error) and check its record size.
+        subroutine open_one(series)
+            type(h5_series_t), intent(inout) :: series
+            character(len=:), allocatable :: why
+            if (.not. self%file%exists(name)) then
+                why = 'missing'
+                if (name(:7) == '/state/') why = why//' (a file without restart data cannot '// &
+                    'be continued)'
+            else
+                call self%file%open_series(series, name, err)
+                if (allocated(err)) return
+                why = series%unfit(kind)
+                if (len(why) == 0 .and. kind /= SERIES_TEXT .and. &
+                    series%record_size() /= expected) why = 'records of '// &
+                    int_text(series%record_size())//' values, expected '//int_text(expected)// &
+                    ' for the '//int_text(self%n_elements)//' elements and state size '// &
+                    int_text(self%state_size(1))//' of the scene'
+            end if
+            if (len(why) > 0) call make_error(err, ERR_INPUT, path//': '//name//': '//why// &
+                                              ': the file cannot be continued')
+        end subroutine open_one
+    end subroutine open_checked
+
+    !> Records keep + 1 .. n_records are to be cut: only a last record off the file's own
+    !! output grid may be (where an interrupted or failed run stopped). A record on that
+    !! grid (a multiple of the stored scene's output_interval, or its t_end) is a completed
+    !! record: ERR_INPUT (a resume with another output_interval would delete it).
+    subroutine check_cut(self, path, keep, err)
+        type(output_file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: keep
+        type(error_t), allocatable, intent(out) :: err
+        type(scene_t) :: stored
+        character(len=:), allocatable :: text
+        character(len=0) :: none(0)
+        real(wp), allocatable :: t(:)
+        real(wp) :: dt, tol
+        integer(hsize_t) :: k
+
+        if (int(keep, hsize_t) >= self%n_records) return
+        call self%file%read_attribute('scene', text, err)
+        if (.not. allocated(err)) call read_scene_text(path//': scene', text, none, stored, err)
+        if (allocated(err)) return
+        dt = stored%solver%output_interval
+        do k = max(1_hsize_t, int(keep + 1, hsize_t)), self%n_records
+            call self%file%read_record('/time', k, t, err)
+            if (allocated(err)) return
+            tol = 1.0e-12_wp*max(abs(t(1)), dt)
+            if (abs(t(1) - dt*anint(t(1)/dt)) <= tol .or. &
+                abs(t(1) - stored%solver%t_end) <= tol) then
+                call make_error(err, ERR_INPUT, path//': record '//int_text(int(k) - 1)// &
+                    ' (t = '//real_text(t(1))//' s) is on the output grid of the file '// &
+                    '(output_interval = '//real_text(dt)//' s): continuing on another '// &
+                    'grid would delete it (a resume keeps the output_interval)')
+                return
+            end if
+        end do
+    end subroutine check_cut
 
     module procedure output_add_restart
         type(h5_series_t) :: entry(size(RESTART_NAME))
@@ -85,7 +185,7 @@ contains
         character(len=:), allocatable :: name
 
         if (.not. self%is_open) then
-            call make_error(err, ERR_INTERNAL, file_label(self)//': add_restart: file is not open')
+            call not_open(self, 'add_restart', err)
             return
         end if
         steps_: block
@@ -120,7 +220,8 @@ contains
             call entry(k)%close(close_err)
             if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
         end do
-        if (.not. allocated(err)) call self%file%flush(err)
+        if (.not. allocated(err)) call flush_file(self, err)
+        if (allocated(err)) call abandon(self, err)
     end procedure output_add_restart
 
     module procedure shutdown
@@ -140,10 +241,52 @@ contains
         end do
         call self%file%close(e)
         if (allocated(e) .and. .not. allocated(first)) call move_alloc(e, first)
+        call release_space(self%file%file_name())
         self%n_pending = 0
         self%is_open = .false.
         if (present(err) .and. allocated(first)) call move_alloc(first, err)
     end procedure shutdown
+
+    module procedure abandon
+        type(error_t), allocatable :: e
+        character(len=:), allocatable :: note, kept
+        integer :: k
+
+        if (.not. self%is_open) return
+        self%n_pending = 0      ! not to be written: the file takes nothing more
+        do k = 1, N_SERIES
+            call self%series(k)%close(e)
+        end do
+        do k = 1, 2
+            call self%state(k)%close(e)
+        end do
+        kept = int_text(int(self%n_records))//' complete records'
+        call self%file%attribute('/', 'status', 'failed', e)
+        if (.not. allocated(e)) call self%file%attribute('/', 'reason', err%message, e)
+        if (.not. allocated(e)) call self%file%flush(e)
+        if (allocated(e)) then
+            note = '; the file is incomplete and may be unreadable (its status could not '// &
+                'be set to failed)'
+        else
+            note = '; the file is closed with status failed ('//kept//' kept)'
+        end if
+        call self%file%close(e)
+        if (allocated(e)) note = '; the file is incomplete and may be unreadable (it could '// &
+            'not be closed)'
+        call release_space(self%file%file_name())
+        self%is_open = .false.
+        err%message = err%message//note
+        self%broken = err%message
+    end procedure abandon
+
+    module procedure not_open
+        if (allocated(self%broken)) then
+            call make_error(err, ERR_IO, self%broken)
+        else
+            call make_error(err, ERR_INTERNAL, file_label(self)//': '//what// &
+                            ': file is not open')
+        end if
+    end procedure not_open
 
     module procedure file_label
         label = self%file%file_name()

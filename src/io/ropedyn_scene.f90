@@ -10,7 +10,8 @@
 !! `--set` argument), the group, the key and the value.
 module ropedyn_scene
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
-    use ropedyn_text, only: int_text, lower, line_quote, printable, text_t, clip, append_text
+    use ropedyn_text, only: int_text, real_text, lower, line_quote, printable, text_t, clip, &
+        append_text
     use ropedyn_namelist_file, only: nml_file_t, nml_value_t, read_namelist_file, &
         parse_namelist_lines, parse_values, V_STRING
     use ropedyn_scene_types, only: scene_t, solver_params_t, output_params_t
@@ -22,7 +23,7 @@ module ropedyn_scene
     private
     public :: solver_params_t, output_params_t, scene_t
     public :: read_scene, read_scene_text, scene_namelist_text, scene_key_listing, &
-        check_override_value
+        check_override_value, override_target
 
     !> One `--set group.key=value` argument, parsed.
     type :: override_t
@@ -58,19 +59,58 @@ contains
         call load_scene(overrides, scene, err)
     end subroutine read_scene
 
-    !> Read a scene from namelist text (e.g. the `scene` attribute of a run file, the echo of
+    !> Read the scene of a run file being continued (its `scene` attribute, the echo of
     !! `scene_namelist_text`) as `read_scene` reads a file; `origin` names the text in
-    !! messages (and becomes the scene's path).
+    !! messages (and becomes the scene's path). The overrides may not set output.file (the
+    !! run appends to that file) nor change solver.output_interval (the file's records are
+    !! on its grid; docs/output.md, "Resume").
     subroutine read_scene_text(origin, text, overrides, scene, err)
         character(len=*), intent(in) :: origin        !< e.g. 'out/run.h5: scene'
         character(len=*), intent(in) :: text          !< lines separated by new lines
         character(len=*), intent(in) :: overrides(:)  !< 'group.key=value', may be empty
         type(scene_t), target, intent(out) :: scene
         type(error_t), allocatable, intent(out) :: err
+        type(scene_t) :: stored
+        character(len=0) :: none(0)
+        integer :: k
 
         scene%path = origin
         call load_scene(overrides, scene, err, text)
+        if (allocated(err)) return
+        do k = 1, size(overrides)
+            select case (override_target(overrides(k)))
+            case ('output.file')
+                call make_error(err, ERR_INPUT, '--set '//clip(printable(trim(overrides(k))))// &
+                    ': a resume appends to the file it continues: output.file cannot be set')
+            case ('solver.output_interval')
+                stored%path = origin
+                call load_scene(none, stored, err, text)
+                if (allocated(err)) return
+                if (stored%solver%output_interval /= scene%solver%output_interval) &
+                    call make_error(err, ERR_INPUT, '--set '// &
+                    clip(printable(trim(overrides(k))))//': a resume keeps the output grid '// &
+                    'of the file it continues (output_interval = '// &
+                    real_text(stored%solver%output_interval)//' s); start a new run to '// &
+                    'change it')
+            end select
+            if (allocated(err)) return
+        end do
     end subroutine read_scene_text
+
+    !> 'group.key' of a `--set group.key=value` argument as the scene reads it (lower case,
+    !! blanks around the parts removed; '' when it has no '=').
+    pure function override_target(arg) result(target)
+        character(len=*), intent(in) :: arg
+        character(len=:), allocatable :: target, lhs
+        integer :: eq, dot
+        target = ''
+        eq = index(arg, '=')
+        if (eq <= 1) return
+        lhs = trim(adjustl(arg(:eq - 1)))
+        dot = index(lhs, '.')
+        if (dot <= 1) return
+        target = lower(trim(lhs(:dot - 1)))//'.'//lower(trim(adjustl(lhs(dot + 1:))))
+    end function override_target
 
     !> The steps of `read_scene` and `read_scene_text` after scene%path is set: the
     !! overrides parsed against the scene's keys, then the namelist read (from `text` when

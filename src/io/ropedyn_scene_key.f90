@@ -98,6 +98,11 @@ contains
         case (T_PAIR, T_LIST)
             first = max(index, 1)
             ok = first + size(values) - 1 <= size(self%v)
+            ! a pair without an index takes both components (one alone: key(1) = x)
+            if (self%type == T_PAIR .and. index == 0) ok = size(values) == size(self%v)
+            if (.not. ok .and. self%type == T_PAIR .and. index == 0 .and. size(values) == 1) &
+                reason = reason//' (or one component: '//self%name//'(1) = x or '// &
+                self%name//'(2) = y)'
             do k = 1, size(values)
                 if (ok) call value_real(values(k), x(k), ok)
             end do

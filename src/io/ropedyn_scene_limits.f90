@@ -4,7 +4,8 @@
 !! - memory: the state and Jacobian storage of the model and its integrator, estimated from
 !!   `elements` (RFEM: band storage, ~6 kB per element; MPP: dense n^2 matrices), at most
 !!   MEMORY_LIMIT bytes;
-!! - output: t_end/output_interval at most MAX_RECORDS records;
+!! - output: t_end/output_interval at most MAX_RECORDS records, t_end at most MAX_TIME (and
+!!   so the time of a record a run starts from: ropedyn_run_record);
 !! - magnitudes: the derived values of the rope (element mass and inertia, spring and damper
 !!   constants, energies and forces at the start) within MAGNITUDE_LIMIT (masses and inertias
 !!   at least 1/MAGNITUDE_LIMIT). A value beyond them would make the initial state, the energy
@@ -19,14 +20,17 @@ module ropedyn_scene_limits
     use ropedyn_rope_section, only: section_t, rope_section
     use ropedyn_scene_types, only: scene_t
     use ropedyn_scene_key, only: scene_key_t, T_INT, T_REAL, T_LIST
-    use ropedyn_scene_keys, only: find_key, fail, group_index, G_MODEL, G_SOLVER
+    use ropedyn_scene_keys, only: find_key, fail, group_index, G_MODEL, G_SOLVER, G_SUPPORTS
     implicit none
     private
-    public :: check_limits, MAX_RECORDS, MEMORY_LIMIT, MAGNITUDE_LIMIT
+    public :: check_limits, MAX_RECORDS, MEMORY_LIMIT, MAGNITUDE_LIMIT, MAX_TIME
 
     integer, parameter :: MAX_RECORDS = 10000000          !< output records of one run
     real(wp), parameter :: MEMORY_LIMIT = 8.0_wp*1024.0_wp**3  !< bytes (8 GiB)
     real(wp), parameter :: MAGNITUDE_LIMIT = 1.0e100_wp   !< derived values, SI units
+    !> The latest time of a run, s (about 32 years): beyond it the round-off of t (1.2e-7 s)
+    !! is coarser than the steps of a rope's motion, and no integrator could advance t.
+    real(wp), parameter :: MAX_TIME = 1.0e9_wp
 
     real(wp), parameter :: pi = acos(-1.0_wp)
     integer, parameter :: KL = 40
@@ -112,6 +116,9 @@ contains
                 real_text(records)//' output records, more than the limit '// &
                 int_text(MAX_RECORDS)//' (docs/input.md, Limits)', err)
         end if
+        if (.not. allocated(err) .and. scene%solver%t_end > MAX_TIME) call fail(keys, G_SOLVER, &
+            't_end', real_text(scene%solver%t_end), 'out of range (at most '// &
+            real_text(MAX_TIME)//' s; docs/input.md, Limits)', err)
     end subroutine check_sizes
 
     !> The derived values of the rope within MAGNITUDE_LIMIT.
@@ -120,10 +127,14 @@ contains
         type(scene_t), intent(in) :: scene
         type(error_t), allocatable, intent(out) :: err
         type(section_t) :: sec
-        real(wp) :: dl, m_e, mass, reach, speed, c, b, factor, loads, drag, motion
+        real(wp) :: dl, m_e, mass, reach, speed, c, b, factor, loads, drag, motion, &
+            table_reach, table_speed, table_accel
         logical :: given(N_ATTACH)
         integer :: k
 
+        table_reach = 0.0_wp
+        table_speed = 0.0_wp
+        table_accel = 0.0_wp
         associate (r => scene%rope, s => scene%supports, a => scene%attachments, &
                 f => scene%fluid, g => scene%ground)
             sec = rope_section(r)
@@ -145,19 +156,26 @@ contains
             call bound(sec%bending_damping/dl*factor, 'a bending damper constant', 'N m s', &
                 DAMPER_KEYS, .false.)
 
+            ! the motion tables: each alone (naming the table and its row), then with the rest
+            call table_bounds(keys, scene, 'top', s%top_table, s%top_table_rows, mass, c, &
+                              table_reach, table_speed, table_accel, err)
+            call table_bounds(keys, scene, 'bottom', s%bottom_table, s%bottom_table_rows, &
+                              mass, c, table_reach, table_speed, table_accel, err)
+            if (allocated(err)) return
             reach = norm2(s%top_anchor) + r%length + abs(scene%initial%mode_amplitude) &
-                + norm2(s%top_amplitude) + norm2(s%bottom_amplitude)
+                + norm2(s%top_amplitude) + norm2(s%bottom_amplitude) + table_reach
             if (s%bottom_anchor_set) reach = reach + norm2(s%bottom_anchor)
             if (scene%effects%ground) reach = reach + norm2(g%point)
             speed = norm2(scene%initial%velocity) + 2.0_wp*pi*(s%top_frequency* &
-                norm2(s%top_amplitude) + s%bottom_frequency*norm2(s%bottom_amplitude))
+                norm2(s%top_amplitude) + s%bottom_frequency*norm2(s%bottom_amplitude)) + &
+                table_speed
             if (scene%effects%drag) speed = speed + norm2(f%current)
             call bound(mass*r%gravity*reach, 'the gravity energy', 'J', GRAVITY_KEYS, .false.)
             call bound(mass*speed**2, 'the kinetic energy', 'J', KINETIC_KEYS, .false.)
             call bound(c*reach**2, 'the energy of a spring', 'J', [SPRING_KEYS, REACH_KEYS], &
                 .false.)
-            motion = mass*(2.0_wp*pi)**2*(s%top_frequency**2*norm2(s%top_amplitude) + &
-                s%bottom_frequency**2*norm2(s%bottom_amplitude))*reach
+            motion = mass*((2.0_wp*pi)**2*(s%top_frequency**2*norm2(s%top_amplitude) + &
+                s%bottom_frequency**2*norm2(s%bottom_amplitude)) + table_accel)*reach
             call bound(motion, 'the work of a moving support', 'J', MOTION_KEYS, .false.)
             if (scene%effects%ground) call bound((g%stiffness*reach + g%damping*speed)* &
                 r%length*reach, 'the ground contact energy', 'J', GROUND_KEYS, .false.)
@@ -196,6 +214,64 @@ contains
                 real_text(x)//' '//unit//' ('//limit//'; docs/input.md, Limits)', err)
         end subroutine bound
     end subroutine check_magnitudes
+
+    !> The motion table of the `end` support (`path`, its rows t, dx, dy, dangle) of a rope
+    !! of `mass` (kg), spring constant `c` (N/m): its largest displacement, speed and
+    !! acceleration (the angle's rates times the rope's length) each make an energy within
+    !! MAGNITUDE_LIMIT, else ERR_INPUT naming the table and the row; added to reach (m),
+    !! speed (m/s) and accel (m/s^2).
+    subroutine table_bounds(keys, scene, end, path, rows, mass, c, reach, speed, accel, err)
+        type(scene_key_t), intent(in) :: keys(:)
+        type(scene_t), intent(in) :: scene
+        character(len=*), intent(in) :: end, path
+        real(wp), allocatable, intent(in) :: rows(:, :)
+        real(wp), intent(in) :: mass, c
+        real(wp), intent(inout) :: reach, speed, accel
+        type(error_t), allocatable, intent(inout) :: err
+        character(len=*), parameter :: HOW(3) = [character(len=12) :: 'displacement', &
+            'speed', 'acceleration']
+        character(len=*), parameter :: UNIT(3) = [character(len=6) :: 'm', 'm/s', 'm/s^2']
+        real(wp) :: d, v, a, worst(3), span
+        integer :: k, at(3)
+        if (.not. allocated(rows) .or. allocated(err)) return
+        worst = 0.0_wp
+        at = 1
+        do k = 1, size(rows, 2)
+            d = norm2(rows(2:3, k)) + abs(rows(4, k))*scene%rope%length
+            if (.not. d <= worst(1)) at(1) = k
+            worst(1) = max(worst(1), d)
+            if (k == 1) cycle
+            ! the spline's slopes reach 1.5 times a segment's, its acceleration some 6
+            ! times a slope over the segment's span
+            span = rows(1, k) - rows(1, k - 1)
+            v = 2.0_wp*(norm2(rows(2:3, k) - rows(2:3, k - 1)) + &
+                        abs(rows(4, k) - rows(4, k - 1))*scene%rope%length)/span
+            a = 3.0_wp*v/span
+            if (.not. v <= worst(2)) at(2) = k
+            if (.not. a <= worst(3)) at(3) = k
+            worst(2) = max(worst(2), v)
+            worst(3) = max(worst(3), a)
+        end do
+        reach = reach + worst(1)
+        speed = speed + worst(2)
+        accel = accel + worst(3)
+        call table_bound(mass*scene%rope%gravity*worst(1), 'the gravity energy', 1)
+        call table_bound(c*worst(1)**2, 'the energy of a spring', 1)
+        call table_bound(mass*worst(2)**2, 'the kinetic energy', 2)
+        call table_bound(mass*worst(3)*worst(1), 'the work of the moving support', 3)
+    contains
+        subroutine table_bound(x, what, which)
+            real(wp), intent(in) :: x
+            character(len=*), intent(in) :: what
+            integer, intent(in) :: which
+            if (allocated(err) .or. x <= MAGNITUDE_LIMIT) return
+            call fail(keys, G_SUPPORTS, end//'_table', '"'//trim(path)//'"', 'row '// &
+                int_text(at(which))//' (t = '//real_text(rows(1, at(which)))//' s): a '// &
+                trim(HOW(which))//' of '//real_text(worst(which))//' '//trim(UNIT(which))// &
+                ' makes '//what//' '//real_text(x)//' J (at most '// &
+                real_text(MAGNITUDE_LIMIT)//'; docs/input.md, Limits)', err)
+        end subroutine table_bound
+    end subroutine table_bounds
 
     !> Of the keys `names` ('group.key'), the one whose value is furthest from 1 in decades
     !! (zero and NaN entries count as 1): its index, its name (a list's with the entry's

@@ -5,13 +5,13 @@
 !! The model turns the fields back into its ODE state (`state_from_fields`) when there is no
 !! native state. docs/output.md, "Starting from a record".
 module ropedyn_state_record
-    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use hdf5, only: hsize_t
     use ropedyn_kinds, only: wp
     use ropedyn_text, only: int_text, real_text
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_h5, only: h5_file_t
-    use ropedyn_run_record, only: read_record_times
+    use ropedyn_run_record, only: read_record_times, check_record_values, speed_bound
+    use ropedyn_scene_limits, only: MAGNITUDE_LIMIT
     implicit none
     private
     public :: state_record_t, read_state_record
@@ -36,8 +36,9 @@ contains
     !> The record of the run file `path` whose time is nearest `state_time` (s; < 0: the
     !! last complete record). ERR_INPUT names the file and what is wrong: no such file, not a
     !! run file (no /time, /state/q, model attribute), no complete record, `state_time`
-    !! outside the file's times (by more than half the largest record spacing), a state
-    !! that is not finite. ERR_IO: the file cannot be read.
+    !! outside the file's times (by more than half the largest record spacing), times that
+    !! do not increase, a value of the state that is not finite or beyond the limits of a
+    !! scene (naming the dataset and the record). ERR_IO: the file cannot be read.
     subroutine read_state_record(path, state_time, rec, err)
         character(len=*), intent(in) :: path
         real(wp), intent(in) :: state_time
@@ -46,9 +47,9 @@ contains
         type(h5_file_t) :: h5
         type(error_t), allocatable :: close_err
         real(wp), allocatable :: time(:), values(:)
-        integer(hsize_t) :: dims2(2), dims3(3)
+        integer(hsize_t) :: dims1(1), dims2(2), dims3(3)
         logical :: found
-        real(wp) :: slack
+        real(wp) :: slack, bound
         integer :: k, nt
 
         call h5%open(path, err)
@@ -122,13 +123,31 @@ contains
                 end if
             end if
 
-            if (.not. (all(ieee_is_finite(rec%q)) .and. all(ieee_is_finite(rec%qdot)) .and. &
-                       ieee_is_finite(rec%t) .and. ieee_is_finite(rec%dissipated) .and. &
-                       ieee_is_finite(rec%support_work))) then
-                call make_error(err, ERR_INPUT, path//': record '//int_text(rec%record)// &
-                                ' (t = '//real_text(rec%t)//' s): the state is not finite')
-                exit steps
+            ! finite, and within the limits of a scene (ropedyn_run_record)
+            bound = MAGNITUDE_LIMIT
+            if (h5%exists('/rope/element_mass')) then
+                call h5%read_reals('/rope/element_mass', values, dims1, err)
+                if (allocated(err)) exit steps
+                bound = speed_bound(values)
             end if
+            call check_record_values(path, '/state/q', rec%record, rec%t, &
+                                     reshape(rec%q, [size(rec%q)]), bound, err)
+            if (allocated(err)) exit steps
+            call check_record_values(path, '/state/qdot', rec%record, rec%t, &
+                                     reshape(rec%qdot, [size(rec%qdot)]), bound, err)
+            if (allocated(err)) exit steps
+            if (allocated(rec%y)) then
+                call check_record_values(path, '/state/y', rec%record, rec%t, rec%y, bound, err)
+                if (allocated(err)) exit steps
+                call check_record_values(path, '/state/yq', rec%record, rec%t, rec%yq, &
+                                         MAGNITUDE_LIMIT, err)
+                if (allocated(err)) exit steps
+            end if
+            call check_record_values(path, '/energy/dissipated', rec%record, rec%t, &
+                                     [rec%dissipated], MAGNITUDE_LIMIT, err)
+            if (allocated(err)) exit steps
+            call check_record_values(path, '/energy/support_work', rec%record, rec%t, &
+                                     [rec%support_work], MAGNITUDE_LIMIT, err)
         end block steps
         call h5%close(close_err)
         if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)

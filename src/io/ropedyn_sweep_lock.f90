@@ -30,7 +30,7 @@ module ropedyn_sweep_lock
     use, intrinsic :: iso_fortran_env, only: int64
     use ropedyn_error, only: error_t, make_error, ERR_IO
     use ropedyn_text, only: int_text
-    use ropedyn_os, only: delete_file
+    use ropedyn_os, only: delete_file, special_file_reason
     use ropedyn_clock, only: utc_timestamp, utc_text, unix_time
     use ropedyn_signals, only: signal_name
     use ropedyn_process, only: process_id, process_start, host_name, file_mtime, &
@@ -54,6 +54,8 @@ module ropedyn_sweep_lock
         integer :: signal = 0          !< the signal that ended the writer (0: none recorded)
         integer(int64) :: changed = 0  !< last heartbeat (or the signal), s since 1970
         integer(int64) :: age = 0      !< s since then
+        !> '' or why the lock's path cannot be a lock (not a regular file: a FIFO, ...)
+        character(len=:), allocatable :: problem
     contains
         procedure :: holder => lock_holder
         procedure :: gone => lock_gone
@@ -73,6 +75,13 @@ contains
         lock%boot = ''
         lock%job = ''
         lock%started = ''
+        lock%problem = special_file_reason(path)
+        if (len(lock%problem) > 0) then
+            ! a FIFO would block the open: not a lock of ropedyn, nor is a device
+            lock%exists = .true.
+            lock%problem = path//': '//lock%problem//' (a lock is a regular file: remove it)'
+            return
+        end if
         ! open first: on NFS, an open revalidates the attributes (close-to-open)
         open (newunit=unit, file=path, status='old', action='read', iostat=ios)
         if (ios /= 0) return
@@ -187,6 +196,10 @@ contains
             if (created) exit
             call read_lock(path, lock)
             if (.not. lock%exists) cycle        ! removed meanwhile: try again
+            if (len(lock%problem) > 0) then
+                call make_error(err, ERR_IO, lock%problem)
+                return
+            end if
             if (lock%live) then
                 call make_error(err, ERR_IO, 'being written by '//lock%holder()//' (lock '// &
                     path//'): a case is written by one process at a time')

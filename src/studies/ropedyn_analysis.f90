@@ -10,6 +10,7 @@ module ropedyn_analysis
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_os, only: make_parent_dirs
+    use ropedyn_run_inputs, only: check_not_input
     use ropedyn_text, only: int_text
     use ropedyn_model_factory, only: create_model
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
@@ -65,6 +66,9 @@ contains
 
         out_path = out_path_given
         if (len(out_path) == 0) out_path = default_output(scene, command)
+        ! never over an input (the scene, its tables, its state file): before any work
+        call check_not_input(out_path, scene, err)
+        if (allocated(err)) return
         call create_model(scene%rope_spec_t, model, err)
         if (allocated(err)) return
         allocate (y(model%size()))

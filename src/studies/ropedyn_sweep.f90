@@ -12,6 +12,7 @@ module ropedyn_sweep
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_kinds, only: wp
     use ropedyn_case_file, only: case_data_t, read_case_file
+    use ropedyn_run_inputs, only: check_not_input
     use ropedyn_sweep_file, only: sweep_file_t, read_sweep_file, without_set, MAX_LIST, &
         MAX_VARY, REF_NONE, REF_TIGHTEST, REF_FILE, REF_TIGHTEST_PER_METHOD
     implicit none
@@ -49,7 +50,34 @@ contains
         call expand(sweep, err)
         if (allocated(err)) return
         if (sweep%reference == REF_FILE) call check_reference_file(sweep, err)
+        if (allocated(err)) return
+        call check_outputs(sweep, err)
     end subroutine read_sweep
+
+    !> No case file and no summary file is an input of the sweep: the sweep file, a
+    !! reference file, a case's scene, tables or state file (ropedyn_run_inputs).
+    subroutine check_outputs(sweep, err)
+        type(sweep_t), intent(in) :: sweep
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: extra(:), reference
+        character(len=20), parameter :: ROLES(2) = [character(len=20) :: 'the sweep file', &
+            'the reference file']
+        integer :: c
+        reference = ''
+        if (sweep%reference == REF_FILE) reference = sweep%reference_file
+        allocate (character(len=max(len(sweep%path), len(reference))) :: extra(2))
+        extra(1) = sweep%path
+        extra(2) = reference
+        do c = 1, size(sweep%cases)
+            call check_not_input(sweep%cases(c)%file, sweep%cases(c)%scene, err, extra, ROLES)
+            if (allocated(err)) return
+        end do
+        if (size(sweep%cases) == 0) return
+        call check_not_input(sweep%output_dir//'/summary.csv', sweep%cases(1)%scene, err, &
+                             extra, ROLES)
+        if (.not. allocated(err)) call check_not_input(sweep%output_dir//'/summary.h5', &
+            sweep%cases(1)%scene, err, extra, ROLES)
+    end subroutine check_outputs
 
     !> A reference file serves every case: the same number of elements, and the case's
     !! output times (0, dt, 2 dt, ..., t_end, as the run driver writes them) are its first.

@@ -158,6 +158,7 @@ contains
         integer :: n, c, next, finished, failed, rc, s, width, sig
         real(wp) :: start, now, last_draw
         logical :: tty, redraw, woken
+        character(len=:), allocatable :: other
 
         n = size(sweep%cases)
         width = id_width(sweep)
@@ -236,15 +237,22 @@ contains
                 c = slot(s)
                 slot(s) = 0
                 finished = finished + 1
-                if (rc /= 0) failed = failed + 1
+                ! a worker that found the case being written by another runner did not fail
+                other = ''
+                if (rc /= 0) call written_elsewhere(c, other)
+                if (rc /= 0 .and. len(other) == 0) failed = failed + 1
                 call remove_if_empty(log_path(c))
                 now = clock_seconds()
                 if (.not. opt%quiet) then
                     if (tty) write (error_unit, '(a)', advance='no') achar(13)//repeat(' ', 78) &
                         //achar(13)
-                    if (rc /= 0 .or. .not. tty) write (error_unit, '(a)') 'sweep: case '// &
-                        zero_padded(c, width)//' '//outcome(rc, c)//' ('// &
-                        progress_text(now)//')'
+                    if (len(other) > 0) then
+                        write (error_unit, '(a)') 'sweep: case '//zero_padded(c, width)// &
+                            ' not run here: '//other//' ('//progress_text(now)//')'
+                    else if (rc /= 0 .or. .not. tty) then
+                        write (error_unit, '(a)') 'sweep: case '//zero_padded(c, width)// &
+                            ' '//outcome(rc, c)//' ('//progress_text(now)//')'
+                    end if
                 end if
                 redraw = .true.
             end do
@@ -332,6 +340,18 @@ contains
             end do
             if (size(ids) > 20) text = text//' ...'
         end function id_text
+
+        !> '' unless case `id` is written, or was completed, by another process (another
+        !! runner of the same sweep, whose lock made this one's worker give up): then that.
+        subroutine written_elsewhere(id, text)
+            integer, intent(in) :: id
+            character(len=:), allocatable, intent(out) :: text
+            type(case_state_t) :: now_state
+            call case_state(sweep%cases(id), now_state)
+            text = ''
+            if (now_state%status == 'running') text = now_state%reason
+            if (now_state%status == 'complete') text = 'completed by another process'
+        end subroutine written_elsewhere
 
         function outcome(code, id) result(text)
             integer, intent(in) :: code, id

@@ -63,6 +63,11 @@ contains
         state%reason = ''
         call read_lock(lock_path(c%file), state%lock)
         associate (lock => state%lock)
+            if (len(lock%problem) > 0) then
+                state%status = 'unreadable'
+                state%reason = lock%problem
+                return
+            end if
             if (lock%live .and. .not. lock%mine) then
                 state%status = 'running'
                 state%reason = 'being written by '//lock%holder()

@@ -360,7 +360,7 @@ contains
         call expect_error('missing', [character(len=L) ::], NO_SET, [character(len=L) :: &
             P//'missing.nml: cannot open: '])
         call expect_error('no_model', [character(len=L) :: '&rope length = 2.0 /'], NO_SET, &
-            [character(len=L) :: P//'no_model.nml: no &model group: not a scene file'])
+            [character(len=L) :: P//'no_model.nml: no &model group (found &rope): not a scene file'])
         call expect_error('not_closed', [character(len=L) :: '&rope', '  length = 2.0', &
             '&model /'], NO_SET, [character(len=L) :: P//'not_closed.nml: &rope: ', &
             'not closed by "/" before line 3', '"&model /"'])
