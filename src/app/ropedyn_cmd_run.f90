@@ -24,9 +24,10 @@ contains
         character(len=:), allocatable :: resume_path
         type(scene_t) :: scene
         type(run_summary_t) :: summary
-        logical :: verbose
+        logical :: verbose, force
 
         verbose = .false.
+        force = .false.
         do while (cli%next())
             select case (cli%option)
             case ('--help', '-h')
@@ -34,6 +35,8 @@ contains
                 return
             case ('--verbose', '-v')
                 verbose = .true.
+            case ('--force')
+                force = .true.
             case ('--resume')
                 if (allocated(resume_path)) then
                     call cli%usage_error('--resume is given twice', err)
@@ -61,7 +64,7 @@ contains
             call read_scene(cli%scene_path, cli%scene_overrides(), scene, err)
             if (allocated(err)) return
             call print_warnings(scene)
-            call run_scene(scene, summary, err)
+            call run_scene(scene, summary, err, force=force)
         end if
         if (summary%records > 0) call print_summary(scene, summary, verbose)
         if (allocated(err)) then

@@ -302,7 +302,8 @@ contains
     !! (its file keeps status 'running'). With `state_size` and `quad_size` (the model's),
     !! every record also holds the restart data /state/y, /state/yq (`append`'s y, yq).
     subroutine output_create(self, path, n_elements, element_length, element_mass, model, &
-                             method, version, scene_text, err, state_size, quad_size)
+                             method, version, scene_text, err, state_size, quad_size, &
+                             source)
         class(output_file_t), intent(inout) :: self
         character(len=*), intent(in) :: path              !< e.g. out/run.h5
         integer, intent(in) :: n_elements                 !< elements of the rope
@@ -315,6 +316,8 @@ contains
         type(error_t), allocatable, intent(out) :: err
         integer, intent(in), optional :: state_size       !< unknowns of the ODE state
         integer, intent(in), optional :: quad_size        !< quadrature variables
+        !> where the scene came from (root attribute `source`; scene_t's source)
+        character(len=*), intent(in), optional :: source
 
         if (self%is_open) call shutdown(self)
 
@@ -356,6 +359,8 @@ contains
             call self%file%attribute('/', 'status', 'running', err)
             if (allocated(err)) return
             call write_provenance(self%file, version, model, scene_text, err)
+            if (allocated(err)) return
+            if (present(source)) call self%file%attribute('/', 'source', source, err)
             if (allocated(err)) return
             call self%file%attribute('/', 'method', method, err)
             if (allocated(err)) return

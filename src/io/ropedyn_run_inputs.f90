@@ -20,7 +20,7 @@ module ropedyn_run_inputs
     use ropedyn_h5, only: h5_file_t
     implicit none
     private
-    public :: scene_inputs, check_not_input, check_replaceable
+    public :: scene_inputs, check_not_input, check_replaceable, check_own_source
 
     !> The first bytes of an HDF5 file (its signature at offset 0: ropedyn writes no user
     !! block).
@@ -125,4 +125,34 @@ contains
             ': exists and is an HDF5 file not written by ropedyn (no root attribute '// &
             trim(OWN_ATTRIBUTES(k))//'): not replaced')
     end subroutine check_replaceable
+
+    !> A run replaces a file of its own source only (a rerun of the same scene file with
+    !! the same --set overrides): ERR_USAGE naming what the existing ropedyn file at `path`
+    !! holds when its root attribute `source` is another (a --set variant, another scene)
+    !! or missing (written by a version before the rule). Nothing when `path` does not
+    !! exist; call check_replaceable first (a file ropedyn did not write).
+    subroutine check_own_source(path, source, err)
+        character(len=*), intent(in) :: path, source
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: stored
+        type(h5_file_t) :: h5
+        type(error_t), allocatable :: close_err
+        logical :: exists, found
+        inquire (file=path, exist=exists)
+        if (.not. exists) return
+        call h5%open(path, err)
+        if (allocated(err)) return
+        call h5%read_attribute('source', stored, err, found)
+        call h5%close(close_err)
+        if (allocated(err)) return
+        if (.not. found) then
+            call make_error(err, ERR_USAGE, path//': exists and holds a run whose source '// &
+                'is not recorded (an older file): not replaced; give this run another '// &
+                'file (--set output.file=...) or --force')
+        else if (stored /= source) then
+            call make_error(err, ERR_USAGE, path//': exists and holds the run of "'// &
+                stored//'", not of this run "'//source//'": not replaced; give this run '// &
+                'another file (--set output.file=...) or --force')
+        end if
+    end subroutine check_own_source
 end module ropedyn_run_inputs

@@ -15,6 +15,7 @@ module ropedyn_scene
     use ropedyn_namelist_file, only: nml_file_t, nml_value_t, read_namelist_file, &
         parse_namelist_lines, parse_values, V_STRING
     use ropedyn_scene_types, only: scene_t, solver_params_t, output_params_t
+    use ropedyn_os, only: canonical_path
     use ropedyn_scene_key, only: scene_key_t, T_NAME, T_PATH
     use ropedyn_scene_keys, only: bind_keys, find_key, key_hint, group_index, group_list, &
         GROUP_NAMES, N_GROUPS
@@ -50,6 +51,7 @@ contains
         type(scene_t), target, intent(out) :: scene
         type(error_t), allocatable, intent(out) :: err
 
+        integer :: k
         scene%path = trim(path)
         if (printable(scene%path) /= scene%path) then
             call make_error(err, ERR_INPUT, printable(scene%path)//': a control character in ' &
@@ -57,6 +59,13 @@ contains
             return
         end if
         call load_scene(overrides, scene, err)
+        if (allocated(err)) return
+        ! the scene file and the overrides that change the run (not those of &output)
+        scene%source = canonical_path(scene%path)
+        do k = 1, size(overrides)
+            if (index(override_target(overrides(k)), 'output.') == 1) cycle
+            scene%source = scene%source//' --set '//trim(adjustl(overrides(k)))
+        end do
     end subroutine read_scene
 
     !> Read the scene of a run file being continued (its `scene` attribute, the echo of

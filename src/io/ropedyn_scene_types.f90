@@ -53,5 +53,11 @@ module ropedyn_scene_types
     type, extends(rope_spec_t) :: scene_t
         type(solver_params_t) :: solver
         type(output_params_t) :: output
+        !> where the scene came from: the scene file's full name and the --set overrides in
+        !! their order, but those of &output ('/dir/a.nml --set model.elements=70'); a run
+        !! file stores it, and a
+        !! run replaces only a file of its own source (the output guide, "Write, lock and
+        !! resume rules")
+        character(len=:), allocatable :: source
     end type scene_t
 end module ropedyn_scene_types

@@ -20,6 +20,12 @@
 !! Resume (`open` with resume, submodule ropedyn_run_resume; the rules are in the output
 !! guide, "Resume"): the last record of the file is the start, the file is reopened and
 !! appended to; an off-grid last record is replaced by the grid records that follow.
+!!
+!! The output file is guarded (`open` with guard, submodule ropedyn_run_guard; the output
+!! guide, "Write, lock and resume rules"): no input of the run is its output, a lock keeps
+!! a second run off the file, a file the run may not replace is refused, and a new run
+!! writes FILE.part and renames it to FILE when it finishes, so that the earlier FILE stays
+!! whole until then.
 module ropedyn_run
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp, i8
@@ -100,6 +106,9 @@ module ropedyn_run
         logical :: monitoring = .false.
         integer(i8) :: steps_mark = 0
         procedure(stop_query_i), pointer, nopass :: stop_requested => null()
+        ! the guard of the output file: the lock held ('' none), and for a new run the
+        ! file written (FILE.part) and its final name
+        character(len=:), allocatable :: lock_file, part_file, final_file
     contains
         procedure :: open => run_open
         procedure :: begin => run_begin
@@ -110,11 +119,28 @@ module ropedyn_run
         procedure :: end_time => run_end_time
         procedure :: output_file => run_output_file
         procedure, private :: fresh_start, output_time, start_integrator, record, &
-                              steps_taken, keep_as_previous, asked_to_stop
+                              steps_taken, keep_as_previous, asked_to_stop, end_on
         procedure, private :: resume_from_file, check_energy, second_look
+        procedure, private :: guard_output, release_output
     end type run_t
 
     interface
+        !> Guard the output file before anything is written (submodule ropedyn_run_guard):
+        !! refuse an input as output, take its lock, refuse a file not to be replaced
+        !! (unless `force`) or left by a killed run; a new run then writes FILE.part.
+        module subroutine guard_output(self, resume, force, err)
+            class(run_t), intent(inout) :: self
+            logical, intent(in) :: resume, force
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine guard_output
+
+        !> Give the guarded file its final name (a new run: FILE.part -> FILE) and drop the
+        !! lock; an error of the rename goes into `err` unless it holds one.
+        module subroutine release_output(self, err)
+            class(run_t), intent(inout) :: self
+            type(error_t), allocatable, intent(inout) :: err
+        end subroutine release_output
+
         !> Resume: the last record of the run file as the starting point, the file reopened
         !! (an off-grid last record cut), the restart recorded (submodule
         !! ropedyn_run_resume).
@@ -145,14 +171,38 @@ contains
     !> Build the run of a validated scene: its model and integrator, the start (the
     !! scene's initial state, or with `resume` the last record of the run file
     !! scene%output%file) and the output file with its first record. A failure before the
-    !! file exists leaves none; a failure after it is the caller's to finish.
-    subroutine run_open(self, scene, err, resume)
+    !! file exists leaves none; a failure after it is the caller's to finish. With `guard`
+    !! (the default) the output file is guarded; `force` lets a run replace a file it would
+    !! otherwise refuse (not an input, not a locked or special file).
+    subroutine run_open(self, scene, err, resume, guard, force)
         class(run_t), intent(inout) :: self
         type(scene_t), intent(in) :: scene
         type(error_t), allocatable, intent(out) :: err
-        logical, intent(in), optional :: resume
-        integer :: n
+        logical, intent(in), optional :: resume, guard, force
+        logical :: resuming, guarding, forced
+        resuming = .false.
+        if (present(resume)) resuming = resume
+        guarding = .true.
+        if (present(guard)) guarding = guard
+        forced = .false.
+        if (present(force)) forced = force
         self%scene = scene
+        self%summary%file = trim(scene%output%file)
+        if (guarding) then
+            call self%guard_output(resuming, forced, err)
+            if (allocated(err)) return
+        end if
+        call start_from(self, resuming, err)
+        if (allocated(err) .and. guarding) call self%release_output(err)
+    end subroutine run_open
+
+    !> open's work after the guard: the model, the integrator, the start.
+    subroutine start_from(self, resuming, err)
+        class(run_t), intent(inout) :: self
+        logical, intent(in) :: resuming
+        type(error_t), allocatable, intent(out) :: err
+        integer :: n
+        associate (scene => self%scene)
         call create_model(scene%rope_spec_t, self%model, err)
         if (allocated(err)) return
         call create_integrator(scene, self%integrator, err)
@@ -165,17 +215,15 @@ contains
         self%dt = scene%solver%output_interval
         self%t_end = scene%solver%t_end
         self%n_out = max(1, ceiling(self%t_end/self%dt*(1.0_wp - 1.0e-12_wp)))
-        self%summary%file = trim(scene%output%file)
         self%k_next = 1
-        if (present(resume)) then
-            if (resume) then
-                call self%resume_from_file(err)
-                if (.not. allocated(err)) call self%keep_as_previous()
-                return
-            end if
+        end associate
+        if (resuming) then
+            call self%resume_from_file(err)
+            if (.not. allocated(err)) call self%keep_as_previous()
+        else
+            call self%fresh_start(err)
         end if
-        call self%fresh_start(err)
-    end subroutine run_open
+    end subroutine start_from
 
     !> The scene's start: the initial state (statics and modes first for 'equilibrium' and
     !! 'mode'; a record of an earlier run for 'state', whose output times it keeps), checked
@@ -211,10 +259,18 @@ contains
             if (allocated(err)) return
             allocate (lengths(model%n_elements()), masses(model%n_elements()))
             call model%element_data(lengths, masses)
-            call self%out%create(self%summary%file, model%n_elements(), lengths, masses, &
-                                 model%model_name(), self%integrator%name(), version_string, &
-                                 scene_namelist_text(scene), err, state_size=model%size(), &
-                                 quad_size=self%nq)
+            if (allocated(scene%source)) then
+                call self%out%create(self%summary%file, model%n_elements(), lengths, masses, &
+                                     model%model_name(), self%integrator%name(), &
+                                     version_string, scene_namelist_text(scene), err, &
+                                     state_size=model%size(), quad_size=self%nq, &
+                                     source=scene%source)
+            else
+                call self%out%create(self%summary%file, model%n_elements(), lengths, masses, &
+                                     model%model_name(), self%integrator%name(), &
+                                     version_string, scene_namelist_text(scene), err, &
+                                     state_size=model%size(), quad_size=self%nq)
+            end if
             if (allocated(err)) return
         end associate
         call self%record(err)
@@ -287,7 +343,7 @@ contains
             call self%progress%done()
             if (self%t > self%t_last) call self%record(err)
             if (allocated(err)) then
-                if (err%code == ERR_SOLVER) call self%finish('failed', (err%message), err)
+                call self%end_on(err)
                 return
             end if
             outcome = STEP_STOPPED
@@ -296,7 +352,7 @@ contains
         call self%record(err)
         if (allocated(err)) then
             call self%progress%done()
-            if (err%code == ERR_SOLVER) call self%finish('failed', (err%message), err)
+            call self%end_on(err)
             return
         end if
         outcome = STEP_RECORDED
@@ -338,6 +394,19 @@ contains
         self%summary%t_reached = self%t
         call self%keep_as_previous()
     end subroutine record
+
+    !> End the run on an error of `record`: a failed integration finishes it as 'failed';
+    !! an error of the file (which the io layer has closed and marked failed) only releases
+    !! the guarded output.
+    subroutine end_on(self, err)
+        class(run_t), intent(inout) :: self
+        type(error_t), allocatable, intent(inout) :: err
+        if (err%code == ERR_SOLVER) then
+            call self%finish('failed', (err%message), err)
+        else
+            call self%release_output(err)
+        end if
+    end subroutine end_on
 
     !> The state now is the previous record's (where the order safety looks back to).
     subroutine keep_as_previous(self)
@@ -385,6 +454,7 @@ contains
         call self%out%close_run(status, reason, ferr)
         if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
         call self%integrator%finalize()
+        call self%release_output(err)
     end subroutine run_finish
 
     !> m g L of a scene's rope (its model's element masses), J; 0 without gravity.

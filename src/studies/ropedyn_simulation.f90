@@ -26,15 +26,17 @@ contains
 
     !> Run a validated scene to its end, or with `resume` continue the run file
     !! scene%output%file to the scene's t_end. The file is written as the run goes; a failed
-    !! integration leaves the data up to the failure and status 'failed'.
-    subroutine run_scene(scene, summary, err, resume)
+    !! integration leaves the data up to the failure and status 'failed'. The output file
+    !! is guarded (run_t%open) unless `guard` is .false. (a sweep case guards its own);
+    !! `force` lets the run replace a file the guard would keep.
+    subroutine run_scene(scene, summary, err, resume, guard, force)
         type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(out) :: summary
         type(error_t), allocatable, intent(out) :: err
-        logical, intent(in), optional :: resume
+        logical, intent(in), optional :: resume, guard, force
         type(run_t) :: run
         integer :: outcome
-        call run%open(scene, err, resume)
+        call run%open(scene, err, resume, guard, force)
         if (allocated(err)) then
             summary = run%summary
             return

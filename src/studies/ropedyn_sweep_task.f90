@@ -168,14 +168,14 @@ contains
                         'before: continuing it from its last record'
                 end if
                 start = clock_seconds()
-                call run_scene(scene, summary, err, resume=resume)
+                call run_scene(scene, summary, err, resume=resume, guard=.false.)
                 if (resume .and. allocated(err)) then
                     ! not to be continued (nothing left, no restart data, ...): run it anew
                     if (err%code == ERR_INPUT) then
                         write (error_unit, '(a)') label//': cannot be continued ('// &
                             err%message//'): running it anew'
                         removed = delete_file(part)
-                        call run_scene(scene, summary, err)
+                        call run_scene(scene, summary, err, guard=.false.)
                     end if
                 end if
                 wall = clock_seconds() - start

@@ -37,7 +37,10 @@ def start(ropedyn_exe, cwd, *args):
 
 
 def wait_for_records(path, count, proc, timeout=60):
-    """Until the run file (flushed every 0.1 s of wall clock) has `count` records."""
+    """Until the run file (flushed every 0.1 s of wall clock) has `count` records. A new
+    run writes FILE.part and renames it to FILE when it ends: FILE.part is watched."""
+    if not path.name.endswith(".part"):
+        path = path.with_name(path.name + ".part")
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         assert proc.poll() is None, "the run ended before the signal: make it longer"
@@ -156,7 +159,9 @@ def test_second_signal_ends_at_once(ropedyn_exe, tmp_path, scene):
     # ended by whichever of the two was delivered second (pending signals go lowest first)
     assert proc.returncode in (-signal.SIGTERM, -signal.SIGINT), stderr
     assert "a second signal: ending at once" in stderr
-    with h5py.File(tmp_path / out) as f:
+    # ended at once: the run's data stays in FILE.part (FILE, had there been one, untouched)
+    assert not (tmp_path / out).exists()
+    with h5py.File(tmp_path / (out + ".part")) as f:
         assert attr(f, "status") == "running"
 
 

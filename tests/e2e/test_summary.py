@@ -12,7 +12,9 @@ PAPER = ROOT / "input" / "paper.nml"
 
 
 def summary(run, *sets, verbose=False):
-    args = ["run", PAPER, "--set", "output.file='s.h5'", "--set", "output.progress=.false."]
+    # each call its own variant of the scene: --force replaces the one before
+    args = ["run", PAPER, "--set", "output.file='s.h5'", "--set", "output.progress=.false.",
+            "--force"]
     for s in sets:
         args += ["--set", s]
     if verbose:

@@ -1,0 +1,136 @@
+!> The guard of a run's output file (the output guide, "Write, lock and resume rules"):
+!!
+!! - no input of the run (its scene, motion tables, state file) is its output;
+!! - an output that is a symbolic link is the file it points to (a loop or a name too long
+!!   for FILE.part is an error with the system's reason);
+!! - FILE.lock is taken before anything is written, the lock a sweep case takes, so that a
+!!   second run on the same file is refused before it touches it; a resume continues FILE
+!!   in place under that lock;
+!! - a new run replaces an existing FILE only when it is a file ropedyn wrote for the same
+!!   source (the same scene file with the same --set overrides: a rerun); another file, a
+!!   run of another scene or of a --set variant, is refused unless --force; a special file
+!!   (a device, a FIFO, a link to one) always;
+!! - a new run writes FILE.part and renames it to FILE when it finishes (complete, failed
+!!   or interrupted), so that the earlier FILE stays whole until the new one is; a FILE.part
+!!   left by a killed run is refused (resume it, or remove it) unless --force.
+submodule (ropedyn_run) ropedyn_run_guard
+    use ropedyn_os, only: make_parent_dirs, rename_file, delete_file, special_file_reason, &
+                          file_kind, real_path, canonical_path, errno_text, FILE_SYMLINK, &
+                          FILE_MISSING
+    use ropedyn_sweep_lock, only: take_lock, drop_lock
+    use ropedyn_run_inputs, only: check_not_input, check_replaceable, check_own_source
+    use ropedyn_error, only: ERR_USAGE, ERR_IO
+    implicit none
+
+    !> The longest name of a file in a directory (Linux's NAME_MAX).
+    integer, parameter :: NAME_MAX = 255
+
+contains
+
+    module procedure guard_output
+        character(len=:), allocatable :: file
+        logical :: exists, removed
+        integer :: errnum
+        file = self%summary%file
+        if (.not. resume) then
+            call check_not_input(file, self%scene, err)
+            if (allocated(err)) return
+            call make_parent_dirs(file, err)
+            if (allocated(err)) return
+            if (len(special_file_reason(file)) > 0) then
+                call make_error(err, ERR_USAGE, file//': exists and is '// &
+                    special_file_reason(file)//': not replaced')
+                return
+            end if
+            ! a link: the file it points to (written there, renamed there)
+            if (file_kind(file, follow=.false.) == FILE_SYMLINK) then
+                if (file_kind(file) == FILE_MISSING) then
+                    file = canonical_path(file)
+                    if (len(real_path(file, errnum)) == 0 .and. errnum /= 2) then
+                        call make_error(err, ERR_IO, self%summary%file//': cannot create '// &
+                                        'file: '//errno_text(errnum))
+                        return
+                    end if
+                else
+                    file = real_path(file)
+                end if
+            end if
+            if (len(file) - index(file, '/', back=.true.) + len('.part') > NAME_MAX) then
+                call make_error(err, ERR_IO, file//': cannot create file: File name too '// &
+                                'long (the run writes FILE.part and FILE.lock beside it)')
+                return
+            end if
+        end if
+        call take_lock(file//'.lock', err)
+        if (allocated(err)) then
+            err%message = file//': '//err%message
+            return
+        end if
+        self%lock_file = file//'.lock'
+        if (resume) return
+        ! a new run: is there a FILE.part of a killed run, may it replace FILE?
+        inquire (file=file//'.part', exist=exists)
+        if (exists .and. force) then
+            removed = delete_file(file//'.part')
+        else if (exists) then
+            call make_error(err, ERR_USAGE, file//'.part: left by a run of '//file// &
+                ' that was killed: continue it (ropedyn run --resume '//file// &
+                '.part) or remove it, or give --force')
+        else if (len(special_file_reason(file)) > 0) then
+            call make_error(err, ERR_USAGE, file//': exists and is '// &
+                special_file_reason(file)//': not replaced')
+        else if (.not. force) then
+            call check_replaceable(file, err)
+            if (.not. allocated(err) .and. allocated(self%scene%source)) &
+                call check_own_source(file, self%scene%source, err)
+        end if
+        if (allocated(err)) then
+            call drop_lock(self%lock_file)
+            self%lock_file = ''
+            return
+        end if
+        self%final_file = file
+        self%part_file = file//'.part'
+        self%summary%file = self%part_file
+    end procedure guard_output
+
+    module procedure release_output
+        type(error_t), allocatable :: rerr
+        logical :: exists
+        if (allocated(self%part_file)) then
+            if (len(self%part_file) > 0) then
+                inquire (file=self%part_file, exist=exists)
+                ! complete, failed or interrupted: the file is whole (closed, its status set)
+                if (exists) then
+                    call rename_file(self%part_file, self%final_file, rerr)
+                    if (allocated(rerr) .and. .not. allocated(err)) call move_alloc(rerr, err)
+                    ! a message about the file names it where it now is
+                    if (allocated(err) .and. .not. allocated(rerr)) &
+                        err%message = renamed(err%message, self%part_file, self%final_file)
+                end if
+                self%summary%file = self%final_file
+                self%part_file = ''
+            end if
+        end if
+        if (allocated(self%lock_file)) then
+            if (len(self%lock_file) > 0) call drop_lock(self%lock_file)
+            self%lock_file = ''
+        end if
+    end procedure release_output
+
+    !> `text` with every `old` replaced by `new`.
+    pure function renamed(text, old, new) result(out)
+        character(len=*), intent(in) :: text, old, new
+        character(len=:), allocatable :: out
+        integer :: k, from
+        out = ''
+        from = 1
+        do
+            k = index(text(from:), old)
+            if (k == 0) exit
+            out = out//text(from:from + k - 2)//new
+            from = from + k - 1 + len(old)
+        end do
+        out = out//text(from:)
+    end function renamed
+end submodule ropedyn_run_guard

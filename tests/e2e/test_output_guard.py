@@ -1,0 +1,136 @@
+"""The guard of a run's output file (docs/guide/output.md, "Write, lock and resume rules"):
+a rerun of the same scene replaces its own file; a --set variant, another scene, a file ropedyn
+did not write or an input of the run is never replaced (exit 2, the file unchanged) unless
+--force (never an input); a second run on a locked file is refused; a killed run leaves the
+earlier file whole and its data in FILE.part; an interrupted run ends in FILE."""
+import hashlib
+import signal
+import subprocess
+import time
+
+import h5py
+import pytest
+
+from conftest import ROOT
+
+PAPER = ROOT / "input" / "paper.nml"
+
+
+def digest(path):
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+@pytest.fixture
+def scene(tmp_path):
+    path = tmp_path / "paper.nml"
+    path.write_text(PAPER.read_text())
+    return path
+
+
+def created(path):
+    with h5py.File(path) as f:
+        return f.attrs["created"], f.attrs["source"].decode()
+
+
+def test_a_rerun_replaces_its_own_file_and_a_variant_is_refused(run, tmp_path, scene):
+    first = run("run", scene, "--set", "solver.t_end=0.05")
+    assert first.returncode == 0, first.stderr
+    out = tmp_path / "out" / "paper.h5"
+    source = created(out)[1]
+    assert source == f"{scene} --set solver.t_end=0.05"
+    time.sleep(1.1)
+    again = run("run", scene, "--set", "solver.t_end=0.05", "--set", "output.progress=.false.")
+    assert again.returncode == 0, again.stderr
+    before = digest(out)
+    variant = run("run", scene, "--set", "solver.t_end=0.06")
+    assert variant.returncode == 2
+    assert (f'out/paper.h5: exists and holds the run of "{source}", not of this run'
+            in variant.stderr), variant.stderr
+    assert digest(out) == before
+    forced = run("run", scene, "--set", "solver.t_end=0.06", "--force")
+    assert forced.returncode == 0, forced.stderr
+    assert created(out)[1].endswith("--set solver.t_end=0.06")
+    assert not list((tmp_path / "out").glob("*.part")) and not list((tmp_path / "out").glob("*.lock"))
+
+
+@pytest.mark.parametrize("content", [b"my notes\n", b"\x89HDF\r\n\x1a\n" + bytes(600)])
+def test_a_file_ropedyn_did_not_write_is_never_replaced_silently(run, tmp_path, scene, content):
+    out = tmp_path / "mine.h5"
+    if content.startswith(b"\x89HDF"):
+        with h5py.File(out, "w") as f:
+            f["data"] = [1.0, 2.0]
+    else:
+        out.write_bytes(content)
+    before = digest(out)
+    proc = run("run", scene, "--set", "output.file='mine.h5'", "--set", "solver.t_end=0.01")
+    assert proc.returncode == 2 and "mine.h5: exists and is" in proc.stderr, proc.stderr
+    assert "not replaced" in proc.stderr
+    assert digest(out) == before
+
+
+def test_an_input_is_never_the_output(run, tmp_path, scene):
+    table = tmp_path / "top.dat"
+    table.write_text("0 0 0 0\n1 0.1 0 0\n")
+    before = {p: digest(p) for p in (scene, table)}
+    for target in ("paper.nml", "top.dat"):
+        proc = run("run", scene, "--set", f"output.file='{target}'", "--set",
+                   "supports.top_motion='table'", "--set", "supports.top_table='top.dat'",
+                   "--force")
+        assert proc.returncode == 2, proc.stderr
+        assert "writing it would destroy an input of this run" in proc.stderr
+    assert {p: digest(p) for p in before} == before
+
+
+def long_run(ropedyn_exe, cwd, scene, *extra):
+    return subprocess.Popen([str(ropedyn_exe), "run", str(scene), "--set", "solver.t_end=30",
+                             "--set", "model.elements=60", "--set", "output.progress=.false.",
+                             *extra],
+                            cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def wait_for(path, proc, timeout=60):
+    deadline = time.monotonic() + timeout
+    while not path.exists():
+        assert proc.poll() is None and time.monotonic() < deadline, "the run ended early"
+        time.sleep(0.02)
+
+
+def test_a_second_run_on_a_locked_file_is_refused(run, ropedyn_exe, tmp_path, scene):
+    first = long_run(ropedyn_exe, tmp_path, scene)
+    try:
+        wait_for(tmp_path / "out" / "paper.h5.part", first)
+        second = run("run", scene, "--set", "solver.t_end=30", "--set", "model.elements=60")
+        assert second.returncode != 0
+        assert "out/paper.h5: " in second.stderr and "lock" in second.stderr, second.stderr
+    finally:
+        first.send_signal(signal.SIGTERM)
+        first.wait(60)
+    assert first.returncode == 130, first.stderr
+    with h5py.File(tmp_path / "out" / "paper.h5") as f:
+        assert f.attrs["status"] == b"interrupted"      # the interrupted run ends in FILE
+
+
+def test_a_killed_run_leaves_the_earlier_file_whole(run, ropedyn_exe, tmp_path, scene):
+    sets = ["--set", "solver.t_end=30", "--set", "model.elements=60"]
+    (tmp_path / "out").mkdir()
+    earlier = run("run", scene, *sets[:2], "--set", "solver.t_end=0.02", "--set",
+                  "model.elements=60", "--force")
+    assert earlier.returncode == 0, earlier.stderr
+    out = tmp_path / "out" / "paper.h5"
+    before = digest(out)
+    proc = long_run(ropedyn_exe, tmp_path, scene, "--force")
+    part = tmp_path / "out" / "paper.h5.part"
+    wait_for(part, proc)
+    time.sleep(0.5)
+    proc.kill()
+    proc.wait(60)
+    assert digest(out) == before and part.exists()
+    refused = run("run", scene, *sets)
+    assert refused.returncode == 2
+    assert "paper.h5.part: left by a run of out/paper.h5 that was killed" in refused.stderr
+    with h5py.File(part, "r+") as f:         # the user's way to continue a killed run
+        f.attrs["status"] = "interrupted"
+        last = f["time"][-1]
+    resumed = run("run", "--resume", "out/paper.h5.part", "--set", f"solver.t_end={last + 0.05}")
+    assert resumed.returncode == 0, resumed.stderr
+    assert digest(out) == before
