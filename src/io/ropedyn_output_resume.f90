@@ -16,6 +16,8 @@ contains
         self%n_elements = n_elements
         self%restart_data = .true.
         self%state_size = [state_size, quad_size]
+        self%force_data = .false.
+        if (present(internal_forces)) self%force_data = internal_forces
         steps: block
             do k = 1, N_SERIES
                 call self%file%open_series(self%series(k), trim(SERIES_NAME(k)), err)
@@ -56,6 +58,10 @@ contains
                 call make_error(err, ERR_IO, path//': /state/y: fewer records than /time')
                 exit steps
             end if
+            if (self%force_data) then
+                call reopen_forces(self, path, err)
+                if (allocated(err)) exit steps
+            end if
             do k = 1, N_SERIES
                 call self%series(k)%truncate(self%n_records, err)
                 if (allocated(err)) exit steps
@@ -76,6 +82,41 @@ contains
             call allocate_pending(self)
         end if
     end procedure output_reopen
+
+    !> Open the internal-force series of a file being reopened (self%n_records set), check
+    !! their record sizes and lengths, and cut them to n_records. A file without them was
+    !! written before they were stored: it is not continued (its records would lack them).
+    subroutine reopen_forces(self, path, err)
+        type(output_file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: err
+        integer :: k, expected
+        do k = 1, N_FORCE_SERIES
+            if (.not. self%file%exists(trim(FORCE_NAME(k)))) then
+                call make_error(err, ERR_IO, path//': '//trim(FORCE_NAME(k))//': missing: '// &
+                    'the file was written by a version of ropedyn that did not store the '// &
+                    'internal forces; it cannot be continued (run the scene again)')
+                return
+            end if
+            call self%file%open_series(self%force(k), trim(FORCE_NAME(k)), err)
+            if (allocated(err)) return
+            expected = force_record_size(k, self%n_elements)
+            if (self%force(k)%record_size() /= expected) then
+                call make_error(err, ERR_IO, path//': '//trim(FORCE_NAME(k))// &
+                    ': records of '//int_text(self%force(k)%record_size())// &
+                    ' values, expected '//int_text(expected)//' for '// &
+                    int_text(self%n_elements)//' elements')
+                return
+            end if
+            if (self%force(k)%length() < self%n_records) then
+                call make_error(err, ERR_IO, path//': '//trim(FORCE_NAME(k))// &
+                    ': fewer records than /time')
+                return
+            end if
+            call self%force(k)%truncate(self%n_records, err)
+            if (allocated(err)) return
+        end do
+    end subroutine reopen_forces
 
     module procedure output_add_restart
         type(h5_series_t) :: entry(size(RESTART_NAME))
@@ -136,6 +177,10 @@ contains
         end do
         do k = 1, 2
             call self%state(k)%close(e)
+            if (allocated(e) .and. .not. allocated(first)) call move_alloc(e, first)
+        end do
+        do k = 1, N_FORCE_SERIES
+            call self%force(k)%close(e)
             if (allocated(e) .and. .not. allocated(first)) call move_alloc(e, first)
         end do
         call self%file%close(e)
