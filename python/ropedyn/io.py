@@ -61,7 +61,7 @@ class Run:
     forces: dict = dataclasses.field(default_factory=dict)
     # force of each support on the rope, 'top'/'bottom' -> (T, 2) N (x, y); may be empty
     reactions: dict = dataclasses.field(default_factory=dict)
-    # each support's anchor at every record, 'top'/'bottom' -> (T, 2) m (NaN: free end)
+    # each support's anchor at every record, 'top'/'bottom' -> (T, 2) m (none for a free end)
     anchors: dict = dataclasses.field(default_factory=dict)
 
     @property

@@ -23,7 +23,8 @@
 !!     /forces/{axial, shear, moment}  (times, elements + 1)  N, N, N m   internal forces at
 !!              the joints, 0 the top end (with internal_forces at create; FORCE_DESCRIPTION)
 !!     /supports/{top, bottom}/reaction (times, 2)    N             force of the support on
-!!              the rope; /supports/{top, bottom}/position (times, 2) m: its anchor
+!!              the rope; /supports/{top, bottom}/position (times, 2) m: its anchor (only
+!!              for a support with one: not for a free end)
 !!     /solver/restarts/{time, record, steps, cpu_time, wall_clock, previous_status,
 !!              previous_reason} (restarts,)   one entry per resume (add_restart)
 !!     /solver/order_lowered_at () s, /solver/order_lowered_from, _to () int64 1,
@@ -45,6 +46,7 @@
 !! The HDF5 calls are those of `ropedyn_h5`. An `output_file_t` must not be copied while open
 !! (both copies would hold the same ids).
 module ropedyn_output
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use hdf5, only: hsize_t
     use ropedyn_kinds, only: wp, i8
     use ropedyn_clock, only: utc_timestamp, clock_seconds
@@ -101,7 +103,9 @@ module ropedyn_output
     !> The internal forces and the supports at every record (`create` with
     !! internal_forces; `append`'s axial, shear, moment, reaction, position): name, units,
     !! columns, description; a record of the first N_JOINT_SERIES holds the n + 1 joints,
-    !! of the others x and y. The definitions: docs/theory/internal-forces.md.
+    !! of the others x and y. The positions (the last two) exist only for the supports
+    !! that have an anchor (`anchored`): a free end has none, and no record holds a NaN.
+    !! The definitions: docs/theory/internal-forces.md.
     integer, parameter :: N_FORCE_SERIES = 7, N_JOINT_SERIES = 3
     character(len=*), parameter :: FORCE_NAME(N_FORCE_SERIES) = [character(len=25) :: &
         '/forces/axial', '/forces/shear', '/forces/moment', '/supports/top/reaction', &
@@ -123,9 +127,9 @@ module ropedyn_output
         'force of the top support on the rope (x, y); 0 when free or released', &
         'force of the bottom support on the rope (x, y); 0 when free or released', &
         'anchor of the top support at the time of the record, from its prescribed '// &
-        'motion (x, y); NaN when free', &
+        'motion (x, y)', &
         'anchor of the bottom support at the time of the record, from its prescribed '// &
-        'motion (x, y); NaN when free']
+        'motion (x, y)']
 
     !> The entries of /solver/restarts (one per resume): name, units, width of a string
     !! (0: a number; integer for record and steps).
@@ -170,9 +174,11 @@ module ropedyn_output
         type(h5_series_t) :: state(2)
         logical :: restart_data = .false.
         integer :: state_size(2) = 0
-        !> the internal forces and supports (FORCE_NAME, when `force_data`)
+        !> the internal forces and supports (FORCE_NAME, when `force_data`; those of them
+        !! that the file has: force_on)
         type(h5_series_t) :: force(N_FORCE_SERIES)
         logical :: force_data = .false.
+        logical :: force_on(N_FORCE_SERIES) = .false.
         !> records appended but not yet written: record m of series k (the state's two
         !! after the N_SERIES, then the N_FORCE_SERIES) at pending(k)%v((m - 1) r + 1 : m r),
         !! r its record size; written as one block per series when `capacity` are held,
@@ -202,7 +208,7 @@ module ropedyn_output
         !! status 'running' again and its old reason removed. The file must be for
         !! `n_elements` elements and the given state and quadrature sizes.
         module subroutine output_reopen(self, path, n_elements, state_size, quad_size, err, &
-                                        keep, internal_forces)
+                                        keep, internal_forces, anchored)
             class(output_file_t), intent(inout) :: self
             character(len=*), intent(in) :: path
             integer, intent(in) :: n_elements, state_size, quad_size
@@ -212,6 +218,9 @@ module ropedyn_output
             !> the file must hold the internal forces (ERR_IO naming the first missing series
             !! if not: a file written before they were stored cannot be continued)
             logical, intent(in), optional :: internal_forces
+            !> with internal_forces: which supports (top, bottom) have an anchor, as at
+            !! `create` (default both); the file's positions must be those
+            logical, intent(in), optional :: anchored(2)
         end subroutine output_reopen
 
         !> Add an entry to /solver/restarts: the run continues from record `record` (0-based, as
@@ -254,7 +263,8 @@ module ropedyn_output
             real(wp), intent(in), optional :: yq(:)   !< its quadratures, J (restart data)
             !> (n + 1) joints 0 (top end) .. n: tension (N), shear force (N), moment (N m)
             real(wp), intent(in), optional :: axial(:), shear(:), moment(:)
-            !> (2, 2) top, bottom: force of the support on the rope (N), its anchor (m)
+            !> (2, 2) top, bottom: force of the support on the rope (N), its anchor (m; only
+            !! those of the supports with an anchor are written)
             real(wp), intent(in), optional :: reaction(:, :), position(:, :)
         end subroutine output_append
 
@@ -277,6 +287,14 @@ module ropedyn_output
             integer :: values
         end function force_record_size
 
+        !> Which force series a file with `force_data` has (force_on): all but the anchors
+        !! of supports without one (`anchored`, default both; submodule
+        !! ropedyn_output_pending).
+        module subroutine set_force_series(self, anchored)
+            type(output_file_t), intent(inout) :: self
+            logical, intent(in), optional :: anchored(2)
+        end subroutine set_force_series
+
         !> The path of the file, or a placeholder if create never succeeded.
         module function file_label(self) result(label)
             type(output_file_t), intent(in) :: self
@@ -290,10 +308,11 @@ contains
     !! The directory of `path` must exist. An object that is still open is closed first
     !! (its file keeps status 'running'). With `state_size` and `quad_size` (the model's),
     !! every record also holds the restart data /state/y, /state/yq (`append`'s y, yq); with
-    !! `internal_forces`, the internal forces and supports (FORCE_NAME).
+    !! `internal_forces`, the internal forces and supports (FORCE_NAME; the anchors of
+    !! those supports that have one, `anchored`, default both).
     subroutine output_create(self, path, n_elements, element_length, element_mass, model, &
                              method, version, scene_text, err, state_size, quad_size, &
-                             internal_forces)
+                             internal_forces, anchored)
         class(output_file_t), intent(inout) :: self
         character(len=*), intent(in) :: path              !< e.g. out/run.h5
         integer, intent(in) :: n_elements                 !< elements of the rope
@@ -307,6 +326,7 @@ contains
         integer, intent(in), optional :: state_size       !< unknowns of the ODE state
         integer, intent(in), optional :: quad_size        !< quadrature variables
         logical, intent(in), optional :: internal_forces  !< records hold the forces
+        logical, intent(in), optional :: anchored(2)      !< top, bottom have an anchor
 
         if (self%is_open) call shutdown(self)
 
@@ -332,6 +352,7 @@ contains
         if (self%restart_data) self%state_size = [state_size, quad_size]
         self%force_data = .false.
         if (present(internal_forces)) self%force_data = internal_forces
+        call set_force_series(self, anchored)
 
         call write_contents()
         if (allocated(err)) then
@@ -416,7 +437,8 @@ contains
 
     !> The internal forces and supports of one state as the datasets of a run file with one
     !! record (FORCE_NAME: h5py shapes (1, n + 1) and (1, 2)), for the statics and modes
-    !! files: axial, shear, moment (0:n) and reaction, position (2, 2; top, bottom).
+    !! files: axial, shear, moment (0:n) and reaction, position (2, 2; top, bottom; a
+    !! position that is not finite, a free end's, is not written).
     subroutine write_forces(file, axial, shear, moment, reaction, position, err)
         type(h5_file_t), intent(inout) :: file
         real(wp), intent(in) :: axial(:), shear(:), moment(:)   !< N, N, N m
@@ -432,6 +454,7 @@ contains
         values(1:2, 4:5) = reaction
         values(1:2, 6:7) = position
         do k = 1, N_FORCE_SERIES
+            if (k >= N_FORCE_SERIES - 1 .and. .not. all(ieee_is_finite(values(1:2, k)))) cycle
             m = merge(size(axial), 2, k <= N_JOINT_SERIES)
             call file%write(trim(FORCE_NAME(k)), reshape(values(1:m, k), [m, 1]), &
                             trim(FORCE_UNITS(k)), err, trim(FORCE_DESCRIPTION(k)))
@@ -449,6 +472,7 @@ contains
         call force_groups(self%file, err)
         if (allocated(err)) return
         do k = 1, N_FORCE_SERIES
+            if (.not. self%force_on(k)) cycle
             call self%file%create_series(self%force(k), trim(FORCE_NAME(k)), &
                                          [int(force_record_size(k, self%n_elements), hsize_t)], &
                                          .false., trim(FORCE_UNITS(k)), &

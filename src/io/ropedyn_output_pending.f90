@@ -52,8 +52,8 @@ contains
             call put(N_SERIES + 5, moment)
             call put(N_SERIES + 6, reaction(:, 1))
             call put(N_SERIES + 7, reaction(:, 2))
-            call put(N_SERIES + 8, position(:, 1))
-            call put(N_SERIES + 9, position(:, 2))
+            if (self%force_on(N_FORCE_SERIES - 1)) call put(N_SERIES + 8, position(:, 1))
+            if (self%force_on(N_FORCE_SERIES)) call put(N_SERIES + 9, position(:, 2))
         end if
         self%n_pending = m
 
@@ -134,11 +134,9 @@ contains
         end do
         sizes(N_SERIES + 1:) = 0
         if (self%restart_data) sizes(N_SERIES + 1:N_SERIES + 2) = max(1, self%state_size)
-        if (self%force_data) then
-            do k = 1, N_FORCE_SERIES
-                sizes(N_SERIES + 2 + k) = force_record_size(k, self%n_elements)
-            end do
-        end if
+        do k = 1, N_FORCE_SERIES
+            if (self%force_on(k)) sizes(N_SERIES + 2 + k) = force_record_size(k, self%n_elements)
+        end do
         self%capacity = max(1, min(MAX_PENDING, PENDING_BYTES/(8*sum(sizes))))
         do k = 1, size(self%pending)
             if (allocated(self%pending(k)%v)) deallocate (self%pending(k)%v)
@@ -174,6 +172,7 @@ contains
         end if
         if (self%force_data) then
             do k = 1, N_FORCE_SERIES
+                if (.not. self%force_on(k)) cycle
                 r = size(self%pending(N_SERIES + 2 + k)%v)/self%capacity
                 call self%force(k)%append(first, self%pending(N_SERIES + 2 + k)%v(1:m*r), err)
                 if (allocated(err)) return
@@ -185,6 +184,11 @@ contains
         self%n_records = self%n_records + int(m, hsize_t)
         self%n_pending = 0
     end procedure write_pending
+
+    module procedure set_force_series
+        self%force_on = self%force_data
+        if (present(anchored)) self%force_on(N_FORCE_SERIES - 1:) = self%force_data .and. anchored
+    end procedure set_force_series
 
     module procedure force_record_size
         values = merge(n + 1, 2, k <= N_JOINT_SERIES)

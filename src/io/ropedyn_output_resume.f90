@@ -18,6 +18,7 @@ contains
         self%state_size = [state_size, quad_size]
         self%force_data = .false.
         if (present(internal_forces)) self%force_data = internal_forces
+        call set_force_series(self, anchored)
         steps: block
             do k = 1, N_SERIES
                 call self%file%open_series(self%series(k), trim(SERIES_NAME(k)), err)
@@ -92,12 +93,20 @@ contains
         type(error_t), allocatable, intent(out) :: err
         integer :: k, expected
         do k = 1, N_FORCE_SERIES
-            if (.not. self%file%exists(trim(FORCE_NAME(k)))) then
-                call make_error(err, ERR_IO, path//': '//trim(FORCE_NAME(k))//': missing: '// &
-                    'the file was written by a version of ropedyn that did not store the '// &
-                    'internal forces; it cannot be continued (run the scene again)')
+            if (self%file%exists(trim(FORCE_NAME(k))) .neqv. self%force_on(k)) then
+                if (k < N_FORCE_SERIES - 1) then
+                    call make_error(err, ERR_IO, path//': '//trim(FORCE_NAME(k))// &
+                        ': missing: the file was written by a version of ropedyn that did '// &
+                        'not store the internal forces; it cannot be continued (run the '// &
+                        'scene again)')
+                else
+                    call make_error(err, ERR_IO, path//': '//trim(FORCE_NAME(k))//': '// &
+                        trim(merge('missing', 'present', self%force_on(k)))//': the '// &
+                        'scene''s supports differ from those of the file')
+                end if
                 return
             end if
+            if (.not. self%force_on(k)) cycle
             call self%file%open_series(self%force(k), trim(FORCE_NAME(k)), err)
             if (allocated(err)) return
             expected = force_record_size(k, self%n_elements)

@@ -220,10 +220,13 @@ contains
             if (allocated(err)) return
             allocate (lengths(model%n_elements()), masses(model%n_elements()))
             call model%element_data(lengths, masses)
+            ! a free end has no anchor (NaN): the file has no position series for it
+            call model%support_positions(self%t, self%anchors)
             call self%out%create(self%summary%file, model%n_elements(), lengths, masses, &
                                  model%model_name(), self%integrator%name(), version_string, &
                                  scene_namelist_text(scene), err, state_size=model%size(), &
-                                 quad_size=self%nq, internal_forces=.true.)
+                                 quad_size=self%nq, internal_forces=.true., &
+                                 anchored=ieee_is_finite(self%anchors(1, :)))
             if (allocated(err)) return
         end associate
         call self%record(err)

@@ -70,8 +70,10 @@ contains
             call read_peak_tension(file, keep, peak, joint, t_peak, err)
             if (allocated(err)) return
             if (joint >= 0) call self%note_peak(t_peak, peak, joint)
+            call self%model%support_positions(self%t, self%anchors)
             call self%out%reopen(file, self%model%n_elements(), self%model%size(), self%nq, &
-                                 err, keep=keep, internal_forces=.true.)
+                                 err, keep=keep, internal_forces=.true., &
+                                 anchored=ieee_is_finite(self%anchors(1, :)))
             if (allocated(err)) return
             call self%out%add_restart(rec%record, self%t, before%status, before%reason, &
                                       self%counters_before(1), self%cpu_before, err)

@@ -2,7 +2,9 @@
 !! internal_forces; docs/theory/internal-forces.md), for RFEM and MPP:
 !! - the reactions at a moving support against the whole rope's momentum balance, sum of
 !!   the external forces = d/dt sum m v (the rods' centre velocities), at one state in
-!!   motion, for a harmonic and a table-driven top (and a pinned bottom), to 1e-6;
+!!   motion, for a harmonic and a table-driven top (and a pinned bottom), to 1e-6; a
+!!   released bottom: its reaction and joint forces zero after the release, the balance
+!!   holding before and after;
 !! - a 3-element rope at rest against a hand calculation of every joint force;
 !! - the MPP's member tension against its spring law k u + d u' in motion;
 !! - the tension along a hanging rope at equilibrium: w (L - s), linear in arc length;
@@ -38,6 +40,8 @@ program test_internal_forces
     call test_momentum('rfem', 'table')
     call test_momentum('mpp', 'harmonic')
     call test_momentum('mpp', 'table')
+    call test_released('rfem')
+    call test_released('mpp')
     call test_rfem_by_hand()
     call test_mpp_by_hand()
     call test_mpp_spring_law()
@@ -160,6 +164,60 @@ contains
         call suite%check_le(1.0e-3_wp*scale, norm2(reaction(:, 2)), label// &
                             ': 1e-6 scale < 1e-3 |R_bottom|')
     end subroutine test_momentum
+
+    !> W + R_top + R_bottom - dp/dt relative to the largest of them, at state y and time t
+    !! (dp/dt as in test_momentum); the reactions out.
+    real(wp) function imbalance(model, t, y, reaction) result(r)
+        class(rope_model_t), intent(inout) :: model
+        real(wp), intent(in) :: t, y(:)
+        real(wp), intent(out) :: reaction(2, 2)
+        real(wp) :: ydot(size(y)), axial(0:model%n_elements()), shear(0:model%n_elements())
+        real(wp) :: moment(0:model%n_elements()), dpdt(2), weight(2), h
+        real(wp) :: lengths(model%n_elements()), masses(model%n_elements())
+        integer :: status
+        call model%rhs(t, y, ydot, status)
+        call model%internal_forces(t, y, axial, shear, moment, reaction)
+        h = 1.0e-5_wp
+        dpdt = (8.0_wp*(momentum(model, t + h, y + h*ydot) - momentum(model, t - h, y - h*ydot)) &
+                - (momentum(model, t + 2*h, y + 2*h*ydot) &
+                   - momentum(model, t - 2*h, y - 2*h*ydot)))/(12.0_wp*h)
+        call model%element_data(lengths, masses)
+        weight = [sum(masses)*G, 0.0_wp]
+        r = norm2(weight + reaction(:, 1) + reaction(:, 2) - dpdt)/ &
+            max(norm2(reaction(:, 1)), norm2(reaction(:, 2)), norm2(dpdt), weight(1))
+    end function imbalance
+
+    !> A clamped bottom released at t = 0.2 s (pinned 0.2 mm off the lower end, the top
+    !! harmonic): before the release its reaction and end moment are the support's, after
+    !! it they are zero and the free end carries nothing; the momentum balance holds at both
+    !! times (the state of `moving_state`).
+    subroutine test_released(kind)
+        character(len=*), intent(in) :: kind
+        class(rope_model_t), allocatable :: model
+        real(wp), allocatable :: y(:)
+        real(wp) :: reaction(2, 2), axial(0:6), shear(0:6), moment(0:6), r
+        character(len=64) :: sets(9)
+        character(len=:), allocatable :: label
+        sets = [character(len=64) :: '', 'model.elements = 6', 'supports.bottom = "clamped"', &
+                'supports.bottom_anchor = 0.9849, 0.1738', 'initial.angle_deg = 10.0', &
+                'supports.bottom_angle_deg = 10.0', 'supports.bottom_release_time = 0.2', &
+                'supports.top_motion = "harmonic"', 'supports.top_frequency = 1.3']
+        sets(1) = 'model.kind = "'//kind//'"'
+        call model_of(sets, model)
+        call moving_state(model, y)
+        label = kind//', bottom released at 0.2 s'
+        r = imbalance(model, 0.1_wp, y, reaction)
+        call suite%check_le(r, 1.0e-6_wp, label//': momentum balance at 0.1 s')
+        call suite%check_le(1.0e-3_wp, norm2(reaction(:, 2)), label//': held at 0.1 s')
+        r = imbalance(model, 0.3_wp, y, reaction)
+        call suite%check_le(r, 1.0e-6_wp, label//': momentum balance at 0.3 s')
+        call model%internal_forces(0.3_wp, y, axial, shear, moment, reaction)
+        call suite%check_true(all(reaction(:, 2) == 0.0_wp) .and. axial(6) == 0.0_wp .and. &
+                              shear(6) == 0.0_wp .and. moment(6) == 0.0_wp, label// &
+                              ': no reaction, no end force at 0.3 s')
+        call model%internal_forces(0.1_wp, y, axial, shear, moment, reaction)
+        call suite%check_le(1.0e-9_wp, abs(moment(6)), label//': end moment at 0.1 s')
+    end subroutine test_released
 
     !> RFEM, 3 elements (lengths dl/2, dl, dl/2, dl = L/2), at rest in a deformed state:
     !! angles (0, a, 0), the centres placed so that the SDEs are stretched and sheared,
