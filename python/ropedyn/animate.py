@@ -1,5 +1,6 @@
-"""Animate a ropedyn run: the rope's polyline over time, the tip's trail, the supports,
-a time stamp and optionally an energy panel. Works from the HDF5 file alone (any model).
+"""Animate a ropedyn run: the rope's polyline over time, the tip's trail, the supports (a
+moving one on its path), the ground, a time stamp and optionally an energy panel. Works
+from the HDF5 file alone (any model).
 
 usage: scripts/animate RUN.h5 [-o RUN.gif|RUN.mp4] [--max-frames 300] [--fps F] [--energy]
        (python -m ropedyn.animate)
@@ -21,7 +22,7 @@ import numpy as np
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from ropedyn import io, plot  # noqa: E402
+from ropedyn import fields, io, plot  # noqa: E402
 
 ROPE_COLOR = "#1f4e9c"
 TIP_COLOR = "#d62728"
@@ -70,7 +71,9 @@ def build_figure(run, size, dpi, energy):
     else:
         ax, ex = fig.add_subplot(), None
     plot.setup_picture_axes(ax, run)
-    plot.draw_supports(ax, run)
+    plot.draw_ground(ax, run)
+    plot.draw_supports(ax, run, moving=False)
+    plot.draw_support_paths(ax, run)
     ax.set_title(io.title(run), fontsize=9)
     return fig, ax, ex
 
@@ -86,6 +89,10 @@ class RopeFrames:
         self.trail_line, = ax.plot([], [], "-", color=TIP_COLOR, lw=1, alpha=0.6,
                                    animated=True)
         self.tip, = ax.plot([], [], "o", color=TIP_COLOR, ms=4, animated=True)
+        # moving supports: their anchor, moved along the stored path frame by frame
+        self.moving = [s for s in fields.supports(run) if s.kind != "free" and s.moving]
+        self.anchors = [ax.plot([], [], "s", ms=6, mfc="white", mec=plot.SUPPORT_PATH_COLOR,
+                                mew=1.8, animated=True)[0] for _ in self.moving]
         self.stamp = ax.text(0.03, 0.04, "", transform=ax.transAxes, fontsize=10,
                              family="monospace", animated=True,
                              bbox={"fc": "white", "ec": "0.7", "alpha": 0.8})
@@ -93,7 +100,7 @@ class RopeFrames:
         self.fig.tight_layout()
         plot.fit_equal(ax)
         self.fig.tight_layout()  # the tick labels may have changed width
-        self.axes = [(ax, [self.trail_line, self.rope, self.tip, self.stamp])]
+        self.axes = [(ax, [self.trail_line, self.rope, self.tip, *self.anchors, self.stamp])]
         if ex is not None:
             self.axes.append((ex, [self.cursor]))
         canvas = self.fig.canvas
@@ -108,6 +115,8 @@ class RopeFrames:
         self.rope.set_data(pts[k, :, 1], pts[k, :, 0])
         self.trail_line.set_data(tip[first:k + 1, 1], tip[first:k + 1, 0])
         self.tip.set_data([tip[k, 1]], [tip[k, 0]])
+        for sup, marker in zip(self.moving, self.anchors):
+            marker.set_data([sup.path[k, 1]], [sup.path[k, 0]])
         self.stamp.set_text(f"t = {t[k]:7.3f} s")
         if self.cursor is not None:
             self.cursor.set_xdata([t[k], t[k]])
@@ -123,7 +132,7 @@ class RopeFrames:
 
 def _swatches(width):
     """Blocks of the moving artists' colours, so that the shared palette keeps them."""
-    colors = [ROPE_COLOR, TIP_COLOR]
+    colors = [ROPE_COLOR, TIP_COLOR, plot.SUPPORT_PATH_COLOR]
     rgb = [np.array(matplotlib.colors.to_rgb(c)) for c in colors]
     rgb.append(0.6 * rgb[1] + 0.4)  # the trail (alpha 0.6) over white
     return np.concatenate([np.broadcast_to((255 * c).astype(np.uint8), (40, width, 3))

@@ -1,8 +1,10 @@
-"""Derived fields of a run (definitions in docs/visualization.md): the supports, element
-velocity and speed, element angles, curvature at the joints and the axial force.
+"""Fields of a run (definitions in docs/visualization.md): the supports and the ground,
+element velocity and speed, element angles, curvature at the joints, and the axial force.
 
-Everything is computed from the run file alone (a `ropedyn.io.Run`): the polyline, the
-state, the element lengths and the effective scene text.
+Everything comes from the run file alone (a `ropedyn.io.Run`): the polyline, the state, the
+element lengths, the effective scene text, and the internal forces and support anchors the
+model stored with each record. No force law is evaluated here: the axial force is the
+model's own (/forces/axial); a file written before the forces were stored has none.
 """
 import dataclasses
 
@@ -13,11 +15,18 @@ import numpy as np
 
 @dataclasses.dataclass
 class Support:
-    """One end support: kind ('pinned', 'clamped', 'free'), anchor (x, y) m, clamp angle."""
+    """One end support: kind ('pinned', 'clamped', 'free'), anchor (x, y) m at the first
+    record, clamp angle; path (T, 2) m: the anchor at every record (/supports/*/position;
+    None for a file without it), moving: whether it moves."""
 
     kind: str
     anchor: np.ndarray
     angle: float  # rad, from x towards y
+    path: np.ndarray = None
+
+    @property
+    def moving(self):
+        return self.path is not None and bool(np.any(np.ptp(self.path, axis=0) > 0.0))
 
 
 def _vector(value, fallback):
@@ -29,16 +38,37 @@ def _vector(value, fallback):
 
 
 def supports(run):
-    """(top, bottom) supports from the scene. The bottom anchor defaults to the rope's lower
-    end in its initial state, as in the models."""
+    """(top, bottom) supports: their kinds and clamp angles from the scene, their anchors
+    from the file (/supports/*/position, where the model put them at each record). A file
+    without those: the scene's anchors (the bottom's default: the rope's lower end at the
+    start, as in the models), no path."""
     sup = run.group("supports")
-    top_kind = str(sup.get("top", "pinned")).lower()
-    bottom_kind = str(sup.get("bottom", "free")).lower()
-    top = Support(top_kind, _vector(sup.get("top_anchor"), run.points[0, 0].copy()),
-                  np.radians(float(sup.get("top_angle_deg", 0.0))))
-    bottom = Support(bottom_kind, _vector(sup.get("bottom_anchor"), run.points[0, -1].copy()),
-                     np.radians(float(sup.get("bottom_angle_deg", 0.0))))
-    return top, bottom
+    out = []
+    for end, point in (("top", 0), ("bottom", -1)):
+        kind = str(sup.get(end, "pinned" if end == "top" else "free")).lower()
+        path = run.anchors.get(end)
+        if path is not None and path.shape[0] > 0 and np.all(np.isfinite(path[0])):
+            anchor = path[0].copy()
+        else:
+            path = None
+            anchor = _vector(sup.get(f"{end}_anchor"), run.points[0, point].copy())
+        out.append(Support(kind, anchor, np.radians(float(sup.get(f"{end}_angle_deg", 0.0))),
+                           path))
+    return tuple(out)
+
+
+def ground_plane(run):
+    """(point, unit normal) of the scene's ground plane (x, y; the normal towards the free
+    side), or None when the scene has no ground contact (&effects ground = .false.)."""
+    if not bool(run.group("effects").get("ground", False)):
+        return None
+    ground = run.group("ground")
+    point = _vector(ground.get("point"), np.array([1.0, 0.0]))
+    normal = _vector(ground.get("normal"), np.array([-1.0, 0.0]))
+    length = np.linalg.norm(normal)
+    if not length > 0:
+        return None
+    return point, normal / length
 
 
 # --- derived fields -----------------------------------------------------------------------
@@ -109,10 +139,11 @@ def joints_to_points(joint_values):
 
 @dataclasses.dataclass
 class AxialForce:
-    """The axial force N (tension > 0) at positions s along the unstretched rope.
+    """The axial force N (tension > 0) at the joints, as the run stored it (/forces/axial).
 
-    values (T, m) at arc lengths s (m,); per_element (T, n); per_point (T, 2n);
-    definition: one line saying what was computed."""
+    values (T, n+1) at joints 0 (top end) .. n (bottom end), at arc lengths s (n+1,) m along
+    the unstretched rope; per_element (T, n): the mean of an element's two joints;
+    per_point (T, 2n): A_i its upper joint, B_i its lower one; definition: what it is."""
 
     s: np.ndarray
     values: np.ndarray
@@ -121,101 +152,25 @@ class AxialForce:
     definition: str
 
 
-def _rope_constants(run):
-    rope = run.group("rope")
-    effects = run.group("effects")
-    area = np.pi * float(rope.get("diameter", 0.005)) ** 2 / 4.0
-    young = float(rope.get("young_modulus", 35e6))
-    eta = float(rope.get("normal_damping", 1e3))
-    factor = float(run.group("supports").get("support_stiffness_factor", 1.0))
-    return (area, young, eta, factor, bool(effects.get("tension", True)),
-            bool(effects.get("damping", True)))
+#: What /forces/axial holds (docs/visualization.md): the model's own value at each joint.
+AXIAL_DEFINITION = ("the model's tension at the joints (/forces/axial); element value: "
+                    "the mean of its two joints")
+
+#: Why a file without /forces/axial has no axial force.
+PREDATES_FORCES = ("axial force not shown: the file predates stored internal forces "
+                   "(no /forces/axial); run the scene again with this version of ropedyn")
 
 
-def _rfem_axial_force(run):
-    """RFEM: spring + damper of the axial SDEs, exactly as src/ropedyn_rfem.f90 forms them."""
-    area, young, eta, factor, tension_on, damping_on = _rope_constants(run)
-    dl = run.element_length.sum() / (run.n - 1)
-    cx, bx = young * area / dl, (eta * area / dl if damping_on else 0.0)
-    phi, w = run.q[..., 2], run.qdot[..., 2]
-    e = np.stack([np.cos(phi), np.sin(phi)], axis=-1)
-    nrm = np.stack([-np.sin(phi), np.cos(phi)], axis=-1)
-    v = velocity(run)
-    half = run.element_length / 2.0
-    a_pts, b_pts = run.points[:, 0::2], run.points[:, 1::2]
-    force = np.zeros((run.time.size, run.n + 1))
-    if tension_on:
-        d = a_pts[:, 1:] - b_pts[:, :-1]                       # A_{j+1} - B_j
-        ea, na, nb = e[:, :-1], nrm[:, :-1], nrm[:, 1:]
-        s = np.sum(ea * d, axis=-1)
-        s_dot = (np.sum(ea * (v[:, 1:] - v[:, :-1]), axis=-1)
-                 + np.sum(na * d, axis=-1) * w[:, :-1]
-                 - half[1:] * np.sum(ea * nb, axis=-1) * w[:, 1:])
-        force[:, 1:-1] = cx * s + bx * s_dot
-    top, bottom = supports(run)
-    if top.kind in ("pinned", "clamped"):
-        d = a_pts[:, 0] - top.anchor
-        d_dot = v[:, 0] - half[0] * w[:, 0, None] * nrm[:, 0]
-        force[:, 0] = factor * (cx * np.sum(e[:, 0] * d, axis=-1)
-                                + bx * np.sum(e[:, 0] * d_dot, axis=-1))
-    if bottom.kind in ("pinned", "clamped"):
-        d = bottom.anchor - b_pts[:, -1]
-        d_dot = -(v[:, -1] + half[-1] * w[:, -1, None] * nrm[:, -1])
-        force[:, -1] = factor * (cx * np.sum(e[:, -1] * d, axis=-1)
-                                 + bx * np.sum(e[:, -1] * d_dot, axis=-1))
-    s_joint = np.concatenate([[0.0], np.cumsum(run.element_length)])
-    damper = "spring + damper" if bx > 0 else "spring (no damping)"
-    return AxialForce(s_joint, force, joints_to_elements(force), joints_to_points(force),
-                      f"RFEM axial SDEs ({damper}) at the joints and supports; "
-                      "element value = mean of its two joints")
-
-
-def _member_axial_force(run):
-    """MPP: the force in each member's spring and damper, k_s u + d_s u', k_s = E A/l,
-    d_s = mpp_axial_damping_factor * eta A/l (docs/physics-mpp.md).
-
-    u_i = |B_i - A_i| - l (member i is drawn from joint P_{i-1} to joint P_i). Its rate comes
-    from the chain of joint velocities, P_0 fixed at the top anchor:
-    u_i' = e_i . (C_i' - P_{i-1}'), P_i' = P_{i-1}' + u_i' e_i + (l + u_i) phi_i' n_i."""
-    area, young, eta, _, tension_on, damping_on = _rope_constants(run)
-    if not tension_on:
-        return None, ("axial force skipped: inextensible members (&effects tension = "
-                      ".false.): the axial force is a constraint force the output does not hold")
-    length = run.element_length
-    chord = run.points[:, 1::2] - run.points[:, 0::2]
-    member = np.linalg.norm(chord, axis=-1)
-    if not (np.all(np.isfinite(member)) and np.all(length > 0) and np.all(member > 0)):
-        return None, "axial force skipped: the polyline does not give the member lengths"
-    stretch = member - length
-    force = young * area * stretch / length
-    top, _ = supports(run)
-    factor = float(run.group("model").get("mpp_axial_damping_factor", 1.0))
-    damper = damping_on and eta * factor > 0
-    if damper and top.kind == "free":
-        damper = False  # the MPP needs a fixed top joint; should not happen
-    if damper:
-        e = chord / member[..., None]
-        nrm = np.stack([-e[..., 1], e[..., 0]], axis=-1)
-        v, w = velocity(run), run.qdot[..., 2]
-        joint_v = np.zeros_like(v[:, 0])
-        rate = np.empty_like(stretch)
-        for i in range(run.n):
-            rate[:, i] = np.sum(e[:, i] * (v[:, i] - joint_v), axis=-1)
-            joint_v = (joint_v + rate[:, i, None] * e[:, i]
-                       + (length[i] + stretch[:, i])[:, None] * w[:, i, None] * nrm[:, i])
-        force = force + factor * eta * area / length * rate
-    s_mid = np.cumsum(length) - length / 2.0
-    parts = "spring + damper" if damper else "spring (no damping)"
-    return AxialForce(s_mid, force, force, np.repeat(force, 2, axis=1),
-                      f"{run.model.upper()} member {parts}, stretch u = polyline member "
-                      "length - element_length; one value per member"), ""
+def joint_arc_length(run):
+    """Arc length of joints 0 .. n from the top along the unstretched rope (n+1,) m."""
+    return np.concatenate([[0.0], np.cumsum(run.element_length)])
 
 
 def axial_force(run):
-    """(AxialForce, message): the force along the rope, or (None, why it was skipped)."""
-    if run.model == "rfem":
-        return _rfem_axial_force(run), ""
-    if run.model == "mpp":
-        return _member_axial_force(run)
-    return None, f"axial force skipped: unknown model '{run.model}'"
-
+    """(AxialForce, "") from the file's /forces/axial, or (None, why): a file written before
+    the internal forces were stored has none, and none is derived here."""
+    axial = run.forces.get("axial")
+    if axial is None:
+        return None, PREDATES_FORCES
+    return AxialForce(joint_arc_length(run), axial, joints_to_elements(axial),
+                      joints_to_points(axial), AXIAL_DEFINITION), ""

@@ -2,6 +2,7 @@
 
     run = load_run("out/paper.h5")
     run.time, run.q, run.qdot, run.points, run.energy["total"], run.stats["steps"]
+    run.forces["axial"], run.reactions["top"], run.anchors["top"]
     run.units["state/q"]  # 'm, m, rad', from the file's own "units" attributes
 
 The one reader of run files for the plots, the animation, the XDMF sidecar and the
@@ -15,6 +16,10 @@ import numpy as np
 from ropedyn.namelist import parse_namelist
 
 ENERGY_NAMES = ("kinetic", "elastic", "gravity", "dissipated", "support_work", "total")
+#: Internal forces at the joints (/forces/NAME, (T, n+1)), stored by the model with each record.
+FORCE_NAMES = ("axial", "shear", "moment")
+#: The supports (/supports/END/reaction and /position, (T, 2)).
+SUPPORT_ENDS = ("top", "bottom")
 #: Scalar solver statistics written at the end of a run (/solver/NAME).
 SOLVER_STATS = ("steps", "rhs_evals", "jac_evals", "lin_setups", "err_test_fails",
                 "nonlin_iters", "nonlin_conv_fails", "cpu_time", "time_advance", "time_rhs", "time_jacobian",
@@ -51,6 +56,13 @@ class Run:
     stats: dict = dataclasses.field(default_factory=dict)  # /solver/steps, ...: int; cpu_time: s
     attrs: dict = dataclasses.field(default_factory=dict)  # root attributes as str, unchanged
     units: dict = dataclasses.field(default_factory=dict)  # dataset path -> its "units"
+    # the model's internal forces at joints 0 (top end) .. n: name -> (T, n+1) N, N m;
+    # empty for a file written before ropedyn stored them
+    forces: dict = dataclasses.field(default_factory=dict)
+    # force of each support on the rope, 'top'/'bottom' -> (T, 2) N (x, y); may be empty
+    reactions: dict = dataclasses.field(default_factory=dict)
+    # each support's anchor at every record, 'top'/'bottom' -> (T, 2) m (none for a free end)
+    anchors: dict = dataclasses.field(default_factory=dict)
 
     @property
     def n(self):
@@ -71,6 +83,11 @@ def load_run(path):
             return f[name][:records] if name in f else None
 
         energy = {k: series(f"energy/{k}") for k in ENERGY_NAMES if f"energy/{k}" in f}
+        forces = {k: series(f"forces/{k}") for k in FORCE_NAMES if f"forces/{k}" in f}
+        reactions = {k: series(f"supports/{k}/reaction") for k in SUPPORT_ENDS
+                     if f"supports/{k}/reaction" in f}
+        anchors = {k: series(f"supports/{k}/position") for k in SUPPORT_ENDS
+                   if f"supports/{k}/position" in f}
         stats = {k: f[f"solver/{k}"][()].item() for k in SOLVER_STATS if f"solver/{k}" in f}
         attrs = {k: text(v) for k, v in f.attrs.items()}
         units = {}
@@ -89,7 +106,7 @@ def load_run(path):
                    method=attrs.get("method", "").strip(),
                    status=attrs.get("status", "").strip(),
                    scene=parse_namelist(attrs.get("scene", "")), stats=stats, attrs=attrs,
-                   units=units)
+                   units=units, forces=forces, reactions=reactions, anchors=anchors)
 
 
 def title(run):

@@ -23,7 +23,8 @@ import numpy as np
 from ropedyn.io import text as _text
 
 #: Step-by-step datasets: path -> (record shape as h5py sees it without the time axis, units)
-#: (the record shapes use "n" for n_elements and "2n" for 2 * n_elements).
+#: (the record shapes use "n" for n_elements, "2n" for 2 * n_elements and "n+1" for the
+#: joints).
 SERIES = {
     "time": ((), "s"),
     "state/q": (("n", 3), "m, m, rad"),
@@ -37,6 +38,18 @@ SERIES = {
     "energy/total": ((), "J"),
     "solver/step_size": ((), "s"),
     "solver/order": ((), "1"),
+    "forces/axial": (("n+1",), "N"),
+    "forces/shear": (("n+1",), "N"),
+    "forces/moment": (("n+1",), "N m"),
+    "supports/top/reaction": ((2,), "N"),
+    "supports/bottom/reaction": ((2,), "N"),
+}
+
+#: Step-by-step datasets that exist only for some scenes, checked when present: the anchor of
+#: a support that has one (not of a free end).
+OPTIONAL_SERIES = {
+    "supports/top/position": ((2,), "m"),
+    "supports/bottom/position": ((2,), "m"),
 }
 
 #: Datasets written once at create: path -> units (shape (n_elements,)).
@@ -61,6 +74,10 @@ STATS = {
 COLUMNS = {
     "state/q": "x, y, phi",
     "rope/points": "x, y",
+    "supports/top/reaction": "x, y",
+    "supports/bottom/reaction": "x, y",
+    "supports/top/position": "x, y",
+    "supports/bottom/position": "x, y",
 }
 
 ROOT_ATTRIBUTES = ("status", "version", "model", "method", "scene", "created",
@@ -78,7 +95,7 @@ def check_layout(path, n_elements):
     """Assert the layout of output file `path` of a rope of `n_elements` elements."""
     path = str(path)
     n_elements = int(n_elements)
-    extents = {"n": n_elements, "2n": 2 * n_elements}
+    extents = {"n": n_elements, "2n": 2 * n_elements, "n+1": n_elements + 1}
     with h5py.File(path, "r") as f:
         # root attributes
         for name in ROOT_ATTRIBUTES:
@@ -113,7 +130,8 @@ def check_layout(path, n_elements):
         # step-by-step datasets: (times, ...) extendible along time
         _require("time" in f, f"{path}: /time is missing")
         n_times = f["time"].shape[0]
-        for name, (record, units) in SERIES.items():
+        present = {k: v for k, v in OPTIONAL_SERIES.items() if k in f}
+        for name, (record, units) in {**SERIES, **present}.items():
             _require(name in f, f"{path}: /{name} is missing")
             dset = f[name]
             expected = (n_times,) + tuple(extents.get(e, e) for e in record)
@@ -124,6 +142,8 @@ def check_layout(path, n_elements):
             got = _text(dset.attrs["units"])
             _require(got == units, f"{path}: /{name} units '{got}', expected '{units}'")
         for name, columns in COLUMNS.items():
+            if name in OPTIONAL_SERIES and name not in f:
+                continue
             _require("columns" in f[name].attrs, f"{path}: /{name} has no 'columns' attribute")
             got = _text(f[name].attrs["columns"])
             _require(got == columns, f"{path}: /{name} columns '{got}', expected '{columns}'")

@@ -5,8 +5,8 @@ usage: scripts/xdmf RUN.h5 [--every K]     writes RUN.xmf and RUN_fields.h5 next
        (python -m ropedyn.xdmf)
 
 The geometry (the run's /rope/points, one plain dataset per described record) and the
-derived fields (axial force, curvature, speed, velocity, angle; definitions in
-docs/visualization.md) go into the sidecar RUN_fields.h5. The run file is only read, never
+fields (the model's stored internal forces: tension, shear, moment; curvature, speed,
+velocity, angle; definitions in docs/visualization.md) go into the sidecar RUN_fields.h5. The run file is only read, never
 modified. RUN.xmf opens in ParaView with File > Open (OpenDataFile) and with each of its
 XDMF readers ("XDMF Reader", "Xdmf3 Reader S", "Xdmf3 Reader T"): the layout avoids what
 the Xdmf3 readers cannot read (a HyperSlab in a Geometry crashes them). The coordinates are the run's: x
@@ -24,7 +24,8 @@ from ropedyn import fields as derived
 from ropedyn import io
 
 FIELD_UNITS = {"tension": "N", "curvature": "1/m", "speed": "m/s", "velocity": "m/s",
-               "angle": "rad", "joint_tension": "N", "joint_curvature": "1/m"}
+               "angle": "rad", "joint_tension": "N", "joint_curvature": "1/m",
+               "joint_shear": "N", "joint_moment": "N m"}
 
 
 def derived_fields(run):
@@ -48,8 +49,12 @@ def derived_fields(run):
         cell["tension"] = force.per_element
         point["joint_tension"] = force.per_point
         notes["tension"] = force.definition
-        notes["joint_tension"] = ("the axial force at the element end points: A_i takes its "
-                                  "upper joint, B_i its lower joint (MPP: the member's value)")
+        notes["joint_tension"] = ("the stored axial force (/forces/axial) at the element end "
+                                  "points: A_i takes its upper joint, B_i its lower joint")
+        for name in ("shear", "moment"):
+            point[f"joint_{name}"] = derived.joints_to_points(run.forces[name])
+            notes[f"joint_{name}"] = (f"the stored {name} (/forces/{name}) at the element end "
+                                      "points, as joint_tension")
     else:
         notes["tension"] = message
     return {"cell": cell, "point": point}, notes

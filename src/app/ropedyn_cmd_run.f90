@@ -2,7 +2,7 @@
 module ropedyn_cmd_run
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
     use ropedyn_kinds, only: wp
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, fixed_text
     use ropedyn_switch_log, only: switch_event_t
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_INTERRUPTED
     use ropedyn_cli, only: cli_t
@@ -113,7 +113,7 @@ contains
     end subroutine resume_scene
 
     !> The summary of a run: what ran, its cost, the methods it used, its energies and how
-    !! well they balance, the order safety's actions, the file. Counters that did not
+    !! well they balance, the peak tension, the order safety's actions, the file. Counters that did not
     !! apply (no implicit step: no Jacobians, factorizations) are left out. With `verbose`
     !! every switch of method or order on a line of its own.
     subroutine print_summary(scene, s, verbose)
@@ -142,6 +142,9 @@ contains
                                     s%stats%time_factor + s%stats%time_solve)
         call print_switches(scene, s, verbose)
         call print_energies(s)
+        if (s%peak_joint >= 0) write (output_unit, '(a, es12.5, a)') '  peak tension   ', &
+            s%peak_tension, ' N at joint '//int_text(s%peak_joint)//' ('// &
+            fixed_text(s%peak_arc, 4)//' m from the top), t = '//fixed_text(s%peak_time, 4)//' s'
         call print_safety(s)
         write (output_unit, '(a)') '  output          '//s%file
     end subroutine print_summary

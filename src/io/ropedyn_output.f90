@@ -20,6 +20,11 @@
 !!              reduced second-order matrix
 !!     /state/y                (times, state size)    SI            restart data (with the
 !!     /state/yq               (times, quadratures)   J             state sizes at create)
+!!     /forces/{axial, shear, moment}  (times, elements + 1)  N, N, N m   internal forces at
+!!              the joints, 0 the top end (with internal_forces at create; FORCE_DESCRIPTION)
+!!     /supports/{top, bottom}/reaction (times, 2)    N             force of the support on
+!!              the rope; /supports/{top, bottom}/position (times, 2) m: its anchor (only
+!!              for a support with one: not for a free end)
 !!     /solver/restarts/{time, record, steps, cpu_time, wall_clock, previous_status,
 !!              previous_reason} (restarts,)   one entry per resume (add_restart)
 !!     /solver/order_lowered_at () s, /solver/order_lowered_from, _to () int64 1,
@@ -41,6 +46,7 @@
 !! The HDF5 calls are those of `ropedyn_h5`. An `output_file_t` must not be copied while open
 !! (both copies would hold the same ids).
 module ropedyn_output
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use hdf5, only: hsize_t
     use ropedyn_kinds, only: wp, i8
     use ropedyn_clock, only: utc_timestamp, clock_seconds
@@ -53,7 +59,7 @@ module ropedyn_output
     implicit none
     private
     public :: output_file_t, write_provenance, COUNTER_NAMES, counter_values, TIMER_NAMES
-    public :: add_counter_values
+    public :: add_counter_values, write_forces
 
     !> The convention written into every file (root attribute `units_convention`).
     character(len=*), parameter :: units_convention = &
@@ -93,6 +99,37 @@ module ropedyn_output
         //'the coordinates q, then their rates): m, rad, m/s, rad/s', &
         'the quadratures: dissipated energy, then (when supports move or effects do work) ' &
         //'the external work']
+
+    !> The internal forces and the supports at every record (`create` with
+    !! internal_forces; `append`'s axial, shear, moment, reaction, position): name, units,
+    !! columns, description; a record of the first N_JOINT_SERIES holds the n + 1 joints,
+    !! of the others x and y. The positions (the last two) exist only for the supports
+    !! that have an anchor (`anchored`): a free end has none, and no record holds a NaN.
+    !! The definitions: docs/theory/internal-forces.md.
+    integer, parameter :: N_FORCE_SERIES = 7, N_JOINT_SERIES = 3
+    character(len=*), parameter :: FORCE_NAME(N_FORCE_SERIES) = [character(len=25) :: &
+        '/forces/axial', '/forces/shear', '/forces/moment', '/supports/top/reaction', &
+        '/supports/bottom/reaction', '/supports/top/position', '/supports/bottom/position']
+    character(len=*), parameter :: FORCE_UNITS(N_FORCE_SERIES) = [character(len=3) :: 'N', &
+        'N', 'N m', 'N', 'N', 'm', 'm']
+    character(len=*), parameter :: FORCE_FRAME = ' (frame: rfem, the element above the '// &
+        'joint, at joint 0 element 1; mpp, the member below the joint, at joint n member n)'
+    character(len=*), parameter :: FORCE_DESCRIPTION(N_FORCE_SERIES) = [character(len=300) :: &
+        'tension (> 0: stretched) at joints 0 (top end) .. n (bottom end): the component '// &
+        'along the rope of the force of the rope below the joint on the rope above it (at '// &
+        'the ends: of the rope on the top support, of the bottom support on the rope)'// &
+        FORCE_FRAME, &
+        'shear force at joints 0 .. n: the component of that force along n = (-sin phi, '// &
+        'cos phi) of the frame'//FORCE_FRAME, &
+        'bending moment at joints 0 .. n: the moment of the rope below the joint on the '// &
+        'rope above it, > 0 from x towards y: C (phi below - phi above) + B (its rate); '// &
+        '0 at a pinned or free end', &
+        'force of the top support on the rope (x, y); 0 when free or released', &
+        'force of the bottom support on the rope (x, y); 0 when free or released', &
+        'anchor of the top support at the time of the record, from its prescribed '// &
+        'motion (x, y)', &
+        'anchor of the bottom support at the time of the record, from its prescribed '// &
+        'motion (x, y)']
 
     !> The entries of /solver/restarts (one per resume): name, units, width of a string
     !! (0: a number; integer for record and steps).
@@ -142,11 +179,17 @@ module ropedyn_output
         type(h5_series_t) :: state(2)
         logical :: restart_data = .false.
         integer :: state_size(2) = 0
+        !> the internal forces and supports (FORCE_NAME, when `force_data`; those of them
+        !! that the file has: force_on)
+        type(h5_series_t) :: force(N_FORCE_SERIES)
+        logical :: force_data = .false.
+        logical :: force_on(N_FORCE_SERIES) = .false.
         !> records appended but not yet written: record m of series k (the state's two
-        !! after the N_SERIES) at pending(k)%v((m - 1) r + 1 : m r), r its record size;
-        !! written as one block per series when `capacity` are held, when FLUSH_PERIOD has
-        !! passed, and before the file is finished or closed (write_pending)
-        type(block_t) :: pending(N_SERIES + 2)
+        !! after the N_SERIES, then the N_FORCE_SERIES) at pending(k)%v((m - 1) r + 1 : m r),
+        !! r its record size; written as one block per series when `capacity` are held,
+        !! when FLUSH_PERIOD has passed, and before the file is finished or closed
+        !! (write_pending)
+        type(block_t) :: pending(N_SERIES + 2 + N_FORCE_SERIES)
         integer, allocatable :: pending_order(:)
         integer :: n_pending = 0
         integer :: capacity = 1
@@ -174,13 +217,20 @@ module ropedyn_output
         !! record cut short, are cut back to the length of /time, or to `keep` records), the
         !! status 'running' again and its old reason removed. The file must be for
         !! `n_elements` elements and the given state and quadrature sizes.
-        module subroutine output_reopen(self, path, n_elements, state_size, quad_size, err, keep)
+        module subroutine output_reopen(self, path, n_elements, state_size, quad_size, err, &
+                                        keep, internal_forces, anchored)
             class(output_file_t), intent(inout) :: self
             character(len=*), intent(in) :: path
             integer, intent(in) :: n_elements, state_size, quad_size
             type(error_t), allocatable, intent(out) :: err
             !> keep only the first `keep` records (fewer than the file has: the others are cut)
             integer, intent(in), optional :: keep
+            !> the file must hold the internal forces (ERR_IO naming the first missing series
+            !! if not: a file written before they were stored cannot be continued)
+            logical, intent(in), optional :: internal_forces
+            !> with internal_forces: which supports (top, bottom) have an anchor, as at
+            !! `create` (default both); the file's positions must be those
+            logical, intent(in), optional :: anchored(2)
         end subroutine output_reopen
 
         !> Add an entry to /solver/restarts: the run continues from record `record` (0-based, as
@@ -206,9 +256,10 @@ module ropedyn_output
 
         !> Append one output time (held in memory and written in blocks, see `pending`);
         !! flush the file when FLUSH_PERIOD has passed since the last flush. A file with
-        !! restart data needs the ODE state `y` and quadratures `yq` of the record too.
+        !! restart data needs the ODE state `y` and quadratures `yq` of the record too, one
+        !! with internal forces its axial, shear, moment, reaction and position.
         module subroutine output_append(self, t, q, qdot, points, energy, step_size, order, &
-                                        err, y, yq)
+                                        err, y, yq, axial, shear, moment, reaction, position)
             class(output_file_t), intent(inout) :: self
             real(wp), intent(in) :: t                 !< time, s
             real(wp), intent(in) :: q(:, :)           !< (3, n) x, y (m), phi (rad) per element
@@ -220,6 +271,11 @@ module ropedyn_output
             type(error_t), allocatable, intent(out) :: err
             real(wp), intent(in), optional :: y(:)    !< the model's ODE state (restart data)
             real(wp), intent(in), optional :: yq(:)   !< its quadratures, J (restart data)
+            !> (n + 1) joints 0 (top end) .. n: tension (N), shear force (N), moment (N m)
+            real(wp), intent(in), optional :: axial(:), shear(:), moment(:)
+            !> (2, 2) top, bottom: force of the support on the rope (N), its anchor (m; only
+            !! those of the supports with an anchor are written)
+            real(wp), intent(in), optional :: reaction(:, :), position(:, :)
         end subroutine output_append
 
         !> The buffers of the pending records for the series of an open file (none held).
@@ -287,6 +343,21 @@ module ropedyn_output
             type(output_file_t), intent(inout) :: self
             type(error_t), allocatable, intent(out) :: err
         end subroutine keep_room
+        !> Values in a record of force series k of a rope of n elements: n + 1 joints, or
+        !! x, y (submodule ropedyn_output_pending; a private procedure of this module used
+        !! only by its submodules is dropped from the object by gfortran).
+        pure module function force_record_size(k, n) result(values)
+            integer, intent(in) :: k, n
+            integer :: values
+        end function force_record_size
+
+        !> Which force series a file with `force_data` has (force_on): all but the anchors
+        !! of supports without one (`anchored`, default both; submodule
+        !! ropedyn_output_pending).
+        module subroutine set_force_series(self, anchored)
+            type(output_file_t), intent(inout) :: self
+            logical, intent(in), optional :: anchored(2)
+        end subroutine set_force_series
 
         !> The path of the file, or a placeholder if create never succeeded.
         module function file_label(self) result(label)
@@ -300,10 +371,12 @@ contains
     !> Create (or overwrite) the file `path` and write the run's fixed data; status 'running'.
     !! The directory of `path` must exist. An object that is still open is closed first
     !! (its file keeps status 'running'). With `state_size` and `quad_size` (the model's),
-    !! every record also holds the restart data /state/y, /state/yq (`append`'s y, yq).
+    !! every record also holds the restart data /state/y, /state/yq (`append`'s y, yq); with
+    !! `internal_forces`, the internal forces and supports (FORCE_NAME; the anchors of
+    !! those supports that have one, `anchored`, default both).
     subroutine output_create(self, path, n_elements, element_length, element_mass, model, &
                              method, version, scene_text, err, state_size, quad_size, &
-                             source)
+                             source, internal_forces, anchored)
         class(output_file_t), intent(inout) :: self
         character(len=*), intent(in) :: path              !< e.g. out/run.h5
         integer, intent(in) :: n_elements                 !< elements of the rope
@@ -318,6 +391,8 @@ contains
         integer, intent(in), optional :: quad_size        !< quadrature variables
         !> where the scene came from (root attribute `source`; scene_t's source)
         character(len=*), intent(in), optional :: source
+        logical, intent(in), optional :: internal_forces  !< records hold the forces
+        logical, intent(in), optional :: anchored(2)      !< top, bottom have an anchor
 
         if (self%is_open) call shutdown(self)
 
@@ -341,6 +416,9 @@ contains
         self%n_records = 0
         self%restart_data = present(state_size) .and. present(quad_size)
         if (self%restart_data) self%state_size = [state_size, quad_size]
+        self%force_data = .false.
+        if (present(internal_forces)) self%force_data = internal_forces
+        call set_force_series(self, anchored)
 
         call write_contents()
         if (allocated(err)) then
@@ -389,6 +467,8 @@ contains
             if (allocated(err)) return
             if (self%restart_data) call create_state_series(self, err)
             if (allocated(err)) return
+            if (self%force_data) call create_force_series(self, err)
+            if (allocated(err)) return
 
             call flush_file(self, err)
             if (.not. allocated(err)) call keep_room(self, err)
@@ -410,6 +490,68 @@ contains
             if (allocated(err)) return
         end do
     end subroutine create_state_series
+
+    !> The groups of the internal-force and support datasets (FORCE_NAME) in `file`.
+    subroutine force_groups(file, err)
+        type(h5_file_t), intent(inout) :: file
+        type(error_t), allocatable, intent(out) :: err
+        character(len=*), parameter :: groups(4) = [character(len=17) :: '/forces', &
+            '/supports', '/supports/top', '/supports/bottom']
+        integer :: k
+        do k = 1, size(groups)
+            call file%group(trim(groups(k)), err)
+            if (allocated(err)) return
+        end do
+    end subroutine force_groups
+
+    !> The internal forces and supports of one state as the datasets of a run file with one
+    !! record (FORCE_NAME: h5py shapes (1, n + 1) and (1, 2)), for the statics and modes
+    !! files: axial, shear, moment (0:n) and reaction, position (2, 2; top, bottom; a
+    !! position that is not finite, a free end's, is not written).
+    subroutine write_forces(file, axial, shear, moment, reaction, position, err)
+        type(h5_file_t), intent(inout) :: file
+        real(wp), intent(in) :: axial(:), shear(:), moment(:)   !< N, N, N m
+        real(wp), intent(in) :: reaction(2, 2), position(2, 2)  !< N, m
+        type(error_t), allocatable, intent(out) :: err
+        real(wp) :: values(size(axial), N_FORCE_SERIES)
+        integer :: k, m
+        call force_groups(file, err)
+        if (allocated(err)) return
+        values(:, 1) = axial
+        values(:, 2) = shear
+        values(:, 3) = moment
+        values(1:2, 4:5) = reaction
+        values(1:2, 6:7) = position
+        do k = 1, N_FORCE_SERIES
+            if (k >= N_FORCE_SERIES - 1 .and. .not. all(ieee_is_finite(values(1:2, k)))) cycle
+            m = merge(size(axial), 2, k <= N_JOINT_SERIES)
+            call file%write(trim(FORCE_NAME(k)), reshape(values(1:m, k), [m, 1]), &
+                            trim(FORCE_UNITS(k)), err, trim(FORCE_DESCRIPTION(k)))
+            if (allocated(err)) return
+            if (k > N_JOINT_SERIES) call file%attribute(trim(FORCE_NAME(k)), 'columns', 'x, y', err)
+            if (allocated(err)) return
+        end do
+    end subroutine write_forces
+
+    !> The internal-force and support series of an open file (FORCE_NAME) with their groups.
+    subroutine create_force_series(self, err)
+        type(output_file_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: err
+        integer :: k
+        call force_groups(self%file, err)
+        if (allocated(err)) return
+        do k = 1, N_FORCE_SERIES
+            if (.not. self%force_on(k)) cycle
+            call self%file%create_series(self%force(k), trim(FORCE_NAME(k)), &
+                                         [int(force_record_size(k, self%n_elements), hsize_t)], &
+                                         .false., trim(FORCE_UNITS(k)), &
+                                         trim(merge('    ', 'x, y', k <= N_JOINT_SERIES)), err)
+            if (allocated(err)) return
+            call self%file%attribute(trim(FORCE_NAME(k)), 'description', &
+                                     trim(FORCE_DESCRIPTION(k)), err)
+            if (allocated(err)) return
+        end do
+    end subroutine create_force_series
 
     !> The root attributes every ropedyn HDF5 file carries so that it can be re-run and
     !! read: version, model, scene (the effective namelist text), created (UTC) and

@@ -27,6 +27,8 @@ contains
         if (allocated(err)) return
         if (self%restart_data) call check_state()
         if (allocated(err)) return
+        if (self%force_data) call check_forces()
+        if (allocated(err)) return
 
         m = self%n_pending + 1
         call put(S_TIME, [t])
@@ -44,6 +46,15 @@ contains
             call put(N_SERIES + 2, [yq(1:self%state_size(2)), &
                                     spread(0.0_wp, 1, max(1, self%state_size(2)) &
                                            - self%state_size(2))])
+        end if
+        if (self%force_data) then
+            call put(N_SERIES + 3, axial)
+            call put(N_SERIES + 4, shear)
+            call put(N_SERIES + 5, moment)
+            call put(N_SERIES + 6, reaction(:, 1))
+            call put(N_SERIES + 7, reaction(:, 2))
+            if (self%force_on(N_FORCE_SERIES - 1)) call put(N_SERIES + 8, position(:, 1))
+            if (self%force_on(N_FORCE_SERIES)) call put(N_SERIES + 9, position(:, 2))
         end if
         self%n_pending = m
 
@@ -97,17 +108,41 @@ contains
                                 int_text(self%state_size(2)))
             end if
         end subroutine check_state
+
+        !> ERR_INTERNAL unless the internal forces are present with n + 1 joints and the
+        !! reactions and positions with shape (2, 2).
+        subroutine check_forces()
+            if (.not. (present(axial) .and. present(shear) .and. present(moment) .and. &
+                       present(reaction) .and. present(position))) then
+                call make_error(err, ERR_INTERNAL, self%file%file_name()//': append: the '// &
+                                'file holds internal forces: axial, shear, moment, '// &
+                                'reaction and position are needed')
+            else if (size(axial) /= n + 1 .or. size(shear) /= n + 1 .or. &
+                     size(moment) /= n + 1) then
+                call make_error(err, ERR_INTERNAL, self%file%file_name()//': append: '// &
+                                'axial, shear, moment have '//int_text(size(axial))//', '// &
+                                int_text(size(shear))//', '//int_text(size(moment))// &
+                                ' values, expected '//int_text(n + 1))
+            else
+                call check_shape(reaction, '/supports/*/reaction', 2, 2)
+                if (.not. allocated(err)) &
+                    call check_shape(position, '/supports/*/position', 2, 2)
+            end if
+        end subroutine check_forces
     end procedure output_append
 
     module procedure allocate_pending
-        integer :: sizes(N_SERIES + 2), k
+        integer :: sizes(size(self%pending)), k
         do k = 1, N_SERIES
             sizes(k) = max(1, RECORD_ROWS(k)*RECORD_PER_ELEMENT(k)*self%n_elements)
         end do
         sizes(N_SERIES + 1:) = 0
-        if (self%restart_data) sizes(N_SERIES + 1:) = max(1, self%state_size)
+        if (self%restart_data) sizes(N_SERIES + 1:N_SERIES + 2) = max(1, self%state_size)
+        do k = 1, N_FORCE_SERIES
+            if (self%force_on(k)) sizes(N_SERIES + 2 + k) = force_record_size(k, self%n_elements)
+        end do
         self%capacity = max(1, min(MAX_PENDING, PENDING_BYTES/(8*sum(sizes))))
-        do k = 1, N_SERIES + 2
+        do k = 1, size(self%pending)
             if (allocated(self%pending(k)%v)) deallocate (self%pending(k)%v)
             allocate (self%pending(k)%v(sizes(k)*self%capacity))
         end do
@@ -139,6 +174,14 @@ contains
                 if (allocated(err)) return
             end do
         end if
+        if (self%force_data) then
+            do k = 1, N_FORCE_SERIES
+                if (.not. self%force_on(k)) cycle
+                r = size(self%pending(N_SERIES + 2 + k)%v)/self%capacity
+                call self%force(k)%append(first, self%pending(N_SERIES + 2 + k)%v(1:m*r), err)
+                if (allocated(err)) return
+            end do
+        end if
         ! /time last: its length counts the complete records
         call self%series(S_TIME)%append(first, self%pending(S_TIME)%v(1:m), err)
         if (allocated(err)) return
@@ -163,4 +206,13 @@ contains
             'not flushed and a reserve of '//int_text(int(RESERVE_BYTES/2**20))//' MiB: '// &
             'the run stops while the file can still be closed)')
     end procedure keep_room
+
+    module procedure set_force_series
+        self%force_on = self%force_data
+        if (present(anchored)) self%force_on(N_FORCE_SERIES - 1:) = self%force_data .and. anchored
+    end procedure set_force_series
+
+    module procedure force_record_size
+        values = merge(n + 1, 2, k <= N_JOINT_SERIES)
+    end procedure force_record_size
 end submodule ropedyn_output_pending

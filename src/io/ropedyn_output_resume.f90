@@ -25,6 +25,10 @@ contains
         ! first every check, with nothing changed: a file that cannot be continued is left
         ! as it was (its status, its reason, its records)
         call open_checked(self, path, err)
+        self%force_data = .false.
+        if (present(internal_forces)) self%force_data = internal_forces
+        call set_force_series(self, anchored)
+        if (.not. allocated(err) .and. self%force_data) call open_forces(self, path, err)
         if (.not. allocated(err) .and. present(keep)) call check_cut(self, path, keep, err)
         if (allocated(err)) then
             call shutdown(self)
@@ -39,6 +43,11 @@ contains
             end do
             do k = 1, 2
                 call self%state(k)%truncate(self%n_records, err)
+                if (allocated(err)) exit steps
+            end do
+            do k = 1, size(self%force)
+                if (.not. self%force_on(k)) cycle
+                call self%force(k)%truncate(self%n_records, err)
                 if (allocated(err)) exit steps
             end do
             call self%file%attribute('/', 'status', 'running', err)
@@ -177,6 +186,47 @@ contains
         end do
     end subroutine check_cut
 
+    !> Open the internal-force series of a file being reopened (self%n_records set) and
+    !! check their record sizes and lengths (nothing changed). A file without them was
+    !! written before they were stored: it is not continued (its records would lack them).
+    subroutine open_forces(self, path, err)
+        type(output_file_t), intent(inout) :: self
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: err
+        integer :: k, expected
+        do k = 1, N_FORCE_SERIES
+            if (self%file%exists(trim(FORCE_NAME(k))) .neqv. self%force_on(k)) then
+                if (k < N_FORCE_SERIES - 1) then
+                    call make_error(err, ERR_IO, path//': '//trim(FORCE_NAME(k))// &
+                        ': missing: the file was written by a version of ropedyn that did '// &
+                        'not store the internal forces; it cannot be continued (run the '// &
+                        'scene again)')
+                else
+                    call make_error(err, ERR_IO, path//': '//trim(FORCE_NAME(k))//': '// &
+                        trim(merge('missing', 'present', self%force_on(k)))//': the '// &
+                        'scene''s supports differ from those of the file')
+                end if
+                return
+            end if
+            if (.not. self%force_on(k)) cycle
+            call self%file%open_series(self%force(k), trim(FORCE_NAME(k)), err)
+            if (allocated(err)) return
+            expected = force_record_size(k, self%n_elements)
+            if (self%force(k)%record_size() /= expected) then
+                call make_error(err, ERR_IO, path//': '//trim(FORCE_NAME(k))// &
+                    ': records of '//int_text(self%force(k)%record_size())// &
+                    ' values, expected '//int_text(expected)//' for '// &
+                    int_text(self%n_elements)//' elements')
+                return
+            end if
+            if (self%force(k)%length() < self%n_records) then
+                call make_error(err, ERR_IO, path//': '//trim(FORCE_NAME(k))// &
+                    ': fewer records than /time')
+                return
+            end if
+        end do
+    end subroutine open_forces
+
     module procedure output_add_restart
         type(h5_series_t) :: entry(size(RESTART_NAME))
         type(error_t), allocatable :: close_err
@@ -239,6 +289,10 @@ contains
             call self%state(k)%close(e)
             if (allocated(e) .and. .not. allocated(first)) call move_alloc(e, first)
         end do
+        do k = 1, N_FORCE_SERIES
+            call self%force(k)%close(e)
+            if (allocated(e) .and. .not. allocated(first)) call move_alloc(e, first)
+        end do
         call self%file%close(e)
         if (allocated(e) .and. .not. allocated(first)) call move_alloc(e, first)
         call release_space(self%file%file_name())
@@ -259,6 +313,9 @@ contains
         end do
         do k = 1, 2
             call self%state(k)%close(e)
+        end do
+        do k = 1, N_FORCE_SERIES
+            call self%force(k)%close(e)
         end do
         kept = int_text(int(self%n_records))//' complete records'
         call self%file%attribute('/', 'status', 'failed', e)

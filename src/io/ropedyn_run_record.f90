@@ -31,6 +31,7 @@ module ropedyn_run_record
     !> The values of a run file's `status` attribute.
     character(len=*), parameter :: RUN_STATUSES(4) = [character(len=11) :: 'running', &
         'complete', 'failed', 'interrupted']
+    public :: read_peak_tension
 
     !> `record` argument of read_run_record: the last complete record.
     integer, parameter :: LAST_RECORD = -1
@@ -138,6 +139,44 @@ contains
         if (.not. allocated(rec%y)) allocate (rec%y(0))
         if (.not. allocated(rec%yq)) allocate (rec%yq(0))
     end subroutine read_run_record
+
+    !> The peak tension of the first `records` records of the run file `path`: the largest
+    !! value of /forces/axial (N), its joint (0 the top end) and its record's time (s);
+    !! joint = -1 when the file has no internal forces (or no such records). One record
+    !! read at a time: the memory of a long run stays small.
+    subroutine read_peak_tension(path, records, peak, joint, t, err)
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: records
+        real(wp), intent(out) :: peak, t
+        integer, intent(out) :: joint
+        type(error_t), allocatable, intent(out) :: err
+        type(h5_file_t) :: h5
+        type(error_t), allocatable :: close_err
+        real(wp), allocatable :: time(:), axial(:)
+        integer :: k, j
+        peak = 0.0_wp
+        t = 0.0_wp
+        joint = -1
+        call h5%open(path, err)
+        if (allocated(err)) return
+        steps: block
+            if (.not. h5%exists('/forces/axial')) exit steps
+            call read_record_times(h5, path, time, err)
+            if (allocated(err)) exit steps
+            do k = 1, min(records, size(time))
+                call h5%read_record('/forces/axial', int(k, hsize_t), axial, err)
+                if (allocated(err)) exit steps
+                if (size(axial) == 0) exit steps
+                j = maxloc(axial, 1)
+                if (joint >= 0 .and. .not. axial(j) > peak) cycle
+                peak = axial(j)
+                joint = j - 1
+                t = time(k)
+            end do
+        end block steps
+        call h5%close(close_err)
+        if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
+    end subroutine read_peak_tension
 
     !> The times of the complete records of the run file `path`, open as h5: /time, which
     !! the writer extends last in a record, so that its length counts the complete records.

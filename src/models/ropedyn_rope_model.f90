@@ -1,6 +1,8 @@
 !> What every rope model offers beyond the generic problem: its energies, element data for
-!! output, the initial state of its spec, and the mapping from the ODE state to element
-!! fields and to the polyline used for drawing.
+!! output, the initial state of its spec, the mapping from the ODE state to element
+!! fields and to the polyline used for drawing, and the internal forces and support
+!! reactions of a state (from the force laws of its right-hand side; definitions in
+!! docs/theory/internal-forces.md).
 module ropedyn_rope_model
     use ropedyn_kinds, only: wp
     use ropedyn_problem, only: problem_t
@@ -24,6 +26,10 @@ module ropedyn_rope_model
     type, abstract, extends(problem_t) :: rope_model_t
         integer :: n = 0                   !< number of elements (RFEM) or members (MPP)
         logical :: with_work = .false.     !< external work is quadrature 2
+        !> statics and modes: every support rests where its motion puts it at the time of
+        !! a call, with zero velocity and acceleration (a static force never depends on
+        !! them); set by ropedyn_statics_terms around its evaluations, .false. in a run
+        logical :: supports_at_rest = .false.
     contains
         procedure(energy_i), deferred :: energy
         procedure :: n_elements => rope_n_elements, quad_size => rope_quad_size
@@ -32,6 +38,8 @@ module ropedyn_rope_model
         procedure(fields_i), deferred :: fields
         procedure(polyline_i), deferred :: polyline
         procedure(element_data_i), deferred :: element_data
+        procedure(internal_forces_i), deferred :: internal_forces
+        procedure(support_positions_i), deferred :: support_positions
         procedure(coordinates_i), deferred :: coordinates
         procedure(coordinate_mass_i), deferred :: coordinate_mass
         procedure :: has_second_order => rope_has_second_order, &
@@ -91,6 +99,33 @@ module ropedyn_rope_model
             class(rope_model_t), intent(in) :: self
             real(wp), intent(out) :: length(:), mass(:)
         end subroutine element_data_i
+
+        !> The internal forces of state y at time t, from the same force laws as the
+        !! right-hand side (damping included): at every joint j = 0 .. n (0 the top end, n
+        !! the bottom end) the axial force (tension > 0, N), the shear force (N) and the
+        !! bending moment (N m) that the part of the rope below the joint exerts on the
+        !! part above it (at the ends: the rope on the support, the support on the rope),
+        !! axial and shear in a frame the model names; and the force of each support on
+        !! the rope, reaction(:, 1) the top's, reaction(:, 2) the bottom's (x, y, N; zero
+        !! for a free or released end). NaN where the state has no finite forces.
+        subroutine internal_forces_i(self, t, y, axial, shear, moment, reaction)
+            import :: rope_model_t, wp
+            class(rope_model_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(out) :: axial(0:), shear(0:), moment(0:)  !< (0:n)
+            real(wp), intent(out) :: reaction(:, :)                    !< (2, 2)
+        end subroutine internal_forces_i
+
+        !> The anchors of the supports at time t from their prescribed motions (fixed ones:
+        !! where they are), positions(:, 1) the top's, positions(:, 2) the bottom's (x, y,
+        !! m); NaN for a free end (no anchor).
+        subroutine support_positions_i(self, t, positions)
+            import :: rope_model_t, wp
+            class(rope_model_t), intent(in) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(out) :: positions(:, :)
+        end subroutine support_positions_i
 
         !> Generalized coordinates in the ODE state (statics and modes, ropedyn_statics):
         !! y(pos(k)) is coordinate k, y(vel(k)) its rate and ydot(vel(k)) its acceleration.

@@ -1,7 +1,8 @@
 !> The work of `ropedyn statics` and `ropedyn modes` (src/app/ropedyn_cmd_statics.f90): the
 !! static equilibrium of a scene (ropedyn_statics), optionally the lowest modes about it
-!! (ropedyn_modes), the support forces, one HDF5 file and a printed summary. Layout and
-!! method: docs/statics-modes.md.
+!! (ropedyn_modes), the internal forces and support reactions there (the model's, with
+!! its supports at rest), one HDF5 file and a printed summary. Layout and method:
+!! docs/statics-modes.md.
 module ropedyn_analysis
     use, intrinsic :: iso_fortran_env, only: output_unit
     use ropedyn_kinds, only: wp, i8
@@ -17,7 +18,7 @@ module ropedyn_analysis
                                potential_energy, rope_length
     use ropedyn_modes, only: modes_result_t, compute_modes
     use ropedyn_h5, only: h5_file_t
-    use ropedyn_output, only: write_provenance
+    use ropedyn_output, only: write_provenance, write_forces
     use ropedyn_version, only: version_string
     implicit none
     private
@@ -61,8 +62,8 @@ contains
         class(rope_model_t), allocatable :: model
         type(statics_result_t) :: sres
         type(modes_result_t) :: mres
-        real(wp), allocatable :: y(:)
-        real(wp) :: force_top(2), force_bottom(2)
+        real(wp), allocatable :: y(:), axial(:), shear(:), moment(:)
+        real(wp) :: reaction(2, 2), anchors(2, 2), force_top(2), force_bottom(2)
 
         out_path = out_path_given
         if (len(out_path) == 0) out_path = default_output(scene, command)
@@ -71,12 +72,18 @@ contains
         if (allocated(err)) return
         call create_model(scene%rope_spec_t, model, err)
         if (allocated(err)) return
+        ! a static state: the supports rest where they are at t = 0
+        model%supports_at_rest = .true.
         allocate (y(model%size()))
         call model%initial_state(y)
         call find_equilibrium(model, scene%rope_spec_t, y, options, sres, err)
         if (allocated(err)) return
-        call support_forces(scene%rope_spec_t, model, y, force_top, force_bottom, err)
-        if (allocated(err)) return
+        allocate (axial(0:model%n_elements()), shear(0:model%n_elements()), &
+                  moment(0:model%n_elements()))
+        call model%internal_forces(0.0_wp, y, axial, shear, moment, reaction)
+        call model%support_positions(0.0_wp, anchors)
+        force_top = reaction(:, 1)
+        force_bottom = reaction(:, 2)
         if (command == 'modes') then
             call compute_modes(model, y, count, mres, err)
             if (allocated(err)) return
@@ -142,12 +149,14 @@ contains
                 end do
                 if (trim(scene%supports%top) /= 'free') then
                     call h5%write('/statics/support_force_top', force_top, 'N', err, &
-                                  'force of the top support on the rope (x, y)')
+                                  'force of the top support on the rope (x, y): '// &
+                                  '/supports/top/reaction')
                     if (allocated(err)) exit steps
                 end if
                 if (trim(scene%supports%bottom) /= 'free') then
                     call h5%write('/statics/support_force_bottom', force_bottom, 'N', err, &
-                                  'force of the bottom support on the rope (x, y)')
+                                  'force of the bottom support on the rope (x, y): '// &
+                                  '/supports/bottom/reaction')
                     if (allocated(err)) exit steps
                 end if
                 call h5%group('/energy', err)
@@ -155,6 +164,8 @@ contains
                 call h5%write('/energy/elastic', sres%elastic, 'J', err)
                 if (allocated(err)) exit steps
                 call h5%write('/energy/gravity', sres%gravity, 'J', err)
+                if (allocated(err)) exit steps
+                call write_forces(h5, axial, shear, moment, reaction, anchors, err)
                 if (allocated(err)) exit steps
                 call h5%group('/state', err)
                 if (allocated(err)) exit steps
@@ -252,7 +263,9 @@ contains
     !! the coordinates held fixed (virtual work), by central differences of the potential
     !! energy of models rebuilt with the anchor moved by +-h (V is quadratic in the anchor
     !! of a pinned support: exact up to rounding), point loads included (their potential at
-    !! t = 0: an MPP's ideal pin carries them). Zero for a free end.
+    !! t = 0: an MPP's ideal pin carries them). Zero for a free end. Independent of the
+    !! model's force laws: the check (in the tests) of the reactions that `run_analysis`
+    !! takes from the model (rope_model_t%internal_forces).
     subroutine support_forces(scene, model, y, top, bottom, err)
         type(rope_spec_t), intent(in) :: scene
         class(rope_model_t), intent(inout) :: model

@@ -71,6 +71,11 @@ module ropedyn_run
         !> m g L: the rope's weight (with its point masses) times its length, the unit in
         !! which the summary states the energy balance; 0 without gravity, J
         real(wp) :: weight_length = 0.0_wp
+        !> the peak tension: the largest axial force of all records and joints (N), its
+        !! joint (0 the top end; -1 before the first record), the joint's arc length from
+        !! the top along the unstretched rope (m) and the record's time (s)
+        real(wp) :: peak_tension = 0.0_wp, peak_arc = 0.0_wp, peak_time = 0.0_wp
+        integer :: peak_joint = -1
     end type run_summary_t
 
     !> A run of one scene (see the module header for the order of the steps).
@@ -94,8 +99,11 @@ module ropedyn_run
         ! the state: time (s), ODE state and quadratures; at the previous record too
         real(wp) :: t = 0.0_wp, t_prev = 0.0_wp, t_last = 0.0_wp
         real(wp), allocatable :: y(:), yq(:), y_prev(:), yq_prev(:)
-        ! work arrays of a record: element fields and the polyline
+        ! work arrays of a record: element fields, the polyline, the internal forces at the
+        ! joints (0:n), the supports' reactions and anchors (2, 2)
         real(wp), allocatable :: q(:, :), qdot(:, :), points(:, :)
+        real(wp), allocatable :: axial(:), shear(:), moment(:)
+        real(wp) :: reaction(2, 2) = 0.0_wp, anchors(2, 2) = 0.0_wp
         integer :: nq = 0                   !< quadratures of the model
         ! the output grid: every dt up to t_end, records 0 .. n_out; the next is k_next
         real(wp) :: dt = 1.0_wp, t_end = 0.0_wp
@@ -120,7 +128,7 @@ module ropedyn_run
         procedure :: output_file => run_output_file
         procedure, private :: fresh_start, output_time, start_integrator, record, &
                               steps_taken, keep_as_previous, asked_to_stop, end_on
-        procedure, private :: resume_from_file, check_energy, second_look
+        procedure, private :: resume_from_file, check_energy, second_look, note_peak
         procedure, private :: guard_output, release_output
     end type run_t
 
@@ -212,6 +220,7 @@ contains
         self%summary%weight_length = weight_length(scene, self%model)
         allocate (self%y(self%model%size()), self%yq(max(1, self%nq)))
         allocate (self%q(3, n), self%qdot(3, n), self%points(2, 2*n))
+        allocate (self%axial(0:n), self%shear(0:n), self%moment(0:n))
         self%dt = scene%solver%output_interval
         self%t_end = scene%solver%t_end
         self%n_out = max(1, ceiling(self%t_end/self%dt*(1.0_wp - 1.0e-12_wp)))
@@ -259,17 +268,22 @@ contains
             if (allocated(err)) return
             allocate (lengths(model%n_elements()), masses(model%n_elements()))
             call model%element_data(lengths, masses)
+            ! a free end has no anchor (NaN): the file has no position series for it
+            call model%support_positions(self%t, self%anchors)
             if (allocated(scene%source)) then
                 call self%out%create(self%summary%file, model%n_elements(), lengths, masses, &
                                      model%model_name(), self%integrator%name(), &
                                      version_string, scene_namelist_text(scene), err, &
                                      state_size=model%size(), quad_size=self%nq, &
-                                     source=scene%source)
+                                     source=scene%source, internal_forces=.true., &
+                                     anchored=ieee_is_finite(self%anchors(1, :)))
             else
                 call self%out%create(self%summary%file, model%n_elements(), lengths, masses, &
                                      model%model_name(), self%integrator%name(), &
                                      version_string, scene_namelist_text(scene), err, &
-                                     state_size=model%size(), quad_size=self%nq)
+                                     state_size=model%size(), quad_size=self%nq, &
+                                     internal_forces=.true., &
+                                     anchored=ieee_is_finite(self%anchors(1, :)))
             end if
             if (allocated(err)) return
         end associate
@@ -377,9 +391,14 @@ contains
         self%steps_now = stats%steps
         call self%model%fields(self%y, self%q, self%qdot, self%t)
         call self%model%polyline(self%y, self%points, self%t)
+        call self%model%internal_forces(self%t, self%y, self%axial, self%shear, self%moment, &
+                                        self%reaction)
+        call self%model%support_positions(self%t, self%anchors)
         e = self%model%energy(self%t, self%y, self%yq)
         if (.not. (all(ieee_is_finite(self%y)) .and. all(ieee_is_finite(self%yq)) .and. &
-                   ieee_is_finite(e%balance()) .and. all(ieee_is_finite(self%points)))) then
+                   ieee_is_finite(e%balance()) .and. all(ieee_is_finite(self%points)) .and. &
+                   all(ieee_is_finite(self%axial)) .and. all(ieee_is_finite(self%shear)) .and. &
+                   all(ieee_is_finite(self%moment)) .and. all(ieee_is_finite(self%reaction)))) then
             write (where, '(a, es12.5, a, es11.3e3, a)') 't = ', self%t, ' s, step size ', &
                 h, ' s'
             call make_error(err, ERR_SOLVER, 'non-finite state or energy at '// &
@@ -388,7 +407,9 @@ contains
             return
         end if
         call self%out%append(self%t, self%q, self%qdot, self%points, e, h, order, err, &
-                             y=self%y, yq=self%yq)
+                             y=self%y, yq=self%yq, axial=self%axial, shear=self%shear, &
+                             moment=self%moment, reaction=self%reaction, position=self%anchors)
+        call self%note_peak(self%t, maxval(self%axial), maxloc(self%axial, 1) - 1)
         self%summary%records = self%summary%records + 1
         self%summary%final_energy = e
         self%summary%t_reached = self%t
@@ -407,6 +428,23 @@ contains
             call self%release_output(err)
         end if
     end subroutine end_on
+
+    !> Keep `tension` (N), the largest axial force of a record at time t (s), at joint
+    !! `joint` (0 the top end), as the peak tension when it exceeds the one so far.
+    subroutine note_peak(self, t, tension, joint)
+        class(run_t), intent(inout) :: self
+        real(wp), intent(in) :: t, tension
+        integer, intent(in) :: joint
+        real(wp) :: lengths(self%model%n_elements()), masses(self%model%n_elements())
+        associate (s => self%summary)
+            if (s%peak_joint >= 0 .and. .not. tension > s%peak_tension) return
+            call self%model%element_data(lengths, masses)
+            s%peak_tension = tension
+            s%peak_joint = joint
+            s%peak_arc = sum(lengths(1:joint))
+            s%peak_time = t
+        end associate
+    end subroutine note_peak
 
     !> The state now is the previous record's (where the order safety looks back to).
     subroutine keep_as_previous(self)

@@ -5,7 +5,8 @@ submodule (ropedyn_run) ropedyn_run_resume
     use, intrinsic :: iso_fortran_env, only: error_unit
     use ropedyn_text, only: int_text
     use ropedyn_case_file, only: case_data_t, read_case_file
-    use ropedyn_run_record, only: run_record_t, read_run_record, check_record_fits, LAST_RECORD
+    use ropedyn_run_record, only: run_record_t, read_run_record, check_record_fits, LAST_RECORD, &
+                                  read_peak_tension
     implicit none
 
 contains
@@ -18,8 +19,8 @@ contains
     module procedure resume_from_file
         type(run_record_t) :: rec, first
         type(case_data_t) :: before
-        real(wp) :: tol
-        integer :: keep, j
+        real(wp) :: tol, peak, t_peak
+        integer :: keep, j, joint
         associate (file => self%summary%file)
             call read_run_record(file, LAST_RECORD, rec, err)
             if (allocated(err)) return
@@ -65,8 +66,14 @@ contains
                 self%counters_before(j) = max(0_i8, before%counters(j))
             end do
             if (ieee_is_finite(before%cpu_time)) self%cpu_before = before%cpu_time
+            ! the peak tension of the records kept (a file without forces is refused next)
+            call read_peak_tension(file, keep, peak, joint, t_peak, err)
+            if (allocated(err)) return
+            if (joint >= 0) call self%note_peak(t_peak, peak, joint)
+            call self%model%support_positions(self%t, self%anchors)
             call self%out%reopen(file, self%model%n_elements(), self%model%size(), self%nq, &
-                                 err, keep=keep)
+                                 err, keep=keep, internal_forces=.true., &
+                                 anchored=ieee_is_finite(self%anchors(1, :)))
             if (allocated(err)) return
             call self%out%add_restart(rec%record, self%t, before%status, before%reason, &
                                       self%counters_before(1), self%cpu_before, err)

@@ -2,7 +2,10 @@
 !! weight, the potential energy (elastic, gravity, point loads), the generalized force
 !! f(q) = -dV/dq and the tangent matrices (stiffness K = -df/dq, mass, damping), for the
 !! statics (ropedyn_statics) and the modal analysis (ropedyn_modes). How each model gives
-!! them: the header of ropedyn_statics and docs/statics-modes.md.
+!! them: the header of ropedyn_statics and docs/statics-modes.md. The model is evaluated
+!! with its supports at rest (rope_model_t%supports_at_rest, set for the evaluation and
+!! restored): a moving support sits where its motion puts it at t = 0, and its velocity
+!! and acceleration there do not enter a static force.
 module ropedyn_statics_terms
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
     use ropedyn_kinds, only: wp
@@ -86,6 +89,9 @@ contains
         real(wp), intent(out) :: f(:)
         integer, intent(out) :: status
         real(wp), allocatable :: w(:), mm(:, :)
+        logical :: held
+        held = model%supports_at_rest
+        model%supports_at_rest = .true.
         allocate (w(size(y)))
         if (model%has_mass_matrix()) then
             call model%implicit_rhs(0.0_wp, y, w, status)
@@ -97,10 +103,26 @@ contains
             f = matmul(mm, w(vel))
         end if
         if (status == STATUS_OK .and. .not. all(ieee_is_finite(f))) status = -1
+        model%supports_at_rest = held
     end subroutine generalized_force
 
     !> Tangent stiffness kt = -df/dq and, if present, damping cv = -df/dq' at state y.
     subroutine tangent_matrices(model, y, pos, vel, kt, status, cv)
+        class(rope_model_t), intent(inout) :: model
+        real(wp), intent(in) :: y(:)
+        integer, intent(in) :: pos(:), vel(:)
+        real(wp), intent(out) :: kt(:, :)
+        integer, intent(out) :: status
+        real(wp), intent(out), optional :: cv(:, :)
+        logical :: held
+        held = model%supports_at_rest
+        model%supports_at_rest = .true.
+        call tangents(model, y, pos, vel, kt, status, cv)
+        model%supports_at_rest = held
+    end subroutine tangent_matrices
+
+    !> tangent_matrices with the supports as the model has them.
+    subroutine tangents(model, y, pos, vel, kt, status, cv)
         class(rope_model_t), intent(inout) :: model
         real(wp), intent(in) :: y(:)
         integer, intent(in) :: pos(:), vel(:)
@@ -195,7 +217,7 @@ contains
                 call model%rhs(0.0_wp, z, g, stat)
             end if
         end subroutine evaluate
-    end subroutine tangent_matrices
+    end subroutine tangents
 
     !> a <- mm a, with a fast path for a diagonal mm.
     subroutine scale_by_mass(mm, a)

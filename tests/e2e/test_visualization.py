@@ -139,15 +139,64 @@ def test_plot(which, request, tmp_path):
         assert_picture(image, (900, 700))
 
 
-def test_plot_without_axial_force(ropedyn_exe, tmp_path):
-    """Inextensible MPP: the axial force is a constraint force; the panel says so."""
-    run_file = ropedyn(ropedyn_exe, tmp_path, TINY_MPP, "inext", "effects.tension=.false.")
+def test_plot_of_a_file_without_forces(ropedyn_exe, tmp_path):
+    """A file written before the internal forces were stored (here: with them removed):
+    no axial force is derived; the panel and the XDMF writer say why."""
+    run_file = ropedyn(ropedyn_exe, tmp_path, TINY, "old")
+    with h5py.File(run_file, "a") as f:
+        del f["forces"], f["supports"]
     force, message = fields.axial_force(io.load_run(run_file))
-    assert force is None and "inextensible" in message
+    assert force is None and "predates stored internal forces" in message
     result = script("plot", run_file)
     assert result.returncode == 0, result.stderr
-    with Image.open(tmp_path / "inext_plot.png") as image:
+    with Image.open(tmp_path / "old_plot.png") as image:
         assert_picture(image, (1200, 900))
+    result = script("xdmf", run_file)
+    assert result.returncode == 0 and "predates stored internal forces" in result.stderr
+    with h5py.File(tmp_path / "old_fields.h5") as f:
+        assert "cell/tension" not in f and "cell/curvature" in f
+
+
+SHAKEN_GROUND = ("&model kind = '{kind}', elements = 5 /\n"
+                 "&supports top_motion = 'harmonic', top_amplitude = 0.0, 0.2, "
+                 "top_frequency = 2.0 /\n"
+                 "&effects ground = .true. /\n&ground point = 0.9, 0.0, normal = -1.0, 0.2 /\n"
+                 "&solver t_end = 0.2, output_interval = 0.01 /\n")
+
+
+@pytest.mark.parametrize("kind", ["rfem", "mpp"])
+def test_pictures_show_the_moving_support_and_the_ground(ropedyn_exe, tmp_path, kind):
+    """A top shaken sideways over a sloping ground: the overview's picture draws the
+    support's stored path and the ground line through &ground point with its normal, and
+    the animation moves the support's marker along the path."""
+    from ropedyn import animate
+    from ropedyn.plot import overview
+
+    run_file = ropedyn(ropedyn_exe, tmp_path, SHAKEN_GROUND.format(kind=kind), kind)
+    run = io.load_run(run_file)
+    top, _ = fields.supports(run)
+    assert top.moving and np.array_equal(top.path, run.anchors["top"])
+    fig = overview.make_figure(run, [0.1], (900, 700), 100)
+    ax = fig.axes[1]
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    path = lines["top support path"]
+    assert np.array_equal(path.get_xdata(), run.anchors["top"][:, 1])
+    assert np.array_equal(path.get_ydata(), run.anchors["top"][:, 0])
+    ground = lines["ground"]
+    (y0, x0), (y1, x1) = ground._xy1, ground._xy2
+    assert (x0, y0) == (0.9, 0.0)
+    assert np.dot([x1 - x0, y1 - y0], [-1.0, 0.2]) == pytest.approx(0.0, abs=1e-12)
+    frames = animate.RopeFrames(run, (320, 240), 100, False, 1.0)
+    try:
+        frames.rgb(7)
+        marker, = frames.anchors
+        assert marker.get_xdata()[0] == run.anchors["top"][7, 1]
+        assert marker.get_ydata()[0] == run.anchors["top"][7, 0]
+    finally:
+        frames.close()
+    result = script("animate", run_file, "-o", tmp_path / "a.gif", "--max-frames", "4",
+                    "--size", "320x240")
+    assert result.returncode == 0, result.stderr
 
 
 # --- XDMF ----------------------------------------------------------------------------------
@@ -233,9 +282,14 @@ def test_xdmf_for_mpp(tiny_mpp):
     assert result.returncode == 0, result.stderr
     root = ET.parse(tiny_mpp.with_suffix(".xmf")).getroot()
     assert len(root.findall("./Domain/Grid/Grid")) == 5  # records 0, 5, 10, 15, 20
-    with h5py.File(tiny_mpp.with_name("tiny_mpp_fields.h5")) as f:
+    with h5py.File(tiny_mpp.with_name("tiny_mpp_fields.h5")) as f, h5py.File(tiny_mpp) as g:
         assert f["cell/tension"].shape == (RECORDS, 5)
-        assert "damper" in f["cell/tension"].attrs["definition"]
+        assert "/forces/axial" in f["cell/tension"].attrs["definition"]
+        axial, moment = g["forces/axial"][()], g["forces/moment"][()]
+        assert np.array_equal(f["cell/tension"][()], 0.5 * (axial[:, :-1] + axial[:, 1:]))
+        assert np.array_equal(f["point/joint_moment"][:, 0::2], moment[:, :-1])
+        assert np.array_equal(f["point/joint_moment"][:, 1::2], moment[:, 1:])
+        assert f["point/joint_moment"].attrs["units"] == "N m"
 
 
 # --- README figures -----------------------------------------------------------------------
@@ -263,25 +317,28 @@ def central_difference(values, times):
 FINE = "&solver t_end = 0.1, output_interval = 0.0005, rtol = 1e-9, atol = 1e-12 /\n"
 
 
-@pytest.mark.parametrize("model", ["rfem", "mpp"])
-def test_axial_force_is_newtons_law(ropedyn_exe, tmp_path, model):
-    """The axial force at each element's upper end equals the axial component of what the
-    rope below needs to move as it does: e . sum m (g - a), a by 4th-order central
-    differences of /state/qdot. RFEM: the joint springs + dampers; MPP: member spring +
-    damper. Leaving out the damper would be off by 1e-3 of the force, the check is 5e-5."""
+@pytest.mark.parametrize("model,tension", [("rfem", ".true."), ("mpp", ".true."),
+                                           ("mpp", ".false.")])
+def test_axial_force_is_newtons_law(ropedyn_exe, tmp_path, model, tension):
+    """The stored axial force at each element's upper joint equals the axial component of
+    what the rope below needs to move as it does: e . sum m (g - a), a by 4th-order central
+    differences of /state/qdot. RFEM: the SDE's spring + damper in the frame of the element
+    above; MPP: the force the member carries, in its own frame (inextensible members: the
+    constraint force). Leaving out the damper would be off by 1e-3 of the force, the
+    check is 5e-5."""
     run_file = ropedyn(ropedyn_exe, tmp_path, f"&model kind = '{model}', elements = 5 /\n"
-                       + FINE, model)
+                       f"&effects tension = {tension} /\n" + FINE, model)
     run = io.load_run(run_file)
     force, _ = fields.axial_force(run)
     acc = central_difference(run.qdot[:, :, :2], run.time)[2:-2]
     need = np.cumsum((run.element_mass[:, None] * (G - acc))[:, ::-1], axis=1)[:, ::-1]
     phi = fields.element_angles(run)[2:-2]
     e = np.stack([np.cos(phi), np.sin(phi)], axis=-1)
-    if model == "rfem":
-        upper = force.values[:, :-1]  # joint above element i, in element i-1's frame
+    upper = force.values[:, :-1]  # the joint above element i
+    if model == "rfem":  # in element i-1's frame (joint 0: element 1's)
         frame = np.concatenate([e[:, :1], e[:, :-1]], axis=1)
-    else:
-        upper, frame = force.per_element, e
+    else:  # in member i's
+        frame = e
     newton = np.sum(frame * need, axis=-1)
     scale = np.abs(newton).max()
     assert scale > 0.5

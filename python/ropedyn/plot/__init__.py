@@ -7,15 +7,19 @@ import re
 
 import numpy as np
 
-from ropedyn.fields import supports
+from ropedyn.fields import ground_plane, supports
+
+SUPPORT_PATH_COLOR = "#2ca02c"
+GROUND_COLOR = "#8c564b"
 
 
-def draw_supports(ax, run, size=None, color="0.25"):
+def draw_supports(ax, run, size=None, color="0.25", moving=True):
     """Draw the anchors of pinned and clamped ends (hatched ceiling / wall) on ax,
-    which shows (y, x) with x downward."""
+    which shows (y, x) with x downward, where they are at the first record (`moving`
+    False: only the supports that do not move)."""
     size = size or 0.06 * float(run.group("rope").get("length", run.element_length.sum()))
     for sup, sign in zip(supports(run), (-1.0, 1.0)):
-        if sup.kind not in ("pinned", "clamped"):
+        if sup.kind not in ("pinned", "clamped") or (sup.moving and not moving):
             continue
         x0, y0 = sup.anchor
         if sup.kind == "pinned":
@@ -37,10 +41,54 @@ def draw_supports(ax, run, size=None, color="0.25"):
                 ax.plot([p[1], q[1]], [p[0], q[0]], color=color, lw=0.8)
 
 
+def draw_support_paths(ax, run, color=SUPPORT_PATH_COLOR):
+    """Draw the path of each moving support (its anchor at every record, as the model
+    stored it in /supports/*/position); returns the supports drawn."""
+    drawn = []
+    for end, sup in zip(("top", "bottom"), supports(run)):
+        if sup.kind == "free" or not sup.moving:
+            continue
+        ax.plot(sup.path[:, 1], sup.path[:, 0], ":", color=color, lw=1.2,
+                label=f"{end} support path")
+        drawn.append(sup)
+    return drawn
+
+
+def draw_ground(ax, run, color=GROUND_COLOR):
+    """Draw the scene's ground line (&ground point and normal) when it has ground contact
+    (&effects ground = .true.), with short hatches on the solid side; True if drawn."""
+    plane = ground_plane(run)
+    if plane is None:
+        return False
+    point, normal = plane
+    along = np.array([-normal[1], normal[0]])
+    ax.axline((point[1], point[0]), (point[1] + along[1], point[0] + along[0]), color=color,
+              lw=1.5, label="ground")
+    (ymin, ymax), (xmin, xmax) = ax.get_xlim(), sorted(ax.get_ylim())
+    size = 0.03 * max(ymax - ymin, xmax - xmin)
+    span = 2.0 * max(ymax - ymin, xmax - xmin)
+    for k in np.linspace(-span, span, 121):
+        p = point + k * along
+        q = p - size * normal + size * along
+        ax.plot([p[1], q[1]], [p[0], q[0]], color=color, lw=0.6, alpha=0.6)
+    ax.set_xlim(ymin, ymax)
+    ax.set_ylim(xmax, xmin)
+    return True
+
+
 def picture_limits(run, margin=0.08):
-    """((ymin, ymax), (xmin, xmax)) covering every record and the anchors, with a margin."""
+    """((ymin, ymax), (xmin, xmax)) covering every record, the anchors (over the whole run
+    for moving ones) and, with ground contact, the ground below the rope's first point
+    (its foot on the plane), with a margin."""
     pts = run.points.reshape(-1, 2)
-    anchors = np.array([s.anchor for s in supports(run) if s.kind != "free"]).reshape(-1, 2)
+    anchors = [s.path if s.path is not None else s.anchor for s in supports(run)
+               if s.kind != "free"]
+    plane = ground_plane(run)
+    if plane is not None:
+        point, normal = plane
+        start = run.points[0, 0]
+        anchors.append(start - np.dot(start - point, normal) * normal)
+    anchors = np.vstack(anchors).reshape(-1, 2) if anchors else np.zeros((0, 2))
     allp = np.vstack([pts, anchors]) if anchors.size else pts
     lo, hi = allp.min(axis=0), allp.max(axis=0)
     pad = margin * max(hi - lo) + 1e-9

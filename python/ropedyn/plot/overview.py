@@ -1,11 +1,13 @@
-"""Overview plot of a ropedyn run: energies over time, the tip's trajectory, the solver's
-step size and order over time, and the axial force along the rope at chosen times.
+"""Overview plot of a ropedyn run: energies over time, the tip's trajectory (with a moving
+support's path and the ground), the solver's step size and order over time, and the axial
+force along the rope at chosen times.
 
 usage: scripts/plot RUN.h5 [-o RUN_plot.png] [--times 0.5,1,2] [--size 1200x900]
        (python -m ropedyn.plot, or python -m ropedyn.plot.overview)
 
-Works from the HDF5 file alone (any model; the axial force is skipped with a note where
-the model's output does not determine it, see docs/visualization.md).
+Works from the HDF5 file alone (any model): the axial force is the one the model stored
+with each record (a file written before that has none: the panel says so; see
+docs/visualization.md).
 """
 import argparse
 import pathlib
@@ -40,7 +42,9 @@ def plot_tip(ax, run):
     """The free end's path, coloured by time, with the first and last rope shapes."""
     tip = run.points[:, -1, :]
     plot.setup_picture_axes(ax, run)
+    plot.draw_ground(ax, run)
     plot.draw_supports(ax, run)
+    plot.draw_support_paths(ax, run)
     ax.plot(run.points[0, :, 1], run.points[0, :, 0], color="0.6", lw=1.2, label="rope, start")
     ax.plot(run.points[-1, :, 1], run.points[-1, :, 0], color="#1f4e9c", lw=1.6,
             label="rope, end")
@@ -93,7 +97,7 @@ def plot_axial_force(ax, run, wanted):
     for k in record_indices(run.time, wanted):
         ax.plot(force.s, force.values[k], "-o", ms=2.5, lw=1, label=f"t = {run.time[k]:.3g} s")
     ax.axhline(0.0, color="0.5", lw=0.8)
-    ax.set_xlabel("s (m), along the unstretched rope from the top")
+    ax.set_xlabel("s (m), joints along the unstretched rope from the top")
     ax.set_ylabel("N (N), tension > 0")
     ax.legend(fontsize=7, loc="best")
     ax.grid(alpha=0.3)

@@ -81,6 +81,9 @@ module ropedyn_mpp
         real(wp), allocatable :: mom(:)       !< moments on the rods (n)
         !> suffix sums sum_{i>=k} w_i + F_b (2, n+1), column n+1 the bottom support's force
         real(wp), allocatable :: wsum(:, :)
+        !> the moments of the joints' and the clamps' rotational springs and dampers (0:n),
+        !! joint k between members k and k+1 (0, n: the supports), docs/theory/internal-forces.md
+        real(wp), allocatable :: jmom(:)
         type(bodies_t) :: bodies              !< the rods as bodies for the effects
         real(wp), allocatable :: ejac(:, :, :)  !< the effects' blocks (3, 6, n)
         !> factors of M(q) (mass_factor): per member the 2x2 blocks G, H = D^{-1} G^T,
@@ -107,6 +110,8 @@ module ropedyn_mpp
         procedure :: state_from_fields => mpp_state_from_fields
         procedure :: polyline => mpp_polyline
         procedure :: element_data => mpp_element_data
+        procedure :: internal_forces => mpp_internal_forces
+        procedure :: support_positions => mpp_support_positions
         procedure :: residual => mpp_residual
         procedure :: mass_dense => mpp_mass_dense
         procedure :: coordinates => mpp_coordinates
@@ -269,6 +274,24 @@ module ropedyn_mpp
             integer, intent(out) :: status
         end subroutine mpp_second_order_blocks
 
+        !> The internal forces (submodule ropedyn_mpp_forces): the suffix sums of the
+        !! residual at the true accelerations resolved in the frame of the member below the
+        !! joint (joint n: member n), the joints' moments of the residual.
+        module subroutine mpp_internal_forces(self, t, y, axial, shear, moment, reaction)
+            class(mpp_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(out) :: axial(0:), shear(0:), moment(0:)
+            real(wp), intent(out) :: reaction(:, :)
+        end subroutine mpp_internal_forces
+
+        !> The anchors at time t (submodule ropedyn_mpp_forces).
+        module subroutine mpp_support_positions(self, t, positions)
+            class(mpp_t), intent(in) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(out) :: positions(:, :)
+        end subroutine mpp_support_positions
+
         module function mpp_energy(self, t, y, yq) result(en)
             class(mpp_t), intent(inout) :: self
             real(wp), intent(in) :: t
@@ -399,7 +422,8 @@ contains
             allocate (model%cs(2, n), model%w(2, n), model%cacc(2, n), model%mom(n), &
                       model%ab_g(2, 2, n), model%ab_h(2, 2, n), model%ab_dinv(2, 2, n), &
                       model%ab_lam(n), model%acc(nd), model%r0(nd), model%dr(nd, 2*nd), &
-                      model%mm(nd, nd), model%wsum(2, n + 1), model%ejac(3, 6, n))
+                      model%mm(nd, nd), model%wsum(2, n + 1), model%ejac(3, 6, n), &
+                      model%jmom(0:n))
         end associate
         model%cs = 0.0_wp
         model%w = 0.0_wp
@@ -415,10 +439,11 @@ contains
         model%mm = 0.0_wp
         model%wsum = 0.0_wp
         model%ejac = 0.0_wp
+        model%jmom = 0.0_wp
     end subroutine mpp_create
 
     !> The supports at time t: top joint, bottom anchor (motion states) and whether the
-    !! bottom support still holds.
+    !! bottom support still holds. At rest (statics): no velocities, accelerations, rates.
     pure subroutine supports_at(self, t, top, bottom, bottom_on)
         class(mpp_t), intent(in) :: self
         real(wp), intent(in) :: t
@@ -437,6 +462,10 @@ contains
             bottom%angle = self%bottom_angle
         end if
         bottom_on = self%bottom > 0 .and. t < self%bottom_release
+        if (self%supports_at_rest) then
+            top = motion_state_t(p=top%p, angle=top%angle)
+            bottom = motion_state_t(p=bottom%p, angle=bottom%angle)
+        end if
     end subroutine supports_at
 
     pure integer function mpp_size(self)
@@ -506,6 +535,7 @@ contains
             if (present(t)) top = self%motion(1)%state(t)
             p(:, 0) = top%p
             pd(:, 0) = top%v
+            if (self%supports_at_rest) pd(:, 0) = 0.0_wp
         end if
         do k = 1, self%n
             e = [cos(phi(k)), sin(phi(k))]

@@ -141,22 +141,27 @@ contains
         ! Member springs and dampers.
         if (self%nu > 0) r(n + 1:nd) = r(n + 1:nd) - self%ks*y(n + 1:nd) &
                                        - self%ds*y(nd + n + 1:2*nd)
-        ! Joint bending springs and dampers between members.
+        ! Joint bending springs and dampers between members; their moments (the lower
+        ! member's on the upper one) kept by joint for the internal forces.
+        self%jmom = 0.0_wp
         if (self%cb > 0.0_wp .or. self%db > 0.0_wp) then
             do k = 2, n
                 d = self%cb*(y(k) - y(k - 1)) + self%db*(y(nd + k) - y(nd + k - 1))
                 r(k) = r(k) - d
                 r(k - 1) = r(k - 1) + d
+                self%jmom(k - 1) = d
             end do
         end if
         ! Rotational springs of clamped supports.
         if (self%top_clamped) then
             dd = self%c_rot*(y(1) - top%angle) + self%d_rot*(y(nd + 1) - top%rate)
             r(1) = r(1) - dd
+            self%jmom(0) = dd
         end if
         if (self%bottom == 2 .and. bottom_on) then
             dd = self%c_rot*(y(n) - bottom%angle) + self%d_rot*(y(nd + n) - bottom%rate)
             r(n) = r(n) - dd
+            self%jmom(n) = -dd
         end if
     end procedure residual_core
 

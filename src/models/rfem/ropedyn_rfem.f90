@@ -127,6 +127,8 @@ module ropedyn_rfem
         procedure :: state_from_fields => rfem_state_from_fields
         procedure :: polyline => rfem_polyline
         procedure :: element_data => rfem_element_data
+        procedure :: internal_forces => rfem_internal_forces
+        procedure :: support_positions => rfem_support_positions
         procedure :: coordinates => rfem_coordinates
         procedure :: second_order_layout => rfem_second_order_layout
         procedure :: coordinate_mass => rfem_coordinate_mass
@@ -145,13 +147,19 @@ module ropedyn_rfem
         !> The generalized forces (3, n) of everything at time t and state y into self%gen
         !! (one pass over the SDEs); optionally the elastic energy (J, springs and the
         !! effects' potential energy).
-        module subroutine forces(self, t, y, elastic, power)
+        module subroutine forces(self, t, y, elastic, power, joint, support)
             class(rfem_t), intent(inout) :: self
             real(wp), intent(in) :: t
             real(wp), intent(in) :: y(6*self%n)
             real(wp), intent(out), optional :: elastic
             !> when present: the internal SDEs' dissipation power sum B s'^2
             real(wp), intent(out), optional :: power
+            !> when present: the forces fx, fy (N) and fp (N m) of the internal SDEs j = 2 ..
+            !! n in joint(:, j - 1) (columns 0 and n, the supports', are left as they are)
+            real(wp), intent(inout), optional :: joint(3, 0:self%n)
+            !> when present: the support SDEs' forces fs (x, y, N) and fr (N m), top and
+            !! bottom (zero for a free or released end; support_force in the kernels)
+            real(wp), intent(out), optional :: support(3, 2)
         end subroutine forces
 
         !> The derivatives of the generalized forces with respect to the coordinates and
@@ -287,6 +295,26 @@ module ropedyn_rfem
             class(rfem_t), intent(inout) :: self
             real(wp), intent(in) :: y(:)
         end subroutine angles
+
+        !> The internal forces of the SDEs (submodule ropedyn_rfem_forces): joint j is SDE
+        !! j + 1, axial and shear its tension and shear force, components of its force on
+        !! the element above in that element's frame (e, n) (joint 0, the top support: the
+        !! force of the rope on the support in the frame of element 1), the moment its
+        !! rotational spring and damper's.
+        module subroutine rfem_internal_forces(self, t, y, axial, shear, moment, reaction)
+            class(rfem_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(out) :: axial(0:), shear(0:), moment(0:)
+            real(wp), intent(out) :: reaction(:, :)
+        end subroutine rfem_internal_forces
+
+        !> The anchors at time t (submodule ropedyn_rfem_forces).
+        module subroutine rfem_support_positions(self, t, positions)
+            class(rfem_t), intent(in) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(out) :: positions(:, :)
+        end subroutine rfem_support_positions
     end interface
 
 contains
@@ -307,6 +335,10 @@ contains
             self%sup(k)%angle = ms%angle
             self%sup(k)%anchor_vel = ms%v
             self%sup(k)%angle_rate = ms%rate
+            if (self%supports_at_rest) then
+                self%sup(k)%anchor_vel = 0.0_wp
+                self%sup(k)%angle_rate = 0.0_wp
+            end if
         end do
     end subroutine set_time
 

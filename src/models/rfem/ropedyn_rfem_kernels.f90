@@ -111,16 +111,20 @@ contains
 
     !> Add the generalized force of support k (translational spring and damper on d, and
     !! for a clamp the rotational one) to f(3), the force on its element; with `energy`
-    !! its spring energy to e_el.
-    pure subroutine support_force(self, k, y, f, energy, e_el)
+    !! its spring energy to e_el. `sde`: the SDE's own forces, fs = Ct d + Bt d' (x, y) and
+    !! fr = Cr s + Br s' (zero where it has none): the support's force on the rope is
+    !! -sgn fs, its moment on the element -sgn fr.
+    pure subroutine support_force(self, k, y, f, energy, e_el, sde)
         class(rfem_t), intent(in) :: self
         integer, intent(in) :: k
         real(wp), intent(in) :: y(:)
         real(wp), intent(inout) :: f(3)
         logical, intent(in) :: energy
         real(wp), intent(inout) :: e_el
+        real(wp), intent(out) :: sde(3)
         real(wp) :: h, co, si, d(2), fs(2), s, fr
         integer :: m
+        sde = 0.0_wp
         associate (sp => self%sup(k))
             m = 6*(sp%elem - 1)
             h = self%half(sp%elem)
@@ -133,6 +137,7 @@ contains
                 if (sp%damped_t) fs = fs + sp%bt*support_offset_rate(self, k, y, co, si)
                 f(1:2) = f(1:2) - sp%sgn*fs
                 f(3) = f(3) + h*(co*fs(2) - si*fs(1))
+                sde(1:2) = fs
             end if
             if (sp%rotational) then
                 s = sp%sgn*(y(m + 3) - sp%angle)
@@ -140,6 +145,7 @@ contains
                 if (energy) e_el = e_el + 0.5_wp*sp%cr*s**2
                 if (sp%damped_r) fr = fr + sp%br*sp%sgn*(y(m + 6) - sp%angle_rate)
                 f(3) = f(3) - sp%sgn*fr
+                sde(3) = fr
             end if
         end associate
     end subroutine support_force
@@ -245,7 +251,7 @@ contains
 
     module procedure forces
         integer :: j, n, p, i
-        real(wp) :: fx, fy, fp, ffx, ffy, c(3), e_el, p_in
+        real(wp) :: fx, fy, fp, ffx, ffy, c(3), e_el, p_in, sup_sde(3, 2)
         type(sde_t) :: s
         logical :: energy, with_power
 
@@ -258,7 +264,8 @@ contains
         call angles(self, y)
         ! c: the force of the previous SDE on its element b (first: the top support's)
         c = 0.0_wp
-        if (self%sup(1)%active) call support_force(self, 1, y, c, energy, e_el)
+        sup_sde = 0.0_wp
+        if (self%sup(1)%active) call support_force(self, 1, y, c, energy, e_el, sup_sde(:, 1))
         do j = 2, n
             s = sde_at(self, y, j)
             fx = 0.0_wp
@@ -277,6 +284,7 @@ contains
                 if (with_power) p_in = p_in + (self%bx*s%rx**2 + self%by*s%ry**2 + &
                                                self%bpj(j)*s%rp**2)
             end if
+            if (present(joint)) joint(:, j - 1) = [fx, fy, fp]
             ffx = fx*s%ca - fy*s%sa
             ffy = fx*s%sa + fy*s%ca
             self%gen(1, j - 1) = c(1) + ffx + self%weight(j - 1)
@@ -286,7 +294,8 @@ contains
             c(2) = -ffy
             c(3) = -s%hb*(fx*s%sd - fy*s%cd) - fp
         end do
-        if (self%sup(2)%active) call support_force(self, 2, y, c, energy, e_el)
+        if (self%sup(2)%active) call support_force(self, 2, y, c, energy, e_el, sup_sde(:, 2))
+        if (present(support)) support = sup_sde
         self%gen(1, n) = c(1) + self%weight(n)
         self%gen(2:3, n) = c(2:3)
         ! moment of the point masses' weight about their element's centre
