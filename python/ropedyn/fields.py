@@ -1,4 +1,4 @@
-"""Derived fields of a run (definitions in docs/visualization.md): the supports, element
+"""Derived fields of a run (definitions in docs/guide/visualization.md): the supports, element
 velocity and speed, element angles, curvature at the joints and the axial force.
 
 Everything is computed from the run file alone (a `ropedyn.io.Run`): the polyline, the
@@ -172,7 +172,7 @@ def _rfem_axial_force(run):
 
 def _member_axial_force(run):
     """MPP: the force in each member's spring and damper, k_s u + d_s u', k_s = E A/l,
-    d_s = mpp_axial_damping_factor * eta A/l (docs/physics-mpp.md).
+    d_s = mpp_axial_damping_factor * eta A/l (docs/theory/mpp.md).
 
     u_i = |B_i - A_i| - l (member i is drawn from joint P_{i-1} to joint P_i). Its rate comes
     from the chain of joint velocities, P_0 fixed at the top anchor:

@@ -1,13 +1,13 @@
-"""docs/input.md against the key table: `ropedyn keys` lists every key of a scene file with
+"""docs/reference/scene-file.md against the key table: `ropedyn keys` lists every key of a scene file with
 its default (from the table in src/io/ropedyn_scene_keys.f90); every key must have a row in
-the table of its group in docs/input.md whose default cell holds that default, and every key
+the table of its group in docs/reference/scene-file.md whose default cell holds that default, and every key
 the docs list must exist."""
 import pathlib
 import re
 
 import pytest
 
-DOCS = pathlib.Path(__file__).resolve().parents[2] / "docs" / "input.md"
+DOCS = pathlib.Path(__file__).resolve().parents[2] / "docs" / "reference" / "scene-file.md"
 
 
 def listing(run):
@@ -81,14 +81,14 @@ def test_every_key_documented_with_its_default(run):
             missing.append(f"&{k['group']} {k['key']}")
         elif not documented(cell, k["default"]):
             wrong.append(f"&{k['group']} {k['key']}: docs {cell!r}, table {k['default']!r}")
-    assert not missing, "keys without a row in docs/input.md: " + ", ".join(missing)
+    assert not missing, "keys without a row in docs/reference/scene-file.md: " + ", ".join(missing)
     assert not wrong, "defaults that differ:\n" + "\n".join(wrong)
 
 
 def test_docs_list_no_other_keys(run):
     table = {(k["group"], k["key"]) for k in listing(run)}
     extra = sorted(f"&{g} {k}" for g, k in doc_rows() if (g, k) not in table)
-    assert not extra, "docs/input.md lists keys the table does not have: " + ", ".join(extra)
+    assert not extra, "docs/reference/scene-file.md lists keys the table does not have: " + ", ".join(extra)
 
 
 @pytest.mark.parametrize("default,cell,ok", [

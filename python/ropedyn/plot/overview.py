@@ -5,7 +5,7 @@ usage: scripts/plot RUN.h5 [-o RUN_plot.png] [--times 0.5,1,2] [--size 1200x900]
        (python -m ropedyn.plot, or python -m ropedyn.plot.overview)
 
 Works from the HDF5 file alone (any model; the axial force is skipped with a note where
-the model's output does not determine it, see docs/visualization.md).
+the model's output does not determine it, see docs/guide/visualization.md).
 """
 import argparse
 import pathlib
