@@ -123,3 +123,14 @@ def test_a_bad_line_in_numbers_unchanged_is_named(tmp_path):
         docs_status.status(tmp_path)
     message = str(stop.value)
     assert "numbers-unchanged.txt: line 3: 'not-a-commit' is not a commit" in message
+
+
+def test_a_section_a_test_keeps_current_is_not_listed(tmp_path):
+    """The key reference is written exactly from the program (no run, no date): its test
+    checks it, not docs_status."""
+    _repo(tmp_path)
+    (tmp_path / "docs" / "keys.md").write_text(
+        "<!-- keys:begin -->\nWritten by `scripts/keys_reference` from `ropedyn keys`.\n"
+        "<!-- keys:end -->\n")
+    names = {r["name"] for r in docs_status.status(tmp_path)}
+    assert "keys" not in names and "run" in names

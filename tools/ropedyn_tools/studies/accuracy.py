@@ -644,12 +644,8 @@ def figure_fig4(rows, t_end):
 # --------------------------------------------------------------------------------------
 # choosing
 
-CHOOSING_HEAD = """# Which method, tolerance and n should I use, and what will it cost?
-
-Written by `scripts/accuracy choosing` (`tools/ropedyn_tools/studies/accuracy.py`) from the
-data of the other subcommands ([accuracy.md](../validation/accuracy.md)); re-run them and it, never edit
-the numbers. Scene: the paper's rope (`input/paper.nml`).
-"""
+#: the generated section of the guide's page on choosing a method (docs/guide/choosing.md)
+CHOOSING_BEGIN, CHOOSING_END = "<!-- choosing:begin -->", "<!-- choosing:end -->"
 
 
 def choosing(args):
@@ -658,9 +654,9 @@ def choosing(args):
     f4 = read_csv(DATA / "acc_fig4.csv")
     chaos_rows = read_csv(DATA / "acc_chaos.csv")
     md = headline(win, disc, f4, chaos_rows)
-    md += ["", "## 1. Pick n for the accuracy you need in space", "",
+    md += ["", "### 1. Pick n for the accuracy you need in space", "",
            "Discretization error of the tip over the first second against a fine reference "
-           "([accuracy.md](../validation/accuracy.md#discretization)):", ""]
+           "([accuracy](../validation/accuracy.md#discretization)):", ""]
     if disc:
         ns = list(dict.fromkeys(int(r["n"]) for r in disc))
         md += ["| model | " + " | ".join(f"n = {n}" for n in ns) + " |",
@@ -673,10 +669,10 @@ def choosing(args):
             md.append(f"| {model} | " + " | ".join(cells) + " |")
     else:
         md.append("(no data yet: run `scripts/accuracy discretization`)")
-    md += ["", "## 2. Pick rtol so that the time error stays below that", "",
+    md += ["", "### 2. Pick rtol so that the time error stays below that", "",
            "Time error of the tip over the first second at each rtol (CVODE, against its "
            "own rtol 1e-9 run); tighter than the discretization error buys nothing, looser "
-           "spoils the n you paid for ([accuracy.md](../validation/accuracy.md#discretization)).", ""]
+           "spoils the n you paid for ([accuracy](../validation/accuracy.md#discretization)).", ""]
     if disc:
         rt = [k for k in disc[0] if k.startswith("time_")]
         md += ["| model, n | discretization | " + " | ".join(f"rtol {k[5:]}" for k in rt) +
@@ -684,10 +680,10 @@ def choosing(args):
         for r in disc:
             md.append(f"| {r['model']}, {r['n']} | {float(r['disc_tip']):.1e} | " +
                       " | ".join(f"{float(r[k]):.1e}" if r[k] else "-" for k in rt) + " |")
-    md += ["", "## 3. Pick the method that is cheapest at that accuracy", "",
+    md += ["", "### 3. Pick the method that is cheapest at that accuracy", "",
            "Windows of 0.5 s across the whole motion (restarted from t0 = 0, 5, 10, 20 s), "
            "median CPU per window at the loosest rtol reaching the accuracy "
-           "([accuracy.md](../validation/accuracy.md#windows)):", ""]
+           "([accuracy](../validation/accuracy.md#windows)):", ""]
     if win:
         md += ["| model | n | tip accuracy (m) | cheapest method (rtol): CPU per window (s) | "
                "runner-up | auto (rtol): CPU |", "|---|---|---|---|---|---|"]
@@ -703,14 +699,14 @@ def choosing(args):
                "after the fold (t0 = 5, 10, 20 s) have larger errors than the first one (t0 = "
                "0), by these factors (median and 90th percentile over models, n and rtol): " +
                "; ".join(f"{m} {a:.1f} ({b:.0f})" for m, a, b in later_over_first(win)) +
-               ". A study of the first seconds alone (results.md) understates the error of "
-               "the whole motion by that much."]
+               ". A study of the first seconds alone ([over 2 s](../validation/work-precision.md))"
+               " understates the error of the whole motion by that much."]
     else:
         md.append("(no data yet: run `scripts/accuracy windows`)")
-    md += ["", "## 4. What the whole motion costs", "",
+    md += ["", "### 4. What the whole motion costs", "",
            "CPU of the whole 30 s run at the loosest rtol reaching the tip accuracy in the "
            "windows (the paper's Figure 4 over the whole motion, "
-           "[accuracy.md](../validation/accuracy.md#fig4)): the cheapest method, and the default auto:", ""]
+           "[accuracy](../validation/accuracy.md#fig4)): the cheapest method, and the default auto:", ""]
     if f4:
         for target in dict.fromkeys(float(r["target"]) for r in f4):
             sel = [r for r in f4 if float(r["target"]) == target and r["status"] == "ok"
@@ -729,7 +725,12 @@ def choosing(args):
             md.append("")
     else:
         md.append("(no data yet: run `scripts/accuracy fig4`)")
-    CHOOSING.write_text(CHOOSING_HEAD + f"\nData as of {run_stamp()}.\n\n" + "\n".join(md) + "\n")
+    block = "\n".join([CHOOSING_BEGIN, "",
+                        "Written by `scripts/accuracy choosing` from the data of the other "
+                        "subcommands ([accuracy](../validation/accuracy.md)), data as of "
+                        f"{run_stamp()}. Scene: the paper's rope (`input/paper.nml`).", "",
+                        *md, CHOOSING_END])
+    update_doc(CHOOSING, CHOOSING_BEGIN, CHOOSING_END, block)
     print(f"accuracy: wrote {CHOOSING}")
 
 
@@ -766,7 +767,7 @@ def cheapest_in_windows(win, model, n, target):
 
 def headline(win, disc, f4, chaos_rows):
     """The answer in a few lines, from the data of the studies."""
-    md = ["## In short", ""]
+    md = ["### In short", ""]
     if not (win and disc and f4):
         return md + ["(run `scripts/accuracy all` for the data)"]
     lines = []
@@ -799,7 +800,7 @@ def headline(win, disc, f4, chaos_rows):
                f"RFEM n = 30, 8 starts 1e-9 rad apart): {sum(z < 2 for z in zs)} of "
                f"{len(zs)} ensembles (methods x rtol) reproduce the tightest within sampling "
                f"error, {len(loose_ok)} of {len(loose)} at rtol 1e-3 "
-               "([accuracy.md](../validation/accuracy.md#chaos)): a loose tolerance is enough for them."]
+               "([accuracy](../validation/accuracy.md#chaos)): a loose tolerance is enough for them."]
     # where the default is far off the cheapest fixed method over the whole motion
     misses = []
     for r in f4:
