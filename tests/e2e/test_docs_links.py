@@ -1,5 +1,7 @@
 """The manual (docs/ and README.md) holds together: every relative link and picture points
-at a file that exists and, with an anchor, at a heading (or an `<a id>`) of that page."""
+at a file that exists and, with an anchor, at a heading (or an `<a id>`) of that page; the
+user pages (getting started, the user guide, the reference) name no source file, test or
+issue; and no page grows into a lab notebook (at most MAX_LINES lines)."""
 import pathlib
 import re
 
@@ -8,8 +10,17 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 PAGES = sorted(DOCS.rglob("*.md")) + [ROOT / "README.md"]
+#: the pages a user reads: no source paths, tests or issue numbers there
+USER_PAGES = ([DOCS / "README.md", DOCS / "getting-started.md"]
+              + sorted((DOCS / "guide").glob("*.md")) + sorted((DOCS / "reference").glob("*.md")))
+#: "no page over about 400 lines" (the generated tables included)
+MAX_LINES = 450
+
 LINK = re.compile(r"\]\(([^)\s]+)\)")
 FENCE = re.compile(r"^(```|~~~).*?^\1", re.MULTILINE | re.DOTALL)
+#: what a user page must not name: source and test files, the tools' code, issues
+DEVELOPER = re.compile(r"(?<![\w./-])(src|solvers|tests|tools|python)/[\w./-]+"
+                       r"|\b\w+\.(f90|c)\b|\btest_\w+|\b[Ii]ssues? #?\d+|(?<![\w&])#\d+\b")
 
 
 def prose(page):
@@ -51,6 +62,18 @@ def test_links_resolve(page):
         elif anchor and file.suffix == ".md" and anchor not in anchors(file):
             broken.append(f"{target}: no such heading")
     assert not broken, f"{page.relative_to(ROOT)}: " + "; ".join(broken)
+
+
+@pytest.mark.parametrize("page", USER_PAGES, ids=lambda p: str(p.relative_to(ROOT)))
+def test_user_pages_name_no_source_test_or_issue(page):
+    named = sorted({m.group(0) for m in DEVELOPER.finditer(prose(page))})
+    assert not named, f"{page.relative_to(ROOT)} names {named}"
+
+
+@pytest.mark.parametrize("page", sorted(DOCS.rglob("*.md")), ids=lambda p: str(p.relative_to(ROOT)))
+def test_pages_stay_short(page):
+    lines = len(page.read_text().splitlines())
+    assert lines <= MAX_LINES, f"{page.relative_to(ROOT)}: {lines} lines"
 
 
 def test_slug():
