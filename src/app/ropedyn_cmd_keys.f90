@@ -1,6 +1,6 @@
 !> `ropedyn keys`: the keys of scene files from the key table, one a line (tab-separated
 !! group, key, type, unit, default, allowed values, meaning). tests/e2e/test_keys.py checks
-!! that docs/input.md lists every key with this default.
+!! that docs/reference/keys.md, written from this listing, is current.
 module ropedyn_cmd_keys
     use, intrinsic :: iso_fortran_env, only: output_unit
     use ropedyn_error, only: error_t

@@ -1,6 +1,6 @@
 !> One record of a run file as a starting point: the time, the model's native ODE state y
 !! and its quadratures yq of a record (the restart data /state/y and /state/yq that
-!! `ropedyn_output` writes with every record; docs/output.md, "Restart data"), with what is
+!! `ropedyn_output` writes with every record; docs/reference/file-format.md), with what is
 !! needed to check that a model can start from it.
 !!
 !! API (io layer; no model is built here):

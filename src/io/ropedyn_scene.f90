@@ -1,6 +1,6 @@
 !> Scene files: the namelist input of ropedyn (rope, model, supports, initial state, effects,
 !! solver and output), read with defaults, `--set group.key=value` overrides and a check of
-!! every key. The reference is docs/input.md.
+!! every key. The reference is docs/reference/keys.md.
 !!
 !! Reading: the file is parsed by the one namelist reader (`ropedyn_namelist_file`); for
 !! each group in order its assignments and then the overrides of that group are stored

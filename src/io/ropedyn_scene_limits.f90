@@ -1,4 +1,4 @@
-!> The limits of a scene (docs/input.md, "Limits"), checked when it is read so that no run
+!> The limits of a scene (docs/reference/scene-file.md, "Limits"), checked when it is read so that no run
 !! allocates more than it can or starts from a non-finite state:
 !!
 !! - memory: the state and Jacobian storage of the model and its integrator, estimated from

@@ -1,7 +1,7 @@
 !> The work of `ropedyn statics` and `ropedyn modes` (src/app/ropedyn_cmd_statics.f90): the
 !! static equilibrium of a scene (ropedyn_statics), optionally the lowest modes about it
 !! (ropedyn_modes), the support forces, one HDF5 file and a printed summary. Layout and
-!! method: docs/statics-modes.md.
+!! method: docs/theory/statics-modes.md.
 module ropedyn_analysis
     use, intrinsic :: iso_fortran_env, only: output_unit
     use ropedyn_kinds, only: wp, i8

@@ -2,7 +2,7 @@
 !! weight, the potential energy (elastic, gravity, point loads), the generalized force
 !! f(q) = -dV/dq and the tangent matrices (stiffness K = -df/dq, mass, damping), for the
 !! statics (ropedyn_statics) and the modal analysis (ropedyn_modes). How each model gives
-!! them: the header of ropedyn_statics and docs/statics-modes.md.
+!! them: the header of ropedyn_statics and docs/theory/statics-modes.md.
 module ropedyn_statics_terms
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
     use ropedyn_kinds, only: wp

@@ -81,3 +81,49 @@ def test_slug():
     assert slug("Overrides: `--set group.key=value`") == "overrides---set-groupkeyvalue"
     assert slug("Anchors: expected values from outside the model") == \
         "anchors-expected-values-from-outside-the-model"
+
+
+#: where the code, tests, tools and scenes may name pages of the manual
+SOURCES = ["src", "solvers", "tests", "tools", "scripts", "python", "input", "CMakeLists.txt"]
+DOC_PATH = re.compile(r"(?<![\w/.-])docs/[\w./-]+\.md\b")
+OUTSIDE = re.compile(r"\.\./shared|shared/docs|\bsolvers\.md|\bphysics\.md|\bintegrators\.md"
+                     r"|\bperformance\.md")
+#: names of pages that no longer exist, still printed by messages of the program (Fortran
+#: strings, not comments); each entry goes when its message names the new page
+STALE_IN_MESSAGES = {
+    ("src/io/ropedyn_scene_limits.f90", "docs/input.md"),
+    ("src/studies/ropedyn_run.f90", "docs/input.md"),
+    ("src/studies/ropedyn_run_safety.f90", "docs/stability.md"),
+    ("src/io/ropedyn_sweep_lists.f90", "docs/sweeps.md"),
+    ("tests/unit/test_mpp_physics.f90", "docs/physics-mpp.md"),
+}
+#: ... and the one message that names notes outside the project
+OUTSIDE_IN_MESSAGES = {"tests/unit/test_testset_accuracy.f90: solvers.md"}
+#: files that name docs/ pages of scratch repositories or quote the old names on purpose
+NOT_SOURCES = {"tests/e2e/test_docs_links.py", "tests/e2e/test_docs_status.py",
+               "tests/e2e/test_python_package.py"}
+
+
+def source_files():
+    for name in SOURCES:
+        path = ROOT / name
+        for file in ([path] if path.is_file() else sorted(path.rglob("*"))):
+            if file.is_file() and file.suffix not in (".h5", ".png", ".dat", ".pyc"):
+                yield file
+
+
+def test_sources_cite_only_pages_of_the_project():
+    """Every docs/... page a source file, test, tool or scene names exists, and none cites
+    notes outside the project."""
+    missing, outside = set(), []
+    for file in source_files():
+        rel = file.relative_to(ROOT).as_posix()
+        if rel in NOT_SOURCES:
+            continue
+        text = file.read_text(errors="replace")
+        for page in DOC_PATH.findall(text):
+            if not (ROOT / page).exists():
+                missing.add((rel, page))
+        outside += [f"{rel}: {m.group(0)}" for m in OUTSIDE.finditer(text)]
+    assert missing == STALE_IN_MESSAGES, sorted(missing ^ STALE_IN_MESSAGES)
+    assert set(outside) == OUTSIDE_IN_MESSAGES, sorted(set(outside) ^ OUTSIDE_IN_MESSAGES)
