@@ -127,3 +127,12 @@ def test_sources_cite_only_pages_of_the_project():
         outside += [f"{rel}: {m.group(0)}" for m in OUTSIDE.finditer(text)]
     assert missing == STALE_IN_MESSAGES, sorted(missing ^ STALE_IN_MESSAGES)
     assert set(outside) == OUTSIDE_IN_MESSAGES, sorted(set(outside) ^ OUTSIDE_IN_MESSAGES)
+
+
+def test_the_index_links_every_page():
+    """docs/README.md, the manual's index, links every page of the manual."""
+    index = DOCS / "README.md"
+    linked = {(DOCS / target.partition("#")[0]).resolve()
+              for target in LINK.findall(prose(index)) if not re.match(r"^[a-z]+:", target)}
+    pages = {p.resolve() for p in DOCS.rglob("*.md")} - {index.resolve()}
+    assert not pages - linked, sorted(str(p.relative_to(DOCS)) for p in pages - linked)
