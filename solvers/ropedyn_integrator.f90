@@ -7,7 +7,7 @@
 !! Stopping early: with `options%stop_requested` set, an integrator asks it after every
 !! accepted step and, when it says .true., returns from `advance_to` at once with t < tout
 !! and the state at t (no error). The run driver uses it to end a run at the next step after
-!! a signal (docs/output.md, "Interrupts"). An integrator that does not ask simply returns at
+!! a signal (docs/development/internals.md, "Interrupts"). An integrator that does not ask simply returns at
 !! tout; the driver then stops there.
 module ropedyn_integrator
     use ropedyn_kinds, only: wp, i8
@@ -34,7 +34,7 @@ module ropedyn_integrator
 
     !> Steps per simulated second beyond which a method held at a crawl by the problem's
     !! stiffness gives up with a diagnosis (erk, adams) instead of running on: the step
-    !! guarantee of the hard scenes (docs/stability.md).
+    !! guarantee of the hard scenes (docs/validation/hard-scenes.md).
     real(wp), parameter :: STIFF_STEP_RATE = 2.0e5_wp
 
     !> Options shared by all integrators (same meaning for every method).

@@ -1,7 +1,7 @@
 !> The record of what an integrator changed during a run: which method it ran from when,
 !! with which order limit, and why (`method = 'auto'` switching between an explicit and an
 !! implicit integrator, CVODE lowering and restoring its maximum order). The run driver
-!! writes it to `/solver/switch_*` and prints it in the run summary (docs/output.md).
+!! writes it to `/solver/switch_*` and prints it in the run summary (docs/reference/file-format.md).
 module ropedyn_switch_log
     use ropedyn_kinds, only: wp
     implicit none

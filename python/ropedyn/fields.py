@@ -1,4 +1,4 @@
-"""Fields of a run (definitions in docs/visualization.md): the supports and the ground,
+"""Fields of a run (definitions in docs/guide/visualization.md): the supports and the ground,
 element velocity and speed, element angles, curvature at the joints, and the axial force.
 
 Everything comes from the run file alone (a `ropedyn.io.Run`): the polyline, the state, the
@@ -152,7 +152,7 @@ class AxialForce:
     definition: str
 
 
-#: What /forces/axial holds (docs/visualization.md): the model's own value at each joint.
+#: What /forces/axial holds (docs/guide/visualization.md): the model's own value at each joint.
 AXIAL_DEFINITION = ("the model's tension at the joints (/forces/axial); element value: "
                     "the mean of its two joints")
 

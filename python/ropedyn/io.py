@@ -1,4 +1,4 @@
-"""Read a ropedyn run file (HDF5, layout: docs/output.md) into numpy arrays with units.
+"""Read a ropedyn run file (HDF5, layout: docs/reference/file-format.md) into numpy arrays with units.
 
     run = load_run("out/paper.h5")
     run.time, run.q, run.qdot, run.points, run.energy["total"], run.stats["steps"]

@@ -1,4 +1,4 @@
-"""Check that a ropedyn HDF5 output file has the documented layout (docs/output.md).
+"""Check that a ropedyn HDF5 output file has the documented layout (docs/reference/file-format.md).
 
 Use from Python (the end-to-end tests do)::
 

@@ -6,7 +6,7 @@ usage: scripts/xdmf RUN.h5 [--every K]     writes RUN.xmf and RUN_fields.h5 next
 
 The geometry (the run's /rope/points, one plain dataset per described record) and the
 fields (the model's stored internal forces: tension, shear, moment; curvature, speed,
-velocity, angle; definitions in docs/visualization.md) go into the sidecar RUN_fields.h5. The run file is only read, never
+velocity, angle; definitions in docs/guide/visualization.md) go into the sidecar RUN_fields.h5. The run file is only read, never
 modified. RUN.xmf opens in ParaView with File > Open (OpenDataFile) and with each of its
 XDMF readers ("XDMF Reader", "Xdmf3 Reader S", "Xdmf3 Reader T"): the layout avoids what
 the Xdmf3 readers cannot read (a HyperSlab in a Geometry crashes them). The coordinates are the run's: x

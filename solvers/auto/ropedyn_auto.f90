@@ -20,7 +20,7 @@
 !!   steps (a rope hanging at rest, catenary: 13 x h_e; every other scene in input/ and
 !!   input/hard/ is below 1, a rope released from rest at 0.001 .. 0.5). MEBDF's
 !!   maximum order follows from the damping of the fast modes (A(alpha) of MEBDF,
-!!   docs/solvers.md): order 4, A-stable, when a fast mode is damped by less than 3 %, order
+!!   docs/theory/mebdf.md): order 4, A-stable, when a fast mode is damped by less than 3 %, order
 !!   5 (A(88.4 deg)) up to BDF_DAMPING = 12 %; above, CVODE's BDF at up to order 5.
 !!   `max_order` given by the user caps either.
 !! - **Cost**: counted, not timed (runs stay reproducible): explicit, the evaluations of f;

@@ -21,7 +21,7 @@
 !!   0.2 ms of its 1.9). Both only for problems without a mass matrix: on the
 !!   MPP (M(q) in MEBDF's residual, a dense Newton matrix) an implicit step costs far
 !!   more, a trial there is no cheap experiment, and erk's own estimate decides alone.
-!!   With the stable step there, the 0.5 s windows of docs/accuracy.md at rtol 1e-2 went
+!!   With the stable step there, the 0.5 s windows of docs/validation/accuracy.md at rtol 1e-2 went
 !!   to mebdf at once: 1.02 s against 0.093 (n = 100), 0.063 against 0.0087 (n = 30).
 !!   Implicit -> explicit when
 !!   the explicit cost predicted from the spectrum at the current state (evaluations per

@@ -2,7 +2,7 @@
 !! and the watch on crawling.
 !!
 !! **Crawl detection and order control (BDF).** BDF orders 3-5 amplify lightly damped
-!! oscillations near the imaginary axis (docs/solvers.md). When a barely damped stiff mode
+!! oscillations near the imaginary axis (docs/theory/cvode.md). When a barely damped stiff mode
 !! is present, CVODE at order 5 either lets it grow or, more often, its error test catches
 !! the growth, rejects steps and holds h far below what the smooth motion needs: a crawl
 !! (the steel wire: 8.5e5 steps per simulated second at order 5, 9e4 at order 2). The loop

@@ -3,7 +3,7 @@
  *
  * Debian's SUNDIALS 6.4.1 libraries are built without optimization (-O0: every element of
  * every vector operation goes through the stack, about 20 instructions per element), and
- * CVODE spends most of a step in these operations (docs/benchmarks.md, "A fast step").
+ * CVODE spends most of a step in these operations (docs/theory/cvode.md, "What ropedyn adds").
  * ropedyn_nvector_fast_ops(v) replaces the operations of a serial vector made by
  * N_VMake_Serial with the functions below; vectors cloned from it (all of CVODE's
  * internal vectors) copy the table. The content stays the serial one, so

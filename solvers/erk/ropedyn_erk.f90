@@ -6,8 +6,8 @@
 !! Why a bundled method and not ARKODE's ERKStep: on the rope the step of every explicit
 !! method is limited by stability, so what counts is f evaluations per simulated second
 !! and the cost around each one; ARKODE adds about 2 us per f call, more than a whole
-!! RHS costs at n = 30 once the kernels are fast (docs/performance notes in
-!! docs/integrators.md).
+!! RHS costs at n = 30 once the kernels are fast (docs/theory/erk.md, "Why a bundled
+!! method").
 !!
 !! - **Error test**: the weighted RMS norm of h sum e_i k_i with weights
 !!   rtol max(|y_n|, |y_n+1|) + atol (atol per component when given) must be <= 1.

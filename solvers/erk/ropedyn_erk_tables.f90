@@ -1,5 +1,5 @@
 !> Butcher tables of the embedded explicit Runge-Kutta pairs behind `method = 'erk'`
-!! (docs/input.md, the key `method`, says how they were chosen).
+!! (docs/theory/erk.md says how they were chosen).
 !!
 !! Each table is first-same-as-last (FSAL): its last stage is f at the new solution and
 !! serves as the first stage of the next step, so a step costs `stages - 1` evaluations

@@ -2,13 +2,13 @@
 !! integrator interface: variable step, variable order 2 .. 7, for y' = f(t, y) and for
 !! linearly implicit problems M(t, y) y' = F(t, y).
 !!
-!! One step of order k+1 from t_n to t_n + h (docs/solvers.md, section 1):
+!! One step of order k+1 from t_n to t_n + h (docs/theory/mebdf.md, "One step"):
 !!  1. k-step BDF for ybar_{n+1};
 !!  2. k-step BDF one step further for ybar_{n+2}, with ybar_{n+1} in the history;
 !!  3. the modified extended corrector for y_{n+1}, using the slopes of stages 1 and 2.
 !! All three stages share one Newton (iteration) matrix M - h beta_k J.
 !!
-!! Formulation (see docs/mebdf.md): fixed-step coefficients on a backward-difference
+!! Formulation (see docs/theory/mebdf.md): fixed-step coefficients on a backward-difference
 !! history (as in Shampine's ode15s and the classic codes); a step-size change rescales the
 !! differences by interpolation. Every stage is an equation of the form
 !!     M(t, y) (y - c) = h beta_k F(t, y),
@@ -51,7 +51,7 @@ module ropedyn_mebdf
     !! The classic codes use 1.5, 1.6, 1.7; the error test measures the BDF (order k)
     !! error while the solution is of order k+1, so smaller factors are safe: with
     !! 1.2/1.3/1.4 the test-set step counts at equal accuracy drop by 10-20 % with no
-    !! more rejections worth noting (docs/mebdf.md).
+    !! more rejections worth noting (docs/theory/mebdf.md).
     real(wp), parameter :: SAFETY_SAME = 1.2_wp, SAFETY_DOWN = 1.3_wp, SAFETY_UP = 1.4_wp
     !> Safety factor of the new step after a failed error test (the classic value).
     real(wp), parameter :: SAFETY_FAILED = 1.5_wp

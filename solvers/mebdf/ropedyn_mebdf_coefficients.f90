@@ -1,5 +1,5 @@
 !> Coefficients of the k-step BDF and of Cash's modified extended BDF (MEBDF), derived from
-!! their order conditions (docs/solvers.md, section 1; Cash 1980, 1983).
+!! their order conditions (docs/theory/mebdf.md, "The coefficients"; Cash 1980, 1983).
 !!
 !! Points are numbered 0 .. k+1 at unit spacing. The k-step BDF (order k)
 !!     sum_{j=0..k} alpha_j y_j = h beta f_k,               alpha_k = 1,
@@ -10,7 +10,7 @@
 !!     sum_j ahat_j j^q = q (bhat_k k^(q-1) + bhat_{k+1} (k+1)^(q-1))    (q = 0 .. k+1).
 !! Both systems are solved here in extended precision (the Vandermonde-like matrices are
 !! ill-conditioned for large k) and rounded to working precision; a test compares them
-!! with the exact fractions of solvers.md.
+!! with the exact fractions of docs/theory/mebdf.md.
 module ropedyn_mebdf_coefficients
     use ropedyn_kinds, only: wp, qp
     implicit none

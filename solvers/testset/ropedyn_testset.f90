@@ -1,5 +1,5 @@
 !> The stiff test problems of the Bari "Test Set for IVP Solvers" (release 2.3) that
-!! ropedyn carries, by name: the umbrella module of src/testset (docs/testset.md).
+!! ropedyn carries, by name: the umbrella module of solvers/testset (docs/theory/testset.md).
 module ropedyn_testset
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_text, only: lower

@@ -1,6 +1,6 @@
 !> Runs one test-set problem with one integrator and measures what the integration
 !! achieved and cost: scd and mescd at t_end against the reference solution, the
-!! integrator's counters and the CPU time of one run (docs/testset.md).
+!! integrator's counters and the CPU time of one run (docs/theory/testset.md).
 !!
 !! Accuracy measures (Test Set for IVP Solvers, release 2.3):
 !! - scd   = -log10 max_i |y_i - yref_i| / |yref_i|, over the components with

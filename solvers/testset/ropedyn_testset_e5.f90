@@ -1,6 +1,6 @@
 !> E5: a chemical pyrolysis model (Enright, Hull and Lindberg's stiff set), 4 equations,
 !! t in [0, 1e13]. Test Set for IVP Solvers (Bari), release 2.3, problem E5; the equations
-!! and the reference solution are those of docs/solvers.md, section 2.
+!! and the reference solution are those of docs/theory/testset.md.
 !!
 !! The solution is tiny (y2, y3 ~ 1e-22 at t_end, y1 ~ 1e-290, y4 = 0), so the test set
 !! uses a fixed atol = 1.7e-24 whatever rtol is and judges accuracy by mescd.

@@ -1,6 +1,6 @@
 !> HIRES: "High Irradiance RESponse" of photomorphogenesis (Schaefer 1975), 8 equations,
 !! t in [0, 321.8122]. Test Set for IVP Solvers (Bari), release 2.3, problem HIRES; the
-!! equations and the reference solution are those of docs/solvers.md, section 2.
+!! equations and the reference solution are those of docs/theory/testset.md.
 module ropedyn_testset_hires
     use ropedyn_kinds, only: wp
     use ropedyn_problem, only: STATUS_OK

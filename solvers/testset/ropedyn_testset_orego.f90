@@ -1,6 +1,6 @@
 !> OREGO: the Oregonator (Belousov-Zhabotinskii reaction, Field and Noyes 1974),
 !! 3 equations, t in [0, 360]. Test Set for IVP Solvers (Bari), release 2.3, problem
-!! OREGO; the equations and the reference solution are those of docs/solvers.md, section 2.
+!! OREGO; the equations and the reference solution are those of docs/theory/testset.md.
 module ropedyn_testset_orego
     use ropedyn_kinds, only: wp
     use ropedyn_problem, only: STATUS_OK

@@ -1,6 +1,6 @@
 !> ROBER: Robertson's chemical reaction (1966), 3 equations, t in [0, 1e11].
 !! Test Set for IVP Solvers (Bari), release 2.3, problem ROBER; the equations and the
-!! reference solution are those of docs/solvers.md, section 2. y2 is of order 1e-13 at
+!! reference solution are those of docs/theory/testset.md. y2 is of order 1e-13 at
 !! t_end, so the recommended atol is 1e-6 rtol (with atol = rtol the computed y2 and y1
 !! are wrong).
 module ropedyn_testset_rober

@@ -1,6 +1,6 @@
 !> VDPOL: the van der Pol oscillator in relaxation form, epsilon = 1e-6, 2 equations,
 !! t in [0, 2]. Test Set for IVP Solvers (Bari), release 2.3, problem VDPOL; the
-!! equations and the reference solution are those of docs/solvers.md, section 2.
+!! equations and the reference solution are those of docs/theory/testset.md.
 module ropedyn_testset_vdpol
     use ropedyn_kinds, only: wp
     use ropedyn_problem, only: STATUS_OK

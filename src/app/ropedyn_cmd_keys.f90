@@ -1,6 +1,7 @@
 !> `ropedyn keys [GROUP]`: the keys of scene files from the key table, one a line
 !! (tab-separated group, key, type, unit, default, allowed values, meaning); with GROUP
-!! that group's only.
+!! that group's only. tests/e2e/test_keys.py checks that
+!! docs/reference/keys.md, written from the whole listing, is current.
 module ropedyn_cmd_keys
     use, intrinsic :: iso_fortran_env, only: output_unit
     use ropedyn_error, only: error_t

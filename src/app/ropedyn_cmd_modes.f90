@@ -1,5 +1,5 @@
 !> `ropedyn modes SCENE.nml [--count K] [options]`: the lowest natural frequencies and mode
-!! shapes about a scene's static equilibrium (docs/statics-modes.md).
+!! shapes about a scene's static equilibrium (docs/guide/statics-modes.md).
 !!
 !!   ropedyn modes SCENE.nml [--count K] [--set ...] [-o FILE.h5] [--max-iterations N]
 module ropedyn_cmd_modes

@@ -1,5 +1,5 @@
 !> `ropedyn statics SCENE.nml [options]`: the static equilibrium of a scene, and the command
-!! line shared with `ropedyn modes` (docs/statics-modes.md).
+!! line shared with `ropedyn modes` (docs/guide/statics-modes.md).
 !!
 !!   ropedyn statics SCENE.nml [--set group.key=value ...] [-o FILE.h5] [--max-iterations N]
 module ropedyn_cmd_statics

@@ -1,4 +1,4 @@
-!> `ropedyn sweep SWEEP.nml [options]`: list, run and summarize a sweep (docs/sweeps.md).
+!> `ropedyn sweep SWEEP.nml [options]`: list, run and summarize a sweep (docs/guide/sweeps.md).
 !!
 !!     ropedyn sweep SWEEP.nml [--jobs N] [--force] [--quiet] [--output-dir DIR]
 !!     ropedyn sweep SWEEP.nml --list | --count | --status

@@ -1,5 +1,5 @@
 !> `ropedyn testset PROBLEM|all [options]` and `ropedyn testset --list`: the stiff test
-!! problems of the Bari test set against their reference solutions (docs/testset.md).
+!! problems of the Bari test set against their reference solutions (docs/theory/testset.md).
 module ropedyn_cmd_testset
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
     use ropedyn_kinds, only: wp

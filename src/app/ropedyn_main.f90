@@ -3,13 +3,13 @@
 !!
 !!   ropedyn run SCENE.nml [--set group.key=value ...]
 !!   ropedyn testset PROBLEM|all [--method M] [--rtol R] [--atol A] [--max-order K]
-!!                   [--repeat-time S] [--csv]      (docs/testset.md)
+!!                   [--repeat-time S] [--csv]      (docs/reference/cli.md)
 !!   ropedyn testset --list
 !!   ropedyn sweep SWEEP.nml [--jobs N | --task LIST | --summary | --list | --count | --status]
-!!                   [--force] [--quiet] [--output-dir DIR]   (docs/sweeps.md)
+!!                   [--force] [--quiet] [--output-dir DIR]   (docs/reference/cli.md)
 !!   ropedyn statics SCENE.nml [--set ...] [-o FILE.h5] [--max-iterations N]
-!!   ropedyn modes SCENE.nml [--count K] [--set ...] [-o FILE.h5]  (docs/statics-modes.md)
-!!   ropedyn keys              (every key of a scene file with its default; docs/input.md)
+!!   ropedyn modes SCENE.nml [--count K] [--set ...] [-o FILE.h5]  (docs/reference/cli.md)
+!!   ropedyn keys              (every key of a scene file with its default; docs/reference/keys.md)
 !!   ropedyn --version | --help
 !!
 !! Exit codes: 0 success, 2 bad input or command line, 3 integration failed,

@@ -10,7 +10,7 @@ module ropedyn_error
     public :: ERR_USAGE, ERR_INPUT, ERR_SOLVER, ERR_IO, ERR_INTERNAL, ERR_INTERRUPTED
     public :: exit_code_of
 
-    !> Error classes. The exit codes of `ropedyn` are documented in docs/input.md.
+    !> Error classes. The exit codes of `ropedyn` are documented in docs/reference/exit-codes.md.
     integer, parameter :: ERR_USAGE = 1     !< bad command line
     integer, parameter :: ERR_INPUT = 2     !< bad scene file or override
     integer, parameter :: ERR_SOLVER = 3    !< integration failed

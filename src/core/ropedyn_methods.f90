@@ -3,11 +3,11 @@
 !! that input checking needs no solver module.
 !!
 !! Why the defaults: CVODE keeps its own limit, BDF order 5, after measuring orders 2 .. 5
-!! with and without stability-limit detection on the hard scenes (docs/stability.md): orders
+!! with and without stability-limit detection on the hard scenes (docs/validation/cvode-order.md): orders
 !! 3 and 4 let undamped modes gain energy, order 2 crawls where the rope's oscillations must
 !! be resolved, and order 5 never amplified. MEBDF defaults to order 4 (k = 3), the highest
 !! at which it is A-stable and does not amplify undamped oscillations (order 5 amplifies by
-!! up to 1.027 per step on the imaginary axis, order 6 by 1.114; docs/solvers.md).
+!! up to 1.027 per step on the imaginary axis, order 6 by 1.114; docs/theory/mebdf.md).
 !! The safe orders: BDF is A-stable up to order 2, MEBDF up to order 4.
 module ropedyn_methods
     implicit none
@@ -24,7 +24,7 @@ module ropedyn_methods
         integer :: default_order = 1
         !> the highest order at which the method never amplifies an undamped oscillation
         !! (A-stable; 0: none known): the order ropedyn's energy monitor lowers it to when
-        !! the energy balance shows a gain (&solver order_safety, docs/stability.md)
+        !! the energy balance shows a gain (&solver order_safety, docs/theory/energy-balance.md)
         integer :: safe_order = 0
     end type method_info_t
 

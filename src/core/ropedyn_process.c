@@ -7,7 +7,7 @@
  *   that arrives when one was caught already ends the process at once by that signal (a
  *   second Ctrl-C). With a lock file given, the handler instead appends "signal=N" to that
  *   file and ends the process by the same signal (default action), so that a lock records
- *   why its writer stopped (docs/sweeps.md, "Locks").
+ *   why its writer stopped (docs/development/internals.md, "One writer per case").
  * - A lock's heartbeat: a thread that touches the lock file every few seconds, so that a
  *   reader on another host can tell a live writer from one that is gone.
  * - Worker processes: spawned in their own process group with stdout and stderr in a log

@@ -1,7 +1,7 @@
 !> Cosine and sine of many angles at once, for the model kernels.
 !!
 !! The RFEM right-hand side needs cos and sin of every element's angle on every call; the C
-!! library's scalar `sincos` was a fifth of the paper run's time (perf, docs/benchmarks.md).
+!! library's scalar `sincos` was a fifth of the paper run's time (perf, docs/performance/step.md).
 !! Here the loop over the angles is branch-free and vectorizes: Cody-Waite reduction by
 !! pi/2 (three-part constant, exact for |x| < 2^19 pi/2) to r in [-pi/4, pi/4], fdlibm's
 !! minimax polynomials for sin r and cos r (errors below 1 ulp of 1 on that interval), and

@@ -1,5 +1,5 @@
 !> The one reader of namelist-syntax text: scene files, sweep files and the values of
-!! `--set` (docs/input.md, "The file format"). It does not use the Fortran runtime's namelist
+!! `--set` (docs/reference/scene-file.md, "The file format"). It does not use the Fortran runtime's namelist
 !! READ: it splits the text into groups of assignments and reports every syntax error with
 !! the file, the group, the key, the value and the line.
 !!

@@ -36,7 +36,7 @@
 !!
 !! Root attributes: status ('running' | 'complete' | 'failed' | 'interrupted'), reason
 !! (failed and interrupted), version, model, method, scene, created, units_convention.
-!! See docs/output.md. A file is continued (`ropedyn run --resume`) by `reopen`.
+!! See docs/reference/file-format.md (the layout), docs/development/internals.md. A file is continued (`ropedyn run --resume`) by `reopen`.
 !!
 !! The file is flushed after an `append` when FLUSH_PERIOD (wall clock) has passed since the
 !! last flush, and always when it is finished or closed, so a run that crashes leaves
@@ -289,7 +289,7 @@ module ropedyn_output
             type(error_t), allocatable, intent(out) :: err
         end subroutine write_pending
 
-        !> Record what the order safety did (docs/stability.md; times < 0: never): the order
+        !> Record what the order safety did (docs/theory/energy-balance.md; times < 0: never): the order
         !! limit lowered from `from` to `to` at time `lowered_at`; the order kept at a gain
         !! judged the integration error, first at `kept_at`, `kept_count` times in all; `gain`,
         !! the first gain beyond the bound. Nothing when it did neither.

@@ -1,5 +1,5 @@
 !> The input files of a run and the check that an output file is none of them: a run must
-!! never write over what it reads (docs/output.md, "Inputs are never outputs").
+!! never write over what it reads (docs/guide/output.md, "Inputs are never outputs").
 !!
 !! The inputs of a scene: the scene file itself, its motion tables (`&supports
 !! top_table`, `bottom_table` with motion 'table') and the run file of its starting record
@@ -12,7 +12,7 @@
 !!     call check_not_input(case_file, scene, err, [sweep_file], ['the sweep file'])
 !!
 !! And whether an existing file may be replaced at all (check_replaceable): only a run file
-!! that ropedyn wrote (docs/output.md, "Write, lock and resume rules").
+!! that ropedyn wrote (docs/guide/output.md, "Write, lock and resume rules").
 module ropedyn_run_inputs
     use ropedyn_error, only: error_t, make_error, ERR_USAGE, ERR_INPUT
     use ropedyn_os, only: output_clash, special_file_reason

@@ -1,6 +1,6 @@
 !> One record of a run file as a starting point: the time, the model's native ODE state y
 !! and its quadratures yq of a record (the restart data /state/y and /state/yq that
-!! `ropedyn_output` writes with every record; docs/output.md, "Restart data"), with what is
+!! `ropedyn_output` writes with every record; docs/reference/file-format.md), with what is
 !! needed to check that a model can start from it.
 !!
 !! API (io layer; no model is built here):
@@ -196,7 +196,7 @@ contains
             if (.not. (time(k) >= 0.0_wp .and. time(k) <= MAX_TIME)) then
                 call make_error(err, ERR_INPUT, path//': /time: record '//int_text(k - 1)// &
                     ': t = '//real_text(time(k))//' s: not a time of a run (0 .. '// &
-                    real_text(MAX_TIME)//' s; docs/input.md, Limits)')
+                    real_text(MAX_TIME)//' s; docs/reference/scene-file.md, Limits)')
                 return
             end if
             if (k == 1) cycle
@@ -228,7 +228,7 @@ contains
                 call make_error(err, ERR_INPUT, where//': not finite')
             else
                 call make_error(err, ERR_INPUT, where//': beyond the limits of a scene '// &
-                    '(at most '//real_text(bound)//' here; docs/input.md, Limits)')
+                    '(at most '//real_text(bound)//' here; docs/reference/scene-file.md, Limits)')
             end if
             return
         end do

@@ -1,6 +1,6 @@
 !> Scene files: the namelist input of ropedyn (rope, model, supports, initial state, effects,
 !! solver and output), read with defaults, `--set group.key=value` overrides and a check of
-!! every key. The reference is docs/input.md.
+!! every key. The reference is docs/reference/keys.md.
 !!
 !! Reading: the file is parsed by the one namelist reader (`ropedyn_namelist_file`); for
 !! each group in order its assignments and then the overrides of that group are stored
@@ -72,7 +72,7 @@ contains
     !! `scene_namelist_text`) as `read_scene` reads a file; `origin` names the text in
     !! messages (and becomes the scene's path). The overrides may not set output.file (the
     !! run appends to that file) nor change solver.output_interval (the file's records are
-    !! on its grid; docs/output.md, "Resume").
+    !! on its grid; docs/guide/output.md, "Resume").
     subroutine read_scene_text(origin, text, overrides, scene, err)
         character(len=*), intent(in) :: origin        !< e.g. 'out/run.h5: scene'
         character(len=*), intent(in) :: text          !< lines separated by new lines

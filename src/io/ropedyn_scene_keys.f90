@@ -3,7 +3,7 @@
 !! The component's default initialization is the key's default. The table drives reading
 !! and type conversion (`assign`), `--set`, the per-key checks (`check`), the echo (`echo`)
 !! and the listing `ropedyn keys`, which tests/e2e/test_keys.py compares with
-!! docs/input.md. Checks that involve several keys are in `ropedyn_scene_checks`.
+!! docs/reference/keys.md. Checks that involve several keys are in `ropedyn_scene_checks`.
 module ropedyn_scene_keys
     use ropedyn_kinds, only: wp
     use ropedyn_methods, only: method_list

@@ -1,4 +1,4 @@
-!> The limits of a scene (docs/input.md, "Limits"), checked when it is read so that no run
+!> The limits of a scene (docs/reference/scene-file.md, "Limits"), checked when it is read so that no run
 !! allocates more than it can or starts from a non-finite state:
 !!
 !! - memory: the state and Jacobian storage of the model and its integrator, estimated from
@@ -106,7 +106,7 @@ contains
                 //'the state and Jacobian of the '//trim(scene%model%kind)//' model would ' &
                 //'need about '//real_text(anint(bytes/1.0e9_wp))// &
                 ' GB, more than the limit of '//int_text(nint(MEMORY_LIMIT/1024.0_wp**3))// &
-                ' GiB (docs/input.md, Limits)', err)
+                ' GiB (docs/reference/scene-file.md, Limits)', err)
             return
         end if
         records = scene%solver%t_end/scene%solver%output_interval
@@ -114,11 +114,11 @@ contains
             call fail(keys, G_SOLVER, 'output_interval', real_text(scene%solver%output_interval), &
                 'with t_end = '//real_text(scene%solver%t_end)//' that makes '// &
                 real_text(records)//' output records, more than the limit '// &
-                int_text(MAX_RECORDS)//' (docs/input.md, Limits)', err)
+                int_text(MAX_RECORDS)//' (docs/reference/scene-file.md, Limits)', err)
         end if
         if (.not. allocated(err) .and. scene%solver%t_end > MAX_TIME) call fail(keys, G_SOLVER, &
             't_end', real_text(scene%solver%t_end), 'out of range (at most '// &
-            real_text(MAX_TIME)//' s; docs/input.md, Limits)', err)
+            real_text(MAX_TIME)//' s; docs/reference/scene-file.md, Limits)', err)
     end subroutine check_sizes
 
     !> The derived values of the rope within MAGNITUDE_LIMIT.
@@ -211,7 +211,7 @@ contains
             call culprit(keys, names, k, key, value)
             g = keys(k)%group
             call fail(keys, g, key, value, 'out of range: it makes '//what//' '// &
-                real_text(x)//' '//unit//' ('//limit//'; docs/input.md, Limits)', err)
+                real_text(x)//' '//unit//' ('//limit//'; docs/reference/scene-file.md, Limits)', err)
         end subroutine bound
     end subroutine check_magnitudes
 
@@ -269,7 +269,7 @@ contains
                 int_text(at(which))//' (t = '//real_text(rows(1, at(which)))//' s): a '// &
                 trim(HOW(which))//' of '//real_text(worst(which))//' '//trim(UNIT(which))// &
                 ' makes '//what//' '//real_text(x)//' J (at most '// &
-                real_text(MAGNITUDE_LIMIT)//'; docs/input.md, Limits)', err)
+                real_text(MAGNITUDE_LIMIT)//'; docs/reference/scene-file.md, Limits)', err)
         end subroutine table_bound
     end subroutine table_bounds
 

@@ -32,7 +32,7 @@ module ropedyn_scene_types
         !> what the run does when the energy balance gains more than energy_gain_bound:
         !! 'lower' the order to the method's A-stable one if, over the same output interval,
         !! that order does better (else the gain is the integration error: the order kept),
-        !! 'stop' (a diagnosed failure), or 'off' (no check); docs/stability.md
+        !! 'stop' (a diagnosed failure), or 'off' (no check); docs/theory/energy-balance.md
         character(len=NAME_LEN) :: order_safety = 'lower'
         !> the gain that counts, in units of rtol S (S: the energy scale of the run) [-]
         real(wp) :: energy_gain_bound = 10.0_wp

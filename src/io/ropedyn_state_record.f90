@@ -3,7 +3,7 @@
 !! quadratures written with it (/energy/dissipated, /energy/support_work), and, when the file
 !! holds the model's native ODE state (/state/y, /state/yq: restart data), that state too.
 !! The model turns the fields back into its ODE state (`state_from_fields`) when there is no
-!! native state. docs/output.md, "Starting from a record".
+!! native state. docs/guide/output.md, "Starting from a record".
 module ropedyn_state_record
     use hdf5, only: hsize_t
     use ropedyn_kinds, only: wp

@@ -1,4 +1,4 @@
-!> Sweep files (docs/sweeps.md): one `&sweep` group read by the namelist reader, its keys
+!> Sweep files (docs/reference/sweep-file.md): one `&sweep` group read by the namelist reader, its keys
 !! from a small table, and every check that can be made before anything runs: the base
 !! scene (named as `base`), each list value on its own (by the scene's key table) and with
 !! the base scene, duplicate values, the `set` and `vary` entries, the reference (value and

@@ -2,7 +2,7 @@
 !! before anything runs: on its own by the scene's key table (`check_override_value`),
 !! against the other values of its list (no value twice), and with the base scene and the
 !! common overrides (`read_scene`). Also the `set` and `vary` entries and the number of
-!! cases (docs/sweeps.md).
+!! cases (docs/reference/sweep-file.md).
 module ropedyn_sweep_lists
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
@@ -80,7 +80,7 @@ contains
         if (cases > MAX_CASES) then
             call make_error(err, ERR_INPUT, where//'the lists make '// &
                 real_text(cases)//' cases, more than the limit '//int_text(MAX_CASES)// &
-                ' (docs/sweeps.md)')
+                ' (docs/reference/sweep-file.md)')
             return
         end if
 

@@ -1,4 +1,4 @@
-!> The lock of a sweep case: one writer per case (docs/sweeps.md, "One writer per case").
+!> The lock of a sweep case: one writer per case (docs/development/internals.md, "One writer per case").
 !!
 !! A writer creates `<output_dir>/.case_<id>.lock` exclusively (`open(status='new')`:
 !! O_CREAT|O_EXCL, atomic on local file systems and on NFS v3 and later) and writes who it

@@ -2,7 +2,7 @@
 !! supports and their motion, the initial state, the effects switched on and their data.
 !! Every model (RFEM, MPP) is built from a `rope_spec_t` alone; the scene file is one way to
 !! fill it (src/io, whose key table names each component once, with its rule and units).
-!! The defaults here are the paper's rope (docs/input.md).
+!! The defaults here are the paper's rope (docs/theory/rfem.md, Table 1).
 module ropedyn_rope_spec
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
     use ropedyn_kinds, only: wp, i8

@@ -7,7 +7,7 @@
 !! dangle(t), with the slopes of the three-point (parabolic) rule at interior rows and zero
 !! slope at the first and last row; before the first row and after the last the support rests
 !! at the end values, so the motion is C1 for all t. Frame: x down, y horizontal, angles
-!! from x towards y (docs/input.md, `&supports`).
+!! from x towards y (docs/guide/scenes.md, `&supports`).
 module ropedyn_support_motion
     use ropedyn_kinds, only: wp
     implicit none

@@ -2,7 +2,7 @@
 !! static equilibrium of a scene (ropedyn_statics), optionally the lowest modes about it
 !! (ropedyn_modes), the internal forces and support reactions there (the model's, with
 !! its supports at rest), one HDF5 file and a printed summary. Layout and method:
-!! docs/statics-modes.md.
+!! docs/theory/statics-modes.md.
 module ropedyn_analysis
     use, intrinsic :: iso_fortran_env, only: output_unit
     use ropedyn_kinds, only: wp, i8

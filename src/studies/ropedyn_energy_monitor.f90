@@ -1,4 +1,4 @@
-!> The energy monitor of a run (order safety, docs/stability.md): watches the energy balance
+!> The energy monitor of a run (order safety, docs/theory/energy-balance.md): watches the energy balance
 !! B = T + V + dissipated - external work at the output times and says when B has risen
 !! above its start E0 by more than `factor` rtol S.
 !!
@@ -59,7 +59,7 @@ module ropedyn_energy_monitor
         procedure :: accept => monitor_accept
     end type energy_monitor_t
 
-    !> What the order safety did in a run (docs/stability.md; times in s, < 0: never).
+    !> What the order safety did in a run (docs/theory/energy-balance.md; times in s, < 0: never).
     type :: safety_record_t
         real(wp) :: energy_gain = 0.0_wp        !< the first gain beyond the bound, J
         real(wp) :: energy_gain_bound = 0.0_wp  !< ... and its bound, J

@@ -261,7 +261,7 @@ contains
                 call make_error(err, ERR_INPUT, scene%path//': the initial state or its '// &
                     'energy is not finite (energy '// &
                     real_text(self%summary%initial_energy%balance())//' J): a value of '// &
-                    'the scene is too large or too small (docs/input.md, Limits)')
+                    'the scene is too large or too small (docs/reference/scene-file.md, Limits)')
                 return
             end if
             call make_parent_dirs(self%summary%file, err)

@@ -38,7 +38,7 @@ contains
             call make_error(err, ERR_SOLVER, self%integrator%name()//' failed at t = '// &
                 real_text(self%t_prev)//' s, step size '//real_text(stats%last_step)// &
                 ' s: '//trim(what)//': the integrator created energy (&solver '// &
-                'order_safety = ''stop''; docs/stability.md)')
+                'order_safety = ''stop''; docs/theory/energy-balance.md)')
             ! the record with the gain is not written
             self%t = self%t_prev
             self%y = self%y_prev

@@ -1,5 +1,5 @@
 !> The start of a run from a record of an earlier run's file (`&initial shape = 'state'`,
-!! docs/output.md "Starting from a record"): its time, the model's ODE state and the
+!! docs/guide/output.md "Starting from a record"): its time, the model's ODE state and the
 !! quadratures.
 module ropedyn_state_start
     use ropedyn_kinds, only: wp

@@ -20,7 +20,7 @@
 !! step_tolerance * L, or when max |f| is at the rounding level of the stiffness
 !! (10 eps sum_j |K_kj| (|q_j| + L)). `find_equilibrium` adds a continuation in the support
 !! stiffness for a bottom anchor far from the start. Derivation and limits:
-!! docs/statics-modes.md.
+!! docs/theory/statics-modes.md.
 module ropedyn_statics
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp

@@ -2,7 +2,7 @@
 !! weight, the potential energy (elastic, gravity, point loads), the generalized force
 !! f(q) = -dV/dq and the tangent matrices (stiffness K = -df/dq, mass, damping), for the
 !! statics (ropedyn_statics) and the modal analysis (ropedyn_modes). How each model gives
-!! them: the header of ropedyn_statics and docs/statics-modes.md. The model is evaluated
+!! them: the header of ropedyn_statics and docs/theory/statics-modes.md. The model is evaluated
 !! with its supports at rest (rope_model_t%supports_at_rest, set for the evaluation and
 !! restored): a moving support sits where its motion puts it at t = 0, and its velocity
 !! and acceleration there do not enter a static force.

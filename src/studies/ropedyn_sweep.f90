@@ -1,5 +1,5 @@
 !> Sweeps: the cases of a sweep file (read and checked by `ropedyn_sweep_file`, src/io) as
-!! the cartesian product of its lists (docs/sweeps.md).
+!! the cartesian product of its lists (docs/reference/sweep-file.md).
 !!
 !! Case ids run from 1 in the order of the cartesian product models > elements > vary(1) >
 !! vary(2) ... > methods > max_orders > rtols, the last varying fastest. A list that is not

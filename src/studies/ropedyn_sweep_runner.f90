@@ -1,4 +1,4 @@
-!> Running a sweep (docs/sweeps.md): list its cases and their status, run them locally with
+!> Running a sweep (docs/guide/sweeps.md): list its cases and their status, run them locally with
 !! N worker processes, and summarize (the command line is src/app/ropedyn_cmd_sweep.f90;
 !! one case in one process is ropedyn_sweep_task).
 !!

@@ -1,5 +1,5 @@
 !> The status of a sweep case, from its lock (src/io/ropedyn_sweep_lock.f90) and its file
-!! (docs/sweeps.md, "Status of a case"):
+!! (docs/guide/sweeps.md, "Status of a case"):
 !!
 !! - running: its lock is live: a writer is at it (here or on another host);
 !! - complete: its file holds this case's scene, status complete, and its data reads back;

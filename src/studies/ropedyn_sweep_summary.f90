@@ -1,7 +1,7 @@
 !> The summary of a sweep, built from whatever case files exist: one row per case with its
 !! parameters, status, cost counters, errors against the reference and energy-balance
 !! error, written as `<output_dir>/summary.csv` and `<output_dir>/summary.h5`
-!! (docs/sweeps.md lists the columns).
+!! (docs/reference/file-format.md lists the columns).
 !!
 !! The reference of a row is named (`reference`: the case id; `reference_kind`: how it
 !! relates to the row), and when the tightest case of a reference group is not complete,
@@ -24,7 +24,7 @@ module ropedyn_sweep_summary
     private
     public :: case_row_t, build_summary
 
-    !> Columns of summary.h5 measured per case: name and units (docs/sweeps.md).
+    !> Columns of summary.h5 measured per case: name and units (docs/reference/file-format.md).
     character(len=*), parameter :: MEASURED(2, 8) = reshape([character(len=18) :: &
         't_reached', 's', 'wall_time', 's', 'cpu_time', 's', 'tip_error_final', 'm', &
         'tip_error_max', 'm', 'position_error_max', 'm', 'energy_error_final', 'J', &
@@ -39,7 +39,7 @@ module ropedyn_sweep_summary
         !> the solver counters named in ropedyn_output's COUNTER_NAMES (-1: absent)
         integer(i8) :: counters(size(COUNTER_NAMES)) = -1
         integer :: reference = 0                 !< case id of the reference (0: none)
-        !> tighter | same_rtol | self | file | none (docs/sweeps.md)
+        !> tighter | same_rtol | self | file | none (docs/guide/sweeps.md)
         character(len=:), allocatable :: reference_kind
         character(len=:), allocatable :: warning  !< about the reference ('' if none)
         real(wp) :: tip_error_final, tip_error_max, position_error_max  !< m

@@ -1,5 +1,5 @@
 !> Running sweep cases in this process: `ropedyn sweep SWEEP --task LIST`, what every local
-!! worker and every Slurm array task runs (docs/sweeps.md, "One writer per case").
+!! worker and every Slurm array task runs (docs/development/internals.md, "One writer per case").
 !!
 !! For each case: skip it when it is complete (unless forced); take its lock (a live lock
 !! of another writer: the case is not run, with a message naming that writer); run the

@@ -1,7 +1,7 @@
 !> Benchmark (not a test): CPU time of the kernels of a scene's model, per call and per
 !! element: the right-hand side, the Jacobian of the first-order system, the second-order
 !! blocks K, C, M of the reduced Newton systems (explicit and implicit form) and the
-!! quadratures. Used by scripts/bench_effects and scripts/bench_kernels (docs/benchmarks.md).
+!! quadratures. Used by scripts/bench_effects and scripts/bench_kernels (docs/performance/effects.md, docs/performance/step.md).
 !!
 !!   bench_rhs SCENE.nml [--set group.key=value ...] [--seconds S]
 !!   bench_rhs SCENE.nml [--set ...] --calls K --kernel rhs|jac|blocks|blocks_implicit|quad

@@ -1,5 +1,5 @@
 """An independent RFEM implementation for the end-to-end tests (numpy only, no code shared
-with ropedyn): the paper's model written from shared/docs/physics.md, "RFEM model", as
+with ropedyn): the paper's model written from the paper's equations as docs/theory/rfem.md states them, as
 energies alone. Forces are derived numerically, not by hand: the strains s(q) of every
 spring-damping element are evaluated at q + i h e_j (complex-step differentiation, exact to
 rounding for h = 1e-30), which gives their gradients G = ds/dq, and then
@@ -13,7 +13,7 @@ has |lambda| = 1.16e3 1/s (RK4 is stable for dt < 2.4e-3 s). Its error over the 
 first 2 s, against dt = 1.25e-4 s: tip 6.3e-7 m, dissipated energy 2.5e-8 J, T + V 4.2e-8 J
 at dt = 5e-4 s; 3.7e-8 m, 1.2e-9 J, 2.5e-9 J at dt = 2.5e-4 s (fourth order).
 
-Conventions (physics.md): x down, y horizontal, angles from x towards y; elements 1 and n of
+Conventions (docs/theory/rfem.md): x down, y horizontal, angles from x towards y; elements 1 and n of
 length dl/2, the others dl = L/(n - 1); m_i = rho A l_i, J_i = m_i (l_i^2/12 + d^2/16);
 SDE strains in the frame of the upper element: e_a.(A_b - B_a), n_a.(A_b - B_a),
 phi_b - phi_a with C = (EA, GA/chi, EI)/dl and B = (eta A, eta_bar A/chi, eta I)/dl; a
@@ -24,7 +24,7 @@ import numpy as np
 
 
 class Rope:
-    """The paper's rope (Table 1 as read in physics.md) discretized with n elements, top
+    """The paper's rope (Table 1 as read in docs/theory/rfem.md) discretized with n elements, top
     pinned at the origin, bottom free."""
 
     def __init__(self, n, length=1.0, diameter=0.005, density=6000.0, young=35e6, shear=14e6,

@@ -1,5 +1,5 @@
 """The analysis of scripts/accuracy (tools/ropedyn_tools/studies/accuracy.py) on small made-up
-data: the choices docs/choosing.md states come out of these functions, so each must pick
+data: the choices docs/guide/choosing.md states come out of these functions, so each must pick
 what its description says."""
 import math
 

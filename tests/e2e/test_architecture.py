@@ -1,4 +1,4 @@
-"""The layer rule holds in the code and docs/architecture.md is its current picture
+"""The layer rule holds in the code and docs/development/architecture.md is its current picture
 (scripts/architecture --check: every `use` goes to the same or a lower layer, solvers and
 models never use each other; the generated tables match the code)."""
 import os

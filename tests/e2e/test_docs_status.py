@@ -75,6 +75,21 @@ def test_sections_count_the_code_commits_since_their_run(tmp_path):
     assert hashes["run"] == [later]
 
 
+def test_a_moved_section_is_judged_from_the_commit_that_first_wrote_it(tmp_path):
+    """A page moved into a folder (or split: its sections written into new pages) keeps
+    the commit of its run: the move writes the stamp again, but into docs/ it was first
+    written by the run's commit."""
+    second, with_page, later = _repo(tmp_path)
+    (tmp_path / "docs" / "sub").mkdir()
+    subprocess.run(["git", "-C", str(tmp_path), "mv", "docs/committed.md",
+                    "docs/sub/moved.md"], check=True)
+    subprocess.run(["git", "-C", str(tmp_path), "-c", "user.name=t", "-c", "user.email=t@t",
+                    "commit", "-qm", "move the page"], check=True)
+    rows = {r["name"]: r for r in docs_status.status(tmp_path)}
+    assert rows["run"]["page"] == "docs/sub/moved.md"
+    assert [c[0] for c in rows["run"]["commits"]] == [later]
+
+
 def test_check_fails_on_a_stale_section(tmp_path, capsys):
     _repo(tmp_path)
     assert docs_status.main(["--root", str(tmp_path)]) == 0
@@ -108,3 +123,14 @@ def test_a_bad_line_in_numbers_unchanged_is_named(tmp_path):
         docs_status.status(tmp_path)
     message = str(stop.value)
     assert "numbers-unchanged.txt: line 3: 'not-a-commit' is not a commit" in message
+
+
+def test_a_section_a_test_keeps_current_is_not_listed(tmp_path):
+    """The key reference is written exactly from the program (no run, no date): its test
+    checks it, not docs_status."""
+    _repo(tmp_path)
+    (tmp_path / "docs" / "keys.md").write_text(
+        "<!-- keys:begin -->\nWritten by `scripts/keys_reference` from `ropedyn keys`.\n"
+        "<!-- keys:end -->\n")
+    names = {r["name"] for r in docs_status.status(tmp_path)}
+    assert "keys" not in names and "run" in names

@@ -5,7 +5,7 @@ as inputs; a full file system (an LD_PRELOAD shim that fails writes as a full di
 `ulimit -f`, and a small tmpfs where mounting is allowed); the resume from a record with
 velocities of 1e50, which hung; two runners on one sweep. Each case asserts the exit code,
 its one message line, that no protected file changed (checksums) and that no run file is
-left 'running' (docs/output.md, "Write, lock and resume rules")."""
+left 'running' (docs/guide/output.md, "Write, lock and resume rules")."""
 import hashlib
 import os
 import pathlib

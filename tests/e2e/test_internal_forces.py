@@ -1,4 +1,4 @@
-"""The internal forces and support reactions the model stores (docs/output.md, /forces and
+"""The internal forces and support reactions the model stores (docs/reference/file-format.md, /forces and
 /supports; definitions in docs/theory/internal-forces.md): the datasets of a run and of the
 statics, the stored reaction of a moving top against the rope's momentum balance from the
 file for every model and integrator, the static reaction of a moving top, the run

@@ -122,7 +122,7 @@ def test_auto_does_not_try_mebdf_early_on_the_mpp(run, tmp_path):
     """The early trial above is for problems without a mass matrix. On the MPP at rtol
     1e-2 erk's steps sit at the stable step too, but an MEBDF step there (M(q) in its
     residual, a dense Newton matrix) costs so much more that the trial is no cheap
-    experiment: with it, the 0.5 s windows of docs/accuracy.md went to mebdf at once
+    experiment: with it, the 0.5 s windows of docs/validation/accuracy.md went to mebdf at once
     and cost 7 to 11 times erk's. Here (n = 30, 0.5 s) auto stays explicit."""
     proc, out = run_scene(run, tmp_path, ROOT / "input" / "paper.nml", "mpp_loose",
                           "model.kind='mpp'", "model.elements=30", "solver.rtol=1e-2",

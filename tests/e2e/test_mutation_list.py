@@ -1,7 +1,7 @@
 """The mutation list of scripts/mutation_check stays valid as the code moves: every
 mutation's snippet occurs exactly once in its file, ids are unique, the declared tests exist
 (CTest programs registered in tests/CMakeLists.txt, pytest files present), and the list is
-as large as docs/testing.md promises. A snippet is found as Fortran (blanks, comments and
+as large as docs/development/testing.md promises. A snippet is found as Fortran (blanks, comments and
 continuations aside), so reformatting keeps it and a change of the code loses it. (The
 check itself takes minutes and runs on demand.)"""
 import os
@@ -118,7 +118,7 @@ def test_list_covers_every_area_and_the_page_names_it():
     areas = {m.file.split("/")[1] if m.file.startswith("src/") else m.file.split("/")[0]
              for m in MUTATIONS}
     assert {"models", "io", "studies", "solvers"} <= areas, areas
-    page = (ROOT / "docs" / "testing.md").read_text()
+    page = (ROOT / "docs" / "development" / "testing.md").read_text()
     assert "scripts/mutation_check" in page and BEGIN in page and END in page
 
 

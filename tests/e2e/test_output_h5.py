@@ -49,7 +49,7 @@ def test_layout_and_rerun(run, tmp_path):
 
 def test_free_rope_falls_freely(run, tmp_path):
     """The same rope with its top free: released straight and unstretched, every element
-    starts in free fall (docs/physics-rfem.md, "Initial states") and no strain ever builds
+    starts in free fall (docs/theory/rfem.md, "Initial states") and no strain ever builds
     up, so every element centre falls g t^2/2 from rest, none moves sideways or turns.
     Measured: 7.5e-10 m at rtol 1e-8 (the integrator's error of its first, low-order
     steps); bound 5e-9 m."""

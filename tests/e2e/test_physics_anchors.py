@@ -1,4 +1,4 @@
-"""Published numbers of shared/docs/physics.md reproduced by the whole program, and the
+"""Closed forms of docs/theory/statics-modes.md reproduced by the whole program, and the
 paper's experiment against an independent implementation (tests/e2e/rfem_oracle.py)."""
 import h5py
 import numpy as np
@@ -8,11 +8,11 @@ import rfem_oracle
 
 def test_paper_experiment_against_an_independent_implementation(run, tmp_path):
     """The paper's experiment with n = 6 (Table 1 rope, damping 1e3/400, released from
-    75 deg) against tests/e2e/rfem_oracle.py, an independent RFEM written from physics.md as
+    75 deg) against tests/e2e/rfem_oracle.py, an independent RFEM written from the paper's equations as
     energies only (forces by complex-step derivatives of the strains, fixed-step RK4), over
     the first 2 s, before the motion's sensitivity grows: from 3 s on, two accurate
     solutions separate exponentially (5 s: 0.1 m at the tip, 8 % in the dissipated energy;
-    physics.md's "about 0.023 J in 5 s, 0.18 J in 30 s" of another implementation is in
+    a published "about 0.023 J in 5 s, 0.18 J in 30 s" of another implementation is in
     that regime and cannot be a sharp anchor). E0 = -m g (L/2) cos 75 deg = -0.1495603 J
     exactly. Measured at rtol 1e-8 (Debug build, oracle dt = 5e-4 s): tip 6.0e-7 m,
     dissipated 1.8e-8 J (of 1.486e-3 J at 2 s), T + V 3.7e-8 J, energy balance 2.7e-8 J;

@@ -42,6 +42,7 @@ COMMANDS = {
     "update_references": "ropedyn_tools.update_references",
     "mutation_check": "ropedyn_tools.mutation_check",
     "docs_status": "ropedyn_tools.docs_status",
+    "keys_reference": "ropedyn_tools.keys_reference",
 }
 # Python files under scripts/ that the README and docs/ call by path
 SHIMS = {"plot_energy.py": "ropedyn.plot.energy",

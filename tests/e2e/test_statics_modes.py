@@ -143,7 +143,7 @@ def test_clamped_top_converges(run, tmp_path, kind, tension, lowest):
     """The clamped top converges at (better than) first order: the change of omega_1 from
     n to 3n shrinks by more than 3 for n = 20, 60, 180. The clamp's rotational SDE and its
     neighbour share the first primary section (RFEM: 2 EI/dl each; MPP: the clamp 2 EI/l,
-    docs/validation.md section 2). Measured ratios 3.7 (RFEM, order 1.2) and 6.0 (MPP,
+    docs/validation/statics-modes.md section 2). Measured ratios 3.7 (RFEM, order 1.2) and 6.0 (MPP,
     order 1.6); with the clamp at EI/dl on top of the sections (the former model) the
     same ratio for n = 30, 100, 300 was 1.8 and 2.6 (order 0.5 and 0.8). RFEM's
     extensibility shifts its limit by -5e-4, hence differences rather than errors against

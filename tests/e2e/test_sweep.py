@@ -185,7 +185,7 @@ def test_task_equals_case_run_alone(run, sweep_dir):
 
 
 # ---------------------------------------------------------------------------------------
-# One writer per case, status, signals (docs/sweeps.md, "One writer per case")
+# One writer per case, status, signals (docs/guide/sweeps.md, "One writer per case")
 # ---------------------------------------------------------------------------------------
 
 # cases of one to two seconds each (Debug build): long enough to be caught while running

@@ -136,7 +136,7 @@ def test_work_precision_script_print_only(ropedyn_exe):
     scd = [float(r[1]) for r in rows]
     steps = [int(r[2]) for r in rows]
     assert scd == sorted(scd) and steps == sorted(steps), rows
-    # The reference row: MEBDFI's and CVODE's counts quoted from docs/solvers.md (constants
+    # The reference row: MEBDFI's and CVODE's counts of docs/theory/testset.md (constants
     # of the script), then ours interpolated at those scd values (positive integers).
     ref = re.search(r"^\| HIRES \| 1e-06 \| 3\.30 / 168 \| (\d+) \| 2\.37 / 374 \| (\d+) \|$",
                     result.stdout, re.M)

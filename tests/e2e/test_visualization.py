@@ -1,4 +1,4 @@
-"""Seeing the results (docs/visualization.md): animations, the overview plot, the XDMF
+"""Seeing the results (docs/guide/visualization.md): animations, the overview plot, the XDMF
 sidecar read by ParaView, the README figures, and the derived fields they show.
 
 Small runs (5 elements, 0.2 s) are made once per module; each script runs as a user would

@@ -1,5 +1,5 @@
 """The failure path end to end: a NaN in the right-hand side (the testing aid
-`&effects fault_nan_after`, docs/input.md) or an exhausted step budget ends the run with
+`&effects fault_nan_after`, docs/guide/effects.md) or an exhausted step budget ends the run with
 exit code 3 and one message naming the time, the step size and the cause; the HDF5 file is
 marked failed with that reason, holds only finite numbers, and keeps every record before
 the failure unchanged (bit for bit the records of the same run without the fault)."""

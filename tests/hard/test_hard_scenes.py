@@ -1,5 +1,5 @@
 """The stiff-case suite: every hard scene of input/hard, with both solvers at their defaults,
-keeps the guarantees of docs/stability.md:
+keeps the guarantees of docs/validation/hard-scenes.md:
 
 1. it completes within its step budget (`&solver max_steps`), or it fails with exit code 3,
    status 'failed' and a reason naming the time, the step size and the cause;
@@ -12,7 +12,7 @@ keeps the guarantees of docs/stability.md:
 S is the energy scale of the run (ropedyn_tools.studies.stability_metrics: max T + max elastic +
 gravity range + dissipated) and L the rope length. B_E (per scene and solver) and B_X (per
 scene) are three times the larger of the values measured with the Debug and the Release
-build, rounded up to one digit (docs/stability.md, "The guarantees"; measured values in the
+build, rounded up to one digit (docs/validation/hard-scenes.md, "The guarantees"; measured values in the
 comments of ENERGY_BOUND and TIP_BOUND, regenerate them with the measurement described
 there). Forces that are not the gradient of their energy make errors of order S (1e6 rtol S),
 far beyond every bound; a solver whose error control loosens shows in the bounds too. The

@@ -1,4 +1,4 @@
-"""Order safety end to end (docs/stability.md, "Order safety"): CVODE held at order 4 (not
+"""Order safety end to end (docs/validation/order-safety.md): CVODE held at order 4 (not
 A-stable) on the undamped rope at rtol 1e-3 creates energy within a second (measured:
 T + V + dissipated reaches E0 + 10 rtol S at 0.7 s, 850 rtol S at 10 s). The run driver's
 energy monitor sees the balance rise above E0 by more than `energy_gain_bound` rtol S and

@@ -1,8 +1,8 @@
-"""Long-horizon guarantees (issue 18; docs/stability.md, "Long horizons"): every hard scene
+"""Long-horizon guarantees (issue 18; docs/validation/long-horizon.md): every hard scene
 of input/hard to its full t_end, with the default method and with every method of
 ropedyn_tools.studies.long_horizon.METHODS at rtol 1e-3, 1e-5 and 1e-7 (atol = rtol/100), in the
 Release build: 311 runs (METHODS = cvode, mebdf, adams, erk). CTest label `long`
-(`scripts/test --long`, about half an hour of CPU, see docs/stability.md); not part of the
+(`scripts/test --long`, about half an hour of CPU, see docs/validation/long-horizon.md); not part of the
 normal suite.
 
 For every case:
@@ -45,7 +45,7 @@ import pytest
 from ropedyn_tools.studies import long_horizon as lh
 
 #: B_E per method: bound on balance error / (rtol S), about three times the largest measured
-#: over all scenes and tolerances outside KNOWN_DEFECTS (docs/stability.md "Long horizons")
+#: over all scenes and tolerances outside KNOWN_DEFECTS (docs/validation/long-horizon.md)
 BALANCE_BOUND = {"cvode": 6e3,   # 1871: undamped, rtol 1e-7
                  "mebdf": 2e2,   # 58: undamped, rtol 1e-5
                  # 18.4 on mpp_undamped (the default runs, rtol 1e-6), where auto now

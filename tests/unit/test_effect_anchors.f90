@@ -1,7 +1,7 @@
 !> Independent anchors for the external effects, in both models where they apply. Each
 !! expected value is derived here from the law the effect is meant to implement, not from
 !! the model's energy bookkeeping, so a wrong coefficient used consistently fails.
-!! Derivations (also in docs/testing.md, "Anchors"); lambda = rho A is the rope's mass per
+!! Derivations (also in docs/development/testing.md, "Anchors"); lambda = rho A is the rope's mass per
 !! length, M = lambda L, g = 9.81, x down, y horizontal, angles from x towards y:
 !!
 !! - Drag, c_n /= c_t (RFEM): a free straight rope at 45 deg with linear drag only. Every
@@ -39,7 +39,7 @@
 !!   spring (k = EA/l) at an anchor delta below the tip: the spring stores k delta^2/2, which
 !!   leaves the books at the release; the rope stays at rest.
 !! Tolerances are a few times the discrepancies measured (Debug build, CVODE; printed by
-!! each check and listed in docs/testing.md).
+!! each check and listed in docs/development/testing.md).
 program test_effect_anchors
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t

@@ -1,4 +1,4 @@
-!> One physics check per effect (docs/physics-rfem.md, "Effects"):
+!> One physics check per effect (docs/theory/effects.md):
 !! - drag: the terminal speed of a falling horizontal rope against the balance of weight and
 !!   quadratic drag; with linear drag and a current, the drift velocity (lambda g / c_n, u);
 !! - ground: a rope sliding along the ground carries its weight in contact force and stops
@@ -13,7 +13,7 @@
 !! Bounds are about three times the larger of the values measured with the Debug and the
 !! Release build (CVODE at the rtol given; printed by each check): e.g. the drag balances
 !! 8.0e-9 and 3.9e-8 J, the every-effect balance 3.1e-8 (RFEM, Release 8.0e-8) and 6.5e-8 of
-!! the energy moved (docs/testing.md). Without the quadratures' error control the drag
+!! the energy moved (docs/development/testing.md). Without the quadratures' error control the drag
 !! balances reach 4.1e-8 and 2.3e-7 J and fail.
 program test_effects_physics
     use ropedyn_kinds, only: wp

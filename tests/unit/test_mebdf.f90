@@ -1,5 +1,5 @@
 !> Tests of the MEBDF integrator: coefficients against the order conditions and the exact
-!! fractions of docs/solvers.md; observed order at fixed step and order; the mass-matrix
+!! fractions of docs/theory/mebdf.md; observed order at fixed step and order; the mass-matrix
 !! form; quadratures; per-component atol; difference Jacobians; re-entrancy; stability
 !! on a lightly damped stiff oscillator; failure reports.
 module test_mebdf_problems
@@ -274,7 +274,7 @@ program test_mebdf
 
 contains
 
-    !> Exact fractions of docs/solvers.md against the coefficients solved in code, and the
+    !> Exact fractions of docs/theory/mebdf.md against the coefficients solved in code, and the
     !! order conditions themselves (including that q = k+2 fails: the order is exactly k+1).
     subroutine test_coefficients()
         type(mebdf_coefficients_t) :: c
@@ -559,7 +559,7 @@ contains
     !> A slow undamped mode (omega 50, amplitude 1) drives the step size; a lightly damped
     !! stiff mode (omega 1e3, zeta 1e-4) sits below the tolerance (amplitude 1e-9). Its
     !! energy must not grow (exact: decays to e^-2 in 10 s). MEBDF up to order 4 is stable
-    !! on the imaginary axis; orders 5 and 6 amplify there (docs/solvers.md), which is why
+    !! on the imaginary axis; orders 5 and 6 amplify there (docs/theory/mebdf.md), which is why
     !! the default max_order is 4: this test shows both.
     subroutine test_hidden_mode()
         type(oscillator_t), target :: p

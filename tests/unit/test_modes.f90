@@ -1,4 +1,4 @@
-!> Modal analysis (ropedyn_modes) against theory (shared/docs/physics.md, validation anchors):
+!> Modal analysis (ropedyn_modes) against theory (docs/theory/statics-modes.md, the closed forms):
 !! - the hanging chain (top pinned, EI = 0): omega_k = (j_{0,k}/2) sqrt(g/L), RFEM and MPP at
 !!   n = 100;
 !! - the hanging rope with its bending stiffness (MPP, beam reference);
@@ -23,7 +23,7 @@ program test_modes
     !> (j_{0,k}/2) sqrt(g/L), L = 1 m, g = 9.81 m/s^2
     real(wp), parameter :: BESSEL(5) = [3.766067388_wp, 8.644696114_wp, 13.552135778_wp, &
                                         18.466085063_wp, 23.382503600_wp]
-    !> converged beam reference with the rope's EI, pinned top (physics.md)
+    !> converged beam reference with the rope's EI, pinned top (docs/theory/statics-modes.md)
     real(wp), parameter :: BEAM_PINNED(5) = [3.76847_wp, 8.94578_wp, 15.44021_wp, &
                                              23.48340_wp, 32.92258_wp]
     type(test_suite_t) :: suite

@@ -1,5 +1,5 @@
 !> Independent anchors for the MPP's damping rules, the axial stiffness of both models and
-!! point masses in both models (docs/testing.md, "Anchors"). lambda = rho A, M = lambda L,
+!! point masses in both models (docs/development/testing.md, "Anchors"). lambda = rho A, M = lambda L,
 !! EA, EI, tau = eta/E; x down, y horizontal.
 !!
 !! - MPP axial damping (factor a = 2): the members' springs k = EA/l and dampers
@@ -20,7 +20,7 @@
 !!   point mass m_p at arc length s_p, w0^2 = g (M L/2 + m_p s_p)/(M L^2/3 + M d^2/16 +
 !!   m_p s_p^2), and the period at amplitude theta0 is 2 pi/w0 (1 + theta0^2/16 + ...).
 !! Tolerances are a few times the discrepancies measured (Debug build, CVODE; printed by
-!! each check and listed in docs/testing.md).
+!! each check and listed in docs/development/testing.md).
 program test_mpp_anchors
     use ropedyn_kinds, only: wp
     use ropedyn_test_run, only: run_t, simulate, completed, kind_set, SET_LEN

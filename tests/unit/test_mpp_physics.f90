@@ -14,7 +14,7 @@ program test_mpp_physics
     use ropedyn_assert, only: test_suite_t
     implicit none
 
-    !> (j_{0,1}/2) sqrt(g/L) for L = 1 m, g = 9.81 m/s^2 (docs/physics.md)
+    !> (j_{0,1}/2) sqrt(g/L) for L = 1 m, g = 9.81 m/s^2 (docs/theory/statics-modes.md)
     real(wp), parameter :: OMEGA_BESSEL = 3.766067_wp
     real(wp), parameter :: PI = 4.0_wp*atan(1.0_wp)
     type(test_suite_t) :: suite
@@ -135,7 +135,7 @@ contains
     !! as n grows (n = 10, 20, 40).
     subroutine test_rfem_mpp_convergence()
         integer, parameter :: ns(3) = [10, 20, 40]
-        !> the distances quoted in docs/physics-mpp.md (measured at rtol 1e-8, where they are
+        !> the distances quoted in docs/theory/mpp.md (measured at rtol 1e-8, where they are
         !! reproducible to ~1e-6 relative; 1 % covers the quoted digits)
         real(wp), parameter :: quoted(3) = [3.61e-3_wp, 1.12e-3_wp, 6.04e-4_wp]
         real(wp) :: dist(3)
@@ -147,7 +147,7 @@ contains
             call tip_history('mpp', ns(i), tip_m)
             dist(i) = maxval(norm2(tip_r - tip_m, dim=1))
             write (label, '(a, i0, a, es11.4, a)') 'n = ', ns(i), &
-                ': max |tip_rfem - tip_mpp| over 0.5 s = ', dist(i), ' m (docs/physics-mpp.md)'
+                ': max |tip_rfem - tip_mpp| over 0.5 s = ', dist(i), ' m (docs/theory/mpp.md)'
             call suite%check_close(dist(i), quoted(i), 0.01_wp, 0.0_wp, trim(label))
         end do
         call suite%check_true(dist(2) < 0.6_wp*dist(1) .and. dist(3) < 0.8_wp*dist(2), &

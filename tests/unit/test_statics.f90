@@ -1,7 +1,7 @@
 !> Static equilibrium (ropedyn_statics) of both models against closed forms:
 !! - the hanging rope's static stretch (exact for each discretization) and support force,
 !!   reached from a straight start at 75 degrees;
-!! - the elastic catenary (Irvine; shared/docs/physics.md): sag, H and T_max of a stiff
+!! - the elastic catenary (Irvine; docs/theory/statics-modes.md): sag, H and T_max of a stiff
 !!   (EA = 687.22 N) and a soft (EA = 10 N) rope hung between two pins 0.8 m apart, started
 !!   hanging vertically with the bottom support spring stretched by 1.28 m;
 !! - the equilibrium residual, the 'equilibrium' and 'mode' initial shapes, and the errors
@@ -30,7 +30,7 @@ program test_statics
     if (len_trim(source_dir) == 0) source_dir = '.'
     call test_hanging('rfem')
     call test_hanging('mpp')
-    ! Irvine's elastic catenary, span 0.8 m, supports at equal height (physics.md)
+    ! Irvine's elastic catenary, span 0.8 m, supports at equal height (docs/theory/statics-modes.md)
     call test_catenary('rfem', 100, 35.0e6_wp, 0.389941_wp, 0.265999_wp, 0.697117_wp)
     call test_catenary('rfem', 100, 10.0_wp/AREA, 0.340871_wp, 0.300012_wp, 0.670904_wp)
     call test_catenary('mpp', 50, 35.0e6_wp, 0.389941_wp, 0.265999_wp, 0.697117_wp)

@@ -39,7 +39,7 @@ program test_testset_accuracy
     end type shortfall_t
     type(shortfall_t), parameter :: known_shortfalls(*) = [ &
         shortfall_t('cvode', 'OREGO', 1.0e-9_wp, 6.5_wp, &
-                    'CVODE global error ~130 rtol on OREGO (scd 6.88; solvers.md: 7.50 at 1e-10)')]
+                    'CVODE global error ~130 rtol on OREGO (scd 6.88; 7.50 at 1e-10)')]
 
     type(test_suite_t) :: suite
     class(testset_problem_t), allocatable :: p

@@ -39,7 +39,7 @@ program test_testset_problems
 
 contains
 
-    !> Sizes, intervals, y0 (transcribed again here from docs/solvers.md and pollu.f),
+    !> Sizes, intervals, y0 (transcribed again here from docs/theory/testset.md and pollu.f),
     !! reference sizes, bandwidths and tolerance rules.
     subroutine check_definitions()
         real(wp), allocatable :: y0(:)

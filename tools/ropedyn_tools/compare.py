@@ -6,7 +6,7 @@ Works for the files of `ropedyn run`, `ropedyn statics` and `ropedyn modes`: the
 of TOLERANCES that the reference holds are compared (a quantity missing from the new file
 fails). Each has an explicit absolute tolerance in its own units. The references are
 converged: scripts/update_references refuses one that differs from its own run at a ten
-times tighter solver tolerance by more than these tolerances (docs/testing.md), so a more
+times tighter solver tolerance by more than these tolerances (docs/development/testing.md), so a more
 accurate run of a reference scene passes; the tolerances also allow for the differences
 between compilers, optimization levels and LAPACK builds (measured: ~1e-9 m between the
 Debug and Release builds), and are far below what a change in the physics produces (a 1 %

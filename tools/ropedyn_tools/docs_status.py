@@ -1,10 +1,12 @@
 """Which generated sections of docs/ were written before the code under them last changed.
 
 Every table or figure in docs/ stands between two markers, `<!-- NAME:begin -->` and
-`<!-- NAME:end -->`, and opens with the command that wrote it and when (a "Run:" stamp, a
-"(... min, YYYY-MM-DD HH:MM UTC)" or a "YYYY-MM-DD, commit `abc1234`" line). For each section
+`<!-- NAME:end -->`, and opens with the command that wrote it, when, and on which commit (a
+"Run: YYYY-MM-DD HH:MM UTC, commit `abc1234`" stamp, a "(... min, YYYY-MM-DD HH:MM UTC)" or
+a "YYYY-MM-DD, commit `abc1234`" line; the studies write the commit when the code they ran
+had no uncommitted changes: studies.common.run_stamp). For each section
 this lists the commits that changed the code its numbers come from after the commit that
-wrote that stamp into the page (after the run's time while it is not committed): the
+first wrote that stamp into docs/ (after the run's time while it is not committed): the
 Fortran (src/, solvers/, CMakeLists.txt), the scenes (input/) and the study's own module
 (tools/ropedyn_tools/studies/SCRIPT.py or tools/ropedyn_tools/SCRIPT.py, earlier
 python/ropedyn/studies/SCRIPT.py; SCRIPT read from the section's command; NARROWER lists
@@ -37,6 +39,11 @@ CODE_PATHS = ("src", "solvers", "CMakeLists.txt", "input")
 NARROWER = {
     # the stiff test set: the integrators and their driver, no rope, no scene
     "work_precision_testset": ("solvers", "CMakeLists.txt"),
+}
+#: sections whose currency a test checks instead (their script regenerates them exactly from
+#: the program: no run to date); not listed
+CHECKED_BY_TESTS = {
+    "keys_reference": "tests/e2e/test_keys.py",
 }
 #: the line of a commit message that keeps a code commit from counting (see above)
 UNCHANGED = "Numbers-unchanged:"
@@ -136,23 +143,28 @@ def code_commits(root, since, paths, commit=None, skip=frozenset()):
 
 
 def status(root=ROOT):
-    """One row per generated section of root/docs/*.md: dict(page, name, script, stamp,
+    """One row per generated section of root/docs/**/*.md: dict(page, name, script, stamp,
     commits); commits None when the section names no run time."""
     root = pathlib.Path(root)
     skip = unchanged_commits(root)
     rows = []
-    for page in sorted((root / "docs").glob("*.md")):
+    for page in sorted((root / "docs").rglob("*.md")):
         for name, script, stamp, commit in sections(page):
+            if script in CHECKED_BY_TESTS:
+                continue
             paths = list(NARROWER.get(script, CODE_PATHS))
             if script:
                 paths += [f"{folder}/{script}.py" for folder in STUDY_FOLDERS]
             commits = None
             if stamp and not commit:
-                # the commit that wrote this stamp into the page: the code it ran is that
-                # commit's (a study is run on the working tree and committed with the code
-                # it measured); a stamp not committed yet is judged by its time
-                commit = _git_text(root, "log", "-1", "--format=%h", "-S", stamp, "--",
-                                  str(page.relative_to(root))) or None
+                # the commit that first wrote this stamp into docs/: the code it ran is
+                # that commit's (a study is run on the working tree and committed with the
+                # code it measured); the first, since a page may have moved or been split
+                # since (which writes the stamp again); a stamp not committed yet is
+                # judged by its time
+                written = _git_text(root, "log", "--format=%h", "-S", stamp, "--",
+                                    "docs").split()
+                commit = written[-1] if written else None
             if stamp or commit:
                 when = run_time(stamp) if stamp else None
                 commits = code_commits(root, when, paths, commit, skip)

@@ -11,7 +11,7 @@ tests run first (the CTest programs and pytest files that guard its area); when 
 pass, the whole suite runs (CTest, then pytest tests/e2e tests/hard). A mutation is
 "caught" when a test fails (the first failing test is reported), "survived" when the whole
 suite passes. Before the first mutation the declared tests run once on the unchanged copy
-(they must pass). The result table is written into docs/testing.md between the markers
+(they must pass). The result table is written into docs/development/testing.md between the markers
 <!-- mutation-results:begin --> and <!-- mutation-results:end --> (not with --no-write or
 --only). Takes about 10 minutes on two cores when every mutation is caught by its declared
 tests; each survivor costs a full suite run (~3 minutes). Run on demand, not part of CI.
@@ -39,7 +39,7 @@ import time
 
 from ropedyn_tools.repo import ROOT
 
-DOC = ROOT / "docs" / "testing.md"
+DOC = ROOT / "docs" / "development" / "testing.md"
 BEGIN, END = "<!-- mutation-results:begin -->", "<!-- mutation-results:end -->"
 
 
@@ -486,7 +486,7 @@ def apply(tree, m):
 
 
 def results_table(results, commit, minutes):
-    """The docs/testing.md section with the results."""
+    """The docs/development/testing.md section with the results."""
     caught = sum(r["status"] == "caught" for r in results)
     lines = [BEGIN, "",
              f"Last run: {datetime.date.today().isoformat()}, commit `{commit}`, "
@@ -519,7 +519,7 @@ def main(argv=None):
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--only", help="comma-separated mutation ids")
     parser.add_argument("--list", action="store_true", help="print the mutations and exit")
-    parser.add_argument("--no-write", action="store_true", help="do not update docs/testing.md")
+    parser.add_argument("--no-write", action="store_true", help="do not update docs/development/testing.md")
     parser.add_argument("--full", action="store_true",
                         help="run the whole suite for every mutation (not the declared tests first)")
     parser.add_argument("--workdir", type=pathlib.Path, default=ROOT / "build" / "mutation",

@@ -27,7 +27,7 @@ from ropedyn.namelist import parse_namelist
 from ropedyn_tools.repo import ROOT, add_exe_argument, exe_or_build
 
 REFERENCE = ROOT / "tests" / "reference"
-#: solver tolerances of a scene that does not set them (docs/input.md, &solver)
+#: solver tolerances of a scene that does not set them (docs/reference/keys.md, &solver)
 DEFAULT_RTOL, DEFAULT_ATOL = 1e-6, 1e-8
 #: largest residual / weight of an accepted statics or modes reference
 STATICS_RESIDUAL = 1e-10

@@ -7,7 +7,7 @@ usage: scripts/plot RUN.h5 [-o RUN_plot.png] [--times 0.5,1,2] [--size 1200x900]
 
 Works from the HDF5 file alone (any model): the axial force is the one the model stored
 with each record (a file written before that has none: the panel says so; see
-docs/visualization.md).
+docs/guide/visualization.md).
 """
 import argparse
 import pathlib

@@ -1,4 +1,4 @@
-!> Drag of the surrounding fluid on each body (docs/physics-rfem.md, "Drag").
+!> Drag of the surrounding fluid on each body (docs/theory/effects.md, "Drag").
 !!
 !! With the velocity relative to the fluid v_r = v - u (u a uniform current), split into the
 !! tangential part a = e . v_r and the normal part b = n . v_r, a body of length l feels at

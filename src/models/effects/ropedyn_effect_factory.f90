@@ -1,6 +1,6 @@
 !> Builds the external effects a spec enables, for a model whose bodies tile the rope:
 !! body i covers the arc lengths [s_i, s_i + l_i] of the unstretched rope from its top end.
-!! Only enabled effects are allocated (docs/input.md, `&effects`).
+!! Only enabled effects are allocated (docs/guide/effects.md, `&effects`).
 module ropedyn_effect_factory
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
     use ropedyn_kinds, only: wp

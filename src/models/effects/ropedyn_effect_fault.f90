@@ -1,5 +1,5 @@
 !> Testing aid: forces and moments that turn NaN after a given time (`&solver
-!! fault_nan_after`, docs/input.md).
+!! fault_nan_after`, docs/guide/effects.md).
 !!
 !! It exists to test the failure path end to end through a real model: a NaN in the forces
 !! must make the model report a recoverable error (`STATUS_RECOVERABLE`: the integrator cuts

@@ -1,4 +1,4 @@
-!> Contact of the rope with a ground plane (docs/physics-rfem.md, "Ground contact").
+!> Contact of the rope with a ground plane (docs/theory/effects.md, "Ground contact").
 !!
 !! The plane passes through p0 with unit normal n_g pointing to the free side. Contact acts
 !! at both end points X = c +- (l/2) e of each body, each point standing for half the body's

@@ -1,7 +1,7 @@
 !> The multiple physical pendulum (MPP) rope model: n identical members, each a massless
 !! spring (elongation u_i) followed by a uniform rigid rod (length l = L/n, mass m = M/n),
 !! joined by elastic-dissipative joints; Lagrange's equations M(q) q'' = f(t, q, q').
-!! Derivation and parameter rules: docs/physics-mpp.md.
+!! Derivation and parameter rules: docs/theory/mpp.md.
 !!
 !! Coordinates q = (phi_1 .. phi_n, u_1 .. u_nu) with nu = n (extensible, &effects
 !! tension = .true.) or nu = 0 (inextensible members). State y = (q, q').
@@ -14,7 +14,7 @@
 !! solves M(q) q'' = f in O(n) as well: M is the mass matrix of a chain whose members hang
 !! from the previous joint by a translation only (the angles are absolute), so the tip-to-
 !! root recursion of articulated-body inertias (2x2 per joint) factors it and two sweeps
-!! solve (mass_factor, ab_solve; docs/physics-mpp.md). The dense M(q) is assembled (O(n^2),
+!! solve (mass_factor, ab_solve; docs/theory/mpp.md). The dense M(q) is assembled (O(n^2),
 !! cos/sin of each angle once) only for the implicit form and the modal analysis.
 !!
 !! External effects (drag, ground contact, point loads; ropedyn_effect) act on the rods as

@@ -1,5 +1,5 @@
 !> The MPP's energies (kinetic, elastic, gravity, the effects') and the powers integrated
-!! as quadratures (dissipation, external work). docs/physics-mpp.md.
+!! as quadratures (dissipation, external work). docs/theory/mpp.md.
 submodule (ropedyn_mpp) ropedyn_mpp_energy
     implicit none
 

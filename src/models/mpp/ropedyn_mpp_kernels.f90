@@ -1,7 +1,7 @@
 !> The MPP kernels: the O(n) Lagrange residual, the O(n) solve of M(q) q'' = f by the
 !! articulated-body recursion, the dense mass matrix (O(n^2)), the Jacobian and the
 !! second-order blocks (O(n^2): a difference quotient of the residual and a solve per
-!! column), energies and powers. The derivation is in docs/physics-mpp.md.
+!! column), energies and powers. The derivation is in docs/theory/mpp.md.
 !!
 !! Work arrays are held by the model (allocated at creation): cos and sin of every angle
 !! once per call (self%cs), the rods' forces, the factors of M and the residual's
@@ -188,7 +188,7 @@ contains
         end do
     end procedure rod_bodies
 
-    !> The articulated-body recursion, from the tip (docs/physics-mpp.md, "Solving
+    !> The articulated-body recursion, from the tip (docs/theory/mpp.md, "Solving
     !! M q'' = f in O(n)"). The members k .. n, hanging from joint P_{k-1}, exert on it the
     !! force S_k = I_k A + z_k for its acceleration A, with a 2x2 articulated inertia I_k
     !! (I_{n+1} = 0: the tip is free of inertia; springs are forces, not inertia). With
@@ -311,7 +311,7 @@ contains
 
     !> The dense M(q) from cos/sin of the angles and the elongations u (zero when
     !! inextensible), O(n^2): for k <= j, c = cos(phi_j - phi_k) = c_k c_j + s_k s_j,
-    !! s = sin(phi_j - phi_k) = s_j c_k - c_j s_k (docs/physics-mpp.md, the table), then the
+    !! s = sin(phi_j - phi_k) = s_j c_k - c_j s_k (docs/theory/mpp.md, the table), then the
     !! point masses m_p J_p^T J_p.
     pure subroutine assemble_mass(n, nu, m, inertia, l, cs, u, pm_body, pm_r, pm_m, mm)
         integer, intent(in) :: n, nu, pm_body(:)

@@ -1,6 +1,6 @@
 !> The MPP's exact residual tangent: one column of d r(q, q', a)/d(q, q') in O(n) (the
 !! Jacobian and the implicit second-order blocks are built from these columns, in
-!! ropedyn_mpp_kernels). The derivation is in docs/physics-mpp.md.
+!! ropedyn_mpp_kernels). The derivation is in docs/theory/mpp.md.
 submodule (ropedyn_mpp) ropedyn_mpp_tangent
     implicit none
 

@@ -4,7 +4,7 @@
 !! spring-damping elements (SDEs). SDE j (j = 1 .. n+1) joins element j-1 to element j;
 !! elements 0 and n+1 are the supports. Its deformation, in the frame of element j-1, is
 !! (tension, shear, bending) = (e_{j-1}.d, n_{j-1}.d, phi_j - phi_{j-1}), d = A_j - B_{j-1}.
-!! The derivation (forces, the analytic Jacobian) is in docs/physics-rfem.md.
+!! The derivation (forces, the analytic Jacobian) is in docs/theory/rfem.md.
 !!
 !! Every deformation measure ("strain") s(q) enters as energy C s^2/2 and dissipation
 !! B (ds/dt)^2/2, so its generalized force is -(C s + B s') grad s. A strain kind exists

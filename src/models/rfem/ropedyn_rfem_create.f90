@@ -1,5 +1,5 @@
 !> Building an RFEM model from its spec: element lengths and masses, the spring-damping
-!! constants, supports, point masses and effects (docs/physics-rfem.md).
+!! constants, supports, point masses and effects (docs/theory/rfem.md, docs/theory/effects.md).
 submodule (ropedyn_rfem) ropedyn_rfem_create
     implicit none
 

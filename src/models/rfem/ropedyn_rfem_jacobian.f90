@@ -1,7 +1,7 @@
 !> The RFEM's point masses (the accelerations of the elements carrying them, and their rows
 !! of the Jacobian blocks) and the writing of the 3x6 blocks of element pairs, which
 !! ropedyn_rfem_kernels' `jacobian_blocks` leaves in self%blk, into the first-order band
-!! (`jacobian`) or the second-order blocks (`second_order_blocks`). docs/physics-rfem.md.
+!! (`jacobian`) or the second-order blocks (`second_order_blocks`). docs/theory/rfem.md.
 submodule (ropedyn_rfem) ropedyn_rfem_jacobian
     implicit none
 

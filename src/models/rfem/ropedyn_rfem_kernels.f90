@@ -1,6 +1,6 @@
 !> The RFEM kernels: generalized forces, right-hand side, the analytic Jacobian as blocks of
 !! element pairs (written into the band by ropedyn_rfem_jacobian), energies and the
-!! dissipation and external power (the derivation is in docs/physics-rfem.md).
+!! dissipation and external power (the derivation is in docs/theory/rfem.md).
 !!
 !! Each kernel makes one pass over the internal SDEs j = 2 .. n (elements a = j-1, b = j),
 !! with cos and sin of every angle computed once per call (self%cs), and takes the geometry

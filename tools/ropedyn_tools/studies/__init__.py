@@ -3,12 +3,15 @@
 
 | module | command | writes |
 |---|---|---|
-| work_precision | scripts/work_precision | docs/results.md, docs/data/rope_*.csv, figures |
-| work_precision_testset | scripts/work_precision_testset | docs/benchmarks.md, testset_wp.csv, wp_*.png |
-| validation | scripts/validation | docs/validation.md |
-| stability_report | scripts/stability_report | docs/stability.md (measures: stability_metrics) |
-| bench_rfem, bench_models, bench_effects, bench_kernels, bench_step, bench_sweep, bench_peers | scripts/bench_* | docs/benchmarks.md |
-| profile_step | scripts/profile_step | docs/benchmarks.md (callgrind split of a step) |
+| work_precision | scripts/work_precision | docs/validation/work-precision.md, docs/data/rope_*.csv, figures |
+| work_precision_testset | scripts/work_precision_testset | docs/validation/testset.md, testset_wp.csv, wp_*.png |
+| validation | scripts/validation | docs/validation/statics-modes.md |
+| stability_report | scripts/stability_report | docs/validation/hard-scenes.md, cvode-order.md, long-horizon.md, order-safety.md (measures: stability_metrics) |
+| bench_rfem, bench_models | scripts/bench_rfem, bench_models | docs/performance/cost-vs-n.md |
+| bench_step, bench_kernels | scripts/bench_step, bench_kernels | docs/performance/step.md |
+| bench_effects, bench_sweep, bench_peers | scripts/bench_* | docs/performance/effects.md, sweeps.md, peers.md |
+| auto_table, auto_accuracy, cost_model | scripts/auto_table, ... | docs/performance/auto.md |
+| profile_step | scripts/profile_step | docs/performance/step.md (callgrind split of a step) |
 | fig5 | scripts/fig5 | docs/figures/fig5_energy.png, docs/data/fig5_energy.csv |
 | calibrate | scripts/calibrate | prints the fitted MPP damping factors |
 | readme_figures | scripts/readme_figures | docs/figures/rope_motion.png, energy.png |

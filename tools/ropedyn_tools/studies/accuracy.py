@@ -1,5 +1,5 @@
-"""What accuracy costs over the whole 30 s motion (issue 16): writes docs/accuracy.md,
-docs/data/acc_*.csv, docs/figures/acc_*.png and docs/choosing.md.
+"""What accuracy costs over the whole 30 s motion (issue 16): writes docs/validation/accuracy.md,
+docs/data/acc_*.csv, docs/figures/acc_*.png and docs/guide/choosing.md.
 
     scripts/accuracy windows        [--quick] [--methods cvode,cvode:2,adams,erk,mebdf:4,...]
     scripts/accuracy discretization [--quick]
@@ -13,7 +13,7 @@ A method is `name` or `name:max_order` with `name` any `&solver method` the exec
 lists (`ropedyn keys`): new integrators (erk, adams, auto, ...) are measured by adding their
 names to --methods. Runs go one at a time (`ropedyn run`, its own CPU time
 /solver/cpu_time). --quick is a smoke test (small n, short horizons, few tolerances); the
-full studies are meant for the final code and take hours on 2 cores (docs/accuracy.md).
+full studies are meant for the final code and take hours on 2 cores (docs/validation/accuracy.md).
 
 - windows: tight references to T (two integrators at rtol_ref, which must agree until the
   motion's divergence horizon); from the first reference's record at each t0 every method
@@ -44,10 +44,10 @@ import h5py
 import numpy as np
 
 from ropedyn_tools.repo import DOCS, add_exe_argument, exe_or_build
-from ropedyn_tools.studies.common import machine, update_doc, utc_stamp
+from ropedyn_tools.studies.common import machine, update_doc, run_stamp
 
-PAGE = DOCS / "accuracy.md"
-CHOOSING = DOCS / "choosing.md"
+PAGE = DOCS / "validation" / "accuracy.md"
+CHOOSING = DOCS / "guide" / "choosing.md"
 DATA = DOCS / "data"
 FIGURES = DOCS / "figures"
 SCENE = DOCS.parent / "input" / "paper.nml"
@@ -63,7 +63,7 @@ machine shared with other jobs: read factors below 1.3 as ties. Methods: CVODE B
 default order 5 and at order 2 (`cvode:2`), CVODE Adams, the explicit pair (`erk`, RK4),
 MEBDF at orders 4 and 7, and `auto` (the default). The answers drawn from these data
 (which n, rtol and method, and the cost of the whole motion) are on
-[choosing.md](choosing.md), written by `scripts/accuracy choosing` from the CSV files.
+[choosing.md](../guide/choosing.md), written by `scripts/accuracy choosing` from the CSV files.
 
 Left out, for cost: Figure 4's MPP above n = 70 with the implicit methods.
 """
@@ -166,7 +166,7 @@ def read_csv(path):
 
 def section(name, command, body, seconds):
     begin, end = f"<!-- accuracy-{name}:begin -->", f"<!-- accuracy-{name}:end -->"
-    block = (f"{begin}\n\nCommand: `{command}` ({seconds / 60:.1f} min, {utc_stamp()}). "
+    block = (f"{begin}\n\nCommand: `{command}` ({seconds / 60:.1f} min, {run_stamp()}). "
              f"Machine: {machine()}.\n\n{body}\n\n{end}")
     update_doc(PAGE, begin, end, block, default=PAGE_HEAD)
 
@@ -289,8 +289,8 @@ def windows_section(rows, agreement, t_end, t0s, width, rtols, note=""):
           "(cvode and mebdf; cvode and erk for the MPP at n >= 70); windows of "
           f"{width} s from t0 = {', '.join(f'{t:g}' for t in t0s)} s, each measured against "
           "a tight window reference restarted from the same record with the other "
-          "reference method. Raw data: [data/acc_windows.csv](data/acc_windows.csv), "
-          "[data/acc_windows_refs.csv](data/acc_windows_refs.csv)." + note, "",
+          "reference method. Raw data: [data/acc_windows.csv](../data/acc_windows.csv), "
+          "[data/acc_windows_refs.csv](../data/acc_windows_refs.csv)." + note, "",
           "**References** (horizon: last time the two agree within 1e-6 m at every point; "
           "after it they are two different, equally valid motions, which is why the windows "
           "restart from one of them)", "",
@@ -301,7 +301,7 @@ def windows_section(rows, agreement, t_end, t0s, width, rtols, note=""):
     md += ["", "**Per window** (tip L2 error m / all points m / pin force N / CPU s), median "
            "over the windows t0; the full table per t0 is in the CSV:", ""]
     md += window_table(rows, rtols)
-    md += ["", "![windowed accuracy against CPU](figures/acc_windows.png)"]
+    md += ["", "![windowed accuracy against CPU](../figures/acc_windows.png)"]
     return "\n".join(md)
 
 
@@ -400,7 +400,7 @@ def discretization(runner, args):
     md = [f"Tip position over [0, {t_end:g}] s (L2 in time) at n against a fine reference "
           f"(RFEM n = {fine['rfem']}, MPP n = {fine['mpp']}; rtol {tight:g}, CVODE): the "
           "discretization error. Time error: the same n at rtol r against its own rtol "
-          f"{tight:g} run. Raw data: [data/acc_discretization.csv](data/acc_discretization.csv).",
+          f"{tight:g} run. Raw data: [data/acc_discretization.csv](../data/acc_discretization.csv).",
           "", "| model | n | discretization (m) | " +
           " | ".join(f"time error at {r:g}" for r in rtols) + " | rtol matching |",
           "|---|---|---|" + "---|" * len(rtols) + "---|"]
@@ -480,7 +480,7 @@ def chaos(runner, args):
           "- 1)). 'reproduces': the mean differs from the tightest ensemble's "
           f"({best['method']}, rtol {float(best['rtol']):g}) by less than twice the standard "
           "error of the difference (z < 2; 1 in 20 ensembles fails that by chance). Raw "
-          "data: [data/acc_chaos.csv](data/acc_chaos.csv).", "",
+          "data: [data/acc_chaos.csv](../data/acc_chaos.csv).", "",
           "| method | rtol | mean rate (W) | spread (W) | z | reproduces | CPU per run (s) |",
           "|---|---|---|---|---|---|---|"]
     for r in rows:
@@ -563,8 +563,8 @@ def fig4(runner, args):
           "discretization error at n = 30) and 1e-5 m (below it at every n up to 300); "
           f"else rtol {args.fig4_rtol:g}. The MPP with the implicit methods only up to n = "
           f"{mpp_max} ('-': not run; their dense O(n³) Newton matrix makes a 30 s run at n = "
-          "300 take some 20 min each). Raw data: [data/acc_fig4.csv](data/acc_fig4.csv).",
-          "", "![Figure 4 over the whole motion](figures/acc_fig4.png)"]
+          "300 take some 20 min each). Raw data: [data/acc_fig4.csv](../data/acc_fig4.csv).",
+          "", "![Figure 4 over the whole motion](../figures/acc_fig4.png)"]
     if methods != list(args.methods):
         md[0] += (f" Rows of {', '.join(args.methods)} from this run (the rtol chosen from "
                   "the windows data as it stands); the other methods' rows from the CSV file "
@@ -644,12 +644,8 @@ def figure_fig4(rows, t_end):
 # --------------------------------------------------------------------------------------
 # choosing
 
-CHOOSING_HEAD = """# Which method, tolerance and n should I use, and what will it cost?
-
-Written by `scripts/accuracy choosing` (`tools/ropedyn_tools/studies/accuracy.py`) from the
-data of the other subcommands ([accuracy.md](accuracy.md)); re-run them and it, never edit
-the numbers. Scene: the paper's rope (`input/paper.nml`).
-"""
+#: the generated section of the guide's page on choosing a method (docs/guide/choosing.md)
+CHOOSING_BEGIN, CHOOSING_END = "<!-- choosing:begin -->", "<!-- choosing:end -->"
 
 
 def choosing(args):
@@ -658,9 +654,9 @@ def choosing(args):
     f4 = read_csv(DATA / "acc_fig4.csv")
     chaos_rows = read_csv(DATA / "acc_chaos.csv")
     md = headline(win, disc, f4, chaos_rows)
-    md += ["", "## 1. Pick n for the accuracy you need in space", "",
+    md += ["", "### 1. Pick n for the accuracy you need in space", "",
            "Discretization error of the tip over the first second against a fine reference "
-           "([accuracy.md](accuracy.md#discretization)):", ""]
+           "([accuracy](../validation/accuracy.md#discretization)):", ""]
     if disc:
         ns = list(dict.fromkeys(int(r["n"]) for r in disc))
         md += ["| model | " + " | ".join(f"n = {n}" for n in ns) + " |",
@@ -673,10 +669,10 @@ def choosing(args):
             md.append(f"| {model} | " + " | ".join(cells) + " |")
     else:
         md.append("(no data yet: run `scripts/accuracy discretization`)")
-    md += ["", "## 2. Pick rtol so that the time error stays below that", "",
+    md += ["", "### 2. Pick rtol so that the time error stays below that", "",
            "Time error of the tip over the first second at each rtol (CVODE, against its "
            "own rtol 1e-9 run); tighter than the discretization error buys nothing, looser "
-           "spoils the n you paid for ([accuracy.md](accuracy.md#discretization)).", ""]
+           "spoils the n you paid for ([accuracy](../validation/accuracy.md#discretization)).", ""]
     if disc:
         rt = [k for k in disc[0] if k.startswith("time_")]
         md += ["| model, n | discretization | " + " | ".join(f"rtol {k[5:]}" for k in rt) +
@@ -684,10 +680,10 @@ def choosing(args):
         for r in disc:
             md.append(f"| {r['model']}, {r['n']} | {float(r['disc_tip']):.1e} | " +
                       " | ".join(f"{float(r[k]):.1e}" if r[k] else "-" for k in rt) + " |")
-    md += ["", "## 3. Pick the method that is cheapest at that accuracy", "",
+    md += ["", "### 3. Pick the method that is cheapest at that accuracy", "",
            "Windows of 0.5 s across the whole motion (restarted from t0 = 0, 5, 10, 20 s), "
            "median CPU per window at the loosest rtol reaching the accuracy "
-           "([accuracy.md](accuracy.md#windows)):", ""]
+           "([accuracy](../validation/accuracy.md#windows)):", ""]
     if win:
         md += ["| model | n | tip accuracy (m) | cheapest method (rtol): CPU per window (s) | "
                "runner-up | auto (rtol): CPU |", "|---|---|---|---|---|---|"]
@@ -703,14 +699,14 @@ def choosing(args):
                "after the fold (t0 = 5, 10, 20 s) have larger errors than the first one (t0 = "
                "0), by these factors (median and 90th percentile over models, n and rtol): " +
                "; ".join(f"{m} {a:.1f} ({b:.0f})" for m, a, b in later_over_first(win)) +
-               ". A study of the first seconds alone (results.md) understates the error of "
-               "the whole motion by that much."]
+               ". A study of the first seconds alone ([over 2 s](../validation/work-precision.md))"
+               " understates the error of the whole motion by that much."]
     else:
         md.append("(no data yet: run `scripts/accuracy windows`)")
-    md += ["", "## 4. What the whole motion costs", "",
+    md += ["", "### 4. What the whole motion costs", "",
            "CPU of the whole 30 s run at the loosest rtol reaching the tip accuracy in the "
            "windows (the paper's Figure 4 over the whole motion, "
-           "[accuracy.md](accuracy.md#fig4)): the cheapest method, and the default auto:", ""]
+           "[accuracy](../validation/accuracy.md#fig4)): the cheapest method, and the default auto:", ""]
     if f4:
         for target in dict.fromkeys(float(r["target"]) for r in f4):
             sel = [r for r in f4 if float(r["target"]) == target and r["status"] == "ok"
@@ -729,7 +725,12 @@ def choosing(args):
             md.append("")
     else:
         md.append("(no data yet: run `scripts/accuracy fig4`)")
-    CHOOSING.write_text(CHOOSING_HEAD + f"\nData as of {utc_stamp()}.\n\n" + "\n".join(md) + "\n")
+    block = "\n".join([CHOOSING_BEGIN, "",
+                        "Written by `scripts/accuracy choosing` from the data of the other "
+                        "subcommands ([accuracy](../validation/accuracy.md)), data as of "
+                        f"{run_stamp()}. Scene: the paper's rope (`input/paper.nml`).", "",
+                        *md, CHOOSING_END])
+    update_doc(CHOOSING, CHOOSING_BEGIN, CHOOSING_END, block)
     print(f"accuracy: wrote {CHOOSING}")
 
 
@@ -766,7 +767,7 @@ def cheapest_in_windows(win, model, n, target):
 
 def headline(win, disc, f4, chaos_rows):
     """The answer in a few lines, from the data of the studies."""
-    md = ["## In short", ""]
+    md = ["### In short", ""]
     if not (win and disc and f4):
         return md + ["(run `scripts/accuracy all` for the data)"]
     lines = []
@@ -799,7 +800,7 @@ def headline(win, disc, f4, chaos_rows):
                f"RFEM n = 30, 8 starts 1e-9 rad apart): {sum(z < 2 for z in zs)} of "
                f"{len(zs)} ensembles (methods x rtol) reproduce the tightest within sampling "
                f"error, {len(loose_ok)} of {len(loose)} at rtol 1e-3 "
-               "([accuracy.md](accuracy.md#chaos)): a loose tolerance is enough for them."]
+               "([accuracy](../validation/accuracy.md#chaos)): a loose tolerance is enough for them."]
     # where the default is far off the cheapest fixed method over the whole motion
     misses = []
     for r in f4:

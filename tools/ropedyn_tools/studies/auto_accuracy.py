@@ -25,7 +25,7 @@ each method's error and the cost of each fixed method at auto's accuracy:
 CPU: /solver/cpu_time, the minimum of `--repeat` runs (more, up to 8, while they add up to
 less than 1 s). A run is given max(4 x auto's CPU, 3 s) of CPU; one that needs more or ends
 with a diagnosis does not count. The table goes between the auto_accuracy markers of
-docs/benchmarks.md. The code of scripts/auto_accuracy.
+docs/performance/auto.md. The code of scripts/auto_accuracy.
 """
 import argparse
 import pathlib
@@ -38,7 +38,7 @@ from ropedyn_tools.repo import DOCS, add_exe_argument, exe_or_build
 from ropedyn_tools.studies import auto_table
 from ropedyn_tools.studies.auto_table import FIXED, scene_t_end, scenes
 from ropedyn_tools.studies.common import (machine, method_chain, method_label, scene_number,
-                                          update_doc, utc_stamp)
+                                          update_doc, run_stamp)
 
 BEGIN = "<!-- auto_accuracy:begin -->"
 END = "<!-- auto_accuracy:end -->"
@@ -160,11 +160,11 @@ def main(argv=None):
              f"rtol x 1e3 .. 1e-3 (atol alike) whose error is at most {SLACK:g} times "
              f"auto's (errors below {args.floor:g} m count as {args.floor:g} m). CPU: "
              f"/solver/cpu_time, minimum "
-             f"of {args.repeat} runs. Machine: {machine()}. Run: {utc_stamp()}.", "",
+             f"of {args.repeat} runs. Machine: {machine()}. Run: {run_stamp()}.", "",
              header, "|" + "---|" * (11 + len(FIXED)), *rows, END]
-    update_doc(DOCS / "benchmarks.md", BEGIN, END, "\n".join(lines),
+    update_doc(DOCS / "performance" / "auto.md", BEGIN, END, "\n".join(lines),
                heading="## Auto's choice at equal accuracy (issue 15)\n\n")
-    print(f"auto_accuracy: {DOCS / 'benchmarks.md'}")
+    print(f"auto_accuracy: {DOCS / 'performance' / 'auto.md'}")
     return 0
 
 

@@ -2,7 +2,7 @@
 
 Runs every scene of input/ and input/hard/ with auto (the default) and with cvode, adams,
 mebdf and erk (each at its default order limit), all with the scene's own tolerances and
-the same horizon, and writes a table between the auto_table markers of docs/benchmarks.md:
+the same horizon, and writes a table between the auto_table markers of docs/performance/auto.md:
 the scene, auto's choice and switches (time: method/order limit), auto's CPU time, the
 fastest fixed method and its CPU time, and auto's CPU over the best's (target: <= 1.3).
 
@@ -33,7 +33,7 @@ import tempfile
 import h5py
 
 from ropedyn_tools.repo import DOCS, INPUT, add_exe_argument, exe_or_build, set_args
-from ropedyn_tools.studies.common import machine, scene_number, update_doc, utc_stamp
+from ropedyn_tools.studies.common import machine, scene_number, update_doc, run_stamp
 
 BEGIN = "<!-- auto_table:begin -->"
 END = "<!-- auto_table:end -->"
@@ -194,11 +194,11 @@ def main(argv=None):
              f"{args.repeat} runs (up to 8 while they add up to less than 1 s); a fixed "
              f"method gets max({args.cap_factor:g} x auto's CPU, "
              f"{args.cap_min:g} s) of CPU ('> cap' when it needs more), 'failed': it ended "
-             f"with its diagnosis (exit code 3). Machine: {machine()}. Run: {utc_stamp()}.",
+             f"with its diagnosis (exit code 3). Machine: {machine()}. Run: {run_stamp()}.",
              "", header, "|---|---|---|---|---|---|---|---|---|---|", *rows, END]
-    update_doc(DOCS / "benchmarks.md", BEGIN, END, "\n".join(lines),
+    update_doc(DOCS / "performance" / "auto.md", BEGIN, END, "\n".join(lines),
                heading="## Auto's choice on every scene (issue 15)\n\n")
-    print(f"auto_table: {DOCS / 'benchmarks.md'}")
+    print(f"auto_table: {DOCS / 'performance' / 'auto.md'}")
     return 0
 
 

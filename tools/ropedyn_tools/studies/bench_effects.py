@@ -7,7 +7,7 @@ internal effects (the paper's rope); each external effect added on its own; all 
 all internal effects with every external effect configured but switched off; and, with
 --baseline REV, all internal effects built from git revision REV (before the effects
 existed), which shows that effects that are off cost nothing. The table goes into
-docs/benchmarks.md between the markers of the section "Cost of the effects".
+docs/performance/effects.md between the markers of the section "Cost of the effects".
 """
 import argparse
 import pathlib
@@ -17,7 +17,7 @@ import tempfile
 
 from ropedyn_tools.repo import DOCS, PAPER, build, set_args
 from ropedyn_tools.studies.bench_rhs import build_bench_rhs
-from ropedyn_tools.studies.common import baseline_revision, machine, update_doc, utc_stamp
+from ropedyn_tools.studies.common import baseline_revision, machine, update_doc, run_stamp
 
 BEGIN = "<!-- bench_effects:begin -->"
 END = "<!-- bench_effects:end -->"
@@ -102,7 +102,7 @@ def main(argv=None):
 
     if args.no_write:
         return 0
-    stamp = utc_stamp()
+    stamp = run_stamp()
     cmd = "scripts/bench_effects" + (f" --baseline {args.baseline}" if args.baseline else "") \
         + (f" --elements {n}" if n != 100 else "")
     block = "\n".join([
@@ -117,7 +117,7 @@ def main(argv=None):
         *rows,
         END,
     ])
-    doc = DOCS / "benchmarks.md"
+    doc = DOCS / "performance" / "effects.md"
     update_doc(doc, BEGIN, END, block, heading="## Cost of the effects\n\n", strip="\n")
     print(f"wrote {doc}")
     return 0

@@ -10,7 +10,7 @@ blocks K, C, M (explicit form; for the MPP also the implicit form) and the quadr
   different numbers of calls, so set-up is not counted): the noise-free figure.
 With --baseline REV the same bench_rhs.f90 is also built from git revision REV (git archive;
 the working tree is untouched) and both are reported side by side. The table goes into
-docs/benchmarks.md between the markers of the section "Model kernels".
+docs/performance/step.md between the markers of the section "Model kernels".
 """
 import argparse
 import pathlib
@@ -22,7 +22,7 @@ import tempfile
 
 from ropedyn_tools.repo import DOCS, PAPER, build, set_args
 from ropedyn_tools.studies.bench_rhs import build_bench_rhs
-from ropedyn_tools.studies.common import baseline_revision, machine, update_doc, utc_stamp
+from ropedyn_tools.studies.common import baseline_revision, machine, update_doc, run_stamp
 
 BEGIN = "<!-- bench_kernels:begin -->"
 END = "<!-- bench_kernels:end -->"
@@ -150,12 +150,12 @@ def main(argv=None):
         "zeroing of its output arrays; instructions: callgrind, per call, set-up "
         f"excluded).{before_note} n/a: the kernel is not offered (the default second-order "
         "blocks need an analytic implicit Jacobian, which the MPP does not have).",
-        f"Machine: {machine()}. Run: {utc_stamp()}.",
+        f"Machine: {machine()}. Run: {run_stamp()}.",
         "",
         *lines,
         END,
     ])
-    doc = DOCS / "benchmarks.md"
+    doc = DOCS / "performance" / "step.md"
     update_doc(doc, BEGIN, END, block, heading="## Model kernels (issue 14)\n\n", strip="\n")
     print(f"wrote {doc}")
     return 0

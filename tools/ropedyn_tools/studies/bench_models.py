@@ -4,7 +4,7 @@ The paper's Figure 4 compares the CPU time of RFEM and MPP against n: "the MPP m
 numerically more efficient only for small n". This runs input/paper.nml (75 deg release,
 Table 1 damping) for a short horizon at a fixed tolerance for every (model, solver, n),
 skipping the larger n of a (model, solver) once one case exceeds the time budget, and
-writes a table (between the bench_models markers in docs/benchmarks.md) and
+writes a table (between the bench_models markers in docs/performance/cost-vs-n.md) and
 docs/figures/cost_vs_n.png. The crossover n where RFEM becomes cheaper is printed. The runs
 have `&solver profile = .true.`: the table gives the CPU time per step and where it went.
 The code of scripts/bench_models (python -m ropedyn_tools.studies.bench_models).
@@ -24,7 +24,7 @@ from ropedyn import io  # noqa: E402
 from ropedyn_tools.repo import (DOCS, PAPER, add_scaling_arguments, exe_or_build,  # noqa: E402
                                 set_args)
 from ropedyn_tools.studies.common import (SPLIT_HEADER, machine, time_split,  # noqa: E402
-                                          update_doc, utc_stamp)
+                                          update_doc, run_stamp)
 
 BEGIN = "<!-- bench_models:begin -->"
 END = "<!-- bench_models:end -->"
@@ -115,18 +115,18 @@ def main(argv=None):
     figpath = DOCS / "figures" / "cost_vs_n.png"
     figpath.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(figpath, dpi=110)
-    stamp = utc_stamp()
+    stamp = run_stamp()
     lines = [BEGIN,
              f"Command: `scripts/bench_models --t-end {args.t_end:g} --elements "
              f"\"{args.elements}\"` (input/paper.nml, rtol {args.rtol:g}, atol 1e-8, default "
              f"max orders: CVODE 5, MEBDF 4). Machine: {machine()}. Run: {stamp}.",
-             "", "![cost versus n](figures/cost_vs_n.png)", "", header,
+             "", "![cost versus n](../figures/cost_vs_n.png)", "", header,
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     lines += [line(m, s, n, results[(m, s, n)]) for m, s in settings for n in ns]
     lines += ["", *(f"Crossover with {m}: RFEM cheaper than MPP from n = {n}."
                     for m, n in crossover.items()),
               f"Crossover with the best solver for each model: n = {best_cross}.", END]
-    doc = DOCS / "benchmarks.md"
+    doc = DOCS / "performance" / "cost-vs-n.md"
     update_doc(doc, BEGIN, END, "\n".join(lines),
                heading="## RFEM and MPP cost versus n (the paper's Figure 4)\n\n")
     print(f"bench_models: {doc}, {figpath}")

@@ -37,7 +37,7 @@ venv) on the same rope as input/paper.nml, n segments against ropedyn's n elemen
   (atol = rtol / 100, as the scene's) whose tip error over [0, 2 s] is at most MoorDyn's
   time error, over the whole run.
 
-The table goes between the bench_peers markers of docs/benchmarks.md. The code of
+The table goes between the bench_peers markers of docs/performance/peers.md. The code of
 scripts/bench_peers.
 
 MoorDyn-C 2.7.2's reader scans for the next line of dashes without a bound: an input file
@@ -57,7 +57,7 @@ import numpy as np
 from ropedyn import io
 from ropedyn_tools.repo import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import (least_cpu, machine, method_chain, method_label,
-                                          update_doc, utc_stamp)
+                                          update_doc, run_stamp)
 
 BEGIN = "<!-- bench_peers:begin -->"
 END = "<!-- bench_peers:end -->"
@@ -331,7 +331,7 @@ def main(argv=None):
              f"in [0, {ACCURACY_SPAN:g} s] against ropedyn with cvode at rtol 1e-10, atol "
              f"1e-12, same n; MoorDyn's time error: its tip against its run at a quarter of the "
              f"step (MoorDyn against ropedyn's reference: the difference of the models). "
-             f"Machine: {machine()}. Run: {utc_stamp()}.", "", header,
+             f"Machine: {machine()}. Run: {run_stamp()}.", "", header,
              "|---|---|---|---|---|---|---|---|---|---|---|---|",
              *rows, "",
              "At equal accuracy: ropedyn's default method at the loosest rtol of "
@@ -339,9 +339,9 @@ def main(argv=None):
              "error over [0, 2 s] is at most MoorDyn's time error (the same run length, "
              "output and MoorDyn run as above):", "", equal_header,
              "|---|---|---|---|---|---|---|---|---|---|", *equal_rows, END]
-    update_doc(DOCS / "benchmarks.md", BEGIN, END, "\n".join(lines),
+    update_doc(DOCS / "performance" / "peers.md", BEGIN, END, "\n".join(lines),
                heading="## The peer side by side: MoorDyn-C (issue 15)\n\n")
-    print(f"bench_peers: {DOCS / 'benchmarks.md'}")
+    print(f"bench_peers: {DOCS / 'performance' / 'peers.md'}")
     return 0
 
 

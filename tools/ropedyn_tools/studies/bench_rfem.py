@@ -4,7 +4,7 @@ The code of scripts/bench_rfem (python -m ropedyn_tools.studies.bench_rfem; with
 builds the Release executable first). Every n runs with each integrator (default: CVODE and
 MEBDF, their default orders) with `&solver profile = .true.`, so the table gives the CPU time
 per step and element and where it went (right-hand side, Jacobian, factorizations, solves,
-the rest). The table goes into docs/benchmarks.md between the markers of the section "RFEM
+the rest). The table goes into docs/performance/cost-vs-n.md between the markers of the section "RFEM
 cost versus n"; the rest of that file (the reading of the numbers) is kept.
 """
 import argparse
@@ -15,7 +15,7 @@ import tempfile
 
 from ropedyn import io
 from ropedyn_tools.repo import DOCS, PAPER, add_scaling_arguments, exe_or_build, set_args
-from ropedyn_tools.studies.common import SPLIT_HEADER, machine, time_split, update_doc, utc_stamp
+from ropedyn_tools.studies.common import SPLIT_HEADER, machine, time_split, update_doc, run_stamp
 
 BEGIN = "<!-- bench_rfem:begin -->"
 END = "<!-- bench_rfem:end -->"
@@ -74,7 +74,7 @@ def main(argv=None):
 
     if args.no_write:
         return 0
-    stamp = utc_stamp()
+    stamp = run_stamp()
     newton = ("first-order Newton matrix (`--first-order-newton`)" if args.first_order_newton
               else "reduced second-order Newton matrix")
     block = "\n".join([
@@ -91,7 +91,7 @@ def main(argv=None):
         *rows,
         END,
     ])
-    doc = DOCS / "benchmarks.md"
+    doc = DOCS / "performance" / "cost-vs-n.md"
     update_doc(doc, BEGIN, END, block, default="# Benchmarks\n\n## RFEM cost versus n\n\n")
     print(f"bench_rfem: table written to {doc}")
     return 0

@@ -6,7 +6,7 @@ the MPP n = 70 over 0.3 s; CVODE and MEBDF each) with the executable built from 
 --baseline (git archive, Release; or --baseline-exe PATH) and with this tree's, one right
 after the other, --repeat times; the smallest CPU time of each is kept (the machine is
 shared: the smallest is the least disturbed). The table (between the bench_step markers of
-docs/benchmarks.md) gives steps, CPU per step per element (RFEM, us) or per step (MPP, ms)
+docs/performance/step.md) gives steps, CPU per step per element (RFEM, us) or per step (MPP, ms)
 and the speed-up.
 """
 import argparse
@@ -16,7 +16,7 @@ import sys
 import tempfile
 
 from ropedyn_tools.repo import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
-from ropedyn_tools.studies.common import baseline_revision, machine, update_doc, utc_stamp
+from ropedyn_tools.studies.common import baseline_revision, machine, update_doc, run_stamp
 from ropedyn_tools.studies.profile_step import build_baseline
 
 BEGIN = "<!-- bench_step:begin -->"
@@ -94,11 +94,11 @@ def main(argv=None):
         + "(input/paper.nml, rtol 1e-6, default orders, output every 0.1 s; before: the "
         f"Release executable of {args.baseline}, after: this tree's; interleaved, the "
         "smallest CPU time of the repeats).",
-        f"Machine: {machine()}. Run: {utc_stamp()}.",
+        f"Machine: {machine()}. Run: {run_stamp()}.",
         "", HEADER, RULE, *rows, END])
-    update_doc(DOCS / "benchmarks.md", BEGIN, END, block,
+    update_doc(DOCS / "performance" / "step.md", BEGIN, END, block,
                heading="### Before and after (scripts/bench_step)\n\n")
-    print(f"bench_step: table written to {DOCS / 'benchmarks.md'}")
+    print(f"bench_step: table written to {DOCS / 'performance' / 'step.md'}")
     return 0
 
 

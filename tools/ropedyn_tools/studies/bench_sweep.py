@@ -5,7 +5,7 @@ builds the Release executable first). The sweep is 16
 cases of the paper scene (n = 30, 1 s, CVODE and MEBDF, two tolerances, two release angles,
 two dampings), each run with `ropedyn sweep --force` into a fresh directory; the median wall
 time of --repeat runs per worker count gives the speed-up. The result goes into
-docs/benchmarks.md between the markers of the section "Sweep runner: parallel workers".
+docs/performance/sweeps.md between the markers of the section "Sweep runner: parallel workers".
 """
 import argparse
 import os
@@ -17,7 +17,7 @@ import tempfile
 import time
 
 from ropedyn_tools.repo import DOCS, PAPER, add_exe_argument, exe_or_build
-from ropedyn_tools.studies.common import machine, update_doc, utc_stamp
+from ropedyn_tools.studies.common import machine, update_doc, run_stamp
 
 BEGIN = "<!-- bench_sweep:begin -->"
 END = "<!-- bench_sweep:end -->"
@@ -92,7 +92,7 @@ def main(argv=None):
           f"{cap:.2f}")
     if args.no_write:
         return
-    stamp = utc_stamp()
+    stamp = run_stamp()
     block = "\n".join([
         BEGIN,
         f"Command: `scripts/bench_sweep` (Release; {n} cases of the paper scene, n = 30, "
@@ -118,12 +118,12 @@ def main(argv=None):
         f"{', '.join(f'{c:.2f}' for c in capacity)}; 2.0 on two idle cores). The sweep "
         f"runner's median speed-up was {speedup / cap:.0%} of that.",
         END])
-    update_doc(DOCS / "benchmarks.md", BEGIN, END, block, strip="\n",
+    update_doc(DOCS / "performance" / "sweeps.md", BEGIN, END, block, strip="\n",
                heading="## Sweep runner: parallel workers\n\n"
                "`ropedyn sweep` runs each case in its own process; this measures what a "
                "second worker buys on a 2-core machine. The section between the markers is "
                "rewritten by `scripts/bench_sweep`.\n\n")
-    print("bench_sweep: wrote docs/benchmarks.md", file=sys.stderr)
+    print("bench_sweep: wrote docs/performance/sweeps.md", file=sys.stderr)
 
 
 if __name__ == "__main__":

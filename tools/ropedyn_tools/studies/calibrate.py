@@ -1,7 +1,7 @@
 """Fit the MPP damping constants so that its energy history matches an RFEM run.
 
 The paper matched the two models' damping "by trial and error". ropedyn's default rule
-(docs/physics-mpp.md) gives the MPP the RFEM's material law: member springs d_s = eta A/l,
+(docs/theory/mpp.md) gives the MPP the RFEM's material law: member springs d_s = eta A/l,
 joints d_b = eta I/l. RFEM also dissipates in its shear dampers, which the MPP lacks, so
 the histories differ. This script runs the scene with the RFEM once (the target), then
 minimizes over the MPP factors (a, b) = (mpp_axial_damping_factor,

@@ -50,6 +50,30 @@ def utc_stamp():
     return datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
 
 
+#: what a study's numbers come from (as scripts/docs_status counts it), besides docs/
+RUN_PATHS = ("src", "solvers", "CMakeLists.txt", "input", "tools", "python")
+
+
+def run_commit(root=None):
+    """Which code a study ran on: ', commit `abc1234`' (HEAD) when RUN_PATHS have no
+    uncommitted changes, else ', on `abc1234` with uncommitted changes' (scripts/docs_status
+    then judges the section by the commit that writes its stamp, which should be the one
+    that commits those changes); '' outside a git checkout."""
+    try:
+        rev = git("rev-parse", "--short", "HEAD", root=root).decode().strip()
+        dirty = git("status", "--porcelain", "--", *RUN_PATHS, root=root).decode().strip()
+    except (subprocess.CalledProcessError, OSError):
+        return ""
+    return f", on `{rev}` with uncommitted changes" if dirty else f", commit `{rev}`"
+
+
+def run_stamp(root=None):
+    """The stamp of a study's run: 'YYYY-MM-DD HH:MM UTC, commit `abc1234`' (see run_commit).
+    Every generated section of docs/ names it, so that its page says when and on which code
+    its numbers were made."""
+    return utc_stamp() + run_commit(root)
+
+
 def splice(text, begin, end, block):
     """text with everything from the marker `begin` to the marker `end` (both included)
     replaced by block (which carries the markers again); None when a marker is missing."""

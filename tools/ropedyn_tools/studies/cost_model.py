@@ -10,7 +10,7 @@ This runs the paper's rope (RFEM) with each method over a grid of n and rtol and
 CPU time per counted unit, and its ratio to erk's at the same n and rtol: 1 where the model
 is right, above 1 where it undercounts the method (auto then holds it cheaper than it is).
 The constants are read from the Fortran source, so the table follows them. Writes the table
-between the cost_model markers of docs/benchmarks.md.
+between the cost_model markers of docs/performance/auto.md.
 The code of scripts/cost_model (python -m ropedyn_tools.studies.cost_model).
 """
 import argparse
@@ -21,7 +21,7 @@ import tempfile
 
 from ropedyn import io
 from ropedyn_tools.repo import DOCS, PAPER, ROOT, add_exe_argument, exe_or_build, set_args
-from ropedyn_tools.studies.common import least_cpu, machine, update_doc, utc_stamp
+from ropedyn_tools.studies.common import least_cpu, machine, update_doc, run_stamp
 
 BEGIN = "<!-- cost_model:begin -->"
 END = "<!-- cost_model:end -->"
@@ -162,10 +162,10 @@ def main(argv=None):
              "read from solvers/auto/ropedyn_auto.f90); CPU: /solver/cpu_time, the least of "
              f"{args.repeat} runs. '/ erk's': CPU per counted unit over erk's at the same n and "
              "rtol (above 1: auto counts the method cheaper than it is). Machine: "
-             f"{machine()}. Run: {utc_stamp()}.\n\n" + "\n".join(table) + f"\n{END}")
-    update_doc(DOCS / "benchmarks.md", BEGIN, END, block,
+             f"{machine()}. Run: {run_stamp()}.\n\n" + "\n".join(table) + f"\n{END}")
+    update_doc(DOCS / "performance" / "auto.md", BEGIN, END, block,
                heading="## Auto's counted cost against CPU time\n\n")
-    print(f"cost_model: {DOCS / 'benchmarks.md'}")
+    print(f"cost_model: {DOCS / 'performance' / 'auto.md'}")
     return 0
 
 

@@ -5,7 +5,7 @@ n = 30 and n = 70 for 30 s, the MPP twice: with the default damping rule (factor
 and with the factors fitted to the RFEM's energy history by `scripts/calibrate` (read from
 docs/data/mpp_damping_fit.csv). Plots T + V - E0 and the energy-balance error of each run;
 writes docs/figures/fig5_energy.png, docs/data/fig5_energy.csv and the section of
-docs/physics-mpp.md between its fig5 markers. The code of scripts/fig5 (python -m
+docs/theory/mpp.md between its fig5 markers. The code of scripts/fig5 (python -m
 ropedyn_tools.studies.fig5).
 """
 import argparse
@@ -25,9 +25,9 @@ from ropedyn import io  # noqa: E402
 from ropedyn_tools.repo import (DOCS, PAPER, ROOT, add_exe_argument, exe_or_build,  # noqa: E402
                                 set_args)
 from ropedyn_tools.studies.calibrate import FIT_DATA, read_fit  # noqa: E402
-from ropedyn_tools.studies.common import machine, update_doc, utc_stamp  # noqa: E402
+from ropedyn_tools.studies.common import machine, update_doc, run_stamp  # noqa: E402
 
-PAGE = DOCS / "physics-mpp.md"
+PAGE = DOCS / "validation" / "fig5.md"
 BEGIN, END = "<!-- fig5:begin -->", "<!-- fig5:end -->"
 
 
@@ -124,13 +124,13 @@ def section(rows, fit, args, seconds):
     """The Figure 5 section of physics-mpp.md: the runs' table and the calibration."""
     lines = [BEGIN, "",
              f"Written by `scripts/fig5` (method `{args.method}`, {args.t_end:g} s from 75°, "
-             f"Table 1 damping 10³/400; {seconds / 60:.1f} min, {utc_stamp()}, "
-             f"{machine()}) → [figures/fig5_energy.png](figures/fig5_energy.png), data in "
-             "[data/fig5_energy.csv](data/fig5_energy.csv). The MPP runs twice: with the "
+             f"Table 1 damping 10³/400; {seconds / 60:.1f} min, {run_stamp()}, "
+             f"{machine()}) → [figures/fig5_energy.png](../figures/fig5_energy.png), data in "
+             "[data/fig5_energy.csv](../data/fig5_energy.csv). The MPP runs twice: with the "
              "default damping rule (member springs ηA/l, joints ηI/l: factors a = b = 1) and "
              "with the factors `scripts/calibrate` fitted to the RFEM's energy history "
-             f"([data/{FIT_DATA.name}](data/{FIT_DATA.name})).", "",
-             "![E(t) - E0 of RFEM and MPP](figures/fig5_energy.png)", "",
+             f"([data/{FIT_DATA.name}](../data/{FIT_DATA.name})).", "",
+             "![E(t) - E0 of RFEM and MPP](../figures/fig5_energy.png)", "",
              "| model | n | MPP damping factors a, b | E(30 s) − E0 (J) | max balance error (J) "
              "| steps | CPU (s) |", "|---|---|---|---|---|---|---|"]
     for r in rows:

@@ -1,11 +1,11 @@
-"""The long-horizon matrix of the hard scenes (issue 18; docs/stability.md, "Long horizons").
+"""The long-horizon matrix of the hard scenes (issue 18; docs/validation/long-horizon.md).
 
 Every scene of input/hard/ runs to its full t_end with the default method and settings, and
 with every method of METHODS at every tolerance of RTOLS (atol = rtol / 100, as the scenes'
 1e-6 / 1e-8), plus the order-safety cases (ORDER_CASES: MEBDF order 7 and CVODE orders 4
 and 5 on the undamped and lightly damped rope at rtol 1e-3, with the monitor off and on).
 Used by the CTest label `long` (tests/long/test_long_horizon.py, `scripts/test --long`) and by
-scripts/stability_report (the tables of docs/stability.md).
+scripts/stability_report (the tables of docs/validation/long-horizon.md and order-safety.md).
 
 **A new method is one line**: append its name to METHODS.
 
@@ -42,7 +42,7 @@ RTOLS = [1e-3, 1e-5, 1e-7]
 ATOL_RATIO = 1e-2
 
 #: order-safety cases: (label, scene, overrides), all at rtol 1e-3 (where the amplification
-#: of orders that are not A-stable shows within 10 s; docs/stability.md)
+#: of orders that are not A-stable shows within 10 s; docs/validation/order-safety.md)
 ORDER_CASES = [
     (f"{method} {order}, {policy}", scene,
      [f"solver.method={method}", f"solver.max_order={order}", f"solver.order_safety={policy}",

@@ -23,7 +23,7 @@ into its own table (the profile_step erk markers).
 profile_step whole-run markers): the integrator's RHS and rest as above, the output (the
 run file: output_append, and the stats and close that write the last records) and the
 remainder (start-up, the records' fields and energies, the driver); per accepted step.
-The table goes into docs/benchmarks.md between the profile_step markers.
+The table goes into docs/performance/step.md between the profile_step markers.
 """
 import argparse
 import os
@@ -35,7 +35,7 @@ import sys
 import tempfile
 
 from ropedyn_tools.repo import DOCS, PAPER, ROOT, add_exe_argument, exe_or_build, set_args
-from ropedyn_tools.studies.common import baseline_revision, machine, update_doc, utc_stamp
+from ropedyn_tools.studies.common import baseline_revision, machine, update_doc, run_stamp
 
 BEGIN = "<!-- profile_step:begin -->"
 END = "<!-- profile_step:end -->"
@@ -203,10 +203,10 @@ def main(argv=None):
         begin,
         f"Command: `{command}` (valgrind callgrind, input/paper.nml, n = 30, {what}; see "
         "tools/ropedyn_tools/studies/profile_step.py for the functions that make each part).",
-        f"Machine: {machine()}. Run: {utc_stamp()}.",
+        f"Machine: {machine()}. Run: {run_stamp()}.",
         "", header, rule, *rows, end])
-    update_doc(DOCS / "benchmarks.md", begin, end, block, heading=heading)
-    print(f"profile_step: table written to {DOCS / 'benchmarks.md'}")
+    update_doc(DOCS / "performance" / "step.md", begin, end, block, heading=heading)
+    print(f"profile_step: table written to {DOCS / 'performance' / 'step.md'}")
     return 0
 
 

@@ -1,7 +1,7 @@
 """Measures of one ropedyn run file used by the stiff-case suite (tests/hard) and by
-scripts/stability_report (ropedyn_tools.studies.stability_report; docs/stability.md).
+scripts/stability_report (ropedyn_tools.studies.stability_report; docs/validation/hard-scenes.md).
 
-Every measure is read from the HDF5 file alone (layout: docs/output.md):
+Every measure is read from the HDF5 file alone (layout: docs/guide/output.md):
 
 - energy balance error: max over the records of |B(t) - B(0)|, B = T + V + dissipated -
   support work (J);

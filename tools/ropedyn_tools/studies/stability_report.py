@@ -1,8 +1,8 @@
-"""Run the hard scenes (input/hard) and the CVODE order study; write docs/stability.md.
+"""Run the hard scenes (input/hard) and the CVODE order study; write docs/validation/.
 
 The code of scripts/stability_report (python -m ropedyn_tools.studies.stability_report; without
 --exe it builds the Release executable first). Two
-sections of docs/stability.md are rewritten between their markers; the text around them
+sections of docs/validation/ (PAGES) are rewritten between their markers; the text around them
 (the reading of the numbers) is kept:
 
 - `cvode-order`: the measurements behind CVODE's default maximum order: the light-damping
@@ -30,9 +30,16 @@ import tempfile
 
 from ropedyn_tools.repo import DOCS, INPUT, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies import long_horizon, stability_metrics
-from ropedyn_tools.studies.common import machine, splice
+from ropedyn_tools.studies.common import machine, run_commit, splice
 
-DOC = DOCS / "stability.md"
+#: the page of each generated section
+PAGES = {
+    "hard-scenes": DOCS / "validation" / "hard-scenes.md",
+    "cvode-order": DOCS / "validation" / "cvode-order.md",
+    "long-horizon": DOCS / "validation" / "long-horizon.md",
+    "order-safety": DOCS / "validation" / "order-safety.md",
+    "numerical-damping": DOCS / "validation" / "order-safety.md",
+}
 HARD = INPUT / "hard"
 
 # (label, scene file, horizon in s, extra --set overrides)
@@ -204,7 +211,7 @@ def replace_section(text, name, body):
     begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
     new = splice(text, begin, end, f"{begin}\n{body}\n{end}")
     if new is None:
-        raise SystemExit(f"{DOC}: markers {begin} ... {end} not found")
+        raise SystemExit(f"{PAGES[name]}: markers {begin} ... {end} not found")
     return new
 
 
@@ -353,7 +360,7 @@ def main(argv=None):
     parser.add_argument("--only", choices=["cvode-order", "hard-scenes", "long-horizon"],
                         default=None)
     parser.add_argument("--quick", action="store_true", help="horizons / 10, no file written")
-    parser.add_argument("--write", action="store_true", help="write docs/stability.md "
+    parser.add_argument("--write", action="store_true", help="write the pages "
                         "even with --quick")
     parser.add_argument("--no-write", action="store_true", help="print only")
     parser.add_argument("--cached-only", action="store_true", help="long-horizon: only "
@@ -364,7 +371,7 @@ def main(argv=None):
     scale = 0.1 if args.quick else 1.0
     write = not args.no_write and (args.write or not args.quick)
     started = datetime.datetime.now(datetime.timezone.utc)
-    stamp = (f"Machine: {machine()}. Run: {started:%Y-%m-%d %H:%M} UTC, "
+    stamp = (f"Machine: {machine()}. Run: {started:%Y-%m-%d %H:%M} UTC{run_commit()}, "
              f"--jobs {args.jobs}.")
     command = "Command: `scripts/stability_report" + (" --quick" if args.quick else "") + "`"
     sections = {}
@@ -386,11 +393,13 @@ def main(argv=None):
     elapsed = datetime.datetime.now(datetime.timezone.utc) - started
     print(f"elapsed: {elapsed.total_seconds():.0f} s")
     if write:
-        text = DOC.read_text()
-        for name, body in sections.items():
-            text = replace_section(text, name, body)
-        DOC.write_text(text)
-        print(f"wrote {DOC}")
+        for page in sorted({PAGES[name] for name in sections}):
+            text = page.read_text()
+            for name, body in sections.items():
+                if PAGES[name] == page:
+                    text = replace_section(text, name, body)
+            page.write_text(text)
+            print(f"wrote {page}")
 
 
 if __name__ == "__main__":

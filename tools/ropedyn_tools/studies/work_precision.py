@@ -22,7 +22,7 @@ All runs go through `ropedyn sweep` (references with 2 workers; measured runs wi
 default 1 so that CPU times are not disturbed), so an interrupted study resumes where it
 stopped. Writes docs/data/rope_wp.csv, docs/data/rope_references.csv,
 docs/figures/rope_wp_<model>.png, docs/figures/rope_cost_vs_n.png,
-docs/figures/rope_horizon.png and the section between the markers in docs/results.md.
+docs/figures/rope_horizon.png and the section between the markers in docs/validation/work-precision.md.
 """
 import argparse
 import csv
@@ -37,7 +37,7 @@ import numpy as np
 
 from ropedyn import io
 from ropedyn_tools.repo import DOCS, PAPER, ROOT, add_exe_argument, exe_or_build
-from ropedyn_tools.studies.common import machine, update_doc, utc_stamp
+from ropedyn_tools.studies.common import machine, update_doc, run_stamp
 
 BEGIN = "<!-- work-precision:begin -->"
 END = "<!-- work-precision:end -->"
@@ -438,9 +438,9 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
         plt.close(fig)
         figures.append("rope_horizon.png")
 
-    # the generated block of docs/results.md
+    # the generated block of docs/validation/work-precision.md
     cmd = "scripts/work_precision" + (" --quick" if args.quick else "")
-    stamp = utc_stamp()
+    stamp = run_stamp()
     b = [BEGIN, ""]
     b.append(f"Command: `{cmd}` ({elapsed / 60:.1f} min). Machine: {machine()}. Run: {stamp}.")
     b.append("")
@@ -451,8 +451,8 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
              f"[0, horizon] against the other integrator's reference (MEBDF's for cvode "
              "and adams, CVODE's for the others); CPU time: median over "
              f">= {args.repeat_time} s of repeated runs. Raw data: "
-             "[data/rope_wp.csv](data/rope_wp.csv), "
-             "[data/rope_references.csv](data/rope_references.csv).")
+             "[data/rope_wp.csv](../data/rope_wp.csv), "
+             "[data/rope_references.csv](../data/rope_references.csv).")
     b.append("")
     b.append("**References** (agreement: max over output times and element end points of "
              "|CVODE ref - MEBDF ref|; horizon: last time with agreement within "
@@ -474,18 +474,18 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
         b.append("")
         b.append(f"Horizon check ({hz['model']}, n = {hz['n']}, both references to "
                  f"{args.horizon_t} s): they part by " + "; ".join(marks) + ". "
-                 "![agreement of the references](figures/rope_horizon.png)")
+                 "![agreement of the references](../figures/rope_horizon.png)")
     b.append("")
     for name in figures:
         if name.startswith("rope_wp_"):
-            b.append(f"![work-precision {name[8:-4]}](figures/{name})")
+            b.append(f"![work-precision {name[8:-4]}](../figures/{name})")
             b.append("")
     b.append(f"**CPU time (s) at tip L2 error {args.target:.0e} m** (log-log interpolation "
              "along each line; ≤: even the loosest rtol is more accurate, the value is that "
              "run's CPU time, an upper bound, drawn as an open triangle; – : the line does not "
              "reach that accuracy) — the paper's Figure 4:")
     b.append("")
-    b.append("![cost versus n](figures/rope_cost_vs_n.png)")
+    b.append("![cost versus n](../figures/rope_cost_vs_n.png)")
     b.append("")
     keys = sorted({(k[0], k[1], k[2]) for k in cost})
     ns = sorted({k[3] for k in cost})
@@ -535,9 +535,9 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
     b.append("")
     b.append(END)
 
-    update_doc(DOCS / "results.md", BEGIN, END, "\n".join(b), strip="\n",
+    update_doc(DOCS / "validation" / "work-precision.md", BEGIN, END, "\n".join(b), strip="\n",
                default="# Results\n\n" + BEGIN + "\n" + END + "\n")
-    print(f"work_precision: wrote docs/results.md, docs/data/rope_wp.csv, figures "
+    print(f"work_precision: wrote docs/validation/work-precision.md, docs/data/rope_wp.csv, figures "
           f"{', '.join(figures)}", file=sys.stderr)
 
 

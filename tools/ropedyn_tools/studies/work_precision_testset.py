@@ -9,9 +9,9 @@ mescd for E5), the counters and the median CPU time per run. It writes
 
 - docs/data/testset_wp.csv: every run, failed ones included (status, message);
 - docs/figures/wp_<problem>.png: CPU time and steps against the accuracy;
-- the section between the markers below in docs/benchmarks.md: a table per problem and
+- the section between the markers below in docs/validation/testset.md: a table per problem and
   a comparison (MEBDF/CVODE CPU at equal scd; steps against the MEBDFI reference counts
-  of docs/solvers.md, section 2). The rest of benchmarks.md is kept.
+  of docs/theory/testset.md). The rest of the page is kept.
 
 A method whose runs fail (e.g. not implemented yet) is skipped with a note.
 """
@@ -24,7 +24,7 @@ import sys
 import numpy as np
 
 from ropedyn_tools.repo import DOCS, add_exe_argument, exe_or_build
-from ropedyn_tools.studies.common import machine, update_doc, utc_stamp
+from ropedyn_tools.studies.common import machine, update_doc, run_stamp
 
 BEGIN = "<!-- testset-wp:begin -->"
 END = "<!-- testset-wp:end -->"
@@ -34,7 +34,7 @@ SETTINGS = [("cvode", 5), ("mebdf", 4), ("mebdf", 7)]
 M_VALUES = list(range(17))          # rtol = 10^-(3 + m/2)
 QUICK_M_VALUES = [0, 4, 8, 12]      # rtol 1e-3, 1e-5, 1e-7, 1e-9
 # MEBDFI (classic Fortran, numerical Jacobian, max order 7) and CVODE 6.4.1 (dense,
-# difference-quotient Jacobian), rtol = atol (ROBER atol = 1e-6 rtol): docs/solvers.md, sec. 2
+# difference-quotient Jacobian), rtol = atol (ROBER atol = 1e-6 rtol): docs/theory/testset.md
 REFERENCE_STEPS = [
     # problem, rtol, MEBDFI scd, MEBDFI steps, CVODE scd, CVODE steps
     ("HIRES", 1e-6, 3.30, 168, 2.37, 374),
@@ -147,9 +147,9 @@ def plot(rows, problem, settings, path):
     if problem in {r[0] for r in REFERENCE_STEPS}:
         refs = [r for r in REFERENCE_STEPS if r[0] == problem]
         ax_steps.semilogy([r[2] for r in refs], [r[3] for r in refs], "k*", ms=10,
-                          label="MEBDFI (docs/solvers.md)")
+                          label="MEBDFI (reference counts)")
         ax_steps.semilogy([r[4] for r in refs], [r[5] for r in refs], "kx", ms=8,
-                          label="CVODE, FD Jacobian (docs/solvers.md)")
+                          label="CVODE, FD Jacobian (reference counts)")
     ax_cpu.set_xlabel(f"accuracy at t_end ({measure}, digits)")
     ax_cpu.set_ylabel("CPU time per run (s)")
     ax_steps.set_xlabel(f"accuracy at t_end ({measure}, digits)")
@@ -224,7 +224,7 @@ def comparison(rows, problems, settings):
                 if any_value:
                     lines.append(f"| {problem} | {level} | " + " | ".join(cells) + " |")
         lines.append("")
-    lines += ["**Steps against the reference counts of docs/solvers.md** (MEBDFI: classic "
+    lines += ["**Steps against the reference counts of the classic codes** (MEBDFI: classic "
               "Fortran, numerical Jacobian, max order 7; CVODE there: dense FD Jacobian). Our "
               "step counts are interpolated (log steps linear in scd) at the reference scd; "
               "empty where that scd is outside our sweep:", "",
@@ -311,7 +311,7 @@ def main(argv=None):
     for problem in problems:
         plot(rows, problem, shown, DOCS / "figures" / f"wp_{problem.lower()}.png")
 
-    stamp = utc_stamp()
+    stamp = run_stamp()
     command = "scripts/work_precision_testset"
     if args.quick:
         command += " --quick"
@@ -319,7 +319,7 @@ def main(argv=None):
         command += f" --methods {args.methods}"
     if args.problems != ",".join(PROBLEMS):
         command += f" --problems {args.problems}"
-    figures = ", ".join(f"[{p}](figures/wp_{p.lower()}.png)" for p in problems)
+    figures = ", ".join(f"[{p}](../figures/wp_{p.lower()}.png)" for p in problems)
     block = [
         BEGIN,
         f"Command: `{command}` (Release build; rtol = 10^-(3 + m/2), "
@@ -328,17 +328,17 @@ def main(argv=None):
         f"Machine: {machine()}. Run: {stamp}.",
         "",
         f"Figures: {figures}. Raw data (all 17 tolerances, every counter): "
-        "[data/testset_wp.csv](data/testset_wp.csv).",
+        "[data/testset_wp.csv](../data/testset_wp.csv).",
         "",
         *([*notes, ""] if notes else []),
         *tables(rows, problems, shown, m_values),
         *comparison(rows, problems, shown),
         END,
     ]
-    doc = DOCS / "benchmarks.md"
+    doc = DOCS / "validation" / "testset.md"
     update_doc(doc, BEGIN, END, "\n".join(block), default="# Benchmarks\n",
                heading="## Stiff test problems: work-precision\n\n"
-               "The six stiff problems of the Bari test set ([testset.md](testset.md)) with\n"
+               "The six stiff problems of the Bari test set ([testset.md](../validation/testset.md)) with\n"
                "every integrator; each point is one `ropedyn testset ... --csv` run.\n\n")
     print(f"work_precision_testset: {data}, docs/figures/wp_*.png and {doc} written")
     return 0
