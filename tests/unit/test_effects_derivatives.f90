@@ -91,6 +91,24 @@ contains
             call power_balance(model, y, 0.31_wp*trial, 'rfem')
         end do
         call rfem_gradient_check()
+        ! the same in water through the rope's middle: buoyancy, added mass (with the
+        ! current), the drag of the wetted part; a thick rope, so the smoothed surface is 1 cm
+        block
+            character(len=64) :: wet(size(sets) + 5)
+            wet(1:size(sets)) = sets
+            wet(size(sets) + 1:) = [character(len=64) :: 'effects.water = .true.', &
+                'fluid.surface = 0.13', 'fluid.added_mass_coefficient = 1.0', &
+                'fluid.tangential_added_mass_coefficient = 0.3', 'rope.diameter = 0.02']
+            call make_scene(wet, scene)
+            call rfem_create(model, scene%rope_spec_t, err)
+            call suite%check_true(.not. allocated(err), 'rfem: create in water')
+            if (allocated(err)) return
+            do trial = 1, 3
+                call random_state(model, trial, y)
+                call rfem_jacobian_check(model, y, trial)
+                call power_balance(model, y, 0.31_wp*trial, 'rfem in water')
+            end do
+        end block
     end subroutine rfem_checks
 
     !> A state near the initial one: positions by 2 mm, angles by 0.5 rad, velocities up to

@@ -34,7 +34,8 @@ module ropedyn_rfem
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_effect, only: effect_box_t, bodies_t, add_forces_of, add_jacobians_of, &
                               add_energies_of, add_powers_of
-    use ropedyn_effect_factory, only: build_body_effects, attached_masses
+    use ropedyn_effect_factory, only: build_body_effects, attached_masses, water_added_mass
+    use ropedyn_added_mass, only: added_mass_t
     use ropedyn_support_motion, only: support_motion_t, motion_state_t
     use ropedyn_rope_section, only: section_t, rope_section
     use ropedyn_rope_setup, only: initial_angle, clamp_angles, &
@@ -103,6 +104,10 @@ module ropedyn_rfem
         integer, allocatable :: pm_elem(:)
         real(wp), allocatable :: pm_moment(:)
         real(wp), allocatable :: rowscale(:, :)  !< (3, n): 1/m, 1/m, 1/J; 1 on pm elements
+        !> in water (&effects water): every element's mass block holds its added mass, its
+        !! accelerations solve it (submodule ropedyn_rfem_water); rowscale is 1 then
+        logical :: water = .false.
+        type(added_mass_t) :: added
         ! workspace, allocated once (no state is kept between calls)
         real(wp), allocatable :: cs(:, :)      !< cos, sin of every angle, (2, n)
         real(wp), allocatable :: phi(:)        !< every angle, gathered from y (n)
@@ -141,6 +146,7 @@ module ropedyn_rfem
         procedure, private :: set_time
         procedure, private :: fill_bodies
         procedure, private :: point_mass_accelerations
+        procedure, private :: water_forces, water_accelerations, water_kinetic, water_rows
     end type rfem_t
 
     interface
@@ -282,6 +288,36 @@ module ropedyn_rfem
             real(wp), intent(out) :: yqdot(:)
             integer, intent(out) :: status
         end subroutine rfem_rhs_quad
+        !> The added mass's forces at y into self%gen; with e_el, its potential added (the
+        !! current's, J). Submodule ropedyn_rfem_water.
+        module subroutine water_forces(self, y, e_el)
+            class(rfem_t), intent(inout) :: self
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(inout), optional :: e_el
+        end subroutine water_forces
+
+        !> Every element's accelerations from its mass block (in water).
+        module subroutine water_accelerations(self, y, gen, ydot)
+            class(rfem_t), intent(in) :: self
+            real(wp), intent(in) :: y(:), gen(:, :)
+            real(wp), intent(inout) :: ydot(:)
+        end subroutine water_accelerations
+
+        !> The added mass's kinetic energy at y, J.
+        module function water_kinetic(self, y) result(e_k)
+            class(rfem_t), intent(in) :: self
+            real(wp), intent(in) :: y(:)
+            real(wp) :: e_k
+        end function water_kinetic
+
+        !> self%blk's rows to acceleration rows through the elements' mass blocks (in
+        !! water); self%gen must hold the forces at (t, y).
+        module subroutine water_rows(self, t, y)
+            class(rfem_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+        end subroutine water_rows
+
         !> Build the model of a spec (its values are already validated; submodule
         !! ropedyn_rfem_create).
         module subroutine rfem_create(model, spec, err)
@@ -485,6 +521,7 @@ contains
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: mm(:, :)
         integer :: i, k
+        real(wp) :: blk(3, 3), g(3)
         mm = 0.0_wp
         do i = 1, self%n
             k = 3*(i - 1)
@@ -499,5 +536,14 @@ contains
                 [-sin(y(6*self%pm_elem(i) - 3)), cos(y(6*self%pm_elem(i) - 3))]
             mm(k + 3, k + 1:k + 2) = mm(k + 1:k + 2, k + 3)
         end do
+        ! the water's added mass (at the state's coordinates and rates)
+        if (self%water) then
+            do i = 1, self%n
+                k = 6*(i - 1)
+                call self%added%terms(y(k + 1:k + 2), y(k + 3), y(k + 4:k + 5), y(k + 6), &
+                                      self%len(i), blk, g)
+                mm(3*i - 2:3*i, 3*i - 2:3*i) = mm(3*i - 2:3*i, 3*i - 2:3*i) + blk
+            end do
+        end if
     end subroutine rfem_coordinate_mass
 end module ropedyn_rfem

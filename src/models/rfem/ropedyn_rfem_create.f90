@@ -136,6 +136,12 @@ contains
         model%rowscale(2, :) = 1.0_wp/model%mass
         model%rowscale(3, :) = 1.0_wp/model%inertia
         model%rowscale(:, model%pm_elem) = 1.0_wp
+        ! in water every element's accelerations come from its mass block
+        model%water = spec%effects%water
+        if (model%water) then
+            model%added = water_added_mass(spec)
+            model%rowscale = 1.0_wp
+        end if
 
         call build_body_effects(spec, model%len, model%effects)
         if (size(model%effects) > 0) then

@@ -310,6 +310,13 @@ contains
             call add_forces_of(self%effects, t, self%bodies, self%gen(1:2, :), self%gen(3, :))
             if (energy) call add_energies_of(self%effects, t, self%bodies, e_el)
         end if
+        if (self%water) then
+            if (energy) then
+                call self%water_forces(y, e_el)
+            else
+                call self%water_forces(y)
+            end if
+        end if
         if (energy) elastic = e_el
         if (with_power) power = p_in
     end procedure forces
@@ -359,7 +366,11 @@ contains
             ydot(k + 5) = self%gen(2, i)*self%rowscale(2, i)
             ydot(k + 6) = self%gen(3, i)*self%rowscale(3, i)
         end do
-        if (size(self%pm_elem) > 0) call self%point_mass_accelerations(y, self%gen, ydot)
+        if (self%water) then
+            call self%water_accelerations(y, self%gen, ydot)
+        else if (size(self%pm_elem) > 0) then
+            call self%point_mass_accelerations(y, self%gen, ydot)
+        end if
     end subroutine accelerations
 
     module procedure rfem_has_jacobian
@@ -505,6 +516,7 @@ contains
                         (-y(k + 4)*sin(y(k + 3)) + y(k + 5)*cos(y(k + 3)))
             if (self%gravity_on) e%gravity = e%gravity - self%g*self%pm_moment(p)*cos(y(k + 3))
         end do
+        if (self%water) e%kinetic = e%kinetic + self%water_kinetic(y)
         ! the springs' and the effects' potential energy
         call self%forces(t, y, e%elastic)
         e%dissipated = 0.0_wp
