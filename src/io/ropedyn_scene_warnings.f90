@@ -73,6 +73,10 @@ contains
                 ' .. '//real_text(MAX_DAMPING_RATIO)//'): a coefficient in the wrong unit? '// &
                 '(the unit is '//trim(merge('N s    ', 'N s/m^2', section))//')')
         end if
+        if (scene%effects%water .and. scene%fluid%density < MIN_WATER_DENSITY) &
+            call append_text(list, scene%path//': &fluid: density = '// &
+                real_text(scene%fluid%density)//': water = .true. in a fluid this light '// &
+                '(air is 1.225 kg/m^3): water is about 1000 (fresh) or 1025 (sea)')
     contains
         function stiffness_text() result(text)
             character(len=:), allocatable :: text
