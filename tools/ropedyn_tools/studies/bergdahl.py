@@ -1,0 +1,406 @@
+"""Validation against a measured chain, the Bergdahl experiment: writes docs/validation/bergdahl.md.
+
+Bergdahl, Palm, Eskilsson and Lindahl (2016), "Dynamically scaled model experiment of a
+mooring cable", J. Mar. Sci. Eng. 4(1):5, measured the mean cycle maximum of the fairlead
+tension of a 33 m chain whose fairlead moves on a circle, for 6 periods T x 5 radii R. The
+scene and the sweeps are input/validation/bergdahl/ (base.nml, sweeps/T*.nml, one file per
+period: the ramp and the end time are multiples of T). This study runs the sweeps (RFEM and
+MPP, `ropedyn sweep --jobs 2`), takes the cycle maxima of |top reaction| over the last 5 of
+12 cycles, and compares them with the measurement; the convergence runs (element length and
+tolerance halved) on demand.
+
+    scripts/validation bergdahl [--models rfem,mpp] [--convergence] [--quick] [--out PAGE]
+    (python -m ropedyn_tools.studies.bergdahl; without --exe it builds the Release executable)
+"""
+import argparse
+import csv
+import math
+import os
+import pathlib
+import subprocess
+import time
+
+import h5py
+import numpy as np
+
+from ropedyn_tools.repo import DOCS, INPUT, ROOT, add_exe_argument, exe_or_build
+from ropedyn_tools.studies.common import run_stamp, update_doc
+
+SCENE_DIR = INPUT / "validation" / "bergdahl"
+BASE = SCENE_DIR / "base.nml"
+PERIODS = (1.25, 1.5, 2.0, 2.5, 3.0, 3.5)
+RADII = (0.075, 0.1, 0.125, 0.15, 0.2)
+#: mean cycle maximum of the fairlead tension (N), measured; rows T, columns R
+MEASURED = {1.25: (42.5, 46.8, 54.1, 60.4, 70.3),
+            1.50: (41.0, 45.3, 51.5, 59.0, 68.0),
+            2.00: (36.0, 39.5, 47.5, 54.1, 62.3),
+            2.50: (31.1, 35.4, 42.5, 49.0, 57.3),
+            3.00: (29.5, 33.1, 39.3, 45.8, 54.0),
+            3.50: (27.8, 31.5, 37.5, 42.5, 50.1)}
+CYCLES, RAMP_CYCLES, ANALYSED = 12, 3, 5
+MODELS = ("rfem", "mpp")
+LENGTH = 33.0
+#: the two conditions whose tension histories the page shows
+HISTORIES = ((1.25, 0.2), (3.5, 0.075))
+BEGIN, END = "<!-- bergdahl:begin -->", "<!-- bergdahl:end -->"
+
+
+def sweep_path(period):
+    return SCENE_DIR / "sweeps" / (f"T{period:.2f}".replace(".", "") + ".nml")
+
+
+# ---------------------------------------------------------------- analysis
+
+def peak(t, f, i):
+    """The maximum near sample i of the sampled f(t): the vertex of the parabola through
+    samples i-1, i, i+1 (the sample itself at an end or where the three are collinear)."""
+    if i == 0 or i == len(f) - 1:
+        return f[i]
+    a, b, c = f[i - 1], f[i], f[i + 1]
+    den = a - 2 * b + c
+    if den >= 0:
+        return b
+    return b - (a - c) ** 2 / (8 * den)
+
+
+def cycle_maxima(t, force, period, cycles=ANALYSED):
+    """The maxima of force over each of the last `cycles` whole periods before t[-1]."""
+    t_end = t[-1]
+    maxima = []
+    for k in range(cycles, 0, -1):
+        lo, hi = t_end - k * period, t_end - (k - 1) * period
+        idx = np.nonzero((t >= lo - 1e-9) & (t <= hi + 1e-9))[0]
+        if len(idx) < 3:
+            raise ValueError(f"cycle [{lo:.3f}, {hi:.3f}] s has {len(idx)} records")
+        i = idx[np.argmax(force[idx])]
+        maxima.append(peak(t, force, i))
+    return np.array(maxima)
+
+
+def fairlead_tension(path):
+    """Times and |top support reaction| (N) of a run file: the fairlead tension."""
+    with h5py.File(path, "r") as f:
+        t = f["time"][:]
+        r = f["supports/top/reaction"][:]
+        solver = {k: float(f["solver"][k][()]) for k in ("cpu_time", "steps", "err_test_fails")
+                  if k in f["solver"]}
+        if "wall_time" in f["solver"]:
+            solver["wall_time"] = float(f["solver/wall_time"][()])
+    return t, np.hypot(r[:, 0], r[:, 1]), solver
+
+
+def case_result(path, period, cycles=ANALYSED):
+    t, tension, solver = fairlead_tension(path)
+    m = cycle_maxima(t, tension, period, cycles)
+    return dict(maxima=m, mean=float(m.mean()), spread=float(m.std(ddof=1)) if len(m) > 1
+                else 0.0, **solver)
+
+
+def scores(computed, measured):
+    """RMSE (N), mean absolute percentage error (%), bias (N, computed - measured) and the
+    correlation of computed with measured."""
+    c, m = np.asarray(computed, float), np.asarray(measured, float)
+    err = c - m
+    corr = float(np.corrcoef(c, m)[0, 1]) if len(c) > 1 else float("nan")
+    return dict(rmse=float(np.sqrt(np.mean(err ** 2))),
+                mape=float(100 * np.mean(np.abs(err) / m)),
+                bias=float(err.mean()), corr=corr, worst=float(100 * np.max(np.abs(err) / m)))
+
+
+# ---------------------------------------------------------------- running
+
+def run_sweeps(exe, periods, models, radii, work, jobs, extra_set=(), quick=None):
+    """Run the period sweeps into work/T<..>; returns {period: wall seconds}.
+
+    quick = (elements, cycles): a copy of each sweep file in work with that many elements,
+    cycles and a one-cycle ramp (a smoke test of the pipeline)."""
+    walls = {}
+    for period in periods:
+        src = sweep_path(period)
+        out = work / src.stem
+        sweep = src
+        if quick is not None or extra_set:
+            sweep = work / src.name
+            text = src.read_text().replace("base = '../base.nml'", f"base = '{BASE}'")
+            sets = list(extra_set)
+            if quick is not None:
+                elements, cycles = quick
+                text = text.replace(f"'solver.t_end={12 * period:.12g}'",
+                                    f"'solver.t_end={cycles * period:.12g}'")
+                text = text.replace(f"'supports.top_ramp_time={3 * period:.12g}'",
+                                    f"'supports.top_ramp_time={period:.12g}'")
+                sets.append(f"model.elements={elements}")
+            if sets:
+                text = text.replace("    set = ", "    set = " +
+                                    "".join(f"'{s}', " for s in sets), 1)
+            work.mkdir(parents=True, exist_ok=True)
+            sweep.write_text(text)
+        tasks = task_list(models, radii)
+        w0 = time.perf_counter()
+        cmd = [str(exe), "sweep", str(sweep), "--output-dir", str(out), "--quiet"]
+        cmd += ["--jobs", str(jobs)] if tasks is None else ["--task", tasks]
+        result = subprocess.run(cmd, capture_output=True, text=True)
+        walls[period] = time.perf_counter() - w0
+        if result.returncode != 0:
+            raise RuntimeError(f"{' '.join(cmd)}: exit {result.returncode}\n{result.stderr}")
+        if tasks is not None:          # --task writes no summary
+            subprocess.run([str(exe), "sweep", str(sweep), "--output-dir", str(out),
+                            "--summary"], capture_output=True, text=True, check=True)
+    return walls
+
+
+def case_id(model, radius):
+    """The id of a case in a period's sweep file: models > radii, the radii fastest."""
+    return MODELS.index(model) * len(RADII) + RADII.index(radius) + 1
+
+
+def task_list(models, radii):
+    """The --task list of the cases of these models and radii (None: all, run with --jobs)."""
+    if set(models) == set(MODELS) and set(radii) == set(RADII):
+        return None
+    return ",".join(str(case_id(m, r)) for m in models for r in radii)
+
+
+def case_path(work, period, model, radius):
+    return work / sweep_path(period).stem / f"case_{case_id(model, radius):04d}.h5"
+
+
+def collect(work, periods, models, cycles=ANALYSED):
+    results = {}
+    for model in models:
+        for period in periods:
+            for radius in RADII:
+                path = case_path(work, period, model, radius)
+                if path.exists():
+                    results[model, period, radius] = case_result(path, period, cycles)
+    return results
+
+
+# ---------------------------------------------------------------- convergence
+
+def convergence(exe, work, periods=(1.25, 3.5), radius=0.2, models=MODELS, base_n=165,
+                base_rtol=1e-4):
+    """Mean cycle maxima at elements of 0.4, 0.2, 0.1 m and at rtol halved twice."""
+    rows = []
+    for model in models:
+        for period in periods:
+            variants = [(base_n // 2, base_rtol), (base_n, base_rtol), (base_n * 2, base_rtol),
+                        (base_n, base_rtol / 2), (base_n, base_rtol / 4)]
+            for n, rtol in variants:
+                out = work / "convergence" / f"{model}_T{period}_n{n}_rtol{rtol:g}.h5"
+                out.parent.mkdir(parents=True, exist_ok=True)
+                if not out.exists():
+                    sets = [f"model.kind={model}", f"model.elements={n}",
+                            f"solver.rtol={rtol:g}", f"supports.top_frequency={1 / period:.12g}",
+                            f"solver.t_end={CYCLES * period:.12g}",
+                            f"supports.top_ramp_time={RAMP_CYCLES * period:.12g}",
+                            f"supports.top_amplitude={radius},{radius}",
+                            f"output.file={out}"]
+                    subprocess.run([str(exe), "run", str(BASE), *sum(
+                        (["--set", s] for s in sets), [])], check=True, capture_output=True)
+                res = case_result(out, period)
+                rows.append(dict(model=model, period=period, n=n, rtol=rtol, **res))
+    return rows
+
+
+# ---------------------------------------------------------------- page
+
+def fmt(x, digits=1):
+    return f"{x:.{digits}f}"
+
+
+def results_table(results, models, periods):
+    head = "| T (s) | R (m) | measured (N) | " + " | ".join(
+        f"{m.upper()} mean (N) | spread | error" for m in models) + " |"
+    lines = [head, "|---|---|---|" + "---|---|---|" * len(models)]
+    for period in periods:
+        for j, radius in enumerate(RADII):
+            meas = MEASURED[period][j]
+            cells = []
+            for model in models:
+                r = results.get((model, period, radius))
+                if r is None:
+                    cells.append("– | – | –")
+                else:
+                    cells.append(f"{r['mean']:.2f} | {r['spread']:.2f} | "
+                                 f"{100 * (r['mean'] / meas - 1):+.1f} %")
+            lines.append(f"| {period} | {radius} | {meas} | " + " | ".join(cells) + " |")
+    return lines
+
+
+def model_scores(results, model, periods):
+    comp, meas = [], []
+    for period in periods:
+        for j, radius in enumerate(RADII):
+            r = results.get((model, period, radius))
+            if r is not None:
+                comp.append(r["mean"])
+                meas.append(MEASURED[period][j])
+    return (scores(comp, meas), len(comp)) if comp else (None, 0)
+
+
+def cost_lines(results, models, periods, walls):
+    lines = ["| model | cases | CPU per case, mean (s) | min | max | CPU, all (s) | steps per case | rejected |",
+             "|---|---|---|---|---|---|---|---|"]
+    for model in models:
+        rs = [results[k] for k in results if k[0] == model and k[1] in periods]
+        if not rs:
+            continue
+        cpu = np.array([r["cpu_time"] for r in rs])
+        steps = np.mean([r["steps"] for r in rs])
+        rej = np.mean([r["err_test_fails"] for r in rs])
+        lines.append(f"| {model.upper()} | {len(rs)} | {cpu.mean():.1f} | {cpu.min():.1f} | "
+                     f"{cpu.max():.1f} | {cpu.sum():.0f} | {steps:,.0f} | {rej:,.0f} |")
+    if walls:
+        lines += ["", f"Wall time of the sweeps (`ropedyn sweep --jobs 2`, one per period, "
+                      f"static start included): {sum(walls.values()):.0f} s for "
+                      f"{len(walls)} periods x {len(RADII)} radii x {len(models)} model(s)."]
+    return lines
+
+
+def convergence_lines(rows):
+    if not rows:
+        return []
+    lines = ["| model | T (s) | elements | rtol | mean cycle max (N) | change from 165, 1e-4 | CPU (s) |",
+             "|---|---|---|---|---|---|---|"]
+    for row in rows:
+        ref = next(r for r in rows if r["model"] == row["model"] and
+                   r["period"] == row["period"] and r["n"] == 165 and r["rtol"] == 1e-4)
+        lines.append(f"| {row['model'].upper()} | {row['period']} | {row['n']} | {row['rtol']:g} | "
+                     f"{row['mean']:.3f} | {100 * (row['mean'] / ref['mean'] - 1):+.2f} % | "
+                     f"{row['cpu_time']:.1f} |")
+    return lines
+
+
+def figures(results, models, periods, work, figdir, stem):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    figdir.mkdir(parents=True, exist_ok=True)
+    names = []
+    fig, ax = plt.subplots(figsize=(5, 5))
+    lo, hi = 20, 80
+    ax.plot([lo, hi], [lo, hi], "k-", lw=0.8)
+    for model, marker in zip(models, "os"):
+        xs, ys = [], []
+        for period in periods:
+            for j, radius in enumerate(RADII):
+                r = results.get((model, period, radius))
+                if r is not None:
+                    xs.append(MEASURED[period][j])
+                    ys.append(r["mean"])
+        ax.plot(xs, ys, marker, mfc="none", label=model.upper())
+    ax.set_xlabel("measured mean cycle maximum (N)")
+    ax.set_ylabel("computed (N)")
+    ax.set_xlim(lo, hi)
+    ax.set_ylim(lo, hi)
+    ax.legend()
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    names.append(f"{stem}_measured.png")
+    fig.savefig(figdir / names[-1], dpi=110)
+    plt.close(fig)
+    conds = [c for c in HISTORIES if c[0] in periods]
+    if conds:
+        fig, axes = plt.subplots(len(conds), 1, figsize=(8, 2.6 * len(conds)), squeeze=False)
+        for ax, (period, radius) in zip(axes[:, 0], conds):
+            for model in models:
+                path = case_path(work, period, model, radius)
+                if path.exists():
+                    t, tension, _ = fairlead_tension(path)
+                    ax.plot(t / period, tension, lw=0.8, label=model.upper())
+            ax.axhline(MEASURED[period][RADII.index(radius)], color="k", ls="--", lw=0.8,
+                       label="measured mean max")
+            ax.axvspan(CYCLES - ANALYSED, CYCLES, color="0.9")
+            ax.set_title(f"T = {period} s, R = {radius} m", fontsize=9)
+            ax.set_ylabel("fairlead tension (N)")
+            ax.legend(fontsize=7, loc="upper left")
+        axes[-1, 0].set_xlabel("t / T (shaded: the analysed cycles)")
+        fig.tight_layout()
+        names.append(f"{stem}_histories.png")
+        fig.savefig(figdir / names[-1], dpi=110)
+        plt.close(fig)
+    return names
+
+
+def section(results, models, periods, walls, conv, figs, command):
+    md = [BEGIN, "",
+          f"Generated by `{command}` ({run_stamp()}, {os.cpu_count()} cores); do not edit "
+          "by hand.", ""]
+    md += ["### Scores", "",
+           "| model | cases | RMSE (N) | MAPE (%) | bias (N) | correlation | worst (%) |",
+           "|---|---|---|---|---|---|---|"]
+    for model in models:
+        s, count = model_scores(results, model, periods)
+        if s is not None:
+            md.append(f"| {model.upper()} | {count} | {s['rmse']:.2f} | {s['mape']:.2f} | "
+                      f"{s['bias']:+.2f} | {s['corr']:.4f} | {s['worst']:.1f} |")
+    md += ["", "### Each condition", "",
+           "Mean of the 5 cycle maxima, their standard deviation (spread) and the error "
+           "against the measurement.", ""]
+    md += results_table(results, models, periods)
+    if figs:
+        md += ["", f"![measured against computed](../figures/{figs[0]})", ""]
+        if len(figs) > 1:
+            md += [f"![tension histories](../figures/{figs[1]})", ""]
+    md += ["### Cost", ""] + cost_lines(results, models, periods, walls)
+    if conv:
+        md += ["", "### Convergence", "",
+               "R = 0.2 m, each run its own 12 cycles; the change of the mean cycle maximum "
+               "against 165 elements (0.2 m) at rtol 1e-4.", ""] + convergence_lines(conv)
+    md += ["", END]
+    return "\n".join(md)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    add_exe_argument(parser)
+    parser.add_argument("--out", default=str(DOCS / "validation" / "bergdahl.md"))
+    parser.add_argument("--work", default=str(ROOT / "out" / "bergdahl"),
+                        help="directory of the case files (kept: a rerun reuses them)")
+    parser.add_argument("--models", default="rfem,mpp")
+    parser.add_argument("--periods", default=",".join(str(p) for p in PERIODS))
+    parser.add_argument("--radii", default=",".join(str(r) for r in RADII))
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--convergence", action="store_true",
+                        help="also the runs at other element lengths and tolerances")
+    parser.add_argument("--analyse-only", action="store_true",
+                        help="no runs: analyse the case files in --work")
+    parser.add_argument("--quick", default=None, metavar="ELEMENTS,CYCLES",
+                        help="smoke test: that many elements and cycles (one analysed), "
+                             "a one-cycle ramp")
+    parser.add_argument("--figures", default=str(DOCS / "figures"))
+    args = parser.parse_args(argv)
+    models = tuple(args.models.split(","))
+    periods = tuple(float(p) for p in args.periods.split(","))
+    radii = tuple(float(r) for r in args.radii.split(","))
+    work = pathlib.Path(args.work).resolve()
+    quick = tuple(int(v) for v in args.quick.split(",")) if args.quick else None
+    cycles = 1 if quick else ANALYSED
+    walls = {}
+    exe = None
+    if not args.analyse_only:
+        exe = pathlib.Path(exe_or_build(args.exe)).resolve()
+        walls = run_sweeps(exe, periods, models, radii, work, args.jobs, quick=quick)
+    results = collect(work, periods, models, cycles)
+    conv = []
+    if args.convergence:
+        exe = exe or pathlib.Path(exe_or_build(args.exe)).resolve()
+        conv = convergence(exe, work, models=models)
+    out = pathlib.Path(args.out)
+    stem = out.stem
+    figs = figures(results, models, periods, work, pathlib.Path(args.figures), stem)
+    command = "scripts/validation bergdahl" + (f" --quick {args.quick}" if quick else "")
+    block = section(results, models, periods, walls, conv, figs, command)
+    update_doc(out, BEGIN, END, block, heading="## Results\n\n",
+               default=f"# Bergdahl chain\n")
+    for model in models:
+        s, count = model_scores(results, model, periods)
+        if s is not None:
+            print(f"bergdahl {model}: {count} cases, RMSE {s['rmse']:.2f} N, MAPE "
+                  f"{s['mape']:.2f} %, bias {s['bias']:+.2f} N, correlation {s['corr']:.4f}")
+    print(f"bergdahl: wrote {out}")
+
+
+if __name__ == "__main__":
+    main()
