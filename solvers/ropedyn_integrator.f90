@@ -52,6 +52,10 @@ module ropedyn_integrator
         !! second-order structure (the reduced matrix M - g C - g^2 K of half the size is
         !! the default then; ropedyn_iteration_matrix)
         logical :: first_order_newton = .false.
+        !> the end of the run (s), when the caller knows it (huge: not known); auto starts
+        !! the symplectic method for its bounded energy only on runs long enough for an
+        !! adaptive method's energy drift to matter (ropedyn_auto, LONG_RUN)
+        real(wp) :: t_end = huge(1.0_wp)
         !> time the parts of a step (right-hand side, Jacobian, factorizations, solves) into
         !! the stats' time_* fields (a clock reading costs about 30 ns: a few % of a step of a
         !! small rope, so it is off unless asked for)

@@ -48,7 +48,7 @@ module ropedyn_symplectic
                                     OVERDAMPED_LIMIT
     implicit none
     private
-    public :: symplectic_t, split_stable_step, TABLE_VERLET, TABLE_BM6
+    public :: symplectic_t, split_stable_step, choose_step, TABLE_VERLET, TABLE_BM6
 
     !> the step over the stable step where the mode that limits it is lightly damped: the
     !! combination frequencies of such modes (up to twice the fastest) near the stability
@@ -100,6 +100,7 @@ module ropedyn_symplectic
         real(wp) :: fast_damping = 0.0_wp
         integer :: order_limit = 4
         real(wp) :: fixed_h = 0.0_wp           !< fix_step's step (0: the rule's)
+        real(wp) :: h_rule = 0.0_wp            !< the rule's step before fitting, s
     contains
         procedure :: start => symplectic_start
         procedure :: advance_to => symplectic_advance_to
@@ -144,6 +145,19 @@ module ropedyn_symplectic
             character(len=*), intent(in) :: reason
             logical, intent(in) :: warn
         end subroutine set_step
+
+        !> The composition and its step for a spectrum estimate, a tolerance and an order
+        !! limit (ropedyn_symplectic_steps, where the rule is); `light`: the mode that limits
+        !! the step is lightly damped (below LIGHT_DAMPING); h = 0: no estimate.
+        module subroutine choose_step(spec, rtol, max_order, tab, h, light, text)
+            type(spectrum_t), intent(in) :: spec
+            real(wp), intent(in) :: rtol
+            integer, intent(in) :: max_order
+            type(split_table_t), intent(out) :: tab
+            real(wp), intent(out) :: h
+            logical, intent(out) :: light
+            character(len=*), intent(out) :: text
+        end subroutine choose_step
 
         !> The largest step (s) at which the composition `tab` is stable for every fast Ritz
         !! value of `spec` (|lambda| >= radius/10), each taken as a damped oscillator with
@@ -282,6 +296,7 @@ contains
             call self%review_step(tout, err)
         end if
         if (allocated(err)) return
+        call fit_to_output(self, tout)
         snap = snapshot_t(self%t_base, self%h, self%t, self%k, self%q, self%v, self%yq, &
                           self%ac, self%ar, self%gc, self%gr)
         retries = 0
@@ -328,6 +343,23 @@ contains
         end if
         t = tout
     end subroutine symplectic_advance_to
+
+    !> The output time tout a whole number of steps from t (to 1e-6 of a step): else the
+    !! step is fitted to it (after a switch to this method, or a last output off the
+    !! interval: once or twice, then every output falls on a step).
+    subroutine fit_to_output(self, tout)
+        class(symplectic_t), intent(inout) :: self
+        real(wp), intent(in) :: tout
+        real(wp) :: steps, target
+        if (self%fixed_h > 0.0_wp .or. tout <= self%t .or. self%h <= 0.0_wp) return
+        steps = (tout - self%t)/self%h
+        if (abs(steps - anint(steps)) <= 1.0e-6_wp*max(1.0_wp, steps)) return
+        target = self%h_rule
+        if (target <= 0.0_wp) target = self%h
+        self%h = (tout - self%t)/real(ceiling((tout - self%t)/target*(1.0_wp - 1.0e-12_wp)), wp)
+        self%t_base = self%t
+        self%k = 0
+    end subroutine fit_to_output
 
     !> The stepping state as it was at the snapshot.
     subroutine restore(self, snap)

@@ -54,11 +54,12 @@ contains
         real(wp), intent(out) :: h
         character(len=*), intent(out) :: text
         type(spectrum_t) :: spec
+        logical :: light
         self%y(self%pos) = self%q
         self%y(self%vel) = self%v
         call estimate_spectrum(self%problem, self%t, self%y, spec)
         self%estimated_at = self%counters%steps
-        call choose_step(spec, self%options%rtol, self%order_limit, self%tab, h, text)
+        call choose_step(spec, self%options%rtol, self%order_limit, self%tab, h, light, text)
         self%radius = spec%radius
         self%fast_damping = spec%fast_damping
     end subroutine stable_step_here
@@ -71,18 +72,13 @@ contains
     !! except that lightly damped fast modes take the 4th-order composition when allowed
     !! (at Verlet's resonance-safe step its energy error is 100 times larger). h = 0: no
     !! estimate.
-    subroutine choose_step(spec, rtol, max_order, tab, h, text)
-        type(spectrum_t), intent(in) :: spec
-        real(wp), intent(in) :: rtol
-        integer, intent(in) :: max_order
-        type(split_table_t), intent(out) :: tab
-        real(wp), intent(out) :: h
-        character(len=*), intent(out) :: text
+    module procedure choose_step
         type(split_table_t) :: cand
         real(wp) :: hs, hk, zeta, safety, scale, cost, best
         integer :: kind
-        logical :: light
+        logical :: slight
         h = 0.0_wp
+        light = .false.
         text = 'no estimate of the spectrum'
         best = huge(1.0_wp)
         tab = split_table(TABLE_VERLET)
@@ -91,10 +87,10 @@ contains
             cand = split_table(kind)
             call split_stable_step(cand, spec, hs, zeta)
             if (hs <= 0.0_wp) return
-            light = zeta < LIGHT_DAMPING
-            if (light .and. kind == TABLE_VERLET .and. max_order >= 4) cycle
+            slight = zeta < LIGHT_DAMPING
+            if (slight .and. kind == TABLE_VERLET .and. max_order >= 4) cycle
             safety = cand%safety
-            if (light) safety = RESONANT_SAFETY
+            if (slight) safety = RESONANT_SAFETY
             scale = min(1.0_wp, (rtol/cand%rtol_at)**(1.0_wp/cand%order))
             hk = safety*scale*hs
             cost = cand%stages/hk
@@ -102,11 +98,12 @@ contains
             best = cost
             tab = cand
             h = hk
+            light = slight
             write (text, '(a, es9.2, a, f6.3, a, es9.2, a, f5.2, a, f5.3, a)') &
                 'spectral radius ', spec%radius, ' 1/s, the mode limiting the step damped ', &
                 zeta, ', stable step ', hs, ' s, the step ', safety, ' x', scale, ' of it'
         end do
-    end subroutine choose_step
+    end procedure choose_step
 
     !> The step from now on: `h` at most, fitted so that the interval to tout is a whole
     !! number of steps; the change logged (as a warning when `warn`).
@@ -114,6 +111,7 @@ contains
         real(wp) :: span
         character(len=120) :: what
         span = tout - self%t
+        self%h_rule = h
         self%h = h
         if (span > 0.0_wp) self%h = span/real(ceiling(span/h*(1.0_wp - 1.0e-12_wp)), wp)
         self%t_base = self%t
