@@ -123,6 +123,7 @@ module ropedyn_integrator
                      default_max_order => integrator_default_max_order, &
                      max_order_limit => integrator_max_order_limit
         procedure :: switch_log => integrator_switch_log
+        procedure :: steps_exhausted => integrator_steps_exhausted
     end type integrator_t
 
     abstract interface
@@ -234,6 +235,27 @@ contains
         type(switch_event_t), allocatable :: events(:)
         allocate (events(0))
     end function integrator_switch_log
+
+    !> The cause of a run that ran out of its step budget: the budget and, when the
+    !! integrator's own log diagnosed something on the way (its last warning: cvode's
+    !! lightly damped stiff modes, with the methods that avoid them), that diagnosis, so
+    !! that the message names the cause and the cure.
+    function integrator_steps_exhausted(self) result(cause)
+        class(integrator_t), intent(in) :: self
+        character(len=:), allocatable :: cause
+        type(switch_event_t), allocatable :: events(:)
+        integer :: k
+        character(len=16) :: at
+        cause = 'max_steps exceeded ('//int_text(self%options%max_steps)//' steps)'
+        events = self%switch_log()
+        do k = size(events), 1, -1
+            if (.not. events(k)%warning) cycle
+            write (at, '(es10.3)') events(k)%t
+            cause = cause//'; the run had diagnosed at t = '//trim(adjustl(at))// &
+                    ' s: '//events(k)%reason
+            exit
+        end do
+    end function integrator_steps_exhausted
 
     !> Prepare to integrate `problem` from (t0, y0, yq0). The problem must outlive the
     !! integrator (it is referenced, not copied). The checks every method shares: the order

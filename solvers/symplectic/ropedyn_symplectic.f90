@@ -42,7 +42,7 @@ module ropedyn_symplectic
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
     use ropedyn_integrator, only: integrator_t, start_t, solver_stats_t, stop_now
-    use ropedyn_spectrum, only: spectrum_t, estimate_spectrum
+    use ropedyn_spectrum, only: spectrum_t, estimate_spectrum, LIGHT_DAMPING
     use ropedyn_switch_log, only: switch_log_t, switch_event_t
     use ropedyn_split_tables, only: split_table_t, split_table, TABLE_VERLET, TABLE_BM6, &
                                     OVERDAMPED_LIMIT
@@ -58,8 +58,6 @@ module ropedyn_symplectic
     !! 6.9e-6; 0.35: 3.0e-7 .. 1.6e-6, while the rope's elastic energy, where the fast modes'
     !! energy is, rose 4 times (docs/theory/symplectic.md, "The step")
     real(wp), parameter :: RESONANT_SAFETY = 0.4_wp
-    !> the damping ratio below which the mode that limits the step counts as lightly damped
-    real(wp), parameter :: LIGHT_DAMPING = 0.01_wp
     !> steps between estimates of the spectrum (at an output time): at first, and at most
     !! (doubled after each estimate that leaves the step as it is)
     integer(i8), parameter :: RESPECTRUM_STEPS = 2000, RESPECTRUM_MAX = 64000
@@ -303,8 +301,7 @@ contains
         tol = 1.0e-7_wp*self%h
         do while (self%t < tout - tol)
             if (self%counters%steps >= self%options%max_steps) then
-                call self%failure(err, 'max_steps exceeded ('// &
-                                  int_text(self%options%max_steps)//' steps)')
+                call self%failure(err, self%steps_exhausted())
                 exit
             end if
             call self%step(status)
