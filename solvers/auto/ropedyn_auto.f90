@@ -339,7 +339,8 @@ contains
             target = tout
             if (h_look > 0.0_wp) target = min(tout, self%t + 0.25_wp*WINDOW*h_look)
             if (self%active == SYMPLECTIC) then
-                ! kept for good, to the output time (where its steps fall)
+                ! kept, to the output time (where its steps fall)
+                target = tout
                 call self%sym%advance_to(tout, self%t, self%y, self%yq, err)
             else if (self%active == EXPLICIT) then
                 call self%erk%advance_to(target, self%t, self%y, self%yq, err)

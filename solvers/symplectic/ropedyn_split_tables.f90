@@ -83,8 +83,8 @@ contains
             tab%a = [1.0_wp]
             tab%b = [0.5_wp, 0.5_wp]
             tab%limit = LIMIT_VERLET
-            tab%safety = 0.8_wp
-            tab%rtol_at = 3.0e-4_wp
+            tab%safety = 0.5_wp
+            tab%rtol_at = 1.0e-4_wp
         end select
         tab%stages = size(tab%a)
     end function split_table

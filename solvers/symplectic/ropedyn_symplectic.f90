@@ -33,15 +33,17 @@
 !!   simulated second at its step; the 4th-order one where the fast modes are lightly
 !!   damped (their energy stays, and Verlet's error on it is 100 times larger).
 !! - **Failures**: a force evaluation that is not finite (an unstable step) restarts the
-!!   output interval from its start at half the step, up to MAX_RETRIES times; the
-!!   problem must offer the force split (else `init` says why not).
+!!   output interval from its start at half the step, up to MAX_RETRIES times; a step that
+!!   would take more than STIFF_STEP_RATE steps per simulated second ends the run with the
+!!   diagnosis erk gives (naming auto and mebdf); the problem must offer the force split
+!!   (else `init` says why not).
 module ropedyn_symplectic
     use ropedyn_kinds, only: wp, i8
     use ropedyn_text, only: int_text
     use ropedyn_sums, only: sum_products
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
-    use ropedyn_integrator, only: integrator_t, start_t, solver_stats_t, stop_now
+    use ropedyn_integrator, only: integrator_t, start_t, solver_stats_t, stop_now, STIFF_STEP_RATE
     use ropedyn_spectrum, only: spectrum_t, estimate_spectrum, LIGHT_DAMPING
     use ropedyn_switch_log, only: switch_log_t, switch_event_t
     use ropedyn_split_tables, only: split_table_t, split_table, TABLE_VERLET, TABLE_BM6, &
@@ -287,6 +289,10 @@ contains
             call self%dense(self%t, y, yq)
             return
         end if
+        if (self%started .and. tout < self%t_old - 1.0e-7_wp*self%h) then
+            call make_error(err, ERR_SOLVER, 'symplectic: output time lies before the last step')
+            return
+        end if
         if (.not. self%started) then
             call self%begin(tout, err)
         else if (self%counters%steps - self%estimated_at >= self%respectrum .and. &
@@ -304,7 +310,8 @@ contains
                 call self%failure(err, self%steps_exhausted())
                 exit
             end if
-            call self%step(status)
+            ! (the state before the step is kept only where the dense output may need it)
+            call self%step(status, self%t_base + real(self%k + 1, wp)*self%h > tout - tol)
             if (status == STATUS_FATAL) then
                 call self%failure(err, 'the forces reported a fatal error')
                 exit
@@ -313,7 +320,11 @@ contains
                 retries = retries + 1
                 if (retries > MAX_RETRIES) then
                     call self%failure(err, 'the forces are not finite (NaN or Inf) even at '// &
-                                      'the step halved '//int_text(MAX_RETRIES)//' times')
+                                      'the step halved '//int_text(MAX_RETRIES)//' times: '// &
+                                      'the motion had become unstable before this output '// &
+                                      'interval (the energy balance of the records shows '// &
+                                      'where); a tighter rtol (a shorter step) or method = '// &
+                                      '''auto'' avoids it')
                     exit
                 end if
                 call restore(self, snap)
@@ -382,18 +393,22 @@ contains
 
 
     !> One step from t to t + h (the module header); status not OK: the state is not usable.
-    subroutine step(self, status)
+    subroutine step(self, status, keep_old)
         class(symplectic_t), intent(inout) :: self
         integer, intent(out) :: status
+        !> keep the state before the step for the dense output (the last step to an output)
+        logical, intent(in) :: keep_old
         real(wp) :: h, ti, t_new
         integer :: i, s
         h = self%h
         s = self%tab%stages
-        self%t_old = self%t
-        self%q_old = self%q
-        self%v_old = self%v
-        self%a_old = self%ac + self%ar
-        self%yq_old = self%yq
+        if (keep_old) then
+            self%t_old = self%t
+            self%q_old = self%q
+            self%v_old = self%v
+            self%a_old = self%ac + self%ar
+            self%yq_old = self%yq
+        end if
         t_new = self%t_base + real(self%k + 1, wp)*h
         call self%dmap(0.5_wp*h)
         ti = self%t

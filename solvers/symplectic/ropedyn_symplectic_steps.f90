@@ -29,8 +29,28 @@ contains
             call self%failure(err, 'no estimate of the spectrum to choose the step from')
             return
         end if
+        call too_stiff(self, h, err)
+        if (allocated(err)) return
         call self%set_step(h, tout, trim(text), .false.)
     end procedure begin
+
+    !> The run ends (ERR_SOLVER) when the step h would take more than STIFF_STEP_RATE steps
+    !! per simulated second, as erk's and adams' do: the step of an explicit method held by
+    !! the spectral radius, where an implicit method takes steps many times longer.
+    subroutine too_stiff(self, h, err)
+        class(symplectic_t), intent(inout) :: self
+        real(wp), intent(in) :: h
+        type(error_t), allocatable, intent(out) :: err
+        character(len=240) :: text
+        if (1.0_wp/h <= STIFF_STEP_RATE) return
+        write (text, '(a, es9.2, a, es9.2, a, es9.2, a)') 'the problem is too stiff for an '// &
+            'explicit method here: the step is held by stability (spectral radius ', &
+            self%radius, ' 1/s, step ', h, ' s), which takes ', 1.0_wp/h, &
+            ' steps per simulated second'
+        self%h = h
+        call self%failure(err, trim(text)//'; use method = ''auto'' (it switches to an '// &
+                          'implicit method where this happens) or ''mebdf''')
+    end subroutine too_stiff
 
     !> The spectrum at the current state again; the step changed when it must shrink or
     !! may grow by GROW_AT (the first output interval from here a whole number of steps).
@@ -39,6 +59,8 @@ contains
         character(len=200) :: text
         call stable_step_here(self, h, text)
         if (h <= 0.0_wp) return
+        call too_stiff(self, h, err)
+        if (allocated(err)) return
         if (h < self%h .or. h > GROW_AT*self%h) then
             call self%set_step(h, tout, trim(text), .false.)
             self%respectrum = RESPECTRUM_STEPS
@@ -87,7 +109,8 @@ contains
             cand = split_table(kind)
             call split_stable_step(cand, spec, hs, zeta)
             if (hs <= 0.0_wp) return
-            slight = zeta < LIGHT_DAMPING
+            ! the limiting mode, or any settled fast mode (their combinations)
+            slight = zeta < LIGHT_DAMPING .or. spec%settled_damping() < LIGHT_DAMPING
             if (slight .and. kind == TABLE_VERLET .and. max_order >= 4) cycle
             safety = cand%safety
             if (slight) safety = RESONANT_SAFETY
