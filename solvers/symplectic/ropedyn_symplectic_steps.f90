@@ -10,6 +10,7 @@ contains
         integer :: status
         real(wp) :: h
         character(len=200) :: text
+        type(split_table_t) :: tab
         self%started = .true.
         self%vt = self%v
         call self%evaluate(self%t, status, full=.true.)
@@ -24,13 +25,14 @@ contains
                               ' at a fixed step')
             return
         end if
-        call stable_step_here(self, h, text)
+        call stable_step_here(self, tab, h, text)
         if (h <= 0.0_wp) then
             call self%failure(err, 'no estimate of the spectrum to choose the step from')
             return
         end if
         call too_stiff(self, h, err)
         if (allocated(err)) return
+        self%tab = tab
         call self%set_step(h, tout, trim(text), .false.)
     end procedure begin
 
@@ -57,11 +59,14 @@ contains
     module procedure review_step
         real(wp) :: h
         character(len=200) :: text
-        call stable_step_here(self, h, text)
+        type(split_table_t) :: tab
+        call stable_step_here(self, tab, h, text)
         if (h <= 0.0_wp) return
         call too_stiff(self, h, err)
         if (allocated(err)) return
-        if (h < self%h .or. h > GROW_AT*self%h) then
+        ! the composition and its step change together (the step is the composition's)
+        if (tab%kind /= self%tab%kind .or. h < self%h .or. h > GROW_AT*self%h) then
+            self%tab = tab
             call self%set_step(h, tout, trim(text), .false.)
             self%respectrum = RESPECTRUM_STEPS
         else
@@ -71,8 +76,9 @@ contains
 
     !> The composition and step for the spectrum at the current state (choose_step; h = 0:
     !! no estimate), and its reason for the log.
-    subroutine stable_step_here(self, h, text)
+    subroutine stable_step_here(self, tab, h, text)
         class(symplectic_t), intent(inout) :: self
+        type(split_table_t), intent(out) :: tab
         real(wp), intent(out) :: h
         character(len=*), intent(out) :: text
         type(spectrum_t) :: spec
@@ -81,7 +87,7 @@ contains
         self%y(self%vel) = self%v
         call estimate_spectrum(self%problem, self%t, self%y, spec)
         self%estimated_at = self%counters%steps
-        call choose_step(spec, self%options%rtol, self%order_limit, self%tab, h, light, text)
+        call choose_step(spec, self%options%rtol, self%order_limit, tab, h, light, text)
         self%radius = spec%radius
         self%fast_damping = spec%fast_damping
     end subroutine stable_step_here
