@@ -27,6 +27,7 @@ COMMANDS = {
     "bench_step": "ropedyn.studies.bench_step",
     "bench_sweep": "ropedyn.studies.bench_sweep",
     "bench_peers": "ropedyn.studies.bench_peers",
+    "bench_symplectic": "ropedyn.studies.bench_symplectic",
     "auto_table": "ropedyn.studies.auto_table",
     "auto_accuracy": "ropedyn.studies.auto_accuracy",
     "cost_model": "ropedyn.studies.cost_model",
