@@ -132,8 +132,7 @@ contains
             tn = self%t + self%h
             hmin = 16.0_wp*epsilon(1.0_wp)*max(abs(self%t), abs(tn))
             if (self%counters%steps >= self%options%max_steps) then
-                call self%failure(err, 'max_steps exceeded ('// &
-                                  trim(int_text(self%options%max_steps))//' steps)')
+                call self%failure(err, self%steps_exhausted())
                 return
             end if
             if (self%h < hmin) then

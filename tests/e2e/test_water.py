@@ -87,14 +87,16 @@ def test_submerged_elastic_catenary(run, tmp_path, kind, n):
     assert abs(np.hypot(*reaction) / t_end - 1) < 1e-4
 
 
-def test_hanging_chain_frequencies_in_water(run, tmp_path):
+@pytest.mark.parametrize("kind", ["rfem", "mpp"])
+def test_hanging_chain_frequencies_in_water(run, tmp_path, kind):
     """A chain hanging under water: omega_k = (j_0k / 2) sqrt(w' / (m' L)) with the
     submerged weight w' and the mass with the added mass m' = mu + C_a rho A, to the
-    model's discretization error at n = 100 (the same as in air)."""
+    model's discretization error at n = 100 (the same as in air); the RFEM carries the
+    added mass in its elements' blocks, the MPP in its rods' inertia."""
     length, mu, d, ca = 2.0, 0.5, 0.01, 1.0
     scene = write(tmp_path, "chain.nml", f"""
 &rope length = {length}, mass_per_length = {mu}, axial_stiffness = 1.0e7, diameter = {d} /
-&model kind = 'rfem', elements = 100 /
+&model kind = '{kind}', elements = 100 /
 &supports top = 'pinned', bottom = 'free' /
 &initial shape = 'hanging' /
 &effects water = .true. /
@@ -144,8 +146,9 @@ def test_a_sinking_line_reaches_the_terminal_speed_with_the_added_mass_time_cons
     assert np.max(np.abs(v - v_t * np.tanh(t / tau_dry))) > 0.01 * v_t
 
 
-@pytest.mark.parametrize("method", ["auto", "erk", "mebdf", "cvode"])
-def test_energy_balance_through_the_surface(run, tmp_path, method):
+@pytest.mark.parametrize("kind,method", [("rfem", "auto"), ("rfem", "erk"), ("rfem", "mebdf"),
+                                         ("rfem", "cvode"), ("mpp", "auto"), ("mpp", "cvode")])
+def test_energy_balance_through_the_surface(run, tmp_path, kind, method):
     """A chain swinging through the surface with a current, tangential added mass, drag
     and material damping: T + V + dissipated - work stays at E0 to the tolerance (the added
     mass's kinetic energy and the current's potential counted, the buoyancy's potential,
@@ -153,7 +156,7 @@ def test_energy_balance_through_the_surface(run, tmp_path, method):
     scene = write(tmp_path, "swing.nml", """
 &rope length = 3.0, mass_per_length = 0.0818, axial_stiffness = 1.0e4, axial_damping = 5.0,
       bending_stiffness = 1.0e-3, diameter = 0.003654 /
-&model kind = 'rfem', elements = 20 /
+&model kind = '%s', elements = 20 /
 &supports top = 'pinned', bottom = 'free' /
 &initial shape = 'straight', angle_deg = 60.0 /
 &effects water = .true., drag = .true. /
@@ -161,7 +164,7 @@ def test_energy_balance_through_the_surface(run, tmp_path, method):
        tangential_drag_coefficient = 0.1, added_mass_coefficient = 1.0,
        tangential_added_mass_coefficient = 0.5, current = 0.05, 0.2 /
 &solver t_end = 2.0, rtol = 1e-7, atol = 1e-9 /
-""")
+""" % kind)
     proc = run("run", scene, "--set", f"solver.method='{method}'", "--set",
                f"output.file='{method}.h5'")
     assert proc.returncode == 0, proc.stderr

@@ -108,10 +108,13 @@ module ropedyn_rfem
         !! accelerations solve it (submodule ropedyn_rfem_water); rowscale is 1 then
         logical :: water = .false.
         type(added_mass_t) :: added
+        real(wp), allocatable :: inv_mass(:, :)  !< (3, n): 1/m, 1/m, 1/J (the force split)
         ! workspace, allocated once (no state is kept between calls)
         real(wp), allocatable :: cs(:, :)      !< cos, sin of every angle, (2, n)
         real(wp), allocatable :: phi(:)        !< every angle, gathered from y (n)
         real(wp), allocatable :: gen(:, :)     !< generalized forces, (3, n)
+        !> the forces other than the potential's (damping, effects), (3, n): split_forces
+        real(wp), allocatable :: gen_r(:, :)
         !> Jacobian blocks (3, 6, -1:1, n): blk(r, l, o, i) is the derivative of row r of
         !! element i (force x, y, moment; times rowscale(r, i) its acceleration, and after
         !! `point_mass_rows` the acceleration on elements with point masses) with respect
@@ -140,6 +143,8 @@ module ropedyn_rfem
         procedure :: second_order_blocks => rfem_second_order_blocks
         procedure :: generalized_forces => rfem_generalized_forces
         procedure :: potential_energy => rfem_potential_energy
+        procedure :: force_split_refusal => rfem_force_split_refusal, &
+                     split_layout => rfem_split_layout, split_rhs => rfem_split_rhs
         procedure, private :: forces
         procedure, private :: jacobian_blocks
         procedure, private :: point_mass_rows
@@ -153,7 +158,7 @@ module ropedyn_rfem
         !> The generalized forces (3, n) of everything at time t and state y into self%gen
         !! (one pass over the SDEs); optionally the elastic energy (J, springs and the
         !! effects' potential energy).
-        module subroutine forces(self, t, y, elastic, power, joint, support)
+        module subroutine forces(self, t, y, elastic, power, joint, support, rest)
             class(rfem_t), intent(inout) :: self
             real(wp), intent(in) :: t
             real(wp), intent(in) :: y(6*self%n)
@@ -166,6 +171,11 @@ module ropedyn_rfem
             !> when present: the support SDEs' forces fs (x, y, N) and fr (N m), top and
             !! bottom (zero for a free or released end; support_force in the kernels)
             real(wp), intent(out), optional :: support(3, 2)
+            !> when present, the force split (ropedyn_rfem_energy): self%gen holds the
+            !! potential's forces alone (springs, supports' springs, gravity) and, when
+            !! .true., self%gen_r the rest (dampers, effects); .false.: the rest is not
+            !! evaluated
+            logical, intent(in), optional :: rest
         end subroutine forces
 
         !> The derivatives of the generalized forces with respect to the coordinates and
@@ -317,6 +327,32 @@ module ropedyn_rfem
             real(wp), intent(in) :: t
             real(wp), intent(in) :: y(:)
         end subroutine water_rows
+
+        !> Why the model offers no force split ('' when it does; submodule ropedyn_rfem_energy).
+        module pure function rfem_force_split_refusal(self) result(why)
+            class(rfem_t), intent(in) :: self
+            character(len=:), allocatable :: why
+        end function rfem_force_split_refusal
+
+        !> The masses of the coordinates (m, m, J per element) and the balance signs of the
+        !! quadratures (dissipated -1, external work +1).
+        module pure subroutine rfem_split_layout(self, mass, signs)
+            class(rfem_t), intent(in) :: self
+            real(wp), intent(out) :: mass(:)
+            integer, intent(out) :: signs(:)
+        end subroutine rfem_split_layout
+
+        !> The accelerations of the springs, supports' springs and gravity (the potential)
+        !! and, with `ar`, of the rest (dampers, effects), with the quadratures' rates split
+        !! the same way (problem_t's split_rhs; submodule ropedyn_rfem_energy).
+        module subroutine rfem_split_rhs(self, t, y, ac, gc, status, ar, gr)
+            class(rfem_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(out) :: ac(:), gc(:)
+            integer, intent(out) :: status
+            real(wp), intent(out), optional :: ar(:), gr(:)
+        end subroutine rfem_split_rhs
 
         !> Build the model of a spec (its values are already validated; submodule
         !! ropedyn_rfem_create).
