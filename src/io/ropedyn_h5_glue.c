@@ -1,6 +1,7 @@
 /* Glue for ropedyn_h5.f90, which is the only caller: why an HDF5 call failed, the
- * library's end at the exit of the process, and string attributes of variable length
- * (which the Fortran interface of HDF5 1.10 does not read).
+ * library's end at the exit of the process, string attributes of variable length
+ * (which the Fortran interface of HDF5 1.10 does not read), and files in memory (the core
+ * driver without a backing store) with their image.
  *
  * Why a call failed, in the system's words (h5_reason). The Fortran interface of HDF5
  * returns only a negative code;
@@ -111,4 +112,25 @@ int ropedyn_h5_vlen_attribute(hid_t loc, const char *name, char *buf, int size)
     if (type >= 0) H5Tclose(type);
     H5Aclose(attr);
     return rc;
+}
+
+/* Create the file `name` in memory only (the core driver, grown 1 MiB at a time, nothing
+ * written to disk; `name` must differ from that of every other file open in the process).
+ * Returns its id, or a negative value. */
+hid_t ropedyn_h5_create_memory(const char *name)
+{
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS), file = -1;
+    if (fapl < 0) return -1;
+    if (H5Pset_fapl_core(fapl, (size_t)1 << 20, 0) >= 0)
+        file = H5Fcreate(name, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    H5Pclose(fapl);
+    return file;
+}
+
+/* The image of the open file `file` (what would be on disk) into `buf` of `size` bytes
+ * (NULL: only the size). Returns the image's size, or -1. */
+long long ropedyn_h5_image(hid_t file, void *buf, long long size)
+{
+    H5Fflush(file, H5F_SCOPE_GLOBAL);
+    return (long long)H5Fget_file_image(file, buf, buf ? (size_t)size : 0);
 }

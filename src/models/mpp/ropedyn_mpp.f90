@@ -35,7 +35,7 @@ module ropedyn_mpp
     use ropedyn_effect, only: effect_box_t, bodies_t, add_forces_of, add_jacobians_of, &
                               add_energies_of, add_powers_of
     use ropedyn_effect_factory, only: build_body_effects, attached_masses
-    use ropedyn_support_motion, only: support_motion_t, motion_state_t
+    use ropedyn_support_motion, only: motion_state_t
     use ropedyn_rope_section, only: section_t, rope_section
     use ropedyn_rope_setup, only: initial_angle, clamp_angles, &
                                   configure_motions, any_does_work
@@ -63,9 +63,8 @@ module ropedyn_mpp
         real(wp) :: top_angle = 0.0_wp, bottom_angle = 0.0_wp
         real(wp) :: init_angle = 0.0_wp
         logical :: folded = .false.    !< initial shape 'folded' (n even)
-        ! supports (1 top joint, 2 bottom): base anchors and angles in top_anchor, ...
-        type(support_motion_t) :: motion(2)
-        logical :: moving(2) = .false.
+        ! supports (1 top joint, 2 bottom): base anchors and angles in top_anchor, ...;
+        ! their motions: rope_model_t%motion
         real(wp) :: bottom_release = huge(1.0_wp)  !< s
         type(effect_box_t), allocatable :: effects(:)
         ! point masses: rod, offset from the rod's centre along it (m), mass (kg)
