@@ -12,6 +12,7 @@
  *     unable to lock file, errno = 11, error message = 'Resource temporarily unavailable'
  *
  * The reason is that text when a frame has one, else the innermost frame's description. */
+#include <pthread.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -69,16 +70,20 @@ static void end_library(void)
     if (!close_failed) H5close();
 }
 
-void ropedyn_h5_prepare(void)
+static void prepare_once(void)
 {
-    static int prepared = 0;
-    if (prepared) return;
-    prepared = 1;
     if (H5dont_atexit() >= 0) atexit(end_library);
     /* A file-size limit (ulimit -f) then makes a write fail with EFBIG, an I/O error the
      * writer handles (the file closed, marked failed), instead of ending the process by
      * SIGXFSZ with its file left 'running'. */
     signal(SIGXFSZ, SIG_IGN);
+}
+
+/* Once per process (the library's runs in two threads may both be first). */
+void ropedyn_h5_prepare(void)
+{
+    static pthread_once_t once = PTHREAD_ONCE_INIT;
+    pthread_once(&once, prepare_once);
 }
 
 void ropedyn_h5_close_failed(void) { close_failed = 1; }

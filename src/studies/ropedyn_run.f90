@@ -55,6 +55,7 @@ module ropedyn_run
     use ropedyn_methods, only: METHODS, method_index, resolved_max_order
     use ropedyn_energy_monitor, only: energy_monitor_t, safety_record_t
     use ropedyn_state_start, only: state_initial_state
+    use ropedyn_process, only: heartbeat_t
     implicit none
     private
     public :: run_t, run_summary_t, run_snapshot_t, STEP_RECORDED, STEP_STOPPED, STEP_FAILED
@@ -141,6 +142,7 @@ module ropedyn_run
         ! the guard of the output file: the lock held ('' none), and for a new run the
         ! file written (FILE.part) and its final name
         character(len=:), allocatable :: lock_file, part_file, final_file
+        type(heartbeat_t) :: beat                 !< the lock's heartbeat
         integer :: output = OUTPUT_FILE        !< where the records go
         integer(int8), allocatable :: image(:) !< OUTPUT_MEMORY: the file's bytes at its end
         !> OUTPUT_NONE: the position (m) and velocity (m/s) prescribed for each coupled
