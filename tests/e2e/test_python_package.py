@@ -1,5 +1,5 @@
-"""The ropedyn Python package (python/ropedyn, installed editable into .venv by
-scripts/setup) holds what a user imports; the studies and maintenance tools
+"""The ropedyn Python package (python/ropedyn, used in place by .venv, set up
+by scripts/setup) holds what a user imports; the studies and maintenance tools
 (tools/ropedyn_tools) are not installed and the scripts/ commands find them there. The
 package imports from any directory, its reader gives a run file's arrays with their units,
 and every command answers --help (without building or running anything)."""
