@@ -91,5 +91,6 @@ def _load():
             lib.path = path
             return lib
     raise Error("libropedyn not found (looked for " + ", ".join(map(str, tried)) +
-                "): build it with scripts/build, install the package with pip, or set "
+                "): build the library of this source tree (build/release), install the package "
+                "with pip, or set "
                 "ROPEDYN_LIBRARY to the file", 2)

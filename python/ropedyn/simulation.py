@@ -117,8 +117,17 @@ class Simulation:
         self._p = (ctypes.c_double * 2)()
         self._v = (ctypes.c_double * 2)()
         self._f = (ctypes.c_double * 2)()
+        # buffers of the reads made every exchange of a coupling, with their pointers made
+        # once (a numpy array from a ctypes array, or a pointer made per call, costs more
+        # than the call into the library)
+        self._force = np.empty(2)
+        self._force_ptr = self._force.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+        self._xy = np.empty((2 * self.n, 2))
+        self._xy_ptr = self._xy.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._advance = self._lib.ropedyn_advance
         self._set_support = self._lib.ropedyn_set_support
+        self._reaction = self._lib.ropedyn_reaction
+        self._points = self._lib.ropedyn_points
 
     def _check(self, status):
         if status != 0:
@@ -167,10 +176,10 @@ class Simulation:
     def points(self):
         """The polyline (2n, 2), m: element end points A_1, B_1, A_2, ... (x, y), as a
         record of /rope/points."""
-        out = np.empty((2 * self.n, 2))
-        self._check(self._lib.ropedyn_points(
-            self._handle(), out.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 2 * self.n))
-        return out
+        status = self._points(self._handle(), self._xy_ptr, 2 * self.n)
+        if status != 0:
+            self._check(status)
+        return self._xy.copy()
 
     @property
     def forces(self):
@@ -185,8 +194,10 @@ class Simulation:
 
     def reaction(self, end):
         """The force (x, y) of support `end` on the rope, N (zero for a free end)."""
-        self._check(self._lib.ropedyn_reaction(self._handle(), _support(end), self._f))
-        return np.array(self._f[:])
+        status = self._reaction(self._handle(), _support(end), self._force_ptr)
+        if status != 0:
+            self._check(status)
+        return self._force.copy()
 
     def anchor(self, end):
         """Where support `end` holds the rope now (x, y), m (NaN for a free end)."""
