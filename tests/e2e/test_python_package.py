@@ -1,5 +1,5 @@
-"""The ropedyn Python package (python/ropedyn, installed editable into .venv by
-scripts/setup) holds what a user imports; the studies and maintenance tools
+"""The ropedyn Python package (python/ropedyn, used in place by .venv, set up
+by scripts/setup) holds what a user imports; the studies and maintenance tools
 (tools/ropedyn_tools) are not installed and the scripts/ commands find them there. The
 package imports from any directory, its reader gives a run file's arrays with their units,
 and every command answers --help (without building or running anything)."""
@@ -31,6 +31,7 @@ COMMANDS = {
     "bench_sweep": "ropedyn_tools.studies.bench_sweep",
     "bench_peers": "ropedyn_tools.studies.bench_peers",
     "bench_symplectic": "ropedyn_tools.studies.bench_symplectic",
+    "bench_library": "ropedyn_tools.studies.bench_library",
     "auto_table": "ropedyn_tools.studies.auto_table",
     "auto_accuracy": "ropedyn_tools.studies.auto_accuracy",
     "cost_model": "ropedyn_tools.studies.cost_model",

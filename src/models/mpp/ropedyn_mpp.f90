@@ -69,9 +69,8 @@ module ropedyn_mpp
         real(wp) :: top_angle = 0.0_wp, bottom_angle = 0.0_wp
         real(wp) :: init_angle = 0.0_wp
         logical :: folded = .false.    !< initial shape 'folded' (n even)
-        ! supports (1 top joint, 2 bottom): base anchors and angles in top_anchor, ...
-        type(support_motion_t) :: motion(2)
-        logical :: moving(2) = .false.
+        ! supports (1 top joint, 2 bottom): base anchors and angles in top_anchor, ...;
+        ! their motions: rope_model_t%motion
         real(wp) :: bottom_release = huge(1.0_wp)  !< s
         type(effect_box_t), allocatable :: effects(:)
         !> in water (&effects water): the rods' added mass (submodule ropedyn_mpp_water)

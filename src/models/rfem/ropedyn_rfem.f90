@@ -90,10 +90,8 @@ module ropedyn_rfem
         real(wp) :: init_angle = 0.0_wp        !< angle of the straight initial state, rad
         real(wp) :: init_velocity(2) = 0.0_wp  !< initial velocity of every element, m/s
         logical :: folded = .false.            !< initial shape 'folded'
-        ! supports (index 1 top, 2 bottom): base anchors and prescribed motions; the anchors
+        ! supports (index 1 top, 2 bottom; their motions: rope_model_t%motion): the anchors
         ! and angles above are their values at the time of the current call
-        type(support_motion_t) :: motion(2)
-        logical :: moving(2) = .false.
         real(wp) :: release(2) = huge(1.0_wp)  !< release times, s
         logical :: timed = .false.             !< the supports depend on time
         ! external effects (only those enabled) and their workspace
