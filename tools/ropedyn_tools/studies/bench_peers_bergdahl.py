@@ -19,7 +19,8 @@ line, water, seabed and fairlead motion as input/validation/bergdahl/base.nml:
 - the fairlead tension every coupling step (GetLineFairTen); its cycle maxima over the last
   5 of 12 cycles, refined like ropedyn's (the vertex of the parabola through the three
   samples about the largest);
-- CPU: process time of the whole case, Create and static start included.
+- CPU: process time of the whole case, Create and static start included (a result is
+  kept in WORK/moordyn/ and reused by a rerun, CPU and all).
 
 ropedyn's side comes from the case files of `scripts/validation bergdahl` (its --work
 directory), its CPU from their /solver/cpu_time (the integration; the static start adds
@@ -46,6 +47,7 @@ BEGIN, END = "<!-- bergdahl_peers:begin -->", "<!-- bergdahl_peers:end -->"
 D = 0.003654
 K_GROUND, C_GROUND = 6.6e6, 1469.5      # per metre of chain, as the scene
 CT_WIDTH = 0.09582                      # the scene's tangential drag coefficient (on pi d)
+CT_PERIMETER = 0.30104                  # the other reading: 0.5 on the 2.2 mm perimeter
 COUPLING = 2.0 ** -10
 
 DRIVER = r"""
@@ -109,7 +111,23 @@ RK4      tScheme
 """)
 
 
-def run_case(py, work, period, radius, segments, dt_m, ct=CT_WIDTH, cycles=bg.CYCLES):
+def run_case(py, work, period, radius, segments, dt_m, ct=CT_WIDTH, cycles=bg.CYCLES,
+             cache=None):
+    """MoorDyn on one condition: its cycle maxima, CPU and static tension. With a cache
+    directory the result is kept there as JSON and reused by a rerun."""
+    key = f"T{period:g}_R{radius:g}_n{segments}_dt{dt_m:g}_ct{ct:g}_c{cycles}.json"
+    if cache is not None and (cache / key).exists():
+        r = json.loads((cache / key).read_text())
+        r["maxima"] = np.array(r["maxima"])
+        return r
+    r = run_moordyn(py, work, period, radius, segments, dt_m, ct, cycles)
+    if cache is not None and r.get("ok"):
+        cache.mkdir(parents=True, exist_ok=True)
+        (cache / key).write_text(json.dumps(dict(r, maxima=list(r["maxima"]))))
+    return r
+
+
+def run_moordyn(py, work, period, radius, segments, dt_m, ct, cycles):
     f = work / f"chain_{segments}_{dt_m:g}_{ct:g}.txt"
     moordyn_file(f, segments, dt_m, ct)
     proc = subprocess.run([str(py), "-c", DRIVER, str(f), str(period), str(radius),
@@ -138,6 +156,9 @@ def main(argv=None):
     parser.add_argument("--convergence", action="store_true",
                         help="also T = 1.25 and 3.5 s at R = 0.2 m with dtM halved and the "
                              "segments doubled")
+    parser.add_argument("--perimeter", action="store_true",
+                        help="also every condition with the other reading of the tangential "
+                             "drag (0.5 on the 2.2 mm perimeter)")
     parser.add_argument("--no-write", action="store_true")
     args = parser.parse_args(argv)
     py = ensure_bench_venv()
@@ -145,13 +166,14 @@ def main(argv=None):
     radii = [float(r) for r in args.radii.split(",")]
     work = pathlib.Path(args.work).resolve()
     ours = bg.collect(work, periods, bg.MODELS)
-    rows, md_res = [], {}
+    cache = work / "moordyn"
+    rows, md_res, md_per = [], {}, {}
     w0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = pathlib.Path(tmp)
         for period in periods:
             for radius in radii:
-                r = run_case(py, tmp, period, radius, args.segments, args.dt)
+                r = run_case(py, tmp, period, radius, args.segments, args.dt, cache=cache)
                 md_res[period, radius] = r
                 meas = bg.MEASURED[period][bg.RADII.index(radius)]
                 cells = [f"{period}", f"{radius}", f"{meas}"]
@@ -160,6 +182,11 @@ def main(argv=None):
                               f"{r['cpu']:.1f}"]
                 else:
                     cells += [r.get("error", "failed")[:60], "", ""]
+                if args.perimeter:
+                    rp = run_case(py, tmp, period, radius, args.segments, args.dt,
+                                  ct=CT_PERIMETER, cache=cache)
+                    md_per[period, radius] = rp
+                    cells += [f"{rp['mean']:.2f}", f"{100 * (rp['mean'] / meas - 1):+.1f} %"]
                 for model in bg.MODELS:
                     o = ours.get((model, period, radius))
                     cells += ([f"{o['mean']:.2f}", f"{100 * (o['mean'] / meas - 1):+.1f} %",
@@ -170,10 +197,10 @@ def main(argv=None):
         conv = []
         if args.convergence:
             for period in (1.25, 3.5):
-                base = md_res.get((period, 0.2)) or run_case(py, tmp, period, 0.2,
-                                                             args.segments, args.dt)
+                base = md_res.get((period, 0.2)) or run_case(
+                    py, tmp, period, 0.2, args.segments, args.dt, cache=cache)
                 for segs, dt in ((args.segments, args.dt / 2), (2 * args.segments, args.dt)):
-                    r = run_case(py, tmp, period, 0.2, segs, dt)
+                    r = run_case(py, tmp, period, 0.2, segs, dt, cache=cache)
                     conv.append(f"| {period} | {segs} | {dt:.3g} | {r['mean']:.3f} | "
                                 f"{100 * (r['mean'] / base['mean'] - 1):+.2f} % | "
                                 f"{r['cpu']:.1f} |")
@@ -204,9 +231,19 @@ def main(argv=None):
                 lines.append(f"- ropedyn {model.upper()} on the same cases: CPU {oc:.0f} s; "
                              f"MoorDyn / ropedyn = {np.sum(cpu) / oc:.2f}.")
         lines.append("")
-    lines += ["| T (s) | R (m) | measured (N) | MoorDyn (N) | error | CPU (s) | "
-              "RFEM (N) | error | CPU (s) | MPP (N) | error | CPU (s) |",
-              "|---|---|---|---|---|---|---|---|---|---|---|---|", *rows]
+    if md_per:
+        okp = [(k, r) for k, r in md_per.items() if r.get("ok")]
+        s = bg.scores([r["mean"] for _, r in okp],
+                      [bg.MEASURED[p][bg.RADII.index(rad)] for (p, rad), _ in okp])
+        lines += [f"MoorDyn-C with the other reading of the tangential drag (0.5 on the 2.2 mm "
+                  f"perimeter, CdAx = {CT_PERIMETER}): RMSE {s['rmse']:.2f} N, MAPE "
+                  f"{s['mape']:.2f} %, bias {s['bias']:+.2f} N, correlation {s['corr']:.4f}.",
+                  ""]
+    per_head = " MoorDyn, perimeter (N) | error |" if md_per else ""
+    lines += ["| T (s) | R (m) | measured (N) | MoorDyn (N) | error | CPU (s) |" + per_head +
+              " RFEM (N) | error | CPU (s) | MPP (N) | error | CPU (s) |",
+              "|---|---|---|---|---|---|" + ("---|---|" if md_per else "") +
+              "---|---|---|---|---|---|", *rows]
     if conv:
         lines += ["", "MoorDyn's convergence at R = 0.2 m (change of the mean cycle maximum "
                       f"against {args.segments} segments, dtM {args.dt:g} s):", "",
