@@ -196,6 +196,20 @@ def case_path(work, period, model, radius):
     return work / model / sweep_path(period).stem / f"case_{RADII.index(radius) + 1:04d}.h5"
 
 
+def sweep_walls(work, models, periods):
+    """Wall time of each period's sweep run: from the writing of its sweep file (just before
+    `ropedyn sweep` starts) to that of its summary (when it ends), so that a later
+    --analyse-only still knows it."""
+    walls = {}
+    for label in models:
+        for period in periods:
+            folder = work / label / sweep_path(period).stem
+            sweep, summary = folder / sweep_path(period).name, folder / "summary.csv"
+            if sweep.exists() and summary.exists():
+                walls[label, period] = summary.stat().st_mtime - sweep.stat().st_mtime
+    return walls
+
+
 def collect(work, periods, models, cycles=ANALYSED):
     results = {}
     for model in models:
@@ -553,6 +567,8 @@ def main(argv=None):
         exe = pathlib.Path(exe_or_build(args.exe)).resolve()
         walls = run_sweeps(exe, periods, models, radii, work, args.jobs, quick=quick)
     results = collect(work, periods, models, cycles)
+    if not quick:
+        walls = sweep_walls(work, models, periods)
     conv = []
     if args.convergence:
         exe = exe or pathlib.Path(exe_or_build(args.exe)).resolve()
