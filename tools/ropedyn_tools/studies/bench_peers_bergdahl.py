@@ -137,6 +137,8 @@ def run_moordyn(py, work, period, radius, segments, dt_m, ct, cycles):
         if "RESULT " in line:          # MoorDyn's progress shares the line
             r = json.loads(line.split("RESULT ", 1)[1])
             ten = np.array(r.pop("tension"))
+            if not np.all(np.isfinite(ten)):
+                return {"ok": False, "error": "the tension is not finite (unstable)"}
             t = COUPLING * np.arange(1, len(ten) + 1)
             m = bg.cycle_maxima(t, ten, period, min(bg.ANALYSED, cycles))
             r.update(maxima=m, mean=float(m.mean()), spread=float(m.std(ddof=1))
@@ -199,11 +201,16 @@ def main(argv=None):
             for period in (1.25, 3.5):
                 base = md_res.get((period, 0.2)) or run_case(
                     py, tmp, period, 0.2, args.segments, args.dt, cache=cache)
-                for segs, dt in ((args.segments, args.dt / 2), (2 * args.segments, args.dt)):
+                for segs, dt in ((args.segments, args.dt / 2), (2 * args.segments, args.dt),
+                                 (2 * args.segments, args.dt / 2)):
                     r = run_case(py, tmp, period, 0.2, segs, dt, cache=cache)
-                    conv.append(f"| {period} | {segs} | {dt:.3g} | {r['mean']:.3f} | "
-                                f"{100 * (r['mean'] / base['mean'] - 1):+.2f} % | "
-                                f"{r['cpu']:.1f} |")
+                    if r.get("ok"):
+                        conv.append(f"| {period} | {segs} | {dt:.3g} | {r['mean']:.3f} | "
+                                    f"{100 * (r['mean'] / base['mean'] - 1):+.2f} % | "
+                                    f"{r['cpu']:.1f} |")
+                    else:
+                        conv.append(f"| {period} | {segs} | {dt:.3g} | failed: "
+                                    f"{r.get('error', 'not finite')[:50]} | | |")
                     print(conv[-1], flush=True)
     ok = [(k, r) for k, r in md_res.items() if r.get("ok")]
     lines = [BEGIN, "",
