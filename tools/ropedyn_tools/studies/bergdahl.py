@@ -408,6 +408,10 @@ def figures(results, models, periods, work, figdir, stem):
                     xs.append(MEASURED[period][j])
                     ys.append(r["mean"])
         ax.plot(xs, ys, marker, mfc="none", label=name(model))
+    md = moordyn_means(work, periods)
+    if md:
+        ax.plot([MEASURED[p][RADII.index(r)] for p, r in md], list(md.values()), "x",
+                color="0.4", label="MoorDyn-C")
     ax.set_xlabel("measured mean cycle maximum (N)")
     ax.set_ylabel("computed (N)")
     ax.set_xlim(lo, hi)
@@ -439,6 +443,20 @@ def figures(results, models, periods, work, figdir, stem):
         fig.savefig(figdir / names[-1], dpi=110)
         plt.close(fig)
     return names
+
+
+def moordyn_file(work, period, radius):
+    """The kept result of MoorDyn-C on a condition (scripts/bench_peers bergdahl, its default
+    setting), or None."""
+    path = (work / "moordyn" / f"T{period:g}_R{radius:g}_n165_dt0.000326_ct0.09582_"
+            f"c{CYCLES}.json")
+    return path if path.exists() else None
+
+
+def moordyn_means(work, periods):
+    import json
+    return {(p, r): json.loads(f.read_text())["mean"] for p in periods for r in RADII
+            if (f := moordyn_file(work, p, r)) is not None}
 
 
 def moordyn_cpu(work, periods):
