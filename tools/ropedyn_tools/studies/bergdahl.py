@@ -302,10 +302,12 @@ def contact_cost(exe, work, jobs, period=1.25, radius=0.2, start_cycle=6, cycles
             subprocess.run([str(exe), "run", str(BASE),
                             *set_args(common + CONTACT_VARIANTS[k][1] + [f"output.file={out}"])],
                            check=True, capture_output=True)
+        t, tension, _ = fairlead_tension(out)
+        peak_mean = float(cycle_maxima(t, tension, period, cycles).mean())
         with h5py.File(out, "r") as f:
             return (CONTACT_VARIANTS[k][0], int(f["solver/steps"][()]),
                     int(f["solver/err_test_fails"][()]), int(f["solver/rhs_evals"][()]),
-                    float(f["solver/cpu_time"][()]))
+                    float(f["solver/cpu_time"][()]), peak_mean)
 
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         return list(pool.map(one, range(len(CONTACT_VARIANTS))))
@@ -314,9 +316,10 @@ def contact_cost(exe, work, jobs, period=1.25, radius=0.2, start_cycle=6, cycles
 def contact_lines(rows):
     if not rows:
         return []
-    return ["| variant | steps | rejected | f evaluations | CPU (s) |", "|---|---|---|---|---|",
-            *(f"| {label} | {steps:,} | {rej:,} | {rhs:,} | {cpu:.2f} |"
-              for label, steps, rej, rhs, cpu in rows)]
+    return ["| variant | steps | rejected | f evaluations | CPU (s) | mean of the 2 cycle maxima (N) |",
+            "|---|---|---|---|---|---|",
+            *(f"| {label} | {steps:,} | {rej:,} | {rhs:,} | {cpu:.2f} | {peak:.2f} |"
+              for label, steps, rej, rhs, cpu, peak in rows)]
 
 
 # ---------------------------------------------------------------- page
@@ -477,6 +480,7 @@ def moordyn_cpu(work, periods):
 def target_lines(results, models, periods, walls, conv, work):
     """Each target of the study, met or not, from the results at hand."""
     lines = ["| target | value | met |", "|---|---|---|"]
+    models = [m for m in models if m in MODELS]       # the variants are for information
     for model in models:
         s, count = model_scores(results, model, periods)
         if s is None:
@@ -528,6 +532,18 @@ def section(results, models, periods, walls, conv, figs, command, work, contact=
         if s is not None:
             md.append(f"| {name(model)} | {count} | {s['rmse']:.2f} | {s['mape']:.2f} | "
                       f"{s['bias']:+.2f} | {s['corr']:.4f} | {s['worst']:.1f} |")
+    mdm = moordyn_means(work, periods)
+    for model in models:
+        keys = [k for k in mdm if (model, *k) in results]
+        if len(keys) > 2:
+            d = np.array([results[model, p, r]["mean"] / mdm[p, r] - 1 for p, r in keys])
+            e_md = [mdm[p, r] / MEASURED[p][RADII.index(r)] - 1 for p, r in keys]
+            e_us = [results[model, p, r]["mean"] / MEASURED[p][RADII.index(r)] - 1
+                    for p, r in keys]
+            md += ["", f"{name(model)} against MoorDyn-C on the same {len(keys)} conditions: "
+                   f"{100 * d.mean():+.2f} % on average ({100 * d.min():+.2f} .. "
+                   f"{100 * d.max():+.2f} %); the correlation of the two codes' errors against "
+                   f"the measurement is {np.corrcoef(e_md, e_us)[0, 1]:.3f}."]
     md += ["", "### Each condition", "",
            "Mean of the 5 cycle maxima, their standard deviation (spread) and the error "
            "against the measurement.", ""]
@@ -563,6 +579,8 @@ def main(argv=None):
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--convergence", action="store_true",
                         help="also the runs at other element lengths and tolerances")
+    parser.add_argument("--convergence-models", default=None,
+                        help="the models of the convergence runs (default: --models)")
     parser.add_argument("--contact-cost", action="store_true",
                         help="also the cost of the floor: one window with other methods and "
                              "floor laws")
@@ -590,7 +608,8 @@ def main(argv=None):
     conv = []
     if args.convergence:
         exe = exe or pathlib.Path(exe_or_build(args.exe)).resolve()
-        conv = convergence(exe, work, args.jobs, models=models)
+        conv = convergence(exe, work, args.jobs, models=tuple(
+            (args.convergence_models or ",".join(m for m in models if m in MODELS)).split(",")))
     contact = []
     if args.contact_cost:
         exe = exe or pathlib.Path(exe_or_build(args.exe)).resolve()
