@@ -219,8 +219,9 @@ def main(argv=None):
              f"`moordyn`, .venv-bench): RK4 at dtM = {args.dt:g} s, {args.segments} segments, "
              f"its static start; CPU per case includes it. ropedyn: the case files of "
              f"`scripts/validation bergdahl`, CPU of the integration (/solver/cpu_time). "
-             f"Machine: {machine()}. Run: {run_stamp()}; MoorDyn wall time {wall:.0f} s "
-             f"for {len(md_res)} cases, one after the other.", ""]
+             f"Machine: {machine()}. Run: {run_stamp()}; MoorDyn's CPU is that of its own runs "
+             f"(one after the other, on the shared cores; a kept result keeps its CPU; this "
+             f"command took {wall:.0f} s).", ""]
     if ok:
         comp = [r["mean"] for _, r in ok]
         meas = [bg.MEASURED[p][bg.RADII.index(rad)] for (p, rad), _ in ok]
