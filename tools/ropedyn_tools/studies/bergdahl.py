@@ -211,13 +211,35 @@ def sweep_walls(work, models, periods):
     return walls
 
 
+def status(path):
+    """The run file's status ('complete', 'failed', ...) and its reason."""
+    with h5py.File(path, "r") as f:
+        get = lambda k: f.attrs[k].decode() if isinstance(f.attrs.get(k), bytes) else \
+            str(f.attrs.get(k, ""))
+        return get("status"), get("reason")
+
+
+def failures(work, periods, models):
+    """The case files that are there but not complete: (label, period, radius, reason)."""
+    out = []
+    for model in models:
+        for period in periods:
+            for radius in RADII:
+                path = case_path(work, period, model, radius)
+                if path.exists():
+                    state, reason = status(path)
+                    if state != "complete":
+                        out.append((model, period, radius, f"{state}: {reason}"))
+    return out
+
+
 def collect(work, periods, models, cycles=ANALYSED):
     results = {}
     for model in models:
         for period in periods:
             for radius in RADII:
                 path = case_path(work, period, model, radius)
-                if path.exists():
+                if path.exists() and status(path)[0] == "complete":
                     results[model, period, radius] = case_result(path, period, cycles)
     return results
 
@@ -434,7 +456,7 @@ def figures(results, models, periods, work, figdir, stem):
         for ax, (period, radius) in zip(axes[:, 0], conds):
             for model in models:
                 path = case_path(work, period, model, radius)
-                if path.exists():
+                if path.exists() and status(path)[0] == "complete":
                     t, tension, _ = fairlead_tension(path)
                     ax.plot(t / period, tension, lw=0.8, label=name(model))
             ax.axhline(MEASURED[period][RADII.index(radius)], color="k", ls="--", lw=0.8,
@@ -555,7 +577,11 @@ def section(results, models, periods, walls, conv, figs, command, work, contact=
         md += ["", f"![measured against computed](../figures/{figs[0]})", ""]
         if len(figs) > 1:
             md += [f"![tension histories](../figures/{figs[1]})", ""]
-    md += ["### Targets", ""] + target_lines(results, models, periods, walls, conv, work)
+    failed = failures(work, periods, models)
+    if failed:
+        md += ["", "Runs that did not complete (not in the scores):", ""]
+        md += [f"- {name(m)}, T = {p} s, R = {r} m: {why}" for m, p, r, why in failed]
+    md += ["", "### Targets", ""] + target_lines(results, models, periods, walls, conv, work)
     md += ["", "### Cost", ""] + cost_lines(results, models, periods, walls)
     if conv:
         md += ["", "### Convergence", "",
