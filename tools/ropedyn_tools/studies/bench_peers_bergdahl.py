@@ -214,7 +214,7 @@ def main(argv=None):
                     print(conv[-1], flush=True)
     ok = [(k, r) for k, r in md_res.items() if r.get("ok")]
     lines = [BEGIN, "",
-             f"Command: `scripts/bench_peers bergdahl` (code: "
+             f"Command: `{' '.join(['scripts/bench_peers bergdahl', *(argv if argv is not None else sys.argv[1:])])}` (code: "
              f"tools/ropedyn_tools/studies/bench_peers_bergdahl.py). MoorDyn-C 2.7.2 (PyPI "
              f"`moordyn`, .venv-bench): RK4 at dtM = {args.dt:g} s, {args.segments} segments, "
              f"its static start; CPU per case includes it. ropedyn: the case files of "

@@ -19,6 +19,7 @@ import os
 import pathlib
 import re
 import subprocess
+import sys
 import time
 
 import h5py
@@ -646,7 +647,11 @@ def main(argv=None):
     out = pathlib.Path(args.out)
     stem = out.stem
     figs = figures(results, models, periods, work, pathlib.Path(args.figures), stem)
-    command = "scripts/validation bergdahl" + (f" --quick {args.quick}" if quick else "")
+    shown = [a for a in (argv if argv is not None else sys.argv[1:])]
+    if "--exe" in shown:                       # a path of this machine: not part of the command
+        i = shown.index("--exe")
+        del shown[i:i + 2]
+    command = " ".join(["scripts/validation bergdahl", *shown])
     block = section(results, models, periods, walls, conv, figs, command, work, contact)
     update_doc(out, BEGIN, END, block, heading="## Results\n\n",
                default=f"# Bergdahl chain\n")
