@@ -559,7 +559,7 @@ def section(results, models, periods, walls, conv, figs, command, work, contact=
             md.append(f"| {name(model)} | {count} | {s['rmse']:.2f} | {s['mape']:.2f} | "
                       f"{s['bias']:+.2f} | {s['corr']:.4f} | {s['worst']:.1f} |")
     mdm = moordyn_means(work, periods)
-    for model in models:
+    for model in (m for m in models if m in MODELS):     # MoorDyn's reading is the scene's
         keys = [k for k in mdm if (model, *k) in results]
         if len(keys) > 2:
             d = np.array([results[model, p, r]["mean"] / mdm[p, r] - 1 for p, r in keys])
