@@ -9,6 +9,13 @@
 !! and the state at t (no error). The run driver uses it to end a run at the next step after
 !! a signal (docs/development/internals.md, "Interrupts"). An integrator that does not ask simply returns at
 !! tout; the driver then stops there.
+!!
+!! Stop time: an integrator steps past tout and interpolates back to it, unless `t_stop`
+!! (`set_stop_time`) bounds it: then no step ends beyond t_stop, and the step that reaches
+!! it ends exactly there. A driver whose right-hand side changes at a known time (a support
+!! coupled to another program, whose motion is known only up to the next exchange) stops
+!! there and, after changing it, calls `rhs_changed`: a method that carries f from the end
+!! of its last step into the next (erk's first-same-as-last stage) evaluates it again.
 module ropedyn_integrator
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
@@ -118,8 +125,13 @@ module ropedyn_integrator
         type(solver_options_t) :: options
         integer :: n = 0   !< unknowns of the state
         integer :: nq = 0  !< quadrature variables
+        !> no step ends beyond this time, s (`set_stop_time`; huge: no bound; `init`
+        !! clears it)
+        real(wp) :: t_stop = huge(1.0_wp)
     contains
         procedure :: init => integrator_init
+        procedure :: set_stop_time => integrator_set_stop_time
+        procedure :: rhs_changed => integrator_rhs_changed
         procedure(start_i), deferred :: start
         procedure(advance_to_i), deferred :: advance_to
         procedure(stats_i), deferred :: stats
@@ -208,6 +220,21 @@ contains
         self%time_solve = self%time_solve + part%time_solve
     end subroutine stats_add
 
+    !> No step of the following `advance_to` calls ends beyond t_stop (s; huge(1.0_wp): no
+    !! bound again); the step that reaches it ends there.
+    subroutine integrator_set_stop_time(self, t_stop)
+        class(integrator_t), intent(inout) :: self
+        real(wp), intent(in) :: t_stop
+        self%t_stop = t_stop
+    end subroutine integrator_set_stop_time
+
+    !> The right-hand side has changed from the current time on (the driver changed what
+    !! f depends on, at a time the integration stopped at): a method that keeps f of its
+    !! current point evaluates it again. Nothing to do for most methods.
+    subroutine integrator_rhs_changed(self)
+        class(integrator_t), intent(inout) :: self
+    end subroutine integrator_rhs_changed
+
     !> The lowest value options%max_order may take for this method.
     pure integer function integrator_min_order(self) result(order)
         class(integrator_t), intent(in) :: self
@@ -270,6 +297,7 @@ contains
         name = self%name()
         self%problem => problem
         self%options = options
+        self%t_stop = huge(1.0_wp)
         self%n = problem%size()
         self%nq = problem%quad_size()
         start%max_order = resolved_max_order(name, options%max_order)

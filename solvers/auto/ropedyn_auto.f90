@@ -180,6 +180,7 @@ module ropedyn_auto
         procedure :: finalize => auto_finalize
         procedure :: name => auto_name
         procedure :: switch_log => auto_switch_log
+        procedure :: rhs_changed => auto_rhs_changed
         procedure, private :: start_method
         procedure, private :: watch
         procedure, private :: current_stats
@@ -224,6 +225,22 @@ contains
         character(len=:), allocatable :: name
         name = 'auto'
     end function auto_name
+
+    !> f has changed from the current time on: the method in use is told.
+    subroutine auto_rhs_changed(self)
+        class(auto_t), intent(inout) :: self
+        select case (self%active)
+        case (EXPLICIT)
+            call self%erk%rhs_changed()
+        case (HIGH)
+            call self%erk_high%rhs_changed()
+        case (ADAMS)
+            call self%am%rhs_changed()
+        case (IMPLICIT)
+            call self%mebdf%rhs_changed()
+            call self%bdf%rhs_changed()
+        end select
+    end subroutine auto_rhs_changed
 
     !> auto's switches, then the symplectic method's own choices of its step, when it ran.
     function auto_switch_log(self) result(events)
@@ -341,6 +358,13 @@ contains
             ! a look-ahead below the round-off of t rounds back to t: the method would take
             ! no step (and never reach its own round-off limit): on to tout instead
             if (target <= self%t) target = tout
+            ! the stop time holds for every method it runs (the symplectic method's steps
+            ! end on the output time, never beyond it)
+            call self%erk%set_stop_time(self%t_stop)
+            call self%erk_high%set_stop_time(self%t_stop)
+            call self%am%set_stop_time(self%t_stop)
+            call self%bdf%set_stop_time(self%t_stop)
+            call self%mebdf%set_stop_time(self%t_stop)
             if (self%active == SYMPLECTIC) then
                 ! kept, to the output time (where its steps fall)
                 target = tout

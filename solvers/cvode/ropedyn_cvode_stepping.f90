@@ -75,6 +75,11 @@ contains
                 exit
             end if
             tret = self%tn
+            ! a stop time: CVODE ends the step that reaches it there (and forgets it then)
+            if (self%t_stop < huge(1.0_wp)) then
+                flag = FCVodeSetStopTime(self%mem, real(self%t_stop, c_double))
+                if (flag < 0) exit
+            end if
             flag = FCVode(self%mem, real(tout, c_double), self%nv_y, tret, CV_ONE_STEP)
             if (flag < 0) exit
             self%tn = tret(1)

@@ -84,6 +84,9 @@ module ropedyn_erk
         real(wp) :: h_old = 0.0_wp      !< size of the last accepted step
         real(wp) :: err_old = 1.0e-4_wp !< error norm of the last accepted step
         logical :: started = .false.    !< k(:, 1) holds f(t, y)
+        !> f changed at t (`rhs_changed`): the next step evaluates its first stage anew
+        !! instead of taking the last stage of the step before
+        logical :: fsal_stale = .false.
         logical :: rejected = .false.   !< the last attempt was rejected
         real(wp), allocatable :: y(:), y_old(:), ynew(:), ytmp(:), yprev(:), k(:, :), atol(:)
         real(wp), allocatable :: dk(:), dy(:)  !< the spectral estimate's stage combinations
@@ -118,8 +121,9 @@ module ropedyn_erk
         procedure :: set_initial_step => erk_set_initial_step
         procedure :: set_stable_step => erk_set_stable_step
         procedure :: stopped_by_stiffness => erk_stopped_by_stiffness
+        procedure :: rhs_changed => erk_rhs_changed
         procedure, private :: attempt_step
-        procedure, private :: first_step
+        procedure, private :: first_step, first_stage
         procedure, private :: quad_step
         procedure, private :: dense
         procedure, private :: failure
@@ -250,6 +254,7 @@ contains
         self%h_old = 0.0_wp
         self%err_old = 1.0e-4_wp
         self%started = .false.
+        self%fsal_stale = .false.
         self%rejected = .false.
         self%rho = 0.0_wp
         self%stiff_steps = 0
@@ -261,6 +266,12 @@ contains
         self%stiff_stop = .false.
         self%counters = solver_stats_t()
     end subroutine erk_start
+
+    !> f has changed from the current time on: the next step evaluates its first stage.
+    subroutine erk_rhs_changed(self)
+        class(erk_t), intent(inout) :: self
+        if (self%started) self%fsal_stale = .true.
+    end subroutine erk_rhs_changed
 
     subroutine erk_advance_to(self, tout, t, y, yq, err)
         class(erk_t), intent(inout) :: self
@@ -300,7 +311,13 @@ contains
                 return
             end if
         end do
-        call self%dense(tout, y, yq)
+        if (self%t == tout .and. tout == self%t_stop) then
+            ! the step ended at the stop time: its own end point, not the interpolant's
+            y = self%y
+            if (self%nq > 0) yq(1:self%nq) = self%yq
+        else
+            call self%dense(tout, y, yq)
+        end if
         t = tout
     end subroutine erk_advance_to
 
@@ -313,21 +330,8 @@ contains
         real(wp) :: d0, d1, d2, h0, h1, w(self%n)
         integer :: status, p
 
-        call self%problem%rhs(self%t, self%y, self%k(:, 1), status)
-        self%counters%rhs_evals = self%counters%rhs_evals + 1
-        if (status /= STATUS_OK .or. .not. all(ieee_is_finite(self%k(:, 1)))) then
-            call self%failure(err, 'the right-hand side could not be evaluated at the '// &
-                              'initial state')
-            return
-        end if
-        if (self%nq > 0) then
-            call self%problem%quad_rhs(self%t, self%y, self%gk(:, 1), status)
-            if (status /= STATUS_OK .or. .not. all(ieee_is_finite(self%gk(:, 1)))) then
-                call self%failure(err, 'the quadrature right-hand side could not be '// &
-                                  'evaluated at the initial state')
-                return
-            end if
-        end if
+        call self%first_stage(err)
+        if (allocated(err)) return
         self%started = .true.
         if (self%h > 0.0_wp) then
             self%h = min(self%h, span)
@@ -359,14 +363,38 @@ contains
         self%h = min(100.0_wp*h0, h1, span)
     end subroutine first_step
 
+    !> f (and the quadratures' g) at the current point into the first stage.
+    subroutine first_stage(self, err)
+        class(erk_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: err
+        integer :: status
+        self%fsal_stale = .false.
+        call self%problem%rhs(self%t, self%y, self%k(:, 1), status)
+        self%counters%rhs_evals = self%counters%rhs_evals + 1
+        if (status /= STATUS_OK .or. .not. all(ieee_is_finite(self%k(:, 1)))) then
+            call self%failure(err, 'the right-hand side could not be evaluated at the '// &
+                              merge('initial', 'current', .not. self%started)//' state')
+            return
+        end if
+        if (self%nq > 0) then
+            call self%problem%quad_rhs(self%t, self%y, self%gk(:, 1), status)
+            if (status /= STATUS_OK .or. .not. all(ieee_is_finite(self%gk(:, 1)))) then
+                call self%failure(err, 'the quadrature right-hand side could not be '// &
+                                  'evaluated at the '//merge('initial', 'current', &
+                                  .not. self%started)//' state')
+                return
+            end if
+        end if
+    end subroutine first_stage
+
     !> Attempt steps until one is accepted; then self%t, self%y have moved on and the
     !! stages of that step are kept for dense output.
     subroutine attempt_step(self, err)
         class(erk_t), intent(inout) :: self
         type(error_t), allocatable, intent(out) :: err
-        real(wp) :: h, errnorm, errq, fac, tnew, gain_i, gain_p
+        real(wp) :: h, errnorm, errq, fac, tnew, gain_i, gain_p, h_wanted
         integer :: i, status, s
-        logical :: recoverable
+        logical :: recoverable, clipped
 
         s = self%s
         recoverable = .false.
@@ -376,12 +404,26 @@ contains
             self%k(:, 1) = self%k(:, s)
             if (self%nq > 0) self%gk(:, 1) = self%gk(:, s)
         end if
+        if (self%fsal_stale) then
+            ! f changed at t (a coupled support's new motion): the first stage anew
+            call self%first_stage(err)
+            if (allocated(err)) return
+        end if
+        clipped = .false.
+        h_wanted = 0.0_wp
         attempts: do
             if (self%counters%steps >= self%options%max_steps) then
                 call self%failure(err, self%steps_exhausted())
                 return
             end if
             h = self%h
+            ! a stop time ahead: the step that would reach it (or come within 1 % of a
+            ! step of it) ends exactly there
+            clipped = self%t + 1.01_wp*h >= self%t_stop
+            if (clipped) then
+                h_wanted = merge(0.0_wp, h, self%rejected)
+                h = self%t_stop - self%t
+            end if
             if (h < 16.0_wp*epsilon(1.0_wp)*max(abs(self%t), tiny(1.0_wp))) then
                 if (recoverable) then
                     call self%failure(err, 'step size fell below the round-off limit after '// &
@@ -438,6 +480,7 @@ contains
 
         ! accepted
         tnew = self%t + h
+        if (clipped) tnew = self%t_stop
         if (self%rho_last_two) then
             self%dk = self%k(:, s) - self%k(:, s - 1)
             self%dy = self%ynew - self%yprev
@@ -479,6 +522,8 @@ contains
         self%err_old = errnorm
         self%rejected = .false.
         self%h = h*fac
+        ! a step cut short by the stop time: the next one as long as the one wanted
+        if (clipped) self%h = max(self%h, h_wanted)
         call self%monitor_stiffness(h, err)
     end subroutine attempt_step
 

@@ -381,9 +381,15 @@ contains
                 return
             end if
         end do
-        call self%interpolate(tout, z)
-        y = z(1:self%n)
-        if (self%nq > 0) yq(1:self%nq) = z(self%n + 1:)
+        if (self%t == tout .and. tout == self%t_stop) then
+            ! the step ended at the stop time: its own end point
+            y = self%dif(1:self%n, 0)
+            if (self%nq > 0) yq(1:self%nq) = self%dif(self%n + 1:, 0)
+        else
+            call self%interpolate(tout, z)
+            y = z(1:self%n)
+            if (self%nq > 0) yq(1:self%nq) = z(self%n + 1:)
+        end if
         t = tout
     end subroutine mebdf_advance_to
 

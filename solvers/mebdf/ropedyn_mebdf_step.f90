@@ -126,10 +126,18 @@ contains
                 self%pending = .false.
                 self%steps_at_h = 0
             end if
+            ! a stop time ahead: the step that would reach it (or come within 1 % of a
+            ! step of it) ends exactly there (stage 2 still looks one step beyond)
+            if (self%t + 1.01_wp*self%h >= self%t_stop .and. self%t < self%t_stop) then
+                ratio = (self%t_stop - self%t)/self%h
+                if (ratio /= 1.0_wp) call self%rescale(ratio, self%k)
+                if (abs(ratio - 1.0_wp) > 0.01_wp) self%steps_at_h = 0
+            end if
             k = self%k
             beta = self%coef(k)%beta
             hbeta = self%h*beta
             tn = self%t + self%h
+            if (self%t + 1.01_wp*self%h >= self%t_stop) tn = self%t_stop
             hmin = 16.0_wp*epsilon(1.0_wp)*max(abs(self%t), abs(tn))
             if (self%counters%steps >= self%options%max_steps) then
                 call self%failure(err, self%steps_exhausted())

@@ -9,7 +9,9 @@
  *   file and ends the process by the same signal (default action), so that a lock records
  *   why its writer stopped (docs/development/internals.md, "One writer per case").
  * - A lock's heartbeat: a thread that touches the lock file every few seconds, so that a
- *   reader on another host can tell a live writer from one that is gone.
+ *   reader on another host can tell a live writer from one that is gone. One thread per
+ *   lock (a handle each): two runs in one process (the library's, in two threads) hold
+ *   two locks.
  * - Worker processes: spawned in their own process group with stdout and stderr in a log
  *   file; reaped without blocking; signalled as a group; waited for: while children are
  *   watched, SIGCHLD has a handler that does nothing and is blocked except inside
@@ -44,10 +46,12 @@ static volatile sig_atomic_t received = 0;
 static volatile sig_atomic_t second_ends = 0;
 static volatile int note_fd = -1;
 
-static int beat_fd = -1;
-static int beat_seconds = 10;
-static int beat_running = 0;
-static pthread_t beat_thread;
+/* One heartbeat: the lock file, its period, the thread that touches it. */
+struct heartbeat {
+    int fd;
+    int seconds;
+    pthread_t thread;
+};
 
 static void on_signal(int sig)
 {
@@ -141,48 +145,55 @@ void ropedyn_release_signals(void)
 /* The first signal caught (its number), or 0. */
 int ropedyn_signal_received(void) { return (int)received; }
 
-static void *beat(void *unused)
+static void *beat(void *arg)
 {
-    (void)unused;
+    struct heartbeat *h = arg;
     for (;;) {
-        sleep((unsigned)beat_seconds);   /* a cancellation point */
-        futimens(beat_fd, NULL);
+        sleep((unsigned)h->seconds);   /* a cancellation point */
+        futimens(h->fd, NULL);
     }
     return NULL;
 }
 
 /* Touch `path` now and every `seconds` s from a thread (which blocks every signal) until
- * ropedyn_stop_heartbeat. Returns 0, or errno. */
-int ropedyn_start_heartbeat(const char *path, int seconds)
+ * ropedyn_stop_heartbeat of the handle put in *handle. Returns 0, or errno. */
+int ropedyn_start_heartbeat(const char *path, int seconds, void **handle)
 {
     sigset_t all, old;
     int rc;
-    if (beat_running) return EBUSY;
-    beat_fd = open(path, O_WRONLY | O_CLOEXEC);
-    if (beat_fd < 0) return errno;
-    futimens(beat_fd, NULL);
-    beat_seconds = seconds > 0 ? seconds : 1;
-    sigfillset(&all);
-    pthread_sigmask(SIG_SETMASK, &all, &old);
-    rc = pthread_create(&beat_thread, NULL, beat, NULL);
-    pthread_sigmask(SIG_SETMASK, &old, NULL);
-    if (rc != 0) {
-        close(beat_fd);
-        beat_fd = -1;
+    struct heartbeat *h = malloc(sizeof *h);
+    *handle = NULL;
+    if (!h) return ENOMEM;
+    h->fd = open(path, O_WRONLY | O_CLOEXEC);
+    if (h->fd < 0) {
+        rc = errno;
+        free(h);
         return rc;
     }
-    beat_running = 1;
+    futimens(h->fd, NULL);
+    h->seconds = seconds > 0 ? seconds : 1;
+    sigfillset(&all);
+    pthread_sigmask(SIG_SETMASK, &all, &old);
+    rc = pthread_create(&h->thread, NULL, beat, h);
+    pthread_sigmask(SIG_SETMASK, &old, NULL);
+    if (rc != 0) {
+        close(h->fd);
+        free(h);
+        return rc;
+    }
+    *handle = h;
     return 0;
 }
 
-void ropedyn_stop_heartbeat(void)
+/* Stop the heartbeat `handle` (NULL: none) and free it. */
+void ropedyn_stop_heartbeat(void *handle)
 {
-    if (!beat_running) return;
-    pthread_cancel(beat_thread);
-    pthread_join(beat_thread, NULL);
-    close(beat_fd);
-    beat_fd = -1;
-    beat_running = 0;
+    struct heartbeat *h = handle;
+    if (!h) return;
+    pthread_cancel(h->thread);
+    pthread_join(h->thread, NULL);
+    close(h->fd);
+    free(h);
 }
 
 /* Start `nargs` NUL-separated arguments (the first is the program, looked up in PATH

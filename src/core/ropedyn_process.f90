@@ -4,27 +4,37 @@
 !! host name, the Slurm job, file times. Used by the sweep runner and a sweep case's lock
 !! (the sweeps guide). Signals are ropedyn_signals', clocks ropedyn_clock's.
 module ropedyn_process
-    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_long_long, c_null_char, c_size_t
+    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_long_long, c_null_char, &
+        c_size_t, c_ptr, c_null_ptr
     use, intrinsic :: iso_fortran_env, only: int64
     use ropedyn_error, only: error_t, make_error, ERR_IO
     use ropedyn_text, only: int_text
     implicit none
     private
     public :: slurm_job, process_text
-    public :: start_heartbeat, stop_heartbeat
+    public :: heartbeat_t, start_heartbeat, stop_heartbeat
     public :: spawn, reap, signal_group, process_id, process_start, host_name
     public :: watch_children, unwatch_children, wait_children
     public :: file_mtime
 
+    !> A lock file's heartbeat (start_heartbeat .. stop_heartbeat): each lock has its own.
+    type :: heartbeat_t
+        private
+        type(c_ptr) :: handle = c_null_ptr
+    end type heartbeat_t
+
     interface
-        integer(c_int) function c_start_heartbeat(path, seconds) &
+        integer(c_int) function c_start_heartbeat(path, seconds, handle) &
                 bind(C, name='ropedyn_start_heartbeat')
-            import :: c_char, c_int
+            import :: c_char, c_int, c_ptr
             character(kind=c_char), intent(in) :: path(*)
             integer(c_int), value :: seconds
+            type(c_ptr), intent(out) :: handle
         end function c_start_heartbeat
-        subroutine stop_heartbeat() bind(C, name='ropedyn_stop_heartbeat')
-        end subroutine stop_heartbeat
+        subroutine c_stop_heartbeat(handle) bind(C, name='ropedyn_stop_heartbeat')
+            import :: c_ptr
+            type(c_ptr), value :: handle
+        end subroutine c_stop_heartbeat
         integer(c_int) function c_spawn(args, nargs, log, pid) bind(C, name='ropedyn_spawn')
             import :: c_char, c_int
             character(kind=c_char), intent(in) :: args(*), log(*)
@@ -70,16 +80,25 @@ module ropedyn_process
 
 contains
 
-    !> Touch the file `path` now and every `seconds` s (from a thread) until stop_heartbeat.
-    subroutine start_heartbeat(path, seconds, err)
+    !> Touch the file `path` now and every `seconds` s (from a thread of its own) until
+    !! stop_heartbeat(beat).
+    subroutine start_heartbeat(path, seconds, beat, err)
         character(len=*), intent(in) :: path
         integer, intent(in) :: seconds
+        type(heartbeat_t), intent(out) :: beat
         type(error_t), allocatable, intent(out) :: err
         integer(c_int) :: rc
-        rc = c_start_heartbeat(path//c_null_char, int(seconds, c_int))
+        rc = c_start_heartbeat(path//c_null_char, int(seconds, c_int), beat%handle)
         if (rc /= 0) call make_error(err, ERR_IO, path//': cannot start its heartbeat (errno ' &
             //int_text(int(rc))//')')
     end subroutine start_heartbeat
+
+    !> Stop a heartbeat (one never started, or stopped already: nothing).
+    subroutine stop_heartbeat(beat)
+        type(heartbeat_t), intent(inout) :: beat
+        call c_stop_heartbeat(beat%handle)
+        beat%handle = c_null_ptr
+    end subroutine stop_heartbeat
 
     !> Start `args(1)` (looked up in PATH when it has no '/') with the other arguments in a
     !! process group of its own, stdin from /dev/null, stdout and stderr to the file `log`.

@@ -23,7 +23,8 @@
 !! Files and groups are here; attributes, datasets and readers in the submodule
 !! ropedyn_h5_data, series in ropedyn_h5_series.
 module ropedyn_h5
-    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr, c_char, c_int, c_null_char
+    use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr, c_char, c_int, c_null_char, &
+        c_long_long
     use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5eset_auto_f, &
         h5fcreate_f, h5fopen_f, h5fclose_f, h5fflush_f, h5fget_filesize_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, &
         H5F_ACC_RDWR_F, H5F_SCOPE_GLOBAL_F, h5gcreate_f, h5gclose_f, h5lexists_f, &
@@ -37,6 +38,7 @@ module ropedyn_h5
         h5tget_size_f, h5tset_strpad_f, H5T_NATIVE_CHARACTER, H5T_STR_NULLPAD_F, &
         h5kind_to_type, H5_REAL_KIND, H5_INTEGER_KIND, h5dget_type_f, h5tget_class_f, &
         H5T_STRING_F, H5T_FLOAT_F, H5T_INTEGER_F, h5tis_variable_str_f, h5ldelete_f
+    use, intrinsic :: iso_fortran_env, only: int8
     use ropedyn_kinds, only: wp, i8
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INPUT, ERR_INTERNAL
@@ -55,8 +57,11 @@ module ropedyn_h5
         character(len=:), allocatable :: path   !< as given to create/open
         integer(hid_t) :: id = -1
         logical :: is_open = .false.
+        logical :: memory = .false.             !< created in memory (`create`'s memory)
     contains
         procedure :: create => h5_create
+        procedure :: in_memory => h5_in_memory
+        procedure :: image => h5_image
         procedure :: open => h5_open
         procedure :: close => h5_close
         procedure :: flush => h5_flush
@@ -126,6 +131,18 @@ module ropedyn_h5
             integer(c_int), value :: size
         end function c_h5_vlen_attribute
 
+        !> A file in memory, and its image (ropedyn_h5_glue.c).
+        integer(hid_t) function c_h5_create_memory(name) bind(C, name='ropedyn_h5_create_memory')
+            import :: c_char, hid_t
+            character(kind=c_char), intent(in) :: name(*)
+        end function c_h5_create_memory
+        integer(c_long_long) function c_h5_image(file, buf, size) bind(C, name='ropedyn_h5_image')
+            import :: c_long_long, c_ptr, hid_t
+            integer(hid_t), value :: file
+            type(c_ptr), value :: buf
+            integer(c_long_long), value :: size
+        end function c_h5_image
+
         !> HDF5's reason of its last failure (ropedyn_h5_glue.c).
         integer(c_int) function c_h5_reason(buf, size) bind(C, name='ropedyn_h5_reason')
             import :: c_char, c_int
@@ -158,10 +175,13 @@ module ropedyn_h5
         !! in this object is closed first. An existing `path` that is not a regular file (a
         !! device, a FIFO, a link to one) is bad input and left alone; one that another
         !! program holds open (locked) is not truncated. Errors give the system's reason.
-        module subroutine h5_create(self, path, err)
+        !! With `memory`, the file is made in memory only (`path` names it, unique among
+        !! the files open in the process; nothing is written to disk): `image` gives it.
+        module subroutine h5_create(self, path, err, memory)
             class(h5_file_t), intent(inout) :: self
             character(len=*), intent(in) :: path
             type(error_t), allocatable, intent(out) :: err
+            logical, intent(in), optional :: memory
         end subroutine h5_create
 
         !> Open the existing file `path`, read-only unless `writable`; a missing file, or one
@@ -416,6 +436,31 @@ contains
         if (self%is_open .and. hdferr < 0) call c_h5_close_failed()
         self%is_open = .false.
     end subroutine h5_final
+
+    !> Whether the file was created in memory.
+    pure logical function h5_in_memory(self)
+        class(h5_file_t), intent(in) :: self
+        h5_in_memory = self%memory
+    end function h5_in_memory
+
+    !> The bytes of the open file, as they would be on disk (an HDF5 file image: h5py
+    !! opens it from a file-like object).
+    subroutine h5_image(self, image, err)
+        class(h5_file_t), intent(inout) :: self
+        integer(int8), allocatable, target, intent(out) :: image(:)
+        type(error_t), allocatable, intent(out) :: err
+        integer(c_long_long) :: size
+        size = c_h5_image(self%id, c_null_ptr, 0_c_long_long)
+        if (size >= 0) then
+            allocate (image(max(1_c_long_long, size)))
+            size = c_h5_image(self%id, c_loc(image), size)
+        end if
+        if (size < 0) then
+            call h5_error(err, self%path//': cannot take the image of the file')
+            return
+        end if
+        image = image(1:size)
+    end subroutine h5_image
 
     !> Write everything buffered to disk.
     subroutine h5_flush(self, err)

@@ -20,6 +20,21 @@ contains
         integer :: hdferr
         call self%close(err)
         if (allocated(err)) return
+        self%memory = .false.
+        if (present(memory)) self%memory = memory
+        if (self%memory) then
+            call library_acquire(path, err)
+            if (allocated(err)) return
+            self%id = c_h5_create_memory(path//c_null_char)
+            if (self%id < 0) then
+                self%id = -1
+                call h5_error(err, path//': cannot create the file in memory')
+                return
+            end if
+            self%path = path
+            self%is_open = .true.
+            return
+        end if
         special = special_file_reason(path)
         if (len(special) > 0) then
             call make_error(err, ERR_INPUT, path//': cannot create file: it is '//special)

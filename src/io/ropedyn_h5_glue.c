@@ -1,6 +1,7 @@
 /* Glue for ropedyn_h5.f90, which is the only caller: why an HDF5 call failed, the
- * library's end at the exit of the process, and string attributes of variable length
- * (which the Fortran interface of HDF5 1.10 does not read).
+ * library's end at the exit of the process, string attributes of variable length
+ * (which the Fortran interface of HDF5 1.10 does not read), and files in memory (the core
+ * driver without a backing store) with their image.
  *
  * Why a call failed, in the system's words (h5_reason). The Fortran interface of HDF5
  * returns only a negative code;
@@ -11,6 +12,7 @@
  *     unable to lock file, errno = 11, error message = 'Resource temporarily unavailable'
  *
  * The reason is that text when a frame has one, else the innermost frame's description. */
+#include <pthread.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -68,16 +70,20 @@ static void end_library(void)
     if (!close_failed) H5close();
 }
 
-void ropedyn_h5_prepare(void)
+static void prepare_once(void)
 {
-    static int prepared = 0;
-    if (prepared) return;
-    prepared = 1;
     if (H5dont_atexit() >= 0) atexit(end_library);
     /* A file-size limit (ulimit -f) then makes a write fail with EFBIG, an I/O error the
      * writer handles (the file closed, marked failed), instead of ending the process by
      * SIGXFSZ with its file left 'running'. */
     signal(SIGXFSZ, SIG_IGN);
+}
+
+/* Once per process (the library's runs in two threads may both be first). */
+void ropedyn_h5_prepare(void)
+{
+    static pthread_once_t once = PTHREAD_ONCE_INIT;
+    pthread_once(&once, prepare_once);
 }
 
 void ropedyn_h5_close_failed(void) { close_failed = 1; }
@@ -111,4 +117,25 @@ int ropedyn_h5_vlen_attribute(hid_t loc, const char *name, char *buf, int size)
     if (type >= 0) H5Tclose(type);
     H5Aclose(attr);
     return rc;
+}
+
+/* Create the file `name` in memory only (the core driver, grown 1 MiB at a time, nothing
+ * written to disk; `name` must differ from that of every other file open in the process).
+ * Returns its id, or a negative value. */
+hid_t ropedyn_h5_create_memory(const char *name)
+{
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS), file = -1;
+    if (fapl < 0) return -1;
+    if (H5Pset_fapl_core(fapl, (size_t)1 << 20, 0) >= 0)
+        file = H5Fcreate(name, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    H5Pclose(fapl);
+    return file;
+}
+
+/* The image of the open file `file` (what would be on disk) into `buf` of `size` bytes
+ * (NULL: only the size). Returns the image's size, or -1. */
+long long ropedyn_h5_image(hid_t file, void *buf, long long size)
+{
+    H5Fflush(file, H5F_SCOPE_GLOBAL);
+    return (long long)H5Fget_file_image(file, buf, buf ? (size_t)size : 0);
 }

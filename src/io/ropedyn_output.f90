@@ -47,6 +47,7 @@
 !! (both copies would hold the same ids).
 module ropedyn_output
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use, intrinsic :: iso_fortran_env, only: int8
     use hdf5, only: hsize_t
     use ropedyn_kinds, only: wp, i8
     use ropedyn_clock, only: utc_timestamp, clock_seconds
@@ -373,10 +374,11 @@ contains
     !! (its file keeps status 'running'). With `state_size` and `quad_size` (the model's),
     !! every record also holds the restart data /state/y, /state/yq (`append`'s y, yq); with
     !! `internal_forces`, the internal forces and supports (FORCE_NAME; the anchors of
-    !! those supports that have one, `anchored`, default both).
+    !! those supports that have one, `anchored`, default both). With `memory`, the file is
+    !! made in memory only (`path` its unique name; `close_run` gives its image).
     subroutine output_create(self, path, n_elements, element_length, element_mass, model, &
                              method, version, scene_text, err, state_size, quad_size, &
-                             source, internal_forces, anchored)
+                             source, internal_forces, anchored, memory)
         class(output_file_t), intent(inout) :: self
         character(len=*), intent(in) :: path              !< e.g. out/run.h5
         integer, intent(in) :: n_elements                 !< elements of the rope
@@ -393,6 +395,7 @@ contains
         character(len=*), intent(in), optional :: source
         logical, intent(in), optional :: internal_forces  !< records hold the forces
         logical, intent(in), optional :: anchored(2)      !< top, bottom have an anchor
+        logical, intent(in), optional :: memory           !< the file in memory only
 
         if (self%is_open) call shutdown(self)
 
@@ -409,7 +412,7 @@ contains
             return
         end if
 
-        call self%file%create(path, err)
+        call self%file%create(path, err, memory)
         if (allocated(err)) return
         self%is_open = .true.
         self%n_elements = n_elements
@@ -649,11 +652,13 @@ contains
 
     !> Set the root status ('complete', or 'failed' or 'interrupted' with `reason`) and close
     !! everything. The file is closed even when writing the status fails.
-    subroutine output_close_run(self, status, reason, err)
+    subroutine output_close_run(self, status, reason, err, image)
         class(output_file_t), intent(inout) :: self
         character(len=*), intent(in) :: status            !< complete, failed, interrupted
         character(len=*), intent(in), optional :: reason  !< why it failed or stopped
         type(error_t), allocatable, intent(out) :: err
+        !> a file in memory: its bytes before it is closed (h5_file_t%image)
+        integer(int8), allocatable, intent(out), optional :: image(:)
 
         if (.not. self%is_open) then
             call not_open(self, 'close_run', err)
@@ -680,6 +685,9 @@ contains
             end if
         end if
         if (.not. allocated(err)) call flush_file(self, err)
+        if (.not. allocated(err) .and. present(image)) then
+            if (self%file%in_memory()) call self%file%image(image, err)
+        end if
 
         if (allocated(err)) then
             call abandon(self, err)

@@ -198,6 +198,7 @@ contains
 
     module procedure keep_room
         integer :: errnum
+        if (self%file%in_memory()) return
         errnum = reserve_space(self%file%file_name(), self%file%size(), &
                                self%unflushed + RESERVE_BYTES)
         if (errnum == ERRNO_ENOSPC .or. errnum == ERRNO_EDQUOT .or. errnum == ERRNO_EFBIG) &

@@ -295,7 +295,7 @@ contains
         end do
         call self%file%close(e)
         if (allocated(e) .and. .not. allocated(first)) call move_alloc(e, first)
-        call release_space(self%file%file_name())
+        if (.not. self%file%in_memory()) call release_space(self%file%file_name())
         self%n_pending = 0
         self%is_open = .false.
         if (present(err) .and. allocated(first)) call move_alloc(first, err)

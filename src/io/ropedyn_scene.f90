@@ -23,8 +23,8 @@ module ropedyn_scene
     implicit none
     private
     public :: solver_params_t, output_params_t, scene_t
-    public :: read_scene, read_scene_text, scene_namelist_text, scene_key_listing, &
-        check_override_value, override_target
+    public :: read_scene, read_scene_text, read_scene_string, scene_namelist_text, &
+        scene_key_listing, check_override_value, override_target
 
     !> One `--set group.key=value` argument, parsed.
     type :: override_t
@@ -105,6 +105,25 @@ contains
             if (allocated(err)) return
         end do
     end subroutine read_scene_text
+
+    !> Read a scene given as namelist text (the library's scenes) as `read_scene` reads a
+    !! file: `name` names it in messages, gives the default output file (out/NAME.h5 without
+    !! its .nml) and resolves relative paths (against its directory; the current one when
+    !! it has none). A scene read so has no `source`.
+    subroutine read_scene_string(name, text, overrides, scene, err)
+        character(len=*), intent(in) :: name          !< e.g. 'scene' or 'input/paper.nml'
+        character(len=*), intent(in) :: text          !< lines separated by new lines
+        character(len=*), intent(in) :: overrides(:)  !< 'group.key=value', may be empty
+        type(scene_t), target, intent(out) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        scene%path = name
+        if (printable(scene%path) /= scene%path) then
+            call make_error(err, ERR_INPUT, printable(scene%path)//': a control character in ' &
+                //'the scene''s name')
+            return
+        end if
+        call load_scene(overrides, scene, err, text)
+    end subroutine read_scene_string
 
     !> 'group.key' of a `--set group.key=value` argument as the scene reads it (lower case,
     !! blanks around the parts removed; '' when it has no '=').

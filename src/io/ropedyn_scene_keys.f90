@@ -108,10 +108,11 @@ contains
                 R_POSITIVE, '-', 'factor on the support springs and dampers')
             call add_motion('top', s%top_motion, s%top_amplitude, s%top_frequency, &
                 s%top_phase_deg, s%top_angle_amplitude_deg, s%top_angle_phase_deg, &
-                s%top_table, s%top_release_time)
+                s%top_ramp_time, s%top_table, s%top_release_time)
             call add_motion('bottom', s%bottom_motion, s%bottom_amplitude, &
                 s%bottom_frequency, s%bottom_phase_deg, s%bottom_angle_amplitude_deg, &
-                s%bottom_angle_phase_deg, s%bottom_table, s%bottom_release_time)
+                s%bottom_angle_phase_deg, s%bottom_ramp_time, s%bottom_table, &
+                s%bottom_release_time)
 
             call add_name(G_INITIAL, 'shape', i%shape, &
                 'straight, hanging, equilibrium, mode, folded, state', 'initial shape of the rope')
@@ -312,13 +313,14 @@ contains
 
         !> The motion and release keys of one support, 'top' or 'bottom'.
         subroutine add_motion(end, motion, amplitude, frequency, phase_deg, &
-                angle_amplitude_deg, angle_phase_deg, table, release_time)
+                angle_amplitude_deg, angle_phase_deg, ramp_time, table, release_time)
             character(len=*), intent(in) :: end
             character(len=*), target, intent(inout) :: motion, table
             real(wp), target, intent(inout) :: amplitude(:), frequency, phase_deg(:), &
-                angle_amplitude_deg, angle_phase_deg, release_time
-            call add_name(G_SUPPORTS, end//'_motion', motion, 'fixed, harmonic, table', &
-                'prescribed motion of the '//end//' support')
+                angle_amplitude_deg, angle_phase_deg, ramp_time, release_time
+            call add_name(G_SUPPORTS, end//'_motion', motion, 'fixed, harmonic, table, coupled', &
+                'prescribed motion of the '//end//' support (coupled: driven through the '// &
+                'library, at rest otherwise)')
             call add_pair(G_SUPPORTS, end//'_amplitude', amplitude, R_FINITE, 'm', &
                 'harmonic: amplitudes (x, y) of the anchor')
             call add_real(G_SUPPORTS, end//'_frequency', frequency, R_NONNEGATIVE, 'Hz', &
@@ -329,6 +331,9 @@ contains
                 R_FINITE, 'deg', 'harmonic: amplitude of the clamp angle (clamped only)')
             call add_real(G_SUPPORTS, end//'_angle_phase_deg', angle_phase_deg, R_FINITE, &
                 'deg', 'harmonic: phase of the clamp angle')
+            call add_real(G_SUPPORTS, end//'_ramp_time', ramp_time, R_NONNEGATIVE, 's', &
+                'harmonic: time over which the amplitudes grow from 0 to full (smoothstep '// &
+                '10u^3 - 15u^4 + 6u^5); 0: no ramp')
             call add_path(G_SUPPORTS, end//'_table', table, &
                 'table: file of rows t dx dy dangle_deg (relative to the scene file)')
             call add_real(G_SUPPORTS, end//'_release_time', release_time, R_FINITE, 's', &

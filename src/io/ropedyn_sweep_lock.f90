@@ -34,10 +34,11 @@ module ropedyn_sweep_lock
     use ropedyn_clock, only: utc_timestamp, utc_text, unix_time
     use ropedyn_signals, only: signal_name
     use ropedyn_process, only: process_id, process_start, host_name, file_mtime, &
-        start_heartbeat, stop_heartbeat, slurm_job
+        start_heartbeat, stop_heartbeat, slurm_job, heartbeat_t
     implicit none
     private
     public :: lock_t, read_lock, take_lock, drop_lock, LOCK_BEAT, LOCK_ABANDONED_AFTER
+    public :: heartbeat_t
 
     integer, parameter :: LOCK_BEAT = 15                !< s between heartbeats
     integer, parameter :: LOCK_ABANDONED_AFTER = 120    !< s: a lock of another host is gone
@@ -181,10 +182,11 @@ contains
         end if
     end function lock_gone
 
-    !> Take the lock `path` for this process (and start its heartbeat): create it, or take
-    !! over an abandoned one. A live lock is an ERR_IO error naming its holder.
-    subroutine take_lock(path, err)
+    !> Take the lock `path` for this process (and start its heartbeat `beat`): create it, or
+    !! take over an abandoned one. A live lock is an ERR_IO error naming its holder.
+    subroutine take_lock(path, beat, err)
         character(len=*), intent(in) :: path
+        type(heartbeat_t), intent(out) :: beat
         type(error_t), allocatable, intent(out) :: err
         type(lock_t) :: lock
         logical :: created, removed
@@ -241,14 +243,15 @@ contains
         end if
         call write_holder(path, err)
         if (allocated(err)) return
-        call start_heartbeat(path, LOCK_BEAT, err)
+        call start_heartbeat(path, LOCK_BEAT, beat, err)
     end subroutine take_lock
 
-    !> Stop the heartbeat and remove the lock.
-    subroutine drop_lock(path)
+    !> Stop the lock's heartbeat and remove the lock.
+    subroutine drop_lock(path, beat)
         character(len=*), intent(in) :: path
+        type(heartbeat_t), intent(inout) :: beat
         logical :: removed
-        call stop_heartbeat()
+        call stop_heartbeat(beat)
         removed = delete_file(path)
     end subroutine drop_lock
 

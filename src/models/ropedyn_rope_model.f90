@@ -6,6 +6,7 @@
 module ropedyn_rope_model
     use ropedyn_kinds, only: wp
     use ropedyn_problem, only: problem_t
+    use ropedyn_support_motion, only: support_motion_t
     implicit none
     private
     public :: rope_model_t, energy_t
@@ -30,6 +31,11 @@ module ropedyn_rope_model
         !! a call, with zero velocity and acceleration (a static force never depends on
         !! them); set by ropedyn_statics_terms around its evaluations, .false. in a run
         logical :: supports_at_rest = .false.
+        !> the supports (1 top, 2 bottom): their prescribed motions (anchors and angles at
+        !! rest in p0, angle0) and whether they move; set by the model's constructor (a
+        !! driver changes only a coupled motion's curve: support_motion_t%couple)
+        type(support_motion_t) :: motion(2)
+        logical :: moving(2) = .false.
     contains
         procedure(energy_i), deferred :: energy
         procedure :: n_elements => rope_n_elements, quad_size => rope_quad_size

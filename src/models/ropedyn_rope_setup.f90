@@ -44,10 +44,10 @@ contains
         associate (s => spec%supports)
             if (wanted(1)) moving(1) = motion(1)%configure(s%top_motion, s%top_amplitude, &
                 s%top_frequency, s%top_phase_deg, s%top_angle_amplitude_deg, &
-                s%top_angle_phase_deg, s%top_table_rows)
+                s%top_angle_phase_deg, s%top_table_rows, s%top_ramp_time)
             if (wanted(2)) moving(2) = motion(2)%configure(s%bottom_motion, s%bottom_amplitude, &
                 s%bottom_frequency, s%bottom_phase_deg, s%bottom_angle_amplitude_deg, &
-                s%bottom_angle_phase_deg, s%bottom_table_rows)
+                s%bottom_angle_phase_deg, s%bottom_table_rows, s%bottom_ramp_time)
         end associate
     end subroutine configure_motions
 

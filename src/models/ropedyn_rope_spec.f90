@@ -75,7 +75,8 @@ module ropedyn_rope_spec
         real(wp) :: top_angle_deg = 0.0_wp           !< top clamp angle from down x [deg]
         real(wp) :: bottom_angle_deg = 0.0_wp        !< bottom clamp angle from down x [deg]
         real(wp) :: support_stiffness_factor = 1.0_wp  !< support springs/dampers factor [-]
-        !> prescribed motion of each support: 'fixed' | 'harmonic' | 'table'
+        !> prescribed motion of each support: 'fixed' | 'harmonic' | 'table' | 'coupled'
+        !! (driven through the library; at rest otherwise)
         character(len=NAME_LEN) :: top_motion = 'fixed'
         character(len=NAME_LEN) :: bottom_motion = 'fixed'
         real(wp) :: top_amplitude(2) = 0.0_wp           !< harmonic amplitudes (x, y) [m]
@@ -88,6 +89,9 @@ module ropedyn_rope_spec
         real(wp) :: bottom_angle_amplitude_deg = 0.0_wp
         real(wp) :: top_angle_phase_deg = 0.0_wp        !< its phase [deg]
         real(wp) :: bottom_angle_phase_deg = 0.0_wp
+        !> harmonic: the amplitudes grow from 0 to 1 over this time [s]; 0: no ramp
+        real(wp) :: top_ramp_time = 0.0_wp
+        real(wp) :: bottom_ramp_time = 0.0_wp
         !> motion table files (rows t, dx, dy, dangle_deg); resolved by `read_scene` against
         !! the scene file's directory
         character(len=PATH_LEN) :: top_table = ''

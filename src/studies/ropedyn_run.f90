@@ -26,12 +26,20 @@
 !! a second run off the file, a file the run may not replace is refused, and a new run
 !! writes FILE.part and renames it to FILE when it finishes, so that the earlier FILE stays
 !! whole until then.
+!!
+!! Output (`open`'s output): OUTPUT_FILE, the scene's file as above (the command line);
+!! OUTPUT_MEMORY, the same records into an HDF5 file in memory whose bytes `take_image`
+!! hands over after `finish` (the library's whole run, that writes no file); OUTPUT_NONE,
+!! no records at all: the library's simulation, which a driver moves on with `advance`
+!! (submodule ropedyn_run_library, which says what of the above applies there).
 module ropedyn_run
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use, intrinsic :: iso_fortran_env, only: int8
     use ropedyn_kinds, only: wp, i8
     use ropedyn_text, only: real_text
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_SOLVER
     use ropedyn_rope_model, only: rope_model_t, energy_t
+    use ropedyn_support_motion, only: support_motion_t
     use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, &
                                   stop_query_i
     use ropedyn_clock, only: clock_seconds
@@ -47,9 +55,14 @@ module ropedyn_run
     use ropedyn_methods, only: METHODS, method_index, resolved_max_order
     use ropedyn_energy_monitor, only: energy_monitor_t, safety_record_t
     use ropedyn_state_start, only: state_initial_state
+    use ropedyn_process, only: heartbeat_t
     implicit none
     private
-    public :: run_t, run_summary_t, STEP_RECORDED, STEP_STOPPED, STEP_FAILED
+    public :: run_t, run_summary_t, run_snapshot_t, STEP_RECORDED, STEP_STOPPED, STEP_FAILED
+    public :: OUTPUT_FILE, OUTPUT_MEMORY, OUTPUT_NONE
+
+    !> Where the records go (`open`'s output; see the module header).
+    integer, parameter :: OUTPUT_FILE = 0, OUTPUT_MEMORY = 1, OUTPUT_NONE = 2
 
     !> What `step` did: recorded the next output time; stopped early (the last record is
     !! the state reached; the driver finishes); failed (`err`; finished unless the error is
@@ -77,6 +90,18 @@ module ropedyn_run
         real(wp) :: peak_tension = 0.0_wp, peak_arc = 0.0_wp, peak_time = 0.0_wp
         integer :: peak_joint = -1
     end type run_summary_t
+
+    !> A state of a run without output kept in memory (`save`, `restore`): time, ODE state,
+    !! quadratures, the supports' motions and the prescriptions for the next advance.
+    type :: run_snapshot_t
+        private
+        logical :: valid = .false.
+        real(wp) :: t = 0.0_wp
+        real(wp), allocatable :: y(:), yq(:)
+        type(support_motion_t) :: motion(2)
+        real(wp) :: target_p(2, 2) = 0.0_wp, target_v(2, 2) = 0.0_wp
+        logical :: target_given(2) = .false.
+    end type run_snapshot_t
 
     !> A run of one scene (see the module header for the order of the steps).
     type :: run_t
@@ -117,6 +142,13 @@ module ropedyn_run
         ! the guard of the output file: the lock held ('' none), and for a new run the
         ! file written (FILE.part) and its final name
         character(len=:), allocatable :: lock_file, part_file, final_file
+        type(heartbeat_t) :: beat                 !< the lock's heartbeat
+        integer :: output = OUTPUT_FILE        !< where the records go
+        integer(int8), allocatable :: image(:) !< OUTPUT_MEMORY: the file's bytes at its end
+        !> OUTPUT_NONE: the position (m) and velocity (m/s) prescribed for each coupled
+        !! support at the next `advance` (columns 1 top, 2 bottom), and which are given
+        real(wp) :: target_p(2, 2) = 0.0_wp, target_v(2, 2) = 0.0_wp
+        logical :: target_given(2) = .false.
     contains
         procedure :: open => run_open
         procedure :: begin => run_begin
@@ -126,6 +158,21 @@ module ropedyn_run
         procedure :: time => run_time
         procedure :: end_time => run_end_time
         procedure :: output_file => run_output_file
+        procedure :: take_image => run_take_image
+        procedure :: release => run_release
+        procedure :: advance => run_advance
+        procedure :: state_size => run_state_size
+        procedure :: elements => run_elements
+        procedure :: get_state => run_get_state
+        procedure :: set_state => run_set_state
+        procedure :: points_now => run_points_now
+        procedure :: forces_now => run_forces_now
+        procedure :: energy_now => run_energy_now
+        procedure :: anchors_now => run_anchors_now
+        procedure :: set_support => run_set_support
+        procedure :: save => run_save
+        procedure :: restore => run_restore
+        procedure, private :: restart
         procedure, private :: fresh_start, output_time, start_integrator, record, &
                               steps_taken, keep_as_previous, asked_to_stop, end_on
         procedure, private :: resume_from_file, check_energy, second_look, note_peak
@@ -164,6 +211,96 @@ module ropedyn_run
             type(error_t), allocatable, intent(out) :: err
         end subroutine check_energy
 
+        !> OUTPUT_NONE: integrate to time t (s) > the current time, where the coupled
+        !! supports are at the position and velocity prescribed by `set_support` (submodule
+        !! ropedyn_run_library). A failure leaves the last good state.
+        module subroutine run_advance(self, t, err)
+            class(run_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine run_advance
+
+        !> Unknowns of the ODE state (the model's; its layout: docs/reference/file-format.md,
+        !! /state/y).
+        pure module integer function run_state_size(self)
+            class(run_t), intent(in) :: self
+        end function run_state_size
+
+        !> Elements (RFEM) or members (MPP) of the rope.
+        pure module integer function run_elements(self)
+            class(run_t), intent(in) :: self
+        end function run_elements
+
+        !> The ODE state now.
+        module subroutine run_get_state(self, y)
+            class(run_t), intent(in) :: self
+            real(wp), intent(out) :: y(:)
+        end subroutine run_get_state
+
+        !> Replace the ODE state at the current time (finite values, the model's size); the
+        !! integrator starts again from it.
+        module subroutine run_set_state(self, y, err)
+            class(run_t), intent(inout) :: self
+            real(wp), intent(in) :: y(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine run_set_state
+
+        !> The polyline now: end points A_1, B_1, A_2, ... (2, 2 n), m.
+        module subroutine run_points_now(self, points)
+            class(run_t), intent(in) :: self
+            real(wp), intent(out) :: points(:, :)
+        end subroutine run_points_now
+
+        !> The internal forces at the joints 0 .. n and the supports' reactions (2, 2) now
+        !! (rope_model_t%internal_forces).
+        module subroutine run_forces_now(self, axial, shear, moment, reaction)
+            class(run_t), intent(inout) :: self
+            real(wp), intent(out) :: axial(0:), shear(0:), moment(0:), reaction(:, :)
+        end subroutine run_forces_now
+
+        !> The energies now.
+        module subroutine run_energy_now(self, e)
+            class(run_t), intent(inout) :: self
+            type(energy_t), intent(out) :: e
+        end subroutine run_energy_now
+
+        !> The supports' anchors now (2, 2): columns top, bottom; NaN for a free end.
+        module subroutine run_anchors_now(self, anchors)
+            class(run_t), intent(in) :: self
+            real(wp), intent(out) :: anchors(:, :)
+        end subroutine run_anchors_now
+
+        !> Prescribe the position p (m) and velocity v (m/s) of support k (1 top, 2
+        !! bottom), a coupled one, at the time of the next `advance`.
+        module subroutine run_set_support(self, k, p, v, err)
+            class(run_t), intent(inout) :: self
+            integer, intent(in) :: k
+            real(wp), intent(in) :: p(2), v(2)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine run_set_support
+
+        !> Keep the state now in `snap`; the integrator starts again from it, so that the
+        !! run goes on from here as it will after `restore`.
+        module subroutine run_save(self, snap, err)
+            class(run_t), intent(inout) :: self
+            type(run_snapshot_t), intent(out) :: snap
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine run_save
+
+        !> Go back to the state kept in `snap` (by `save` of this run); the integrator
+        !! starts again from it.
+        module subroutine run_restore(self, snap, err)
+            class(run_t), intent(inout) :: self
+            type(run_snapshot_t), intent(in) :: snap
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine run_restore
+
+        !> The integrator started again at the run's state (its counters kept).
+        module subroutine restart(self, err)
+            class(run_t), intent(inout) :: self
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine restart
+
         !> The second look of the order safety (submodule ropedyn_run_safety).
         module subroutine second_look(self, tout, e, bound, err)
             class(run_t), intent(inout) :: self
@@ -182,11 +319,16 @@ contains
     !! file exists leaves none; a failure after it is the caller's to finish. With `guard`
     !! (the default) the output file is guarded; `force` lets a run replace a file it would
     !! otherwise refuse (not an input, not a locked or special file).
-    subroutine run_open(self, scene, err, resume, guard, force)
+    subroutine run_open(self, scene, err, resume, guard, force, output, name)
         class(run_t), intent(inout) :: self
         type(scene_t), intent(in) :: scene
         type(error_t), allocatable, intent(out) :: err
         logical, intent(in), optional :: resume, guard, force
+        !> OUTPUT_FILE (the default), OUTPUT_MEMORY or OUTPUT_NONE; a run without a file
+        !! neither resumes nor guards one. OUTPUT_MEMORY: `name` names the file in memory,
+        !! unique among the files open in the process.
+        integer, intent(in), optional :: output
+        character(len=*), intent(in), optional :: name
         logical :: resuming, guarding, forced
         resuming = .false.
         if (present(resume)) resuming = resume
@@ -194,8 +336,16 @@ contains
         if (present(guard)) guarding = guard
         forced = .false.
         if (present(force)) forced = force
+        self%output = OUTPUT_FILE
+        if (present(output)) self%output = output
         self%scene = scene
         self%summary%file = trim(scene%output%file)
+        if (self%output /= OUTPUT_FILE) then
+            resuming = .false.
+            guarding = .false.
+            self%summary%file = ''
+            if (present(name) .and. self%output == OUTPUT_MEMORY) self%summary%file = name
+        end if
         if (guarding) then
             call self%guard_output(resuming, forced, err)
             if (allocated(err)) return
@@ -264,7 +414,11 @@ contains
                     'the scene is too large or too small (docs/reference/scene-file.md, Limits)')
                 return
             end if
-            call make_parent_dirs(self%summary%file, err)
+            if (self%output == OUTPUT_NONE) then
+                call model%support_positions(self%t, self%anchors)
+                return
+            end if
+            if (self%output == OUTPUT_FILE) call make_parent_dirs(self%summary%file, err)
             if (allocated(err)) return
             allocate (lengths(model%n_elements()), masses(model%n_elements()))
             call model%element_data(lengths, masses)
@@ -276,14 +430,16 @@ contains
                                      version_string, scene_namelist_text(scene), err, &
                                      state_size=model%size(), quad_size=self%nq, &
                                      source=scene%source, internal_forces=.true., &
-                                     anchored=ieee_is_finite(self%anchors(1, :)))
+                                     anchored=ieee_is_finite(self%anchors(1, :)), &
+                                     memory=self%output == OUTPUT_MEMORY)
             else
                 call self%out%create(self%summary%file, model%n_elements(), lengths, masses, &
                                      model%model_name(), self%integrator%name(), &
                                      version_string, scene_namelist_text(scene), err, &
                                      state_size=model%size(), quad_size=self%nq, &
                                      internal_forces=.true., &
-                                     anchored=ieee_is_finite(self%anchors(1, :)))
+                                     anchored=ieee_is_finite(self%anchors(1, :)), &
+                                     memory=self%output == OUTPUT_MEMORY)
             end if
             if (allocated(err)) return
         end associate
@@ -311,8 +467,10 @@ contains
                                 self%scene%solver%energy_gain_bound)
         call self%start_integrator(err)
         if (allocated(err)) return
-        call self%progress%start_run(self%t, self%t_end, self%scene%output%progress, &
-                                     self%scene%output%progress_given)
+        ! no progress display without a file: the caller's own loop is the run
+        if (self%output == OUTPUT_FILE) &
+            call self%progress%start_run(self%t, self%t_end, self%scene%output%progress, &
+                                         self%scene%output%progress_given)
     end subroutine run_begin
 
     !> (Re)start the integrator at the run's state with the order limit `max_order` and the
@@ -406,9 +564,12 @@ contains
                             '): not written to the output')
             return
         end if
-        call self%out%append(self%t, self%q, self%qdot, self%points, e, h, order, err, &
-                             y=self%y, yq=self%yq, axial=self%axial, shear=self%shear, &
-                             moment=self%moment, reaction=self%reaction, position=self%anchors)
+        if (self%output /= OUTPUT_NONE) &
+            call self%out%append(self%t, self%q, self%qdot, self%points, e, h, order, err, &
+                                 y=self%y, yq=self%yq, axial=self%axial, shear=self%shear, &
+                                 moment=self%moment, reaction=self%reaction, &
+                                 position=self%anchors)
+        if (allocated(err)) return
         call self%note_peak(self%t, maxval(self%axial), maxloc(self%axial, 1) - 1)
         self%summary%records = self%summary%records + 1
         self%summary%final_energy = e
@@ -473,6 +634,15 @@ contains
         real(wp) :: cpu_now
         call self%progress%done()
         call cpu_time(cpu_now)
+        if (self%output == OUTPUT_NONE) then
+            ! no file: the counters only
+            self%summary%cpu_time = self%cpu_before + (cpu_now - self%cpu_start)
+            self%summary%stats = self%integrator%stats()
+            call self%summary%stats%add(self%stats_before)
+            self%summary%t_reached = max(self%summary%t_reached, self%t)
+            call self%integrator%finalize()
+            return
+        end if
         associate (s => self%summary)
             s%cpu_time = self%cpu_before + (cpu_now - self%cpu_start)
             s%stats = self%integrator%stats()
@@ -489,7 +659,11 @@ contains
                         r%order_before, r%order_after, r%kept_at, r%kept_count, ferr)
             end associate
         end associate
-        call self%out%close_run(status, reason, ferr)
+        if (self%output == OUTPUT_MEMORY) then
+            call self%out%close_run(status, reason, ferr, self%image)
+        else
+            call self%out%close_run(status, reason, ferr)
+        end if
         if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
         call self%integrator%finalize()
         call self%release_output(err)
@@ -531,6 +705,21 @@ contains
         character(len=:), allocatable :: path
         path = self%summary%file
     end function run_output_file
+
+    !> OUTPUT_MEMORY, after `finish`: the bytes of the run's file (an HDF5 file image),
+    !! moved out of the run; none before, or after a failure to take them.
+    subroutine run_take_image(self, image)
+        class(run_t), intent(inout) :: self
+        integer(int8), allocatable, intent(out) :: image(:)
+        if (allocated(self%image)) call move_alloc(self%image, image)
+    end subroutine run_take_image
+
+    !> Free what the run holds outside Fortran's reach (the integrator's memory); after
+    !! `finish` or for a run without output that ends here.
+    subroutine run_release(self)
+        class(run_t), intent(inout) :: self
+        if (allocated(self%integrator)) call self%integrator%finalize()
+    end subroutine run_release
 
     !> Output time k (k = 0: the start; n_out: t_end).
     pure real(wp) function output_time(self, k) result(tk)

@@ -61,7 +61,7 @@ contains
                 return
             end if
         end if
-        call take_lock(file//'.lock', err)
+        call take_lock(file//'.lock', self%beat, err)
         if (allocated(err)) then
             err%message = file//': '//err%message
             return
@@ -85,7 +85,7 @@ contains
                 call check_own_source(file, self%scene%source, err)
         end if
         if (allocated(err)) then
-            call drop_lock(self%lock_file)
+            call drop_lock(self%lock_file, self%beat)
             self%lock_file = ''
             return
         end if
@@ -113,7 +113,7 @@ contains
             end if
         end if
         if (allocated(self%lock_file)) then
-            if (len(self%lock_file) > 0) call drop_lock(self%lock_file)
+            if (len(self%lock_file) > 0) call drop_lock(self%lock_file, self%beat)
             self%lock_file = ''
         end if
     end procedure release_output

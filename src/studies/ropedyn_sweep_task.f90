@@ -28,7 +28,7 @@ module ropedyn_sweep_task
     use ropedyn_scene, only: scene_t, scene_namelist_text
     use ropedyn_simulation, only: run_summary_t, run_scene
     use ropedyn_case_file, only: case_data_t, read_case_file, finish_case_file
-    use ropedyn_sweep_lock, only: take_lock, drop_lock
+    use ropedyn_sweep_lock, only: take_lock, drop_lock, heartbeat_t
     use ropedyn_sweep, only: sweep_t, sweep_case_t
     use ropedyn_sweep_status, only: case_state_t, case_state, lock_path, part_path
     implicit none
@@ -110,6 +110,7 @@ contains
         type(scene_t) :: scene
         type(error_t), allocatable :: ferr
         character(len=:), allocatable :: label, lock, part
+        type(heartbeat_t) :: beat
         real(wp) :: start
         real(wp) :: wall
         logical :: removed, resume
@@ -132,7 +133,7 @@ contains
             end if
             call make_dirs(sweep%output_dir, err, 'sweep')
             if (allocated(err)) return
-            call take_lock(lock, err)
+            call take_lock(lock, beat, err)
             if (allocated(err)) then
                 err%message = label//' ('//c%file//'): not run: '//err%message
                 return
@@ -192,7 +193,7 @@ contains
                     fixed_text(summary%cpu_time, 3)//' s, wall '//fixed_text(wall, 3)//' s -> '// &
                     c%file
             end block locked
-            call drop_lock(lock)
+            call drop_lock(lock, beat)
         end associate
     contains
         subroutine skipped()

@@ -16,6 +16,27 @@ def ropedyn_exe():
     return exe
 
 
+def library_path():
+    """libropedyn of the build under test: ROPEDYN_LIBRARY, else beside the executable."""
+    if os.environ.get("ROPEDYN_LIBRARY"):
+        return pathlib.Path(os.environ["ROPEDYN_LIBRARY"]).resolve()
+    exe = pathlib.Path(os.environ.get("ROPEDYN_EXE", ROOT / "build" / "debug" / "ropedyn"))
+    return exe.resolve().parent / "libropedyn.so"
+
+
+# `import ropedyn` in the tests (and in the programs they start) loads the library of the
+# build under test, not another build of the tree (python/ropedyn/_lib.py)
+os.environ.setdefault("ROPEDYN_LIBRARY", str(library_path()))
+
+
+@pytest.fixture(scope="session")
+def ropedyn_library():
+    path = library_path()
+    if not path.is_file():
+        pytest.fail(f"libropedyn not found at {path} (set ROPEDYN_LIBRARY)")
+    return path
+
+
 @pytest.fixture
 def run(ropedyn_exe, tmp_path):
     """Run `ropedyn ARGS...` in tmp_path; returns the CompletedProcess."""

@@ -25,6 +25,16 @@ def test_check_catches_an_upward_use():
     units["ropedyn_rfem"]["uses"].discard("ropedyn_scene")
     units["ropedyn_mebdf"]["uses"].add("ropedyn_rope_model")   # solvers -> models
     assert any("ropedyn_mebdf" in v for v in arch.violations(units))
+    units["ropedyn_mebdf"]["uses"].discard("ropedyn_rope_model")
+    # the library (src/lib) and the executable (src/app) are side by side: neither uses
+    # the other, and nothing below uses the library
+    assert units["ropedyn_capi"]["layer"] == "lib"
+    units["ropedyn_cmd_run"]["uses"].add("ropedyn_lib")   # app -> lib
+    assert any("ropedyn_cmd_run" in v for v in arch.violations(units))
+    units["ropedyn_cmd_run"]["uses"].discard("ropedyn_lib")
+    units["ropedyn_run"]["uses"].add("ropedyn_lib")       # studies -> lib
+    assert any("ropedyn_run (studies) uses ropedyn_lib (lib)" in v
+               for v in arch.violations(units))
 
 
 def _tree(root, files):

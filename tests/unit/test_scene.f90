@@ -600,7 +600,7 @@ contains
         call expect_error('motion_name', [character(len=L) :: MODEL, &
             '&supports top_motion = ''wobble'' /'], NO_SET, [character(len=L) :: &
             P//'motion_name.nml: &supports: top_motion = "wobble": ', &
-            'unknown (allowed: fixed, harmonic, table)'])
+            'unknown (allowed: fixed, harmonic, table, coupled)'])
         call expect_error('motion_frequency', [character(len=L) :: MODEL, &
             '&supports top_motion = ''harmonic'', top_amplitude = 0.01, 0 /'], NO_SET, &
             [character(len=L) :: P//'motion_frequency.nml: &supports: top_frequency = 0.0: ', &

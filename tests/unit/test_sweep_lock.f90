@@ -8,7 +8,7 @@ program test_sweep_lock
     use ropedyn_os, only: make_dirs, sleep_microseconds
     use ropedyn_clock, only: utc_text
     use ropedyn_process, only: process_id, process_start, host_name, file_mtime, &
-        start_heartbeat, stop_heartbeat
+        start_heartbeat, stop_heartbeat, heartbeat_t
     use ropedyn_sweep_lock, only: lock_t, read_lock, take_lock, drop_lock
     use ropedyn_assert, only: test_suite_t
     implicit none
@@ -16,6 +16,7 @@ program test_sweep_lock
     character(len=*), parameter :: DIR = 'test_sweep_lock_tmp'
     type(test_suite_t) :: suite
     type(error_t), allocatable :: err
+    type(heartbeat_t) :: beat
 
     suite%name = 'sweep_lock'
     call make_dirs(DIR, err)
@@ -54,8 +55,8 @@ contains
         character(len=*), parameter :: PATH = DIR//'/.case_0001.lock'
         type(lock_t) :: lock
         logical :: exists
-        call drop_lock(PATH)
-        call take_lock(PATH, err)
+        call drop_lock(PATH, beat)
+        call take_lock(PATH, beat, err)
         call suite%check_true(.not. allocated(err), 'take a free lock')
         call read_lock(PATH, lock)
         call suite%check_true(lock%exists .and. lock%live .and. lock%mine, 'own lock: live, mine')
@@ -63,14 +64,14 @@ contains
                               'own lock: pid and host')
         call suite%check_contains(lock%holder(), 'pid ', 'holder')
         ! a second taker (this process again: the lock is live) is refused
-        call take_lock(PATH, err)
+        call take_lock(PATH, beat, err)
         call suite%check_true(allocated(err), 'a live lock is refused')
         if (allocated(err)) then
             call suite%check_true(err%code == ERR_IO, 'refused: ERR_IO')
             call suite%check_contains(err%message, 'being written by host '//host_name(), &
                                       'refused: names the holder')
         end if
-        call drop_lock(PATH)
+        call drop_lock(PATH, beat)
         inquire (file=PATH, exist=exists)
         call suite%check_true(.not. exists, 'drop removes the lock')
         call read_lock(PATH, lock)
@@ -126,38 +127,46 @@ contains
         call write_lines(PATH, lines(:2))
         call read_lock(PATH, lock)
         call suite%check_true(lock%live .and. .not. lock%mine, 'other host, fresh: live')
-        call take_lock(PATH, err)
+        call take_lock(PATH, beat, err)
         call suite%check_true(allocated(err), 'other host, fresh: refused')
         ! an abandoned lock is taken over
         lines = ''
         lines(1) = 'host='//host_name()
         lines(2) = 'pid=2147483000'
         call write_lines(PATH, lines(:2))
-        call take_lock(PATH, err)
+        call take_lock(PATH, beat, err)
         call suite%check_true(.not. allocated(err), 'abandoned: taken over')
         call read_lock(PATH, lock)
         call suite%check_true(lock%mine .and. lock%pid == process_id(), 'taken over: mine')
-        call drop_lock(PATH)
+        call drop_lock(PATH, beat)
     end subroutine test_abandoned
 
-    !> The heartbeat touches the file: its time moves on within about a second.
+    !> The heartbeat touches the file: its time moves on within about a second. Two locks
+    !! have two heartbeats at once (one per lock, not one per process).
     subroutine test_heartbeat()
-        character(len=*), parameter :: PATH = DIR//'/beat'
-        integer(int64) :: before
+        character(len=*), parameter :: PATH = DIR//'/beat', OTHER = DIR//'/beat2'
+        type(heartbeat_t) :: beat, beat2
+        integer(int64) :: before, before2
         integer :: k
         call write_lines(PATH, ['x'])
+        call write_lines(OTHER, ['x'])
         before = file_mtime(PATH)
         call sleep_microseconds(1100000)
-        call start_heartbeat(PATH, 1, err)
+        call start_heartbeat(PATH, 1, beat, err)
         call suite%check_true(.not. allocated(err), 'heartbeat: started')
+        call start_heartbeat(OTHER, 1, beat2, err)
+        call suite%check_true(.not. allocated(err), 'a second heartbeat: started')
         call suite%check_true(file_mtime(PATH) > before, 'heartbeat: touched at the start')
         before = file_mtime(PATH)
+        before2 = file_mtime(OTHER)
         do k = 1, 30
             call sleep_microseconds(100000)
-            if (file_mtime(PATH) > before) exit
+            if (file_mtime(PATH) > before .and. file_mtime(OTHER) > before2) exit
         end do
         call suite%check_true(file_mtime(PATH) > before, 'heartbeat: touched again')
-        call stop_heartbeat()
+        call suite%check_true(file_mtime(OTHER) > before2, 'second heartbeat: touched again')
+        call stop_heartbeat(beat)
+        call stop_heartbeat(beat2)
         before = file_mtime(PATH)
         call sleep_microseconds(1200000)
         call suite%check_true(file_mtime(PATH) == before, 'heartbeat: stopped')

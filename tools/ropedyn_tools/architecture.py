@@ -40,6 +40,7 @@ LAYERS = [
     ("io", 2, ["src/io"]),
     ("studies", 3, ["src/studies"]),
     ("app", 4, ["src/app"]),
+    ("lib", 4, ["src/lib"]),
 ]
 RANK = {name: rank for name, rank, _ in LAYERS}
 
@@ -232,7 +233,7 @@ def dot_source(units):
     """The layer picture: one box per layer listing its folders and modules, and an arrow
     from each layer to every lower layer it uses, labelled with the number of `use`s."""
     colors = dict(core="#dddddd", solvers="#cfe2f3", models="#d9ead3", io="#fff2cc",
-                  studies="#fce5cd", app="#ead1dc")
+                  studies="#fce5cd", app="#ead1dc", lib="#d0e0e3")
     lines = ["digraph ropedyn {", "  rankdir=TB; nodesep=0.6; ranksep=0.7;",
              '  node [shape=box, style="rounded,filled", fontname="Helvetica", fontsize=10];',
              '  edge [fontname="Helvetica", fontsize=9, color="#555555"];']

@@ -207,10 +207,10 @@ MUTATIONS = [
              "harmonic support frequency in Hz used as rad/s",
              ctest=("test_effect_anchors", "test_effects_physics")),
     Mutation("table-hermite-basis", MOTION,
-             "h01 = u**2*(3.0_wp - 2.0_wp*u)",
-             "h01 = u**2*(3.0_wp - u)",
+             "b(3) = u**2*(3.0_wp - 2.0_wp*u)",
+             "b(3) = u**2*(3.0_wp - u)",
              "motion table interpolation misses its rows",
-             ctest=("test_effect_anchors",)),
+             ctest=("test_effect_anchors", "test_support_motion")),
     Mutation("table-slopes-swapped", MOTION,
              "self%slope(:, k) = (h1*(rows(2:4, k) - rows(2:4, k - 1))/h0 + &\n"
              "                                h0*(rows(2:4, k + 1) - rows(2:4, k))/h1)",

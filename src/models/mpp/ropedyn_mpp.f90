@@ -41,7 +41,7 @@ module ropedyn_mpp
                               add_energies_of, add_powers_of
     use ropedyn_effect_factory, only: build_body_effects, attached_masses, water_added_mass
     use ropedyn_added_mass, only: added_mass_t
-    use ropedyn_support_motion, only: support_motion_t, motion_state_t
+    use ropedyn_support_motion, only: motion_state_t
     use ropedyn_rope_section, only: section_t, rope_section
     use ropedyn_rope_setup, only: initial_angle, clamp_angles, &
                                   configure_motions, any_does_work
@@ -69,9 +69,8 @@ module ropedyn_mpp
         real(wp) :: top_angle = 0.0_wp, bottom_angle = 0.0_wp
         real(wp) :: init_angle = 0.0_wp
         logical :: folded = .false.    !< initial shape 'folded' (n even)
-        ! supports (1 top joint, 2 bottom): base anchors and angles in top_anchor, ...
-        type(support_motion_t) :: motion(2)
-        logical :: moving(2) = .false.
+        ! supports (1 top joint, 2 bottom): base anchors and angles in top_anchor, ...;
+        ! their motions: rope_model_t%motion
         real(wp) :: bottom_release = huge(1.0_wp)  !< s
         type(effect_box_t), allocatable :: effects(:)
         !> in water (&effects water): the rods' added mass (submodule ropedyn_mpp_water)

@@ -36,7 +36,7 @@ module ropedyn_rfem
                               add_energies_of, add_powers_of
     use ropedyn_effect_factory, only: build_body_effects, attached_masses, water_added_mass
     use ropedyn_added_mass, only: added_mass_t
-    use ropedyn_support_motion, only: support_motion_t, motion_state_t
+    use ropedyn_support_motion, only: motion_state_t
     use ropedyn_rope_section, only: section_t, rope_section
     use ropedyn_rope_setup, only: initial_angle, clamp_angles, &
                                   configure_motions, any_does_work
@@ -90,10 +90,8 @@ module ropedyn_rfem
         real(wp) :: init_angle = 0.0_wp        !< angle of the straight initial state, rad
         real(wp) :: init_velocity(2) = 0.0_wp  !< initial velocity of every element, m/s
         logical :: folded = .false.            !< initial shape 'folded'
-        ! supports (index 1 top, 2 bottom): base anchors and prescribed motions; the anchors
+        ! supports (index 1 top, 2 bottom; their motions: rope_model_t%motion): the anchors
         ! and angles above are their values at the time of the current call
-        type(support_motion_t) :: motion(2)
-        logical :: moving(2) = .false.
         real(wp) :: release(2) = huge(1.0_wp)  !< release times, s
         logical :: timed = .false.             !< the supports depend on time
         ! external effects (only those enabled) and their workspace

@@ -1,0 +1,173 @@
+!> A run without output driven step by step from outside (the library, src/lib): advance
+!! to any time, read and replace the state, the polyline, internal forces, reactions and
+!! energies of the state now, prescribe coupled supports, keep and restore states.
+!!
+!! What applies of a file's run: the scene's model, integrator, tolerances, initial state
+!! (with statics and modes for 'equilibrium' and 'mode') and step budget (solver.max_steps,
+!! for the whole simulation); a state that is not finite after an advance is a failed
+!! integration (ERR_SOLVER), as it is before a record. What does not: the output grid and
+!! t_end (an advance goes to any later time), records, the progress display, and the
+!! order safety with its energy monitor (it integrates an output interval a second time,
+!! which a coupled support's past motion does not allow; set solver.max_order to the
+!! method's A-stable order where a run would need it). No signal is caught.
+!!
+!! Coupled supports (`&supports top_motion = 'coupled'`): `advance` to t1 moves each on
+!! the cubic Hermite curve from its position and velocity now to those `set_support`
+!! prescribed for t1 (not prescribed: on with its velocity now, a straight line), and
+!! stops the integration exactly at t1, so that no step sees the next exchange's motion
+!! before it is known (integrator_t%set_stop_time; mebdf's second stage still looks one
+!! step ahead along the curve). With such a support the integrator is told at every
+!! advance that f changed (integrator_t%rhs_changed).
+submodule (ropedyn_run) ropedyn_run_library
+    use ropedyn_error, only: ERR_USAGE
+    use ropedyn_text, only: int_text
+    use ropedyn_support_motion, only: motion_state_t, MOTION_COUPLED
+    implicit none
+
+contains
+
+    module procedure run_advance
+        type(motion_state_t) :: now
+        logical :: coupled(2)
+        integer :: k
+        if (.not. ieee_is_finite(t)) then
+            call make_error(err, ERR_USAGE, 'advance: t = '//real_text(t)//' s is not finite')
+            return
+        end if
+        if (t < self%t) then
+            call make_error(err, ERR_USAGE, 'advance: t = '//real_text(t)//' s lies before '// &
+                'the time reached, '//real_text(self%t)//' s (a simulation only goes forward; '// &
+                'restore a saved state to go back)')
+            return
+        end if
+        if (t == self%t) return
+        coupled = self%model%moving .and. self%model%motion%kind == MOTION_COUPLED
+        if (any(coupled)) then
+            do k = 1, 2
+                if (.not. coupled(k)) cycle
+                if (.not. self%target_given(k)) then
+                    now = self%model%motion(k)%state(self%t)
+                    self%target_p(:, k) = now%p + now%v*(t - self%t)
+                    self%target_v(:, k) = now%v
+                end if
+                call self%model%motion(k)%couple(self%t, t, self%target_p(:, k), &
+                                                 self%target_v(:, k))
+            end do
+            self%target_given = .false.
+            call self%integrator%set_stop_time(t)
+            call self%integrator%rhs_changed()
+        end if
+        call self%integrator%advance_to(t, self%t, self%y, self%yq(1:self%nq), err)
+        if (allocated(err)) return
+        if (.not. (all(ieee_is_finite(self%y)) .and. all(ieee_is_finite(self%yq)))) &
+            call make_error(err, ERR_SOLVER, 'non-finite state at t = '//real_text(self%t)// &
+                            ' s (integrator '//self%integrator%name()//')')
+    end procedure run_advance
+
+    module procedure run_state_size
+        run_state_size = self%model%size()
+    end procedure run_state_size
+
+    module procedure run_elements
+        run_elements = self%model%n_elements()
+    end procedure run_elements
+
+    module procedure run_get_state
+        y = self%y
+    end procedure run_get_state
+
+    module procedure run_set_state
+        if (size(y) /= size(self%y)) then
+            call make_error(err, ERR_USAGE, 'set_state: '//int_text(size(y))//' values, the '// &
+                'state has '//int_text(size(self%y)))
+            return
+        end if
+        if (.not. all(ieee_is_finite(y))) then
+            call make_error(err, ERR_USAGE, 'set_state: a value is not finite')
+            return
+        end if
+        self%y = y
+        call self%restart(err)
+    end procedure run_set_state
+
+    module procedure run_points_now
+        call self%model%polyline(self%y, points, self%t)
+    end procedure run_points_now
+
+    module procedure run_forces_now
+        call self%model%internal_forces(self%t, self%y, axial, shear, moment, reaction)
+    end procedure run_forces_now
+
+    module procedure run_energy_now
+        e = self%model%energy(self%t, self%y, self%yq)
+    end procedure run_energy_now
+
+    module procedure run_anchors_now
+        call self%model%support_positions(self%t, anchors)
+    end procedure run_anchors_now
+
+    module procedure run_set_support
+        character(len=*), parameter :: ENDS(2) = ['top   ', 'bottom']
+        if (k < 1 .or. k > 2) then
+            call make_error(err, ERR_USAGE, 'set_support: support '//int_text(k)// &
+                            ' (1 top, 2 bottom)')
+            return
+        end if
+        if (.not. (self%model%moving(k) .and. self%model%motion(k)%kind == MOTION_COUPLED)) then
+            call make_error(err, ERR_USAGE, 'set_support: the '//trim(ENDS(k))//' support is '// &
+                'not coupled (&supports '//trim(ENDS(k))//'_motion = '''// &
+                trim(merge(self%scene%supports%top_motion, self%scene%supports%bottom_motion, &
+                           k == 1))//''', '//trim(ENDS(k))//' = '''// &
+                trim(merge(self%scene%supports%top, self%scene%supports%bottom, k == 1))// &
+                '''; a coupled support needs '//trim(ENDS(k))//'_motion = ''coupled'' and '// &
+                'a pinned or clamped end)')
+            return
+        end if
+        if (.not. (all(ieee_is_finite(p)) .and. all(ieee_is_finite(v)))) then
+            call make_error(err, ERR_USAGE, 'set_support: the '//trim(ENDS(k))//' support''s '// &
+                'position or velocity is not finite')
+            return
+        end if
+        self%target_p(:, k) = p
+        self%target_v(:, k) = v
+        self%target_given(k) = .true.
+    end procedure run_set_support
+
+    module procedure run_save
+        call self%restart(err)
+        if (allocated(err)) return
+        snap%t = self%t
+        snap%y = self%y
+        snap%yq = self%yq
+        snap%motion = self%model%motion
+        snap%target_p = self%target_p
+        snap%target_v = self%target_v
+        snap%target_given = self%target_given
+        snap%valid = .true.
+    end procedure run_save
+
+    module procedure run_restore
+        if (.not. snap%valid) then
+            call make_error(err, ERR_USAGE, 'restore: the snapshot holds no state')
+            return
+        end if
+        if (size(snap%y) /= size(self%y) .or. size(snap%yq) /= size(self%yq)) then
+            call make_error(err, ERR_USAGE, 'restore: the snapshot is of another scene ('// &
+                int_text(size(snap%y))//' unknowns, this one has '//int_text(size(self%y))//')')
+            return
+        end if
+        self%t = snap%t
+        self%y = snap%y
+        self%yq = snap%yq
+        self%model%motion = snap%motion
+        self%target_p = snap%target_p
+        self%target_v = snap%target_v
+        self%target_given = snap%target_given
+        call self%restart(err)
+    end procedure run_restore
+
+    module procedure restart
+        call self%stats_before%add(self%integrator%stats())
+        call self%start_integrator(err)
+    end procedure restart
+end submodule ropedyn_run_library
