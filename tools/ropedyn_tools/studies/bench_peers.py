@@ -379,12 +379,20 @@ def coupled_row(py, exe, work, n, t_end, probe, repeat):
     rd_err = l2(rd["tip"], ref["tip"])
     if not md.get("ok"):
         return (f"| {n} | none stable | | | {rd['cpu']:.3g} | | {rd_err:.1e} | | "
-                f"| {rd['peak']:.3f} |")
+                f"| {rd['peak']:.3f} | | | |")
     fine = run_moordyn_coupled(py, work, n, dt / 4, ACCURACY_SPAN)
     md_err = l2(md["tip"], fine["tip"]) if fine.get("ok") else float("nan")
+    # at equal accuracy: the loosest rtol whose tip error is at most MoorDyn's time error
+    equal = "| none | | "
+    for rtol in EQUAL_RTOLS:
+        sets = (f"solver.rtol={rtol:g}", f"solver.atol={rtol / 100:g}")
+        if l2(run_ropedyn_coupled(n, ACCURACY_SPAN, sets=sets)["tip"], ref["tip"]) <= md_err:
+            loose = least_cpu(lambda: run_ropedyn_coupled(n, t_end, sets=sets), repeat)
+            equal = f"| {rtol:g} | {loose['cpu']:.3g} | {md['cpu'] / loose['cpu']:.2f}"
+            break
     return (f"| {n} | {dt:.3g} | {md['cpu']:.3g} | {md['peak']:.3f} | {rd['cpu']:.3g} "
             f"| {md['cpu'] / rd['cpu']:.2f} | {rd_err:.1e} | {md_err:.1e} "
-            f"| {l2(md['tip'], ref['tip']):.1e} | {rd['peak']:.3f} |")
+            f"| {l2(md['tip'], ref['tip']):.1e} | {rd['peak']:.3f} {equal} |")
 
 
 COUPLED_BEGIN = "<!-- bench_peers_coupled:begin -->"
@@ -393,7 +401,8 @@ COUPLED_HEADER = ("| n | MoorDyn dt (s) | MoorDyn CPU (s) | MoorDyn peak top for
                   "| ropedyn CPU (s) | MoorDyn / ropedyn | ropedyn tip error [0, 2 s] (m) "
                   "| MoorDyn time error [0, 2 s] (m) "
                   "| MoorDyn tip - ropedyn reference [0, 2 s] (m) "
-                  "| ropedyn peak top force (N) |")
+                  "| ropedyn peak top force (N) | ropedyn rtol at equal accuracy "
+                  "| its CPU (s) | MoorDyn / ropedyn at equal accuracy |")
 
 
 def coupled_main(args, exe, py):
@@ -419,7 +428,10 @@ def coupled_main(args, exe, py):
              "Python package, a Coupled point, RK4 at the step of the first table's ladder. "
              f"Tip columns as in the first table (ropedyn's reference: the same coupled "
              f"run with cvode at rtol 1e-10). Machine: {machine()}. Run: {run_stamp()}.", "",
-             COUPLED_HEADER, "|---|---|---|---|---|---|---|---|---|---|", *rows,
+             "At equal accuracy: ropedyn's default method at the loosest rtol of "
+             f"{', '.join(f'{r:g}' for r in EQUAL_RTOLS)} (atol = rtol / 100) whose tip "
+             "error over [0, 2 s] is at most MoorDyn's time error.", "",
+             COUPLED_HEADER, "|---|---|---|---|---|---|---|---|---|---|---|---|---|", *rows,
              COUPLED_END]
     update_doc(DOCS / "performance" / "peers.md", COUPLED_BEGIN, COUPLED_END,
                "\n".join(lines), heading="## Coupled: the top driven from Python\n\n")
