@@ -66,6 +66,10 @@ module ropedyn_integrator
         !! second-order structure (the reduced matrix M - g C - g^2 K of half the size is
         !! the default then; ropedyn_iteration_matrix)
         logical :: first_order_newton = .false.
+        !> the end of the run (s), when the caller knows it (huge: not known); auto starts
+        !! the symplectic method for its bounded energy only on runs long enough for an
+        !! adaptive method's energy drift to matter (ropedyn_auto, LONG_RUN)
+        real(wp) :: t_end = huge(1.0_wp)
         !> time the parts of a step (right-hand side, Jacobian, factorizations, solves) into
         !! the stats' time_* fields (a clock reading costs about 30 ns: a few % of a step of a
         !! small rope, so it is off unless asked for)
@@ -137,6 +141,7 @@ module ropedyn_integrator
         procedure :: min_order => integrator_min_order, &
                      max_order_limit => integrator_max_order_limit
         procedure :: switch_log => integrator_switch_log
+        procedure :: steps_exhausted => integrator_steps_exhausted
     end type integrator_t
 
     abstract interface
@@ -249,6 +254,27 @@ contains
         type(switch_event_t), allocatable :: events(:)
         allocate (events(0))
     end function integrator_switch_log
+
+    !> The cause of a run that ran out of its step budget: the budget and, when the
+    !! integrator's own log diagnosed something on the way (its last warning: cvode's
+    !! lightly damped stiff modes, with the methods that avoid them), that diagnosis, so
+    !! that the message names the cause and the cure.
+    function integrator_steps_exhausted(self) result(cause)
+        class(integrator_t), intent(in) :: self
+        character(len=:), allocatable :: cause
+        type(switch_event_t), allocatable :: events(:)
+        integer :: k
+        character(len=16) :: at
+        cause = 'max_steps exceeded ('//int_text(self%options%max_steps)//' steps)'
+        events = self%switch_log()
+        do k = size(events), 1, -1
+            if (.not. events(k)%warning) cycle
+            write (at, '(es10.3)') events(k)%t
+            cause = cause//'; the run had diagnosed at t = '//trim(adjustl(at))// &
+                    ' s: '//events(k)%reason
+            exit
+        end do
+    end function integrator_steps_exhausted
 
     !> Prepare to integrate `problem` from (t0, y0, yq0). The problem must outlive the
     !! integrator (it is referenced, not copied). The checks every method shares: the order

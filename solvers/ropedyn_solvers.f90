@@ -8,6 +8,7 @@ module ropedyn_solvers
     use ropedyn_mebdf, only: mebdf_t
     use ropedyn_erk, only: erk_t
     use ropedyn_auto, only: auto_t
+    use ropedyn_symplectic, only: symplectic_t
     implicit none
     private
     public :: new_integrator, method_order_range
@@ -30,6 +31,8 @@ contains
             allocate (adams_t :: integrator)
         case ('auto')
             allocate (auto_t :: integrator)
+        case ('symplectic')
+            allocate (symplectic_t :: integrator)
         case default
             call make_error(err, ERR_INPUT, 'unknown integration method "'//method// &
                             '" (available: '//method_list()//')')

@@ -42,8 +42,9 @@
 !!   14.6 us): a residual with M(q) v costs 4.4 / 10.3 / 16.6 f, the solves and vector work
 !!   of a step 11 / 27 / 45 f, a factorization 29 / 225 / 664 f, a Jacobian 26 / 92 /
 !!   149 f. At lambda = 1 and no mass matrix the counts are those of the RFEM above.
-!! - **Switching** and **Adams**: the rules of `watch`, with their measurements, are in
-!!   the submodule ropedyn_auto_switching.
+!! - **Switching**, **Adams** and **Symplectic** (the symplectic method where the fast
+!!   modes are lightly damped): the rules of `watch`, with their measurements, are in the
+!!   submodule ropedyn_auto_switching.
 !! Every switch (time, method, order limit, reason) goes into the switch log.
 module ropedyn_auto
     use ropedyn_kinds, only: wp, i8
@@ -58,12 +59,20 @@ module ropedyn_auto
     use ropedyn_spectrum, only: spectrum_t, estimate_spectrum, erk_stable_step
     use ropedyn_band_lu, only: factored_dense
     use ropedyn_switch_log, only: switch_log_t, switch_event_t
+    use ropedyn_symplectic, only: symplectic_t, choose_step
+    use ropedyn_split_tables, only: split_table_t
     implicit none
     private
     public :: auto_t
 
-    !> The methods: erk's order-4 pair, the implicit method, Adams, erk's order-5 pair
-    integer, parameter :: EXPLICIT = 1, IMPLICIT = 2, ADAMS = 3, HIGH = 4
+    !> The methods: erk's order-4 pair, the implicit method, Adams, erk's order-5 pair, the
+    !! symplectic method
+    integer, parameter :: EXPLICIT = 1, IMPLICIT = 2, ADAMS = 3, HIGH = 4, SYMPLECTIC = 5
+    !> the symplectic method for lightly damped fast modes (ropedyn_auto_switching's
+    !! header, "Symplectic"): when its step costs at most this many times erk's predicted
+    !! cost per simulated second, on a run at least LONG_RUN long (options%t_end)
+    real(wp), parameter :: LIGHT_COST_LIMIT = 4.0_wp
+    real(wp), parameter :: LONG_RUN = 5.0_wp
     integer, parameter :: ERK_ORDER = 4            !< the explicit pair (RK4, 3rd-order estimate)
     !> the explicit pair for stretches held by accuracy on problems without a mass matrix
     !! (Dormand-Prince 5(4))
@@ -113,6 +122,8 @@ module ropedyn_auto
         type(mebdf_t) :: mebdf
         type(cvode_t) :: bdf
         type(adams_t) :: am
+        type(symplectic_t) :: sym
+        integer :: sym_order = 0           !< the symplectic method's order at its start
         logical :: use_bdf = .false.       !< the implicit method is cvode (else mebdf)
         type(erk_table_t) :: tab
         type(erk_table_t) :: tab_high      !< the order-5 pair's
@@ -177,9 +188,29 @@ module ropedyn_auto
         procedure, private :: implicit_name
         procedure, private :: accurate_name
         procedure, private :: trials_are_cheap
+        procedure, private :: symplectic_fits
     end type auto_t
 
     interface
+        !> The spectrum at the start and the first method (submodule ropedyn_auto_start).
+        module subroutine auto_start(self, start, err)
+            class(auto_t), intent(inout) :: self
+            type(start_t), intent(in) :: start
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine auto_start
+
+        !> Whether the run goes symplectic, and why (submodule ropedyn_auto_start).
+        module function symplectic_fits(self, spec, h_e, t0, why, below) result(fits)
+            class(auto_t), intent(inout) :: self
+            type(spectrum_t), intent(in) :: spec
+            real(wp), intent(in) :: h_e, t0
+            character(len=*), intent(out) :: why
+            !> a cost per simulated second (evaluations of f) the symplectic method must
+            !! stay under (the implicit method's measured cost over GAIN)
+            real(wp), intent(in), optional :: below
+            logical :: fits
+        end function symplectic_fits
+
         !> At the end of a window: measure, compare, switch (submodule ropedyn_auto_switching).
         module subroutine watch(self, err)
             class(auto_t), intent(inout) :: self
@@ -211,138 +242,13 @@ contains
         end select
     end subroutine auto_rhs_changed
 
+    !> auto's switches, then the symplectic method's own choices of its step, when it ran.
     function auto_switch_log(self) result(events)
         class(auto_t), intent(in) :: self
         type(switch_event_t), allocatable :: events(:)
         events = self%log%items()
+        if (self%sym_order > 0) events = [events, self%sym%switch_log()]
     end function auto_switch_log
-
-    subroutine auto_start(self, start, err)
-        class(auto_t), intent(inout) :: self
-        type(start_t), intent(in) :: start
-        type(error_t), allocatable, intent(out) :: err
-        type(spectrum_t) :: spec
-        real(wp) :: h_e, h_a, rate
-        character(len=200) :: text
-        character(len=100) :: slow
-
-        self%user_order = start%max_order
-        self%y = start%y0
-        self%yq = start%yq0
-        self%t = start%t0
-        self%tab = erk_table(ERK_ORDER)
-        self%tab_high = erk_table(HIGH_ORDER)
-        self%done = solver_stats_t()
-        call self%log%clear()
-        self%rate_explicit = -1.0_wp
-        self%rate_implicit = -1.0_wp
-        self%implicit_age = 0
-        self%stale_after = STALE_WINDOWS
-        self%rate_accurate = -1.0_wp
-        self%accurate = merge(ADAMS, HIGH, self%problem%has_mass_matrix())
-        self%trial = .false.
-        self%wait = 0
-        self%backoff = 1
-        self%h_stable = 0.0_wp
-        self%h_stable_high = 0.0_wp
-        self%explicit_age = 0
-        self%radius = 0.0_wp
-
-        call newton_widths(self%problem, self%lambda, self%mebdf_eval_cost)
-        call estimate_spectrum(self%problem, start%t0, start%y0, spec)
-        self%use_bdf = spec%valid .and. spec%fast_damping >= BDF_DAMPING
-        self%mebdf_order = mebdf_order_for(spec%fast_damping)
-        if (self%use_bdf) self%mebdf_order = BDF_ORDER
-        if (self%user_order /= 0) self%mebdf_order = min(self%mebdf_order, self%user_order)
-        h_e = erk_stable_step(self%tab, spec)
-        if (self%accurate == HIGH) self%h_stable_high = erk_stable_step(self%tab_high, spec)
-        self%radius = spec%radius
-        self%h_chunk = h_e
-        if (spec%valid .and. h_e > 0.0_wp) then
-            rate = 1.0_wp/h_e
-            write (text, '(a, es9.2, a, f6.3, a, es9.2, a)') 'spectral radius ', &
-                spec%radius, ' 1/s, fast modes damped >= ', spec%fast_damping, &
-                ', explicit stable step ', h_e, ' s'
-        else
-            rate = 0.0_wp
-            text = 'no spectrum estimate'
-        end if
-        h_a = 0.0_wp
-        if (rate > 0.0_wp .and. rate <= START_RATE) &
-            h_a = accuracy_step(self%problem, start%t0, start%y0, self%options, h_e)
-        if (rate > START_RATE) then
-            call self%start_method(IMPLICIT, trim(text)//': explicit steps too short', err)
-        else if (h_a > START_ACCURACY*h_e) then
-            write (slow, '(a, es9.2, a)') '; a first-order step of ', h_a, &
-                ' s within the tolerance: motion too slow for explicit steps'
-            call self%start_method(IMPLICIT, trim(text)//trim(slow), err)
-        else
-            call self%start_method(EXPLICIT, trim(text), err, h_e)
-        end if
-        if (allocated(err)) return
-        self%initialized = .true.
-    end subroutine auto_start
-
-    !> The width of the implicit methods' Newton matrix (the reduced second-order one when
-    !! the problem has the structure, else the first-order one; dense: all its rows) over
-    !! the RFEM's, at least 1; and the cost of an MEBDF evaluation of f, which for a problem
-    !! with a mass matrix includes M(q) v (see Cost).
-    subroutine newton_widths(problem, lambda, eval_cost)
-        class(problem_t), intent(in) :: problem
-        real(wp), intent(out) :: lambda, eval_cost
-        integer, allocatable :: pos(:), vel(:)
-        integer :: np, kl, ku, width
-        call problem%second_order_layout(pos, vel, kl, ku)
-        np = size(pos)
-        if (np == 0) then
-            np = problem%size()
-            call problem%bandwidths(kl, ku)
-        end if
-        kl = min(max(kl, 0), np - 1)
-        ku = min(max(ku, 0), np - 1)
-        width = kl + ku + 1
-        if (factored_dense(np, kl, ku)) width = np
-        lambda = max(1.0_wp, real(width, wp)/REFERENCE_WIDTH)
-        eval_cost = 1.0_wp
-        if (problem%has_mass_matrix()) eval_cost = 1.0_wp + MASS_COST*real(width, wp)
-    end subroutine newton_widths
-
-    !> A step the implicit method may take at the start, by accuracy alone: sqrt(2 / |y''|)
-    !! in the error weights (|y''| from a difference of f along f over h_probe), the
-    !! step of a first-order method with a local error of one tolerance unit (CVODE's
-    !! first-step estimate). 0 when f fails; huge when y'' is 0.
-    real(wp) function accuracy_step(problem, t, y, options, h_probe) result(h)
-        class(problem_t), intent(inout) :: problem
-        real(wp), intent(in) :: t, y(:), h_probe
-        type(solver_options_t), intent(in) :: options
-        real(wp), allocatable :: w(:), f0(:), f1(:)
-        real(wp) :: d2
-        integer :: status
-        h = 0.0_wp
-        if (h_probe <= 0.0_wp) return
-        w = options%rtol*abs(y) + options%atol
-        if (allocated(options%atol_vector)) w = options%rtol*abs(y) + options%atol_vector
-        allocate (f0(size(y)), f1(size(y)))
-        call problem%rhs(t, y, f0, status)
-        if (status /= STATUS_OK) return
-        call problem%rhs(t + h_probe, y + h_probe*f0, f1, status)
-        if (status /= STATUS_OK) return
-        d2 = sqrt(sum(((f1 - f0)/w)**2)/size(y))/h_probe
-        h = huge(1.0_wp)
-        if (d2 > 0.0_wp) h = sqrt(2.0_wp/d2)
-    end function accuracy_step
-
-    !> MEBDF's maximum order for fast modes damped by `zeta` (clipped at 0).
-    pure integer function mebdf_order_for(zeta) result(order)
-        real(wp), intent(in) :: zeta
-        if (zeta < 0.03_wp) then
-            order = 4
-        else if (zeta < 0.12_wp) then
-            order = 5
-        else
-            order = 6
-        end if
-    end function mebdf_order_for
 
     !> Initialize `which` at the current state (self%t, y, yq); log the switch.
     subroutine start_method(self, which, reason, err, h_first)
@@ -368,6 +274,7 @@ contains
             call self%mebdf%finalize()
             call self%bdf%finalize()
         end if
+        if (self%active == SYMPLECTIC) call self%sym%finalize()
         opts = self%options
         opts%max_steps = max(1_i8, self%options%max_steps - self%done%steps)
         if (which == EXPLICIT) then
@@ -394,6 +301,11 @@ contains
             call self%erk_high%set_stable_step(self%h_stable_high)
             self%explicit_age = 0
             call self%log%add(self%t, 'erk', HIGH_ORDER, reason)
+        else if (which == SYMPLECTIC) then
+            opts%max_order = 4
+            call self%sym%init(self%problem, self%t, self%y, self%yq, opts, err)
+            if (allocated(err)) return
+            call self%log%add(self%t, 'symplectic', self%sym_order, reason)
         else if (which == ADAMS) then
             self%calm_accurate = -1.0_wp
             opts%max_order = ADAMS_ORDER
@@ -446,13 +358,18 @@ contains
             ! a look-ahead below the round-off of t rounds back to t: the method would take
             ! no step (and never reach its own round-off limit): on to tout instead
             if (target <= self%t) target = tout
-            ! the stop time holds for every method it runs
+            ! the stop time holds for every method it runs (the symplectic method's steps
+            ! end on the output time, never beyond it)
             call self%erk%set_stop_time(self%t_stop)
             call self%erk_high%set_stop_time(self%t_stop)
             call self%am%set_stop_time(self%t_stop)
             call self%bdf%set_stop_time(self%t_stop)
             call self%mebdf%set_stop_time(self%t_stop)
-            if (self%active == EXPLICIT) then
+            if (self%active == SYMPLECTIC) then
+                ! kept, to the output time (where its steps fall)
+                target = tout
+                call self%sym%advance_to(tout, self%t, self%y, self%yq, err)
+            else if (self%active == EXPLICIT) then
                 call self%erk%advance_to(target, self%t, self%y, self%yq, err)
             else if (self%active == HIGH) then
                 call self%erk_high%advance_to(target, self%t, self%y, self%yq, err)
@@ -552,6 +469,8 @@ contains
             s = self%erk_high%stats()
         case (ADAMS)
             s = self%am%stats()
+        case (SYMPLECTIC)
+            s = self%sym%stats()
         case (IMPLICIT)
             if (self%use_bdf) then
                 s = self%bdf%stats()
@@ -586,6 +505,7 @@ contains
         call self%mebdf%finalize()
         call self%bdf%finalize()
         call self%am%finalize()
+        call self%sym%finalize()
         self%active = 0
         self%initialized = .false.
         self%problem => null()

@@ -82,6 +82,20 @@
 !!   STALE_WINDOWS windows of the order-5 pair, after which auto measures it again
 !!   (shaken_top: the order-5 pair paid in the first 0.03 s and then ran to the end at
 !!   1.18 times the order-4 pair's evaluations of f).
+!! - **Symplectic** (ropedyn_symplectic; docs/theory/symplectic.md): where the fast modes
+!!   are lightly damped (the mode that limits the symplectic step damped by less than 1 %),
+!!   an adaptive method's energy balance drifts over a long run (the undamped paper rope,
+!!   n = 20, rtol 1e-3: erk and auto lost 0.11 m g L in 30 s, 0.15 in 300 s), biasing the
+!!   energy, dissipation and spectra a long run is for; the symplectic method's stays
+!!   bounded (1e-6 .. 7e-6 m g L). So auto takes it, at the start (before the slow start's
+!!   test) or instead of erk when leaving the implicit method, on a problem that offers
+!!   the force split (the RFEM without ground contact or point masses off centre), a run
+!!   at least LONG_RUN long (options%t_end; not known: long), a step of at most START_RATE
+!!   steps per simulated second (and, leaving the implicit method, a cost below its
+!!   measured one by GAIN), and a cost of at most LIGHT_COST_LIMIT = 4 times erk's
+!!   predicted one (the 4th-order composition at 0.4 of its stable step: 2.9 times on that
+!!   rope). It keeps it unless its step gets too short (START_RATE: then the implicit
+!!   method); its own log of the step joins the switch log.
 submodule (ropedyn_auto) ropedyn_auto_switching
     implicit none
 
@@ -98,8 +112,20 @@ contains
         logical :: early    !< erk's early first window (early_look)
         character(len=240) :: text
         character(len=12) :: age
+        character(len=400) :: why_sym
 
         now = self%current_stats()
+        if (self%active == SYMPLECTIC) then
+            ! kept (the header, Symplectic) unless its steps have become too short
+            if (now%last_step > 0.0_wp) then
+                if (1.0_wp/now%last_step > START_RATE) then
+                    write (text, '(a, es9.2, a)') 'symplectic step ', now%last_step, &
+                        ' s: explicit steps too short'
+                    call self%start_method(IMPLICIT, trim(text), err)
+                end if
+            end if
+            return
+        end if
         early = .false.
         if (now%steps - self%win_steps0 < WINDOW) then
             early = early_look()
@@ -249,7 +275,11 @@ contains
                     ' s: predicted cost ', predicted, ' f per second against ', rate, &
                     ' for '//self%implicit_name()
                 if (self%windows <= 2) call back_off()
-                call self%start_method(EXPLICIT, trim(text), err, h_e)
+                if (self%symplectic_fits(spec, h_e, self%t, why_sym, rate/GAIN)) then
+                    call self%start_method(SYMPLECTIC, trim(text)//'; '//trim(why_sym), err)
+                else
+                    call self%start_method(EXPLICIT, trim(text), err, h_e)
+                end if
             end if
         end if
     contains

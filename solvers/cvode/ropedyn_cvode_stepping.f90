@@ -71,7 +71,7 @@ contains
         do while (self%tn < tout)
             qflag = FCVodeGetNumSteps(self%mem, nsteps)
             if (self%base%steps + int(nsteps(1), i8) >= self%options%max_steps) then
-                cause = 'max_steps exceeded ('//int_text(self%options%max_steps)//' steps)'
+                cause = self%steps_exhausted()
                 exit
             end if
             tret = self%tn

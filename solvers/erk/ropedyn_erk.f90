@@ -413,8 +413,7 @@ contains
         h_wanted = 0.0_wp
         attempts: do
             if (self%counters%steps >= self%options%max_steps) then
-                call self%failure(err, 'max_steps exceeded ('// &
-                                  int_text(self%options%max_steps)//' steps)')
+                call self%failure(err, self%steps_exhausted())
                 return
             end if
             h = self%h

@@ -237,23 +237,33 @@ contains
     end subroutine print_switches
 
     !> 'erk 4 -> erk 5 -> erk 4 (2 switches; ropedyn run -v lists them)': the method and
-    !! order limit in use after each event; of a long chain the first three and the last.
+    !! order limit in use after each event that changed them (an event that keeps both, such
+    !! as the symplectic method's new step, is listed by -v only); of a long chain the
+    !! first three and the last.
     pure function method_chain(events) result(text)
         type(switch_event_t), intent(in) :: events(:)
         character(len=:), allocatable :: text
         integer, parameter :: MOST = 5
+        character(len=40) :: labels(size(events))
         integer :: k, n
-        n = size(events)
-        text = label(events(1))
+        n = 1
+        labels(1) = label(events(1))
+        do k = 2, size(events)
+            if (label(events(k)) == labels(n)) cycle
+            n = n + 1
+            labels(n) = label(events(k))
+        end do
+        text = trim(labels(1))
         do k = 2, n
             if (n > MOST .and. k > 3 .and. k < n) then
                 if (k == 4) text = text//' -> ...'
                 cycle
             end if
-            text = text//' -> '//label(events(k))
+            text = text//' -> '//trim(labels(k))
         end do
         if (n == 2) text = text//' (1 switch; ropedyn run -v lists it)'
         if (n > 2) text = text//' ('//int_text(n - 1)//' switches; ropedyn run -v lists them)'
+        if (n == 1 .and. size(events) > 1) text = text//' (ropedyn run -v lists its events)'
     contains
         pure function label(e) result(t)
             type(switch_event_t), intent(in) :: e

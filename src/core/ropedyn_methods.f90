@@ -16,7 +16,7 @@ module ropedyn_methods
 
     !> One method: its name in `&solver method` and the orders of accuracy it allows.
     type :: method_info_t
-        character(len=8) :: name = ''
+        character(len=10) :: name = ''
         integer :: lowest_order = 1     !< smallest allowed max_order
         integer :: highest_order = 1    !< largest allowed max_order
         !> the max_order used when max_order = 0 (0 for auto: it chooses MEBDF's limit
@@ -33,7 +33,8 @@ module ropedyn_methods
         method_info_t('mebdf', 2, 7, 4, safe_order=4), &
         method_info_t('erk', 3, 5, 4), &
         method_info_t('adams', 1, 12, 12, safe_order=2), &
-        method_info_t('auto', 2, 7, 0)]
+        method_info_t('auto', 2, 7, 0), &
+        method_info_t('symplectic', 2, 4, 4)]
 
 contains
 

@@ -21,6 +21,14 @@
 !!   r_v the residual of the rate rows, M dv - ...). `second_order_blocks` gives K, C, M in
 !!   band storage (default: taken from the first-order Jacobian, so every problem with a
 !!   Jacobian can use the reduced path; models override it with a direct assembly).
+!! - a force split (`force_split_refusal` empty) for splitting methods (solvers/symplectic):
+!!   a second-order problem whose mass matrix of the coordinates is constant and diagonal,
+!!   M = diag(m), and whose rate equations are m v' = F_c(t, q) + F_r(t, q, v), F_c =
+!!   -dV/dq the forces of a potential V(t, q) and F_r the rest (damping, drag, friction,
+!!   loads). `split_rhs` gives the accelerations F_c/m and F_r/m and the quadratures'
+!!   rates split the same way; `split_layout` gives m and which quadratures are energy
+!!   taken out (dissipated) or put in (external work), so that T + V - sum s_k yq_k is
+!!   constant (T = sum m v^2/2). Default: refused (no split).
 module ropedyn_problem
     use ropedyn_kinds, only: wp
     implicit none
@@ -51,6 +59,8 @@ module ropedyn_problem
         procedure :: has_second_order => problem_has_second_order, &
                      second_order_layout => problem_second_order_layout, &
                      second_order_blocks => problem_second_order_blocks
+        procedure :: force_split_refusal => problem_force_split_refusal, &
+                     split_layout => problem_split_layout, split_rhs => problem_split_rhs
     end type problem_t
 
     abstract interface
@@ -259,4 +269,45 @@ contains
             if (i - j <= ml .and. j - i <= mu) x = band(joff + i - j, j)
         end function entry
     end subroutine problem_second_order_blocks
+
+    !> Why the problem offers no force split ('' when it does; see the module header). The
+    !! default: none.
+    pure function problem_force_split_refusal(self) result(why)
+        class(problem_t), intent(in) :: self
+        character(len=:), allocatable :: why
+        why = 'the problem does not split its forces into those of a potential and the rest'
+    end function problem_force_split_refusal
+
+    !> The split's constants: the diagonal of the constant mass matrix of the coordinates
+    !! (size(pos), in the order of `second_order_layout`'s pos) and, for each quadrature,
+    !! its sign in the energy balance: -1 energy taken out (dissipated), +1 put in (external
+    !! work), 0 not energy. Only called when the split is offered (the default: m = 1, 0).
+    pure subroutine problem_split_layout(self, mass, signs)
+        class(problem_t), intent(in) :: self
+        real(wp), intent(out) :: mass(:)
+        integer, intent(out) :: signs(:)
+        mass = 1.0_wp
+        signs = 0
+    end subroutine problem_split_layout
+
+    !> The split at (t, y): ac = F_c(t, q)/m, the accelerations of the potential's forces
+    !! (size(pos), in the order of pos), and gc the quadratures' rates that depend on (t, q)
+    !! alone (the work of a potential that depends on time: dV/dt at fixed q, e.g. a spring
+    !! to a moving anchor); with `ar` present also ar = F_r(t, q, v)/m and gr, the rates of
+    !! the rest (dissipation and work of the other forces), so that gc + gr is the whole of
+    !! quad_rhs. Without `ar` only the potential's part is evaluated (the cheaper call).
+    !! Only called when the split is offered (the default reports STATUS_FATAL).
+    subroutine problem_split_rhs(self, t, y, ac, gc, status, ar, gr)
+        class(problem_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: ac(:), gc(:)
+        integer, intent(out) :: status
+        real(wp), intent(out), optional :: ar(:), gr(:)
+        ac = 0.0_wp
+        gc = 0.0_wp
+        if (present(ar)) ar = 0.0_wp
+        if (present(gr)) gr = 0.0_wp
+        status = STATUS_FATAL
+    end subroutine problem_split_rhs
 end module ropedyn_problem

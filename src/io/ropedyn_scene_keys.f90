@@ -142,6 +142,8 @@ contains
                 'the point masses of &attachments')
             call add_logical(G_EFFECTS, 'point_loads', e%point_loads, &
                 'the point loads of &attachments')
+            call add_logical(G_EFFECTS, 'water', e%water, &
+                'water below &fluid surface: buoyancy, added mass, drag of the wetted part')
             call add_real(G_EFFECTS, 'fault_nan_after', e%fault_nan_after, R_FINITE, 's', &
                 'testing aid: NaN forces after this time; < 0: off')
 
@@ -185,6 +187,13 @@ contains
                 R_NONNEGATIVE, NSM2, 'linear tangential drag per metre')
             call add_pair(G_FLUID, 'current', f%current, R_FINITE, 'm/s', &
                 'velocity (x, y) of the fluid')
+            call add_real(G_FLUID, 'surface', f%surface, R_FINITE, 'm', &
+                'water: x of the free surface (water where x > surface; x down)')
+            call add_real(G_FLUID, 'added_mass_coefficient', f%added_mass_coefficient, &
+                R_NONNEGATIVE, '-', 'water: normal added mass C_a on the displaced volume')
+            call add_real(G_FLUID, 'tangential_added_mass_coefficient', &
+                f%tangential_added_mass_coefficient, R_NONNEGATIVE, '-', &
+                'water: tangential added mass on the displaced volume')
 
             call add_pair(G_GROUND, 'point', g%point, R_FINITE, 'm', 'a point of the plane')
             call add_pair(G_GROUND, 'normal', g%normal, R_NONE, '-', &

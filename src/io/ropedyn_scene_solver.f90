@@ -31,5 +31,6 @@ contains
         options%stab_lim_det = scene%solver%stability_limit_detection
         options%first_order_newton = scene%solver%first_order_newton
         options%profile = scene%solver%profile
+        options%t_end = scene%solver%t_end
     end function solver_options_of
 end module ropedyn_scene_solver

@@ -16,9 +16,10 @@ module ropedyn_scene_warnings
     !> The bounds of the checks.
     real(wp), parameter :: MAX_DIAMETER_SHARE = 0.1_wp   !< of the length
     real(wp), parameter :: MAX_SELF_STRAIN = 0.1_wp      !< under the rope's own weight
-    !> an element's axial damping ratio: the paper's rope, heavily damped by design, has 13 at
-    !! n = 30 and 31 at n = 70; a coefficient in N s/m^2 given as N s, or the reverse, is off
-    !! by the area, 1e4 .. 1e8 for ropes
+    !> an element's axial damping ratio (as computed below) grows with n: the paper's rope
+    !! with its heavy damping reading has 0.032 at n = 30 and 10.9 at n = 10,000 (10, the
+    !! issue's example, warned there); a coefficient in N s/m^2 given as N s, or the
+    !! reverse, is off by the section area, 1e4 .. 1e8 for ropes
     real(wp), parameter :: MIN_DAMPING_RATIO = 1.0e-6_wp, MAX_DAMPING_RATIO = 1.0e3_wp
     real(wp), parameter :: MIN_WATER_DENSITY = 100.0_wp  !< kg/m^3
 
@@ -73,6 +74,10 @@ contains
                 ' .. '//real_text(MAX_DAMPING_RATIO)//'): a coefficient in the wrong unit? '// &
                 '(the unit is '//trim(merge('N s    ', 'N s/m^2', section))//')')
         end if
+        if (scene%effects%water .and. scene%fluid%density < MIN_WATER_DENSITY) &
+            call append_text(list, scene%path//': &fluid: density = '// &
+                real_text(scene%fluid%density)//': water = .true. in a fluid this light '// &
+                '(air is 1.225 kg/m^3): water is about 1000 (fresh) or 1025 (sea)')
     contains
         function stiffness_text() result(text)
             character(len=:), allocatable :: text

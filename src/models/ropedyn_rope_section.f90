@@ -2,7 +2,7 @@
 !! and EI and the damping coefficients of the three strains, per unit length of rope (a
 !! spring-damper over a length l takes each divided by l). The one place where the values
 !! of `&rope`, of either set, become these numbers, and where the defaults derived from
-!! other values are resolved (the theory page of the RFEM, "Springs and dampers").
+!! other values are resolved (docs/guide/scenes.md, "The rope (`&rope`)").
 !!
 !! The solid-rod set (the paper's rope): a round rod of diameter d, density rho, moduli E
 !! and G, shear shape factor chi and damping eta (axial, bending) and eta_bar (shear; not

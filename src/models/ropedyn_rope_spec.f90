@@ -131,12 +131,15 @@ module ropedyn_rope_spec
         logical :: support_motion = .true.  !< the motions and releases given in &supports
         logical :: point_masses = .true.    !< the point masses given in &attachments
         logical :: point_loads = .true.     !< the point loads given in &attachments
+        !> water below a free surface (&fluid surface): buoyancy, added mass, drag of the
+        !! wetted part
+        logical :: water = .false.
         !> testing aid: NaN forces on every body for t > this time, s; < 0: off
         !! (ropedyn_effect_fault)
         real(wp) :: fault_nan_after = -1.0_wp
     end type effects_params_t
 
-    !> `&fluid`: the surrounding fluid (used with `&effects drag = .true.`).
+    !> `&fluid`: the surrounding fluid (used with `&effects drag = .true.` and `water`).
     type :: fluid_params_t
         real(wp) :: density = 1.225_wp                     !< rho_f [kg/m^3] (air)
         real(wp) :: normal_drag_coefficient = 1.2_wp       !< C_n on d l [-]
@@ -144,6 +147,12 @@ module ropedyn_rope_spec
         real(wp) :: linear_normal_drag = 0.0_wp            !< [N s/m^2]
         real(wp) :: linear_tangential_drag = 0.0_wp        !< [N s/m^2]
         real(wp) :: current(2) = 0.0_wp                    !< fluid velocity (x, y) [m/s]
+        !> with water: x of the free surface (the water where x > surface; x points down) [m]
+        real(wp) :: surface = 0.0_wp
+        !> with water: normal added mass C_a, on the displaced volume pi d^2/4 per metre [-]
+        real(wp) :: added_mass_coefficient = 1.0_wp
+        !> with water: tangential added mass, on the displaced volume [-]
+        real(wp) :: tangential_added_mass_coefficient = 0.0_wp
     end type fluid_params_t
 
     !> `&ground`: a ground plane (used with `&effects ground = .true.`).

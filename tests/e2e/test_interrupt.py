@@ -1,7 +1,8 @@
-"""Interrupts and resume (docs/guide/output.md, "Interrupts" and "Resume"): SIGTERM/SIGINT end a
-run at the next step boundary with its last record, counters and status `interrupted`
-(exit 130); a second signal ends it at once; `ropedyn run --resume FILE` continues it and
-ends with the records of the uninterrupted run; a sweep continues its interrupted cases."""
+"""Interrupts and resume (docs/development/internals.md, "Interrupts"; docs/guide/output.md,
+"Resume"): SIGTERM/SIGINT end a run at the next step boundary with its last record, counters
+and status `interrupted` (exit 130); a second signal ends it at once; `ropedyn run --resume
+FILE` continues it and ends with the records of the uninterrupted run; a sweep continues its
+interrupted cases."""
 import random
 import signal
 import subprocess

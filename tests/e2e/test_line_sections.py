@@ -122,6 +122,7 @@ def test_a_chain_without_bending_stiffness_hangs(run, tmp_path, kind):
     (["rope.young_modulus=200"], "&rope: young_modulus = 200.0: the rope stretches by"),
     (["rope.normal_damping=1e9"], "&rope: normal_damping = 1.0e9: an element's axial damping"),
     (["rope.normal_damping=1e-9"], "&rope: normal_damping = 1.0e-9: an element's axial damping"),
+    (["effects.water=.true."], "&fluid: density = 1.225: water = .true. in a fluid this light"),
 ])
 def test_a_probable_unit_slip_gets_one_warning(run, tmp_path, sets, fragment):
     args = ["run", PAPER, "--set", "solver.t_end=1e-4", "--set", "solver.output_interval=1e-4",

@@ -31,6 +31,7 @@ COMMANDS = {
     "bench_sweep": "ropedyn_tools.studies.bench_sweep",
     "bench_peers": "ropedyn_tools.studies.bench_peers",
     "bench_library": "ropedyn_tools.studies.bench_library",
+    "bench_symplectic": "ropedyn_tools.studies.bench_symplectic",
     "auto_table": "ropedyn_tools.studies.auto_table",
     "auto_accuracy": "ropedyn_tools.studies.auto_accuracy",
     "cost_model": "ropedyn_tools.studies.cost_model",

@@ -33,6 +33,12 @@ def runs(run_many, tmp_path_factory):
     for method in ("cvode", "mebdf"):
         jobs[f"budget_{method}"] = (STEEL, [f"solver.method={method}", "solver.t_end=0.05",
                                             "solver.max_steps=300"])
+    # the budget spent after cvode's own log diagnosed lightly damped stiff modes
+    jobs["budget_diagnosed_cvode"] = (STEEL, ["solver.method=cvode", "solver.rtol=1e-7",
+                                              "solver.atol=1e-9", "solver.max_steps=150000"])
+    for method in ("erk", "symplectic"):
+        jobs[f"budget_{method}"] = (PAPER, [f"solver.method={method}", "model.elements=10",
+                                            "solver.t_end=0.05", "solver.max_steps=30"])
     jobs["stald_mebdf"] = (PAPER, ["solver.method=mebdf",
                                    "solver.stability_limit_detection=.true."])
     jobs["stald_cvode"] = (PAPER, ["solver.method=cvode", "model.elements=10",
@@ -86,6 +92,28 @@ def test_step_budget_exhausted(runs, method):
     proc, path = runs[f"budget_{method}"]
     check_diagnosis(proc, path, "max_steps")
     assert stability_metrics.analyse(path)["steps"] <= 300
+
+
+@pytest.mark.parametrize("method", ["erk", "symplectic"])
+def test_step_budget_exhausted_explicit(runs, method):
+    proc, path = runs[f"budget_{method}"]
+    check_diagnosis(proc, path, "max_steps exceeded (30 steps)")
+
+
+def test_step_budget_exhausted_names_the_diagnosed_cause(runs):
+    """The steel wire with cvode at rtol 1e-7: cvode's crawl watch diagnoses lightly
+    damped stiff modes at 0.12 s (and lowers its order); when the budget runs out later, the
+    message names that cause, when it was found, and the methods that avoid it."""
+    proc, path = runs["budget_diagnosed_cvode"]
+    assert proc.returncode == 3, proc.stderr
+    # (the warning of the diagnosis was printed while the run went on)
+    message = proc.stderr.strip().splitlines()[-1]
+    for fragment in ("ropedyn: error: ", "max_steps exceeded (150000 steps)",
+                     "the run had diagnosed at t = ", "lightly damped stiff modes",
+                     "method = 'mebdf' or 'auto' avoids it"):
+        assert fragment in message, (fragment, message)
+    with h5py.File(path, "r") as f:
+        assert f.attrs["reason"].decode() == message[len("ropedyn: error: "):]
 
 
 def test_stability_limit_detection_only_for_cvode(runs):

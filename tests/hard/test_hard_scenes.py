@@ -12,9 +12,9 @@ keeps the guarantees of docs/validation/hard-scenes.md:
 S is the energy scale of the run (ropedyn_tools.studies.stability_metrics: max T + max elastic +
 gravity range + dissipated) and L the rope length. B_E (per scene and solver) and B_X (per
 scene) are three times the larger of the values measured with the Debug and the Release
-build, rounded up to one digit (docs/validation/hard-scenes.md, "The guarantees"; measured values in the
-comments of ENERGY_BOUND and TIP_BOUND, regenerate them with the measurement described
-there). Forces that are not the gradient of their energy make errors of order S (1e6 rtol S),
+build, rounded up to one digit (docs/validation/hard-scenes.md, its table of guarantees;
+measured values in the comments of ENERGY_BOUND and TIP_BOUND, regenerate them with the
+measurement described there). Forces that are not the gradient of their energy make errors of order S (1e6 rtol S),
 far beyond every bound; a solver whose error control loosens shows in the bounds too. The
 whip is also run at rtol 1e-8, so that the energy bound is seen to follow the tolerance.
 

@@ -28,10 +28,14 @@ program test_newton_paths
         'model.elements = 10', 'supports.top = "clamped"', 'supports.top_motion = "harmonic"', &
         'supports.top_amplitude = 0.02, 0.05', 'supports.top_frequency = 3.0', &
         'initial.angle_deg = 20']
+    !> the shaken rope half in water (buoyancy, added mass, the wetted part's drag)
+    character(len=64), parameter :: WET(11) = [character(len=64) :: SHAKEN, &
+        'effects.water = .true.', 'fluid.density = 1000', 'fluid.surface = 0.5', &
+        'fluid.added_mass_coefficient = 1.0', 'fluid.tangential_added_mass_coefficient = 0.3']
     character(len=8), parameter :: MODELS(2) = [character(len=8) :: 'rfem', 'mpp']
     character(len=8), parameter :: SOLVERS(2) = [character(len=8) :: 'cvode', 'mebdf']
     integer :: im, is
-    real(wp), allocatable :: ref_paper(:, :), ref_shaken(:, :)
+    real(wp), allocatable :: ref_paper(:, :), ref_shaken(:, :), ref_wet(:, :)
 
     suite%name = 'newton_paths'
     call get_command_argument(1, source_dir)
@@ -39,10 +43,13 @@ program test_newton_paths
     do im = 1, size(MODELS)
         call reference(PAPER, trim(MODELS(im)), ref_paper)
         call reference(SHAKEN, trim(MODELS(im)), ref_shaken)
+        call reference(WET, trim(MODELS(im)), ref_wet)
         do is = 1, size(SOLVERS)
             call compare('paper', PAPER, trim(MODELS(im)), trim(SOLVERS(is)), ref_paper)
             call compare('shaken clamped top', SHAKEN, trim(MODELS(im)), trim(SOLVERS(is)), &
                          ref_shaken)
+            call compare('shaken, half in water', WET, trim(MODELS(im)), trim(SOLVERS(is)), &
+                         ref_wet)
         end do
     end do
     call suite%finish()

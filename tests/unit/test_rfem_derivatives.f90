@@ -1,6 +1,10 @@
 !> RFEM model derivatives: the analytic band Jacobian against central differences of
 !! the right-hand side, conservative forces against minus the gradient of the potential
-!! energy, and the damping forces against the dissipation power.
+!! energy, and the damping forces against the dissipation power. Configurations 4 and 5
+!! are in water crossing its surface (buoyancy, added mass, the drag of the wetted part;
+!! 5 with a current and a point mass): their Jacobian rows go through each element's mass
+!! block. (Their velocity-dependent forces include the added mass's, which do no work on
+!! balance but are not dissipation: the damping check is for configurations 1 to 3.)
 program test_rfem_derivatives
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t
@@ -13,7 +17,7 @@ program test_rfem_derivatives
 
     suite%name = 'rfem_derivatives'
     call random_seed_fixed()
-    do config = 1, 3
+    do config = 1, 5
         call check_config(config)
     end do
     call check_effects_off()
@@ -54,19 +58,35 @@ contains
             scene%supports%top = 'free'
             scene%supports%bottom = 'clamped'
             scene%effects%gravity = .false.
+        case (4, 5)
+            ! the rope's middle at the surface; a thick rope: the smoothed surface 1 cm wide
+            scene%rope%diameter = 0.02_wp
+            scene%effects%water = .true.
+            scene%fluid%density = 1000.0_wp
+            scene%fluid%surface = 0.13_wp
+            scene%fluid%added_mass_coefficient = 1.0_wp
+            scene%fluid%tangential_added_mass_coefficient = 0.3_wp
+            scene%effects%drag = config == 4
+            if (config == 5) then
+                scene%fluid%current = [0.3_wp, -0.2_wp]
+                scene%attachments%mass_positions(1) = 0.4_wp
+                scene%attachments%masses(1) = 0.05_wp
+            end if
         end select
         call rfem_create(model, scene%rope_spec_t, err)
         call suite%check_true(.not. allocated(err), 'create model')
         if (allocated(err)) return
         do trial = 1, 3
             write (tag, '(a, i0, a, i0)') ' config ', config, ' trial ', trial
-            call check_state(model, trim(tag))
+            call check_state(model, trim(tag), config <= 3)
         end do
     end subroutine check_config
 
-    subroutine check_state(model, tag)
+    subroutine check_state(model, tag, dissipative_only)
         type(rfem_t), intent(inout) :: model
         character(len=*), intent(in) :: tag
+        !> the velocity-dependent forces are the dampers' alone (no added mass)
+        logical, intent(in) :: dissipative_only
         real(wp), allocatable :: y(:), yp(:), ym(:), fp(:), fm(:), f0(:), jb(:, :), jfd(:, :)
         real(wp), allocatable :: jan(:, :), gen(:, :), gen0(:, :), y0v(:)
         real(wp) :: h, worst, col_scale, vp, vm, grad_err, grad_scale, power, power_check
@@ -146,6 +166,7 @@ contains
         end do
         call suite%check_le(grad_err/grad_scale, 1.0e-6_wp, 'forces = -grad V'//tag)
 
+        if (.not. dissipative_only) return
         ! damping forces F_d = F(q, q') - F(q, 0) satisfy -F_d . q' = 2D, the dissipation
         ! power that quad_rhs integrates
         call model%generalized_forces(y, gen)

@@ -296,6 +296,26 @@ contains
             call mass_solve_check(model, 0.29_wp*trial, y, trim(tag))
             call implicit_identity(model, 0.29_wp*trial, y, trim(tag))
         end do
+        ! the same in water through the rope's middle: the rods' added mass in M(q), in the
+        ! O(n) solve and in K (the derivative of M(q) a)
+        block
+            character(len=64) :: wet(size(sets) + 5)
+            wet(1:size(sets)) = sets
+            wet(size(sets) + 1:) = [character(len=64) :: 'effects.water = .true.', &
+                'fluid.surface = 0.13', 'fluid.added_mass_coefficient = 1.0', &
+                'fluid.tangential_added_mass_coefficient = 0.3', 'rope.diameter = 0.02']
+            call make_scene(wet, scene)
+            call mpp_create(model, scene%rope_spec_t, err)
+            call suite%check_true(.not. allocated(err), 'mpp: create in water')
+            if (allocated(err)) return
+            do trial = 1, 2
+                write (tag, '(a, i0)') 'mpp in water, trial ', trial
+                call some_state(model, trial, y)
+                call against_default(model, 0.29_wp*trial, y, trim(tag))
+                call mass_solve_check(model, 0.29_wp*trial, y, trim(tag))
+                call implicit_identity(model, 0.29_wp*trial, y, trim(tag))
+            end do
+        end block
         ! inextensible members, pinned top: the angle rows alone
         call make_scene([character(len=64) :: 'model.kind = "mpp"', 'model.elements = 6', &
                          'effects.tension = .false.', 'supports.bottom = "pinned"', &
@@ -305,6 +325,18 @@ contains
         call against_default(model, 0.0_wp, y, 'mpp, inextensible')
         call mass_solve_check(model, 0.0_wp, y, 'mpp, inextensible')
         call implicit_identity(model, 0.0_wp, y, 'mpp, inextensible')
+        ! inextensible in water (the angle rows of the O(n) solve with the added mass)
+        call make_scene([character(len=64) :: 'model.kind = "mpp"', 'model.elements = 6', &
+                         'effects.tension = .false.', 'supports.bottom = "pinned"', &
+                         'supports.bottom_anchor = 0.5, 0.6', 'effects.water = .true.', &
+                         'fluid.surface = 0.3', 'fluid.added_mass_coefficient = 1.0', &
+                         'fluid.tangential_added_mass_coefficient = 0.3', &
+                         'fluid.current = 0.2, -0.4', 'rope.diameter = 0.02'], scene)
+        call mpp_create(model, scene%rope_spec_t, err)
+        call some_state(model, 3, y)
+        call against_default(model, 0.0_wp, y, 'mpp, inextensible, in water')
+        call mass_solve_check(model, 0.0_wp, y, 'mpp, inextensible, in water')
+        call implicit_identity(model, 0.0_wp, y, 'mpp, inextensible, in water')
     end subroutine mpp_cases
 
     !> M(q) a = f for the accelerations a of `rhs` (the O(n) solve) and f = r(q, q', 0).
@@ -318,7 +350,7 @@ contains
         zero = 0.0_wp
         call model%rhs(t, y, ydot, status)
         call model%residual(y, zero, f, t)
-        call model%mass_dense(y, mm)
+        call model%mass_dense(y, mm, t)
         call suite%check_le(maxval(abs(matmul(mm, ydot(nd + 1:)) - f))/maxval(abs(f)), &
                             1.0e-12_wp, label//': M(q) (rhs accelerations) = f (O(n) solve)')
     end subroutine mass_solve_check
@@ -340,7 +372,7 @@ contains
         call suite%check_true(status == STATUS_OK, label//': implicit blocks assembled')
         ! accelerations a = M^{-1} f, densely
         allocate (acc(nd), f(nd), a(nd, nd), ipiv(2*nd), rp(nd), rm(nd), yp(size(y)))
-        call model%mass_dense(y, a)
+        call model%mass_dense(y, a, t)
         call suite%check_le(maxval(abs(m - a)), 0.0_wp, label//': implicit mass block = M(q)')
         acc = 0.0_wp
         call model%residual(y, acc, f, t)
@@ -364,7 +396,7 @@ contains
         end do
         ! dense first-order solve of (blockdiag(I, M) - g J) x = r
         allocate (big(2*nd, 2*nd), x(2*nd, 1), rhs(2*nd))
-        call model%mass_dense(y, a)
+        call model%mass_dense(y, a, t)
         big = -g*jf
         do j = 1, nd
             big(j, j) = big(j, j) + 1.0_wp

@@ -4,10 +4,12 @@
 !! - the order the module header fixes: components i = 8 m + j in partial sum j, the eight
 !!   added pairwise; written out here for a vector where another order rounds differently
 !!   (squares 1 and nine times 2^-54: a plain sum gives 1, the module's order 1 + 2^-52);
-!! - against the plain sum on 600 random values (within rounding).
+!! - against the plain sum on 600 random values (within rounding);
+!! - the sums of products (sum_products) the same way: exact on integers for every length
+!!   0 .. 40, equal to sum_squares(x) for y = x.
 program test_sums
     use ropedyn_kinds, only: wp
-    use ropedyn_sums, only: sum_squares
+    use ropedyn_sums, only: sum_squares, sum_products
     use ropedyn_assert, only: test_suite_t
     implicit none
 
@@ -41,5 +43,13 @@ program test_sums
     x = 2.0_wp*x - 1.0_wp
     call suite%check_close(sum_squares(x), sum(x**2), 1.0e-13_wp, 0.0_wp, &
                            '600 random values against the plain sum')
+    call suite%check_true(sum_products(x, x) == sum_squares(x), &
+                          'sum_products(x, x) is sum_squares(x), bit for bit')
+    do n = 0, 40
+        x = [(real(mod(7*i, 11) - 5, wp), i = 1, n)]
+        write (label, '(i0)') n
+        call suite%check_true(sum_products(x, x + 1.0_wp) == sum(x*(x + 1.0_wp)), &
+                              'products of integers, length '//trim(label))
+    end do
     call suite%finish()
 end program test_sums

@@ -37,6 +37,8 @@ module ropedyn_effect
         procedure(add_jacobian_i), deferred :: add_jacobian
         ! its part of the energy balance (the defaults: none)
         procedure :: does_work => effect_does_work, energy => effect_energy, power => effect_power
+        ! why a splitting method cannot take its forces as the rest (default: it can)
+        procedure :: split_refusal => effect_split_refusal
     end type body_effect_t
 
     !> A container, so that a model can hold an array of different effects.
@@ -88,6 +90,16 @@ contains
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: dissipation, work
     end subroutine effect_power
+
+    !> Why a model cannot offer a force split with this effect on ('' when it can). A
+    !! splitting method (problem_t's force split) takes every effect's forces as forces
+    !! other than the potential's; an effect with potential energy must say why that does
+    !! not hold for it (default: '', the effect has none).
+    pure function effect_split_refusal(self) result(why)
+        class(body_effect_t), intent(in) :: self
+        character(len=:), allocatable :: why
+        why = ''
+    end function effect_split_refusal
 
     !> True when the effect can do external work (then the model integrates it).
     pure logical function effect_does_work(self) result(does)

@@ -8,10 +8,13 @@
 !! and, for its rotation (the normal velocity xi w along the body integrated over
 !! xi in [-l/2, l/2]), the moment M = -q_n l^4/32 |w| w - c_n l^3/12 w.
 !! The dissipation rate is -(F . v_r + M w) >= 0; the current does the work F . u.
+!! In water with a free surface (`&effects water`) a body feels the drag of its wetted
+!! fraction f (ropedyn_wetting): F and M times f, and the derivatives of f in the Jacobian.
 module ropedyn_effect_drag
     use ropedyn_kinds, only: wp
     use ropedyn_effect, only: body_effect_t, bodies_t
     use ropedyn_trig, only: cos_sin
+    use ropedyn_wetting, only: wetting_t, wet_t
     implicit none
     private
     public :: drag_effect_t, drag_effect
@@ -24,6 +27,8 @@ module ropedyn_effect_drag
         real(wp) :: cn = 0.0_wp, ct = 0.0_wp   !< linear coefficients per length, N s/m^2
         real(wp) :: u(2) = 0.0_wp              !< current, m/s
         logical :: quadratic = .false., linear = .false., current = .false.
+        logical :: wet = .false.               !< only the wetted fraction feels the drag
+        type(wetting_t) :: wetting
     contains
         procedure :: name => drag_name
         procedure :: add_forces => drag_add_forces
@@ -37,8 +42,10 @@ contains
     !> Drag of a fluid of density rho (kg/m^3) with normal and tangential drag coefficients
     !! cd_n, cd_t (-), linear drag lin_n, lin_t (N s/m^2) and current u (m/s) on bodies of
     !! diameter d (m).
-    pure function drag_effect(rho, cd_n, cd_t, lin_n, lin_t, u, d) result(eff)
+    !! With `wetting`, only the wetted fraction of each body feels it.
+    pure function drag_effect(rho, cd_n, cd_t, lin_n, lin_t, u, d, wetting) result(eff)
         real(wp), intent(in) :: rho, cd_n, cd_t, lin_n, lin_t, u(2), d
+        type(wetting_t), intent(in), optional :: wetting
         type(drag_effect_t) :: eff
         eff%qn = 0.5_wp*rho*cd_n*d
         eff%qt = 0.5_wp*rho*cd_t*pi*d
@@ -48,6 +55,8 @@ contains
         eff%quadratic = eff%qn > 0.0_wp .or. eff%qt > 0.0_wp
         eff%linear = eff%cn > 0.0_wp .or. eff%ct > 0.0_wp
         eff%current = any(abs(u) > 0.0_wp)
+        eff%wet = present(wetting)
+        if (eff%wet) eff%wetting = wetting
     end function drag_effect
 
     pure function drag_name(self) result(name)
@@ -78,14 +87,16 @@ contains
         bb = dot_product(nv, vr)
     end subroutine relative_motion
 
-    !> Force and moment of body i with axis e.
-    pure subroutine body_drag(self, b, i, e, f, m)
+    !> Force and moment of body i with axis e (of its wetted fraction, unless `whole`).
+    pure subroutine body_drag(self, b, i, e, f, m, whole)
         class(drag_effect_t), intent(in) :: self
         type(bodies_t), intent(in) :: b
         integer, intent(in) :: i
         real(wp), intent(in) :: e(2)
         real(wp), intent(out) :: f(2), m
+        logical, intent(in), optional :: whole
         real(wp) :: nv(2), a, bb, l
+        type(wet_t) :: wt
         call relative_motion(self, b, i, e, l, nv, a, bb)
         f = 0.0_wp
         m = 0.0_wp
@@ -97,6 +108,13 @@ contains
             f = f - self%cn*l*bb*nv - self%ct*l*a*e
             m = m - self%cn*l**3/12.0_wp*b%w(i)
         end if
+        if (.not. self%wet) return
+        if (present(whole)) then
+            if (whole) return
+        end if
+        wt = self%wetting%of(b%c(1, i), e(1), 0.5_wp*l)
+        f = wt%f*f
+        m = wt%f*m
     end subroutine body_drag
 
     pure subroutine drag_add_forces(self, t, b, f, m)
@@ -120,6 +138,8 @@ contains
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: jac(:, :, :)
         real(wp) :: e(2), nv(2), a, bb, l, kn, kt, dfdv(2, 2), dfdphi(2), dmdw, cs(2, b%n)
+        real(wp) :: f0(2), m0, scale
+        type(wet_t) :: wt
         integer :: i, p
         call cos_sin(b%phi, cs)
         do i = 1, b%n
@@ -145,11 +165,23 @@ contains
                 dfdphi = dfdphi + (self%cn - self%ct)*l*(a*nv + bb*e)
                 dmdw = dmdw - self%cn*l**3/12.0_wp
             end if
-            jac(1:2, 3, i) = jac(1:2, 3, i) + dfdphi
-            jac(1:2, 4:5, i) = jac(1:2, 4:5, i) + dfdv
-            jac(3, 6, i) = jac(3, 6, i) + dmdw
+            scale = 1.0_wp
+            if (self%wet) then
+                ! d(f F)/dz = f dF/dz + F df/dz, f depending on x and phi
+                wt = self%wetting%of(b%c(1, i), e(1), 0.5_wp*l)
+                scale = wt%f
+                call body_drag(self, b, i, e, f0, m0, whole=.true.)
+                jac(1:2, 1, i) = jac(1:2, 1, i) + f0*wt%f_d
+                jac(3, 1, i) = jac(3, 1, i) + m0*wt%f_d
+                jac(1:2, 3, i) = jac(1:2, 3, i) - f0*wt%f_c*e(2)
+                jac(3, 3, i) = jac(3, 3, i) - m0*wt%f_c*e(2)
+            end if
+            jac(1:2, 3, i) = jac(1:2, 3, i) + scale*dfdphi
+            jac(1:2, 4:5, i) = jac(1:2, 4:5, i) + scale*dfdv
+            jac(3, 6, i) = jac(3, 6, i) + scale*dmdw
         end do
     end subroutine drag_add_jacobian
+
 
     pure subroutine drag_power(self, t, b, dissipation, work)
         class(drag_effect_t), intent(in) :: self

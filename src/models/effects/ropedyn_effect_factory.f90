@@ -10,9 +10,12 @@ module ropedyn_effect_factory
     use ropedyn_effect_ground, only: ground_effect
     use ropedyn_effect_loads, only: loads_effect_t, point_load_t
     use ropedyn_effect_fault, only: fault_effect_t
+    use ropedyn_effect_buoyancy, only: buoyancy_effect
+    use ropedyn_wetting, only: wetting_t
+    use ropedyn_added_mass, only: added_mass_t
     implicit none
     private
-    public :: build_body_effects, locate_on_bodies, attached_masses
+    public :: build_body_effects, locate_on_bodies, attached_masses, water_of, water_added_mass
 
     real(wp), parameter :: pi = acos(-1.0_wp)
 
@@ -54,17 +57,29 @@ contains
         if (spec%effects%point_loads) &
             with_loads = any(.not. ieee_is_nan(spec%attachments%load_positions))
         n_eff = count([spec%effects%drag, spec%effects%ground, with_loads, &
-                       spec%effects%fault_nan_after >= 0.0_wp])
+                       spec%effects%fault_nan_after >= 0.0_wp, buoyant(spec)])
         allocate (effects(n_eff))
         k = 0
         if (spec%effects%drag) then
             k = k + 1
             associate (f => spec%fluid)
-                allocate (effects(k)%e, source=drag_effect(f%density, &
-                    f%normal_drag_coefficient, f%tangential_drag_coefficient, &
-                    f%linear_normal_drag, f%linear_tangential_drag, f%current, &
-                    spec%rope%diameter))
+                if (spec%effects%water) then
+                    allocate (effects(k)%e, source=drag_effect(f%density, &
+                        f%normal_drag_coefficient, f%tangential_drag_coefficient, &
+                        f%linear_normal_drag, f%linear_tangential_drag, f%current, &
+                        spec%rope%diameter, water_of(spec)))
+                else
+                    allocate (effects(k)%e, source=drag_effect(f%density, &
+                        f%normal_drag_coefficient, f%tangential_drag_coefficient, &
+                        f%linear_normal_drag, f%linear_tangential_drag, f%current, &
+                        spec%rope%diameter))
+                end if
             end associate
+        end if
+        if (buoyant(spec)) then
+            k = k + 1
+            allocate (effects(k)%e, source=buoyancy_effect(spec%fluid%density, &
+                spec%rope%gravity, pi*spec%rope%diameter**2/4.0_wp, water_of(spec)))
         end if
         if (spec%effects%ground) then
             k = k + 1
@@ -94,6 +109,36 @@ contains
         if (spec%effects%fault_nan_after >= 0.0_wp) &
             allocate (effects(n_eff)%e, source=fault_effect_t(spec%effects%fault_nan_after))
     end subroutine build_body_effects
+
+    !> Whether the spec's rope floats in water that pushes it up: water and gravity on.
+    pure logical function buoyant(spec)
+        type(rope_spec_t), intent(in) :: spec
+        buoyant = spec%effects%water .and. spec%effects%gravity .and. spec%rope%gravity > 0.0_wp
+    end function buoyant
+
+    !> Where the spec's water is: the free surface of &fluid, the step smoothed over half
+    !! the rope's (hydrodynamic) diameter, the thickness with which a section crosses it.
+    pure function water_of(spec) result(w)
+        type(rope_spec_t), intent(in) :: spec
+        type(wetting_t) :: w
+        w%surface = spec%fluid%surface
+        w%delta = 0.5_wp*spec%rope%diameter
+    end function water_of
+
+    !> The water's added mass on the spec's bodies (with `&effects water`; zero added mass
+    !! without): normal C_a rho A and tangential C_at rho A per metre, A = pi d^2/4, with
+    !! the current of &fluid.
+    pure function water_added_mass(spec) result(am)
+        type(rope_spec_t), intent(in) :: spec
+        type(added_mass_t) :: am
+        real(wp) :: area
+        if (.not. spec%effects%water) return
+        area = pi*spec%rope%diameter**2/4.0_wp
+        am%man = spec%fluid%added_mass_coefficient*spec%fluid%density*area
+        am%mat = spec%fluid%tangential_added_mass_coefficient*spec%fluid%density*area
+        am%u = spec%fluid%current
+        am%wetting = water_of(spec)
+    end function water_added_mass
 
     !> The point masses of a spec (none when `&effects point_masses` is off): for each, the
     !! body, the offset r (m) from the body's centre along it, and the mass (kg).

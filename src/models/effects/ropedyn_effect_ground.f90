@@ -34,6 +34,7 @@ module ropedyn_effect_ground
         procedure :: energy => ground_energy
         procedure :: power => ground_power
         procedure :: total_normal_force => ground_total_normal_force
+        procedure :: split_refusal => ground_split_refusal
     end type ground_effect_t
 
     !> The contact at one end point of a body (all zero but i, e, r and delta when not in
@@ -204,6 +205,16 @@ contains
             end associate
         end do
     end subroutine ground_power
+
+    !> The contact springs are potential energy, and their stiffness acts only while a point
+    !! touches: absent from the spectrum of a rope above the ground, it would not bound a
+    !! fixed step chosen at the start.
+    pure function ground_split_refusal(self) result(why)
+        class(ground_effect_t), intent(in) :: self
+        character(len=:), allocatable :: why
+        why = 'ground contact: its springs act only while the rope touches, so a fixed '// &
+              'step chosen from the spectrum at the start need not be stable in contact'
+    end function ground_split_refusal
 
     !> Sum of the normal contact forces on all bodies, N (a diagnostic).
     pure real(wp) function ground_total_normal_force(self, b) result(total)

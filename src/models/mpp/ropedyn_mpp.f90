@@ -23,6 +23,11 @@
 !! m_p J_p^T J_p). The top joint may follow a prescribed motion P_0(t) (its acceleration
 !! starts the prefix sums); the bottom support may move or be released.
 !!
+!! In water (&effects water) each rod also carries the water's added mass
+!! (ropedyn_added_mass): its inertia becomes m I + A_i(q) (2x2) in translation and J + J_a,i
+!! in rotation, and its force gains the added mass's g_i; the residual, the O(n) solve, the
+!! dense M(q), the energy and the tangent take them (submodule ropedyn_mpp_water).
+!!
 !! This module builds the model and maps its state (creation, supports, joint positions);
 !! the residual, mass matrix and energy kernels are in the submodule ropedyn_mpp_kernels.
 module ropedyn_mpp
@@ -34,7 +39,8 @@ module ropedyn_mpp
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_effect, only: effect_box_t, bodies_t, add_forces_of, add_jacobians_of, &
                               add_energies_of, add_powers_of
-    use ropedyn_effect_factory, only: build_body_effects, attached_masses
+    use ropedyn_effect_factory, only: build_body_effects, attached_masses, water_added_mass
+    use ropedyn_added_mass, only: added_mass_t
     use ropedyn_support_motion, only: motion_state_t
     use ropedyn_rope_section, only: section_t, rope_section
     use ropedyn_rope_setup, only: initial_angle, clamp_angles, &
@@ -67,6 +73,9 @@ module ropedyn_mpp
         ! their motions: rope_model_t%motion
         real(wp) :: bottom_release = huge(1.0_wp)  !< s
         type(effect_box_t), allocatable :: effects(:)
+        !> in water (&effects water): the rods' added mass (submodule ropedyn_mpp_water)
+        logical :: water = .false.
+        type(added_mass_t) :: added
         ! point masses: rod, offset from the rod's centre along it (m), mass (kg)
         integer, allocatable :: pm_body(:)
         real(wp), allocatable :: pm_r(:), pm_m(:)
@@ -84,7 +93,10 @@ module ropedyn_mpp
         !! joint k between members k and k+1 (0, n: the supports), docs/theory/internal-forces.md
         real(wp), allocatable :: jmom(:)
         type(bodies_t) :: bodies              !< the rods as bodies for the effects
-        real(wp), allocatable :: ejac(:, :, :)  !< the effects' blocks (3, 6, n)
+        real(wp), allocatable :: ejac(:, :, :)  !< the effects' (and the water's) blocks (3, 6, n)
+        !> in water: the rods' added-mass blocks (3x3 on centre and angle) at the state of the
+        !! last residual_core (3, 3, n)
+        real(wp), allocatable :: wblk(:, :, :)
         !> factors of M(q) (mass_factor): per member the 2x2 blocks G, H = D^{-1} G^T,
         !! D^{-1} (rows and columns: angle, elongation) and the member length lambda
         real(wp), allocatable :: ab_g(:, :, :), ab_h(:, :, :), ab_dinv(:, :, :), ab_lam(:)
@@ -188,7 +200,8 @@ module ropedyn_mpp
             real(wp), intent(out) :: col(:)
         end subroutine residual_column
 
-        !> Factor M(q) (self%cs holding the angles of y): the articulated-body recursion from
+        !> Factor M(q) (self%cs holding the angles of y; in water self%wblk the added-mass
+        !! blocks, as residual_core at y leaves them): the articulated-body recursion from
         !! the tip into self%ab_*; ab_solve then solves M x = b in O(n). status is
         !! STATUS_RECOVERABLE when a pivot is not positive (an impossible configuration).
         module subroutine mass_factor(self, y, status)
@@ -210,12 +223,46 @@ module ropedyn_mpp
             integer, intent(out) :: status
         end subroutine derivatives
 
-        !> The dense mass matrix M(q) (ndof x ndof), O(n^2).
-        module pure subroutine mpp_mass_dense(self, y, mm)
+        !> The dense mass matrix M(q) (ndof x ndof), O(n^2); in water with the added mass of
+        !! the rods placed with the top joint at time t (default 0).
+        module pure subroutine mpp_mass_dense(self, y, mm, t)
             class(mpp_t), intent(in) :: self
             real(wp), intent(in) :: y(:)
             real(wp), intent(out) :: mm(:, :)
+            real(wp), intent(in), optional :: t
         end subroutine mpp_mass_dense
+
+        !> In water: the added mass's force on every rod at the accelerations qacc (self%bodies
+        !! and self%cacc as residual_core fills them), w_i += g_i - A_i C_i'', moment
+        !! += g_i(3) - J_a,i phi_i'', and the blocks into self%wblk (submodule
+        !! ropedyn_mpp_water).
+        module subroutine water_forces(self, qacc)
+            class(mpp_t), intent(inout) :: self
+            real(wp), intent(in) :: qacc(:)
+        end subroutine water_forces
+
+        !> In water: add to self%ejac every rod's 3x6 block of d(g - blk acc)/d(centre, angle,
+        !! velocity, rate) at fixed accelerations (qacc, self%cacc of the last residual_core).
+        module subroutine water_jacobian(self, qacc)
+            class(mpp_t), intent(inout) :: self
+            real(wp), intent(in) :: qacc(:)
+        end subroutine water_jacobian
+
+        !> In water: the added mass's kinetic energy and the current's potential of the rods
+        !! as bodies b, J.
+        module pure subroutine water_energy(self, b, kinetic, potential)
+            class(mpp_t), intent(in) :: self
+            type(bodies_t), intent(in) :: b
+            real(wp), intent(out) :: kinetic, potential
+        end subroutine water_energy
+
+        !> In water: add the rods' added mass sum_i J_i^T blk_i J_i to the dense mm at (t, y).
+        module pure subroutine water_mass_dense(self, t, y, mm)
+            class(mpp_t), intent(in) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(inout) :: mm(:, :)
+        end subroutine water_mass_dense
 
         !> y' = (q', M^{-1} f): f = r(q, q', 0), solved in O(n) (mass_factor, ab_solve).
         module subroutine mpp_rhs(self, t, y, ydot, status)
@@ -397,7 +444,9 @@ contains
             end associate
         end do
         call build_body_effects(spec, [(model%l, k = 1, model%n)], model%effects)
-        if (size(model%effects) > 0) then
+        model%water = spec%effects%water
+        if (model%water) model%added = water_added_mass(spec)
+        if (size(model%effects) > 0 .or. model%water) then
             model%bodies%n = model%n
             allocate (model%bodies%c(2, model%n), model%bodies%v(2, model%n), &
                       model%bodies%phi(model%n), model%bodies%w(model%n))
@@ -422,7 +471,7 @@ contains
                       model%ab_g(2, 2, n), model%ab_h(2, 2, n), model%ab_dinv(2, 2, n), &
                       model%ab_lam(n), model%acc(nd), model%r0(nd), model%dr(nd, 2*nd), &
                       model%mm(nd, nd), model%wsum(2, n + 1), model%ejac(3, 6, n), &
-                      model%jmom(0:n))
+                      model%jmom(0:n), model%wblk(3, 3, n))
         end associate
         model%cs = 0.0_wp
         model%w = 0.0_wp
@@ -439,6 +488,7 @@ contains
         model%wsum = 0.0_wp
         model%ejac = 0.0_wp
         model%jmom = 0.0_wp
+        model%wblk = 0.0_wp
     end subroutine mpp_create
 
     !> The supports at time t: top joint, bottom anchor (motion states) and whether the
@@ -618,7 +668,8 @@ contains
         vel = [(self%ndof + k, k = 1, self%ndof)]
     end subroutine mpp_coordinates
 
-    !> The configuration-dependent mass matrix M(q) (mass_dense).
+    !> The configuration-dependent mass matrix M(q) (mass_dense; in water with the added
+    !! mass, the top joint where it is at t = 0).
     subroutine mpp_coordinate_mass(self, y, mm)
         class(mpp_t), intent(in) :: self
         real(wp), intent(in) :: y(:)

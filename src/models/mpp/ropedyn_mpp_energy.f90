@@ -11,6 +11,7 @@ contains
         real(wp) :: e(2), nv(2)
         type(motion_state_t) :: top, bottom
         type(bodies_t) :: b
+        real(wp) :: e_kin, e_pot
         logical :: bottom_on
         integer :: k, n, i
         n = self%n
@@ -37,9 +38,15 @@ contains
                                     sum((p(:, n) - bottom%p)**2)
         if (self%bottom == 2 .and. bottom_on) en%elastic = en%elastic + 0.5_wp*self%c_rot* &
                                                           (phi(n) - bottom%angle)**2
-        if (size(self%effects) > 0) then
+        if (size(self%effects) > 0 .or. self%water) then
             call rod_bodies(self, y, top, b)
-            call add_energies_of(self%effects, t, b, en%elastic)
+            if (size(self%effects) > 0) call add_energies_of(self%effects, t, b, en%elastic)
+            if (self%water) then
+                ! the added mass's kinetic energy; the current's potential -1/2 u^T A u
+                call water_energy(self, b, e_kin, e_pot)
+                en%kinetic = en%kinetic + e_kin
+                en%elastic = en%elastic + e_pot
+            end if
         end if
         en%dissipated = 0.0_wp
         if (size(yq) >= 1) en%dissipated = yq(1)

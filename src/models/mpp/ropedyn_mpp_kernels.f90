@@ -46,12 +46,13 @@ contains
         real(wp) :: pacc(2), pn(2), pnd(2), wsum(2), fb(2), fp(2), pv(2)
         real(wp) :: c, s, u, ud, phd, pdd, udd, hk, lk, a1, a2, d, dd
         type(motion_state_t) :: top, bottom
-        logical :: bottom_on, effects
+        logical :: bottom_on, effects, bodied
         integer :: k, n, nd, i
 
         n = self%n
         nd = self%ndof
         effects = size(self%effects) > 0
+        bodied = effects .or. self%water
         call self%supports_at(t, top, bottom, bottom_on)
         u = 0.0_wp
         ud = 0.0_wp
@@ -85,7 +86,7 @@ contains
             a2 = udd - lk*phd**2
             pacc(1) = pacc(1) - a1*s + a2*c
             pacc(2) = pacc(2) + a1*c + a2*s
-            if (effects) then
+            if (bodied) then
                 self%bodies%c(1, k) = pn(1) + hk*c
                 self%bodies%c(2, k) = pn(2) + hk*s
                 self%bodies%v(1, k) = pnd(1) - hk*phd*s + ud*c
@@ -112,6 +113,9 @@ contains
             self%w(:, i) = self%w(:, i) + fp
             self%mom(i) = self%mom(i) + self%pm_r(k)*(-s*fp(1) + c*fp(2))
         end do
+
+        ! The water's added mass on the rods as bodies.
+        if (self%water) call water_forces(self, qacc)
 
         ! External effects on the rods as bodies.
         if (effects) call add_forces_of(self%effects, t, self%bodies, self%w, self%mom)
@@ -197,10 +201,12 @@ contains
     !!     D22 = m + e.I'e,  G = [(m eta + s1) n + lambda I'n, m e + I'e],
     !! and I_k = m I + I' - G D^{-1} G^T (m the member's mass with its point masses, s1, s2
     !! their first and second moments about the rod's centre). Inextensible members keep
-    !! the angle row only.
+    !! the angle row only. In water the rod's translational inertia is m I + A (A its
+    !! added-mass block, self%wblk) and its rotational J + J_a: D11 gains eta^2 n.An + J_a,
+    !! D12 eta n.Ae, D22 e.Ae, G's columns eta An and Ae, and I_k gains A.
     module procedure mass_factor
         real(wp) :: ixx, ixy, iyy, inx, iny, iex, iey, c, s, u, eta, lam, mb, s1, s2
-        real(wp) :: d11, d12, d22, det, g1(2), g2(2), h1(2), h2(2)
+        real(wp) :: d11, d12, d22, det, g1(2), g2(2), h1(2), h2(2), an(2), ae(2)
         integer :: k, n
 
         n = self%n
@@ -226,11 +232,23 @@ contains
             d11 = mb*eta**2 + 2.0_wp*s1*eta + s2 + self%inertia + lam**2*(-s*inx + c*iny)
             g1(1) = -(mb*eta + s1)*s + lam*inx
             g1(2) = (mb*eta + s1)*c + lam*iny
+            if (self%water) then
+                ! the added mass: A n and A e
+                an = matmul(self%wblk(1:2, 1:2, k), [-s, c])
+                ae = matmul(self%wblk(1:2, 1:2, k), [c, s])
+                d11 = d11 + eta**2*(-s*an(1) + c*an(2)) + self%wblk(3, 3, k)
+                g1 = g1 + eta*an
+            end if
             if (self%nu > 0) then
                 d12 = lam*(c*inx + s*iny)
                 d22 = mb + c*iex + s*iey
                 g2(1) = mb*c + iex
                 g2(2) = mb*s + iey
+                if (self%water) then
+                    d12 = d12 + eta*(-s*ae(1) + c*ae(2))
+                    d22 = d22 + c*ae(1) + s*ae(2)
+                    g2 = g2 + ae
+                end if
                 det = d11*d22 - d12**2
                 if (.not. (d11 > 0.0_wp .and. det > 0.0_wp)) then
                     status = STATUS_RECOVERABLE
@@ -263,6 +281,11 @@ contains
             ixx = mb + ixx - (g1(1)*h1(1) + g2(1)*h2(1))
             ixy = ixy - (g1(1)*h1(2) + g2(1)*h2(2))
             iyy = mb + iyy - (g1(2)*h1(2) + g2(2)*h2(2))
+            if (self%water) then
+                ixx = ixx + self%wblk(1, 1, k)
+                ixy = ixy + self%wblk(1, 2, k)
+                iyy = iyy + self%wblk(2, 2, k)
+            end if
         end do
     end procedure mass_factor
 
@@ -377,7 +400,7 @@ contains
     end subroutine assemble_mass
 
     module procedure mpp_mass_dense
-        real(wp) :: cs(2, self%n), u(self%n)
+        real(wp) :: cs(2, self%n), u(self%n), tt
         integer :: k
         do k = 1, self%n
             cs(1, k) = cos(y(k))
@@ -387,17 +410,25 @@ contains
         if (self%nu > 0) u = y(self%n + 1:self%ndof)
         call assemble_mass(self%n, self%nu, self%m, self%inertia, self%l, cs, u, &
                            self%pm_body, self%pm_r, self%pm_m, mm)
+        if (self%water) then
+            tt = 0.0_wp
+            if (present(t)) tt = t
+            call water_mass_dense(self, tt, y, mm)
+        end if
     end procedure mpp_mass_dense
 
-    !> M(q) into self%mm (self%cs holding the angles of y).
-    subroutine assemble_mass_work(self, y)
+    !> M(q) at time t (its added mass in water) into self%mm (self%cs holding the angles
+    !! of y).
+    subroutine assemble_mass_work(self, t, y)
         class(mpp_t), intent(inout) :: self
+        real(wp), intent(in) :: t
         real(wp), intent(in) :: y(:)
         real(wp) :: u(self%n)
         u = 0.0_wp
         if (self%nu > 0) u = y(self%n + 1:self%ndof)
         call assemble_mass(self%n, self%nu, self%m, self%inertia, self%l, self%cs, u, &
                            self%pm_body, self%pm_r, self%pm_m, self%mm)
+        if (self%water) call water_mass_dense(self, t, y, self%mm)
     end subroutine assemble_mass_work
 
     !> F of the implicit form M(q) y' = F: (q', r(t, q, q', 0)), the residual at zero
@@ -437,7 +468,7 @@ contains
         integer :: j, nd
         nd = self%ndof
         call angles(self, y)
-        call assemble_mass_work(self, y)
+        call assemble_mass_work(self, t, y)
         do j = 1, nd
             mb(offset, j) = mb(offset, j) + 1.0_wp
         end do
@@ -460,10 +491,12 @@ contains
         call self%residual_core(t, y, a, r0)
         self%acc = a
         self%r0 = r0
-        ! the effects' blocks at the bodies the residual left
-        if (size(self%effects) > 0) then
+        ! the effects' (and the water's) blocks at the bodies the residual left
+        if (size(self%effects) > 0 .or. self%water) then
             self%ejac = 0.0_wp
-            call add_jacobians_of(self%effects, t, self%bodies, self%ejac)
+            if (size(self%effects) > 0) call add_jacobians_of(self%effects, t, self%bodies, &
+                                                              self%ejac)
+            if (self%water) call water_jacobian(self, a)
         end if
         do j = 1, 2*nd
             call self%residual_column(t, y, a, j, col)
@@ -514,7 +547,7 @@ contains
         call self%derivatives(t, y, .not. implicit_form, status)
         if (status /= STATUS_OK) return
         if (implicit_form) then
-            call assemble_mass_work(self, y)
+            call assemble_mass_work(self, t, y)
             call add_to_band(mb, size(mb, 1), offset, self%mm, 0, 0)
         else
             mb(offset, 1:nd) = mb(offset, 1:nd) + 1.0_wp

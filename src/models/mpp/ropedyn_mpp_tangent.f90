@@ -16,7 +16,8 @@ contains
 
         n = self%n
         nd = self%ndof
-        effects = size(self%effects) > 0
+        ! the effects' blocks self%ejac hold the water's too
+        effects = size(self%effects) > 0 .or. self%water
         ! the member m and which of its variables (1 angle, 2 elongation, 3 and 4 their rates)
         if (j <= nd) then
             kind = merge(1, 2, j <= n)
@@ -87,6 +88,11 @@ contains
         do k = n, m + 1, -1
             dw = -self%mbar(k)*sh_a
             dmom = -self%pm_s1(k)*(-self%cs(2, k)*sh_a(1) + self%cs(1, k)*sh_a(2))
+            if (self%water) then
+                ! the added mass's inertia -blk (C_k'', phi_k'') at the shifted acceleration
+                dw = dw - matmul(self%wblk(1:2, 1:2, k), sh_a)
+                dmom = dmom - dot_product(self%wblk(3, 1:2, k), sh_a)
+            end if
             if (effects) then
                 dw = dw + matmul(self%ejac(1:2, 1:2, k), sh_p) &
                      + matmul(self%ejac(1:2, 4:5, k), sh_v)
@@ -99,6 +105,10 @@ contains
         ! member m itself
         dw = -self%m*dcacc
         dmom = 0.0_wp
+        if (self%water) then
+            dw = dw - matmul(self%wblk(1:2, 1:2, m), dcacc)
+            dmom = dmom - dot_product(self%wblk(3, 1:2, m), dcacc)
+        end if
         do p = 1, size(self%pm_body)
             if (self%pm_body(p) /= m) cycle
             pv = self%cacc(:, m) + self%pm_r(p)*(pdd*nv - phd**2*e)

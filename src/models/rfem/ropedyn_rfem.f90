@@ -34,7 +34,8 @@ module ropedyn_rfem
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_effect, only: effect_box_t, bodies_t, add_forces_of, add_jacobians_of, &
                               add_energies_of, add_powers_of
-    use ropedyn_effect_factory, only: build_body_effects, attached_masses
+    use ropedyn_effect_factory, only: build_body_effects, attached_masses, water_added_mass
+    use ropedyn_added_mass, only: added_mass_t
     use ropedyn_support_motion, only: motion_state_t
     use ropedyn_rope_section, only: section_t, rope_section
     use ropedyn_rope_setup, only: initial_angle, clamp_angles, &
@@ -101,10 +102,17 @@ module ropedyn_rfem
         integer, allocatable :: pm_elem(:)
         real(wp), allocatable :: pm_moment(:)
         real(wp), allocatable :: rowscale(:, :)  !< (3, n): 1/m, 1/m, 1/J; 1 on pm elements
+        !> in water (&effects water): every element's mass block holds its added mass, its
+        !! accelerations solve it (submodule ropedyn_rfem_water); rowscale is 1 then
+        logical :: water = .false.
+        type(added_mass_t) :: added
+        real(wp), allocatable :: inv_mass(:, :)  !< (3, n): 1/m, 1/m, 1/J (the force split)
         ! workspace, allocated once (no state is kept between calls)
         real(wp), allocatable :: cs(:, :)      !< cos, sin of every angle, (2, n)
         real(wp), allocatable :: phi(:)        !< every angle, gathered from y (n)
         real(wp), allocatable :: gen(:, :)     !< generalized forces, (3, n)
+        !> the forces other than the potential's (damping, effects), (3, n): split_forces
+        real(wp), allocatable :: gen_r(:, :)
         !> Jacobian blocks (3, 6, -1:1, n): blk(r, l, o, i) is the derivative of row r of
         !! element i (force x, y, moment; times rowscale(r, i) its acceleration, and after
         !! `point_mass_rows` the acceleration on elements with point masses) with respect
@@ -133,19 +141,22 @@ module ropedyn_rfem
         procedure :: second_order_blocks => rfem_second_order_blocks
         procedure :: generalized_forces => rfem_generalized_forces
         procedure :: potential_energy => rfem_potential_energy
+        procedure :: force_split_refusal => rfem_force_split_refusal, &
+                     split_layout => rfem_split_layout, split_rhs => rfem_split_rhs
         procedure, private :: forces
         procedure, private :: jacobian_blocks
         procedure, private :: point_mass_rows
         procedure, private :: set_time
         procedure, private :: fill_bodies
         procedure, private :: point_mass_accelerations
+        procedure, private :: water_forces, water_accelerations, water_kinetic, water_rows
     end type rfem_t
 
     interface
         !> The generalized forces (3, n) of everything at time t and state y into self%gen
         !! (one pass over the SDEs); optionally the elastic energy (J, springs and the
         !! effects' potential energy).
-        module subroutine forces(self, t, y, elastic, power, joint, support)
+        module subroutine forces(self, t, y, elastic, power, joint, support, rest)
             class(rfem_t), intent(inout) :: self
             real(wp), intent(in) :: t
             real(wp), intent(in) :: y(6*self%n)
@@ -158,6 +169,11 @@ module ropedyn_rfem
             !> when present: the support SDEs' forces fs (x, y, N) and fr (N m), top and
             !! bottom (zero for a free or released end; support_force in the kernels)
             real(wp), intent(out), optional :: support(3, 2)
+            !> when present, the force split (ropedyn_rfem_energy): self%gen holds the
+            !! potential's forces alone (springs, supports' springs, gravity) and, when
+            !! .true., self%gen_r the rest (dampers, effects); .false.: the rest is not
+            !! evaluated
+            logical, intent(in), optional :: rest
         end subroutine forces
 
         !> The derivatives of the generalized forces with respect to the coordinates and
@@ -280,6 +296,62 @@ module ropedyn_rfem
             real(wp), intent(out) :: yqdot(:)
             integer, intent(out) :: status
         end subroutine rfem_rhs_quad
+        !> The added mass's forces at y into self%gen; with e_el, its potential added (the
+        !! current's, J). Submodule ropedyn_rfem_water.
+        module subroutine water_forces(self, y, e_el)
+            class(rfem_t), intent(inout) :: self
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(inout), optional :: e_el
+        end subroutine water_forces
+
+        !> Every element's accelerations from its mass block (in water).
+        module subroutine water_accelerations(self, y, gen, ydot)
+            class(rfem_t), intent(in) :: self
+            real(wp), intent(in) :: y(:), gen(:, :)
+            real(wp), intent(inout) :: ydot(:)
+        end subroutine water_accelerations
+
+        !> The added mass's kinetic energy at y, J.
+        module function water_kinetic(self, y) result(e_k)
+            class(rfem_t), intent(in) :: self
+            real(wp), intent(in) :: y(:)
+            real(wp) :: e_k
+        end function water_kinetic
+
+        !> self%blk's rows to acceleration rows through the elements' mass blocks (in
+        !! water); self%gen must hold the forces at (t, y).
+        module subroutine water_rows(self, t, y)
+            class(rfem_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+        end subroutine water_rows
+
+        !> Why the model offers no force split ('' when it does; submodule ropedyn_rfem_energy).
+        module pure function rfem_force_split_refusal(self) result(why)
+            class(rfem_t), intent(in) :: self
+            character(len=:), allocatable :: why
+        end function rfem_force_split_refusal
+
+        !> The masses of the coordinates (m, m, J per element) and the balance signs of the
+        !! quadratures (dissipated -1, external work +1).
+        module pure subroutine rfem_split_layout(self, mass, signs)
+            class(rfem_t), intent(in) :: self
+            real(wp), intent(out) :: mass(:)
+            integer, intent(out) :: signs(:)
+        end subroutine rfem_split_layout
+
+        !> The accelerations of the springs, supports' springs and gravity (the potential)
+        !! and, with `ar`, of the rest (dampers, effects), with the quadratures' rates split
+        !! the same way (problem_t's split_rhs; submodule ropedyn_rfem_energy).
+        module subroutine rfem_split_rhs(self, t, y, ac, gc, status, ar, gr)
+            class(rfem_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(out) :: ac(:), gc(:)
+            integer, intent(out) :: status
+            real(wp), intent(out), optional :: ar(:), gr(:)
+        end subroutine rfem_split_rhs
+
         !> Build the model of a spec (its values are already validated; submodule
         !! ropedyn_rfem_create).
         module subroutine rfem_create(model, spec, err)
@@ -483,6 +555,7 @@ contains
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: mm(:, :)
         integer :: i, k
+        real(wp) :: blk(3, 3), g(3)
         mm = 0.0_wp
         do i = 1, self%n
             k = 3*(i - 1)
@@ -497,5 +570,14 @@ contains
                 [-sin(y(6*self%pm_elem(i) - 3)), cos(y(6*self%pm_elem(i) - 3))]
             mm(k + 3, k + 1:k + 2) = mm(k + 1:k + 2, k + 3)
         end do
+        ! the water's added mass (at the state's coordinates and rates)
+        if (self%water) then
+            do i = 1, self%n
+                k = 6*(i - 1)
+                call self%added%terms(y(k + 1:k + 2), y(k + 3), y(k + 4:k + 5), y(k + 6), &
+                                      self%len(i), blk, g)
+                mm(3*i - 2:3*i, 3*i - 2:3*i) = mm(3*i - 2:3*i, 3*i - 2:3*i) + blk
+            end do
+        end if
     end subroutine rfem_coordinate_mass
 end module ropedyn_rfem

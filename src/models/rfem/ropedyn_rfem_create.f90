@@ -135,7 +135,14 @@ contains
         model%rowscale(1, :) = 1.0_wp/model%mass
         model%rowscale(2, :) = 1.0_wp/model%mass
         model%rowscale(3, :) = 1.0_wp/model%inertia
+        model%inv_mass = model%rowscale
         model%rowscale(:, model%pm_elem) = 1.0_wp
+        ! in water every element's accelerations come from its mass block
+        model%water = spec%effects%water
+        if (model%water) then
+            model%added = water_added_mass(spec)
+            model%rowscale = 1.0_wp
+        end if
 
         call build_body_effects(spec, model%len, model%effects)
         if (size(model%effects) > 0) then
@@ -168,9 +175,11 @@ contains
 
         model%half = 0.5_wp*model%len
         model%weight = merge(model%mass*model%g, 0.0_wp*model%mass, model%gravity_on)
-        allocate (model%cs(2, n), model%phi(n), model%gen(3, n), model%blk(3, 6, -1:1, n))
+        allocate (model%cs(2, n), model%phi(n), model%gen(3, n), model%gen_r(3, n), &
+                  model%blk(3, 6, -1:1, n))
         model%cs = 0.0_wp
         model%gen = 0.0_wp
+        model%gen_r = 0.0_wp
         model%blk = 0.0_wp
     end procedure rfem_create
 end submodule ropedyn_rfem_create

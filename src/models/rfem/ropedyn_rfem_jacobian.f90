@@ -70,6 +70,20 @@ contains
         end do
     end procedure point_mass_rows
 
+    !> The rows of the elements whose mass block is not diagonal (in water: every element;
+    !! else those with point masses) from force rows to acceleration rows.
+    subroutine mass_rows(self, t, y)
+        class(rfem_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        if (self%water) then
+            call self%forces(t, y)
+            call self%water_rows(t, y)
+        else if (size(self%pm_elem) > 0) then
+            call self%point_mass_rows(t, y)
+        end if
+    end subroutine mass_rows
+
     !> Add the Jacobian of the first-order system into band storage jb(ld, 6n) (entry (i, j)
     !! at row offset + i - j): the identity of the position rows and the velocity rows from
     !! the blocks times the row scales.
@@ -119,14 +133,14 @@ contains
 
     module procedure rfem_jacobian
         call self%jacobian_blocks(t, y)
-        if (size(self%pm_elem) > 0) call self%point_mass_rows(t, y)
+        call mass_rows(self, t, y)
         call write_first_order(self, jb, size(jb, 1), offset)
         status = STATUS_OK
     end procedure rfem_jacobian
 
     module procedure rfem_second_order_blocks
         call self%jacobian_blocks(t, y)
-        if (size(self%pm_elem) > 0) call self%point_mass_rows(t, y)
+        call mass_rows(self, t, y)
         call write_second_order(self, kb, cb, mb, size(kb, 1), offset)
         status = STATUS_OK
     end procedure rfem_second_order_blocks

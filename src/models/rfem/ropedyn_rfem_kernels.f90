@@ -113,18 +113,24 @@ contains
     !! for a clamp the rotational one) to f(3), the force on its element; with `energy`
     !! its spring energy to e_el. `sde`: the SDE's own forces, fs = Ct d + Bt d' (x, y) and
     !! fr = Cr s + Br s' (zero where it has none): the support's force on the rope is
-    !! -sgn fs, its moment on the element -sgn fr.
-    pure subroutine support_force(self, k, y, f, energy, e_el, sde)
+    !! -sgn fs, its moment on the element -sgn fr. With `fr` (the force split) the dampers'
+    !! part goes to fr, and with `rest` false it is not evaluated.
+    pure subroutine support_force(self, k, y, f, energy, e_el, sde, fr, rest)
         class(rfem_t), intent(in) :: self
         integer, intent(in) :: k
         real(wp), intent(in) :: y(:)
         real(wp), intent(inout) :: f(3)
         logical, intent(in) :: energy
         real(wp), intent(inout) :: e_el
-        real(wp), intent(out) :: sde(3)
-        real(wp) :: h, co, si, d(2), fs(2), s, fr
+        real(wp), intent(out), optional :: sde(3)
+        real(wp), intent(inout), optional :: fr(3)
+        logical, intent(in), optional :: rest
+        real(wp) :: h, co, si, d(2), fs(2), fd(2), s, fq
         integer :: m
-        sde = 0.0_wp
+        logical :: damp
+        damp = .true.
+        if (present(rest)) damp = rest
+        if (present(sde)) sde = 0.0_wp
         associate (sp => self%sup(k))
             m = 6*(sp%elem - 1)
             h = self%half(sp%elem)
@@ -134,18 +140,32 @@ contains
                 d = support_offset(self, k, y, co, si)
                 fs = sp%ct*d
                 if (energy) e_el = e_el + 0.5_wp*sp%ct*(d(1)**2 + d(2)**2)
-                if (sp%damped_t) fs = fs + sp%bt*support_offset_rate(self, k, y, co, si)
+                if (sp%damped_t .and. damp) then
+                    fd = sp%bt*support_offset_rate(self, k, y, co, si)
+                    if (present(fr)) then
+                        fr(1:2) = fr(1:2) - sp%sgn*fd
+                        fr(3) = fr(3) + h*(co*fd(2) - si*fd(1))
+                    else
+                        fs = fs + fd
+                    end if
+                end if
                 f(1:2) = f(1:2) - sp%sgn*fs
                 f(3) = f(3) + h*(co*fs(2) - si*fs(1))
-                sde(1:2) = fs
+                if (present(sde)) sde(1:2) = fs
             end if
             if (sp%rotational) then
                 s = sp%sgn*(y(m + 3) - sp%angle)
-                fr = sp%cr*s
+                fq = sp%cr*s
                 if (energy) e_el = e_el + 0.5_wp*sp%cr*s**2
-                if (sp%damped_r) fr = fr + sp%br*sp%sgn*(y(m + 6) - sp%angle_rate)
-                f(3) = f(3) - sp%sgn*fr
-                sde(3) = fr
+                if (sp%damped_r .and. damp) then
+                    if (present(fr)) then
+                        fr(3) = fr(3) - sp%br*(y(m + 6) - sp%angle_rate)
+                    else
+                        fq = fq + sp%br*sp%sgn*(y(m + 6) - sp%angle_rate)
+                    end if
+                end if
+                f(3) = f(3) - sp%sgn*fq
+                if (present(sde)) sde(3) = fq
             end if
         end associate
     end subroutine support_force
@@ -251,21 +271,35 @@ contains
 
     module procedure forces
         integer :: j, n, p, i
-        real(wp) :: fx, fy, fp, ffx, ffy, c(3), e_el, p_in, sup_sde(3, 2)
+        real(wp) :: fx, fy, fp, dx, dy, dp, c(3), cr(3), e_el, p_in, sup_sde(3, 2)
         type(sde_t) :: s
-        logical :: energy, with_power
+        logical :: energy, with_power, split, with_rest, damp
 
         n = self%n
         energy = present(elastic)
         with_power = present(power)
+        ! the force split: the dampers' and effects' forces into gen_r (rest), or not at all
+        split = present(rest)
+        with_rest = .false.
+        if (split) with_rest = rest
+        damp = self%damped .and. (with_rest .or. .not. split)
         e_el = 0.0_wp
         p_in = 0.0_wp
         call self%set_time(t)
         call angles(self, y)
-        ! c: the force of the previous SDE on its element b (first: the top support's)
+        ! c: the force of the previous SDE on its element b (first: the top support's);
+        ! cr: its dampers' part when split
         c = 0.0_wp
         sup_sde = 0.0_wp
-        if (self%sup(1)%active) call support_force(self, 1, y, c, energy, e_el, sup_sde(:, 1))
+        cr = 0.0_wp
+        if (with_rest) self%gen_r = 0.0_wp
+        if (self%sup(1)%active) then
+            if (split) then
+                call support_force(self, 1, y, c, energy, e_el, fr=cr, rest=rest)
+            else
+                call support_force(self, 1, y, c, energy, e_el, sde=sup_sde(:, 1))
+            end if
+        end if
         do j = 2, n
             s = sde_at(self, y, j)
             fx = 0.0_wp
@@ -276,28 +310,39 @@ contains
             if (self%bending) fp = self%cpj(j)*(y(s%kb + 3) - y(s%ka + 3))
             if (energy) e_el = e_el + 0.5_wp*(fx*s%dwx + fy*s%dwy &
                                               + fp*(y(s%kb + 3) - y(s%ka + 3)))
-            if (self%damped) then
+            if (damp) then
                 call sde_rates(s, y)
-                fx = fx + self%bx*s%rx
-                fy = fy + self%by*s%ry
-                fp = fp + self%bpj(j)*s%rp
+                dx = self%bx*s%rx
+                dy = self%by*s%ry
+                dp = self%bpj(j)*s%rp
                 if (with_power) p_in = p_in + (self%bx*s%rx**2 + self%by*s%ry**2 + &
                                                self%bpj(j)*s%rp**2)
+                if (.not. split) then
+                    fx = fx + dx
+                    fy = fy + dy
+                    fp = fp + dp
+                end if
+            else
+                dx = 0.0_wp
+                dy = 0.0_wp
+                dp = 0.0_wp
             end if
             if (present(joint)) joint(:, j - 1) = [fx, fy, fp]
-            ffx = fx*s%ca - fy*s%sa
-            ffy = fx*s%sa + fy*s%ca
-            self%gen(1, j - 1) = c(1) + ffx + self%weight(j - 1)
-            self%gen(2, j - 1) = c(2) + ffy
-            self%gen(3, j - 1) = c(3) + (fy*(s%dwx + s%ha) - fx*s%dwy + fp)
-            c(1) = -ffx
-            c(2) = -ffy
-            c(3) = -s%hb*(fx*s%sd - fy*s%cd) - fp
+            if (with_rest) call scatter(self%gen_r, j, s, dx, dy, dp, cr)
+            call scatter(self%gen, j, s, fx, fy, fp, c)
+            self%gen(1, j - 1) = self%gen(1, j - 1) + self%weight(j - 1)
         end do
-        if (self%sup(2)%active) call support_force(self, 2, y, c, energy, e_el, sup_sde(:, 2))
+        if (self%sup(2)%active) then
+            if (split) then
+                call support_force(self, 2, y, c, energy, e_el, fr=cr, rest=rest)
+            else
+                call support_force(self, 2, y, c, energy, e_el, sde=sup_sde(:, 2))
+            end if
+        end if
         if (present(support)) support = sup_sde
         self%gen(1, n) = c(1) + self%weight(n)
         self%gen(2:3, n) = c(2:3)
+        if (with_rest) self%gen_r(:, n) = cr
         ! moment of the point masses' weight about their element's centre
         if (self%gravity_on) then
             do p = 1, size(self%pm_elem)
@@ -305,14 +350,47 @@ contains
                 self%gen(3, i) = self%gen(3, i) - self%g*self%pm_moment(p)*self%cs(2, i)
             end do
         end if
-        if (size(self%effects) > 0) then
+        if (size(self%effects) > 0 .and. (with_rest .or. .not. split)) then
             call self%fill_bodies(y)
-            call add_forces_of(self%effects, t, self%bodies, self%gen(1:2, :), self%gen(3, :))
+            if (with_rest) then
+                call add_forces_of(self%effects, t, self%bodies, self%gen_r(1:2, :), &
+                                   self%gen_r(3, :))
+            else
+                call add_forces_of(self%effects, t, self%bodies, self%gen(1:2, :), &
+                                   self%gen(3, :))
+            end if
             if (energy) call add_energies_of(self%effects, t, self%bodies, e_el)
+        end if
+        if (self%water) then
+            if (energy) then
+                call self%water_forces(y, e_el)
+            else
+                call self%water_forces(y)
+            end if
         end if
         if (energy) elastic = e_el
         if (with_power) power = p_in
     end procedure forces
+
+    !> The generalized forces of SDE j (geometry s) with forces (fx, fy, fp): element a's into
+    !! g(:, j - 1), with the carry c (the previous SDE's force on its element b, which is a),
+    !! and the force on element b into c (the module header: F = fx e_a + fy n_a).
+    pure subroutine scatter(g, j, s, fx, fy, fp, c)
+        real(wp), intent(inout) :: g(:, :)
+        integer, intent(in) :: j
+        type(sde_t), intent(in) :: s
+        real(wp), intent(in) :: fx, fy, fp
+        real(wp), intent(inout) :: c(3)
+        real(wp) :: ffx, ffy
+        ffx = fx*s%ca - fy*s%sa
+        ffy = fx*s%sa + fy*s%ca
+        g(1, j - 1) = c(1) + ffx
+        g(2, j - 1) = c(2) + ffy
+        g(3, j - 1) = c(3) + (fy*(s%dwx + s%ha) - fx*s%dwy + fp)
+        c(1) = -ffx
+        c(2) = -ffy
+        c(3) = -s%hb*(fx*s%sd - fy*s%cd) - fp
+    end subroutine scatter
 
     module procedure rfem_generalized_forces
         real(wp) :: tt
@@ -359,7 +437,11 @@ contains
             ydot(k + 5) = self%gen(2, i)*self%rowscale(2, i)
             ydot(k + 6) = self%gen(3, i)*self%rowscale(3, i)
         end do
-        if (size(self%pm_elem) > 0) call self%point_mass_accelerations(y, self%gen, ydot)
+        if (self%water) then
+            call self%water_accelerations(y, self%gen, ydot)
+        else if (size(self%pm_elem) > 0) then
+            call self%point_mass_accelerations(y, self%gen, ydot)
+        end if
     end subroutine accelerations
 
     module procedure rfem_has_jacobian
@@ -479,39 +561,6 @@ contains
             call add_jacobians_of(self%effects, t, self%bodies, self%blk(:, :, 0, :))
         end if
     end procedure jacobian_blocks
-
-    module procedure rfem_potential_energy
-        type(energy_t) :: e
-        e = self%energy(0.0_wp, y, [0.0_wp])
-        v = e%elastic + e%gravity
-    end procedure rfem_potential_energy
-
-    module procedure rfem_energy
-        integer :: i, k, p
-
-        call self%set_time(t)
-        e%kinetic = 0.0_wp
-        e%gravity = 0.0_wp
-        do i = 1, self%n
-            k = 6*(i - 1)
-            e%kinetic = e%kinetic + 0.5_wp*(self%mass(i)*(y(k + 4)**2 + y(k + 5)**2) + &
-                                            self%inertia(i)*y(k + 6)**2)
-            if (self%gravity_on) e%gravity = e%gravity - self%mass(i)*self%g*y(k + 1)
-        end do
-        ! point masses off the element centres: T += s w (v . n), V_g -= g s cos(phi)
-        do p = 1, size(self%pm_elem)
-            k = 6*(self%pm_elem(p) - 1)
-            e%kinetic = e%kinetic + self%pm_moment(p)*y(k + 6)* &
-                        (-y(k + 4)*sin(y(k + 3)) + y(k + 5)*cos(y(k + 3)))
-            if (self%gravity_on) e%gravity = e%gravity - self%g*self%pm_moment(p)*cos(y(k + 3))
-        end do
-        ! the springs' and the effects' potential energy
-        call self%forces(t, y, e%elastic)
-        e%dissipated = 0.0_wp
-        if (size(yq) >= 1) e%dissipated = yq(1)
-        e%support_work = 0.0_wp  ! fixed supports and no loads: no external work
-        if (self%with_work .and. size(yq) >= 2) e%support_work = yq(2)
-    end procedure rfem_energy
 
     !> Add the dissipation power sum B s'^2 of the internal SDEs (self%cs holding the
     !! angles of y; the module header's geometry and rates).

@@ -37,12 +37,23 @@ venv) on the same rope as input/paper.nml, n segments against ropedyn's n elemen
   (atol = rtol / 100, as the scene's) whose tip error over [0, 2 s] is at most MoorDyn's
   time error, over the whole run.
 
-The coupled case (its own table, also alone with --coupled-only): the same rope with its
-top driven from Python every millisecond, ropedyn through ropedyn.Simulation and MoorDyn
-through its Python package (COUPLED_DT and what follows it).
+- At equal accuracy, both ropedyn's default method (auto) and `method = 'symplectic'`.
+- The undamped rope over 300 s (`--undamped-elements`, `--undamped-t-end`; alone with
+  `--only-undamped`): damping off in both codes and MoorDyn's bending off too (a chain of
+  tension-only springs, whose energy its driver sums: kinetic and gravity of the lumped node
+  masses, mu L/n, half at the free end, and EA/(2 l0) (l - l0)^2 per stretched segment;
+  MoorDyn's own node masses are 0 before its first step), RK4 at the largest step of the
+  ladder that stays finite and whose energy never rises by m g L (no agreement test: the chain without damping and bending
+  follows no trajectory that a smaller step converges on; its tip differs by 1 .. 3 cm over
+  the first second between a step and its half); ropedyn's symplectic method at rtol 1e-3:
+  the energy error at 30 s and 300 s in m g L and the CPU of each.
 
-The tables go between the bench_peers markers of docs/performance/peers.md. The code of
-scripts/bench_peers.
+- The coupled case (its own table, also alone with --coupled-only): the same rope with
+  its top driven from Python every millisecond, ropedyn through ropedyn.Simulation and
+  MoorDyn through its Python package (COUPLED_DT and what follows it).
+
+The tables go between the bench_peers (bench_peers_undamped, bench_peers_coupled) markers
+of docs/performance/peers.md. The code of scripts/bench_peers.
 
 MoorDyn-C 2.7.2's reader scans for the next line of dashes without a bound: an input file
 that does not end with one (the "need this line" line of its examples) makes `Create`
@@ -65,6 +76,11 @@ from ropedyn_tools.studies.common import (least_cpu, machine, method_chain, meth
 
 BEGIN = "<!-- bench_peers:begin -->"
 END = "<!-- bench_peers:end -->"
+UNDAMPED_BEGIN = "<!-- bench_peers_undamped:begin -->"
+UNDAMPED_END = "<!-- bench_peers_undamped:end -->"
+UNDAMPED_HEADER = ("| n | MoorDyn dt (s) | MoorDyn E - E0 at 30 s | at 300 s | MoorDyn CPU (s) "
+                   "| ropedyn E - E0 at 30 s | at 300 s | ropedyn max abs | ropedyn CPU (s) "
+                   "| MoorDyn / ropedyn |")
 ROOT = DOCS.parent
 BENCH_VENV = ROOT / ".venv-bench"
 
@@ -80,13 +96,38 @@ import json, sys, time, math
 import moordyn
 path, t_end, dt_out, length, span = (sys.argv[1], float(sys.argv[2]), float(sys.argv[3]),
                                      float(sys.argv[4]), float(sys.argv[5]))
+# the energy (no bending, no damping: kinetic + gravity + tension-only segments) at these
+# times, outside the timed loop's CPU (argv[6], EA:L0:mu:t1,t2,...); the node masses are
+# the lumped ones, mu L0 (half at the free end; MoorDyn's own are 0 before its first step)
+energy_at = []
+if len(sys.argv) > 6:
+    ea, l0, mu, when = sys.argv[6].split(":")
+    ea, l0, mu, energy_at = float(ea), float(l0), float(mu), [float(x) for x in when.split(",")]
 s = moordyn.Create(path)
 moordyn.Init_NoIC(s, [], [])
 line = moordyn.GetLine(s, 1)
 n = moordyn.GetLineNumberNodes(line)
 top = moordyn.GetLineNodePos(line, 0)
 tips = [list(moordyn.GetLineNodePos(line, n - 1))]
-t, ok, c = 0.0, True, time.process_time()
+
+
+def energy():
+    e = 0.0
+    pos = [moordyn.GetLineNodePos(line, i) for i in range(n)]
+    for i in range(1, n):            # node 0 is fixed
+        v = moordyn.GetLineNodeVel(line, i)
+        m = mu * l0 * (0.5 if i == n - 1 else 1.0)
+        # kinetic, and gravity (z up, g = 9.81 as in the input file; no added mass)
+        e += 0.5 * m * sum(x * x for x in v) + m * 9.81 * pos[i][2]
+    for i in range(n - 1):
+        stretch = math.dist(pos[i], pos[i + 1]) - l0
+        if stretch > 0.0:
+            e += 0.5 * ea / l0 * stretch ** 2
+    return e
+
+
+energies = [energy()] if energy_at else []
+t, ok, c, spent = 0.0, True, time.process_time(), 0.0
 steps = int(round(t_end / dt_out))
 for k in range(steps):
     moordyn.Step(s, [], [], t, dt_out)
@@ -94,13 +135,18 @@ for k in range(steps):
     p = moordyn.GetLineNodePos(line, n - 1)
     if t <= span + 1e-9:
         tips.append(list(p))
+    if any(abs(t - x) < 0.5 * dt_out for x in energy_at):
+        e0 = time.process_time()
+        energies.append(energy())
+        spent += time.process_time() - e0
     r = math.dist(p, top)
     if not (math.isfinite(r) and r < 1.05 * length):
         ok = False
         break
-cpu = time.process_time() - c
+cpu = time.process_time() - c - spent
 moordyn.Close(s)
-print("RESULT " + json.dumps({"cpu": cpu, "ok": ok, "t": t, "tip": tips}), flush=True)
+print("RESULT " + json.dumps({"cpu": cpu, "ok": ok, "t": t, "tip": tips,
+                              "energies": energies}), flush=True)
 """
 
 
@@ -110,11 +156,17 @@ def segment_damping_ratio(n):
     return ETA * area * n / (2 * LENGTH * math.sqrt(YOUNG * area * DENSITY * area))
 
 
-def moordyn_file(path, n, dt, top="Fixed", outputs="p"):
+def moordyn_file(path, n, dt, undamped=False, top="Fixed", outputs="p"):
+    """MoorDyn's input for the paper's rope; `undamped`: no internal damping and no bending
+    stiffness (a chain of tension-only springs, whose energy the driver can sum); `top`: the
+    top point's attachment (Fixed, or Coupled for the coupled case); `outputs`: the line's
+    outputs (p: node positions; -: none)."""
     area = math.pi * DIAMETER ** 2 / 4
     ea, mu = YOUNG * area, DENSITY * area
     ei = YOUNG * math.pi * DIAMETER ** 4 / 64
     ba = ETA * area            # N s: force per unit strain rate, as ropedyn's eta A
+    if undamped:
+        ba, ei = 0.0, 0.0
     x, z = LENGTH * math.sin(ANGLE), TOP_Z - LENGTH * math.cos(ANGLE)
     path.write_text(f"""--------------------- MoorDyn Input File ------------------------------------
 ropedyn bench_peers: the paper's rope
@@ -152,14 +204,21 @@ def ensure_bench_venv():
     return py
 
 
-def run_moordyn(py, workdir, n, dt, t_end, span=ACCURACY_SPAN):
-    """MoorDyn over [0, t_end] at step dt; the tip at the output times up to span."""
-    f = workdir / f"rope_{n}.txt"
-    moordyn_file(f, n, dt)
+def run_moordyn(py, workdir, n, dt, t_end, span=ACCURACY_SPAN, undamped=False,
+                energy_at=()):
+    """MoorDyn over [0, t_end] at step dt; the tip at the output times up to span; with
+    `energy_at`, its energy at the start and at those times ("energies")."""
+    f = workdir / f"rope_{n}{'_undamped' if undamped else ''}.txt"
+    moordyn_file(f, n, dt, undamped)
+    extra = []
+    if energy_at:
+        area = math.pi * DIAMETER ** 2 / 4
+        extra = [f"{YOUNG * area!r}:{LENGTH / n!r}:{DENSITY * area!r}:"
+                 + ",".join(f"{x:g}" for x in energy_at)]
     # MoorDyn prints its progress; keep stdout and stderr apart and read the result line
     proc = subprocess.run([str(py), "-X", "faulthandler", "-c", DRIVER, str(f), str(t_end),
-                           str(OUT_DT), str(LENGTH), str(span)], capture_output=True,
-                          text=True, cwd=workdir, timeout=3600)
+                           str(OUT_DT), str(LENGTH), str(span), *extra], capture_output=True,
+                          text=True, cwd=workdir, timeout=7200)
     for line in proc.stdout.splitlines()[::-1]:
         if "RESULT " in line:
             r = json.loads(line.split("RESULT ", 1)[1])
@@ -177,12 +236,12 @@ def ladder(n):
     return [base * 2.0 ** (k / 4) for k in range(8, -13, -1)]
 
 
-def stable_and_right(py, workdir, n, dt, probe):
+def stable_and_right(py, workdir, n, dt, probe, undamped=False):
     """The probe at dt stays finite and agrees with the probe at dt/2 (1 % of L, L2)."""
-    coarse = run_moordyn(py, workdir, n, dt, probe, span=probe)
+    coarse = run_moordyn(py, workdir, n, dt, probe, span=probe, undamped=undamped)
     if not coarse["ok"]:
         return False
-    fine = run_moordyn(py, workdir, n, dt / 2, probe, span=probe)
+    fine = run_moordyn(py, workdir, n, dt / 2, probe, span=probe, undamped=undamped)
     if not fine["ok"]:
         return False
     k = min(len(coarse["tip"]), len(fine["tip"]))
@@ -210,6 +269,7 @@ def run_ropedyn(exe, workdir, n, t_end, sets=(), name="run"):
     return {"status": "complete", "cpu": float(run.stats["cpu_time"]),
             "steps": int(run.stats["steps"]), "methods": methods,
             "balance": float(abs(total + dissipated - total[0]).max()),
+            "drift": total + dissipated - total[0],
             "time": run.time, "tip": run.points[:, -1, :]}
 
 
@@ -225,27 +285,88 @@ def tip_l2(time, tip, ref):
 EQUAL_RTOLS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
 
 
-def at_equal_accuracy(exe, work, n, t_end, ref, md, md_error, repeat=1):
-    """ropedyn at the loosest rtol of EQUAL_RTOLS whose tip error is <= MoorDyn's time
-    error: the table row (n, MoorDyn's error, rtol, method, error, balance, CPU (the least
-    of `repeat` runs), ratio)."""
+def at_equal_accuracy(exe, work, n, t_end, ref, md, md_error, repeat=1, method="auto"):
+    """ropedyn (`method`) at the loosest rtol of EQUAL_RTOLS whose tip error is <= MoorDyn's
+    time error: the table row (n, MoorDyn's error, rtol, method, error, balance, CPU (the
+    least of `repeat` runs), ratio)."""
     for rtol in EQUAL_RTOLS:
-        sets = [f"solver.rtol={rtol:g}", f"solver.atol={rtol / 100:g}"]
-        r = run_ropedyn(exe, work, n, t_end, name=f"rtol{rtol:g}", sets=sets)
+        sets = [f"solver.rtol={rtol:g}", f"solver.atol={rtol / 100:g}",
+                f"solver.method='{method}'"]
+        r = run_ropedyn(exe, work, n, t_end, name=f"{method}_rtol{rtol:g}", sets=sets)
         if r["status"] != "complete":
             continue
         err = tip_l2(r["time"], r["tip"], ref)
         if err <= md_error:
             if repeat > 1:
                 again = least_cpu(lambda: run_ropedyn(exe, work, n, t_end, sets=sets,
-                                                      name=f"rtol{rtol:g}"), repeat - 1,
+                                                      name=f"{method}_rtol{rtol:g}"), repeat - 1,
                                   complete=lambda x: x["status"] == "complete")
                 if again["status"] == "complete" and again["cpu"] < r["cpu"]:
                     r["cpu"] = again["cpu"]
-            return (f"| {n} | {md_error:.1e} | {rtol:g} | auto ({r['methods']}) | {err:.1e} "
+            return (f"| {n} | {md_error:.1e} | {rtol:g} | {method} ({r['methods']}) | {err:.1e} "
                     f"| {r['balance']:.1e} | {r['steps']} | {r['cpu']:.3g} | {md['cpu']:.3g} "
                     f"| {md['cpu'] / r['cpu']:.2f} |")
-    return f"| {n} | {md_error:.1e} | none of {EQUAL_RTOLS} | | | | | | {md['cpu']:.3g} | |"
+    return (f"| {n} | {md_error:.1e} | none of {EQUAL_RTOLS} | {method} | | | | | "
+            f"{md['cpu']:.3g} | |")
+
+
+ENERGY_TIMES = (30.0, 300.0)
+MGL = DENSITY * math.pi * DIAMETER ** 2 / 4 * LENGTH * 9.81 * LENGTH
+
+
+def bounded(r):
+    """A MoorDyn run of the undamped chain that stayed finite, its tip within 1.05 L of the
+    top, and whose energy never rose by a whole m g L at the times it was taken (no energy
+    can come in: such a rise is the step's instability; n = 20 at 1.0e-3 s kept its tip
+    within bounds while its energy rose by 120 m g L in 30 s)."""
+    e = r.get("energies") or [0.0]
+    return bool(r.get("ok")) and max(e) - e[0] < MGL
+
+
+def undamped_row(py, exe, work, n, t_end, probe, repeat):
+    """The undamped rope (no damping in either code; MoorDyn without bending, a chain of
+    tension-only springs whose energy its driver sums): MoorDyn's RK4 at the largest step of
+    the ladder that stays finite over the probe and the whole run, and ropedyn's
+    symplectic method at rtol 1e-3, each to t_end: the energy error at ENERGY_TIMES (m g L)
+    and the CPU of each (the least of `repeat`)."""
+    when = [x for x in ENERGY_TIMES if x <= t_end + 1e-9]
+    steps = ladder(n)
+    # stable only, no agreement test: without damping and bending the chain's tip differs
+    # by 1 .. 3 cm (L2 over 1 s) between a step and its half at every step of the ladder
+    # (n = 20), a trajectory no step converges on; the energy is what is compared
+    k = next((i for i, h in enumerate(steps)
+              if bounded(run_moordyn(py, work, n, h, probe, span=0.0, undamped=True,
+                                     energy_at=(probe,)))), None)
+    md, dt = {"ok": False}, None
+    while k is not None and k < len(steps):
+        h = steps[k]
+        md = least_cpu(lambda: run_moordyn(py, work, n, h, t_end, span=0.0, undamped=True,
+                                           energy_at=when), repeat,
+                       complete=bounded)
+        if bounded(md):
+            dt = h
+            break
+        md = {"ok": False}
+        k += 1
+    sets = ["effects.damping=.false.", "solver.method='symplectic'", "solver.rtol=1e-3",
+            "solver.atol=1e-5", "solver.output_interval=0.1", "solver.max_steps=100000000"]
+    rd = least_cpu(lambda: run_ropedyn(exe, work, n, t_end, sets=sets, name="undamped"),
+                   repeat, complete=lambda r: r["status"] == "complete")
+    cells = [f"{dt:.3g}" if dt else "none stable"]
+    if md.get("ok"):
+        e = md["energies"]
+        cells += [f"{(e[i + 1] - e[0]) / MGL:+.1e}" for i in range(len(when))]
+        cells.append(f"{md['cpu']:.3g}")
+    else:
+        cells += [""] * (len(when) + 1)
+    if rd["status"] == "complete":
+        t = rd["time"]
+        cells += [f"{rd['drift'][int(np.searchsorted(t, x - 1e-9))] / MGL:+.1e}" for x in when]
+        cells += [f"{abs(rd['drift']).max() / MGL:.1e}", f"{rd['cpu']:.3g}"]
+        cells.append(f"{md['cpu'] / rd['cpu']:.2f}" if md.get("ok") else "")
+    else:
+        cells += [""] * (len(when) + 2) + [rd["status"]]
+    return f"| {n} | " + " | ".join(cells) + " |"
 
 
 # The coupled case: the top driven from Python every COUPLED_DT by the smooth motion of
@@ -447,6 +568,13 @@ def main(argv=None):
     parser.add_argument("--elements", default="10 30 100")
     parser.add_argument("--repeat", type=int, default=3,
                         help="runs of each timed run (the least CPU counts)")
+    parser.add_argument("--undamped-elements", default="20 100",
+                        help="n of the undamped comparison (energy over --undamped-t-end)")
+    parser.add_argument("--undamped-t-end", type=float, default=300.0)
+    parser.add_argument("--only-undamped", action="store_true",
+                        help="only the undamped comparison (the other tables kept)")
+    parser.add_argument("--no-undamped", action="store_true",
+                        help="without the undamped comparison (its table kept)")
     parser.add_argument("--no-write", action="store_true")
     parser.add_argument("--coupled-elements", default="30",
                         help="n of the coupled case (top driven from Python)")
@@ -466,10 +594,18 @@ def main(argv=None):
     equal_header = ("| n | MoorDyn time error [0, 2 s] (m) | ropedyn rtol | ropedyn method "
                     "| ropedyn tip error [0, 2 s] (m) | ropedyn balance error (J) "
                     "| ropedyn steps | ropedyn CPU (s) | MoorDyn CPU (s) | MoorDyn / ropedyn |")
-    print(header, flush=True)
+    if not args.only_undamped:
+        print(header, flush=True)
     with tempfile.TemporaryDirectory() as tmp:
         work = pathlib.Path(tmp)
-        for n in (int(x) for x in args.elements.split()):
+        undamped_rows = []
+        if not args.no_undamped:
+            print(UNDAMPED_HEADER, flush=True)
+            for n in (int(x) for x in args.undamped_elements.split()):
+                undamped_rows.append(undamped_row(py, exe, work, n, args.undamped_t_end,
+                                                  args.probe, args.repeat))
+                print(undamped_rows[-1], flush=True)
+        for n in ([] if args.only_undamped else (int(x) for x in args.elements.split())):
             zeta = segment_damping_ratio(n)
             # the largest step of the ladder stable over the probe, then over the run (a
             # run that goes unstable later takes the next smaller step)
@@ -506,9 +642,11 @@ def main(argv=None):
                     md_time_error = float(np.sqrt(np.mean(d ** 2)))
                     md_self = f"{md_time_error:.1e}"
                     if ref["status"] == "complete":
-                        equal_rows.append(at_equal_accuracy(exe, work, n, args.t_end, ref, md,
-                                                            md_time_error, args.repeat))
-                        print(equal_rows[-1], flush=True)
+                        for method in ("auto", "symplectic"):
+                            equal_rows.append(at_equal_accuracy(
+                                exe, work, n, args.t_end, ref, md, md_time_error, args.repeat,
+                                method))
+                            print(equal_rows[-1], flush=True)
             dt_text = f"{dt:.3g}" if dt else "none stable (or MoorDyn crashed)"
             row = (f"| {n} | {dt_text} | {zeta:.4f} | {md_cpu} | auto ({rd.get('methods', '')}) "
                    f"| {rd.get('steps', '')} | {rd_cpu} | {ratio} | {rd_err} | "
@@ -516,7 +654,30 @@ def main(argv=None):
             rows.append(row)
             print(row, flush=True)
     if args.no_write:
-        return coupled_main(args, exe, py)
+        return 0 if args.only_undamped else coupled_main(args, exe, py)
+    if undamped_rows:
+        update_doc(DOCS / "performance" / "peers.md", UNDAMPED_BEGIN, UNDAMPED_END, "\n".join([
+            UNDAMPED_BEGIN,
+            f"Command: `scripts/bench_peers --only-undamped --undamped-elements "
+            f"\"{args.undamped_elements}\" --undamped-t-end {args.undamped_t_end:g} --repeat "
+            f"{args.repeat}` (code: tools/ropedyn_tools/studies/bench_peers.py; CPU: the least of "
+            f"{args.repeat} runs each). The paper's rope with damping off in both codes, "
+            f"{args.undamped_t_end:g} s; MoorDyn without bending stiffness either (a chain of "
+            "tension-only springs, whose energy - kinetic, gravity, springs - its driver sums "
+            "outside the timed loop), RK4 at the largest step of the ladder that stays "
+            f"finite (tip within 1.05 L of the top) and whose energy never rises by m g L, "
+            f"over a {args.probe:g} s probe and over "
+            "the whole run (no agreement test: without damping and bending the tip differs "
+            "by 1 .. 3 cm over 1 s between any step of the ladder and its half); ropedyn: "
+            "`method = 'symplectic'`, rtol 1e-3, a record every 0.1 s. The energy error "
+            "E - E0 in units of m g L (1.156 J), MoorDyn's of its own energy. Machine: "
+            f"{machine()}. Run: {utc_stamp()}.", "", UNDAMPED_HEADER,
+            "|" + "---|" * (UNDAMPED_HEADER.count("|") - 1), *undamped_rows, UNDAMPED_END]),
+            heading="## The undamped rope over 300 s: MoorDyn's RK4 and the symplectic "
+                    "method\n\n")
+    if args.only_undamped:
+        print(f"bench_peers: {DOCS / 'performance' / 'peers.md'}")
+        return 0
     lines = [BEGIN,
              f"Command: `scripts/bench_peers --t-end {args.t_end:g} --elements "
              f"\"{args.elements}\" --repeat {args.repeat}` (code: "

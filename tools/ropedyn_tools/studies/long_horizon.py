@@ -3,7 +3,9 @@
 Every scene of input/hard/ runs to its full t_end with the default method and settings, and
 with every method of METHODS at every tolerance of RTOLS (atol = rtol / 100, as the scenes'
 1e-6 / 1e-8), plus the order-safety cases (ORDER_CASES: MEBDF order 7 and CVODE orders 4
-and 5 on the undamped and lightly damped rope at rtol 1e-3, with the monitor off and on).
+and 5 on the undamped and lightly damped rope at rtol 1e-3, with the monitor off and on)
+and the energy cases (energy_cases: the undamped and lightly damped rope to 300 s with
+every method and auto at rtol 1e-3, the balance error in m g L at 30 s and 300 s).
 Used by the CTest label `long` (tests/long/test_long_horizon.py, `scripts/test --long`) and by
 scripts/stability_report (the tables of docs/validation/long-horizon.md and order-safety.md).
 
@@ -36,7 +38,7 @@ from ropedyn_tools.studies.common import git, scene_number
 HARD = INPUT / "hard"
 
 #: the methods of the matrix (each at every tolerance); a new method is one more name here
-METHODS = ["cvode", "mebdf", "adams", "erk"]
+METHODS = ["cvode", "mebdf", "adams", "erk", "symplectic"]
 #: the tolerances of the matrix; atol = rtol * ATOL_RATIO
 RTOLS = [1e-3, 1e-5, 1e-7]
 ATOL_RATIO = 1e-2
@@ -51,6 +53,24 @@ ORDER_CASES = [
     for method, order in (("mebdf", 7), ("cvode", 5), ("cvode", 4))
     for policy in ("off", "lower")
 ]
+
+
+#: the energy over long runs (docs/validation/energy.md): the undamped and the
+#: lightly damped rope (n = 30) to ENERGY_T_END with every method and auto at rtol 1e-3;
+#: the balance error (m g L) at ENERGY_TIMES and its largest value up to each
+ENERGY_SCENES = ("undamped", "light_damping")
+ENERGY_T_END = 300.0
+ENERGY_TIMES = (30.0, 300.0)
+ENERGY_RTOL = 1e-3
+
+
+def energy_cases():
+    """[(key, scene, overrides)]: every method and auto on the ENERGY_SCENES to 300 s."""
+    return [(f"energy/{scene}/{method}", scene, [
+        f"solver.method={method}", f"solver.rtol={ENERGY_RTOL:g}",
+        f"solver.atol={ENERGY_RTOL * ATOL_RATIO:g}", f"solver.t_end={ENERGY_T_END:g}",
+        "solver.output_interval=0.1", "solver.max_steps=100000000"])
+        for scene in ENERGY_SCENES for method in METHODS + ["auto"]]
 
 
 def scenes():
@@ -175,7 +195,9 @@ def measures(rc, stderr, path, scene):
         return r
     m = stability_metrics.analyse(path)
     bad = stability_metrics.all_finite(path)
-    scale = m["rtol"] * m["energy_scale"]
+    # (a run that stopped at its start - a method that refused the problem, or a stiffness
+    # watch at the first step - moved no energy: its ratios are 0)
+    scale = m["rtol"] * m["energy_scale"] or float("inf")
     drift = m["balance_drift"]
     t = m["time"]
     r.update({
@@ -197,11 +219,31 @@ def measures(rc, stderr, path, scene):
         if "order_lowered_at" in f["solver"]:
             r["order_lowered_at"] = float(f["solver/order_lowered_at"][()])
             r["order_lowered_to"] = int(f["solver/order_lowered_to"][()])
+    r.update(energy_in_mgl(path, t, drift))
     r["outcome"] = "complete" if (m["status"] == "complete" and rc == 0) else \
         f"failed (exit {rc}) at t = {m['t_reached']:.4g} s: {m['reason']}"
     r["_series"] = {"time": t, "tip": m["tip"], "mech": m["mech"],
                     "dissipated": m["dissipated"], "drift": drift}
     return r
+
+
+def energy_in_mgl(path, t, drift):
+    """The balance error B - E0 in units of m g L (the rope's weight times its length) at
+    ENERGY_TIMES and its largest |value| up to each (those reached), and m g L itself (J)."""
+    import h5py
+    with h5py.File(path, "r") as f:
+        mass = float(np.sum(f["rope/element_mass"][()]))
+        length = float(np.sum(f["rope/element_length"][()]))
+        scene = f.attrs["scene"].decode()
+    g = re.search(r"gravity\s*=\s*([0-9.eE+-]+)", scene)
+    mgl = mass * (float(g.group(1)) if g else 9.81) * length
+    out = {"mgl": mgl, "drift_mgl_at": {}, "max_drift_mgl_to": {}}
+    for when in ENERGY_TIMES:
+        if len(t) and t[-1] >= when - 1e-9:
+            k = int(np.searchsorted(t, when - 1e-9))
+            out["drift_mgl_at"][f"{when:g}"] = float(drift[k]) / mgl
+            out["max_drift_mgl_to"][f"{when:g}"] = float(np.abs(drift[:k + 1]).max()) / mgl
+    return out
 
 
 def run_all(exe, cases, workdir, jobs=2, timeout=3000, log=print, cached_only=False):

@@ -10,7 +10,8 @@ sections of docs/validation/ (PAGES) are rewritten between their markers; the te
   without stability-limit detection, and MEBDF at its default for comparison;
 - `hard-scenes`: one table per hard scene (solver, settings, steps, CPU time, energy-balance
   error, energy growth, max tip speed, outcome);
-- `long-horizon` (and with it `numerical-damping` and `order-safety`): the long-horizon
+- `long-horizon` (and with it `numerical-damping`, `order-safety` and `energy-horizon`,
+  the balance error over 300 s in m g L): the long-horizon
   matrix of ropedyn_tools.studies.long_horizon (every scene of input/hard to its t_end, the
   default and every method at rtol 1e-3, 1e-5, 1e-7; the order-safety cases), the same runs
   as the CTest label `long` and from the same cache (build/long): after `scripts/test
@@ -39,6 +40,7 @@ PAGES = {
     "long-horizon": DOCS / "validation" / "long-horizon.md",
     "order-safety": DOCS / "validation" / "order-safety.md",
     "numerical-damping": DOCS / "validation" / "order-safety.md",
+    "energy-horizon": DOCS / "validation" / "energy.md",
 }
 HARD = INPUT / "hard"
 
@@ -299,7 +301,8 @@ def damping_table(res):
             key = f"{scene}/default" if rtol is None else f"{scene}/{method}/{rtol:g}"
             r = res[key]
             label = "default" if rtol is None else f"{method}, rtol {rtol:g}"
-            if "steps" not in r:
+            if "steps" not in r or not r["energy_scale"]:
+                # (not run, or stopped at its start: the symplectic method's refusal)
                 lines.append(f"| {scene} | {label} |  |  |  |  | {short(r['outcome'])} |")
                 continue
             lines.append(f"| {scene} | {label} | {r['t_reached']:g} | "
@@ -327,9 +330,29 @@ def order_safety_table(res):
     return "\n".join(lines)
 
 
+def energy_table(res):
+    """The balance error over 300 s of every method (long_horizon.energy_cases), m g L."""
+    lines = ["| scene | method | steps | CPU (s) | B - E0 at 30 s | at 300 s | "
+             "max abs to 30 s | max abs to 300 s | outcome |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for key, scene, _ in long_horizon.energy_cases():
+        r = res[key]
+        method = key.rsplit("/", 1)[1]
+        if "steps" not in r:
+            lines.append(f"| {scene} | {method} |  |  |  |  |  |  | {short(r['outcome'])} |")
+            continue
+        at, mx = r.get("drift_mgl_at", {}), r.get("max_drift_mgl_to", {})
+        cells = [f"{d[k]:+.1e}" if k in d else "" for d in (at,) for k in ("30", "300")] + \
+            [f"{d[k]:.1e}" if k in d else "" for d in (mx,) for k in ("30", "300")]
+        lines.append(f"| {scene} | {method} | {r['steps']} | {fmt(r['cpu_time'], '.1f')} | "
+                     + " | ".join(cells) + f" | {short(r['outcome'])} |")
+    return "\n".join(lines)
+
+
 def long_sections(exe, jobs, command, stamp, cached_only=False):
-    """Run (or read from the cache) the long-horizon matrix; the three sections."""
-    cases = long_horizon.matrix_cases() + long_horizon.order_cases()
+    """Run (or read from the cache) the long-horizon matrix; the four sections."""
+    cases = long_horizon.matrix_cases() + long_horizon.order_cases() + \
+        long_horizon.energy_cases()
     res = long_horizon.run_all(exe, cases, long_horizon.default_workdir(), jobs=jobs,
                                cached_only=cached_only)
     head = (f"{command} (Release build; the runs of `scripts/test --long`, cached in "
@@ -350,6 +373,13 @@ def long_sections(exe, jobs, command, stamp, cached_only=False):
             "rtol 1e-3, atol 1e-5, 10 s. `off`: no energy monitor; `lower` (the default): "
             "on a gain above 10 rtol S the run goes back one record and on at the "
             "method's A-stable order.\n\n") + order_safety_table(res),
+        "energy-horizon": head + (
+            f"The undamped and the lightly damped rope (n = 30) to "
+            f"{long_horizon.ENERGY_T_END:g} s, rtol 1e-3, atol 1e-5, a record every 0.1 s, "
+            f"every method and auto: the balance error B - E0 = T + V + dissipated - "
+            f"work - E0 in units of m g L (the rope's weight times its length, "
+            f"1.156 J), signed at 30 s and 300 s, and its largest absolute value over "
+            f"the records up to each.\n\n") + energy_table(res),
     }
 
 

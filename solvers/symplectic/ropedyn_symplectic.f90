@@ -1,0 +1,539 @@
+!> A symplectic splitting method (`method = 'symplectic'`) for mechanical problems with a
+!! constant diagonal mass matrix (problem_t's force split; the RFEM offers it): Stormer-
+!! Verlet (order 2) or Blanes & Moan's 4th-order composition (ropedyn_split_tables) for the
+!! forces of the potential, the other forces (damping, drag, loads) between the steps. The
+!! derivation, the choice of the step and the measurements are in docs/theory/symplectic.md.
+!!
+!! - **Step** (Strang splitting, processed): from (q_n, v_n), with the forces at q_n known
+!!   from the previous step, v += (h/2) a_r (the second half of the D-map at q_n); the
+!!   composition's kicks v += b_i h a_c(t_i, q) and drifts q += a_i h v, t += a_i h; at
+!!   q_n+1 one evaluation gives a_c and, at a predicted velocity v~ (the velocity after
+!!   the last kick plus (h/2) a_r, both taken from the most recent forces: O(h^2) off),
+!!   a_r; then the last kick and v += (h/2) a_r (the first half of the next D-map). Without
+!!   other forces this is the composition itself, symplectic and time-reversible; a step
+!!   costs `stages` evaluations of the forces (1 for Verlet).
+!! - **Energy balance**: a D-map changes v at fixed q, t, so it changes only T, by exactly
+!!   dT = m d . (v + d/2), d = (h/2) a_r: the quadratures of energy put in (external work)
+!!   advance by their rates (h/2) g_r, and the one of energy taken out (dissipated) by what
+!!   closes the balance, dT - work (problem_t's split_layout gives the signs). A kick at a
+!!   potential that depends on time advances the work by b_i h g_c (the p_t-kick of the
+!!   extended phase space). So T + V + dissipated - work changes only in the composition's
+!!   steps on the potential, whose energy error is bounded (a modified energy is
+!!   conserved), not in the D-maps: the balance error stays bounded, with or without
+!!   damping, instead of drifting as an adaptive method's does.
+!! - **Step size** (choose_step): fixed, a safety factor times the stable step of the
+!!   composition for the fast modes of the spectrum estimate (ropedyn_spectrum: modulus and
+!!   damping of each Ritz value; ropedyn_split_tables: stable h w at each damping), shorter
+!!   below the tolerance that step reaches; fitted so that the first output interval is a
+!!   whole number of steps (the outputs then fall on steps; between steps the state is a
+!!   cubic Hermite interpolation, the steps go on undisturbed). The spectrum is estimated
+!!   again at an output time after RESPECTRUM_STEPS steps (doubled up to RESPECTRUM_MAX
+!!   while the step stays), and the step changed when it must shrink or may grow by
+!!   GROW_AT. The composition: Verlet or the 4th-order one, whichever is cheaper per
+!!   simulated second at its step; the 4th-order one where the fast modes are lightly
+!!   damped (their energy stays, and Verlet's error on it is 100 times larger).
+!! - **Failures**: a force evaluation that is not finite (an unstable step) restarts the
+!!   output interval from its start at half the step, up to MAX_RETRIES times; a step that
+!!   would take more than STIFF_STEP_RATE steps per simulated second ends the run with the
+!!   diagnosis erk gives (naming auto and mebdf); the problem must offer the force split
+!!   (else `init` says why not).
+module ropedyn_symplectic
+    use ropedyn_kinds, only: wp, i8
+    use ropedyn_text, only: int_text
+    use ropedyn_sums, only: sum_products
+    use ropedyn_error, only: error_t, make_error, ERR_SOLVER
+    use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
+    use ropedyn_integrator, only: integrator_t, start_t, solver_stats_t, stop_now, STIFF_STEP_RATE
+    use ropedyn_spectrum, only: spectrum_t, estimate_spectrum, LIGHT_DAMPING
+    use ropedyn_switch_log, only: switch_log_t, switch_event_t
+    use ropedyn_split_tables, only: split_table_t, split_table, TABLE_VERLET, TABLE_BM6, &
+                                    OVERDAMPED_LIMIT
+    implicit none
+    private
+    public :: symplectic_t, split_stable_step, choose_step, TABLE_VERLET, TABLE_BM6
+
+    !> the step over the stable step where the mode that limits it is lightly damped: the
+    !! combination frequencies of such modes (up to twice the fastest) near the stability
+    !! limit feed an energy drift. The 4th-order composition on the undamped paper rope,
+    !! n = 20, rtol 1e-3, 300 s (largest |T + V - E0| in the first and the last 20 s, m g L):
+    !! at 0.55 of the stable step 3.2e-6 .. 8.1e-4; 0.45: 1.0e-6 .. 1.8e-5; 0.4: 5.2e-7 ..
+    !! 6.9e-6; 0.35: 3.0e-7 .. 1.6e-6, while the rope's elastic energy, where the fast modes'
+    !! energy is, rose 4 times (docs/theory/symplectic.md, "The step")
+    real(wp), parameter :: RESONANT_SAFETY = 0.4_wp
+    !> steps between estimates of the spectrum (at an output time): at first, and at most
+    !! (doubled after each estimate that leaves the step as it is)
+    integer(i8), parameter :: RESPECTRUM_STEPS = 2000, RESPECTRUM_MAX = 64000
+    !> the step grows only when the new target is this much longer
+    real(wp), parameter :: GROW_AT = 1.25_wp
+    !> restarts of an output interval at half the step after a non-finite force
+    integer, parameter :: MAX_RETRIES = 4
+
+    type, extends(integrator_t) :: symplectic_t
+        private
+        type(split_table_t) :: tab
+        type(solver_stats_t) :: counters
+        type(switch_log_t) :: log
+        integer :: np = 0                      !< coordinates
+        integer, allocatable :: pos(:), vel(:)
+        real(wp), allocatable :: mass(:)       !< of the coordinates
+        integer, allocatable :: signs(:)       !< the quadratures' signs in the balance
+        integer :: closing = 0                 !< the quadrature that closes the balance
+        ! the grid: t = t_base + k h
+        real(wp) :: t_base = 0.0_wp
+        real(wp) :: h = 0.0_wp
+        integer(i8) :: k = 0
+        real(wp) :: t = 0.0_wp
+        !> the state at t and the forces there (a_r, g_r at the predicted velocity)
+        real(wp), allocatable :: q(:), v(:), yq(:), ac(:), ar(:), gc(:), gr(:)
+        !> the previous grid point, for the dense output
+        real(wp) :: t_old = 0.0_wp
+        real(wp), allocatable :: q_old(:), v_old(:), a_old(:), yq_old(:)
+        real(wp), allocatable :: y(:)          !< the problem's state, work
+        real(wp), allocatable :: vt(:)         !< the predicted velocity, work
+        real(wp), allocatable :: mar(:)        !< m a_r, the force of the rest
+        logical :: started = .false.
+        !> the state handed out last was the grid point at t (not an interpolation)
+        logical :: on_grid = .true.
+        integer(i8) :: estimated_at = 0        !< steps at the last spectrum estimate
+        integer(i8) :: respectrum = RESPECTRUM_STEPS  !< steps to the next
+        real(wp) :: radius = 0.0_wp            !< spectral radius of that estimate, 1/s
+        real(wp) :: fast_damping = 0.0_wp
+        integer :: order_limit = 4
+        real(wp) :: fixed_h = 0.0_wp           !< fix_step's step (0: the rule's)
+        real(wp) :: h_rule = 0.0_wp            !< the rule's step before fitting, s
+    contains
+        procedure :: start => symplectic_start
+        procedure :: advance_to => symplectic_advance_to
+        procedure :: stats => symplectic_stats
+        procedure :: finalize => symplectic_finalize
+        procedure :: name => symplectic_name
+        procedure :: switch_log => symplectic_switch_log
+        procedure :: step_size => symplectic_step_size
+        procedure :: fix_step => symplectic_fix_step
+        procedure, private :: begin
+        procedure, private :: review_step
+        procedure, private :: set_step
+        procedure, private :: step
+        procedure, private :: evaluate
+        procedure, private :: dmap
+        procedure, private :: dense
+        procedure, private :: failure
+    end type symplectic_t
+
+    interface
+        !> The first step size (from the spectrum at the initial state) and the forces there
+        !! (submodule ropedyn_symplectic_steps, as the rest of the step-size choice).
+        module subroutine begin(self, tout, err)
+            class(symplectic_t), intent(inout) :: self
+            real(wp), intent(in) :: tout
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine begin
+
+        !> The spectrum at the current state again; the step changed when it must shrink or
+        !! may grow by GROW_AT (the interval to tout from here a whole number of steps).
+        module subroutine review_step(self, tout, err)
+            class(symplectic_t), intent(inout) :: self
+            real(wp), intent(in) :: tout
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine review_step
+
+        !> The step from now on: `h` at most, fitted so that the interval to tout is a whole
+        !! number of steps; the change logged (as a warning when `warn`).
+        module subroutine set_step(self, h, tout, reason, warn)
+            class(symplectic_t), intent(inout) :: self
+            real(wp), intent(in) :: h, tout
+            character(len=*), intent(in) :: reason
+            logical, intent(in) :: warn
+        end subroutine set_step
+
+        !> The composition and its step for a spectrum estimate, a tolerance and an order
+        !! limit (ropedyn_symplectic_steps, where the rule is); `light`: the mode that limits
+        !! the step is lightly damped (below LIGHT_DAMPING); h = 0: no estimate.
+        module subroutine choose_step(spec, rtol, max_order, tab, h, light, text)
+            type(spectrum_t), intent(in) :: spec
+            real(wp), intent(in) :: rtol
+            integer, intent(in) :: max_order
+            type(split_table_t), intent(out) :: tab
+            real(wp), intent(out) :: h
+            logical, intent(out) :: light
+            character(len=*), intent(out) :: text
+        end subroutine choose_step
+
+        !> The largest step (s) at which the composition `tab` is stable for every fast Ritz
+        !! value of `spec` (|lambda| >= radius/10), each taken as a damped oscillator with
+        !! w = |lambda| and zeta = -Re(lambda)/|lambda| (a real lambda < 0: damping alone,
+        !! h |lambda| <= OVERDAMPED_LIMIT; a Ritz value in the right half plane: undamped).
+        !! 0 when there is no estimate.
+        pure module subroutine split_stable_step(tab, spec, h, zeta_limit)
+            type(split_table_t), intent(in) :: tab
+            type(spectrum_t), intent(in) :: spec
+            real(wp), intent(out) :: h
+            !> the damping ratio of the Ritz value that limits h (1 for a real one)
+            real(wp), intent(out), optional :: zeta_limit
+        end subroutine split_stable_step
+    end interface
+
+    !> A copy of the stepping state (a restart of an output interval).
+    type :: snapshot_t
+        real(wp) :: t_base, h, t
+        integer(i8) :: k
+        real(wp), allocatable :: q(:), v(:), yq(:), ac(:), ar(:), gc(:), gr(:)
+    end type snapshot_t
+
+contains
+
+    pure function symplectic_name(self) result(name)
+        class(symplectic_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'symplectic'
+    end function symplectic_name
+
+    function symplectic_switch_log(self) result(events)
+        class(symplectic_t), intent(in) :: self
+        type(switch_event_t), allocatable :: events(:)
+        events = self%log%items()
+    end function symplectic_switch_log
+
+    !> The step in use (s; 0 before the first advance_to).
+    pure real(wp) function symplectic_step_size(self) result(h)
+        class(symplectic_t), intent(in) :: self
+        h = self%h
+    end function symplectic_step_size
+
+    !> Use the composition `table` (TABLE_VERLET or TABLE_BM6) at the step h (s) for the
+    !! whole run instead of the rule (tests, studies); call after init, before the first
+    !! advance_to.
+    subroutine symplectic_fix_step(self, table, h)
+        class(symplectic_t), intent(inout) :: self
+        integer, intent(in) :: table
+        real(wp), intent(in) :: h
+        self%tab = split_table(table)
+        self%fixed_h = h
+    end subroutine symplectic_fix_step
+
+    subroutine symplectic_start(self, start, err)
+        class(symplectic_t), intent(inout) :: self
+        type(start_t), intent(in) :: start
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: why
+        integer :: kl, ku, j
+
+        why = self%problem%force_split_refusal()
+        if (len(why) > 0 .and. self%problem%has_mass_matrix()) why = why//'; its mass '// &
+            'matrix depends on the state, which no explicit symplectic method integrates '// &
+            '(docs/theory/symplectic.md, "The MPP")'
+        if (len(why) == 0 .and. .not. self%problem%has_second_order()) &
+            why = 'the problem has no coordinates and rates'
+        if (len(why) == 0) then
+            call self%problem%second_order_layout(self%pos, self%vel, kl, ku)
+            if (2*size(self%pos) /= self%n) why = 'the problem has unknowns other than '// &
+                'coordinates and their rates'
+        end if
+        if (len(why) > 0) then
+            call make_error(err, ERR_SOLVER, 'symplectic: cannot integrate this problem: '// &
+                            why//' (use method = ''auto'' or ''erk'')')
+            return
+        end if
+        self%np = size(self%pos)
+        allocate (self%mass(self%np), self%signs(self%nq))
+        call self%problem%split_layout(self%mass, self%signs)
+        self%closing = 0
+        do j = 1, self%nq
+            if (self%signs(j) == -1) then
+                self%closing = j
+                exit
+            end if
+        end do
+        self%y = start%y0
+        self%q = start%y0(self%pos)
+        self%v = start%y0(self%vel)
+        self%yq = start%yq0
+        allocate (self%ac(self%np), self%ar(self%np), self%vt(self%np), self%mar(self%np), &
+                  self%gc(self%nq), self%gr(self%nq))
+        self%q_old = self%q
+        self%v_old = self%v
+        self%a_old = 0.0_wp*self%q
+        self%yq_old = self%yq
+        self%t = start%t0
+        self%t_old = start%t0
+        self%t_base = start%t0
+        self%k = 0
+        self%h = 0.0_wp
+        self%started = .false.
+        self%on_grid = .true.
+        self%order_limit = start%max_order
+        self%respectrum = RESPECTRUM_STEPS
+        self%fixed_h = 0.0_wp
+        self%tab = split_table(merge(TABLE_BM6, TABLE_VERLET, start%max_order >= 4))
+        self%counters = solver_stats_t()
+        call self%log%clear()
+    end subroutine symplectic_start
+
+    subroutine symplectic_advance_to(self, tout, t, y, yq, err)
+        class(symplectic_t), intent(inout) :: self
+        real(wp), intent(in) :: tout
+        real(wp), intent(out) :: t
+        real(wp), intent(inout) :: y(:)
+        real(wp), intent(inout) :: yq(:)
+        type(error_t), allocatable, intent(out) :: err
+        type(snapshot_t) :: snap
+        integer :: status, retries
+        real(wp) :: tol
+
+        t = self%t
+        if (.not. associated(self%problem)) then
+            call make_error(err, ERR_SOLVER, 'symplectic: advance_to called before init')
+            return
+        end if
+        if (tout <= self%t .and. .not. self%started) then
+            call self%dense(self%t, y, yq)
+            return
+        end if
+        if (self%started .and. tout < self%t_old - 1.0e-7_wp*self%h) then
+            call make_error(err, ERR_SOLVER, 'symplectic: output time lies before the last step')
+            return
+        end if
+        if (.not. self%started) then
+            call self%begin(tout, err)
+        else if (self%counters%steps - self%estimated_at >= self%respectrum .and. &
+                 self%on_grid) then
+            call self%review_step(tout, err)
+        end if
+        if (allocated(err)) return
+        call fit_to_output(self, tout)
+        snap = snapshot_t(self%t_base, self%h, self%t, self%k, self%q, self%v, self%yq, &
+                          self%ac, self%ar, self%gc, self%gr)
+        retries = 0
+        tol = 1.0e-7_wp*self%h
+        do while (self%t < tout - tol)
+            if (self%counters%steps >= self%options%max_steps) then
+                call self%failure(err, self%steps_exhausted())
+                exit
+            end if
+            ! (the state before the step is kept only where the dense output may need it)
+            call self%step(status, self%t_base + real(self%k + 1, wp)*self%h > tout - tol)
+            if (status == STATUS_FATAL) then
+                call self%failure(err, 'the forces reported a fatal error')
+                exit
+            else if (status /= STATUS_OK) then
+                ! not finite: the step was unstable; the interval again at half the step
+                retries = retries + 1
+                if (retries > MAX_RETRIES) then
+                    call self%failure(err, 'the forces are not finite (NaN or Inf) even at '// &
+                                      'the step halved '//int_text(MAX_RETRIES)//' times: '// &
+                                      'the motion had become unstable before this output '// &
+                                      'interval (the energy balance of the records shows '// &
+                                      'where); a tighter rtol (a shorter step) or method = '// &
+                                      '''auto'' avoids it')
+                    exit
+                end if
+                call restore(self, snap)
+                call self%set_step(0.5_wp*self%h, tout, 'the forces were not finite '// &
+                                   '(an unstable step): the output interval again at half '// &
+                                   'the step', .true.)
+                tol = 1.0e-7_wp*self%h
+                cycle
+            end if
+            if (self%t < tout - tol .and. stop_now(self%options)) exit
+        end do
+        if (allocated(err) .or. self%t < tout - tol) then
+            ! failed or stopped early: the state at the last step
+            call self%dense(self%t, y, yq)
+            t = self%t
+            self%on_grid = .true.
+            return
+        end if
+        self%on_grid = abs(self%t - tout) <= tol
+        if (self%on_grid) then
+            call self%dense(self%t, y, yq)
+        else
+            call self%dense(tout, y, yq)
+        end if
+        t = tout
+    end subroutine symplectic_advance_to
+
+    !> The output time tout a whole number of steps from t (to 1e-6 of a step): else the
+    !! step is fitted to it (after a switch to this method, or a last output off the
+    !! interval: once or twice, then every output falls on a step).
+    subroutine fit_to_output(self, tout)
+        class(symplectic_t), intent(inout) :: self
+        real(wp), intent(in) :: tout
+        real(wp) :: steps, target
+        if (self%fixed_h > 0.0_wp .or. tout <= self%t .or. self%h <= 0.0_wp) return
+        steps = (tout - self%t)/self%h
+        if (abs(steps - anint(steps)) <= 1.0e-6_wp*max(1.0_wp, steps)) return
+        target = self%h_rule
+        if (target <= 0.0_wp) target = self%h
+        self%h = (tout - self%t)/real(ceiling((tout - self%t)/target*(1.0_wp - 1.0e-12_wp)), wp)
+        self%t_base = self%t
+        self%k = 0
+    end subroutine fit_to_output
+
+    !> The stepping state as it was at the snapshot.
+    subroutine restore(self, snap)
+        class(symplectic_t), intent(inout) :: self
+        type(snapshot_t), intent(in) :: snap
+        self%t_base = snap%t_base
+        self%h = snap%h
+        self%t = snap%t
+        self%k = snap%k
+        self%q = snap%q
+        self%v = snap%v
+        self%yq = snap%yq
+        self%ac = snap%ac
+        self%ar = snap%ar
+        self%gc = snap%gc
+        self%gr = snap%gr
+    end subroutine restore
+
+
+
+
+
+
+
+    !> One step from t to t + h (the module header); status not OK: the state is not usable.
+    subroutine step(self, status, keep_old)
+        class(symplectic_t), intent(inout) :: self
+        integer, intent(out) :: status
+        !> keep the state before the step for the dense output (the last step to an output)
+        logical, intent(in) :: keep_old
+        real(wp) :: h, ti, t_new
+        integer :: i, s
+        h = self%h
+        s = self%tab%stages
+        if (keep_old) then
+            self%t_old = self%t
+            self%q_old = self%q
+            self%v_old = self%v
+            self%a_old = self%ac + self%ar
+            self%yq_old = self%yq
+        end if
+        t_new = self%t_base + real(self%k + 1, wp)*h
+        call self%dmap(0.5_wp*h)
+        ti = self%t
+        do i = 1, s
+            if (i > 1) then
+                call self%evaluate(ti, status, full=.false.)
+                if (status /= STATUS_OK) return
+            end if
+            self%v = self%v + (self%tab%b(i)*h)*self%ac
+            if (self%nq > 0) self%yq = self%yq + (self%tab%b(i)*h)*self%gc
+            self%q = self%q + (self%tab%a(i)*h)*self%v
+            ti = ti + self%tab%a(i)*h
+        end do
+        ! the predicted velocity: after the last kick and half the D-map, from the most
+        ! recent forces
+        self%vt = self%v + (self%tab%b(s + 1)*h)*self%ac + (0.5_wp*h)*self%ar
+        call self%evaluate(t_new, status, full=.true.)
+        if (status /= STATUS_OK) return
+        self%v = self%v + (self%tab%b(s + 1)*h)*self%ac
+        if (self%nq > 0) self%yq = self%yq + (self%tab%b(s + 1)*h)*self%gc
+        call self%dmap(0.5_wp*h)
+        self%k = self%k + 1
+        self%t = t_new
+        self%counters%steps = self%counters%steps + 1
+        self%counters%last_step = h
+        self%counters%last_order = self%tab%order
+        self%counters%order_steps(self%tab%order) = &
+            self%counters%order_steps(self%tab%order) + 1
+    end subroutine step
+
+    !> The forces at (tt, q): the potential's (ac, gc) and, when `full`, the rest's (ar, gr)
+    !! at the predicted velocity vt.
+    subroutine evaluate(self, tt, status, full)
+        class(symplectic_t), intent(inout) :: self
+        real(wp), intent(in) :: tt
+        integer, intent(out) :: status
+        logical, intent(in) :: full
+        self%y(self%pos) = self%q
+        if (full) then
+            self%y(self%vel) = self%vt
+            call self%problem%split_rhs(tt, self%y, self%ac, self%gc, status, self%ar, self%gr)
+            self%mar = self%mass*self%ar
+        else
+            call self%problem%split_rhs(tt, self%y, self%ac, self%gc, status)
+        end if
+        self%counters%rhs_evals = self%counters%rhs_evals + 1
+    end subroutine evaluate
+
+    !> The D-map over hh at fixed q, t: v += hh a_r; the quadratures of work by their rates,
+    !! the closing one by the exact change of T, hh (m a_r) . (v + hh a_r / 2) (the module
+    !! header).
+    subroutine dmap(self, hh)
+        class(symplectic_t), intent(inout) :: self
+        real(wp), intent(in) :: hh
+        real(wp) :: dt_kin, rest, dyq(self%nq)
+        integer :: j
+        if (self%nq == 0) then
+            self%v = self%v + hh*self%ar
+            return
+        end if
+        self%vt = self%v + (0.5_wp*hh)*self%ar
+        dt_kin = hh*sum_products(self%mar, self%vt)
+        self%v = self%v + hh*self%ar
+        dyq = hh*self%gr
+        if (self%closing > 0) then
+            rest = 0.0_wp
+            do j = 1, self%nq
+                if (j /= self%closing) rest = rest + self%signs(j)*dyq(j)
+            end do
+            dyq(self%closing) = (dt_kin - rest)/real(self%signs(self%closing), wp)
+        end if
+        self%yq = self%yq + dyq
+    end subroutine dmap
+
+    !> The state at tt in [t_old, t]: the grid point itself, or the cubic Hermite
+    !! interpolation of q (with v) and of v (with a = a_c + a_r), the quadratures linear.
+    subroutine dense(self, tt, y, yq)
+        class(symplectic_t), intent(inout) :: self
+        real(wp), intent(in) :: tt
+        real(wp), intent(inout) :: y(:), yq(:)
+        real(wp) :: dt, s, h00, h10, h01, h11
+        if (tt >= self%t .or. self%t <= self%t_old) then
+            self%y(self%pos) = self%q
+            self%y(self%vel) = self%v
+            y = self%y
+            if (self%nq > 0) yq(1:self%nq) = self%yq
+            return
+        end if
+        dt = self%t - self%t_old
+        s = (tt - self%t_old)/dt
+        h00 = (1.0_wp + 2.0_wp*s)*(1.0_wp - s)**2
+        h10 = s*(1.0_wp - s)**2
+        h01 = s**2*(3.0_wp - 2.0_wp*s)
+        h11 = s**2*(s - 1.0_wp)
+        y(self%pos) = h00*self%q_old + h10*dt*self%v_old + h01*self%q + h11*dt*self%v
+        y(self%vel) = h00*self%v_old + h10*dt*self%a_old + h01*self%v + &
+                      h11*dt*(self%ac + self%ar)
+        if (self%nq > 0) yq(1:self%nq) = (1.0_wp - s)*self%yq_old + s*self%yq
+    end subroutine dense
+
+    subroutine failure(self, err, cause)
+        class(symplectic_t), intent(in) :: self
+        type(error_t), allocatable, intent(out) :: err
+        character(len=*), intent(in) :: cause
+        character(len=96) :: buffer
+        write (buffer, '(a, es12.5, a, es11.3e3, a, i0)') 't = ', self%t, ' s, step size ', &
+            self%h, ' s, order ', self%tab%order
+        call make_error(err, ERR_SOLVER, 'symplectic failed at '//trim(buffer)//': '//cause)
+    end subroutine failure
+
+    function symplectic_stats(self) result(stats)
+        class(symplectic_t), intent(in) :: self
+        type(solver_stats_t) :: stats
+        stats = self%counters
+    end function symplectic_stats
+
+    subroutine symplectic_finalize(self)
+        class(symplectic_t), intent(inout) :: self
+        self%problem => null()
+        if (allocated(self%mass)) deallocate (self%mass, self%signs)
+        if (allocated(self%q)) deallocate (self%q, self%v, self%yq)
+        if (allocated(self%ac)) deallocate (self%ac, self%ar, self%gc, self%gr, self%vt, self%mar)
+        if (allocated(self%q_old)) deallocate (self%q_old, self%v_old, self%a_old, self%yq_old)
+        if (allocated(self%y)) deallocate (self%y)
+        if (allocated(self%pos)) deallocate (self%pos, self%vel)
+        self%started = .false.
+    end subroutine symplectic_finalize
+end module ropedyn_symplectic

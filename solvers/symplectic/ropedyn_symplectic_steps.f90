@@ -1,0 +1,180 @@
+!> The step-size choice of the symplectic method (ropedyn_symplectic's header, "Step
+!! size"; docs/theory/symplectic.md, "The step").
+submodule (ropedyn_symplectic) ropedyn_symplectic_steps
+    implicit none
+
+contains
+
+    !> The first step size and the forces at the initial state.
+    module procedure begin
+        integer :: status
+        real(wp) :: h
+        character(len=200) :: text
+        type(split_table_t) :: tab
+        self%started = .true.
+        self%vt = self%v
+        call self%evaluate(self%t, status, full=.true.)
+        if (status /= STATUS_OK) then
+            call self%failure(err, 'the forces could not be evaluated at the initial state')
+            return
+        end if
+        if (self%fixed_h > 0.0_wp) then
+            self%h = self%fixed_h
+            self%respectrum = huge(1_i8)
+            call self%log%add(self%t, self%name(), self%tab%order, trim(self%tab%label)// &
+                              ' at a fixed step')
+            return
+        end if
+        call stable_step_here(self, tab, h, text)
+        if (h <= 0.0_wp) then
+            call self%failure(err, 'no estimate of the spectrum to choose the step from')
+            return
+        end if
+        call too_stiff(self, h, err)
+        if (allocated(err)) return
+        self%tab = tab
+        call self%set_step(h, tout, trim(text), .false.)
+    end procedure begin
+
+    !> The run ends (ERR_SOLVER) when the step h would take more than STIFF_STEP_RATE steps
+    !! per simulated second, as erk's and adams' do: the step of an explicit method held by
+    !! the spectral radius, where an implicit method takes steps many times longer.
+    subroutine too_stiff(self, h, err)
+        class(symplectic_t), intent(inout) :: self
+        real(wp), intent(in) :: h
+        type(error_t), allocatable, intent(out) :: err
+        character(len=240) :: text
+        if (1.0_wp/h <= STIFF_STEP_RATE) return
+        write (text, '(a, es9.2, a, es9.2, a, es9.2, a)') 'the problem is too stiff for an '// &
+            'explicit method here: the step is held by stability (spectral radius ', &
+            self%radius, ' 1/s, step ', h, ' s), which takes ', 1.0_wp/h, &
+            ' steps per simulated second'
+        self%h = h
+        call self%failure(err, trim(text)//'; use method = ''auto'' (it switches to an '// &
+                          'implicit method where this happens) or ''mebdf''')
+    end subroutine too_stiff
+
+    !> The spectrum at the current state again; the step changed when it must shrink or
+    !! may grow by GROW_AT (the first output interval from here a whole number of steps).
+    module procedure review_step
+        real(wp) :: h
+        character(len=200) :: text
+        type(split_table_t) :: tab
+        call stable_step_here(self, tab, h, text)
+        if (h <= 0.0_wp) return
+        call too_stiff(self, h, err)
+        if (allocated(err)) return
+        ! the composition and its step change together (the step is the composition's)
+        if (tab%kind /= self%tab%kind .or. h < self%h .or. h > GROW_AT*self%h) then
+            self%tab = tab
+            call self%set_step(h, tout, trim(text), .false.)
+            self%respectrum = RESPECTRUM_STEPS
+        else
+            self%respectrum = min(RESPECTRUM_MAX, 2*self%respectrum)
+        end if
+    end procedure review_step
+
+    !> The composition and step for the spectrum at the current state (choose_step; h = 0:
+    !! no estimate), and its reason for the log.
+    subroutine stable_step_here(self, tab, h, text)
+        class(symplectic_t), intent(inout) :: self
+        type(split_table_t), intent(out) :: tab
+        real(wp), intent(out) :: h
+        character(len=*), intent(out) :: text
+        type(spectrum_t) :: spec
+        logical :: light
+        self%y(self%pos) = self%q
+        self%y(self%vel) = self%v
+        call estimate_spectrum(self%problem, self%t, self%y, spec)
+        self%estimated_at = self%counters%steps
+        call choose_step(spec, self%options%rtol, self%order_limit, tab, h, light, text)
+        self%radius = spec%radius
+        self%fast_damping = spec%fast_damping
+    end subroutine stable_step_here
+
+    !> The composition (Verlet, or Blanes-Moan's when max_order >= 4) and its step for a
+    !! spectrum estimate and a tolerance (docs/theory/symplectic.md, "The step"): each
+    !! composition's step is its `safety` times its stable step (RESONANT_SAFETY when the mode
+    !! that limits it is damped by less than LIGHT_DAMPING), times (rtol / rtol_at)^(1/order)
+    !! below the tolerance that step reaches; the cheaper per simulated second is taken,
+    !! except that lightly damped fast modes take the 4th-order composition when allowed
+    !! (at Verlet's resonance-safe step its energy error is 100 times larger). h = 0: no
+    !! estimate.
+    module procedure choose_step
+        type(split_table_t) :: cand
+        real(wp) :: hs, hk, zeta, safety, scale, cost, best
+        integer :: kind
+        logical :: slight
+        h = 0.0_wp
+        light = .false.
+        text = 'no estimate of the spectrum'
+        best = huge(1.0_wp)
+        tab = split_table(TABLE_VERLET)
+        do kind = TABLE_VERLET, TABLE_BM6
+            if (kind == TABLE_BM6 .and. max_order < 4) exit
+            cand = split_table(kind)
+            call split_stable_step(cand, spec, hs, zeta)
+            if (hs <= 0.0_wp) return
+            ! the limiting mode, or any settled fast mode (their combinations)
+            slight = zeta < LIGHT_DAMPING .or. spec%settled_damping() < LIGHT_DAMPING
+            if (slight .and. kind == TABLE_VERLET .and. max_order >= 4) cycle
+            safety = cand%safety
+            if (slight) safety = RESONANT_SAFETY
+            scale = min(1.0_wp, (rtol/cand%rtol_at)**(1.0_wp/cand%order))
+            hk = safety*scale*hs
+            cost = cand%stages/hk
+            if (cost >= best) cycle
+            best = cost
+            tab = cand
+            h = hk
+            light = slight
+            write (text, '(a, es9.2, a, f6.3, a, es9.2, a, f5.2, a, f5.3, a)') &
+                'spectral radius ', spec%radius, ' 1/s, the mode limiting the step damped ', &
+                zeta, ', stable step ', hs, ' s, the step ', safety, ' x', scale, ' of it'
+        end do
+    end procedure choose_step
+
+    !> The step from now on: `h` at most, fitted so that the interval to tout is a whole
+    !! number of steps; the change logged (as a warning when `warn`).
+    module procedure set_step
+        real(wp) :: span
+        character(len=120) :: what
+        span = tout - self%t
+        self%h_rule = h
+        self%h = h
+        if (span > 0.0_wp) self%h = span/real(ceiling(span/h*(1.0_wp - 1.0e-12_wp)), wp)
+        self%t_base = self%t
+        self%k = 0
+        write (what, '(a, a, es10.3, a)') trim(self%tab%label), ', step ', self%h, ' s: '
+        call self%log%add(self%t, self%name(), self%tab%order, trim(what)//' '//reason, warn)
+    end procedure set_step
+
+    !> The stable step of a composition for a spectrum estimate (interface in the module).
+    module procedure split_stable_step
+        complex(wp), allocatable :: fast(:)
+        real(wp) :: w, zeta, hi
+        integer :: i
+        h = 0.0_wp
+        if (present(zeta_limit)) zeta_limit = 0.0_wp
+        if (.not. spec%valid) return
+        fast = spec%fast(0.1_wp)
+        h = huge(1.0_wp)
+        do i = 1, size(fast)
+            w = abs(fast(i))
+            if (w <= 0.0_wp) cycle
+            if (abs(aimag(fast(i))) <= 1.0e-8_wp*w .and. real(fast(i), wp) < 0.0_wp) then
+                ! a damping rate c = |lambda| alone
+                zeta = 1.0_wp
+                hi = OVERDAMPED_LIMIT/w
+            else
+                zeta = max(0.0_wp, -real(fast(i), wp)/w)
+                hi = tab%stable_hw(zeta)/w
+            end if
+            if (hi < h) then
+                h = hi
+                if (present(zeta_limit)) zeta_limit = zeta
+            end if
+        end do
+        if (h == huge(1.0_wp)) h = 0.0_wp
+    end procedure split_stable_step
+end submodule ropedyn_symplectic_steps

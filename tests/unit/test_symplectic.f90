@@ -1,0 +1,341 @@
+!> A damped linear oscillator m q'' = -m w^2 q - m c q' with the force split (problem_t):
+!! the spring is the potential, the damper the rest; one quadrature, the dissipated energy
+!! (rate m c v^2, sign -1 in the balance).
+module test_symplectic_oscillator
+    use ropedyn_kinds, only: wp
+    use ropedyn_problem, only: problem_t, STATUS_OK
+    implicit none
+    private
+    public :: oscillator_t
+
+    type, extends(problem_t) :: oscillator_t
+        real(wp) :: w = 1.0_wp    !< 1/s
+        real(wp) :: c = 0.0_wp    !< 1/s
+        real(wp) :: m = 2.0_wp    !< kg
+    contains
+        procedure :: size => osc_size
+        procedure :: bandwidths => osc_bandwidths
+        procedure :: rhs => osc_rhs
+        procedure :: has_jacobian => osc_has_jacobian
+        procedure :: jacobian => osc_jacobian
+        procedure :: quad_size => osc_quad_size
+        procedure :: quad_rhs => osc_quad_rhs
+        procedure :: has_second_order => osc_has_second_order
+        procedure :: second_order_layout => osc_layout
+        procedure :: force_split_refusal => osc_refusal
+        procedure :: split_layout => osc_split_layout
+        procedure :: split_rhs => osc_split_rhs
+    end type oscillator_t
+
+contains
+
+    pure integer function osc_size(self)
+        class(oscillator_t), intent(in) :: self
+        osc_size = 2
+    end function osc_size
+
+    pure subroutine osc_bandwidths(self, ml, mu)
+        class(oscillator_t), intent(in) :: self
+        integer, intent(out) :: ml, mu
+        ml = 1
+        mu = 1
+    end subroutine osc_bandwidths
+
+    subroutine osc_rhs(self, t, y, ydot, status)
+        class(oscillator_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: ydot(:)
+        integer, intent(out) :: status
+        ydot = [y(2), -self%w**2*y(1) - self%c*y(2)]
+        status = STATUS_OK
+    end subroutine osc_rhs
+
+    pure logical function osc_has_jacobian(self) result(has)
+        class(oscillator_t), intent(in) :: self
+        has = .true.
+    end function osc_has_jacobian
+
+    subroutine osc_jacobian(self, t, y, jb, offset, status)
+        class(oscillator_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(inout) :: jb(:, :)
+        integer, intent(in) :: offset
+        integer, intent(out) :: status
+        jb(offset - 1, 2) = jb(offset - 1, 2) + 1.0_wp           ! d q'/d v
+        jb(offset + 1, 1) = jb(offset + 1, 1) - self%w**2        ! d v'/d q
+        jb(offset, 2) = jb(offset, 2) - self%c                   ! d v'/d v
+        status = STATUS_OK
+    end subroutine osc_jacobian
+
+    pure integer function osc_quad_size(self) result(nq)
+        class(oscillator_t), intent(in) :: self
+        nq = 1
+    end function osc_quad_size
+
+    subroutine osc_quad_rhs(self, t, y, yqdot, status)
+        class(oscillator_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: yqdot(:)
+        integer, intent(out) :: status
+        yqdot(1) = self%m*self%c*y(2)**2
+        status = STATUS_OK
+    end subroutine osc_quad_rhs
+
+    pure logical function osc_has_second_order(self) result(has)
+        class(oscillator_t), intent(in) :: self
+        has = .true.
+    end function osc_has_second_order
+
+    pure subroutine osc_layout(self, pos, vel, kl, ku)
+        class(oscillator_t), intent(in) :: self
+        integer, allocatable, intent(out) :: pos(:), vel(:)
+        integer, intent(out) :: kl, ku
+        pos = [1]
+        vel = [2]
+        kl = 0
+        ku = 0
+    end subroutine osc_layout
+
+    pure function osc_refusal(self) result(why)
+        class(oscillator_t), intent(in) :: self
+        character(len=:), allocatable :: why
+        why = ''
+    end function osc_refusal
+
+    pure subroutine osc_split_layout(self, mass, signs)
+        class(oscillator_t), intent(in) :: self
+        real(wp), intent(out) :: mass(:)
+        integer, intent(out) :: signs(:)
+        mass = self%m
+        signs = -1
+    end subroutine osc_split_layout
+
+    subroutine osc_split_rhs(self, t, y, ac, gc, status, ar, gr)
+        class(oscillator_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: ac(:), gc(:)
+        integer, intent(out) :: status
+        real(wp), intent(out), optional :: ar(:), gr(:)
+        ac(1) = -self%w**2*y(1)
+        gc = 0.0_wp
+        if (present(ar)) ar(1) = -self%c*y(2)
+        if (present(gr)) gr(1) = self%m*self%c*y(2)**2
+        status = STATUS_OK
+    end subroutine osc_split_rhs
+end module test_symplectic_oscillator
+
+!> The symplectic method (solvers/symplectic, docs/theory/symplectic.md):
+!! - its stability table against the method itself, on the damped oscillator at fixed steps:
+!!   bounded at 0.97 of the tabulated h w, growing above it (Verlet at 1.03; the 4th-order
+!!   composition in its narrow gap at h w = 3.166 undamped and at 1.03 of the limit when
+!!   damped by 30 %);
+!! - its order on the oscillator (error at t = 10 at h and h/2: ratio 4 for Verlet, 16 for
+!!   the 4th-order composition), and the energy balance with damping bounded over 500
+!!   periods (the D-map's dissipated energy closes it);
+!! - bounded energy on an undamped 4-element rope over 20 s (about 2,200 periods of its
+!!   fastest mode): |T + V - E0| <= 1e-3 m g L at every record for the symplectic method,
+!!   while erk's error passes that bound (rtol 1e-3 both);
+!! - the balance with light damping and a shaken clamped top (the work of the support by
+!!   its springs' kicks and dampers' D-maps) stays within 1e-3 m g L, with work done;
+!! - refusals: point masses off the element centres, ground contact, the MPP.
+program test_symplectic
+    use ropedyn_kinds, only: wp
+    use ropedyn_error, only: error_t
+    use ropedyn_integrator, only: solver_options_t
+    use ropedyn_symplectic, only: symplectic_t, TABLE_VERLET, TABLE_BM6
+    use ropedyn_assert, only: test_suite_t
+    use ropedyn_test_run, only: run_t, simulate, completed, SET_LEN
+    use test_symplectic_oscillator, only: oscillator_t
+    implicit none
+
+    real(wp), parameter :: MGL = 6000.0_wp*acos(-1.0_wp)*0.005_wp**2/4.0_wp*9.81_wp
+    type(test_suite_t) :: suite
+
+    suite%name = 'symplectic'
+    call stability_table()
+    call order_and_balance()
+    call undamped_rope()
+    call shaken_rope()
+    call refusals()
+    call suite%finish()
+
+contains
+
+    !> The oscillator (w = 1) at a fixed step from q = 1, v = 0 over `steps` steps: the
+    !! largest |q| at the outputs (every step) and the balance T + V + dissipated - E0 at each.
+    subroutine run_fixed(table, zeta, h, steps, qmax, balance, q_end, err)
+        integer, intent(in) :: table
+        real(wp), intent(in) :: zeta, h
+        integer, intent(in) :: steps
+        real(wp), intent(out) :: qmax
+        real(wp), allocatable, intent(out) :: balance(:)
+        real(wp), intent(out) :: q_end
+        type(error_t), allocatable, intent(out) :: err
+        type(oscillator_t), target :: osc
+        type(symplectic_t) :: integ
+        type(solver_options_t) :: options
+        real(wp) :: y(2), yq(1), t, e0
+        integer :: k
+        osc%c = 2.0_wp*zeta*osc%w
+        y = [1.0_wp, 0.0_wp]
+        yq = 0.0_wp
+        e0 = 0.5_wp*osc%m*osc%w**2
+        call integ%init(osc, 0.0_wp, y, yq, options, err)
+        if (allocated(err)) return
+        call integ%fix_step(table, h)
+        allocate (balance(steps))
+        qmax = 0.0_wp
+        do k = 1, steps
+            call integ%advance_to(real(k, wp)*h, t, y, yq, err)
+            if (allocated(err)) return
+            qmax = max(qmax, abs(y(1)))
+            balance(k) = 0.5_wp*osc%m*(y(2)**2 + osc%w**2*y(1)**2) + yq(1) - e0
+        end do
+        q_end = y(1)
+    end subroutine run_fixed
+
+    subroutine stability_table()
+        real(wp), parameter :: ZETAS(3) = [0.0_wp, 0.05_wp, 0.3_wp]
+        ! the tabulated limits (ropedyn_split_tables) at those zetas
+        real(wp), parameter :: VERLET(3) = [2.0_wp, 1.8095_wp, 1.132_wp]
+        real(wp), parameter :: BM6(3) = [3.163_wp, 3.141_wp, 1.6175_wp]
+        real(wp), allocatable :: balance(:)
+        real(wp) :: qmax, q_end
+        type(error_t), allocatable :: err
+        character(len=80) :: label
+        integer :: i
+        do i = 1, 3
+            write (label, '(a, f4.2)') 'Verlet, zeta = ', ZETAS(i)
+            call run_fixed(TABLE_VERLET, ZETAS(i), 0.97_wp*VERLET(i), 3000, qmax, balance, &
+                           q_end, err)
+            call suite%check_true(.not. allocated(err) .and. qmax <= 10.0_wp, &
+                                  trim(label)//': bounded at 0.97 of the table''s h w')
+            call run_fixed(TABLE_VERLET, ZETAS(i), 1.03_wp*VERLET(i), 3000, qmax, balance, &
+                           q_end, err)
+            call suite%check_true(allocated(err) .or. qmax > 100.0_wp, &
+                                  trim(label)//': growing at 1.03 of it')
+            write (label, '(a, f4.2)') 'Blanes-Moan, zeta = ', ZETAS(i)
+            call run_fixed(TABLE_BM6, ZETAS(i), 0.97_wp*BM6(i), 3000, qmax, balance, q_end, err)
+            call suite%check_true(.not. allocated(err) .and. qmax <= 10.0_wp, &
+                                  trim(label)//': bounded at 0.97 of the table''s h w')
+        end do
+        call run_fixed(TABLE_BM6, 0.0_wp, 3.166_wp, 3000, qmax, balance, q_end, err)
+        call suite%check_true(allocated(err) .or. qmax > 100.0_wp, &
+                              'Blanes-Moan, undamped: growing in its gap at h w = 3.166')
+        call run_fixed(TABLE_BM6, 0.3_wp, 1.03_wp*BM6(3), 3000, qmax, balance, q_end, err)
+        call suite%check_true(allocated(err) .or. qmax > 100.0_wp, &
+                              'Blanes-Moan, zeta = 0.30: growing at 1.03 of the table''s h w')
+    end subroutine stability_table
+
+    subroutine order_and_balance()
+        real(wp), allocatable :: balance(:)
+        real(wp) :: qmax, q1, q2, e1, e2, exact, ratio, early, late
+        type(error_t), allocatable :: err
+        character(len=120) :: label
+        exact = cos(10.0_wp)
+        call run_fixed(TABLE_VERLET, 0.0_wp, 0.1_wp, 100, qmax, balance, q1, err)
+        call run_fixed(TABLE_VERLET, 0.0_wp, 0.05_wp, 200, qmax, balance, q2, err)
+        ratio = abs(q1 - exact)/abs(q2 - exact)
+        write (label, '(a, f6.2)') 'Verlet: error ratio at h and h/2 (order 2: 4) ', ratio
+        call suite%check_true(ratio > 3.6_wp .and. ratio < 4.4_wp, trim(label))
+        call run_fixed(TABLE_BM6, 0.0_wp, 0.2_wp, 50, qmax, balance, q1, err)
+        call run_fixed(TABLE_BM6, 0.0_wp, 0.1_wp, 100, qmax, balance, q2, err)
+        ratio = abs(q1 - exact)/abs(q2 - exact)
+        write (label, '(a, f6.2)') 'Blanes-Moan: error ratio at h and h/2 (order 4: 16) ', ratio
+        call suite%check_true(ratio > 14.0_wp .and. ratio < 18.0_wp, trim(label))
+        ! damped by 1 % over 500 periods: the balance oscillates, it does not drift (the
+        ! D-maps' dissipated energy is the change of T they make)
+        call run_fixed(TABLE_VERLET, 0.01_wp, 0.5_wp, 6284, qmax, balance, q1, err)
+        early = maxval(abs(balance(1:628)))
+        late = maxval(abs(balance(5656:6284)))
+        e1 = maxval(abs(balance))
+        write (label, '(a, es9.2, a, es9.2)') 'Verlet, zeta = 0.01, 500 periods: balance '// &
+            'in the first 50 periods ', early, ', in the last ', late
+        call suite%check_le(late, 1.1_wp*early, trim(label))
+        call run_fixed(TABLE_BM6, 0.01_wp, 1.0_wp, 3142, qmax, balance, q1, err)
+        e2 = maxval(abs(balance))
+        call suite%check_le(e2, 1.0e-3_wp, 'Blanes-Moan, zeta = 0.01, h w = 1: |balance| '// &
+                            '<= 1e-3 E0 over 500 periods')
+        call suite%check_true(e1 > 0.0_wp .and. e2 < e1, 'the 4th order''s balance error is '// &
+                              'below Verlet''s')
+    end subroutine order_and_balance
+
+    !> The largest |T + V + dissipated - work - E0| over a run's records, in m g L.
+    real(wp) function worst_balance(run) result(worst)
+        type(run_t), intent(in) :: run
+        integer :: k
+        worst = 0.0_wp
+        do k = 0, run%last()
+            worst = max(worst, abs(run%e(k)%balance() - run%e(0)%balance()))
+        end do
+        worst = worst/MGL
+    end function worst_balance
+
+    subroutine undamped_rope()
+        character(len=SET_LEN), parameter :: SETS(2) = [character(len=SET_LEN) :: &
+            'model.elements = 4', 'effects.damping = .false.']
+        type(run_t) :: run
+        real(wp) :: worst
+        character(len=100) :: label
+        call simulate(SETS, 20.0_wp, 0.1_wp, 1.0e-3_wp, run, 'symplectic')
+        if (completed(suite, run, 'undamped 4-element rope, symplectic')) then
+            worst = worst_balance(run)
+            write (label, '(a, es9.2, a)') 'undamped 4-element rope, 20 s, symplectic: '// &
+                'max |T + V - E0| = ', worst, ' m g L <= 1e-3'
+            call suite%check_le(worst, 1.0e-3_wp, trim(label))
+        end if
+        call simulate(SETS, 20.0_wp, 0.1_wp, 1.0e-3_wp, run, 'erk')
+        if (completed(suite, run, 'undamped 4-element rope, erk')) then
+            worst = worst_balance(run)
+            write (label, '(a, es9.2, a)') 'undamped 4-element rope, 20 s, erk (RK4): '// &
+                'max |T + V - E0| = ', worst, ' m g L > 1e-3 (it drifts)'
+            call suite%check_true(worst > 1.0e-3_wp, trim(label))
+        end if
+    end subroutine undamped_rope
+
+    subroutine shaken_rope()
+        character(len=SET_LEN), parameter :: SETS(8) = [character(len=SET_LEN) :: &
+            'model.elements = 6', 'rope.normal_damping = 0.1', &
+            'rope.tangential_damping = 0.04', 'supports.top = "clamped"', &
+            'supports.top_motion = "harmonic"', 'supports.top_amplitude = 0.02, 0.05', &
+            'supports.top_frequency = 3.0', 'initial.angle_deg = 20']
+        type(run_t) :: run
+        real(wp) :: worst
+        character(len=100) :: label
+        call simulate(SETS, 5.0_wp, 0.05_wp, 1.0e-3_wp, run, 'symplectic')
+        if (completed(suite, run, 'shaken lightly damped rope, symplectic')) then
+            worst = worst_balance(run)
+            write (label, '(a, es9.2, a)') 'shaken lightly damped rope, 5 s: max |T + V + '// &
+                'dissipated - work - E0| = ', worst, ' m g L <= 1e-3'
+            call suite%check_le(worst, 1.0e-3_wp, trim(label))
+            call suite%check_true(abs(run%e(run%last())%support_work) > 10.0_wp*worst*MGL, &
+                                  'shaken rope: the support did work (10 times the balance error)')
+            call suite%check_true(run%e(run%last())%dissipated > 0.0_wp, &
+                                  'shaken rope: energy was dissipated')
+        end if
+    end subroutine shaken_rope
+
+    subroutine refusals()
+        character(len=SET_LEN) :: sets(3)
+        type(run_t) :: run
+        sets(1) = 'model.elements = 6'
+        sets(2) = 'attachments.mass_positions = 0.9'
+        sets(3) = 'attachments.masses = 0.05'
+        call simulate(sets, 0.1_wp, 0.05_wp, 1.0e-3_wp, run, 'symplectic')
+        call suite%check_true(.not. run%ok, 'a point mass off an element centre is refused')
+        call suite%check_contains(run%message, 'point masses off the element centres', &
+                                  'the refusal says why')
+        sets(2) = 'effects.ground = .true.'
+        sets(3) = 'model.elements = 6'
+        call simulate(sets, 0.1_wp, 0.05_wp, 1.0e-3_wp, run, 'symplectic')
+        call suite%check_contains(run%message, 'ground contact', 'ground contact is refused')
+        sets(2) = 'model.kind = "mpp"'
+        call simulate(sets, 0.1_wp, 0.05_wp, 1.0e-3_wp, run, 'symplectic')
+        call suite%check_contains(run%message, 'mass matrix depends on the state', &
+                                  'the MPP is refused, saying why')
+    end subroutine refusals
+end program test_symplectic
