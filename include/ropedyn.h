@@ -65,7 +65,8 @@ int ropedyn_create_from_file(const char *path, ropedyn_t **sim);
 int ropedyn_create_from_text(const char *text, const char *name, ropedyn_t **sim);
 
 /* Change the scene as `--set group.key=value` does, e.g. "model.elements=40" (before
- * ropedyn_init). A bad setting leaves the scene as it was. */
+ * ropedyn_init); several settings separated by new lines are checked together (as several
+ * --set are). A bad setting leaves the scene as it was. */
 int ropedyn_set(ropedyn_t *sim, const char *setting);
 
 /* The effective scene as namelist text (every key; reads in again to the same scene), and

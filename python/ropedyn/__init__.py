@@ -1,4 +1,14 @@
-"""Reading, plotting and animating what the ropedyn executable writes.
+"""ropedyn in Python: scenes and simulations in-process, and what the executable writes.
+
+In-process (the shared library libropedyn through ctypes; docs/reference/api.md):
+
+- `ropedyn.Scene.from_file(path)`, `ropedyn.Scene(text)`: a scene, changed with
+  `scene.set("group.key", value)` (the rules of `--set`), written with `scene.write(path)`;
+- `ropedyn.run(scene)`: the whole run as `ropedyn run` makes it, as the `Run` that
+  `ropedyn.load_run` reads (no file unless `output=` names one);
+- `ropedyn.Simulation(scene)`: a simulation moved on with `advance(t)`, read with `t`,
+  `points`, `forces`, `reaction(end)`, driven with `set_support(end, position, velocity)`;
+- `ropedyn.Error`: every failure, with the command line's message and exit code.
 
 Modules (each command-line module has `main(argv=None)` and runs with `python -m`):
 
@@ -13,15 +23,20 @@ Modules (each command-line module has `main(argv=None)` and runs with `python -m
 The studies that write docs/ and the maintenance tools of the repository are not part of
 this package: they are `ropedyn_tools` in tools/ of the source tree, run by scripts/.
 
-`import ropedyn` is light; `ropedyn.load_run` and `ropedyn.Run` are loaded on first use.
+`import ropedyn` is light; everything above is loaded on first use.
 """
 
 __version__ = "0.1.0"
-__all__ = ["Run", "load_run", "__version__"]
+__all__ = ["Run", "load_run", "Scene", "Simulation", "Snapshot", "run", "Error",
+           "__version__"]
+
+_LAZY = {"Run": "ropedyn.io", "load_run": "ropedyn.io", "Scene": "ropedyn.scene",
+         "Simulation": "ropedyn.simulation", "Snapshot": "ropedyn.simulation",
+         "run": "ropedyn.simulation", "Error": "ropedyn.errors"}
 
 
 def __getattr__(name):
-    if name in ("Run", "load_run"):
-        from ropedyn import io
-        return getattr(io, name)
+    if name in _LAZY:
+        import importlib
+        return getattr(importlib.import_module(_LAZY[name]), name)
     raise AttributeError(f"module 'ropedyn' has no attribute {name!r}")

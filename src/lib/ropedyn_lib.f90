@@ -140,21 +140,31 @@ contains
         end if
     end subroutine read
 
-    !> Apply `group.key=value` as `--set` does (before `init`); a bad one changes nothing.
+    !> Apply `group.key=value` as `--set` does (before `init`); several separated by new
+    !! lines are applied together (as several --set). A bad one changes nothing.
     subroutine instance_set(self, setting, err)
         class(instance_t), intent(inout) :: self
         character(len=*), intent(in) :: setting
         type(error_t), allocatable, intent(out) :: err
         type(error_t), allocatable :: again
+        integer :: before, start, nl
         if (self%stage /= STAGE_SCENE) then
             call make_error(err, ERR_USAGE, 'set: the simulation has started: a scene '// &
                             'changes only before init')
             return
         end if
-        call append_text(self%overrides, trim(adjustl(setting)))
+        before = size(self%overrides)
+        start = 1
+        do while (start <= len(setting))
+            nl = index(setting(start:), new_line('a'))
+            if (nl == 0) nl = len(setting) - start + 2
+            if (len_trim(setting(start:start + nl - 2)) > 0) &
+                call append_text(self%overrides, trim(adjustl(setting(start:start + nl - 2))))
+            start = start + nl
+        end do
         call self%read(err)
         if (allocated(err)) then
-            self%overrides = self%overrides(:size(self%overrides) - 1)
+            self%overrides = self%overrides(:before)
             call self%read(again)
         end if
     end subroutine instance_set

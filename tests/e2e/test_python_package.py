@@ -1,5 +1,5 @@
-"""The ropedyn Python package (python/ropedyn, installed editable into .venv by
-scripts/setup) holds what a user imports; the studies and maintenance tools
+"""The ropedyn Python package (python/ropedyn, used in place by .venv, set up
+by scripts/setup) holds what a user imports; the studies and maintenance tools
 (tools/ropedyn_tools) are not installed and the scripts/ commands find them there. The
 package imports from any directory, its reader gives a run file's arrays with their units,
 and every command answers --help (without building or running anything)."""
@@ -30,6 +30,7 @@ COMMANDS = {
     "bench_step": "ropedyn_tools.studies.bench_step",
     "bench_sweep": "ropedyn_tools.studies.bench_sweep",
     "bench_peers": "ropedyn_tools.studies.bench_peers",
+    "bench_library": "ropedyn_tools.studies.bench_library",
     "bench_symplectic": "ropedyn_tools.studies.bench_symplectic",
     "auto_table": "ropedyn_tools.studies.auto_table",
     "auto_accuracy": "ropedyn_tools.studies.auto_accuracy",

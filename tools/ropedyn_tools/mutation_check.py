@@ -209,7 +209,7 @@ MUTATIONS = [
     Mutation("table-hermite-basis", MOTION,
              "b(3) = u**2*(3.0_wp - 2.0_wp*u)",
              "b(3) = u**2*(3.0_wp - u)",
-             "motion table interpolation misses its rows",
+             "motion table (and coupled support) interpolation misses its rows",
              ctest=("test_effect_anchors", "test_support_motion")),
     Mutation("table-slopes-swapped", MOTION,
              "self%slope(:, k) = (h1*(rows(2:4, k) - rows(2:4, k - 1))/h0 + &\n"

@@ -1,0 +1,150 @@
+"""Scenes in-process: a scene file or namelist text, changed as `--set` changes it.
+
+    scene = ropedyn.Scene.from_file("input/paper.nml")
+    scene.set("model.elements", 40).set("solver.rtol", 1e-8)
+    scene.get("model.elements")        # 40
+    scene.write("out/paper_n40.nml")   # reads in again to the same scene
+
+A Scene holds the effective scene as the library reads it (every key, as a run file's
+`scene` attribute has it): each change is read and checked by the library with the rules
+of `--set`, and a bad one raises ropedyn.Error and leaves the scene as it was.
+"""
+import ctypes
+import pathlib
+
+from ropedyn._lib import c_handle, library
+from ropedyn.errors import Error
+from ropedyn.namelist import parse_namelist
+
+
+def _value_text(value):
+    """A Python value as the text of `--set group.key=VALUE`."""
+    if isinstance(value, bool):
+        return ".true." if value else ".false."
+    if isinstance(value, float):
+        return repr(value)
+    if isinstance(value, (list, tuple)):
+        return ", ".join(_value_text(v) for v in value)
+    if hasattr(value, "tolist"):   # numpy scalars and arrays
+        return _value_text(value.tolist())
+    return str(value)
+
+
+class _Handle:
+    """An instance of the library for one call sequence; destroyed on exit."""
+
+    def __init__(self, create, *args):
+        self.lib = library()
+        self.h = c_handle()
+        status = create(*args, ctypes.byref(self.h))
+        if status != 0:
+            self.fail(status)
+
+    def fail(self, status):
+        message = self.lib.ropedyn_last_error(self.h).decode()
+        self.close()
+        raise Error(message, status)
+
+    def check(self, status):
+        if status != 0:
+            self.fail(status)
+
+    def text(self, function):
+        out = ctypes.c_char_p()
+        self.check(function(self.h, ctypes.byref(out)))
+        return out.value.decode()
+
+    def close(self):
+        if self.h:
+            self.lib.ropedyn_destroy(self.h)
+            self.h = c_handle()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def _open(text, name, settings=()):
+    """A library instance of the scene `text` named `name`, with `settings` applied
+    together."""
+    lib = library()
+    handle = _Handle(lib.ropedyn_create_from_text, text.encode(), name.encode())
+    if settings:
+        if any("\n" in s for s in settings):
+            handle.close()
+            raise Error("set: a value holds a new line", 2)
+        handle.check(lib.ropedyn_set(handle.h, "\n".join(settings).encode()))
+    return handle
+
+
+class Scene:
+    """A scene: namelist text (a scene file's content) read and checked by the library."""
+
+    def __init__(self, text, name="scene"):
+        """The scene of namelist `text`; `name` stands for its file in messages and in the
+        default output file (out/NAME.h5). Relative paths in it are relative to the
+        current directory."""
+        self.name = str(name)
+        with _open(str(text), self.name) as handle:
+            self._text = handle.text(handle.lib.ropedyn_scene_text)
+            self._warnings = handle.text(handle.lib.ropedyn_warnings)
+
+    @classmethod
+    def from_file(cls, path):
+        """The scene of a scene file (as `ropedyn run PATH` reads it)."""
+        lib = library()
+        scene = cls.__new__(cls)
+        scene.name = str(path)
+        with _Handle(lib.ropedyn_create_from_file, str(path).encode()) as handle:
+            scene._text = handle.text(lib.ropedyn_scene_text)
+            scene._warnings = handle.text(lib.ropedyn_warnings)
+        return scene
+
+    @property
+    def text(self):
+        """The effective scene as namelist text (every key)."""
+        return self._text
+
+    @property
+    def warnings(self):
+        """Values that are legal but probably a unit slip, one text each."""
+        return [line for line in self._warnings.splitlines() if line]
+
+    def set(self, key, value=None):
+        """Set "group.key" to `value` with the rules of `--set group.key=value` (a bool, a
+        number, a string, a pair as a tuple); or, with a dict as `key`, several keys at once
+        (checked together, as several --set are). Returns the scene."""
+        items = key.items() if isinstance(key, dict) else [(key, value)]
+        settings = [f"{k}={_value_text(v)}" for k, v in items]
+        with _open(self._text, self.name, settings) as handle:
+            self._text = handle.text(handle.lib.ropedyn_scene_text)
+            self._warnings = handle.text(handle.lib.ropedyn_warnings)
+        return self
+
+    def get(self, key):
+        """The value of "group.key" (a number, bool, string, or a list for a pair)."""
+        group, _, name = key.lower().partition(".")
+        values = parse_namelist(self._text).get(group, {})
+        if name not in values:
+            raise KeyError(key)
+        return values[name]
+
+    def write(self, path):
+        """Write the scene to `path` (a scene file: it reads in again to this scene)."""
+        path = pathlib.Path(path)
+        path.write_text(self._text + "\n")
+        return path
+
+    def copy(self):
+        """An independent copy."""
+        other = Scene.__new__(Scene)
+        other.__dict__.update(self.__dict__)
+        return other
+
+    def __eq__(self, other):
+        return isinstance(other, Scene) and self._text == other._text
+
+    def __repr__(self):
+        return f"<ropedyn.Scene {self.name!r}>"

@@ -1,0 +1,265 @@
+"""Simulations in-process: run a scene, or drive one step by step.
+
+    run = ropedyn.run(ropedyn.Scene.from_file("input/paper.nml"))   # a Run, no file
+    run.energy["total"], run.points[-1]
+
+    with ropedyn.Simulation(scene) as sim:           # top_motion = 'coupled'
+        for k in range(1, 1001):
+            t = k * 1e-3
+            sim.set_support("top", position=(0.0, 0.05 * sin(t)), velocity=(0.0, 0.05 * cos(t)))
+            sim.advance(t)
+            tension = sim.reaction("top")            # (2,) N: the support's force on the rope
+
+The frame: x down (gravity), y horizontal; SI units. What applies of a command-line run,
+and the coupling rule: the API page of the manual (docs/reference/api.md).
+"""
+import ctypes
+import io
+import pathlib
+
+import numpy as np
+
+from ropedyn._lib import c_handle, library
+from ropedyn.errors import Error
+from ropedyn.scene import Scene
+
+SUPPORTS = {"top": 0, "bottom": 1}
+ENERGY_NAMES = ("kinetic", "elastic", "gravity", "dissipated", "support_work", "total")
+
+
+def _scene_of(scene):
+    """A Scene from a Scene, or from the path of a scene file."""
+    return scene if isinstance(scene, Scene) else Scene.from_file(scene)
+
+
+def _support(end):
+    if end not in SUPPORTS:
+        raise Error(f"unknown support {end!r} (top or bottom)", 2)
+    return SUPPORTS[end]
+
+
+def run(scene, output=None):
+    """Run `scene` (a Scene, or a scene file's path) from its start to t_end as `ropedyn run`
+    does (the same records, order safety and statuses; no signals caught) and return it as
+    the Run that ropedyn.load_run reads. No file is written unless `output` names one (it is
+    then guarded as the command line's output: a lock, FILE.part until the end)."""
+    from ropedyn.io import load_run
+    scene = _scene_of(scene)
+    lib = library()
+    h = c_handle()
+    image, size = ctypes.c_void_p(), ctypes.c_size_t()
+    try:
+        status = lib.ropedyn_create_from_text(scene.text.encode(), scene.name.encode(),
+                                              ctypes.byref(h))
+        if status == 0:
+            status = lib.ropedyn_run(h, str(output).encode() if output else None,
+                                     ctypes.byref(image), ctypes.byref(size))
+        message = lib.ropedyn_last_error(h).decode()
+        data = ctypes.string_at(image, size.value) if image.value and size.value else b""
+    finally:
+        lib.ropedyn_destroy(h)
+    if status == 0:
+        return _loaded(load_run, scene, output, data)
+    error = Error(message, status)
+    if status == 3 and (data or (output and pathlib.Path(output).is_file())):
+        # a failed integration: the records up to the failure, as the file has them
+        error.run = _loaded(load_run, scene, output, data)
+    raise error
+
+
+def _loaded(load_run, scene, output, data):
+    """The Run of a file, or of a file's bytes in memory."""
+    if output:
+        return load_run(output)
+    result = load_run(io.BytesIO(data))
+    result.path = f"{scene.name} (in memory)"
+    return result
+
+
+class Snapshot:
+    """A state of a Simulation kept in memory (Simulation.save); restore it with
+    Simulation.restore."""
+
+    def __init__(self, lib, handle, t):
+        self._lib = lib
+        self._h = handle
+        self.t = t
+
+    def close(self):
+        if self._h:
+            self._lib.ropedyn_snapshot_destroy(self._h)
+            self._h = c_handle()
+
+    def __del__(self):
+        self.close()
+
+
+class Simulation:
+    """A scene's simulation, moved on by `advance`; no file is written.
+
+    `statics=True` starts at the static equilibrium (at rest) instead of the scene's
+    initial state. The scene's t_end and output interval do not apply; the order safety
+    does not run (docs/reference/api.md says why)."""
+
+    def __init__(self, scene, statics=False):
+        self.scene = _scene_of(scene)
+        self._lib = library()
+        self._h = c_handle()
+        status = self._lib.ropedyn_create_from_text(
+            self.scene.text.encode(), self.scene.name.encode(), ctypes.byref(self._h))
+        if status == 0:
+            status = self._lib.ropedyn_init(self._h, 1 if statics else 0)
+        self._check(status)
+        n, size = ctypes.c_int(), ctypes.c_int()
+        self._check(self._lib.ropedyn_size(self._h, ctypes.byref(n), ctypes.byref(size)))
+        self.n, self.state_size = n.value, size.value
+        self._t = ctypes.c_double()
+        self._p = (ctypes.c_double * 2)()
+        self._v = (ctypes.c_double * 2)()
+        self._f = (ctypes.c_double * 2)()
+        # buffers of the reads made every exchange of a coupling, with their pointers made
+        # once (a numpy array from a ctypes array, or a pointer made per call, costs more
+        # than the call into the library)
+        self._force = np.empty(2)
+        self._force_ptr = self._force.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+        self._xy = np.empty((2 * self.n, 2))
+        self._xy_ptr = self._xy.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+        self._advance = self._lib.ropedyn_advance
+        self._set_support = self._lib.ropedyn_set_support
+        self._reaction = self._lib.ropedyn_reaction
+        self._points = self._lib.ropedyn_points
+
+    def _check(self, status):
+        if status != 0:
+            message = self._lib.ropedyn_last_error(self._h).decode()
+            if not self._alive():
+                self.close()
+            raise Error(message, status)
+
+    def _alive(self):
+        return bool(self._h) and hasattr(self, "n")
+
+    def _handle(self):
+        if not self._h:
+            raise Error("the simulation is closed", 2)
+        return self._h
+
+    # ---- moving on -------------------------------------------------------------------
+
+    def advance(self, t):
+        """Integrate to time `t` (s, not before the time reached)."""
+        status = self._advance(self._handle(), t)
+        if status != 0:
+            self._check(status)
+
+    def set_support(self, end, position, velocity=(0.0, 0.0)):
+        """Prescribe the coupled support `end` ('top' or 'bottom'; its &supports motion
+        'coupled') at the time of the next `advance`: position (x, y) in m, velocity in m/s.
+        In between it moves on the cubic Hermite curve from its position and velocity now
+        (as a motion table's segment)."""
+        p, v = self._p, self._v
+        p[0], p[1] = position
+        v[0], v[1] = velocity
+        status = self._set_support(self._handle(), _support(end), p, v)
+        if status != 0:
+            self._check(status)
+
+    # ---- the state now ---------------------------------------------------------------
+
+    @property
+    def t(self):
+        """The time reached, s."""
+        self._check(self._lib.ropedyn_time(self._handle(), ctypes.byref(self._t)))
+        return self._t.value
+
+    @property
+    def points(self):
+        """The polyline (2n, 2), m: element end points A_1, B_1, A_2, ... (x, y), as a
+        record of /rope/points."""
+        status = self._points(self._handle(), self._xy_ptr, 2 * self.n)
+        if status != 0:
+            self._check(status)
+        return self._xy.copy()
+
+    @property
+    def forces(self):
+        """The internal forces at the joints 0 (top end) .. n: 'axial' (tension > 0, N),
+        'shear' (N), 'moment' (N m), each (n + 1,)."""
+        out = {k: np.empty(self.n + 1) for k in ("axial", "shear", "moment")}
+        ptr = ctypes.POINTER(ctypes.c_double)
+        self._check(self._lib.ropedyn_forces(
+            self._handle(), *(out[k].ctypes.data_as(ptr) for k in ("axial", "shear", "moment")),
+            self.n + 1))
+        return out
+
+    def reaction(self, end):
+        """The force (x, y) of support `end` on the rope, N (zero for a free end)."""
+        status = self._reaction(self._handle(), _support(end), self._force_ptr)
+        if status != 0:
+            self._check(status)
+        return self._force.copy()
+
+    def anchor(self, end):
+        """Where support `end` holds the rope now (x, y), m (NaN for a free end)."""
+        self._check(self._lib.ropedyn_support_position(self._handle(), _support(end),
+                                                       self._f))
+        return np.array(self._f[:])
+
+    @property
+    def energy(self):
+        """The energies now, J: kinetic, elastic, gravity, dissipated, support_work (the
+        external work so far), total (kinetic + elastic + gravity)."""
+        out = (ctypes.c_double * 6)()
+        self._check(self._lib.ropedyn_energy(self._handle(), out))
+        return dict(zip(ENERGY_NAMES, out[:]))
+
+    @property
+    def state(self):
+        """The ODE state (as /state/y of a record)."""
+        out = np.empty(self.state_size)
+        self._check(self._lib.ropedyn_get_state(
+            self._handle(), out.ctypes.data_as(ctypes.POINTER(ctypes.c_double)),
+            self.state_size))
+        return out
+
+    @state.setter
+    def state(self, y):
+        y = np.ascontiguousarray(y, dtype=float)
+        self._check(self._lib.ropedyn_set_state(
+            self._handle(), y.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), y.size))
+
+    # ---- keeping states --------------------------------------------------------------
+
+    def save(self):
+        """Keep the state now (a Snapshot). The simulation goes on from here exactly as it
+        will after `restore` of it."""
+        snap = c_handle()
+        self._check(self._lib.ropedyn_save(self._handle(), ctypes.byref(snap)))
+        return Snapshot(self._lib, snap, self.t)
+
+    def restore(self, snapshot):
+        """Go back to a state kept by `save` (also after a failed advance)."""
+        if not snapshot._h:
+            raise Error("restore: the snapshot is closed", 2)
+        self._check(self._lib.ropedyn_restore(self._handle(), snapshot._h))
+
+    # ---- the end ---------------------------------------------------------------------
+
+    def close(self):
+        """Free the simulation (further calls raise ropedyn.Error)."""
+        if getattr(self, "_h", None):
+            self._lib.ropedyn_destroy(self._h)
+            self._h = c_handle()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        self.close()
+
+    def __repr__(self):
+        state = f"t = {self.t:g} s" if self._h else "closed"
+        return f"<ropedyn.Simulation {self.scene.name!r}, n = {getattr(self, 'n', '?')}, {state}>"
