@@ -8,9 +8,9 @@ import sys
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-# input/sweeps holds sweep files (ropedyn sweep), not scenes
+# folders named sweeps hold sweep files (ropedyn sweep), not scenes
 SCENES = sorted(p for p in (ROOT / "input").glob("**/*.nml") if "sweeps" not in p.parts)
-SWEEPS = sorted((ROOT / "input" / "sweeps").glob("*.nml"))
+SWEEPS = sorted(p for p in (ROOT / "input").glob("**/*.nml") if "sweeps" in p.parts)
 # 10000 elements cost about 0.1 s of CPU per millisecond in the Debug build: a shorter run
 HORIZON = {"elements_10000": 0.001}
 
@@ -23,7 +23,7 @@ def test_shipped_scene_runs(run, tmp_path, scene):
     assert "balance error" in result.stdout
 
 
-@pytest.mark.parametrize("sweep", SWEEPS, ids=[s.stem for s in SWEEPS])
+@pytest.mark.parametrize("sweep", SWEEPS, ids=[str(s.relative_to(ROOT / "input")) for s in SWEEPS])
 def test_shipped_sweep_reads(run, tmp_path, sweep):
     result = run("sweep", sweep, "--list")
     assert result.returncode == 0, result.stderr

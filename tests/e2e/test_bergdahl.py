@@ -1,0 +1,70 @@
+"""The Bergdahl validation's pipeline (scripts/validation bergdahl,
+tools/ropedyn_tools/studies/bergdahl.py): one short condition end to end, and its analysis
+on made-up data. These check the pipeline, not the accuracy."""
+import math
+import os
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+
+from ropedyn_tools.studies import bergdahl as bg
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def test_cycle_maxima_are_the_peaks_of_the_last_whole_cycles():
+    period = 1.25
+    t = np.arange(0.0, 6 * period + 1e-9, 0.004)
+    # a peak in the middle of each cycle, between two samples, 1 N higher each cycle
+    force = 40.0 + np.floor(t / period) + 10.0 * np.cos(2 * math.pi * (t / period - 0.5013))
+    maxima = bg.cycle_maxima(t, force, period, cycles=5)
+    # cycles 2..6 (the last five whole periods before t[-1]): 50 + 1, ..., 50 + 5; the
+    # parabola through the samples finds each peak to 2e-5 N (the largest sample alone is
+    # up to 2.4e-4 N low)
+    assert np.allclose(maxima, 51.0 + np.arange(5), rtol=0.0, atol=2e-5), maxima
+
+
+def test_scores_of_a_known_error():
+    s = bg.scores([11.0, 22.0, 33.0], [10.0, 20.0, 30.0])
+    assert math.isclose(s["rmse"], math.sqrt((1 + 4 + 9) / 3))
+    assert math.isclose(s["mape"], 10.0) and math.isclose(s["worst"], 10.0)
+    assert math.isclose(s["bias"], 2.0) and math.isclose(s["corr"], 1.0)
+    s = bg.scores([10.0, 22.0, 27.0], [10.0, 20.0, 30.0])
+    assert math.isclose(s["bias"], -1.0 / 3) and math.isclose(s["worst"], 10.0)
+    assert s["corr"] < 1.0
+
+
+def test_one_short_condition_end_to_end(ropedyn_exe, tmp_path):
+    """T = 1.25 s, R = 0.2 m, 20 elements, 2 cycles (one of them the ramp), both models:
+    the runs complete, the analysis finds a cycle maximum of each and the page gets its
+    table and figures."""
+    page = tmp_path / "bergdahl.md"
+    figs = tmp_path / "figures"
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "tools"))
+    result = subprocess.run(
+        [sys.executable, "-m", "ropedyn_tools.studies.bergdahl", "--exe", str(ropedyn_exe),
+         "--quick", "20,2", "--periods", "1.25", "--radii", "0.2", "--work",
+         str(tmp_path / "work"), "--out", str(page), "--figures", str(figs)],
+        capture_output=True, text=True, env=env, timeout=900)
+    assert result.returncode == 0, result.stderr
+    results = bg.collect(tmp_path / "work", (1.25,), bg.MODELS, cycles=1)
+    assert sorted(results) == [("mpp", 1.25, 0.2), ("rfem", 1.25, 0.2)]
+    for r in results.values():
+        assert len(r["maxima"]) == 1 and 20.0 < r["mean"] < 200.0, r
+        assert r["cpu_time"] > 0 and r["steps"] > 0
+    text = page.read_text()
+    assert bg.BEGIN in text and bg.END in text
+    row = next(line for line in text.splitlines() if line.startswith("| 1.25 | 0.2 | 70.3 |"))
+    assert row.count("%") == 2, row                       # an error for each model
+    assert "| RFEM | 1 |" in text and "| MPP | 1 |" in text     # the scores
+    assert (figs / "bergdahl_measured.png").stat().st_size > 0
+    assert (figs / "bergdahl_histories.png").stat().st_size > 0
+    # the page was new: a rerun keeps one section
+    subprocess.run(
+        [sys.executable, "-m", "ropedyn_tools.studies.bergdahl", "--analyse-only",
+         "--quick", "20,2", "--periods", "1.25", "--radii", "0.2", "--work",
+         str(tmp_path / "work"), "--out", str(page), "--figures", str(figs)],
+        check=True, capture_output=True, env=env, timeout=300)
+    assert page.read_text().count(bg.BEGIN) == 1
