@@ -1,5 +1,5 @@
 """Animate a ropedyn run: the rope's polyline over time, the tip's trail, the supports (a
-moving one on its path), the ground, a time stamp and optionally an energy panel. Works
+moving one on its path), the ground, the water surface, a time stamp and optionally an energy panel. Works
 from the HDF5 file alone (any model).
 
 usage: scripts/animate RUN.h5 [-o RUN.gif|RUN.mp4] [--max-frames 300] [--fps F] [--energy]
@@ -72,6 +72,7 @@ def build_figure(run, size, dpi, energy):
         ax, ex = fig.add_subplot(), None
     plot.setup_picture_axes(ax, run)
     plot.draw_ground(ax, run)
+    plot.draw_water(ax, run)
     plot.draw_supports(ax, run, moving=False)
     plot.draw_support_paths(ax, run)
     ax.set_title(io.title(run), fontsize=9)

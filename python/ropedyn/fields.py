@@ -71,6 +71,15 @@ def ground_plane(run):
     return point, normal / length
 
 
+def water_surface(run):
+    """x of the free surface (m, x down: water where x > surface), or None when the scene
+    has no water (&effects water = .false.)."""
+    if not bool(run.group("effects").get("water", False)):
+        return None
+    value = run.group("fluid").get("surface", 0.0)
+    return float(np.asarray(value, dtype=float).reshape(-1)[0])
+
+
 # --- derived fields -----------------------------------------------------------------------
 
 def velocity(run):

@@ -358,7 +358,8 @@ contains
             ! a look-ahead below the round-off of t rounds back to t: the method would take
             ! no step (and never reach its own round-off limit): on to tout instead
             if (target <= self%t) target = tout
-            ! the stop time holds for every method it runs
+            ! the stop time holds for every method it runs (the symplectic method's steps
+            ! end on the output time, never beyond it)
             call self%erk%set_stop_time(self%t_stop)
             call self%erk_high%set_stop_time(self%t_stop)
             call self%am%set_stop_time(self%t_stop)

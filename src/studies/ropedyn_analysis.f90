@@ -46,6 +46,27 @@ module ropedyn_analysis
         'damping_ratio', '1', 'z^T C z / (2 omega z^T M z)', &
         'axial_fraction', '1', 'share of the point motion along the rope'], [3, 5])
 
+    !> One `ropedyn statics|modes` (`run_analysis`): the model, its equilibrium and modes,
+    !! the internal forces and reactions there; steps: solve, write_file, print_summary.
+    type :: analysis_t
+        character(len=:), allocatable :: command    !< 'statics' or 'modes'
+        character(len=:), allocatable :: out_path   !< the HDF5 file
+        class(rope_model_t), allocatable :: model
+        type(statics_result_t) :: sres
+        type(modes_result_t) :: mres
+        real(wp), allocatable :: y(:)               !< the equilibrium (ODE state)
+        real(wp), allocatable :: axial(:), shear(:), moment(:)  !< at the joints 0:n, N, N m
+        !> the supports' forces on the rope (x, y; top, bottom), N, and their anchors, m
+        real(wp) :: reaction(2, 2) = 0.0_wp, anchors(2, 2) = 0.0_wp
+    contains
+        procedure :: solve => analysis_solve
+        procedure :: write_file => analysis_write_file
+        procedure :: write_statics => analysis_write_statics
+        procedure :: write_shape => analysis_write_shape
+        procedure :: write_modes => analysis_write_modes
+        procedure :: print_summary => analysis_print_summary
+    end type analysis_t
+
 contains
 
     !> `ropedyn statics|modes` on a scene that is read already: the equilibrium from the
@@ -58,206 +79,247 @@ contains
         integer, intent(in) :: count              !< modes wanted ('modes' only)
         character(len=*), intent(in) :: out_path_given
         type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: out_path
-        class(rope_model_t), allocatable :: model
-        type(statics_result_t) :: sres
-        type(modes_result_t) :: mres
-        real(wp), allocatable :: y(:), axial(:), shear(:), moment(:)
-        real(wp) :: reaction(2, 2), anchors(2, 2), force_top(2), force_bottom(2)
+        type(analysis_t) :: analysis
 
-        out_path = out_path_given
-        if (len(out_path) == 0) out_path = default_output(scene, command)
+        analysis%command = command
+        analysis%out_path = out_path_given
+        if (len(analysis%out_path) == 0) analysis%out_path = default_output(scene, command)
         ! never over an input (the scene, its tables, its state file): before any work
-        call check_not_input(out_path, scene, err)
+        call check_not_input(analysis%out_path, scene, err)
         if (allocated(err)) return
-        call create_model(scene%rope_spec_t, model, err)
+        call analysis%solve(scene, options, count, err)
+        if (allocated(err)) return
+        call make_parent_dirs(analysis%out_path, err)
+        if (allocated(err)) return
+        call analysis%write_file(scene, err)
+        if (allocated(err)) return
+        call analysis%print_summary(scene)
+    end subroutine run_analysis
+
+    !> The model of the scene (its supports at rest where they are at t = 0), its
+    !! equilibrium from the initial shape, the internal forces and reactions there, and
+    !! for 'modes' the lowest `count` modes.
+    subroutine analysis_solve(self, scene, options, count, err)
+        class(analysis_t), intent(inout) :: self
+        type(scene_t), intent(in) :: scene
+        type(statics_options_t), intent(in) :: options
+        integer, intent(in) :: count
+        type(error_t), allocatable, intent(out) :: err
+        integer :: n
+        call create_model(scene%rope_spec_t, self%model, err)
         if (allocated(err)) return
         ! a static state: the supports rest where they are at t = 0
-        model%supports_at_rest = .true.
-        allocate (y(model%size()))
-        call model%initial_state(y)
-        call find_equilibrium(model, scene%rope_spec_t, y, options, sres, err)
+        self%model%supports_at_rest = .true.
+        allocate (self%y(self%model%size()))
+        call self%model%initial_state(self%y)
+        call find_equilibrium(self%model, scene%rope_spec_t, self%y, options, self%sres, err)
         if (allocated(err)) return
-        allocate (axial(0:model%n_elements()), shear(0:model%n_elements()), &
-                  moment(0:model%n_elements()))
-        call model%internal_forces(0.0_wp, y, axial, shear, moment, reaction)
-        call model%support_positions(0.0_wp, anchors)
-        force_top = reaction(:, 1)
-        force_bottom = reaction(:, 2)
-        if (command == 'modes') then
-            call compute_modes(model, y, count, mres, err)
+        n = self%model%n_elements()
+        allocate (self%axial(0:n), self%shear(0:n), self%moment(0:n))
+        call self%model%internal_forces(0.0_wp, self%y, self%axial, self%shear, self%moment, &
+                                        self%reaction)
+        call self%model%support_positions(0.0_wp, self%anchors)
+        if (self%command == 'modes') call compute_modes(self%model, self%y, count, self%mres, err)
+    end subroutine analysis_solve
+
+    !> The HDF5 file: /statics and /energy, the forces, the shape, for 'modes' /modes.
+    subroutine analysis_write_file(self, scene, err)
+        class(analysis_t), intent(inout) :: self
+        type(scene_t), intent(in) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        type(h5_file_t) :: h5
+        type(error_t), allocatable :: close_err
+        call h5%create(self%out_path, err)
+        if (allocated(err)) return
+        call self%write_statics(h5, scene, err)
+        if (.not. allocated(err)) call self%write_shape(h5, err)
+        if (.not. allocated(err) .and. self%command == 'modes') call self%write_modes(h5, err)
+        call h5%close(close_err)
+        if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
+    end subroutine analysis_write_file
+
+    !> The root's attributes and provenance, /statics (the equilibrium, how it was found,
+    !! the support forces) and /energy.
+    subroutine analysis_write_statics(self, h5, scene, err)
+        class(analysis_t), intent(inout) :: self
+        type(h5_file_t), intent(inout) :: h5
+        type(scene_t), intent(in) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        integer, allocatable :: pos(:), vel(:)
+        real(wp) :: reals(size(STATICS_REALS, 2))
+        integer(i8) :: counts(size(STATICS_COUNTS, 2))
+        integer :: k
+        call self%model%coordinates(pos, vel)
+        reals = [self%sres%residual, self%sres%residual_relative, self%sres%last_step, &
+                 self%sres%weight]
+        counts = int([self%sres%iterations, self%sres%rejected, self%sres%stages], i8)
+        call h5%attribute('/', 'status', 'complete', err)
+        if (allocated(err)) return
+        call h5%attribute('/', 'analysis', self%command, err)
+        if (allocated(err)) return
+        call write_provenance(h5, version_string, self%model%model_name(), &
+                              scene_namelist_text(scene), err)
+        if (allocated(err)) return
+        call h5%group('/statics', err)
+        if (allocated(err)) return
+        call h5%write('/statics/q', self%y(pos), coordinate_units(self%model%model_name()), &
+                      err, 'generalized coordinates of the equilibrium')
+        if (allocated(err)) return
+        call h5%attribute('/statics', 'criterion', self%sres%criterion, err)
+        if (allocated(err)) return
+        do k = 1, size(reals)
+            call h5%write('/statics/'//trim(STATICS_REALS(1, k)), reals(k), &
+                          trim(STATICS_REALS(2, k)), err, trim(STATICS_REALS(3, k)))
+            if (allocated(err)) return
+        end do
+        do k = 1, size(counts)
+            call h5%write('/statics/'//trim(STATICS_COUNTS(1, k)), counts(k), &
+                          trim(STATICS_COUNTS(2, k)), err, trim(STATICS_COUNTS(3, k)))
+            if (allocated(err)) return
+        end do
+        if (trim(scene%supports%top) /= 'free') then
+            call h5%write('/statics/support_force_top', self%reaction(:, 1), 'N', err, &
+                          'force of the top support on the rope (x, y): '// &
+                          '/supports/top/reaction')
             if (allocated(err)) return
         end if
-        call make_parent_dirs(out_path, err)
+        if (trim(scene%supports%bottom) /= 'free') then
+            call h5%write('/statics/support_force_bottom', self%reaction(:, 2), 'N', err, &
+                          'force of the bottom support on the rope (x, y): '// &
+                          '/supports/bottom/reaction')
+            if (allocated(err)) return
+        end if
+        call h5%group('/energy', err)
         if (allocated(err)) return
-        call write_file()
+        call h5%write('/energy/elastic', self%sres%elastic, 'J', err)
         if (allocated(err)) return
-        call print_summary()
+        call h5%write('/energy/gravity', self%sres%gravity, 'J', err)
+    end subroutine analysis_write_statics
 
-    contains
+    !> The internal forces and reactions, /state and /rope of the equilibrium (one record).
+    subroutine analysis_write_shape(self, h5, err)
+        class(analysis_t), intent(inout) :: self
+        type(h5_file_t), intent(inout) :: h5
+        type(error_t), allocatable, intent(out) :: err
+        real(wp), allocatable :: q(:, :), qdot(:, :), points(:, :), lengths(:), masses(:)
+        integer :: n
+        n = self%model%n_elements()
+        allocate (q(3, n), qdot(3, n), points(2, 2*n), lengths(n), masses(n))
+        call self%model%fields(self%y, q, qdot)
+        call self%model%polyline(self%y, points)
+        call self%model%element_data(lengths, masses)
+        call write_forces(h5, self%axial, self%shear, self%moment, self%reaction, self%anchors, &
+                          err)
+        if (allocated(err)) return
+        call h5%group('/state', err)
+        if (allocated(err)) return
+        call h5%write('/state/q', reshape(q, [3, n, 1]), 'm, m, rad', err, &
+                      'x, y, phi of each element centre (one record)')
+        if (allocated(err)) return
+        call h5%group('/rope', err)
+        if (allocated(err)) return
+        call h5%write('/rope/points', reshape(points, [2, 2*n, 1]), 'm', err, &
+                      'element end points A_1, B_1, A_2, ... (one record)')
+        if (allocated(err)) return
+        call h5%write('/rope/element_length', lengths, 'm', err)
+        if (allocated(err)) return
+        call h5%write('/rope/element_mass', masses, 'kg', err)
+    end subroutine analysis_write_shape
 
-        function stage_text() result(text)
-            character(len=40) :: text
-            text = ''
-            if (sres%stages > 0) write (text, '(a, i0, a)') '; ', sres%stages, &
-                ' continuation stages'
-        end function stage_text
-
-        subroutine write_file()
-            type(h5_file_t) :: h5
-            type(error_t), allocatable :: close_err
-            real(wp), allocatable :: q(:, :), qdot(:, :), points(:, :), lengths(:), masses(:)
-            integer, allocatable :: pos(:), vel(:)
-            real(wp) :: reals(size(STATICS_REALS, 2))
-            integer(i8) :: counts(size(STATICS_COUNTS, 2))
-            integer :: n, k
-            n = model%n_elements()
-            allocate (q(3, n), qdot(3, n), points(2, 2*n), lengths(n), masses(n))
-            call model%fields(y, q, qdot)
-            call model%polyline(y, points)
-            call model%element_data(lengths, masses)
-            call model%coordinates(pos, vel)
-            reals = [sres%residual, sres%residual_relative, sres%last_step, sres%weight]
-            counts = int([sres%iterations, sres%rejected, sres%stages], i8)
-
-            call h5%create(out_path, err)
+    !> /modes: the frequencies and what else each mode has, and the shapes.
+    subroutine analysis_write_modes(self, h5, err)
+        class(analysis_t), intent(in) :: self
+        type(h5_file_t), intent(inout) :: h5
+        type(error_t), allocatable, intent(out) :: err
+        real(wp) :: values(self%mres%count, size(MODE_VALUES, 2))
+        integer :: k
+        values(:, 1) = self%mres%omega
+        values(:, 2) = self%mres%omega/(2*PI)
+        values(:, 3) = 2*PI/max(abs(self%mres%omega), tiny(1.0_wp))
+        values(:, 4) = self%mres%damping_ratio
+        values(:, 5) = self%mres%axial_fraction
+        call h5%group('/modes', err)
+        if (allocated(err)) return
+        call h5%attribute('/modes', 'eigensolver', self%mres%eigensolver, err)
+        if (allocated(err)) return
+        do k = 1, size(MODE_VALUES, 2)
+            call h5%write('/modes/'//trim(MODE_VALUES(1, k)), values(:, k), &
+                          trim(MODE_VALUES(2, k)), err, trim(MODE_VALUES(3, k)))
             if (allocated(err)) return
-            steps: block
-                call h5%attribute('/', 'status', 'complete', err)
-                if (allocated(err)) exit steps
-                call h5%attribute('/', 'analysis', command, err)
-                if (allocated(err)) exit steps
-                call write_provenance(h5, version_string, model%model_name(), &
-                                      scene_namelist_text(scene), err)
-                if (allocated(err)) exit steps
-                call h5%group('/statics', err)
-                if (allocated(err)) exit steps
-                call h5%write('/statics/q', y(pos), coordinate_units(model%model_name()), err, &
-                              'generalized coordinates of the equilibrium')
-                if (allocated(err)) exit steps
-                call h5%attribute('/statics', 'criterion', sres%criterion, err)
-                if (allocated(err)) exit steps
-                do k = 1, size(reals)
-                    call h5%write('/statics/'//trim(STATICS_REALS(1, k)), reals(k), &
-                                  trim(STATICS_REALS(2, k)), err, trim(STATICS_REALS(3, k)))
-                    if (allocated(err)) exit steps
-                end do
-                do k = 1, size(counts)
-                    call h5%write('/statics/'//trim(STATICS_COUNTS(1, k)), counts(k), &
-                                  trim(STATICS_COUNTS(2, k)), err, trim(STATICS_COUNTS(3, k)))
-                    if (allocated(err)) exit steps
-                end do
-                if (trim(scene%supports%top) /= 'free') then
-                    call h5%write('/statics/support_force_top', force_top, 'N', err, &
-                                  'force of the top support on the rope (x, y): '// &
-                                  '/supports/top/reaction')
-                    if (allocated(err)) exit steps
-                end if
-                if (trim(scene%supports%bottom) /= 'free') then
-                    call h5%write('/statics/support_force_bottom', force_bottom, 'N', err, &
-                                  'force of the bottom support on the rope (x, y): '// &
-                                  '/supports/bottom/reaction')
-                    if (allocated(err)) exit steps
-                end if
-                call h5%group('/energy', err)
-                if (allocated(err)) exit steps
-                call h5%write('/energy/elastic', sres%elastic, 'J', err)
-                if (allocated(err)) exit steps
-                call h5%write('/energy/gravity', sres%gravity, 'J', err)
-                if (allocated(err)) exit steps
-                call write_forces(h5, axial, shear, moment, reaction, anchors, err)
-                if (allocated(err)) exit steps
-                call h5%group('/state', err)
-                if (allocated(err)) exit steps
-                call h5%write('/state/q', reshape(q, [3, n, 1]), 'm, m, rad', err, &
-                              'x, y, phi of each element centre (one record)')
-                if (allocated(err)) exit steps
-                call h5%group('/rope', err)
-                if (allocated(err)) exit steps
-                call h5%write('/rope/points', reshape(points, [2, 2*n, 1]), 'm', err, &
-                              'element end points A_1, B_1, A_2, ... (one record)')
-                if (allocated(err)) exit steps
-                call h5%write('/rope/element_length', lengths, 'm', err)
-                if (allocated(err)) exit steps
-                call h5%write('/rope/element_mass', masses, 'kg', err)
-                if (allocated(err)) exit steps
-                if (command == 'modes') call write_modes(h5)
-            end block steps
-            call h5%close(close_err)
-            if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
-        end subroutine write_file
+        end do
+        call h5%write('/modes/shape', self%mres%shape, &
+                      coordinate_units(self%model%model_name()), err, &
+                      'mode shapes in the generalized coordinates of /statics/q, '// &
+                      '(mode, coordinate), largest entry 1')
+        if (allocated(err)) return
+        call h5%write('/modes/shape_points', self%mres%shape_points, 'm', err, &
+                      'displacement of the /rope/points per unit of /modes/shape')
+        if (allocated(err)) return
+        call h5%write('/modes/stiffness_asymmetry', self%mres%asymmetry, '1', err, &
+                      'max |K - K^T| / max |K| before symmetrization')
+    end subroutine analysis_write_modes
 
-        subroutine write_modes(h5)
-            type(h5_file_t), intent(inout) :: h5
-            real(wp) :: values(mres%count, size(MODE_VALUES, 2))
-            integer :: k
-            values(:, 1) = mres%omega
-            values(:, 2) = mres%omega/(2*PI)
-            values(:, 3) = 2*PI/max(abs(mres%omega), tiny(1.0_wp))
-            values(:, 4) = mres%damping_ratio
-            values(:, 5) = mres%axial_fraction
-            call h5%group('/modes', err)
-            if (allocated(err)) return
-            call h5%attribute('/modes', 'eigensolver', mres%eigensolver, err)
-            if (allocated(err)) return
-            do k = 1, size(MODE_VALUES, 2)
-                call h5%write('/modes/'//trim(MODE_VALUES(1, k)), values(:, k), &
-                              trim(MODE_VALUES(2, k)), err, trim(MODE_VALUES(3, k)))
-                if (allocated(err)) return
-            end do
-            call h5%write('/modes/shape', mres%shape, coordinate_units(model%model_name()), &
-                          err, 'mode shapes in the generalized coordinates of /statics/q, '// &
-                          '(mode, coordinate), largest entry 1')
-            if (allocated(err)) return
-            call h5%write('/modes/shape_points', mres%shape_points, 'm', err, &
-                          'displacement of the /rope/points per unit of /modes/shape')
-            if (allocated(err)) return
-            call h5%write('/modes/stiffness_asymmetry', mres%asymmetry, '1', err, &
-                          'max |K - K^T| / max |K| before symmetrization')
-        end subroutine write_modes
+    !> The printed summary: the equilibrium, how it was found, the support forces, the modes.
+    subroutine analysis_print_summary(self, scene)
+        class(analysis_t), intent(inout) :: self
+        type(scene_t), intent(in) :: scene
+        real(wp), allocatable :: points(:, :)
+        real(wp) :: force_top(2), force_bottom(2)
+        integer :: n, deepest
+        n = self%model%n_elements()
+        allocate (points(2, 2*n))
+        call self%model%polyline(self%y, points)
+        deepest = maxloc(points(1, :), 1)
+        force_top = self%reaction(:, 1)
+        force_bottom = self%reaction(:, 2)
+        write (output_unit, '(a)') 'ropedyn '//version_string//': '//self%command//', '// &
+            self%model%model_name()//' model, '//int_text(n)//' elements, scene '//scene%path
+        write (output_unit, '(a, i0, a, i0, a, i0, a)') '  equilibrium     '// &
+            self%sres%criterion//' after ', self%sres%iterations, ' iterations (', &
+            self%sres%rejected, ' rejected, ', self%sres%newton_steps, ' Newton'// &
+            trim(stage_text(self%sres%stages))//')'
+        write (output_unit, '(a, es10.3, a, es10.3, a, f8.4, a)') '  residual        '// &
+            'max |f| = ', self%sres%residual, ' N (', self%sres%residual_relative, &
+            ' of the weight ', self%sres%weight, ' N)'
+        write (output_unit, '(a, es14.6, a, es14.6)') '  energy (J)      elastic', &
+            self%sres%elastic, '   gravity', self%sres%gravity
+        write (output_unit, '(a, f12.7, a, f12.7, a)') '  lowest point    x = ', &
+            points(1, deepest), ' m at y = ', points(2, deepest), ' m'
+        write (output_unit, '(a, f12.7, a, f12.7, a)') '  lower end       x = ', &
+            points(1, 2*n), ' m,   y = ', points(2, 2*n), ' m'
+        if (trim(scene%supports%top) /= 'free') write (output_unit, '(a, 3f12.6)') &
+            '  top support force on the rope (x, y, |F|) N:   ', force_top, norm2(force_top)
+        if (trim(scene%supports%bottom) /= 'free') write (output_unit, '(a, 3f12.6)') &
+            '  bottom support force on the rope (x, y, |F|) N:', force_bottom, &
+            norm2(force_bottom)
+        if (self%command == 'modes') call print_modes(self%mres)
+        write (output_unit, '(a)') '  output          '//self%out_path
+    end subroutine analysis_print_summary
 
-        subroutine print_summary()
-            real(wp), allocatable :: points(:, :)
-            integer :: k, n, deepest
-            n = model%n_elements()
-            allocate (points(2, 2*n))
-            call model%polyline(y, points)
-            deepest = maxloc(points(1, :), 1)
-            write (output_unit, '(a)') 'ropedyn '//version_string//': '//command//', '// &
-                model%model_name()//' model, '//int_text(n)//' elements, scene '//scene%path
-            write (output_unit, '(a, i0, a, i0, a, i0, a)') '  equilibrium     '// &
-                sres%criterion//' after ', sres%iterations, ' iterations (', sres%rejected, &
-                ' rejected, ', sres%newton_steps, ' Newton'//trim(stage_text())//')'
-            write (output_unit, '(a, es10.3, a, es10.3, a, f8.4, a)') '  residual        '// &
-                'max |f| = ', sres%residual, ' N (', sres%residual_relative, &
-                ' of the weight ', sres%weight, ' N)'
-            write (output_unit, '(a, es14.6, a, es14.6)') '  energy (J)      elastic', &
-                sres%elastic, '   gravity', sres%gravity
-            write (output_unit, '(a, f12.7, a, f12.7, a)') '  lowest point    x = ', &
-                points(1, deepest), ' m at y = ', points(2, deepest), ' m'
-            write (output_unit, '(a, f12.7, a, f12.7, a)') '  lower end       x = ', &
-                points(1, 2*n), ' m,   y = ', points(2, 2*n), ' m'
-            if (trim(scene%supports%top) /= 'free') write (output_unit, '(a, 3f12.6)') &
-                '  top support force on the rope (x, y, |F|) N:   ', force_top, norm2(force_top)
-            if (trim(scene%supports%bottom) /= 'free') write (output_unit, '(a, 3f12.6)') &
-                '  bottom support force on the rope (x, y, |F|) N:', force_bottom, &
-                norm2(force_bottom)
-            if (command == 'modes') then
-                write (output_unit, '(a, i0, a, i0, 2a, es8.1, a)') '  modes           ', &
-                    mres%count, ' of ', mres%ndof, ' (', mres%eigensolver// &
-                    ', stiffness asymmetry ', mres%asymmetry, ')'
-                write (output_unit, '(a)') '   mode   omega (rad/s)    f (Hz)     period (s)'// &
-                    '   damping ratio   axial share'
-                do k = 1, mres%count
-                    write (output_unit, '(i7, f16.6, f11.5, f14.6, es16.3, f12.3)') k, &
-                        mres%omega(k), mres%omega(k)/(2*PI), &
-                        2*PI/max(abs(mres%omega(k)), tiny(1.0_wp)), mres%damping_ratio(k), &
-                        mres%axial_fraction(k)
-                end do
-            end if
-            write (output_unit, '(a)') '  output          '//out_path
-        end subroutine print_summary
-    end subroutine run_analysis
+    !> The modes' lines of the summary.
+    subroutine print_modes(mres)
+        type(modes_result_t), intent(in) :: mres
+        integer :: k
+        write (output_unit, '(a, i0, a, i0, 2a, es8.1, a)') '  modes           ', &
+            mres%count, ' of ', mres%ndof, ' (', mres%eigensolver// &
+            ', stiffness asymmetry ', mres%asymmetry, ')'
+        write (output_unit, '(a)') '   mode   omega (rad/s)    f (Hz)     period (s)'// &
+            '   damping ratio   axial share'
+        do k = 1, mres%count
+            write (output_unit, '(i7, f16.6, f11.5, f14.6, es16.3, f12.3)') k, &
+                mres%omega(k), mres%omega(k)/(2*PI), &
+                2*PI/max(abs(mres%omega(k)), tiny(1.0_wp)), mres%damping_ratio(k), &
+                mres%axial_fraction(k)
+        end do
+    end subroutine print_modes
+
+    !> '; N continuation stages' when there were any, else ''.
+    pure function stage_text(stages) result(text)
+        integer, intent(in) :: stages
+        character(len=40) :: text
+        text = ''
+        if (stages > 0) write (text, '(a, i0, a)') '; ', stages, ' continuation stages'
+    end function stage_text
 
     !> Forces of the supports on the rope at the equilibrium y, N: R = dV/d(anchor) with
     !! the coordinates held fixed (virtual work), by central differences of the potential

@@ -18,9 +18,11 @@
 !! (chord) corrections; sigma shrinks after good steps, grows after poor or rejected ones,
 !! and is 0 (Newton) near the solution. Converged when a Newton step is below
 !! step_tolerance * L, or when max |f| is at the rounding level of the stiffness
-!! (10 eps sum_j |K_kj| (|q_j| + L)). `find_equilibrium` adds a continuation in the support
-!! stiffness for a bottom anchor far from the start. Derivation and limits:
-!! docs/theory/statics-modes.md.
+!! (10 eps sum_j |K_kj| (|q_j| + L)). The iteration's state is a `descent_t` whose steps
+!! are start, assemble (K, M, the rounding test), trial (solve, corrections), accept or
+!! reject (the shift), finish. `find_equilibrium` adds a continuation in the support
+!! stiffness for a bottom anchor far from the start (`continuation_t`: plan, run).
+!! Derivation and limits: docs/theory/statics-modes.md.
 module ropedyn_statics
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp
@@ -63,6 +65,54 @@ module ropedyn_statics
         character(len=:), allocatable :: criterion  !< 'newton step' or 'rounding level'
     end type statics_result_t
 
+    !> The continuation of `find_equilibrium` in the support stiffness: the log of
+    !! support_stiffness_factor at its start (s = 0) and end (s = 1), and what it cost.
+    type :: continuation_t
+        real(wp) :: log_f0 = 0.0_wp, log_f1 = 0.0_wp
+        integer :: iterations = 0, rejected = 0   !< of all its stages
+        integer :: stages = 0                     !< 0 when given up
+        character(len=:), allocatable :: fallback !< '' or how far it got before given up
+    contains
+        procedure :: plan => continuation_plan
+        procedure :: run => continuation_run
+    end type continuation_t
+
+    !> The state of `solve_statics`' iteration at y, and its steps (the module header).
+    type :: descent_t
+        integer, allocatable :: pos(:), vel(:)      !< where q and q' sit in y
+        real(wp), allocatable :: f(:), f_new(:)     !< generalized force at y, at the trial
+        real(wp), allocatable :: kt(:, :), mm(:, :) !< stiffness (symmetrized) and mass at y
+        real(wp), allocatable :: mdiag(:)           !< diagonal of the starting mass
+        real(wp), allocatable :: delta(:), kd(:)    !< the step, K delta
+        real(wp), allocatable :: y_new(:), q0(:)    !< the trial state; the starting q
+        type(ldl_t) :: fac                          !< the factors of K + sigma M + E
+        real(wp) :: length = 0.0_wp, step_limit = 0.0_wp  !< rope length, largest step
+        real(wp) :: v_old = 0.0_wp, v_new = 0.0_wp  !< potential energy at y, at the trial
+        !> the shift: now, its scale, of the last solve, of the last good shifted step
+        real(wp) :: sigma = 0.0_wp, sigma0 = 0.0_wp, sigma_used = 0.0_wp, sigma_good = 0.0_wp
+        real(wp) :: step = 0.0_wp       !< max |delta|
+        real(wp) :: predicted = 0.0_wp  !< decrease of V the quadratic model predicts
+        real(wp) :: rho = 0.0_wp        !< actual / predicted decrease
+        integer :: status = STATUS_OK   !< of the last evaluation of the forces
+        integer :: consecutive = 0      !< rejections in a row
+        logical :: fresh = .true.       !< y moved: the stiffness is to be evaluated
+        logical :: newton = .false.     !< the last solve was a Newton step
+        type(statics_result_t) :: result
+    contains
+        procedure :: start => descent_start
+        procedure :: iterate => descent_iterate
+        procedure :: assemble => descent_assemble
+        procedure :: measure_rounding => descent_measure_rounding
+        procedure :: no_convergence => descent_no_convergence
+        procedure :: trial => descent_trial
+        procedure :: limit_step => descent_limit_step
+        procedure :: try_step => descent_try_step
+        procedure :: reject => descent_reject
+        procedure :: accept => descent_accept
+        procedure :: update_shift => descent_update_shift
+        procedure :: finish => descent_finish
+    end type descent_t
+
 contains
 
     !> ERR_SOLVER when the spec cannot have an equilibrium: both ends free under gravity.
@@ -82,13 +132,13 @@ contains
     !! configuration, the support spring starts hugely stretched: its pull (~ EA/dl times the
     !! distance) dwarfs the weight and pushes the straight rope along its axis, a saddle
     !! (compression) where the steps must be tiny. Then the solution is
-    !! first continued in `support_stiffness_factor`: from the value at which the spring pulls
-    !! with 0.3 times the weight up to the spec's value in geometric stages, each started
-    !! from the previous equilibrium (models rebuilt); a stage multiplies the
-    !! factor by 10 at first, by 100 after an easy stage, and its step is cut by 4 after a
-    !! failure. If the first stage fails or the continuation stalls (RFEM: its top support
-    !! softens too and the rope drops far), it solves directly from the start, which the
-    !! RFEM's Cartesian coordinates tolerate. Otherwise it is `solve_statics`.
+    !! first continued in `support_stiffness_factor` (continuation_t): from the value at
+    !! which the spring pulls with 0.3 times the weight up to the spec's value in geometric
+    !! stages, each started from the previous equilibrium (models rebuilt); a stage
+    !! multiplies the factor by 10 at first, by 100 after an easy stage, and its step is cut
+    !! by 4 after a failure. If the first stage fails or the continuation stalls (RFEM: its
+    !! top support softens too and the rope drops far), it solves directly from the start,
+    !! which the RFEM's Cartesian coordinates tolerate. Otherwise it is `solve_statics`.
     subroutine find_equilibrium(model, spec, y, options, result, err)
         class(rope_model_t), intent(inout) :: model
         type(rope_spec_t), intent(in) :: spec
@@ -96,112 +146,143 @@ contains
         type(statics_options_t), intent(in) :: options
         type(statics_result_t), intent(out) :: result
         type(error_t), allocatable, intent(out) :: err
+        type(continuation_t) :: path
+        logical :: needed
+
+        path%fallback = ''
+        call check_equilibrium_exists(spec, err)
+        if (allocated(err)) return
+        if (options%continuation) then
+            call path%plan(model, spec, y, needed, err)
+            if (allocated(err)) return
+            if (needed) call path%run(spec, y, err)
+            if (allocated(err)) return
+        end if
+        call solve_statics(model, spec, y, options, result, err)
+        if (allocated(err) .and. len(path%fallback) > 0) then
+            err%message = err%message//' ('//path%fallback//'solved directly from the start)'
+        end if
+        result%iterations = result%iterations + path%iterations
+        result%rejected = result%rejected + path%rejected
+        result%stages = path%stages
+    end subroutine find_equilibrium
+
+    !> Whether the equilibrium from y needs the continuation (a bottom pin or clamp far from
+    !! the start, its spring pulling with more than 0.3 times the weight), and if so its
+    !! range: log_f1 the spec's support_stiffness_factor, log_f0 the pull of 0.3 weights.
+    subroutine continuation_plan(self, model, spec, y, needed, err)
+        class(continuation_t), intent(inout) :: self
+        class(rope_model_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(in) :: y(:)
+        logical, intent(out) :: needed
+        type(error_t), allocatable, intent(out) :: err
+        real(wp), allocatable :: points(:, :)
+        real(wp) :: p_end(2), target(2), distance, pull, weight
+
+        needed = .false.
+        weight = total_weight(model, spec)
+        if (.not. (trim(spec%supports%bottom) /= 'free' .and. bottom_anchor_given(spec) &
+                   .and. weight > 0.0_wp)) return
+        allocate (points(2, 2*model%n_elements()))
+        call model%polyline(y, points)
+        p_end = points(:, size(points, 2))
+        target = spec%supports%bottom_anchor
+        distance = norm2(target - p_end)
+        if (distance <= 1.0e-3_wp*rope_length(model)) return
+        ! the spring's pull at the start: dV/d(anchor) along the anchor's offset
+        pull = anchor_pull(model, spec, y, (target - p_end)/distance, err)
+        if (allocated(err)) return
+        if (pull <= 0.3_wp*weight) return
+        self%log_f1 = log(spec%supports%support_stiffness_factor)
+        self%log_f0 = self%log_f1 + log(0.3_wp*weight/pull)
+        needed = .true.
+    end subroutine continuation_plan
+
+    !> The stages of the continuation, from s = 0 (log_f0) to s = 1 (log_f1): y is the
+    !! equilibrium of the last stage, or the start again when it was given up (fallback).
+    subroutine continuation_run(self, spec, y, err)
+        class(continuation_t), intent(inout) :: self
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(inout) :: y(:)
+        type(error_t), allocatable, intent(out) :: err
         type(rope_spec_t) :: stage_spec
         class(rope_model_t), allocatable :: stage_model
         type(statics_result_t) :: stage
         type(statics_options_t) :: stage_options
         type(error_t), allocatable :: stage_err
-        real(wp), allocatable :: points(:, :), y_try(:), y_start(:)
-        real(wp) :: p_end(2), target(2), distance, pull, weight, log_f0, log_f1, s, ds, s_try
-        character(len=:), allocatable :: fallback
-        integer :: iterations, rejected, stages
+        real(wp), allocatable :: y_try(:), y_start(:)
+        real(wp) :: s, ds, s_try
 
-        iterations = 0
-        rejected = 0
-        stages = 0
-        fallback = ''
-        call check_equilibrium_exists(spec, err)
-        if (allocated(err)) return
-        weight = total_weight(model, spec)
-        continuation: if (options%continuation .and. &
-                          trim(spec%supports%bottom) /= 'free' .and. &
-                          bottom_anchor_given(spec) .and. weight > 0.0_wp) then
-            allocate (points(2, 2*model%n_elements()))
-            call model%polyline(y, points)
-            p_end = points(:, size(points, 2))
-            target = spec%supports%bottom_anchor
-            distance = norm2(target - p_end)
-            if (distance <= 1.0e-3_wp*rope_length(model)) exit continuation
-            ! the spring's pull at the start: dV/d(anchor) along the anchor's offset
-            pull = anchor_pull()
+        y_start = y
+        stage_options%max_iterations = 100
+        stage_options%step_tolerance = 1.0e-8_wp
+        s = 0.0_wp
+        ds = log(10.0_wp)/(self%log_f1 - self%log_f0)
+        ! the first stage starts at s = 0 itself
+        s_try = 0.0_wp
+        do
+            stage_spec = spec
+            stage_spec%supports%support_stiffness_factor = &
+                exp(self%log_f0 + s_try*(self%log_f1 - self%log_f0))
+            call create_model(stage_spec, stage_model, err)
             if (allocated(err)) return
-            if (pull <= 0.3_wp*weight) exit continuation
-            y_start = y
-            log_f1 = log(spec%supports%support_stiffness_factor)
-            log_f0 = log_f1 + log(0.3_wp*weight/pull)
-            stage_options%max_iterations = 100
-            stage_options%step_tolerance = 1.0e-8_wp
-            s = 0.0_wp
-            ds = log(10.0_wp)/(log_f1 - log_f0)
-            ! the first stage starts at s = 0 itself
-            s_try = 0.0_wp
-            do
-                stage_spec = spec
-                stage_spec%supports%support_stiffness_factor = &
-                    exp(log_f0 + s_try*(log_f1 - log_f0))
-                call create_model(stage_spec, stage_model, err)
-                if (allocated(err)) return
-                y_try = y
-                call solve_statics(stage_model, stage_spec, y_try, stage_options, stage, &
-                                   stage_err)
-                iterations = iterations + stage%iterations
-                rejected = rejected + stage%rejected
-                stages = stages + 1
-                if (allocated(stage_err)) then
-                    deallocate (stage_err)
-                    ds = 0.25_wp*ds
-                    if (ds < 1.0e-3_wp .or. stages == 1) then
-                        ! give up the continuation: solve directly from the start
-                        fallback = 'continuation in support_stiffness_factor stalled at '// &
-                                   fixed_text(100*s, 1)//' % of the way, then '
-                        y = y_start
-                        stages = 0
-                        exit
-                    end if
-                else
-                    y = y_try
-                    s = s_try
-                    if (s >= 1.0_wp) exit
-                    if (stage%iterations < 15) ds = 2.0_wp*ds
+            y_try = y
+            call solve_statics(stage_model, stage_spec, y_try, stage_options, stage, stage_err)
+            self%iterations = self%iterations + stage%iterations
+            self%rejected = self%rejected + stage%rejected
+            self%stages = self%stages + 1
+            if (allocated(stage_err)) then
+                deallocate (stage_err)
+                ds = 0.25_wp*ds
+                if (ds < 1.0e-3_wp .or. self%stages == 1) then
+                    ! give up the continuation: solve directly from the start
+                    self%fallback = 'continuation in support_stiffness_factor stalled at '// &
+                                    fixed_text(100*s, 1)//' % of the way, then '
+                    y = y_start
+                    self%stages = 0
+                    exit
                 end if
-                s_try = min(1.0_wp, s + ds)
-                if (s_try > 1.0_wp - 1.0e-9_wp) s_try = 1.0_wp
-            end do
-        end if continuation
-        call solve_statics(model, spec, y, options, result, err)
-        if (allocated(err) .and. len(fallback) > 0) then
-            err%message = err%message//' ('//fallback//'solved directly from the start)'
-        end if
-        result%iterations = result%iterations + iterations
-        result%rejected = result%rejected + rejected
-        result%stages = stages
-    contains
-        !> |dV/d(anchor)| along the unit offset of the bottom anchor, N (central differences).
-        real(wp) function anchor_pull() result(r)
-            type(rope_spec_t) :: moved
-            class(rope_model_t), allocatable :: probe
-            real(wp) :: u(2), h, vp, vm
-            u = (target - p_end)/distance
-            h = 1.0e-4_wp*rope_length(model)
-            r = 0.0_wp
-            moved = spec
-            moved%supports%bottom_anchor = target + h*u
-            call create_model(moved, probe, err)
-            if (allocated(err)) return
-            vp = potential_energy(probe, y, moved)
-            moved%supports%bottom_anchor = target - h*u
-            call create_model(moved, probe, err)
-            if (allocated(err)) return
-            vm = potential_energy(probe, y, moved)
-            r = abs(vp - vm)/(2*h)
-        end function anchor_pull
-    end subroutine find_equilibrium
+            else
+                y = y_try
+                s = s_try
+                if (s >= 1.0_wp) exit
+                if (stage%iterations < 15) ds = 2.0_wp*ds
+            end if
+            s_try = min(1.0_wp, s + ds)
+            if (s_try > 1.0_wp - 1.0e-9_wp) s_try = 1.0_wp
+        end do
+    end subroutine continuation_run
+
+    !> |dV/d(anchor)| along the unit vector u from the bottom anchor, N (central
+    !! differences, models rebuilt with the anchor moved).
+    real(wp) function anchor_pull(model, spec, y, u, err) result(r)
+        class(rope_model_t), intent(in) :: model
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(in) :: y(:), u(2)
+        type(error_t), allocatable, intent(out) :: err
+        type(rope_spec_t) :: moved
+        class(rope_model_t), allocatable :: probe
+        real(wp) :: h, vp, vm
+        h = 1.0e-4_wp*rope_length(model)
+        r = 0.0_wp
+        moved = spec
+        moved%supports%bottom_anchor = spec%supports%bottom_anchor + h*u
+        call create_model(moved, probe, err)
+        if (allocated(err)) return
+        vp = potential_energy(probe, y, moved)
+        moved%supports%bottom_anchor = spec%supports%bottom_anchor - h*u
+        call create_model(moved, probe, err)
+        if (allocated(err)) return
+        vm = potential_energy(probe, y, moved)
+        r = abs(vp - vm)/(2*h)
+    end function anchor_pull
 
     !> Find the static equilibrium reached from the state y by descending the potential energy.
     !! On entry y holds the starting configuration (velocities are set to zero); on
     !! success it holds the equilibrium at rest. Errors (ERR_SOLVER) name the cause:
     !! no equilibrium (free-free under gravity), no convergence, divergence, non-finite
-    !! forces, or no step that lowers the energy.
+    !! forces, or no step that lowers the energy. The iteration's state and steps: descent_t.
     subroutine solve_statics(model, spec, y, options, result, err)
         class(rope_model_t), intent(inout) :: model
         type(rope_spec_t), intent(in) :: spec
@@ -209,205 +290,313 @@ contains
         type(statics_options_t), intent(in) :: options
         type(statics_result_t), intent(out) :: result
         type(error_t), allocatable, intent(out) :: err
-        integer, allocatable :: pos(:), vel(:)
-        real(wp), allocatable :: f(:), f_new(:), kt(:, :), mm(:, :), delta(:)
-        real(wp), allocatable :: y_new(:), q0(:), mdiag(:), qscale(:), kd(:)
-        real(wp) :: length, v_old, v_new, sigma, sigma0, sigma_used, step, noise, rho
-        real(wp) :: predicted, lambda_step, dmdd, step_limit, sigma_good
-        integer :: nd, status, consecutive, k
-        logical :: accept, fresh, modified, newton
-        type(ldl_t) :: fac
-        character(len=200) :: text
+        type(descent_t) :: descent
 
         call check_equilibrium_exists(spec, err)
         if (allocated(err)) return
-        call model%coordinates(pos, vel)
-        nd = size(pos)
-        allocate (f(nd), f_new(nd), kt(nd, nd), mm(nd, nd), delta(nd), mdiag(nd), kd(nd))
-        y(vel) = 0.0_wp
-        length = rope_length(model)
-        step_limit = 0.5_wp*max(length, 1.0_wp)
-        result%weight = total_weight(model, spec)
-        q0 = y(pos)
+        call descent%start(model, spec, y, err)
+        if (.not. allocated(err)) call descent%iterate(model, spec, y, options, err)
+        if (.not. allocated(err)) call descent%finish(model, y)
+        result = descent%result
+    end subroutine solve_statics
 
-        call generalized_force(model, y, pos, vel, f, status)
-        if (status /= STATUS_OK) then
+    !> Set up the iteration at y (velocities zeroed): coordinates, force, energy, mass, and
+    !! the shift scale; ERR_SOLVER if the forces are not finite there.
+    subroutine descent_start(self, model, spec, y, err)
+        class(descent_t), intent(inout) :: self
+        class(rope_model_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(inout) :: y(:)
+        type(error_t), allocatable, intent(out) :: err
+        integer :: nd, k
+
+        call model%coordinates(self%pos, self%vel)
+        nd = size(self%pos)
+        allocate (self%f(nd), self%f_new(nd), self%kt(nd, nd), self%mm(nd, nd), &
+                  self%delta(nd), self%mdiag(nd), self%kd(nd))
+        y(self%vel) = 0.0_wp
+        self%length = rope_length(model)
+        self%step_limit = 0.5_wp*max(self%length, 1.0_wp)
+        self%result%weight = total_weight(model, spec)
+        self%q0 = y(self%pos)
+
+        call generalized_force(model, y, self%pos, self%vel, self%f, self%status)
+        if (self%status /= STATUS_OK) then
             call make_error(err, ERR_SOLVER, spec%path//': statics: non-finite forces '// &
                             'in the starting configuration')
             return
         end if
-        v_old = potential_energy(model, y, spec)
-        call model%coordinate_mass(y, mm)
-        mdiag = [(mm(k, k), k = 1, nd)]
+        self%v_old = potential_energy(model, y, spec)
+        call model%coordinate_mass(y, self%mm)
+        self%mdiag = [(self%mm(k, k), k = 1, nd)]
         ! shift scale: a step of the freest coordinate of L/10 (explicit estimate); the
         ! iteration starts as Newton (sigma = 0) and shifts only when it must
-        sigma0 = maxval(abs(f)/mdiag)/(0.1_wp*max(length, 1.0e-3_wp))
-        sigma0 = max(sigma0, sqrt(tiny(1.0_wp)))
-        sigma = 0.0_wp
-        sigma_good = 0.0_wp
-        consecutive = 0
-        fresh = .true.
+        self%sigma0 = maxval(abs(self%f)/self%mdiag)/(0.1_wp*max(self%length, 1.0e-3_wp))
+        self%sigma0 = max(self%sigma0, sqrt(tiny(1.0_wp)))
+        self%sigma = 0.0_wp
+        self%sigma_good = 0.0_wp
+        self%consecutive = 0
+        self%fresh = .true.
+    end subroutine descent_start
+
+    !> Steps until converged (result%criterion) or an error: after each accepted step the
+    !! stiffness is evaluated afresh and the rounding level tested; a rejected step raises
+    !! the shift and tries again with the same matrices.
+    subroutine descent_iterate(self, model, spec, y, options, err)
+        class(descent_t), intent(inout) :: self
+        class(rope_model_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(inout) :: y(:)
+        type(statics_options_t), intent(in) :: options
+        type(error_t), allocatable, intent(out) :: err
+        logical :: accept, converged
 
         do
-            if (fresh) then
-                call tangent_matrices(model, y, pos, vel, kt, status)
-                if (status /= STATUS_OK) then
-                    call make_error(err, ERR_SOLVER, spec%path//': statics: the stiffness '// &
-                                    'matrix is not finite at iteration '// &
-                                    int_text(result%iterations))
-                    return
-                end if
-                kt = 0.5_wp*(kt + transpose(kt))
-                if (at_rounding_level()) then
-                    result%criterion = 'rounding level'
-                    exit
-                end if
-                call model%coordinate_mass(y, mm)
-                fresh = .false.
+            if (self%fresh) then
+                call self%assemble(model, spec, y, converged, err)
+                if (allocated(err) .or. converged) return
             end if
-            if (result%iterations >= options%max_iterations) then
-                write (text, '(a, i0, a, es10.3, a, es10.3, a, es9.2)') 'no convergence in ', &
-                    result%iterations, ' iterations (max |f| = ', maxval(abs(f)), &
-                    ' N, last step ', result%last_step, ' m or rad, shift ', sigma
-                call make_error(err, ERR_SOLVER, spec%path//': statics: '//trim(text)// &
-                    '); the rope may have no stable equilibrium near the start, or needs '// &
-                    'more iterations (--max-iterations)')
+            if (self%result%iterations >= options%max_iterations) then
+                call self%no_convergence(spec, err)
                 return
             end if
-            sigma_used = sigma
-            result%iterations = result%iterations + 1
-            ! (K + sigma M + E) delta = f, E >= 0 from the modified Cholesky factorization
-            call ldl_factor(kt + sigma*mm, 1.0_wp/sqrt(mdiag), fac, modified)
-            newton = sigma == 0.0_wp .and. .not. modified
-            delta = ldl_solve(fac, f)
-            accept = all(ieee_is_finite(delta))
-            status = STATUS_OK
+            call self%trial(model, spec, y, accept)
             if (accept) then
-                call limit_step(delta)
-                kd = matmul(kt, delta)
-                predicted = dot_product(f, delta) - 0.5_wp*dot_product(delta, kd)
-                call try_step(delta, accept)
-                ! second-order corrections: chord steps with the same matrix pull the trial
-                ! point back towards the manifold the linear step left (stiff springs
-                ! stretched by a linearized rotation), judged against the same prediction
-                do k = 1, 2
-                    if (accept .or. status /= STATUS_OK) exit
-                    delta = delta + ldl_solve(fac, f_new)
-                    call limit_step(delta)
-                    call try_step(delta, accept)
-                    rho = min(rho, 0.5_wp)
-                end do
-            end if
-            if (.not. accept) then
-                result%rejected = result%rejected + 1
-                consecutive = consecutive + 1
-                if (consecutive > 40) then
-                    call make_error(err, ERR_SOLVER, spec%path//': statics: no step lowers '// &
-                        'the potential energy (40 rejections in a row at iteration '// &
-                        int_text(result%iterations)//'); the forces may be inconsistent with '// &
-                        'the energy, or the equilibrium is singular')
-                    return
-                end if
-                if (sigma == 0.0_wp) then
-                    ! Newton failed: back to the last shift that worked
-                    sigma = sigma_good
-                    if (sigma == 0.0_wp) sigma = 1.0e-6_wp*sigma0
-                else
-                    sigma = 4.0_wp*sigma
-                end if
-                cycle
-            end if
-
-            ! accepted
-            consecutive = 0
-            fresh = .true.
-            y = y_new
-            result%last_step = step
-            if (newton) result%newton_steps = result%newton_steps + 1
-            if (maxval(abs(y(pos) - q0)) > 1.0e4_wp*(length + maxval(abs(q0)))) then
-                call make_error(err, ERR_SOLVER, spec%path//': statics: diverged: the '// &
-                    'rope moves away without bound (no equilibrium?)')
-                return
-            end if
-            f = f_new
-            v_old = v_new
-            if (newton .and. step <= options%step_tolerance*length) then
-                result%criterion = 'newton step'
-                exit
-            end if
-            ! shift update (Levenberg-Marquardt): good model -> smaller shift, and Newton
-            ! once the shift is small against the stiffness along the step
-            if (rho > 0.75_wp) then
-                sigma = 0.0625_wp*sigma
-            else if (rho < 0.25_wp) then
-                sigma = 4.0_wp*sigma
-            end if
-            dmdd = dot_product(delta, matmul(mm, delta))
-            lambda_step = 0.0_wp
-            if (dmdd > 0.0_wp) lambda_step = dot_product(delta, kd)/dmdd
-            if (sigma_used > 0.0_wp) sigma_good = sigma_used
-            if ((sigma < 1.0e-3_wp*lambda_step .and. step <= 1.0e-2_wp*length) .or. &
-                sigma < 1.0e-12_wp*sigma0) sigma = 0.0_wp
-        end do
-
-        y(vel) = 0.0_wp
-        result%residual = maxval(abs(f))
-        result%residual_relative = result%residual/merge(result%weight, 1.0_wp, &
-                                                          result%weight > 0.0_wp)
-        block
-            type(energy_t) :: e
-            real(wp) :: yq(max(1, model%quad_size()))
-            yq = 0.0_wp
-            e = model%energy(0.0_wp, y, yq)
-            result%elastic = e%elastic
-            result%gravity = e%gravity
-        end block
-    contains
-        !> Scale delta down to at most step_limit in every coordinate.
-        subroutine limit_step(dq)
-            real(wp), intent(inout) :: dq(:)
-            step = maxval(abs(dq))
-            if (step > step_limit) dq = dq*(step_limit/step)
-            step = maxval(abs(dq))
-        end subroutine limit_step
-
-        !> Evaluate q + dq: accept when V falls by at least 1e-4 of the predicted decrease.
-        subroutine try_step(dq, ok)
-            real(wp), intent(in) :: dq(:)
-            logical, intent(out) :: ok
-            ok = .false.
-            y_new = y
-            y_new(pos) = y(pos) + dq
-            call generalized_force(model, y_new, pos, vel, f_new, status)
-            if (status /= STATUS_OK) return
-            v_new = potential_energy(model, y_new, spec)
-            if (.not. ieee_is_finite(v_new)) then
-                status = -1
-                return
-            end if
-            noise = 1.0e-13_wp*(abs(v_old) + result%weight*length) + tiny(1.0_wp)
-            if (predicted <= noise) then
-                ! at the rounding level of V: judge by the forces
-                rho = 1.0_wp
-                ok = maxval(abs(f_new)) <= maxval(abs(f)) .or. v_new <= v_old + noise
+                call self%accept(spec, y, options, converged, err)
+                if (allocated(err) .or. converged) return
             else
-                rho = (v_old - v_new)/predicted
-                ok = rho > 1.0e-4_wp
+                call self%reject(spec, err)
+                if (allocated(err)) return
             end if
-        end subroutine try_step
+        end do
+    end subroutine descent_iterate
 
-        !> max |f| is within the rounding error of the stiffness forces.
-        logical function at_rounding_level() result(yes)
-            real(wp) :: floor_k
-            integer :: i
-            qscale = abs(y(pos)) + length
-            result%rounding_level = 0.0_wp
-            do i = 1, nd
-                floor_k = 10.0_wp*epsilon(1.0_wp)*(sum(abs(kt(i, :))*qscale) &
-                                                   + result%weight) + tiny(1.0_wp)
-                result%rounding_level = max(result%rounding_level, abs(f(i))/floor_k)
-            end do
-            yes = result%rounding_level <= 1.0_wp
-        end function at_rounding_level
-    end subroutine solve_statics
+    !> The symmetrized tangent stiffness and the mass at y; `converged` (and no mass) when
+    !! max |f| is at the rounding level of the stiffness there.
+    subroutine descent_assemble(self, model, spec, y, converged, err)
+        class(descent_t), intent(inout) :: self
+        class(rope_model_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(in) :: y(:)
+        logical, intent(out) :: converged
+        type(error_t), allocatable, intent(out) :: err
+
+        converged = .false.
+        call tangent_matrices(model, y, self%pos, self%vel, self%kt, self%status)
+        if (self%status /= STATUS_OK) then
+            call make_error(err, ERR_SOLVER, spec%path//': statics: the stiffness '// &
+                            'matrix is not finite at iteration '// &
+                            int_text(self%result%iterations))
+            return
+        end if
+        self%kt = 0.5_wp*(self%kt + transpose(self%kt))
+        call self%measure_rounding(y)
+        if (self%result%rounding_level <= 1.0_wp) then
+            self%result%criterion = 'rounding level'
+            converged = .true.
+            return
+        end if
+        call model%coordinate_mass(y, self%mm)
+        self%fresh = .false.
+    end subroutine descent_assemble
+
+    !> result%rounding_level: max |f| over its rounding floor, the rounding error of the
+    !! stiffness forces (10 eps sum_j |K_kj| (|q_j| + L), plus the weight).
+    subroutine descent_measure_rounding(self, y)
+        class(descent_t), intent(inout) :: self
+        real(wp), intent(in) :: y(:)
+        real(wp), allocatable :: qscale(:)
+        real(wp) :: floor_k
+        integer :: i
+        qscale = abs(y(self%pos)) + self%length
+        self%result%rounding_level = 0.0_wp
+        do i = 1, size(self%pos)
+            floor_k = 10.0_wp*epsilon(1.0_wp)*(sum(abs(self%kt(i, :))*qscale) &
+                                               + self%result%weight) + tiny(1.0_wp)
+            self%result%rounding_level = max(self%result%rounding_level, &
+                                             abs(self%f(i))/floor_k)
+        end do
+    end subroutine descent_measure_rounding
+
+    !> ERR_SOLVER: the iterations are used up.
+    subroutine descent_no_convergence(self, spec, err)
+        class(descent_t), intent(in) :: self
+        type(rope_spec_t), intent(in) :: spec
+        type(error_t), allocatable, intent(out) :: err
+        character(len=200) :: text
+        write (text, '(a, i0, a, es10.3, a, es10.3, a, es9.2)') 'no convergence in ', &
+            self%result%iterations, ' iterations (max |f| = ', maxval(abs(self%f)), &
+            ' N, last step ', self%result%last_step, ' m or rad, shift ', self%sigma
+        call make_error(err, ERR_SOLVER, spec%path//': statics: '//trim(text)// &
+            '); the rope may have no stable equilibrium near the start, or needs '// &
+            'more iterations (--max-iterations)')
+    end subroutine descent_no_convergence
+
+    !> One linear solve and its trial point: (K + sigma M + E) delta = f, E >= 0 from the
+    !! modified Cholesky factorization; `accept` when the energy falls enough there, after
+    !! up to two second-order corrections.
+    subroutine descent_trial(self, model, spec, y, accept)
+        class(descent_t), intent(inout) :: self
+        class(rope_model_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(in) :: y(:)
+        logical, intent(out) :: accept
+        logical :: modified
+        integer :: k
+
+        self%sigma_used = self%sigma
+        self%result%iterations = self%result%iterations + 1
+        call ldl_factor(self%kt + self%sigma*self%mm, 1.0_wp/sqrt(self%mdiag), self%fac, &
+                        modified)
+        self%newton = self%sigma == 0.0_wp .and. .not. modified
+        self%delta = ldl_solve(self%fac, self%f)
+        accept = all(ieee_is_finite(self%delta))
+        self%status = STATUS_OK
+        if (.not. accept) return
+        call self%limit_step()
+        self%kd = matmul(self%kt, self%delta)
+        self%predicted = dot_product(self%f, self%delta) - &
+                         0.5_wp*dot_product(self%delta, self%kd)
+        call self%try_step(model, spec, y, accept)
+        ! second-order corrections: chord steps with the same matrix pull the trial
+        ! point back towards the manifold the linear step left (stiff springs
+        ! stretched by a linearized rotation), judged against the same prediction
+        do k = 1, 2
+            if (accept .or. self%status /= STATUS_OK) exit
+            self%delta = self%delta + ldl_solve(self%fac, self%f_new)
+            call self%limit_step()
+            call self%try_step(model, spec, y, accept)
+            self%rho = min(self%rho, 0.5_wp)
+        end do
+    end subroutine descent_trial
+
+    !> Scale delta down to at most step_limit in every coordinate; step is its max |entry|.
+    subroutine descent_limit_step(self)
+        class(descent_t), intent(inout) :: self
+        self%step = maxval(abs(self%delta))
+        if (self%step > self%step_limit) self%delta = self%delta*(self%step_limit/self%step)
+        self%step = maxval(abs(self%delta))
+    end subroutine descent_limit_step
+
+    !> Evaluate q + delta (y_new, f_new, v_new): `ok` when V falls by at least 1e-4 of the
+    !! predicted decrease (rho: the ratio); status /= STATUS_OK when it is not finite.
+    subroutine descent_try_step(self, model, spec, y, ok)
+        class(descent_t), intent(inout) :: self
+        class(rope_model_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(in) :: y(:)
+        logical, intent(out) :: ok
+        real(wp) :: noise
+        ok = .false.
+        self%y_new = y
+        self%y_new(self%pos) = y(self%pos) + self%delta
+        call generalized_force(model, self%y_new, self%pos, self%vel, self%f_new, self%status)
+        if (self%status /= STATUS_OK) return
+        self%v_new = potential_energy(model, self%y_new, spec)
+        if (.not. ieee_is_finite(self%v_new)) then
+            self%status = -1
+            return
+        end if
+        noise = 1.0e-13_wp*(abs(self%v_old) + self%result%weight*self%length) + tiny(1.0_wp)
+        if (self%predicted <= noise) then
+            ! at the rounding level of V: judge by the forces
+            self%rho = 1.0_wp
+            ok = maxval(abs(self%f_new)) <= maxval(abs(self%f)) .or. &
+                 self%v_new <= self%v_old + noise
+        else
+            self%rho = (self%v_old - self%v_new)/self%predicted
+            ok = self%rho > 1.0e-4_wp
+        end if
+    end subroutine descent_try_step
+
+    !> A rejected step: a larger shift (back to the last one that worked after a failed
+    !! Newton step); ERR_SOLVER after 40 rejections in a row.
+    subroutine descent_reject(self, spec, err)
+        class(descent_t), intent(inout) :: self
+        type(rope_spec_t), intent(in) :: spec
+        type(error_t), allocatable, intent(out) :: err
+        self%result%rejected = self%result%rejected + 1
+        self%consecutive = self%consecutive + 1
+        if (self%consecutive > 40) then
+            call make_error(err, ERR_SOLVER, spec%path//': statics: no step lowers '// &
+                'the potential energy (40 rejections in a row at iteration '// &
+                int_text(self%result%iterations)//'); the forces may be inconsistent with '// &
+                'the energy, or the equilibrium is singular')
+            return
+        end if
+        if (self%sigma == 0.0_wp) then
+            ! Newton failed: back to the last shift that worked
+            self%sigma = self%sigma_good
+            if (self%sigma == 0.0_wp) self%sigma = 1.0e-6_wp*self%sigma0
+        else
+            self%sigma = 4.0_wp*self%sigma
+        end if
+    end subroutine descent_reject
+
+    !> An accepted step: y moves to the trial point; `converged` after a small Newton step;
+    !! ERR_SOLVER if the rope moves away without bound. Then the shift update.
+    subroutine descent_accept(self, spec, y, options, converged, err)
+        class(descent_t), intent(inout) :: self
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(inout) :: y(:)
+        type(statics_options_t), intent(in) :: options
+        logical, intent(out) :: converged
+        type(error_t), allocatable, intent(out) :: err
+
+        converged = .false.
+        self%consecutive = 0
+        self%fresh = .true.
+        y = self%y_new
+        self%result%last_step = self%step
+        if (self%newton) self%result%newton_steps = self%result%newton_steps + 1
+        if (maxval(abs(y(self%pos) - self%q0)) > &
+            1.0e4_wp*(self%length + maxval(abs(self%q0)))) then
+            call make_error(err, ERR_SOLVER, spec%path//': statics: diverged: the '// &
+                'rope moves away without bound (no equilibrium?)')
+            return
+        end if
+        self%f = self%f_new
+        self%v_old = self%v_new
+        if (self%newton .and. self%step <= options%step_tolerance*self%length) then
+            self%result%criterion = 'newton step'
+            converged = .true.
+            return
+        end if
+        call self%update_shift()
+    end subroutine descent_accept
+
+    !> The shift after an accepted step (Levenberg-Marquardt): good model -> smaller shift,
+    !! and Newton once the shift is small against the stiffness along the step.
+    subroutine descent_update_shift(self)
+        class(descent_t), intent(inout) :: self
+        real(wp) :: dmdd, lambda_step
+        if (self%rho > 0.75_wp) then
+            self%sigma = 0.0625_wp*self%sigma
+        else if (self%rho < 0.25_wp) then
+            self%sigma = 4.0_wp*self%sigma
+        end if
+        dmdd = dot_product(self%delta, matmul(self%mm, self%delta))
+        lambda_step = 0.0_wp
+        if (dmdd > 0.0_wp) lambda_step = dot_product(self%delta, self%kd)/dmdd
+        if (self%sigma_used > 0.0_wp) self%sigma_good = self%sigma_used
+        if ((self%sigma < 1.0e-3_wp*lambda_step .and. self%step <= 1.0e-2_wp*self%length) &
+            .or. self%sigma < 1.0e-12_wp*self%sigma0) self%sigma = 0.0_wp
+    end subroutine descent_update_shift
+
+    !> The equilibrium's results: velocities zeroed, the residual, the energies.
+    subroutine descent_finish(self, model, y)
+        class(descent_t), intent(inout) :: self
+        class(rope_model_t), intent(inout) :: model
+        real(wp), intent(inout) :: y(:)
+        type(energy_t) :: e
+        real(wp) :: yq(max(1, model%quad_size()))
+        y(self%vel) = 0.0_wp
+        self%result%residual = maxval(abs(self%f))
+        self%result%residual_relative = self%result%residual/ &
+            merge(self%result%weight, 1.0_wp, self%result%weight > 0.0_wp)
+        yq = 0.0_wp
+        e = model%energy(0.0_wp, y, yq)
+        self%result%elastic = e%elastic
+        self%result%gravity = e%gravity
+    end subroutine descent_finish
 end module ropedyn_statics

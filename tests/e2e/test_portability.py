@@ -2,7 +2,7 @@
 is missing with the package that provides it (Debian, RHEL, Spack, module); a copy of the
 clone (with its build folder) configures and builds afresh, with SUNDIALS and HDF5 found
 from prefixes given; the venv names the package folder relative to itself, so that a
-copied venv imports its own clone's package."""
+copied venv imports its own clone's package; SUNDIALS is found under a prefix elsewhere."""
 import os
 import pathlib
 import shutil
@@ -66,3 +66,31 @@ def test_venv_names_the_package_relative_to_itself():
     line = pth[0].read_text().strip()
     assert not os.path.isabs(line)
     assert (pth[0].parent / line).resolve() == (ROOT / "python").resolve()
+
+
+def test_sundials_from_a_prefix_elsewhere(tmp_path):
+    """SUNDIALS installed under another prefix (here the system's files linked into one,
+    in Debian's layout) is found from SUNDIALS_DIR=PREFIX: its config, its libraries and
+    its Fortran modules come from there, not from /usr; the solvers build against it."""
+    system = pathlib.Path("/usr/lib/x86_64-linux-gnu")
+    if not (system / "cmake" / "sundials" / "SUNDIALSConfig.cmake").is_file():
+        pytest.skip("needs Debian's SUNDIALS (libsundials-dev) to make the prefix from")
+    prefix = tmp_path / "sundials"
+    lib = prefix / "lib" / "x86_64-linux-gnu"
+    (lib / "cmake").mkdir(parents=True)
+    shutil.copytree(system / "cmake" / "sundials", lib / "cmake" / "sundials")
+    for so in system.glob("libsundials_*"):
+        (lib / so.name).symlink_to(so)
+    (prefix / "include").symlink_to("/usr/include")
+    (prefix / "fortran").symlink_to("/usr/include/sundials/fortran")
+    build = tmp_path / "build"
+    result = subprocess.run(["cmake", "-S", str(ROOT), "-B", str(build),
+                             "-DCMAKE_BUILD_TYPE=Debug", f"-DSUNDIALS_DIR={prefix}",
+                             "-DHDF5_ROOT=/usr"], capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    cache = (build / "CMakeCache.txt").read_text()
+    assert f"SUNDIALS_DIR:PATH={lib / 'cmake' / 'sundials'}" in cache
+    assert f"SUNDIALS_FORTRAN_MODULE_DIR:PATH={prefix / 'fortran'}" in cache
+    result = subprocess.run(["cmake", "--build", str(build), "-j2", "--target",
+                             "ropedyn_solvers"], capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout[-3000:]

@@ -199,6 +199,39 @@ def test_pictures_show_the_moving_support_and_the_ground(ropedyn_exe, tmp_path, 
     assert result.returncode == 0, result.stderr
 
 
+WATER = ("&model kind = '{kind}', elements = 6 /\n"
+         "&rope diameter = 0.01 /\n&initial shape = 'straight', angle_deg = 60.0 /\n"
+         "&effects water = .true. /\n&fluid density = 1000.0, surface = 0.4 /\n"
+         "&solver t_end = 0.1, output_interval = 0.01 /\n")
+
+
+@pytest.mark.parametrize("kind", ["rfem", "mpp"])
+def test_pictures_show_the_water_surface(ropedyn_exe, tmp_path, kind):
+    """A rope swinging into water: the overview's picture and the animation draw the
+    surface at &fluid surface (x down) and shade the water below it; a scene without water
+    draws none."""
+    from ropedyn import animate
+    from ropedyn.plot import overview
+
+    wet = io.load_run(ropedyn(ropedyn_exe, tmp_path, WATER.format(kind=kind), kind))
+    dry = io.load_run(ropedyn(ropedyn_exe, tmp_path, WATER.format(kind=kind), kind + "_dry",
+                              "effects.water=.false."))
+    for run, drawn in ((wet, True), (dry, False)):
+        ax = overview.make_figure(run, [0.05], (900, 700), 100).axes[1]
+        lines = {line.get_label(): line for line in ax.get_lines()}
+        assert ("water surface" in lines) == drawn
+        if drawn:
+            assert list(lines["water surface"].get_ydata()) == [0.4, 0.4]
+            shade, = [p for p in ax.patches if p.get_alpha() == 0.08]
+            assert shade.get_y() == pytest.approx(0.4) and shade.get_height() > 0
+    frames = animate.RopeFrames(wet, (320, 240), 100, False, 1.0)
+    try:
+        labels = [line.get_label() for line in frames.fig.axes[0].get_lines()]
+        assert "water surface" in labels
+    finally:
+        frames.close()
+
+
 # --- XDMF ----------------------------------------------------------------------------------
 
 def sha256(path):

@@ -178,7 +178,8 @@ def test_energy_balance_through_the_surface(run, tmp_path, kind, method):
     assert e["dissipated"][-1] > 0 and np.abs(e["support_work"]).max() > 0
 
 
-def test_a_damped_run_settles_on_the_submerged_catenary(run, tmp_path):
+@pytest.mark.parametrize("kind", ["rfem", "mpp"])
+def test_a_damped_run_settles_on_the_submerged_catenary(run, tmp_path, kind):
     """Started from the catenary displaced along its first mode by 0.3 m, the chain
     damped by its material and the water's drag comes to rest on the statics' equilibrium
     (to 1e-6 of the sag) and so on the elastic catenary (1e-4)."""
@@ -187,7 +188,7 @@ def test_a_damped_run_settles_on_the_submerged_catenary(run, tmp_path):
     common = f"""
 &rope length = {length}, mass_per_length = {mu}, axial_stiffness = {ea}, diameter = {d},
       axial_damping = 20.0 /
-&model kind = 'rfem', elements = 100 /
+&model kind = '{kind}', elements = 100 /
 &supports top = 'pinned', bottom = 'pinned', top_anchor = 5.0, 0.0,
           bottom_anchor = 5.0, {span}, support_stiffness_factor = 1000.0 /
 &effects water = .true., drag = .true. /

@@ -7,10 +7,11 @@ import re
 
 import numpy as np
 
-from ropedyn.fields import ground_plane, supports
+from ropedyn.fields import ground_plane, supports, water_surface
 
 SUPPORT_PATH_COLOR = "#2ca02c"
 GROUND_COLOR = "#8c564b"
+WATER_COLOR = "#1f77b4"
 
 
 def draw_supports(ax, run, size=None, color="0.25", moving=True):
@@ -71,6 +72,22 @@ def draw_ground(ax, run, color=GROUND_COLOR):
         p = point + k * along
         q = p - size * normal + size * along
         ax.plot([p[1], q[1]], [p[0], q[0]], color=color, lw=0.6, alpha=0.6)
+    ax.set_xlim(ymin, ymax)
+    ax.set_ylim(xmax, xmin)
+    return True
+
+
+def draw_water(ax, run, color=WATER_COLOR):
+    """Draw the water's free surface (&fluid surface, a horizontal line: x is down) and
+    shade the water below it when the scene has water (&effects water = .true.); True if
+    drawn."""
+    surface = water_surface(run)
+    if surface is None:
+        return False
+    ax.axhline(surface, color=color, lw=1.2, ls="--", label="water surface")
+    (ymin, ymax), (xmin, xmax) = ax.get_xlim(), sorted(ax.get_ylim())
+    if xmax > surface:
+        ax.axhspan(max(surface, xmin), xmax, color=color, alpha=0.08, lw=0)
     ax.set_xlim(ymin, ymax)
     ax.set_ylim(xmax, xmin)
     return True

@@ -1,6 +1,6 @@
 """Overview plot of a ropedyn run: energies over time, the tip's trajectory (with a moving
-support's path and the ground), the solver's step size and order over time, and the axial
-force along the rope at chosen times.
+support's path, the ground and the water surface), the solver's step size and order over
+time, and the axial force along the rope at chosen times.
 
 usage: scripts/plot RUN.h5 [-o RUN_plot.png] [--times 0.5,1,2] [--size 1200x900]
        (python -m ropedyn.plot, or python -m ropedyn.plot.overview)
@@ -43,6 +43,7 @@ def plot_tip(ax, run):
     tip = run.points[:, -1, :]
     plot.setup_picture_axes(ax, run)
     plot.draw_ground(ax, run)
+    plot.draw_water(ax, run)
     plot.draw_supports(ax, run)
     plot.draw_support_paths(ax, run)
     ax.plot(run.points[0, :, 1], run.points[0, :, 0], color="0.6", lw=1.2, label="rope, start")

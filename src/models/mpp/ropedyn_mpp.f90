@@ -41,7 +41,7 @@ module ropedyn_mpp
                               add_energies_of, add_powers_of
     use ropedyn_effect_factory, only: build_body_effects, attached_masses, water_added_mass
     use ropedyn_added_mass, only: added_mass_t
-    use ropedyn_support_motion, only: support_motion_t, motion_state_t
+    use ropedyn_support_motion, only: motion_state_t
     use ropedyn_rope_section, only: section_t, rope_section
     use ropedyn_rope_setup, only: initial_angle, clamp_angles, &
                                   configure_motions, any_does_work

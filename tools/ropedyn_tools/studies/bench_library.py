@@ -191,6 +191,10 @@ to the time asked for does not depend on it), and the difference of the two CPU 
 then stands well above the drift of the timings on a shared machine (at 1 ms over 30 s,
 three runs gave -11 to +5 us a call for the same code).
 
+The memory grows over the first cycles, while the allocators fill their pools, and then
+stays flat to within a few pages: a leak of the smallest allocation, 16 bytes a cycle,
+would add 1.6 MB over 100,000 cycles.
+
 <!-- bench_library:begin -->
 <!-- bench_library:end -->
 """

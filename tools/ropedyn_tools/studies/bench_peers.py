@@ -48,8 +48,12 @@ venv) on the same rope as input/paper.nml, n segments against ropedyn's n elemen
   the first second between a step and its half); ropedyn's symplectic method at rtol 1e-3:
   the energy error at 30 s and 300 s in m g L and the CPU of each.
 
-The tables go between the bench_peers (and bench_peers_undamped) markers of
-docs/performance/peers.md. The code of scripts/bench_peers.
+- The coupled case (its own table, also alone with --coupled-only): the same rope with
+  its top driven from Python every millisecond, ropedyn through ropedyn.Simulation and
+  MoorDyn through its Python package (COUPLED_DT and what follows it).
+
+The tables go between the bench_peers (bench_peers_undamped, bench_peers_coupled) markers
+of docs/performance/peers.md. The code of scripts/bench_peers.
 
 MoorDyn-C 2.7.2's reader scans for the next line of dashes without a bound: an input file
 that does not end with one (the "need this line" line of its examples) makes `Create`
@@ -152,9 +156,11 @@ def segment_damping_ratio(n):
     return ETA * area * n / (2 * LENGTH * math.sqrt(YOUNG * area * DENSITY * area))
 
 
-def moordyn_file(path, n, dt, undamped=False):
+def moordyn_file(path, n, dt, undamped=False, top="Fixed", outputs="p"):
     """MoorDyn's input for the paper's rope; `undamped`: no internal damping and no bending
-    stiffness (a chain of tension-only springs, whose energy the driver can sum)."""
+    stiffness (a chain of tension-only springs, whose energy the driver can sum); `top`: the
+    top point's attachment (Fixed, or Coupled for the coupled case); `outputs`: the line's
+    outputs (p: node positions; -: none)."""
     area = math.pi * DIAMETER ** 2 / 4
     ea, mu = YOUNG * area, DENSITY * area
     ei = YOUNG * math.pi * DIAMETER ** 4 / 64
@@ -363,6 +369,197 @@ def undamped_row(py, exe, work, n, t_end, probe, repeat):
     return f"| {n} | " + " | ".join(cells) + " |"
 
 
+# The coupled case: the top driven from Python every COUPLED_DT by the smooth motion of
+# coupled_motion, ropedyn through ropedyn.Simulation (top_motion = 'coupled') and MoorDyn
+# through its Python package (a Coupled point), each reading the top's force back at every
+# exchange; nothing written by either. MoorDyn takes the position and velocity at the
+# start of each step and moves the point on with that velocity; ropedyn takes them at the
+# end and moves the support on the cubic Hermite curve between.
+COUPLED_DT = 1e-3                                      # s
+COUPLED_AMPLITUDE, COUPLED_FREQUENCY, COUPLED_RAMP = 0.05, 1.5, 0.4   # m, Hz, s
+
+DRIVER_COUPLED = r"""
+import json, sys, time, math
+import moordyn
+path, t_end, dt, length, span, top_z, amp, freq, ramp = (
+    sys.argv[1], *map(float, sys.argv[2:]))
+
+def motion(t):
+    u = min(t / ramp, 1.0)
+    r = u ** 3 * (10 - 15 * u + 6 * u * u)
+    dr = 30 * u * u * (1 - u) ** 2 / ramp if t < ramp else 0.0
+    w = 2 * math.pi * freq
+    return r * amp * math.sin(w * t), r * amp * w * math.cos(w * t) + dr * amp * math.sin(w * t)
+
+s = moordyn.Create(path)
+moordyn.Init_NoIC(s, [0.0, 0.0, top_z], [0.0, 0.0, 0.0])
+line = moordyn.GetLine(s, 1)
+n = moordyn.GetLineNumberNodes(line)
+tips = [list(moordyn.GetLineNodePos(line, n - 1))]
+steps, every = int(round(t_end / dt)), int(round(0.01 / dt))
+ok, peak, c = True, 0.0, time.process_time()
+for k in range(steps):
+    t = k * dt
+    y, v = motion(t)
+    f = moordyn.Step(s, [y, 0.0, top_z], [v, 0.0, 0.0], t, dt)
+    peak = max(peak, math.hypot(f[0], f[2]))
+    if (k + 1) % every == 0:
+        p = moordyn.GetLineNodePos(line, n - 1)
+        if (k + 1) * dt <= span + 1e-9:
+            tips.append(list(p))
+        if not all(math.isfinite(x) for x in p):
+            ok = False
+            break
+cpu = time.process_time() - c
+moordyn.Close(s)
+print("RESULT " + json.dumps({"cpu": cpu, "ok": ok, "peak": peak, "tip": tips}), flush=True)
+"""
+
+
+def coupled_motion(t):
+    """The top's sideways position and velocity at t: a harmonic motion of
+    COUPLED_AMPLITUDE at COUPLED_FREQUENCY, ramped from rest over COUPLED_RAMP (as a
+    harmonic support with top_ramp_time); the same text runs in MoorDyn's driver."""
+    u = min(t / COUPLED_RAMP, 1.0)
+    r = u ** 3 * (10 - 15 * u + 6 * u * u)
+    dr = 30 * u * u * (1 - u) ** 2 / COUPLED_RAMP if t < COUPLED_RAMP else 0.0
+    w = 2 * math.pi * COUPLED_FREQUENCY
+    return (r * COUPLED_AMPLITUDE * math.sin(w * t),
+            r * COUPLED_AMPLITUDE * w * math.cos(w * t) + dr * COUPLED_AMPLITUDE * math.sin(w * t))
+
+
+def run_moordyn_coupled(py, workdir, n, dt, t_end, span=ACCURACY_SPAN):
+    f = workdir / f"coupled_{n}.txt"
+    moordyn_file(f, n, dt, top="Coupled", outputs="-")
+    proc = subprocess.run([str(py), "-X", "faulthandler", "-c", DRIVER_COUPLED, str(f),
+                           str(t_end), str(COUPLED_DT), str(LENGTH), str(span), str(TOP_Z),
+                           str(COUPLED_AMPLITUDE), str(COUPLED_FREQUENCY), str(COUPLED_RAMP)],
+                          capture_output=True, text=True, cwd=workdir, timeout=3600)
+    for line in proc.stdout.splitlines()[::-1]:
+        if "RESULT " in line:
+            r = json.loads(line.split("RESULT ", 1)[1])
+            xyz = np.array(r.pop("tip"))
+            r["tip"] = np.column_stack([TOP_Z - xyz[:, 2], xyz[:, 0]])
+            return r
+    return {"ok": False, "cpu": float("nan"),
+            "error": (proc.stderr.strip().splitlines() or ["no output"])[-1][:80]}
+
+
+def run_ropedyn_coupled(n, t_end, sets=(), span=ACCURACY_SPAN):
+    """The paper's rope with its top coupled, driven every COUPLED_DT from this process
+    through ropedyn.Simulation; CPU (process time) of the loop, the peak top force, the
+    tip every 0.01 s up to span."""
+    import time
+    import ropedyn
+    scene = ropedyn.Scene.from_file(PAPER).set({
+        "model.elements": n, "supports.top_motion": "coupled",
+        **dict(item.split("=", 1) for item in sets)})
+    tips, peak = [], 0.0
+    steps, every = int(round(t_end / COUPLED_DT)), int(round(OUT_DT / COUPLED_DT))
+    with ropedyn.Simulation(scene) as sim:
+        tips.append(sim.points[-1])
+        set_support, advance, reaction = sim.set_support, sim.advance, sim.reaction
+        c = time.process_time()
+        for k in range(1, steps + 1):
+            t = k * COUPLED_DT
+            y, v = coupled_motion(t)
+            set_support("top", position=(0.0, y), velocity=(0.0, v))
+            advance(t)
+            f = reaction("top")
+            peak = max(peak, math.hypot(f[0], f[1]))
+            if k % every == 0 and t <= span + 1e-9:
+                tips.append(sim.points[-1])
+        cpu = time.process_time() - c
+    return {"cpu": cpu, "peak": peak, "tip": np.array(tips)}
+
+
+def l2(a, b):
+    k = min(len(a), len(b))
+    return float(np.sqrt(np.mean(np.linalg.norm(a[:k] - b[:k], axis=1) ** 2)))
+
+
+def coupled_row(py, exe, work, n, t_end, probe, repeat):
+    """The coupled case at n: the table row, MoorDyn at the step the ladder finds."""
+    import os
+    os.environ.setdefault("ROPEDYN_LIBRARY", str(pathlib.Path(exe).resolve().parent /
+                                                  "libropedyn.so"))
+    steps = ladder(n)
+    k = next((i for i, h in enumerate(steps) if stable_and_right(py, work, n, h, probe)), None)
+    md, dt = {"ok": False}, None
+    while k is not None and k < len(steps):
+        h = steps[k]
+        md = least_cpu(lambda: run_moordyn_coupled(py, work, n, h, t_end), repeat,
+                       complete=lambda r: r["ok"])
+        if md["ok"]:
+            dt = h
+            break
+        k += 1
+    rd = least_cpu(lambda: run_ropedyn_coupled(n, t_end), repeat)
+    ref = run_ropedyn_coupled(n, ACCURACY_SPAN, sets=('solver.method="cvode"',
+                                                      "solver.rtol=1e-10", "solver.atol=1e-12"))
+    rd_err = l2(rd["tip"], ref["tip"])
+    if not md.get("ok"):
+        return (f"| {n} | none stable | | | {rd['cpu']:.3g} | | {rd_err:.1e} | | "
+                f"| {rd['peak']:.3f} | | | |")
+    fine = run_moordyn_coupled(py, work, n, dt / 4, ACCURACY_SPAN)
+    md_err = l2(md["tip"], fine["tip"]) if fine.get("ok") else float("nan")
+    # at equal accuracy: the loosest rtol whose tip error is at most MoorDyn's time error
+    equal = "| none | | "
+    for rtol in EQUAL_RTOLS:
+        sets = (f"solver.rtol={rtol:g}", f"solver.atol={rtol / 100:g}")
+        if l2(run_ropedyn_coupled(n, ACCURACY_SPAN, sets=sets)["tip"], ref["tip"]) <= md_err:
+            loose = least_cpu(lambda: run_ropedyn_coupled(n, t_end, sets=sets), repeat)
+            equal = f"| {rtol:g} | {loose['cpu']:.3g} | {md['cpu'] / loose['cpu']:.2f}"
+            break
+    return (f"| {n} | {dt:.3g} | {md['cpu']:.3g} | {md['peak']:.3f} | {rd['cpu']:.3g} "
+            f"| {md['cpu'] / rd['cpu']:.2f} | {rd_err:.1e} | {md_err:.1e} "
+            f"| {l2(md['tip'], ref['tip']):.1e} | {rd['peak']:.3f} {equal} |")
+
+
+COUPLED_BEGIN = "<!-- bench_peers_coupled:begin -->"
+COUPLED_END = "<!-- bench_peers_coupled:end -->"
+COUPLED_HEADER = ("| n | MoorDyn dt (s) | MoorDyn CPU (s) | MoorDyn peak top force (N) "
+                  "| ropedyn CPU (s) | MoorDyn / ropedyn | ropedyn tip error [0, 2 s] (m) "
+                  "| MoorDyn time error [0, 2 s] (m) "
+                  "| MoorDyn tip - ropedyn reference [0, 2 s] (m) "
+                  "| ropedyn peak top force (N) | ropedyn rtol at equal accuracy "
+                  "| its CPU (s) | MoorDyn / ropedyn at equal accuracy |")
+
+
+def coupled_main(args, exe, py):
+    rows = []
+    print(COUPLED_HEADER, flush=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        for n in (int(x) for x in args.coupled_elements.split()):
+            rows.append(coupled_row(py, exe, pathlib.Path(tmp), n, args.t_end, args.probe,
+                                    args.repeat))
+            print(rows[-1], flush=True)
+    if args.no_write:
+        return 0
+    lines = [COUPLED_BEGIN,
+             f"Command: `scripts/bench_peers --coupled-only --t-end {args.t_end:g} "
+             f"--coupled-elements \"{args.coupled_elements}\" --repeat {args.repeat}` (code: "
+             "tools/ropedyn_tools/studies/bench_peers.py; CPU: the least of "
+             f"{args.repeat} runs each, the process time of the driving loop alone). "
+             f"The paper's rope, its top driven sideways every {COUPLED_DT * 1e3:g} ms from "
+             f"Python: {COUPLED_AMPLITUDE:g} m at {COUPLED_FREQUENCY:g} Hz, ramped from rest "
+             f"over {COUPLED_RAMP:g} s; the top's force read back at every exchange; no "
+             "output written. ropedyn: `ropedyn.Simulation` of input/paper.nml with "
+             "`top_motion = 'coupled'` (its default method, rtol 1e-6). MoorDyn-C: its "
+             "Python package, a Coupled point, RK4 at the step of the first table's ladder. "
+             f"Tip columns as in the first table (ropedyn's reference: the same coupled "
+             f"run with cvode at rtol 1e-10). Machine: {machine()}. Run: {run_stamp()}.", "",
+             "At equal accuracy: ropedyn's default method at the loosest rtol of "
+             f"{', '.join(f'{r:g}' for r in EQUAL_RTOLS)} (atol = rtol / 100) whose tip "
+             "error over [0, 2 s] is at most MoorDyn's time error.", "",
+             COUPLED_HEADER, "|---|---|---|---|---|---|---|---|---|---|---|---|---|", *rows,
+             COUPLED_END]
+    update_doc(DOCS / "performance" / "peers.md", COUPLED_BEGIN, COUPLED_END,
+               "\n".join(lines), heading="## Coupled: the top driven from Python\n\n")
+    print(f"bench_peers: {DOCS / 'performance' / 'peers.md'}")
+    return 0
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     add_exe_argument(parser)
@@ -451,7 +648,7 @@ def main(argv=None):
             rows.append(row)
             print(row, flush=True)
     if args.no_write:
-        return 0
+        return 0 if args.only_undamped else coupled_main(args, exe, py)
     if undamped_rows:
         update_doc(DOCS / "performance" / "peers.md", UNDAMPED_BEGIN, UNDAMPED_END, "\n".join([
             UNDAMPED_BEGIN,
