@@ -19,6 +19,7 @@ module ropedyn_cvode
     use, intrinsic :: iso_c_binding
     use ropedyn_kinds, only: wp, i8
     use ropedyn_text, only: int_text
+    use ropedyn_c_strings, only: c_string
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK
     use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, stop_now
@@ -192,10 +193,6 @@ module ropedyn_cvode
             import :: c_int, N_Vector
             type(N_Vector) :: v
         end function nvector_fast_ops
-        pure integer(c_size_t) function c_strlen(s) bind(C, name='strlen')
-            import :: c_ptr, c_size_t
-            type(c_ptr), value, intent(in) :: s
-        end function c_strlen
     end interface
 
 contains
@@ -544,23 +541,6 @@ contains
         if (code < 0) ctx%message = c_string(msg)
         if (c_associated(module) .and. c_associated(function)) continue
     end subroutine cv_error_handler
-
-    function c_string(p) result(s)
-        type(c_ptr), intent(in) :: p
-        character(len=:), allocatable :: s
-        character(kind=c_char), pointer :: chars(:)
-        integer :: i, n
-        if (.not. c_associated(p)) then
-            s = ''
-            return
-        end if
-        n = int(c_strlen(p))
-        call c_f_pointer(p, chars, [n])
-        allocate (character(len=n) :: s)
-        do i = 1, n
-            s(i:i) = chars(i)
-        end do
-    end function c_string
 
     !> Name of a CVODE return flag.
     function flag_name(flag) result(name)

@@ -19,6 +19,7 @@ module ropedyn_capi
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, exit_code_of, ERR_USAGE
     use ropedyn_text, only: int_text
+    use ropedyn_c_strings, only: c_string
     use ropedyn_version, only: version_string
     use ropedyn_rope_model, only: energy_t
     use ropedyn_scene, only: scene_namelist_text
@@ -32,34 +33,9 @@ module ropedyn_capi
     character(kind=c_char), target :: VERSION_C(len(version_string) + 1) = &
         transfer(version_string//c_null_char, 'a', len(version_string) + 1)
 
-    interface
-        pure integer(c_size_t) function c_strlen(s) bind(C, name='strlen')
-            import :: c_ptr, c_size_t
-            type(c_ptr), value :: s
-        end function c_strlen
-    end interface
-
 contains
 
     ! ---- helpers ---------------------------------------------------------------------
-
-    !> The C string at `p` ('' for NULL).
-    function c_string(p) result(s)
-        type(c_ptr), intent(in) :: p
-        character(len=:), allocatable :: s
-        character(kind=c_char), pointer :: chars(:)
-        integer :: k, n
-        if (.not. c_associated(p)) then
-            s = ''
-            return
-        end if
-        n = int(c_strlen(p))
-        call c_f_pointer(p, chars, [n])
-        allocate (character(len=n) :: s)
-        do k = 1, n
-            s(k:k) = chars(k)
-        end do
-    end function c_string
 
     !> `text` as a NUL-terminated C array.
     pure function c_text(text) result(chars)
