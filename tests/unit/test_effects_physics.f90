@@ -2,7 +2,8 @@
 !! - drag: the terminal speed of a falling horizontal rope against the balance of weight and
 !!   quadratic drag; with linear drag and a current, the drift velocity (lambda g / c_n, u);
 !! - ground: a rope sliding along the ground carries its weight in contact force and stops
-!!   after v0^2/(2 mu g) (Coulomb friction);
+!!   after v0^2/(2 mu g) (Coulomb friction); a body lying on it gets the distributed law's
+!!   force and moments (k l delta, k l^3/12 per radian, c l^3/12 per rad/s);
 !! - moving support: the work of a shaken top equals the energy change of an undamped rope
 !!   (RFEM and MPP);
 !! - release: a folded rope with one end released falls with tip acceleration > g and the
@@ -31,6 +32,7 @@ program test_effects_physics
     suite%name = 'effects_physics'
     call drag_terminal_speed()
     call ground_friction()
+    call ground_lying_body()
     call shaken_top('rfem')
     call shaken_top('mpp')
     call folded_fall()
@@ -156,6 +158,50 @@ contains
         call suite%check_le(abs(run%e(last)%balance() - run%e(0)%balance()), 1.5e-9_wp, &
                             'ground: T + V + dissipated = E0 (friction and contact damping)')
     end subroutine ground_friction
+
+    !> One body of length l lying on the ground (along y, x down), its centre delta below the
+    !! plane: the contact is the per-metre law integrated along the body, force k l delta up;
+    !! tilted by dphi, the moment -k l^3/12 dphi; turning at w, the moment -c l^3/12 w. (At
+    !! the body's end points the moments would be three times these.)
+    subroutine ground_lying_body()
+        real(wp), parameter :: k = 1.0e5_wp, c = 200.0_wp, l = 0.2_wp, delta = 1.0e-4_wp
+        type(ground_effect_t) :: ground
+        type(bodies_t) :: b
+        real(wp) :: f(2, 1), m(1), dphi, w
+        ground = ground_effect([1.0_wp, 0.0_wp], [-1.0_wp, 0.0_wp], k, c, 0.3_wp, 1.0e-3_wp)
+        b%n = 1
+        b%c = reshape([1.0_wp + delta, 0.5_wp], [2, 1])
+        b%v = reshape([0.0_wp, 0.0_wp], [2, 1])
+        b%l = [l]
+        dphi = 1.0e-4_wp
+        w = 0.0_wp
+        call lying_forces(ground, b, dphi, w, f, m)
+        write (*, '(a, 2es14.6, a)') '  ground: lying body, force and tilt moment', f(1, 1), m(1)
+        call suite%check_close(f(1, 1), -k*l*delta, 1.0e-12_wp, 0.0_wp, &
+                               'ground: a lying body carries k l delta')
+        call suite%check_close(m(1), -k*l**3/12.0_wp*dphi, 1.0e-6_wp, 0.0_wp, &
+                               'ground: the tilt moment of a lying body is k l^3/12 dphi')
+        dphi = 0.0_wp
+        w = 0.05_wp
+        call lying_forces(ground, b, dphi, w, f, m)
+        write (*, '(a, es14.6, a)') '  ground: lying body turning, moment', m(1), ' N m'
+        call suite%check_close(m(1), -c*l**3/12.0_wp*w, 1.0e-6_wp, 0.0_wp, &
+                               'ground: the damping moment of a lying body is c l^3/12 w')
+    end subroutine ground_lying_body
+
+    !> The ground's force f and moment m on body b turned by dphi from lying along y and
+    !! turning at w.
+    subroutine lying_forces(ground, b, dphi, w, f, m)
+        type(ground_effect_t), intent(in) :: ground
+        type(bodies_t), intent(inout) :: b
+        real(wp), intent(in) :: dphi, w
+        real(wp), intent(out) :: f(:, :), m(:)
+        b%phi = [0.5_wp*pi + dphi]
+        b%w = [w]
+        f = 0.0_wp
+        m = 0.0_wp
+        call ground%add_forces(0.0_wp, b, f, m)
+    end subroutine lying_forces
 
     !> An undamped rope whose top is shaken (2 Hz, 1 cm and 2 cm): the work of the support
     !! equals the change of T + V.

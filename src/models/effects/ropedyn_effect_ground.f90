@@ -1,9 +1,14 @@
 !> Contact of the rope with a ground plane (docs/theory/effects.md, "Ground contact").
 !!
-!! The plane passes through p0 with unit normal n_g pointing to the free side. Contact acts
-!! at both end points X = c +- (l/2) e of each body, each point standing for half the body's
-!! length: stiffness k_p = k l/2, damping c_p = c l/2 (k in N/m per metre of rope, c in
-!! N s/m per metre). With the penetration delta = -(X - p0) . n_g > 0 and its rate
+!! The plane passes through p0 with unit normal n_g pointing to the free side. The law is
+!! per metre of rope (k in N/m per metre, c in N s/m per metre); on each body it is
+!! integrated by the two-point Gauss rule: contact acts at X = c +- (l/(2 sqrt 3)) e, each
+!! point standing for half the body's length: stiffness k_p = k l/2, damping c_p = c l/2.
+!! For a body wholly in contact the rule is exact (the penetration is linear along the body,
+!! the springs' energy quadratic): force k l delta and moment k l^3/12 per radian about the
+!! centre, as the distributed law gives. (At the end points the body's rotation would get
+!! three times the distributed stiffness and damping: a spurious fast mode of a rope lying
+!! on the ground.) With the penetration delta = -(X - p0) . n_g > 0 and its rate
 !! delta' = -V . n_g (V the point's velocity), the normal force is
 !!     F_N = max(0, k_p delta + c_p delta'),
 !! and regularized Coulomb friction acts along the tangent t_g = (-n_g2, n_g1):
@@ -37,7 +42,7 @@ module ropedyn_effect_ground
         procedure :: split_refusal => ground_split_refusal
     end type ground_effect_t
 
-    !> The contact at one end point of a body (all zero but i, e, r and delta when not in
+    !> The contact at one Gauss point of a body (all zero but i, e, r and delta when not in
     !! contact). No default initialization: `contact` sets every component, and the lists
     !! of contacts (automatic arrays of 2n in every caller of `touching`) would otherwise be
     !! filled with zeros on each call before being written.
@@ -52,6 +57,9 @@ module ropedyn_effect_ground
         real(wp) :: th                !< tanh(vt / v_reg)
         real(wp) :: f(2)              !< force on the body, N
     end type contact_t
+
+    !> the Gauss points' offset from a body's centre, in body lengths: 1/(2 sqrt 3)
+    real(wp), parameter :: GAUSS_OFFSET = 0.28867513459481288_wp
 
 contains
 
@@ -76,10 +84,11 @@ contains
         name = 'ground'
     end function ground_name
 
-    !> Contact at end s (-1: A, +1: B) of body i, the point at offset r = s l/2 from the
-    !! centre: penetration, its rate, normal force, tangential speed, tanh(v_t / v_reg) and
-    !! the force vector (zero when not in contact). e: the body's axis (cos phi, sin phi),
-    !! computed once per body by the caller for both ends.
+    !> Contact at Gauss point s (-1: towards end A, +1: towards B) of body i, the point at
+    !! offset r = s GAUSS_OFFSET l from the centre: penetration, its rate, normal force,
+    !! tangential speed, tanh(v_t / v_reg) and the force vector (zero when not in
+    !! contact). e: the body's axis (cos phi, sin phi), computed once per body by the caller
+    !! for both points.
     pure function contact(self, b, i, s, e) result(c)
         class(ground_effect_t), intent(in) :: self
         type(bodies_t), intent(in) :: b
@@ -87,7 +96,7 @@ contains
         real(wp), intent(in) :: e(2)
         type(contact_t) :: c
         real(wp) :: nv(2), x(2), v(2), kp, cp
-        c = contact_t(i=i, e=e, r=0.5_wp*real(s, wp)*b%l(i), delta=0.0_wp, ddelta=0.0_wp, &
+        c = contact_t(i=i, e=e, r=GAUSS_OFFSET*real(s, wp)*b%l(i), delta=0.0_wp, ddelta=0.0_wp, &
                       fn=0.0_wp, vt=0.0_wp, th=0.0_wp, f=0.0_wp)
         nv = [-e(2), e(1)]
         x = b%c(:, i) + c%r*e
@@ -107,7 +116,7 @@ contains
         c%f = c%fn*(self%ng - self%mu*c%th*self%tg)
     end function contact
 
-    !> The end points below the plane (delta > 0), body by body, end A before end B, in
+    !> The contact points below the plane (delta > 0), body by body, A's side before B's, in
     !! cc(1:nc) (cc holds at least 2 b%n). Those separating faster than their spring relaxes
     !! carry no force (fn = 0).
     pure subroutine touching(self, b, cc, nc)
