@@ -8,7 +8,8 @@
 !! - explicit models (RFEM): f = M a with a = ydot(vel) from `rhs`, K = -M da/dq from the
 !!   analytic band Jacobian (rows vel, columns pos);
 !! - linearly implicit models (MPP: M(y) y' = F(y)): f = F(vel) from `implicit_rhs` (O(n))
-!!   and K by central differences of it (step 1e-6, error ~1e-12 relative).
+!!   and K by central differences of it (step 1e-8: below a stiff ground's penetration;
+!!   docs/theory/statics-modes.md).
 !!
 !! Solver (`solve_statics`): a trust-region (Levenberg-Marquardt) Newton iteration on V,
 !!     (K + sigma M + E) delta = f,    q <- q + delta,
@@ -65,15 +66,25 @@ module ropedyn_statics
         character(len=:), allocatable :: criterion  !< 'newton step' or 'rounding level'
     end type statics_result_t
 
-    !> The continuation of `find_equilibrium` in the support stiffness: the log of
-    !! support_stiffness_factor at its start (s = 0) and end (s = 1), and what it cost.
+    !> the parameters `find_equilibrium` continues in
+    integer, parameter :: ON_SUPPORT = 1, ON_GROUND = 2
+    !> the ground's continuation starts where the rope's weight per metre sinks it by this
+    !! fraction of its length, and is needed above 100 times that stiffness
+    real(wp), parameter :: GROUND_START_SINK = 1.0e-3_wp, GROUND_CONTINUED_ABOVE = 100.0_wp
+
+    !> A continuation of `find_equilibrium`: in the support stiffness (ON_SUPPORT) or in the
+    !! ground's stiffness (ON_GROUND); the log of the parameter at its start (s = 0) and end
+    !! (s = 1), and what it cost.
     type :: continuation_t
+        integer :: which = ON_SUPPORT
         real(wp) :: log_f0 = 0.0_wp, log_f1 = 0.0_wp
         integer :: iterations = 0, rejected = 0   !< of all its stages
         integer :: stages = 0                     !< 0 when given up
         character(len=:), allocatable :: fallback !< '' or how far it got before given up
     contains
         procedure :: plan => continuation_plan
+        procedure :: plan_ground => continuation_plan_ground
+        procedure :: stage => continuation_stage
         procedure :: run => continuation_run
     end type continuation_t
 
@@ -127,6 +138,61 @@ contains
         end if
     end subroutine check_equilibrium_exists
 
+    !> The equilibrium of the spec from the starting state y. On a ground much stiffer than
+    !! the rope's weight needs (GROUND_CONTINUED_ABOVE), the descent meets a penalty far
+    !! stiffer than the rope wherever a step reaches into the ground, and its steps must be
+    !! tiny. Then the solution is first continued in the ground's stiffness
+    !! (continuation_t, ON_GROUND): the equilibrium on a soft ground (the rope sinks by
+    !! GROUND_START_SINK of its length), then geometric stages up to the spec's stiffness,
+    !! each from the previous equilibrium, as in `equilibrium_of`'s continuation. If that
+    !! fails, `equilibrium_of` solves directly from the start.
+    subroutine find_equilibrium(model, spec, y, options, result, err)
+        class(rope_model_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(inout) :: y(:)
+        type(statics_options_t), intent(in) :: options
+        type(statics_result_t), intent(out) :: result
+        type(error_t), allocatable, intent(out) :: err
+        type(continuation_t) :: ground
+        type(rope_spec_t) :: soft
+        class(rope_model_t), allocatable :: soft_model
+        type(statics_result_t) :: first
+        type(error_t), allocatable :: soft_err
+        real(wp), allocatable :: y_start(:)
+        logical :: needed
+
+        ground%fallback = ''
+        call check_equilibrium_exists(spec, err)
+        if (allocated(err)) return
+        needed = .false.
+        if (options%continuation) call ground%plan_ground(model, spec, needed)
+        if (needed) then
+            y_start = y
+            soft = ground%stage(spec, 0.0_wp)
+            call create_model(soft, soft_model, err)
+            if (allocated(err)) return
+            call equilibrium_of(soft_model, soft, y, options, first, soft_err)
+            ground%iterations = first%iterations
+            ground%rejected = first%rejected
+            if (allocated(soft_err)) then
+                ground%fallback = 'continuation in the ground stiffness failed at its start, then '
+                y = y_start
+            else
+                ground%stages = 1 + first%stages
+                call ground%run(spec, y, err, start_solved=.true.)
+                if (allocated(err)) return
+                if (ground%stages == 0) y = y_start     ! given up
+            end if
+        end if
+        call equilibrium_of(model, spec, y, options, result, err)
+        if (allocated(err) .and. len(ground%fallback) > 0) then
+            err%message = err%message//' ('//ground%fallback//'solved directly from the start)'
+        end if
+        result%iterations = result%iterations + ground%iterations
+        result%rejected = result%rejected + ground%rejected
+        result%stages = result%stages + ground%stages
+    end subroutine find_equilibrium
+
     !> The equilibrium of the spec from the starting state y. When the bottom end is
     !! pinned or clamped to an anchor far (> L/1000) from the lower end of the starting
     !! configuration, the support spring starts hugely stretched: its pull (~ EA/dl times the
@@ -139,7 +205,7 @@ contains
     !! by 4 after a failure. If the first stage fails or the continuation stalls (RFEM: its
     !! top support softens too and the rope drops far), it solves directly from the start,
     !! which the RFEM's Cartesian coordinates tolerate. Otherwise it is `solve_statics`.
-    subroutine find_equilibrium(model, spec, y, options, result, err)
+    subroutine equilibrium_of(model, spec, y, options, result, err)
         class(rope_model_t), intent(inout) :: model
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(inout) :: y(:)
@@ -150,8 +216,6 @@ contains
         logical :: needed
 
         path%fallback = ''
-        call check_equilibrium_exists(spec, err)
-        if (allocated(err)) return
         if (options%continuation) then
             call path%plan(model, spec, y, needed, err)
             if (allocated(err)) return
@@ -165,7 +229,46 @@ contains
         result%iterations = result%iterations + path%iterations
         result%rejected = result%rejected + path%rejected
         result%stages = path%stages
-    end subroutine find_equilibrium
+    end subroutine equilibrium_of
+
+    !> Whether the ground needs the continuation (ON_GROUND): gravity, ground contact and a
+    !! stiffness above GROUND_CONTINUED_ABOVE times k0, the stiffness at which the rope's
+    !! weight per metre w sinks it by GROUND_START_SINK of its length L, k0 = w/(s L).
+    subroutine continuation_plan_ground(self, model, spec, needed)
+        class(continuation_t), intent(inout) :: self
+        class(rope_model_t), intent(in) :: model
+        type(rope_spec_t), intent(in) :: spec
+        logical, intent(out) :: needed
+        real(wp) :: weight, length, k0
+        needed = .false.
+        self%which = ON_GROUND
+        if (.not. spec%effects%ground) return
+        weight = total_weight(model, spec)
+        length = rope_length(model)
+        if (weight <= 0.0_wp .or. length <= 0.0_wp) return
+        k0 = weight/length/(GROUND_START_SINK*length)
+        if (spec%ground%stiffness <= GROUND_CONTINUED_ABOVE*k0) return
+        self%log_f0 = log(k0)
+        self%log_f1 = log(spec%ground%stiffness)
+        needed = .true.
+    end subroutine continuation_plan_ground
+
+    !> The spec at s of the way (0 <= s <= 1) along the continued parameter.
+    function continuation_stage(self, spec, s) result(stage_spec)
+        class(continuation_t), intent(in) :: self
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(in) :: s
+        type(rope_spec_t) :: stage_spec
+        real(wp) :: value
+        stage_spec = spec
+        value = exp(self%log_f0 + s*(self%log_f1 - self%log_f0))
+        if (self%which == ON_GROUND) then
+            ! at s = 1 the spec's own stiffness, to the bit
+            if (s < 1.0_wp) stage_spec%ground%stiffness = value
+        else
+            stage_spec%supports%support_stiffness_factor = value
+        end if
+    end function continuation_stage
 
     !> Whether the equilibrium from y needs the continuation (a bottom pin or clamp far from
     !! the start, its spring pulling with more than 0.3 times the weight), and if so its
@@ -201,11 +304,12 @@ contains
 
     !> The stages of the continuation, from s = 0 (log_f0) to s = 1 (log_f1): y is the
     !! equilibrium of the last stage, or the start again when it was given up (fallback).
-    subroutine continuation_run(self, spec, y, err)
+    subroutine continuation_run(self, spec, y, err, start_solved)
         class(continuation_t), intent(inout) :: self
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(inout) :: y(:)
         type(error_t), allocatable, intent(out) :: err
+        logical, intent(in), optional :: start_solved  !< y is the equilibrium at s = 0
         type(rope_spec_t) :: stage_spec
         class(rope_model_t), allocatable :: stage_model
         type(statics_result_t) :: stage
@@ -213,18 +317,19 @@ contains
         type(error_t), allocatable :: stage_err
         real(wp), allocatable :: y_try(:), y_start(:)
         real(wp) :: s, ds, s_try
+        logical :: solved
 
         y_start = y
         stage_options%max_iterations = 100
         stage_options%step_tolerance = 1.0e-8_wp
         s = 0.0_wp
         ds = log(10.0_wp)/(self%log_f1 - self%log_f0)
-        ! the first stage starts at s = 0 itself
-        s_try = 0.0_wp
+        ! the first stage starts at s = 0 itself, unless that is solved
+        solved = .false.
+        if (present(start_solved)) solved = start_solved
+        s_try = merge(min(1.0_wp, ds), 0.0_wp, solved)
         do
-            stage_spec = spec
-            stage_spec%supports%support_stiffness_factor = &
-                exp(self%log_f0 + s_try*(self%log_f1 - self%log_f0))
+            stage_spec = self%stage(spec, s_try)
             call create_model(stage_spec, stage_model, err)
             if (allocated(err)) return
             y_try = y
@@ -235,10 +340,13 @@ contains
             if (allocated(stage_err)) then
                 deallocate (stage_err)
                 ds = 0.25_wp*ds
-                if (ds < 1.0e-3_wp .or. self%stages == 1) then
+                if (ds < 1.0e-3_wp .or. (self%stages == 1 .and. .not. solved)) then
                     ! give up the continuation: solve directly from the start
-                    self%fallback = 'continuation in support_stiffness_factor stalled at '// &
-                                    fixed_text(100*s, 1)//' % of the way, then '
+                    self%fallback = 'continuation in '// &
+                                    trim(merge('the ground stiffness    ', &
+                                               'support_stiffness_factor', &
+                                               self%which == ON_GROUND))// &
+                                    ' stalled at '//fixed_text(100*s, 1)//' % of the way, then '
                     y = y_start
                     self%stages = 0
                     exit

@@ -192,7 +192,9 @@ contains
         subroutine differenced(k, out)
             integer, intent(in) :: k
             real(wp), intent(out) :: out(:)
-            h = 1.0e-6_wp*max(1.0_wp, abs(y(k)))
+            ! below the shortest length of the force law, a stiff ground's penetration
+            ! (docs/theory/statics-modes.md), at a rounding error of ~1e-8 of the result
+            h = 1.0e-8_wp*max(1.0_wp, abs(y(k)))
             yp = y
             yp(k) = y(k) + h
             call evaluate(yp, gp, st)

@@ -160,3 +160,45 @@ def test_clamped_top_converges(run, tmp_path, kind, tension, lowest):
     assert ratio > lowest, (omega, ratio)
     # and the limit is the clamped beam's (3.82997 rad/s; RFEM -5e-4 for EA = 687 N)
     assert abs(omega[2] / 3.82997 - 1) < 1.5e-3
+
+
+STIFF_FLOOR = ("&rope length = 10.0, mass_per_length = 0.1, axial_stiffness = 1.0e4,"
+               " bending_stiffness = 0.0, diameter = 0.004 /\n"
+               "&model kind = '{kind}', elements = 40 /\n"
+               "&supports top = 'pinned', bottom = 'pinned', bottom_anchor = 2.0, -9.0 /\n"
+               "&initial shape = 'equilibrium', angle_deg = -90.0 /\n"
+               "&effects ground = .true. /\n"
+               "&ground point = 2.0, 0.0, normal = -1.0, 0.0, stiffness = 1.0e7,"
+               " damping = 100.0, friction_coefficient = 0.3 /\n")
+
+
+def touchdown_top_tension(length, depth, span, w):
+    """Top tension (N) of an inextensible chain hanging from a pin `depth` above a rigid
+    floor to an anchor on it `span` away, its lower part lying on the floor: the suspended
+    catenary (parameter a = H/w) drops `depth` over the arc sqrt(depth^2 + 2 a depth) and
+    the horizontal a acosh(1 + depth/a); the rest lies straight to the anchor."""
+    def fit(a):     # increases with a: a flatter catenary reaches farther
+        return a * np.arccosh(1 + depth / a) + length - np.sqrt(depth**2 + 2 * a * depth) - span
+    lo, hi = 1e-3, 1e3
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if fit(mid) < 0 else (lo, mid)
+    return w * (0.5 * (lo + hi) + depth)    # T = H + w depth at the top of a catenary
+
+
+@pytest.mark.parametrize("kind", ["rfem", "mpp"])
+def test_statics_on_a_stiff_floor(run, tmp_path, kind):
+    """A chain from a straight start onto a floor 2e5 times stiffer than its weight needs:
+    the continuation in the ground's stiffness finds the touchdown catenary. (Without it
+    the RFEM settled with 8.50 N at the top, part of the chain through the floor, and the
+    MPP did not converge.)"""
+    (tmp_path / "floor.nml").write_text(STIFF_FLOOR.format(kind=kind))
+    result = run("statics", "floor.nml", "-o", "f.h5")
+    assert result.returncode == 0, result.stderr
+    assert "continuation stages" in result.stdout, result.stdout
+    expected = touchdown_top_tension(10.0, 2.0, 9.0, 0.1 * 9.81)
+    with h5py.File(tmp_path / "f.h5") as f:
+        top = np.linalg.norm(f["statics/support_force_top"][:])
+        lowest = f["rope/points"][0, :, 0].max()
+    assert abs(top / expected - 1) < 5e-3, (top, expected)      # n = 40, EA finite
+    assert 2.0 <= lowest < 2.0 + 1e-5, lowest                   # on the floor, not through
