@@ -115,32 +115,13 @@ def scores(computed, measured):
 
 # ---------------------------------------------------------------- running
 
-def mpp_start(exe, work, elements):
-    """A run file whose record at t = 0 is the MPP's static equilibrium (its path).
-
-    The statics' Newton iteration does not converge for the MPP on the paper's stiff floor
-    (6.6e6 N/m^2; it does for the RFEM); on a floor 100 times softer it does, and the chain
-    then rests on the real floor 1e-5 m higher than on the soft one: the MPP runs start from
-    that record (&initial shape = 'state'), the RFEM runs from their own equilibrium."""
-    path = work / f"mpp_start_{elements}.h5"
-    if not path.exists():
-        work.mkdir(parents=True, exist_ok=True)
-        sets = ["model.kind=mpp", f"model.elements={elements}", "supports.top_motion=fixed",
-                "ground.stiffness=6.6e4", "solver.t_end=0.001", "solver.output_interval=0.001",
-                f"output.file={path}"]
-        subprocess.run([str(exe), "run", str(BASE), *set_args(sets)], check=True,
-                       capture_output=True, text=True)
-    return path
-
-
 def base_elements():
     return int(scene_number(BASE, "elements"))
 
 
 def run_sweeps(exe, periods, models, radii, work, jobs, quick=None):
     """Run the period sweeps of each model into work/MODEL/T<..>; returns {(model, period):
-    wall seconds}. The shipped sweep files are the RFEM's; a copy in work sets the model
-    (and, for the MPP, its static start).
+    wall seconds}. The shipped sweep files are the RFEM's; a copy in work sets the model.
 
     quick = (elements, cycles): that many elements and cycles and a one-cycle ramp (a smoke
     test of the pipeline)."""
@@ -148,7 +129,6 @@ def run_sweeps(exe, periods, models, radii, work, jobs, quick=None):
     elements = quick[0] if quick else base_elements()
     for label in models:
         model, _, variant = label.partition("_")
-        start = mpp_start(exe, work, elements) if model == "mpp" else None
         for period in periods:
             src = sweep_path(period)
             out = work / label / src.stem
@@ -162,9 +142,6 @@ def run_sweeps(exe, periods, models, radii, work, jobs, quick=None):
                 text = text.replace(f"'supports.top_ramp_time={RAMP_CYCLES * period:.12g}'",
                                     f"'supports.top_ramp_time={period:.12g}'")
                 sets.append(f"model.elements={elements}")
-            if start is not None:
-                sets += ["initial.shape=state", f"initial.state_file={start}",
-                         "initial.state_time=0"]
             if sets:
                 text = text.replace("    set = ", "    set = " +
                                     "".join(f"'{s}', " for s in sets), 1)
@@ -264,7 +241,6 @@ def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS,
                     out = case_path(work, period, model, radius)
                 todo.append((model, period, n, rtol, out))
     (work / "convergence").mkdir(parents=True, exist_ok=True)
-    starts = {n: mpp_start(exe, work, n) for n, _ in variants} if "mpp" in models else {}
 
     def one(item):
         model, period, n, rtol, out = item
@@ -275,9 +251,6 @@ def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS,
                 f"solver.t_end={CYCLES * period:.12g}",
                 f"supports.top_ramp_time={RAMP_CYCLES * period:.12g}",
                 f"supports.top_amplitude={radius},{radius}", f"output.file={out}"]
-        if model == "mpp":
-            sets += ["initial.shape=state", "initial.state_time=0",
-                     f"initial.state_file={starts[n]}"]
         subprocess.run([str(exe), "run", str(BASE), *set_args(sets)], check=True,
                        capture_output=True)
 
