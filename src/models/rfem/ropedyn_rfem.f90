@@ -111,6 +111,9 @@ module ropedyn_rfem
         real(wp), allocatable :: cs(:, :)      !< cos, sin of every angle, (2, n)
         real(wp), allocatable :: phi(:)        !< every angle, gathered from y (n)
         real(wp), allocatable :: gen(:, :)     !< generalized forces, (3, n)
+        !> in water: every element's added-mass block (3, 3, n) and force (3, n) at the
+        !! state of the last `forces` (water_forces), for the accelerations at that state
+        real(wp), allocatable :: am_blk(:, :, :), am_g(:, :)
         !> the forces other than the potential's (damping, effects), (3, n): split_forces
         real(wp), allocatable :: gen_r(:, :)
         !> Jacobian blocks (3, 6, -1:1, n): blk(r, l, o, i) is the derivative of row r of
@@ -304,7 +307,8 @@ module ropedyn_rfem
             real(wp), intent(inout), optional :: e_el
         end subroutine water_forces
 
-        !> Every element's accelerations from its mass block (in water).
+        !> Every element's accelerations from its mass block (in water; self%am_blk and
+        !! self%am_g at y, from `forces`).
         module subroutine water_accelerations(self, y, gen, ydot)
             class(rfem_t), intent(in) :: self
             real(wp), intent(in) :: y(:), gen(:, :)

@@ -142,6 +142,9 @@ contains
         if (model%water) then
             model%added = water_added_mass(spec)
             model%rowscale = 1.0_wp
+            allocate (model%am_blk(3, 3, n), model%am_g(3, n))
+            model%am_blk = 0.0_wp
+            model%am_g = 0.0_wp
         end if
 
         call build_body_effects(spec, model%len, model%effects)
