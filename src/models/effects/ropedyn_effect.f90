@@ -15,9 +15,10 @@
 !! off is not allocated and costs nothing.
 module ropedyn_effect
     use ropedyn_kinds, only: wp
+    use ropedyn_trig, only: cos_sin
     implicit none
     private
-    public :: body_effect_t, effect_box_t, bodies_t, point_force_block
+    public :: body_effect_t, effect_box_t, bodies_t, point_force_block, set_axes
     public :: add_forces_of, add_jacobians_of, add_energies_of, add_powers_of
 
     !> Kinematics of all bodies of a model at one instant.
@@ -28,6 +29,9 @@ module ropedyn_effect
         real(wp), allocatable :: v(:, :)    !< centre velocities (2, n), m/s
         real(wp), allocatable :: w(:)       !< angular velocities (n), rad/s
         real(wp), allocatable :: l(:)       !< lengths (n), m
+        !> cos and sin of every angle (2, n), ropedyn_trig's (`set_axes`, or the model's own
+        !! of the same angles): each body's axis e once per evaluation for every effect
+        real(wp), allocatable :: cs(:, :)
     end type bodies_t
 
     type, abstract :: body_effect_t
@@ -73,6 +77,16 @@ module ropedyn_effect
     end interface
 
 contains
+
+    !> Set b%cs from b%phi (allocating it when needed): after the angles change.
+    pure subroutine set_axes(b)
+        type(bodies_t), intent(inout) :: b
+        if (allocated(b%cs)) then
+            if (size(b%cs, 2) /= size(b%phi)) deallocate (b%cs)
+        end if
+        if (.not. allocated(b%cs)) allocate (b%cs(2, size(b%phi)))
+        call cos_sin(b%phi, b%cs)
+    end subroutine set_axes
 
     !> Potential energy of the effect, J (default: none).
     pure real(wp) function effect_energy(self, t, b) result(e)

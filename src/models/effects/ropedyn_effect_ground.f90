@@ -13,7 +13,6 @@
 module ropedyn_effect_ground
     use ropedyn_kinds, only: wp
     use ropedyn_effect, only: body_effect_t, bodies_t, point_force_block
-    use ropedyn_trig, only: cos_sin
     implicit none
     private
     public :: ground_effect_t, ground_effect
@@ -116,13 +115,11 @@ contains
         type(contact_t), intent(inout) :: cc(:)
         integer, intent(out) :: nc
         type(contact_t) :: c
-        real(wp) :: cs(2, b%n)
         integer :: i, s
         nc = 0
-        call cos_sin(b%phi, cs)
         do i = 1, b%n
             do s = -1, 1, 2
-                c = contact(self, b, i, s, cs(:, i))
+                c = contact(self, b, i, s, b%cs(:, i))
                 if (c%delta <= 0.0_wp) cycle
                 nc = nc + 1
                 cc(nc) = c

@@ -197,7 +197,7 @@ module ropedyn_rfem
             real(wp), intent(in) :: y(:)
         end subroutine point_mass_rows
 
-        !> Element kinematics for the effects.
+        !> Element kinematics for the effects (self%cs holding the angles of y).
         module subroutine fill_bodies(self, y)
             class(rfem_t), intent(inout) :: self
             real(wp), intent(in) :: y(:)

@@ -152,7 +152,7 @@ contains
             model%bodies%n = n
             model%bodies%l = model%len
             allocate (model%bodies%c(2, n), model%bodies%phi(n), model%bodies%v(2, n), &
-                      model%bodies%w(n))
+                      model%bodies%w(n), model%bodies%cs(2, n))
         end if
 
         ! supports: base anchor and angle, prescribed motion

@@ -267,6 +267,7 @@ contains
             self%bodies%v(:, i) = y(k + 4:k + 5)
             self%bodies%w(i) = y(k + 6)
         end do
+        self%bodies%cs = self%cs    ! ropedyn_trig's of the same angles (angles, at y)
     end procedure fill_bodies
 
     module procedure forces
