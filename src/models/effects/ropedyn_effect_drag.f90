@@ -33,6 +33,7 @@ module ropedyn_effect_drag
         procedure :: add_forces => drag_add_forces
         procedure :: add_jacobian => drag_add_jacobian
         procedure :: power => drag_power
+        procedure :: add_forces_power => drag_add_forces_power
         procedure :: does_work => drag_does_work
     end type drag_effect_t
 
@@ -189,8 +190,35 @@ contains
         integer :: i
         do i = 1, b%n
             call body_drag(self, b, i, b%cs(:, i), fi, mi)
-            dissipation = dissipation - dot_product(fi, b%v(:, i) - self%u) - mi*b%w(i)
-            if (self%current) work = work + dot_product(fi, self%u)
+            call add_body_power(self, b, i, fi, mi, dissipation, work)
         end do
     end subroutine drag_power
+
+    !> Add the dissipation and the current's work rate of body i's drag fi, mi.
+    pure subroutine add_body_power(self, b, i, fi, mi, dissipation, work)
+        class(drag_effect_t), intent(in) :: self
+        type(bodies_t), intent(in) :: b
+        integer, intent(in) :: i
+        real(wp), intent(in) :: fi(2), mi
+        real(wp), intent(inout) :: dissipation, work
+        dissipation = dissipation - dot_product(fi, b%v(:, i) - self%u) - mi*b%w(i)
+        if (self%current) work = work + dot_product(fi, self%u)
+    end subroutine add_body_power
+
+    !> drag_add_forces and drag_power with one drag per body.
+    pure subroutine drag_add_forces_power(self, t, b, f, m, dissipation, work)
+        class(drag_effect_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp), intent(inout) :: f(:, :), m(:)
+        real(wp), intent(inout) :: dissipation, work
+        real(wp) :: fi(2), mi
+        integer :: i
+        do i = 1, b%n
+            call body_drag(self, b, i, b%cs(:, i), fi, mi)
+            f(:, i) = f(:, i) + fi
+            m(i) = m(i) + mi
+            call add_body_power(self, b, i, fi, mi, dissipation, work)
+        end do
+    end subroutine drag_add_forces_power
 end module ropedyn_effect_drag
