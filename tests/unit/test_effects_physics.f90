@@ -19,7 +19,7 @@
 program test_effects_physics
     use ropedyn_kinds, only: wp
     use ropedyn_test_run, only: run_t, simulate_scene => simulate, kind_set, SET_LEN
-    use ropedyn_effect, only: bodies_t
+    use ropedyn_effect, only: bodies_t, set_axes
     use ropedyn_effect_ground, only: ground_effect_t, ground_effect
     use ropedyn_assert, only: test_suite_t
     implicit none
@@ -150,6 +150,7 @@ contains
         b%v = qdot(1:2, :)
         b%w = qdot(3, :)
         b%l = len
+        call set_axes(b)
         normal_force = ground%total_normal_force(b)
         weight = sum(mass)*g
         write (*, '(a, 2f12.8, a)') '  ground: contact force, weight', normal_force, weight, ' N'

@@ -15,10 +15,12 @@
 !! off is not allocated and costs nothing.
 module ropedyn_effect
     use ropedyn_kinds, only: wp
+    use ropedyn_trig, only: cos_sin
     implicit none
     private
-    public :: body_effect_t, effect_box_t, bodies_t, point_force_block
+    public :: body_effect_t, effect_box_t, bodies_t, point_force_block, set_axes
     public :: add_forces_of, add_jacobians_of, add_energies_of, add_powers_of
+    public :: add_forces_powers_of
 
     !> Kinematics of all bodies of a model at one instant.
     type :: bodies_t
@@ -28,6 +30,9 @@ module ropedyn_effect
         real(wp), allocatable :: v(:, :)    !< centre velocities (2, n), m/s
         real(wp), allocatable :: w(:)       !< angular velocities (n), rad/s
         real(wp), allocatable :: l(:)       !< lengths (n), m
+        !> cos and sin of every angle (2, n), ropedyn_trig's (`set_axes`, or the model's own
+        !! of the same angles): each body's axis e once per evaluation for every effect
+        real(wp), allocatable :: cs(:, :)
     end type bodies_t
 
     type, abstract :: body_effect_t
@@ -37,6 +42,9 @@ module ropedyn_effect
         procedure(add_jacobian_i), deferred :: add_jacobian
         ! its part of the energy balance (the defaults: none)
         procedure :: does_work => effect_does_work, energy => effect_energy, power => effect_power
+        ! add_forces and power at one instant in one call (default: the two one after the
+        ! other; an effect whose power repeats its forces' work overrides it)
+        procedure :: add_forces_power => effect_add_forces_power
         ! why a splitting method cannot take its forces as the rest (default: it can)
         procedure :: split_refusal => effect_split_refusal
     end type body_effect_t
@@ -74,6 +82,16 @@ module ropedyn_effect
 
 contains
 
+    !> Set b%cs from b%phi (allocating it when needed): after the angles change.
+    pure subroutine set_axes(b)
+        type(bodies_t), intent(inout) :: b
+        if (allocated(b%cs)) then
+            if (size(b%cs, 2) /= size(b%phi)) deallocate (b%cs)
+        end if
+        if (.not. allocated(b%cs)) allocate (b%cs(2, size(b%phi)))
+        call cos_sin(b%phi, b%cs)
+    end subroutine set_axes
+
     !> Potential energy of the effect, J (default: none).
     pure real(wp) function effect_energy(self, t, b) result(e)
         class(body_effect_t), intent(in) :: self
@@ -90,6 +108,18 @@ contains
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: dissipation, work
     end subroutine effect_power
+
+    !> add_forces, then power, at time t: an override must give the same forces and the
+    !! same sums, term by term in the same order.
+    pure subroutine effect_add_forces_power(self, t, b, f, m, dissipation, work)
+        class(body_effect_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp), intent(inout) :: f(:, :), m(:)
+        real(wp), intent(inout) :: dissipation, work
+        call self%add_forces(t, b, f, m)
+        call self%power(t, b, dissipation, work)
+    end subroutine effect_add_forces_power
 
     !> Why a model cannot offer a force split with this effect on ('' when it can). A
     !! splitting method (problem_t's force split) takes every effect's forces as forces
@@ -118,6 +148,21 @@ contains
             call effects(k)%e%add_forces(t, b, f, m)
         end do
     end subroutine add_forces_of
+
+    !> add_forces_of and add_powers_of in one pass over the `effects` (each effect's forces
+    !! and power together; the same sums as the two passes, as the forces and the powers
+    !! are separate sums).
+    pure subroutine add_forces_powers_of(effects, t, b, f, m, dissipation, work)
+        type(effect_box_t), intent(in) :: effects(:)
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp), intent(inout) :: f(:, :), m(:)
+        real(wp), intent(inout) :: dissipation, work
+        integer :: k
+        do k = 1, size(effects)
+            call effects(k)%e%add_forces_power(t, b, f, m, dissipation, work)
+        end do
+    end subroutine add_forces_powers_of
 
     !> Add the Jacobian blocks jac(3, 6, n) of all `effects` at time t.
     pure subroutine add_jacobians_of(effects, t, b, jac)

@@ -13,7 +13,6 @@
 module ropedyn_effect_drag
     use ropedyn_kinds, only: wp
     use ropedyn_effect, only: body_effect_t, bodies_t
-    use ropedyn_trig, only: cos_sin
     use ropedyn_wetting, only: wetting_t, wet_t
     implicit none
     private
@@ -34,6 +33,7 @@ module ropedyn_effect_drag
         procedure :: add_forces => drag_add_forces
         procedure :: add_jacobian => drag_add_jacobian
         procedure :: power => drag_power
+        procedure :: add_forces_power => drag_add_forces_power
         procedure :: does_work => drag_does_work
     end type drag_effect_t
 
@@ -71,7 +71,7 @@ contains
     end function drag_does_work
 
     !> Length l of body i, its normal nv, and the components a (along its axis e = (cos phi,
-    !! sin phi), from the caller's vectorized pass) and bb (along nv) of its centre's
+    !! sin phi), b%cs) and bb (along nv) of its centre's
     !! velocity relative to the fluid.
     pure subroutine relative_motion(self, b, i, e, l, nv, a, bb)
         class(drag_effect_t), intent(in) :: self
@@ -122,11 +122,10 @@ contains
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: f(:, :), m(:)
-        real(wp) :: fi(2), mi, cs(2, b%n)
+        real(wp) :: fi(2), mi
         integer :: i
-        call cos_sin(b%phi, cs)
         do i = 1, b%n
-            call body_drag(self, b, i, cs(:, i), fi, mi)
+            call body_drag(self, b, i, b%cs(:, i), fi, mi)
             f(:, i) = f(:, i) + fi
             m(i) = m(i) + mi
         end do
@@ -137,13 +136,12 @@ contains
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: jac(:, :, :)
-        real(wp) :: e(2), nv(2), a, bb, l, kn, kt, dfdv(2, 2), dfdphi(2), dmdw, cs(2, b%n)
+        real(wp) :: e(2), nv(2), a, bb, l, kn, kt, dfdv(2, 2), dfdphi(2), dmdw
         real(wp) :: f0(2), m0, scale
         type(wet_t) :: wt
         integer :: i, p
-        call cos_sin(b%phi, cs)
         do i = 1, b%n
-            e = cs(:, i)
+            e = b%cs(:, i)
             call relative_motion(self, b, i, e, l, nv, a, bb)
             dfdv = 0.0_wp
             dfdphi = 0.0_wp
@@ -188,13 +186,39 @@ contains
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: dissipation, work
-        real(wp) :: fi(2), mi, cs(2, b%n)
+        real(wp) :: fi(2), mi
         integer :: i
-        call cos_sin(b%phi, cs)
         do i = 1, b%n
-            call body_drag(self, b, i, cs(:, i), fi, mi)
-            dissipation = dissipation - dot_product(fi, b%v(:, i) - self%u) - mi*b%w(i)
-            if (self%current) work = work + dot_product(fi, self%u)
+            call body_drag(self, b, i, b%cs(:, i), fi, mi)
+            call add_body_power(self, b, i, fi, mi, dissipation, work)
         end do
     end subroutine drag_power
+
+    !> Add the dissipation and the current's work rate of body i's drag fi, mi.
+    pure subroutine add_body_power(self, b, i, fi, mi, dissipation, work)
+        class(drag_effect_t), intent(in) :: self
+        type(bodies_t), intent(in) :: b
+        integer, intent(in) :: i
+        real(wp), intent(in) :: fi(2), mi
+        real(wp), intent(inout) :: dissipation, work
+        dissipation = dissipation - dot_product(fi, b%v(:, i) - self%u) - mi*b%w(i)
+        if (self%current) work = work + dot_product(fi, self%u)
+    end subroutine add_body_power
+
+    !> drag_add_forces and drag_power with one drag per body.
+    pure subroutine drag_add_forces_power(self, t, b, f, m, dissipation, work)
+        class(drag_effect_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp), intent(inout) :: f(:, :), m(:)
+        real(wp), intent(inout) :: dissipation, work
+        real(wp) :: fi(2), mi
+        integer :: i
+        do i = 1, b%n
+            call body_drag(self, b, i, b%cs(:, i), fi, mi)
+            f(:, i) = f(:, i) + fi
+            m(i) = m(i) + mi
+            call add_body_power(self, b, i, fi, mi, dissipation, work)
+        end do
+    end subroutine drag_add_forces_power
 end module ropedyn_effect_drag

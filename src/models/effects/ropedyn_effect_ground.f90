@@ -18,7 +18,6 @@
 module ropedyn_effect_ground
     use ropedyn_kinds, only: wp
     use ropedyn_effect, only: body_effect_t, bodies_t, point_force_block
-    use ropedyn_trig, only: cos_sin
     implicit none
     private
     public :: ground_effect_t, ground_effect
@@ -38,6 +37,7 @@ module ropedyn_effect_ground
         procedure :: add_jacobian => ground_add_jacobian
         procedure :: energy => ground_energy
         procedure :: power => ground_power
+        procedure :: add_forces_power => ground_add_forces_power
         procedure :: total_normal_force => ground_total_normal_force
         procedure :: split_refusal => ground_split_refusal
     end type ground_effect_t
@@ -125,13 +125,11 @@ contains
         type(contact_t), intent(inout) :: cc(:)
         integer, intent(out) :: nc
         type(contact_t) :: c
-        real(wp) :: cs(2, b%n)
         integer :: i, s
         nc = 0
-        call cos_sin(b%phi, cs)
         do i = 1, b%n
             do s = -1, 1, 2
-                c = contact(self, b, i, s, cs(:, i))
+                c = contact(self, b, i, s, b%cs(:, i))
                 if (c%delta <= 0.0_wp) cycle
                 nc = nc + 1
                 cc(nc) = c
@@ -145,16 +143,38 @@ contains
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: f(:, :), m(:)
         type(contact_t) :: cc(2*b%n)
-        integer :: k, nc
+        integer :: nc
         call touching(self, b, cc, nc)
-        do k = 1, nc
+        call add_contact_forces(cc(:nc), f, m)
+    end subroutine ground_add_forces
+
+    !> Add the forces and moments of the contacts cc.
+    pure subroutine add_contact_forces(cc, f, m)
+        type(contact_t), intent(in) :: cc(:)
+        real(wp), intent(inout) :: f(:, :), m(:)
+        integer :: k
+        do k = 1, size(cc)
             associate (c => cc(k), i => cc(k)%i)
                 if (c%fn <= 0.0_wp) cycle
                 f(:, i) = f(:, i) + c%f
                 m(i) = m(i) + c%r*(c%e(1)*c%f(2) - c%e(2)*c%f(1))
             end associate
         end do
-    end subroutine ground_add_forces
+    end subroutine add_contact_forces
+
+    !> ground_add_forces and ground_power from one search for the contacts.
+    pure subroutine ground_add_forces_power(self, t, b, f, m, dissipation, work)
+        class(ground_effect_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp), intent(inout) :: f(:, :), m(:)
+        real(wp), intent(inout) :: dissipation, work
+        type(contact_t) :: cc(2*b%n)
+        integer :: nc
+        call touching(self, b, cc, nc)
+        call add_contact_forces(cc(:nc), f, m)
+        call add_contact_power(self, b, cc(:nc), dissipation)
+    end subroutine ground_add_forces_power
 
     pure subroutine ground_add_jacobian(self, t, b, jac)
         class(ground_effect_t), intent(in) :: self
@@ -203,9 +223,19 @@ contains
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: dissipation, work
         type(contact_t) :: cc(2*b%n)
-        integer :: k, nc
+        integer :: nc
         call touching(self, b, cc, nc)
-        do k = 1, nc
+        call add_contact_power(self, b, cc(:nc), dissipation)
+    end subroutine ground_power
+
+    !> Add the dissipation rate of the contacts cc.
+    pure subroutine add_contact_power(self, b, cc, dissipation)
+        class(ground_effect_t), intent(in) :: self
+        type(bodies_t), intent(in) :: b
+        type(contact_t), intent(in) :: cc(:)
+        real(wp), intent(inout) :: dissipation
+        integer :: k
+        do k = 1, size(cc)
             associate (c => cc(k))
                 ! F_N = 0 when separating faster than the spring relaxes: then the spring's
                 ! energy still falls at -k_p delta delta' > 0 (th = 0 there)
@@ -213,7 +243,7 @@ contains
                               + self%mu*c%fn*c%th*c%vt
             end associate
         end do
-    end subroutine ground_power
+    end subroutine add_contact_power
 
     !> The contact springs are potential energy, and their stiffness acts only while a point
     !! touches: absent from the spectrum of a rope above the ground, it would not bound a

@@ -99,6 +99,7 @@ contains
             pnd(1) = pnd(1) - lk*phd*s + ud*c
             pnd(2) = pnd(2) + lk*phd*c + ud*s
         end do
+        if (effects) call set_axes(self%bodies)
         self%mom = 0.0_wp
 
         ! Point masses at P = C_i + r e_i: their applied-minus-inertial force joins w_i,
@@ -190,6 +191,7 @@ contains
             p = p + (self%l + u(k))*e
             pd = pd + (self%l + u(k))*phid(k)*nv + ud(k)*e
         end do
+        call set_axes(b)
     end procedure rod_bodies
 
     !> The articulated-body recursion, from the tip (docs/theory/mpp.md, "Solving

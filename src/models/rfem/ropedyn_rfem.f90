@@ -33,7 +33,7 @@ module ropedyn_rfem
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_effect, only: effect_box_t, bodies_t, add_forces_of, add_jacobians_of, &
-                              add_energies_of, add_powers_of
+                              add_energies_of, add_powers_of, add_forces_powers_of
     use ropedyn_effect_factory, only: build_body_effects, attached_masses, water_added_mass
     use ropedyn_added_mass, only: added_mass_t
     use ropedyn_support_motion, only: motion_state_t
@@ -111,6 +111,9 @@ module ropedyn_rfem
         real(wp), allocatable :: cs(:, :)      !< cos, sin of every angle, (2, n)
         real(wp), allocatable :: phi(:)        !< every angle, gathered from y (n)
         real(wp), allocatable :: gen(:, :)     !< generalized forces, (3, n)
+        !> in water: every element's added-mass block (3, 3, n) and force (3, n) at the
+        !! state of the last `forces` (water_forces), for the accelerations at that state
+        real(wp), allocatable :: am_blk(:, :, :), am_g(:, :)
         !> the forces other than the potential's (damping, effects), (3, n): split_forces
         real(wp), allocatable :: gen_r(:, :)
         !> Jacobian blocks (3, 6, -1:1, n): blk(r, l, o, i) is the derivative of row r of
@@ -156,7 +159,7 @@ module ropedyn_rfem
         !> The generalized forces (3, n) of everything at time t and state y into self%gen
         !! (one pass over the SDEs); optionally the elastic energy (J, springs and the
         !! effects' potential energy).
-        module subroutine forces(self, t, y, elastic, power, joint, support, rest)
+        module subroutine forces(self, t, y, elastic, power, joint, support, rest, work)
             class(rfem_t), intent(inout) :: self
             real(wp), intent(in) :: t
             real(wp), intent(in) :: y(6*self%n)
@@ -174,6 +177,10 @@ module ropedyn_rfem
             !! .true., self%gen_r the rest (dampers, effects); .false.: the rest is not
             !! evaluated
             logical, intent(in), optional :: rest
+            !> when present (with power, without rest): the supports' and the effects'
+            !! dissipation added to power and their external work rate, W, as store_powers
+            !! adds them (the same terms in the same order), each effect's with its forces
+            real(wp), intent(out), optional :: work
         end subroutine forces
 
         !> The derivatives of the generalized forces with respect to the coordinates and
@@ -194,7 +201,7 @@ module ropedyn_rfem
             real(wp), intent(in) :: y(:)
         end subroutine point_mass_rows
 
-        !> Element kinematics for the effects.
+        !> Element kinematics for the effects (self%cs holding the angles of y).
         module subroutine fill_bodies(self, y)
             class(rfem_t), intent(inout) :: self
             real(wp), intent(in) :: y(:)
@@ -304,7 +311,8 @@ module ropedyn_rfem
             real(wp), intent(inout), optional :: e_el
         end subroutine water_forces
 
-        !> Every element's accelerations from its mass block (in water).
+        !> Every element's accelerations from its mass block (in water; self%am_blk and
+        !! self%am_g at y, from `forces`).
         module subroutine water_accelerations(self, y, gen, ydot)
             class(rfem_t), intent(in) :: self
             real(wp), intent(in) :: y(:), gen(:, :)

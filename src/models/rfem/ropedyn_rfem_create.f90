@@ -142,6 +142,9 @@ contains
         if (model%water) then
             model%added = water_added_mass(spec)
             model%rowscale = 1.0_wp
+            allocate (model%am_blk(3, 3, n), model%am_g(3, n))
+            model%am_blk = 0.0_wp
+            model%am_g = 0.0_wp
         end if
 
         call build_body_effects(spec, model%len, model%effects)
@@ -149,7 +152,7 @@ contains
             model%bodies%n = n
             model%bodies%l = model%len
             allocate (model%bodies%c(2, n), model%bodies%phi(n), model%bodies%v(2, n), &
-                      model%bodies%w(n))
+                      model%bodies%w(n), model%bodies%cs(2, n))
         end if
 
         ! supports: base anchor and angle, prescribed motion

@@ -267,10 +267,11 @@ contains
             self%bodies%v(:, i) = y(k + 4:k + 5)
             self%bodies%w(i) = y(k + 6)
         end do
+        self%bodies%cs = self%cs    ! ropedyn_trig's of the same angles (angles, at y)
     end procedure fill_bodies
 
     module procedure forces
-        integer :: j, n, p, i
+        integer :: j, n, p, i, k
         real(wp) :: fx, fy, fp, dx, dy, dp, c(3), cr(3), e_el, p_in, sup_sde(3, 2)
         type(sde_t) :: s
         logical :: energy, with_power, split, with_rest, damp
@@ -350,11 +351,21 @@ contains
                 self%gen(3, i) = self%gen(3, i) - self%g*self%pm_moment(p)*self%cs(2, i)
             end do
         end if
+        if (present(work)) then
+            ! the supports' powers before the effects', as in store_powers
+            work = 0.0_wp
+            do k = 1, 2
+                if (self%sup(k)%active) call support_power(self, k, y, p_in, work)
+            end do
+        end if
         if (size(self%effects) > 0 .and. (with_rest .or. .not. split)) then
             call self%fill_bodies(y)
             if (with_rest) then
                 call add_forces_of(self%effects, t, self%bodies, self%gen_r(1:2, :), &
                                    self%gen_r(3, :))
+            else if (present(work)) then
+                call add_forces_powers_of(self%effects, t, self%bodies, self%gen(1:2, :), &
+                                          self%gen(3, :), p_in, work)
             else
                 call add_forces_of(self%effects, t, self%bodies, self%gen(1:2, :), &
                                    self%gen(3, :))
@@ -408,17 +419,12 @@ contains
     end procedure rfem_rhs
 
     module procedure rfem_rhs_quad
-        real(wp) :: power
-        ! the order of the sums as in rfem_quad_rhs: internal SDEs, supports, effects
-        power = 0.0_wp
-        if (self%damped) then
-            call self%forces(t, y, power=power)
-        else
-            call self%forces(t, y)
-        end if
+        real(wp) :: power, work
+        ! the order of the sums as in rfem_quad_rhs: internal SDEs, supports, effects (all
+        ! in forces, each effect's power with its forces)
+        call self%forces(t, y, power=power, work=work)
         call accelerations(self, y, ydot)
-        ! forces filled the bodies of the effects
-        call store_powers(self, t, y, power, yqdot, status)
+        call store_rates(self, power, work, yqdot, status)
         if (.not. all(ieee_is_finite(ydot))) status = STATUS_RECOVERABLE
     end procedure rfem_rhs_quad
 
@@ -605,9 +611,19 @@ contains
             if (self%sup(k)%active) call support_power(self, k, y, power, work)
         end do
         if (size(self%effects) > 0) call add_powers_of(self%effects, t, self%bodies, power, work)
+        call store_rates(self, power, work, yqdot, status)
+    end subroutine store_powers
+
+    !> Store the dissipation power and the external work rate as the quadratures' rates;
+    !! STATUS_RECOVERABLE when either is not finite.
+    subroutine store_rates(self, power, work, yqdot, status)
+        class(rfem_t), intent(in) :: self
+        real(wp), intent(in) :: power, work
+        real(wp), intent(out) :: yqdot(:)
+        integer, intent(out) :: status
         yqdot(1) = power
         if (self%with_work) yqdot(2) = work
         status = STATUS_OK
         if (.not. (ieee_is_finite(power) .and. ieee_is_finite(work))) status = STATUS_RECOVERABLE
-    end subroutine store_powers
+    end subroutine store_rates
 end submodule ropedyn_rfem_kernels

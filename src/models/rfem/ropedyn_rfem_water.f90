@@ -25,7 +25,18 @@ contains
         integer, intent(in) :: i
         real(wp), intent(in) :: z(6)
         real(wp), intent(out) :: m(3, 3), g(3)
-        real(wp) :: blk(3, 3), ga(3), e(2)
+        real(wp) :: blk(3, 3), ga(3)
+        call self%added%terms(z(1:2), z(3), z(4:5), z(6), self%len(i), blk, ga)
+        call inertia_with(self, i, z, blk, ga, m, g)
+    end subroutine local_inertia
+
+    !> local_inertia with the added mass's block blk and force ga at z given.
+    pure subroutine inertia_with(self, i, z, blk, ga, m, g)
+        class(rfem_t), intent(in) :: self
+        integer, intent(in) :: i
+        real(wp), intent(in) :: z(6), blk(3, 3), ga(3)
+        real(wp), intent(out) :: m(3, 3), g(3)
+        real(wp) :: e(2)
         integer :: p
         m = 0.0_wp
         m(1, 1) = self%mass(i)
@@ -39,10 +50,9 @@ contains
             m(3, 1:2) = m(1:2, 3)
             g(1:2) = self%pm_moment(p)*z(6)**2*e
         end do
-        call self%added%terms(z(1:2), z(3), z(4:5), z(6), self%len(i), blk, ga)
         m = m + blk
         g = g + ga
-    end subroutine local_inertia
+    end subroutine inertia_with
 
     !> x with m x = b, m (3x3) symmetric positive definite (Gaussian elimination).
     pure function solve3(m, b) result(x)
@@ -72,30 +82,32 @@ contains
         z = y(6*(i - 1) + 1:6*(i - 1) + 6)
     end function element_state
 
-    !> The added mass's forces into self%gen and, with `energy`, its potential (the
-    !! current's, -1/2 u^T A u) added to e_el.
+    !> The added mass's forces into self%gen (its blocks and forces kept in self%am_blk,
+    !! self%am_g for water_accelerations) and, with `energy`, its potential (the current's,
+    !! -1/2 u^T A u) added to e_el.
     module procedure water_forces
-        real(wp) :: blk(3, 3), ga(3), z(6)
+        real(wp) :: z(6)
         integer :: i
         do i = 1, self%n
             z = element_state(i, y)
-            call self%added%terms(z(1:2), z(3), z(4:5), z(6), self%len(i), blk, ga)
-            self%gen(:, i) = self%gen(:, i) + ga
+            call self%added%terms(z(1:2), z(3), z(4:5), z(6), self%len(i), &
+                                  self%am_blk(:, :, i), self%am_g(:, i))
+            self%gen(:, i) = self%gen(:, i) + self%am_g(:, i)
             if (present(e_el)) e_el = e_el + self%added%potential(z(1:2), z(3), self%len(i))
         end do
     end procedure water_forces
 
     !> The accelerations of every element from its block: M a = gen + the point masses'
-    !! centripetal force (the added mass's force is in gen already).
+    !! centripetal force (the added mass's force is in gen already; its block and force at
+    !! y are those water_forces kept).
     module procedure water_accelerations
-        real(wp) :: m(3, 3), g(3), blk(3, 3), ga(3), z(6)
+        real(wp) :: m(3, 3), g(3), z(6)
         integer :: i, k
         do i = 1, self%n
             k = 6*(i - 1)
             z = element_state(i, y)
-            call local_inertia(self, i, z, m, g)
-            call self%added%terms(z(1:2), z(3), z(4:5), z(6), self%len(i), blk, ga)
-            ydot(k + 4:k + 6) = solve3(m, gen(:, i) + g - ga)
+            call inertia_with(self, i, z, self%am_blk(:, :, i), self%am_g(:, i), m, g)
+            ydot(k + 4:k + 6) = solve3(m, gen(:, i) + g - self%am_g(:, i))
         end do
     end procedure water_accelerations
 
