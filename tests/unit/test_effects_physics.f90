@@ -199,6 +199,7 @@ contains
         real(wp), intent(out) :: f(:, :), m(:)
         b%phi = [0.5_wp*pi + dphi]
         b%w = [w]
+        call set_axes(b)
         f = 0.0_wp
         m = 0.0_wp
         call ground%add_forces(0.0_wp, b, f, m)
