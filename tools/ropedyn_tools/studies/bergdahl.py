@@ -119,6 +119,16 @@ def base_elements():
     return int(scene_number(BASE, "elements"))
 
 
+def base_rtol():
+    """The study's setting: the base scene's rtol."""
+    return scene_number(BASE, "rtol")
+
+
+def is_base(row):
+    """Whether a convergence row is the run at the study's setting."""
+    return row["n"] == base_elements() and row["rtol"] == base_rtol()
+
+
 def run_sweeps(exe, periods, models, radii, work, jobs, quick=None):
     """Run the period sweeps of each model into work/MODEL/T<..>; returns {(model, period):
     wall seconds}. The shipped sweep files are the RFEM's; a copy in work sets the model.
@@ -224,19 +234,19 @@ def collect(work, periods, models, cycles=ANALYSED):
 
 # ---------------------------------------------------------------- convergence
 
-def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS,
-                base_n=165, base_rtol=1e-4):
+def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS):
     """Mean cycle maxima at elements of 0.4, 0.2, 0.1 m and at rtol halved twice (the
     sweep's case at 0.2 m and base_rtol is the middle run); `jobs` runs at a time."""
     from concurrent.futures import ThreadPoolExecutor
-    variants = [((base_n + 1) // 2, base_rtol), (base_n, base_rtol), (base_n * 2, base_rtol),
-                (base_n, base_rtol / 2), (base_n, base_rtol / 4)]
+    base_n, base_r = base_elements(), base_rtol()
+    variants = [((base_n + 1) // 2, base_r), (base_n, base_r), (base_n * 2, base_r),
+                (base_n, base_r / 2), (base_n, base_r / 4)]
     todo = []
     for model in models:
         for period in periods:
             for n, rtol in variants:
                 out = work / "convergence" / f"{model}_T{period}_n{n}_rtol{rtol:g}.h5"
-                if (n, rtol) == (base_n, base_rtol) and case_path(work, period, model,
+                if (n, rtol) == (base_n, base_r) and case_path(work, period, model,
                                                                    radius).exists():
                     out = case_path(work, period, model, radius)
                 todo.append((model, period, n, rtol, out))
@@ -381,11 +391,12 @@ def cost_lines(results, models, periods, walls):
 def convergence_lines(rows):
     if not rows:
         return []
-    lines = ["| model | T (s) | elements | rtol | mean cycle max (N) | change from 165, 1e-4 | CPU (s) |",
+    lines = [f"| model | T (s) | elements | rtol | mean cycle max (N) | change from "
+             f"{base_elements()}, {base_rtol():g} | CPU (s) |",
              "|---|---|---|---|---|---|---|"]
     for row in rows:
         ref = next(r for r in rows if r["model"] == row["model"] and
-                   r["period"] == row["period"] and r["n"] == 165 and r["rtol"] == 1e-4)
+                   r["period"] == row["period"] and is_base(r))
         lines.append(f"| {row['model'].upper()} | {row['period']} | {row['n']} | {row['rtol']:g} | "
                      f"{row['mean']:.3f} | {100 * (row['mean'] / ref['mean'] - 1):+.2f} % | "
                      f"{row['cpu_time']:.1f} |")
@@ -494,11 +505,10 @@ def target_lines(results, models, periods, walls, conv, work):
             continue
         worst = 0.0
         for r in rows:
-            if (r["n"], r["rtol"]) == (165, 1e-4):
+            if is_base(r):
                 continue
-            ref = next(x for x in rows if x["period"] == r["period"] and x["n"] == 165
-                       and x["rtol"] == 1e-4)
-            if r["n"] >= 165:                # the halvings, not the coarser run
+            ref = next(x for x in rows if x["period"] == r["period"] and is_base(x))
+            if r["n"] >= base_elements():    # the halvings, not the coarser run
                 worst = max(worst, abs(r["mean"] / ref["mean"] - 1))
         lines.append(f"| {name(model)}: halving the element length or rtol changes the mean "
                      f"cycle maximum by <= 0.5 % | {100 * worst:.2f} % | "
@@ -560,10 +570,12 @@ def section(results, models, periods, walls, conv, figs, command, work, contact=
     if conv:
         md += ["", "### Convergence", "",
                "R = 0.2 m, each run its own 12 cycles; the change of the mean cycle maximum "
-               "against 165 elements (0.2 m) at rtol 1e-4.", ""] + convergence_lines(conv)
+               f"against {base_elements()} elements at rtol {base_rtol():g}.", ""]
+        md += convergence_lines(conv)
     if contact:
         md += ["", "### The floor's cost", "",
-               "RFEM, 165 elements, rtol 1e-4: T = 1.25 s, R = 0.2 m from its record at the "
+               f"RFEM, {base_elements()} elements, rtol {base_rtol():g}: T = 1.25 s, R = 0.2 m "
+               "from its record at the "
                "start of the 7th cycle, 2 cycles (2.5 s), each variant the same window.", ""]
         md += contact_lines(contact)
     md += ["", END]
