@@ -277,6 +277,7 @@ CONTACT_VARIANTS = (
     ("cvode", ["solver.method=cvode"]),
     ("erk", ["solver.method=erk"]),
     ("mebdf", ["solver.method=mebdf"]),
+    ("auto, atol 1e-6 (1e-8: the default)", ["solver.atol=1e-6"]),
     ("auto, no friction", ["ground.friction_coefficient=0"]),
     ("cvode, no friction", ["solver.method=cvode", "ground.friction_coefficient=0"]),
     ("auto, no contact damping", ["ground.damping=0"]),
