@@ -94,3 +94,23 @@ def test_sundials_from_a_prefix_elsewhere(tmp_path):
     result = subprocess.run(["cmake", "--build", str(build), "-j2", "--target",
                              "ropedyn_solvers"], capture_output=True, text=True)
     assert result.returncode == 0, result.stdout[-3000:]
+
+
+def test_setup_never_clears_a_linked_venv(tmp_path):
+    """A .venv that is a link (to another clone's venv, say) is replaced by the clone's own
+    venv; the link's target keeps its files. (Made through the link, the venv's --clear
+    emptied the other clone's venv.)"""
+    clone = tmp_path / "clone"
+    (clone / "scripts").mkdir(parents=True)
+    (clone / "python").mkdir()
+    for name in ("setup", "requirements.txt"):
+        shutil.copy2(ROOT / "scripts" / name, clone / "scripts" / name)
+    other = tmp_path / "other_venv"
+    other.mkdir()
+    (other / "keep").write_text("the other clone's")
+    (clone / ".venv").symlink_to(other)
+    result = subprocess.run([str(clone / "scripts" / "setup")], capture_output=True, text=True)
+    assert (other / "keep").exists(), "the linked venv was cleared"
+    assert result.returncode == 0, result.stderr
+    assert not (clone / ".venv").is_symlink()
+    assert (clone / ".venv" / "bin" / "python").exists()
