@@ -32,8 +32,17 @@ def attr(f, name):
     return value.decode() if isinstance(value, bytes) else str(value)
 
 
+def default_sigint():
+    """In the child before ropedyn starts: SIGINT to its default. A suite started in the
+    background by a shell without job control (`scripts/test &`, nohup) inherits SIGINT
+    ignored, and ropedyn, like any program, keeps a signal ignored that it was started
+    with; the signals sent here would then find nothing to interrupt."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def start(ropedyn_exe, cwd, *args):
     return subprocess.Popen([str(ropedyn_exe), *map(str, args)], cwd=cwd,
+                            preexec_fn=default_sigint,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
