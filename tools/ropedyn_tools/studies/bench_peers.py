@@ -177,12 +177,12 @@ rope       {DIAMETER}  {mu:.10g}  {ea:.10g}  {ba:.10g}  {ei:.10g}  0.0  0.0  0.0
 ---------------------- POINTS --------------------------------
 ID   Attachment  X       Y     Z      Mass   Volume  CdA    Ca
 (#)   (-)        (m)    (m)   (m)     (kg)   (m^3)   (m^2)  (-)
-1    Fixed       0      0     {TOP_Z}    0      0       0      0
+1    {top}       0      0     {TOP_Z}    0      0       0      0
 2    Free        {x:.12f}   0    {z:.12f}  0      0       0      0
 ---------------------- LINES --------------------------------------
 ID    LineType   AttachA  AttachB  UnstrLen  NumSegs  LineOutputs
 (#)   (name)     (#)      (#)      (m)       (-)       (-)
-1     rope       1        2        {LENGTH}       {n}        p
+1     rope       1        2        {LENGTH}       {n}        {outputs}
 ---------------------- OPTIONS -----------------------------------------
 {dt:.6g}   dtM
 {OUT_DT}     dtOut
@@ -576,9 +576,15 @@ def main(argv=None):
     parser.add_argument("--no-undamped", action="store_true",
                         help="without the undamped comparison (its table kept)")
     parser.add_argument("--no-write", action="store_true")
+    parser.add_argument("--coupled-elements", default="30",
+                        help="n of the coupled case (top driven from Python)")
+    parser.add_argument("--coupled-only", action="store_true",
+                        help="only the coupled case (its own table)")
     args = parser.parse_args(argv)
     exe = exe_or_build(args.exe)
     py = ensure_bench_venv()
+    if args.coupled_only:
+        return coupled_main(args, exe, py)
     header = ("| n | MoorDyn dt (s) | segment damping ratio (both) | MoorDyn CPU (s) "
               "| ropedyn method | ropedyn steps | ropedyn CPU (s) | MoorDyn / ropedyn "
               "| ropedyn tip error [0, 2 s] (m) | ropedyn balance error (J) "
@@ -698,7 +704,7 @@ def main(argv=None):
     update_doc(DOCS / "performance" / "peers.md", BEGIN, END, "\n".join(lines),
                heading="## The peer side by side: MoorDyn-C (issue 15)\n\n")
     print(f"bench_peers: {DOCS / 'performance' / 'peers.md'}")
-    return 0
+    return coupled_main(args, exe, py)
 
 
 if __name__ == "__main__":
