@@ -219,6 +219,12 @@ def run_moordyn(py, workdir, n, dt, t_end, span=ACCURACY_SPAN, undamped=False,
     proc = subprocess.run([str(py), "-X", "faulthandler", "-c", DRIVER, str(f), str(t_end),
                            str(OUT_DT), str(LENGTH), str(span), *extra], capture_output=True,
                           text=True, cwd=workdir, timeout=7200)
+    return driver_result(proc, t=0.0)
+
+
+def driver_result(proc, **failed):
+    """The result a MoorDyn driver printed (its last RESULT line), the tip in ropedyn's
+    frame; else a failure with the driver's last error line and `failed`'s entries."""
     for line in proc.stdout.splitlines()[::-1]:
         if "RESULT " in line:
             r = json.loads(line.split("RESULT ", 1)[1])
@@ -226,7 +232,7 @@ def run_moordyn(py, workdir, n, dt, t_end, span=ACCURACY_SPAN, undamped=False,
             # ropedyn's frame: x down from the top anchor, y horizontal
             r["tip"] = np.column_stack([TOP_Z - xyz[:, 2], xyz[:, 0]])
             return r
-    return {"ok": False, "cpu": float("nan"), "t": 0.0,
+    return {"ok": False, "cpu": float("nan"), **failed,
             "error": (proc.stderr.strip().splitlines() or ["no output"])[-1][:80]}
 
 
@@ -435,14 +441,7 @@ def run_moordyn_coupled(py, workdir, n, dt, t_end, span=ACCURACY_SPAN):
                            str(t_end), str(COUPLED_DT), str(LENGTH), str(span), str(TOP_Z),
                            str(COUPLED_AMPLITUDE), str(COUPLED_FREQUENCY), str(COUPLED_RAMP)],
                           capture_output=True, text=True, cwd=workdir, timeout=3600)
-    for line in proc.stdout.splitlines()[::-1]:
-        if "RESULT " in line:
-            r = json.loads(line.split("RESULT ", 1)[1])
-            xyz = np.array(r.pop("tip"))
-            r["tip"] = np.column_stack([TOP_Z - xyz[:, 2], xyz[:, 0]])
-            return r
-    return {"ok": False, "cpu": float("nan"),
-            "error": (proc.stderr.strip().splitlines() or ["no output"])[-1][:80]}
+    return driver_result(proc)
 
 
 def run_ropedyn_coupled(n, t_end, sets=(), span=ACCURACY_SPAN):
