@@ -136,7 +136,6 @@ def run_sweeps(exe, periods, models, radii, work, jobs, quick=None):
     quick = (elements, cycles): that many elements and cycles and a one-cycle ramp (a smoke
     test of the pipeline)."""
     walls = {}
-    elements = quick[0] if quick else base_elements()
     for label in models:
         model, _, variant = label.partition("_")
         for period in periods:
@@ -151,7 +150,7 @@ def run_sweeps(exe, periods, models, radii, work, jobs, quick=None):
                                     f"'solver.t_end={quick[1] * period:.12g}'")
                 text = text.replace(f"'supports.top_ramp_time={RAMP_CYCLES * period:.12g}'",
                                     f"'supports.top_ramp_time={period:.12g}'")
-                sets.append(f"model.elements={elements}")
+                sets.append(f"model.elements={quick[0]}")
             if sets:
                 text = text.replace("    set = ", "    set = " +
                                     "".join(f"'{s}', " for s in sets), 1)
