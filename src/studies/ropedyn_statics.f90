@@ -86,6 +86,8 @@ module ropedyn_statics
         procedure :: plan_ground => continuation_plan_ground
         procedure :: stage => continuation_stage
         procedure :: run => continuation_run
+        procedure :: name => continuation_name
+        procedure :: account => continuation_account
     end type continuation_t
 
     !> The state of `solve_statics`' iteration at y, and its steps (the module header).
@@ -175,7 +177,7 @@ contains
             ground%iterations = first%iterations
             ground%rejected = first%rejected
             if (allocated(soft_err)) then
-                ground%fallback = 'continuation in the ground stiffness failed at its start, then '
+                ground%fallback = 'continuation in '//ground%name()//' failed at its start, then '
                 y = y_start
             else
                 ground%stages = 1 + first%stages
@@ -185,12 +187,7 @@ contains
             end if
         end if
         call equilibrium_of(model, spec, y, options, result, err)
-        if (allocated(err) .and. len(ground%fallback) > 0) then
-            err%message = err%message//' ('//ground%fallback//'solved directly from the start)'
-        end if
-        result%iterations = result%iterations + ground%iterations
-        result%rejected = result%rejected + ground%rejected
-        result%stages = result%stages + ground%stages
+        call ground%account(result, err)
     end subroutine find_equilibrium
 
     !> The equilibrium of the spec from the starting state y. When the bottom end is
@@ -223,13 +220,33 @@ contains
             if (allocated(err)) return
         end if
         call solve_statics(model, spec, y, options, result, err)
-        if (allocated(err) .and. len(path%fallback) > 0) then
-            err%message = err%message//' ('//path%fallback//'solved directly from the start)'
-        end if
-        result%iterations = result%iterations + path%iterations
-        result%rejected = result%rejected + path%rejected
-        result%stages = path%stages
+        call path%account(result, err)
     end subroutine equilibrium_of
+
+    !> Add what the continuation cost to the result of the solve after it, and to that
+    !! solve's error, when the continuation was given up, how far it got.
+    subroutine continuation_account(self, result, err)
+        class(continuation_t), intent(in) :: self
+        type(statics_result_t), intent(inout) :: result
+        type(error_t), allocatable, intent(inout) :: err
+        if (allocated(err) .and. len(self%fallback) > 0) then
+            err%message = err%message//' ('//self%fallback//'solved directly from the start)'
+        end if
+        result%iterations = result%iterations + self%iterations
+        result%rejected = result%rejected + self%rejected
+        result%stages = result%stages + self%stages
+    end subroutine continuation_account
+
+    !> The name of the continued parameter, for messages.
+    pure function continuation_name(self) result(name)
+        class(continuation_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        if (self%which == ON_GROUND) then
+            name = 'the ground stiffness'
+        else
+            name = 'support_stiffness_factor'
+        end if
+    end function continuation_name
 
     !> Whether the ground needs the continuation (ON_GROUND): gravity, ground contact and a
     !! stiffness above GROUND_CONTINUED_ABOVE times k0, the stiffness at which the rope's
@@ -342,11 +359,8 @@ contains
                 ds = 0.25_wp*ds
                 if (ds < 1.0e-3_wp .or. (self%stages == 1 .and. .not. solved)) then
                     ! give up the continuation: solve directly from the start
-                    self%fallback = 'continuation in '// &
-                                    trim(merge('the ground stiffness    ', &
-                                               'support_stiffness_factor', &
-                                               self%which == ON_GROUND))// &
-                                    ' stalled at '//fixed_text(100*s, 1)//' % of the way, then '
+                    self%fallback = 'continuation in '//self%name()//' stalled at '// &
+                                    fixed_text(100*s, 1)//' % of the way, then '
                     y = y_start
                     self%stages = 0
                     exit
