@@ -28,6 +28,7 @@ module ropedyn_added_mass
         type(wetting_t) :: wetting
     contains
         procedure :: terms => added_terms
+        procedure :: terms_e => added_terms_e
         procedure :: kinetic => added_kinetic
         procedure :: potential => added_potential
     end type added_mass_t
@@ -41,31 +42,43 @@ contains
         class(added_mass_t), intent(in) :: self
         real(wp), intent(in) :: c(2), phi, v(2), w, l
         real(wp), intent(out) :: blk(3, 3), g(3)
+        call self%terms_e(c, [cos(phi), sin(phi)], v, w, l, blk, g)
+    end subroutine added_terms
+
+    !> added_terms with the body's axis e = (cos phi, sin phi) given (a model that keeps
+    !! them computes no angle's cosine again).
+    pure subroutine added_terms_e(self, c, e, v, w, l, blk, g)
+        class(added_mass_t), intent(in) :: self
+        real(wp), intent(in) :: c(2), e(2), v(2), w, l
+        real(wp), intent(out) :: blk(3, 3), g(3)
         type(wet_t) :: wt
-        real(wp) :: e(2), nv(2), bm(2, 2), bp(2, 2), jb, vr(2), q, qp, f_phi, fdot
-        integer :: p
+        real(wp) :: nv(2), jb, vr(2), ve, vn, bv(2), bpv(2), q, qp, f_phi, fdot
         blk = 0.0_wp
         g = 0.0_wp
-        e = [cos(phi), sin(phi)]
         wt = self%wetting%of(c(1), e(1), 0.5_wp*l)
         if (wt%f <= 0.0_wp .and. wt%f_d == 0.0_wp .and. wt%f_c == 0.0_wp) return
         nv = [-e(2), e(1)]
-        do p = 1, 2
-            bm(:, p) = l*(self%mat*e*e(p) + self%man*nv*nv(p))
-            bp(:, p) = l*(self%mat - self%man)*(e*nv(p) + nv*e(p))
-        end do
-        jb = self%man*l**3/12.0_wp
-        blk(1:2, 1:2) = wt%f*bm
-        blk(3, 3) = wt%f*jb
+        ! B = l (m_at e e^T + m_an n n^T) and B' = l (m_at - m_an)(e n^T + n e^T) act on v_r
+        ! through its components along the axis and the normal
         vr = v - self%u
-        q = dot_product(vr, matmul(bm, vr))
-        qp = dot_product(vr, matmul(bp, vr))
+        ve = dot_product(vr, e)
+        vn = dot_product(vr, nv)
+        bv = l*(self%mat*ve*e + self%man*vn*nv)
+        bpv = l*(self%mat - self%man)*(vn*e + ve*nv)
+        jb = self%man*l**3/12.0_wp
+        blk(1, 1) = wt%f*l*(self%mat*e(1)**2 + self%man*nv(1)**2)
+        blk(2, 2) = wt%f*l*(self%mat*e(2)**2 + self%man*nv(2)**2)
+        blk(1, 2) = wt%f*l*(self%mat*e(1)*e(2) + self%man*nv(1)*nv(2))
+        blk(2, 1) = blk(1, 2)
+        blk(3, 3) = wt%f*jb
+        q = dot_product(vr, bv)
+        qp = dot_product(vr, bpv)
         f_phi = -e(2)*wt%f_c
         fdot = wt%f_d*v(1) + f_phi*w
-        g(1:2) = -matmul(fdot*bm + wt%f*w*bp, vr)
+        g(1:2) = -(fdot*bv + wt%f*w*bpv)
         g(1) = g(1) + 0.5_wp*wt%f_d*(q + jb*w**2)
         g(3) = -fdot*jb*w + 0.5_wp*(f_phi*q + wt%f*qp + f_phi*jb*w**2)
-    end subroutine added_terms
+    end subroutine added_terms_e
 
     !> 1/2 v^T A v + 1/2 J_a w^2 of the body, J.
     pure real(wp) function added_kinetic(self, c, phi, v, w, l) result(e_k)

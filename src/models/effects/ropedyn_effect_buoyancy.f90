@@ -52,9 +52,9 @@ contains
         type(wet_t) :: wt
         integer :: i
         do i = 1, b%n
-            wt = self%wetting%of(b%c(1, i), cos(b%phi(i)), 0.5_wp*b%l(i))
+            wt = self%wetting%of(b%c(1, i), b%cs(1, i), 0.5_wp*b%l(i))
             f(1, i) = f(1, i) - self%w*b%l(i)*wt%f
-            m(i) = m(i) + self%w*wt%i1*sin(b%phi(i))
+            m(i) = m(i) + self%w*wt%i1*b%cs(2, i)
         end do
     end subroutine buoyancy_add_forces
 
@@ -67,8 +67,8 @@ contains
         real(wp) :: s, c, cross
         integer :: i
         do i = 1, b%n
-            c = cos(b%phi(i))
-            s = sin(b%phi(i))
+            c = b%cs(1, i)
+            s = b%cs(2, i)
             wt = self%wetting%of(b%c(1, i), c, 0.5_wp*b%l(i))
             cross = self%w*b%l(i)*wt%f_c*s
             jac(1, 1, i) = jac(1, 1, i) - self%w*b%l(i)*wt%f_d
@@ -87,7 +87,7 @@ contains
         integer :: i
         e = 0.0_wp
         do i = 1, b%n
-            wt = self%wetting%of(b%c(1, i), cos(b%phi(i)), 0.5_wp*b%l(i))
+            wt = self%wetting%of(b%c(1, i), b%cs(1, i), 0.5_wp*b%l(i))
             e = e + self%w*wt%v
         end do
     end function buoyancy_energy

@@ -21,7 +21,7 @@ contains
         real(wp) :: g(3)
         integer :: k
         do k = 1, self%n
-            call self%added%terms(self%bodies%c(:, k), self%bodies%phi(k), &
+            call self%added%terms_e(self%bodies%c(:, k), self%cs(:, k), &
                                   self%bodies%v(:, k), self%bodies%w(k), self%l, &
                                   self%wblk(:, :, k), g)
             g = g - matmul(self%wblk(:, :, k), [self%cacc(:, k), qacc(k)])
@@ -104,10 +104,10 @@ contains
         lam = u + self%l
         sfx(:, :, n + 1) = 0.0_wp
         do j = n, 1, -1
-            call self%added%terms(b%c(:, j), b%phi(j), b%v(:, j), b%w(j), b%l(j), &
-                                  blk(:, :, j), g)
+            call self%added%terms_e(b%c(:, j), b%cs(:, j), b%v(:, j), b%w(j), b%l(j), &
+                                    blk(:, :, j), g)
             sfx(:, :, j) = sfx(:, :, j + 1) + blk(1:2, 1:2, j)
-            e(:, j) = [cos(b%phi(j)), sin(b%phi(j))]
+            e(:, j) = b%cs(:, j)
             nv(:, j) = [-e(2, j), e(1, j)]
         end do
         do j = 1, n

@@ -90,8 +90,8 @@ contains
         integer :: i
         do i = 1, self%n
             z = element_state(i, y)
-            call self%added%terms(z(1:2), z(3), z(4:5), z(6), self%len(i), &
-                                  self%am_blk(:, :, i), self%am_g(:, i))
+            call self%added%terms_e(z(1:2), self%cs(:, i), z(4:5), z(6), self%len(i), &
+                                    self%am_blk(:, :, i), self%am_g(:, i))
             self%gen(:, i) = self%gen(:, i) + self%am_g(:, i)
             if (present(e_el)) e_el = e_el + self%added%potential(z(1:2), z(3), self%len(i))
         end do
@@ -101,8 +101,25 @@ contains
     !! centripetal force (the added mass's force is in gen already; its block and force at
     !! y are those water_forces kept).
     module procedure water_accelerations
-        real(wp) :: m(3, 3), g(3), z(6)
+        real(wp) :: m(3, 3), g(3), z(6), a11, a12, a22, det
         integer :: i, k
+        if (size(self%pm_elem) == 0) then
+            ! no point mass couples translation and rotation: each block is a symmetric 2x2
+            ! (mass and the added mass's translational block) and the rotational inertia
+            do i = 1, self%n
+                k = 6*(i - 1)
+                associate (blk => self%am_blk(:, :, i), f => gen(:, i))
+                    a11 = self%mass(i) + blk(1, 1)
+                    a12 = blk(1, 2)
+                    a22 = self%mass(i) + blk(2, 2)
+                    det = a11*a22 - a12*a12
+                    ydot(k + 4) = (a22*f(1) - a12*f(2))/det
+                    ydot(k + 5) = (a11*f(2) - a12*f(1))/det
+                    ydot(k + 6) = f(3)/(self%inertia(i) + blk(3, 3))
+                end associate
+            end do
+            return
+        end if
         do i = 1, self%n
             k = 6*(i - 1)
             z = element_state(i, y)
