@@ -125,6 +125,12 @@ def base_rtol():
     return scene_number(BASE, "rtol")
 
 
+def base_atol():
+    """The study's setting: the base scene's atol (halved with rtol in the convergence
+    runs)."""
+    return scene_number(BASE, "atol")
+
+
 def is_base(row):
     """Whether a convergence row is the run at the study's setting."""
     return row["n"] == base_elements() and row["rtol"] == base_rtol()
@@ -252,8 +258,9 @@ def collect(work, periods, models, cycles=ANALYSED):
 # ---------------------------------------------------------------- convergence
 
 def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS):
-    """Mean cycle maxima at elements of 0.4, 0.2, 0.1 m and at rtol halved twice (the
-    sweep's case at 0.2 m and base_rtol is the middle run); `jobs` runs at a time."""
+    """Mean cycle maxima at elements of 0.4, 0.2, 0.1 m and at the tolerances (rtol and
+    atol together) halved twice (the sweep's case at 0.2 m and the base scene's tolerances
+    is the middle run); `jobs` runs at a time."""
     from concurrent.futures import ThreadPoolExecutor
     base_n, base_r = base_elements(), base_rtol()
     variants = [((base_n + 1) // 2, base_r), (base_n, base_r), (base_n * 2, base_r),
@@ -262,7 +269,9 @@ def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS)
     for model in models:
         for period in periods:
             for n, rtol in variants:
-                out = work / "convergence" / f"{model}_T{period}_n{n}_rtol{rtol:g}.h5"
+                atol = base_atol() * rtol / base_r
+                out = work / "convergence" / (f"{model}_T{period}_n{n}_rtol{rtol:g}"
+                                              f"_atol{atol:g}.h5")
                 if (n, rtol) == (base_n, base_r) and case_path(work, period, model,
                                                                    radius).exists():
                     out = case_path(work, period, model, radius)
@@ -274,6 +283,7 @@ def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS)
         if out.exists():
             return
         sets = [f"model.kind={model}", f"model.elements={n}", f"solver.rtol={rtol:g}",
+                f"solver.atol={base_atol() * rtol / base_r:g}",
                 f"supports.top_frequency={1 / period:.12g}",
                 f"solver.t_end={CYCLES * period:.12g}",
                 f"supports.top_ramp_time={RAMP_CYCLES * period:.12g}",
@@ -294,7 +304,7 @@ CONTACT_VARIANTS = (
     ("cvode", ["solver.method=cvode"]),
     ("erk", ["solver.method=erk"]),
     ("mebdf", ["solver.method=mebdf"]),
-    ("auto, atol 1e-6 (1e-8: the default)", ["solver.atol=1e-6"]),
+    ("auto, atol 1e-8 (ropedyn's default)", ["solver.atol=1e-8"]),
     ("auto, no friction", ["ground.friction_coefficient=0"]),
     ("cvode, no friction", ["solver.method=cvode", "ground.friction_coefficient=0"]),
     ("auto, no contact damping", ["ground.damping=0"]),
@@ -408,7 +418,8 @@ def cost_lines(results, models, periods, walls):
 def convergence_lines(rows):
     if not rows:
         return []
-    lines = [f"| model | T (s) | elements | rtol | mean cycle max (N) | change from "
+    lines = [f"| model | T (s) | elements | rtol (atol = {base_atol() / base_rtol():g} rtol) "
+             f"| mean cycle max (N) | change from "
              f"{base_elements()}, {base_rtol():g} | CPU (s) |",
              "|---|---|---|---|---|---|---|"]
     for row in rows:
@@ -527,7 +538,7 @@ def target_lines(results, models, periods, walls, conv, work):
             ref = next(x for x in rows if x["period"] == r["period"] and is_base(x))
             if r["n"] >= base_elements():    # the halvings, not the coarser run
                 worst = max(worst, abs(r["mean"] / ref["mean"] - 1))
-        lines.append(f"| {name(model)}: halving the element length or rtol changes the mean "
+        lines.append(f"| {name(model)}: halving the element length or the tolerances changes the mean "
                      f"cycle maximum by <= 0.5 % | {100 * worst:.2f} % | "
                      f"{'yes' if worst <= 0.005 else 'no'} |")
     for model in models:
@@ -587,11 +598,13 @@ def section(results, models, periods, walls, conv, figs, command, work, contact=
     if conv:
         md += ["", "### Convergence", "",
                "R = 0.2 m, each run its own 12 cycles; the change of the mean cycle maximum "
-               f"against {base_elements()} elements at rtol {base_rtol():g}.", ""]
+               f"against {base_elements()} elements at rtol {base_rtol():g}, atol "
+               f"{base_atol():g}.", ""]
         md += convergence_lines(conv)
     if contact:
         md += ["", "### The floor's cost", "",
-               f"RFEM, {base_elements()} elements, rtol {base_rtol():g}: T = 1.25 s, R = 0.2 m "
+               f"RFEM, {base_elements()} elements, rtol {base_rtol():g}, atol {base_atol():g} "
+               "(the scene's): T = 1.25 s, R = 0.2 m "
                "from its record at the "
                "start of the 7th cycle, 2 cycles (2.5 s), each variant the same window.", ""]
         md += contact_lines(contact)
