@@ -111,8 +111,9 @@ module ropedyn_auto
     !! steps below the limit)
     real(wp), parameter :: EXPLICIT_MARGIN = 1.15_wp
     integer, parameter :: MAX_WAIT = 64            !< windows between switches, at most
-    !> explicit windows after which the implicit method's measured cost is stale (times the
-    !! cost ratio, at least 2, of each trial that does not pay)
+    !> explicit windows after which the implicit method's, or the accuracy method's,
+    !! measured cost is stale (times the cost ratio, at least 2, of each of its trials that
+    !! does not pay)
     integer, parameter :: STALE_WINDOWS = 32
 
     type, extends(integrator_t) :: auto_t
@@ -148,6 +149,9 @@ module ropedyn_auto
         !! solves with a mass matrix, else erk's order-5 pair (HIGH)
         integer :: accurate = ADAMS
         real(wp) :: rate_accurate = -1.0_wp  !< its measured cost per simulated second
+        !> explicit windows since rate_accurate was measured, and how many make it stale
+        integer :: accurate_age = 0
+        integer :: accurate_stale_after = STALE_WINDOWS
         !> windows of the order-5 pair since rate_explicit was measured
         integer :: explicit_age = 0
         !> its cost in its last window that was not dearer than erk's by GAIN (< 0: none)

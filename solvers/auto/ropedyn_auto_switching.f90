@@ -52,9 +52,15 @@
 !!   only for problems with a mass matrix (the MPP: f solves with it); on the RFEM scenes
 !!   where it was tried it kept Adams at up to twice erk's CPU (table_motion).
 !!   When most steps of an explicit window were not held by stability, auto tries Adams
-!!   (once; a trial, judged on its second window against the explicit cost, goes back
-!!   at once unless it is cheaper by GAIN) and later switches to it when its measured
-!!   cost is lower by GAIN; from Adams it goes back to erk when erk's last measured cost is lower
+!!   (a trial, judged on its second window against the explicit cost, goes back at once
+!!   unless it is cheaper by GAIN) and later switches to it when its measured cost is
+!!   lower by GAIN. That cost is evidence for STALE_WINDOWS explicit windows (times the
+!!   cost ratio, at least 2, of each trial that does not pay), as the implicit method's;
+!!   then the next window held by accuracy tries Adams again. Without that, one trial in
+!!   a short stretch decided a whole run: on the Bergdahl chain's MPP at atol 1e-8, Adams
+!!   tried for 0.02 s at 1.1 s (in the ramp's first cycle) was dearer, and erk ran to the
+!!   end with 2.1e6 evaluations of f in 24 s, against 0.54e6 for a neighbouring case that
+!!   kept Adams (316 s of CPU against 84); mpp_undamped tries it again at 2.5 s. From Adams it goes back to erk when erk's last measured cost is lower
 !!   by GAIN in two windows in a row (snap_load_mpp: Adams measured once at 6.6e4 f/s in the
 !!   window of the snap sent auto back to erk, whose cost of 4.5e4 measured before the
 !!   snap then kept Adams out for the remaining 9 s: 1.36 s CPU against Adams' 0.82);
@@ -108,7 +114,7 @@ contains
         real(wp) :: rate, span, h_e, predicted, share
         real(wp) :: growth  !< of stale_after after a trial that did not pay
         logical :: dearer   !< Adams' window cost more than erk's last by GAIN
-        logical :: stale    !< the implicit method's measured cost is old (explicit windows)
+        logical :: stale    !< the implicit or accuracy method's measured cost is old
         logical :: early    !< erk's early first window (early_look)
         character(len=240) :: text
         character(len=12) :: age
@@ -143,6 +149,7 @@ contains
         if (self%active == EXPLICIT) then
             self%rate_explicit = rate
             if (self%rate_implicit > 0.0_wp) self%implicit_age = self%implicit_age + 1
+            if (self%rate_accurate > 0.0_wp) self%accurate_age = self%accurate_age + 1
             if (early) then
                 share = self%erk%stiff_share_of_steps(EARLY_WINDOW)
             else
@@ -154,11 +161,23 @@ contains
                 ! (judged on the explicit method's second window on: the first includes its
                 ! start)
                 if (self%windows < 2) return
-                if (self%rate_accurate > 0.0_wp .and. GAIN*self%rate_accurate >= rate) return
+                ! its measured cost is evidence for accurate_stale_after windows: a trial
+                ! in a short stretch of the start (the MPP's Adams, 0.02 s at 1.1 s of
+                ! the Bergdahl chain) must not keep it out of a long run
+                stale = self%rate_accurate > 0.0_wp .and. &
+                        self%accurate_age >= self%accurate_stale_after
+                if (self%rate_accurate > 0.0_wp .and. GAIN*self%rate_accurate >= rate .and. &
+                    .not. stale) return
                 write (text, '(a, i0, a, es9.2, a)') 'explicit step held by accuracy (', &
                     nint(100*(1 - share)), ' % of the steps; cost ', rate, ' f per second)'
-                self%trial = self%rate_accurate <= 0.0_wp
-                if (self%trial) text = trim(text)//': trying '//self%accurate_name()
+                self%trial = self%rate_accurate <= 0.0_wp .or. stale
+                if (stale) then
+                    write (age, '(i0)') self%accurate_age
+                    text = trim(text)//': trying '//self%accurate_name()// &
+                           ' again (its cost was measured '//trim(age)//' windows ago)'
+                else if (self%trial) then
+                    text = trim(text)//': trying '//self%accurate_name()
+                end if
                 if (self%windows <= 2) call back_off()
                 call self%start_method(self%accurate, trim(text), err)
                 return
@@ -208,12 +227,17 @@ contains
             end if
             if (self%windows < 2) return
             self%rate_accurate = rate
+            self%accurate_age = 0
             if (self%trial) then
                 ! kept only when cheaper by GAIN: Adams' counted cost misses CVODE's fixed
                 ! work per step, which weighs most where f is cheap (the RFEM at small n);
                 ! the order-5 pair is not worth a switch for less either
                 self%trial = .false.
                 if (self%rate_explicit > 0.0_wp .and. GAIN*rate > self%rate_explicit) then
+                    growth = max(2.0_wp, real(ceiling(min(rate/self%rate_explicit, &
+                                                          1.0e9_wp)), wp))
+                    self%accurate_stale_after = int(min(real(huge(0)/2, wp), &
+                                                        growth*self%accurate_stale_after))
                     call trial_failed(self%accurate_name()//' was not cheaper by 1.3')
                     return
                 end if

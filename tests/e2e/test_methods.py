@@ -256,6 +256,25 @@ def test_auto_tries_adams_where_the_explicit_step_is_held_by_accuracy(run, tmp_p
         assert np.max(np.abs(f["/state/q"][()] - q)) < 1e-3
 
 
+def test_auto_tries_adams_again_when_its_cost_is_stale(run, tmp_path):
+    """The undamped MPP (n = 30): the first trial of adams, 0.04 s at 0.07 s, is not cheaper
+    by GAIN and sends auto back to erk. That cost is evidence for STALE_WINDOWS explicit
+    windows times the trial's cost ratio (at least 2), as the implicit method's: then the
+    next window held by accuracy tries adams again (before, one trial decided the whole
+    run: the Bergdahl chain's MPP ran erk to the end after a trial in its first cycle)."""
+    scene = ROOT / "input" / "hard" / "mpp_undamped.nml"
+    proc, out = run_scene(run, tmp_path, scene, "auto", "solver.t_end=2.6")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods, _, _, reasons = switch_log(f)
+    first = next(i for i, r in enumerate(reasons) if "adams was not cheaper" in r)
+    again = [r for r in reasons[first:] if "trying adams again" in r]
+    assert again, (methods, reasons)
+    age = int(re.search(r"measured (\d+) windows ago", again[0]).group(1))
+    stale = auto_parameter("STALE_WINDOWS")
+    assert 2 * stale <= age < 3 * stale, (age, reasons)
+
+
 def test_erk_rejects_few_steps_where_stability_holds_them(run, tmp_path):
     """The paper's rope with erk at rtol 1e-2 (5 s): the step is held by stability (h rho
     near RK4's limit). With Gustafsson's PI gains there the controller cycled into the
