@@ -92,6 +92,8 @@ module ropedyn_mpp
         !> the moments of the joints' and the clamps' rotational springs and dampers (0:n),
         !! joint k between members k and k+1 (0, n: the supports), docs/theory/internal-forces.md
         real(wp), allocatable :: jmom(:)
+        !> the lower end P_n and its velocity at the last residual_core, m and m/s
+        real(wp) :: tip(2) = 0.0_wp, tipd(2) = 0.0_wp
         type(bodies_t) :: bodies              !< the rods as bodies for the effects
         real(wp), allocatable :: ejac(:, :, :)  !< the effects' (and the water's) blocks (3, 6, n)
         !> in water: the rods' added-mass blocks (3x3 on centre and angle) at the state of the
@@ -115,6 +117,7 @@ module ropedyn_mpp
         procedure :: implicit_rhs => mpp_implicit_rhs
         procedure :: energy => mpp_energy
         procedure :: quad_rhs => mpp_quad_rhs
+        procedure :: rhs_quad => mpp_rhs_quad
         procedure :: model_name => mpp_model_name
         procedure :: initial_state => mpp_initial_state
         procedure :: fields => mpp_fields
@@ -357,6 +360,19 @@ module ropedyn_mpp
             real(wp), intent(out) :: yqdot(:)
             integer, intent(out) :: status
         end subroutine mpp_quad_rhs
+
+        !> mpp_rhs and mpp_quad_rhs in one call: the quadratures take the rods as bodies,
+        !! the tip and the factors of M the right-hand side leaves, and the pin force from
+        !! one more residual, at the accelerations it solved for (the same numbers as the
+        !! two calls, for a third of the work).
+        module subroutine mpp_rhs_quad(self, t, y, ydot, yqdot, status)
+            class(mpp_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(out) :: ydot(:)
+            real(wp), intent(out) :: yqdot(:)
+            integer, intent(out) :: status
+        end subroutine mpp_rhs_quad
     end interface
 
 contains

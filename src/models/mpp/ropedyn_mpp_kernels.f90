@@ -100,6 +100,8 @@ contains
             pnd(2) = pnd(2) + lk*phd*c + ud*s
         end do
         if (effects) call set_axes(self%bodies)
+        self%tip = pn
+        self%tipd = pnd
         self%mom = 0.0_wp
 
         ! Point masses at P = C_i + r e_i: their applied-minus-inertial force joins w_i,
