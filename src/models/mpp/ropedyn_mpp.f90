@@ -171,6 +171,15 @@ module ropedyn_mpp
             real(wp), intent(out), optional :: pin(2)
         end subroutine residual_core
 
+        !> The force of the top joint on the rope (N) at the accelerations qacc, the last
+        !! residual_core having been at y with zero accelerations (O(n), no effect again).
+        module pure function pin_force(self, y, qacc) result(pin)
+            class(mpp_t), intent(in) :: self
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(in) :: qacc(:)
+            real(wp) :: pin(2)
+        end function pin_force
+
         !> cos and sin of every angle of y into self%cs, once per call.
         module subroutine angles(self, y)
             class(mpp_t), intent(inout) :: self
@@ -362,9 +371,9 @@ module ropedyn_mpp
         end subroutine mpp_quad_rhs
 
         !> mpp_rhs and mpp_quad_rhs in one call: the quadratures take the rods as bodies,
-        !! the tip and the factors of M the right-hand side leaves, and the pin force from
-        !! one more residual, at the accelerations it solved for (the same numbers as the
-        !! two calls, for a third of the work).
+        !! the tip, the residual at zero accelerations and the factors of M the right-hand
+        !! side leaves, and the pin force at the accelerations it solved for (pin_force; the
+        !! same numbers as the two calls).
         module subroutine mpp_rhs_quad(self, t, y, ydot, yqdot, status)
             class(mpp_t), intent(inout) :: self
             real(wp), intent(in) :: t

@@ -68,12 +68,12 @@ contains
             call self%residual_core(t, y, a, r)
         end if
         if (self%moving(1)) then
-            ! the pin force needs the accelerations: a = M^{-1} f, then r(q, q', a) gives it
+            ! the pin force needs the accelerations a = M^{-1} f (pin_force)
             call self%mass_factor(y, status)
             if (status == STATUS_OK) then
                 a = r
                 call mass_solve(self, a)
-                call self%residual_core(t, y, a, r, pin)
+                pin = pin_force(self, y, a)
             end if
         end if
         if (status == STATUS_OK) then
@@ -84,15 +84,15 @@ contains
     end procedure mpp_quad_rhs
 
     module procedure mpp_rhs_quad
-        real(wp) :: r(self%ndof), pin(2)
+        real(wp) :: pin(2)
         integer :: nd
         nd = self%ndof
         call mpp_rhs(self, t, y, ydot, status)
         if (status /= STATUS_OK) return
-        ! mpp_rhs left the rods as bodies, the tip and the factors; the pin force from the
-        ! residual at the accelerations it solved for, as mpp_quad_rhs forms it
+        ! mpp_rhs left the rods as bodies, the tip, the residual at zero accelerations and
+        ! the factors; the pin force at the accelerations it solved for
         pin = 0.0_wp
-        if (self%moving(1)) call self%residual_core(t, y, ydot(nd + 1:2*nd), r, pin)
+        if (self%moving(1)) pin = pin_force(self, y, ydot(nd + 1:2*nd))
         call quad_rates(self, t, y, pin, yqdot, status)
     end procedure mpp_rhs_quad
 

@@ -172,6 +172,48 @@ contains
         end if
     end procedure residual_core
 
+    !> The residual's pin force is -(F_b + sum_i w_i) and only the inertial part of w_i
+    !! depends on the accelerations: w_i(a) = w_i(0) - (m I + A_i) dC_i, the point masses'
+    !! forces -m_p (dC_i + r_p phi_i'' n_i), where dC_i = C_i''(a) - C_i''(0) is the part
+    !! of the centre's acceleration linear in a (prefix sums from the top joint, whose own
+    !! acceleration is in both): dC_i = dP_{i-1} + eta_i phi_i'' n_i + u_i'' e_i,
+    !! dP_i = dP_{i-1} + lambda_i phi_i'' n_i + u_i'' e_i. So the pin force at a is the one
+    !! at zero accelerations (-self%wsum(:, 1) of the last residual, the effects' forces
+    !! in it) plus sum_i (m I + A_i) dC_i and the point masses' m_p dP_p (A_i: self%wblk).
+    module procedure pin_force
+        real(wp) :: dp(2), dc(2, self%n), c, s, u, udd, hk, lk
+        integer :: k, n, i
+        n = self%n
+        u = 0.0_wp
+        udd = 0.0_wp
+        dp = 0.0_wp
+        do k = 1, n
+            c = self%cs(1, k)
+            s = self%cs(2, k)
+            if (self%nu > 0) then
+                u = y(n + k)
+                udd = qacc(n + k)
+            end if
+            hk = u + 0.5_wp*self%l
+            lk = u + self%l
+            dc(1, k) = dp(1) - hk*qacc(k)*s + udd*c
+            dc(2, k) = dp(2) + hk*qacc(k)*c + udd*s
+            dp(1) = dp(1) - lk*qacc(k)*s + udd*c
+            dp(2) = dp(2) + lk*qacc(k)*c + udd*s
+        end do
+        pin = -self%wsum(:, 1) + self%m*sum(dc, dim=2)
+        if (self%water) then
+            do k = 1, n
+                pin = pin + matmul(self%wblk(1:2, 1:2, k), dc(:, k))
+            end do
+        end if
+        do k = 1, size(self%pm_body)
+            i = self%pm_body(k)
+            pin = pin + self%pm_m(k)*(dc(:, i) + self%pm_r(k)*qacc(i)* &
+                                      [-self%cs(2, i), self%cs(1, i)])
+        end do
+    end procedure pin_force
+
     !> The rods as bodies (centre, angle, their rates, length l) for the effects.
     module procedure rod_bodies
         real(wp), dimension(self%n) :: phi, u, phid, ud
