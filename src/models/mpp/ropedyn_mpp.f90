@@ -474,7 +474,8 @@ contains
         if (size(model%effects) > 0 .or. model%water) then
             model%bodies%n = model%n
             allocate (model%bodies%c(2, model%n), model%bodies%v(2, model%n), &
-                      model%bodies%phi(model%n), model%bodies%w(model%n))
+                      model%bodies%phi(model%n), model%bodies%w(model%n), &
+                      model%bodies%cs(2, model%n))
             model%bodies%l = [(model%l, k = 1, model%n)]
         end if
         model%motion(1)%p0 = model%top_anchor
