@@ -38,7 +38,7 @@ module ropedyn_mpp
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_effect, only: effect_box_t, bodies_t, add_forces_of, add_jacobians_of, &
-                              add_energies_of, add_powers_of, set_axes
+                              add_energies_of, add_forces_powers_of, set_axes
     use ropedyn_effect_factory, only: build_body_effects, attached_masses, water_added_mass
     use ropedyn_added_mass, only: added_mass_t
     use ropedyn_support_motion, only: motion_state_t
@@ -162,14 +162,28 @@ module ropedyn_mpp
 
         !> The residual with self%cs holding cos and sin of the angles of y (mpp_residual
         !! without that step; the Jacobian's difference quotients update one angle at a time).
-        module subroutine residual_core(self, t, y, qacc, r, pin)
+        !! With `powers`, the effects' dissipation and work rates (W) are added to it, from
+        !! the same pass as their forces.
+        module subroutine residual_core(self, t, y, qacc, r, pin, powers)
             class(mpp_t), intent(inout) :: self
             real(wp), intent(in) :: t
             real(wp), intent(in) :: y(:)
             real(wp), intent(in) :: qacc(:)
             real(wp), intent(out) :: r(:)
             real(wp), intent(out), optional :: pin(2)
+            real(wp), intent(inout), optional :: powers(2)
         end subroutine residual_core
+
+        !> mpp_rhs; with `powers`, the effects' dissipation and work rates (W) at (t, y) are
+        !! added to it (residual_core).
+        module subroutine rhs_powers(self, t, y, ydot, status, powers)
+            class(mpp_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(out) :: ydot(:)
+            integer, intent(out) :: status
+            real(wp), intent(inout), optional :: powers(2)
+        end subroutine rhs_powers
 
         !> The force of the top joint on the rope (N) at the accelerations qacc, the last
         !! residual_core having been at y with zero accelerations (O(n), no effect again).

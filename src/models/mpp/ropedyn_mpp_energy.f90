@@ -55,17 +55,19 @@ contains
     end procedure mpp_energy
 
     module procedure mpp_quad_rhs
-        real(wp) :: a(self%ndof), r(self%ndof), pin(2)
+        real(wp) :: a(self%ndof), r(self%ndof), pin(2), powers(2)
         type(motion_state_t) :: top, bottom
         logical :: bottom_on
         call self%supports_at(t, top, bottom, bottom_on)
         status = STATUS_OK
         pin = 0.0_wp
-        ! the residual at zero accelerations places the rods as bodies and the tip
+        powers = 0.0_wp
+        ! the residual at zero accelerations places the rods as bodies and the tip, and
+        ! gives the effects' powers
         if (size(self%effects) > 0 .or. self%moving(1) .or. bottom_on) then
             call angles(self, y)
             a = 0.0_wp
-            call self%residual_core(t, y, a, r)
+            call self%residual_core(t, y, a, r, powers=powers)
         end if
         if (self%moving(1)) then
             ! the pin force needs the accelerations a = M^{-1} f (pin_force)
@@ -77,34 +79,35 @@ contains
             end if
         end if
         if (status == STATUS_OK) then
-            call quad_rates(self, t, y, pin, yqdot, status)
+            call quad_rates(self, t, y, pin, powers, yqdot, status)
         else
-            call quad_rates(self, t, y, pin, yqdot)
+            call quad_rates(self, t, y, pin, powers, yqdot)
         end if
     end procedure mpp_quad_rhs
 
     module procedure mpp_rhs_quad
-        real(wp) :: pin(2)
+        real(wp) :: pin(2), powers(2)
         integer :: nd
         nd = self%ndof
-        call mpp_rhs(self, t, y, ydot, status)
+        powers = 0.0_wp
+        call rhs_powers(self, t, y, ydot, status, powers)
         if (status /= STATUS_OK) return
-        ! mpp_rhs left the rods as bodies, the tip, the residual at zero accelerations and
-        ! the factors; the pin force at the accelerations it solved for
+        ! the right-hand side left the tip, the residual at zero accelerations and the
+        ! factors; the pin force at the accelerations it solved for
         pin = 0.0_wp
         if (self%moving(1)) pin = pin_force(self, y, ydot(nd + 1:2*nd))
-        call quad_rates(self, t, y, pin, yqdot, status)
+        call quad_rates(self, t, y, pin, powers, yqdot, status)
     end procedure mpp_rhs_quad
 
-    !> The quadratures' rates at (t, y), the last residual_core having been at y (the rods
-    !! as bodies, the tip P_n and its velocity) and pin the top joint's force on the rope
-    !! (used when the top joint moves). status (if present) is STATUS_RECOVERABLE when a
-    !! rate is not finite.
-    subroutine quad_rates(self, t, y, pin, yqdot, status)
+    !> The quadratures' rates at (t, y), the last residual_core having been at y (the tip
+    !! P_n and its velocity), with pin the top joint's force on the rope (used when the top
+    !! joint moves) and powers the effects' dissipation and work rates. status (if
+    !! present) is STATUS_RECOVERABLE when a rate is not finite.
+    subroutine quad_rates(self, t, y, pin, powers, yqdot, status)
         class(mpp_t), intent(inout) :: self
         real(wp), intent(in) :: t
         real(wp), intent(in) :: y(:)
-        real(wp), intent(in) :: pin(2)
+        real(wp), intent(in) :: pin(2), powers(2)
         real(wp), intent(out) :: yqdot(:)
         integer, intent(out), optional :: status
         real(wp) :: power, work, rel(2)
@@ -137,7 +140,8 @@ contains
                                                   *bottom%rate
             end if
         end if
-        if (size(self%effects) > 0) call add_powers_of(self%effects, t, self%bodies, power, work)
+        power = power + powers(1)
+        work = work + powers(2)
         if (self%moving(1)) work = work + dot_product(pin, top%v)
         yqdot(1) = power
         if (self%with_work) yqdot(2) = work

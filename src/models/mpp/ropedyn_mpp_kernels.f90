@@ -120,8 +120,15 @@ contains
         ! The water's added mass on the rods as bodies.
         if (self%water) call water_forces(self, qacc)
 
-        ! External effects on the rods as bodies.
-        if (effects) call add_forces_of(self%effects, t, self%bodies, self%w, self%mom)
+        ! External effects on the rods as bodies (and their powers).
+        if (effects) then
+            if (present(powers)) then
+                call add_forces_powers_of(self%effects, t, self%bodies, self%w, self%mom, &
+                                          powers(1), powers(2))
+            else
+                call add_forces_of(self%effects, t, self%bodies, self%w, self%mom)
+            end if
+        end if
 
         ! Force of the bottom support on the tip P_n.
         fb = 0.0_wp
@@ -475,31 +482,36 @@ contains
     end subroutine assemble_mass_work
 
     !> F of the implicit form M(q) y' = F: (q', r(t, q, q', 0)), the residual at zero
-    !! accelerations (self%cs set to the angles of y on the way).
-    subroutine implicit_form_rhs(self, t, y, f)
+    !! accelerations (self%cs set to the angles of y on the way; `powers` as residual_core).
+    subroutine implicit_form_rhs(self, t, y, f, powers)
         class(mpp_t), intent(inout) :: self
         real(wp), intent(in) :: t
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: f(:)
+        real(wp), intent(inout), optional :: powers(2)
         real(wp) :: zero(self%ndof)
         integer :: nd
         nd = self%ndof
         zero = 0.0_wp
         f(1:nd) = y(nd + 1:2*nd)
         call angles(self, y)
-        call self%residual_core(t, y, zero, f(nd + 1:2*nd))
+        call self%residual_core(t, y, zero, f(nd + 1:2*nd), powers=powers)
     end subroutine implicit_form_rhs
 
     module procedure mpp_rhs
+        call rhs_powers(self, t, y, ydot, status)
+    end procedure mpp_rhs
+
+    module procedure rhs_powers
         integer :: nd
         nd = self%ndof
-        call implicit_form_rhs(self, t, y, ydot)
+        call implicit_form_rhs(self, t, y, ydot, powers)
         call self%mass_factor(y, status)
         if (status /= STATUS_OK) return
         call mass_solve(self, ydot(nd + 1:2*nd))
         status = STATUS_OK
         if (.not. all(ieee_is_finite(ydot(nd + 1:2*nd)))) status = STATUS_RECOVERABLE
-    end procedure mpp_rhs
+    end procedure rhs_powers
 
     module procedure mpp_implicit_rhs
         call implicit_form_rhs(self, t, y, f)
