@@ -38,7 +38,7 @@ module ropedyn_mpp
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_effect, only: effect_box_t, bodies_t, add_forces_of, add_jacobians_of, &
-                              add_energies_of, add_powers_of, set_axes
+                              add_energies_of, add_forces_powers_of, set_axes
     use ropedyn_effect_factory, only: build_body_effects, attached_masses, water_added_mass
     use ropedyn_added_mass, only: added_mass_t
     use ropedyn_support_motion, only: motion_state_t
@@ -92,6 +92,8 @@ module ropedyn_mpp
         !> the moments of the joints' and the clamps' rotational springs and dampers (0:n),
         !! joint k between members k and k+1 (0, n: the supports), docs/theory/internal-forces.md
         real(wp), allocatable :: jmom(:)
+        !> the lower end P_n and its velocity at the last residual_core, m and m/s
+        real(wp) :: tip(2) = 0.0_wp, tipd(2) = 0.0_wp
         type(bodies_t) :: bodies              !< the rods as bodies for the effects
         real(wp), allocatable :: ejac(:, :, :)  !< the effects' (and the water's) blocks (3, 6, n)
         !> in water: the rods' added-mass blocks (3x3 on centre and angle) at the state of the
@@ -115,6 +117,7 @@ module ropedyn_mpp
         procedure :: implicit_rhs => mpp_implicit_rhs
         procedure :: energy => mpp_energy
         procedure :: quad_rhs => mpp_quad_rhs
+        procedure :: rhs_quad => mpp_rhs_quad
         procedure :: model_name => mpp_model_name
         procedure :: initial_state => mpp_initial_state
         procedure :: fields => mpp_fields
@@ -159,14 +162,37 @@ module ropedyn_mpp
 
         !> The residual with self%cs holding cos and sin of the angles of y (mpp_residual
         !! without that step; the Jacobian's difference quotients update one angle at a time).
-        module subroutine residual_core(self, t, y, qacc, r, pin)
+        !! With `powers`, the effects' dissipation and work rates (W) are added to it, from
+        !! the same pass as their forces.
+        module subroutine residual_core(self, t, y, qacc, r, pin, powers)
             class(mpp_t), intent(inout) :: self
             real(wp), intent(in) :: t
             real(wp), intent(in) :: y(:)
             real(wp), intent(in) :: qacc(:)
             real(wp), intent(out) :: r(:)
             real(wp), intent(out), optional :: pin(2)
+            real(wp), intent(inout), optional :: powers(2)
         end subroutine residual_core
+
+        !> mpp_rhs; with `powers`, the effects' dissipation and work rates (W) at (t, y) are
+        !! added to it (residual_core).
+        module subroutine rhs_powers(self, t, y, ydot, status, powers)
+            class(mpp_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(out) :: ydot(:)
+            integer, intent(out) :: status
+            real(wp), intent(inout), optional :: powers(2)
+        end subroutine rhs_powers
+
+        !> The force of the top joint on the rope (N) at the accelerations qacc, the last
+        !! residual_core having been at y with zero accelerations (O(n), no effect again).
+        module pure function pin_force(self, y, qacc) result(pin)
+            class(mpp_t), intent(in) :: self
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(in) :: qacc(:)
+            real(wp) :: pin(2)
+        end function pin_force
 
         !> cos and sin of every angle of y into self%cs, once per call.
         module subroutine angles(self, y)
@@ -357,6 +383,19 @@ module ropedyn_mpp
             real(wp), intent(out) :: yqdot(:)
             integer, intent(out) :: status
         end subroutine mpp_quad_rhs
+
+        !> mpp_rhs and mpp_quad_rhs in one call: the quadratures take the rods as bodies,
+        !! the tip, the residual at zero accelerations and the factors of M the right-hand
+        !! side leaves, and the pin force at the accelerations it solved for (pin_force; the
+        !! same numbers as the two calls).
+        module subroutine mpp_rhs_quad(self, t, y, ydot, yqdot, status)
+            class(mpp_t), intent(inout) :: self
+            real(wp), intent(in) :: t
+            real(wp), intent(in) :: y(:)
+            real(wp), intent(out) :: ydot(:)
+            real(wp), intent(out) :: yqdot(:)
+            integer, intent(out) :: status
+        end subroutine mpp_rhs_quad
     end interface
 
 contains
@@ -449,7 +488,8 @@ contains
         if (size(model%effects) > 0 .or. model%water) then
             model%bodies%n = model%n
             allocate (model%bodies%c(2, model%n), model%bodies%v(2, model%n), &
-                      model%bodies%phi(model%n), model%bodies%w(model%n))
+                      model%bodies%phi(model%n), model%bodies%w(model%n), &
+                      model%bodies%cs(2, model%n))
             model%bodies%l = [(model%l, k = 1, model%n)]
         end if
         model%motion(1)%p0 = model%top_anchor

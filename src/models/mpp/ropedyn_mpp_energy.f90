@@ -55,8 +55,62 @@ contains
     end procedure mpp_energy
 
     module procedure mpp_quad_rhs
-        real(wp) :: p(2, 0:self%n), c(2, self%n), pd(2, 0:self%n), cd(2, self%n)
-        real(wp) :: power, work, rel(2), pin(2), a(self%ndof), r(self%ndof)
+        real(wp) :: a(self%ndof), r(self%ndof), pin(2), powers(2)
+        type(motion_state_t) :: top, bottom
+        logical :: bottom_on
+        call self%supports_at(t, top, bottom, bottom_on)
+        status = STATUS_OK
+        pin = 0.0_wp
+        powers = 0.0_wp
+        ! the residual at zero accelerations places the rods as bodies and the tip, and
+        ! gives the effects' powers
+        if (size(self%effects) > 0 .or. self%moving(1) .or. bottom_on) then
+            call angles(self, y)
+            a = 0.0_wp
+            call self%residual_core(t, y, a, r, powers=powers)
+        end if
+        if (self%moving(1)) then
+            ! the pin force needs the accelerations a = M^{-1} f (pin_force)
+            call self%mass_factor(y, status)
+            if (status == STATUS_OK) then
+                a = r
+                call mass_solve(self, a)
+                pin = pin_force(self, y, a)
+            end if
+        end if
+        if (status == STATUS_OK) then
+            call quad_rates(self, t, y, pin, powers, yqdot, status)
+        else
+            call quad_rates(self, t, y, pin, powers, yqdot)
+        end if
+    end procedure mpp_quad_rhs
+
+    module procedure mpp_rhs_quad
+        real(wp) :: pin(2), powers(2)
+        integer :: nd
+        nd = self%ndof
+        powers = 0.0_wp
+        call rhs_powers(self, t, y, ydot, status, powers)
+        if (status /= STATUS_OK) return
+        ! the right-hand side left the tip, the residual at zero accelerations and the
+        ! factors; the pin force at the accelerations it solved for
+        pin = 0.0_wp
+        if (self%moving(1)) pin = pin_force(self, y, ydot(nd + 1:2*nd))
+        call quad_rates(self, t, y, pin, powers, yqdot, status)
+    end procedure mpp_rhs_quad
+
+    !> The quadratures' rates at (t, y), the last residual_core having been at y (the tip
+    !! P_n and its velocity), with pin the top joint's force on the rope (used when the top
+    !! joint moves) and powers the effects' dissipation and work rates. status (if
+    !! present) is STATUS_RECOVERABLE when a rate is not finite.
+    subroutine quad_rates(self, t, y, pin, powers, yqdot, status)
+        class(mpp_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(in) :: pin(2), powers(2)
+        real(wp), intent(out) :: yqdot(:)
+        integer, intent(out), optional :: status
+        real(wp) :: power, work, rel(2)
         type(motion_state_t) :: top, bottom
         logical :: bottom_on
         integer :: k, n, nd
@@ -75,10 +129,9 @@ contains
                                                  + self%d_rot*(y(nd + 1) - top%rate))*top%rate
         end if
         if (bottom_on) then
-            call self%positions(y, p, c, pd, cd, t)
-            rel = pd(:, n) - bottom%v
+            rel = self%tipd - bottom%v
             power = power + self%d_sup*sum(rel**2)
-            if (self%moving(2)) work = work + dot_product(-self%k_sup*(p(:, n) - bottom%p) &
+            if (self%moving(2)) work = work + dot_product(-self%k_sup*(self%tip - bottom%p) &
                                                           - self%d_sup*rel, bottom%v)
             if (self%bottom == 2) then
                 power = power + self%d_rot*(y(nd + n) - bottom%rate)**2
@@ -87,28 +140,15 @@ contains
                                                   *bottom%rate
             end if
         end if
-        if (size(self%effects) > 0 .or. self%moving(1)) call angles(self, y)
-        if (size(self%effects) > 0) then
-            ! the residual at zero accelerations fills the rods as bodies
-            a = 0.0_wp
-            call self%residual_core(t, y, a, r)
-            call add_powers_of(self%effects, t, self%bodies, power, work)
-        end if
-        status = STATUS_OK
-        if (self%moving(1)) then
-            ! the pin force needs the accelerations: a = M^{-1} f, then r(q, q', a) gives it
-            a = 0.0_wp
-            call self%residual_core(t, y, a, r)
-            call self%mass_factor(y, status)
-            if (status == STATUS_OK) then
-                a = r
-                call mass_solve(self, a)
-                call self%residual_core(t, y, a, r, pin)
-                work = work + dot_product(pin, top%v)
-            end if
-        end if
+        power = power + powers(1)
+        work = work + powers(2)
+        if (self%moving(1)) work = work + dot_product(pin, top%v)
         yqdot(1) = power
         if (self%with_work) yqdot(2) = work
-        if (.not. (ieee_is_finite(power) .and. ieee_is_finite(work))) status = STATUS_RECOVERABLE
-    end procedure mpp_quad_rhs
+        if (present(status)) then
+            status = STATUS_OK
+            if (.not. (ieee_is_finite(power) .and. ieee_is_finite(work))) &
+                status = STATUS_RECOVERABLE
+        end if
+    end subroutine quad_rates
 end submodule ropedyn_mpp_energy

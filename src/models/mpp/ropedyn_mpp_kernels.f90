@@ -7,6 +7,7 @@
 !! once per call (self%cs), the rods' forces, the factors of M and the residual's
 !! derivatives. No allocation per call.
 submodule (ropedyn_mpp) ropedyn_mpp_kernels
+    use ropedyn_trig, only: cos_sin
     implicit none
 
 contains
@@ -25,13 +26,12 @@ contains
         end if
     end procedure unpack
 
-    !> cos and sin of every angle of y into self%cs, once per call.
+    !> cos and sin of every angle of y into self%cs, once per call (ropedyn_trig's
+    !! vectorized loop; libm's sincos, one call per angle, was 5 % of a run in water).
     module procedure angles
-        integer :: k
-        do k = 1, self%n
-            self%cs(1, k) = cos(y(k))
-            self%cs(2, k) = sin(y(k))
-        end do
+        real(wp) :: phi(self%n)
+        phi = y(1:self%n)
+        call cos_sin(phi, self%cs)
     end procedure angles
 
     module procedure mpp_residual
@@ -99,7 +99,9 @@ contains
             pnd(1) = pnd(1) - lk*phd*s + ud*c
             pnd(2) = pnd(2) + lk*phd*c + ud*s
         end do
-        if (effects) call set_axes(self%bodies)
+        if (effects) self%bodies%cs = self%cs    ! the angles' of y (angles)
+        self%tip = pn
+        self%tipd = pnd
         self%mom = 0.0_wp
 
         ! Point masses at P = C_i + r e_i: their applied-minus-inertial force joins w_i,
@@ -118,8 +120,15 @@ contains
         ! The water's added mass on the rods as bodies.
         if (self%water) call water_forces(self, qacc)
 
-        ! External effects on the rods as bodies.
-        if (effects) call add_forces_of(self%effects, t, self%bodies, self%w, self%mom)
+        ! External effects on the rods as bodies (and their powers).
+        if (effects) then
+            if (present(powers)) then
+                call add_forces_powers_of(self%effects, t, self%bodies, self%w, self%mom, &
+                                          powers(1), powers(2))
+            else
+                call add_forces_of(self%effects, t, self%bodies, self%w, self%mom)
+            end if
+        end if
 
         ! Force of the bottom support on the tip P_n.
         fb = 0.0_wp
@@ -170,6 +179,48 @@ contains
         end if
     end procedure residual_core
 
+    !> The residual's pin force is -(F_b + sum_i w_i) and only the inertial part of w_i
+    !! depends on the accelerations: w_i(a) = w_i(0) - (m I + A_i) dC_i, the point masses'
+    !! forces -m_p (dC_i + r_p phi_i'' n_i), where dC_i = C_i''(a) - C_i''(0) is the part
+    !! of the centre's acceleration linear in a (prefix sums from the top joint, whose own
+    !! acceleration is in both): dC_i = dP_{i-1} + eta_i phi_i'' n_i + u_i'' e_i,
+    !! dP_i = dP_{i-1} + lambda_i phi_i'' n_i + u_i'' e_i. So the pin force at a is the one
+    !! at zero accelerations (-self%wsum(:, 1) of the last residual, the effects' forces
+    !! in it) plus sum_i (m I + A_i) dC_i and the point masses' m_p dP_p (A_i: self%wblk).
+    module procedure pin_force
+        real(wp) :: dp(2), dc(2, self%n), c, s, u, udd, hk, lk
+        integer :: k, n, i
+        n = self%n
+        u = 0.0_wp
+        udd = 0.0_wp
+        dp = 0.0_wp
+        do k = 1, n
+            c = self%cs(1, k)
+            s = self%cs(2, k)
+            if (self%nu > 0) then
+                u = y(n + k)
+                udd = qacc(n + k)
+            end if
+            hk = u + 0.5_wp*self%l
+            lk = u + self%l
+            dc(1, k) = dp(1) - hk*qacc(k)*s + udd*c
+            dc(2, k) = dp(2) + hk*qacc(k)*c + udd*s
+            dp(1) = dp(1) - lk*qacc(k)*s + udd*c
+            dp(2) = dp(2) + lk*qacc(k)*c + udd*s
+        end do
+        pin = -self%wsum(:, 1) + self%m*sum(dc, dim=2)
+        if (self%water) then
+            do k = 1, n
+                pin = pin + matmul(self%wblk(1:2, 1:2, k), dc(:, k))
+            end do
+        end if
+        do k = 1, size(self%pm_body)
+            i = self%pm_body(k)
+            pin = pin + self%pm_m(k)*(dc(:, i) + self%pm_r(k)*qacc(i)* &
+                                      [-self%cs(2, i), self%cs(1, i)])
+        end do
+    end procedure pin_force
+
     !> The rods as bodies (centre, angle, their rates, length l) for the effects.
     module procedure rod_bodies
         real(wp), dimension(self%n) :: phi, u, phid, ud
@@ -181,17 +232,17 @@ contains
         b%phi = phi
         b%w = phid
         b%l = self%l
+        call set_axes(b)
         p = top%p
         pd = top%v
         do k = 1, self%n
-            e = [cos(phi(k)), sin(phi(k))]
+            e = b%cs(:, k)
             nv = [-e(2), e(1)]
             b%c(:, k) = p + (u(k) + 0.5_wp*self%l)*e
             b%v(:, k) = pd + (u(k) + 0.5_wp*self%l)*phid(k)*nv + ud(k)*e
             p = p + (self%l + u(k))*e
             pd = pd + (self%l + u(k))*phid(k)*nv + ud(k)*e
         end do
-        call set_axes(b)
     end procedure rod_bodies
 
     !> The articulated-body recursion, from the tip (docs/theory/mpp.md, "Solving
@@ -402,12 +453,9 @@ contains
     end subroutine assemble_mass
 
     module procedure mpp_mass_dense
-        real(wp) :: cs(2, self%n), u(self%n), tt
-        integer :: k
-        do k = 1, self%n
-            cs(1, k) = cos(y(k))
-            cs(2, k) = sin(y(k))
-        end do
+        real(wp) :: cs(2, self%n), phi(self%n), u(self%n), tt
+        phi = y(1:self%n)
+        call cos_sin(phi, cs)    ! as angles: the same M(q) as the solve's and the blocks'
         u = 0.0_wp
         if (self%nu > 0) u = y(self%n + 1:self%ndof)
         call assemble_mass(self%n, self%nu, self%m, self%inertia, self%l, cs, u, &
@@ -434,31 +482,36 @@ contains
     end subroutine assemble_mass_work
 
     !> F of the implicit form M(q) y' = F: (q', r(t, q, q', 0)), the residual at zero
-    !! accelerations (self%cs set to the angles of y on the way).
-    subroutine implicit_form_rhs(self, t, y, f)
+    !! accelerations (self%cs set to the angles of y on the way; `powers` as residual_core).
+    subroutine implicit_form_rhs(self, t, y, f, powers)
         class(mpp_t), intent(inout) :: self
         real(wp), intent(in) :: t
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: f(:)
+        real(wp), intent(inout), optional :: powers(2)
         real(wp) :: zero(self%ndof)
         integer :: nd
         nd = self%ndof
         zero = 0.0_wp
         f(1:nd) = y(nd + 1:2*nd)
         call angles(self, y)
-        call self%residual_core(t, y, zero, f(nd + 1:2*nd))
+        call self%residual_core(t, y, zero, f(nd + 1:2*nd), powers=powers)
     end subroutine implicit_form_rhs
 
     module procedure mpp_rhs
+        call rhs_powers(self, t, y, ydot, status)
+    end procedure mpp_rhs
+
+    module procedure rhs_powers
         integer :: nd
         nd = self%ndof
-        call implicit_form_rhs(self, t, y, ydot)
+        call implicit_form_rhs(self, t, y, ydot, powers)
         call self%mass_factor(y, status)
         if (status /= STATUS_OK) return
         call mass_solve(self, ydot(nd + 1:2*nd))
         status = STATUS_OK
         if (.not. all(ieee_is_finite(ydot(nd + 1:2*nd)))) status = STATUS_RECOVERABLE
-    end procedure mpp_rhs
+    end procedure rhs_powers
 
     module procedure mpp_implicit_rhs
         call implicit_form_rhs(self, t, y, f)

@@ -17,16 +17,21 @@ submodule (ropedyn_mpp) ropedyn_mpp_water
 
 contains
 
+    !> blk's translational and rotational parts are uncoupled (added_terms_e leaves
+    !! blk(1:2, 3) and blk(3, 1:2) zero): g - blk acc is written with the 2x2 and the
+    !! scalar, without the temporaries of a matmul of an array constructor.
     module procedure water_forces
         real(wp) :: g(3)
         integer :: k
         do k = 1, self%n
             call self%added%terms_e(self%bodies%c(:, k), self%cs(:, k), &
-                                  self%bodies%v(:, k), self%bodies%w(k), self%l, &
-                                  self%wblk(:, :, k), g)
-            g = g - matmul(self%wblk(:, :, k), [self%cacc(:, k), qacc(k)])
-            self%w(:, k) = self%w(:, k) + g(1:2)
-            self%mom(k) = self%mom(k) + g(3)
+                                    self%bodies%v(:, k), self%bodies%w(k), self%l, &
+                                    self%wblk(:, :, k), g)
+            associate (blk => self%wblk(:, :, k), a => self%cacc(:, k))
+                self%w(1, k) = self%w(1, k) + (g(1) - (blk(1, 1)*a(1) + blk(1, 2)*a(2)))
+                self%w(2, k) = self%w(2, k) + (g(2) - (blk(2, 1)*a(1) + blk(2, 2)*a(2)))
+                self%mom(k) = self%mom(k) + (g(3) - blk(3, 3)*qacc(k))
+            end associate
         end do
     end procedure water_forces
 
