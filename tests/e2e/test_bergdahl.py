@@ -37,6 +37,15 @@ def test_scores_of_a_known_error():
     assert s["corr"] < 1.0
 
 
+def test_sampling_error_of_a_convergence_change():
+    """Two runs of 5 analysed cycles each: the standard errors of their means (spread over
+    sqrt(5)) combine in quadrature, over the reference's mean."""
+    row = dict(mean=50.5, spread=0.4, maxima=np.zeros(5))
+    ref = dict(mean=50.0, spread=0.3, maxima=np.zeros(5))
+    expected = 100 * math.sqrt(0.3**2 / 5 + 0.4**2 / 5) / 50.0     # 0.447 %
+    assert math.isclose(bg.change_error(row, ref), expected)
+
+
 def test_one_short_condition_end_to_end(ropedyn_exe, tmp_path):
     """T = 1.25 s, R = 0.2 m, 20 elements, 2 cycles (one of them the ramp), both models:
     the runs complete, the analysis finds a cycle maximum of each and the page gets its

@@ -415,18 +415,29 @@ def cost_lines(results, models, periods, walls):
     return lines
 
 
+def change_error(row, ref):
+    """The sampling error of a convergence row's change against ref, %: the standard errors
+    of the two means of cycle maxima (spread / sqrt(cycles)) combined, over ref's mean. The
+    cycle maxima of an irregular condition vary from cycle to cycle, and a change smaller
+    than this is not resolved by the runs."""
+    se2 = sum(r["spread"] ** 2 / len(r["maxima"]) for r in (row, ref))
+    return 100 * math.sqrt(se2) / ref["mean"]
+
+
 def convergence_lines(rows):
     if not rows:
         return []
     lines = [f"| model | T (s) | elements | rtol (atol = {base_atol() / base_rtol():g} rtol) "
-             f"| mean cycle max (N) | change from "
-             f"{base_elements()}, {base_rtol():g} | CPU (s) |",
-             "|---|---|---|---|---|---|---|"]
+             f"| mean cycle max (N) | spread (N) | change from "
+             f"{base_elements()}, {base_rtol():g} | its sampling error | CPU (s) |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for row in rows:
         ref = next(r for r in rows if r["model"] == row["model"] and
                    r["period"] == row["period"] and is_base(r))
+        err = "" if is_base(row) else f"± {change_error(row, ref):.2f} %"
         lines.append(f"| {row['model'].upper()} | {row['period']} | {row['n']} | {row['rtol']:g} | "
-                     f"{row['mean']:.3f} | {100 * (row['mean'] / ref['mean'] - 1):+.2f} % | "
+                     f"{row['mean']:.3f} | {row['spread']:.2f} | "
+                     f"{100 * (row['mean'] / ref['mean'] - 1):+.2f} % | {err} | "
                      f"{row['cpu_time']:.1f} |")
     return lines
 
@@ -531,16 +542,17 @@ def target_lines(results, models, periods, walls, conv, work):
         rows = [r for r in conv if r["model"] == model]
         if not rows:
             continue
-        worst = 0.0
+        worst, worst_err = 0.0, 0.0
         for r in rows:
             if is_base(r):
                 continue
             ref = next(x for x in rows if x["period"] == r["period"] and is_base(x))
-            if r["n"] >= base_elements():    # the halvings, not the coarser run
-                worst = max(worst, abs(r["mean"] / ref["mean"] - 1))
+            if r["n"] >= base_elements() and abs(r["mean"] / ref["mean"] - 1) > worst:
+                # the halvings, not the coarser run
+                worst, worst_err = abs(r["mean"] / ref["mean"] - 1), change_error(r, ref)
         lines.append(f"| {name(model)}: halving the element length or the tolerances changes the mean "
-                     f"cycle maximum by <= 0.5 % | {100 * worst:.2f} % | "
-                     f"{'yes' if worst <= 0.005 else 'no'} |")
+                     f"cycle maximum by <= 0.5 % | {100 * worst:.2f} % (sampling error "
+                     f"± {worst_err:.2f} %) | {'yes' if worst <= 0.005 else 'no'} |")
     for model in models:
         if model in walls and sum(1 for k in results if k[0] == model) == 30:
             w = walls[model]
