@@ -218,7 +218,8 @@ def main(argv=None):
              f"tools/ropedyn_tools/studies/bench_peers_bergdahl.py). MoorDyn-C 2.7.2 (PyPI "
              f"`moordyn`, .venv-bench): RK4 at dtM = {args.dt:g} s, {args.segments} segments, "
              f"its static start; CPU per case includes it. ropedyn: the case files of "
-             f"`scripts/validation bergdahl`, CPU of the integration (/solver/cpu_time). "
+             f"`scripts/validation bergdahl`, CPU of the integration (/solver/cpu_time) and, in the "
+             f"totals, of the static start. "
              f"Machine: {machine()}. Run: {run_stamp()}; MoorDyn's CPU is that of its own runs "
              f"(one after the other, on the shared cores; a kept result keeps its CPU; this "
              f"command took {wall:.0f} s).", ""]
@@ -234,9 +235,13 @@ def main(argv=None):
                   f"start), {np.sum(cpu):.0f} s in all.", ""]
         for model in bg.MODELS:
             ro = [ours[model, p, rad] for (p, rad), _ in ok if (model, p, rad) in ours]
-            if len(ro) == len(ok):
-                oc = sum(o["cpu_time"] for o in ro)
-                lines.append(f"- ropedyn {model.upper()} on the same cases: CPU {oc:.0f} s; "
+            start = bg.static_start_cpu(work, model)
+            if len(ro) == len(ok) and start is not None:
+                # MoorDyn's CPU includes its static start: ropedyn's with its own, which is
+                # the same for every condition (scripts/validation bergdahl measures it)
+                oc = sum(o["cpu_time"] for o in ro) + len(ro) * start
+                lines.append(f"- ropedyn {model.upper()} on the same cases: CPU {oc:.0f} s "
+                             f"({start:.2f} s of it per case the static start); "
                              f"MoorDyn / ropedyn = {np.sum(cpu) / oc:.2f}.")
         lines.append("")
     if md_per:
