@@ -112,19 +112,24 @@ EVERY_EFFECT_SET = ["solver.t_end=0.1"]
 def kept_runs(run_many, tmp_path_factory):
     workdir = tmp_path_factory.mktemp("kept")
     return run_many({"bound1": (EVERY_EFFECT, EVERY_EFFECT_SET + ["solver.energy_gain_bound=1"]),
-                     "bound10": (EVERY_EFFECT, EVERY_EFFECT_SET)}, workdir)
+                     # the gain, 1.3e-9 .. 2.3e-9 J by rounding, sits at the default bound
+                     # (10 rtol S = 1.8e-9 J): the run without the alarm takes 100
+                     "bound100": (EVERY_EFFECT, EVERY_EFFECT_SET +
+                                  ["solver.energy_gain_bound=100"])}, workdir)
 
 
 def test_integration_error_keeps_the_order(kept_runs):
     proc, path = kept_runs["bound1"]
-    ref_proc, ref_path = kept_runs["bound10"]
+    ref_proc, ref_path = kept_runs["bound100"]
     assert proc.returncode == 0, proc.stderr
     assert ref_proc.returncode == 0, ref_proc.stderr
-    assert "the order kept (once)" in proc.stdout and "did not get through" in proc.stdout, \
+    # how many times the alarm comes is rounding's business here (a gain of 1e-9 J against
+    # a bound of 1 rtol S at rtol 1e-11): once in Release, twice in Debug since 0f24a28
+    assert "the order kept (" in proc.stdout and "did not get through" in proc.stdout, \
         proc.stdout
     with h5py.File(path, "r") as f, h5py.File(ref_path, "r") as g:
         assert "order_lowered_at" not in f["solver"]
-        assert "order_kept_at" not in g["solver"]      # no alarm at the default bound
+        assert "order_kept_at" not in g["solver"]      # no alarm at 100 rtol S
         t_kept = f["solver/order_kept_at"][()]
         assert 0.0 < t_kept <= 0.1 and f["solver/order_kept_count"][()] >= 1
         assert f["solver/energy_gain"][()] > 0
