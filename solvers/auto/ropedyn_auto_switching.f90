@@ -112,7 +112,6 @@ contains
         type(solver_stats_t) :: now
         type(spectrum_t) :: spec
         real(wp) :: rate, span, h_e, predicted, share
-        real(wp) :: growth  !< of stale_after after a trial that did not pay
         logical :: dearer   !< Adams' window cost more than erk's last by GAIN
         logical :: stale    !< the implicit or accuracy method's measured cost is old
         logical :: early    !< erk's early first window (early_look)
@@ -171,13 +170,7 @@ contains
                 write (text, '(a, i0, a, es9.2, a)') 'explicit step held by accuracy (', &
                     nint(100*(1 - share)), ' % of the steps; cost ', rate, ' f per second)'
                 self%trial = self%rate_accurate <= 0.0_wp .or. stale
-                if (stale) then
-                    write (age, '(i0)') self%accurate_age
-                    text = trim(text)//': trying '//self%accurate_name()// &
-                           ' again (its cost was measured '//trim(age)//' windows ago)'
-                else if (self%trial) then
-                    text = trim(text)//': trying '//self%accurate_name()
-                end if
+                call add_trial(self%accurate_name(), stale, self%accurate_age)
                 if (self%windows <= 2) call back_off()
                 call self%start_method(self%accurate, trim(text), err)
                 return
@@ -191,13 +184,7 @@ contains
                 max(self%erk%spectral_radius(), self%radius), ' 1/s; cost ', rate, &
                 ' f per second)'
             self%trial = self%rate_implicit <= 0.0_wp .or. stale
-            if (stale) then
-                write (age, '(i0)') self%implicit_age
-                text = trim(text)//': trying '//self%implicit_name()// &
-                       ' again (its cost was measured '//trim(age)//' windows ago)'
-            else if (self%trial) then
-                text = trim(text)//': trying '//self%implicit_name()
-            end if
+            call add_trial(self%implicit_name(), stale, self%implicit_age)
             if (self%windows <= 2) call back_off()
             call self%start_method(IMPLICIT, trim(text), err)
         else if (self%active == self%accurate) then
@@ -234,10 +221,7 @@ contains
                 ! the order-5 pair is not worth a switch for less either
                 self%trial = .false.
                 if (self%rate_explicit > 0.0_wp .and. GAIN*rate > self%rate_explicit) then
-                    growth = max(2.0_wp, real(ceiling(min(rate/self%rate_explicit, &
-                                                          1.0e9_wp)), wp))
-                    self%accurate_stale_after = int(min(real(huge(0)/2, wp), &
-                                                        growth*self%accurate_stale_after))
+                    self%accurate_stale_after = grown(self%accurate_stale_after)
                     call trial_failed(self%accurate_name()//' was not cheaper by 1.3')
                     return
                 end if
@@ -279,9 +263,7 @@ contains
                 if (self%rate_explicit > 0.0_wp .and. rate > self%rate_explicit) then
                     ! the dearer the trial, the longer until the next: times the cost
                     ! ratio rounded up, at least 2 (capped below integer overflow)
-                    growth = max(2.0_wp, real(ceiling(min(rate/self%rate_explicit, &
-                                                          1.0e9_wp)), wp))
-                    self%stale_after = int(min(real(huge(0)/2, wp), growth*self%stale_after))
+                    self%stale_after = grown(self%stale_after)
                     call trial_failed(self%implicit_name()//' was not cheaper')
                     return
                 end if
@@ -307,6 +289,30 @@ contains
             end if
         end if
     contains
+        !> Add to text what the switch tries: `what` on trial, or again when its cost,
+        !! measured `windows_ago` explicit windows ago, is stale.
+        subroutine add_trial(what, is_stale, windows_ago)
+            character(len=*), intent(in) :: what
+            logical, intent(in) :: is_stale
+            integer, intent(in) :: windows_ago
+            if (is_stale) then
+                write (age, '(i0)') windows_ago
+                text = trim(text)//': trying '//what//' again (its cost was measured '// &
+                       trim(age)//' windows ago)'
+            else if (self%trial) then
+                text = trim(text)//': trying '//what
+            end if
+        end subroutine add_trial
+
+        !> A stale-cost wait after a trial that cost `rate` against erk's: times the cost
+        !! ratio rounded up, at least 2 (capped below integer overflow).
+        integer function grown(windows)
+            integer, intent(in) :: windows
+            real(wp) :: growth
+            growth = max(2.0_wp, real(ceiling(min(rate/self%rate_explicit, 1.0e9_wp)), wp))
+            grown = int(min(0.5_wp*real(huge(0), wp), growth*windows))
+        end function grown
+
         !> A switch soon after the last one: wait longer before the next.
         subroutine back_off()
             self%wait = self%backoff
