@@ -46,6 +46,24 @@ def test_sampling_error_of_a_convergence_change():
     assert math.isclose(bg.change_error(row, ref), expected)
 
 
+def test_runs_without_friction_change_against_their_own_reference():
+    """The element halving without the floor's friction is measured against the run at the
+    study's element length without it, not against the study's own run."""
+    n, rtol = bg.base_elements(), bg.base_rtol()
+
+    def row(elements, friction, mean):
+        return dict(model="rfem", period=1.25, n=elements, rtol=rtol, friction=friction,
+                    mean=mean, spread=0.0, maxima=np.zeros(5), cpu_time=1.0)
+
+    rows = [row(n, True, 50.0), row((n + 1) // 2, True, 49.0), row((n + 1) // 2, False, 51.51),
+            row(n, False, 51.0)]
+    lines = bg.convergence_lines(rows)
+    coarse = next(x for x in lines if x.startswith(f"| RFEM, no friction | 1.25 | {(n + 1) // 2} |"))
+    assert "| +1.00 % |" in coarse, coarse                # against 51.0, not 50.0 (+3.02 %)
+    assert "| -2.00 % |" in next(x for x in lines if x.startswith(f"| RFEM | 1.25 | {(n + 1) // 2} |"))
+    assert bg.is_base(rows[0]) and not bg.is_base(rows[3])
+
+
 def test_one_short_condition_end_to_end(ropedyn_exe, tmp_path):
     """T = 1.25 s, R = 0.2 m, 20 elements, 2 cycles (one of them the ramp), both models:
     the runs complete, the analysis finds a cycle maximum of each and the page gets its

@@ -137,7 +137,15 @@ def base_atol():
 
 def is_base(row):
     """Whether a convergence row is the run at the study's setting."""
-    return row["n"] == base_elements() and row["rtol"] == base_rtol()
+    return row["n"] == base_elements() and row["rtol"] == base_rtol() and row["friction"]
+
+
+def reference(rows, row):
+    """The convergence row a row's change is measured against: the study's setting, with the
+    floor's friction as in the row (the runs without it measure its share of the change)."""
+    return next(r for r in rows if r["model"] == row["model"] and r["period"] == row["period"]
+                and r["friction"] == row["friction"] and r["n"] == base_elements()
+                and r["rtol"] == base_rtol())
 
 
 def write_sweep(period, label, work, quick=None):
@@ -293,22 +301,26 @@ def collect(work, periods, models, cycles=ANALYSED):
 def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS):
     """Mean cycle maxima at elements of 0.4, 0.2, 0.1 m and at the tolerances (rtol and
     atol together) halved twice, each run CONV_CYCLES cycles with the last CONV_ANALYSED
-    analysed (the middle run is the study's setting); `jobs` runs at a time."""
+    analysed (the middle run is the study's setting); then the element halving without the
+    floor's friction (its share of the change); `jobs` runs at a time."""
     from concurrent.futures import ThreadPoolExecutor
     base_n, base_r = base_elements(), base_rtol()
-    variants = [((base_n + 1) // 2, base_r), (base_n, base_r), (base_n * 2, base_r),
-                (base_n, base_r / 2), (base_n, base_r / 4)]
+    variants = [((base_n + 1) // 2, base_r, True), (base_n, base_r, True),
+                (base_n * 2, base_r, True), (base_n, base_r / 2, True),
+                (base_n, base_r / 4, True), ((base_n + 1) // 2, base_r, False),
+                (base_n, base_r, False)]
     todo = []
     for model in models:
         for period in periods:
-            for n, rtol in variants:
+            for n, rtol, friction in variants:
                 atol = base_atol() * rtol / base_r
-                todo.append((model, period, n, rtol, atol, work / "convergence" / (
-                    f"{model}_T{period}_n{n}_rtol{rtol:g}_atol{atol:g}_c{CONV_CYCLES}.h5")))
+                tag = "" if friction else "_nofriction"
+                todo.append((model, period, n, rtol, friction, atol, work / "convergence" / (
+                    f"{model}_T{period}_n{n}_rtol{rtol:g}_atol{atol:g}{tag}_c{CONV_CYCLES}.h5")))
     (work / "convergence").mkdir(parents=True, exist_ok=True)
 
     def one(item):
-        model, period, n, rtol, atol, out = item
+        model, period, n, rtol, friction, atol, out = item
         if out.exists():
             if status(out)[0] == "complete":
                 return
@@ -320,14 +332,16 @@ def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS)
                 f"solver.t_end={CONV_CYCLES * period:.12g}",
                 f"supports.top_ramp_time={RAMP_CYCLES * period:.12g}",
                 f"supports.top_amplitude={radius},{radius}", f"output.file={out}"]
+        if not friction:
+            sets.append("ground.friction_coefficient=0")
         subprocess.run([str(exe), "run", str(BASE), *set_args(sets)], check=True,
                        capture_output=True)
 
     # the longest first: the two cores stay busy to the end
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         list(pool.map(one, sorted(todo, key=lambda x: -x[1] * x[2])))
-    return [dict(model=m, period=p, n=n, rtol=r, **case_result(out, p, CONV_ANALYSED))
-            for m, p, n, r, _, out in todo]
+    return [dict(model=m, period=p, n=n, rtol=r, friction=fr,
+                 **case_result(out, p, CONV_ANALYSED)) for m, p, n, r, fr, _, out in todo]
 
 
 #: the contact-cost variants: label, overrides (from the run of T = 1.25 s, R = 0.2 m at its
@@ -336,6 +350,7 @@ CONTACT_VARIANTS = (
     ("default (auto)", []),
     ("cvode", ["solver.method=cvode"]),
     ("erk", ["solver.method=erk"]),
+    ("erk, order-3 pair", ["solver.method=erk", "solver.max_order=3"]),
     ("mebdf", ["solver.method=mebdf"]),
     ("auto, atol 1e-8 (ropedyn's default)", ["solver.atol=1e-8"]),
     ("auto, no friction", ["ground.friction_coefficient=0"]),
@@ -471,10 +486,10 @@ def convergence_lines(rows):
              f"{base_elements()}, {base_rtol():g} | its sampling error | CPU (s) |",
              "|---|---|---|---|---|---|---|---|---|"]
     for row in rows:
-        ref = next(r for r in rows if r["model"] == row["model"] and
-                   r["period"] == row["period"] and is_base(r))
-        err = "" if is_base(row) else f"± {change_error(row, ref):.2f} %"
-        lines.append(f"| {row['model'].upper()} | {row['period']} | {row['n']} | {row['rtol']:g} | "
+        ref = reference(rows, row)
+        err = "" if row is ref else f"± {change_error(row, ref):.2f} %"
+        label = row["model"].upper() + ("" if row["friction"] else ", no friction")
+        lines.append(f"| {label} | {row['period']} | {row['n']} | {row['rtol']:g} | "
                      f"{row['mean']:.3f} | {row['spread']:.2f} | "
                      f"{100 * (row['mean'] / ref['mean'] - 1):+.2f} % | {err} | "
                      f"{row['cpu_time']:.1f} |")
@@ -578,7 +593,7 @@ def target_lines(results, models, periods, walls, conv, work):
         lines.append(f"| {name(model)}: MAPE <= 3 % | {s['mape']:.2f} % | "
                      f"{'yes' if s['mape'] <= 3 else 'no'} |")
     for model in models:
-        rows = [r for r in conv if r["model"] == model]
+        rows = [r for r in conv if r["model"] == model and r["friction"]]
         if not rows:
             continue
         worst, worst_err = 0.0, 0.0
@@ -654,7 +669,9 @@ def section(results, models, periods, walls, conv, figs, command, work, contact=
                "analysed (more than the study's 5: see the sampling error); the change of the "
                "mean cycle maximum "
                f"against {base_elements()} elements at rtol {base_rtol():g}, atol "
-               f"{base_atol():g}.", ""]
+               f"{base_atol():g} (the runs without the floor's friction against their own "
+               f"{base_elements()} elements: the friction's share of the element length's "
+               "error).", ""]
         md += convergence_lines(conv)
     if contact:
         md += ["", "### The floor's cost", "",
