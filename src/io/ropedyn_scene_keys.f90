@@ -106,6 +106,10 @@ contains
                 'clamp angle of the bottom support from down x')
             call add_real(G_SUPPORTS, 'support_stiffness_factor', s%support_stiffness_factor, &
                 R_POSITIVE, '-', 'factor on the support springs and dampers')
+            call add_name(G_SUPPORTS, 'end_compliance', s%end_compliance, 'added, split', &
+                "a pinned end's axial compliance: 'added' (the paper's: the support's " &
+                //"spring on top of the rope's, one section more), 'split' (the end section " &
+                //'shared with the support: the rope is exactly as compliant as L/EA)')
             call add_motion('top', s%top_motion, s%top_amplitude, s%top_frequency, &
                 s%top_phase_deg, s%top_angle_amplitude_deg, s%top_angle_phase_deg, &
                 s%top_ramp_time, s%top_table, s%top_release_time)

@@ -140,6 +140,7 @@ contains
             sec = rope_section(r)
             dl = r%length/real(max(scene%model%elements - 1, 1), wp)
             factor = max(1.0_wp, s%support_stiffness_factor)
+            if (s%end_compliance == 'split') factor = 2.0_wp*factor
             m_e = sec%mass_per_length*dl/2.0_wp
             call bound(m_e, "an element's mass", 'kg', ELEMENT_KEYS, .true.)
             call bound(m_e*(dl**2/12.0_wp + r%diameter**2/16.0_wp), "an element's rotary " &

@@ -75,6 +75,10 @@ module ropedyn_rope_spec
         real(wp) :: top_angle_deg = 0.0_wp           !< top clamp angle from down x [deg]
         real(wp) :: bottom_angle_deg = 0.0_wp        !< bottom clamp angle from down x [deg]
         real(wp) :: support_stiffness_factor = 1.0_wp  !< support springs/dampers factor [-]
+        !> 'added' (the paper's RFEM: a pinned support's spring adds one section's axial
+        !! compliance to the rope's L/EA) | 'split' (the end section shared between the
+        !! support and its neighbour, each at twice the section's stiffness: exactly L/EA)
+        character(len=NAME_LEN) :: end_compliance = 'added'
         !> prescribed motion of each support: 'fixed' | 'harmonic' | 'table' | 'coupled'
         !! (driven through the library; at rest otherwise)
         character(len=NAME_LEN) :: top_motion = 'fixed'

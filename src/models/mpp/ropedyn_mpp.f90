@@ -60,6 +60,9 @@ module ropedyn_mpp
         real(wp) :: inertia = 0.0_wp  !< rod inertia about its centre (with rotary inertia), kg m^2
         real(wp) :: g = 0.0_wp      !< gravity, m/s^2 (0 when off)
         real(wp) :: ks = 0.0_wp, ds = 0.0_wp  !< member spring stiffness N/m, damping N s/m
+        !> each member's (n): ks, ds but the last next to a pinned bottom with
+        !! supports%end_compliance = 'split' (twice)
+        real(wp), allocatable :: ksj(:), dsj(:)
         real(wp) :: cb = 0.0_wp, db = 0.0_wp  !< joint bending stiffness N m, damping N m s
         logical :: top_clamped = .false.
         integer :: bottom = 0       !< 0 free, 1 pinned, 2 clamped
@@ -452,6 +455,20 @@ contains
         if (spec%effects%damping) then
             model%d_sup = factor*sec%axial_damping/model%l
             model%d_rot = 2.0_wp*factor*sec%bending_damping/model%l
+        end if
+
+        ! The members' springs (EA/l) cover [0, L]; the top pin is ideal, but the bottom
+        ! pin's spring adds one member's compliance l/EA (an O(l) error, as RFEM's supports).
+        ! With end_compliance = 'split' the last member is shared with it: each 2 EA/l
+        ! (damping alike), the compliance adds up to L/EA.
+        allocate (model%ksj(model%n), model%dsj(model%n))
+        model%ksj = model%ks
+        model%dsj = model%ds
+        if (model%bottom > 0 .and. spec%supports%end_compliance == 'split') then
+            model%ksj(model%n) = 2.0_wp*model%ks
+            model%dsj(model%n) = 2.0_wp*model%ds
+            model%k_sup = 2.0_wp*model%k_sup
+            model%d_sup = 2.0_wp*model%d_sup
         end if
 
         model%init_angle = initial_angle(spec)

@@ -28,7 +28,8 @@ contains
                          sum((cd(:, i) + self%pm_r(k)*phid(i)*nv)**2)
             en%gravity = en%gravity - self%pm_m(k)*self%g*(c(1, i) + self%pm_r(k)*e(1))
         end do
-        en%elastic = 0.5_wp*self%ks*sum(u**2)
+        ! (the last member's own stiffness as a correction: the same sum as without it)
+        en%elastic = 0.5_wp*self%ks*sum(u**2) + 0.5_wp*(self%ksj(n) - self%ks)*u(n)**2
         do k = 2, n
             en%elastic = en%elastic + 0.5_wp*self%cb*(phi(k) - phi(k - 1))**2
         end do
@@ -118,7 +119,8 @@ contains
         nd = self%ndof
         call self%supports_at(t, top, bottom, bottom_on)
         power = 0.0_wp
-        if (self%nu > 0) power = self%ds*sum(y(nd + n + 1:2*nd)**2)
+        if (self%nu > 0) power = self%ds*sum(y(nd + n + 1:2*nd)**2) &
+                                 + (self%dsj(n) - self%ds)*y(2*nd)**2
         work = 0.0_wp
         do k = 2, n
             power = power + self%db*(y(nd + k) - y(nd + k - 1))**2

@@ -153,8 +153,8 @@ contains
         if (present(pin)) pin = -wsum
 
         ! Member springs and dampers.
-        if (self%nu > 0) r(n + 1:nd) = r(n + 1:nd) - self%ks*y(n + 1:nd) &
-                                       - self%ds*y(nd + n + 1:2*nd)
+        if (self%nu > 0) r(n + 1:nd) = r(n + 1:nd) - self%ksj*y(n + 1:nd) &
+                                       - self%dsj*y(nd + n + 1:2*nd)
         ! Joint bending springs and dampers between members; their moments (the lower
         ! member's on the upper one) kept by joint for the internal forces.
         self%jmom = 0.0_wp

@@ -143,9 +143,9 @@ contains
         ! springs, dampers and clamps on member m's own variables
         select case (kind)
         case (2)
-            col(n + m) = col(n + m) - self%ks
+            col(n + m) = col(n + m) - self%ksj(m)
         case (4)
-            col(n + m) = col(n + m) - self%ds
+            col(n + m) = col(n + m) - self%dsj(m)
         case (1, 3)
             cb = merge(self%cb, self%db, kind == 1)
             if (m >= 2) then

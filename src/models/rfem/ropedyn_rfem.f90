@@ -86,6 +86,9 @@ module ropedyn_rfem
         !! next to a clamp (the clamp and its neighbour share one primary section; see
         !! rfem_create)
         real(wp), allocatable :: cpj(:), bpj(:)
+        !> axial stiffness and damping of internal SDE j (2:n): cx, bx but next to a pinned
+        !! end with supports%end_compliance = 'split' (twice: ropedyn_rfem_create)
+        real(wp), allocatable :: cxj(:), bxj(:)
         type(support_t) :: sup(2)              !< top, bottom
         real(wp) :: init_angle = 0.0_wp        !< angle of the straight initial state, rad
         real(wp) :: init_velocity(2) = 0.0_wp  !< initial velocity of every element, m/s

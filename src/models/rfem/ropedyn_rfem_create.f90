@@ -109,6 +109,28 @@ contains
             end do
         end if
 
+        ! Axial compliance next to a pinned end. The internal SDEs' tension springs (EA/dl)
+        ! lump the sections [(j-2) dl, (j-1) dl] and so cover [0, L] alone; a pinned
+        ! support's spring (EA/dl) on top of them adds one section's compliance dl/EA at each
+        ! end (the paper's model), an O(dl) error: the Bergdahl chain's static fairlead
+        ! tension converges at first order, -0.26 % at dl = 0.2 m. With end_compliance =
+        ! 'split' the end section is shared as the clamp's bending is: [0, dl/2] at the
+        ! support, [dl/2, dl] at SDE 2, each 2 EA/dl (damping alike), the compliance adds up
+        ! to L/EA (second order; docs/theory/rfem.md, Supports).
+        allocate (model%cxj(2:n), model%bxj(2:n))
+        model%cxj = model%cx
+        model%bxj = model%bx
+        if (n > 2 .and. spec%supports%end_compliance == 'split') then
+            do k = 1, 2
+                if (.not. model%sup(k)%translational) cycle
+                model%sup(k)%ct = 2.0_wp*model%sup(k)%ct
+                model%sup(k)%bt = 2.0_wp*model%sup(k)%bt
+                i = merge(2, n, k == 1)
+                model%cxj(i) = 2.0_wp*model%cxj(i)
+                model%bxj(i) = 2.0_wp*model%bxj(i)
+            end do
+        end if
+
         model%init_angle = initial_angle(spec)
         model%folded = spec%initial%shape == 'folded'
         model%init_velocity = spec%initial%velocity

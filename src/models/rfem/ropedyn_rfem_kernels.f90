@@ -306,17 +306,17 @@ contains
             fx = 0.0_wp
             fy = 0.0_wp
             fp = 0.0_wp
-            if (self%tension) fx = self%cx*s%dwx
+            if (self%tension) fx = self%cxj(j)*s%dwx
             if (self%shear) fy = self%cy*s%dwy
             if (self%bending) fp = self%cpj(j)*(y(s%kb + 3) - y(s%ka + 3))
             if (energy) e_el = e_el + 0.5_wp*(fx*s%dwx + fy*s%dwy &
                                               + fp*(y(s%kb + 3) - y(s%ka + 3)))
             if (damp) then
                 call sde_rates(s, y)
-                dx = self%bx*s%rx
+                dx = self%bxj(j)*s%rx
                 dy = self%by*s%ry
                 dp = self%bpj(j)*s%rp
-                if (with_power) p_in = p_in + (self%bx*s%rx**2 + self%by*s%ry**2 + &
+                if (with_power) p_in = p_in + (self%bxj(j)*s%rx**2 + self%by*s%ry**2 + &
                                                self%bpj(j)*s%rp**2)
                 if (.not. split) then
                     fx = fx + dx
@@ -492,8 +492,8 @@ contains
             fy = 0.0_wp
             fp = 0.0_wp
             if (self%tension) then
-                fx = self%cx*s%dwx
-                dfx = self%cx*gx
+                fx = self%cxj(j)*s%dwx
+                dfx = self%cxj(j)*gx
             end if
             if (self%shear) then
                 fy = self%cy*s%dwy
@@ -508,15 +508,15 @@ contains
                 call sde_rates(s, y)
                 ! d(rate)/dq = H q' (ry and -rx on phi_a), d(rate)/dq' = the gradient
                 if (self%tension) then
-                    fx = fx + self%bx*s%rx
-                    dfx(1) = dfx(1) + self%bx*s%sa*s%wa
-                    dfx(2) = dfx(2) - self%bx*s%ca*s%wa
-                    dfx(3) = dfx(3) + self%bx*s%ry
-                    dfx(7) = dfx(7) - self%bx*s%sa*s%wa
-                    dfx(8) = dfx(8) + self%bx*s%ca*s%wa
-                    dfx(9) = dfx(9) + self%bx*s%hb*s%cd*(s%wb - s%wa)
-                    dfx(4:6) = self%bx*gx(1:3)
-                    dfx(10:12) = self%bx*gx(7:9)
+                    fx = fx + self%bxj(j)*s%rx
+                    dfx(1) = dfx(1) + self%bxj(j)*s%sa*s%wa
+                    dfx(2) = dfx(2) - self%bxj(j)*s%ca*s%wa
+                    dfx(3) = dfx(3) + self%bxj(j)*s%ry
+                    dfx(7) = dfx(7) - self%bxj(j)*s%sa*s%wa
+                    dfx(8) = dfx(8) + self%bxj(j)*s%ca*s%wa
+                    dfx(9) = dfx(9) + self%bxj(j)*s%hb*s%cd*(s%wb - s%wa)
+                    dfx(4:6) = self%bxj(j)*gx(1:3)
+                    dfx(10:12) = self%bxj(j)*gx(7:9)
                 end if
                 if (self%shear) then
                     fy = fy + self%by*s%ry
@@ -579,7 +579,7 @@ contains
         do j = 2, self%n
             s = sde_at(self, y, j)
             call sde_rates(s, y)
-            power = power + (self%bx*s%rx**2 + self%by*s%ry**2 + self%bpj(j)*s%rp**2)
+            power = power + (self%bxj(j)*s%rx**2 + self%by*s%ry**2 + self%bpj(j)*s%rp**2)
         end do
     end subroutine internal_power
 
