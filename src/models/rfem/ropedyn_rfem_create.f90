@@ -101,11 +101,8 @@ contains
             do k = 1, 2
                 ! (a clamp released later leaves its neighbour at 2 EI/dl)
                 if (.not. model%sup(k)%rotational) cycle
-                model%sup(k)%cr = 2.0_wp*model%sup(k)%cr
-                model%sup(k)%br = 2.0_wp*model%sup(k)%br
-                i = merge(2, n, k == 1)
-                model%cpj(i) = 2.0_wp*model%cpj(i)
-                model%bpj(i) = 2.0_wp*model%bpj(i)
+                call share_end_section(merge(2, n, k == 1), model%sup(k)%cr, &
+                                       model%sup(k)%br, model%cpj, model%bpj)
             end do
         end if
 
@@ -116,18 +113,15 @@ contains
         ! tension converges at first order, -0.26 % at dl = 0.2 m. With end_compliance =
         ! 'split' the end section is shared as the clamp's bending is: [0, dl/2] at the
         ! support, [dl/2, dl] at SDE 2, each 2 EA/dl (damping alike), the compliance adds up
-        ! to L/EA (second order; docs/theory/rfem.md, Supports).
+        ! to L/EA (second order; docs/theory/rfem.md, Strains).
         allocate (model%cxj(2:n), model%bxj(2:n))
         model%cxj = model%cx
         model%bxj = model%bx
         if (n > 2 .and. spec%supports%end_compliance == 'split') then
             do k = 1, 2
                 if (.not. model%sup(k)%translational) cycle
-                model%sup(k)%ct = 2.0_wp*model%sup(k)%ct
-                model%sup(k)%bt = 2.0_wp*model%sup(k)%bt
-                i = merge(2, n, k == 1)
-                model%cxj(i) = 2.0_wp*model%cxj(i)
-                model%bxj(i) = 2.0_wp*model%bxj(i)
+                call share_end_section(merge(2, n, k == 1), model%sup(k)%ct, &
+                                       model%sup(k)%bt, model%cxj, model%bxj)
             end do
         end if
 
@@ -207,4 +201,15 @@ contains
         model%gen_r = 0.0_wp
         model%blk = 0.0_wp
     end procedure rfem_create
+    !> An end section shared between a support and its neighbour SDE i (at 2:n): the
+    !! support's stiffness c_sup and damping b_sup and the neighbour's cj(i), bj(i) doubled,
+    !! each then lumping half the section (rfem_create).
+    pure subroutine share_end_section(i, c_sup, b_sup, cj, bj)
+        integer, intent(in) :: i
+        real(wp), intent(inout) :: c_sup, b_sup, cj(2:), bj(2:)
+        c_sup = 2.0_wp*c_sup
+        b_sup = 2.0_wp*b_sup
+        cj(i) = 2.0_wp*cj(i)
+        bj(i) = 2.0_wp*bj(i)
+    end subroutine share_end_section
 end submodule ropedyn_rfem_create
