@@ -50,6 +50,7 @@ module ropedyn_rope_model
         procedure(coordinate_mass_i), deferred :: coordinate_mass
         procedure :: mass_bandwidth => rope_mass_bandwidth
         procedure :: coordinate_mass_band => rope_coordinate_mass_band
+        procedure :: angle_coordinates => rope_angle_coordinates
         procedure :: has_second_order => rope_has_second_order, &
                      second_order_layout => rope_second_order_layout
         procedure :: state_from_fields => rope_state_from_fields
@@ -221,6 +222,17 @@ contains
             end do
         end do
     end subroutine rope_coordinate_mass_band
+
+    !> Which generalized coordinates are angles (rad, the state repeats every 2 pi in each),
+    !! in the order of `coordinates`. The default: none.
+    pure function rope_angle_coordinates(self) result(angle)
+        class(rope_model_t), intent(in) :: self
+        logical, allocatable :: angle(:)
+        integer, allocatable :: pos(:), vel(:)
+        call self%coordinates(pos, vel)
+        allocate (angle(size(pos)))
+        angle = .false.
+    end function rope_angle_coordinates
 
     !> T + V (kinetic + elastic + gravity), J.
     pure real(wp) function energy_total(self) result(e)

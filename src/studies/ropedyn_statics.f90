@@ -16,8 +16,8 @@
 !! E >= 0 from a modified Cholesky factorization (Gill, Murray & Wright), so that every step
 !! descends even where K is indefinite (a compressed rope); a step is accepted when V falls
 !! by at least 1e-4 of the quadratic model's prediction, after up to two second-order
-!! (chord) corrections; sigma shrinks after good steps, grows after poor or rejected ones,
-!! and is 0 (Newton) near the solution. Converged when a Newton step is below
+!! (chord) corrections; sigma shrinks after good steps, grows after poor or rejected ones
+!! (Nielsen's rule), and is 0 (Newton) near the solution. Converged when a Newton step is below
 !! step_tolerance * L, or when max |f| is at the rounding level of the stiffness
 !! (10 eps sum_j |K_kj| (|q_j| + L)). The iteration's state is a `descent_t` whose steps
 !! are start, assemble (K, M, the rounding test), trial (solve, corrections), accept or
@@ -71,6 +71,8 @@ module ropedyn_statics
     !> the ground's continuation starts where the rope's weight per metre sinks it by this
     !! fraction of its length, and is needed above 100 times that stiffness
     real(wp), parameter :: GROUND_START_SINK = 1.0e-3_wp, GROUND_CONTINUED_ABOVE = 100.0_wp
+    !> the iterations of one continuation stage
+    integer, parameter :: STAGE_ITERATIONS = 150
 
     !> A continuation of `find_equilibrium`: in the support stiffness (ON_SUPPORT) or in the
     !! ground's stiffness (ON_GROUND); the log of the parameter at its start (s = 0) and end
@@ -107,6 +109,7 @@ module ropedyn_statics
         real(wp) :: v_old = 0.0_wp, v_new = 0.0_wp  !< potential energy at y, at the trial
         !> the shift: now, its scale, of the last solve, of the last good shifted step
         real(wp) :: sigma = 0.0_wp, sigma0 = 0.0_wp, sigma_used = 0.0_wp, sigma_good = 0.0_wp
+        real(wp) :: growth = 2.0_wp     !< the factor of the shift at the next rejection
         real(wp) :: step = 0.0_wp       !< max |delta|
         real(wp) :: predicted = 0.0_wp  !< decrease of V the quadratic model predicts
         real(wp) :: rho = 0.0_wp        !< actual / predicted decrease
@@ -341,7 +344,7 @@ contains
         logical :: solved
 
         y_start = y
-        stage_options%max_iterations = 100
+        stage_options%max_iterations = STAGE_ITERATIONS
         stage_options%step_tolerance = 1.0e-8_wp
         s = 0.0_wp
         ds = log(10.0_wp)/(self%log_f1 - self%log_f0)
@@ -675,7 +678,9 @@ contains
             self%sigma = self%sigma_good
             if (self%sigma == 0.0_wp) self%sigma = 1.0e-6_wp*self%sigma0
         else
-            self%sigma = 4.0_wp*self%sigma
+            ! x2, x4, x8, ... for rejections in a row
+            self%sigma = self%growth*self%sigma
+            self%growth = 2.0_wp*self%growth
         end if
     end subroutine descent_reject
 
@@ -711,16 +716,15 @@ contains
         call self%update_shift()
     end subroutine descent_accept
 
-    !> The shift after an accepted step (Levenberg-Marquardt): good model -> smaller shift,
-    !! and Newton once the shift is small against the stiffness along the step.
+    !> The shift after an accepted step (Levenberg-Marquardt, Nielsen's rule): times
+    !! max(1/3, 1 - (2 rho - 1)^3), smaller the better the model predicted the step, and the
+    !! factor of the next rejection back to 2; Newton once the shift is small against the
+    !! stiffness along the step.
     subroutine descent_update_shift(self)
         class(descent_t), intent(inout) :: self
         real(wp) :: dmdd, lambda_step
-        if (self%rho > 0.75_wp) then
-            self%sigma = 0.0625_wp*self%sigma
-        else if (self%rho < 0.25_wp) then
-            self%sigma = 4.0_wp*self%sigma
-        end if
+        self%sigma = self%sigma*max(1.0_wp/3.0_wp, 1.0_wp - (2.0_wp*self%rho - 1.0_wp)**3)
+        self%growth = 2.0_wp
         dmdd = dot_product(self%delta, band_matvec(self%mm, self%delta))
         lambda_step = 0.0_wp
         if (dmdd > 0.0_wp) lambda_step = dot_product(self%delta, self%kd)/dmdd
@@ -729,14 +733,24 @@ contains
             .or. self%sigma < 1.0e-12_wp*self%sigma0) self%sigma = 0.0_wp
     end subroutine descent_update_shift
 
-    !> The equilibrium's results: velocities zeroed, the residual, the energies.
+    !> The equilibrium's results: velocities zeroed, each angle within pi of where the
+    !! iteration started it (a step may turn an element by whole turns, which changes
+    !! nothing but the angle's value), the residual, the energies.
     subroutine descent_finish(self, model, y)
         class(descent_t), intent(inout) :: self
         class(rope_model_t), intent(inout) :: model
         real(wp), intent(inout) :: y(:)
         type(energy_t) :: e
         real(wp) :: yq(max(1, model%quad_size()))
+        real(wp), parameter :: TWO_PI = 8.0_wp*atan(1.0_wp)
+        logical, allocatable :: angle(:)
+        integer :: k
         y(self%vel) = 0.0_wp
+        angle = model%angle_coordinates()
+        do k = 1, size(self%pos)
+            if (angle(k)) y(self%pos(k)) = y(self%pos(k)) - &
+                TWO_PI*anint((y(self%pos(k)) - self%q0(k))/TWO_PI)
+        end do
         self%result%residual = maxval(abs(self%f))
         self%result%residual_relative = self%result%residual/ &
             merge(self%result%weight, 1.0_wp, self%result%weight > 0.0_wp)

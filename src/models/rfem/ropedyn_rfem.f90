@@ -142,6 +142,7 @@ module ropedyn_rfem
         procedure :: second_order_layout => rfem_second_order_layout
         procedure :: coordinate_mass => rfem_coordinate_mass
         procedure :: mass_bandwidth => rfem_mass_bandwidth
+        procedure :: angle_coordinates => rfem_angle_coordinates
         procedure :: coordinate_mass_band => rfem_coordinate_mass_band
         procedure :: second_order_blocks => rfem_second_order_blocks
         procedure :: generalized_forces => rfem_generalized_forces
@@ -574,6 +575,14 @@ contains
             end do
         end do
     end subroutine rfem_coordinate_mass
+
+    !> The coordinates (x, y, phi) of each element: every third is an angle.
+    pure function rfem_angle_coordinates(self) result(angle)
+        class(rfem_t), intent(in) :: self
+        logical, allocatable :: angle(:)
+        integer :: k
+        angle = [(mod(k, 3) == 0, k = 1, 3*self%n)]
+    end function rfem_angle_coordinates
 
     !> The mass matrix is block diagonal (3x3 per element): bandwidth 2.
     pure integer function rfem_mass_bandwidth(self) result(kd)
