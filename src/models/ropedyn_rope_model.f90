@@ -48,6 +48,9 @@ module ropedyn_rope_model
         procedure(support_positions_i), deferred :: support_positions
         procedure(coordinates_i), deferred :: coordinates
         procedure(coordinate_mass_i), deferred :: coordinate_mass
+        procedure :: mass_bandwidth => rope_mass_bandwidth
+        procedure :: coordinate_mass_band => rope_coordinate_mass_band
+        procedure :: angle_coordinates => rope_angle_coordinates
         procedure :: has_second_order => rope_has_second_order, &
                      second_order_layout => rope_second_order_layout
         procedure :: state_from_fields => rope_state_from_fields
@@ -192,6 +195,44 @@ contains
         y = 0.0_wp
         ok = .false.
     end subroutine rope_state_from_fields
+
+    !> The bandwidth kd of `coordinate_mass` (M_ij = 0 for |i - j| > kd). The default: dense.
+    pure integer function rope_mass_bandwidth(self) result(kd)
+        class(rope_model_t), intent(in) :: self
+        integer, allocatable :: pos(:), vel(:)
+        call self%coordinates(pos, vel)
+        kd = max(0, size(pos) - 1)
+    end function rope_mass_bandwidth
+
+    !> `coordinate_mass` as its lower band, mb(i - j, j) = M_ij for 0 <= i - j <= kd,
+    !! mb(0:kd, size(pos)) with kd = `mass_bandwidth`. The default: from the dense matrix.
+    subroutine rope_coordinate_mass_band(self, y, mb)
+        class(rope_model_t), intent(in) :: self
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: mb(0:, :)
+        real(wp), allocatable :: mm(:, :)
+        integer :: i, j, n
+        n = size(mb, 2)
+        allocate (mm(n, n))
+        call self%coordinate_mass(y, mm)
+        mb = 0.0_wp
+        do j = 1, n
+            do i = j, min(n, j + ubound(mb, 1))
+                mb(i - j, j) = mm(i, j)
+            end do
+        end do
+    end subroutine rope_coordinate_mass_band
+
+    !> Which generalized coordinates are angles (rad, the state repeats every 2 pi in each),
+    !! in the order of `coordinates`. The default: none.
+    pure function rope_angle_coordinates(self) result(angle)
+        class(rope_model_t), intent(in) :: self
+        logical, allocatable :: angle(:)
+        integer, allocatable :: pos(:), vel(:)
+        call self%coordinates(pos, vel)
+        allocate (angle(size(pos)))
+        angle = .false.
+    end function rope_angle_coordinates
 
     !> T + V (kinetic + elastic + gravity), J.
     pure real(wp) function energy_total(self) result(e)

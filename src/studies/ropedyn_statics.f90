@@ -16,8 +16,8 @@
 !! E >= 0 from a modified Cholesky factorization (Gill, Murray & Wright), so that every step
 !! descends even where K is indefinite (a compressed rope); a step is accepted when V falls
 !! by at least 1e-4 of the quadratic model's prediction, after up to two second-order
-!! (chord) corrections; sigma shrinks after good steps, grows after poor or rejected ones,
-!! and is 0 (Newton) near the solution. Converged when a Newton step is below
+!! (chord) corrections; sigma shrinks after good steps, grows after poor or rejected ones
+!! (Nielsen's rule), and is 0 (Newton) near the solution. Converged when a Newton step is below
 !! step_tolerance * L, or when max |f| is at the rounding level of the stiffness
 !! (10 eps sum_j |K_kj| (|q_j| + L)). The iteration's state is a `descent_t` whose steps
 !! are start, assemble (K, M, the rounding test), trial (solve, corrections), accept or
@@ -33,9 +33,9 @@ module ropedyn_statics
     use ropedyn_model_factory, only: create_model
     use ropedyn_text, only: int_text, fixed_text
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
-    use ropedyn_ldl, only: ldl_t, ldl_factor, ldl_solve
+    use ropedyn_ldl, only: ldl_t, ldl_factor, ldl_solve, band_matvec
     use ropedyn_statics_terms, only: generalized_force, tangent_matrices, potential_energy, &
-                                     rope_length, total_weight
+                                     rope_length, total_weight, tangent_band, tangent_bandwidth
     implicit none
     private
     public :: statics_options_t, statics_result_t
@@ -71,6 +71,8 @@ module ropedyn_statics
     !> the ground's continuation starts where the rope's weight per metre sinks it by this
     !! fraction of its length, and is needed above 100 times that stiffness
     real(wp), parameter :: GROUND_START_SINK = 1.0e-3_wp, GROUND_CONTINUED_ABOVE = 100.0_wp
+    !> the iterations of one continuation stage
+    integer, parameter :: STAGE_ITERATIONS = 150
 
     !> A continuation of `find_equilibrium`: in the support stiffness (ON_SUPPORT) or in the
     !! ground's stiffness (ON_GROUND); the log of the parameter at its start (s = 0) and end
@@ -94,7 +96,11 @@ module ropedyn_statics
     type :: descent_t
         integer, allocatable :: pos(:), vel(:)      !< where q and q' sit in y
         real(wp), allocatable :: f(:), f_new(:)     !< generalized force at y, at the trial
-        real(wp), allocatable :: kt(:, :), mm(:, :) !< stiffness (symmetrized) and mass at y
+        !> stiffness (symmetrized) and mass at y, lower bands kt(0:kw, n), mm(0:km, n)
+        real(wp), allocatable :: kt(:, :), mm(:, :)
+        real(wp), allocatable :: kfull(:, :)        !< the stiffness's band kfull(-kw:kw, n)
+        real(wp), allocatable :: shifted(:, :)      !< K + sigma M, lower band (0:kw, n)
+        integer :: kw = 0, km = 0                   !< bandwidths of K and M
         real(wp), allocatable :: mdiag(:)           !< diagonal of the starting mass
         real(wp), allocatable :: delta(:), kd(:)    !< the step, K delta
         real(wp), allocatable :: y_new(:), q0(:)    !< the trial state; the starting q
@@ -103,6 +109,7 @@ module ropedyn_statics
         real(wp) :: v_old = 0.0_wp, v_new = 0.0_wp  !< potential energy at y, at the trial
         !> the shift: now, its scale, of the last solve, of the last good shifted step
         real(wp) :: sigma = 0.0_wp, sigma0 = 0.0_wp, sigma_used = 0.0_wp, sigma_good = 0.0_wp
+        real(wp) :: growth = 2.0_wp     !< the factor of the shift at the next rejection
         real(wp) :: step = 0.0_wp       !< max |delta|
         real(wp) :: predicted = 0.0_wp  !< decrease of V the quadratic model predicts
         real(wp) :: rho = 0.0_wp        !< actual / predicted decrease
@@ -337,7 +344,7 @@ contains
         logical :: solved
 
         y_start = y
-        stage_options%max_iterations = 100
+        stage_options%max_iterations = STAGE_ITERATIONS
         stage_options%step_tolerance = 1.0e-8_wp
         s = 0.0_wp
         ds = log(10.0_wp)/(self%log_f1 - self%log_f0)
@@ -430,12 +437,15 @@ contains
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(inout) :: y(:)
         type(error_t), allocatable, intent(out) :: err
-        integer :: nd, k
+        integer :: nd
 
         call model%coordinates(self%pos, self%vel)
         nd = size(self%pos)
-        allocate (self%f(nd), self%f_new(nd), self%kt(nd, nd), self%mm(nd, nd), &
-                  self%delta(nd), self%mdiag(nd), self%kd(nd))
+        self%km = model%mass_bandwidth()
+        self%kw = max(tangent_bandwidth(model), self%km)
+        allocate (self%f(nd), self%f_new(nd), self%kt(0:self%kw, nd), &
+                  self%mm(0:self%km, nd), self%kfull(-self%kw:self%kw, nd), &
+                  self%shifted(0:self%kw, nd), self%delta(nd), self%mdiag(nd), self%kd(nd))
         y(self%vel) = 0.0_wp
         self%length = rope_length(model)
         self%step_limit = 0.5_wp*max(self%length, 1.0_wp)
@@ -449,8 +459,8 @@ contains
             return
         end if
         self%v_old = potential_energy(model, y, spec)
-        call model%coordinate_mass(y, self%mm)
-        self%mdiag = [(self%mm(k, k), k = 1, nd)]
+        call model%coordinate_mass_band(y, self%mm)
+        self%mdiag = self%mm(0, :)
         ! shift scale: a step of the freest coordinate of L/10 (explicit estimate); the
         ! iteration starts as Newton (sigma = 0) and shifts only when it must
         self%sigma0 = maxval(abs(self%f)/self%mdiag)/(0.1_wp*max(self%length, 1.0e-3_wp))
@@ -503,22 +513,28 @@ contains
         logical, intent(out) :: converged
         type(error_t), allocatable, intent(out) :: err
 
+        integer :: i, j
         converged = .false.
-        call tangent_matrices(model, y, self%pos, self%vel, self%kt, self%status)
+        call tangent_band(model, y, self%pos, self%vel, self%kw, self%kfull, self%status)
         if (self%status /= STATUS_OK) then
             call make_error(err, ERR_SOLVER, spec%path//': statics: the stiffness '// &
                             'matrix is not finite at iteration '// &
                             int_text(self%result%iterations))
             return
         end if
-        self%kt = 0.5_wp*(self%kt + transpose(self%kt))
+        ! the symmetric part, K_ij = (K_ij + K_ji)/2, i >= j: kfull(i - j, j), kfull(j - i, i)
+        do j = 1, size(self%pos)
+            do i = 0, min(self%kw, size(self%pos) - j)
+                self%kt(i, j) = 0.5_wp*(self%kfull(i, j) + self%kfull(-i, j + i))
+            end do
+        end do
         call self%measure_rounding(y)
         if (self%result%rounding_level <= 1.0_wp) then
             self%result%criterion = 'rounding level'
             converged = .true.
             return
         end if
-        call model%coordinate_mass(y, self%mm)
+        call model%coordinate_mass_band(y, self%mm)
         self%fresh = .false.
     end subroutine descent_assemble
 
@@ -527,14 +543,24 @@ contains
     subroutine descent_measure_rounding(self, y)
         class(descent_t), intent(inout) :: self
         real(wp), intent(in) :: y(:)
-        real(wp), allocatable :: qscale(:)
+        real(wp), allocatable :: qscale(:), row(:)
         real(wp) :: floor_k
-        integer :: i
+        integer :: i, j, n
+        n = size(self%pos)
         qscale = abs(y(self%pos)) + self%length
+        ! row(i) = sum_j |K_ij| qscale_j over the symmetric band
+        allocate (row(n))
+        row = 0.0_wp
+        do j = 1, n
+            row(j) = row(j) + abs(self%kt(0, j))*qscale(j)
+            do i = j + 1, min(n, j + self%kw)
+                row(i) = row(i) + abs(self%kt(i - j, j))*qscale(j)
+                row(j) = row(j) + abs(self%kt(i - j, j))*qscale(i)
+            end do
+        end do
         self%result%rounding_level = 0.0_wp
-        do i = 1, size(self%pos)
-            floor_k = 10.0_wp*epsilon(1.0_wp)*(sum(abs(self%kt(i, :))*qscale) &
-                                               + self%result%weight) + tiny(1.0_wp)
+        do i = 1, n
+            floor_k = 10.0_wp*epsilon(1.0_wp)*(row(i) + self%result%weight) + tiny(1.0_wp)
             self%result%rounding_level = max(self%result%rounding_level, &
                                              abs(self%f(i))/floor_k)
         end do
@@ -568,15 +594,16 @@ contains
 
         self%sigma_used = self%sigma
         self%result%iterations = self%result%iterations + 1
-        call ldl_factor(self%kt + self%sigma*self%mm, 1.0_wp/sqrt(self%mdiag), self%fac, &
-                        modified)
+        self%shifted = self%kt
+        self%shifted(0:self%km, :) = self%shifted(0:self%km, :) + self%sigma*self%mm
+        call ldl_factor(self%shifted, 1.0_wp/sqrt(self%mdiag), self%fac, modified)
         self%newton = self%sigma == 0.0_wp .and. .not. modified
         self%delta = ldl_solve(self%fac, self%f)
         accept = all(ieee_is_finite(self%delta))
         self%status = STATUS_OK
         if (.not. accept) return
         call self%limit_step()
-        self%kd = matmul(self%kt, self%delta)
+        self%kd = band_matvec(self%kt, self%delta)
         self%predicted = dot_product(self%f, self%delta) - &
                          0.5_wp*dot_product(self%delta, self%kd)
         call self%try_step(model, spec, y, accept)
@@ -651,7 +678,9 @@ contains
             self%sigma = self%sigma_good
             if (self%sigma == 0.0_wp) self%sigma = 1.0e-6_wp*self%sigma0
         else
-            self%sigma = 4.0_wp*self%sigma
+            ! x2, x4, x8, ... for rejections in a row
+            self%sigma = self%growth*self%sigma
+            self%growth = 2.0_wp*self%growth
         end if
     end subroutine descent_reject
 
@@ -687,17 +716,16 @@ contains
         call self%update_shift()
     end subroutine descent_accept
 
-    !> The shift after an accepted step (Levenberg-Marquardt): good model -> smaller shift,
-    !! and Newton once the shift is small against the stiffness along the step.
+    !> The shift after an accepted step (Levenberg-Marquardt, Nielsen's rule): times
+    !! max(1/3, 1 - (2 rho - 1)^3), smaller the better the model predicted the step, and the
+    !! factor of the next rejection back to 2; Newton once the shift is small against the
+    !! stiffness along the step.
     subroutine descent_update_shift(self)
         class(descent_t), intent(inout) :: self
         real(wp) :: dmdd, lambda_step
-        if (self%rho > 0.75_wp) then
-            self%sigma = 0.0625_wp*self%sigma
-        else if (self%rho < 0.25_wp) then
-            self%sigma = 4.0_wp*self%sigma
-        end if
-        dmdd = dot_product(self%delta, matmul(self%mm, self%delta))
+        self%sigma = self%sigma*max(1.0_wp/3.0_wp, 1.0_wp - (2.0_wp*self%rho - 1.0_wp)**3)
+        self%growth = 2.0_wp
+        dmdd = dot_product(self%delta, band_matvec(self%mm, self%delta))
         lambda_step = 0.0_wp
         if (dmdd > 0.0_wp) lambda_step = dot_product(self%delta, self%kd)/dmdd
         if (self%sigma_used > 0.0_wp) self%sigma_good = self%sigma_used
@@ -705,14 +733,24 @@ contains
             .or. self%sigma < 1.0e-12_wp*self%sigma0) self%sigma = 0.0_wp
     end subroutine descent_update_shift
 
-    !> The equilibrium's results: velocities zeroed, the residual, the energies.
+    !> The equilibrium's results: velocities zeroed, each angle within pi of where the
+    !! iteration started it (a step may turn an element by whole turns, which changes
+    !! nothing but the angle's value), the residual, the energies.
     subroutine descent_finish(self, model, y)
         class(descent_t), intent(inout) :: self
         class(rope_model_t), intent(inout) :: model
         real(wp), intent(inout) :: y(:)
         type(energy_t) :: e
         real(wp) :: yq(max(1, model%quad_size()))
+        real(wp), parameter :: TWO_PI = 8.0_wp*atan(1.0_wp)
+        logical, allocatable :: angle(:)
+        integer :: k
         y(self%vel) = 0.0_wp
+        angle = model%angle_coordinates()
+        do k = 1, size(self%pos)
+            if (angle(k)) y(self%pos(k)) = y(self%pos(k)) - &
+                TWO_PI*anint((y(self%pos(k)) - self%q0(k))/TWO_PI)
+        end do
         self%result%residual = maxval(abs(self%f))
         self%result%residual_relative = self%result%residual/ &
             merge(self%result%weight, 1.0_wp, self%result%weight > 0.0_wp)

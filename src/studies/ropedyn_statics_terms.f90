@@ -13,10 +13,11 @@ module ropedyn_statics_terms
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_rope_spec, only: rope_spec_t, N_ATTACH
     use ropedyn_effect_factory, only: locate_on_bodies
-    use ropedyn_ldl, only: bandwidth
+    use ropedyn_ldl, only: band_matvec
     implicit none
     private
     public :: generalized_force, tangent_matrices, potential_energy, rope_length, total_weight
+    public :: tangent_band, tangent_bandwidth
 
     real(wp), parameter :: PI = 4.0_wp*atan(1.0_wp)
 
@@ -88,7 +89,7 @@ contains
         integer, intent(in) :: pos(:), vel(:)
         real(wp), intent(out) :: f(:)
         integer, intent(out) :: status
-        real(wp), allocatable :: w(:), mm(:, :)
+        real(wp), allocatable :: w(:), mb(:, :)
         logical :: held
         held = model%supports_at_rest
         model%supports_at_rest = .true.
@@ -98,15 +99,29 @@ contains
             f = w(vel)
         else
             call model%rhs(0.0_wp, y, w, status)
-            allocate (mm(size(pos), size(pos)))
-            call model%coordinate_mass(y, mm)
-            f = matmul(mm, w(vel))
+            allocate (mb(0:model%mass_bandwidth(), size(pos)))
+            call model%coordinate_mass_band(y, mb)
+            f = band_matvec(mb, w(vel))
         end if
         if (status == STATUS_OK .and. .not. all(ieee_is_finite(f))) status = -1
         model%supports_at_rest = held
     end subroutine generalized_force
 
-    !> Tangent stiffness kt = -df/dq and, if present, damping cv = -df/dq' at state y.
+    !> The bandwidth of the tangent matrices of `tangent_band`: dense (size(pos) - 1) when
+    !! they are differenced or the model is linearly implicit, else that of the model's
+    !! second-order blocks plus that of its mass (K = -M da/dq).
+    integer function tangent_bandwidth(model) result(kd)
+        class(rope_model_t), intent(in) :: model
+        integer, allocatable :: pos(:), vel(:)
+        integer :: kl, ku
+        call model%coordinates(pos, vel)
+        kd = size(pos) - 1
+        if (model%has_mass_matrix() .or. .not. model%has_jacobian()) return
+        call model%second_order_layout(pos, vel, kl, ku)
+        kd = min(kd, max(kl, ku) + model%mass_bandwidth())
+    end function tangent_bandwidth
+
+    !> Tangent stiffness kt = -df/dq and, if present, damping cv = -df/dq' at state y, dense.
     subroutine tangent_matrices(model, y, pos, vel, kt, status, cv)
         class(rope_model_t), intent(inout) :: model
         real(wp), intent(in) :: y(:)
@@ -114,24 +129,65 @@ contains
         real(wp), intent(out) :: kt(:, :)
         integer, intent(out) :: status
         real(wp), intent(out), optional :: cv(:, :)
-        logical :: held
-        held = model%supports_at_rest
-        model%supports_at_rest = .true.
-        call tangents(model, y, pos, vel, kt, status, cv)
-        model%supports_at_rest = held
+        real(wp), allocatable :: kb(:, :), cb(:, :)
+        integer :: kd
+        kd = tangent_bandwidth(model)
+        allocate (kb(-kd:kd, size(pos)))
+        if (present(cv)) then
+            allocate (cb(-kd:kd, size(pos)))
+            call tangent_band(model, y, pos, vel, kd, kb, status, cb)
+            cv = dense_of(cb)
+        else
+            call tangent_band(model, y, pos, vel, kd, kb, status)
+        end if
+        kt = dense_of(kb)
     end subroutine tangent_matrices
 
-    !> tangent_matrices with the supports as the model has them.
-    subroutine tangents(model, y, pos, vel, kt, status, cv)
+    !> The square matrix of a band b(-kd:kd, n), b(i - j, j) = a(i, j).
+    pure function dense_of(b) result(a)
+        real(wp), intent(in) :: b(:, :)
+        real(wp) :: a(size(b, 2), size(b, 2))
+        integer :: i, j, n, kd
+        n = size(b, 2)
+        kd = (size(b, 1) - 1)/2
+        a = 0.0_wp
+        do j = 1, n
+            do i = max(1, j - kd), min(n, j + kd)
+                a(i, j) = b(kd + 1 + i - j, j)
+            end do
+        end do
+    end function dense_of
+
+    !> tangent_matrices in band storage: kb(i - j, j) = K_ij for |i - j| <= kd, kb(-kd:kd,
+    !! size(pos)) with kd = `tangent_bandwidth` (and cb likewise for C).
+    subroutine tangent_band(model, y, pos, vel, kd, kb, status, cb)
         class(rope_model_t), intent(inout) :: model
         real(wp), intent(in) :: y(:)
         integer, intent(in) :: pos(:), vel(:)
-        real(wp), intent(out) :: kt(:, :)
+        integer, intent(in) :: kd
+        real(wp), intent(out) :: kb(-kd:, :)
         integer, intent(out) :: status
-        real(wp), intent(out), optional :: cv(:, :)
-        real(wp), allocatable :: mm(:, :), jb(:, :), yp(:), gp(:), gm(:)
-        integer, allocatable :: vel_of_row(:)
-        integer :: nd, ns, ml, mu, offset, j, r, c, i, st
+        real(wp), intent(out), optional :: cb(-kd:, :)
+        logical :: held
+        held = model%supports_at_rest
+        model%supports_at_rest = .true.
+        call tangents(model, y, pos, vel, kd, kb, status, cb)
+        model%supports_at_rest = held
+    end subroutine tangent_band
+
+    !> tangent_band with the supports as the model has them.
+    subroutine tangents(model, y, pos, vel, kd, kb, status, cb)
+        class(rope_model_t), intent(inout) :: model
+        real(wp), intent(in) :: y(:)
+        integer, intent(in) :: pos(:), vel(:)
+        integer, intent(in) :: kd
+        real(wp), intent(out) :: kb(-kd:, :)
+        integer, intent(out) :: status
+        real(wp), intent(out), optional :: cb(-kd:, :)
+        real(wp), allocatable :: mb(:, :), ka(:, :), ca(:, :), yp(:), gp(:), gm(:)
+        real(wp), allocatable :: col(:), unit_mass(:, :)
+        integer, allocatable :: lpos(:), lvel(:)
+        integer :: nd, ns, kl, ku, ja, j, st
         real(wp) :: h
         logical :: implicit
 
@@ -139,53 +195,50 @@ contains
         ns = size(y)
         status = STATUS_OK
         implicit = model%has_mass_matrix()
-        if (.not. implicit) then
-            allocate (mm(nd, nd))
-            call model%coordinate_mass(y, mm)
-        end if
         if (implicit .or. .not. model%has_jacobian()) then
             ! central differences: of f = F(vel) of the implicit form (F is cheap, O(n)), or
-            ! of the accelerations of an explicit model without a Jacobian
-            allocate (yp(ns), gp(ns), gm(ns))
+            ! of the accelerations of an explicit model without a Jacobian (dense)
+            allocate (yp(ns), gp(ns), gm(ns), col(nd))
+            ja = merge(kd, nd - 1, implicit)
+            allocate (ka(-ja:ja, nd))
+            if (present(cb)) allocate (ca(-ja:ja, nd))
             do j = 1, nd
-                call differenced(pos(j), kt(:, j))
+                call differenced(pos(j), col)
                 if (status /= STATUS_OK) return
-                if (present(cv)) then
-                    call differenced(vel(j), cv(:, j))
+                call store_column(ka, ja, j, col)
+                if (present(cb)) then
+                    call differenced(vel(j), col)
                     if (status /= STATUS_OK) return
+                    call store_column(ca, ja, j, col)
                 end if
             end do
-            if (implicit) return
+            if (implicit) then
+                kb = ka
+                if (present(cb)) cb = ca
+                return
+            end if
         else
-            call model%bandwidths(ml, mu)
-            offset = mu + 1
-            allocate (jb(ml + mu + 1, ns), vel_of_row(ns))
-            jb = 0.0_wp
-            call model%jacobian(0.0_wp, y, jb, offset, status)
+            call model%second_order_layout(lpos, lvel, kl, ku)
+            ja = max(kl, ku)
+            allocate (ka(-ja:ja, nd), ca(-ja:ja, nd), unit_mass(-ja:ja, nd))
+            ka = 0.0_wp
+            ca = 0.0_wp
+            unit_mass = 0.0_wp
+            ! entry (i, j) at row ja + 1 + i - j of the (2 ja + 1, nd) arrays: ka(i - j, j)
+            call model%second_order_blocks(0.0_wp, y, .false., ka, ca, unit_mass, ja + 1, &
+                                           status)
             if (status /= STATUS_OK) return
-            vel_of_row = 0
-            vel_of_row(vel) = [(i, i = 1, nd)]
-            kt = 0.0_wp
-            if (present(cv)) cv = 0.0_wp
-            do j = 1, nd
-                c = pos(j)
-                do r = max(1, c - mu), min(ns, c + ml)
-                    if (vel_of_row(r) > 0) kt(vel_of_row(r), j) = jb(offset + r - c, c)
-                end do
-                if (present(cv)) then
-                    c = vel(j)
-                    do r = max(1, c - mu), min(ns, c + ml)
-                        if (vel_of_row(r) > 0) cv(vel_of_row(r), j) = jb(offset + r - c, c)
-                    end do
-                end if
-            end do
         end if
         ! da/dz -> df/dz = M da/dz at rest (the dM/dq a term vanishes at an equilibrium and
         ! is left out elsewhere: Newton on a(q) = 0 in the metric M)
-        call scale_by_mass(mm, kt)
-        if (present(cv)) call scale_by_mass(mm, cv)
-        kt = -kt
-        if (present(cv)) cv = -cv
+        allocate (mb(0:model%mass_bandwidth(), nd))
+        call model%coordinate_mass_band(y, mb)
+        call mass_times(mb, ubound(mb, 1), ka, ja, kb, kd)
+        kb = -kb
+        if (present(cb)) then
+            call mass_times(mb, ubound(mb, 1), ca, ja, cb, kd)
+            cb = -cb
+        end if
     contains
         !> By central differences in y(k): -dF(vel)/dy(k) of an implicit model, da/dy(k)
         !! (a = ydot(vel)) of an explicit one.
@@ -221,30 +274,45 @@ contains
         end subroutine evaluate
     end subroutine tangents
 
-    !> a <- mm a over the band of the symmetric mm (|i - j| <= its bandwidth kd): O(n^2 kd)
-    !! where a dense product is O(n^3) (the RFEM's mass in water is block diagonal, kd = 2).
-    subroutine scale_by_mass(mm, a)
-        real(wp), intent(in) :: mm(:, :)
-        real(wp), intent(inout) :: a(:, :)
-        real(wp), allocatable :: b(:, :)
-        integer :: i, c, kd, n, lo, hi
-        n = size(a, 1)
-        kd = bandwidth(mm)
-        if (kd == 0) then
-            do i = 1, n
-                a(i, :) = mm(i, i)*a(i, :)
-            end do
-            return
-        end if
-        allocate (b(n, size(a, 2)))
-        do c = 1, size(a, 2)
-            do i = 1, n
-                ! mm is symmetric: its column i is row i, read contiguously
-                lo = max(1, i - kd)
-                hi = min(n, i + kd)
-                b(i, c) = dot_product(mm(lo:hi, i), a(lo:hi, c))
+    !> Column j of a matrix into its band b(-kd:kd, n) (the entries outside the band are
+    !! dropped: they are zero).
+    pure subroutine store_column(b, kd, j, col)
+        integer, intent(in) :: kd, j
+        real(wp), intent(inout) :: b(-kd:, :)
+        real(wp), intent(in) :: col(:)
+        integer :: i, n
+        n = size(col)
+        b(:, j) = 0.0_wp
+        do i = max(1, j - kd), min(n, j + kd)
+            b(i - j, j) = col(i)
+        end do
+    end subroutine store_column
+
+    !> c = M a for the symmetric M in lower band storage mb(0:km, n) and a, c in band
+    !! storage (-ka:ka, n), (-kc:kc, n): O(n km ka) where a dense product is O(n^3) (the
+    !! RFEM's mass is block diagonal, km = 2). Entries of the product outside c's band are
+    !! dropped (kc >= km + ka keeps them all).
+    pure subroutine mass_times(mb, km, a, ka, c, kc)
+        integer, intent(in) :: km, ka, kc
+        real(wp), intent(in) :: mb(0:, :)
+        real(wp), intent(in) :: a(-ka:, :)
+        real(wp), intent(out) :: c(-kc:, :)
+        integer :: i, j, k, n
+        real(wp) :: mik
+        n = size(mb, 2)
+        c = 0.0_wp
+        do j = 1, n
+            do k = max(1, j - ka), min(n, j + ka)
+                if (a(k - j, j) == 0.0_wp) cycle
+                do i = max(1, k - km, j - kc), min(n, k + km, j + kc)
+                    if (i >= k) then
+                        mik = mb(i - k, k)
+                    else
+                        mik = mb(k - i, i)
+                    end if
+                    c(i - j, j) = c(i - j, j) + mik*a(k - j, j)
+                end do
             end do
         end do
-        a = b
-    end subroutine scale_by_mass
+    end subroutine mass_times
 end module ropedyn_statics_terms

@@ -82,7 +82,9 @@ def test_initial_equilibrium_run(run, tmp_path):
         assert "shape = 'equilibrium'" in f.attrs["scene"].decode()
         q, qdot = f["state/q"][:], f["state/qdot"][:]
         kinetic = f["energy/kinetic"][:]
-    assert np.max(np.abs(q[0, :, 1])) < 1e-12, "the equilibrium hangs vertically"
+    # the statics stop at the rounding level of the stiff springs' forces (~10 eps EA/dl L,
+    # 1e-10 N), which the pendulum's stiffness W/L turns into ~1e-10 m sideways
+    assert np.max(np.abs(q[0, :, 1])) < 1e-10, "the equilibrium hangs vertically"
     assert np.max(np.abs(qdot)) < 1e-6
     assert np.max(kinetic) < 1e-12
 

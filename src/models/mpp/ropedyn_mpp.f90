@@ -133,6 +133,7 @@ module ropedyn_mpp
         procedure :: mass_dense => mpp_mass_dense
         procedure :: coordinates => mpp_coordinates
         procedure :: coordinate_mass => mpp_coordinate_mass
+        procedure :: angle_coordinates => mpp_angle_coordinates
         procedure :: second_order_blocks => mpp_second_order_blocks
         procedure, private :: positions
         procedure, private :: supports_at
@@ -733,4 +734,12 @@ contains
         real(wp), intent(out) :: mm(:, :)
         call self%mass_dense(y, mm)
     end subroutine mpp_coordinate_mass
+
+    !> The coordinates (phi_1 .. phi_n, u_1 .. u_nu): the first n are angles.
+    pure function mpp_angle_coordinates(self) result(angle)
+        class(mpp_t), intent(in) :: self
+        logical, allocatable :: angle(:)
+        integer :: k
+        angle = [(k <= self%n, k = 1, self%ndof)]
+    end function mpp_angle_coordinates
 end module ropedyn_mpp

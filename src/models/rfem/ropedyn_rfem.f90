@@ -144,6 +144,9 @@ module ropedyn_rfem
         procedure :: coordinates => rfem_coordinates
         procedure :: second_order_layout => rfem_second_order_layout
         procedure :: coordinate_mass => rfem_coordinate_mass
+        procedure :: mass_bandwidth => rfem_mass_bandwidth
+        procedure :: angle_coordinates => rfem_angle_coordinates
+        procedure :: coordinate_mass_band => rfem_coordinate_mass_band
         procedure :: second_order_blocks => rfem_second_order_blocks
         procedure :: generalized_forces => rfem_generalized_forces
         procedure :: potential_energy => rfem_potential_energy
@@ -559,27 +562,61 @@ contains
         ku = kl
     end subroutine rfem_second_order_layout
 
-    !> The mass matrix of the coordinates: diag(m_i, m_i, J_i), plus the translation-rotation
-    !! coupling s n_i of elements with point masses off their centre.
+    !> The mass matrix of the coordinates, dense (from `rfem_coordinate_mass_band`).
     subroutine rfem_coordinate_mass(self, y, mm)
         class(rfem_t), intent(in) :: self
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: mm(:, :)
-        integer :: i, k
-        real(wp) :: blk(3, 3), g(3)
+        real(wp) :: mb(0:2, 3*self%n)
+        integer :: i, j
+        call self%coordinate_mass_band(y, mb)
         mm = 0.0_wp
+        do j = 1, 3*self%n
+            do i = j, min(3*self%n, j + 2)
+                mm(i, j) = mb(i - j, j)
+                mm(j, i) = mb(i - j, j)
+            end do
+        end do
+    end subroutine rfem_coordinate_mass
+
+    !> The coordinates (x, y, phi) of each element: every third is an angle.
+    pure function rfem_angle_coordinates(self) result(angle)
+        class(rfem_t), intent(in) :: self
+        logical, allocatable :: angle(:)
+        integer :: k
+        angle = [(mod(k, 3) == 0, k = 1, 3*self%n)]
+    end function rfem_angle_coordinates
+
+    !> The mass matrix is block diagonal (3x3 per element): bandwidth 2.
+    pure integer function rfem_mass_bandwidth(self) result(kd)
+        class(rfem_t), intent(in) :: self
+        kd = min(2, 3*self%n - 1)
+    end function rfem_mass_bandwidth
+
+    !> The mass matrix of the coordinates as its lower band mb(0:2, 3n): diag(m_i, m_i,
+    !! J_i), plus the translation-rotation coupling s n_i of elements with point masses off
+    !! their centre, plus in water each element's added-mass block.
+    subroutine rfem_coordinate_mass_band(self, y, mb)
+        class(rfem_t), intent(in) :: self
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: mb(0:, :)
+        integer :: i, k, r, c
+        real(wp) :: blk(3, 3), g(3), coupling(2)
+        mb = 0.0_wp
         do i = 1, self%n
             k = 3*(i - 1)
-            mm(k + 1, k + 1) = self%mass(i)
-            mm(k + 2, k + 2) = self%mass(i)
-            mm(k + 3, k + 3) = self%inertia(i)
+            mb(0, k + 1) = self%mass(i)
+            mb(0, k + 2) = self%mass(i)
+            mb(0, k + 3) = self%inertia(i)
         end do
         ! point masses off the element centres couple translation and rotation: s n
+        ! (entries (k+3, k+1) and (k+3, k+2) of the lower band)
         do i = 1, size(self%pm_elem)
             k = 3*(self%pm_elem(i) - 1)
-            mm(k + 1:k + 2, k + 3) = self%pm_moment(i)* &
+            coupling = self%pm_moment(i)* &
                 [-sin(y(6*self%pm_elem(i) - 3)), cos(y(6*self%pm_elem(i) - 3))]
-            mm(k + 3, k + 1:k + 2) = mm(k + 1:k + 2, k + 3)
+            mb(2, k + 1) = coupling(1)
+            mb(1, k + 2) = coupling(2)
         end do
         ! the water's added mass (at the state's coordinates and rates)
         if (self%water) then
@@ -587,8 +624,12 @@ contains
                 k = 6*(i - 1)
                 call self%added%terms(y(k + 1:k + 2), y(k + 3), y(k + 4:k + 5), y(k + 6), &
                                       self%len(i), blk, g)
-                mm(3*i - 2:3*i, 3*i - 2:3*i) = mm(3*i - 2:3*i, 3*i - 2:3*i) + blk
+                do c = 1, 3
+                    do r = c, 3
+                        mb(r - c, 3*(i - 1) + c) = mb(r - c, 3*(i - 1) + c) + blk(r, c)
+                    end do
+                end do
             end do
         end if
-    end subroutine rfem_coordinate_mass
+    end subroutine rfem_coordinate_mass_band
 end module ropedyn_rfem
