@@ -135,17 +135,21 @@ def base_atol():
     return scene_number(BASE, "atol")
 
 
+def at_setting(row):
+    """Whether a convergence row has the study's element count and tolerance."""
+    return row["n"] == base_elements() and row["rtol"] == base_rtol()
+
+
 def is_base(row):
     """Whether a convergence row is the run at the study's setting."""
-    return row["n"] == base_elements() and row["rtol"] == base_rtol() and row["friction"]
+    return at_setting(row) and row["friction"]
 
 
 def reference(rows, row):
     """The convergence row a row's change is measured against: the study's setting, with the
     floor's friction as in the row (the runs without it measure its share of the change)."""
     return next(r for r in rows if r["model"] == row["model"] and r["period"] == row["period"]
-                and r["friction"] == row["friction"] and r["n"] == base_elements()
-                and r["rtol"] == base_rtol())
+                and r["friction"] == row["friction"] and at_setting(r))
 
 
 def write_sweep(period, label, work, quick=None):
@@ -600,7 +604,7 @@ def target_lines(results, models, periods, walls, conv, work):
         for r in rows:
             if is_base(r):
                 continue
-            ref = next(x for x in rows if x["period"] == r["period"] and is_base(x))
+            ref = reference(rows, r)
             if r["n"] >= base_elements() and abs(r["mean"] / ref["mean"] - 1) > worst:
                 # the halvings, not the coarser run
                 worst, worst_err = abs(r["mean"] / ref["mean"] - 1), change_error(r, ref)
