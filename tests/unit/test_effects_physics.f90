@@ -33,6 +33,7 @@ program test_effects_physics
     call drag_terminal_speed()
     call ground_friction()
     call ground_lying_body()
+    call ground_tilted_body()
     call shaken_top('rfem')
     call shaken_top('mpp')
     call folded_fall()
@@ -189,6 +190,38 @@ contains
         call suite%check_close(m(1), -c*l**3/12.0_wp*w, 1.0e-6_wp, 0.0_wp, &
                                'ground: the damping moment of a lying body is c l^3/12 w')
     end subroutine ground_lying_body
+
+    !> One body of length l, tilted by theta so that only its end B is below the plane, by
+    !! p: the law integrated over the part below, r in [r0, l/2] (r0 = l/2 - p/sin theta),
+    !! gives the force k p^2/(2 sin theta), the moment cos theta k int r delta dr about the
+    !! centre and the springs' energy k p^3/(6 sin theta). Here p/sin theta < 0.21 l: both
+    !! Gauss points of the whole body are above the plane, and a rule at fixed points
+    !! would let the end (a joint of the rope) sink freely.
+    subroutine ground_tilted_body()
+        real(wp), parameter :: k = 1.0e5_wp, c = 200.0_wp, l = 0.2_wp, p = 1.0e-3_wp, &
+                               theta = 0.1_wp
+        type(ground_effect_t) :: ground
+        type(bodies_t) :: b
+        real(wp) :: f(2, 1), m(1), a, r0, h, moment
+        ground = ground_effect([1.0_wp, 0.0_wp], [-1.0_wp, 0.0_wp], k, c, 0.3_wp, 1.0e-3_wp)
+        a = sin(theta)
+        h = 0.5_wp*l
+        r0 = h - p/a
+        b%n = 1
+        b%c = reshape([1.0_wp + p - h*a, 0.5_wp], [2, 1])
+        b%v = reshape([0.0_wp, 0.0_wp], [2, 1])
+        b%l = [l]
+        call lying_forces(ground, b, -theta, 0.0_wp, f, m)
+        moment = cos(theta)*k*a*((h**3 - r0**3)/3.0_wp - r0*(h**2 - r0**2)/2.0_wp)
+        write (*, '(a, 3es14.6, a)') '  ground: tilted body, force, moment, energy', f(1, 1), &
+            m(1), ground%energy(0.0_wp, b), ' (N, N m, J)'
+        call suite%check_close(f(1, 1), -k*p**2/(2.0_wp*a), 1.0e-12_wp, 0.0_wp, &
+                               'ground: a body touching with its end carries k p^2/(2 sin theta)')
+        call suite%check_close(m(1), moment, 1.0e-10_wp, 0.0_wp, &
+                               'ground: the moment of a body touching with its end')
+        call suite%check_close(ground%energy(0.0_wp, b), k*p**3/(6.0_wp*a), 1.0e-12_wp, &
+                               0.0_wp, 'ground: the springs of a body touching with its end')
+    end subroutine ground_tilted_body
 
     !> The ground's force f and moment m on body b turned by dphi from lying along y and
     !! turning at w.

@@ -1,20 +1,20 @@
 !> Contact of the rope with a ground plane (docs/theory/effects.md, "Ground contact").
 !!
 !! The plane passes through p0 with unit normal n_g pointing to the free side. The law is
-!! per metre of rope (k in N/m per metre, c in N s/m per metre); on each body it is
-!! integrated by the two-point Gauss rule: contact acts at X = c +- (l/(2 sqrt 3)) e, each
-!! point standing for half the body's length: stiffness k_p = k l/2, damping c_p = c l/2.
-!! For a body wholly in contact the rule is exact (the penetration is linear along the body,
-!! the springs' energy quadratic): force k l delta and moment k l^3/12 per radian about the
-!! centre, as the distributed law gives. (At the end points the body's rotation would get
-!! three times the distributed stiffness and damping: a spurious fast mode of a rope lying
-!! on the ground.) With the penetration delta = -(X - p0) . n_g > 0 and its rate
-!! delta' = -V . n_g (V the point's velocity), the normal force is
-!!     F_N = max(0, k_p delta + c_p delta'),
+!! per metre of rope (k in N/m per metre, c in N s/m per metre): at a point below the plane
+!! by delta = -(X - p0) . n_g, sinking at delta' = -V . n_g (V the point's velocity),
+!!     f = max(0, k delta + c delta')  per metre,
 !! and regularized Coulomb friction acts along the tangent t_g = (-n_g2, n_g1):
-!!     F_T = -mu F_N tanh(v_t / v_reg),  v_t = V . t_g.
-!! The contact springs store V_c = sum k_p delta^2/2 (in the elastic energy); the
-!! dissipation rate is (F_N - k_p delta) delta' + mu F_N tanh(v_t/v_reg) v_t >= 0.
+!!     f_T = -mu f tanh(v_t / v_reg),  v_t = V . t_g.
+!! Along a rigid body delta, delta' and so k delta + c delta' are linear in the offset from
+!! its centre: the force acts on one interval of the body, where delta > 0 and f > 0, and
+!! that interval's two Gauss points, each standing for half of it, give the law's force and
+!! moment exactly (`body_contact`). A body lying on the ground gets the distributed law's
+!! tilt stiffness and damping (k l^3/12, c l^3/12); a body touching with a part, or a
+!! joint between two bodies, is held by the part below the plane. The contact springs store
+!! V_c = int k delta^2/2 over the part below the plane (in the elastic energy); the
+!! dissipation rate is the force points' (F_N delta' + mu F_N tanh(v_t/v_reg) v_t) less
+!! d V_c/dt, >= 0.
 module ropedyn_effect_ground
     use ropedyn_kinds, only: wp
     use ropedyn_effect, only: body_effect_t, bodies_t, point_force_block
@@ -42,14 +42,15 @@ module ropedyn_effect_ground
         procedure :: split_refusal => ground_split_refusal
     end type ground_effect_t
 
-    !> The contact at one Gauss point of a body (all zero but i, e, r and delta when not in
-    !! contact). No default initialization: `contact` sets every component, and the lists
-    !! of contacts (automatic arrays of 2n in every caller of `touching`) would otherwise be
-    !! filled with zeros on each call before being written.
+    !> A force point of a body in contact (`body_contact`). No default initialization:
+    !! `contact` sets every component, and the lists of contacts (automatic arrays of 2n in
+    !! every caller of `touching`) would otherwise be filled with zeros on each call before
+    !! being written.
     type :: contact_t
         integer :: i                  !< the body
         real(wp) :: e(2)              !< its axis (cos phi, sin phi)
         real(wp) :: r                 !< offset of the point from the body's centre, m
+        real(wp) :: w                 !< the length of rope the point stands for, m
         real(wp) :: delta             !< penetration, m
         real(wp) :: ddelta            !< its rate, m/s
         real(wp) :: fn                !< normal force, N
@@ -58,7 +59,8 @@ module ropedyn_effect_ground
         real(wp) :: f(2)              !< force on the body, N
     end type contact_t
 
-    !> the Gauss points' offset from a body's centre, in body lengths: 1/(2 sqrt 3)
+    !> the two-point Gauss rule's offset from an interval's centre, in interval lengths:
+    !! 1/(2 sqrt 3)
     real(wp), parameter :: GAUSS_OFFSET = 0.28867513459481288_wp
 
 contains
@@ -84,33 +86,84 @@ contains
         name = 'ground'
     end function ground_name
 
-    !> Contact at Gauss point s (-1: towards end A, +1: towards B) of body i, the point at
-    !! offset r = s GAUSS_OFFSET l from the centre: penetration, its rate, normal force,
-    !! tangential speed, tanh(v_t / v_reg) and the force vector (zero when not in
-    !! contact). e: the body's axis (cos phi, sin phi), computed once per body by the caller
-    !! for both points.
-    pure function contact(self, b, i, s, e) result(c)
+    !> The part [r1, r2] of the segment [lo, hi] where alpha + beta r > 0 (r2 <= r1: none).
+    pure subroutine positive_part(alpha, beta, lo, hi, r1, r2)
+        real(wp), intent(in) :: alpha, beta, lo, hi
+        real(wp), intent(out) :: r1, r2
+        r1 = lo
+        r2 = hi
+        if (beta > 0.0_wp) then
+            r1 = max(lo, -alpha/beta)
+        else if (beta < 0.0_wp) then
+            r2 = min(hi, -alpha/beta)
+        else if (alpha <= 0.0_wp) then
+            r2 = lo
+        end if
+    end subroutine positive_part
+
+    !> The contact of body i (axis e): its force points, appended to cc(nc+1:), and its
+    !! springs' energy and rate, added to spring_energy and spring_rate. Along the body
+    !! (offset r from the centre) the penetration delta(r) = d0 + a r, its rate
+    !! delta'(r) = v0 + b r and the normal force per metre f(r) = k delta + c delta' are
+    !! linear. The force acts where delta > 0 and f > 0, an interval [r1, r2]; the two Gauss
+    !! points of that interval, each standing for half of it, integrate f, its moment and
+    !! its power exactly. The springs' energy k delta^2/2 and rate k delta delta' are
+    !! integrated over the interval where delta > 0 alone, by its own Gauss points.
+    pure subroutine body_contact(self, b, i, e, cc, nc, spring_energy, spring_rate)
         class(ground_effect_t), intent(in) :: self
         type(bodies_t), intent(in) :: b
-        integer, intent(in) :: i, s
+        integer, intent(in) :: i
         real(wp), intent(in) :: e(2)
-        type(contact_t) :: c
-        real(wp) :: nv(2), x(2), v(2), kp, cp
-        c = contact_t(i=i, e=e, r=GAUSS_OFFSET*real(s, wp)*b%l(i), delta=0.0_wp, ddelta=0.0_wp, &
-                      fn=0.0_wp, vt=0.0_wp, th=0.0_wp, f=0.0_wp)
+        type(contact_t), intent(inout) :: cc(:)
+        integer, intent(inout) :: nc
+        real(wp), intent(inout) :: spring_energy, spring_rate
+        real(wp) :: nv(2), d0, a, v0, bb, s1, s2, r1, r2, mid, half, r, dl, dv
+        integer :: s
         nv = [-e(2), e(1)]
-        x = b%c(:, i) + c%r*e
+        d0 = -dot_product(b%c(:, i) - self%p0, self%ng)
+        a = -dot_product(e, self%ng)
+        call positive_part(d0, a, -0.5_wp*b%l(i), 0.5_wp*b%l(i), s1, s2)
+        if (s2 <= s1) return
+        v0 = -dot_product(b%v(:, i), self%ng)
+        bb = -b%w(i)*dot_product(nv, self%ng)
+        mid = 0.5_wp*(s1 + s2)
+        half = 0.5_wp*(s2 - s1)
+        do s = -1, 1, 2
+            r = mid + 2.0_wp*GAUSS_OFFSET*real(s, wp)*half
+            dl = d0 + a*r
+            dv = v0 + bb*r
+            spring_energy = spring_energy + half*0.5_wp*self%k*dl**2
+            spring_rate = spring_rate + half*self%k*dl*dv
+        end do
+        call positive_part(self%k*d0 + self%c*v0, self%k*a + self%c*bb, s1, s2, r1, r2)
+        if (r2 <= r1) return
+        mid = 0.5_wp*(r1 + r2)
+        half = 0.5_wp*(r2 - r1)
+        do s = -1, 1, 2
+            nc = nc + 1
+            cc(nc) = contact(self, b, i, mid + 2.0_wp*GAUSS_OFFSET*real(s, wp)*half, half, e, nv)
+        end do
+    end subroutine body_contact
+
+    !> The force point at offset r of body i (axis e, normal nv), standing for the length w:
+    !! penetration, its rate, normal force (at least 0), tangential speed,
+    !! tanh(v_t / v_reg) and the force vector.
+    pure function contact(self, b, i, r, w, e, nv) result(c)
+        class(ground_effect_t), intent(in) :: self
+        type(bodies_t), intent(in) :: b
+        integer, intent(in) :: i
+        real(wp), intent(in) :: r, w, e(2), nv(2)
+        type(contact_t) :: c
+        real(wp) :: x(2), v(2)
+        c%i = i
+        c%e = e
+        c%r = r
+        c%w = w
+        x = b%c(:, i) + r*e
+        v = b%v(:, i) + r*b%w(i)*nv
         c%delta = -dot_product(x - self%p0, self%ng)
-        if (c%delta <= 0.0_wp) return
-        v = b%v(:, i) + c%r*b%w(i)*nv
         c%ddelta = -dot_product(v, self%ng)
-        kp = 0.5_wp*self%k*b%l(i)
-        cp = 0.5_wp*self%c*b%l(i)
-        c%fn = kp*c%delta + cp*c%ddelta
-        if (c%fn <= 0.0_wp) then
-            c%fn = 0.0_wp
-            return
-        end if
+        c%fn = max(0.0_wp, w*(self%k*c%delta + self%c*c%ddelta))
         c%vt = dot_product(v, self%tg)
         c%th = smooth_sign(c%vt/self%v_reg)
         c%f = c%fn*(self%ng - self%mu*c%th*self%tg)
@@ -124,28 +177,26 @@ contains
         th = 1.0_wp - 2.0_wp/(exp(2.0_wp*min(x, 350.0_wp)) + 1.0_wp)
     end function smooth_sign
 
-    !> The contact points below the plane (delta > 0), body by body, A's side before B's, in
-    !! cc(1:nc) (cc holds at least 2 b%n). Those separating faster than their spring relaxes
-    !! carry no force (fn = 0).
-    pure subroutine touching(self, b, cc, nc)
+    !> The force points of the bodies in contact, body by body, in cc(1:nc) (cc holds at
+    !! least 2 b%n), and the contact springs' energy, J, and its rate, W (`body_contact`).
+    pure subroutine touching(self, b, cc, nc, spring_energy, spring_rate)
         class(ground_effect_t), intent(in) :: self
         type(bodies_t), intent(in) :: b
         type(contact_t), intent(inout) :: cc(:)
         integer, intent(out) :: nc
+        real(wp), intent(out) :: spring_energy, spring_rate
         real(wp) :: hn, rg
-        integer :: i, s
+        integer :: i
         nc = 0
+        spring_energy = 0.0_wp
+        spring_rate = 0.0_wp
         do i = 1, b%n
-            ! the centre's height above the plane and the Gauss points' offset along the
-            ! normal: most bodies are clear of the plane at both points
+            ! the centre's height above the plane and the ends' offset along the normal:
+            ! most bodies are clear of the plane
             hn = dot_product(b%c(:, i) - self%p0, self%ng)
-            rg = GAUSS_OFFSET*b%l(i)*abs(dot_product(b%cs(:, i), self%ng))
+            rg = 0.5_wp*b%l(i)*abs(dot_product(b%cs(:, i), self%ng))
             if (hn - rg >= 0.0_wp) cycle
-            do s = -1, 1, 2
-                nc = nc + 1
-                cc(nc) = contact(self, b, i, s, b%cs(:, i))
-                if (cc(nc)%delta <= 0.0_wp) nc = nc - 1
-            end do
+            call body_contact(self, b, i, b%cs(:, i), cc, nc, spring_energy, spring_rate)
         end do
     end subroutine touching
 
@@ -155,8 +206,9 @@ contains
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: f(:, :), m(:)
         type(contact_t) :: cc(2*b%n)
+        real(wp) :: es, er
         integer :: nc
-        call touching(self, b, cc, nc)
+        call touching(self, b, cc, nc, es, er)
         call add_contact_forces(cc(:nc), f, m)
     end subroutine ground_add_forces
 
@@ -182,26 +234,30 @@ contains
         real(wp), intent(inout) :: f(:, :), m(:)
         real(wp), intent(inout) :: dissipation, work
         type(contact_t) :: cc(2*b%n)
+        real(wp) :: es, er
         integer :: nc
-        call touching(self, b, cc, nc)
+        call touching(self, b, cc, nc, es, er)
         call add_contact_forces(cc(:nc), f, m)
-        call add_contact_power(self, b, cc(:nc), dissipation)
+        call add_contact_power(self, cc(:nc), er, dissipation)
     end subroutine ground_add_forces_power
 
+    !> Each force point's block with its offset and its length held fixed: the term of an
+    !! interval's end that moves with the state (where delta = 0, f = c delta') is left out
+    !! (in statics delta' = 0 there, and the tangent is exact).
     pure subroutine ground_add_jacobian(self, t, b, jac)
         class(ground_effect_t), intent(in) :: self
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: jac(:, :, :)
         type(contact_t) :: cc(2*b%n)
-        real(wp) :: kp, cp, dir(2), dfdx(2, 2), dfdv(2, 2)
+        real(wp) :: kp, cp, dir(2), dfdx(2, 2), dfdv(2, 2), es, er
         integer :: k, nc, p
-        call touching(self, b, cc, nc)
+        call touching(self, b, cc, nc, es, er)
         do k = 1, nc
             associate (c => cc(k), i => cc(k)%i)
                 if (c%fn <= 0.0_wp) cycle
-                kp = 0.5_wp*self%k*b%l(i)
-                cp = 0.5_wp*self%c*b%l(i)
+                kp = self%k*c%w
+                cp = self%c*c%w
                 dir = self%ng - self%mu*c%th*self%tg
                 ! dF_N/dX = -k_p n_g, dF_N/dV = -c_p n_g; d tanh/dV = (1 - th^2)/v_reg t_g
                 do p = 1, 2
@@ -221,12 +277,9 @@ contains
         real(wp), intent(in) :: t
         type(bodies_t), intent(in) :: b
         type(contact_t) :: cc(2*b%n)
-        integer :: k, nc
-        e = 0.0_wp
-        call touching(self, b, cc, nc)
-        do k = 1, nc
-            e = e + 0.25_wp*self%k*b%l(cc(k)%i)*cc(k)%delta**2
-        end do
+        real(wp) :: er
+        integer :: nc
+        call touching(self, b, cc, nc, e, er)
     end function ground_energy
 
     pure subroutine ground_power(self, t, b, dissipation, work)
@@ -235,24 +288,26 @@ contains
         type(bodies_t), intent(in) :: b
         real(wp), intent(inout) :: dissipation, work
         type(contact_t) :: cc(2*b%n)
+        real(wp) :: es, er
         integer :: nc
-        call touching(self, b, cc, nc)
-        call add_contact_power(self, b, cc(:nc), dissipation)
+        call touching(self, b, cc, nc, es, er)
+        call add_contact_power(self, cc(:nc), er, dissipation)
     end subroutine ground_power
 
-    !> Add the dissipation rate of the contacts cc.
-    pure subroutine add_contact_power(self, b, cc, dissipation)
+    !> Add the dissipation rate of the contacts: the power the force points take from the
+    !! rope, F_N delta' + mu F_N tanh(v_t/v_reg) v_t each, less the rate at which the
+    !! springs store energy, spring_rate (W). Where F_N is clipped to 0 (separating faster
+    !! than the spring relaxes) the springs' energy still falls: -k delta delta' > 0.
+    pure subroutine add_contact_power(self, cc, spring_rate, dissipation)
         class(ground_effect_t), intent(in) :: self
-        type(bodies_t), intent(in) :: b
         type(contact_t), intent(in) :: cc(:)
+        real(wp), intent(in) :: spring_rate
         real(wp), intent(inout) :: dissipation
         integer :: k
+        dissipation = dissipation - spring_rate
         do k = 1, size(cc)
             associate (c => cc(k))
-                ! F_N = 0 when separating faster than the spring relaxes: then the spring's
-                ! energy still falls at -k_p delta delta' > 0 (th = 0 there)
-                dissipation = dissipation + (c%fn - 0.5_wp*self%k*b%l(c%i)*c%delta)*c%ddelta &
-                              + self%mu*c%fn*c%th*c%vt
+                dissipation = dissipation + c%fn*c%ddelta + self%mu*c%fn*c%th*c%vt
             end associate
         end do
     end subroutine add_contact_power
@@ -272,8 +327,9 @@ contains
         class(ground_effect_t), intent(in) :: self
         type(bodies_t), intent(in) :: b
         type(contact_t) :: cc(2*b%n)
+        real(wp) :: es, er
         integer :: nc
-        call touching(self, b, cc, nc)
+        call touching(self, b, cc, nc, es, er)
         total = sum(cc(:nc)%fn)
     end function ground_total_normal_force
 end module ropedyn_effect_ground

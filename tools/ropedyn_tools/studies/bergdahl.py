@@ -100,11 +100,29 @@ def fairlead_tension(path):
     return t, np.hypot(r[:, 0], r[:, 1]), solver
 
 
+def deepest(path, period, cycles=ANALYSED):
+    """How far the rope's deepest point goes below the floor (m) over the last `cycles`
+    cycles of a run file (the floor: the scene's &ground point, normal (-1, 0))."""
+    floor = scene_number(BASE, "point")
+    with h5py.File(path, "r") as f:
+        t = f["time"][:]
+        first = int(np.searchsorted(t, t[-1] - cycles * period))
+        x = f["rope/points"][first:, :, 0]
+    return float(np.max(x) - floor)
+
+
+def static_sinking():
+    """The floor law's sinking of rope lying still in water, (m - rho_w A) g / k (m)."""
+    submerged = (scene_number(BASE, "mass_per_length") - scene_number(BASE, "density")
+                 * math.pi / 4 * scene_number(BASE, "diameter") ** 2)
+    return submerged * scene_number(BASE, "gravity") / scene_number(BASE, "stiffness")
+
+
 def case_result(path, period, cycles=ANALYSED):
     t, tension, solver = fairlead_tension(path)
     m = cycle_maxima(t, tension, period, cycles)
     return dict(maxima=m, mean=float(m.mean()), spread=float(m.std(ddof=1)) if len(m) > 1
-                else 0.0, **solver)
+                else 0.0, deepest=deepest(path, period, cycles), **solver)
 
 
 def scores(computed, measured):
@@ -657,6 +675,12 @@ def section(results, models, periods, walls, conv, figs, command, work, contact=
            "Mean of the 5 cycle maxima, their standard deviation (spread) and the error "
            "against the measurement.", ""]
     md += results_table(results, models, periods)
+    depths = [f"{name(m)} {1e3 * max(r['deepest'] for k, r in results.items() if k[0] == m):.2f} mm"
+              for m in models if any(k[0] == m for k in results)]
+    md += ["", "How deep the rope's deepest point goes below the floor over the analysed cycles "
+           f"of all conditions: {', '.join(depths)}. Lying still, the floor's law sinks the "
+           f"chain by {1e3 * static_sinking():.1e} mm; the rest is landings "
+           "([ground contact](../theory/effects.md#ground-contact))."]
     if figs:
         md += ["", f"![measured against computed](../figures/{figs[0]})", ""]
         if len(figs) > 1:
