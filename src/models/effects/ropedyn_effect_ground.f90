@@ -126,6 +126,21 @@ contains
         if (s2 <= s1) return
         v0 = -dot_product(b%v(:, i), self%ng)
         bb = -b%w(i)*dot_product(nv, self%ng)
+        call positive_part(self%k*d0 + self%c*v0, self%k*a + self%c*bb, s1, s2, r1, r2)
+        if (r1 == s1 .and. r2 == s2) then
+            ! the force acts on all of the part below the plane (a body lying on it, one
+            ! landing): the force points are the springs' points too
+            mid = 0.5_wp*(r1 + r2)
+            half = 0.5_wp*(r2 - r1)
+            do s = -1, 1, 2
+                nc = nc + 1
+                cc(nc) = contact(self, b, i, mid + 2.0_wp*GAUSS_OFFSET*real(s, wp)*half, half, &
+                                 e, nv)
+                spring_energy = spring_energy + half*0.5_wp*self%k*cc(nc)%delta**2
+                spring_rate = spring_rate + half*self%k*cc(nc)%delta*cc(nc)%ddelta
+            end do
+            return
+        end if
         mid = 0.5_wp*(s1 + s2)
         half = 0.5_wp*(s2 - s1)
         do s = -1, 1, 2
@@ -135,7 +150,6 @@ contains
             spring_energy = spring_energy + half*0.5_wp*self%k*dl**2
             spring_rate = spring_rate + half*self%k*dl*dv
         end do
-        call positive_part(self%k*d0 + self%c*v0, self%k*a + self%c*bb, s1, s2, r1, r2)
         if (r2 <= r1) return
         mid = 0.5_wp*(r1 + r2)
         half = 0.5_wp*(r2 - r1)
