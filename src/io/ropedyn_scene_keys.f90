@@ -82,6 +82,9 @@ contains
             call add_real(G_ROPE, 'bending_damping', r%bending_damping, R_NONNEGATIVE, &
                 'N m^2 s', 'section set: bending damping coefficient', &
                 unset='not set: axial_damping EI/EA with the section set; else the solid rod')
+            call add_logical(G_ROPE, 'compression', r%compression, 'the axial springs '// &
+                'push back when compressed (.false.: tension only, a chain or a cable that '// &
+                'goes slack)')
             call add_real(G_ROPE, 'gravity', r%gravity, R_NONNEGATIVE, 'm/s^2', &
                 'gravitational acceleration, along +x (down)')
 

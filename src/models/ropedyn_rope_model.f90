@@ -31,6 +31,10 @@ module ropedyn_rope_model
         !! a call, with zero velocity and acceleration (a static force never depends on
         !! them); set by ropedyn_statics_terms around its evaluations, .false. in a run
         logical :: supports_at_rest = .false.
+        !> the axial springs carry tension only (&rope compression = .false.; set by the
+        !! model's constructor). Not in statics and modes (supports_at_rest): there they
+        !! keep the linear law, which a line hanging in tension shares with it
+        logical :: tension_only = .false.
         !> the supports (1 top, 2 bottom): their prescribed motions (anchors and angles at
         !! rest in p0, angle0) and whether they move; set by the model's constructor (a
         !! driver changes only a coupled motion's curve: support_motion_t%couple)

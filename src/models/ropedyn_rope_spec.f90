@@ -51,6 +51,9 @@ module ropedyn_rope_spec
         real(wp) :: shear_damping = NOT_SET
         !> [N m^2 s]; not set: axial_damping times bending_stiffness/axial_stiffness
         real(wp) :: bending_damping = NOT_SET
+        !> the axial springs push back when compressed; .false.: they carry tension only,
+        !! as a chain or a cable that goes slack
+        logical :: compression = .true.
     end type rope_params_t
 
     !> `&model`: which discretisation and how fine.

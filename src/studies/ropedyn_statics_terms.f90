@@ -50,8 +50,12 @@ contains
         type(rope_spec_t), intent(in), optional :: spec
         type(energy_t) :: e
         real(wp) :: yq(max(1, model%quad_size()))
+        logical :: held
         yq = 0.0_wp
+        held = model%supports_at_rest
+        model%supports_at_rest = .true.
         e = model%energy(0.0_wp, y, yq)
+        model%supports_at_rest = held
         v = e%elastic + e%gravity
         if (present(spec)) v = v + load_potential(model, spec, y)
     end function potential_energy

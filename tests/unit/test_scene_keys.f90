@@ -24,7 +24,7 @@ program test_scene_keys
     call execute_command_line('mkdir -p '//DIR, exitstat=stat)
     call suite%check_true(stat == 0, 'create '//DIR)
     call bind_keys(defaults, keys)
-    call suite%check_true(size(keys) == 103, 'the table has 103 keys: '//int_text(size(keys)))
+    call suite%check_true(size(keys) == 104, 'the table has 104 keys: '//int_text(size(keys)))
     do k = 1, size(keys)
         call round_trip(keys(k))
     end do

@@ -143,7 +143,9 @@ contains
         ! springs, dampers and clamps on member m's own variables
         select case (kind)
         case (2)
-            col(n + m) = col(n + m) - self%ksj(m)
+            ! a slack member of a line carrying tension only has no stiffness
+            if (member_stretch(self, y(n + m)) /= 0.0_wp .or. y(n + m) >= 0.0_wp) &
+                col(n + m) = col(n + m) - self%ksj(m)
         case (4)
             col(n + m) = col(n + m) - self%dsj(m)
         case (1, 3)

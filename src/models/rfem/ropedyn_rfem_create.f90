@@ -52,6 +52,7 @@ contains
         ! internal SDEs: a strain exists only when its effect is on, its damping only when
         ! damping is on
         model%tension = spec%effects%tension
+        model%tension_only = .not. spec%rope%compression
         model%shear = spec%effects%shear
         model%bending = spec%effects%bending
         if (model%tension) model%cx = cx
