@@ -46,21 +46,21 @@ def test_sampling_error_of_a_convergence_change():
     assert math.isclose(bg.change_error(row, ref), expected)
 
 
-def test_runs_without_friction_change_against_their_own_reference():
-    """The element halving without the floor's friction is measured against the run at the
-    study's element length without it, not against the study's own run."""
+def test_runs_with_another_law_change_against_their_own_reference():
+    """The element halving with the axial springs carrying compression is measured against
+    the run at the study's element length with that law, not against the study's own run."""
     n, rtol = bg.base_elements(), bg.base_rtol()
 
-    def row(elements, friction, mean):
-        return dict(model="rfem", period=1.25, n=elements, rtol=rtol, friction=friction,
+    def row(elements, law, mean):
+        return dict(model="rfem", period=1.25, n=elements, rtol=rtol, law=law,
                     mean=mean, spread=0.0, maxima=np.zeros(5), cpu_time=1.0)
 
-    rows = [row(n, True, 50.0), row((n + 1) // 2, True, 49.0), row((n + 1) // 2, False, 51.51),
-            row(n, False, 51.0)]
+    rows = [row(n, "", 50.0), row(2 * n, "", 49.0), row(2 * n, "compression", 51.51),
+            row(n, "compression", 51.0)]
     lines = bg.convergence_lines(rows)
-    coarse = next(x for x in lines if x.startswith(f"| RFEM, no friction | 1.25 | {(n + 1) // 2} |"))
-    assert "| +1.00 % |" in coarse, coarse                # against 51.0, not 50.0 (+3.02 %)
-    assert "| -2.00 % |" in next(x for x in lines if x.startswith(f"| RFEM | 1.25 | {(n + 1) // 2} |"))
+    fine = next(x for x in lines if x.startswith(f"| RFEM, compression | 1.25 | {2 * n} |"))
+    assert "| +1.00 % |" in fine, fine                    # against 51.0, not 50.0 (+3.02 %)
+    assert "| -2.00 % |" in next(x for x in lines if x.startswith(f"| RFEM | 1.25 | {2 * n} |"))
     assert bg.is_base(rows[0]) and not bg.is_base(rows[3])
 
 
