@@ -138,6 +138,10 @@ module ropedyn_run
         integer :: max_order = 0, safe_order = 0
         logical :: monitoring = .false.
         integer(i8) :: steps_mark = 0
+        ! the energy of the state (t, y, yq) the order safety has just looked at, for its
+        ! record (valid until the state changes): one evaluation of the energy per record
+        type(energy_t) :: e_checked
+        logical :: e_checked_valid = .false.
         procedure(stop_query_i), pointer, nopass :: stop_requested => null()
         ! the guard of the output file: the lock held ('' none), and for a new run the
         ! file written (FILE.part) and its final name
@@ -497,6 +501,7 @@ contains
         real(wp) :: tout, clock_start
         tout = self%output_time(self%k_next)
         outcome = STEP_FAILED
+        self%e_checked_valid = .false.
         if (self%scene%solver%profile) clock_start = clock_seconds()
         call self%integrator%advance_to(tout, self%t, self%y, self%yq(1:self%nq), err)
         if (self%scene%solver%profile) &
@@ -552,7 +557,12 @@ contains
         call self%model%internal_forces(self%t, self%y, self%axial, self%shear, self%moment, &
                                         self%reaction)
         call self%model%support_positions(self%t, self%anchors)
-        e = self%model%energy(self%t, self%y, self%yq)
+        if (self%e_checked_valid) then
+            e = self%e_checked
+        else
+            e = self%model%energy(self%t, self%y, self%yq)
+        end if
+        self%e_checked_valid = .false.
         if (.not. (all(ieee_is_finite(self%y)) .and. all(ieee_is_finite(self%yq)) .and. &
                    ieee_is_finite(e%balance()) .and. all(ieee_is_finite(self%points)) .and. &
                    all(ieee_is_finite(self%axial)) .and. all(ieee_is_finite(self%shear)) .and. &
