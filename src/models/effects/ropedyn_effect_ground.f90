@@ -117,7 +117,7 @@ contains
         type(contact_t), intent(inout) :: cc(:)
         integer, intent(inout) :: nc
         real(wp), intent(inout) :: spring_energy, spring_rate
-        real(wp) :: nv(2), d0, a, v0, bb, s1, s2, r1, r2, mid, half, r, dl, dv
+        real(wp) :: nv(2), d0, a, v0, bb, t0, t1, s1, s2, r1, r2, mid, half, r, dl, dv
         integer :: s
         nv = [-e(2), e(1)]
         d0 = -dot_product(b%c(:, i) - self%p0, self%ng)
@@ -126,6 +126,8 @@ contains
         if (s2 <= s1) return
         v0 = -dot_product(b%v(:, i), self%ng)
         bb = -b%w(i)*dot_product(nv, self%ng)
+        t0 = dot_product(b%v(:, i), self%tg)
+        t1 = b%w(i)*dot_product(nv, self%tg)
         call positive_part(self%k*d0 + self%c*v0, self%k*a + self%c*bb, s1, s2, r1, r2)
         if (r1 == s1 .and. r2 == s2) then
             ! the force acts on all of the part below the plane (a body lying on it, one
@@ -134,8 +136,8 @@ contains
             half = 0.5_wp*(r2 - r1)
             do s = -1, 1, 2
                 nc = nc + 1
-                cc(nc) = contact(self, b, i, mid + 2.0_wp*GAUSS_OFFSET*real(s, wp)*half, half, &
-                                 e, nv)
+                r = mid + 2.0_wp*GAUSS_OFFSET*real(s, wp)*half
+                cc(nc) = contact(self, i, e, r, half, d0 + a*r, v0 + bb*r, t0 + t1*r)
                 spring_energy = spring_energy + half*0.5_wp*self%k*cc(nc)%delta**2
                 spring_rate = spring_rate + half*self%k*cc(nc)%delta*cc(nc)%ddelta
             end do
@@ -155,31 +157,28 @@ contains
         half = 0.5_wp*(r2 - r1)
         do s = -1, 1, 2
             nc = nc + 1
-            cc(nc) = contact(self, b, i, mid + 2.0_wp*GAUSS_OFFSET*real(s, wp)*half, half, e, nv)
+            r = mid + 2.0_wp*GAUSS_OFFSET*real(s, wp)*half
+            cc(nc) = contact(self, i, e, r, half, d0 + a*r, v0 + bb*r, t0 + t1*r)
         end do
     end subroutine body_contact
 
-    !> The force point at offset r of body i (axis e, normal nv), standing for the length w:
-    !! penetration, its rate, normal force (at least 0), tangential speed,
-    !! tanh(v_t / v_reg) and the force vector.
-    pure function contact(self, b, i, r, w, e, nv) result(c)
+    !> The force point at offset r of body i (axis e), standing for the length w, with its
+    !! penetration delta, its rate ddelta and its tangential speed vt: the normal force (at
+    !! least 0), tanh(v_t / v_reg) and the force vector.
+    pure function contact(self, i, e, r, w, delta, ddelta, vt) result(c)
         class(ground_effect_t), intent(in) :: self
-        type(bodies_t), intent(in) :: b
         integer, intent(in) :: i
-        real(wp), intent(in) :: r, w, e(2), nv(2)
+        real(wp), intent(in) :: e(2), r, w, delta, ddelta, vt
         type(contact_t) :: c
-        real(wp) :: x(2), v(2)
         c%i = i
         c%e = e
         c%r = r
         c%w = w
-        x = b%c(:, i) + r*e
-        v = b%v(:, i) + r*b%w(i)*nv
-        c%delta = -dot_product(x - self%p0, self%ng)
-        c%ddelta = -dot_product(v, self%ng)
-        c%fn = max(0.0_wp, w*(self%k*c%delta + self%c*c%ddelta))
-        c%vt = dot_product(v, self%tg)
-        c%th = smooth_sign(c%vt/self%v_reg)
+        c%delta = delta
+        c%ddelta = ddelta
+        c%fn = max(0.0_wp, w*(self%k*delta + self%c*ddelta))
+        c%vt = vt
+        c%th = smooth_sign(vt/self%v_reg)
         c%f = c%fn*(self%ng - self%mu*c%th*self%tg)
     end function contact
 
