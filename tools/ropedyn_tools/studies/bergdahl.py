@@ -248,17 +248,31 @@ def run_sweeps(exe, periods, models, radii, work, jobs, quick=None):
                 raise RuntimeError(f"{' '.join(cmd)}: exit {result.returncode}\n"
                                    f"{result.stdout}\n{result.stderr}")
 
+        # the wall time counts only when every case of the queue runs now: kept cases
+        # (a rerun) would make it short, and the file keeps the last full measurement
+        todo = [(period, task) for period, task in queue
+                if not complete(case_path(work, period, label, RADII[task - 1]))]
         w0 = time.perf_counter()
         with ThreadPoolExecutor(max_workers=jobs) as pool:
-            list(pool.map(one, queue))
-        walls[label] = time.perf_counter() - w0
+            list(pool.map(one, todo))
+        wall = time.perf_counter() - w0
         for sweep in sweeps.values():   # exit 3 when cases are missing (a subset of radii)
             subprocess.run([str(exe), "sweep", str(sweep), "--output-dir", str(sweep.parent),
                             "--summary"], capture_output=True, text=True)
-        (work / label / "wall.json").write_text(json.dumps(
-            {"wall": walls[label], "jobs": jobs, "periods": list(periods),
-             "radii": list(radii)}) + "\n")
+        if len(todo) == len(queue):
+            walls[label] = wall
+            (work / label / "wall.json").write_text(json.dumps(
+                {"wall": wall, "jobs": jobs, "periods": list(periods),
+                 "radii": list(radii)}) + "\n")
+        else:
+            print(f"bergdahl: {label}: {len(queue) - len(todo)} of {len(queue)} cases kept; "
+                  "their wall time is not measured again", file=sys.stderr)
     return walls
+
+
+def complete(path):
+    """Whether a case file exists and holds a complete run."""
+    return path.exists() and status(path)[0] == "complete"
 
 
 def name(label):
