@@ -119,6 +119,7 @@ contains
         real(wp), intent(inout) :: spring_energy, spring_rate
         real(wp) :: nv(2), d0, a, v0, bb, t0, t1, s1, s2, r1, r2, mid, half, r, dl, dv
         integer :: s
+        logical :: same
         nv = [-e(2), e(1)]
         d0 = -dot_product(b%c(:, i) - self%p0, self%ng)
         a = -dot_product(e, self%ng)
@@ -129,29 +130,20 @@ contains
         t0 = dot_product(b%v(:, i), self%tg)
         t1 = b%w(i)*dot_product(nv, self%tg)
         call positive_part(self%k*d0 + self%c*v0, self%k*a + self%c*bb, s1, s2, r1, r2)
-        if (r1 == s1 .and. r2 == s2) then
-            ! the force acts on all of the part below the plane (a body lying on it, one
-            ! landing): the force points are the springs' points too
-            mid = 0.5_wp*(r1 + r2)
-            half = 0.5_wp*(r2 - r1)
+        ! the force acts on all of the part below the plane (a body lying on it, one
+        ! landing): then the force points are the springs' points too
+        same = r1 == s1 .and. r2 == s2
+        if (.not. same) then
+            mid = 0.5_wp*(s1 + s2)
+            half = 0.5_wp*(s2 - s1)
             do s = -1, 1, 2
-                nc = nc + 1
                 r = mid + 2.0_wp*GAUSS_OFFSET*real(s, wp)*half
-                cc(nc) = contact(self, i, e, r, half, d0 + a*r, v0 + bb*r, t0 + t1*r)
-                spring_energy = spring_energy + half*0.5_wp*self%k*cc(nc)%delta**2
-                spring_rate = spring_rate + half*self%k*cc(nc)%delta*cc(nc)%ddelta
+                dl = d0 + a*r
+                dv = v0 + bb*r
+                spring_energy = spring_energy + half*0.5_wp*self%k*dl**2
+                spring_rate = spring_rate + half*self%k*dl*dv
             end do
-            return
         end if
-        mid = 0.5_wp*(s1 + s2)
-        half = 0.5_wp*(s2 - s1)
-        do s = -1, 1, 2
-            r = mid + 2.0_wp*GAUSS_OFFSET*real(s, wp)*half
-            dl = d0 + a*r
-            dv = v0 + bb*r
-            spring_energy = spring_energy + half*0.5_wp*self%k*dl**2
-            spring_rate = spring_rate + half*self%k*dl*dv
-        end do
         if (r2 <= r1) return
         mid = 0.5_wp*(r1 + r2)
         half = 0.5_wp*(r2 - r1)
@@ -159,6 +151,10 @@ contains
             nc = nc + 1
             r = mid + 2.0_wp*GAUSS_OFFSET*real(s, wp)*half
             cc(nc) = contact(self, i, e, r, half, d0 + a*r, v0 + bb*r, t0 + t1*r)
+            if (same) then
+                spring_energy = spring_energy + half*0.5_wp*self%k*cc(nc)%delta**2
+                spring_rate = spring_rate + half*self%k*cc(nc)%delta*cc(nc)%ddelta
+            end if
         end do
     end subroutine body_contact
 
@@ -187,7 +183,12 @@ contains
     !! a few 1e-16, also near x = 0).
     elemental real(wp) function smooth_sign(x) result(th)
         real(wp), intent(in) :: x
-        th = 1.0_wp - 2.0_wp/(exp(2.0_wp*min(x, 350.0_wp)) + 1.0_wp)
+        ! beyond |x| = 20 the formula gives +-1 exactly (2/(exp(40) + 1) < 1e-17): no exp
+        if (abs(x) > 20.0_wp) then
+            th = sign(1.0_wp, x)
+        else
+            th = 1.0_wp - 2.0_wp/(exp(2.0_wp*x) + 1.0_wp)
+        end if
     end function smooth_sign
 
     !> The force points of the bodies in contact, body by body, in cc(1:nc) (cc holds at
