@@ -58,6 +58,7 @@ module ropedyn_rope_model
         procedure :: has_second_order => rope_has_second_order, &
                      second_order_layout => rope_second_order_layout
         procedure :: state_from_fields => rope_state_from_fields
+        procedure :: spring_stretch => rope_spring_stretch, spring_slope => rope_spring_slope
     end type rope_model_t
 
     abstract interface
@@ -249,4 +250,23 @@ contains
         class(energy_t), intent(in) :: self
         e = self%kinetic + self%elastic + self%gravity + self%dissipated - self%support_work
     end function energy_balance
+
+    !> The stretch s (m) an axial spring of the line acts on: s, or with a line carrying
+    !! tension only (tension_only, outside statics and modes) its positive part: a
+    !! compressed chain is slack.
+    elemental real(wp) function rope_spring_stretch(self, s) result(stretch)
+        class(rope_model_t), intent(in) :: self
+        real(wp), intent(in) :: s
+        stretch = s
+        if (self%tension_only .and. .not. self%supports_at_rest) stretch = max(s, 0.0_wp)
+    end function rope_spring_stretch
+
+    !> d spring_stretch / ds at s: 1, or 0 where a line carrying tension only is slack.
+    elemental real(wp) function rope_spring_slope(self, s) result(slope)
+        class(rope_model_t), intent(in) :: self
+        real(wp), intent(in) :: s
+        slope = 1.0_wp
+        if (self%tension_only .and. .not. self%supports_at_rest .and. s < 0.0_wp) &
+            slope = 0.0_wp
+    end function rope_spring_slope
 end module ropedyn_rope_model

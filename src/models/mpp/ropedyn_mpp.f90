@@ -353,15 +353,6 @@ module ropedyn_mpp
         !> The internal forces (submodule ropedyn_mpp_forces): the suffix sums of the
         !! residual at the true accelerations resolved in the frame of the member below the
         !! joint (joint n: member n), the joints' moments of the residual.
-        !> The stretch a member spring acts on: its extension u, or with a line carrying
-        !! tension only (tension_only, outside statics and modes) the positive part: a
-        !! compressed chain is slack.
-        elemental module function member_stretch(self, u) result(stretch)
-            class(mpp_t), intent(in) :: self
-            real(wp), intent(in) :: u
-            real(wp) :: stretch
-        end function member_stretch
-
         module subroutine mpp_internal_forces(self, t, y, axial, shear, moment, reaction)
             class(mpp_t), intent(inout) :: self
             real(wp), intent(in) :: t
@@ -412,7 +403,6 @@ module ropedyn_mpp
     end interface
 
 contains
-
 
     subroutine mpp_create(model, spec, err)
         type(mpp_t), intent(out) :: model

@@ -29,7 +29,7 @@ contains
             en%gravity = en%gravity - self%pm_m(k)*self%g*(c(1, i) + self%pm_r(k)*e(1))
         end do
         ! (the last member's own stiffness as a correction: the same sum as without it)
-        u = member_stretch(self, u)
+        u = self%spring_stretch(u)
         en%elastic = 0.5_wp*self%ks*sum(u**2) + 0.5_wp*(self%ksj(n) - self%ks)*u(n)**2
         do k = 2, n
             en%elastic = en%elastic + 0.5_wp*self%cb*(phi(k) - phi(k - 1))**2

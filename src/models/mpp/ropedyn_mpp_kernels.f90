@@ -153,7 +153,7 @@ contains
         if (present(pin)) pin = -wsum
 
         ! Member springs and dampers.
-        if (self%nu > 0) r(n + 1:nd) = r(n + 1:nd) - self%ksj*member_stretch(self, y(n + 1:nd)) &
+        if (self%nu > 0) r(n + 1:nd) = r(n + 1:nd) - self%ksj*self%spring_stretch(y(n + 1:nd)) &
                                        - self%dsj*y(nd + n + 1:2*nd)
         ! Joint bending springs and dampers between members; their moments (the lower
         ! member's on the upper one) kept by joint for the internal forces.
@@ -610,9 +610,4 @@ contains
         call add_to_band(kb, size(kb, 1), offset, self%dr(:, 1:nd), 0, 0)
         call add_to_band(cb, size(cb, 1), offset, self%dr(:, nd + 1:2*nd), 0, 0)
     end procedure mpp_second_order_blocks
-
-    module procedure member_stretch
-        stretch = u
-        if (self%tension_only .and. .not. self%supports_at_rest) stretch = max(u, 0.0_wp)
-    end procedure member_stretch
 end submodule ropedyn_mpp_kernels

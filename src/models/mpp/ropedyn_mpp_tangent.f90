@@ -143,9 +143,7 @@ contains
         ! springs, dampers and clamps on member m's own variables
         select case (kind)
         case (2)
-            ! a slack member of a line carrying tension only has no stiffness
-            if (member_stretch(self, y(n + m)) /= 0.0_wp .or. y(n + m) >= 0.0_wp) &
-                col(n + m) = col(n + m) - self%ksj(m)
+            col(n + m) = col(n + m) - self%ksj(m)*self%spring_slope(y(n + m))
         case (4)
             col(n + m) = col(n + m) - self%dsj(m)
         case (1, 3)

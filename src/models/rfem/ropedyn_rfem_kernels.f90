@@ -306,7 +306,7 @@ contains
             fx = 0.0_wp
             fy = 0.0_wp
             fp = 0.0_wp
-            if (self%tension) fx = self%cxj(j)*axial_stretch(self, s%dwx)
+            if (self%tension) fx = self%cxj(j)*self%spring_stretch(s%dwx)
             if (self%shear) fy = self%cy*s%dwy
             if (self%bending) fp = self%cpj(j)*(y(s%kb + 3) - y(s%ka + 3))
             if (energy) e_el = e_el + 0.5_wp*(fx*s%dwx + fy*s%dwy &
@@ -492,8 +492,8 @@ contains
             fy = 0.0_wp
             fp = 0.0_wp
             if (self%tension) then
-                fx = self%cxj(j)*axial_stretch(self, s%dwx)
-                dfx = merge(self%cxj(j), 0.0_wp, fx /= 0.0_wp .or. s%dwx >= 0.0_wp)*gx
+                fx = self%cxj(j)*self%spring_stretch(s%dwx)
+                dfx = self%cxj(j)*self%spring_slope(s%dwx)*gx
             end if
             if (self%shear) then
                 fy = self%cy*s%dwy
@@ -626,14 +626,4 @@ contains
         status = STATUS_OK
         if (.not. (ieee_is_finite(power) .and. ieee_is_finite(work))) status = STATUS_RECOVERABLE
     end subroutine store_rates
-
-    !> The stretch an axial spring acts on: dwx, or with a line carrying tension only
-    !! (tension_only, outside statics and modes) its positive part: a compressed chain is
-    !! slack.
-    pure real(wp) function axial_stretch(self, dwx) result(stretch)
-        class(rfem_t), intent(in) :: self
-        real(wp), intent(in) :: dwx
-        stretch = dwx
-        if (self%tension_only .and. .not. self%supports_at_rest) stretch = max(dwx, 0.0_wp)
-    end function axial_stretch
 end submodule ropedyn_rfem_kernels
