@@ -138,10 +138,6 @@ module ropedyn_run
         integer :: max_order = 0, safe_order = 0
         logical :: monitoring = .false.
         integer(i8) :: steps_mark = 0
-        ! the energy of the state (t, y, yq) the order safety has just looked at, for its
-        ! record (valid until the state changes): one evaluation of the energy per record
-        type(energy_t) :: e_checked
-        logical :: e_checked_valid = .false.
         procedure(stop_query_i), pointer, nopass :: stop_requested => null()
         ! the guard of the output file: the lock held ('' none), and for a new run the
         ! file written (FILE.part) and its final name
@@ -208,11 +204,14 @@ module ropedyn_run
             type(error_t), allocatable, intent(out) :: err
         end subroutine resume_from_file
 
-        !> The order safety at the output time just reached (submodule ropedyn_run_safety).
-        module subroutine check_energy(self, tout, err)
+        !> The order safety at the output time just reached (submodule ropedyn_run_safety);
+        !! e_now: the energy of the state it leaves, when it did not change it (for the
+        !! record: one evaluation of the energy per record).
+        module subroutine check_energy(self, tout, err, e_now)
             class(run_t), intent(inout) :: self
             real(wp), intent(in) :: tout
             type(error_t), allocatable, intent(out) :: err
+            type(energy_t), allocatable, intent(out) :: e_now
         end subroutine check_energy
 
         !> OUTPUT_NONE: integrate to time t (s) > the current time, where the coupled
@@ -498,16 +497,16 @@ contains
         integer, intent(out) :: outcome
         type(error_t), allocatable, intent(out) :: err
         type(error_t), allocatable :: io_err
+        type(energy_t), allocatable :: e_now
         real(wp) :: tout, clock_start
         tout = self%output_time(self%k_next)
         outcome = STEP_FAILED
-        self%e_checked_valid = .false.
         if (self%scene%solver%profile) clock_start = clock_seconds()
         call self%integrator%advance_to(tout, self%t, self%y, self%yq(1:self%nq), err)
         if (self%scene%solver%profile) &
             self%time_advance = self%time_advance + (clock_seconds() - clock_start)
         if (.not. allocated(err) .and. self%monitoring .and. self%t >= tout) &
-            call self%check_energy(tout, err)
+            call self%check_energy(tout, err, e_now)
         if (allocated(err)) then
             call self%progress%done()
             ! keep the last good state if the solver got past the previous record
@@ -518,7 +517,7 @@ contains
         if (self%t < tout .or. self%asked_to_stop()) then
             ! stopped at a step boundary: that state is the last record
             call self%progress%done()
-            if (self%t > self%t_last) call self%record(err)
+            if (self%t > self%t_last) call self%record(err, e_now)
             if (allocated(err)) then
                 call self%end_on(err)
                 return
@@ -526,7 +525,7 @@ contains
             outcome = STEP_STOPPED
             return
         end if
-        call self%record(err)
+        call self%record(err, e_now)
         if (allocated(err)) then
             call self%progress%done()
             call self%end_on(err)
@@ -538,10 +537,13 @@ contains
     end subroutine run_step
 
     !> Append the state at t to the file (after checking it is finite) and make it the
-    !! previous record.
-    subroutine record(self, err)
+    !! previous record; e_now: its energy when already computed (absent or not allocated:
+    !! computed here).
+    subroutine record(self, err, e_now)
         class(run_t), intent(inout) :: self
         type(error_t), allocatable, intent(out) :: err
+        type(energy_t), allocatable, intent(in), optional :: e_now
+        logical :: have_e
         type(solver_stats_t) :: stats
         type(energy_t) :: e
         real(wp) :: h
@@ -557,12 +559,13 @@ contains
         call self%model%internal_forces(self%t, self%y, self%axial, self%shear, self%moment, &
                                         self%reaction)
         call self%model%support_positions(self%t, self%anchors)
-        if (self%e_checked_valid) then
-            e = self%e_checked
+        have_e = .false.
+        if (present(e_now)) have_e = allocated(e_now)
+        if (have_e) then
+            e = e_now
         else
             e = self%model%energy(self%t, self%y, self%yq)
         end if
-        self%e_checked_valid = .false.
         if (.not. (all(ieee_is_finite(self%y)) .and. all(ieee_is_finite(self%yq)) .and. &
                    ieee_is_finite(e%balance()) .and. all(ieee_is_finite(self%points)) .and. &
                    all(ieee_is_finite(self%axial)) .and. all(ieee_is_finite(self%shear)) .and. &

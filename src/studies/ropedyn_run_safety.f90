@@ -24,8 +24,7 @@ contains
         if (.not. self%monitor%gained(e)) then
             call self%monitor%observe(e)
             self%steps_mark = self%steps_taken()
-            self%e_checked = e                   ! the record of this state takes it
-            self%e_checked_valid = .true.
+            e_now = e                            ! the record of this state takes it
             return
         end if
         next = self%monitor
