@@ -327,7 +327,7 @@ def collect(work, periods, models, cycles=ANALYSED):
         for period in periods:
             for radius in RADII:
                 path = case_path(work, period, model, radius)
-                if path.exists() and status(path)[0] == "complete":
+                if complete(path):
                     results[model, period, radius] = case_result(path, period, cycles)
     return results
 
@@ -575,7 +575,7 @@ def figures(results, models, periods, work, figdir, stem):
         for ax, (period, radius) in zip(axes[:, 0], conds):
             for model in models:
                 path = case_path(work, period, model, radius)
-                if path.exists() and status(path)[0] == "complete":
+                if complete(path):
                     t, tension, _ = fairlead_tension(path)
                     ax.plot(t / period, tension, lw=0.8, label=name(model))
             ax.axhline(MEASURED[period][RADII.index(radius)], color="k", ls="--", lw=0.8,
