@@ -32,6 +32,7 @@ COMMANDS = {
     "bench_peers": "ropedyn_tools.studies.bench_peers",
     "bench_library": "ropedyn_tools.studies.bench_library",
     "bench_symplectic": "ropedyn_tools.studies.bench_symplectic",
+    "compositions": "ropedyn_tools.studies.compositions",
     "auto_table": "ropedyn_tools.studies.auto_table",
     "auto_accuracy": "ropedyn_tools.studies.auto_accuracy",
     "cost_model": "ropedyn_tools.studies.cost_model",
