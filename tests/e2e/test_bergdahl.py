@@ -64,6 +64,22 @@ def test_runs_with_another_law_change_against_their_own_reference():
     assert bg.is_base(rows[0]) and not bg.is_base(rows[3])
 
 
+def test_runs_with_another_method_change_against_the_setting():
+    """A run with another method (CONV_METHODS) has no run of its own at the study's
+    element length: its change is against the scene's own run there."""
+    n, rtol = bg.base_elements(), bg.base_rtol()
+    fine = bg.CONV_ELEMENTS[-1]
+    assert "cvode" in bg.CONV_METHODS
+
+    def row(elements, law, mean):
+        return dict(model="rfem", period=3.5, n=elements, rtol=rtol, law=law,
+                    mean=mean, spread=0.0, maxima=np.zeros(5), cpu_time=1.0)
+
+    rows = [row(n, "", 50.0), row(fine, "cvode", 50.5), row(n, "compression", 40.0)]
+    line = next(x for x in bg.convergence_lines(rows) if x.startswith("| RFEM, cvode |"))
+    assert "| +1.00 % |" in line, line
+
+
 def test_one_short_condition_end_to_end(ropedyn_exe, tmp_path):
     """T = 1.25 s, R = 0.2 m, 20 elements, 2 cycles (one of them the ramp), both models:
     the runs complete, the analysis finds a cycle maximum of each and the page gets its

@@ -165,9 +165,12 @@ def is_base(row):
 
 def reference(rows, row):
     """The convergence row a row's change is measured against: the study's setting, with the
-    law of the row (the runs with another law measure its share of the change)."""
-    return next(r for r in rows if r["model"] == row["model"] and r["period"] == row["period"]
-                and r["law"] == row["law"] and at_setting(r))
+    law of the row (the runs with another law measure its share of the change; a row whose
+    label has no run at the setting, another method's, against the scene's own)."""
+    same = [r for r in rows if r["model"] == row["model"] and r["period"] == row["period"]
+            and at_setting(r)]
+    return next((r for r in same if r["law"] == row["law"]),
+                next(r for r in same if not r["law"]))
 
 
 def write_sweep(period, label, work, quick=None):
@@ -336,8 +339,14 @@ def collect(work, periods, models, cycles=ANALYSED):
 
 #: the element counts of the convergence runs: elements of 0.4, 0.2 and 0.1 m
 CONV_ELEMENTS = (83, 165, 330)
-#: the convergence runs with another law than the scene's: label, overrides
+#: the convergence runs with another law than the scene's: label, overrides (at the two
+#: coarsest element lengths, each against its own run at the study's element length)
 CONV_LAWS = {"compression": ["rope.compression=.true."]}
+#: the runs at the finest element length with another method (against the study's setting):
+#: CVODE alone, and CVODE held at BDF2 (A-stable); with the tolerance quartered there, they
+#: show what the finest row's change is made of
+CONV_METHODS = {"cvode": ["solver.method=cvode"],
+                "cvode, max order 2": ["solver.method=cvode", "solver.max_order=2"]}
 
 
 def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS):
@@ -348,15 +357,17 @@ def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS)
     `jobs` runs at a time."""
     from concurrent.futures import ThreadPoolExecutor
     base_n, base_r = base_elements(), base_rtol()
+    finest = CONV_ELEMENTS[-1]
     variants = sorted({(n, base_r, "") for n in CONV_ELEMENTS + (base_n,)}) + [
         (base_n, base_r / 2, ""), (base_n, base_r / 4, "")] + [
-        (n, base_r, law) for law in CONV_LAWS for n in CONV_ELEMENTS[:2]]
+        (n, base_r, law) for law in CONV_LAWS for n in CONV_ELEMENTS[:2]] + [
+        (finest, base_r / 4, "")] + [(finest, base_r, method) for method in CONV_METHODS]
     todo = []
     for model in models:
         for period in periods:
             for n, rtol, law in variants:
                 atol = base_atol() * rtol / base_r
-                tag = f"_{law}" if law else ""
+                tag = "_" + re.sub(r"[^a-z0-9]+", "_", law) if law else ""
                 todo.append((model, period, n, rtol, law, atol, work / "convergence" / (
                     f"{model}_T{period}_n{n}_rtol{rtol:g}_atol{atol:g}{tag}_c{CONV_CYCLES}.h5")))
     (work / "convergence").mkdir(parents=True, exist_ok=True)
@@ -374,7 +385,7 @@ def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS)
                 f"solver.t_end={CONV_CYCLES * period:.12g}",
                 f"supports.top_ramp_time={RAMP_CYCLES * period:.12g}",
                 f"supports.top_amplitude={radius},{radius}", f"output.file={out}"]
-        sets += CONV_LAWS.get(law, [])
+        sets += CONV_LAWS.get(law, []) + CONV_METHODS.get(law, [])
         subprocess.run([str(exe), "run", str(BASE), *set_args(sets)], check=True,
                        capture_output=True)
 
