@@ -3,7 +3,9 @@
 !!   quadratic drag; with linear drag and a current, the drift velocity (lambda g / c_n, u);
 !! - ground: a rope sliding along the ground carries its weight in contact force and stops
 !!   after v0^2/(2 mu g) (Coulomb friction); a body lying on it gets the distributed law's
-!!   force and moments (k l delta, k l^3/12 per radian, c l^3/12 per rad/s);
+!!   force and moments (k l delta, k l^3/12 per radian, c l^3/12 per rad/s); the Jacobian
+!!   of a body touching with a part equals central differences, also where the part's end
+!!   moves with the state;
 !! - moving support: the work of a shaken top equals the energy change of an undamped rope
 !!   (RFEM and MPP);
 !! - release: a folded rope with one end released falls with tip acceleration > g and the
@@ -34,6 +36,8 @@ program test_effects_physics
     call ground_friction()
     call ground_lying_body()
     call ground_tilted_body()
+    call ground_moving_ends('landing', 0.3_wp, 0.7_wp, 1)
+    call ground_moving_ends('leaving', -0.3_wp, 0.7_wp, 2)
     call shaken_top('rfem')
     call shaken_top('mpp')
     call folded_fall()
@@ -222,6 +226,98 @@ contains
         call suite%check_close(ground%energy(0.0_wp, b), k*p**3/(6.0_wp*a), 1.0e-12_wp, &
                                0.0_wp, 'ground: the springs of a body touching with its end')
     end subroutine ground_tilted_body
+
+    !> A body tilted by 0.1 rad with one end 1 mm below the plane, sinking at v_x (x is
+    !! down) and turning at w: the ground's Jacobian (add_jacobian) against central
+    !! differences of its force and moment. Landing (v_x > 0) the force acts on all the part
+    !! below the plane, whose end, where delta = 0, carries f = c delta' > 0 and moves with
+    !! the body; leaving (v_x < 0) the force ends inside that part, where k delta + c delta'
+    !! = 0. The end's motion is part of the Jacobian: without it the landing body's differs
+    !! by a third of its largest entry (at an end where f = 0 the integrand vanishes, and the
+    !! term is almost nothing). `end_kind` is the kind of end the case must have.
+    subroutine ground_moving_ends(label, vx, w, end_kind)
+        character(len=*), intent(in) :: label
+        real(wp), intent(in) :: vx, w
+        integer, intent(in) :: end_kind
+        real(wp), parameter :: k = 1.0e5_wp, c = 200.0_wp, l = 0.2_wp, p = 1.0e-3_wp, &
+                               theta = 0.1_wp
+        real(wp), parameter :: steps(6) = [1.0e-8_wp, 1.0e-8_wp, 1.0e-7_wp, 1.0e-6_wp, &
+                                           1.0e-6_wp, 1.0e-6_wp]
+        type(ground_effect_t) :: ground
+        type(bodies_t) :: b
+        real(wp) :: z(6), jac(3, 6, 1), fd(3, 6), gp(3), gm(3), worst, scale, full
+        integer :: col
+        ground = ground_effect([1.0_wp, 0.0_wp], [-1.0_wp, 0.0_wp], k, c, 0.3_wp, 5.0e-2_wp)
+        z = [1.0_wp + p - 0.5_wp*l*sin(theta), 0.5_wp, 0.5_wp*pi - theta, vx, 0.2_wp, w]
+        call body_state(b, z, l)
+        jac = 0.0_wp
+        call ground%add_jacobian(0.0_wp, b, jac)
+        do col = 1, 6
+            call body_state(b, z + steps(col)*unit(col), l)
+            gp = generalized(ground, b)
+            call body_state(b, z - steps(col)*unit(col), l)
+            gm = generalized(ground, b)
+            fd(:, col) = (gp - gm)/(2.0_wp*steps(col))
+        end do
+        scale = maxval(abs(fd))
+        worst = maxval(abs(jac(:, :, 1) - fd))/scale
+        full = maxval(abs(fd(1:2, 1)))
+        write (*, '(a, 2es11.3)') '  ground: '//label//' body, largest entry, jacobian - '// &
+            'differences (relative)', scale, worst
+        call suite%check_true(ground_end_kind(z, l) == end_kind, 'ground: the '// &
+                              label//' body''s force interval ends where the case says')
+        call suite%check_true(full > 0.0_wp, 'ground: the '//label//' body is in contact')
+        call suite%check_le(worst, 1.0e-6_wp, 'ground: jacobian of a '//label//' body '// &
+                            '(its force interval''s end moving) = central differences')
+    end subroutine ground_moving_ends
+
+    !> The j-th unit vector of six.
+    pure function unit(j) result(u)
+        integer, intent(in) :: j
+        real(wp) :: u(6)
+        u = 0.0_wp
+        u(j) = 1.0_wp
+    end function unit
+
+    !> One body of length l at z = (x, y, phi, v_x, v_y, w).
+    subroutine body_state(b, z, l)
+        type(bodies_t), intent(inout) :: b
+        real(wp), intent(in) :: z(6), l
+        b%n = 1
+        b%c = reshape(z(1:2), [2, 1])
+        b%phi = [z(3)]
+        b%v = reshape(z(4:5), [2, 1])
+        b%w = [z(6)]
+        b%l = [l]
+        call set_axes(b)
+    end subroutine body_state
+
+    !> The ground's (F_x, F_y, M) on the one body of b.
+    function generalized(ground, b) result(gen)
+        type(ground_effect_t), intent(in) :: ground
+        type(bodies_t), intent(in) :: b
+        real(wp) :: gen(3), f(2, 1), m(1)
+        f = 0.0_wp
+        m = 0.0_wp
+        call ground%add_forces(0.0_wp, b, f, m)
+        gen = [f(:, 1), m(1)]
+    end function generalized
+
+    !> 1: the body's force interval ends at the plane (delta = 0) with a force there; 2: it
+    !! ends where k delta + c delta' = 0, inside the part below the plane. From the
+    !! per-metre law along the body at z (the plane x = 1, x down), independently of the
+    !! effect's own search.
+    integer function ground_end_kind(z, l) result(kind)
+        real(wp), intent(in) :: z(6), l
+        real(wp) :: e(2), nv(2), r0, rate0
+        e = [cos(z(3)), sin(z(3))]
+        nv = [-e(2), e(1)]
+        ! delta(r) = x(r) - 1 along the body; its zero r0, and delta' there
+        r0 = (1.0_wp - z(1))/e(1)
+        rate0 = z(4) + z(6)*r0*nv(1)
+        kind = merge(1, 2, rate0 > 0.0_wp)
+        if (abs(r0) > 0.5_wp*l) kind = 0
+    end function ground_end_kind
 
     !> The ground's force f and moment m on body b turned by dphi from lying along y and
     !! turning at w.

@@ -59,6 +59,17 @@ module ropedyn_effect_ground
         real(wp) :: f(2)              !< force on the body, N
     end type contact_t
 
+    !> Body i's contact along its axis (offset r from the centre): penetration d0 + a r,
+    !! its rate v0 + bb r, tangential speed t0 + t1 r; the part below the plane [s1, s2] and
+    !! the force interval [r1, r2] in it (`body_line`), and what sets each end of the latter
+    !! (END_BODY, END_PLANE: delta = 0, END_FORCE: k delta + c delta' = 0).
+    type :: line_t
+        real(wp) :: d0, a, v0, bb, t0, t1
+        real(wp) :: s1, s2, r1, r2
+        integer :: end1, end2
+    end type line_t
+    integer, parameter :: END_BODY = 0, END_PLANE = 1, END_FORCE = 2
+
     !> the two-point Gauss rule's offset from an interval's centre, in interval lengths:
     !! 1/(2 sqrt 3)
     real(wp), parameter :: GAUSS_OFFSET = 0.28867513459481288_wp
@@ -86,20 +97,54 @@ contains
         name = 'ground'
     end function ground_name
 
-    !> The part [r1, r2] of the segment [lo, hi] where alpha + beta r > 0 (r2 <= r1: none).
-    pure subroutine positive_part(alpha, beta, lo, hi, r1, r2)
+    !> The part [r1, r2] of the segment [lo, hi] where alpha + beta r > 0 (r2 <= r1: none);
+    !! moved1, moved2: whether that end is the root -alpha/beta rather than lo or hi.
+    pure subroutine positive_part(alpha, beta, lo, hi, r1, r2, moved1, moved2)
         real(wp), intent(in) :: alpha, beta, lo, hi
         real(wp), intent(out) :: r1, r2
+        logical, intent(out) :: moved1, moved2
         r1 = lo
         r2 = hi
+        moved1 = .false.
+        moved2 = .false.
         if (beta > 0.0_wp) then
             r1 = max(lo, -alpha/beta)
+            moved1 = -alpha/beta > lo
         else if (beta < 0.0_wp) then
             r2 = min(hi, -alpha/beta)
+            moved2 = -alpha/beta < hi
         else if (alpha <= 0.0_wp) then
             r2 = lo
         end if
     end subroutine positive_part
+
+    !> Body i's contact line (line_t): the part below the plane and the force interval in it.
+    pure function body_line(self, b, i, e) result(g)
+        class(ground_effect_t), intent(in) :: self
+        type(bodies_t), intent(in) :: b
+        integer, intent(in) :: i
+        real(wp), intent(in) :: e(2)
+        type(line_t) :: g
+        real(wp) :: nv(2)
+        logical :: p1, p2, f1, f2
+        nv = [-e(2), e(1)]
+        g%d0 = -dot_product(b%c(:, i) - self%p0, self%ng)
+        g%a = -dot_product(e, self%ng)
+        call positive_part(g%d0, g%a, -0.5_wp*b%l(i), 0.5_wp*b%l(i), g%s1, g%s2, p1, p2)
+        g%v0 = -dot_product(b%v(:, i), self%ng)
+        g%bb = -b%w(i)*dot_product(nv, self%ng)
+        g%t0 = dot_product(b%v(:, i), self%tg)
+        g%t1 = b%w(i)*dot_product(nv, self%tg)
+        g%r1 = g%s1
+        g%r2 = g%s1
+        g%end1 = END_BODY
+        g%end2 = END_BODY
+        if (g%s2 <= g%s1) return
+        call positive_part(self%k*g%d0 + self%c*g%v0, self%k*g%a + self%c*g%bb, g%s1, g%s2, &
+                           g%r1, g%r2, f1, f2)
+        g%end1 = merge(END_FORCE, merge(END_PLANE, END_BODY, p1), f1)
+        g%end2 = merge(END_FORCE, merge(END_PLANE, END_BODY, p2), f2)
+    end function body_line
 
     !> The contact of body i (axis e): its force points, appended to cc(nc+1:), and its
     !! springs' energy and rate, added to spring_energy and spring_rate. Along the body
@@ -117,19 +162,16 @@ contains
         type(contact_t), intent(inout) :: cc(:)
         integer, intent(inout) :: nc
         real(wp), intent(inout) :: spring_energy, spring_rate
-        real(wp) :: nv(2), d0, a, v0, bb, t0, t1, s1, s2, r1, r2, mid, half, r, dl, dv
+        type(line_t) :: g
+        real(wp) :: s1, s2, r1, r2, mid, half, r, dl, dv
         integer :: s
         logical :: same
-        nv = [-e(2), e(1)]
-        d0 = -dot_product(b%c(:, i) - self%p0, self%ng)
-        a = -dot_product(e, self%ng)
-        call positive_part(d0, a, -0.5_wp*b%l(i), 0.5_wp*b%l(i), s1, s2)
+        g = body_line(self, b, i, e)
+        s1 = g%s1
+        s2 = g%s2
         if (s2 <= s1) return
-        v0 = -dot_product(b%v(:, i), self%ng)
-        bb = -b%w(i)*dot_product(nv, self%ng)
-        t0 = dot_product(b%v(:, i), self%tg)
-        t1 = b%w(i)*dot_product(nv, self%tg)
-        call positive_part(self%k*d0 + self%c*v0, self%k*a + self%c*bb, s1, s2, r1, r2)
+        r1 = g%r1
+        r2 = g%r2
         ! the force acts on all of the part below the plane (a body lying on it, one
         ! landing): then the force points are the springs' points too
         same = r1 == s1 .and. r2 == s2
@@ -138,8 +180,8 @@ contains
             half = 0.5_wp*(s2 - s1)
             do s = -1, 1, 2
                 r = mid + 2.0_wp*GAUSS_OFFSET*real(s, wp)*half
-                dl = d0 + a*r
-                dv = v0 + bb*r
+                dl = g%d0 + g%a*r
+                dv = g%v0 + g%bb*r
                 spring_energy = spring_energy + half*0.5_wp*self%k*dl**2
                 spring_rate = spring_rate + half*self%k*dl*dv
             end do
@@ -150,7 +192,7 @@ contains
         do s = -1, 1, 2
             nc = nc + 1
             r = mid + 2.0_wp*GAUSS_OFFSET*real(s, wp)*half
-            cc(nc) = contact(self, i, e, r, half, d0 + a*r, v0 + bb*r, t0 + t1*r)
+            cc(nc) = contact(self, i, e, r, half, g%d0 + g%a*r, g%v0 + g%bb*r, g%t0 + g%t1*r)
             if (same) then
                 spring_energy = spring_energy + half*0.5_wp*self%k*cc(nc)%delta**2
                 spring_rate = spring_rate + half*self%k*cc(nc)%delta*cc(nc)%ddelta
@@ -255,9 +297,9 @@ contains
         call add_contact_power(self, cc(:nc), er, dissipation)
     end subroutine ground_add_forces_power
 
-    !> Each force point's block with its offset and its length held fixed: the term of an
-    !! interval's end that moves with the state (where delta = 0, f = c delta') is left out
-    !! (in statics delta' = 0 there, and the tangent is exact).
+    !> Each force point's block with its offset and its length held fixed, and then the
+    !! moving ends of each body's force interval: an end where delta = 0 (f = c delta' there)
+    !! or where f = 0 moves with the state, and the quadrature moves with it (`end_terms`).
     pure subroutine ground_add_jacobian(self, t, b, jac)
         class(ground_effect_t), intent(in) :: self
         real(wp), intent(in) :: t
@@ -265,10 +307,13 @@ contains
         real(wp), intent(inout) :: jac(:, :, :)
         type(contact_t) :: cc(2*b%n)
         real(wp) :: kp, cp, dir(2), dfdx(2, 2), dfdv(2, 2), es, er
-        integer :: k, nc, p
+        integer :: k, nc, p, i0
         call touching(self, b, cc, nc, es, er)
+        i0 = 0
         do k = 1, nc
             associate (c => cc(k), i => cc(k)%i)
+                if (i /= i0) call end_terms(self, b, i, jac(:, :, i))
+                i0 = i
                 if (c%fn <= 0.0_wp) cycle
                 kp = self%k*c%w
                 cp = self%c*c%w
@@ -284,6 +329,77 @@ contains
             end associate
         end do
     end subroutine ground_add_jacobian
+
+    !> Body i's force and moment from the two points of its force interval [r1, r2] depend
+    !! on the ends; an end that is not the body's own moves with the body's coordinates and
+    !! rates: add dG/dr_end (dr_end/dq)^T to the body's block (rows F_x, F_y, M; columns
+    !! x, y, phi, v_x, v_y, w).
+    pure subroutine end_terms(self, b, i, blk)
+        class(ground_effect_t), intent(in) :: self
+        type(bodies_t), intent(in) :: b
+        integer, intent(in) :: i
+        real(wp), intent(inout) :: blk(:, :)
+        type(line_t) :: g
+        real(wp) :: e(2), nv(2), dgdr(3), drdq(6), dadphi, root, alpha_q(6), beta_q(6)
+        integer :: j, kind
+        e = b%cs(:, i)
+        g = body_line(self, b, i, e)
+        if (g%r2 <= g%r1) return
+        nv = [-e(2), e(1)]
+        dadphi = -dot_product(nv, self%ng)
+        do j = 1, 2
+            kind = merge(g%end1, g%end2, j == 1)
+            if (kind == END_BODY) cycle
+            root = merge(g%r1, g%r2, j == 1)
+            drdq = 0.0_wp
+            if (kind == END_PLANE) then
+                ! r = -d0/a: d0 = -(c - p0).n_g, a = -e.n_g
+                drdq(1:2) = self%ng/g%a
+                drdq(3) = -root/g%a*dadphi
+            else
+                ! r = -alpha/beta, alpha = k d0 + c v0, beta = k a + c bb
+                alpha_q = 0.0_wp
+                alpha_q(1:2) = -self%k*self%ng
+                alpha_q(4:5) = -self%c*self%ng
+                beta_q = 0.0_wp
+                beta_q(3) = self%k*dadphi + self%c*b%w(i)*dot_product(e, self%ng)
+                beta_q(6) = self%c*dadphi
+                drdq = -(alpha_q + root*beta_q)/(self%k*g%a + self%c*g%bb)
+            end if
+            dgdr = interval_rate(self, g, e, j)
+            blk(:, 1:6) = blk(:, 1:6) + spread(dgdr, 2, 6)*spread(drdq, 1, 3)
+        end do
+    end subroutine end_terms
+
+    !> d(F_x, F_y, M)/d r_j of the two force points of interval [r1, r2] of line g (axis e),
+    !! j = 1 or 2, the state held (the points move with the ends and stand for half of it).
+    pure function interval_rate(self, g, e, j) result(dgdr)
+        class(ground_effect_t), intent(in) :: self
+        type(line_t), intent(in) :: g
+        real(wp), intent(in) :: e(2)
+        integer, intent(in) :: j
+        real(wp) :: dgdr(3)
+        real(wp) :: mid, half, dhalf, r, drs, u, du, th, dth, dir(2), ddir(2), f(2), df(2)
+        integer :: s
+        mid = 0.5_wp*(g%r1 + g%r2)
+        half = 0.5_wp*(g%r2 - g%r1)
+        dhalf = merge(-0.5_wp, 0.5_wp, j == 1)
+        du = self%k*g%a + self%c*g%bb
+        dgdr = 0.0_wp
+        do s = -1, 1, 2
+            r = mid + 2.0_wp*GAUSS_OFFSET*real(s, wp)*half
+            drs = 0.5_wp + merge(-1.0_wp, 1.0_wp, j == 1)*GAUSS_OFFSET*real(s, wp)
+            u = self%k*(g%d0 + g%a*r) + self%c*(g%v0 + g%bb*r)
+            th = smooth_sign((g%t0 + g%t1*r)/self%v_reg)
+            dth = (1.0_wp - th**2)*g%t1/self%v_reg
+            dir = self%ng - self%mu*th*self%tg
+            ddir = -self%mu*dth*self%tg
+            f = half*u*dir
+            df = dhalf*u*dir + half*(du*dir + u*ddir)*drs
+            dgdr(1:2) = dgdr(1:2) + df
+            dgdr(3) = dgdr(3) + drs*(e(1)*f(2) - e(2)*f(1)) + r*(e(1)*df(2) - e(2)*df(1))
+        end do
+    end function interval_rate
 
     !> The contact springs' energy, sum k_p delta^2 / 2, J.
     pure real(wp) function ground_energy(self, t, b) result(e)
