@@ -26,9 +26,10 @@
  * Frame and units: x points down (gravity), y horizontal; SI units (m, s, N, J). The
  * supports are ROPEDYN_TOP and ROPEDYN_BOTTOM.
  *
- * Instances share nothing: two can run in two threads at once (one instance must not be
- * used by two threads at the same time). The library catches no signals. A simulation
- * writes no file; ropedyn_run writes one only when given its name.
+ * Instances are independent, and the calls are safe from any thread: the library runs
+ * one call at a time (a process-wide lock; docs/reference/api.md, "Threads"), so threads
+ * do not integrate in parallel. The library catches no signals. A simulation writes no
+ * file; ropedyn_run writes one only when given its name.
  *
  * The manual's API page (docs/reference/api.md) describes each call, the coupling rule
  * and what of a command-line run applies. */

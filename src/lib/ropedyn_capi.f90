@@ -106,13 +106,13 @@ contains
 
     ! ---- life cycle ------------------------------------------------------------------
 
-    function capi_version() result(text) bind(C, name='ropedyn_version')
+    function capi_version() result(text) bind(C, name='ropedyn_f_version')
         type(c_ptr) :: text
         text = c_loc(VERSION_C)
     end function capi_version
 
     integer(c_int) function capi_create_from_file(path, sim) result(status) &
-            bind(C, name='ropedyn_create_from_file')
+            bind(C, name='ropedyn_f_create_from_file')
         type(c_ptr), value :: path, sim
         type(instance_t), pointer :: h
         type(error_t), allocatable :: err
@@ -127,7 +127,7 @@ contains
     end function capi_create_from_file
 
     integer(c_int) function capi_create_from_text(text, name, sim) result(status) &
-            bind(C, name='ropedyn_create_from_text')
+            bind(C, name='ropedyn_f_create_from_text')
         type(c_ptr), value :: text, name, sim
         type(instance_t), pointer :: h
         type(error_t), allocatable :: err
@@ -144,7 +144,7 @@ contains
         if (.not. c_associated(sim)) call delete_instance(h)
     end function capi_create_from_text
 
-    subroutine capi_destroy(sim) bind(C, name='ropedyn_destroy')
+    subroutine capi_destroy(sim) bind(C, name='ropedyn_f_destroy')
         type(c_ptr), value :: sim
         type(instance_t), pointer :: h
         h => handle_of(sim)
@@ -152,7 +152,7 @@ contains
         call delete_instance(h)
     end subroutine capi_destroy
 
-    function capi_last_error(sim) result(message) bind(C, name='ropedyn_last_error')
+    function capi_last_error(sim) result(message) bind(C, name='ropedyn_f_last_error')
         type(c_ptr), value :: sim
         type(c_ptr) :: message
         type(instance_t), pointer :: h
@@ -163,7 +163,7 @@ contains
         message = c_loc(h%message)
     end function capi_last_error
 
-    integer(c_int) function capi_set(sim, setting) result(status) bind(C, name='ropedyn_set')
+    integer(c_int) function capi_set(sim, setting) result(status) bind(C, name='ropedyn_f_set')
         type(c_ptr), value :: sim, setting
         type(instance_t), pointer :: h
         type(error_t), allocatable :: err
@@ -179,7 +179,7 @@ contains
     end function capi_set
 
     integer(c_int) function capi_scene_text(sim, text) result(status) &
-            bind(C, name='ropedyn_scene_text')
+            bind(C, name='ropedyn_f_scene_text')
         type(c_ptr), value :: sim, text
         type(instance_t), pointer :: h
         type(c_ptr), pointer :: out
@@ -198,7 +198,7 @@ contains
     end function capi_scene_text
 
     integer(c_int) function capi_warnings(sim, text) result(status) &
-            bind(C, name='ropedyn_warnings')
+            bind(C, name='ropedyn_f_warnings')
         type(c_ptr), value :: sim, text
         type(instance_t), pointer :: h
         type(c_ptr), pointer :: out
@@ -217,7 +217,7 @@ contains
     end function capi_warnings
 
     integer(c_int) function capi_init(sim, from_statics) result(status) &
-            bind(C, name='ropedyn_init')
+            bind(C, name='ropedyn_f_init')
         type(c_ptr), value :: sim
         integer(c_int), value :: from_statics
         type(instance_t), pointer :: h
@@ -230,7 +230,7 @@ contains
     end function capi_init
 
     integer(c_int) function capi_run(sim, output, image, nbytes) result(status) &
-            bind(C, name='ropedyn_run')
+            bind(C, name='ropedyn_f_run')
         type(c_ptr), value :: sim, output, image, nbytes
         type(instance_t), pointer :: h
         type(c_ptr), pointer :: image_out
@@ -260,7 +260,7 @@ contains
 
     ! ---- the simulation ----------------------------------------------------------------
 
-    integer(c_int) function capi_advance(sim, t) result(status) bind(C, name='ropedyn_advance')
+    integer(c_int) function capi_advance(sim, t) result(status) bind(C, name='ropedyn_f_advance')
         type(c_ptr), value :: sim
         real(c_double), value :: t
         type(instance_t), pointer :: h
@@ -272,7 +272,7 @@ contains
         status = status_of(h, err)
     end function capi_advance
 
-    integer(c_int) function capi_time(sim, t) result(status) bind(C, name='ropedyn_time')
+    integer(c_int) function capi_time(sim, t) result(status) bind(C, name='ropedyn_f_time')
         type(c_ptr), value :: sim
         real(c_double), intent(out) :: t
         type(instance_t), pointer :: h
@@ -286,7 +286,7 @@ contains
     end function capi_time
 
     integer(c_int) function capi_size(sim, elements, state_size) result(status) &
-            bind(C, name='ropedyn_size')
+            bind(C, name='ropedyn_f_size')
         type(c_ptr), value :: sim
         integer(c_int), intent(out) :: elements, state_size
         type(instance_t), pointer :: h
@@ -304,7 +304,7 @@ contains
     end function capi_size
 
     integer(c_int) function capi_get_state(sim, y, size) result(status) &
-            bind(C, name='ropedyn_get_state')
+            bind(C, name='ropedyn_f_get_state')
         type(c_ptr), value :: sim
         integer(c_int), value :: size
         real(c_double), intent(out) :: y(size)
@@ -325,7 +325,7 @@ contains
     end function capi_get_state
 
     integer(c_int) function capi_set_state(sim, y, size) result(status) &
-            bind(C, name='ropedyn_set_state')
+            bind(C, name='ropedyn_f_set_state')
         type(c_ptr), value :: sim
         integer(c_int), value :: size
         real(c_double), intent(in) :: y(size)
@@ -339,7 +339,7 @@ contains
     end function capi_set_state
 
     integer(c_int) function capi_points(sim, xy, count) result(status) &
-            bind(C, name='ropedyn_points')
+            bind(C, name='ropedyn_f_points')
         type(c_ptr), value :: sim
         integer(c_int), value :: count
         real(c_double), intent(out) :: xy(2, count)
@@ -360,7 +360,7 @@ contains
     end function capi_points
 
     integer(c_int) function capi_forces(sim, axial, shear, moment, joints) result(status) &
-            bind(C, name='ropedyn_forces')
+            bind(C, name='ropedyn_f_forces')
         type(c_ptr), value :: sim, axial, shear, moment
         integer(c_int), value :: joints
         type(instance_t), pointer :: h
@@ -396,7 +396,7 @@ contains
     end subroutine put
 
     integer(c_int) function capi_reaction(sim, support, force) result(status) &
-            bind(C, name='ropedyn_reaction')
+            bind(C, name='ropedyn_f_reaction')
         type(c_ptr), value :: sim
         integer(c_int), value :: support
         real(c_double), intent(out) :: force(2)
@@ -422,7 +422,7 @@ contains
     end function capi_reaction
 
     integer(c_int) function capi_support_position(sim, support, position) result(status) &
-            bind(C, name='ropedyn_support_position')
+            bind(C, name='ropedyn_f_support_position')
         type(c_ptr), value :: sim
         integer(c_int), value :: support
         real(c_double), intent(out) :: position(2)
@@ -444,7 +444,7 @@ contains
     end function capi_support_position
 
     integer(c_int) function capi_energy(sim, energy) result(status) &
-            bind(C, name='ropedyn_energy')
+            bind(C, name='ropedyn_f_energy')
         type(c_ptr), value :: sim
         real(c_double), intent(out) :: energy(6)
         type(instance_t), pointer :: h
@@ -462,7 +462,7 @@ contains
     end function capi_energy
 
     integer(c_int) function capi_set_support(sim, support, position, velocity) &
-            result(status) bind(C, name='ropedyn_set_support')
+            result(status) bind(C, name='ropedyn_f_set_support')
         type(c_ptr), value :: sim
         integer(c_int), value :: support
         real(c_double), intent(in) :: position(2), velocity(2)
@@ -481,7 +481,7 @@ contains
         status = status_of(h, err)
     end function capi_set_support
 
-    integer(c_int) function capi_save(sim, snapshot) result(status) bind(C, name='ropedyn_save')
+    integer(c_int) function capi_save(sim, snapshot) result(status) bind(C, name='ropedyn_f_save')
         type(c_ptr), value :: sim, snapshot
         type(instance_t), pointer :: h
         type(snapshot_t), pointer :: snap
@@ -507,7 +507,7 @@ contains
     end function capi_save
 
     integer(c_int) function capi_restore(sim, snapshot) result(status) &
-            bind(C, name='ropedyn_restore')
+            bind(C, name='ropedyn_f_restore')
         type(c_ptr), value :: sim, snapshot
         type(instance_t), pointer :: h
         type(snapshot_t), pointer :: snap
@@ -525,7 +525,7 @@ contains
         status = status_of(h, err)
     end function capi_restore
 
-    subroutine capi_snapshot_destroy(snapshot) bind(C, name='ropedyn_snapshot_destroy')
+    subroutine capi_snapshot_destroy(snapshot) bind(C, name='ropedyn_f_snapshot_destroy')
         type(c_ptr), value :: snapshot
         type(snapshot_t), pointer :: snap
         if (.not. c_associated(snapshot)) return

@@ -1,7 +1,8 @@
 /* The C interface (include/ropedyn.h) from C: statuses and messages of bad scenes and bad
  * calls (no crash on NULL), a simulation's time and sizes, save/restore giving the same
  * bits, two instances (interleaved, and in two threads) giving the same bits as one
- * alone, the run into memory, and a coupled support. Argument: the source tree. */
+ * alone, four threads creating, reading and starting simulations at once, the run into
+ * memory, and a coupled support. Argument: the source tree. */
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -157,6 +158,44 @@ static void simulation(void)
           "two instances in two threads: the bits of one alone");
 }
 
+/* One thread's share of `threads_at_once`: create from text, set, read the scene and its
+ * warnings, init and advance, `rounds` times; the calls that failed, or whose scene text
+ * lost the setting, counted in *bad. */
+static void *busy(void *arg)
+{
+    int *bad = arg;
+    const char *scene = "&model kind = 'rfem', elements = 4 /\n&solver t_end = 1.0 /\n";
+    for (int k = 0; k < 150; k++) {
+        ropedyn_t *sim = NULL;
+        const char *text = NULL;
+        int status = ropedyn_create_from_text(scene, "busy", &sim);
+        if (status == ROPEDYN_OK) status = ropedyn_set(sim, "model.elements=6");
+        if (status == ROPEDYN_OK) status = ropedyn_scene_text(sim, &text);
+        if (status == ROPEDYN_OK && strstr(text, "elements = 6") == NULL) status = -1;
+        if (status == ROPEDYN_OK) status = ropedyn_warnings(sim, &text);
+        if (status == ROPEDYN_OK) status = ropedyn_init(sim, 0);
+        if (status == ROPEDYN_OK) status = ropedyn_advance(sim, 0.002);
+        if (status != ROPEDYN_OK) ++*bad;
+        ropedyn_destroy(sim);
+    }
+    return NULL;
+}
+
+/* Four threads calling at once, 600 simulations in all. Without the library's lock
+ * (src/lib/ropedyn_serial.c) the Fortran code's static lengths of character results are
+ * shared between threads: garbled scene names and messages, and a corrupted heap (the
+ * process aborted in six runs of six). */
+static void threads_at_once(void)
+{
+    pthread_t th[4];
+    int bad[4] = {0, 0, 0, 0};
+    for (int k = 0; k < 4; k++) pthread_create(&th[k], NULL, busy, &bad[k]);
+    for (int k = 0; k < 4; k++) pthread_join(th[k], NULL);
+    check(bad[0] + bad[1] + bad[2] + bad[3] == 0,
+          "four threads creating, setting, reading and starting simulations: every call "
+          "succeeds");
+}
+
 static void whole_run(void)
 {
     ropedyn_t *sim = NULL;
@@ -199,6 +238,7 @@ int main(int argc, char **argv)
     check(strlen(ropedyn_version()) > 0, "version");
     bad_calls();
     simulation();
+    threads_at_once();
     whole_run();
     coupled();
     printf("capi: %d passed, %d failed\n", passed, failed);
