@@ -137,6 +137,11 @@ def unstable_intervals(a, b, grad=None):
     return [(x[r[0]], x[r[-1]] + DX if r[-1] < len(x) - 1 else None) for r in runs]
 
 
+def gaps_text(gaps):
+    """The first three unstable intervals (unstable_intervals) as table text."""
+    return "; ".join(f"{lo:.4f} .. {hi:.4f}" if hi else f"from {lo:.4f}" for lo, hi in gaps[:3])
+
+
 def energy_spread(a, b, x, grad=None):
     """Relative spread of (v^2 + q^2)/2 along the orbit at h = x (0 for the exact flow)."""
     m11, m12, m21, m22 = (float(v[0]) for v in one_step(a, b, np.array([x]), grad))
@@ -157,9 +162,7 @@ def rows():
         gaps = unstable_intervals(a, b)
         limit = gaps[0][0] if gaps else XMAX
         step = SAFETY * limit
-        gap_text = "; ".join(f"{lo:.4f} .. {hi:.4f}" if hi else f"from {lo:.4f}"
-                             for lo, hi in gaps[:3])
-        out.append(f"| {name} | {source} | {order} | {s} | {limit:.4f} | {gap_text} | "
+        out.append(f"| {name} | {source} | {order} | {s} | {limit:.4f} | {gaps_text(gaps)} | "
                    f"{step:.3f} | {s / step:.2f} | {energy_spread(a, b, step):.1e} | "
                    + (f"{e5:.1e}" if order == 4 else "") + " |")
     out.append(force_gradient_row())
@@ -180,10 +183,8 @@ def force_gradient_row():
     gaps = unstable_intervals(a, b, grad)
     limit = gaps[0][0]
     step = SAFETY * limit
-    gap_text = "; ".join(f"{lo:.4f} .. {hi:.4f}" if hi else f"from {lo:.4f}"
-                         for lo, hi in gaps[:3])
     return (f"| Chin's 4A (force gradient) | S. A. Chin, Phys. Lett. A 226 (1997) | 4 (oscillator) | 3 | {limit:.4f} | "
-            f"{gap_text} | {step:.3f} | {3 / step:.2f} | "
+            f"{gaps_text(gaps)} | {step:.3f} | {3 / step:.2f} | "
             f"{energy_spread(a, b, step, grad):.1e} (at h rho = 1.265: "
             f"{energy_spread(a, b, 1.265, grad):.1e}) |  |")
 
