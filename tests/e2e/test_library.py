@@ -32,6 +32,26 @@ def test_header_map_and_exports_agree(ropedyn_library):
     assert exported == functions
 
 
+def test_every_function_goes_through_the_lock():
+    """The header's functions are defined by the lock's wrappers (src/lib/ropedyn_serial.c,
+    docs/development/internals.md "The library's lock"), each calling the Fortran function
+    bound as ropedyn_f_NAME: no Fortran function binds a header name itself (it would be
+    exported without the lock), and every wrapper but ropedyn_version takes the lock."""
+    capi = (ROOT / "src" / "lib" / "ropedyn_capi.f90").read_text()
+    bound = set(re.findall(r"bind\(C, name='(\w+)'\)", capi))
+    functions = header_functions()
+    assert bound == {"ropedyn_f_" + f[len("ropedyn_"):] for f in functions}
+    serial = (ROOT / "src" / "lib" / "ropedyn_serial.c").read_text()
+    for f in functions:
+        body = re.search(rf"^[^\n]*\b{f}\([^;{{]*\)\s*\{{(.*?)^\}}", serial, re.M | re.S)
+        assert body, f"{f}: no wrapper in ropedyn_serial.c"
+        call = "ropedyn_f_" + f[len("ropedyn_"):] + "("
+        assert call in body[1], f
+        locked = "pthread_mutex_lock(&lock);" in body[1] and \
+            "pthread_mutex_unlock(&lock);" in body[1]
+        assert locked == (f != "ropedyn_version"), f
+
+
 @pytest.mark.skipif(shutil.which("g++") is None, reason="no C++ compiler (g++)")
 def test_installed_library_found_from_c_cxx_fortran(ropedyn_library, tmp_path):
     build = ropedyn_library.parent
