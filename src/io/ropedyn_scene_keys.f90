@@ -174,7 +174,8 @@ contains
             call add_name(G_SOLVER, 'order_safety', v%order_safety, 'lower, stop, off', &
                 'on an energy gain: lower the order to the A-stable one, stop, or off')
             call add_real(G_SOLVER, 'energy_gain_bound', v%energy_gain_bound, R_POSITIVE, &
-                'rtol S', 'energy gain that counts, in units of rtol times the energy scale')
+                'rtol S', 'energy gain that counts, in units of rtol times the energy scale '// &
+                '(at most S / 10)')
 
             call add_path(G_OUTPUT, 'file', o%file, "HDF5 result file ('': out/<scene>.h5)")
             call add_logical(G_OUTPUT, 'progress', o%progress, &

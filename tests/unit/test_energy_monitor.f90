@@ -4,8 +4,8 @@
 !!   stability_metrics.analyse computes it from a file (python);
 !! - the gain is B - E0 with B = T + V + dissipated - work (external work counted: a support
 !!   that feeds energy in is no gain);
-!! - `gained` is true exactly above factor rtol S, with the record's own energies in S, and
-!!   does not change the monitor (only `observe` does);
+!! - `gained` is true exactly above factor rtol S (at most S / 10), with the record's own
+!!   energies in S, and does not change the monitor (only `observe` does);
 !! - losses (numerical damping) never count;
 !! - a gain accepted as integration error is counted from: the next alarm is a bound above
 !!   it (and accepting never lowers the level);
@@ -134,5 +134,16 @@ program test_energy_monitor
     call m%start(energy_t(kinetic=0.0_wp, elastic=0.0_wp, gravity=-100.0_wp, &
                           dissipated=0.0_wp, support_work=0.0_wp), rtol, factor)
     call suite%check_close(m%scale(), 0.0_wp, 0.0_wp, 1.0e-300_wp, 'gravity zero arbitrary')
+
+    ! at a loose tolerance the bound is at most a tenth of S: energy created and then
+    ! dissipated raises S with it, and 10 rtol S at rtol 0.1 (S itself) would never be passed
+    call m%start(e0, 0.1_wp, factor)
+    call m%observe(e1)
+    call suite%check_close(m%bound(), 0.1_wp*1.12_wp, 1.0e-14_wp, 0.0_wp, &
+                           'the bound at rtol 0.1 is a tenth of S')
+    e2 = e1
+    e2%dissipated = e1%dissipated + 5.0_wp
+    call suite%check_true(m%gained(e2), 'a runaway in the dissipated energy is a gain, '// &
+                          'however loose the tolerance')
     call suite%finish()
 end program test_energy_monitor
