@@ -32,15 +32,19 @@ def test_every_call_once_under_valgrind(lib_memory, tmp_path):
 
 
 def test_rss_stays_flat_over_create_destroy_cycles(lib_memory, tmp_path):
-    cycles, every = 6000, 1000
+    cycles, every = 7000, 1000
     result = subprocess.run([str(lib_memory), "cycles", str(cycles), str(every)],
                             cwd=tmp_path, capture_output=True, text=True, timeout=900)
     assert result.returncode == 0, result.stderr
     rss = dict(tuple(map(int, line.split())) for line in result.stdout.splitlines())
     assert sorted(rss) == [1] + list(range(every, cycles + 1, every))
-    # after the first thousand (the allocator's pools settle), flat: a leak of 3 bytes
-    # a cycle would show here (measured: 0 KiB)
-    assert rss[cycles] - rss[every] <= 12, rss
+    # after the first thousand, flat but for one step of the allocator's pools settling
+    # (28 KiB, once: before the 1000th cycle, or the 2000th, or the 5000th, as the
+    # environment has it; over 30 000 cycles never again). A leak grows in every thousand:
+    # 3 bytes a cycle is a page in most of them.
+    grew = [rss[k + every] - rss[k] for k in range(every, cycles, every)
+            if rss[k + every] != rss[k]]
+    assert len(grew) <= 1 and sum(grew) <= 32, rss
 
 
 def test_python_simulations_keep_no_objects():
