@@ -446,9 +446,16 @@ contains
         real(wp), intent(in) :: tt
         integer, intent(out) :: status
         logical, intent(in) :: full
-        self%y(self%pos) = self%q
+        integer :: j
+        ! (loops: an assignment through a vector subscript made a temporary, a malloc and a
+        ! copy per evaluation)
+        do j = 1, self%np
+            self%y(self%pos(j)) = self%q(j)
+        end do
         if (full) then
-            self%y(self%vel) = self%vt
+            do j = 1, self%np
+                self%y(self%vel(j)) = self%vt(j)
+            end do
             call self%problem%split_rhs(tt, self%y, self%ac, self%gc, status, self%ar, self%gr)
             self%mar = self%mass*self%ar
         else
@@ -463,7 +470,7 @@ contains
     subroutine dmap(self, hh)
         class(symplectic_t), intent(inout) :: self
         real(wp), intent(in) :: hh
-        real(wp) :: dt_kin, rest, dyq(self%nq)
+        real(wp) :: dt_kin, rest
         integer :: j
         if (self%nq == 0) then
             self%v = self%v + hh*self%ar
@@ -472,15 +479,15 @@ contains
         self%vt = self%v + (0.5_wp*hh)*self%ar
         dt_kin = hh*sum_products(self%mar, self%vt)
         self%v = self%v + hh*self%ar
-        dyq = hh*self%gr
-        if (self%closing > 0) then
-            rest = 0.0_wp
-            do j = 1, self%nq
-                if (j /= self%closing) rest = rest + self%signs(j)*dyq(j)
-            end do
-            dyq(self%closing) = (dt_kin - rest)/real(self%signs(self%closing), wp)
-        end if
-        self%yq = self%yq + dyq
+        ! (no work array: an automatic one was a malloc per D-map)
+        rest = 0.0_wp
+        do j = 1, self%nq
+            if (j == self%closing) cycle
+            rest = rest + self%signs(j)*(hh*self%gr(j))
+            self%yq(j) = self%yq(j) + hh*self%gr(j)
+        end do
+        if (self%closing > 0) self%yq(self%closing) = self%yq(self%closing) + &
+            (dt_kin - rest)/real(self%signs(self%closing), wp)
     end subroutine dmap
 
     !> The state at tt in [t_old, t]: the grid point itself, or the cubic Hermite

@@ -17,7 +17,9 @@ split by the inclusive cost of the functions that do each part:
   operations, error tests, step-size control.
 `--methods erk` profiles the explicit method instead (no Jacobian, factorization or solves:
 RHS and the rest of erk_advance_to: stages, error norm, step control, quadratures' history)
-into its own table (the profile_step erk markers).
+into its own table (the profile_step erk markers); `--methods symplectic` likewise (RHS: the
+split forces, rfem_split_rhs; the rest: symplectic_advance_to's kicks, drifts, D-maps and
+the state's scatter), and both together (`--methods "erk symplectic"`) into one table.
 `--whole-run` profiles the whole program on the paper scene as it ships (output every
 0.01 s, its default method unless --methods names one) into a table of its own (the
 profile_step whole-run markers): the integrator's RHS and rest as above, the output (the
@@ -67,6 +69,11 @@ def split(costs, method):
     rhs = total_of(costs, "_MOD_rfem_rhs", "_MOD_rfem_quad_rhs", "_MOD_rfem_rhs_quad")
     if method == "erk":
         total = total_of(costs, "_MOD_erk_advance_to")
+        return [rhs, 0, 0, 0, total - rhs], total
+    if method == "symplectic":
+        # the forces of the potential and of the rest in one call (rfem_split_rhs)
+        rhs = total_of(costs, "_MOD_rfem_split_rhs")
+        total = total_of(costs, "_MOD_symplectic_advance_to")
         return [rhs, 0, 0, 0, total - rhs], total
     if method == "cvode":
         total = total_of(costs, "CVode")
@@ -149,7 +156,8 @@ def main(argv=None):
     parser.add_argument("--baseline", default=None,
                         help="git revision to profile as 'before' (e.g. main)")
     parser.add_argument("--methods", default="cvode mebdf",
-                        help="integrators to profile: 'cvode mebdf' (default) or 'erk'")
+                        help="integrators to profile: 'cvode mebdf' (default), 'erk', "
+                             "'symplectic'")
     parser.add_argument("--whole-run", action="store_true",
                         help="the whole program with the scene's output (its own table)")
     parser.add_argument("--no-write", action="store_true", help="print only")
