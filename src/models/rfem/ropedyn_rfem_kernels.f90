@@ -272,7 +272,7 @@ contains
 
     module procedure forces
         integer :: j, n, p, i, k
-        real(wp) :: fx, fy, fp, dx, dy, dp, c(3), cr(3), e_el, p_in, sup_sde(3, 2)
+        real(wp) :: fx, fy, fp, dx, dy, dp, c(3), cr(3), e_el, p_in, sup_sde(3, 2), floor
         type(sde_t) :: s
         logical :: energy, with_power, split, with_rest, damp
 
@@ -286,6 +286,7 @@ contains
         damp = self%damped .and. (with_rest .or. .not. split)
         e_el = 0.0_wp
         p_in = 0.0_wp
+        floor = self%stretch_floor()
         call self%set_time(t)
         call angles(self, y)
         ! c: the force of the previous SDE on its element b (first: the top support's);
@@ -306,7 +307,12 @@ contains
             fx = 0.0_wp
             fy = 0.0_wp
             fp = 0.0_wp
-            if (self%tension) fx = self%cxj(j)*self%spring_stretch(s%dwx)
+            if (self%tension) then
+                ! spring_stretch, with the floor taken once
+                fx = s%dwx
+                if (fx < floor) fx = floor
+                fx = self%cxj(j)*fx
+            end if
             if (self%shear) fy = self%cy*s%dwy
             if (self%bending) fp = self%cpj(j)*(y(s%kb + 3) - y(s%ka + 3))
             if (energy) e_el = e_el + 0.5_wp*(fx*s%dwx + fy*s%dwy &
@@ -456,12 +462,13 @@ contains
 
     module procedure jacobian_blocks
         integer :: j, n
-        real(wp) :: fx, fy, fp, t6
+        real(wp) :: fx, fy, fp, t6, floor
         type(sde_t) :: s
         ! local coordinates of an SDE: (x, y, phi, x', y', phi') of element a, then of b
         real(wp) :: gx(12), gy(12), dfx(12), dfy(12), dfp(12), r1(12), r2(12), carry(3, 6)
 
         n = self%n
+        floor = self%stretch_floor()
         call self%set_time(t)
         call angles(self, y)
         ! carry: the diagonal block of element b of the previous SDE (first: the top support)
@@ -492,8 +499,13 @@ contains
             fy = 0.0_wp
             fp = 0.0_wp
             if (self%tension) then
-                fx = self%cxj(j)*self%spring_stretch(s%dwx)
-                dfx = self%cxj(j)*self%spring_slope(s%dwx)*gx
+                ! spring_stretch and spring_slope, with the floor taken once
+                fx = self%cxj(j)*s%dwx
+                dfx = self%cxj(j)*gx
+                if (s%dwx < floor) then
+                    fx = self%cxj(j)*floor
+                    dfx = 0.0_wp
+                end if
             end if
             if (self%shear) then
                 fy = self%cy*s%dwy
