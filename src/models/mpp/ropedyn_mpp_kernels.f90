@@ -44,7 +44,7 @@ contains
 
     module procedure residual_core
         real(wp) :: pacc(2), pn(2), pnd(2), wsum(2), fb(2), fp(2), pv(2)
-        real(wp) :: c, s, u, ud, phd, pdd, udd, hk, lk, a1, a2, d, dd
+        real(wp) :: c, s, u, ud, phd, pdd, udd, hk, lk, a1, a2, d, dd, floor
         type(motion_state_t) :: top, bottom
         logical :: bottom_on, effects, bodied
         integer :: k, n, nd, i
@@ -152,9 +152,13 @@ contains
         end do
         if (present(pin)) pin = -wsum
 
-        ! Member springs and dampers.
-        if (self%nu > 0) r(n + 1:nd) = r(n + 1:nd) - self%ksj*self%spring_stretch(y(n + 1:nd)) &
-                                       - self%dsj*y(nd + n + 1:2*nd)
+        ! Member springs and dampers (spring_stretch, with the floor taken once: a call per
+        ! member cost more than the spring)
+        if (self%nu > 0) then
+            floor = self%stretch_floor()
+            r(n + 1:nd) = r(n + 1:nd) - self%ksj*merge(floor, y(n + 1:nd), y(n + 1:nd) < floor) &
+                          - self%dsj*y(nd + n + 1:2*nd)
+        end if
         ! Joint bending springs and dampers between members; their moments (the lower
         ! member's on the upper one) kept by joint for the internal forces.
         self%jmom = 0.0_wp
