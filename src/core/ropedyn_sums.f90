@@ -1,5 +1,6 @@
 !> Sums of squares (and of products) for the integrators' weighted norms (and energies), in a fixed order that runs at the
-!! additions' throughput rather than their latency.
+!! additions' throughput rather than their latency; and the finiteness test of the
+!! right-hand sides, as such a sum.
 !!
 !! A plain sum s = s + x_i**2 is one chain of dependent additions: each waits for the last
 !! (3-4 cycles), and on the rope's 600-unknown states the integrators' norms spent most of
@@ -11,7 +12,7 @@ module ropedyn_sums
     use ropedyn_kinds, only: wp
     implicit none
     private
-    public :: sum_squares, sum_products
+    public :: sum_squares, sum_products, all_finite
 
 contains
 
@@ -46,4 +47,31 @@ contains
         end do
         s = ((a(1) + a(2)) + (a(3) + a(4))) + ((a(5) + a(6)) + (a(7) + a(8)))
     end function sum_products
+
+    !> True when every x_i is finite, as a sum: x_i * 0 is 0 for a finite x_i and NaN for an
+    !! infinite or NaN one, so the sum of those products is 0 exactly when all are finite.
+    !! Four running sums, no branch per element: all(ieee_is_finite(x)) tests and branches
+    !! element by element and took 13 % of the RFEM's right-hand side at n = 30 (1,077 of
+    !! 8,322 instructions). x need not be contiguous (a `contiguous` dummy makes gfortran
+    !! copy an assumed-shape actual argument).
+    pure logical function all_finite(x) result(ok)
+        real(wp), intent(in) :: x(:)
+        real(wp) :: a1, a2, a3, a4
+        integer :: i, n4
+        a1 = 0.0_wp
+        a2 = 0.0_wp
+        a3 = 0.0_wp
+        a4 = 0.0_wp
+        n4 = size(x) - mod(size(x), 4)
+        do i = 1, n4, 4
+            a1 = a1 + x(i)*0.0_wp
+            a2 = a2 + x(i + 1)*0.0_wp
+            a3 = a3 + x(i + 2)*0.0_wp
+            a4 = a4 + x(i + 3)*0.0_wp
+        end do
+        do i = n4 + 1, size(x)
+            a1 = a1 + x(i)*0.0_wp
+        end do
+        ok = (a1 + a2) + (a3 + a4) == 0.0_wp
+    end function all_finite
 end module ropedyn_sums

@@ -6,17 +6,23 @@
 !!   (squares 1 and nine times 2^-54: a plain sum gives 1, the module's order 1 + 2^-52);
 !! - against the plain sum on 600 random values (within rounding);
 !! - the sums of products (sum_products) the same way: exact on integers for every length
-!!   0 .. 40, equal to sum_squares(x) for y = x.
+!!   0 .. 40, equal to sum_squares(x) for y = x;
+!! - all_finite: true for finite vectors (huge and tiny values, negative zero, length 0, a
+!!   strided section), false for a NaN, +Inf or -Inf at every position of every length
+!!   1 .. 20 (the four running sums and the tail) and in a strided section.
 program test_sums
     use ropedyn_kinds, only: wp
-    use ropedyn_sums, only: sum_squares, sum_products
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf, &
+                                             ieee_negative_inf
+    use ropedyn_sums, only: sum_squares, sum_products, all_finite
     use ropedyn_assert, only: test_suite_t
     implicit none
 
     type(test_suite_t) :: suite
     real(wp), allocatable :: x(:)
-    real(wp) :: a(8), expected, eps
-    integer :: n, i
+    real(wp) :: a(8), expected, eps, bad(3), grid(4, 5)
+    integer :: n, i, k, j
+    logical :: caught
     character(len=8) :: label
 
     suite%name = 'sums'
@@ -51,5 +57,31 @@ program test_sums
         call suite%check_true(sum_products(x, x + 1.0_wp) == sum(x*(x + 1.0_wp)), &
                               'products of integers, length '//trim(label))
     end do
+
+    ! all_finite
+    bad = [ieee_value(1.0_wp, ieee_quiet_nan), ieee_value(1.0_wp, ieee_positive_inf), &
+           ieee_value(1.0_wp, ieee_negative_inf)]
+    call suite%check_true(all_finite(x(1:0)), 'all_finite: an empty vector')
+    call suite%check_true(all_finite([huge(1.0_wp), -huge(1.0_wp), tiny(1.0_wp), -0.0_wp, &
+                                      1.0_wp, 2.0_wp, 3.0_wp, 4.0_wp, 5.0_wp]), &
+                          'all_finite: huge, tiny and negative zero are finite')
+    caught = .true.
+    do n = 1, 20
+        x = [(real(i, wp), i = 1, n)]
+        if (.not. all_finite(x)) caught = .false.
+        do k = 1, n
+            do j = 1, 3
+                x(k) = bad(j)
+                if (all_finite(x)) caught = .false.
+                x(k) = real(k, wp)
+            end do
+        end do
+    end do
+    call suite%check_true(caught, 'all_finite: a NaN, +Inf or -Inf anywhere in lengths '// &
+                          '1 .. 20 is caught, and only then')
+    grid = 1.0_wp
+    grid(2, 4) = bad(2)
+    call suite%check_true(all_finite(grid(1, :)) .and. .not. all_finite(grid(2, :)), &
+                          'all_finite: strided sections')
     call suite%finish()
 end program test_sums

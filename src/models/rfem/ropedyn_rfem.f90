@@ -28,6 +28,7 @@
 module ropedyn_rfem
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp
+    use ropedyn_sums, only: all_finite
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_problem, only: STATUS_OK, STATUS_RECOVERABLE
     use ropedyn_rope_model, only: rope_model_t, energy_t

@@ -129,10 +129,10 @@ contains
                 gr(1) = power
                 if (self%with_work) gr(2) = work
             end if
-            if (.not. (all(ieee_is_finite(ar)) .and. ieee_is_finite(power) .and. &
+            if (.not. (all_finite(ar) .and. ieee_is_finite(power) .and. &
                        ieee_is_finite(work))) status = STATUS_RECOVERABLE
         end if
-        if (.not. (all(ieee_is_finite(ac)) .and. all(ieee_is_finite(gc)))) &
+        if (.not. (all_finite(ac) .and. all_finite(gc))) &
             status = STATUS_RECOVERABLE
     end procedure rfem_split_rhs
 

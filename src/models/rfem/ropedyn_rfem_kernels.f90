@@ -421,7 +421,7 @@ contains
         call self%forces(t, y)
         call accelerations(self, y, ydot)
         status = STATUS_OK
-        if (.not. all(ieee_is_finite(ydot))) status = STATUS_RECOVERABLE
+        if (.not. all_finite(ydot)) status = STATUS_RECOVERABLE
     end procedure rfem_rhs
 
     module procedure rfem_rhs_quad
@@ -431,7 +431,7 @@ contains
         call self%forces(t, y, power=power, work=work)
         call accelerations(self, y, ydot)
         call store_rates(self, power, work, yqdot, status)
-        if (.not. all(ieee_is_finite(ydot))) status = STATUS_RECOVERABLE
+        if (.not. all_finite(ydot)) status = STATUS_RECOVERABLE
     end procedure rfem_rhs_quad
 
     !> ydot from y and the generalized forces in self%gen.
