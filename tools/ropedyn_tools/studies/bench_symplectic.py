@@ -25,12 +25,17 @@ import numpy as np
 
 from ropedyn import io
 from ropedyn_tools.repo import DOCS, INPUT, PAPER, add_exe_argument, exe_or_build, set_args
-from ropedyn_tools.studies.common import least_cpu, machine, update_doc, utc_stamp
+from ropedyn_tools.studies.common import (baseline_revision, least_cpu, machine, run_stamp,
+                                          update_doc)
+from ropedyn_tools.studies.profile_step import build_baseline
 
 DOC = DOCS / "validation" / "energy.md"
 BEGIN = "<!-- symplectic-targets:begin -->"
 END = "<!-- symplectic-targets:end -->"
 LIGHT = INPUT / "paper_light_damping.nml"
+#: the last revision whose default method (auto) ran erk and MEBDF on the undamped rope,
+#: before the symplectic method existed: the symplectic method's CPU target
+FORMER = "4276956"
 
 
 def run(exe, work, scene, name, sets):
@@ -58,21 +63,31 @@ def upto(r, when):
     return float(np.abs(r["drift"][r["t"] <= when + 1e-9]).max())
 
 
-def undamped_rows(exe, work, ns, t_end, repeat):
+def undamped_rows(exe, work, ns, t_end, repeat, former):
+    """The undamped rope's rows: the former default first (`former`: (revision, its
+    executable)), then the symplectic method, auto and erk of this tree, each with its CPU
+    over the former default's (the target: at most 1)."""
+    rev, former_exe = former
     rows = []
     for n in ns:
-        for method in ("symplectic", "auto", "erk"):
+        base = None
+        for label, method, program in ((f"auto at {rev} (the former default)", "auto",
+                                        former_exe), ("symplectic", "symplectic", exe),
+                                       ("auto", "auto", exe), ("erk", "erk", exe)):
             sets = [f"model.elements={n}", "effects.damping=.false.",
                     f"solver.method='{method}'", "solver.rtol=1e-3", "solver.atol=1e-5",
                     f"solver.t_end={t_end:g}", "solver.output_interval=0.1",
                     "solver.max_steps=100000000"]
-            r = least_cpu(lambda: run(exe, work, PAPER, f"u{n}_{method}", sets), repeat,
+            tag = f"u{n}_{method}_{'former' if program is former_exe else 'now'}"
+            r = least_cpu(lambda: run(program, work, PAPER, tag, sets), repeat,
                           complete=lambda x: x["ok"])
             if not r["ok"]:
-                rows.append(f"| {n} | {method} | | | | | | {r['why']} |")
+                rows.append(f"| {n} | {label} | | | | | | | {r['why']} |")
                 continue
-            rows.append(f"| {n} | {method} | {at(r, 30):+.1e} | {at(r, t_end):+.1e} | "
+            base = base or r["cpu"]
+            rows.append(f"| {n} | {label} | {at(r, 30):+.1e} | {at(r, t_end):+.1e} | "
                         f"{upto(r, 30):.1e} | {upto(r, t_end):.1e} | {r['cpu']:.3g} | "
+                        f"{r['cpu'] / base:.2f} | "
                         f"{'yes' if upto(r, t_end) <= 1e-3 else 'no'} |")
             print(rows[-1], flush=True)
     return rows
@@ -108,26 +123,41 @@ def main(argv=None):
     parser.add_argument("--elements", default="20 100")
     parser.add_argument("--t-end", type=float, default=300.0)
     parser.add_argument("--repeat", type=int, default=1)
+    parser.add_argument("--former", default=FORMER,
+                        help="git revision whose default method is the CPU target "
+                             f"(built from git archive; default {FORMER})")
+    parser.add_argument("--former-exe", default=None,
+                        help="that revision's Release executable, built before")
     parser.add_argument("--no-write", action="store_true")
     args = parser.parse_args(argv)
+    if not args.former_exe:
+        args.former = baseline_revision(parser, args.former)
     exe = exe_or_build(args.exe)
     with tempfile.TemporaryDirectory() as work:
+        former_exe = pathlib.Path(args.former_exe) if args.former_exe else \
+            build_baseline(args.former, pathlib.Path(tempfile.mkdtemp(dir=work)))
         undamped = undamped_rows(exe, work, [int(x) for x in args.elements.split()],
-                                 args.t_end, args.repeat)
+                                 args.t_end, args.repeat, (args.former, former_exe))
         light = light_rows(exe, work, args.repeat)
     if args.no_write:
         return 0
     block = "\n".join([
         BEGIN,
         f"Command: `scripts/bench_symplectic --elements \"{args.elements}\" --t-end "
-        f"{args.t_end:g} --repeat {args.repeat}` (code: "
+        f"{args.t_end:g} --repeat {args.repeat} --former {args.former}` "
+        + ("(with `--former-exe`: that revision's Release executable, built before) "
+           if args.former_exe else "") + "(code: "
         "tools/ropedyn_tools/studies/bench_symplectic.py). Machine: "
-        f"{machine()}. Run: {utc_stamp()}.", "",
+        f"{machine()}. Run: {run_stamp()}.", "",
         f"The undamped paper rope to {args.t_end:g} s, rtol 1e-3, atol 1e-5: T + V - E0 in "
         "m g L at 30 s and at the end, its largest absolute value over the records (every "
-        "0.1 s) up to each, the CPU of the run, and whether it stays within 1e-3 m g L:", "",
+        "0.1 s) up to each, the CPU of the run, its ratio to the CPU of the default method "
+        f"before the symplectic method ({args.former}'s auto, built from that revision and "
+        "run in the same session; the target: at most 1), and whether it stays within 1e-3 "
+        "m g L:", "",
         "| n | method | at 30 s | at the end | max abs to 30 s | max abs to the end | "
-        "CPU (s) | within 1e-3 |", "|---|---|---|---|---|---|---|---|", *undamped, "",
+        "CPU (s) | CPU / former default | within 1e-3 |",
+        "|---|---|---|---|---|---|---|---|---|", *undamped, "",
         "The lightly damped paper rope (eta 0.1 N s/m^2), 30 s: the balance T + V + "
         "dissipated - E0 at 30 s and its largest gain, m g L, against the targets (the "
         "default's balance within 1e-3 m g L at 30 s; MEBDF at order 7 gaining at most "
