@@ -172,7 +172,8 @@ contains
             call add_logical(G_SOLVER, 'profile', v%profile, &
                 'time the right-hand side, Jacobian, factorizations and solves')
             call add_name(G_SOLVER, 'order_safety', v%order_safety, 'lower, stop, off', &
-                'on an energy gain: lower the order to the A-stable one, stop, or off')
+                'on an energy gain: lower the order to the A-stable one, stop, or off '// &
+                '(lower and stop fail a run that creates a tenth of max(S, m g L))')
             call add_real(G_SOLVER, 'energy_gain_bound', v%energy_gain_bound, R_POSITIVE, &
                 'rtol S', 'energy gain that counts, in units of rtol times the energy scale '// &
                 '(at most S / 10)')

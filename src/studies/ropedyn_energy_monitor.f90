@@ -17,6 +17,14 @@
 !!
 !! Whether a gain is the high order's (an instability) or the integration error is decided
 !! by `high_order_to_blame` from the same interval integrated at both orders.
+!!
+!! A runaway (`runaway`): B - E0 above a tenth of max(S, m g L), the gain accepted or not.
+!! No tolerance makes that an integration error, and no lower order is left to cure it
+!! when the driver sees it (erk, Adams at order 2 and auto at rtol 0.1 - 0.3 on the paper's
+!! rope created 18 - 175 m g L over 30 s and ended with exit 0): the run fails. m g L
+!! (`floor`) keeps the first records of a rope released from rest, where S is still
+!! small, from counting a tiny gain as one; RUNAWAY_LEAST_SCALE a rope at rest without
+!! gravity, whose energies are round-off.
 module ropedyn_energy_monitor
     use ropedyn_kinds, only: wp, i8
     use ropedyn_rope_model, only: energy_t
@@ -31,6 +39,10 @@ module ropedyn_energy_monitor
     !! a gain of 975 J, 844 m g L, by 30 s with exit 0; capped, BDF2 from 0.3 s keeps 0.03
     !! m g L). A tenth of the energy moved is never an integration error a run may keep.
     real(wp), parameter :: MAX_BOUND_SHARE = 0.1_wp
+    !> the least energy scale of a runaway, J: a rope at rest without gravity moves round-off
+    !! (a weightless paper rope over 0.1 s: S = 2e-27 J, "created" 1e-27 J), and no rope
+    !! this code is for moves less than a nanojoule in earnest
+    real(wp), parameter :: RUNAWAY_LEAST_SCALE = 1.0e-9_wp
     !> the share of the bound a gain must have made in the last interval to be judged by a
     !! comparison with the safe order over that interval (high_order_to_blame)
     real(wp), parameter :: SUDDEN_SHARE = 0.5_wp
@@ -55,6 +67,7 @@ module ropedyn_energy_monitor
         real(wp) :: max_gravity = 0.0_wp    !< J
         real(wp) :: dissipated = 0.0_wp     !< |dissipated| at the last record, J
         real(wp) :: accepted = 0.0_wp       !< gain accepted as integration error, J
+        real(wp) :: floor = 0.0_wp          !< the runaway's least scale (m g L), J
     contains
         procedure :: start => monitor_start
         procedure :: observe => monitor_observe
@@ -63,6 +76,8 @@ module ropedyn_energy_monitor
         procedure :: gain => monitor_gain
         procedure :: gained => monitor_gained
         procedure :: accept => monitor_accept
+        procedure :: runaway_limit => monitor_runaway_limit
+        procedure :: runaway => monitor_runaway
     end type energy_monitor_t
 
     !> What the order safety did in a run (docs/theory/energy-balance.md; times in s, < 0: never).
@@ -192,14 +207,19 @@ contains
         self%accepted = max(self%accepted, gain)
     end subroutine monitor_accept
 
-    !> Start from the energies of the initial state.
-    pure subroutine monitor_start(self, e, rtol, factor)
+    !> Start from the energies of the initial state; `floor` (J, default 0): the least
+    !! scale of a runaway, the rope's m g L.
+    pure subroutine monitor_start(self, e, rtol, factor, floor)
         class(energy_monitor_t), intent(inout) :: self
         type(energy_t), intent(in) :: e
         real(wp), intent(in) :: rtol, factor
+        real(wp), intent(in), optional :: floor
         self%e0 = e%balance()
         self%rtol = rtol
         self%factor = factor
+        self%floor = 0.0_wp
+        if (present(floor)) self%floor = max(0.0_wp, floor)
+        self%accepted = 0.0_wp
         self%max_kinetic = e%kinetic
         self%max_elastic = e%elastic
         self%min_gravity = e%gravity
@@ -249,4 +269,22 @@ contains
         call next%observe(e)
         yes = next%gain(e) - next%accepted > next%bound()
     end function monitor_gained
+
+    !> The gain (J) above which a state's balance is a runaway: MAX_BOUND_SHARE max(S,
+    !! floor, RUNAWAY_LEAST_SCALE), the state's energies counted into S first.
+    pure real(wp) function monitor_runaway_limit(self, e) result(limit)
+        class(energy_monitor_t), intent(in) :: self
+        type(energy_t), intent(in) :: e
+        type(energy_monitor_t) :: next
+        next = self
+        call next%observe(e)
+        limit = MAX_BOUND_SHARE*max(next%scale(), self%floor, RUNAWAY_LEAST_SCALE)
+    end function monitor_runaway_limit
+
+    !> True when a state's B - E0 is above runaway_limit, whatever gain was accepted.
+    pure logical function monitor_runaway(self, e) result(yes)
+        class(energy_monitor_t), intent(in) :: self
+        type(energy_t), intent(in) :: e
+        yes = self%gain(e) > self%runaway_limit(e)
+    end function monitor_runaway
 end module ropedyn_energy_monitor

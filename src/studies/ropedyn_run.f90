@@ -467,7 +467,8 @@ contains
             self%safe_order = METHODS(method_index(self%integrator%name()))%safe_order
         self%monitoring = trim(self%scene%solver%order_safety) /= 'off'
         call self%monitor%start(self%summary%initial_energy, self%scene%solver%rtol, &
-                                self%scene%solver%energy_gain_bound)
+                                self%scene%solver%energy_gain_bound, &
+                                self%summary%weight_length)
         call self%start_integrator(err)
         if (allocated(err)) return
         ! no progress display without a file: the caller's own loop is the run

@@ -2,9 +2,11 @@
 !! at every output time the energy monitor compares the balance B = T + V + dissipated -
 !! work with E0; a gain above `energy_gain_bound` rtol S takes a second look at the
 !! method's safe (A-stable) order with 'lower', and ends the run as a failed integration
-!! naming the gain with 'stop'. The monitor (ropedyn_energy_monitor) holds the rules as
-!! pure functions; this submodule carries them out on the run.
+!! naming the gain with 'stop'. With either, a runaway (B - E0 above a tenth of max(S,
+!! m g L), after any second look) ends the run too. The monitor (ropedyn_energy_monitor)
+!! holds the rules as pure functions; this submodule carries them out on the run.
 submodule (ropedyn_run) ropedyn_run_safety
+    use ropedyn_text, only: significant_text
     use ropedyn_energy_monitor, only: high_order_to_blame, sudden_gain, look_budget, &
                                       look_action, LOOK_LOWER, LOOK_NO_VERDICT, LOOK_FAIL
     implicit none
@@ -12,7 +14,8 @@ submodule (ropedyn_run) ropedyn_run_safety
 contains
 
     !> The energy monitor at the output time just reached: on a gain beyond the bound,
-    !! lower the order and integrate the interval again ('lower'), or fail ('stop').
+    !! lower the order and integrate the interval again ('lower'), or fail ('stop'); on a
+    !! runaway of the state it leaves, fail.
     module procedure check_energy
         type(energy_t) :: e
         type(energy_monitor_t) :: next
@@ -22,6 +25,10 @@ contains
         e = self%model%energy(self%t, self%y, self%yq)
         if (.not. ieee_is_finite(e%balance())) return   ! `record` says so
         if (.not. self%monitor%gained(e)) then
+            if (self%monitor%runaway(e)) then
+                call fail_runaway()
+                return
+            end if
             call self%monitor%observe(e)
             self%steps_mark = self%steps_taken()
             e_now = e                            ! the record of this state takes it
@@ -52,8 +59,38 @@ contains
         else
             call self%summary%safety%unresolved(self%t)
         end if
+        if (self%monitor%runaway(e)) then
+            call fail_runaway()
+            return
+        end if
         call self%monitor%observe(e)
         self%steps_mark = self%steps_taken()
+
+    contains
+
+        !> The run fails at a runaway of state e: the time, the step, the energy created, the
+        !! scale it passed, and what to do; the record is not written.
+        subroutine fail_runaway()
+            character(len=:), allocatable :: created
+            real(wp) :: gain
+            gain = self%monitor%gain(e)
+            stats = self%integrator%stats()
+            created = significant_text(gain, 3)//' J'
+            if (self%summary%weight_length > 0.0_wp) created = created//' ('// &
+                significant_text(gain/self%summary%weight_length, 3)//' m g L)'
+            call make_error(err, ERR_SOLVER, self%integrator%name()//' failed at t = '// &
+                significant_text(self%t, 6)//' s, step size '// &
+                significant_text(stats%last_step, 3)//' s: it created '//created// &
+                ' of energy, more than a tenth of the run''s energy scale (max(S, m g L) = '// &
+                significant_text(10.0_wp*self%monitor%runaway_limit(e), 3)//' J): at rtol '// &
+                significant_text(self%scene%solver%rtol, 3)//' the integration does not '// &
+                'follow this motion; tighten rtol (e.g. rtol = '// &
+                significant_text(0.1_wp*self%scene%solver%rtol, 3)//') (docs/theory/'// &
+                'energy-balance.md, "A runaway ends the run")')
+            self%t = self%t_prev
+            self%y = self%y_prev
+            self%yq = self%yq_prev
+        end subroutine fail_runaway
     end procedure check_energy
 
     !> A gain beyond the bound at the order limit in use: the interval [t_prev, tout]

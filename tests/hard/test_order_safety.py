@@ -19,6 +19,7 @@ import h5py
 import numpy as np
 import pytest
 
+from ropedyn import io
 from ropedyn_tools.studies import stability_metrics
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -198,3 +199,54 @@ def test_a_loose_tolerance_does_not_blind_the_monitor(loose_run):
     assert 0.0 < t_low < 1.0
     assert drift < 0.1 * m["energy_scale"]
     assert m["status"] == "complete"
+
+
+@pytest.fixture(scope="module")
+def runaway_runs(run_many, tmp_path_factory):
+    workdir = tmp_path_factory.mktemp("runaway")
+    paper = ROOT / "input" / "paper.nml"
+    common = ["model.elements=30", "solver.t_end=2", "solver.output_interval=0.01"]
+    return run_many({
+        "erk": (paper, common + ["solver.method=erk", "solver.rtol=0.3", "solver.atol=3e-3"]),
+        "off": (paper, common + ["solver.method=erk", "solver.rtol=0.3", "solver.atol=3e-3",
+                                 "solver.order_safety=off"]),
+        "fine": (paper, common + ["solver.method=erk", "solver.rtol=0.03",
+                                  "solver.atol=3e-4"]),
+    }, workdir)
+
+
+def test_a_runaway_ends_the_run(runaway_runs):
+    """erk on the paper's rope at rtol 0.3 creates energy (89 m g L by 30 s, exit 0 before
+    the rule). No lower order is left to cure it, so the run fails once B - E0 passes a
+    tenth of max(S, m g L): exit code 3, a message naming the time, the step, the energy
+    created and a tighter rtol, the record with the gain not written, the file failed."""
+    proc, path = runaway_runs["erk"]
+    assert proc.returncode == 3, proc.stdout + proc.stderr
+    message = proc.stderr.strip()
+    print(message)
+    for part in ("erk failed at t = ", "step size", "it created", "m g L",
+                 "tighten rtol (e.g. rtol = 0.03)"):
+        assert part in message, message
+    m = stability_metrics.analyse(path)
+    assert m["status"] == "failed"
+    mgl = weight_length(path)
+    # the record with the gain was not written: every record within the limit
+    assert m["balance_drift"].max() <= 0.1 * max(m["energy_scale"], mgl)
+    # unguarded, the same run goes past it
+    proc_off, path_off = runaway_runs["off"]
+    assert proc_off.returncode == 0, proc_off.stderr
+    m_off = stability_metrics.analyse(path_off)
+    assert m_off["balance_drift"].max() > 0.1 * max(m_off["energy_scale"], mgl)
+
+
+def weight_length(path):
+    """m g L of a result file's rope (J)."""
+    run = io.load_run(path)
+    return float(np.sum(run.element_mass)) * 9.81 * float(np.sum(run.element_length))
+
+
+def test_no_runaway_at_a_usable_tolerance(runaway_runs):
+    """The same rope with erk at rtol 0.03: the rule leaves it alone."""
+    proc, path = runaway_runs["fine"]
+    assert proc.returncode == 0, proc.stderr
+    assert stability_metrics.analyse(path)["status"] == "complete"

@@ -13,6 +13,7 @@
 !!   (less than half the bound in the last one) whatever the safe order did; a gain of the
 !!   last interval exactly when the safe order, over the same interval, changed the balance
 !!   less (a gain or a loss alike);
+!! - a runaway: B - E0 above a tenth of max(S, m g L), whatever was accepted;
 !! - the second look's budget (20 times the interval's steps, at least 500, for a sudden
 !!   gain's first look; else all that is left) and its action in every case (lower, keep,
 !!   no verdict once, the run's failure).
@@ -145,5 +146,41 @@ program test_energy_monitor
     e2%dissipated = e1%dissipated + 5.0_wp
     call suite%check_true(m%gained(e2), 'a runaway in the dissipated energy is a gain, '// &
                           'however loose the tolerance')
+
+    ! a runaway: B - E0 above a tenth of max(S, m g L), counted with the record's energies
+    ! in S, whatever gain was accepted. S = 1.12 J after e1; with the dissipated energy
+    ! raised by y, S = 1.12 + y and the limit y* = 0.112 / 0.9
+    x = 0.1_wp*1.12_wp/0.9_wp
+    e2 = e1
+    e2%dissipated = e1%dissipated + 0.99_wp*x
+    call suite%check_true(.not. m%runaway(e2), 'no runaway below a tenth of S')
+    call suite%check_close(m%runaway_limit(e2), 0.1_wp*(1.12_wp + 0.99_wp*x), 1.0e-14_wp, &
+                           0.0_wp, 'the runaway limit counts the record into S')
+    e2%dissipated = e1%dissipated + 1.01_wp*x
+    call suite%check_true(m%runaway(e2), 'a runaway above a tenth of S')
+    call m%accept(10.0_wp)
+    call suite%check_true(m%runaway(e2), 'an accepted gain is still a runaway')
+    ! released from rest, S is small at first: m g L is the least scale
+    call m%start(e0, 0.1_wp, factor, floor=2.0_wp)
+    e2 = e0
+    e2%kinetic = 0.15_wp                       ! from nowhere: S = 0.25, gain 0.15
+    call suite%check_true(m%gained(e2), 'a gain beyond the bound of a small S')
+    call suite%check_true(.not. m%runaway(e2), 'below a tenth of m g L: no runaway')
+    call suite%check_close(m%runaway_limit(e2), 0.2_wp, 1.0e-15_wp, 0.0_wp, &
+                           'the limit is a tenth of m g L while S is smaller')
+    e2%kinetic = 0.21_wp
+    call suite%check_true(m%runaway(e2), 'above a tenth of m g L: a runaway')
+    call m%accept(10.0_wp)
+    call m%start(e0, 0.1_wp, factor)
+    call suite%check_true(m%runaway(e2), 'without m g L, S alone')
+    call suite%check_true(m%gained(e2), 'a restart forgets the accepted gain')
+    ! without gravity, at rest: energies of round-off (S = 2e-27 J) are no runaway
+    e2 = energy_t(kinetic=0.0_wp, elastic=9.0e-28_wp, gravity=0.0_wp, dissipated=0.0_wp, &
+                  support_work=0.0_wp)
+    call m%start(e2, 1.0e-6_wp, factor)
+    e2%elastic = 2.1e-27_wp
+    call suite%check_true(.not. m%runaway(e2), 'round-off at rest is no runaway')
+    e2%kinetic = 1.0e-9_wp
+    call suite%check_true(m%runaway(e2), 'a nanojoule from nothing is one')
     call suite%finish()
 end program test_energy_monitor
