@@ -20,8 +20,9 @@
 !!
 !! A runaway (`runaway`): B - E0 above a tenth of max(S, m g L), the gain accepted or not.
 !! No tolerance makes that an integration error, and no lower order is left to cure it
-!! when the driver sees it (erk, Adams at order 2 and auto at rtol 0.1 - 0.3 on the paper's
-!! rope created 18 - 175 m g L over 30 s and ended with exit 0): the run fails. m g L
+!! when the driver sees it (erk and auto at rtol 0.3 on the paper's rope created 89 and 18
+!! m g L over 30 s and ended with exit 0; docs/validation/order-safety.md, "Loose
+!! tolerances"): the run fails. m g L
 !! (`floor`) keeps the first records of a rope released from rest, where S is still
 !! small, from counting a tiny gain as one; RUNAWAY_LEAST_SCALE a rope at rest without
 !! gravity, whose energies are round-off.

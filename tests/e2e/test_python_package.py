@@ -42,6 +42,7 @@ COMMANDS = {
     "accuracy": "ropedyn_tools.studies.accuracy",
     "work_precision_testset": "ropedyn_tools.studies.work_precision_testset",
     "stability_report": "ropedyn_tools.studies.stability_report",
+    "loose_tolerances": "ropedyn_tools.studies.loose_tolerances",
     "update_references": "ropedyn_tools.update_references",
     "mutation_check": "ropedyn_tools.mutation_check",
     "docs_status": "ropedyn_tools.docs_status",
