@@ -81,7 +81,10 @@ int ropedyn_init(ropedyn_t *sim, int from_statics);
 
 /* Integrate to time t (s, not before the time reached; the scene's t_end does not apply).
  * A failed integration keeps the last good state and ends the simulation: later calls
- * return the same error until ropedyn_restore. */
+ * return the same error until ropedyn_restore. An integration that has created more than
+ * a tenth of the rope's energy scale (looked at up to twice per output interval) fails
+ * too, keeping the state of the last look; a state set by ropedyn_set_state starts the
+ * count again. */
 int ropedyn_advance(ropedyn_t *sim, double t);
 
 /* The time reached (s); the number of elements n and of unknowns of the ODE state. */

@@ -175,7 +175,8 @@ module ropedyn_run
         procedure, private :: restart
         procedure, private :: fresh_start, output_time, start_integrator, record, &
                               steps_taken, keep_as_previous, asked_to_stop, end_on
-        procedure, private :: resume_from_file, check_energy, second_look, note_peak
+        procedure, private :: resume_from_file, check_energy, second_look, note_peak, &
+                              fail_runaway
         procedure, private :: guard_output, release_output
     end type run_t
 
@@ -213,6 +214,14 @@ module ropedyn_run
             type(error_t), allocatable, intent(out) :: err
             type(energy_t), allocatable, intent(out) :: e_now
         end subroutine check_energy
+
+        !> The run's error at a runaway of state e (the energy monitor), the state back at
+        !! the previous one looked at (submodule ropedyn_run_safety).
+        module subroutine fail_runaway(self, e, err)
+            class(run_t), intent(inout) :: self
+            type(energy_t), intent(in) :: e
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine fail_runaway
 
         !> OUTPUT_NONE: integrate to time t (s) > the current time, where the coupled
         !! supports are at the position and velocity prescribed by `set_support` (submodule

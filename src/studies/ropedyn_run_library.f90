@@ -7,9 +7,12 @@
 !! for the whole simulation); a state that is not finite after an advance is a failed
 !! integration (ERR_SOLVER), as it is before a record. What does not: the output grid and
 !! t_end (an advance goes to any later time), records, the progress display, and the
-!! order safety with its energy monitor (it integrates an output interval a second time,
-!! which a coupled support's past motion does not allow; set solver.max_order to the
-!! method's A-stable order where a run would need it). No signal is caught.
+!! order safety's second look (it integrates an output interval a second time, which a
+!! coupled support's past motion does not allow; set solver.max_order to the method's
+!! A-stable order where a run would need it). The runaway rule applies, looking at most
+!! twice per output interval: B - E0 above a tenth of max(S, m g L) fails the advance and
+!! leaves the state it last looked at. A state the caller sets is the rule's new start
+!! (its energy came from the caller), a restored one its new last look. No signal is caught.
 !!
 !! Coupled supports (`&supports top_motion = 'coupled'`): `advance` to t1 moves each on
 !! the cubic Hermite curve from its position and velocity now to those `set_support`
@@ -28,6 +31,7 @@ contains
 
     module procedure run_advance
         type(motion_state_t) :: now
+        type(energy_t) :: e
         logical :: coupled(2)
         integer :: k
         if (.not. ieee_is_finite(t)) then
@@ -59,9 +63,22 @@ contains
         end if
         call self%integrator%advance_to(t, self%t, self%y, self%yq(1:self%nq), err)
         if (allocated(err)) return
-        if (.not. (all(ieee_is_finite(self%y)) .and. all(ieee_is_finite(self%yq)))) &
+        if (.not. (all(ieee_is_finite(self%y)) .and. all(ieee_is_finite(self%yq)))) then
             call make_error(err, ERR_SOLVER, 'non-finite state at t = '//real_text(self%t)// &
                             ' s (integrator '//self%integrator%name()//')')
+            return
+        end if
+        ! the runaway rule as a run's records apply it, at most twice per output interval
+        ! of the scene (one evaluation of the energy there); the order safety's second look
+        ! is the records' alone
+        if (.not. self%monitoring .or. self%t - self%t_prev < 0.5_wp*self%dt) return
+        e = self%model%energy(self%t, self%y, self%yq)
+        if (self%monitor%runaway(e)) then
+            call self%fail_runaway(e, err)
+            return
+        end if
+        call self%monitor%observe(e)
+        call look_here(self)
     end procedure run_advance
 
     module procedure run_state_size
@@ -88,6 +105,11 @@ contains
         end if
         self%y = y
         call self%restart(err)
+        if (allocated(err)) return
+        call self%monitor%start(self%model%energy(self%t, self%y, self%yq), &
+                                self%scene%solver%rtol, self%scene%solver%energy_gain_bound, &
+                                self%summary%weight_length)
+        call look_here(self)
     end procedure run_set_state
 
     module procedure run_points_now
@@ -164,10 +186,19 @@ contains
         self%target_v = snap%target_v
         self%target_given = snap%target_given
         call self%restart(err)
+        call look_here(self)
     end procedure run_restore
 
     module procedure restart
         call self%stats_before%add(self%integrator%stats())
         call self%start_integrator(err)
     end procedure restart
+
+    !> The runaway rule's last look is the state now (where a failure goes back to).
+    subroutine look_here(self)
+        class(run_t), intent(inout) :: self
+        self%t_prev = self%t
+        self%y_prev = self%y
+        self%yq_prev = self%yq
+    end subroutine look_here
 end submodule ropedyn_run_library

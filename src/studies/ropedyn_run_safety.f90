@@ -26,7 +26,7 @@ contains
         if (.not. ieee_is_finite(e%balance())) return   ! `record` says so
         if (.not. self%monitor%gained(e)) then
             if (self%monitor%runaway(e)) then
-                call fail_runaway()
+                call self%fail_runaway(e, err)
                 return
             end if
             call self%monitor%observe(e)
@@ -60,38 +60,38 @@ contains
             call self%summary%safety%unresolved(self%t)
         end if
         if (self%monitor%runaway(e)) then
-            call fail_runaway()
+            call self%fail_runaway(e, err)
             return
         end if
         call self%monitor%observe(e)
         self%steps_mark = self%steps_taken()
-
-    contains
-
-        !> The run fails at a runaway of state e: the time, the step, the energy created, the
-        !! scale it passed, and what to do; the record is not written.
-        subroutine fail_runaway()
-            character(len=:), allocatable :: created
-            real(wp) :: gain
-            gain = self%monitor%gain(e)
-            stats = self%integrator%stats()
-            created = significant_text(gain, 3)//' J'
-            if (self%summary%weight_length > 0.0_wp) created = created//' ('// &
-                significant_text(gain/self%summary%weight_length, 3)//' m g L)'
-            call make_error(err, ERR_SOLVER, self%integrator%name()//' failed at t = '// &
-                significant_text(self%t, 6)//' s, step size '// &
-                significant_text(stats%last_step, 3)//' s: it created '//created// &
-                ' of energy, more than a tenth of the run''s energy scale (max(S, m g L) = '// &
-                significant_text(10.0_wp*self%monitor%runaway_limit(e), 3)//' J): at rtol '// &
-                significant_text(self%scene%solver%rtol, 3)//' the integration does not '// &
-                'follow this motion; tighten rtol (e.g. rtol = '// &
-                significant_text(0.1_wp*self%scene%solver%rtol, 3)//') (docs/theory/'// &
-                'energy-balance.md, "A runaway ends the run")')
-            self%t = self%t_prev
-            self%y = self%y_prev
-            self%yq = self%yq_prev
-        end subroutine fail_runaway
     end procedure check_energy
+
+    !> The run fails at a runaway of state e: the time, the step, the energy created, the
+    !! scale it passed, and what to do; the state goes back to the previous record's (which
+    !! the record of a run keeps, and a library run at its previous look).
+    module procedure fail_runaway
+        type(solver_stats_t) :: stats
+        character(len=:), allocatable :: created
+        real(wp) :: gain
+        gain = self%monitor%gain(e)
+        stats = self%integrator%stats()
+        created = significant_text(gain, 3)//' J'
+        if (self%summary%weight_length > 0.0_wp) created = created//' ('// &
+            significant_text(gain/self%summary%weight_length, 3)//' m g L)'
+        call make_error(err, ERR_SOLVER, self%integrator%name()//' failed at t = '// &
+            significant_text(self%t, 6)//' s, step size '// &
+            significant_text(stats%last_step, 3)//' s: it created '//created// &
+            ' of energy, more than a tenth of the run''s energy scale (max(S, m g L) = '// &
+            significant_text(10.0_wp*self%monitor%runaway_limit(e), 3)//' J): at rtol '// &
+            significant_text(self%scene%solver%rtol, 3)//' the integration does not '// &
+            'follow this motion; tighten rtol (e.g. rtol = '// &
+            significant_text(0.1_wp*self%scene%solver%rtol, 3)//') (docs/theory/'// &
+            'energy-balance.md, "A runaway ends the run")')
+        self%t = self%t_prev
+        self%y = self%y_prev
+        self%yq = self%yq_prev
+    end procedure fail_runaway
 
     !> A gain beyond the bound at the order limit in use: the interval [t_prev, tout]
     !! again at the safe order by a second integrator. When the gain is the order's

@@ -135,6 +135,42 @@ def test_failed_advance_raises_the_cli_message(run, tmp_path):
     assert error.value.code == 3 and error.value.run.status == "failed"
 
 
+def test_a_runaway_fails_the_advance_where_the_run_fails(run, tmp_path):
+    """erk at rtol 0.3 on the paper's rope creates energy; the command line's run fails at
+    the runaway (docs/theory/energy-balance.md, "A runaway ends the run"). A Simulation
+    advanced on the output grid fails at the same advance with the same message, keeps the
+    state it last looked at, and a state set by the caller (energy put in) is no runaway."""
+    loose = (small(n=30, t_end=2).set("solver.method", "erk").set("solver.rtol", 0.3)
+             .set("solver.atol", 3e-3))
+    path = loose.write(tmp_path / "loose.nml")
+    message, code = cli_error(run, path, "--set", "output.file=l.h5")
+    assert code == 3 and "it created" in message, message
+    times = np.arange(1, 201) * 0.01
+    with ropedyn.Simulation(loose) as sim:
+        with pytest.raises(ropedyn.Error) as error:
+            for t in times:
+                sim.advance(t)
+                last = sim.state
+        assert error.value.message == message and error.value.kind == "solver"
+        t_fail = float(message.split("failed at t = ")[1].split(" s")[0])
+        assert t_fail == pytest.approx(t, abs=1e-12)
+        assert np.array_equal(sim.state, last)      # the state of the look before
+    # the same scene with the rule off goes on (the gain is the method's)
+    with ropedyn.Simulation(loose.set("solver.order_safety", "off")) as sim:
+        for t in times:
+            sim.advance(t)
+    # a fine tolerance, and a state the caller sets with 5 m g L more kinetic energy: the
+    # new start, no runaway
+    with ropedyn.Simulation(small(n=8, t_end=2)) as sim:
+        sim.advance(0.5)
+        y = sim.state
+        y[3 * 8:] *= 10.0            # every velocity ten times: energy from the caller
+        sim.state = y
+        assert sim.energy["kinetic"] > 5 * 1.156
+        for t in 0.5 + np.arange(1, 51) * 0.01:
+            sim.advance(t)
+
+
 def test_simulation_calls_and_their_errors():
     scene = small(n=8)
     with ropedyn.Simulation(scene) as sim:
