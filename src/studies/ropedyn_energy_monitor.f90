@@ -22,10 +22,9 @@
 !! No tolerance makes that an integration error, and no lower order is left to cure it
 !! when the driver sees it (erk and auto at rtol 0.3 on the paper's rope created 89 and 18
 !! m g L over 30 s and ended with exit 0; docs/validation/order-safety.md, "Loose
-!! tolerances"): the run fails. m g L
-!! (`floor`) keeps the first records of a rope released from rest, where S is still
-!! small, from counting a tiny gain as one; RUNAWAY_LEAST_SCALE a rope at rest without
-!! gravity, whose energies are round-off.
+!! tolerances"): the run fails. m g L (`floor`) keeps the first records of a rope released
+!! from rest, where S is still small, from counting a tiny gain as one;
+!! RUNAWAY_LEAST_SCALE keeps a rope at rest without gravity, whose energies are round-off.
 module ropedyn_energy_monitor
     use ropedyn_kinds, only: wp, i8
     use ropedyn_rope_model, only: energy_t
