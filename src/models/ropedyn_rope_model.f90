@@ -256,8 +256,8 @@ contains
     !! tension only (tension_only, outside statics and modes: a compressed chain is slack),
     !! else -huge (none). The spring acts on max(s, floor): spring_stretch. The RFEM's
     !! kernels apply the floor themselves, taken once per pass: a call of spring_stretch
-    !! per spring made its right-hand side cost 10,546 instructions at n = 30 instead of
-    !! 8,322 (docs/performance/step.md, "The model's kernels").
+    !! per spring made their right-hand side cost 28 % more instructions at n = 30
+    !! (docs/performance/step.md, "The model's kernels").
     pure real(wp) function rope_stretch_floor(self) result(floor)
         class(rope_model_t), intent(in) :: self
         floor = -huge(1.0_wp)

@@ -174,7 +174,8 @@ module ropedyn_run
         procedure :: restore => run_restore
         procedure, private :: restart
         procedure, private :: fresh_start, output_time, start_integrator, record, &
-                              steps_taken, keep_as_previous, asked_to_stop, end_on
+                              steps_taken, keep_as_previous, asked_to_stop, end_on, &
+                              start_monitor
         procedure, private :: resume_from_file, check_energy, second_look, note_peak, &
                               fail_runaway
         procedure, private :: guard_output, release_output
@@ -475,9 +476,7 @@ contains
         if (method_index(self%integrator%name()) > 0) &
             self%safe_order = METHODS(method_index(self%integrator%name()))%safe_order
         self%monitoring = trim(self%scene%solver%order_safety) /= 'off'
-        call self%monitor%start(self%summary%initial_energy, self%scene%solver%rtol, &
-                                self%scene%solver%energy_gain_bound, &
-                                self%summary%weight_length)
+        call self%start_monitor(self%summary%initial_energy)
         call self%start_integrator(err)
         if (allocated(err)) return
         ! no progress display without a file: the caller's own loop is the run
@@ -630,7 +629,17 @@ contains
         end associate
     end subroutine note_peak
 
-    !> The state now is the previous record's (where the order safety looks back to).
+    !> The energy monitor from the energies e of the state now (its E0), with the scene's
+    !! tolerance and bound and the rope's m g L.
+    subroutine start_monitor(self, e)
+        class(run_t), intent(inout) :: self
+        type(energy_t), intent(in) :: e
+        call self%monitor%start(e, self%scene%solver%rtol, self%scene%solver%energy_gain_bound, &
+                                self%summary%weight_length)
+    end subroutine start_monitor
+
+    !> The state now is the previous record's (where the order safety looks back to; in a
+    !! library simulation, the runaway rule's last look).
     subroutine keep_as_previous(self)
         class(run_t), intent(inout) :: self
         self%t_last = self%t

@@ -78,7 +78,7 @@ contains
             return
         end if
         call self%monitor%observe(e)
-        call look_here(self)
+        call self%keep_as_previous()
     end procedure run_advance
 
     module procedure run_state_size
@@ -106,10 +106,8 @@ contains
         self%y = y
         call self%restart(err)
         if (allocated(err)) return
-        call self%monitor%start(self%model%energy(self%t, self%y, self%yq), &
-                                self%scene%solver%rtol, self%scene%solver%energy_gain_bound, &
-                                self%summary%weight_length)
-        call look_here(self)
+        call self%start_monitor(self%model%energy(self%t, self%y, self%yq))
+        call self%keep_as_previous()
     end procedure run_set_state
 
     module procedure run_points_now
@@ -186,19 +184,11 @@ contains
         self%target_v = snap%target_v
         self%target_given = snap%target_given
         call self%restart(err)
-        call look_here(self)
+        call self%keep_as_previous()
     end procedure run_restore
 
     module procedure restart
         call self%stats_before%add(self%integrator%stats())
         call self%start_integrator(err)
     end procedure restart
-
-    !> The runaway rule's last look is the state now (where a failure goes back to).
-    subroutine look_here(self)
-        class(run_t), intent(inout) :: self
-        self%t_prev = self%t
-        self%y_prev = self%y
-        self%yq_prev = self%yq
-    end subroutine look_here
 end submodule ropedyn_run_library

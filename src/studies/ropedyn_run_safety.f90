@@ -22,49 +22,45 @@ contains
         type(solver_stats_t) :: stats
         character(len=200) :: what
         real(wp) :: next_bound
+        logical :: gained
         e = self%model%energy(self%t, self%y, self%yq)
         if (.not. ieee_is_finite(e%balance())) return   ! `record` says so
-        if (.not. self%monitor%gained(e)) then
-            if (self%monitor%runaway(e)) then
-                call self%fail_runaway(e, err)
+        gained = self%monitor%gained(e)
+        if (gained) then
+            next = self%monitor
+            call next%observe(e)
+            next_bound = next%bound()
+            write (what, '(a, es10.3, a, es10.3, a, es12.5, a, i0)') 'energy gain ', &
+                next%gain(e), ' J above E0 (bound ', next_bound, ' J) at t = ', self%t, &
+                ' s, max order ', self%max_order
+            call self%summary%safety%alarm(next%gain(e), next_bound)
+            if (trim(self%scene%solver%order_safety) == 'stop') then
+                stats = self%integrator%stats()
+                call make_error(err, ERR_SOLVER, self%integrator%name()//' failed at t = '// &
+                    real_text(self%t_prev)//' s, step size '//real_text(stats%last_step)// &
+                    ' s: '//trim(what)//': the integrator created energy (&solver '// &
+                    'order_safety = ''stop''; docs/theory/energy-balance.md)')
+                ! the record with the gain is not written
+                self%t = self%t_prev
+                self%y = self%y_prev
+                self%yq = self%yq_prev
                 return
             end if
-            call self%monitor%observe(e)
-            self%steps_mark = self%steps_taken()
-            e_now = e                            ! the record of this state takes it
-            return
+            if (self%safe_order > 0 .and. self%max_order > self%safe_order) then
+                call self%second_look(tout, e, next_bound, err)
+                if (allocated(err)) return
+            else
+                call self%summary%safety%unresolved(self%t)
+            end if
         end if
-        next = self%monitor
-        call next%observe(e)
-        next_bound = next%bound()
-        write (what, '(a, es10.3, a, es10.3, a, es12.5, a, i0)') 'energy gain ', &
-            next%gain(e), ' J above E0 (bound ', next_bound, ' J) at t = ', self%t, &
-            ' s, max order ', self%max_order
-        call self%summary%safety%alarm(next%gain(e), next_bound)
-        if (trim(self%scene%solver%order_safety) == 'stop') then
-            stats = self%integrator%stats()
-            call make_error(err, ERR_SOLVER, self%integrator%name()//' failed at t = '// &
-                real_text(self%t_prev)//' s, step size '//real_text(stats%last_step)// &
-                ' s: '//trim(what)//': the integrator created energy (&solver '// &
-                'order_safety = ''stop''; docs/theory/energy-balance.md)')
-            ! the record with the gain is not written
-            self%t = self%t_prev
-            self%y = self%y_prev
-            self%yq = self%yq_prev
-            return
-        end if
-        if (self%safe_order > 0 .and. self%max_order > self%safe_order) then
-            call self%second_look(tout, e, next_bound, err)
-            if (allocated(err)) return
-        else
-            call self%summary%safety%unresolved(self%t)
-        end if
+        ! the state the run goes on from (after a second look, perhaps another)
         if (self%monitor%runaway(e)) then
             call self%fail_runaway(e, err)
             return
         end if
         call self%monitor%observe(e)
         self%steps_mark = self%steps_taken()
+        if (.not. gained) e_now = e              ! the record of this state takes it
     end procedure check_energy
 
     !> The run fails at a runaway of state e: the time, the step, the energy created, the
