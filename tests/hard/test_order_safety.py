@@ -229,7 +229,7 @@ def test_a_runaway_ends_the_run(runaway_runs):
         assert part in message, message
     m = stability_metrics.analyse(path)
     assert m["status"] == "failed"
-    mgl = weight_length(path)
+    mgl = stability_metrics.weight_length(io.load_run(path))
     # the record with the gain was not written: every record within the limit
     assert m["balance_drift"].max() <= 0.1 * max(m["energy_scale"], mgl)
     # unguarded, the same run goes past it
@@ -237,12 +237,6 @@ def test_a_runaway_ends_the_run(runaway_runs):
     assert proc_off.returncode == 0, proc_off.stderr
     m_off = stability_metrics.analyse(path_off)
     assert m_off["balance_drift"].max() > 0.1 * max(m_off["energy_scale"], mgl)
-
-
-def weight_length(path):
-    """m g L of a result file's rope (J)."""
-    run = io.load_run(path)
-    return float(np.sum(run.element_mass)) * 9.81 * float(np.sum(run.element_length))
 
 
 def test_no_runaway_at_a_usable_tolerance(runaway_runs):

@@ -25,6 +25,7 @@ import numpy as np
 
 from ropedyn import io
 from ropedyn_tools.repo import DOCS, INPUT, PAPER, add_exe_argument, exe_or_build, set_args
+from ropedyn_tools.studies import stability_metrics
 from ropedyn_tools.studies.common import (baseline_revision, least_cpu, machine, run_stamp,
                                           update_doc)
 from ropedyn_tools.studies.profile_step import build_baseline
@@ -49,7 +50,7 @@ def run(exe, work, scene, name, sets):
     r = io.load_run(out)
     e = r.energy
     drift = e["total"] + e["dissipated"] - e["support_work"] - e["total"][0]
-    mgl = float(np.sum(r.element_mass)) * 9.81 * float(np.sum(r.element_length))
+    mgl = stability_metrics.weight_length(r)
     return {"ok": True, "t": r.time, "drift": drift / mgl, "cpu": float(r.stats["cpu_time"]),
             "steps": int(r.stats["steps"])}
 

@@ -55,7 +55,7 @@ def run(exe, work, scene, sets, tag):
         f = io.load_run(out)
     except (OSError, KeyError, ValueError):
         return r
-    mgl = float(np.sum(f.element_mass)) * 9.81 * float(np.sum(f.element_length))
+    mgl = stability_metrics.weight_length(f)
     scale = max(m["energy_scale"], mgl)
     r.update(gain=float(m["balance_drift"].max()) / mgl,
              runaway=bool(np.any(m["balance_drift"] > RUNAWAY * scale)))

@@ -26,6 +26,12 @@ import numpy as np
 from ropedyn import io
 
 
+def weight_length(run):
+    """m g L of a run's rope (J; `run` from ropedyn.io.load_run): its element masses times
+    g = 9.81 m/s^2 times its length, the unit the run summary gives the balance in."""
+    return float(np.sum(run.element_mass)) * 9.81 * float(np.sum(run.element_length))
+
+
 def all_finite(path):
     """Names of the datasets that hold a NaN or Inf (empty: all finite)."""
     bad = []
