@@ -14,6 +14,7 @@ CVODE at its default order 5 does not gain on the same scene and is left alone. 
 long-horizon suite (tests/long) shows the same for MEBDF at order 7 (which gains only after
 ~8 s) and on the lightly damped rope."""
 import pathlib
+import re
 
 import h5py
 import numpy as np
@@ -212,6 +213,7 @@ def runaway_runs(run_many, tmp_path_factory):
                                  "solver.order_safety=off"]),
         "fine": (paper, common + ["solver.method=erk", "solver.rtol=0.03",
                                   "solver.atol=3e-4"]),
+        "mars": (paper, ["model.elements=4", "solver.t_end=0.5", "rope.gravity=3.71"]),
     }, workdir)
 
 
@@ -237,6 +239,18 @@ def test_a_runaway_ends_the_run(runaway_runs):
     assert proc_off.returncode == 0, proc_off.stderr
     m_off = stability_metrics.analyse(path_off)
     assert m_off["balance_drift"].max() > 0.1 * max(m_off["energy_scale"], mgl)
+
+
+def test_weight_length_is_the_runs(runaway_runs):
+    """The studies' m g L (the unit of the runaway limit and of their tables) is the one the
+    run gives the balance in: the scene's gravity (here Mars's) and the rope's length."""
+    proc, path = runaway_runs["mars"]
+    assert proc.returncode == 0, proc.stderr
+    line = next(x for x in proc.stdout.splitlines() if "balance error" in x)
+    joules, units = (float(w) for w in re.findall(r"\(?\s*([-+0-9.E]+) (?:J|m g L)", line)[:2])
+    mgl = stability_metrics.weight_length(io.load_run(path))
+    assert mgl == pytest.approx(joules / units, rel=2e-2), line
+    assert mgl == pytest.approx(0.25 * 0.005**2 * np.pi * 6000 * 1.0 * 3.71, rel=1e-9)
 
 
 def test_no_runaway_at_a_usable_tolerance(runaway_runs):

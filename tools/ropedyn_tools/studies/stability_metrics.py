@@ -27,9 +27,13 @@ from ropedyn import io
 
 
 def weight_length(run):
-    """m g L of a run's rope (J; `run` from ropedyn.io.load_run): its element masses times
-    g = 9.81 m/s^2 times its length, the unit the run summary gives the balance in."""
-    return float(np.sum(run.element_mass)) * 9.81 * float(np.sum(run.element_length))
+    """m g L of a run's rope (J; `run` from ropedyn.io.load_run), the unit the run summary
+    gives the balance in, as the run computed it: its element masses times the scene's
+    gravity times the rope's length; 0 when the scene switches gravity off."""
+    if not run.group("effects").get("gravity", True):
+        return 0.0
+    rope = run.group("rope")
+    return float(np.sum(run.element_mass)) * float(rope["gravity"]) * float(rope["length"])
 
 
 def all_finite(path):
