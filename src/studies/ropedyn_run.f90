@@ -49,7 +49,7 @@ module ropedyn_run
     use ropedyn_os, only: make_parent_dirs
     use ropedyn_output, only: output_file_t, add_counter_values
     use ropedyn_progress, only: progress_t
-    use ropedyn_switch_log, only: switch_event_t
+    use ropedyn_switch_log, only: switch_event_t, switch_log_t
     use ropedyn_version, only: version_string
     use ropedyn_modes, only: equilibrium_initial_state
     use ropedyn_methods, only: METHODS, method_index, resolved_max_order
@@ -113,8 +113,12 @@ module ropedyn_run
         type(progress_t) :: progress
         type(energy_monitor_t) :: monitor
         type(run_summary_t), public :: summary
-        !> the counters of integrators replaced by the order safety
+        !> the counters and switches of integrators replaced by the order safety (a
+        !! second look's lower order, auto's rescue)
         type(solver_stats_t) :: stats_before
+        type(switch_log_t) :: switches_before
+        !> auto went on with MEBDF at its safe order after a runaway (once per run)
+        logical :: rescued = .false.
         !> resume: the counters and CPU time (s) of the earlier parts of the run
         integer(i8) :: counters_before(7) = 0
         real(wp) :: cpu_before = 0.0_wp
@@ -177,7 +181,7 @@ module ropedyn_run
                               steps_taken, keep_as_previous, asked_to_stop, end_on, &
                               start_monitor
         procedure, private :: resume_from_file, check_energy, second_look, note_peak, &
-                              fail_runaway
+                              fail_runaway, rescue, retire_integrator
         procedure, private :: guard_output, release_output
     end type run_t
 
@@ -322,6 +326,22 @@ module ropedyn_run
             real(wp), intent(in) :: bound
             type(error_t), allocatable, intent(out) :: err
         end subroutine second_look
+
+        !> auto's rescue at a runaway (submodule ropedyn_run_safety): the interval again
+        !! with MEBDF at its safe order, and on with it; e: the state the run goes on from.
+        module subroutine rescue(self, tout, e, err)
+            class(run_t), intent(inout) :: self
+            real(wp), intent(in) :: tout
+            type(energy_t), intent(inout) :: e
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine rescue
+
+        !> The integrator in use replaced by `next`: its counters and switches kept for the
+        !! run's summary (submodule ropedyn_run_safety).
+        module subroutine retire_integrator(self, next)
+            class(run_t), intent(inout) :: self
+            class(integrator_t), allocatable, intent(inout) :: next
+        end subroutine retire_integrator
     end interface
 
 contains
@@ -473,6 +493,8 @@ contains
         self%max_order = resolved_max_order(self%integrator%name(), &
                                             self%scene%solver%max_order)
         self%safe_order = 0
+        self%rescued = .false.
+        call self%switches_before%clear()
         if (method_index(self%integrator%name()) > 0) &
             self%safe_order = METHODS(method_index(self%integrator%name()))%safe_order
         self%monitoring = trim(self%scene%solver%order_safety) /= 'off'
@@ -683,7 +705,7 @@ contains
             call add_counter_values(s%stats, self%counters_before)
             s%t_reached = max(s%t_reached, self%t)
             call self%out%write_stats(s%stats, s%cpu_time, ferr, t_reached=self%t)
-            s%switches = self%integrator%switch_log()
+            s%switches = [self%switches_before%items(), self%integrator%switch_log()]
             if (.not. allocated(ferr)) call self%out%write_switches(s%switches, ferr)
             associate (r => s%safety)
                 if (.not. allocated(ferr)) &

@@ -7,9 +7,10 @@
 !! for the whole simulation); a state that is not finite after an advance is a failed
 !! integration (ERR_SOLVER), as it is before a record. What does not: the output grid and
 !! t_end (an advance goes to any later time), records, the progress display, and the
-!! order safety's second look (it integrates an output interval a second time, which a
-!! coupled support's past motion does not allow; set solver.max_order to the method's
-!! A-stable order where a run would need it). The runaway rule applies, looking at most
+!! order safety's second look and auto's rescue at a runaway (they integrate an output
+!! interval a second time, which a coupled support's past motion and the states already
+!! handed out do not allow; set solver.max_order to the method's A-stable order where a
+!! run would need it). The runaway rule applies, looking at most
 !! twice per output interval: B - E0 above a tenth of max(S, m g L) fails the advance and
 !! leaves the state it last looked at. A state the caller sets is the rule's new start
 !! (its energy came from the caller), a restored one its new last look. No signal is caught.

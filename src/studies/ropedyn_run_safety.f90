@@ -6,7 +6,8 @@
 !! m g L), after any second look) ends the run too. The monitor (ropedyn_energy_monitor)
 !! holds the rules as pure functions; this submodule carries them out on the run.
 submodule (ropedyn_run) ropedyn_run_safety
-    use ropedyn_text, only: significant_text
+    use ropedyn_text, only: significant_text, int_text
+    use ropedyn_solvers, only: new_integrator
     use ropedyn_energy_monitor, only: high_order_to_blame, sudden_gain, look_budget, &
                                       look_action, LOOK_LOWER, LOOK_NO_VERDICT, LOOK_FAIL
     implicit none
@@ -53,7 +54,13 @@ contains
                 call self%summary%safety%unresolved(self%t)
             end if
         end if
-        ! the state the run goes on from (after a second look, perhaps another)
+        ! the state the run goes on from (after a second look, perhaps another); auto has
+        ! one more way out
+        if (self%monitor%runaway(e) .and. trim(self%scene%solver%method) == 'auto' .and. &
+            .not. self%rescued .and. trim(self%scene%solver%order_safety) == 'lower') then
+            call self%rescue(tout, e, err)
+            if (allocated(err)) return
+        end if
         if (self%monitor%runaway(e)) then
             call self%fail_runaway(e, err)
             return
@@ -139,9 +146,7 @@ contains
             ! on from where the safe order got, with it (its failure is the run's)
             if (action == LOOK_LOWER) call self%summary%safety%lowered(self%t_prev, &
                 self%max_order, self%safe_order)
-            call self%stats_before%add(self%integrator%stats())
-            call self%integrator%finalize()
-            call move_alloc(safe, self%integrator)
+            call self%retire_integrator(safe)
             ! the whole budget that is left, no longer the second look's
             self%integrator%options%max_steps = max(1_i8, max_steps - self%stats_before%steps)
             self%max_order = self%safe_order
@@ -171,4 +176,61 @@ contains
         call self%summary%safety%kept(self%t, trim(why))
         call self%monitor%accept(self%monitor%gain(e))
     end procedure second_look
+
+    !> auto at a runaway: none of its methods has a safe order to fall back on, so the
+    !! interval [t_prev, tout] again with MEBDF at its safe order (A-stable: it damps
+    !! what it does not resolve, and did not run away at any tolerance of the loose-
+    !! tolerance study), and the run on with it for good, from the state it reaches. The
+    !! switch is logged as a warning with its cause; its failure is the run's, and a
+    !! runaway after it ends the run (check_energy). e: the energies of that state.
+    module procedure rescue
+        class(integrator_t), allocatable :: safe
+        type(solver_options_t) :: options
+        real(wp) :: gain
+        integer :: order
+        character(len=:), allocatable :: why
+        order = METHODS(method_index('mebdf'))%safe_order
+        gain = self%monitor%gain(e)
+        why = 'energy runaway: '//self%integrator%name()//' created '// &
+            significant_text(gain, 3)//' J'
+        if (self%summary%weight_length > 0.0_wp) why = why//' ('// &
+            significant_text(gain/self%summary%weight_length, 3)//' m g L)'
+        why = why//' by t = '//significant_text(self%t, 6)//' s, more than a tenth of '// &
+            'the energy scale (max(S, m g L) = '// &
+            significant_text(10.0_wp*self%monitor%runaway_limit(e), 3)//' J) at rtol '// &
+            significant_text(self%scene%solver%rtol, 3)//': the interval again from t = '// &
+            significant_text(self%t_prev, 6)//' s and on with mebdf at its safe order '// &
+            int_text(order)//' (a tighter rtol keeps auto; docs/theory/energy-balance.md, '// &
+            '"A runaway ends the run")'
+        call new_integrator('mebdf', safe, err)
+        if (allocated(err)) return
+        call self%retire_integrator(safe)
+        call self%switches_before%add(self%t_prev, 'mebdf', order, why, warning=.true.)
+        self%rescued = .true.
+        self%max_order = order
+        self%safe_order = order
+        self%t = self%t_prev
+        self%y = self%y_prev
+        self%yq = self%yq_prev
+        call self%start_integrator(err)
+        if (allocated(err)) return
+        call self%integrator%advance_to(tout, self%t, self%y, self%yq(1:self%nq), err)
+        e = self%model%energy(self%t, self%y, self%yq)
+    end procedure rescue
+
+    !> The integrator in use replaced by `next` (moved in): its counters and switches go
+    !! to those of the run's earlier integrators.
+    module procedure retire_integrator
+        type(switch_event_t), allocatable :: events(:)
+        integer :: k
+        call self%stats_before%add(self%integrator%stats())
+        events = self%integrator%switch_log()
+        do k = 1, size(events)
+            call self%switches_before%add(events(k)%t, events(k)%method, &
+                                          events(k)%max_order, events(k)%reason, &
+                                          events(k)%warning)
+        end do
+        call self%integrator%finalize()
+        call move_alloc(next, self%integrator)
+    end procedure retire_integrator
 end submodule ropedyn_run_safety

@@ -18,6 +18,7 @@ every run. Runs go two at a time (no timing is measured).
 import argparse
 import concurrent.futures
 import pathlib
+import re
 import subprocess
 import sys
 import tempfile
@@ -47,7 +48,11 @@ def run(exe, work, scene, sets, tag):
                            *set_args([f"output.file='{out}'", *sets])],
                           capture_output=True, text=True, timeout=900)
     why = (proc.stderr.strip().splitlines() or [""])[-1].replace("ropedyn: error: ", "")
-    r = {"code": proc.returncode, "why": why, "gain": None, "force": None}
+    # auto's switch to MEBDF at a runaway: a warning naming the time it integrated from
+    rescued = re.search(r"energy runaway: .* the interval again from t = ([0-9.e+-]+) s",
+                        proc.stderr)
+    r = {"code": proc.returncode, "why": why, "gain": None, "force": None,
+         "rescued": rescued.group(1) if rescued else None}
     if not out.exists():
         return r
     try:
@@ -66,6 +71,8 @@ def run(exe, work, scene, sets, tag):
 
 
 def outcome(r):
+    if r["code"] == 0 and r.get("rescued"):
+        return f"complete, on with mebdf 4 from {r['rescued']} s"
     if r["code"] == 0:
         return "complete"
     if "it created" in r["why"]:
@@ -105,12 +112,14 @@ def main(argv=None):
         ref = {s: f.result() for s, f in ref.items()}
         results = {k: (a.result(), b.result()) for k, (a, b) in jobs.items()}
     rows, counts = [], {"runs": len(results), "off_runaway_ok": 0, "complete": 0,
-                        "runaway": 0, "other": 0, "refused": 0, "largest": 0.0}
+                        "runaway": 0, "other": 0, "refused": 0, "largest": 0.0,
+                        "rescued": 0}
     for (scene, method, rtol), (off, on) in results.items():
         kind = outcome(on)
-        key = ("complete" if kind == "complete" else "runaway" if kind.startswith("runaway")
-               else "refused" if kind == "refused" else "other")
+        key = ("complete" if kind.startswith("complete") else "runaway"
+               if kind.startswith("runaway") else "refused" if kind == "refused" else "other")
         counts[key] += 1
+        counts["rescued"] += bool(on.get("rescued"))
         if key == "complete" and on["gain"] is not None:
             counts["largest"] = max(counts["largest"], on["gain"])
         if not off.get("runaway"):
@@ -135,7 +144,8 @@ def main(argv=None):
         "the default guard.", "",
         f"- Unguarded, {len(rows)} runs pass the runaway limit (B - E0 above a tenth of "
         f"max(S, m g L)); {counts['off_runaway_ok']} of them end with exit code 0.",
-        f"- Guarded: {counts['complete']} runs complete, the largest B - E0 among them "
+        f"- Guarded: {counts['complete']} runs complete ({counts['rescued']} of them auto's, "
+        "on with MEBDF at order 4 after a runaway), the largest B - E0 among them "
         f"{counts['largest']:+.2g} m g L; {counts['runaway']} end at a runaway, "
         f"{counts['other']} fail otherwise (the method's own diagnosis), "
         f"{counts['refused']} are refused (the symplectic method: water, ground).", "",
