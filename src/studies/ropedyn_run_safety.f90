@@ -221,16 +221,20 @@ contains
     !> The integrator in use replaced by `next` (moved in): its counters and switches go
     !! to those of the run's earlier integrators.
     module procedure retire_integrator
+        call self%stats_before%add(self%integrator%stats())
+        call self%keep_switches()
+        call self%integrator%finalize()
+        call move_alloc(next, self%integrator)
+    end procedure retire_integrator
+
+    module procedure keep_switches
         type(switch_event_t), allocatable :: events(:)
         integer :: k
-        call self%stats_before%add(self%integrator%stats())
         events = self%integrator%switch_log()
         do k = 1, size(events)
             call self%switches_before%add(events(k)%t, events(k)%method, &
                                           events(k)%max_order, events(k)%reason, &
                                           events(k)%warning)
         end do
-        call self%integrator%finalize()
-        call move_alloc(next, self%integrator)
-    end procedure retire_integrator
+    end procedure keep_switches
 end submodule ropedyn_run_safety
