@@ -75,20 +75,12 @@ contains
     !! the record of a run keeps, and a library run at its previous look).
     module procedure fail_runaway
         type(solver_stats_t) :: stats
-        character(len=:), allocatable :: created
-        real(wp) :: gain
-        gain = self%monitor%gain(e)
         stats = self%integrator%stats()
-        created = significant_text(gain, 3)//' J'
-        if (self%summary%weight_length > 0.0_wp) created = created//' ('// &
-            significant_text(gain/self%summary%weight_length, 3)//' m g L)'
         call make_error(err, ERR_SOLVER, self%integrator%name()//' failed at t = '// &
             significant_text(self%t, 6)//' s, step size '// &
-            significant_text(stats%last_step, 3)//' s: it created '//created// &
-            ' of energy, more than a tenth of the run''s energy scale (max(S, m g L) = '// &
-            significant_text(10.0_wp*self%monitor%runaway_limit(e), 3)//' J): at rtol '// &
-            significant_text(self%scene%solver%rtol, 3)//' the integration does not '// &
-            'follow this motion; tighten rtol (e.g. rtol = '// &
+            significant_text(stats%last_step, 3)//' s: it '//runaway_text(self, e)// &
+            ': at rtol '//significant_text(self%scene%solver%rtol, 3)//' the integration '// &
+            'does not follow this motion; tighten rtol (e.g. rtol = '// &
             significant_text(0.1_wp*self%scene%solver%rtol, 3)//') (docs/theory/'// &
             'energy-balance.md, "A runaway ends the run")')
         self%t = self%t_prev
@@ -185,19 +177,11 @@ contains
     !! runaway after it ends the run (check_energy). e: the energies of that state.
     module procedure rescue
         class(integrator_t), allocatable :: safe
-        type(solver_options_t) :: options
-        real(wp) :: gain
         integer :: order
         character(len=:), allocatable :: why
         order = METHODS(method_index('mebdf'))%safe_order
-        gain = self%monitor%gain(e)
-        why = 'energy runaway: '//self%integrator%name()//' created '// &
-            significant_text(gain, 3)//' J'
-        if (self%summary%weight_length > 0.0_wp) why = why//' ('// &
-            significant_text(gain/self%summary%weight_length, 3)//' m g L)'
-        why = why//' by t = '//significant_text(self%t, 6)//' s, more than a tenth of '// &
-            'the energy scale (max(S, m g L) = '// &
-            significant_text(10.0_wp*self%monitor%runaway_limit(e), 3)//' J) at rtol '// &
+        why = 'energy runaway: by t = '//significant_text(self%t, 6)//' s '// &
+            self%integrator%name()//' '//runaway_text(self, e)//' at rtol '// &
             significant_text(self%scene%solver%rtol, 3)//': the interval again from t = '// &
             significant_text(self%t_prev, 6)//' s and on with mebdf at its safe order '// &
             int_text(order)//' (a tighter rtol keeps auto; docs/theory/energy-balance.md, '// &
@@ -217,6 +201,21 @@ contains
         call self%integrator%advance_to(tout, self%t, self%y, self%yq(1:self%nq), err)
         e = self%model%energy(self%t, self%y, self%yq)
     end procedure rescue
+
+    !> 'created G J (g m g L) of energy, more than a tenth of the run's energy scale
+    !! (max(S, m g L) = X J)': a runaway of state e, for the messages that name it.
+    function runaway_text(self, e) result(text)
+        class(run_t), intent(in) :: self
+        type(energy_t), intent(in) :: e
+        character(len=:), allocatable :: text
+        real(wp) :: gain
+        gain = self%monitor%gain(e)
+        text = 'created '//significant_text(gain, 3)//' J'
+        if (self%summary%weight_length > 0.0_wp) text = text//' ('// &
+            significant_text(gain/self%summary%weight_length, 3)//' m g L)'
+        text = text//' of energy, more than a tenth of the run''s energy scale (max(S, '// &
+            'm g L) = '//significant_text(10.0_wp*self%monitor%runaway_limit(e), 3)//' J)'
+    end function runaway_text
 
     !> The integrator in use replaced by `next` (moved in): its counters and switches go
     !! to those of the run's earlier integrators.
