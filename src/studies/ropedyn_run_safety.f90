@@ -42,9 +42,7 @@ contains
                     ' s: '//trim(what)//': the integrator created energy (&solver '// &
                     'order_safety = ''stop''; docs/theory/energy-balance.md)')
                 ! the record with the gain is not written
-                self%t = self%t_prev
-                self%y = self%y_prev
-                self%yq = self%yq_prev
+                call back_to_previous(self)
                 return
             end if
             if (self%safe_order > 0 .and. self%max_order > self%safe_order) then
@@ -83,9 +81,7 @@ contains
             'does not follow this motion; tighten rtol (e.g. rtol = '// &
             significant_text(0.1_wp*self%scene%solver%rtol, 3)//') (docs/theory/'// &
             'energy-balance.md, "A runaway ends the run")')
-        self%t = self%t_prev
-        self%y = self%y_prev
-        self%yq = self%yq_prev
+        call back_to_previous(self)
     end procedure fail_runaway
 
     !> A gain beyond the bound at the order limit in use: the interval [t_prev, tout]
@@ -193,14 +189,21 @@ contains
         self%rescued = .true.
         self%max_order = order
         self%safe_order = order
-        self%t = self%t_prev
-        self%y = self%y_prev
-        self%yq = self%yq_prev
+        call back_to_previous(self)
         call self%start_integrator(err)
         if (allocated(err)) return
         call self%integrator%advance_to(tout, self%t, self%y, self%yq(1:self%nq), err)
         e = self%model%energy(self%t, self%y, self%yq)
     end procedure rescue
+
+    !> The run's state back at the previous record (or a library run's previous look),
+    !! where the order safety looks back to.
+    subroutine back_to_previous(self)
+        class(run_t), intent(inout) :: self
+        self%t = self%t_prev
+        self%y = self%y_prev
+        self%yq = self%yq_prev
+    end subroutine back_to_previous
 
     !> 'created G J (g m g L) of energy, more than a tenth of the run's energy scale
     !! (max(S, m g L) = X J)': a runaway of state e, for the messages that name it.
