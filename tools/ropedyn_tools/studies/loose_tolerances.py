@@ -56,11 +56,11 @@ def run(exe, work, scene, sets, tag):
     if not out.exists():
         return r
     try:
-        m = stability_metrics.analyse(out)
         f = io.load_run(out)
+        m = stability_metrics.analyse(out, f)
     except (OSError, KeyError, ValueError):
         return r
-    mgl = stability_metrics.weight_length(f)
+    mgl = m["weight_length"]
     scale = max(m["energy_scale"], mgl)
     r.update(gain=float(m["balance_drift"].max()) / mgl,
              runaway=bool(np.any(m["balance_drift"] > RUNAWAY * scale)))

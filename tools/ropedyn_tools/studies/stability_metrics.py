@@ -50,10 +50,13 @@ def all_finite(path):
     return bad
 
 
-def analyse(path):
-    """A dict of the measures above plus status, reason, counters and the raw series."""
-    run = io.load_run(path)
-    r = {"status": run.attrs["status"], "reason": run.attrs.get("reason", ""),
+def analyse(path, run=None):
+    """A dict of the measures above plus status, reason, counters, the raw series and m g L
+    (weight_length); `run`: the file at `path` already loaded (io.load_run), for a caller
+    that takes measures of its own from it too."""
+    run = io.load_run(path) if run is None else run
+    r = {"weight_length": weight_length(run),
+         "status": run.attrs["status"], "reason": run.attrs.get("reason", ""),
          "scene": run.attrs["scene"], "model": run.attrs["model"], "method": run.attrs["method"]}
     t, e = run.time, run.energy
     kinetic, elastic, gravity = e["kinetic"], e["elastic"], e["gravity"]
