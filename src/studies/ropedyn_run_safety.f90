@@ -54,14 +54,17 @@ contains
         end if
         ! the state the run goes on from (after a second look, perhaps another); auto has
         ! one more way out
-        if (self%monitor%runaway(e) .and. trim(self%scene%solver%method) == 'auto' .and. &
-            .not. self%rescued .and. trim(self%scene%solver%order_safety) == 'lower') then
-            call self%rescue(tout, e, err)
-            if (allocated(err)) return
-        end if
         if (self%monitor%runaway(e)) then
-            call self%fail_runaway(e, err)
-            return
+            if (trim(self%scene%solver%method) == 'auto' .and. .not. self%rescued .and. &
+                trim(self%scene%solver%order_safety) == 'lower') then
+                call self%rescue(tout, e, err)
+                if (allocated(err)) return
+            end if
+            ! (e after the rescue: its own runaway ends the run)
+            if (self%monitor%runaway(e)) then
+                call self%fail_runaway(e, err)
+                return
+            end if
         end if
         call self%monitor%observe(e)
         self%steps_mark = self%steps_taken()
