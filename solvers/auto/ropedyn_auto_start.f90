@@ -8,7 +8,7 @@ contains
     module procedure auto_start
         type(spectrum_t) :: spec
         real(wp) :: h_e, h_a, rate
-        character(len=200) :: text
+        character(len=280) :: text
         character(len=100) :: slow
         character(len=400) :: why_sym
 
@@ -84,7 +84,7 @@ contains
         type(split_table_t) :: tab
         real(wp) :: h, cost_s, cost_e
         logical :: light
-        character(len=200) :: text
+        character(len=280) :: text
         fits = .false.
         why = ''
         if (len(self%problem%force_split_refusal()) > 0 .or. h_e <= 0.0_wp) return
@@ -92,7 +92,7 @@ contains
         call choose_step(spec, self%options%rtol, 4, tab, h, light, text)
         ! (as for the start: a step so short is the implicit method's)
         if (.not. light .or. h <= 0.0_wp .or. 1.0_wp/h > START_RATE) return
-        cost_s = tab%stages/h
+        cost_s = tab%evals/h
         cost_e = EXPLICIT_MARGIN*self%tab%evals_per_step()/h_e
         if (cost_s > LIGHT_COST_LIMIT*cost_e) return
         if (present(below)) then

@@ -9,7 +9,7 @@ contains
     module procedure begin
         integer :: status
         real(wp) :: h
-        character(len=200) :: text
+        character(len=280) :: text
         type(split_table_t) :: tab
         self%started = .true.
         self%vt = self%v
@@ -58,7 +58,7 @@ contains
     !! may grow by GROW_AT (the first output interval from here a whole number of steps).
     module procedure review_step
         real(wp) :: h
-        character(len=200) :: text
+        character(len=280) :: text
         type(split_table_t) :: tab
         call stable_step_here(self, tab, h, text)
         if (h <= 0.0_wp) return
@@ -92,17 +92,20 @@ contains
         self%fast_damping = spec%fast_damping
     end subroutine stable_step_here
 
-    !> The composition (Verlet, or Blanes-Moan's when max_order >= 4) and its step for a
-    !! spectrum estimate and a tolerance (docs/theory/symplectic.md, "The step"): each
-    !! composition's step is its `safety` times its stable step (RESONANT_SAFETY when the mode
-    !! that limits it is damped by less than LIGHT_DAMPING), times (rtol / rtol_at)^(1/order)
-    !! below the tolerance that step reaches; the cheaper per simulated second is taken,
-    !! except that lightly damped fast modes take the 4th-order composition when allowed
-    !! (at Verlet's resonance-safe step its energy error is 100 times larger). h = 0: no
-    !! estimate.
+    !> The composition (Verlet, or when max_order >= 4 also Blanes-Moan's and Chin's) and its
+    !! step for a spectrum estimate and a tolerance (docs/theory/symplectic.md, "The step"):
+    !! each composition's step is its `safety` times its stable step (RESONANT_SAFETY when
+    !! the mode that limits it is damped by less than LIGHT_DAMPING), times
+    !! (rtol / rtol_at)^(1/order) below the tolerance that step reaches; the cheapest per
+    !! simulated second (evaluations per step over the step) is taken, except that lightly
+    !! damped fast modes take a 4th-order composition when allowed (at Verlet's
+    !! resonance-safe step its energy error is 100 times larger), each at most the step at
+    !! which the energy of an undamped mode at the spectral radius errs by
+    !! FAST_SPREAD_PER_RTOL rtol (split_table_t's energy_hw). h = 0: no estimate.
     module procedure choose_step
         type(split_table_t) :: cand
-        real(wp) :: hs, hk, zeta, safety, scale, cost, best
+        real(wp) :: hs, hk, he, zeta, safety, scale, cost, best
+        character(len=80) :: extra
         integer :: kind
         logical :: slight
         h = 0.0_wp
@@ -110,8 +113,8 @@ contains
         text = 'no estimate of the spectrum'
         best = huge(1.0_wp)
         tab = split_table(TABLE_VERLET)
-        do kind = TABLE_VERLET, TABLE_BM6
-            if (kind == TABLE_BM6 .and. max_order < 4) exit
+        do kind = TABLE_VERLET, TABLE_CHIN
+            if (kind /= TABLE_VERLET .and. max_order < 4) exit
             cand = split_table(kind)
             call split_stable_step(cand, spec, hs, zeta)
             if (hs <= 0.0_wp) return
@@ -122,15 +125,24 @@ contains
             if (slight) safety = RESONANT_SAFETY
             scale = min(1.0_wp, (rtol/cand%rtol_at)**(1.0_wp/cand%order))
             hk = safety*scale*hs
-            cost = cand%stages/hk
+            ! lightly damped fast modes keep their energy error: at most FAST_SPREAD_PER_RTOL
+            ! rtol for the fastest
+            he = huge(1.0_wp)
+            if (slight) he = cand%energy_hw(FAST_SPREAD_PER_RTOL*rtol)/spec%radius
+            cost = cand%evals/min(hk, he)
             if (cost >= best) cycle
             best = cost
             tab = cand
-            h = hk
+            h = min(hk, he)
             light = slight
             write (text, '(a, es9.2, a, f6.3, a, es9.2, a, f5.2, a, f5.3, a)') &
                 'spectral radius ', spec%radius, ' 1/s, the mode limiting the step damped ', &
                 zeta, ', stable step ', hs, ' s, the step ', safety, ' x', scale, ' of it'
+            if (he < hk) then
+                write (extra, '(a, f5.3, a)') ', shortened to ', h/hs, &
+                    ' of it: the fastest mode''s energy within 10 rtol'
+                text = trim(text)//extra
+            end if
         end do
     end procedure choose_step
 

@@ -56,3 +56,19 @@ def test_study_prints_every_composition(capsys):
     rows = [r for r in capsys.readouterr().out.splitlines() if r.startswith("| ")]
     assert len(rows) == len(cs.compositions()) + 1
     assert rows[2].startswith("| Blanes-Moan SRKN6b") and "| 4.74 |" in rows[2]
+
+
+@pytest.mark.parametrize("name", ["VERLET", "BM6", "CHIN"])
+def test_the_stability_tables_are_the_methods_own_step(name):
+    """ropedyn_split_tables' stable h w at every damping is the scan of the method's step
+    (the D-map, its predicted velocity, a gradient kick) replicated here: digit for digit."""
+    a, b = cs.symmetric(*cs.method_coefficients(), 6)
+    coefficients = {"VERLET": (np.array([1.0]), np.array([0.5, 0.5]), None),
+                    "BM6": (a, b, None), "CHIN": cs.CHIN}[name]
+    assert cs.damped_limits(*coefficients) == cs.fortran_limits(name)
+
+
+def test_the_scan_tells_a_wrong_step_from_the_right_one():
+    """Without the gradient kick Chin's composition is another method: its table differs."""
+    a, b, grad = cs.CHIN
+    assert cs.damped_limits(a, b, 0 * grad)[:3] != cs.fortran_limits("CHIN")[:3]

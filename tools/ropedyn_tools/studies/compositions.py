@@ -114,12 +114,13 @@ def order5_residuals(a, b):
 
 def one_step(a, b, x, grad=None):
     """The one-step matrix on q'' = -q at h = x, its entries as arrays over x; grad: per kick
-    the coefficient g of a force-gradient kick v += b h (1 + g h^2 w^2) a(q) (None: 0)."""
+    the coefficient g of a force-gradient kick, whose acceleration a + g h^2 (da/dq) a is
+    (1 - g h^2 w^2) a(q) here (None: 0; ropedyn_split_tables' grad)."""
     grad = np.zeros(len(b)) if grad is None else np.asarray(grad)
     m11, m12 = np.ones_like(x), np.zeros_like(x)
     m21, m22 = np.zeros_like(x), np.ones_like(x)
     for i in range(len(a) + 1):
-        k = b[i] * x * (1.0 + grad[i] * x * x)
+        k = b[i] * x * (1.0 - grad[i] * x * x)
         m21, m22 = m21 - k * m11, m22 - k * m12
         if i < len(a):
             m11, m12 = m11 + a[i] * x * m21, m12 + a[i] * x * m22
@@ -135,6 +136,56 @@ def unstable_intervals(a, b, grad=None):
         return []
     runs = np.split(idx, np.nonzero(np.diff(idx) > 1)[0] + 1)
     return [(x[r[0]], x[r[-1]] + DX if r[-1] < len(x) - 1 else None) for r in runs]
+
+
+#: the zetas of the method's stability tables (ropedyn_split_tables' STABLE_ZETA)
+STABLE_ZETA = (0.0, 0.005, 0.01, 0.02, 0.03, 0.05, 0.07, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.7,
+               1.0)
+CHIN = (np.array([0.5, 0.5]), np.array([1 / 6, 2 / 3, 1 / 6]), np.array([0.0, 1 / 24, 0.0]))
+
+
+def method_step(a, b, grad, x, zeta):
+    """The method's step as ropedyn_symplectic runs it, on x'' = -x - 2 zeta x' at h = x (an
+    array): the linear map of (q, v, a_r) over one step (the D-map's halves with a_r at the
+    predicted velocity; a gradient kick's acceleration a (1 - g h^2) for a = -q), as an array
+    of 3 x 3 matrices."""
+    x = np.asarray(x, dtype=float)
+    out = np.empty(x.shape + (3, 3))
+    for j in range(3):
+        q, v, ar = (np.full(x.shape, float(j == k)) for k in range(3))
+        v = v + 0.5 * x * ar
+        ac = -q
+        for i in range(len(a)):
+            ac = -q * (1.0 - grad[i] * x * x)
+            v = v + b[i] * x * ac
+            q = q + a[i] * x * v
+        vt = v + b[-1] * x * ac + 0.5 * x * ar
+        ar = -2.0 * zeta * vt
+        v = v + b[-1] * x * (-q) + 0.5 * x * ar
+        out[..., 0, j], out[..., 1, j], out[..., 2, j] = q, v, ar
+    return out
+
+
+def damped_limits(a, b, grad=None, dx=5e-4, xmax=8.0):
+    """The method's stable h w at each of STABLE_ZETA: the last step of a scan in steps of
+    dx before the one-step map (method_step) has an eigenvalue above 1 + 1e-10 (how
+    ropedyn_split_tables' LIMIT_* were made)."""
+    grad = np.zeros(len(b)) if grad is None else np.asarray(grad)
+    x = np.arange(1, int(round(xmax / dx)) + 1) * dx
+    limits = []
+    for zeta in STABLE_ZETA:
+        radius = np.abs(np.linalg.eigvals(method_step(a, b, grad, x, zeta))).max(axis=-1)
+        first = int(np.argmax(radius > 1.0 + 1e-10))
+        limits.append(round(float(x[first - 1]), 4))
+    return limits
+
+
+def fortran_limits(name):
+    """The table LIMIT_<name> of ropedyn_split_tables."""
+    m = re.search(rf"LIMIT_{name}\(NZ\) = \[([^\]]+)\]", TABLES.read_text())
+    if m is None:
+        raise ValueError(f"{TABLES}: no table LIMIT_{name}")
+    return [float(v.strip().replace("_wp", "")) for v in m.group(1).replace("&", "").split(",")]
 
 
 def gaps_text(gaps):
@@ -172,9 +223,9 @@ def rows():
 def force_gradient_row():
     """Chin's 4A, v += h/6 a, q += h/2 v, v += 2h/3 (a + h^2/24 (da/dq) a), q += h/2 v,
     v += h/6 a: the middle kick's force at a gradient-shifted point costs a second
-    evaluation (a difference), so 3 per step; on the oscillator only (its order conditions
-    are not those of a composition)."""
-    a, b, grad = np.array([0.5, 0.5]), np.array([1 / 6, 2 / 3, 1 / 6]), [0.0, -1 / 24, 0.0]
+    evaluation (a difference), so 3 per step; its order is checked on the oscillator (its
+    order conditions are not those of a composition)."""
+    a, b, grad = CHIN
     # order 4 on the oscillator: the phase error falls 32 times when h halves
     phase = [np.arccos(np.clip((lambda m: (m[0] + m[3]) / 2)(
         [float(v[0]) for v in one_step(a, b, np.array([x]), grad)]), -1, 1)) - x
@@ -183,7 +234,8 @@ def force_gradient_row():
     gaps = unstable_intervals(a, b, grad)
     limit = gaps[0][0]
     step = SAFETY * limit
-    return (f"| Chin's 4A (force gradient) | S. A. Chin, Phys. Lett. A 226 (1997) | 4 (oscillator) | 3 | {limit:.4f} | "
+    return (f"| Chin's 4A, force gradient (the method's) | S. A. Chin, Phys. Lett. A 226 "
+            f"(1997) | 4 | 3 | {limit:.4f} | "
             f"{gaps_text(gaps)} | {step:.3f} | {3 / step:.2f} | "
             f"{energy_spread(a, b, step, grad):.1e} (at h rho = 1.265: "
             f"{energy_spread(a, b, 1.265, grad):.1e}) |  |")
