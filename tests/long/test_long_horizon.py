@@ -120,6 +120,8 @@ ACCEPTED_FAILURES = {
     "mpp_light_damping_n30/mebdf/1e-07": "max_steps exceeded",  # at 8.24 s, h 5.3e-6 s
     "undamped/erk/1e-07": "max_steps exceeded",                # at 9.71 s, h 7.3e-6 s
     "light_damping/erk/1e-07": "max_steps exceeded",           # at 9.70 s, h 8.9e-6 s
+    # the runaway rule: it gained 0.19 m g L (180 rtol S) by 0.6 s before the rule existed
+    "folded_n301/cvode/0.001": "more than a tenth of the run's energy scale",  # at 0.55 s
 }
 #: the explicit methods give up on stiff scenes: the reason names the cause and the
 #: implicit methods ('mebdf'), within STIFF_STOP_CPU seconds
