@@ -670,7 +670,7 @@ def main(argv=None):
             "by 1 .. 3 cm over 1 s between any step of the ladder and its half); ropedyn: "
             "`method = 'symplectic'`, rtol 1e-3, a record every 0.1 s. The energy error "
             "E - E0 in units of m g L (1.156 J), MoorDyn's of its own energy. Machine: "
-            f"{machine()}. Run: {utc_stamp()}.", "", UNDAMPED_HEADER,
+            f"{machine()}. Run: {run_stamp()}.", "", UNDAMPED_HEADER,
             "|" + "---|" * (UNDAMPED_HEADER.count("|") - 1), *undamped_rows, UNDAMPED_END]),
             heading="## The undamped rope over 300 s: MoorDyn's RK4 and the symplectic "
                     "method\n\n")
