@@ -128,7 +128,8 @@ contains
             ! lightly damped fast modes keep their energy error: at most FAST_SPREAD_PER_RTOL
             ! rtol for the fastest
             he = huge(1.0_wp)
-            if (slight) he = cand%energy_hw(FAST_SPREAD_PER_RTOL*rtol)/spec%radius
+            if (slight .and. spec%radius > 0.0_wp) &
+                he = cand%energy_hw(FAST_SPREAD_PER_RTOL*rtol)/spec%radius
             cost = cand%evals/min(hk, he)
             if (cost >= best) cycle
             best = cost
