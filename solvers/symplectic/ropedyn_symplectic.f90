@@ -1,9 +1,9 @@
 !> A symplectic splitting method (`method = 'symplectic'`) for mechanical problems with a
 !! constant diagonal mass matrix (problem_t's force split; the RFEM offers it): Stormer-
 !! Verlet (order 2) or a 4th-order composition (Blanes & Moan's, or Chin's with a force-
-!! gradient kick; ropedyn_split_tables) for the
-!! forces of the potential, the other forces (damping, drag, loads) between the steps. The
-!! derivation, the choice of the step and the measurements are in docs/theory/symplectic.md.
+!! gradient kick; ropedyn_split_tables) for the forces of the potential, the other forces
+!! (damping, drag, loads) between the steps. The derivation, the choice of the step and the
+!! measurements are in docs/theory/symplectic.md.
 !!
 !! - **Step** (Strang splitting, processed): from (q_n, v_n), with the forces at q_n known
 !!   from the previous step, v += (h/2) a_r (the second half of the D-map at q_n); the

@@ -138,9 +138,6 @@ def unstable_intervals(a, b, grad=None):
     return [(x[r[0]], x[r[-1]] + DX if r[-1] < len(x) - 1 else None) for r in runs]
 
 
-#: the zetas of the method's stability tables (ropedyn_split_tables' STABLE_ZETA)
-STABLE_ZETA = (0.0, 0.005, 0.01, 0.02, 0.03, 0.05, 0.07, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.7,
-               1.0)
 CHIN = (np.array([0.5, 0.5]), np.array([1 / 6, 2 / 3, 1 / 6]), np.array([0.0, 1 / 24, 0.0]))
 
 
@@ -154,7 +151,6 @@ def method_step(a, b, grad, x, zeta):
     for j in range(3):
         q, v, ar = (np.full(x.shape, float(j == k)) for k in range(3))
         v = v + 0.5 * x * ar
-        ac = -q
         for i in range(len(a)):
             ac = -q * (1.0 - grad[i] * x * x)
             v = v + b[i] * x * ac
@@ -167,25 +163,30 @@ def method_step(a, b, grad, x, zeta):
 
 
 def damped_limits(a, b, grad=None, dx=5e-4, xmax=8.0):
-    """The method's stable h w at each of STABLE_ZETA: the last step of a scan in steps of
-    dx before the one-step map (method_step) has an eigenvalue above 1 + 1e-10 (how
-    ropedyn_split_tables' LIMIT_* were made)."""
+    """The method's stable h w at each damping of ropedyn_split_tables' STABLE_ZETA: the
+    last step of a scan in steps of dx before the one-step map (method_step) has an
+    eigenvalue above 1 + 1e-10 (how its LIMIT_* were made)."""
     grad = np.zeros(len(b)) if grad is None else np.asarray(grad)
     x = np.arange(1, int(round(xmax / dx)) + 1) * dx
     limits = []
-    for zeta in STABLE_ZETA:
+    for zeta in fortran_array("STABLE_ZETA"):
         radius = np.abs(np.linalg.eigvals(method_step(a, b, grad, x, zeta))).max(axis=-1)
         first = int(np.argmax(radius > 1.0 + 1e-10))
         limits.append(round(float(x[first - 1]), 4))
     return limits
 
 
+def fortran_array(name):
+    """The real parameter array `name`(NZ) of ropedyn_split_tables, as a list."""
+    m = re.search(rf"\b{name}\(NZ\) = \[([^\]]+)\]", TABLES.read_text())
+    if m is None:
+        raise ValueError(f"{TABLES}: no table {name}")
+    return [float(v.strip().replace("_wp", "")) for v in m.group(1).replace("&", "").split(",")]
+
+
 def fortran_limits(name):
     """The table LIMIT_<name> of ropedyn_split_tables."""
-    m = re.search(rf"LIMIT_{name}\(NZ\) = \[([^\]]+)\]", TABLES.read_text())
-    if m is None:
-        raise ValueError(f"{TABLES}: no table LIMIT_{name}")
-    return [float(v.strip().replace("_wp", "")) for v in m.group(1).replace("&", "").split(",")]
+    return fortran_array(f"LIMIT_{name}")
 
 
 def gaps_text(gaps):
