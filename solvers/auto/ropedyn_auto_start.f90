@@ -77,9 +77,10 @@ contains
     !> Whether the run should go symplectic (ropedyn_auto_switching's header, "Symplectic"):
     !! the problem offers the force split, the run is long, the mode that limits the
     !! symplectic step is lightly damped, the step takes at most START_RATE steps per
-    !! simulated second, and it costs at most LIGHT_COST_LIMIT times
-    !! erk's predicted cost (evaluations per step over the stable step h_e, with
-    !! EXPLICIT_MARGIN), and under `below` when given; `why`: the reason for the log.
+    !! simulated second, and its cost (choose_step's: its evaluations and the rest of its
+    !! work per simulated second) is at most LIGHT_COST_LIMIT times erk's predicted cost
+    !! (evaluations per step over the stable step h_e, with EXPLICIT_MARGIN), and under
+    !! `below` when given; `why`: the reason for the log.
     module procedure symplectic_fits
         type(split_table_t) :: tab
         real(wp) :: h, cost_s, cost_e
@@ -89,10 +90,10 @@ contains
         why = ''
         if (len(self%problem%force_split_refusal()) > 0 .or. h_e <= 0.0_wp) return
         if (self%options%t_end - t0 < LONG_RUN) return
-        call choose_step(spec, self%options%rtol, 4, tab, h, light, text)
+        call choose_step(spec, self%options%rtol, 4, self%problem%split_has_rest(), tab, h, &
+                         light, text, cost_s)
         ! (as for the start: a step so short is the implicit method's)
         if (.not. light .or. h <= 0.0_wp .or. 1.0_wp/h > START_RATE) return
-        cost_s = tab%evals/h
         cost_e = EXPLICIT_MARGIN*self%tab%evals_per_step()/h_e
         if (cost_s > LIGHT_COST_LIMIT*cost_e) return
         if (present(below)) then

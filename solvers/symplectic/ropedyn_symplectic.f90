@@ -68,6 +68,16 @@ module ropedyn_symplectic
     !! paper rope reached 13 % of m g L over 300 s at n = 20), so that the balance stays
     !! within about rtol times the energy (docs/theory/symplectic.md, "The step")
     real(wp), parameter :: FAST_SPREAD_PER_RTOL = 10.0_wp
+    !> A step's work besides its evaluations of the potential's forces, in such
+    !! evaluations (choose_step compares the compositions by their evaluations plus this,
+    !! per simulated second): STEP_WORK for the kicks, drifts and checks; REST_WORK more
+    !! when the problem has forces outside the potential (their evaluation, once a step, and
+    !! the D-maps with their quadratures). Measured on the paper's rope, n = 20 and 30
+    !! (docs/theory/symplectic.md, "The step"): undamped, a step of SRKN_6^b (6 evaluations)
+    !! took 2.57 us and one of Chin's 4A (3) 1.37 us, so 0.40 us an evaluation and 0.17 us
+    !! the rest of a step; damped (callgrind), an evaluation of the potential's forces 6.0k
+    !! instructions, one with the rest's 10.8k, a step of Chin's 4A 32k
+    real(wp), parameter :: STEP_WORK = 0.5_wp, REST_WORK = 1.8_wp
     !> steps between estimates of the spectrum (at an output time): at first, and at most
     !! (doubled after each estimate that leaves the step as it is)
     integer(i8), parameter :: RESPECTRUM_STEPS = 2000, RESPECTRUM_MAX = 64000
@@ -163,16 +173,21 @@ module ropedyn_symplectic
         end subroutine set_step
 
         !> The composition and its step for a spectrum estimate, a tolerance and an order
-        !! limit (ropedyn_symplectic_steps, where the rule is); `light`: the mode that limits
-        !! the step is lightly damped (below LIGHT_DAMPING); h = 0: no estimate.
-        module subroutine choose_step(spec, rtol, max_order, tab, h, light, text)
+        !! limit (ropedyn_symplectic_steps, where the rule is); `rest`: the problem has
+        !! forces outside the potential (problem_t's split_has_rest); `light`: the mode that
+        !! limits the step is lightly damped (below LIGHT_DAMPING); `cost`: the step's work
+        !! per simulated second, in evaluations of the potential's forces (step_cost over h);
+        !! h = 0: no estimate.
+        module subroutine choose_step(spec, rtol, max_order, rest, tab, h, light, text, cost)
             type(spectrum_t), intent(in) :: spec
             real(wp), intent(in) :: rtol
             integer, intent(in) :: max_order
+            logical, intent(in) :: rest
             type(split_table_t), intent(out) :: tab
             real(wp), intent(out) :: h
             logical, intent(out) :: light
             character(len=*), intent(out) :: text
+            real(wp), intent(out), optional :: cost
         end subroutine choose_step
 
         !> The largest step (s) at which the composition `tab` is stable for every fast Ritz

@@ -87,7 +87,8 @@ contains
         self%y(self%vel) = self%v
         call estimate_spectrum(self%problem, self%t, self%y, spec)
         self%estimated_at = self%counters%steps
-        call choose_step(spec, self%options%rtol, self%order_limit, tab, h, light, text)
+        call choose_step(spec, self%options%rtol, self%order_limit, self%problem%split_has_rest(), &
+                         tab, h, light, text)
         self%radius = spec%radius
         self%fast_damping = spec%fast_damping
     end subroutine stable_step_here
@@ -97,14 +98,14 @@ contains
     !! each composition's step is its `safety` times its stable step (RESONANT_SAFETY when
     !! the mode that limits it is damped by less than LIGHT_DAMPING), times
     !! (rtol / rtol_at)^(1/order) below the tolerance that step reaches; the cheapest per
-    !! simulated second (evaluations per step over the step) is taken, except that lightly
+    !! simulated second (step_cost over the step) is taken, except that lightly
     !! damped fast modes take a 4th-order composition when allowed (at Verlet's
     !! resonance-safe step its energy error is 100 times larger), each at most the step at
     !! which the energy of an undamped mode at the spectral radius errs by
     !! FAST_SPREAD_PER_RTOL rtol (split_table_t's energy_hw). h = 0: no estimate.
     module procedure choose_step
         type(split_table_t) :: cand
-        real(wp) :: hs, hk, he, zeta, safety, scale, cost, best
+        real(wp) :: hs, hk, he, zeta, safety, scale, here, best
         character(len=80) :: extra
         integer :: kind
         logical :: slight
@@ -112,6 +113,7 @@ contains
         light = .false.
         text = 'no estimate of the spectrum'
         best = huge(1.0_wp)
+        if (present(cost)) cost = 0.0_wp
         tab = split_table(TABLE_VERLET)
         do kind = TABLE_VERLET, TABLE_CHIN
             if (kind /= TABLE_VERLET .and. max_order < 4) exit
@@ -130,12 +132,13 @@ contains
             he = huge(1.0_wp)
             if (slight .and. spec%radius > 0.0_wp) &
                 he = cand%energy_hw(FAST_SPREAD_PER_RTOL*rtol)/spec%radius
-            cost = cand%evals/min(hk, he)
-            if (cost >= best) cycle
-            best = cost
+            here = step_cost(cand, rest)/min(hk, he)
+            if (here >= best) cycle
+            best = here
             tab = cand
             h = min(hk, he)
             light = slight
+            if (present(cost)) cost = best
             write (text, '(a, es9.2, a, f6.3, a, es9.2, a, f5.2, a, f5.3, a)') &
                 'spectral radius ', spec%radius, ' 1/s, the mode limiting the step damped ', &
                 zeta, ', stable step ', hs, ' s, the step ', safety, ' x', scale, ' of it'
@@ -146,6 +149,15 @@ contains
             end if
         end do
     end procedure choose_step
+
+    !> A step's work in evaluations of the potential's forces: its evaluations, STEP_WORK,
+    !! and REST_WORK when the problem has forces outside the potential.
+    pure real(wp) function step_cost(tab, rest) result(work)
+        type(split_table_t), intent(in) :: tab
+        logical, intent(in) :: rest
+        work = tab%evals + STEP_WORK
+        if (rest) work = work + REST_WORK
+    end function step_cost
 
     !> The step from now on: `h` at most, fitted so that the interval to tout is a whole
     !! number of steps; the change logged (as a warning when `warn`).

@@ -60,7 +60,8 @@ module ropedyn_problem
                      second_order_layout => problem_second_order_layout, &
                      second_order_blocks => problem_second_order_blocks
         procedure :: force_split_refusal => problem_force_split_refusal, &
-                     split_layout => problem_split_layout, split_rhs => problem_split_rhs
+                     split_layout => problem_split_layout, split_rhs => problem_split_rhs, &
+                     split_has_rest => problem_split_has_rest
     end type problem_t
 
     abstract interface
@@ -289,6 +290,14 @@ contains
         mass = 1.0_wp
         signs = 0
     end subroutine problem_split_layout
+
+    !> Whether the split has forces outside the potential (dampers, drag, loads: `ar` of
+    !! split_rhs not always zero). A splitting method counts their cost in choosing its
+    !! step. The default: yes (the dearer assumption).
+    pure logical function problem_split_has_rest(self) result(rest)
+        class(problem_t), intent(in) :: self
+        rest = .true.
+    end function problem_split_has_rest
 
     !> The split at (t, y): ac = F_c(t, q)/m, the accelerations of the potential's forces
     !! (size(pos), in the order of pos), and gc the quadratures' rates that depend on (t, q)

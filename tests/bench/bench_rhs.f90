@@ -4,7 +4,8 @@
 !! quadratures. Used by scripts/bench_effects and scripts/bench_kernels (docs/performance/effects.md, docs/performance/step.md).
 !!
 !!   bench_rhs SCENE.nml [--set group.key=value ...] [--seconds S]
-!!   bench_rhs SCENE.nml [--set ...] --calls K --kernel rhs|jac|blocks|blocks_implicit|quad
+!!   bench_rhs SCENE.nml [--set ...] --calls K --kernel rhs|jac|blocks|blocks_implicit|quad|
+!!                                               split|split_rest
 !!
 !! The state is the scene's initial state with a fixed perturbation (RFEM: velocities up to
 !! 0.3 m/s and 1 rad/s, positions by 1e-4 m; MPP: angles by 0.1 rad, elongations by 1e-4 m,
@@ -24,15 +25,17 @@ program bench_rhs
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_model_factory, only: create_model
     implicit none
-    integer, parameter :: K_RHS = 1, K_JAC = 2, K_BLOCKS = 3, K_BLOCKS_IMPLICIT = 4, K_QUAD = 5
-    character(len=*), parameter :: KERNELS(5) = [character(len=15) :: 'rhs', 'jac', 'blocks', &
-                                                 'blocks_implicit', 'quad']
+    integer, parameter :: K_RHS = 1, K_JAC = 2, K_BLOCKS = 3, K_BLOCKS_IMPLICIT = 4, K_QUAD = 5, &
+                          K_SPLIT = 6, K_SPLIT_REST = 7
+    character(len=*), parameter :: KERNELS(7) = [character(len=15) :: 'rhs', 'jac', 'blocks', &
+                                                 'blocks_implicit', 'quad', 'split', 'split_rest']
     character(len=1024), allocatable :: sets(:)
     character(len=1024) :: arg, scene_path, kernel_name
     type(scene_t) :: scene
     class(rope_model_t), allocatable :: model
     type(error_t), allocatable :: err
     real(wp), allocatable :: y(:), ydot(:), jb(:, :), kb(:, :), cb(:, :), mb(:, :), yq(:)
+    real(wp), allocatable :: ac(:), ar(:), gc(:), gr(:)
     integer, allocatable :: pos(:), vel(:)
     real(wp) :: seconds, ns(5), sink
     integer :: i, nargs, nsets, ml, mu, kl, ku, n, np, status, kernel
@@ -71,7 +74,7 @@ program bench_rhs
     kernel = findloc(KERNELS, trim(kernel_name), 1)
     if (len_trim(scene_path) == 0 .or. kernel == 0) then
         write (error_unit, '(a)') 'usage: bench_rhs SCENE.nml [--set group.key=value ...] '// &
-            '[--seconds S] [--calls K --kernel rhs|jac|blocks|blocks_implicit|quad]'
+            '[--seconds S] [--calls K --kernel rhs|jac|blocks|blocks_implicit|quad|split|split_rest]'
         error stop 2
     end if
     call read_scene(trim(scene_path), sets(1:nsets), scene, err)
@@ -82,6 +85,7 @@ program bench_rhs
     end if
     n = model%size()
     allocate (y(n), ydot(n), yq(model%quad_size()))
+    allocate (ac(n/2), ar(n/2), gc(model%quad_size()), gr(model%quad_size()))
     call model%initial_state(y)
     if (model%model_name() == 'mpp') then
         ! (angles, elongations, their rates): angles by 0.1 rad, elongations by 1e-4 m,
@@ -183,6 +187,12 @@ contains
         case (K_RHS)
             call model%rhs(0.1_wp, y, ydot, status)
             sink = sink + ydot(n)*1.0e-30_wp
+        case (K_SPLIT)
+            call model%split_rhs(0.1_wp, y, ac, gc, status)
+            sink = sink + ac(1)*1.0e-30_wp
+        case (K_SPLIT_REST)
+            call model%split_rhs(0.1_wp, y, ac, gc, status, ar, gr)
+            sink = sink + (ac(1) + ar(1))*1.0e-30_wp
         end select
     end subroutine one
 end program bench_rhs

@@ -152,7 +152,8 @@ module ropedyn_rfem
         procedure :: generalized_forces => rfem_generalized_forces
         procedure :: potential_energy => rfem_potential_energy
         procedure :: force_split_refusal => rfem_force_split_refusal, &
-                     split_layout => rfem_split_layout, split_rhs => rfem_split_rhs
+                     split_layout => rfem_split_layout, split_rhs => rfem_split_rhs, &
+                     split_has_rest => rfem_split_has_rest
         procedure, private :: forces
         procedure, private :: jacobian_blocks
         procedure, private :: point_mass_rows
@@ -346,6 +347,12 @@ module ropedyn_rfem
             class(rfem_t), intent(in) :: self
             character(len=:), allocatable :: why
         end function rfem_force_split_refusal
+
+        !> Whether the split has forces outside the potential: dampers of the joints or the
+        !! supports, or effects (submodule ropedyn_rfem_energy).
+        module pure logical function rfem_split_has_rest(self) result(rest)
+            class(rfem_t), intent(in) :: self
+        end function rfem_split_has_rest
 
         !> The masses of the coordinates (m, m, J per element) and the balance signs of the
         !! quadratures (dissipated -1, external work +1).

@@ -71,6 +71,11 @@ contains
         end do
     end procedure rfem_force_split_refusal
 
+    module procedure rfem_split_has_rest
+        rest = self%damped .or. any(self%sup%damped_t .or. self%sup%damped_r)
+        if (allocated(self%effects)) rest = rest .or. size(self%effects) > 0
+    end procedure rfem_split_has_rest
+
     module procedure rfem_split_layout
         integer :: i
         do i = 1, self%n
