@@ -83,7 +83,6 @@ def main(argv=None):
     for label, sets in CONFIGS:
         rhs, jac = bench(exe, n, sets, args.seconds)
         results.append((label, rhs, jac))
-    baseline_line = None
     if args.baseline:
         with tempfile.TemporaryDirectory() as tmp:
             base_exe = build_bench_rhs(args.baseline, pathlib.Path(tmp))

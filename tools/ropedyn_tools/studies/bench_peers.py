@@ -559,6 +559,24 @@ def coupled_main(args, exe, py):
     return 0
 
 
+#: the undamped comparison's defaults: n, and its length (s)
+UNDAMPED_ELEMENTS, UNDAMPED_T_END = "20 100", 300.0
+
+
+def undamped_command(args):
+    """The command that made the undamped table: the one that ran (the full command
+    names the undamped arguments only where they are not the defaults)."""
+    undamped = (f"--undamped-elements \"{args.undamped_elements}\" "
+                f"--undamped-t-end {args.undamped_t_end:g}")
+    if args.only_undamped:
+        return f"scripts/bench_peers --only-undamped {undamped} --repeat {args.repeat}"
+    defaults = (args.undamped_elements, args.undamped_t_end) == (UNDAMPED_ELEMENTS,
+                                                                 UNDAMPED_T_END)
+    extra = "" if defaults else f" {undamped}"
+    return (f"scripts/bench_peers --t-end {args.t_end:g} --elements \"{args.elements}\" "
+            f"--repeat {args.repeat}{extra}")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     add_exe_argument(parser)
@@ -567,9 +585,9 @@ def main(argv=None):
     parser.add_argument("--elements", default="10 30 100")
     parser.add_argument("--repeat", type=int, default=3,
                         help="runs of each timed run (the least CPU counts)")
-    parser.add_argument("--undamped-elements", default="20 100",
+    parser.add_argument("--undamped-elements", default=UNDAMPED_ELEMENTS,
                         help="n of the undamped comparison (energy over --undamped-t-end)")
-    parser.add_argument("--undamped-t-end", type=float, default=300.0)
+    parser.add_argument("--undamped-t-end", type=float, default=UNDAMPED_T_END)
     parser.add_argument("--only-undamped", action="store_true",
                         help="only the undamped comparison (the other tables kept)")
     parser.add_argument("--no-undamped", action="store_true",
@@ -657,9 +675,8 @@ def main(argv=None):
     if undamped_rows:
         update_doc(DOCS / "performance" / "peers.md", UNDAMPED_BEGIN, UNDAMPED_END, "\n".join([
             UNDAMPED_BEGIN,
-            f"Command: `scripts/bench_peers --only-undamped --undamped-elements "
-            f"\"{args.undamped_elements}\" --undamped-t-end {args.undamped_t_end:g} --repeat "
-            f"{args.repeat}` (code: tools/ropedyn_tools/studies/bench_peers.py; CPU: the least of "
+            f"Command: `{undamped_command(args)}` (code: "
+            f"tools/ropedyn_tools/studies/bench_peers.py; CPU: the least of "
             f"{args.repeat} runs each). The paper's rope with damping off in both codes, "
             f"{args.undamped_t_end:g} s; MoorDyn without bending stiffness either (a chain of "
             "tension-only springs, whose energy - kinetic, gravity, springs - its driver sums "

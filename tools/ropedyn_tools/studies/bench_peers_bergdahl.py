@@ -29,7 +29,6 @@ docs/performance/peers.md.
 """
 import argparse
 import json
-import math
 import pathlib
 import subprocess
 import sys

@@ -13,7 +13,6 @@ tolerance halved) on demand.
     (python -m ropedyn_tools.studies.bergdahl; without --exe it builds the Release executable)
 """
 import argparse
-import csv
 import json
 import math
 import os
@@ -808,7 +807,7 @@ def main(argv=None):
     command = " ".join(["scripts/validation bergdahl", *shown])
     block = section(results, models, periods, walls, conv, figs, command, work, contact)
     update_doc(out, BEGIN, END, block, heading="## Results\n\n",
-               default=f"# Bergdahl chain\n")
+               default="# Bergdahl chain\n")
     for model in models:
         s, count = model_scores(results, model, periods)
         if s is not None:

@@ -245,7 +245,7 @@ def hanging_chain(runner, ns):
         for n, row in zip(ns, omega):
             md.append(f"| {n} | " + " | ".join(f"{v:.6f}" for v in row) + " | " +
                       " | ".join(fmt_rel(rel(v, r)) for v, r in zip(row, ref)) + " |")
-        md.append(f"| Bessel | " + " | ".join(f"{v:.6f}" for v in ref) + " | | | | | |")
+        md.append("| Bessel | " + " | ".join(f"{v:.6f}" for v in ref) + " | | | | | |")
         if label == "MPP, inextensible":
             ratios = np.array([order(ns, omega[:, k] - ref[k]) for k in range(5)])[:, 0]
             md += ["", "Observed order against Bessel from n = 10 to 30 (discretization "
