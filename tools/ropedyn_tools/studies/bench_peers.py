@@ -63,6 +63,7 @@ import argparse
 import json
 import math
 import pathlib
+import shlex
 import subprocess
 import sys
 import tempfile
@@ -536,8 +537,7 @@ def coupled_main(args, exe, py):
     if args.no_write:
         return 0
     lines = [COUPLED_BEGIN,
-             f"Command: `scripts/bench_peers --coupled-only --t-end {args.t_end:g} "
-             f"--coupled-elements \"{args.coupled_elements}\" --repeat {args.repeat}` (code: "
+             f"Command: `{args.command}` (code: "
              "tools/ropedyn_tools/studies/bench_peers.py; CPU: the least of "
              f"{args.repeat} runs each, the process time of the driving loop alone). "
              f"The paper's rope, its top driven sideways every {COUPLED_DT * 1e3:g} ms from "
@@ -559,22 +559,9 @@ def coupled_main(args, exe, py):
     return 0
 
 
-#: the undamped comparison's defaults: n, and its length (s)
-UNDAMPED_ELEMENTS, UNDAMPED_T_END = "20 100", 300.0
-
-
-def undamped_command(args):
-    """The command that made the undamped table: the one that ran (the full command
-    names the undamped arguments only where they are not the defaults)."""
-    undamped = (f"--undamped-elements \"{args.undamped_elements}\" "
-                f"--undamped-t-end {args.undamped_t_end:g}")
-    if args.only_undamped:
-        return f"scripts/bench_peers --only-undamped {undamped} --repeat {args.repeat}"
-    defaults = (args.undamped_elements, args.undamped_t_end) == (UNDAMPED_ELEMENTS,
-                                                                 UNDAMPED_T_END)
-    extra = "" if defaults else f" {undamped}"
-    return (f"scripts/bench_peers --t-end {args.t_end:g} --elements \"{args.elements}\" "
-            f"--repeat {args.repeat}{extra}")
+def command_text(argv):
+    """The command as it ran (its arguments as given), for the pages' stamps."""
+    return shlex.join(["scripts/bench_peers", *argv])
 
 
 def main(argv=None):
@@ -585,9 +572,9 @@ def main(argv=None):
     parser.add_argument("--elements", default="10 30 100")
     parser.add_argument("--repeat", type=int, default=3,
                         help="runs of each timed run (the least CPU counts)")
-    parser.add_argument("--undamped-elements", default=UNDAMPED_ELEMENTS,
+    parser.add_argument("--undamped-elements", default="20 100",
                         help="n of the undamped comparison (energy over --undamped-t-end)")
-    parser.add_argument("--undamped-t-end", type=float, default=UNDAMPED_T_END)
+    parser.add_argument("--undamped-t-end", type=float, default=300.0)
     parser.add_argument("--only-undamped", action="store_true",
                         help="only the undamped comparison (the other tables kept)")
     parser.add_argument("--no-undamped", action="store_true",
@@ -597,7 +584,9 @@ def main(argv=None):
                         help="n of the coupled case (top driven from Python)")
     parser.add_argument("--coupled-only", action="store_true",
                         help="only the coupled case (its own table)")
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = parser.parse_args(argv)
+    args.command = command_text(argv)
     exe = exe_or_build(args.exe)
     py = ensure_bench_venv()
     if args.coupled_only:
@@ -675,7 +664,7 @@ def main(argv=None):
     if undamped_rows:
         update_doc(DOCS / "performance" / "peers.md", UNDAMPED_BEGIN, UNDAMPED_END, "\n".join([
             UNDAMPED_BEGIN,
-            f"Command: `{undamped_command(args)}` (code: "
+            f"Command: `{args.command}` (code: "
             f"tools/ropedyn_tools/studies/bench_peers.py; CPU: the least of "
             f"{args.repeat} runs each). The paper's rope with damping off in both codes, "
             f"{args.undamped_t_end:g} s; MoorDyn without bending stiffness either (a chain of "
@@ -695,8 +684,7 @@ def main(argv=None):
         print(f"bench_peers: {DOCS / 'performance' / 'peers.md'}")
         return 0
     lines = [BEGIN,
-             f"Command: `scripts/bench_peers --t-end {args.t_end:g} --elements "
-             f"\"{args.elements}\" --repeat {args.repeat}` (code: "
+             f"Command: `{args.command}` (code: "
              f"tools/ropedyn_tools/studies/bench_peers.py; CPU: the least of {args.repeat} runs "
              f"each). MoorDyn-C "
              f"from PyPI `moordyn` in .venv-bench: RK4 at the largest step of the ladder "
