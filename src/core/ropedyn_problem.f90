@@ -28,7 +28,8 @@
 !!   loads). `split_rhs` gives the accelerations F_c/m and F_r/m and the quadratures'
 !!   rates split the same way; `split_layout` gives m and which quadratures are energy
 !!   taken out (dissipated) or put in (external work), so that T + V - sum s_k yq_k is
-!!   constant (T = sum m v^2/2). Default: refused (no split).
+!!   constant (T = sum m v^2/2); `split_has_rest` whether F_r is there at all (a splitting
+!!   method counts its cost). Default: refused (no split).
 module ropedyn_problem
     use ropedyn_kinds, only: wp
     implicit none
