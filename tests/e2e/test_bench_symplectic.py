@@ -1,0 +1,34 @@
+"""scripts/bench_symplectic (tools/ropedyn_tools/studies/bench_symplectic.py): its window
+table and its growth columns, on records made up so that the answers are known."""
+import numpy as np
+
+from ropedyn_tools.studies import bench_symplectic as bs
+
+
+def records(drift, elastic):
+    t = np.arange(0.0, 300.0 + 1e-9, 0.1)
+    return {"t": t, "drift": drift(t), "elastic": elastic(t)}
+
+
+def test_windows_cover_every_record_and_say_a_drift():
+    """A steady drift: the largest error grows window by window and the last window holds
+    the last record (the error at the end, which the growth column uses too)."""
+    r = records(lambda t: -1e-6 * t, lambda t: np.full_like(t, 0.05))
+    head, rows = bs.window_rows(20, r)
+    assert head.count("|") == 13 and "270-300 s" in head
+    largest = [float(x) for x in rows[0].split("|")[3:-1]]
+    assert largest[0] < largest[-1] and largest[-1] == 3.0e-4
+    assert abs(largest[-1] / bs.upto(r, 30) - 10.0) < 1e-9
+    means = [float(x) for x in rows[1].split("|")[3:-1]]
+    assert all(a > b for a, b in zip(means, means[1:]))
+    # an error at the last record alone shows in the last window
+    r["drift"][-1] = 5e-3
+    assert bs.window_rows(20, r)[1][0].split("|")[-2].strip() == "5.0e-03"
+
+
+def test_the_elastic_growth_is_the_last_window_over_the_first():
+    r = records(lambda t: 1e-5 * np.sin(t), lambda t: 0.04 + 1e-4 * t * (t > 150))
+    first, last = 0.04, 0.04 + 1e-4 * np.arange(270.0, 300.0 + 1e-9, 0.1).mean()
+    assert abs(bs.elastic_growth(r) - last / first) < 1e-12
+    rows = bs.window_rows(100, r)[1]
+    assert rows[2].split("|")[3].strip() == "0.040"
