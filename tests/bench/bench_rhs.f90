@@ -74,7 +74,8 @@ program bench_rhs
     kernel = findloc(KERNELS, trim(kernel_name), 1)
     if (len_trim(scene_path) == 0 .or. kernel == 0) then
         write (error_unit, '(a)') 'usage: bench_rhs SCENE.nml [--set group.key=value ...] '// &
-            '[--seconds S] [--calls K --kernel rhs|jac|blocks|blocks_implicit|quad|split|split_rest]'
+            '[--seconds S] [--calls K --kernel rhs|jac|blocks|blocks_implicit|quad|split|'// &
+            'split_rest]'
         error stop 2
     end if
     call read_scene(trim(scene_path), sets(1:nsets), scene, err)

@@ -345,7 +345,7 @@ contains
         type(spectrum_t) :: spec
         type(split_table_t) :: tab
         type(run_t) :: run
-        real(wp) :: h, cost_rest, cost_bare
+        real(wp) :: h, cost_rest
         logical :: light
         character(len=300) :: text
         spec%ritz = RHO*[cmplx(-ZETA, sqrt(1.0_wp - ZETA**2), wp), &
@@ -353,7 +353,7 @@ contains
         spec%radius = RHO
         spec%fast_damping = ZETA
         spec%valid = .true.
-        call choose_step(spec, 4.0e-6_wp, 4, .false., tab, h, light, text, cost_bare)
+        call choose_step(spec, 4.0e-6_wp, 4, .false., tab, h, light, text)
         call suite%check_true(tab%kind == TABLE_CHIN, 'damped fast modes, rtol 4e-6, the '// &
                               'potential''s forces only: Chin''s 4A, got '//trim(tab%label))
         call choose_step(spec, 4.0e-6_wp, 4, .true., tab, h, light, text, cost_rest)

@@ -37,6 +37,8 @@ LIGHT = INPUT / "paper_light_damping.nml"
 #: the last revision whose default method (auto) ran erk and MEBDF on the undamped rope,
 #: before the symplectic method existed: the symplectic method's CPU target
 FORMER = "4276956"
+#: the window (s) of the growth columns and of the window tables
+WINDOW = 30.0
 
 
 def run(exe, work, scene, name, sets):
@@ -64,14 +66,14 @@ def upto(r, when):
     return float(np.abs(r["drift"][r["t"] <= when + 1e-9]).max())
 
 
-def elastic_growth(r, span=30.0):
+def elastic_growth(r, span=WINDOW):
     """The mean elastic energy (where the fast modes' energy is) over the last `span`
     seconds over its mean over the first: how much the fast modes gained."""
     t, e = r["t"], r["elastic"]
     return float(e[t >= t[-1] - span].mean() / e[t <= span].mean())
 
 
-def window_rows(n, r, span=30.0):
+def window_rows(n, r, span=WINDOW):
     """The symplectic run's error and elastic energy window by window (`span` s each):
     the largest |T + V - E0|, its mean, and the mean elastic energy, m g L."""
     t = r["t"]
@@ -81,7 +83,7 @@ def window_rows(n, r, span=30.0):
     quantities = (("largest abs error", lambda m: np.abs(r["drift"][m]).max(), ".1e"),
                   ("mean error", lambda m: r["drift"][m].mean(), "+.1e"),
                   ("mean elastic energy", lambda m: r["elastic"][m].mean(), ".3f"))
-    head = "| n | per window of 30 s (m g L) | " + " | ".join(
+    head = f"| n | per window of {span:g} s (m g L) | " + " | ".join(
         f"{a:g}-{a + span:g} s" for a in edges[:-1]) + " |"
     rows = [f"| {n} | {name} | " + " | ".join(format(f(m), spec) for m in masks) + " |"
             for name, f, spec in quantities]
@@ -150,8 +152,8 @@ def window_block(windows):
     if not windows:
         return []
     block = ["The symplectic method's runs window by window: the largest |T + V - E0| in "
-             "each 30 s, its mean, and the mean elastic energy (where the fast modes' energy "
-             "is), m g L:", ""]
+             f"each {WINDOW:g} s, its mean, and the mean elastic energy (where the fast "
+             "modes' energy is), m g L:", ""]
     for n, (head, rows) in windows.items():
         block += [head, "|" + "---|" * (head.count("|") - 1), *rows, ""]
     return block
