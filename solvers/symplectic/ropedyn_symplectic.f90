@@ -101,6 +101,9 @@ module ropedyn_symplectic
         real(wp), allocatable :: mass(:)       !< of the coordinates
         integer, allocatable :: signs(:)       !< the quadratures' signs in the balance
         integer :: closing = 0                 !< the quadrature that closes the balance
+        !> the problem has forces outside the potential (problem_t's split_has_rest); without
+        !! them a_r = 0, g_r = 0 and the D-maps are the identity, so neither is computed
+        logical :: rest = .true.
         ! the grid: t = t_base + k h
         real(wp) :: t_base = 0.0_wp
         real(wp) :: h = 0.0_wp
@@ -282,6 +285,10 @@ contains
         allocate (self%ac(self%np), self%ar(self%np), self%vt(self%np), self%mar(self%np), &
                   self%gc(self%nq), self%gr(self%nq), self%q_keep(self%np), &
                   self%a_keep(self%np), self%g_keep(self%nq))
+        self%rest = self%problem%split_has_rest()
+        self%ar = 0.0_wp
+        self%gr = 0.0_wp
+        self%mar = 0.0_wp
         self%q_old = self%q
         self%v_old = self%v
         self%a_old = 0.0_wp*self%q
@@ -442,7 +449,7 @@ contains
             self%yq_old = self%yq
         end if
         t_new = self%t_base + real(self%k + 1, wp)*h
-        call self%dmap(0.5_wp*h)
+        if (self%rest) call self%dmap(0.5_wp*h)
         ti = self%t
         do i = 1, s
             if (i > 1) then
@@ -460,12 +467,12 @@ contains
         end do
         ! the predicted velocity: after the last kick and half the D-map, from the most
         ! recent forces
-        self%vt = self%v + (self%tab%b(s + 1)*h)*self%ac + (0.5_wp*h)*self%ar
+        if (self%rest) self%vt = self%v + (self%tab%b(s + 1)*h)*self%ac + (0.5_wp*h)*self%ar
         call self%evaluate(t_new, status, full=.true.)
         if (status /= STATUS_OK) return
         self%v = self%v + (self%tab%b(s + 1)*h)*self%ac
         if (self%nq > 0) self%yq = self%yq + (self%tab%b(s + 1)*h)*self%gc
-        call self%dmap(0.5_wp*h)
+        if (self%rest) call self%dmap(0.5_wp*h)
         self%k = self%k + 1
         self%t = t_new
         self%counters%steps = self%counters%steps + 1
@@ -499,8 +506,8 @@ contains
         if (self%nq > 0) self%gc = self%g_keep + (self%gc - self%g_keep)/GRADIENT_SHIFT
     end subroutine gradient_force
 
-    !> The forces at (tt, q): the potential's (ac, gc) and, when `full`, the rest's (ar, gr)
-    !! at the predicted velocity vt.
+    !> The forces at (tt, q): the potential's (ac, gc) and, when `full` and the problem has
+    !! them, the rest's (ar, gr) at the predicted velocity vt.
     subroutine evaluate(self, tt, status, full)
         class(symplectic_t), intent(inout) :: self
         real(wp), intent(in) :: tt
@@ -512,7 +519,7 @@ contains
         do j = 1, self%np
             self%y(self%pos(j)) = self%q(j)
         end do
-        if (full) then
+        if (full .and. self%rest) then
             do j = 1, self%np
                 self%y(self%vel(j)) = self%vt(j)
             end do
