@@ -138,7 +138,29 @@ def unstable_intervals(a, b, grad=None):
     return [(x[r[0]], x[r[-1]] + DX if r[-1] < len(x) - 1 else None) for r in runs]
 
 
-CHIN = (np.array([0.5, 0.5]), np.array([1 / 6, 2 / 3, 1 / 6]), np.array([0.0, 1 / 24, 0.0]))
+def table_arrays(case):
+    """(a, b, grad) of the composition `case` (e.g. "TABLE_CHIN") as ropedyn_split_tables
+    sets them: its `tab%a = [...]` lines, each entry a number or a quotient of two."""
+    text = TABLES.read_text()
+    m = re.search(rf"case \({case}\)(.*?)(?:case |end select)", text, re.S)
+    if m is None:
+        raise ValueError(f"{TABLES}: no case {case}")
+
+    def entry(e):
+        parts = [float(x.strip().removesuffix("_wp")) for x in e.split("/")]
+        if not 1 <= len(parts) <= 2:
+            raise ValueError(f"{TABLES}: cannot read {e!r}")
+        return parts[0] / parts[1] if len(parts) == 2 else parts[0]
+
+    def array(name):
+        a = re.search(rf"tab%{name} = \[([^\]]*)\]", m.group(1))
+        if a is None:
+            raise ValueError(f"{TABLES}: {case} sets no tab%{name}")
+        return np.array([entry(e) for e in a.group(1).split(",")])
+    return array("a"), array("b"), array("grad")
+
+
+CHIN = table_arrays("TABLE_CHIN")
 
 
 def method_step(a, b, grad, x, zeta):
