@@ -56,12 +56,13 @@ module ropedyn_symplectic
 
     !> the step over the stable step where the mode that limits it is lightly damped: the
     !! combination frequencies of such modes (up to twice the fastest) near the stability
-    !! limit feed an energy drift. The 4th-order composition on the undamped paper rope,
-    !! n = 20, rtol 1e-3, 300 s (largest |T + V - E0| in the first and the last 20 s, m g L):
-    !! at 0.55 of the stable step 3.2e-6 .. 8.1e-4; 0.45: 1.0e-6 .. 1.8e-5; 0.4: 5.2e-7 ..
-    !! 6.9e-6; 0.35: 3.0e-7 .. 1.6e-6, while the rope's elastic energy, where the fast modes'
-    !! energy is, rose 4 times (docs/theory/symplectic.md, "The step")
-    real(wp), parameter :: RESONANT_SAFETY = 0.4_wp
+    !! limit feed an energy drift. On the undamped paper rope at rtol 1e-3 SRKN_6^b drifted
+    !! over 300 s at 0.55 (n = 20); Chin's 4A at 0.4 over 1000 s let the largest
+    !! |T + V - E0| per 100 s wander up to 7.5e-4 m g L (n = 20, four starts) and drift to
+    !! 1.5e-4 (n = 100, one start of two), and at 0.35 it stayed within 1.5e-4 and 3.8e-5,
+    !! following the elastic energy, where the fast modes' energy is
+    !! (docs/theory/symplectic.md, "The step")
+    real(wp), parameter :: RESONANT_SAFETY = 0.35_wp
     !> where the fast modes are lightly damped, the relative energy error of an undamped mode
     !! at the spectral radius (the spread of its energy along the numerical orbit) over rtol
     !! at most: they hold a tenth of the energy or less (the elastic energy of the undamped
@@ -75,8 +76,9 @@ module ropedyn_symplectic
     !! the D-maps with their quadratures). Measured on the paper's rope, n = 20 and 30
     !! (docs/theory/symplectic.md, "The step"): undamped, a step of SRKN_6^b (6 evaluations)
     !! took 2.57 us and one of Chin's 4A (3) 1.37 us, so 0.40 us an evaluation and 0.17 us
-    !! the rest of a step; damped (callgrind), an evaluation of the potential's forces 6.0k
-    !! instructions, one with the rest's 10.8k, a step of Chin's 4A 32k
+    !! the rest of a step (2.00 and 1.06 us, 0.31 and 0.12 us, once the D-maps were skipped
+    !! without rest forces); damped (callgrind), an evaluation of the potential's forces
+    !! 6.0k instructions, one with the rest's 10.8k, a step of Chin's 4A 32k
     real(wp), parameter :: STEP_WORK = 0.5_wp, REST_WORK = 1.8_wp
     !> steps between estimates of the spectrum (at an output time): at first, and at most
     !! (doubled after each estimate that leaves the step as it is)

@@ -19,10 +19,11 @@ abar_ij = b_j (c_i - c_j), j < i). For each composition:
   in x = h w; the method is stable where |trace| <= 2. The first x where it is not (scanned
   in steps of 1e-5 up to 8, so that narrow gaps are found) is the limit X; the unstable
   intervals below 8 are listed;
-- **the resonance-safe step**: 0.4 X (what ropedyn_symplectic takes where the fast modes are
+- **the resonance-safe step**: S X, S = RESONANT_SAFETY of ropedyn_symplectic (what it takes
+  where the fast modes are
   lightly damped: their combinations reach twice the fastest frequency, which must stay
   inside the stable interval with a margin), and at it the evaluations of the forces per
-  unit of rho t (s / (0.4 X): the cost per simulated second for a spectral radius rho) and
+  unit of rho t (s / (S X): the cost per simulated second for a spectral radius rho) and
   the energy error of the fastest mode: the relative spread of E = (v^2 + w^2 q^2)/2 along
   the numerical orbit (the ratio of the axes of the invariant quadratic form, minus 1).
 """
@@ -36,9 +37,9 @@ from ropedyn_tools.studies.common import run_stamp, update_doc
 
 DOC = DOCS / "theory" / "symplectic.md"
 TABLES = ROOT / "solvers" / "symplectic" / "ropedyn_split_tables.f90"
+SYMPLECTIC = ROOT / "solvers" / "symplectic" / "ropedyn_symplectic.f90"
 BEGIN = "<!-- compositions:begin -->"
 END = "<!-- compositions:end -->"
-SAFETY = 0.4          # the step over the stable step with lightly damped fast modes
 XMAX, DX = 8.0, 1e-5
 
 
@@ -163,6 +164,19 @@ def table_arrays(case):
 CHIN = table_arrays("TABLE_CHIN")
 
 
+def resonant_safety():
+    """The step over the stable step with lightly damped fast modes, as ropedyn_symplectic
+    defines it (RESONANT_SAFETY, read from its source)."""
+    text = SYMPLECTIC.read_text()
+    m = re.search(r"\bRESONANT_SAFETY = ([0-9.]+)_wp", text)
+    if m is None:
+        raise ValueError(f"{SYMPLECTIC}: no parameter RESONANT_SAFETY")
+    return float(m.group(1))
+
+
+SAFETY = resonant_safety()
+
+
 def method_step(a, b, grad, x, zeta):
     """The method's step as ropedyn_symplectic runs it, on x'' = -x - 2 zeta x' at h = x (an
     array): the linear map of (q, v, a_r) over one step (the D-map's halves with a_r at the
@@ -257,11 +271,14 @@ def force_gradient_row():
     gaps = unstable_intervals(a, b, grad)
     limit = gaps[0][0]
     step = SAFETY * limit
+    # its spread also at SRKN6b's resonance-safe step, for comparison at equal h rho
+    bm = symmetric(*method_coefficients(), 6)
+    bm_step = SAFETY * unstable_intervals(*bm)[0][0]
     return (f"| Chin's 4A, force gradient (the method's) | S. A. Chin, Phys. Lett. A 226 "
             f"(1997) | 4 | 3 | {limit:.4f} | "
             f"{gaps_text(gaps)} | {step:.3f} | {3 / step:.2f} | "
-            f"{energy_spread(a, b, step, grad):.1e} (at h rho = 1.265: "
-            f"{energy_spread(a, b, 1.265, grad):.1e}) |  |")
+            f"{energy_spread(a, b, step, grad):.1e} (at h rho = {bm_step:.3f}: "
+            f"{energy_spread(a, b, bm_step, grad):.1e}) |  |")
 
 
 def main(argv=None):
@@ -278,7 +295,7 @@ def main(argv=None):
         "Command: `scripts/compositions` (code: tools/ropedyn_tools/studies/compositions.py; "
         f"from the coefficients alone, no runs). Run: {run_stamp()}.", "",
         "| composition | source | order | force evaluations per step | first unstable h w | "
-        "unstable h w below 8 | step at 0.4 of it (h rho) | evaluations per unit of rho t "
+        f"unstable h w below 8 | step at {SAFETY:g} of it (h rho) | evaluations per unit of rho t "
         "| energy spread of the fastest mode there | order-5 residual norm |",
         "|---|---|---|---|---|---|---|---|---|---|", *table, END])
     update_doc(DOC, BEGIN, END, block)
