@@ -73,3 +73,22 @@ def test_merged_replaces_only_the_cases_and_methods_that_were_run():
     rows = acc.merged(old, new, [("rfem", 30)], ["erk"])
     assert [(r["t0"], r["method"], float(r["rtol"])) for r in rows] == [
         (t0, m, r) for t0 in ("0.0", "5.0") for m in ("cvode", "erk") for r in (1e-2, 1e-3)]
+
+
+def test_the_guide_takes_the_symplectic_bound_from_the_energy_page(tmp_path):
+    """The guide's item on long runs quotes the largest error of the symplectic rows of
+    bench_symplectic's table, not a number of its own."""
+    page = tmp_path / "energy.md"
+    page.write_text("\n".join([
+        "<!-- symplectic-targets:begin -->",
+        "| n | method | at 30 s | at the end | max abs to 30 s | max abs to the end | growth |",
+        "|---|---|---|---|---|---|---|",
+        "| 20 | auto at abc (the former default) | -8e-02 | -1e-01 | 8e-02 | 1.5e-01 | 1.7 |",
+        "| 20 | symplectic | +3.8e-06 | +1.5e-05 | 1.6e-05 | 1.1e-04 | 6.8 |",
+        "| 100 | symplectic | +4.0e-06 | +3.8e-06 | 8.5e-06 | 2.9e-05 | 3.5 |",
+        "<!-- symplectic-targets:end -->", ""]))
+    assert acc.symplectic_bound(page) == "1.1e-04"
+    page.write_text("no table\n")
+    assert acc.symplectic_bound(page) is None
+    bound = acc.symplectic_bound()      # the real page
+    assert bound and f"within {bound} m g L" in acc.long_runs()
