@@ -46,8 +46,9 @@ contains
         dnorm_old = 0.0_wp
         ! Without a mass matrix the quadratures' rates come with each evaluation of f (one
         ! pass, problem_t's rhs_quad): the stage's quadratures then take them at the last
-        ! Newton iterate, off the converged point by the last correction (within the Newton
-        ! tolerance, as is the rest of the stage), instead of one more evaluation there.
+        ! Newton iterate, off the converged point by the last correction (its weighted norm
+        ! below NEWTON_TOL over the contraction rate), instead of one more evaluation there
+        ! (docs/theory/mebdf.md, "Choices, and why": quadratures).
         fused = self%nq > 0 .and. .not. mass
         do iter = 1, MAX_NEWTON_ITERS
             if (profile) start = clock_seconds()
