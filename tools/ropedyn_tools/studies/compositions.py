@@ -20,12 +20,12 @@ abar_ij = b_j (c_i - c_j), j < i). For each composition:
   in steps of 1e-5 up to 8, so that narrow gaps are found) is the limit X; the unstable
   intervals below 8 are listed;
 - **the resonance-safe step**: S X, S = RESONANT_SAFETY of ropedyn_symplectic (what it takes
-  where the fast modes are
-  lightly damped: their combinations reach twice the fastest frequency, which must stay
-  inside the stable interval with a margin), and at it the evaluations of the forces per
-  unit of rho t (s / (S X): the cost per simulated second for a spectral radius rho) and
-  the energy error of the fastest mode: the relative spread of E = (v^2 + w^2 q^2)/2 along
-  the numerical orbit (the ratio of the axes of the invariant quadratic form, minus 1).
+  where the fast modes are lightly damped: their combinations reach twice the fastest
+  frequency, which must stay inside the stable interval with a margin), and at it the
+  evaluations of the forces per unit of rho t (s / (S X): the cost per simulated second for
+  a spectral radius rho) and the energy error of the fastest mode: the relative spread of
+  E = (v^2 + w^2 q^2)/2 along the numerical orbit (the ratio of the axes of the invariant
+  quadratic form, minus 1).
 """
 import argparse
 import re
@@ -41,6 +41,8 @@ SYMPLECTIC = ROOT / "solvers" / "symplectic" / "ropedyn_symplectic.f90"
 BEGIN = "<!-- compositions:begin -->"
 END = "<!-- compositions:end -->"
 XMAX, DX = 8.0, 1e-5
+#: the row of the method's own SRKN6b
+METHOD_BM6 = "Blanes-Moan SRKN6b (the method's)"
 
 
 def symmetric(a_free, b_free, s):
@@ -56,16 +58,20 @@ def symmetric(a_free, b_free, s):
     return np.array(full(a_free, s)), np.array(full(b_free, s + 1))
 
 
+def fortran_parameter(path, name):
+    """The value of the real parameter `name` (`name = 1.5_wp`) in the Fortran source
+    `path`: this study reads the method's own numbers rather than repeating them."""
+    m = re.search(rf"\b{name} = (-?[0-9.]+(?:e-?[0-9]+)?)_wp", path.read_text())
+    if m is None:
+        raise ValueError(f"{path}: no parameter {name}")
+    return float(m.group(1))
+
+
 def method_coefficients():
     """SRKN6b's free coefficients ([a1, a2], [b1, b2, b3]) as ropedyn_split_tables defines
-    them (read from its source, so that this study compares the method's own numbers)."""
-    text = TABLES.read_text()
-
+    them."""
     def value(name):
-        m = re.search(rf"\b{name} = (-?[0-9.]+(?:e-?[0-9]+)?)_wp", text)
-        if m is None:
-            raise ValueError(f"{TABLES}: no parameter {name}")
-        return float(m.group(1))
+        return fortran_parameter(TABLES, name)
     return [value("a1"), value("a2")], [value("b1"), value("b2"), value("b3")]
 
 
@@ -83,7 +89,7 @@ def compositions():
     return [
         ("Stormer-Verlet", "order 2", np.array([1.0]), np.array([0.5, 0.5])),
         ("Forest-Ruth / Yoshida", "the triple jump", *fr),
-        ("Blanes-Moan SRKN6b (the method's)", "Blanes & Moan 2002, table 3", *bm),
+        (METHOD_BM6, "Blanes & Moan 2002, table 3", *bm),
         ("4 stages, longest interval", "b1 = 0.16 of the family", *s4_long),
         ("4 stages, smallest error", "b1 = 0.375 of the family", *s4_best),
         ("6 stages, long interval", "searched: the interval to 6.5", *c6),
@@ -164,17 +170,8 @@ def table_arrays(case):
 CHIN = table_arrays("TABLE_CHIN")
 
 
-def resonant_safety():
-    """The step over the stable step with lightly damped fast modes, as ropedyn_symplectic
-    defines it (RESONANT_SAFETY, read from its source)."""
-    text = SYMPLECTIC.read_text()
-    m = re.search(r"\bRESONANT_SAFETY = ([0-9.]+)_wp", text)
-    if m is None:
-        raise ValueError(f"{SYMPLECTIC}: no parameter RESONANT_SAFETY")
-    return float(m.group(1))
-
-
-SAFETY = resonant_safety()
+#: the step over the stable step with lightly damped fast modes (ropedyn_symplectic's)
+SAFETY = fortran_parameter(SYMPLECTIC, "RESONANT_SAFETY")
 
 
 def method_step(a, b, grad, x, zeta):
@@ -239,7 +236,7 @@ def energy_spread(a, b, x, grad=None):
 
 
 def rows():
-    out = []
+    out, limits = [], {}
     for name, source, a, b in compositions():
         s = len(a)
         res4 = float(np.abs(order4_residuals(a, b)).max())
@@ -249,19 +246,21 @@ def rows():
         e5 = float(np.linalg.norm(order5_residuals(a, b))) if order == 4 else float("nan")
         gaps = unstable_intervals(a, b)
         limit = gaps[0][0] if gaps else XMAX
+        limits[name] = limit
         step = SAFETY * limit
         out.append(f"| {name} | {source} | {order} | {s} | {limit:.4f} | {gaps_text(gaps)} | "
                    f"{step:.3f} | {s / step:.2f} | {energy_spread(a, b, step):.1e} | "
                    + (f"{e5:.1e}" if order == 4 else "") + " |")
-    out.append(force_gradient_row())
+    out.append(force_gradient_row(SAFETY * limits[METHOD_BM6]))
     return out
 
 
-def force_gradient_row():
+def force_gradient_row(bm_step):
     """Chin's 4A, v += h/6 a, q += h/2 v, v += 2h/3 (a + h^2/24 (da/dq) a), q += h/2 v,
     v += h/6 a: the middle kick's force at a gradient-shifted point costs a second
     evaluation (a difference), so 3 per step; its order is checked on the oscillator (its
-    order conditions are not those of a composition)."""
+    order conditions are not those of a composition). Its energy spread is given also at
+    `bm_step` (h rho), SRKN6b's resonance-safe step, for a comparison at equal steps."""
     a, b, grad = CHIN
     # order 4 on the oscillator: the phase error falls 32 times when h halves
     phase = [np.arccos(np.clip((lambda m: (m[0] + m[3]) / 2)(
@@ -271,9 +270,6 @@ def force_gradient_row():
     gaps = unstable_intervals(a, b, grad)
     limit = gaps[0][0]
     step = SAFETY * limit
-    # its spread also at SRKN6b's resonance-safe step, for comparison at equal h rho
-    bm = symmetric(*method_coefficients(), 6)
-    bm_step = SAFETY * unstable_intervals(*bm)[0][0]
     return (f"| Chin's 4A, force gradient (the method's) | S. A. Chin, Phys. Lett. A 226 "
             f"(1997) | 4 | 3 | {limit:.4f} | "
             f"{gaps_text(gaps)} | {step:.3f} | {3 / step:.2f} | "
