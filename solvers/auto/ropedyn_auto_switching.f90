@@ -93,16 +93,16 @@
 !!   1 %), an adaptive method's energy balance drifts over a long run (the undamped paper
 !!   rope, n = 20, rtol 1e-3: erk and auto lost 0.11 m g L in 30 s, 0.15 in 300 s),
 !!   biasing the energy, dissipation and spectra a long run is for; the symplectic
-!!   method's stays bounded (2.6e-4 m g L over 300 s). So auto takes it, at the start
+!!   method's stays bounded (1.1e-4 m g L over 300 s). So auto takes it, at the start
 !!   (before the slow start's test) or instead of erk when leaving the implicit method,
 !!   on a problem that offers the force split (the RFEM without ground contact or point
 !!   masses off centre), a run at least LONG_RUN long (options%t_end; not known: long),
 !!   a step of at most START_RATE steps per simulated second (and, leaving the implicit
 !!   method, a cost below its measured one by GAIN), and a cost of at most
 !!   LIGHT_COST_LIMIT = 4 times erk's predicted one (choose_step's, counting the step's
-!!   whole work: Chin's 4A at 0.4 of its stable step, 1.56 times on that rope; on the
+!!   whole work: Chin's 4A at 0.35 of its stable step, 1.8 times on that rope; on the
 !!   damped paper rope at n = 10, whose fast modes the estimate finds lightly damped,
-!!   4.2 times, so not there). It keeps it unless its step gets too short (START_RATE:
+!!   4.8 times, so not there). It keeps it unless its step gets too short (START_RATE:
 !!   then the implicit method); its own log of the step joins the switch log.
 submodule (ropedyn_auto) ropedyn_auto_switching
     implicit none

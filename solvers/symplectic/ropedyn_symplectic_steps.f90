@@ -87,8 +87,8 @@ contains
         self%y(self%vel) = self%v
         call estimate_spectrum(self%problem, self%t, self%y, spec)
         self%estimated_at = self%counters%steps
-        call choose_step(spec, self%options%rtol, self%order_limit, self%problem%split_has_rest(), &
-                         tab, h, light, text)
+        call choose_step(spec, self%options%rtol, self%order_limit, self%rest, tab, h, light, &
+                         text)
         self%radius = spec%radius
         self%fast_damping = spec%fast_damping
     end subroutine stable_step_here
