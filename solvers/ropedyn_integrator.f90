@@ -19,7 +19,7 @@
 module ropedyn_integrator
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, real_text, significant_text
     use ropedyn_problem, only: problem_t
     use ropedyn_methods, only: METHODS, method_index, resolved_max_order
     use ropedyn_switch_log, only: switch_event_t
@@ -27,7 +27,8 @@ module ropedyn_integrator
     private
     public :: integrator_t, start_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT, &
         STIFF_STEP_RATE
-    public :: stop_query_i, stop_now
+    public :: stop_query_i, stop_now, steps_to_end, budget_covering, last_warning, &
+        exceeded_text
     public :: DEFAULT_RTOL, DEFAULT_ATOL, DEFAULT_MAX_STEPS
 
     !> The defaults of the options every method shares; the scene's &solver keys take
@@ -255,26 +256,71 @@ contains
         allocate (events(0))
     end function integrator_switch_log
 
-    !> The cause of a run that ran out of its step budget: the budget and, when the
+    !> The cause of a run that ran out of its step budget at time t: the budget, what the
+    !! rest of the run takes at the last step size (when the end is known), and, when the
     !! integrator's own log diagnosed something on the way (its last warning: cvode's
     !! lightly damped stiff modes, with the methods that avoid them), that diagnosis, so
     !! that the message names the cause and the cure.
-    function integrator_steps_exhausted(self) result(cause)
+    function integrator_steps_exhausted(self, t) result(cause)
         class(integrator_t), intent(in) :: self
+        real(wp), intent(in) :: t
         character(len=:), allocatable :: cause
-        type(switch_event_t), allocatable :: events(:)
+        type(solver_stats_t) :: stats
+        integer(i8) :: rest
+        real(wp) :: h
+        cause = exceeded_text(self%options%max_steps)
+        stats = self%stats()
+        h = stats%last_step
+        rest = steps_to_end(t, self%options%t_end, h)
+        if (rest > 0) cause = cause//'; at the size of the last accepted step ('// &
+            significant_text(h, 3)//' s) the rest of the run, to t = '// &
+            real_text(self%options%t_end)//' s, takes about '//int_text(rest)//' steps more'
+        cause = cause//last_warning(self%switch_log())
+    end function integrator_steps_exhausted
+
+    !> 'max_steps exceeded (N steps)': how a message says that a budget of N steps ran out.
+    pure function exceeded_text(max_steps) result(text)
+        integer(i8), intent(in) :: max_steps
+        character(len=:), allocatable :: text
+        text = 'max_steps exceeded ('//int_text(max_steps)//' steps)'
+    end function exceeded_text
+
+    !> '; the run had diagnosed at t = T s: REASON', the last warning of a switch log (the
+    !! diagnosis a failure's message ends with), or '' when it has none.
+    function last_warning(events) result(text)
+        type(switch_event_t), intent(in) :: events(:)
+        character(len=:), allocatable :: text
         integer :: k
         character(len=16) :: at
-        cause = 'max_steps exceeded ('//int_text(self%options%max_steps)//' steps)'
-        events = self%switch_log()
+        text = ''
         do k = size(events), 1, -1
             if (.not. events(k)%warning) cycle
             write (at, '(es10.3)') events(k)%t
-            cause = cause//'; the run had diagnosed at t = '//trim(adjustl(at))// &
-                    ' s: '//events(k)%reason
+            text = '; the run had diagnosed at t = '//trim(adjustl(at))//' s: '//events(k)%reason
             exit
         end do
-    end function integrator_steps_exhausted
+    end function last_warning
+
+    !> The steps from t to t_end at the step h, rounded up: what the rest of a run takes at
+    !! that step (0 when t_end is not known, huge, or h <= 0).
+    pure integer(i8) function steps_to_end(t, t_end, h) result(steps)
+        real(wp), intent(in) :: t, t_end, h
+        steps = 0
+        if (.not. (h > 0.0_wp) .or. t_end >= huge(1.0_wp) .or. .not. (t_end > t)) return
+        steps = ceiling(min((t_end - t)/h, 1.0e18_wp), i8)
+    end function steps_to_end
+
+    !> A step budget for `steps` steps: a tenth more (a step may shorten on the way), rounded
+    !! up to two significant digits (1,083,000 -> 1,200,000); 0 for none.
+    pure integer(i8) function budget_covering(steps) result(budget)
+        integer(i8), intent(in) :: steps
+        real(wp) :: x, unit
+        budget = 0
+        if (steps <= 0) return
+        x = 1.1_wp*real(steps, wp)
+        unit = 10.0_wp**max(0, floor(log10(x)) - 1)
+        budget = int(ceiling(x/unit - 1.0e-9_wp)*unit, i8)
+    end function budget_covering
 
     !> Prepare to integrate `problem` from (t0, y0, yq0). The problem must outlive the
     !! integrator (it is referenced, not copied). The checks every method shares: the order

@@ -50,8 +50,10 @@ module ropedyn_auto
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK
+    use ropedyn_text, only: int_text, real_text, significant_text
     use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, &
-                                  STIFF_STEP_RATE, stop_now
+                                  STIFF_STEP_RATE, stop_now, steps_to_end, budget_covering, &
+                                  last_warning, exceeded_text
     use ropedyn_erk, only: erk_t
     use ropedyn_mebdf, only: mebdf_t
     use ropedyn_cvode, only: cvode_t, adams_t
@@ -163,6 +165,9 @@ module ropedyn_auto
         integer :: wait = 0                !< windows to let pass before the next switch
         integer :: backoff = 1
         logical :: initialized = .false.
+        !> the symplectic method was left out once for the step budget (said once, as a
+        !! warning in the log)
+        logical :: budget_said = .false.
         !> the Newton matrix's width over the RFEM's (>= 1), and the cost of one MEBDF
         !! evaluation of f in evaluations of the explicit f (see Cost)
         real(wp) :: lambda = 1.0_wp
@@ -193,6 +198,7 @@ module ropedyn_auto
         procedure, private :: accurate_name
         procedure, private :: trials_are_cheap
         procedure, private :: symplectic_fits
+        procedure, private :: add_warning
     end type auto_t
 
     interface
@@ -203,7 +209,8 @@ module ropedyn_auto
             type(error_t), allocatable, intent(out) :: err
         end subroutine auto_start
 
-        !> Whether the run goes symplectic, and why (submodule ropedyn_auto_start).
+        !> Whether the run goes symplectic, and why (submodule ropedyn_auto_start); when it
+        !! would but for the step budget, .false. with the warning to log in `why` (once).
         module function symplectic_fits(self, spec, h_e, t0, why, below) result(fits)
             class(auto_t), intent(inout) :: self
             type(spectrum_t), intent(in) :: spec
@@ -336,6 +343,19 @@ contains
         self%win_cost0 = 0.0_wp
     end subroutine start_method
 
+    !> A warning in the log at the current time, for the method and order limit in use
+    !! (an event that changes neither: the method chain does not count it as a switch).
+    subroutine add_warning(self, text)
+        class(auto_t), intent(inout) :: self
+        character(len=*), intent(in) :: text
+        type(switch_event_t), allocatable :: events(:)
+        events = self%log%items()
+        if (size(events) == 0) return
+        associate (last => events(size(events)))
+            call self%log%add(self%t, last%method, last%max_order, text, warning=.true.)
+        end associate
+    end subroutine add_warning
+
     subroutine auto_advance_to(self, tout, t, y, yq, err)
         class(auto_t), intent(inout) :: self
         real(wp), intent(in) :: tout
@@ -402,6 +422,8 @@ contains
                 if (self%nq > 0) yq(1:self%nq) = self%yq
                 t = self%t
                 err%message = 'auto: '//err%message
+                now = self%stats()
+                if (now%steps >= self%options%max_steps) call budget_spent(err%message)
                 return
             end if
             if (self%t < target .and. stop_now(self%options)) exit   ! stopped on request
@@ -411,6 +433,20 @@ contains
         y = self%y
         if (self%nq > 0) yq(1:self%nq) = self%yq
         t = self%t
+    contains
+        !> The message of a method that spent the budget auto left it: with the run's own
+        !! budget in place of what was left of it, and auto's own diagnosis (the symplectic
+        !! method left out) at the end.
+        subroutine budget_spent(message)
+            character(len=:), allocatable, intent(inout) :: message
+            character(len=:), allocatable :: part
+            integer :: k
+            part = exceeded_text(max(1_i8, self%options%max_steps - self%done%steps))
+            k = index(message, part)
+            if (k > 0) message = message(:k - 1)//exceeded_text(self%options%max_steps)// &
+                                 message(k + len(part):)
+            message = message//last_warning(self%log%items())
+        end subroutine budget_spent
     end subroutine auto_advance_to
 
 

@@ -20,6 +20,7 @@ contains
         self%tab_high = erk_table(HIGH_ORDER)
         self%done = solver_stats_t()
         call self%log%clear()
+        self%budget_said = .false.
         self%rate_explicit = -1.0_wp
         self%rate_implicit = -1.0_wp
         self%implicit_age = 0
@@ -55,6 +56,7 @@ contains
             text = 'no spectrum estimate'
         end if
         h_a = 0.0_wp
+        why_sym = ''
         if (rate > 0.0_wp .and. rate <= START_RATE) &
             h_a = accuracy_step(self%problem, start%t0, start%y0, self%options, h_e)
         if (rate > START_RATE) then
@@ -71,6 +73,8 @@ contains
             call self%start_method(EXPLICIT, trim(text), err, h_e)
         end if
         if (allocated(err)) return
+        if (self%active /= SYMPLECTIC .and. len_trim(why_sym) > 0) &
+            call self%add_warning(trim(why_sym))
         self%initialized = .true.
     end procedure auto_start
 
@@ -84,6 +88,8 @@ contains
     module procedure symplectic_fits
         type(split_table_t) :: tab
         real(wp) :: h, cost_s, cost_e
+        integer(i8) :: rest, left
+        type(solver_stats_t) :: used
         logical :: light
         character(len=280) :: text
         fits = .false.
@@ -98,6 +104,20 @@ contains
         if (cost_s > LIGHT_COST_LIMIT*cost_e) return
         if (present(below)) then
             if (cost_s >= below) return
+        end if
+        ! (its steps are known in advance: a run it cannot finish goes on with the others)
+        rest = steps_to_end(t0, self%options%t_end, h)
+        used = self%stats()
+        left = self%options%max_steps - used%steps
+        if (rest > left) then
+            if (.not. self%budget_said) why = 'the symplectic method would keep the '// &
+                'energy bounded (the fast modes are lightly damped), but the rest of the '// &
+                'run, to t = '//real_text(self%options%t_end)//' s, takes about '// &
+                int_text(rest)//' of its steps ('//significant_text(h, 3)//' s), more '// &
+                'than the '//int_text(left)//' that max_steps leaves: raise '// &
+                'solver.max_steps by '//int_text(budget_covering(rest) - left)//' to use it'
+            self%budget_said = .true.
+            return
         end if
         fits = .true.
         self%sym_order = tab%order

@@ -102,7 +102,9 @@
 !!   LIGHT_COST_LIMIT = 4 times erk's predicted one (choose_step's, counting the step's
 !!   whole work: Chin's 4A at 0.35 of its stable step, 1.8 times on that rope; on the
 !!   damped paper rope at n = 10, whose fast modes the estimate finds lightly damped,
-!!   4.8 times, so not there). It keeps it unless its step gets too short (START_RATE:
+!!   4.8 times, so not there), and steps to t_end within the step budget left (its step is
+!!   fixed: it knows the count in advance; else a warning, once, names the budget at
+!!   which it would). It keeps it unless its step gets too short (START_RATE:
 !!   then the implicit method); its own log of the step joins the switch log.
 submodule (ropedyn_auto) ropedyn_auto_switching
     implicit none
@@ -287,6 +289,8 @@ contains
                     call self%start_method(SYMPLECTIC, trim(text)//'; '//trim(why_sym), err)
                 else
                     call self%start_method(EXPLICIT, trim(text), err, h_e)
+                    if (.not. allocated(err) .and. len_trim(why_sym) > 0) &
+                        call self%add_warning(trim(why_sym))
                 end if
             end if
         end if

@@ -71,7 +71,7 @@ contains
         do while (self%tn < tout)
             qflag = FCVodeGetNumSteps(self%mem, nsteps)
             if (self%base%steps + int(nsteps(1), i8) >= self%options%max_steps) then
-                cause = self%steps_exhausted()
+                cause = self%steps_exhausted(self%tn)
                 exit
             end if
             tret = self%tn

@@ -413,7 +413,7 @@ contains
         h_wanted = 0.0_wp
         attempts: do
             if (self%counters%steps >= self%options%max_steps) then
-                call self%failure(err, self%steps_exhausted())
+                call self%failure(err, self%steps_exhausted(self%t))
                 return
             end if
             h = self%h

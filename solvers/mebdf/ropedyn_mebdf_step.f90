@@ -150,7 +150,7 @@ contains
             if (self%t + 1.01_wp*self%h >= self%t_stop) tn = self%t_stop
             hmin = 16.0_wp*epsilon(1.0_wp)*max(abs(self%t), abs(tn))
             if (self%counters%steps >= self%options%max_steps) then
-                call self%failure(err, self%steps_exhausted())
+                call self%failure(err, self%steps_exhausted(self%t))
                 return
             end if
             if (self%h < hmin) then

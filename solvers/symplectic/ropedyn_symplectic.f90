@@ -37,15 +37,18 @@
 !! - **Failures**: a force evaluation that is not finite (an unstable step) restarts the
 !!   output interval from its start at half the step, up to MAX_RETRIES times; a step that
 !!   would take more than STIFF_STEP_RATE steps per simulated second ends the run with the
-!!   diagnosis erk gives (naming auto and mebdf); the problem must offer the force split
-!!   (else `init` says why not).
+!!   diagnosis erk gives (naming auto and mebdf); a run to options%t_end that takes more
+!!   steps at the step chosen than the budget has left ends at once, at the start or where
+!!   the step shortens (budget_reaches_end), naming the steps and the budget to add; the
+!!   problem must offer the force split (else `init` says why not).
 module ropedyn_symplectic
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, real_text, significant_text
     use ropedyn_sums, only: sum_products
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
-    use ropedyn_integrator, only: integrator_t, start_t, solver_stats_t, stop_now, STIFF_STEP_RATE
+    use ropedyn_integrator, only: integrator_t, start_t, solver_stats_t, stop_now, &
+                                  STIFF_STEP_RATE, steps_to_end, budget_covering
     use ropedyn_spectrum, only: spectrum_t, estimate_spectrum, LIGHT_DAMPING
     use ropedyn_switch_log, only: switch_log_t, switch_event_t
     use ropedyn_split_tables, only: split_table_t, split_table, TABLE_VERLET, TABLE_BM6, &
@@ -143,6 +146,7 @@ module ropedyn_symplectic
         procedure, private :: begin
         procedure, private :: review_step
         procedure, private :: set_step
+        procedure, private :: budget_reaches_end
         procedure, private :: step
         procedure, private :: evaluate
         procedure, private :: gradient_force
@@ -176,6 +180,13 @@ module ropedyn_symplectic
             character(len=*), intent(in) :: reason
             logical, intent(in) :: warn
         end subroutine set_step
+
+        !> The run ends at once (ERR_SOLVER) when its rest, to options%t_end, takes more
+        !! steps at the step rule than the step budget has left.
+        module subroutine budget_reaches_end(self, err)
+            class(symplectic_t), intent(inout) :: self
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine budget_reaches_end
 
         !> The composition and its step for a spectrum estimate, a tolerance and an order
         !! limit (ropedyn_symplectic_steps, where the rule is); `rest`: the problem has
@@ -348,7 +359,7 @@ contains
         tol = 1.0e-7_wp*self%h
         do while (self%t < tout - tol)
             if (self%counters%steps >= self%options%max_steps) then
-                call self%failure(err, self%steps_exhausted())
+                call self%failure(err, self%steps_exhausted(self%t))
                 exit
             end if
             ! (the state before the step is kept only where the dense output may need it)

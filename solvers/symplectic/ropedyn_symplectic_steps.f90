@@ -34,7 +34,25 @@ contains
         if (allocated(err)) return
         self%tab = tab
         call self%set_step(h, tout, trim(text), .false.)
+        call self%budget_reaches_end(err)
     end procedure begin
+
+    !> The run ends at once (ERR_SOLVER) when its rest, to options%t_end, takes more steps at
+    !! the step rule than the step budget has left. The step is fixed between estimates of
+    !! the spectrum, so the method knows this now: it says so at the start (or where the step
+    !! shortens), with the budget that reaches the end, not when the budget runs out.
+    module procedure budget_reaches_end
+        integer(i8) :: rest, left
+        rest = steps_to_end(self%t, self%options%t_end, self%h_rule)
+        left = self%options%max_steps - self%counters%steps
+        if (rest <= left) return
+        call self%failure(err, 'the rest of the run, to t = '//real_text(self%options%t_end)// &
+            ' s, takes about '//int_text(rest)//' steps of '//significant_text(self%h_rule, 3)// &
+            ' s ('//trim(self%tab%label)//' at the step the spectral radius '// &
+            significant_text(self%radius, 3)//' 1/s allows), more than the '// &
+            int_text(left)//' that max_steps leaves: raise solver.max_steps by '// &
+            int_text(budget_covering(rest) - left))
+    end procedure budget_reaches_end
 
     !> The run ends (ERR_SOLVER) when the step h would take more than STIFF_STEP_RATE steps
     !! per simulated second, as erk's and adams' do: the step of an explicit method held by
@@ -69,6 +87,7 @@ contains
             self%tab = tab
             call self%set_step(h, tout, trim(text), .false.)
             self%respectrum = RESPECTRUM_STEPS
+            call self%budget_reaches_end(err)
         else
             self%respectrum = min(RESPECTRUM_MAX, 2*self%respectrum)
         end if

@@ -161,7 +161,7 @@ contains
             call add_int(G_SOLVER, 'max_order', v%max_order, R_NONE, 0, &
                 "highest order (0: the method's default)", 'the method''s range, or 0')
             call add_int(G_SOLVER, 'max_steps', v%max_steps, R_AT_LEAST, 1, &
-                'step budget of the whole run')
+                'step budget of a run (a resume has one of its own)')
             call add_real(G_SOLVER, 't_end', v%t_end, R_POSITIVE, 's', 'end time')
             call add_real(G_SOLVER, 'output_interval', v%output_interval, R_POSITIVE, 's', &
                 'time between output records; at most a limit of records')

@@ -89,6 +89,9 @@ module ropedyn_run
         !! the top along the unstretched rope (m) and the record's time (s)
         real(wp) :: peak_tension = 0.0_wp, peak_arc = 0.0_wp, peak_time = 0.0_wp
         integer :: peak_joint = -1
+        !> the integration ended on its step budget (solver.max_steps): a resume goes on
+        !! from the last record with a budget of its own
+        logical :: budget_spent = .false.
     end type run_summary_t
 
     !> A state of a run without output kept in memory (`save`, `restore`): time, ODE state,
@@ -535,6 +538,7 @@ contains
         type(error_t), allocatable, intent(out) :: err
         type(error_t), allocatable :: io_err
         type(energy_t), allocatable :: e_now
+        type(solver_stats_t) :: stats
         real(wp) :: tout, clock_start
         tout = self%output_time(self%k_next)
         outcome = STEP_FAILED
@@ -546,6 +550,8 @@ contains
             call self%check_energy(tout, err, e_now)
         if (allocated(err)) then
             call self%progress%done()
+            stats = self%integrator%stats()
+            self%summary%budget_spent = stats%steps >= self%integrator%options%max_steps
             ! keep the last good state if the solver got past the previous record
             if (self%t > self%t_last) call self%record(io_err)
             call self%finish('failed', (err%message), err)

@@ -75,6 +75,45 @@ def test_auto_goes_symplectic_where_the_fast_modes_are_lightly_damped(run, tmp_p
     assert "symplectic" not in methods, (methods, reasons)
 
 
+def test_auto_leaves_the_symplectic_method_out_when_the_budget_is_short(run, tmp_path):
+    """The undamped rope of the test above: with a step budget below what the symplectic
+    method's step takes to t_end, auto goes on with its other methods and warns once, naming
+    the steps and the budget to add; when the budget runs out later, the message ends with
+    that diagnosis. With the budget raised as it says, auto goes symplectic and finishes."""
+    common = ["model.elements=8", "effects.damping=.false.", "solver.rtol=1e-3",
+              "solver.atol=1e-5", "solver.t_end=6", "solver.output_interval=0.05"]
+    proc, out = run_scene(run, tmp_path, PAPER, "full", *common)
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        assert switch_log(f)[0][0] == "symplectic"
+        taken = int(f["/solver/steps"][()])
+    budget = taken * 5 // 8
+    proc, out = run_scene(run, tmp_path, PAPER, "short", *common,
+                          f"solver.max_steps={budget}")
+    with h5py.File(out, "r") as f:
+        methods, _, _, reasons = switch_log(f)
+    assert "symplectic" not in methods, (methods, reasons)
+    warning = re.findall(r"^warning: at t = +0\.0000 s: the symplectic method would keep the "
+                         r"energy bounded .* takes about (\d+) of its steps .* more than the "
+                         rf"{budget} that max_steps leaves: raise solver\.max_steps by (\d+) "
+                         r"to use it$", proc.stderr, re.MULTILINE)
+    assert len(warning) == 1, proc.stderr
+    needed, more = (int(x) for x in warning[0])
+    assert 0.97 * taken <= needed <= taken
+    # erk and MEBDF take fewer steps than the symplectic method here but not few enough
+    assert proc.returncode == 3, proc.stderr
+    error = proc.stderr.strip().splitlines()[-1]
+    # (the run's budget, not what was left of it for the method that spent it)
+    assert f"max_steps exceeded ({budget} steps)" in error, error
+    assert "the run had diagnosed at t = 0.000E+00 s: the symplectic method would keep the " \
+        "energy bounded" in error, error
+    proc, out = run_scene(run, tmp_path, PAPER, "raised", *common,
+                          f"solver.max_steps={budget + more}")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        assert switch_log(f)[0][0] == "symplectic"
+
+
 def test_auto_records_its_choice(run, tmp_path):
     proc, out = run_scene(run, tmp_path, PAPER, "auto", "model.elements=8",
                           "solver.t_end=0.2")

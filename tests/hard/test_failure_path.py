@@ -4,6 +4,8 @@ exit code 3 and one message naming the time, the step size and the cause; the HD
 marked failed with that reason, holds only finite numbers, and keeps every record before
 the failure unchanged (bit for bit the records of the same run without the fault)."""
 import pathlib
+import re
+import subprocess
 
 import h5py
 import numpy as np
@@ -19,6 +21,7 @@ DT = 0.01
 MODELS = {"rfem": ["model.kind=rfem", "model.elements=10"],
           "mpp": ["model.kind=mpp", "model.elements=6"]}
 CASES = [(model, method) for model in MODELS for method in ("cvode", "mebdf")]
+BUDGET_SYMPLECTIC = ["solver.method=symplectic", "model.elements=10", "solver.t_end=0.05"]
 
 
 @pytest.fixture(scope="module")
@@ -36,9 +39,9 @@ def runs(run_many, tmp_path_factory):
     # the budget spent after cvode's own log diagnosed lightly damped stiff modes
     jobs["budget_diagnosed_cvode"] = (STEEL, ["solver.method=cvode", "solver.rtol=1e-7",
                                               "solver.atol=1e-9", "solver.max_steps=150000"])
-    for method in ("erk", "symplectic"):
-        jobs[f"budget_{method}"] = (PAPER, [f"solver.method={method}", "model.elements=10",
-                                            "solver.t_end=0.05", "solver.max_steps=30"])
+    jobs["budget_erk"] = (PAPER, ["solver.method=erk", "model.elements=10",
+                                  "solver.t_end=0.05", "solver.max_steps=30"])
+    jobs["budget_symplectic"] = (PAPER, BUDGET_SYMPLECTIC + ["solver.max_steps=30"])
     jobs["stald_mebdf"] = (PAPER, ["solver.method=mebdf",
                                    "solver.stability_limit_detection=.true."])
     jobs["stald_cvode"] = (PAPER, ["solver.method=cvode", "model.elements=10",
@@ -47,8 +50,10 @@ def runs(run_many, tmp_path_factory):
     return run_many(jobs, workdir)
 
 
-def check_diagnosis(proc, path, cause):
-    """Exit 3, one stderr line, and the same reason in the failed file."""
+def check_diagnosis(proc, path, cause, budget_spent=False):
+    """Exit 3, one stderr line, and the same reason in the failed file; after a spent step
+    budget the line goes on with how to continue (a resume, which has a budget of its own),
+    which is not part of the file's reason. Returns that continuation ('' when none)."""
     assert proc.returncode == 3, proc.stderr
     message = proc.stderr.strip()
     assert message.startswith("ropedyn: error: ") and len(message.splitlines()) == 1, message
@@ -56,9 +61,28 @@ def check_diagnosis(proc, path, cause):
         assert fragment in message, (fragment, message)
     with h5py.File(path, "r") as f:
         assert f.attrs["status"] == b"failed"
-        assert f.attrs["reason"].decode() == message[len("ropedyn: error: "):]
+        reason = f.attrs["reason"].decode()
         assert "steps" in f["solver"] and "cpu_time" in f["solver"]
     assert stability_metrics.all_finite(path) == []
+    body = message[len("ropedyn: error: "):]
+    assert body.startswith(reason), (body, reason)
+    rest = body[len(reason):]
+    if budget_spent:
+        assert rest.startswith(f"; continue with: ropedyn run --resume {path}"), rest
+    else:
+        assert rest == "", rest
+    return rest
+
+
+def resume_as_told(ropedyn_exe, path, rest):
+    """Follow the failure's continuation: `ropedyn run --resume FILE [--set ...]`, as
+    printed; the run then completes."""
+    words = rest[len("; continue with: ropedyn "):].split()
+    proc = subprocess.run([str(ropedyn_exe), *words], capture_output=True, text=True,
+                          timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(path, "r") as f:
+        assert f.attrs["status"] == b"complete"
 
 
 @pytest.mark.parametrize("model,method", CASES)
@@ -88,16 +112,47 @@ def test_data_before_the_failure_kept(runs, model, method):
 
 
 @pytest.mark.parametrize("method", ["cvode", "mebdf"])
-def test_step_budget_exhausted(runs, method):
+def test_step_budget_exhausted(runs, method, ropedyn_exe):
+    """The budget spent: the message says what the rest takes at the last step and how to
+    go on, and going on as it says finishes the run."""
     proc, path = runs[f"budget_{method}"]
-    check_diagnosis(proc, path, "max_steps")
+    rest = check_diagnosis(proc, path, "max_steps", budget_spent=True)
+    assert "the rest of the run, to t = 0.05 s, takes about " in proc.stderr, proc.stderr
     assert stability_metrics.analyse(path)["steps"] <= 300
+    resume_as_told(ropedyn_exe, path, rest)
 
 
-@pytest.mark.parametrize("method", ["erk", "symplectic"])
-def test_step_budget_exhausted_explicit(runs, method):
-    proc, path = runs[f"budget_{method}"]
-    check_diagnosis(proc, path, "max_steps exceeded (30 steps)")
+def test_step_budget_exhausted_explicit(runs, ropedyn_exe):
+    proc, path = runs["budget_erk"]
+    rest = check_diagnosis(proc, path, "max_steps exceeded (30 steps)", budget_spent=True)
+    # the rest takes more than a budget of 30 at erk's step: the resume asks for more
+    m = re.search(r"takes about (\d+) steps more", proc.stderr)
+    assert m and int(m.group(1)) > 30, proc.stderr
+    assert re.search(r" --set solver\.max_steps=(\d+)$", rest), rest
+    resume_as_told(ropedyn_exe, path, rest)
+
+
+def test_symplectic_says_at_once_that_the_budget_is_short(runs, ropedyn_exe, tmp_path):
+    """The symplectic method's step is known before it steps: a budget that cannot reach
+    t_end ends the run at its start, with the steps the run takes and the budget to add;
+    with that added it completes."""
+    proc, path = runs["budget_symplectic"]
+    check_diagnosis(proc, path, "raise solver.max_steps by ")
+    m = re.search(r"failed at t =  0\.0+E\+00 s.*takes about (\d+) steps of .* more than "
+                  r"the 30 that max_steps leaves: raise solver\.max_steps by (\d+)$",
+                  proc.stderr.strip())
+    assert m, proc.stderr
+    needed, more = int(m.group(1)), int(m.group(2))
+    assert stability_metrics.analyse(path)["steps"] == 0
+    out = tmp_path / "enough.h5"
+    done = subprocess.run([str(ropedyn_exe), "run", str(PAPER), "--set", f"output.file={out}",
+                           *sum((["--set", s] for s in BUDGET_SYMPLECTIC), []),
+                           "--set", f"solver.max_steps={30 + more}"],
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    steps = stability_metrics.analyse(out)["steps"]
+    # the count it said, within the fitting of the steps to the output times
+    assert needed <= steps <= 1.05 * needed
 
 
 def test_step_budget_exhausted_names_the_diagnosed_cause(runs):
@@ -113,7 +168,11 @@ def test_step_budget_exhausted_names_the_diagnosed_cause(runs):
                      "method = 'mebdf' or 'auto' avoids it"):
         assert fragment in message, (fragment, message)
     with h5py.File(path, "r") as f:
-        assert f.attrs["reason"].decode() == message[len("ropedyn: error: "):]
+        reason = f.attrs["reason"].decode()
+    # the file's reason, then (not in the file) how to go on
+    assert message[len("ropedyn: error: "):] == (
+        f"{reason}; continue with: ropedyn run --resume {path} --set solver.max_steps="
+        + message.rsplit("=", 1)[1]), message
 
 
 def test_stability_limit_detection_only_for_cvode(runs):
