@@ -1,6 +1,5 @@
 """Command line: bad input gets one clear message (file, group, key, value), exit code 2
 and no output file; a failed integration exits 3 and leaves a file marked failed."""
-import pathlib
 
 import h5py
 import pytest

@@ -8,7 +8,6 @@ its one message line, that no protected file changed (checksums) and that no run
 left 'running' (docs/guide/output.md, "Write, lock and resume rules")."""
 import hashlib
 import os
-import pathlib
 import shutil
 import signal
 import subprocess

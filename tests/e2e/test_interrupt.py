@@ -105,7 +105,7 @@ def test_interrupted_and_resumed_matches_the_uninterrupted_run(run, ropedyn_exe,
     with h5py.File(tmp_path / part) as f:
         assert attr(f, "status") == "interrupted"
         t_reached = f["solver/t_reached"][()]
-        assert f"at t = " in attr(f, "reason")
+        assert "at t = " in attr(f, "reason")
         assert 0 < t_reached < 4.0
         assert f["time"][-1] == t_reached        # the state where it stopped is the last record
         assert f["solver/steps"][()] > 0 and f["solver/cpu_time"][()] > 0

@@ -5,9 +5,7 @@ as large as docs/development/testing.md promises. A snippet is found as Fortran 
 continuations aside), so reformatting keeps it and a change of the code loses it. (The
 check itself takes minutes and runs on demand.)"""
 import os
-import pathlib
 import re
-import shutil
 import subprocess
 import time
 

@@ -4,7 +4,6 @@ in units of m g L."""
 import re
 
 import h5py
-import numpy as np
 
 from conftest import ROOT
 

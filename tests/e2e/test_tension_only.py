@@ -2,12 +2,10 @@
 shaken up and down faster than gravity can follow goes slack, and its axial springs then carry
 no compression, while with the linear law (the default) they push. The energy balance holds
 with both laws: the tension-only spring stores k max(stretch, 0)^2 / 2. Both models."""
-import pathlib
 import re
 import subprocess
 
 import h5py
-import numpy as np
 import pytest
 
 BALANCE = re.compile(r"balance error\s+\S+ J \(\s*(\S+) m g L\)")

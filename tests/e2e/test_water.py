@@ -3,7 +3,7 @@ against physics: the top tension of a rope hanging partly in air and partly in w
 submerged elastic catenary, the hanging chain's frequencies with added mass and submerged
 weight (Bessel), a sinking line's terminal speed and time constant, and the energy balance
 of a rope swinging through the surface with a current, for every method."""
-from math import asinh, pi, sqrt, tanh
+from math import asinh, pi, sqrt
 
 import h5py
 import numpy as np
