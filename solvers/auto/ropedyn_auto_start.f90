@@ -105,16 +105,18 @@ contains
         if (present(below)) then
             if (cost_s >= below) return
         end if
-        ! (its steps are known in advance: a run it cannot finish goes on with the others)
+        ! (its steps are known in advance: a run it cannot finish goes on with the others;
+        ! a tenth to spare, as the step may shorten on the way)
         rest = steps_to_end(t0, self%options%t_end, h)
         used = self%stats()
         left = self%options%max_steps - used%steps
-        if (rest > left) then
+        if (budget_covering(rest) > left) then
             if (.not. self%budget_said) why = 'the symplectic method would keep the '// &
                 'energy bounded (the fast modes are lightly damped), but the rest of the '// &
                 'run, to t = '//real_text(self%options%t_end)//' s, takes about '// &
-                int_text(rest)//' of its steps ('//significant_text(h, 3)//' s), more '// &
-                'than the '//int_text(left)//' that max_steps leaves: raise '// &
+                int_text(rest)//' of its steps ('//significant_text(h, 3)//' s), with a '// &
+                'tenth to spare more than the '//int_text(left)//' that max_steps '// &
+                'leaves: raise '// &
                 'solver.max_steps by '//int_text(budget_covering(rest) - left)//' to use it'
             self%budget_said = .true.
             return
