@@ -15,7 +15,7 @@ fastest fixed method and its CPU time, and auto's CPU over the best's (target: <
   (RLIMIT_CPU) and shows as "> cap" when it needs more, or "failed" (exit code 3: a
   diagnosis, e.g. erk or adams held by stability) when it gives up; a fixed method that does
   not finish cannot be the best.
-- The scenes' own `method` keys are overridden (paper_light_damping names cvode).
+- The scenes' own `method` keys are overridden.
 - A scene on which auto or a fixed method runs out of the step budget (`&solver
   max_steps`, 1e6 by default) is run again, with every method, at max_steps = 1e7, and
   says so: the table compares costs, the budget is a separate question.
