@@ -115,9 +115,9 @@ contains
                 'energy bounded (the fast modes are lightly damped), but the rest of the '// &
                 'run, to t = '//real_text(self%options%t_end)//' s, takes about '// &
                 int_text(rest)//' of its steps ('//significant_text(h, 3)//' s), with a '// &
-                'tenth to spare more than the '//int_text(left)//' that max_steps '// &
-                'leaves: raise '// &
-                'solver.max_steps by '//int_text(budget_covering(rest) - left)//' to use it'
+                'tenth to spare more than the '//int_text(left)//' that max_steps leaves: '// &
+                'raise solver.max_steps by '//int_text(budget_covering(rest) - left)// &
+                ' to use it'
             self%budget_said = .true.
             return
         end if
