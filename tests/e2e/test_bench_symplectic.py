@@ -32,3 +32,26 @@ def test_the_elastic_growth_is_the_last_window_over_the_first():
     assert abs(bs.elastic_growth(r) - last / first) < 1e-12
     rows = bs.window_rows(100, r)[1]
     assert rows[2].split("|")[3].strip() == "0.040"
+
+
+def test_the_ensemble_gives_the_median_range_and_count_of_the_growth(monkeypatch):
+    """Each start's growth is the largest error up to the end over the largest up to 30 s;
+    the row gives their median, range and how many meet the target of 2, from runs made up
+    with growths 1.5, 2, 3 and 5 (and the angle of each start passed to the run)."""
+    growths = [1.5, 2.0, 3.0, 5.0]
+    angles = []
+
+    def fake_run(exe, work, scene, name, sets):
+        k = int(name.rsplit("_", 1)[1])
+        angles.append(float(next(s for s in sets if s.startswith("initial.angle_deg="))
+                            .split("=")[1]))
+        return {"ok": True, **records(lambda t: 1e-5 * np.where(t > 30, growths[k], 1.0)
+                                      * np.cos(t), lambda t: 0.04 + 1e-4 * t)}
+
+    monkeypatch.setattr(bs, "run", fake_run)
+    (row,) = bs.ensemble_rows("exe", "work", [20], 300.0, len(growths))
+    cells = [c.strip() for c in row.split("|")[1:-1]]
+    assert cells[:2] == ["20", "4"]
+    assert float(cells[3]) == 2.5                       # median of 1.5, 2, 3, 5
+    assert cells[4] == "1.50 - 5.00" and cells[5] == "2"
+    assert sorted(angles) == [75.0 + k * bs.START_SPACING for k in range(4)]

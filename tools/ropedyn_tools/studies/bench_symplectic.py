@@ -8,6 +8,11 @@ markers of docs/validation/energy.md.
   which now takes the symplectic method there) and erk (what auto ran there before):
   |T + V - E0| in units of m g L at 30 s and 300 s and its largest value up to each, and
   the CPU of each run.
+- The same undamped runs of the symplectic method from `--starts` release angles 1e-7
+  degrees apart (75, 75 + 1e-7, ...; the first is the run above): the growth from the
+  largest error up to 30 s to the largest up to the end, start by start. The motion is
+  chaotic, so the growth of one run is one draw: its median and range over the starts
+  say what the method does. No CPU: these runs go two at a time.
 - The lightly damped paper rope (input/paper_light_damping.nml) at n = 20 and 30, 30 s: the
   default method at rtol 1e-3, and MEBDF at max_order 7, rtol 1e-4 (n = 20): the balance
   T + V + dissipated - E0 at 30 s and its largest gain, m g L.
@@ -16,6 +21,7 @@ CPU: each run once (`--repeat` for the least of several), process CPU of the run
 (/solver/cpu_time), on a shared two-core machine: 10-20 % from run to run.
 """
 import argparse
+import concurrent.futures
 import pathlib
 import subprocess
 import sys
@@ -39,6 +45,8 @@ LIGHT = INPUT / "paper_light_damping.nml"
 FORMER = "4276956"
 #: the window (s) of the growth columns and of the window tables
 WINDOW = 30.0
+#: the release angles of the ensemble: 75 degrees plus multiples of this (degrees)
+START_SPACING = 1.0e-7
 
 
 def run(exe, work, scene, name, sets):
@@ -101,10 +109,7 @@ def undamped_rows(exe, work, ns, t_end, repeat, former):
         for label, method, program in ((f"auto at {rev} (the former default)", "auto",
                                         former_exe), ("symplectic", "symplectic", exe),
                                        ("auto", "auto", exe), ("erk", "erk", exe)):
-            sets = [f"model.elements={n}", "effects.damping=.false.",
-                    f"solver.method='{method}'", "solver.rtol=1e-3", "solver.atol=1e-5",
-                    f"solver.t_end={t_end:g}", "solver.output_interval=0.1",
-                    "solver.max_steps=100000000"]
+            sets = undamped_sets(n, method, t_end)
             tag = f"u{n}_{method}_{'former' if program is former_exe else 'now'}"
             r = least_cpu(lambda: run(program, work, PAPER, tag, sets), repeat,
                           complete=lambda x: x["ok"])
@@ -121,6 +126,41 @@ def undamped_rows(exe, work, ns, t_end, repeat, former):
                         f"{'yes' if upto(r, t_end) <= 1e-3 else 'no'} |")
             print(rows[-1], flush=True)
     return rows, windows
+
+
+def undamped_sets(n, method, t_end):
+    """The overrides of an undamped run (the table's and the ensemble's)."""
+    return [f"model.elements={n}", "effects.damping=.false.", f"solver.method='{method}'",
+            "solver.rtol=1e-3", "solver.atol=1e-5", f"solver.t_end={t_end:g}",
+            "solver.output_interval=0.1", "solver.max_steps=100000000"]
+
+
+def ensemble_rows(exe, work, ns, t_end, starts):
+    """The symplectic method's growth (the largest error up to t_end over the largest up to
+    WINDOW) and elastic energy growth from `starts` release angles START_SPACING degrees
+    apart, per n: median, range, and how many starts meet the target of 2."""
+    jobs = {(n, k): [*undamped_sets(n, "symplectic", t_end),
+                     f"initial.angle_deg={75.0 + k * START_SPACING!r}"]
+            for n in ns for k in range(starts)}
+    with concurrent.futures.ThreadPoolExecutor(2) as pool:
+        futures = {key: pool.submit(run, exe, work, PAPER, f"ens{key[0]}_{key[1]}", sets)
+                   for key, sets in jobs.items()}
+        results = {key: f.result() for key, f in futures.items()}
+    rows = []
+    for n in ns:
+        runs = [results[(n, k)] for k in range(starts)]
+        if not all(r["ok"] for r in runs):
+            why = next(r["why"] for r in runs if not r["ok"])
+            rows.append(f"| {n} | {starts} | | | | | {why} |")
+            continue
+        growth = np.array([upto(r, t_end) / upto(r, WINDOW) for r in runs])
+        elastic = np.array([elastic_growth(r) for r in runs])
+        largest = np.array([upto(r, t_end) for r in runs])
+        rows.append(f"| {n} | {starts} | {np.median(largest):.1e} | {np.median(growth):.2f} | "
+                    f"{growth.min():.2f} - {growth.max():.2f} | {int((growth <= 2).sum())} | "
+                    f"{np.median(elastic):.1f} ({elastic.min():.1f} - {elastic.max():.1f}) |")
+        print(rows[-1], flush=True)
+    return rows
 
 
 def light_rows(exe, work, repeat):
@@ -165,6 +205,8 @@ def main(argv=None):
     parser.add_argument("--elements", default="20 100")
     parser.add_argument("--t-end", type=float, default=300.0)
     parser.add_argument("--repeat", type=int, default=1)
+    parser.add_argument("--starts", type=int, default=8,
+                        help="release angles of the symplectic method's ensemble")
     parser.add_argument("--former", default=FORMER,
                         help="git revision whose default method is the CPU target "
                              f"(built from git archive; default {FORMER})")
@@ -180,13 +222,16 @@ def main(argv=None):
             build_baseline(args.former, pathlib.Path(tempfile.mkdtemp(dir=work)))
         undamped, windows = undamped_rows(exe, work, [int(x) for x in args.elements.split()],
                                           args.t_end, args.repeat, (args.former, former_exe))
+        ensemble = ensemble_rows(exe, work, [int(x) for x in args.elements.split()],
+                                 args.t_end, args.starts)
         light = light_rows(exe, work, args.repeat)
     if args.no_write:
         return 0
     block = "\n".join([
         BEGIN,
         f"Command: `scripts/bench_symplectic --elements \"{args.elements}\" --t-end "
-        f"{args.t_end:g} --repeat {args.repeat} --former {args.former}` "
+        f"{args.t_end:g} --repeat {args.repeat} --starts {args.starts} --former "
+        f"{args.former}` "
         + ("(with `--former-exe`: that revision's Release executable, built before) "
            if args.former_exe else "") + "(code: "
         "tools/ropedyn_tools/studies/bench_symplectic.py). Machine: "
@@ -203,6 +248,15 @@ def main(argv=None):
         "growth | elastic energy growth | CPU (s) | CPU / former default | within 1e-3 |",
         "|---|---|---|---|---|---|---|---|---|---|---|", *undamped, "",
         *window_block(windows),
+        f"The symplectic method from {args.starts} release angles {START_SPACING:g} degrees "
+        "apart (75 degrees plus multiples; the first is the run above), the same rope and "
+        "settings: the largest |T + V - E0| up to the end (median), the growth from the "
+        f"largest up to {WINDOW:g} s to the largest up to the end (median, range, and the "
+        "starts within the target of 2), and the elastic energy growth as above (median and "
+        "range). The motion is chaotic: one run's growth is one draw.", "",
+        "| n | starts | max abs to the end (median) | growth (median) | growth (range) | "
+        "starts with growth <= 2 | elastic energy growth |",
+        "|---|---|---|---|---|---|---|", *ensemble, "",
         "The lightly damped paper rope (eta 0.1 N s/m^2), 30 s: the balance T + V + "
         "dissipated - E0 at 30 s and its largest gain, m g L, against the targets (the "
         "default's balance within 1e-3 m g L at 30 s; MEBDF at order 7 gaining at most "
