@@ -28,7 +28,7 @@ module ropedyn_integrator
     public :: integrator_t, start_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT, &
         STIFF_STEP_RATE
     public :: stop_query_i, stop_now, steps_to_end, budget_covering, last_warning, &
-        exceeded_text
+        exceeded_text, integrator_budget_shortfall
     public :: DEFAULT_RTOL, DEFAULT_ATOL, DEFAULT_MAX_STEPS
 
     !> The defaults of the options every method shares; the scene's &solver keys take
@@ -143,6 +143,7 @@ module ropedyn_integrator
                      max_order_limit => integrator_max_order_limit
         procedure :: switch_log => integrator_switch_log
         procedure :: steps_exhausted => integrator_steps_exhausted
+        procedure :: budget_shortfall => integrator_budget_shortfall
     end type integrator_t
 
     abstract interface
@@ -277,6 +278,21 @@ contains
             real_text(self%options%t_end)//' s, takes about '//int_text(rest)//' steps more'
         cause = cause//last_warning(self%switch_log())
     end function integrator_steps_exhausted
+
+    !> After a failure at time t: when the run ended for its step budget, the steps the rest
+    !! of it, to options%t_end, takes at the last step size (at least 1); else 0. A method
+    !! that foresees the shortfall (the symplectic method) says it before its budget is
+    !! spent.
+    function integrator_budget_shortfall(self, t) result(rest)
+        class(integrator_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        integer(i8) :: rest
+        type(solver_stats_t) :: stats
+        rest = 0
+        stats = self%stats()
+        if (stats%steps < self%options%max_steps) return
+        rest = max(1_i8, steps_to_end(t, self%options%t_end, stats%last_step))
+    end function integrator_budget_shortfall
 
     !> 'max_steps exceeded (N steps)': how a message says that a budget of N steps ran out.
     pure function exceeded_text(max_steps) result(text)

@@ -190,6 +190,7 @@ module ropedyn_auto
         procedure :: name => auto_name
         procedure :: switch_log => auto_switch_log
         procedure :: rhs_changed => auto_rhs_changed
+        procedure :: budget_shortfall => auto_budget_shortfall
         procedure, private :: start_method
         procedure, private :: watch
         procedure, private :: current_stats
@@ -530,6 +531,32 @@ contains
         total%last_step = part%last_step
         total%last_order = part%last_order
     end subroutine add_counters
+
+    !> After a failure: the shortfall of the method that failed (integrator_t's
+    !! budget_shortfall; it had the budget auto left it).
+    function auto_budget_shortfall(self, t) result(rest)
+        class(auto_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        integer(i8) :: rest
+        select case (self%active)
+        case (EXPLICIT)
+            rest = self%erk%budget_shortfall(t)
+        case (HIGH)
+            rest = self%erk_high%budget_shortfall(t)
+        case (ADAMS)
+            rest = self%am%budget_shortfall(t)
+        case (SYMPLECTIC)
+            rest = self%sym%budget_shortfall(t)
+        case (IMPLICIT)
+            if (self%use_bdf) then
+                rest = self%bdf%budget_shortfall(t)
+            else
+                rest = self%mebdf%budget_shortfall(t)
+            end if
+        case default
+            rest = 0
+        end select
+    end function auto_budget_shortfall
 
     function auto_stats(self) result(stats)
         class(auto_t), intent(in) :: self

@@ -48,7 +48,8 @@ module ropedyn_symplectic
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
     use ropedyn_integrator, only: integrator_t, start_t, solver_stats_t, stop_now, &
-                                  STIFF_STEP_RATE, steps_to_end, budget_covering
+                                  STIFF_STEP_RATE, steps_to_end, budget_covering, &
+                                  integrator_budget_shortfall
     use ropedyn_spectrum, only: spectrum_t, estimate_spectrum, LIGHT_DAMPING
     use ropedyn_switch_log, only: switch_log_t, switch_event_t
     use ropedyn_split_tables, only: split_table_t, split_table, TABLE_VERLET, TABLE_BM6, &
@@ -134,6 +135,8 @@ module ropedyn_symplectic
         integer :: order_limit = 4
         real(wp) :: fixed_h = 0.0_wp           !< fix_step's step (0: the rule's)
         real(wp) :: h_rule = 0.0_wp            !< the rule's step before fitting, s
+        !> the run ended because its steps to t_end outnumber the budget left
+        logical :: budget_short = .false.
     contains
         procedure :: start => symplectic_start
         procedure :: advance_to => symplectic_advance_to
@@ -143,6 +146,7 @@ module ropedyn_symplectic
         procedure :: switch_log => symplectic_switch_log
         procedure :: step_size => symplectic_step_size
         procedure :: fix_step => symplectic_fix_step
+        procedure :: budget_shortfall => symplectic_budget_shortfall
         procedure, private :: begin
         procedure, private :: review_step
         procedure, private :: set_step
@@ -316,6 +320,7 @@ contains
         self%order_limit = start%max_order
         self%respectrum = RESPECTRUM_STEPS
         self%fixed_h = 0.0_wp
+        self%budget_short = .false.
         self%tab = split_table(merge(TABLE_BM6, TABLE_VERLET, start%max_order >= 4))
         self%counters = solver_stats_t()
         call self%log%clear()
@@ -605,6 +610,16 @@ contains
             self%h, ' s, order ', self%tab%order
         call make_error(err, ERR_SOLVER, 'symplectic failed at '//trim(buffer)//': '//cause)
     end subroutine failure
+
+    !> As every method's (integrator_t), and when the run ended at a step whose count to
+    !! t_end outnumbers the budget (budget_reaches_end), that count.
+    function symplectic_budget_shortfall(self, t) result(rest)
+        class(symplectic_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        integer(i8) :: rest
+        rest = integrator_budget_shortfall(self, t)
+        if (self%budget_short) rest = max(1_i8, steps_to_end(t, self%options%t_end, self%h_rule))
+    end function symplectic_budget_shortfall
 
     function symplectic_stats(self) result(stats)
         class(symplectic_t), intent(in) :: self

@@ -46,6 +46,7 @@ contains
         rest = steps_to_end(self%t, self%options%t_end, self%h_rule)
         left = self%options%max_steps - self%counters%steps
         if (rest <= left) return
+        self%budget_short = .true.
         call self%failure(err, 'the rest of the run, to t = '//real_text(self%options%t_end)// &
             ' s, takes about '//int_text(rest)//' steps of '//significant_text(self%h_rule, 3)// &
             ' s ('//trim(self%tab%label)//' at the step the spectral radius '// &

@@ -12,7 +12,7 @@ module ropedyn_cmd_run
     use ropedyn_simulation, only: run_summary_t, run_scene
     use ropedyn_scene_warnings, only: print_warnings
     use ropedyn_version, only: version_string
-    use ropedyn_integrator, only: steps_to_end, budget_covering
+    use ropedyn_integrator, only: budget_covering
     implicit none
     private
     public :: run_command
@@ -71,22 +71,20 @@ contains
         if (allocated(err)) then
             if (err%code == ERR_INTERRUPTED) err%message = err%message// &
                 '; continue with: ropedyn run --resume '//trim(scene%output%file)
-            if (summary%budget_spent .and. summary%records > 0) &
+            if (summary%budget_rest > 0 .and. summary%records > 0) &
                 err%message = err%message//resume_hint(scene, summary)
         end if
     end subroutine run_command
 
-    !> How to go on after the step budget ran out: a resume, which has a budget of its own,
-    !! larger when the rest of the run takes more steps than max_steps at the last step size.
+    !> How to go on after a run ended for its step budget: a resume, which has a budget of
+    !! its own, larger when the rest of the run takes more steps than max_steps.
     function resume_hint(scene, summary) result(text)
         type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(in) :: summary
         character(len=:), allocatable :: text
-        integer(i8) :: rest
         text = '; continue with: ropedyn run --resume '//trim(scene%output%file)
-        rest = steps_to_end(summary%t_reached, scene%solver%t_end, summary%stats%last_step)
-        if (rest > int(scene%solver%max_steps, i8)) text = text// &
-            ' --set solver.max_steps='//int_text(budget_covering(rest))
+        if (summary%budget_rest > int(scene%solver%max_steps, i8)) text = text// &
+            ' --set solver.max_steps='//int_text(budget_covering(summary%budget_rest))
     end function resume_hint
 
     !> The scene of the run file `path` (its `scene` attribute) with `overrides`, its output

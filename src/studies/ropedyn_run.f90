@@ -89,9 +89,10 @@ module ropedyn_run
         !! the top along the unstretched rope (m) and the record's time (s)
         real(wp) :: peak_tension = 0.0_wp, peak_arc = 0.0_wp, peak_time = 0.0_wp
         integer :: peak_joint = -1
-        !> the integration ended on its step budget (solver.max_steps): a resume goes on
-        !! from the last record with a budget of its own
-        logical :: budget_spent = .false.
+        !> the integration ended for its step budget (solver.max_steps, spent or foreseen
+        !! short): the steps the rest of the run takes at its last step (a resume goes on
+        !! from the last record with a budget of its own); 0 otherwise
+        integer(i8) :: budget_rest = 0
     end type run_summary_t
 
     !> A state of a run without output kept in memory (`save`, `restore`): time, ODE state,
@@ -538,7 +539,6 @@ contains
         type(error_t), allocatable, intent(out) :: err
         type(error_t), allocatable :: io_err
         type(energy_t), allocatable :: e_now
-        type(solver_stats_t) :: stats
         real(wp) :: tout, clock_start
         tout = self%output_time(self%k_next)
         outcome = STEP_FAILED
@@ -550,8 +550,7 @@ contains
             call self%check_energy(tout, err, e_now)
         if (allocated(err)) then
             call self%progress%done()
-            stats = self%integrator%stats()
-            self%summary%budget_spent = stats%steps >= self%integrator%options%max_steps
+            self%summary%budget_rest = self%integrator%budget_shortfall(self%t)
             ! keep the last good state if the solver got past the previous record
             if (self%t > self%t_last) call self%record(io_err)
             call self%finish('failed', (err%message), err)

@@ -135,14 +135,16 @@ def test_step_budget_exhausted_explicit(runs, ropedyn_exe):
 def test_symplectic_says_at_once_that_the_budget_is_short(runs, ropedyn_exe, tmp_path):
     """The symplectic method's step is known before it steps: a budget that cannot reach
     t_end ends the run at its start, with the steps the run takes and the budget to add;
-    with that added it completes."""
+    with that added it completes, run again or resumed as the message says (the file of
+    the failed run holds another run's scene: running again on it is refused)."""
     proc, path = runs["budget_symplectic"]
-    check_diagnosis(proc, path, "raise solver.max_steps by ")
+    rest = check_diagnosis(proc, path, "raise solver.max_steps by ", budget_spent=True)
     m = re.search(r"failed at t =  0\.0+E\+00 s.*takes about (\d+) steps of .* more than "
-                  r"the 30 that max_steps leaves: raise solver\.max_steps by (\d+)$",
+                  r"the 30 that max_steps leaves: raise solver\.max_steps by (\d+);",
                   proc.stderr.strip())
     assert m, proc.stderr
     needed, more = int(m.group(1)), int(m.group(2))
+    assert rest.endswith(f" --set solver.max_steps={30 + more}"), rest
     assert stability_metrics.analyse(path)["steps"] == 0
     out = tmp_path / "enough.h5"
     done = subprocess.run([str(ropedyn_exe), "run", str(PAPER), "--set", f"output.file={out}",
@@ -153,6 +155,7 @@ def test_symplectic_says_at_once_that_the_budget_is_short(runs, ropedyn_exe, tmp
     steps = stability_metrics.analyse(out)["steps"]
     # the count it said, within the fitting of the steps to the output times
     assert needed <= steps <= 1.05 * needed
+    resume_as_told(ropedyn_exe, path, rest)
 
 
 def test_step_budget_exhausted_names_the_diagnosed_cause(runs):
