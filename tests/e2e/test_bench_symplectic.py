@@ -55,3 +55,24 @@ def test_the_ensemble_gives_the_median_range_and_count_of_the_growth(monkeypatch
     assert float(cells[3]) == 2.5                       # median of 1.5, 2, 3, 5
     assert cells[4] == "1.50 - 5.00" and cells[5] == "2"
     assert sorted(angles) == [75.0 + k * bs.START_SPACING for k in range(4)]
+
+
+def test_the_ensemble_takes_the_first_start_from_the_table(monkeypatch):
+    """The table's symplectic run is the ensemble's first start (75 degrees): given, it is
+    used and not run again."""
+    growths = [1.5, 2.0, 3.0, 5.0]
+    made = []
+
+    def record(k):
+        return {"ok": True, **records(lambda t: 1e-5 * np.where(t > 30, growths[k], 1.0)
+                                      * np.cos(t), lambda t: 0.04 + 1e-4 * t)}
+
+    def fake_run(exe, work, scene, name, sets):
+        made.append(int(name.rsplit("_", 1)[1]))
+        return record(made[-1])
+
+    monkeypatch.setattr(bs, "run", fake_run)
+    (row,) = bs.ensemble_rows("exe", "work", [20], 300.0, len(growths), {20: record(0)})
+    assert sorted(made) == [1, 2, 3]
+    cells = [c.strip() for c in row.split("|")[1:-1]]
+    assert float(cells[3]) == 2.5 and cells[4] == "1.50 - 5.00" and cells[5] == "2"

@@ -101,9 +101,9 @@ def window_rows(n, r, span=WINDOW):
 def undamped_rows(exe, work, ns, t_end, repeat, former):
     """The undamped rope's rows: the former default first (`former`: (revision, its
     executable)), then the symplectic method, auto and erk of this tree, each with its CPU
-    over the former default's (the target: at most 1)."""
+    over the former default's (the target: at most 1); and the symplectic runs by n."""
     rev, former_exe = former
-    rows, windows = [], {}
+    rows, symplectic = [], {}
     for n in ns:
         base = None
         for label, method, program in ((f"auto at {rev} (the former default)", "auto",
@@ -118,14 +118,14 @@ def undamped_rows(exe, work, ns, t_end, repeat, former):
                 continue
             base = base or r["cpu"]
             if method == "symplectic":
-                windows[n] = window_rows(n, r)
+                symplectic[n] = r
             rows.append(f"| {n} | {label} | {at(r, 30):+.1e} | {at(r, t_end):+.1e} | "
                         f"{upto(r, 30):.1e} | {upto(r, t_end):.1e} | "
                         f"{upto(r, t_end) / upto(r, 30):.1f} | {elastic_growth(r):.1f} | "
                         f"{r['cpu']:.3g} | {r['cpu'] / base:.2f} | "
                         f"{'yes' if upto(r, t_end) <= 1e-3 else 'no'} |")
             print(rows[-1], flush=True)
-    return rows, windows
+    return rows, symplectic
 
 
 def undamped_sets(n, method, t_end):
@@ -135,17 +135,20 @@ def undamped_sets(n, method, t_end):
             "solver.output_interval=0.1", "solver.max_steps=100000000"]
 
 
-def ensemble_rows(exe, work, ns, t_end, starts):
+def ensemble_rows(exe, work, ns, t_end, starts, first=None):
     """The symplectic method's growth (the largest error up to t_end over the largest up to
     WINDOW) and elastic energy growth from `starts` release angles START_SPACING degrees
-    apart, per n: median, range, and how many starts meet the target of 2."""
+    apart, per n: median, range, and how many starts meet the target of 2. `first`: the
+    runs from the first angle (75 degrees, the scene's) already made, by n: not made again."""
+    first = first or {}
     jobs = {(n, k): [*undamped_sets(n, "symplectic", t_end),
                      f"initial.angle_deg={75.0 + k * START_SPACING!r}"]
-            for n in ns for k in range(starts)}
+            for n in ns for k in range(starts) if k > 0 or n not in first}
     with concurrent.futures.ThreadPoolExecutor(2) as pool:
         futures = {key: pool.submit(run, exe, work, PAPER, f"ens{key[0]}_{key[1]}", sets)
                    for key, sets in jobs.items()}
         results = {key: f.result() for key, f in futures.items()}
+    results.update({(n, 0): r for n, r in first.items()})
     rows = []
     for n in ns:
         runs = [results[(n, k)] for k in range(starts)]
@@ -220,10 +223,11 @@ def main(argv=None):
     with tempfile.TemporaryDirectory() as work:
         former_exe = pathlib.Path(args.former_exe) if args.former_exe else \
             build_baseline(args.former, pathlib.Path(tempfile.mkdtemp(dir=work)))
-        undamped, windows = undamped_rows(exe, work, [int(x) for x in args.elements.split()],
-                                          args.t_end, args.repeat, (args.former, former_exe))
-        ensemble = ensemble_rows(exe, work, [int(x) for x in args.elements.split()],
-                                 args.t_end, args.starts)
+        ns = [int(x) for x in args.elements.split()]
+        undamped, symplectic = undamped_rows(exe, work, ns, args.t_end, args.repeat,
+                                             (args.former, former_exe))
+        windows = {n: window_rows(n, r) for n, r in symplectic.items()}
+        ensemble = ensemble_rows(exe, work, ns, args.t_end, args.starts, symplectic)
         light = light_rows(exe, work, args.repeat)
     if args.no_write:
         return 0
