@@ -52,7 +52,7 @@ module ropedyn_auto
     use ropedyn_problem, only: problem_t, STATUS_OK
     use ropedyn_text, only: int_text, real_text, significant_text
     use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, &
-                                  STIFF_STEP_RATE, stop_now, steps_to_end, budget_covering, &
+                                  BUDGET_STEP_RATE, stop_now, steps_to_end, budget_covering, &
                                   last_warning, exceeded_text
     use ropedyn_erk, only: erk_t
     use ropedyn_mebdf, only: mebdf_t
@@ -85,8 +85,9 @@ module ropedyn_auto
     integer, parameter :: EARLY_WINDOW = 50
     real(wp), parameter :: EARLY_SHARE = 0.9_wp
     real(wp), parameter :: GAIN = 1.3_wp           !< hysteresis of a switch
-    !> explicit steps per simulated second above which a run starts implicit
-    real(wp), parameter :: START_RATE = 0.25_wp*STIFF_STEP_RATE
+    !> explicit steps per simulated second above which a run starts implicit: the rate
+    !! that the default step budget allows (so that a run of any length can finish)
+    real(wp), parameter :: START_RATE = BUDGET_STEP_RATE
     !> ... or when a first-order step within the tolerance at the initial state is longer
     !! than this many explicit stable steps (a rope at rest: catenary)
     real(wp), parameter :: START_ACCURACY = 5.0_wp

@@ -13,6 +13,7 @@ module ropedyn_cmd_run
     use ropedyn_scene_warnings, only: print_warnings
     use ropedyn_version, only: version_string
     use ropedyn_integrator, only: budget_covering
+    use ropedyn_scene_solver, only: step_budget
     implicit none
     private
     public :: run_command
@@ -83,7 +84,7 @@ contains
         type(run_summary_t), intent(in) :: summary
         character(len=:), allocatable :: text
         text = '; continue with: ropedyn run --resume '//trim(scene%output%file)
-        if (summary%budget_rest > int(scene%solver%max_steps, i8)) text = text// &
+        if (summary%budget_rest > step_budget(scene)) text = text// &
             ' --set solver.max_steps='//int_text(budget_covering(summary%budget_rest))
     end function resume_hint
 

@@ -11,7 +11,8 @@ module ropedyn_scene_keys
     use ropedyn_scene_key, only: scene_key_t, T_REAL, T_INT, T_LOGICAL, T_NAME, T_PATH, &
         T_PAIR, T_LIST, R_NONE, R_FINITE, R_POSITIVE, R_NONNEGATIVE, R_UNIT, R_AT_LEAST, &
         R_NAMES
-    use ropedyn_text, only: text_t, append_text, name_hint
+    use ropedyn_text, only: text_t, append_text, name_hint, int_text
+    use ropedyn_integrator, only: DEFAULT_MAX_STEPS, BUDGET_STEP_RATE
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     implicit none
     private
@@ -160,8 +161,10 @@ contains
                 'absolute tolerance')
             call add_int(G_SOLVER, 'max_order', v%max_order, R_NONE, 0, &
                 "highest order (0: the method's default)", 'the method''s range, or 0')
-            call add_int(G_SOLVER, 'max_steps', v%max_steps, R_AT_LEAST, 1, &
-                'step budget of a run (a resume has one of its own)')
+            call add_int(G_SOLVER, 'max_steps', v%max_steps, R_AT_LEAST, 0, &
+                'step budget of a run (0: '//int_text(DEFAULT_MAX_STEPS)//', or '// &
+                int_text(nint(BUDGET_STEP_RATE))//' per second of t_end if more; '// &
+                'a resume has one of its own)')
             call add_real(G_SOLVER, 't_end', v%t_end, R_POSITIVE, 's', 'end time')
             call add_real(G_SOLVER, 'output_interval', v%output_interval, R_POSITIVE, 's', &
                 'time between output records; at most a limit of records')

@@ -4,7 +4,7 @@
 module ropedyn_scene_types
     use ropedyn_kinds, only: wp
     use ropedyn_rope_spec, only: rope_spec_t, NAME_LEN, PATH_LEN
-    use ropedyn_integrator, only: DEFAULT_RTOL, DEFAULT_ATOL, DEFAULT_MAX_STEPS
+    use ropedyn_integrator, only: DEFAULT_RTOL, DEFAULT_ATOL
     implicit none
     private
     public :: solver_params_t, output_params_t, scene_t
@@ -17,7 +17,10 @@ module ropedyn_scene_types
         !> highest order of accuracy; 0 in the file: the method's default (resolved by
         !! `read_scene` with `resolved_max_order`, so that the stored scene says it)
         integer :: max_order = 0
-        integer :: max_steps = DEFAULT_MAX_STEPS  !< step budget for the whole run [-]
+        !> step budget for the whole run; 0: the default for the run's length
+        !! (`default_step_budget` of t_end, resolved when the run starts, so that a resume to a
+        !! later t_end has the budget of its length) [-]
+        integer :: max_steps = 0
         real(wp) :: t_end = 30.0_wp           !< end time [s]
         real(wp) :: output_interval = 0.01_wp !< time between output records [s]
         !> CVODE only: BDF stability-limit detection (lowers the order near the stability

@@ -45,7 +45,7 @@ module ropedyn_run
     use ropedyn_clock, only: clock_seconds
     use ropedyn_model_factory, only: create_model
     use ropedyn_scene, only: scene_t, scene_namelist_text
-    use ropedyn_scene_solver, only: create_integrator, solver_options_of
+    use ropedyn_scene_solver, only: create_integrator, solver_options_of, step_budget
     use ropedyn_os, only: make_parent_dirs
     use ropedyn_output, only: output_file_t, add_counter_values
     use ropedyn_progress, only: progress_t

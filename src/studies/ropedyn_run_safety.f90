@@ -113,7 +113,7 @@ contains
         change_safe = 0.0_wp
         steps_high = self%steps_taken() - self%steps_mark
         sudden = sudden_gain(change_high, bound)
-        max_steps = int(self%scene%solver%max_steps, i8)
+        max_steps = step_budget(self%scene)
         budget = look_budget(sudden, self%summary%safety%crawled, steps_high, &
                              max_steps - self%stats_before%steps - self%steps_taken())
         t_safe = self%t_prev

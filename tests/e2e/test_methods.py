@@ -114,6 +114,37 @@ def test_auto_leaves_the_symplectic_method_out_when_the_budget_is_short(run, tmp
         assert switch_log(f)[0][0] == "symplectic"
 
 
+def test_the_default_budget_grows_with_the_run(run, tmp_path):
+    """A scene that names no max_steps has a budget that grows with t_end (`ropedyn keys`
+    states the rule): the undamped 4-element rope over 2000 s takes more symplectic steps
+    than the budget's floor, and auto still takes the method, without a warning, and
+    finishes with its energy bounded. (With the floor alone, auto would leave the method
+    out and drift: test_auto_leaves_the_symplectic_method_out_when_the_budget_is_short.)"""
+    keys = run("keys")
+    assert keys.returncode == 0, keys.stderr
+    rule = re.search(r"^solver\tmax_steps\tinteger\t-\t0\t>= 0\tstep budget of a run "
+                     r"\(0: (\d+), or (\d+) per second of t_end if more", keys.stdout,
+                     re.MULTILINE)
+    assert rule, keys.stdout
+    floor, rate = (int(x) for x in rule.groups())
+    t_end = 2000.0
+    assert rate * t_end > floor
+    proc, out = run_scene(run, tmp_path, PAPER, "long", "model.elements=4",
+                          "effects.damping=.false.", "solver.rtol=1e-3", "solver.atol=1e-5",
+                          f"solver.t_end={t_end:g}", "solver.output_interval=10")
+    assert proc.returncode == 0, proc.stderr
+    assert "warning" not in proc.stderr, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods, _, _, reasons = switch_log(f)
+        steps = int(f["/solver/steps"][()])
+        total = f["/energy/total"][()]
+    assert set(methods) == {"symplectic"}, (methods, reasons)   # its step events
+    assert floor < steps <= rate * t_end, steps
+    mgl = 6000 * np.pi * 0.005 ** 2 / 4 * 9.81     # the paper rope's m g L (J)
+    # the bound of issue 44's target; auto's former erk/MEBDF lose 0.15 m g L over 300 s
+    assert np.max(np.abs(total - total[0])) < 1e-3 * mgl
+
+
 def test_auto_records_its_choice(run, tmp_path):
     proc, out = run_scene(run, tmp_path, PAPER, "auto", "model.elements=8",
                           "solver.t_end=0.2")

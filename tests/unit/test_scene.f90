@@ -3,9 +3,11 @@
 !!
 !! Scene files are written into test_scene_tmp/ under the working directory.
 program test_scene
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, ERR_INPUT
     use ropedyn_scene, only: scene_t, read_scene, scene_namelist_text
+    use ropedyn_scene_solver, only: step_budget
+    use ropedyn_integrator, only: default_step_budget
     use ropedyn_rope_spec, only: bottom_anchor_given
     use ropedyn_assert, only: test_suite_t
     implicit none
@@ -105,7 +107,14 @@ contains
         call suite%check_close(s%solver%rtol, 1.0e-6_wp, TIGHT, 0.0_wp, 'defaults: rtol')
         call suite%check_close(s%solver%atol, 1.0e-8_wp, TIGHT, 0.0_wp, 'defaults: atol')
         call suite%check_true(s%solver%max_order == 0, 'defaults: max_order')
-        call suite%check_true(s%solver%max_steps == 1000000, 'defaults: max_steps')
+        call suite%check_true(s%solver%max_steps == 0, 'defaults: max_steps (0: by t_end)')
+        call suite%check_true(step_budget(s) == default_step_budget(s%solver%t_end), &
+            'defaults: the step budget is the default of the run''s length')
+        s%solver%t_end = 600.0_wp
+        call suite%check_true(step_budget(s) == default_step_budget(600.0_wp) .and. &
+            step_budget(s) > default_step_budget(30.0_wp), &
+            'defaults: a longer run has a larger budget')
+        s%solver%t_end = 30.0_wp
         call suite%check_close(s%solver%t_end, 30.0_wp, TIGHT, 0.0_wp, 'defaults: t_end')
         call suite%check_close(s%solver%output_interval, 0.01_wp, TIGHT, 0.0_wp, &
             'defaults: output_interval')
@@ -190,6 +199,7 @@ contains
         call suite%check_close(s%solver%rtol, 1.0e-9_wp, TIGHT, 0.0_wp, 'values: rtol')
         call suite%check_true(s%solver%max_order == 3 .and. s%solver%max_steps == 5000, &
             'values: max_order, max_steps')
+        call suite%check_true(step_budget(s) == 5000_i8, 'values: the step budget is max_steps')
         call suite%check_close(s%solver%output_interval, 0.5_wp, TIGHT, 0.0_wp, &
             'values: output_interval')
         call suite%check_true(s%solver%stability_limit_detection, &
@@ -453,9 +463,9 @@ contains
         call expect_error('fault_nan_after', [character(len=L) :: MODEL, &
             '&effects fault_nan_after = 1e999 /'], NO_SET, [character(len=L) :: &
             P//'fault_nan_after.nml: &effects: fault_nan_after = +Infinity: must be finite'])
-        call expect_error('max_steps', [character(len=L) :: MODEL, '&solver max_steps = 0 /'], &
-            NO_SET, [character(len=L) :: P//'max_steps.nml: &solver: max_steps = 0: ', &
-            'must be >= 1'])
+        call expect_error('max_steps', [character(len=L) :: MODEL, '&solver max_steps = -1 /'], &
+            NO_SET, [character(len=L) :: P//'max_steps.nml: &solver: max_steps = -1: ', &
+            'must be >= 0'])
         call expect_error('t_end', [character(len=L) :: MODEL, '&solver t_end = 0.0 /'], &
             NO_SET, [character(len=L) :: P//'t_end.nml: &solver: t_end = 0.0: must be > 0'])
         call expect_error('interval', [character(len=L) :: MODEL, &

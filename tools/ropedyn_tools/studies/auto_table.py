@@ -1,7 +1,7 @@
 """Auto's choice on every scene: `method = 'auto'` against each fixed method.
 
 Runs every scene of input/ and input/hard/ with auto (the default) and with cvode, adams,
-mebdf and erk (each at its default order limit), all with the scene's own tolerances and
+mebdf, erk and the symplectic method (each at its default order limit), all with the scene's own tolerances and
 the same horizon, and writes a table between the auto_table markers of docs/performance/auto.md:
 the scene, auto's choice and switches (time: method/order limit), auto's CPU time, the
 fastest fixed method and its CPU time, and auto's CPU over the best's (target: <= 1.3).
@@ -17,8 +17,9 @@ fastest fixed method and its CPU time, and auto's CPU over the best's (target: <
   not finish cannot be the best.
 - The scenes' own `method` keys are overridden.
 - A scene on which auto or a fixed method runs out of the step budget (`&solver
-  max_steps`, 1e6 by default) is run again, with every method, at max_steps = 1e7, and
-  says so: the table compares costs, the budget is a separate question.
+  max_steps`, by default 1e6 or 5e4 per second of t_end) is run again, with every method,
+  at max_steps = 1e7, and says so: the table compares costs, the budget is a separate
+  question.
 
 The code of scripts/auto_table.
 """
@@ -37,7 +38,10 @@ from ropedyn_tools.studies.common import machine, scene_number, update_doc, run_
 
 BEGIN = "<!-- auto_table:begin -->"
 END = "<!-- auto_table:end -->"
-FIXED = ("cvode", "adams", "mebdf", "erk")
+FIXED = ("cvode", "adams", "mebdf", "erk", "symplectic")
+#: how a method says it does not take a scene at all (the symplectic method on the MPP or
+#: with ground contact): shown as n/a, not as a failure
+REFUSED = "cannot integrate this problem"
 ROUND = (1.0, 2.0, 5.0)
 
 
@@ -73,8 +77,9 @@ def run(exe, scene, work, method, t_end, cap=None, extra=(), points=False):
     if proc.returncode != 0:
         if proc.returncode < 0 or proc.returncode in (137, 152):
             return {"status": "cap"}
-        return {"status": "failed", "reason": proc.stderr.strip().splitlines()[-1][:200]
-                if proc.stderr.strip() else f"exit code {proc.returncode}"}
+        reason = (proc.stderr.strip().splitlines()[-1] if proc.stderr.strip()
+                  else f"exit code {proc.returncode}")
+        return {"status": "n/a" if REFUSED in reason else "failed", "reason": reason[:200]}
     with h5py.File(out, "r") as f:
         cpu = float(f["solver/cpu_time"][()])
         steps = int(f["solver/steps"][()])
@@ -133,7 +138,7 @@ def main(argv=None):
     exe = exe_or_build(args.exe)
     todo = [pathlib.Path(s).resolve() for s in args.scenes] if args.scenes else scenes()
     header = ("| scene | horizon (s) | auto's choice (t: method max order) | auto CPU (s) "
-              "| cvode | adams | mebdf | erk | best fixed | auto / best |")
+              "| cvode | adams | mebdf | erk | symplectic | best fixed | auto / best |")
     rows = []
     print(header, flush=True)
     with tempfile.TemporaryDirectory() as tmp:
@@ -161,7 +166,7 @@ def main(argv=None):
                 note += ", max_steps 1e7"
             if auto["status"] != "complete":
                 row = (f"| {name} | {horizon:g}{note} | auto {auto['status']}: "
-                       f"{auto.get('reason', '')} | | | | | | | |")
+                       f"{auto.get('reason', '')} | | | | | | | | |")
                 rows.append(row)
                 print(row, flush=True)
                 continue
@@ -173,6 +178,8 @@ def main(argv=None):
                         best = (m, r["cpu"])
                 elif r["status"] == "cap":
                     cells.append(f"> {cap:.3g}")
+                elif r["status"] == "n/a":
+                    cells.append("n/a")
                 else:
                     cells.append("failed")
             if best is None:
@@ -194,8 +201,10 @@ def main(argv=None):
              f"{args.repeat} runs (up to 8 while they add up to less than 1 s); a fixed "
              f"method gets max({args.cap_factor:g} x auto's CPU, "
              f"{args.cap_min:g} s) of CPU ('> cap' when it needs more), 'failed': it ended "
-             f"with its diagnosis (exit code 3). Machine: {machine()}. Run: {run_stamp()}.",
-             "", header, "|---|---|---|---|---|---|---|---|---|---|", *rows, END]
+             f"with its diagnosis (exit code 3), 'n/a': the method does not take the scene "
+             f"(the symplectic method on the MPP and with ground contact). "
+             f"Machine: {machine()}. Run: {run_stamp()}.",
+             "", header, "|---|---|---|---|---|---|---|---|---|---|---|", *rows, END]
     update_doc(DOCS / "performance" / "auto.md", BEGIN, END, "\n".join(lines),
                heading="## Auto's choice on every scene (issue 15)\n\n")
     print(f"auto_table: {DOCS / 'performance' / 'auto.md'}")

@@ -377,7 +377,7 @@ def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS)
             if status(out)[0] == "complete":
                 return
             out.unlink()                      # a failed or interrupted run: again
-        # 330 elements over 30 cycles of 3.5 s take more than the default 1e6 steps
+        # 330 elements over 30 cycles of 3.5 s take more than the default budget
         sets = [f"model.kind={model}", f"model.elements={n}", f"solver.rtol={rtol:g}",
                 f"solver.atol={atol:g}", "solver.max_steps=100000000",
                 f"supports.top_frequency={1 / period:.12g}",
