@@ -16,8 +16,9 @@ each method's error and the cost of each fixed method at auto's accuracy:
 - **Error**: the largest distance over the output times (`--records` of them over the span)
   and over the rope's points (/rope/points, m) from the reference.
 - **Auto** at the scene's own rtol and atol: its error e_auto and its CPU.
-- **Each fixed method** (cvode, adams, mebdf, erk at their default order limits): its error at
-  the scene's tolerances, and its CPU at equal accuracy: the loosest of the scene's rtol times
+- **Each fixed method** (cvode, adams, mebdf, erk and the symplectic method at their
+  default order limits; n/a where a method does not take the scene): its error at the
+  scene's tolerances, and its CPU at equal accuracy: the loosest of the scene's rtol times
   1e3, 1e2, .. 1e-3 (atol scaled alike) whose error is at most SLACK = 1.5 times e_auto
   (errors below the reference's reach, or `--floor`, count as that).
 - **auto / best at equal accuracy**: auto's CPU over the cheapest of those.
@@ -57,8 +58,10 @@ def distance(a, b):
 def measured(exe, scene, work, method, span, sets, repeat, cap, ref):
     """(cpu, error, switch methods: erk with its pair's order) of `method` with `sets`:
     the least CPU of `repeat` runs (auto_table's best_of); None when a run failed or ran
-    over its cap."""
+    over its cap, "n/a" when the method does not take the scene."""
     r = auto_table.best_of(exe, scene, work, method, span, repeat, cap, sets, points=True)
+    if r["status"] == "n/a":
+        return "n/a"
     if r["status"] != "complete":
         return None
     return r["cpu"], distance(r["points"], ref), [
@@ -109,7 +112,7 @@ def main(argv=None):
                 cap = max(4 * auto[0], 3.0)
                 own = {m: measured(exe, scene, work, m, span, common, args.repeat, cap,
                                    refs[0]["points"]) for m in FIXED}
-                largest = max([auto[1]] + [r[1] for r in own.values() if r is not None])
+                largest = max([auto[1]] + [r[1] for r in own.values() if isinstance(r, tuple)])
                 if spread <= max(0.1 * largest, args.floor):
                     break
                 span /= 2
@@ -126,6 +129,9 @@ def main(argv=None):
             errors, best = [], None
             for method in FIXED:
                 at_own = own[method]
+                if at_own == "n/a":
+                    errors.append("n/a")
+                    continue
                 errors.append(f"{at_own[1]:.1e}" if at_own else "failed")
                 for factor in FACTORS:
                     if factor == 1.0 and at_own is not None:
