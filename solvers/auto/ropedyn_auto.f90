@@ -169,6 +169,10 @@ module ropedyn_auto
         !> the symplectic method was left out once for the step budget (said once, as a
         !! warning in the log)
         logical :: budget_said = .false.
+        !> the symplectic method's cost per simulated second at the last look at it, where
+        !! the fast modes were lightly damped and only its cost against erk's predicted one
+        !! kept it out (< 0: none): erk's measured cost may later show it cheaper
+        real(wp) :: sym_cost = -1.0_wp
         !> the Newton matrix's width over the RFEM's (>= 1), and the cost of one MEBDF
         !! evaluation of f in evaluations of the explicit f (see Cost)
         real(wp) :: lambda = 1.0_wp
@@ -213,14 +217,18 @@ module ropedyn_auto
 
         !> Whether the run goes symplectic, and why (submodule ropedyn_auto_start); when it
         !! would but for the step budget, .false. with the warning to log in `why` (once).
-        module function symplectic_fits(self, spec, h_e, t0, why, below) result(fits)
+        module function symplectic_fits(self, spec, h_e, t0, why, below, measured) &
+            result(fits)
             class(auto_t), intent(inout) :: self
             type(spectrum_t), intent(in) :: spec
             real(wp), intent(in) :: h_e, t0
             character(len=*), intent(out) :: why
             !> a cost per simulated second (evaluations of f) the symplectic method must
-            !! stay under (the implicit method's measured cost over GAIN)
+            !! stay under (the implicit method's measured cost over GAIN, or erk's)
             real(wp), intent(in), optional :: below
+            !> .true.: `below` is erk's own measured cost over GAIN, which replaces the
+            !! limit against erk's predicted cost (LIGHT_COST_LIMIT)
+            logical, intent(in), optional :: measured
             logical :: fits
         end function symplectic_fits
 

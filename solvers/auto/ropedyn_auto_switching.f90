@@ -104,7 +104,15 @@
 !!   damped paper rope at n = 10, whose fast modes the estimate finds lightly damped,
 !!   4.8 times, so not there), and steps to t_end within the step budget left (its step is
 !!   fixed: it knows the count in advance; else a warning, once, names the budget at
-!!   which it would). It keeps it unless its step gets too short (START_RATE:
+!!   which it would). Erk's predicted cost assumes its stable step; where erk's steps
+!!   are held by accuracy instead, its measured cost is higher: from erk's second window
+!!   on (and the order-5 pair's), when the symplectic method's cost at its last look
+!!   (sym_cost) is below the window's measured cost by GAIN, auto estimates the spectrum
+!!   again and takes it if it still fits, with that measured cost in place of the limit
+!!   against the predicted one (input/hard/light_damping.nml, n = 30, rtol 1e-6, 10 s:
+!!   erk held by accuracy at 1.4e5 f per second, the symplectic method 0.41 of that;
+!!   auto 0.9 s CPU before, 0.27 s after, its tip over 2 s 2.5e-8 m from cvode at rtol
+!!   1e-10 against 6.7e-8 before). It keeps it unless its step gets too short (START_RATE:
 !!   then the implicit method); its own log of the step joins the switch log.
 submodule (ropedyn_auto) ropedyn_auto_switching
     implicit none
@@ -153,6 +161,8 @@ contains
             self%rate_explicit = rate
             if (self%rate_implicit > 0.0_wp) self%implicit_age = self%implicit_age + 1
             if (self%rate_accurate > 0.0_wp) self%accurate_age = self%accurate_age + 1
+            call try_symplectic()
+            if (self%active /= EXPLICIT .or. allocated(err)) return
             if (early) then
                 share = self%erk%stiff_share_of_steps(EARLY_WINDOW)
             else
@@ -219,6 +229,10 @@ contains
             if (self%windows < 2) return
             self%rate_accurate = rate
             self%accurate_age = 0
+            if (self%active == HIGH) then
+                call try_symplectic()
+                if (self%active /= HIGH .or. allocated(err)) return
+            end if
             if (self%trial) then
                 ! kept only when cheaper by GAIN: Adams' counted cost misses CVODE's fixed
                 ! work per step, which weighs most where f is cheap (the RFEM at small n);
@@ -295,6 +309,24 @@ contains
             end if
         end if
     contains
+        !> To the symplectic method when its cost (self%sym_cost, from its last look)
+        !! is below the measured cost `rate` of erk's window by GAIN and it still fits at
+        !! the state now (a new spectrum estimate, only then): a lightly damped rope whose
+        !! erk steps are held by accuracy, not by the stability that erk's predicted cost
+        !! assumes (input/hard/light_damping.nml: erk 1.63 s, the symplectic method 0.27 s).
+        subroutine try_symplectic()
+            if (self%windows < 2 .or. .not. (self%sym_cost > 0.0_wp)) return
+            if (GAIN*self%sym_cost >= rate) return
+            call estimate_spectrum(self%problem, self%t, self%y, spec)
+            h_e = erk_stable_step(self%tab, spec)
+            if (self%symplectic_fits(spec, h_e, self%t, why_sym, rate/GAIN, .true.)) then
+                write (text, '(a, es9.2, a)') 'erk''s cost ', rate, ' f per second'
+                call self%start_method(SYMPLECTIC, trim(text)//'; '//trim(why_sym), err)
+            else if (len_trim(why_sym) > 0) then
+                call self%add_warning(trim(why_sym))
+            end if
+        end subroutine try_symplectic
+
         !> Add to text what the switch tries: `what` on trial, or again when its cost,
         !! measured `windows_ago` explicit windows ago, is stale.
         subroutine add_trial(what, is_stale, windows_ago)

@@ -12,6 +12,7 @@ from ropedyn_tools.studies.cost_model import auto_parameter
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
 PAPER = ROOT / "input" / "paper.nml"
 STEEL = ROOT / "input" / "hard" / "steel_wire.nml"
+LIGHT = ROOT / "input" / "hard" / "light_damping.nml"
 
 
 def switch_log(f):
@@ -112,6 +113,35 @@ def test_auto_leaves_the_symplectic_method_out_when_the_budget_is_short(run, tmp
     assert proc.returncode == 0, proc.stderr
     with h5py.File(out, "r") as f:
         assert switch_log(f)[0][0] == "symplectic"
+
+
+def test_auto_goes_symplectic_where_erk_costs_more_than_predicted(run, tmp_path):
+    """The lightly damped rope of input/hard (n = 30, rtol 1e-6) over 6 s: at the start
+    the symplectic method costs more than four times erk's predicted cost (erk at its stable
+    step), so auto starts erk; but erk's steps are held by accuracy, and its measured cost
+    after its second window is higher than the symplectic method's by more than the
+    hysteresis: auto switches, says why, and the rest of the run costs less per simulated
+    second than erk did, with its energy balance within 10 rtol m g L."""
+    mgl = 6000 * np.pi * 0.005 ** 2 / 4 * 9.81
+    proc, out = run_scene(run, tmp_path, LIGHT, "auto", "solver.t_end=6",
+                          "solver.output_interval=0.05")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods, times, _, reasons = switch_log(f)
+        evals = int(f["/solver/rhs_evals"][()])
+        balance = f["/energy/total"][()] + f["/energy/dissipated"][()]
+    assert methods[0] == "erk" and "symplectic" in methods, (methods, reasons)
+    k = methods.index("symplectic")
+    measured = re.match(r"erk's cost +([0-9.E+-]+) f per second; the fast modes are lightly "
+                        r"damped and the symplectic method costs less than erk as measured "
+                        r"\(([0-9.]+) times its cost", reasons[k])
+    assert measured, reasons[k]
+    erk_rate, ratio = float(measured.group(1)), float(measured.group(2))
+    assert ratio < 1 / auto_parameter("GAIN"), reasons[k]
+    assert set(methods[k:]) == {"symplectic"}, methods      # kept to the end
+    # the whole run, erk's start included, against erk's measured rate
+    assert evals / 6.0 < erk_rate, (evals, erk_rate)
+    assert np.max(np.abs(balance - balance[0])) < 10 * 1e-6 * mgl
 
 
 def test_the_default_budget_grows_with_the_run(run, tmp_path):
