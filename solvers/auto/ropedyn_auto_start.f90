@@ -84,7 +84,10 @@ contains
     !! simulated second, and its cost (choose_step's: its evaluations and the rest of its
     !! work per simulated second) is at most LIGHT_COST_LIMIT times erk's predicted cost
     !! (evaluations per step over the stable step h_e, with EXPLICIT_MARGIN), and under
-    !! `below` when given; `why`: the reason for the log.
+    !! `below` when given; with `measured`, `below` is erk's measured cost over GAIN and
+    !! replaces the limit against the predicted one. `why`: the reason for the log. Where
+    !! the method is offered and lightly damped but left out, its cost stays in
+    !! self%sym_cost for the measured look (watch); else that is -1.
     module procedure symplectic_fits
         type(split_table_t) :: tab
         real(wp) :: h, cost_s, cost_e
