@@ -13,6 +13,8 @@ ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
 PAPER = ROOT / "input" / "paper.nml"
 STEEL = ROOT / "input" / "hard" / "steel_wire.nml"
 LIGHT = ROOT / "input" / "hard" / "light_damping.nml"
+#: the paper rope's m g L (J): 6000 kg/m3, 5 mm diameter, 1 m
+MGL = 6000 * np.pi * 0.005 ** 2 / 4 * 9.81
 
 
 def switch_log(f):
@@ -55,7 +57,6 @@ def test_auto_goes_symplectic_where_the_fast_modes_are_lightly_damped(run, tmp_p
     """The undamped rope (n = 8, rtol 1e-3, 6 s): auto starts the symplectic method, says
     why in the switch log, names it in the summary, and its energy balance stays within 1e-4 m g L (erk's
     drifts past 1e-3 m g L by then); the paper's damped rope stays with erk and mebdf."""
-    mgl = 6000 * np.pi * 0.005 ** 2 / 4 * 9.81
     proc, out = run_scene(run, tmp_path, PAPER, "undamped", "model.elements=8",
                           "effects.damping=.false.", "solver.rtol=1e-3", "solver.atol=1e-5",
                           "solver.t_end=6", "solver.output_interval=0.05")
@@ -66,7 +67,7 @@ def test_auto_goes_symplectic_where_the_fast_modes_are_lightly_damped(run, tmp_p
     assert methods[0] == "symplectic" and orders[0] == 4, (methods, reasons)
     assert "lightly damped" in reasons[0], reasons
     assert "auto: symplectic 4 (" in proc.stdout, proc.stdout   # the step event is no switch
-    assert np.max(np.abs(total - total[0])) < 1e-4 * mgl
+    assert np.max(np.abs(total - total[0])) < 1e-4 * MGL
     proc, out = run_scene(run, tmp_path, PAPER, "damped", "model.elements=8",
                           "solver.rtol=1e-3", "solver.atol=1e-5", "solver.t_end=6",
                           "solver.output_interval=0.05")
@@ -122,7 +123,6 @@ def test_auto_goes_symplectic_where_erk_costs_more_than_predicted(run, tmp_path)
     after its second window is higher than the symplectic method's by more than the
     hysteresis: auto switches, says why, and the rest of the run costs less per simulated
     second than erk did, with its energy balance within 10 rtol m g L."""
-    mgl = 6000 * np.pi * 0.005 ** 2 / 4 * 9.81
     proc, out = run_scene(run, tmp_path, LIGHT, "auto", "solver.t_end=6",
                           "solver.output_interval=0.05")
     assert proc.returncode == 0, proc.stderr
@@ -141,7 +141,7 @@ def test_auto_goes_symplectic_where_erk_costs_more_than_predicted(run, tmp_path)
     assert set(methods[k:]) == {"symplectic"}, methods      # kept to the end
     # the whole run, erk's start included, against erk's measured rate
     assert evals / 6.0 < erk_rate, (evals, erk_rate)
-    assert np.max(np.abs(balance - balance[0])) < 10 * 1e-6 * mgl
+    assert np.max(np.abs(balance - balance[0])) < 10 * 1e-6 * MGL
 
 
 def test_the_default_budget_grows_with_the_run(run, tmp_path):
@@ -170,9 +170,8 @@ def test_the_default_budget_grows_with_the_run(run, tmp_path):
         total = f["/energy/total"][()]
     assert set(methods) == {"symplectic"}, (methods, reasons)   # its step events
     assert floor < steps <= rate * t_end, steps
-    mgl = 6000 * np.pi * 0.005 ** 2 / 4 * 9.81     # the paper rope's m g L (J)
     # the bound of issue 44's target; auto's former erk/MEBDF lose 0.15 m g L over 300 s
-    assert np.max(np.abs(total - total[0])) < 1e-3 * mgl
+    assert np.max(np.abs(total - total[0])) < 1e-3 * MGL
 
 
 def test_auto_records_its_choice(run, tmp_path):
