@@ -28,7 +28,7 @@ module ropedyn_integrator
     public :: integrator_t, start_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT, &
         STIFF_STEP_RATE
     public :: stop_query_i, stop_now, steps_to_end, budget_covering, last_warning, &
-        exceeded_text, integrator_budget_shortfall, default_step_budget
+        exceeded_text, integrator_budget_shortfall, default_step_budget, error_weights
     public :: DEFAULT_RTOL, DEFAULT_ATOL, DEFAULT_MAX_STEPS, BUDGET_STEP_RATE
 
     !> The defaults of the options every method shares; the scene's &solver keys take
@@ -343,6 +343,18 @@ contains
         if (.not. (t_end > 0.0_wp)) return
         budget = max(budget, ceiling(min(BUDGET_STEP_RATE*t_end, 1.0e18_wp), i8))
     end function default_step_budget
+
+    !> The weights of the error test at the state y (the type's comment): rtol |y_i| + atol_i.
+    pure function error_weights(options, y) result(w)
+        type(solver_options_t), intent(in) :: options
+        real(wp), intent(in) :: y(:)
+        real(wp) :: w(size(y))
+        if (allocated(options%atol_vector)) then
+            w = options%rtol*abs(y) + options%atol_vector
+        else
+            w = options%rtol*abs(y) + options%atol
+        end if
+    end function error_weights
 
     !> A step budget for `steps` steps: a tenth more (a step may shorten on the way), rounded
     !! up to two significant digits (1,083,000 -> 1,200,000); 0 for none.

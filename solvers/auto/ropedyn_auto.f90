@@ -53,7 +53,7 @@ module ropedyn_auto
     use ropedyn_text, only: int_text, real_text, significant_text
     use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, &
                                   BUDGET_STEP_RATE, stop_now, steps_to_end, budget_covering, &
-                                  last_warning, exceeded_text
+                                  last_warning, exceeded_text, error_weights
     use ropedyn_erk, only: erk_t
     use ropedyn_mebdf, only: mebdf_t
     use ropedyn_cvode, only: cvode_t, adams_t
@@ -62,7 +62,7 @@ module ropedyn_auto
     use ropedyn_band_lu, only: factored_dense
     use ropedyn_switch_log, only: switch_log_t, switch_event_t
     use ropedyn_symplectic, only: symplectic_t, choose_step
-    use ropedyn_split_tables, only: split_table_t
+    use ropedyn_split_tables, only: split_table_t, split_table
     implicit none
     private
     public :: auto_t
@@ -75,6 +75,9 @@ module ropedyn_auto
     !! cost per simulated second, on a run at least LONG_RUN long (options%t_end)
     real(wp), parameter :: LIGHT_COST_LIMIT = 4.0_wp
     real(wp), parameter :: LONG_RUN = 5.0_wp
+    !> the symplectic method's probe before auto takes it (ropedyn_auto_probe): its error
+    !! over PROBE_STEPS of its steps
+    integer, parameter :: PROBE_STEPS = 400
     integer, parameter :: ERK_ORDER = 4            !< the explicit pair (RK4, 3rd-order estimate)
     !> the explicit pair for stretches held by accuracy on problems without a mass matrix
     !! (Dormand-Prince 5(4))
@@ -173,6 +176,15 @@ module ropedyn_auto
         !! the fast modes were lightly damped and only its cost against erk's predicted one
         !! kept it out (< 0: none): erk's measured cost may later show it cheaper
         real(wp) :: sym_cost = -1.0_wp
+        !> the why of symplectic_fits is a warning (the step budget), not a note (a probe)
+        logical :: why_warns = .true.
+        !> the symplectic method's probe (ropedyn_auto_probe), with its own instance (the
+        !! method's log stays that of its runs); windows of the other methods until auto
+        !! may weigh the method again after a probe that failed, and how many the next
+        !! failure makes it (doubled each time)
+        type(symplectic_t) :: sym_probe
+        integer :: sym_wait = 0
+        integer :: sym_backoff = STALE_WINDOWS
         !> the Newton matrix's width over the RFEM's (>= 1), and the cost of one MEBDF
         !! evaluation of f in evaluations of the explicit f (see Cost)
         real(wp) :: lambda = 1.0_wp
@@ -204,7 +216,8 @@ module ropedyn_auto
         procedure, private :: accurate_name
         procedure, private :: trials_are_cheap
         procedure, private :: symplectic_fits
-        procedure, private :: add_warning
+        procedure, private :: probe_symplectic
+        procedure, private :: add_note
     end type auto_t
 
     interface
@@ -231,6 +244,19 @@ module ropedyn_auto
             logical, intent(in), optional :: measured
             logical :: fits
         end function symplectic_fits
+
+        !> Whether the symplectic method is accurate enough to take, from the state now
+        !! (submodule ropedyn_auto_probe): its error after PROBE_STEPS of its steps of
+        !! composition `kind` at the step h at most sqrt(PROBE_STEPS) tolerances; `text`
+        !! says what the probe found. After a probe that fails, auto waits sym_wait windows
+        !! before it weighs the method again.
+        module subroutine probe_symplectic(self, kind, h, passed, text)
+            class(auto_t), intent(inout) :: self
+            integer, intent(in) :: kind
+            real(wp), intent(in) :: h
+            logical, intent(out) :: passed
+            character(len=*), intent(out) :: text
+        end subroutine probe_symplectic
 
         !> At the end of a window: measure, compare, switch (submodule ropedyn_auto_switching).
         module subroutine watch(self, err)
@@ -353,18 +379,20 @@ contains
         self%win_cost0 = 0.0_wp
     end subroutine start_method
 
-    !> A warning in the log at the current time, for the method and order limit in use
-    !! (an event that changes neither: the method chain does not count it as a switch).
-    subroutine add_warning(self, text)
+    !> A note in the log at the current time, for the method and order limit in use (an
+    !! event that changes neither: the method chain does not count it as a switch); a
+    !! `warning` is also printed while the run goes on.
+    subroutine add_note(self, text, warning)
         class(auto_t), intent(inout) :: self
         character(len=*), intent(in) :: text
+        logical, intent(in) :: warning
         type(switch_event_t), allocatable :: events(:)
         events = self%log%items()
         if (size(events) == 0) return
         associate (last => events(size(events)))
-            call self%log%add(self%t, last%method, last%max_order, text, warning=.true.)
+            call self%log%add(self%t, last%method, last%max_order, text, warning=warning)
         end associate
-    end subroutine add_warning
+    end subroutine add_note
 
     subroutine auto_advance_to(self, tout, t, y, yq, err)
         class(auto_t), intent(inout) :: self
@@ -582,6 +610,7 @@ contains
         call self%bdf%finalize()
         call self%am%finalize()
         call self%sym%finalize()
+        call self%sym_probe%finalize()
         self%active = 0
         self%initialized = .false.
         self%problem => null()

@@ -10,7 +10,7 @@ contains
         real(wp) :: h_e, h_a, rate
         character(len=280) :: text
         character(len=100) :: slow
-        character(len=400) :: why_sym
+        character(len=640) :: why_sym
 
         self%user_order = start%max_order
         self%y = start%y0
@@ -35,6 +35,8 @@ contains
         self%explicit_age = 0
         self%radius = 0.0_wp
         self%sym_order = 0
+        self%sym_wait = 0
+        self%sym_backoff = STALE_WINDOWS
 
         call newton_widths(self%problem, self%lambda, self%mebdf_eval_cost)
         call estimate_spectrum(self%problem, start%t0, start%y0, spec)
@@ -74,7 +76,7 @@ contains
         end if
         if (allocated(err)) return
         if (self%active /= SYMPLECTIC .and. len_trim(why_sym) > 0) &
-            call self%add_warning(trim(why_sym))
+            call self%add_note(trim(why_sym), self%why_warns)
         self%initialized = .true.
     end procedure auto_start
 
@@ -85,9 +87,11 @@ contains
     !! work per simulated second) is at most LIGHT_COST_LIMIT times erk's predicted cost
     !! (evaluations per step over the stable step h_e, with EXPLICIT_MARGIN), and under
     !! `below` when given; with `measured`, `below` is erk's measured cost over GAIN and
-    !! replaces the limit against the predicted one. `why`: the reason for the log. Where
+    !! replaces the limit against the predicted one; last, its probe (ropedyn_auto_probe)
+    !! must pass. `why`: the reason for the log (a warning when self%why_warns). Where
     !! the method is offered and lightly damped but left out, its cost stays in
-    !! self%sym_cost for the measured look (watch); else that is -1.
+    !! self%sym_cost for the measured look (watch); else that is -1. While a failed
+    !! probe's wait lasts (sym_wait), it is not weighed at all.
     module procedure symplectic_fits
         type(split_table_t) :: tab
         real(wp) :: h, cost_s, cost_e
@@ -98,6 +102,9 @@ contains
         logical :: by_measure
         fits = .false.
         why = ''
+        self%why_warns = .true.
+        ! (after a probe that failed: its cost stays for the measured look when the wait is over)
+        if (self%sym_wait > 0) return
         self%sym_cost = -1.0_wp
         by_measure = .false.
         if (present(measured)) by_measure = measured .and. present(below)
@@ -130,7 +137,14 @@ contains
             self%sym_cost = -1.0_wp
             return
         end if
-        fits = .true.
+        ! (is it accurate here? its step has no error estimate: ropedyn_auto_probe)
+        call self%probe_symplectic(tab%kind, h, fits, text)
+        if (.not. fits) then
+            why = 'the symplectic method would be used (the fast modes are lightly damped), '// &
+                  'but '//trim(text)
+            self%why_warns = .false.
+            return
+        end if
         self%sym_order = tab%order
         if (by_measure) then
             write (why, '(a, f4.2, a)') 'the fast modes are lightly damped and the '// &
@@ -143,6 +157,7 @@ contains
                 'stays bounded (', cost_s/cost_e, ' times erk''s predicted cost; '// &
                 trim(tab%label)//')'
         end if
+        if (len_trim(text) > 0) why = trim(why)//'; '//trim(text)
     end procedure symplectic_fits
 
     !> The width of the implicit methods' Newton matrix (the reduced second-order one when
@@ -182,9 +197,8 @@ contains
         integer :: status
         h = 0.0_wp
         if (h_probe <= 0.0_wp) return
-        w = options%rtol*abs(y) + options%atol
-        if (allocated(options%atol_vector)) w = options%rtol*abs(y) + options%atol_vector
-        allocate (f0(size(y)), f1(size(y)))
+        allocate (w(size(y)), f0(size(y)), f1(size(y)))
+        w = error_weights(options, y)
         call problem%rhs(t, y, f0, status)
         if (status /= STATUS_OK) return
         call problem%rhs(t + h_probe, y + h_probe*f0, f1, status)

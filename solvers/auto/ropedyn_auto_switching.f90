@@ -112,8 +112,11 @@
 !!   against the predicted one (input/hard/light_damping.nml, n = 30, rtol 1e-6, 10 s:
 !!   erk held by accuracy at 1.4e5 f per second, the symplectic method 0.41 of that;
 !!   auto 0.9 s CPU before, 0.27 s after, its tip over 2 s 2.5e-8 m from cvode at rtol
-!!   1e-10 against 6.7e-8 before). It keeps it unless its step gets too short (START_RATE:
-!!   then the implicit method); its own log of the step joins the switch log.
+!!   1e-10 against 6.7e-8 before). Whichever way auto comes to it, the method must first
+!!   pass a probe of its error from the state reached (ropedyn_auto_probe: 400 steps at its
+!!   step and at half of it, at most 20 tolerances; a support shaken at 20 Hz fails it).
+!!   It keeps it unless its step gets too short (START_RATE: then the implicit method; no
+!!   second probe, see ropedyn_auto_probe); its own log of the step joins the switch log.
 submodule (ropedyn_auto) ropedyn_auto_switching
     implicit none
 
@@ -129,7 +132,7 @@ contains
         logical :: early    !< erk's early first window (early_look)
         character(len=240) :: text
         character(len=12) :: age
-        character(len=400) :: why_sym
+        character(len=640) :: why_sym
 
         now = self%current_stats()
         if (self%active == SYMPLECTIC) then
@@ -156,6 +159,7 @@ contains
         self%win_steps0 = now%steps
         self%win_cost0 = self%cost(now)
         if (self%wait > 0) self%wait = self%wait - 1
+        if (self%sym_wait > 0) self%sym_wait = self%sym_wait - 1
 
         if (self%active == EXPLICIT) then
             self%rate_explicit = rate
@@ -304,7 +308,7 @@ contains
                 else
                     call self%start_method(EXPLICIT, trim(text), err, h_e)
                     if (.not. allocated(err) .and. len_trim(why_sym) > 0) &
-                        call self%add_warning(trim(why_sym))
+                        call self%add_note(trim(why_sym), self%why_warns)
                 end if
             end if
         end if
@@ -316,14 +320,14 @@ contains
         !! assumes (input/hard/light_damping.nml: erk 1.63 s, the symplectic method 0.27 s).
         subroutine try_symplectic()
             if (self%windows < 2 .or. .not. (self%sym_cost > 0.0_wp)) return
-            if (GAIN*self%sym_cost >= rate) return
+            if (GAIN*self%sym_cost >= rate .or. self%sym_wait > 0) return
             call estimate_spectrum(self%problem, self%t, self%y, spec)
             h_e = erk_stable_step(self%tab, spec)
             if (self%symplectic_fits(spec, h_e, self%t, why_sym, rate/GAIN, .true.)) then
                 write (text, '(a, es9.2, a)') 'erk''s cost ', rate, ' f per second'
                 call self%start_method(SYMPLECTIC, trim(text)//'; '//trim(why_sym), err)
             else if (len_trim(why_sym) > 0) then
-                call self%add_warning(trim(why_sym))
+                call self%add_note(trim(why_sym), self%why_warns)
             end if
         end subroutine try_symplectic
 

@@ -13,6 +13,9 @@ ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
 PAPER = ROOT / "input" / "paper.nml"
 STEEL = ROOT / "input" / "hard" / "steel_wire.nml"
 LIGHT = ROOT / "input" / "hard" / "light_damping.nml"
+SHAKEN = ROOT / "input" / "hard" / "shaken_support.nml"
+#: the light damping of input/hard/light_damping.nml (N s/m^2)
+LIGHT_DAMPING = ("rope.normal_damping=0.1", "rope.tangential_damping=0.04")
 #: the paper rope's m g L (J): 6000 kg/m3, 5 mm diameter, 1 m
 MGL = 6000 * np.pi * 0.005 ** 2 / 4 * 9.81
 
@@ -142,6 +145,50 @@ def test_auto_goes_symplectic_where_erk_costs_more_than_predicted(run, tmp_path)
     # the whole run, erk's start included, against erk's measured rate
     assert evals / 6.0 < erk_rate, (evals, erk_rate)
     assert np.max(np.abs(balance - balance[0])) < 10 * 1e-6 * MGL
+
+
+def rope_distance(a, b, span):
+    """The largest distance (m) between the rope points of two runs' records up to `span`
+    seconds (open h5py files with the same output times)."""
+    k = int(np.searchsorted(a["/time"][()], span + 1e-9))
+    assert np.allclose(a["/time"][:k], b["/time"][:k])
+    return float(np.max(np.linalg.norm(a["/rope/points"][:k] - b["/rope/points"][:k],
+                                       axis=-1)))
+
+
+def test_auto_probes_the_symplectic_method_before_taking_it(run, tmp_path):
+    """The shaken support of input/hard with light damping, over 6 s: erk's steps are held
+    by accuracy and its measured cost is higher than the symplectic method's, but the fixed
+    step does not follow the 20 Hz shaking: the probe (the method's error over 400 steps,
+    estimated by halving the step) finds more than sqrt(400) = 20 tolerances, and auto keeps
+    erk and says why. Over the first 0.5 s auto's rope is then more than 5 times closer to
+    cvode at rtol 1e-10 than the symplectic method's (measured: 20 times)."""
+    common = ["solver.output_interval=0.01", *LIGHT_DAMPING]
+    proc, out = run_scene(run, tmp_path, SHAKEN, "auto", "solver.t_end=6", *common)
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods, times, _, reasons = switch_log(f)
+    refused = [k for k, r in enumerate(reasons) if "symplectic method would be used" in r]
+    assert refused, reasons
+    k = refused[0]
+    found = re.search(r"its error over 400 steps of +[0-9.E+-]+ s from t = +[0-9.E+-]+ s, "
+                      r"estimated by halving the step, is +([0-9.E+-]+) tolerances, more "
+                      r"than +20\.0", reasons[k])
+    assert found and float(found.group(1)) > 20, reasons[k]
+    assert "symplectic" not in methods[:k], methods
+    assert methods[k] == "erk" and times[k] < 0.5, (methods, times)
+    after = [t for m, t in zip(methods, times) if m == "symplectic"]
+    assert not after or min(after) > 0.5, (methods, times)
+    ref_proc, ref = run_scene(run, tmp_path, SHAKEN, "ref", "solver.method='cvode'",
+                              "solver.rtol=1e-10", "solver.atol=1e-12", "solver.t_end=0.5",
+                              *common)
+    assert ref_proc.returncode == 0, ref_proc.stderr
+    sym_proc, sym = run_scene(run, tmp_path, SHAKEN, "sym", "solver.method='symplectic'",
+                              "solver.t_end=0.5", *common)
+    assert sym_proc.returncode == 0, sym_proc.stderr
+    with h5py.File(ref, "r") as r, h5py.File(out, "r") as a, h5py.File(sym, "r") as s:
+        auto_error, sym_error = rope_distance(a, r, 0.5), rope_distance(s, r, 0.5)
+    assert 5 * auto_error < sym_error, (auto_error, sym_error)
 
 
 def test_the_default_budget_grows_with_the_run(run, tmp_path):
