@@ -1,5 +1,7 @@
 !> The switching rules of auto (ropedyn_auto): `watch`, at the end of each window of the
-!! method in use, on the counted costs of ropedyn_auto's header (Cost).
+!! method in use, on the counted costs of ropedyn_auto's header (Cost); one routine per
+!! method in use (explicit_window, accurate_window, implicit_window) and the helpers they
+!! share.
 !!
 !! - **Looks**: the method in use runs in chunks of about WINDOW/4 of its last step, each
 !!   cut at the next output time, and `watch` runs after each. Before a method's first
@@ -60,7 +62,8 @@
 !!   a short stretch decided a whole run: on the Bergdahl chain's MPP at atol 1e-8, Adams
 !!   tried for 0.02 s at 1.1 s (in the ramp's first cycle) was dearer, and erk ran to the
 !!   end with 2.1e6 evaluations of f in 24 s, against 0.54e6 for a neighbouring case that
-!!   kept Adams (316 s of CPU against 84); mpp_undamped tries it again at 2.5 s. From Adams it goes back to erk when erk's last measured cost is lower
+!!   kept Adams (316 s of CPU against 84); mpp_undamped tries it again at 2.5 s. From
+!!   Adams it goes back to erk when erk's last measured cost is lower
 !!   by GAIN in two windows in a row (snap_load_mpp: Adams measured once at 6.6e4 f/s in the
 !!   window of the snap sent auto back to erk, whose cost of 4.5e4 measured before the
 !!   snap then kept Adams out for the remaining 9 s: 1.36 s CPU against Adams' 0.82);
@@ -122,17 +125,13 @@ submodule (ropedyn_auto) ropedyn_auto_switching
 
 contains
 
-    !> At the end of a window: measure, compare, switch.
+    !> At the end of a window: measure, compare, switch (the header; one routine per kind
+    !! of method in use below).
     module procedure watch
         type(solver_stats_t) :: now
-        type(spectrum_t) :: spec
-        real(wp) :: rate, span, h_e, predicted, share
-        logical :: dearer   !< Adams' window cost more than erk's last by GAIN
-        logical :: stale    !< the implicit or accuracy method's measured cost is old
+        real(wp) :: rate, span
         logical :: early    !< erk's early first window (early_look)
         character(len=240) :: text
-        character(len=12) :: age
-        character(len=640) :: why_sym
 
         now = self%current_stats()
         if (self%active == SYMPLECTIC) then
@@ -148,7 +147,7 @@ contains
         end if
         early = .false.
         if (now%steps - self%win_steps0 < WINDOW) then
-            early = early_look()
+            early = early_look(self, now)
             if (.not. early) return
         end if
         span = self%t - self%win_t0
@@ -162,223 +161,289 @@ contains
         if (self%sym_wait > 0) self%sym_wait = self%sym_wait - 1
 
         if (self%active == EXPLICIT) then
-            self%rate_explicit = rate
-            if (self%rate_implicit > 0.0_wp) self%implicit_age = self%implicit_age + 1
-            if (self%rate_accurate > 0.0_wp) self%accurate_age = self%accurate_age + 1
-            call try_symplectic()
-            if (self%active /= EXPLICIT .or. allocated(err)) return
-            if (early) then
-                share = self%erk%stiff_share_of_steps(EARLY_WINDOW)
-            else
-                share = self%erk%stiff_share_of_steps()
-            end if
-            if (self%wait > 0) return
-            if (share < 0.5_wp) then
-                ! held by accuracy: the accuracy method may need fewer evaluations of f
-                ! (judged on the explicit method's second window on: the first includes its
-                ! start)
-                if (self%windows < 2) return
-                ! its measured cost is evidence for accurate_stale_after windows: a trial
-                ! in a short stretch of the start (the MPP's Adams, 0.02 s at 1.1 s of
-                ! the Bergdahl chain) must not keep it out of a long run
-                stale = self%rate_accurate > 0.0_wp .and. &
-                        self%accurate_age >= self%accurate_stale_after
-                if (self%rate_accurate > 0.0_wp .and. GAIN*self%rate_accurate >= rate .and. &
-                    .not. stale) return
-                write (text, '(a, i0, a, es9.2, a)') 'explicit step held by accuracy (', &
-                    nint(100*(1 - share)), ' % of the steps; cost ', rate, ' f per second)'
-                self%trial = self%rate_accurate <= 0.0_wp .or. stale
-                call add_trial(self%accurate_name(), stale, self%accurate_age)
-                if (self%windows <= 2) call back_off()
-                call self%start_method(self%accurate, trim(text), err)
+            call explicit_window(self, rate, early, err)
+        else if (self%active == self%accurate) then
+            call accurate_window(self, rate, err)
+        else
+            call implicit_window(self, rate, err)
+        end if
+    end procedure watch
+
+    !> A window of erk's order-4 pair that cost `rate` (f per simulated second; `early`:
+    !! the early first look): to the symplectic method, the accuracy method or the
+    !! implicit one when it pays (the header, Switching).
+    subroutine explicit_window(self, rate, early, err)
+        class(auto_t), intent(inout) :: self
+        real(wp), intent(in) :: rate
+        logical, intent(in) :: early
+        type(error_t), allocatable, intent(out) :: err
+        real(wp) :: share
+        logical :: stale    !< the implicit or accuracy method's measured cost is old
+        character(len=240) :: text
+        self%rate_explicit = rate
+        if (self%rate_implicit > 0.0_wp) self%implicit_age = self%implicit_age + 1
+        if (self%rate_accurate > 0.0_wp) self%accurate_age = self%accurate_age + 1
+        call try_symplectic(self, rate, err)
+        if (self%active /= EXPLICIT .or. allocated(err)) return
+        if (early) then
+            share = self%erk%stiff_share_of_steps(EARLY_WINDOW)
+        else
+            share = self%erk%stiff_share_of_steps()
+        end if
+        if (self%wait > 0) return
+        if (share < 0.5_wp) then
+            ! held by accuracy: the accuracy method may need fewer evaluations of f
+            ! (judged on the explicit method's second window on: the first includes its
+            ! start)
+            if (self%windows < 2) return
+            ! its measured cost is evidence for accurate_stale_after windows: a trial
+            ! in a short stretch of the start (the MPP's Adams, 0.02 s at 1.1 s of
+            ! the Bergdahl chain) must not keep it out of a long run
+            stale = self%rate_accurate > 0.0_wp .and. &
+                    self%accurate_age >= self%accurate_stale_after
+            if (self%rate_accurate > 0.0_wp .and. GAIN*self%rate_accurate >= rate .and. &
+                .not. stale) return
+            write (text, '(a, i0, a, es9.2, a)') 'explicit step held by accuracy (', &
+                nint(100*(1 - share)), ' % of the steps; cost ', rate, ' f per second)'
+            self%trial = self%rate_accurate <= 0.0_wp .or. stale
+            call add_trial(self, text, self%accurate_name(), stale, self%accurate_age)
+            if (self%windows <= 2) call back_off(self)
+            call self%start_method(self%accurate, trim(text), err)
+            return
+        end if
+        stale = self%rate_implicit > 0.0_wp .and. self%implicit_age >= self%stale_after &
+                .and. self%trials_are_cheap()
+        if (self%rate_implicit > 0.0_wp .and. GAIN*self%rate_implicit >= rate .and. &
+            .not. stale) return
+        write (text, '(a, i0, a, es9.2, a, es9.2, a)') 'explicit step held by stability (', &
+            nint(100*share), ' % of the steps; spectral radius about ', &
+            max(self%erk%spectral_radius(), self%radius), ' 1/s; cost ', rate, &
+            ' f per second)'
+        self%trial = self%rate_implicit <= 0.0_wp .or. stale
+        call add_trial(self, text, self%implicit_name(), stale, self%implicit_age)
+        if (self%windows <= 2) call back_off(self)
+        call self%start_method(IMPLICIT, trim(text), err)
+    end subroutine explicit_window
+
+    !> A window of the accuracy method (Adams or the order-5 pair) that cost `rate`: kept,
+    !! or back to erk when erk is cheaper (the header, Adams and the order-5 pair).
+    subroutine accurate_window(self, rate, err)
+        class(auto_t), intent(inout) :: self
+        real(wp), intent(in) :: rate
+        type(error_t), allocatable, intent(out) :: err
+        logical :: dearer   !< its window cost more than erk's last by GAIN
+        character(len=240) :: text
+        if (self%active == HIGH) then
+            call high_pair_looks(self, err)
+            if (self%active /= HIGH .or. allocated(err)) return
+        end if
+        if (self%windows < 2) return
+        self%rate_accurate = rate
+        self%accurate_age = 0
+        if (self%active == HIGH) then
+            call try_symplectic(self, rate, err)
+            if (self%active /= HIGH .or. allocated(err)) return
+        end if
+        if (self%trial) then
+            ! kept only when cheaper by GAIN: Adams' counted cost misses CVODE's fixed
+            ! work per step, which weighs most where f is cheap (the RFEM at small n);
+            ! the order-5 pair is not worth a switch for less either
+            self%trial = .false.
+            if (self%rate_explicit > 0.0_wp .and. GAIN*rate > self%rate_explicit) then
+                self%accurate_stale_after = grown(self, self%accurate_stale_after, rate)
+                call trial_failed(self, self%accurate_name()//' was not cheaper by 1.3', &
+                                  rate, err)
                 return
             end if
-            stale = self%rate_implicit > 0.0_wp .and. self%implicit_age >= self%stale_after &
-                    .and. self%trials_are_cheap()
-            if (self%rate_implicit > 0.0_wp .and. GAIN*self%rate_implicit >= rate .and. &
-                .not. stale) return
-            write (text, '(a, i0, a, es9.2, a, es9.2, a)') 'explicit step held by stability (', &
-                nint(100*share), ' % of the steps; spectral radius about ', &
-                max(self%erk%spectral_radius(), self%radius), ' 1/s; cost ', rate, &
-                ' f per second)'
-            self%trial = self%rate_implicit <= 0.0_wp .or. stale
-            call add_trial(self%implicit_name(), stale, self%implicit_age)
-            if (self%windows <= 2) call back_off()
-            call self%start_method(IMPLICIT, trim(text), err)
-        else if (self%active == self%accurate) then
-            if (self%active == HIGH) then
-                ! the order-5 pair held by stability: the order-4 pair's stable step is
-                ! longer per evaluation of f, and from it auto may try the implicit method
-                share = self%erk_high%stiff_share_of_steps()
-                ! (a switch that did not pay: the waits double, against a ping-pong where
-                ! both pairs step near their limits: steel_wire)
-                if (share >= 0.5_wp) then
-                    write (text, '(a, i0, a)') 'order-5 pair held by stability (', &
-                        nint(100*share), ' % of the steps)'
-                    call back_off()
-                    call self%start_method(EXPLICIT, trim(text), err)
-                    return
-                end if
-                ! the order-4 pair's cost is evidence for STALE_WINDOWS windows: the
-                ! motion changes (shaken_top: the order-5 pair pays in the first 0.03 s,
-                ! not over the run), so then it is measured again
-                if (self%windows >= 2) self%explicit_age = self%explicit_age + 1
-                if (self%explicit_age >= STALE_WINDOWS .and. self%wait == 0) then
-                    write (text, '(a, i0, a)') 'the order-4 pair''s cost was measured ', &
-                        self%explicit_age, ' windows ago: measuring it again'
-                    call self%start_method(EXPLICIT, trim(text), err)
-                    return
-                end if
-            end if
-            if (self%windows < 2) return
-            self%rate_accurate = rate
-            self%accurate_age = 0
-            if (self%active == HIGH) then
-                call try_symplectic()
-                if (self%active /= HIGH .or. allocated(err)) return
-            end if
-            if (self%trial) then
-                ! kept only when cheaper by GAIN: Adams' counted cost misses CVODE's fixed
-                ! work per step, which weighs most where f is cheap (the RFEM at small n);
-                ! the order-5 pair is not worth a switch for less either
-                self%trial = .false.
-                if (self%rate_explicit > 0.0_wp .and. GAIN*rate > self%rate_explicit) then
-                    self%accurate_stale_after = grown(self%accurate_stale_after)
-                    call trial_failed(self%accurate_name()//' was not cheaper by 1.3')
-                    return
-                end if
-            end if
-            dearer = self%rate_explicit > 0.0_wp .and. GAIN*self%rate_explicit < rate
-            if (.not. dearer) self%calm_accurate = rate
-            if (self%wait > 0) return
-            ! two windows in a row: one window of a transient (a snap) must not send auto
-            ! back to erk, whose cost, measured before, then keeps Adams out for the rest
-            ! of the run
-            if (dearer) then
-                self%dearer = self%dearer + 1
-            else
-                self%dearer = 0
-            end if
-            if (self%dearer >= 2) then
-                write (text, '(a, es9.2, a, es9.2, a)') 'erk was cheaper (', &
-                    self%rate_explicit, ' against ', rate, ' f per second for '// &
-                    self%accurate_name()//', two windows in a row)'
-                ! windows 2 and 3 are the earliest two that can send it back (the rate is
-                ! kept from window 2 on): leaving then undoes the switch at once
-                if (self%windows <= 3) call back_off()
-                ! Adams' cost in the stretch that sent it back (a contact) must not keep
-                ! it out once that stretch is over (whip_ground_mpp: 1.16e6 f per second
-                ! in a contact at 1.25 s against erk's 3.3e5 kept erk for the last 8.7 s,
-                ! 3.2 s CPU against Adams' 2.4): erk is weighed against Adams' cost in its
-                ! last window that was not dearer
-                if (self%calm_accurate > 0.0_wp) self%rate_accurate = self%calm_accurate
-                call self%start_method(EXPLICIT, trim(text), err)
-            end if
+        end if
+        dearer = self%rate_explicit > 0.0_wp .and. GAIN*self%rate_explicit < rate
+        if (.not. dearer) self%calm_accurate = rate
+        if (self%wait > 0) return
+        ! two windows in a row: one window of a transient (a snap) must not send auto
+        ! back to erk, whose cost, measured before, then keeps Adams out for the rest
+        ! of the run
+        if (dearer) then
+            self%dearer = self%dearer + 1
         else
-            ! judge the implicit method on its second window on (the first includes its
-            ! start at order 1 with small steps)
-            if (self%windows < 2) return
-            self%rate_implicit = rate
-            self%implicit_age = 0
-            if (self%trial) then
-                self%trial = .false.
-                if (self%rate_explicit > 0.0_wp .and. rate > self%rate_explicit) then
-                    ! the dearer the trial, the longer until the next: times the cost
-                    ! ratio rounded up, at least 2 (capped below integer overflow)
-                    self%stale_after = grown(self%stale_after)
-                    call trial_failed(self%implicit_name()//' was not cheaper')
-                    return
-                end if
-            end if
-            if (self%wait > 0) return
-            call estimate_spectrum(self%problem, self%t, self%y, spec)
-            h_e = erk_stable_step(self%tab, spec)
-            if (h_e <= 0.0_wp) return
-            if (self%accurate == HIGH) &
-                self%h_stable_high = erk_stable_step(self%tab_high, spec)
-            self%radius = spec%radius
-            predicted = EXPLICIT_MARGIN*self%tab%evals_per_step()/h_e
-            if (GAIN*predicted < rate) then
-                write (text, '(a, es9.2, a, es9.2, a, es9.2, a)') 'explicit stable step ', h_e, &
-                    ' s: predicted cost ', predicted, ' f per second against ', rate, &
-                    ' for '//self%implicit_name()
-                if (self%windows <= 2) call back_off()
-                if (self%symplectic_fits(spec, h_e, self%t, why_sym, rate/GAIN)) then
-                    call self%start_method(SYMPLECTIC, trim(text)//'; '//trim(why_sym), err)
-                else
-                    call self%start_method(EXPLICIT, trim(text), err, h_e)
-                    if (.not. allocated(err) .and. len_trim(why_sym) > 0) &
-                        call self%add_note(trim(why_sym), self%why_warns)
-                end if
+            self%dearer = 0
+        end if
+        if (self%dearer >= 2) then
+            write (text, '(a, es9.2, a, es9.2, a)') 'erk was cheaper (', &
+                self%rate_explicit, ' against ', rate, ' f per second for '// &
+                self%accurate_name()//', two windows in a row)'
+            ! windows 2 and 3 are the earliest two that can send it back (the rate is
+            ! kept from window 2 on): leaving then undoes the switch at once
+            if (self%windows <= 3) call back_off(self)
+            ! Adams' cost in the stretch that sent it back (a contact) must not keep
+            ! it out once that stretch is over (whip_ground_mpp: 1.16e6 f per second
+            ! in a contact at 1.25 s against erk's 3.3e5 kept erk for the last 8.7 s,
+            ! 3.2 s CPU against Adams' 2.4): erk is weighed against Adams' cost in its
+            ! last window that was not dearer
+            if (self%calm_accurate > 0.0_wp) self%rate_accurate = self%calm_accurate
+            call self%start_method(EXPLICIT, trim(text), err)
+        end if
+    end subroutine accurate_window
+
+    !> The order-5 pair's own looks before its cost is weighed: back to the order-4 pair
+    !! when its steps were held by stability, or when the order-4 pair's cost is stale.
+    subroutine high_pair_looks(self, err)
+        class(auto_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: err
+        real(wp) :: share
+        character(len=240) :: text
+        ! the order-5 pair held by stability: the order-4 pair's stable step is
+        ! longer per evaluation of f, and from it auto may try the implicit method
+        share = self%erk_high%stiff_share_of_steps()
+        ! (a switch that did not pay: the waits double, against a ping-pong where
+        ! both pairs step near their limits: steel_wire)
+        if (share >= 0.5_wp) then
+            write (text, '(a, i0, a)') 'order-5 pair held by stability (', &
+                nint(100*share), ' % of the steps)'
+            call back_off(self)
+            call self%start_method(EXPLICIT, trim(text), err)
+            return
+        end if
+        ! the order-4 pair's cost is evidence for STALE_WINDOWS windows: the
+        ! motion changes (shaken_top: the order-5 pair pays in the first 0.03 s,
+        ! not over the run), so then it is measured again
+        if (self%windows >= 2) self%explicit_age = self%explicit_age + 1
+        if (self%explicit_age >= STALE_WINDOWS .and. self%wait == 0) then
+            write (text, '(a, i0, a)') 'the order-4 pair''s cost was measured ', &
+                self%explicit_age, ' windows ago: measuring it again'
+            call self%start_method(EXPLICIT, trim(text), err)
+        end if
+    end subroutine high_pair_looks
+
+    !> A window of the implicit method that cost `rate`: judged on trial, and left for erk
+    !! (or the symplectic method) when erk's predicted cost is lower by GAIN.
+    subroutine implicit_window(self, rate, err)
+        class(auto_t), intent(inout) :: self
+        real(wp), intent(in) :: rate
+        type(error_t), allocatable, intent(out) :: err
+        type(spectrum_t) :: spec
+        real(wp) :: h_e, predicted
+        character(len=240) :: text
+        character(len=640) :: why_sym
+        ! judge the implicit method on its second window on (the first includes its
+        ! start at order 1 with small steps)
+        if (self%windows < 2) return
+        self%rate_implicit = rate
+        self%implicit_age = 0
+        if (self%trial) then
+            self%trial = .false.
+            if (self%rate_explicit > 0.0_wp .and. rate > self%rate_explicit) then
+                ! the dearer the trial, the longer until the next: times the cost
+                ! ratio rounded up, at least 2 (capped below integer overflow)
+                self%stale_after = grown(self, self%stale_after, rate)
+                call trial_failed(self, self%implicit_name()//' was not cheaper', rate, err)
+                return
             end if
         end if
-    contains
-        !> To the symplectic method when its cost (self%sym_cost, from its last look)
-        !! is below the measured cost `rate` of erk's window by GAIN and it still fits at
-        !! the state now (a new spectrum estimate, only then): a lightly damped rope whose
-        !! erk steps are held by accuracy, not by the stability that erk's predicted cost
-        !! assumes (input/hard/light_damping.nml: erk 1.63 s, the symplectic method 0.27 s).
-        subroutine try_symplectic()
-            if (self%windows < 2 .or. .not. (self%sym_cost > 0.0_wp)) return
-            if (GAIN*self%sym_cost >= rate .or. self%sym_wait > 0) return
-            call estimate_spectrum(self%problem, self%t, self%y, spec)
-            h_e = erk_stable_step(self%tab, spec)
-            if (self%symplectic_fits(spec, h_e, self%t, why_sym, rate/GAIN, .true.)) then
-                write (text, '(a, es9.2, a)') 'erk''s cost ', rate, ' f per second'
+        if (self%wait > 0) return
+        call estimate_spectrum(self%problem, self%t, self%y, spec)
+        h_e = erk_stable_step(self%tab, spec)
+        if (h_e <= 0.0_wp) return
+        if (self%accurate == HIGH) &
+            self%h_stable_high = erk_stable_step(self%tab_high, spec)
+        self%radius = spec%radius
+        predicted = EXPLICIT_MARGIN*self%tab%evals_per_step()/h_e
+        if (GAIN*predicted < rate) then
+            write (text, '(a, es9.2, a, es9.2, a, es9.2, a)') 'explicit stable step ', h_e, &
+                ' s: predicted cost ', predicted, ' f per second against ', rate, &
+                ' for '//self%implicit_name()
+            if (self%windows <= 2) call back_off(self)
+            if (self%symplectic_fits(spec, h_e, self%t, why_sym, rate/GAIN)) then
                 call self%start_method(SYMPLECTIC, trim(text)//'; '//trim(why_sym), err)
-            else if (len_trim(why_sym) > 0) then
-                call self%add_note(trim(why_sym), self%why_warns)
+            else
+                call self%start_method(EXPLICIT, trim(text), err, h_e)
+                if (.not. allocated(err) .and. len_trim(why_sym) > 0) &
+                    call self%add_note(trim(why_sym), self%why_warns)
             end if
-        end subroutine try_symplectic
+        end if
+    end subroutine implicit_window
 
-        !> Add to text what the switch tries: `what` on trial, or again when its cost,
-        !! measured `windows_ago` explicit windows ago, is stale.
-        subroutine add_trial(what, is_stale, windows_ago)
-            character(len=*), intent(in) :: what
-            logical, intent(in) :: is_stale
-            integer, intent(in) :: windows_ago
-            if (is_stale) then
-                write (age, '(i0)') windows_ago
-                text = trim(text)//': trying '//what//' again (its cost was measured '// &
-                       trim(age)//' windows ago)'
-            else if (self%trial) then
-                text = trim(text)//': trying '//what
-            end if
-        end subroutine add_trial
+    !> To the symplectic method when its cost (self%sym_cost, from its last look) is below
+    !! the measured cost `rate` of erk's window by GAIN and it still fits at the state now
+    !! (a new spectrum estimate, only then): a lightly damped rope whose erk steps are held
+    !! by accuracy, not by the stability that erk's predicted cost assumes
+    !! (input/hard/light_damping.nml: erk 1.63 s, the symplectic method 0.27 s).
+    subroutine try_symplectic(self, rate, err)
+        class(auto_t), intent(inout) :: self
+        real(wp), intent(in) :: rate
+        type(error_t), allocatable, intent(out) :: err
+        type(spectrum_t) :: spec
+        real(wp) :: h_e
+        character(len=240) :: text
+        character(len=640) :: why_sym
+        if (self%windows < 2 .or. .not. (self%sym_cost > 0.0_wp)) return
+        if (GAIN*self%sym_cost >= rate .or. self%sym_wait > 0) return
+        call estimate_spectrum(self%problem, self%t, self%y, spec)
+        h_e = erk_stable_step(self%tab, spec)
+        if (self%symplectic_fits(spec, h_e, self%t, why_sym, rate/GAIN, .true.)) then
+            write (text, '(a, es9.2, a)') 'erk''s cost ', rate, ' f per second'
+            call self%start_method(SYMPLECTIC, trim(text)//'; '//trim(why_sym), err)
+        else if (len_trim(why_sym) > 0) then
+            call self%add_note(trim(why_sym), self%why_warns)
+        end if
+    end subroutine try_symplectic
 
-        !> A stale-cost wait after a trial that cost `rate` against erk's: times the cost
-        !! ratio rounded up, at least 2 (capped below integer overflow).
-        integer function grown(windows)
-            integer, intent(in) :: windows
-            real(wp) :: growth
-            growth = max(2.0_wp, real(ceiling(min(rate/self%rate_explicit, 1.0e9_wp)), wp))
-            grown = int(min(0.5_wp*real(huge(0), wp), growth*windows))
-        end function grown
+    !> Add to text what the switch tries: `what` on trial, or again when its cost,
+    !! measured `windows_ago` explicit windows ago, is stale.
+    subroutine add_trial(self, text, what, is_stale, windows_ago)
+        class(auto_t), intent(in) :: self
+        character(len=*), intent(inout) :: text
+        character(len=*), intent(in) :: what
+        logical, intent(in) :: is_stale
+        integer, intent(in) :: windows_ago
+        if (is_stale) then
+            text = trim(text)//': trying '//what//' again (its cost was measured '// &
+                   int_text(windows_ago)//' windows ago)'
+        else if (self%trial) then
+            text = trim(text)//': trying '//what
+        end if
+    end subroutine add_trial
 
-        !> A switch soon after the last one: wait longer before the next.
-        subroutine back_off()
-            self%wait = self%backoff
-            self%backoff = min(MAX_WAIT, 2*self%backoff)
-        end subroutine back_off
+    !> A stale-cost wait after a trial that cost `rate` against erk's: `windows` times the
+    !! cost ratio rounded up, at least 2 (capped below integer overflow).
+    integer function grown(self, windows, rate)
+        class(auto_t), intent(in) :: self
+        integer, intent(in) :: windows
+        real(wp), intent(in) :: rate
+        real(wp) :: growth
+        growth = max(2.0_wp, real(ceiling(min(rate/self%rate_explicit, 1.0e9_wp)), wp))
+        grown = int(min(0.5_wp*real(huge(0), wp), growth*windows))
+    end function grown
 
-        !> The method on trial cost more than erk: back to erk, and wait longer.
-        subroutine trial_failed(what)
-            character(len=*), intent(in) :: what
-            write (text, '(a, es9.2, a, es9.2, a)') what//' (', rate, ' against ', &
-                self%rate_explicit, ' f per second)'
-            call back_off()
-            call self%start_method(EXPLICIT, trim(text), err)
-        end subroutine trial_failed
+    !> A switch soon after the last one: wait longer before the next.
+    subroutine back_off(self)
+        class(auto_t), intent(inout) :: self
+        self%wait = self%backoff
+        self%backoff = min(MAX_WAIT, 2*self%backoff)
+    end subroutine back_off
 
-        !> erk's first window since the start, nearly every step held by stability and
-        !! the implicit method not yet tried: no need to wait for WINDOW steps (drag_fall:
-        !! 400 steps take 0.38 of its 2 s, where mebdf needs 156 steps in all)
-        logical function early_look()
-            early_look = self%active == EXPLICIT .and. self%windows == 0 .and. &
-                         self%rate_implicit < 0.0_wp .and. self%trials_are_cheap() .and. &
-                         now%steps - self%win_steps0 >= EARLY_WINDOW
-            if (early_look) &
-                early_look = self%erk%stiff_share_of_steps(EARLY_WINDOW) >= EARLY_SHARE
-        end function early_look
-    end procedure watch
+    !> The method on trial (`what`) cost `rate`, more than erk: back to erk, and wait longer.
+    subroutine trial_failed(self, what, rate, err)
+        class(auto_t), intent(inout) :: self
+        character(len=*), intent(in) :: what
+        real(wp), intent(in) :: rate
+        type(error_t), allocatable, intent(out) :: err
+        character(len=240) :: text
+        write (text, '(a, es9.2, a, es9.2, a)') what//' (', rate, ' against ', &
+            self%rate_explicit, ' f per second)'
+        call back_off(self)
+        call self%start_method(EXPLICIT, trim(text), err)
+    end subroutine trial_failed
+
+    !> erk's first window since the start (its counters `now`), nearly every step held by
+    !! stability and the implicit method not yet tried: no need to wait for WINDOW steps
+    !! (drag_fall: 400 steps take 0.38 of its 2 s, where mebdf needs 156 steps in all)
+    logical function early_look(self, now)
+        class(auto_t), intent(in) :: self
+        type(solver_stats_t), intent(in) :: now
+        early_look = self%active == EXPLICIT .and. self%windows == 0 .and. &
+                     self%rate_implicit < 0.0_wp .and. self%trials_are_cheap() .and. &
+                     now%steps - self%win_steps0 >= EARLY_WINDOW
+        if (early_look) &
+            early_look = self%erk%stiff_share_of_steps(EARLY_WINDOW) >= EARLY_SHARE
+    end function early_look
 end submodule ropedyn_auto_switching
