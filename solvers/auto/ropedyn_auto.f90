@@ -62,7 +62,7 @@ module ropedyn_auto
     use ropedyn_band_lu, only: factored_dense
     use ropedyn_switch_log, only: switch_log_t, switch_event_t
     use ropedyn_symplectic, only: symplectic_t, choose_step
-    use ropedyn_split_tables, only: split_table_t, split_table
+    use ropedyn_split_tables, only: split_table_t
     implicit none
     private
     public :: auto_t
@@ -176,8 +176,6 @@ module ropedyn_auto
         !! the fast modes were lightly damped and only its cost against erk's predicted one
         !! kept it out (< 0: none): erk's measured cost may later show it cheaper
         real(wp) :: sym_cost = -1.0_wp
-        !> the why of symplectic_fits is a warning (the step budget), not a note (a probe)
-        logical :: why_warns = .true.
         !> the symplectic method's probe (ropedyn_auto_probe), with its own instance (the
         !! method's log stays that of its runs); windows of the other methods until auto
         !! may weigh the method again after a probe that failed, and how many the next
@@ -229,13 +227,16 @@ module ropedyn_auto
         end subroutine auto_start
 
         !> Whether the run goes symplectic, and why (submodule ropedyn_auto_start); when it
-        !! would but for the step budget, .false. with the warning to log in `why` (once).
-        module function symplectic_fits(self, spec, h_e, t0, why, below, measured) &
+        !! would but for the step budget, .false. with the warning to log in `why` (once,
+        !! `warns`); when its probe fails, .false. with a note in `why`.
+        module function symplectic_fits(self, spec, h_e, t0, why, warns, below, measured) &
             result(fits)
             class(auto_t), intent(inout) :: self
             type(spectrum_t), intent(in) :: spec
             real(wp), intent(in) :: h_e, t0
             character(len=*), intent(out) :: why
+            !> `why` is a warning (printed while the run goes on), not a note
+            logical, intent(out) :: warns
             !> a cost per simulated second (evaluations of f) the symplectic method must
             !! stay under (the implicit method's measured cost over GAIN, or erk's)
             real(wp), intent(in), optional :: below
@@ -247,12 +248,12 @@ module ropedyn_auto
 
         !> Whether the symplectic method is accurate enough to take, from the state now
         !! (submodule ropedyn_auto_probe): its error after PROBE_STEPS of its steps of
-        !! composition `kind` at the step h at most sqrt(PROBE_STEPS) tolerances; `text`
+        !! composition `tab` at the step h at most sqrt(PROBE_STEPS) tolerances; `text`
         !! says what the probe found. After a probe that fails, auto waits sym_wait windows
         !! before it weighs the method again.
-        module subroutine probe_symplectic(self, kind, h, passed, text)
+        module subroutine probe_symplectic(self, tab, h, passed, text)
             class(auto_t), intent(inout) :: self
-            integer, intent(in) :: kind
+            type(split_table_t), intent(in) :: tab
             real(wp), intent(in) :: h
             logical, intent(out) :: passed
             character(len=*), intent(out) :: text

@@ -44,7 +44,6 @@ contains
         integer :: kl, ku, p, n
         real(wp) :: t_end, e, limit
         logical :: done
-        type(split_table_t) :: tab
         passed = .true.
         text = ''
         t_end = min(self%options%t_end, self%t_stop)
@@ -60,7 +59,6 @@ contains
             write (text, '(a, i0, a, es9.2, a)') 'its probe of ', n, ' steps of ', h, &
                 ' s from here did not finish'
         else
-            tab = split_table(kind)
             p = tab%order
             if (self%problem%split_has_rest()) p = min(p, 2)
             call self%problem%second_order_layout(pos, vel, kl, ku)
@@ -103,7 +101,7 @@ contains
             t1 = self%t + real(steps, wp)*h
             call self%sym_probe%init(self%problem, self%t, y, yq, opts, err)
             if (.not. allocated(err)) then
-                call self%sym_probe%fix_step(kind, h)
+                call self%sym_probe%fix_step(tab%kind, h)
                 call self%sym_probe%advance_to(t1, t, y, yq, err)
                 used = self%sym_probe%stats()
                 self%done%rhs_evals = self%done%rhs_evals + used%rhs_evals

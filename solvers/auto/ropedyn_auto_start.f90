@@ -11,6 +11,7 @@ contains
         character(len=280) :: text
         character(len=100) :: slow
         character(len=640) :: why_sym
+        logical :: warns    !< why_sym is a warning (symplectic_fits)
 
         self%user_order = start%max_order
         self%y = start%y0
@@ -63,7 +64,7 @@ contains
             h_a = accuracy_step(self%problem, start%t0, start%y0, self%options, h_e)
         if (rate > START_RATE) then
             call self%start_method(IMPLICIT, trim(text)//': explicit steps too short', err)
-        else if (self%symplectic_fits(spec, h_e, start%t0, why_sym)) then
+        else if (self%symplectic_fits(spec, h_e, start%t0, why_sym, warns)) then
             ! (before the slow start's test: a lightly damped rope released from rest is
             ! slow only at first, and its long run is the symplectic method's)
             call self%start_method(SYMPLECTIC, trim(text)//'; '//trim(why_sym), err)
@@ -76,7 +77,7 @@ contains
         end if
         if (allocated(err)) return
         if (self%active /= SYMPLECTIC .and. len_trim(why_sym) > 0) &
-            call self%add_note(trim(why_sym), self%why_warns)
+            call self%add_note(trim(why_sym), warns)
         self%initialized = .true.
     end procedure auto_start
 
@@ -88,7 +89,7 @@ contains
     !! (evaluations per step over the stable step h_e, with EXPLICIT_MARGIN), and under
     !! `below` when given; with `measured`, `below` is erk's measured cost over GAIN and
     !! replaces the limit against the predicted one; last, its probe (ropedyn_auto_probe)
-    !! must pass. `why`: the reason for the log (a warning when self%why_warns). Where
+    !! must pass. `why`: the reason for the log (a warning when `warns`). Where
     !! the method is offered and lightly damped but left out, its cost stays in
     !! self%sym_cost for the measured look (watch); else that is -1. While a failed
     !! probe's wait lasts (sym_wait), it is not weighed at all.
@@ -102,7 +103,7 @@ contains
         logical :: by_measure
         fits = .false.
         why = ''
-        self%why_warns = .true.
+        warns = .true.
         ! (after a probe that failed: its cost stays for the measured look when the wait is over)
         if (self%sym_wait > 0) return
         self%sym_cost = -1.0_wp
@@ -138,11 +139,11 @@ contains
             return
         end if
         ! (is it accurate here? its step has no error estimate: ropedyn_auto_probe)
-        call self%probe_symplectic(tab%kind, h, fits, text)
+        call self%probe_symplectic(tab, h, fits, text)
         if (.not. fits) then
             why = 'the symplectic method would be used (the fast modes are lightly damped), '// &
                   'but '//trim(text)
-            self%why_warns = .false.
+            warns = .false.
             return
         end if
         self%sym_order = tab%order

@@ -324,6 +324,7 @@ contains
         real(wp) :: h_e, predicted
         character(len=240) :: text
         character(len=640) :: why_sym
+        logical :: warns    !< why_sym is a warning (symplectic_fits)
         ! judge the implicit method on its second window on (the first includes its
         ! start at order 1 with small steps)
         if (self%windows < 2) return
@@ -352,12 +353,12 @@ contains
                 ' s: predicted cost ', predicted, ' f per second against ', rate, &
                 ' for '//self%implicit_name()
             if (self%windows <= 2) call back_off(self)
-            if (self%symplectic_fits(spec, h_e, self%t, why_sym, rate/GAIN)) then
+            if (self%symplectic_fits(spec, h_e, self%t, why_sym, warns, rate/GAIN)) then
                 call self%start_method(SYMPLECTIC, trim(text)//'; '//trim(why_sym), err)
             else
                 call self%start_method(EXPLICIT, trim(text), err, h_e)
                 if (.not. allocated(err) .and. len_trim(why_sym) > 0) &
-                    call self%add_note(trim(why_sym), self%why_warns)
+                    call self%add_note(trim(why_sym), warns)
             end if
         end if
     end subroutine implicit_window
@@ -375,15 +376,17 @@ contains
         real(wp) :: h_e
         character(len=240) :: text
         character(len=640) :: why_sym
+        logical :: warns    !< why_sym is a warning (symplectic_fits)
         if (self%windows < 2 .or. .not. (self%sym_cost > 0.0_wp)) return
         if (GAIN*self%sym_cost >= rate .or. self%sym_wait > 0) return
         call estimate_spectrum(self%problem, self%t, self%y, spec)
         h_e = erk_stable_step(self%tab, spec)
-        if (self%symplectic_fits(spec, h_e, self%t, why_sym, rate/GAIN, .true.)) then
+        if (self%symplectic_fits(spec, h_e, self%t, why_sym, warns, rate/GAIN, &
+                                 .true.)) then
             write (text, '(a, es9.2, a)') 'erk''s cost ', rate, ' f per second'
             call self%start_method(SYMPLECTIC, trim(text)//'; '//trim(why_sym), err)
         else if (len_trim(why_sym) > 0) then
-            call self%add_note(trim(why_sym), self%why_warns)
+            call self%add_note(trim(why_sym), warns)
         end if
     end subroutine try_symplectic
 
