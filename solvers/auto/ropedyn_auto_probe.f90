@@ -32,7 +32,7 @@
 !!   rtol 1e-3 after 60 s, long_rope after 7 s, whip with light damping at 1.6 s), but no
 !!   method follows the trajectory there; what such a run delivers is statistics, which
 !!   an adaptive method's energy drift biases and this method's bounded balance does not
-!!   (issue 44's reason for the method).
+!!   (docs/theory/symplectic.md, "Why").
 submodule (ropedyn_auto) ropedyn_auto_probe
     implicit none
 
