@@ -162,6 +162,7 @@ program test_symplectic
     call order_and_balance()
     call energy_spreads()
     call step_costs()
+    call step_follows_spectrum()
     call undamped_rope()
     call shaken_rope()
     call refusals()
@@ -423,6 +424,41 @@ contains
                                   'shaken rope: energy was dissipated')
         end if
     end subroutine shaken_rope
+
+    !> Over a long run the step follows the spectrum: an oscillator at about the paper
+    !! rope's spectral radius (4,000 1/s: some 300 steps per output, outputs 0.1 s apart)
+    !! whose w grows by 0.3 % every 6 outputs (so that the step shrinks at most estimates
+    !! of the spectrum) and then by 10 % at once, ends at a step no longer than the rule's
+    !! for its last w (0.35 of Chin's stable step) after more than the longest wait
+    !! between estimates (RESPECTRUM_MAX steps). For that the grid must stay on the
+    !! outputs: each change of the step refits it from the time of an output.
+    subroutine step_follows_spectrum()
+        type(oscillator_t), target :: osc
+        type(symplectic_t) :: integ
+        type(solver_options_t) :: options
+        type(error_t), allocatable :: err
+        type(split_table_t) :: tab
+        real(wp) :: y(2), yq(1), t, rule
+        character(len=120) :: label
+        integer :: k
+        osc%w = 4000.0_wp
+        y = [1.0_wp, 0.0_wp]
+        yq = 0.0_wp
+        options%rtol = 1.0e-3_wp
+        call integ%init(osc, 0.0_wp, y, yq, options, err)
+        do k = 1, 700
+            if (allocated(err)) exit
+            if (mod(k, 6) == 0 .and. k <= 300) osc%w = 1.003_wp*osc%w
+            if (k == 400) osc%w = 1.1_wp*osc%w
+            call integ%advance_to(0.1_wp*real(k, wp), t, y, yq, err)
+        end do
+        tab = split_table(TABLE_CHIN)
+        rule = 0.35_wp*tab%stable_hw(0.0_wp)/osc%w
+        write (label, '(a, es11.4, a, es11.4, a)') 'oscillator, w up 0.3 % 50 times, then '// &
+            '10 %: the last step', integ%step_size(), ' s, the rule''s', rule, ' s'
+        call suite%check_true(.not. allocated(err) .and. &
+                              integ%step_size() <= rule*(1.0_wp + 1.0e-9_wp), trim(label))
+    end subroutine step_follows_spectrum
 
     subroutine refusals()
         character(len=SET_LEN) :: sets(3)
