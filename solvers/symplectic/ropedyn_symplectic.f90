@@ -137,6 +137,9 @@ module ropedyn_symplectic
         real(wp) :: h_rule = 0.0_wp            !< the rule's step before fitting, s
         !> the run ended because its steps to t_end outnumber the budget left
         logical :: budget_short = .false.
+        !> an estimate of the spectrum found lightly damped fast modes (choose_step's
+        !! stay_light from then on)
+        logical :: light_seen = .false.
     contains
         procedure :: start => symplectic_start
         procedure :: advance_to => symplectic_advance_to
@@ -198,7 +201,8 @@ module ropedyn_symplectic
         !! limits the step is lightly damped (below LIGHT_DAMPING); `cost`: the step's work
         !! per simulated second, in evaluations of the potential's forces (step_cost over h);
         !! h = 0: no estimate.
-        module subroutine choose_step(spec, rtol, max_order, rest, tab, h, light, text, cost)
+        module subroutine choose_step(spec, rtol, max_order, rest, tab, h, light, text, cost, &
+                                      stay_light)
             type(spectrum_t), intent(in) :: spec
             real(wp), intent(in) :: rtol
             integer, intent(in) :: max_order
@@ -208,6 +212,11 @@ module ropedyn_symplectic
             logical, intent(out) :: light
             character(len=*), intent(out) :: text
             real(wp), intent(out), optional :: cost
+            !> an earlier estimate of this run found lightly damped fast modes: take them as
+            !! such again (the damping of the settled Ritz values varies from one estimate to
+            !! the next, and each change between Verlet and a 4th-order composition moves the
+            !! modified energy)
+            logical, intent(in), optional :: stay_light
         end subroutine choose_step
 
         !> The largest step (s) at which the composition `tab` is stable for every fast Ritz
@@ -321,6 +330,7 @@ contains
         self%respectrum = RESPECTRUM_STEPS
         self%fixed_h = 0.0_wp
         self%budget_short = .false.
+        self%light_seen = .false.
         self%tab = split_table(merge(TABLE_BM6, TABLE_VERLET, start%max_order >= 4))
         self%counters = solver_stats_t()
         call self%log%clear()

@@ -108,7 +108,8 @@ contains
         call estimate_spectrum(self%problem, self%t, self%y, spec)
         self%estimated_at = self%counters%steps
         call choose_step(spec, self%options%rtol, self%order_limit, self%rest, tab, h, light, &
-                         text)
+                         text, stay_light=self%light_seen)
+        self%light_seen = self%light_seen .or. light
         self%radius = spec%radius
         self%fast_damping = spec%fast_damping
     end subroutine stable_step_here
@@ -140,8 +141,10 @@ contains
             cand = split_table(kind)
             call split_stable_step(cand, spec, hs, zeta)
             if (hs <= 0.0_wp) return
-            ! the limiting mode, or any settled fast mode (their combinations)
+            ! the limiting mode, or any settled fast mode (their combinations); or found so
+            ! at an earlier estimate (stay_light)
             slight = zeta < LIGHT_DAMPING .or. spec%settled_damping() < LIGHT_DAMPING
+            if (present(stay_light)) slight = slight .or. stay_light
             if (slight .and. kind == TABLE_VERLET .and. max_order >= 4) cycle
             safety = cand%safety
             if (slight) safety = RESONANT_SAFETY

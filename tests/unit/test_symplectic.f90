@@ -362,6 +362,18 @@ contains
                               'potential: Blanes-Moan, got '//trim(tab%label))
         call suite%check_close(cost_rest*h, tab%evals + 2.3_wp, 1.0e-12_wp, 0.0_wp, &
                                'its cost per step: 6 evaluations and 2.3 of other work')
+        ! at rtol 1e-3 the damped mode takes Verlet at half its stable step; once an earlier
+        ! estimate found lightly damped fast modes, a 4th-order composition at 0.35 (the
+        ! shaken support flipped between the two at every estimate, its balance error 6e-4
+        ! m g L over 10 s against 1e-7 when it stays)
+        call choose_step(spec, 1.0e-3_wp, 4, .true., tab, h, light, text)
+        call suite%check_true(tab%kind == TABLE_VERLET .and. .not. light, 'damped fast '// &
+                              'modes, rtol 1e-3: Verlet, got '//trim(tab%label))
+        call choose_step(spec, 1.0e-3_wp, 4, .true., tab, h, light, text, stay_light=.true.)
+        call suite%check_true(tab%order == 4 .and. light .and. index(text, ' 0.35 x') > 0, &
+                              'the same after lightly damped fast modes were seen: a '// &
+                              '4th-order composition at 0.35 of its stable step, got '// &
+                              trim(tab%label)//': '//trim(text))
         call simulate([character(len=SET_LEN) :: 'model.elements = 4'], 0.02_wp, 0.01_wp, &
                       1.0e-3_wp, run, 'symplectic')
         call suite%check_true(run%model%split_has_rest(), 'the damped RFEM has forces '// &
