@@ -78,6 +78,8 @@ module ropedyn_auto
     !> the symplectic method's probe before auto takes it (ropedyn_auto_probe): its error
     !! over PROBE_STEPS of its steps
     integer, parameter :: PROBE_STEPS = 400
+    !> the length of a reason symplectic_fits gives for taking or refusing the method
+    integer, parameter :: WHY_LEN = 640
     integer, parameter :: ERK_ORDER = 4            !< the explicit pair (RK4, 3rd-order estimate)
     !> the explicit pair for stretches held by accuracy on problems without a mass matrix
     !! (Dormand-Prince 5(4))
@@ -209,6 +211,7 @@ module ropedyn_auto
         procedure, private :: start_method
         procedure, private :: watch
         procedure, private :: current_stats
+        procedure, private :: active_method
         procedure, private :: cost
         procedure, private :: implicit_name
         procedure, private :: accurate_name
@@ -537,26 +540,36 @@ contains
         end if
     end function cost
 
-    !> Counters of the segment in progress.
-    function current_stats(self) result(s)
-        class(auto_t), intent(in) :: self
-        type(solver_stats_t) :: s
+    !> The method of the segment in progress (null before the first).
+    function active_method(self) result(method)
+        class(auto_t), intent(in), target :: self
+        class(integrator_t), pointer :: method
+        method => null()
         select case (self%active)
         case (EXPLICIT)
-            s = self%erk%stats()
+            method => self%erk
         case (HIGH)
-            s = self%erk_high%stats()
+            method => self%erk_high
         case (ADAMS)
-            s = self%am%stats()
+            method => self%am
         case (SYMPLECTIC)
-            s = self%sym%stats()
+            method => self%sym
         case (IMPLICIT)
             if (self%use_bdf) then
-                s = self%bdf%stats()
+                method => self%bdf
             else
-                s = self%mebdf%stats()
+                method => self%mebdf
             end if
         end select
+    end function active_method
+
+    !> Counters of the segment in progress.
+    function current_stats(self) result(s)
+        class(auto_t), intent(in), target :: self
+        type(solver_stats_t) :: s
+        class(integrator_t), pointer :: method
+        method => self%active_method()
+        if (associated(method)) s = method%stats()
     end function current_stats
 
     !> total += part (counters; the last step and order are the part's, the reduced Newton
@@ -576,25 +589,19 @@ contains
         class(auto_t), intent(in) :: self
         real(wp), intent(in) :: t
         integer(i8) :: rest
-        select case (self%active)
-        case (EXPLICIT)
-            rest = self%erk%budget_shortfall(t)
-        case (HIGH)
-            rest = self%erk_high%budget_shortfall(t)
-        case (ADAMS)
-            rest = self%am%budget_shortfall(t)
-        case (SYMPLECTIC)
-            rest = self%sym%budget_shortfall(t)
-        case (IMPLICIT)
-            if (self%use_bdf) then
-                rest = self%bdf%budget_shortfall(t)
-            else
-                rest = self%mebdf%budget_shortfall(t)
-            end if
-        case default
-            rest = 0
-        end select
+        rest = active_shortfall(self, t)
     end function auto_budget_shortfall
+
+    !> auto_budget_shortfall's work (its binding's interface has no target for the pointer).
+    function active_shortfall(self, t) result(rest)
+        class(auto_t), intent(in), target :: self
+        real(wp), intent(in) :: t
+        integer(i8) :: rest
+        class(integrator_t), pointer :: method
+        rest = 0
+        method => self%active_method()
+        if (associated(method)) rest = method%budget_shortfall(t)
+    end function active_shortfall
 
     function auto_stats(self) result(stats)
         class(auto_t), intent(in) :: self

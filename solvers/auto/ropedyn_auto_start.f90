@@ -10,7 +10,7 @@ contains
         real(wp) :: h_e, h_a, rate
         character(len=280) :: text
         character(len=100) :: slow
-        character(len=640) :: why_sym
+        character(len=WHY_LEN) :: why_sym
         logical :: warns    !< why_sym is a warning (symplectic_fits)
 
         self%user_order = start%max_order

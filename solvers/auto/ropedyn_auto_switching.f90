@@ -323,7 +323,7 @@ contains
         type(spectrum_t) :: spec
         real(wp) :: h_e, predicted
         character(len=240) :: text
-        character(len=640) :: why_sym
+        character(len=WHY_LEN) :: why_sym
         logical :: warns    !< why_sym is a warning (symplectic_fits)
         ! judge the implicit method on its second window on (the first includes its
         ! start at order 1 with small steps)
@@ -375,7 +375,7 @@ contains
         type(spectrum_t) :: spec
         real(wp) :: h_e
         character(len=240) :: text
-        character(len=640) :: why_sym
+        character(len=WHY_LEN) :: why_sym
         logical :: warns    !< why_sym is a warning (symplectic_fits)
         if (self%windows < 2 .or. .not. (self%sym_cost > 0.0_wp)) return
         if (GAIN*self%sym_cost >= rate .or. self%sym_wait > 0) return
