@@ -113,6 +113,19 @@ def test_a_commit_listed_as_numbers_unchanged_does_not_count(tmp_path):
     assert rows["before"] == [with_page, second]
 
 
+def test_a_commit_listed_for_some_sections_counts_against_the_others(tmp_path):
+    """A line `HASH  sections=A,B  how` of docs/numbers-unchanged.txt: the commit does not
+    count against sections A and B, and counts against every other."""
+    second, with_page, later = _repo(tmp_path)
+    (tmp_path / "docs" / "numbers-unchanged.txt").write_text(
+        f"{later}  sections=run,after  the runs of run and after take the same steps\n")
+    rows = {r["name"]: [c[0] for c in r["commits"]] for r in docs_status.status(tmp_path)
+            if r["commits"] is not None}
+    assert rows["run"] == []
+    assert later not in rows["after"]
+    assert rows["before"] == [later, with_page, second]
+
+
 def test_a_bad_line_in_numbers_unchanged_is_named(tmp_path):
     """A line of docs/numbers-unchanged.txt that names no commit: an error naming the file,
     the line and the word (not git's traceback)."""

@@ -15,7 +15,9 @@ study has not been run on the code as it is, and its page should say why not or 
 its script. A commit that changes code but, checked, none of the results (a refactoring, a
 comment) says so with a line `Numbers-unchanged: how it was checked` in its message, or,
 once committed, with a line `HASH  how it was checked` in docs/numbers-unchanged.txt; it is
-not counted.
+not counted. A line `HASH  sections=NAME,NAME  how it was checked` there keeps it from
+counting against those sections only (a change that alters some studies' runs, checked
+not to reach the others').
 
     scripts/docs_status            # every section, oldest first
     scripts/docs_status --stale    # only those with code commits since their run
@@ -101,28 +103,39 @@ def _git_text(root, *args):
 
 
 def unchanged_commits(root):
-    """The full hashes of the commits listed in root/UNCHANGED_FILE (comments: #); a line
-    whose first word git knows as no commit is an error naming the file, line and word."""
+    """{full hash: the sections it does not count against (None: every one)} of the commits
+    listed in root/UNCHANGED_FILE (comments: #; a second word `sections=A,B` names them); a
+    line whose first word git knows as no commit is an error naming the file, line and
+    word."""
     path = pathlib.Path(root) / UNCHANGED_FILE
     if not path.exists():
-        return set()
-    full = set()
+        return {}
+    full = {}
     for number, line in enumerate(path.read_text().splitlines(), start=1):
-        line = line.split("#", 1)[0].strip()
-        if not line:
+        words = line.split("#", 1)[0].split()
+        if not words:
             continue
-        rev = line.split()[0]
+        rev = words[0]
         try:
-            full.add(_git_text(root, "rev-parse", "--verify", "--quiet", rev + "^{commit}"))
+            key = _git_text(root, "rev-parse", "--verify", "--quiet", rev + "^{commit}")
         except subprocess.CalledProcessError:
             raise SystemExit(f"docs_status: {path}: line {number}: '{rev}' is not a commit")
+        names = None
+        if len(words) > 1 and words[1].startswith("sections="):
+            names = set(words[1][len("sections="):].split(","))
+        if key in full and (full[key] is None or names is None):
+            full[key] = None
+        else:
+            full[key] = names if key not in full else full[key] | names
     return full
 
 
-def code_commits(root, since, paths, commit=None, skip=frozenset()):
+def code_commits(root, since, paths, commit=None, skip=None, section=None):
     """[(short hash, ISO date, subject)] of the commits that changed `paths` after the time
     `since` (or, given `commit`, after that commit), newest first; not those whose message
-    has a line starting with UNCHANGED, nor those in `skip` (full hashes)."""
+    has a line starting with UNCHANGED, nor those `skip` (unchanged_commits) lists for
+    every section or for `section`."""
+    skip = skip or {}
     cmd = ["log", "-z", "--format=%H%x09%h%x09%cI%x09%s%x09%b"]
     if commit:
         cmd.append(f"{commit}..HEAD")
@@ -136,7 +149,9 @@ def code_commits(root, since, paths, commit=None, skip=frozenset()):
         if not record.strip():
             continue
         full, rev, date, subject, body = record.strip("\n").split("\t", 4)
-        if full in skip or any(line.startswith(UNCHANGED) for line in body.splitlines()):
+        if full in skip and (skip[full] is None or section in skip[full]):
+            continue
+        if any(line.startswith(UNCHANGED) for line in body.splitlines()):
             continue
         commits.append((rev, date, subject))
     return commits
@@ -167,7 +182,7 @@ def status(root=ROOT):
                 commit = written[-1] if written else None
             if stamp or commit:
                 when = run_time(stamp) if stamp else None
-                commits = code_commits(root, when, paths, commit, skip)
+                commits = code_commits(root, when, paths, commit, skip, name)
             rows.append({"page": str(page.relative_to(root)), "name": name, "script": script,
                          "stamp": stamp, "commits": commits})
     return rows
