@@ -92,3 +92,13 @@ def test_the_guide_takes_the_symplectic_bound_from_the_energy_page(tmp_path):
     assert acc.symplectic_bound(page) is None
     bound = acc.symplectic_bound()      # the real page
     assert bound and f"within {bound} m g L" in acc.long_runs()
+
+
+def test_the_long_runs_item_counts_the_symplectic_ensembles():
+    """The guide's long-runs item says at how many tolerances the symplectic method's chaos
+    statistic reproduces the tightest ensemble, from the chaos study's rows."""
+    row = lambda method, rtol, mean: {"method": method, "rtol": str(rtol), "starts": "8",
+                                      "mean": str(mean), "spread": "1e-4", "cpu": "1"}
+    rows = [row("cvode", 1e-8, 3.0e-3), row("symplectic", 1e-3, 3.01e-3),
+            row("symplectic", 1e-5, 3.5e-3), row("symplectic", 1e-7, 2.99e-3)]
+    assert "at 2 of 3 tolerances" in acc.long_runs(rows)
