@@ -126,6 +126,19 @@ def test_a_commit_listed_for_some_sections_counts_against_the_others(tmp_path):
     assert rows["before"] == [later, with_page, second]
 
 
+def test_a_section_no_page_has_is_named(tmp_path):
+    """A `sections=` word of docs/numbers-unchanged.txt naming a section that no page of
+    docs/ has (a typo would keep the commit counting without a word): an error naming the
+    file, the line and the section."""
+    _, _, later = _repo(tmp_path)
+    (tmp_path / "docs" / "numbers-unchanged.txt").write_text(
+        f"# commit  how checked\n{later}  sections=run,aftre  checked\n")
+    with pytest.raises(SystemExit) as stop:
+        docs_status.status(tmp_path)
+    assert "numbers-unchanged.txt: line 2: section 'aftre' is in no page of docs/" in \
+        str(stop.value)
+
+
 def test_a_bad_line_in_numbers_unchanged_is_named(tmp_path):
     """A line of docs/numbers-unchanged.txt that names no commit: an error naming the file,
     the line and the word (not git's traceback)."""

@@ -102,10 +102,11 @@ def _git_text(root, *args):
     return git(*args, root=root).decode().strip()
 
 
-def unchanged_commits(root):
+def unchanged_commits(root, known=None):
     """{full hash: the sections it does not count against (None: every one)} of the commits
     listed in root/UNCHANGED_FILE (comments: #; a second word `sections=A,B` names them); a
-    line whose first word git knows as no commit is an error naming the file, line and
+    line whose first word git knows as no commit, or (given `known`, the section names of
+    docs/) that names a section not among them, is an error naming the file, line and
     word."""
     path = pathlib.Path(root) / UNCHANGED_FILE
     if not path.exists():
@@ -123,10 +124,13 @@ def unchanged_commits(root):
         names = None
         if len(words) > 1 and words[1].startswith("sections="):
             names = set(words[1][len("sections="):].split(","))
-        if key in full and (full[key] is None or names is None):
-            full[key] = None
-        else:
-            full[key] = names if key not in full else full[key] | names
+            unknown = sorted(names - set(known)) if known is not None else []
+            if unknown:
+                raise SystemExit(f"docs_status: {path}: line {number}: section "
+                                 f"'{unknown[0]}' is in no page of docs/")
+        # a commit listed again: the union of its sections (every one if either line says so)
+        before = full.get(key, set())
+        full[key] = None if names is None or before is None else before | names
     return full
 
 
@@ -161,10 +165,11 @@ def status(root=ROOT):
     """One row per generated section of root/docs/**/*.md: dict(page, name, script, stamp,
     commits); commits None when the section names no run time."""
     root = pathlib.Path(root)
-    skip = unchanged_commits(root)
+    pages = {page: sections(page) for page in sorted((root / "docs").rglob("*.md"))}
+    skip = unchanged_commits(root, {s[0] for found in pages.values() for s in found})
     rows = []
-    for page in sorted((root / "docs").rglob("*.md")):
-        for name, script, stamp, commit in sections(page):
+    for page, found in pages.items():
+        for name, script, stamp, commit in found:
             if script in CHECKED_BY_TESTS:
                 continue
             paths = list(NARROWER.get(script, CODE_PATHS))
