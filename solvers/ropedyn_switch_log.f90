@@ -6,7 +6,7 @@ module ropedyn_switch_log
     use ropedyn_kinds, only: wp
     implicit none
     private
-    public :: switch_event_t, switch_log_t
+    public :: switch_event_t, switch_log_t, merged_events
 
     !> One change: from time t on, `method` runs with order limit `max_order`.
     type :: switch_event_t
@@ -65,6 +65,35 @@ contains
             events = self%events(1:self%count)
         end if
     end function log_items
+
+    !> The events of two logs, each oldest first, as one in time order: auto's switches (a)
+    !! and the events of a method it ran (b). At the same time a's event comes first when it
+    !! names the same method (auto's switch to it, then the method's own start), else b's
+    !! (the method's last event, then auto's switch away from it).
+    function merged_events(a, b) result(events)
+        type(switch_event_t), intent(in) :: a(:), b(:)
+        type(switch_event_t), allocatable :: events(:)
+        integer :: i, j, k
+        allocate (events(size(a) + size(b)))
+        i = 1
+        j = 1
+        do k = 1, size(events)
+            if (j > size(b)) then
+                events(k) = a(i)
+                i = i + 1
+            else if (i > size(a)) then
+                events(k) = b(j)
+                j = j + 1
+            else if (b(j)%t < a(i)%t .or. (b(j)%t == a(i)%t .and. &
+                                            a(i)%method /= b(j)%method)) then
+                events(k) = b(j)
+                j = j + 1
+            else
+                events(k) = a(i)
+                i = i + 1
+            end if
+        end do
+    end function merged_events
 
     subroutine log_clear(self)
         class(switch_log_t), intent(inout) :: self

@@ -60,7 +60,7 @@ module ropedyn_auto
     use ropedyn_erk_tables, only: erk_table_t, erk_table
     use ropedyn_spectrum, only: spectrum_t, estimate_spectrum, erk_stable_step
     use ropedyn_band_lu, only: factored_dense
-    use ropedyn_switch_log, only: switch_log_t, switch_event_t
+    use ropedyn_switch_log, only: switch_log_t, switch_event_t, merged_events
     use ropedyn_symplectic, only: symplectic_t, choose_step
     use ropedyn_split_tables, only: split_table_t
     implicit none
@@ -185,6 +185,9 @@ module ropedyn_auto
         type(symplectic_t) :: sym_probe
         integer :: sym_wait = 0
         integer :: sym_backoff = STALE_WINDOWS
+        !> the symplectic method stopped during this run (its step budget, a step too short
+        !! or unstable): not weighed again
+        logical :: sym_barred = .false.
         !> the Newton matrix's width over the RFEM's (>= 1), and the cost of one MEBDF
         !! evaluation of f in evaluations of the explicit f (see Cost)
         real(wp) :: lambda = 1.0_wp
@@ -293,12 +296,13 @@ contains
         end select
     end subroutine auto_rhs_changed
 
-    !> auto's switches, then the symplectic method's own choices of its step, when it ran.
+    !> auto's switches and, when it ran, the symplectic method's own choices of its step,
+    !! in time order.
     function auto_switch_log(self) result(events)
         class(auto_t), intent(in) :: self
         type(switch_event_t), allocatable :: events(:)
         events = self%log%items()
-        if (self%sym_order > 0) events = [events, self%sym%switch_log()]
+        if (self%sym_order > 0) events = merged_events(events, self%sym%switch_log())
     end function auto_switch_log
 
     !> Initialize `which` at the current state (self%t, y, yq); log the switch.
@@ -435,6 +439,13 @@ contains
                 ! kept, to the output time (where its steps fall)
                 target = tout
                 call self%sym%advance_to(tout, self%t, self%y, self%yq, err)
+                if (allocated(err)) then
+                    if (.not. self%sym%failed_fatally()) then
+                        call leave_symplectic(err)
+                        if (allocated(err)) exit
+                        cycle
+                    end if
+                end if
             else if (self%active == EXPLICIT) then
                 call self%erk%advance_to(target, self%t, self%y, self%yq, err)
             else if (self%active == HIGH) then
@@ -476,6 +487,21 @@ contains
         if (self%nq > 0) yq(1:self%nq) = self%yq
         t = self%t
     contains
+        !> The symplectic method stopped (`err`: its step budget ran short, its step became
+        !! unstable or too short) at the last state it reached: on with erk from there,
+        !! whose steps adapt (and auto's switches from erk), without the symplectic method
+        !! for the rest of the run. `err` is then erk's start's, if it failed.
+        subroutine leave_symplectic(err)
+            type(error_t), allocatable, intent(inout) :: err
+            character(len=:), allocatable :: cause
+            cause = err%message(1:min(WHY_LEN - 120, len(err%message)))
+            deallocate (err)
+            self%sym_barred = .true.
+            self%sym_cost = -1.0_wp
+            call self%start_method(EXPLICIT, cause//'; on with erk, without the symplectic '// &
+                                   'method for the rest of the run', err)
+        end subroutine leave_symplectic
+
         !> The message of a method that spent the budget auto left it: with the run's own
         !! budget in place of what was left of it, and auto's own diagnosis (the symplectic
         !! method left out) at the end.

@@ -38,6 +38,7 @@ contains
         self%sym_order = 0
         self%sym_wait = 0
         self%sym_backoff = STALE_WINDOWS
+        self%sym_barred = .false.
 
         call newton_widths(self%problem, self%lambda, self%mebdf_eval_cost)
         call estimate_spectrum(self%problem, start%t0, start%y0, spec)
@@ -92,7 +93,8 @@ contains
     !! must pass. `why`: the reason for the log (a warning when `warns`). Where
     !! the method is offered and lightly damped but left out, its cost stays in
     !! self%sym_cost for the measured look (watch); else that is -1. While a failed
-    !! probe's wait lasts (sym_wait), it is not weighed at all.
+    !! probe's wait lasts (sym_wait), and after the method stopped in this run
+    !! (sym_barred), it is not weighed at all.
     module procedure symplectic_fits
         type(split_table_t) :: tab
         real(wp) :: h, cost_s, cost_e
@@ -105,7 +107,7 @@ contains
         why = ''
         warns = .true.
         ! (after a probe that failed: its cost stays for the measured look when the wait is over)
-        if (self%sym_wait > 0) return
+        if (self%sym_wait > 0 .or. self%sym_barred) return
         self%sym_cost = -1.0_wp
         by_measure = .false.
         if (present(measured)) by_measure = measured .and. present(below)

@@ -119,7 +119,10 @@
 !!   pass a probe of its error from the state reached (ropedyn_auto_probe: 400 steps at its
 !!   step and at half of it, at most 20 tolerances; a support shaken at 20 Hz fails it).
 !!   It keeps it unless its step gets too short (START_RATE: then the implicit method; no
-!!   second probe, see ropedyn_auto_probe); its own log of the step joins the switch log.
+!!   second probe, see ropedyn_auto_probe), or the method stops: the rest of the run
+!!   outgrows the step budget where the step shortens, or a step is unstable at a half,
+!!   a quarter ... a sixteenth (then erk from the last state it reached, and not the
+!!   symplectic method again in that run); its own log of the step joins the switch log.
 submodule (ropedyn_auto) ropedyn_auto_switching
     implicit none
 

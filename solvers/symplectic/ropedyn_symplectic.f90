@@ -35,7 +35,8 @@
 !!   4th-order one where the fast modes are lightly damped (their energy stays, and
 !!   Verlet's error on it is 100 times larger).
 !! - **Failures**: a force evaluation that is not finite (an unstable step) restarts the
-!!   output interval from its start at half the step, up to MAX_RETRIES times; a step that
+!!   output interval from its start at half the step, up to MAX_RETRIES times (then the
+!!   method fails, its state the one at that start, whose forces were finite); a step that
 !!   would take more than STIFF_STEP_RATE steps per simulated second ends the run with the
 !!   diagnosis erk gives (naming auto and mebdf); a run to options%t_end that takes more
 !!   steps at the step chosen than the budget has left ends at once, at the start or where
@@ -140,6 +141,8 @@ module ropedyn_symplectic
         !> an estimate of the spectrum found lightly damped fast modes (choose_step's
         !! stay_light from then on)
         logical :: light_seen = .false.
+        !> the run ended because the forces reported a fatal error (no method can go on)
+        logical :: fatal = .false.
     contains
         procedure :: start => symplectic_start
         procedure :: advance_to => symplectic_advance_to
@@ -150,6 +153,7 @@ module ropedyn_symplectic
         procedure :: step_size => symplectic_step_size
         procedure :: fix_step => symplectic_fix_step
         procedure :: budget_shortfall => symplectic_budget_shortfall
+        procedure :: failed_fatally => symplectic_failed_fatally
         procedure, private :: begin
         procedure, private :: review_step
         procedure, private :: set_step
@@ -331,6 +335,7 @@ contains
         self%fixed_h = 0.0_wp
         self%budget_short = .false.
         self%light_seen = .false.
+        self%fatal = .false.
         self%tab = split_table(merge(TABLE_BM6, TABLE_VERLET, start%max_order >= 4))
         self%counters = solver_stats_t()
         call self%log%clear()
@@ -380,12 +385,15 @@ contains
             ! (the state before the step is kept only where the dense output may need it)
             call self%step(status, self%t_base + real(self%k + 1, wp)*self%h > tout - tol)
             if (status == STATUS_FATAL) then
+                self%fatal = .true.
                 call self%failure(err, 'the forces reported a fatal error')
                 exit
             else if (status /= STATUS_OK) then
                 ! not finite: the step was unstable; the interval again at half the step
                 retries = retries + 1
+                call restore(self, snap)
                 if (retries > MAX_RETRIES) then
+                    ! (the state handed back: the last one whose forces were finite)
                     call self%failure(err, 'the forces are not finite (NaN or Inf) even at '// &
                                       'the step halved '//int_text(MAX_RETRIES)//' times: '// &
                                       'the motion had become unstable before this output '// &
@@ -394,7 +402,6 @@ contains
                                       '''auto'' avoids it')
                     exit
                 end if
-                call restore(self, snap)
                 call self%set_step(0.5_wp*self%h, tout, 'the forces were not finite '// &
                                    '(an unstable step): the output interval again at half '// &
                                    'the step', .true.)
@@ -461,12 +468,6 @@ contains
         self%gc = snap%gc
         self%gr = snap%gr
     end subroutine restore
-
-
-
-
-
-
 
     !> One step from t to t + h (the module header); status not OK: the state is not usable.
     subroutine step(self, status, keep_old)
@@ -639,6 +640,13 @@ contains
         rest = integrator_budget_shortfall(self, t)
         if (self%budget_short) rest = max(1_i8, steps_to_end(t, self%options%t_end, self%h_rule))
     end function symplectic_budget_shortfall
+
+    !> The run ended because the forces reported a fatal error (not for want of steps, nor
+    !! at a step that was unstable or too short): no other method can go on from there.
+    pure logical function symplectic_failed_fatally(self) result(fatal)
+        class(symplectic_t), intent(in) :: self
+        fatal = self%fatal
+    end function symplectic_failed_fatally
 
     function symplectic_stats(self) result(stats)
         class(symplectic_t), intent(in) :: self

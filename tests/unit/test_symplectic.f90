@@ -1,9 +1,13 @@
 !> A damped linear oscillator m q'' = -m w^2 q - m c q' with the force split (problem_t):
 !! the spring is the potential, the damper the rest; one quadrature, the dissipated energy
-!! (rate m c v^2, sign -1 in the balance).
+!! (rate m c v^2, sign -1 in the balance). With w_slow > 0 a second, undamped mode
+!! q2'' = -w_slow^2 q2 beside it (two coordinates: q = (q1, q2), y = (q1, q2, v1, v2)): a
+!! slow motion that a method must follow, and a fast mode that holds its step. Its forces
+!! are reported not finite (STATUS_RECOVERABLE) as a model's are.
 module test_symplectic_oscillator
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp
-    use ropedyn_problem, only: problem_t, STATUS_OK
+    use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_RECOVERABLE
     implicit none
     private
     public :: oscillator_t
@@ -12,6 +16,7 @@ module test_symplectic_oscillator
         real(wp) :: w = 1.0_wp    !< 1/s
         real(wp) :: c = 0.0_wp    !< 1/s
         real(wp) :: m = 2.0_wp    !< kg
+        real(wp) :: w_slow = 0.0_wp  !< 1/s (0: no second mode)
     contains
         procedure :: size => osc_size
         procedure :: bandwidths => osc_bandwidths
@@ -25,21 +30,40 @@ module test_symplectic_oscillator
         procedure :: force_split_refusal => osc_refusal
         procedure :: split_layout => osc_split_layout
         procedure :: split_rhs => osc_split_rhs
+        procedure, private :: dof
     end type oscillator_t
 
 contains
 
+    pure integer function dof(self)
+        class(oscillator_t), intent(in) :: self
+        dof = merge(2, 1, self%w_slow > 0.0_wp)
+    end function dof
+
     pure integer function osc_size(self)
         class(oscillator_t), intent(in) :: self
-        osc_size = 2
+        osc_size = 2*self%dof()
     end function osc_size
 
     pure subroutine osc_bandwidths(self, ml, mu)
         class(oscillator_t), intent(in) :: self
         integer, intent(out) :: ml, mu
-        ml = 1
-        mu = 1
+        ml = self%dof()
+        mu = self%dof()
     end subroutine osc_bandwidths
+
+    !> The accelerations of the springs (ac) and of the damper (ar) at y.
+    pure subroutine accelerations(self, y, ac, ar)
+        class(oscillator_t), intent(in) :: self
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: ac(:), ar(:)
+        integer :: n
+        n = self%dof()
+        ac(1) = -self%w**2*y(1)
+        ar = 0.0_wp
+        ar(1) = -self%c*y(n + 1)
+        if (n == 2) ac(2) = -self%w_slow**2*y(2)
+    end subroutine accelerations
 
     subroutine osc_rhs(self, t, y, ydot, status)
         class(oscillator_t), intent(inout) :: self
@@ -47,8 +71,13 @@ contains
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: ydot(:)
         integer, intent(out) :: status
-        ydot = [y(2), -self%w**2*y(1) - self%c*y(2)]
-        status = STATUS_OK
+        real(wp) :: ac(2), ar(2)
+        integer :: n
+        n = self%dof()
+        call accelerations(self, y, ac, ar)
+        ydot(1:n) = y(n + 1:2*n)
+        ydot(n + 1:2*n) = ac(1:n) + ar(1:n)
+        status = merge(STATUS_OK, STATUS_RECOVERABLE, all(ieee_is_finite(ydot)))
     end subroutine osc_rhs
 
     pure logical function osc_has_jacobian(self) result(has)
@@ -63,9 +92,15 @@ contains
         real(wp), intent(inout) :: jb(:, :)
         integer, intent(in) :: offset
         integer, intent(out) :: status
-        jb(offset - 1, 2) = jb(offset - 1, 2) + 1.0_wp           ! d q'/d v
-        jb(offset + 1, 1) = jb(offset + 1, 1) - self%w**2        ! d v'/d q
-        jb(offset, 2) = jb(offset, 2) - self%c                   ! d v'/d v
+        integer :: n, i
+        ! (band storage: the entry of row i, column j at jb(offset + i - j, j))
+        n = self%dof()
+        do i = 1, n
+            jb(offset - n, n + i) = jb(offset - n, n + i) + 1.0_wp      ! d q_i'/d v_i
+        end do
+        jb(offset + n, 1) = jb(offset + n, 1) - self%w**2               ! d v_1'/d q_1
+        jb(offset, n + 1) = jb(offset, n + 1) - self%c                  ! d v_1'/d v_1
+        if (n == 2) jb(offset + n, 2) = jb(offset + n, 2) - self%w_slow**2
         status = STATUS_OK
     end subroutine osc_jacobian
 
@@ -80,7 +115,7 @@ contains
         real(wp), intent(in) :: y(:)
         real(wp), intent(out) :: yqdot(:)
         integer, intent(out) :: status
-        yqdot(1) = self%m*self%c*y(2)**2
+        yqdot(1) = self%m*self%c*y(self%dof() + 1)**2
         status = STATUS_OK
     end subroutine osc_quad_rhs
 
@@ -93,8 +128,10 @@ contains
         class(oscillator_t), intent(in) :: self
         integer, allocatable, intent(out) :: pos(:), vel(:)
         integer, intent(out) :: kl, ku
-        pos = [1]
-        vel = [2]
+        integer :: i, n
+        n = self%dof()
+        pos = [(i, i=1, n)]
+        vel = [(n + i, i=1, n)]
         kl = 0
         ku = 0
     end subroutine osc_layout
@@ -120,11 +157,12 @@ contains
         real(wp), intent(out) :: ac(:), gc(:)
         integer, intent(out) :: status
         real(wp), intent(out), optional :: ar(:), gr(:)
-        ac(1) = -self%w**2*y(1)
+        real(wp) :: a_rest(2)
+        call accelerations(self, y, ac, a_rest)
         gc = 0.0_wp
-        if (present(ar)) ar(1) = -self%c*y(2)
-        if (present(gr)) gr(1) = self%m*self%c*y(2)**2
-        status = STATUS_OK
+        if (present(ar)) ar = a_rest(1:size(ar))
+        if (present(gr)) gr(1) = self%m*self%c*y(self%dof() + 1)**2
+        status = merge(STATUS_OK, STATUS_RECOVERABLE, all(ieee_is_finite(ac)))
     end subroutine osc_split_rhs
 end module test_symplectic_oscillator
 
@@ -141,11 +179,15 @@ end module test_symplectic_oscillator
 !!   and 1e-4 at rtol 1e-5, while erk's error passes 1e-3 (rtol 1e-3 both);
 !! - the balance with light damping and a shaken clamped top (the work of the support by
 !!   its springs' kicks and dampers' D-maps) stays within 1e-3 m g L, with work done;
+!! - a step unstable at every retry: the method fails with the last finite state; auto,
+!!   whose symplectic run outgrows the step budget mid-run, goes on with erk to the end;
 !! - refusals: point masses off the element centres, ground contact, the MPP.
 program test_symplectic
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t
-    use ropedyn_integrator, only: solver_options_t
+    use ropedyn_integrator, only: integrator_t, solver_options_t
+    use ropedyn_solvers, only: new_integrator
+    use ropedyn_switch_log, only: switch_event_t
     use ropedyn_symplectic, only: symplectic_t, choose_step, TABLE_VERLET, TABLE_BM6, TABLE_CHIN
     use ropedyn_spectrum, only: spectrum_t
     use ropedyn_split_tables, only: split_table, split_table_t
@@ -163,6 +205,8 @@ program test_symplectic
     call energy_spreads()
     call step_costs()
     call step_follows_spectrum()
+    call unstable_to_the_end()
+    call auto_leaves_symplectic()
     call undamped_rope()
     call shaken_rope()
     call refusals()
@@ -471,6 +515,87 @@ contains
         call suite%check_true(.not. allocated(err) .and. &
                               integ%step_size() <= rule*(1.0_wp + 1.0e-9_wp), trim(label))
     end subroutine step_follows_spectrum
+
+    !> A step unstable even when halved MAX_RETRIES (4) times (Verlet at h w = 100 on the
+    !! oscillator, w = 1, to its 4th retry at 6.25: the forces overflow within the
+    !! interval): the method fails, and hands back the state at the start of the interval,
+    !! whose forces were finite (what auto goes on from), not the overflowed one.
+    subroutine unstable_to_the_end()
+        type(oscillator_t), target :: osc
+        type(symplectic_t) :: integ
+        type(solver_options_t) :: options
+        type(error_t), allocatable :: err
+        real(wp) :: y(2), yq(1), t
+        y = [1.0_wp, 0.0_wp]
+        yq = 0.0_wp
+        call integ%init(osc, 0.0_wp, y, yq, options, err)
+        call integ%fix_step(TABLE_VERLET, 100.0_wp)
+        call integ%advance_to(1.0e5_wp, t, y, yq, err)
+        call suite%check_true(allocated(err), 'Verlet at h w = 100: fails')
+        if (.not. allocated(err)) return
+        call suite%check_contains(err%message, 'not finite', 'the failure says why')
+        call suite%check_true(t == 0.0_wp .and. all(y == [1.0_wp, 0.0_wp]) .and. &
+                              .not. integ%failed_fatally(), 'the state handed back is '// &
+                              'the last finite one (the start), the failure not fatal')
+    end subroutine unstable_to_the_end
+
+    !> auto on a slow mode (w = 1) beside a fast one (w = 4,000, undamped: auto takes the
+    !! symplectic method, Chin's 4A at 3.0e-4 s), 10 s, with a step budget that covers its
+    !! run (33,000 steps, 36,300 with the tenth to spare) and not much more (37,000). At 1 s
+    !! the fast mode stiffens 1.5 times: at the next estimate of the spectrum the step
+    !! shortens to 2.0e-4 s, and the rest of the run no longer fits the budget. auto goes
+    !! on with erk from where the method stopped (not the symplectic method again) and
+    !! finishes, the slow mode where it should be; the switch log in time order.
+    subroutine auto_leaves_symplectic()
+        type(oscillator_t), target :: osc
+        class(integrator_t), allocatable :: integ
+        type(solver_options_t) :: options
+        type(error_t), allocatable :: err
+        type(switch_event_t), allocatable :: events(:)
+        real(wp) :: y(4), yq(1), t
+        integer :: k, n
+        character(len=160) :: label
+        osc%w = 4000.0_wp
+        osc%w_slow = 1.0_wp
+        y = [1.0e-7_wp, 1.0_wp, 0.0_wp, 0.0_wp]
+        yq = 0.0_wp
+        options%rtol = 1.0e-3_wp
+        options%atol = 1.0e-6_wp
+        options%t_end = 10.0_wp
+        options%max_steps = 37000
+        call new_integrator('auto', integ, err)
+        if (.not. allocated(err)) call integ%init(osc, 0.0_wp, y, yq, options, err)
+        do k = 1, 100
+            if (allocated(err)) exit
+            if (k == 11) osc%w = 1.5_wp*osc%w
+            call integ%advance_to(0.1_wp*real(k, wp), t, y, yq, err)
+        end do
+        if (allocated(err)) then
+            call suite%check_true(.false., 'auto, fast mode stiffened within a tight '// &
+                                  'budget: completes: '//err%message)
+            return
+        end if
+        events = integ%switch_log()
+        n = size(events)
+        call suite%check_true(trim(events(1)%method) == 'symplectic', &
+                              'auto starts with the symplectic method')
+        do k = n, 1, -1
+            if (index(events(k)%reason, 'without the symplectic method') > 0) exit
+        end do
+        call suite%check_true(k > 0, 'auto leaves the symplectic method')
+        if (k == 0) return
+        call suite%check_true(trim(events(k)%method) == 'erk' .and. events(k)%t > 1.0_wp &
+                              .and. index(events(k)%reason, 'max_steps') > 0, &
+                              'for erk, after the fast mode stiffened, for the step budget: '// &
+                              events(k)%reason(1:min(200, len(events(k)%reason))))
+        call suite%check_true(all(events(k:n)%method /= 'symplectic'), &
+                              'and does not take the symplectic method again')
+        call suite%check_true(all(events(2:n)%t >= events(1:n - 1)%t), &
+                              'the switch log is in time order')
+        write (label, '(a, es9.2)') 'the slow mode at 10 s: |q2 - cos(10)| = ', &
+            abs(y(2) - cos(10.0_wp))
+        call suite%check_le(abs(y(2) - cos(10.0_wp)), 1.0e-2_wp, trim(label))
+    end subroutine auto_leaves_symplectic
 
     subroutine refusals()
         character(len=SET_LEN) :: sets(3)
