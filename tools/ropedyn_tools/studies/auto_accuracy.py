@@ -24,8 +24,9 @@ each method's error and the cost of each fixed method at auto's accuracy:
 - **auto / best at equal accuracy**: auto's CPU over the cheapest of those.
 
 CPU: /solver/cpu_time, the minimum of `--repeat` runs (more, up to 8, while they add up to
-less than 1 s). A run is given max(4 x auto's CPU, 3 s) of CPU; one that needs more or ends
-with a diagnosis does not count. The table goes between the auto_accuracy markers of
+less than 1 s). A run is given max(CAP_FACTOR = 4 x auto's CPU, CAP_MIN = 3 s) of process
+CPU; one that needs more ('> cap' in the table) or ends with a diagnosis ('failed') does
+not count. The table goes between the auto_accuracy markers of
 docs/performance/auto.md. The code of scripts/auto_accuracy.
 """
 import argparse
@@ -47,6 +48,8 @@ FACTORS = (1e3, 1e2, 1e1, 1.0, 1e-1, 1e-2, 1e-3)
 #: errors within this factor of auto's count as equal accuracy (runs of the same method
 #: differ a little: auto starts erk with its own first step)
 SLACK = 1.5
+#: a fixed method's run gets at most max(CAP_FACTOR x auto's CPU, CAP_MIN s) of process CPU
+CAP_FACTOR, CAP_MIN = 4.0, 3.0
 
 
 def distance(a, b):
@@ -57,15 +60,26 @@ def distance(a, b):
 
 def measured(exe, scene, work, method, span, sets, repeat, cap, ref):
     """(cpu, error, switch methods: erk with its pair's order) of `method` with `sets`:
-    the least CPU of `repeat` runs (auto_table's best_of); None when a run failed or ran
-    over its cap, "n/a" when the method does not take the scene."""
+    the least CPU of `repeat` runs (auto_table's best_of); None when a run failed, "cap"
+    when it ran over its CPU cap, "n/a" when the method does not take the scene."""
     r = auto_table.best_of(exe, scene, work, method, span, repeat, cap, sets, points=True)
-    if r["status"] == "n/a":
-        return "n/a"
+    if r["status"] in ("n/a", "cap"):
+        return r["status"]
     if r["status"] != "complete":
         return None
     return r["cpu"], distance(r["points"], ref), [
         method_label(m, o) for _, m, o in r["switches"]] or [method]
+
+
+def error_cell(at_own, cap):
+    """The table's cell for a fixed method at the scene's tolerances: its error, or what
+    kept it from one: 'n/a' (the method does not take the scene), '> cap' (the run needed
+    more than its CPU cap, `cap` s, not a failure of the method) or 'failed'."""
+    if at_own == "n/a":
+        return "n/a"
+    if at_own == "cap":
+        return f"> {cap:.3g} s"
+    return f"{at_own[1]:.1e}" if at_own else "failed"
 
 
 def main(argv=None):
@@ -106,10 +120,11 @@ def main(argv=None):
                 if all(r["status"] == "complete" for r in refs):
                     auto = measured(exe, scene, work, "auto", span, common, args.repeat, None,
                                     refs[0]["points"])
-                if auto is None:
+                if not isinstance(auto, tuple):
+                    auto = None
                     break
                 spread = distance(refs[0]["points"], refs[1]["points"])
-                cap = max(4 * auto[0], 3.0)
+                cap = max(CAP_FACTOR * auto[0], CAP_MIN)
                 own = {m: measured(exe, scene, work, m, span, common, args.repeat, cap,
                                    refs[0]["points"]) for m in FIXED}
                 largest = max([auto[1]] + [r[1] for r in own.values() if isinstance(r, tuple)])
@@ -129,10 +144,9 @@ def main(argv=None):
             errors, best = [], None
             for method in FIXED:
                 at_own = own[method]
+                errors.append(error_cell(at_own, cap))
                 if at_own == "n/a":
-                    errors.append("n/a")
                     continue
-                errors.append(f"{at_own[1]:.1e}" if at_own else "failed")
                 for factor in FACTORS:
                     if factor == 1.0 and at_own is not None:
                         got = at_own
@@ -140,7 +154,7 @@ def main(argv=None):
                         got = measured(exe, scene, work, method, span, [
                             *common, f"solver.rtol={rtol * factor:.3g}",
                             f"solver.atol={atol * factor:.3g}"], args.repeat, cap, ref)
-                    if got is not None and max(got[1], reach) <= SLACK * target:
+                    if isinstance(got, tuple) and max(got[1], reach) <= SLACK * target:
                         if best is None or got[0] < best[0]:
                             best = (got[0], f"{method} ({rtol * factor:.3g})")
                         break
@@ -164,7 +178,10 @@ def main(argv=None):
              f"records; the fixed methods' errors at the scene's tolerances; 'best at "
              f"auto's accuracy': the cheapest fixed method at the loosest of the scene's "
              f"rtol x 1e3 .. 1e-3 (atol alike) whose error is at most {SLACK:g} times "
-             f"auto's (errors below {args.floor:g} m count as {args.floor:g} m). CPU: "
+             f"auto's (errors below {args.floor:g} m count as {args.floor:g} m); each "
+             f"fixed method's run gets max({CAP_FACTOR:g} x auto's CPU, {CAP_MIN:g} s) of process "
+             f"CPU ('> cap' "
+             f"when it needs more), 'failed': it ended with its diagnosis. CPU: "
              f"/solver/cpu_time, minimum "
              f"of {args.repeat} runs. Machine: {machine()}. Run: {run_stamp()}.", "",
              header, "|" + "---|" * (11 + len(FIXED)), *rows, END]
