@@ -115,6 +115,11 @@ def out_of_steps(r):
 
 
 def choice_text(switches):
+    """'m o, t s: m o, ...' of a run's switches (time, method, order limit): the first
+    three and how many there were when more than four. An event that keeps the method
+    and its order limit (the symplectic method's change of step, a note) is not one."""
+    switches = [x for i, x in enumerate(switches)
+                if i == 0 or x[1:] != switches[i - 1][1:]]
     if not switches:
         return ""
     parts = [f"{m} {o}" if i == 0 else f"{t:.3g} s: {m} {o}"

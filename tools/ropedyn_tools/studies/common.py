@@ -146,10 +146,17 @@ def method_label(method, order):
     return f"{method} {order}" if method == "erk" else method
 
 
+def distinct_runs(items):
+    """The items without those equal to the one before them."""
+    items = list(items)
+    return [x for i, x in enumerate(items) if i == 0 or x != items[i - 1]]
+
+
 def method_chain(methods, most=5):
     """'a -> b -> c' of a run's methods in switch order; with more than `most`, the first
-    three and how many switches there were in all."""
-    methods = list(methods)
+    three and how many switches there were in all. An event that keeps the method (the
+    symplectic method's change of step, a note) is not a switch."""
+    methods = distinct_runs(methods)
     if len(methods) > most:
         return " -> ".join(methods[:3]) + f" -> ... ({len(methods) - 1} switches)"
     return " -> ".join(methods)

@@ -1,0 +1,34 @@
+"""scripts/auto_accuracy and scripts/auto_table (tools/ropedyn_tools/studies): a fixed method's
+run that needs more CPU than its cap is shown as such, not as a failure of the method; the
+method chains count switches, not the symplectic method's changes of step."""
+from ropedyn_tools.repo import ROOT
+from ropedyn_tools.studies import auto_accuracy as aa
+
+
+def test_a_run_over_its_cap_is_not_a_failure(ropedyn_exe, tmp_path):
+    # cvode at rtol 1e-10 over the paper's 30 s takes several seconds: killed at 1 s of CPU
+    scene = ROOT / "input" / "paper.nml"
+    got = aa.measured(ropedyn_exe, scene, tmp_path, "cvode", 30.0,
+                      ["solver.rtol=1e-10", "solver.atol=1e-12"], 1, 0.5, None)
+    assert got == "cap"
+    assert aa.error_cell(got, 0.5) == "> 0.5 s"
+    # a run that ends with its diagnosis is a failure
+    got = aa.measured(ropedyn_exe, scene, tmp_path, "erk", 30.0, ["solver.max_steps=10"], 1,
+                      None, None)
+    assert got is None and aa.error_cell(got, 3.0) == "failed"
+    assert aa.error_cell("n/a", 3.0) == "n/a"
+    assert aa.error_cell((0.1, 2.5e-7, ["erk 4"]), 3.0) == "2.5e-07"
+
+
+def test_a_change_of_step_is_not_a_switch():
+    """The study tables' method chains: the symplectic method's own events (a change of
+    its step) are not switches; a real switch back to a method is."""
+    from ropedyn_tools.studies.auto_table import choice_text
+    from ropedyn_tools.studies.common import method_chain
+    assert method_chain(["symplectic"] * 20) == "symplectic"
+    assert method_chain(["erk 4", "symplectic", "symplectic", "erk 4"]) == \
+        "erk 4 -> symplectic -> erk 4"
+    assert method_chain(["erk 4", "erk 5"] * 4) == "erk 4 -> erk 5 -> erk 4 -> ... (7 switches)"
+    assert choice_text([(0.0, "erk", 4), (0.0256, "symplectic", 4), (0.0256, "symplectic", 4),
+                        (26.8, "symplectic", 4)]) == "erk 4, 0.0256 s: symplectic 4"
+    assert choice_text([(0.0, "mebdf", 4), (1.0, "mebdf", 5)]) == "mebdf 4, 1 s: mebdf 5"
