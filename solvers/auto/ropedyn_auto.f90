@@ -305,13 +305,15 @@ contains
         if (self%sym_order > 0) events = merged_events(events, self%sym%switch_log())
     end function auto_switch_log
 
-    !> Initialize `which` at the current state (self%t, y, yq); log the switch.
-    subroutine start_method(self, which, reason, err, h_first)
+    !> Initialize `which` at the current state (self%t, y, yq); log the switch (erk's, with
+    !! `warn`, as a warning: printed while the run goes on).
+    subroutine start_method(self, which, reason, err, h_first, warn)
         class(auto_t), intent(inout) :: self
         integer, intent(in) :: which
         character(len=*), intent(in) :: reason
         type(error_t), allocatable, intent(out) :: err
         real(wp), intent(in), optional :: h_first
+        logical, intent(in), optional :: warn
         type(solver_options_t) :: opts
         type(solver_stats_t) :: old
         if (self%active /= 0) then
@@ -344,7 +346,7 @@ contains
                 end if
             end if
             if (self%trials_are_cheap()) call self%erk%set_stable_step(self%h_stable)
-            call self%log%add(self%t, 'erk', ERK_ORDER, reason)
+            call self%log%add(self%t, 'erk', ERK_ORDER, reason, warning=warn)
         else if (which == HIGH) then
             self%calm_accurate = -1.0_wp
             opts%max_order = HIGH_ORDER
@@ -490,7 +492,8 @@ contains
         !> The symplectic method stopped (`err`: its step budget ran short, its step became
         !! unstable or too short) at the last state it reached: on with erk from there,
         !! whose steps adapt (and auto's switches from erk), without the symplectic method
-        !! for the rest of the run. `err` is then erk's start's, if it failed.
+        !! for the rest of the run, and a warning (the balance may drift from here; a
+        !! larger max_steps keeps the method). `err` is then erk's start's, if it failed.
         subroutine leave_symplectic(err)
             type(error_t), allocatable, intent(inout) :: err
             character(len=:), allocatable :: cause
@@ -499,7 +502,7 @@ contains
             self%sym_barred = .true.
             self%sym_cost = -1.0_wp
             call self%start_method(EXPLICIT, cause//'; on with erk, without the symplectic '// &
-                                   'method for the rest of the run', err)
+                                   'method for the rest of the run', err, warn=.true.)
         end subroutine leave_symplectic
 
         !> The message of a method that spent the budget auto left it: with the run's own

@@ -585,8 +585,10 @@ contains
         call suite%check_true(k > 0, 'auto leaves the symplectic method')
         if (k == 0) return
         call suite%check_true(trim(events(k)%method) == 'erk' .and. events(k)%t > 1.0_wp &
-                              .and. index(events(k)%reason, 'max_steps') > 0, &
-                              'for erk, after the fast mode stiffened, for the step budget: '// &
+                              .and. index(events(k)%reason, 'max_steps') > 0 .and. &
+                              events(k)%warning, &
+                              'for erk (a warning), after the fast mode stiffened, for the '// &
+                              'step budget: '// &
                               events(k)%reason(1:min(200, len(events(k)%reason))))
         call suite%check_true(all(events(k:n)%method /= 'symplectic'), &
                               'and does not take the symplectic method again')
