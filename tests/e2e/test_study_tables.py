@@ -1,6 +1,7 @@
-"""scripts/auto_accuracy and scripts/auto_table (tools/ropedyn_tools/studies): a fixed method's
-run that needs more CPU than its cap is shown as such, not as a failure of the method; the
-method chains count switches, not the symplectic method's changes of step."""
+"""The study tools (tools/ropedyn_tools/studies): auto_accuracy shows a fixed method's run
+that needs more CPU than its cap as such, not as a failure of the method; the method chains
+count switches, not the symplectic method's changes of step; bench_step runs again where a
+run of another build left its file."""
 from ropedyn_tools.repo import ROOT
 from ropedyn_tools.studies import auto_accuracy as aa
 
@@ -32,3 +33,14 @@ def test_a_change_of_step_is_not_a_switch():
     assert choice_text([(0.0, "erk", 4), (0.0256, "symplectic", 4), (0.0256, "symplectic", 4),
                         (26.8, "symplectic", 4)]) == "erk 4, 0.0256 s: symplectic 4"
     assert choice_text([(0.0, "mebdf", 4), (1.0, "mebdf", 5)]) == "mebdf 4, 1 s: mebdf 5"
+
+
+def test_bench_step_runs_again_in_the_same_folder(ropedyn_exe, tmp_path):
+    """bench_step runs the baseline's and this tree's executables one after the other into the
+    same folder; ropedyn replaces no file of another run, so each run's file must go after it
+    (the study stopped at its second run when it did not)."""
+    from ropedyn_tools.studies import bench_step
+    first = bench_step.run(ropedyn_exe, "rfem", 4, "cvode", 0.05, tmp_path)
+    second = bench_step.run(ropedyn_exe, "rfem", 4, "cvode", 0.1, tmp_path)
+    assert first[0] > 0 and second[0] > first[0]
+    assert not list(tmp_path.glob("*.h5"))

@@ -28,12 +28,14 @@ RULE = "|---|---|---|---|---|---|---|---|"
 
 
 def run(exe, model, n, method, t_end, workdir):
-    """(steps, CPU seconds) of one run, from its summary lines."""
+    """(steps, CPU seconds) of one run, from its summary lines. Its output file is removed
+    after it (ropedyn replaces no file of another run: the next run writes it anew)."""
     out = workdir / f"step_{model}_{n}_{method}.h5"
     cmd = [str(exe), "run", str(PAPER), *set_args([
         f'model.kind="{model}"', f"model.elements={n}", f'solver.method="{method}"',
         f"solver.t_end={t_end}", f'output.file="{out}"', "solver.output_interval=0.1"])]
     proc = subprocess.run(cmd, capture_output=True, text=True)
+    out.unlink(missing_ok=True)
     if proc.returncode != 0:
         raise SystemExit(f"bench_step: {' '.join(cmd)} failed:\n{proc.stderr[-2000:]}")
     steps = cpu = None
