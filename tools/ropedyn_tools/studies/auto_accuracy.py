@@ -179,10 +179,9 @@ def main(argv=None):
              f"auto's accuracy': the cheapest fixed method at the loosest of the scene's "
              f"rtol x 1e3 .. 1e-3 (atol alike) whose error is at most {SLACK:g} times "
              f"auto's (errors below {args.floor:g} m count as {args.floor:g} m); each "
-             f"fixed method's run gets max({CAP_FACTOR:g} x auto's CPU, {CAP_MIN:g} s) of process "
-             f"CPU ('> cap' "
-             f"when it needs more), 'failed': it ended with its diagnosis. CPU: "
-             f"/solver/cpu_time, minimum "
+             f"fixed method's run gets max({CAP_FACTOR:g} x auto's CPU, {CAP_MIN:g} s) of "
+             f"process CPU ('> cap' when it needs more), 'failed': it ended with its "
+             f"diagnosis. CPU: /solver/cpu_time, minimum "
              f"of {args.repeat} runs. Machine: {machine()}. Run: {run_stamp()}.", "",
              header, "|" + "---|" * (11 + len(FIXED)), *rows, END]
     update_doc(DOCS / "performance" / "auto.md", BEGIN, END, "\n".join(lines),

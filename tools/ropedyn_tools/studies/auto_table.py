@@ -34,7 +34,8 @@ import tempfile
 import h5py
 
 from ropedyn_tools.repo import DOCS, INPUT, add_exe_argument, exe_or_build, set_args
-from ropedyn_tools.studies.common import machine, scene_number, update_doc, run_stamp
+from ropedyn_tools.studies.common import (distinct_runs, machine, scene_number, update_doc,
+                                          run_stamp)
 
 BEGIN = "<!-- auto_table:begin -->"
 END = "<!-- auto_table:end -->"
@@ -118,8 +119,7 @@ def choice_text(switches):
     """'m o, t s: m o, ...' of a run's switches (time, method, order limit): the first
     three and how many there were when more than four. An event that keeps the method
     and its order limit (the symplectic method's change of step, a note) is not one."""
-    switches = [x for i, x in enumerate(switches)
-                if i == 0 or x[1:] != switches[i - 1][1:]]
+    switches = distinct_runs(switches, key=lambda x: x[1:])
     if not switches:
         return ""
     parts = [f"{m} {o}" if i == 0 else f"{t:.3g} s: {m} {o}"

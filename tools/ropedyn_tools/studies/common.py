@@ -146,10 +146,10 @@ def method_label(method, order):
     return f"{method} {order}" if method == "erk" else method
 
 
-def distinct_runs(items):
-    """The items without those equal to the one before them."""
+def distinct_runs(items, key=lambda x: x):
+    """The items without those whose `key` equals the one before them."""
     items = list(items)
-    return [x for i, x in enumerate(items) if i == 0 or x != items[i - 1]]
+    return [x for i, x in enumerate(items) if i == 0 or key(x) != key(items[i - 1])]
 
 
 def method_chain(methods, most=5):
