@@ -24,6 +24,7 @@ module ropedyn_switch_log
         integer :: count = 0
     contains
         procedure :: add => log_add
+        procedure :: add_all => log_add_all
         procedure :: items => log_items
         procedure :: clear => log_clear
     end type switch_log_t
@@ -54,6 +55,17 @@ contains
             if (present(warning)) e%warning = warning
         end associate
     end subroutine log_add
+
+    !> Events of another log appended, in their order.
+    subroutine log_add_all(self, events)
+        class(switch_log_t), intent(inout) :: self
+        type(switch_event_t), intent(in) :: events(:)
+        integer :: k
+        do k = 1, size(events)
+            call self%add(events(k)%t, events(k)%method, events(k)%max_order, &
+                          events(k)%reason, events(k)%warning)
+        end do
+    end subroutine log_add_all
 
     !> The events so far, oldest first.
     function log_items(self) result(events)

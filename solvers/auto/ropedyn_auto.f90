@@ -133,6 +133,9 @@ module ropedyn_auto
         type(adams_t) :: am
         type(symplectic_t) :: sym
         integer :: sym_order = 0           !< the symplectic method's order at its start
+        !> the symplectic method's own events of its runs that ended (its init clears its
+        !! log, and auto may run it again)
+        type(switch_log_t) :: sym_past
         logical :: use_bdf = .false.       !< the implicit method is cvode (else mebdf)
         type(erk_table_t) :: tab
         type(erk_table_t) :: tab_high      !< the order-5 pair's
@@ -301,8 +304,11 @@ contains
     function auto_switch_log(self) result(events)
         class(auto_t), intent(in) :: self
         type(switch_event_t), allocatable :: events(:)
+        type(switch_event_t), allocatable :: sym_events(:)
         events = self%log%items()
-        if (self%sym_order > 0) events = merged_events(events, self%sym%switch_log())
+        sym_events = self%sym_past%items()
+        if (self%active == SYMPLECTIC) sym_events = [sym_events, self%sym%switch_log()]
+        if (size(sym_events) > 0) events = merged_events(events, sym_events)
     end function auto_switch_log
 
     !> Initialize `which` at the current state (self%t, y, yq); log the switch (erk's, with
@@ -331,7 +337,10 @@ contains
             call self%mebdf%finalize()
             call self%bdf%finalize()
         end if
-        if (self%active == SYMPLECTIC) call self%sym%finalize()
+        if (self%active == SYMPLECTIC) then
+            call self%sym_past%add_all(self%sym%switch_log())
+            call self%sym%finalize()
+        end if
         opts = self%options
         opts%max_steps = max(1_i8, self%options%max_steps - self%done%steps)
         if (which == EXPLICIT) then
@@ -641,6 +650,8 @@ contains
 
     subroutine auto_finalize(self)
         class(auto_t), intent(inout) :: self
+        ! (the log stays readable after the run)
+        if (self%active == SYMPLECTIC) call self%sym_past%add_all(self%sym%switch_log())
         call self%erk%finalize()
         call self%erk_high%finalize()
         call self%mebdf%finalize()

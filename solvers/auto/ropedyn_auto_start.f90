@@ -21,6 +21,7 @@ contains
         self%tab_high = erk_table(HIGH_ORDER)
         self%done = solver_stats_t()
         call self%log%clear()
+        call self%sym_past%clear()
         self%budget_said = .false.
         self%rate_explicit = -1.0_wp
         self%rate_implicit = -1.0_wp

@@ -183,7 +183,7 @@ end module test_symplectic_oscillator
 !!   whose symplectic run outgrows the step budget mid-run, goes on with erk to the end;
 !! - refusals: point masses off the element centres, ground contact, the MPP.
 program test_symplectic
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t
     use ropedyn_integrator, only: integrator_t, solver_options_t
     use ropedyn_solvers, only: new_integrator
@@ -207,6 +207,7 @@ program test_symplectic
     call step_follows_spectrum()
     call unstable_to_the_end()
     call auto_leaves_symplectic()
+    call auto_returns_to_symplectic()
     call undamped_rope()
     call shaken_rope()
     call refusals()
@@ -549,22 +550,12 @@ contains
     subroutine auto_leaves_symplectic()
         type(oscillator_t), target :: osc
         class(integrator_t), allocatable :: integ
-        type(solver_options_t) :: options
         type(error_t), allocatable :: err
         type(switch_event_t), allocatable :: events(:)
         real(wp) :: y(4), yq(1), t
         integer :: k, n
         character(len=160) :: label
-        osc%w = 4000.0_wp
-        osc%w_slow = 1.0_wp
-        y = [1.0e-7_wp, 1.0_wp, 0.0_wp, 0.0_wp]
-        yq = 0.0_wp
-        options%rtol = 1.0e-3_wp
-        options%atol = 1.0e-6_wp
-        options%t_end = 10.0_wp
-        options%max_steps = 37000
-        call new_integrator('auto', integ, err)
-        if (.not. allocated(err)) call integ%init(osc, 0.0_wp, y, yq, options, err)
+        call auto_on_two_modes(osc, 1.0_wp, 10.0_wp, 37000_i8, integ, y, yq, err)
         do k = 1, 100
             if (allocated(err)) exit
             if (k == 11) osc%w = 1.5_wp*osc%w
@@ -598,6 +589,92 @@ contains
             abs(y(2) - cos(10.0_wp))
         call suite%check_le(abs(y(2) - cos(10.0_wp)), 1.0e-2_wp, trim(label))
     end subroutine auto_leaves_symplectic
+
+
+    !> auto runs the symplectic method twice: the fast mode stiffens 25 times over 1-4 s
+    !! (the method's step follows the spectrum until it is too short: auto leaves it), eases
+    !! back from 5 s and drops to its first frequency at 5.3 s, during mebdf's trial, whose
+    !! window then finds the method cheaper. The switch log keeps the method's own events
+    !! of both runs (its init clears its log).
+    subroutine auto_returns_to_symplectic()
+        type(oscillator_t), target :: osc
+        class(integrator_t), allocatable :: integ
+        type(error_t), allocatable :: err
+        type(switch_event_t), allocatable :: events(:)
+        real(wp) :: y(4), yq(1), t, tk, t_left, t_back
+        integer :: k, n
+        call auto_on_two_modes(osc, 1500.0_wp, 30.0_wp, 100000000_i8, integ, y, yq, err)
+        do k = 1, 600
+            if (allocated(err)) exit
+            tk = 0.01_wp*real(k, wp)
+            osc%w = 4000.0_wp*25.0_wp**max(0.0_wp, min(1.0_wp, (tk - 1.0_wp)/3.0_wp, &
+                                                        (8.0_wp - tk)/3.0_wp))
+            if (tk > 5.3_wp) osc%w = 4000.0_wp
+            call integ%advance_to(tk, t, y, yq, err)
+        end do
+        if (allocated(err)) then
+            call suite%check_true(.false., 'auto, fast mode stiffened and eased: runs: '// &
+                                  err%message)
+            return
+        end if
+        events = integ%switch_log()
+        n = size(events)
+        ! (auto's switches name the method; the method's own events its composition)
+        t_left = -1.0_wp
+        t_back = -1.0_wp
+        do k = 2, n
+            if (events(k)%method /= 'symplectic' .and. events(k - 1)%method == 'symplectic' &
+                .and. t_left < 0.0_wp) t_left = events(k)%t
+            if (events(k)%method == 'symplectic' .and. events(k - 1)%method /= 'symplectic' &
+                .and. t_left >= 0.0_wp) t_back = events(k)%t
+        end do
+        call suite%check_true(trim(events(1)%method) == 'symplectic' .and. t_left > 1.0_wp &
+                              .and. t_back > t_left, 'auto starts with the symplectic '// &
+                              'method, leaves it and takes it again')
+        call suite%check_true(count(events%method == 'symplectic' .and. &
+                                    index_all(events, 'Chin 4A, step') .and. &
+                                    events%t > 0.5_wp .and. events%t < t_left) >= 2, &
+                              'the log keeps the first run''s own step changes')
+        call suite%check_true(count(events%method == 'symplectic' .and. &
+                                    index_all(events, 'Chin 4A, step') .and. &
+                                    events%t >= t_back) >= 1, &
+                              'and the second run''s')
+        call suite%check_true(all(events(2:n)%t >= events(1:n - 1)%t), &
+                              'the switch log is in time order')
+    end subroutine auto_returns_to_symplectic
+
+    !> Whether each event's reason contains `text`.
+    pure function index_all(events, text) result(has)
+        type(switch_event_t), intent(in) :: events(:)
+        character(len=*), intent(in) :: text
+        logical :: has(size(events))
+        integer :: k
+        do k = 1, size(events)
+            has(k) = index(events(k)%reason, text) > 0
+        end do
+    end function index_all
+
+    !> auto started on the two-mode oscillator (the fast mode at w = 4000/s from 1e-7,
+    !! the slow one, undamped at w_slow, from 1), rtol 1e-3, atol 1e-6.
+    subroutine auto_on_two_modes(osc, w_slow, t_end, max_steps, integ, y, yq, err)
+        type(oscillator_t), target, intent(inout) :: osc
+        real(wp), intent(in) :: w_slow, t_end
+        integer(i8), intent(in) :: max_steps
+        class(integrator_t), allocatable, intent(out) :: integ
+        real(wp), intent(out) :: y(4), yq(1)
+        type(error_t), allocatable, intent(out) :: err
+        type(solver_options_t) :: options
+        osc%w = 4000.0_wp
+        osc%w_slow = w_slow
+        y = [1.0e-7_wp, 1.0_wp, 0.0_wp, 0.0_wp]
+        yq = 0.0_wp
+        options%rtol = 1.0e-3_wp
+        options%atol = 1.0e-6_wp
+        options%t_end = t_end
+        options%max_steps = max_steps
+        call new_integrator('auto', integ, err)
+        if (.not. allocated(err)) call integ%init(osc, 0.0_wp, y, yq, options, err)
+    end subroutine auto_on_two_modes
 
     subroutine refusals()
         character(len=SET_LEN) :: sets(3)
