@@ -64,6 +64,7 @@ MOTION = "src/models/ropedyn_support_motion.f90"
 SETUP = "src/models/ropedyn_rope_setup.f90"
 SPEC = "src/models/ropedyn_rope_spec.f90"
 SECTION = "src/models/ropedyn_rope_section.f90"
+SYMP = "solvers/symplectic/ropedyn_symplectic.f90"
 ORACLE = "tests/e2e/test_physics_anchors.py"
 REGRESSION = "tests/e2e/test_regression.py"
 
@@ -195,6 +196,33 @@ MUTATIONS = [
              "eff%k = 2.0_wp*k",
              "contact stiffness per point k l instead of k l/2",
              ctest=("test_effect_anchors",)),
+    Mutation("buoyancy-moment-dropped", EFFECTS + "ropedyn_effect_buoyancy.f90",
+             "m(i) = m(i) + self%w*wt%i1*b%cs(2, i)",
+             "m(i) = m(i)",
+             "buoyancy of a partly wetted element without its moment (the uplift acts at "
+             "the centre, not at the wetted part's)",
+             ctest=("test_effects_derivatives",), pytest=("tests/e2e/test_water.py",)),
+    Mutation("added-mass-axes-swapped", EFFECTS + "ropedyn_added_mass.f90",
+             "bv = l*(self%mat*ve*e + self%man*vn*nv)",
+             "bv = l*(self%man*ve*e + self%mat*vn*nv)",
+             "added mass: the axial coefficient across the element and the normal one "
+             "along it",
+             ctest=("test_effects_derivatives",), pytest=("tests/e2e/test_water.py",)),
+    Mutation("section-set-ei-halved", SECTION,
+             "s%ei = r%bending_stiffness",
+             "s%ei = 0.5_wp*r%bending_stiffness",
+             "a line given by its section: half the bending stiffness EI given",
+             pytest=("tests/e2e/test_line_sections.py",)),
+    Mutation("rfem-tension-sign", "src/models/rfem/ropedyn_rfem_forces.f90",
+             "axial(0:n) = joint(1, :)",
+             "axial(0:n) = -joint(1, :)",
+             "the RFEM's tension output with the wrong sign (compression for tension)",
+             ctest=("test_internal_forces",), pytest=("tests/e2e/test_internal_forces.py",)),
+    Mutation("added-mass-rotary-dropped", EFFECTS + "ropedyn_added_mass.f90",
+             "jb = self%man*l**3/12.0_wp",
+             "jb = 0.0_wp",
+             "added mass: an element's rotation about its centre without its added inertia",
+             pytest=("tests/e2e/test_water.py",)),
     # --- supports -------------------------------------------------------------------------
     Mutation("support-phase-in-degrees", MOTION,
              "self%phase = phase_deg*pi/180.0_wp",
@@ -244,6 +272,22 @@ MUTATIONS = [
              "flag = FCVodeSetQuadErrCon(self%mem, 0_c_int)",
              "dissipated energy and work integrated without error control",
              ctest=("test_effects_physics",)),
+    Mutation("erk-rk4-weights", "solvers/erk/ropedyn_erk_tables.f90",
+             "tab%a(5, 1:4) = [0.125_wp, 0.375_wp, 0.375_wp, 0.125_wp]",
+             "tab%a(5, 1:4) = [0.125_wp, 0.375_wp, 0.25_wp, 0.25_wp]",
+             "erk's 3/8-rule weights changed (still consistent, no longer 4th order)",
+             ctest=("test_erk_tables",)),
+    Mutation("symplectic-dmap-at-start-velocity", SYMP,
+             "self%vt = self%v + (0.5_wp*hh)*self%ar",
+             "self%vt = self%v",
+             "the D-map's dissipated energy at the velocity before the kick, not at its "
+             "midpoint (the balance no longer closes exactly)",
+             ctest=("test_symplectic",)),
+    Mutation("chin-gradient-coefficient", "solvers/symplectic/ropedyn_split_tables.f90",
+             "tab%grad = [0.0_wp, 1.0_wp/24.0_wp, 0.0_wp]",
+             "tab%grad = [0.0_wp, 1.0_wp/48.0_wp, 0.0_wp]",
+             "Chin's force-gradient kick with 1/48 instead of 1/24 (order 4 falls to 2)",
+             ctest=("test_symplectic",)),
     # --- input handling and statics -------------------------------------------------------
     Mutation("eq13-inverted", SECTION,
              "eta_bar = rope%normal_damping*rope%shear_modulus/rope%young_modulus",
