@@ -590,7 +590,6 @@ contains
         call suite%check_le(abs(y(2) - cos(10.0_wp)), 1.0e-2_wp, trim(label))
     end subroutine auto_leaves_symplectic
 
-
     !> auto runs the symplectic method twice: the fast mode stiffens 25 times over 1-4 s
     !! (the method's step follows the spectrum until it is too short: auto leaves it), eases
     !! back from 5 s and drops to its first frequency at 5.3 s, during mebdf's trial, whose
