@@ -223,6 +223,12 @@ MUTATIONS = [
              "jb = 0.0_wp",
              "added mass: an element's rotation about its centre without its added inertia",
              pytest=("tests/e2e/test_water.py",)),
+    Mutation("mpp-water-rotary-residual", "src/models/mpp/ropedyn_mpp_water.f90",
+             "self%mom(k) = self%mom(k) + (g(3) - blk(3, 3)*qacc(k))",
+             "self%mom(k) = self%mom(k) + g(3)",
+             "the MPP's residual in water without the rods' rotary added inertia (the "
+             "Newton matrix's and the residual form's; the O(n) solve keeps it)",
+             ctest=("test_mpp",)),
     # --- supports -------------------------------------------------------------------------
     Mutation("support-phase-in-degrees", MOTION,
              "self%phase = phase_deg*pi/180.0_wp",
