@@ -163,7 +163,7 @@ module ropedyn_auto
         !> explicit windows since rate_accurate was measured, and how many make it stale
         integer :: accurate_age = 0
         integer :: accurate_stale_after = STALE_WINDOWS
-        !> windows of the order-5 pair since rate_explicit was measured
+        !> windows of the accuracy method since rate_explicit was measured
         integer :: explicit_age = 0
         !> its cost in its last window that was not dearer than erk's by GAIN (< 0: none)
         real(wp) :: calm_accurate = -1.0_wp
@@ -377,6 +377,7 @@ contains
             opts%max_order = ADAMS_ORDER
             call self%am%init(self%problem, self%t, self%y, self%yq, opts, err)
             if (allocated(err)) return
+            self%explicit_age = 0
             call self%log%add(self%t, 'adams', ADAMS_ORDER, reason)
         else
             opts%max_order = self%mebdf_order

@@ -71,7 +71,19 @@
 !!   that a stretch longer than two windows (a contact) does not keep Adams out once it
 !!   is over (whip_ground_mpp: 3.2 s CPU on erk from 1.25 s against 2.6 s),
 !!   or at once when Adams fails (e.g. the fixed-point iteration does not
-!!   converge: the problem has become stiff). Adams' cost: its evaluations of f plus
+!!   converge: the problem has become stiff). erk's measured cost is evidence for
+!!   STALE_WINDOWS windows of Adams, as for the order-5 pair; then erk runs again to
+!!   measure it. Without that, a cost measured in a transient kept Adams to the end: a
+!!   stiff two-rod MPP pendulum at rtol 1e-9 (test_methods) measured erk at 3.2e5 f per
+!!   second in the release's first 0.007 s, and Adams, its steps then held by the stiff
+!!   modes' stability (11 % failed their error test), ran the remaining 6 s on 255,612
+!!   evaluations of f against erk's own 136,902; measured again at 0.37 s, erk's steps
+!!   were held by stability and auto went to cvode: 21,127, and 0.44 s of CPU became
+!!   0.043. On the shipped MPP scenes that keep Adams, the measurements cost 4 to 7 %
+!!   more CPU (mpp_light_damping_n30/n70, mpp_undamped, snap_load_mpp; heavy_mass_mpp
+!!   and mpp_light_damping the same) and whip_ground_mpp, which found erk cheaper late
+!!   in its run, 29 % less (Release, the least of two runs each, by hand on 2026-11-30).
+!!   Adams' cost: its evaluations of f plus
 !!   ADAMS_STEP_COST per step (CVODE's vector work per step: measured about 2 f on the
 !!   paper's rope at n = 30, where f is cheap, and about 1.2 f on the MPP at n = 30).
 !! - **The order-5 pair** (erk's Dormand-Prince 5(4), HIGH) is the method for a step held
@@ -284,7 +296,9 @@ contains
             ! last window that was not dearer
             if (self%calm_accurate > 0.0_wp) self%rate_accurate = self%calm_accurate
             call self%start_method(EXPLICIT, trim(text), err)
+            return
         end if
+        if (self%active == ADAMS) call explicit_cost_ages(self, err)
     end subroutine accurate_window
 
     !> The order-5 pair's own looks before its cost is weighed: back to the order-4 pair
@@ -306,16 +320,25 @@ contains
             call self%start_method(EXPLICIT, trim(text), err)
             return
         end if
-        ! the order-4 pair's cost is evidence for STALE_WINDOWS windows: the
-        ! motion changes (shaken_top: the order-5 pair pays in the first 0.03 s,
-        ! not over the run), so then it is measured again
-        if (self%windows >= 2) self%explicit_age = self%explicit_age + 1
+        ! (the order-4 pair's cost measured before the motion changed: shaken_top's
+        ! order-5 pair paid in the first 0.03 s, not over the run)
+        if (self%windows >= 2) call explicit_cost_ages(self, err)
+    end subroutine high_pair_looks
+
+    !> One more window of the accuracy method since erk's order-4 pair was measured: that
+    !! cost is evidence for STALE_WINDOWS windows, then erk runs again to measure it (the
+    !! header, Adams and the order-5 pair).
+    subroutine explicit_cost_ages(self, err)
+        class(auto_t), intent(inout) :: self
+        type(error_t), allocatable, intent(out) :: err
+        character(len=240) :: text
+        self%explicit_age = self%explicit_age + 1
         if (self%explicit_age >= STALE_WINDOWS .and. self%wait == 0) then
             write (text, '(a, i0, a)') 'the order-4 pair''s cost was measured ', &
                 self%explicit_age, ' windows ago: measuring it again'
             call self%start_method(EXPLICIT, trim(text), err)
         end if
-    end subroutine high_pair_looks
+    end subroutine explicit_cost_ages
 
     !> A window of the implicit method that cost `rate`: judged on trial, and left for erk
     !! (or the symplectic method) when erk's predicted cost is lower by GAIN.

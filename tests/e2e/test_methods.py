@@ -421,6 +421,48 @@ def test_auto_tries_adams_again_when_its_cost_is_stale(run, tmp_path):
     assert 2 * stale <= age < 3 * stale, (age, reasons)
 
 
+#: A rigid, stiff two-rod MPP pendulum (EA 1e7, EI 1e4, the joint's stiff modes damped,
+#: swinging 1 degree), at a tight tolerance: erk's step is held by accuracy in the ringing
+#: of the release and by the stiff modes' stability after it.
+STIFF_PENDULUM = """&rope length = 1.0, mass_per_length = 0.5, axial_stiffness = 1.0e7,
+      bending_stiffness = 1.0e4, axial_damping = 1.0e3, bending_damping = 5.0 /
+&model kind = 'mpp', elements = 2 /
+&supports top = 'pinned', bottom = 'free' /
+&initial shape = 'straight', angle_deg = 1.0 /
+&solver t_end = 2.0, output_interval = 0.001, rtol = 1e-9, atol = 1e-12 /
+"""
+
+
+def test_auto_measures_erk_again_when_adams_runs_long(run, tmp_path):
+    """The stiff pendulum: erk's cost in the release's ringing (3.2e5 f per second over
+    its first 0.007 s) sends auto to adams, whose steps the stiff modes then hold (11 % of
+    them failed their error test). That first cost kept adams to the end: 6 s took 255,612
+    evaluations of f, against 136,902 for erk alone and 1,226 for cvode. erk's cost is
+    evidence for STALE_WINDOWS windows of the accuracy method, as for the order-5 pair;
+    then erk runs again, finds its steps held by stability, and auto goes implicit.
+    Counted work, not time: auto's evaluations of f stay below erk's own run's."""
+    scene = tmp_path / "stiff_pendulum.nml"
+    scene.write_text(STIFF_PENDULUM)
+    proc, out = run_scene(run, tmp_path, scene, "auto")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods, _, _, reasons = switch_log(f)
+        evals = int(f["/solver/rhs_evals"][()])
+        q = f["/state/q"][()]
+    assert methods[:2] == ["erk", "adams"], (methods, reasons)
+    again = [i for i, r in enumerate(reasons) if "measuring it again" in r]
+    assert again, (methods, reasons)
+    k = again[0]
+    age = int(re.search(r"measured (\d+) windows ago", reasons[k]).group(1))
+    assert methods[k] == "erk" and age == auto_parameter("STALE_WINDOWS"), (age, reasons)
+    assert methods[-1] in ("cvode", "mebdf"), (methods, reasons)
+    proc, erk_out = run_scene(run, tmp_path, scene, "erk", "solver.method='erk'")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(erk_out, "r") as f:
+        assert evals < int(f["/solver/rhs_evals"][()]), evals
+        assert np.max(np.abs(f["/state/q"][()] - q)) < 1e-6
+
+
 def test_erk_rejects_few_steps_where_stability_holds_them(run, tmp_path):
     """The paper's rope with erk at rtol 1e-2 (5 s): the step is held by stability (h rho
     near RK4's limit). With Gustafsson's PI gains there the controller cycled into the
