@@ -51,6 +51,9 @@ Command: `scripts/work_precision_testset`. Run: 2026-01-02 06:00 UTC.
 <!-- undated:begin -->
 A table someone wrote by hand.
 <!-- undated:end -->
+<!-- before erk:begin -->
+Command: `scripts/fig5` (Release). Run: 2026-01-02 06:00 UTC.
+<!-- before erk:end -->
 """)
     return second, with_page, later
 
@@ -124,6 +127,24 @@ def test_a_commit_listed_for_some_sections_counts_against_the_others(tmp_path):
     assert rows["run"] == []
     assert later not in rows["after"]
     assert rows["before"] == [later, with_page, second]
+    assert rows["before erk"] == [later, with_page, second]
+
+
+def test_a_section_name_stands_for_its_variants(tmp_path):
+    """`sections=before` covers "before erk" too (a section name with a space, which a word
+    of the file cannot hold), and not a section whose name merely starts with the same
+    letters."""
+    second, with_page, later = _repo(tmp_path)
+    (tmp_path / "docs" / "numbers-unchanged.txt").write_text(
+        f"{later}  sections=before,aft  checked\n")
+    with pytest.raises(SystemExit, match="section 'aft' is in no page"):
+        docs_status.status(tmp_path)
+    (tmp_path / "docs" / "numbers-unchanged.txt").write_text(
+        f"{later}  sections=before  checked\n")
+    rows = {r["name"]: [c[0] for c in r["commits"]] for r in docs_status.status(tmp_path)
+            if r["commits"] is not None}
+    assert rows["before"] == rows["before erk"] == [with_page, second]
+    assert later in rows["after"]
 
 
 def test_a_section_no_page_has_is_named(tmp_path):

@@ -17,7 +17,8 @@ comment) says so with a line `Numbers-unchanged: how it was checked` in its mess
 once committed, with a line `HASH  how it was checked` in docs/numbers-unchanged.txt; it is
 not counted. A line `HASH  sections=NAME,NAME  how it was checked` there keeps it from
 counting against those sections only (a change that alters some studies' runs, checked
-not to reach the others').
+not to reach the others'); a NAME also stands for the sections named NAME and a variant
+after a space (`profile_step` for `profile_step erk` too), whose names a word cannot hold.
 
     scripts/docs_status            # every section, oldest first
     scripts/docs_status --stale    # only those with code commits since their run
@@ -124,7 +125,8 @@ def unchanged_commits(root, known=None):
         names = None
         if len(words) > 1 and words[1].startswith("sections="):
             names = set(words[1][len("sections="):].split(","))
-            unknown = sorted(names - set(known)) if known is not None else []
+            unknown = sorted(n for n in names if not any(covers(n, k) for k in known)) \
+                if known is not None else []
             if unknown:
                 raise SystemExit(f"docs_status: {path}: line {number}: section "
                                  f"'{unknown[0]}' is in no page of docs/")
@@ -132,6 +134,12 @@ def unchanged_commits(root, known=None):
         before = full.get(key, set())
         full[key] = None if names is None or before is None else before | names
     return full
+
+
+def covers(name, section):
+    """Whether a `sections=` word's `name` stands for `section`: the same name, or the
+    name and a variant after a space."""
+    return section == name or section.startswith(name + " ")
 
 
 def code_commits(root, since, paths, commit=None, skip=None, section=None):
@@ -153,7 +161,8 @@ def code_commits(root, since, paths, commit=None, skip=None, section=None):
         if not record.strip():
             continue
         full, rev, date, subject, body = record.strip("\n").split("\t", 4)
-        if full in skip and (skip[full] is None or section in skip[full]):
+        if full in skip and (skip[full] is None or
+                             any(covers(n, section) for n in skip[full])):
             continue
         if any(line.startswith(UNCHANGED) for line in body.splitlines()):
             continue
