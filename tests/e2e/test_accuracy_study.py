@@ -102,3 +102,21 @@ def test_the_long_runs_item_counts_the_symplectic_ensembles():
     rows = [row("cvode", 1e-8, 3.0e-3), row("symplectic", 1e-3, 3.01e-3),
             row("symplectic", 1e-5, 3.5e-3), row("symplectic", 1e-7, 2.99e-3)]
     assert "at 2 of 3 tolerances" in acc.long_runs(rows)
+
+
+def test_the_guide_is_as_current_as_its_oldest_input(tmp_path):
+    """The choosing section reads the data of every subcommand: its stamp is the oldest of
+    theirs (rerunning one leaves the others' data as they were), not the time it was
+    written; a section without a stamp gives none."""
+    page = tmp_path / "accuracy.md"
+    stamps = {"windows": "2026-11-30 05:56 UTC, commit `ffc3f58`",
+              "discretization": "2026-11-30 14:14 UTC, commit `3ad199a`",
+              "chaos": "2026-11-30 07:54 UTC, commit `53d85c5`",
+              "fig4": "2026-11-29 23:10 UTC, commit `ca9a2aa`"}
+    page.write_text("".join(f"<!-- accuracy-{name}:begin -->\nCommand: `scripts/accuracy "
+                            f"{name}` (1.0 min, {stamp}).\n<!-- accuracy-{name}:end -->\n"
+                            for name, stamp in stamps.items()))
+    assert acc.oldest_input(page) == (stamps["fig4"], "fig4")
+    assert acc.oldest_input(page, ["windows", "chaos"]) == (stamps["windows"], "windows")
+    page.write_text(page.read_text().replace(stamps["chaos"], "2026-11-30"))
+    assert acc.oldest_input(page) == (None, None)

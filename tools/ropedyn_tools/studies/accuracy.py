@@ -35,6 +35,7 @@ import argparse
 import csv
 import math
 import pathlib
+import re
 import subprocess
 import sys
 import tempfile
@@ -712,6 +713,29 @@ def long_runs(chaos_rows=()):
         "method over 300 s: [energy over long runs](../validation/energy.md)).")
 
 
+#: a section's stamp on the accuracy page: its time and commit (section(), run_stamp)
+STAMP = re.compile(r"(\d{4}-\d\d-\d\d \d\d:\d\d UTC), commit `([0-9a-f]+)`")
+
+
+def oldest_input(page=PAGE, names=None):
+    """The stamp ('YYYY-MM-DD HH:MM UTC, commit `abc1234`') of the oldest of the accuracy
+    page's sections `names`, whose data the choosing section reads, and that section's
+    name; (None, None) when a section has no stamp. The choosing section is as current as
+    its oldest input, not as its last run: rerunning one subcommand leaves the others'
+    data as they were."""
+    text = pathlib.Path(page).read_text()
+    found = []
+    for name in names or STUDIES:
+        begin = text.find(f"<!-- accuracy-{name}:begin -->")
+        end = text.find(f"<!-- accuracy-{name}:end -->")
+        m = STAMP.search(text, begin, end) if 0 <= begin < end else None
+        if m is None:
+            return None, None
+        found.append((m.group(1), m.group(0), name))
+    when, stamp, name = min(found)
+    return stamp, name
+
+
 def choosing(args):
     win = read_csv(DATA / "acc_windows.csv")
     disc = read_csv(DATA / "acc_discretization.csv")
@@ -789,10 +813,13 @@ def choosing(args):
             md.append("")
     else:
         md.append("(no data yet: run `scripts/accuracy fig4`)")
+    stamp, oldest = oldest_input()
+    as_of = (f"{stamp} (its oldest input, the {oldest} section)" if stamp else
+             f"{run_stamp()} (a section of the accuracy page has no stamp)")
     block = "\n".join([CHOOSING_BEGIN, "",
                         "Written by `scripts/accuracy choosing` from the data of the other "
                         "subcommands ([accuracy](../validation/accuracy.md)), data as of "
-                        f"{run_stamp()}. Scene: the paper's rope (`input/paper.nml`).", "",
+                        f"{as_of}. Scene: the paper's rope (`input/paper.nml`).", "",
                         *md, CHOOSING_END])
     update_doc(CHOOSING, CHOOSING_BEGIN, CHOOSING_END, block)
     print(f"accuracy: wrote {CHOOSING}")
