@@ -1,7 +1,8 @@
 """The study tools (tools/ropedyn_tools/studies): auto_accuracy shows a fixed method's run
 that needs more CPU than its cap as such, not as a failure of the method; the method chains
 count switches, not the symplectic method's changes of step; bench_step runs again where a
-run of another build left its file."""
+run of another build left its file; calibrate runs its fit (each run to a file of its
+own)."""
 from ropedyn_tools.repo import ROOT
 from ropedyn_tools.studies import auto_accuracy as aa
 
@@ -44,3 +45,17 @@ def test_bench_step_runs_again_in_the_same_folder(ropedyn_exe, tmp_path):
     second = bench_step.run(ropedyn_exe, "rfem", 4, "cvode", 0.1, tmp_path)
     assert first[0] > 0 and second[0] > first[0]
     assert not list(tmp_path.glob("*.h5"))
+
+
+def test_calibrate_fits_with_a_file_for_each_run(ropedyn_exe, tmp_path):
+    """scripts/calibrate ran every MPP run of its fit into one file; since ropedyn replaces
+    no file of another run, its second run stopped the study. A short fit (n = 4, 0.2 s,
+    four runs of the MPP) writes its CSV."""
+    import csv
+    from ropedyn_tools.studies import calibrate
+    data = tmp_path / "fit.csv"
+    assert calibrate.main(["--exe", str(ropedyn_exe), "--elements", "4", "--t-fit", "0.2",
+                           "--window", "0.05", "--max-evals", "4", "--data", str(data)]) == 0
+    with open(data) as f:
+        (row,) = list(csv.DictReader(f))
+    assert int(row["mpp_runs"]) >= 3 and float(row["a"]) > 0 and float(row["b"]) > 0

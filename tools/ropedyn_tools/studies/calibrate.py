@@ -128,9 +128,11 @@ def main(argv=None):
             a, b = math.exp(x[0]), math.exp(x[1])
             key = (round(x[0], 6), round(x[1], 6))
             if key not in cache:
+                # a file of its own: ropedyn does not replace the file of another run
                 _, e = energy_history(exe, args.scene, common + [
                     'model.kind="mpp"', f"model.mpp_axial_damping_factor={a:.6g}",
-                    f"model.mpp_bending_damping_factor={b:.6g}"], f"{tmp}/mpp.h5")
+                    f"model.mpp_bending_damping_factor={b:.6g}"],
+                    f"{tmp}/mpp_{len(cache)}.h5")
                 e = windowed(e)
                 m = min(len(e), len(e_ref))
                 cache[key] = float(np.sum((e[:m] - e_ref[:m]) ** 2))
