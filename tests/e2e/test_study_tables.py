@@ -59,3 +59,16 @@ def test_calibrate_fits_with_a_file_for_each_run(ropedyn_exe, tmp_path):
     with open(data) as f:
         (row,) = list(csv.DictReader(f))
     assert int(row["mpp_runs"]) >= 3 and float(row["a"]) > 0 and float(row["b"]) > 0
+
+
+def test_auto_table_runs_again_after_a_run_killed_at_its_cap(ropedyn_exe, tmp_path):
+    """A run killed at its CPU cap leaves its partial file and lock (kept for --resume);
+    auto_table's pass at max_steps 1e7 runs into the same file, which ropedyn then refused:
+    the table showed "failed" where the method was only over its cap."""
+    from ropedyn_tools.studies import auto_table
+    scene = ROOT / "input" / "paper.nml"
+    sets = ("solver.rtol=1e-10", "solver.atol=1e-12")
+    for _ in range(2):
+        got = auto_table.run(ropedyn_exe, scene, tmp_path, "cvode", 30.0, cap=1, extra=sets)
+        assert got["status"] == "cap", got
+    assert not list(tmp_path.iterdir())

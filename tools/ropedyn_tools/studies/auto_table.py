@@ -76,6 +76,11 @@ def run(exe, scene, work, method, t_end, cap=None, extra=(), points=False):
     proc = subprocess.run([str(exe), "run", str(scene), *set_args(sets)], capture_output=True,
                           text=True, preexec_fn=limit, cwd=work)
     if proc.returncode != 0:
+        # a run killed at its cap leaves its partial file and lock, which ropedyn keeps
+        # for --resume: the next run into the same file (the pass at max_steps 1e7)
+        # would be refused and show as failed
+        for left in work.glob(out.name + ".*"):
+            left.unlink()
         if proc.returncode < 0 or proc.returncode in (137, 152):
             return {"status": "cap"}
         reason = (proc.stderr.strip().splitlines()[-1] if proc.stderr.strip()
