@@ -181,3 +181,16 @@ def test_a_section_a_test_keeps_current_is_not_listed(tmp_path):
         "<!-- keys:end -->\n")
     names = {r["name"] for r in docs_status.status(tmp_path)}
     assert "keys" not in names and "run" in names
+
+
+def test_a_derived_section_is_as_current_as_its_inputs(tmp_path, monkeypatch):
+    """A section made from other sections' data (the choosing guide from the accuracy
+    studies) counts the commits that count against any of them, not its own stamp's."""
+    second, with_page, later = _repo(tmp_path)
+    monkeypatch.setattr(docs_status, "DERIVED", {"run": ("before", "after")})
+    rows = {r["name"]: r["commits"] for r in docs_status.status(tmp_path)}
+    union = {c[0] for c in rows["before"] + rows["after"]}
+    assert [c[0] for c in rows["run"]] == [later, with_page, second] and union == {
+        later, with_page, second}
+    monkeypatch.setattr(docs_status, "DERIVED", {"run": ("before", "undated")})
+    assert {r["name"]: r["commits"] for r in docs_status.status(tmp_path)}["run"] is None

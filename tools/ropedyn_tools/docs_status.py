@@ -19,6 +19,8 @@ not counted. A line `HASH  sections=NAME,NAME  how it was checked` there keeps i
 counting against those sections only (a change that alters some studies' runs, checked
 not to reach the others'); a NAME also stands for the sections named NAME and a variant
 after a space (`profile_step` for `profile_step erk` too), whose names a word cannot hold.
+A section made from other sections' data (DERIVED: the choosing guide) counts the commits
+that count against any of them.
 
     scripts/docs_status            # every section, oldest first
     scripts/docs_status --stale    # only those with code commits since their run
@@ -42,6 +44,13 @@ CODE_PATHS = ("src", "solvers", "CMakeLists.txt", "input")
 NARROWER = {
     # the stiff test set: the integrators and their driver, no rope, no scene
     "work_precision_testset": ("solvers", "CMakeLists.txt"),
+}
+#: sections made from other sections' data, not from runs of their own: as current as those
+#: (the commits listed against any of them), whatever their own stamp says
+DERIVED = {
+    # scripts/accuracy choosing: the guide's tables from the four accuracy studies' CSVs
+    "choosing": ("accuracy-windows", "accuracy-discretization", "accuracy-fig4",
+                 "accuracy-chaos"),
 }
 #: sections whose currency a test checks instead (their script regenerates them exactly from
 #: the program: no run to date); not listed
@@ -199,6 +208,15 @@ def status(root=ROOT):
                 commits = code_commits(root, when, paths, commit, skip, name)
             rows.append({"page": str(page.relative_to(root)), "name": name, "script": script,
                          "stamp": stamp, "commits": commits})
+    by_name = {r["name"]: r for r in rows}
+    for row in rows:
+        inputs = [by_name[n] for n in DERIVED.get(row["name"], ()) if n in by_name]
+        if inputs:
+            if any(r["commits"] is None for r in inputs):
+                row["commits"] = None
+            else:
+                union = {c[0]: c for r in inputs for c in r["commits"]}
+                row["commits"] = sorted(union.values(), key=lambda c: c[1], reverse=True)
     return rows
 
 
