@@ -77,13 +77,13 @@
 !!   stiff two-rod MPP pendulum at rtol 1e-9 (test_methods) measured erk at 3.2e5 f per
 !!   second in the release's first 0.007 s, and Adams, its steps then held by the stiff
 !!   modes' stability (11 % failed their error test), ran the remaining 6 s on 255,612
-!!   evaluations of f against erk's own 136,902; measured again at 0.37 s, erk's steps
-!!   were held by stability and auto went to cvode: 21,127, and 0.44 s of CPU became
-!!   0.043. On the shipped MPP scenes that keep Adams, the measurements cost 4 to 7 %
-!!   more CPU (mpp_light_damping_n30/n70, mpp_undamped, snap_load_mpp; heavy_mass_mpp
-!!   and mpp_light_damping the same) and whip_ground_mpp, which found erk cheaper late
-!!   in its run, 29 % less (Release, the least of two runs each, by hand on 2026-11-30).
-!!   Adams' cost: its evaluations of f plus
+!!   evaluations of f against erk's own 136,506 (cvode: 1,585); measured again at
+!!   0.37 s, erk's steps were held by stability and auto went to cvode: 21,127, and
+!!   0.28 s of CPU became 0.033. On the shipped MPP scenes that keep Adams, the
+!!   measurements cost 4 to 7 % more CPU (mpp_light_damping_n30/n70, mpp_undamped,
+!!   snap_load_mpp; heavy_mass_mpp and mpp_light_damping the same) and whip_ground_mpp,
+!!   which found erk cheaper late in its run, 29 % less (Release, the least of two runs
+!!   each, by hand on 2026-11-30). Adams' cost: its evaluations of f plus
 !!   ADAMS_STEP_COST per step (CVODE's vector work per step: measured about 2 f on the
 !!   paper's rope at n = 30, where f is cheap, and about 1.2 f on the MPP at n = 30).
 !! - **The order-5 pair** (erk's Dormand-Prince 5(4), HIGH) is the method for a step held
