@@ -54,6 +54,9 @@ class Mutation:
     pytest: tuple = ()  #: pytest files or node ids that should catch it
 
 
+#: what the check's copy runs: a change elsewhere (docs/) does not make its stamp dirty
+CHECKED_PATHS = ("src", "solvers", "tests", "tools", "python", "input", "scripts",
+                 "CMakeLists.txt")
 RFEM = "src/models/rfem/ropedyn_rfem.f90"
 RFEM_K = "src/models/rfem/ropedyn_rfem_kernels.f90"
 RFEM_C = "src/models/rfem/ropedyn_rfem_create.f90"
@@ -597,8 +600,13 @@ def main(argv=None):
     tree.mkdir(parents=True, exist_ok=True)
     log = args.workdir / "mutation_check.log"
     log.write_text("")
-    commit = subprocess.run(["git", "describe", "--always", "--dirty"], cwd=ROOT,
+    # dirty only for uncommitted changes to what the check copies and runs (code, tests,
+    # scenes, tools), not to docs/: the table's stamp must name a commit docs_status reads
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
                             capture_output=True, text=True).stdout.strip()
+    if subprocess.run(["git", "status", "--porcelain", "--", *CHECKED_PATHS], cwd=ROOT,
+                      capture_output=True, text=True).stdout.strip():
+        commit += "-dirty"
     print(f"mutation_check: {len(chosen)} mutations on a copy in {tree} (log: {log})")
     sync_tree(ROOT, tree)
     runner = Runner(tree, log)
