@@ -38,6 +38,7 @@ import sys
 import time
 
 from ropedyn_tools.repo import ROOT
+from ropedyn_tools.studies.common import run_commit
 
 DOC = ROOT / "docs" / "development" / "testing.md"
 BEGIN, END = "<!-- mutation-results:begin -->", "<!-- mutation-results:end -->"
@@ -539,10 +540,11 @@ def apply(tree, m):
 
 
 def results_table(results, commit, minutes):
-    """The docs/development/testing.md section with the results."""
+    """The docs/development/testing.md section with the results; `commit`: run_commit's
+    text (', commit `abc1234`')."""
     caught = sum(r["status"] == "caught" for r in results)
     lines = [BEGIN, "",
-             f"Last run: {datetime.date.today().isoformat()}, commit `{commit}`, "
+             f"Last run: {datetime.date.today().isoformat()}{commit}, "
              f"{len(results)} mutations, **{caught} caught**, "
              f"{len(results) - caught} not caught; {minutes:.0f} min on two cores "
              "(`scripts/mutation_check`).", "",
@@ -600,13 +602,8 @@ def main(argv=None):
     tree.mkdir(parents=True, exist_ok=True)
     log = args.workdir / "mutation_check.log"
     log.write_text("")
-    # dirty only for uncommitted changes to what the check copies and runs (code, tests,
-    # scenes, tools), not to docs/: the table's stamp must name a commit docs_status reads
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
-                            capture_output=True, text=True).stdout.strip()
-    if subprocess.run(["git", "status", "--porcelain", "--", *CHECKED_PATHS], cwd=ROOT,
-                      capture_output=True, text=True).stdout.strip():
-        commit += "-dirty"
+    # uncommitted changes count only in what the check copies and runs, not in docs/
+    commit = run_commit(ROOT, CHECKED_PATHS)
     print(f"mutation_check: {len(chosen)} mutations on a copy in {tree} (log: {log})")
     sync_tree(ROOT, tree)
     runner = Runner(tree, log)

@@ -54,14 +54,14 @@ def utc_stamp():
 RUN_PATHS = ("src", "solvers", "CMakeLists.txt", "input", "tools", "python")
 
 
-def run_commit(root=None):
-    """Which code a study ran on: ', commit `abc1234`' (HEAD) when RUN_PATHS have no
+def run_commit(root=None, paths=RUN_PATHS):
+    """Which code a study ran on: ', commit `abc1234`' (HEAD) when `paths` have no
     uncommitted changes, else ', on `abc1234` with uncommitted changes' (scripts/docs_status
     then judges the section by the commit that writes its stamp, which should be the one
     that commits those changes); '' outside a git checkout."""
     try:
         rev = git("rev-parse", "--short", "HEAD", root=root).decode().strip()
-        dirty = git("status", "--porcelain", "--", *RUN_PATHS, root=root).decode().strip()
+        dirty = git("status", "--porcelain", "--", *paths, root=root).decode().strip()
     except (subprocess.CalledProcessError, OSError):
         return ""
     return f", on `{rev}` with uncommitted changes" if dirty else f", commit `{rev}`"
