@@ -35,7 +35,6 @@ import argparse
 import csv
 import math
 import pathlib
-import re
 import subprocess
 import sys
 import tempfile
@@ -44,6 +43,7 @@ import time
 import h5py
 import numpy as np
 
+from ropedyn_tools import docs_status
 from ropedyn_tools.repo import DOCS, add_exe_argument, exe_or_build
 from ropedyn_tools.studies.common import machine, update_doc, run_stamp
 
@@ -713,26 +713,20 @@ def long_runs(chaos_rows=()):
         "method over 300 s: [energy over long runs](../validation/energy.md)).")
 
 
-#: a section's stamp on the accuracy page: its time and commit (section(), run_stamp)
-STAMP = re.compile(r"(\d{4}-\d\d-\d\d \d\d:\d\d UTC), commit `([0-9a-f]+)`")
-
-
 def oldest_input(page=PAGE, names=None):
     """The stamp ('YYYY-MM-DD HH:MM UTC, commit `abc1234`') of the oldest of the accuracy
     page's sections `names`, whose data the choosing section reads, and that section's
-    name; (None, None) when a section has no stamp. The choosing section is as current as
-    its oldest input, not as its last run: rerunning one subcommand leaves the others'
-    data as they were."""
-    text = pathlib.Path(page).read_text()
-    found = []
+    name; (None, None) when one has no stamp with a time and a commit. The choosing section
+    is as current as its oldest input, not as its last run: rerunning one subcommand leaves
+    the others' data as they were. The stamps are read as scripts/docs_status reads them."""
+    found = {name: (stamp, commit) for name, _, stamp, commit in docs_status.sections(page)}
+    stamps = []
     for name in names or STUDIES:
-        begin = text.find(f"<!-- accuracy-{name}:begin -->")
-        end = text.find(f"<!-- accuracy-{name}:end -->")
-        m = STAMP.search(text, begin, end) if 0 <= begin < end else None
-        if m is None:
+        stamp, commit = found.get(f"accuracy-{name}", (None, None))
+        if not stamp or not commit or " " not in stamp:
             return None, None
-        found.append((m.group(1), m.group(0), name))
-    when, stamp, name = min(found)
+        stamps.append((docs_status.run_time(stamp), f"{stamp}, commit `{commit}`", name))
+    _, stamp, name = min(stamps)
     return stamp, name
 
 
