@@ -76,3 +76,17 @@ def test_the_ensemble_takes_the_first_start_from_the_table(monkeypatch):
     assert sorted(made) == [1, 2, 3]
     cells = [c.strip() for c in row.split("|")[1:-1]]
     assert float(cells[3]) == 2.5 and cells[4] == "1.50 - 5.00" and cells[5] == "2"
+
+
+def test_the_tolerance_rows_say_what_a_tighter_rtol_buys(ropedyn_exe, tmp_path, monkeypatch):
+    """On the undamped 4-element rope a tighter rtol takes a shorter step (at 1e-5 the
+    step rule hands it to SRKN6b) and the largest error falls with it; each row names the
+    composition from the run's switch log."""
+    monkeypatch.setattr(bs, "TOLERANCE_RTOLS", (1e-3, 1e-5))
+    monkeypatch.setattr(bs, "TOLERANCE_T_END", 5.0)
+    rows = bs.tolerance_rows(ropedyn_exe, tmp_path)
+    cells = [[c.strip() for c in row.split("|")[1:-1]] for row in rows]
+    assert [c[0] for c in cells] == ["0.001", "1e-05"]
+    assert cells[0][1].startswith("Chin") and cells[1][1].endswith("SRKN6b")
+    assert int(cells[1][2]) > int(cells[0][2])
+    assert float(cells[1][3]) < 0.1 * float(cells[0][3])

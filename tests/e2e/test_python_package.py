@@ -33,6 +33,7 @@ COMMANDS = {
     "bench_library": "ropedyn_tools.studies.bench_library",
     "bench_symplectic": "ropedyn_tools.studies.bench_symplectic",
     "compositions": "ropedyn_tools.studies.compositions",
+    "stiff_modes": "ropedyn_tools.studies.stiff_modes",
     "auto_table": "ropedyn_tools.studies.auto_table",
     "auto_accuracy": "ropedyn_tools.studies.auto_accuracy",
     "cost_model": "ropedyn_tools.studies.cost_model",

@@ -26,6 +26,11 @@ method's. The undamped rope (n = 20, from 75 degrees, as above) with the symplec
 at rtol 1e-3, 1e-5 and 1e-7 (ever shorter steps and, from 1e-5, SRKN6b) and with cvode at
 rtol 1e-9 (an independent method, its step held by accuracy): the growth of the elastic
 energy and of the largest |T + V - E0|, as in the table above. Two runs at a time, no CPU.
+
+`scripts/bench_symplectic tolerance` writes the section between the symplectic-tolerance
+markers (docs/validation/energy.md too): what a tighter rtol buys on an undamped rope whose
+fast modes hold much of the energy (4 elements, 60 s; the step rule's energy spread of the
+fastest mode: docs/theory/symplectic.md, "The step"). No CPU.
 """
 import argparse
 import concurrent.futures
@@ -249,6 +254,60 @@ def write_elastic(exe, n, t_end, no_write):
     return 0
 
 
+TOLERANCE_BEGIN = "<!-- symplectic-tolerance:begin -->"
+TOLERANCE_END = "<!-- symplectic-tolerance:end -->"
+#: the tolerance section: the rtols, the rope's elements and the run's length (s)
+TOLERANCE_RTOLS = (1e-3, 1e-4, 1e-5, 1e-6)
+TOLERANCE_N, TOLERANCE_T_END = 4, 60.0
+
+
+def composition(out):
+    """The composition of a symplectic run's last switch-log entry (its label, the text
+    before the first comma of /solver/switch_reason)."""
+    import h5py
+    with h5py.File(out, "r") as f:
+        return f["/solver/switch_reason"][-1].decode().split(",")[0].strip()
+
+
+def tolerance_rows(exe, work):
+    """The tolerance section's rows: the undamped rope of TOLERANCE_N elements to
+    TOLERANCE_T_END with the symplectic method at each of TOLERANCE_RTOLS."""
+    rows = []
+    for rtol in TOLERANCE_RTOLS:
+        name = f"tol_{rtol:g}"
+        sets = [*undamped_sets(TOLERANCE_N, "symplectic", TOLERANCE_T_END),
+                f"solver.rtol={rtol:g}", f"solver.atol={rtol / 100:g}"]
+        r = run(exe, work, PAPER, name, sets)
+        if not r["ok"]:
+            rows.append(f"| {rtol:g} | | | {r['why']} | |")
+            continue
+        worst = upto(r, TOLERANCE_T_END)
+        rows.append(f"| {rtol:g} | {composition(pathlib.Path(work) / f'{name}.h5')} | "
+                    f"{r['steps']} | {worst:.1e} | {worst / rtol:.2f} |")
+        print(rows[-1], flush=True)
+    return rows
+
+
+def write_tolerance(exe, no_write):
+    with tempfile.TemporaryDirectory() as work:
+        rows = tolerance_rows(exe, work)
+    if no_write:
+        return 0
+    block = "\n".join([
+        TOLERANCE_BEGIN,
+        "Command: `scripts/bench_symplectic tolerance` (code: "
+        f"tools/ropedyn_tools/studies/bench_symplectic.py; no CPU). Run: {run_stamp()}.", "",
+        f"The undamped paper rope of {TOLERANCE_N} elements from 75 degrees, "
+        f"{TOLERANCE_T_END:g} s, `method = 'symplectic'` (atol = rtol / 100, a record every "
+        "0.1 s): the composition the step rule took, its steps, and the largest "
+        "|T + V - E0| over the records, in m g L and over rtol:", "",
+        "| rtol | composition | steps | largest abs T + V - E0 (m g L) | over rtol |",
+        "|---|---|---|---|---|", *rows, TOLERANCE_END])
+    update_doc(DOC, TOLERANCE_BEGIN, TOLERANCE_END, block)
+    print(f"bench_symplectic tolerance: {DOC}")
+    return 0
+
+
 def window_block(windows):
     """The window tables of the symplectic runs (one per n), with their heading."""
     if not windows:
@@ -264,8 +323,9 @@ def window_block(windows):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     add_exe_argument(parser)
-    parser.add_argument("mode", nargs="?", choices=("targets", "elastic"), default="targets",
-                        help="the targets' section (default) or the elastic-growth one")
+    parser.add_argument("mode", nargs="?", choices=("targets", "elastic", "tolerance"),
+                        default="targets", help="the targets' section (default), the "
+                        "elastic-growth one, or the tolerance one")
     parser.add_argument("--elements", default="20 100")
     parser.add_argument("--t-end", type=float, default=300.0)
     parser.add_argument("--repeat", type=int, default=1)
@@ -281,6 +341,8 @@ def main(argv=None):
     if args.mode == "elastic":
         return write_elastic(exe_or_build(args.exe), int(args.elements.split()[0]),
                              args.t_end, args.no_write)
+    if args.mode == "tolerance":
+        return write_tolerance(exe_or_build(args.exe), args.no_write)
     if not args.former_exe:
         args.former = baseline_revision(parser, args.former)
     exe = exe_or_build(args.exe)
