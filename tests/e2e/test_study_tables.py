@@ -2,7 +2,8 @@
 that needs more CPU than its cap as such, not as a failure of the method; the method chains
 count switches, not the symplectic method's changes of step; bench_step runs again where a
 run of another build left its file; calibrate runs its fit (each run to a file of its
-own)."""
+own); bench_peers at equal accuracy takes the loosest rung of a half-decade ladder whose tip
+error is within MoorDyn's."""
 from ropedyn_tools.repo import ROOT
 from ropedyn_tools.studies import auto_accuracy as aa
 
@@ -72,3 +73,28 @@ def test_auto_table_runs_again_after_a_run_killed_at_its_cap(ropedyn_exe, tmp_pa
         got = auto_table.run(ropedyn_exe, scene, tmp_path, "cvode", 30.0, cap=1, extra=sets)
         assert got["status"] == "cap", got
     assert not list(tmp_path.iterdir())
+
+
+def test_equal_accuracy_takes_the_loosest_rung_within_moordyns_error(monkeypatch):
+    """bench_peers at equal accuracy: the rungs are tried loosest first and half a decade
+    apart, and the first whose tip error is within MoorDyn's is taken (here 0.03: 0.1 errs
+    more than MoorDyn, 0.01 less but is tighter)."""
+    from ropedyn_tools.studies import bench_peers as bp
+    ladder = bp.EQUAL_RTOLS
+    assert all(a > b for a, b in zip(ladder, ladder[1:]))
+    assert all(a / b <= 3.5 for a, b in zip(ladder, ladder[1:]))
+    errors = {0.1: 5.0e-3, 0.03: 1.4e-3, 0.01: 3.0e-4}
+    tried = []
+
+    def fake_run(exe, work, n, t_end, sets=(), name="run"):
+        rtol = float(next(s for s in sets if s.startswith("solver.rtol="))[12:])
+        tried.append(rtol)
+        return {"status": "complete", "cpu": 1.0, "steps": 10, "methods": "erk 4",
+                "balance": 0.0, "time": rtol, "tip": None}
+
+    monkeypatch.setattr(bp, "run_ropedyn", fake_run)
+    monkeypatch.setattr(bp, "tip_l2", lambda time, tip, ref: errors.get(time, 0.0))
+    row = bp.at_equal_accuracy("exe", None, 30, 30.0, None, {"cpu": 4.0}, 3.1e-3)
+    cells = [c.strip() for c in row.split("|")[1:-1]]
+    assert tried == [0.1, 0.03]
+    assert cells[2] == "0.03" and cells[-1] == "4.00"

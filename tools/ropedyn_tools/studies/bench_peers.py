@@ -289,7 +289,11 @@ def tip_l2(time, tip, ref):
     return float(np.sqrt(np.mean(d ** 2)))
 
 
-EQUAL_RTOLS = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
+#: the rtols tried for "at equal accuracy", loosest first: half a decade apart, so that
+#: the rung taken errs at most about 3 times less than MoorDyn (with decades ropedyn ran at
+#: 0.01 on the rope of n = 30, its tip 10 times closer than MoorDyn's, where 0.03 was
+#: within MoorDyn's error too)
+EQUAL_RTOLS = (1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6)
 
 
 def at_equal_accuracy(exe, work, n, t_end, ref, md, md_error, repeat=1, method="auto"):
