@@ -47,6 +47,7 @@ COMMANDS = {
     "update_references": "ropedyn_tools.update_references",
     "mutation_check": "ropedyn_tools.mutation_check",
     "docs_status": "ropedyn_tools.docs_status",
+    "docs_rerun": "ropedyn_tools.docs_rerun",
     "keys_reference": "ropedyn_tools.keys_reference",
 }
 # Python files under scripts/ that the README and docs/ call by path
