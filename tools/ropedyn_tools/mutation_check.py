@@ -233,6 +233,12 @@ MUTATIONS = [
              "the MPP's residual in water without the rods' rotary added inertia (the "
              "Newton matrix's and the residual form's; the O(n) solve keeps it)",
              ctest=("test_mpp",)),
+    Mutation("spectrum-no-balanced-pass", "solvers/ropedyn_spectrum.f90",
+             "if (kr%band .and. any(real(spec%ritz, wp) > 0.0_wp",
+             "if (.false. .and. any(real(spec%ritz, wp) > 0.0_wp",
+             "the spectrum estimate keeps a fast Ritz value in the right half plane (a "
+             "non-normal artifact) instead of estimating again on the balanced Jacobian",
+             ctest=("test_spectrum_estimate",)),
     # --- supports -------------------------------------------------------------------------
     Mutation("support-phase-in-degrees", MOTION,
              "self%phase = phase_deg*pi/180.0_wp",
