@@ -45,18 +45,11 @@ _COMMAND = re.compile(r"`(scripts/[^`]+)`")
 
 def section_command(page, name):
     """The command that wrote section `name` of the Markdown page at `page`: the first
-    backquoted `scripts/...` in its head (docs_status.HEAD_LINES lines); None if none."""
-    lines = pathlib.Path(page).read_text().splitlines()
-    begin = f"<!-- {name}:begin -->"
-    for i, line in enumerate(lines):
-        if line.strip() == begin:
-            for text in lines[i + 1:i + 1 + docs_status.HEAD_LINES]:
-                if f"<!-- {name}:end -->" in text:
-                    return None
-                m = _COMMAND.search(text)
-                if m:
-                    return m.group(1)
-            return None
+    backquoted `scripts/...` in its head (docs_status.heads); None if none."""
+    for found, head in docs_status.heads(page):
+        if found == name:
+            m = _COMMAND.search(head)
+            return m.group(1) if m else None
     return None
 
 
@@ -124,7 +117,8 @@ def run(commands, root, logs):
         print(f"[{k}/{len(commands)}] {command}  (log: {log})", flush=True)
         start = time.monotonic()
         with open(log, "w") as out:
-            code = subprocess.run(words, cwd=root, stdout=out, stderr=subprocess.STDOUT).returncode
+            code = subprocess.run(words, cwd=root, stdout=out,
+                                  stderr=subprocess.STDOUT).returncode
         print(f"      exit {code}, {time.monotonic() - start:.0f} s", flush=True)
         if code != 0:
             print(f"docs_rerun: `{command}` failed with exit {code}; see {log}; running "

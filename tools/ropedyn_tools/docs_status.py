@@ -70,9 +70,10 @@ _STAMP = re.compile(r"(?P<date>20\d\d-\d\d-\d\d)(?:[ T](?P<time>\d\d:\d\d)(?: ?U
 _COMMIT = re.compile(r"commit `(?P<rev>[0-9a-f]{7,40})`")
 
 
-def sections(page):
-    """[(name, script or None, stamp text or None, commit or None)] of the generated
-    sections of the Markdown page at `page`, in page order."""
+def heads(page):
+    """[(name, head)] of the generated sections of the Markdown page at `page`, in page
+    order: head is the section's first HEAD_LINES non-blank lines, joined (where its
+    command and stamp are)."""
     lines = pathlib.Path(page).read_text().splitlines()
     found = []
     for i, line in enumerate(lines):
@@ -86,7 +87,15 @@ def sections(page):
                 break
             if text.strip():
                 head.append(text)
-        head = "\n".join(head)
+        found.append((name, "\n".join(head)))
+    return found
+
+
+def sections(page):
+    """[(name, script or None, stamp text or None, commit or None)] of the generated
+    sections of the Markdown page at `page`, in page order."""
+    found = []
+    for name, head in heads(page):
         script = _SCRIPT.search(head)
         stamp = _STAMP.search(head)
         commit = _COMMIT.search(head)

@@ -48,6 +48,8 @@ HEADER = ("| n | modes | largest omega along the rope (1/s) | turning of the ele
           "across the rope | rho (1/s) | its kind | its damping ratio | "
           "rho estimated by the run at its start | step gain, along implicit | "
           "turning implicit | across implicit |")
+#: the n of the table (the --elements default)
+ELEMENTS = "10 30 100"
 _RADIUS = re.compile(r"spectral radius\s+([0-9.Ee+-]+)\s*1/s")
 
 
@@ -132,7 +134,7 @@ def row(exe, work, n):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     add_exe_argument(parser)
-    parser.add_argument("--elements", default="10 30 100")
+    parser.add_argument("--elements", default=ELEMENTS)
     parser.add_argument("--no-write", action="store_true")
     args = parser.parse_args(argv)
     exe = exe_or_build(args.exe)
@@ -145,7 +147,7 @@ def main(argv=None):
     if args.no_write:
         return 0
     command = "scripts/stiff_modes" + (f" --elements '{args.elements}'"
-                                       if args.elements != "10 30 100" else "")
+                                       if args.elements != ELEMENTS else "")
     block = "\n".join([
         BEGIN,
         f"Command: `{command}` (code: tools/ropedyn_tools/studies/stiff_modes.py; "
