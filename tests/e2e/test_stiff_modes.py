@@ -2,9 +2,11 @@
 modes and the step an IMEX method would gain. The turning share tells an element's turning
 from its moving; the gains are rho over the other kinds' largest frequency; and the modes
 of `ropedyn modes` and the spectrum a run estimates, two algorithms at two states, agree on
-the spectral radius at n = 30 (the premise of reading the modes as what holds the step; at
-n = 10 the run's estimate is a Ritz value off the spectrum, docs/performance/peers.md)."""
+the spectral radius at n = 10 and 30 (the premise of reading the modes as what holds the
+step; at n = 10 the first, unbalanced estimate is a Ritz value off the spectrum, which the
+estimate on the balanced Jacobian corrects: docs/theory/auto.md)."""
 import numpy as np
+import pytest
 
 from ropedyn_tools.studies import stiff_modes as sm
 
@@ -35,8 +37,8 @@ def test_step_gains_are_rho_over_the_other_kinds():
     assert gains[0] == 1.0 and gains[2] == 1.0   # the fastest stays explicit
 
 
-def test_modes_and_the_runs_estimate_agree_on_rho(ropedyn_exe, tmp_path):
-    n = 30
+@pytest.mark.parametrize("n", [10, 30])
+def test_modes_and_the_runs_estimate_agree_on_rho(ropedyn_exe, tmp_path, n):
     omega, zeta, kind = sm.modes_of(ropedyn_exe, tmp_path, n)
     assert len(omega) == 3 * n and np.all(omega > 0.0) and np.all(zeta >= 0.0)
     # every kind is there: n springs along the rope, elements turning, the pendulum across
