@@ -15,7 +15,8 @@ module ropedyn_spectrum
     use ropedyn_erk_tables, only: erk_table_t
     implicit none
     private
-    public :: spectrum_t, estimate_spectrum, bdf_growth, erk_stable_step, LIGHT_DAMPING
+    public :: spectrum_t, estimate_spectrum, bdf_growth, erk_stable_step, LIGHT_DAMPING, &
+              FAST_FRACTION
 
     !> Krylov dimension of the estimate. The Jacobian of a rope in first-order form is far
     !! from normal (m and m/s in one vector), so a Ritz value can lie well outside its
@@ -34,6 +35,8 @@ module ropedyn_spectrum
     !! method takes the 4th-order composition for it (docs/validation/energy.md,
     !! docs/theory/symplectic.md).
     real(wp), parameter :: LIGHT_DAMPING = 0.01_wp
+    !> A fast mode: a Ritz value of modulus at least this fraction of the spectral radius.
+    real(wp), parameter :: FAST_FRACTION = 0.1_wp
 
     !> Ritz values of the Jacobian (1/s) and what follows from them.
     type :: spectrum_t
@@ -100,7 +103,7 @@ contains
         call kr%ritz_values(problem, t, y, spec%ritz, ok)
         if (.not. ok) return
         if (kr%band .and. any(real(spec%ritz, wp) > 0.0_wp .and. &
-                              abs(spec%ritz) >= 0.1_wp*abs(spec%ritz(1)))) then
+                              abs(spec%ritz) >= FAST_FRACTION*abs(spec%ritz(1)))) then
             call kr%balance()
             call kr%ritz_values(problem, t, y, spec%ritz, ok)
             if (.not. ok) return
@@ -108,7 +111,7 @@ contains
         spec%radius = abs(spec%ritz(1))
         spec%fast_damping = 1.0_wp
         do i = 1, size(spec%ritz)
-            if (abs(spec%ritz(i)) < 0.1_wp*spec%radius) exit
+            if (abs(spec%ritz(i)) < FAST_FRACTION*spec%radius) exit
             spec%fast_damping = min(spec%fast_damping, &
                                     max(0.0_wp, -real(spec%ritz(i), wp)/abs(spec%ritz(i))))
         end do
@@ -298,7 +301,7 @@ contains
         complex(wp), allocatable :: fast(:)
         integer :: i
         zeta = 1.0_wp
-        fast = self%fast(0.1_wp)
+        fast = self%fast(FAST_FRACTION)
         do i = 1, size(fast)
             if (real(fast(i), wp) > 0.0_wp .or. abs(fast(i)) <= 0.0_wp) cycle
             zeta = min(zeta, -real(fast(i), wp)/abs(fast(i)))
@@ -372,7 +375,7 @@ contains
         integer, parameter :: SAMPLES = 2000, STRIDE = 16
         h = 0.0_wp
         if (.not. spec%valid) return
-        fast = spec%fast(0.1_wp)
+        fast = spec%fast(FAST_FRACTION)
         do i = 1, size(fast)
             if (real(fast(i), wp) > 0.0_wp) fast(i) = cmplx(0.0_wp, aimag(fast(i)), wp)
         end do

@@ -51,7 +51,7 @@ module ropedyn_symplectic
     use ropedyn_integrator, only: integrator_t, start_t, solver_stats_t, stop_now, &
                                   STIFF_STEP_RATE, steps_to_end, budget_covering, &
                                   integrator_budget_shortfall
-    use ropedyn_spectrum, only: spectrum_t, estimate_spectrum, LIGHT_DAMPING
+    use ropedyn_spectrum, only: spectrum_t, estimate_spectrum, LIGHT_DAMPING, FAST_FRACTION
     use ropedyn_switch_log, only: switch_log_t, switch_event_t
     use ropedyn_split_tables, only: split_table_t, split_table, TABLE_VERLET, TABLE_BM6, &
                                     TABLE_CHIN, OVERDAMPED_LIMIT

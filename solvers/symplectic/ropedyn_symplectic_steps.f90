@@ -205,7 +205,7 @@ contains
         h = 0.0_wp
         if (present(zeta_limit)) zeta_limit = 0.0_wp
         if (.not. spec%valid) return
-        fast = spec%fast(0.1_wp)
+        fast = spec%fast(FAST_FRACTION)
         h = huge(1.0_wp)
         do i = 1, size(fast)
             w = abs(fast(i))
