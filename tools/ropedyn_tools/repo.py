@@ -11,6 +11,8 @@ import pathlib
 import subprocess
 import sys
 
+from ropedyn_tools.arguments import list_text, positive
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 INPUT = ROOT / "input"
 PAPER = INPUT / "paper.nml"
@@ -40,7 +42,8 @@ def add_scaling_arguments(parser, t_end, elements, rtol=1e-6):
     add_exe_argument(parser)
     parser.add_argument("--t-end", type=float, default=t_end)
     parser.add_argument("--rtol", type=float, default=rtol)
-    parser.add_argument("--elements", default=elements)
+    parser.add_argument("--elements", type=list_text(positive(int)), default=elements,
+                        help="numbers of elements, space-separated")
 
 
 def exe_or_build(exe):

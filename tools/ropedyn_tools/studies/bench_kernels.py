@@ -20,6 +20,7 @@ import subprocess
 import sys
 import tempfile
 
+from ropedyn_tools.arguments import list_text, positive
 from ropedyn_tools.repo import DOCS, PAPER, build, set_args
 from ropedyn_tools.studies.bench_rhs import build_bench_rhs
 from ropedyn_tools.studies.common import baseline_revision, machine, update_doc, run_stamp
@@ -81,8 +82,9 @@ def main(argv=None):
                         "build the Release configuration with scripts/build and use it)")
     parser.add_argument("--baseline", default=None,
                         help="git revision to compare with (e.g. the merge base)")
-    parser.add_argument("--rfem-elements", default="30 300 1000")
-    parser.add_argument("--mpp-elements", default="10 30 70")
+    parser.add_argument("--rfem-elements", type=list_text(positive(int)),
+                        default="30 300 1000")
+    parser.add_argument("--mpp-elements", type=list_text(positive(int)), default="10 30 70")
     parser.add_argument("--seconds", type=float, default=0.3,
                         help="time per repetition of each timing (5 repetitions, fastest kept)")
     parser.add_argument("--no-callgrind", action="store_true",

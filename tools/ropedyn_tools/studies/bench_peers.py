@@ -71,6 +71,7 @@ import tempfile
 import numpy as np
 
 from ropedyn import io
+from ropedyn_tools.arguments import list_text, positive
 from ropedyn_tools.repo import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import (least_cpu, machine, method_chain, method_label,
                                           update_doc, run_stamp)
@@ -573,10 +574,10 @@ def main(argv=None):
     add_exe_argument(parser)
     parser.add_argument("--t-end", type=float, default=30.0)
     parser.add_argument("--probe", type=float, default=5.0, help="stability probe (s)")
-    parser.add_argument("--elements", default="10 30 100")
+    parser.add_argument("--elements", type=list_text(positive(int)), default="10 30 100")
     parser.add_argument("--repeat", type=int, default=3,
                         help="runs of each timed run (the least CPU counts)")
-    parser.add_argument("--undamped-elements", default="20 100",
+    parser.add_argument("--undamped-elements", type=list_text(positive(int)), default="20 100",
                         help="n of the undamped comparison (energy over --undamped-t-end)")
     parser.add_argument("--undamped-t-end", type=float, default=300.0)
     parser.add_argument("--only-undamped", action="store_true",
@@ -584,7 +585,7 @@ def main(argv=None):
     parser.add_argument("--no-undamped", action="store_true",
                         help="without the undamped comparison (its table kept)")
     parser.add_argument("--no-write", action="store_true")
-    parser.add_argument("--coupled-elements", default="30",
+    parser.add_argument("--coupled-elements", type=list_text(positive(int)), default="30",
                         help="n of the coupled case (top driven from Python)")
     parser.add_argument("--coupled-only", action="store_true",
                         help="only the coupled case (its own table)")

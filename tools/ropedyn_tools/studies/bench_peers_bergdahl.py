@@ -37,6 +37,7 @@ import time
 
 import numpy as np
 
+from ropedyn_tools.arguments import list_text, positive
 from ropedyn_tools.repo import DOCS, ROOT
 from ropedyn_tools.studies import bergdahl as bg
 from ropedyn_tools.studies.bench_peers import ensure_bench_venv
@@ -152,8 +153,10 @@ def main(argv=None):
                         help="the case files of scripts/validation bergdahl")
     parser.add_argument("--segments", type=int, default=165)
     parser.add_argument("--dt", type=float, default=3.26e-4, help="MoorDyn's dtM (s)")
-    parser.add_argument("--periods", default=",".join(str(p) for p in bg.PERIODS))
-    parser.add_argument("--radii", default=",".join(str(r) for r in bg.RADII))
+    parser.add_argument("--periods", type=list_text(positive(float), ","),
+                        default=",".join(str(p) for p in bg.PERIODS))
+    parser.add_argument("--radii", type=list_text(positive(float), ","),
+                        default=",".join(str(r) for r in bg.RADII))
     parser.add_argument("--convergence", action="store_true",
                         help="also T = 1.25 and 3.5 s at R = 0.2 m with dtM halved and the "
                              "segments doubled")

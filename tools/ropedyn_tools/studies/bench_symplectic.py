@@ -42,6 +42,7 @@ import tempfile
 import numpy as np
 
 from ropedyn import io
+from ropedyn_tools.arguments import list_text, positive
 from ropedyn_tools.repo import DOCS, INPUT, PAPER, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies import stability_metrics
 from ropedyn_tools.studies.common import (baseline_revision, least_cpu, machine, run_stamp,
@@ -326,7 +327,7 @@ def main(argv=None):
     parser.add_argument("mode", nargs="?", choices=("targets", "elastic", "tolerance"),
                         default="targets", help="the targets' section (default), the "
                         "elastic-growth one, or the tolerance one")
-    parser.add_argument("--elements", default="20 100")
+    parser.add_argument("--elements", type=list_text(positive(int)), default="20 100")
     parser.add_argument("--t-end", type=float, default=300.0)
     parser.add_argument("--repeat", type=int, default=1)
     parser.add_argument("--starts", type=int, default=8,

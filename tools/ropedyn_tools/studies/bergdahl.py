@@ -25,6 +25,7 @@ import time
 import h5py
 import numpy as np
 
+from ropedyn_tools.arguments import list_text, positive
 from ropedyn_tools.repo import DOCS, INPUT, ROOT, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import least_cpu, run_stamp, scene_number, update_doc
 
@@ -751,8 +752,10 @@ def main(argv=None):
     parser.add_argument("--work", default=str(ROOT / "out" / "bergdahl"),
                         help="directory of the case files (kept: a rerun reuses them)")
     parser.add_argument("--models", default="rfem,mpp")
-    parser.add_argument("--periods", default=",".join(str(p) for p in PERIODS))
-    parser.add_argument("--radii", default=",".join(str(r) for r in RADII))
+    parser.add_argument("--periods", type=list_text(positive(float), ","),
+                        default=",".join(str(p) for p in PERIODS))
+    parser.add_argument("--radii", type=list_text(positive(float), ","),
+                        default=",".join(str(r) for r in RADII))
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--convergence", action="store_true",
                         help="also the runs at other element lengths and tolerances")
@@ -763,7 +766,8 @@ def main(argv=None):
                              "floor laws")
     parser.add_argument("--analyse-only", action="store_true",
                         help="no runs: analyse the case files in --work")
-    parser.add_argument("--quick", default=None, metavar="ELEMENTS,CYCLES",
+    parser.add_argument("--quick", type=list_text(positive(int), ",", length=2), default=None,
+                        metavar="ELEMENTS,CYCLES",
                         help="smoke test: that many elements and cycles (one analysed), "
                              "a one-cycle ramp")
     parser.add_argument("--figures", default=str(DOCS / "figures"))

@@ -20,6 +20,7 @@ import subprocess
 import tempfile
 
 from ropedyn import io
+from ropedyn_tools.arguments import listing, positive
 from ropedyn_tools.repo import DOCS, PAPER, ROOT, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import least_cpu, machine, update_doc, run_stamp
 
@@ -56,30 +57,6 @@ def counted(method, stats, constants):
     return (f + step * float(stats["steps"])
             + constants["FACTOR_BASE"] * float(stats.get("lin_setups", 0))
             + constants["JACOBIAN_COST"] * float(stats["jac_evals"]))
-
-
-def positive(kind):
-    """An argparse type: a number of `kind` above 0."""
-    def parse(text):
-        try:
-            value = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-        if not value > 0:
-            raise argparse.ArgumentTypeError(f"must be above 0: {text!r}")
-        return value
-    parse.__name__ = kind.__name__
-    return parse
-
-
-def listing(item):
-    """An argparse type: a space-separated, non-empty list of `item`."""
-    def parse(text):
-        values = [item(x) for x in text.split()]
-        if not values:
-            raise argparse.ArgumentTypeError("an empty list")
-        return values
-    return parse
 
 
 def run_case(exe, n, rtol, method, t_end, workdir):

@@ -22,6 +22,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from ropedyn import io  # noqa: E402
+from ropedyn_tools.arguments import list_text, positive  # noqa: E402
 from ropedyn_tools.repo import (DOCS, PAPER, ROOT, add_exe_argument, exe_or_build,  # noqa: E402
                                 set_args)
 from ropedyn_tools.studies.calibrate import FIT_DATA, read_fit  # noqa: E402
@@ -57,7 +58,7 @@ def main(argv=None):
     add_exe_argument(parser)
     parser.add_argument("--t-end", type=float, default=30.0)
     parser.add_argument("--method", default="auto")
-    parser.add_argument("--elements", default="30,70")
+    parser.add_argument("--elements", type=list_text(positive(int), ","), default="30,70")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--outdir", default=str(ROOT / "out" / "fig5"))
     parser.add_argument("--figure", default=str(DOCS / "figures" / "fig5_energy.png"))

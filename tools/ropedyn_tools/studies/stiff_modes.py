@@ -38,6 +38,7 @@ import tempfile
 import h5py
 import numpy as np
 
+from ropedyn_tools.arguments import list_text, positive
 from ropedyn_tools.repo import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import machine, run_stamp, update_doc
 
@@ -134,7 +135,7 @@ def row(exe, work, n):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     add_exe_argument(parser)
-    parser.add_argument("--elements", default=ELEMENTS)
+    parser.add_argument("--elements", type=list_text(positive(int)), default=ELEMENTS)
     parser.add_argument("--no-write", action="store_true")
     args = parser.parse_args(argv)
     exe = exe_or_build(args.exe)

@@ -1,0 +1,57 @@
+"""The studies' list options: a list that is not numbers, or a number not above 0, is one
+usage error (exit 2) naming the option, the list and the bad item, before anything is
+built or run (tools/ropedyn_tools/arguments.py); before, the studies traced back where
+they first converted the list."""
+import argparse
+import importlib
+
+import pytest
+
+from ropedyn_tools.arguments import list_text, listing, positive
+
+BAD = [
+    ("stiff_modes", "--elements", "abc", "'abc'"),
+    ("bench_kernels", "--rfem-elements", "30 x", "'x'"),
+    ("bench_kernels", "--mpp-elements", "0", "must be above 0"),
+    ("bench_peers", "--elements", "10,30", "'10,30'"),
+    ("bench_peers", "--undamped-elements", "20 a", "'a'"),
+    ("bench_peers", "--coupled-elements", "-3", "must be above 0"),
+    ("bench_symplectic", "--elements", "2.5", "not a whole number"),
+    ("fig5", "--elements", "30 70", "'30 70'"),
+    ("bergdahl", "--periods", "1.25,,2", "not a number: ''"),
+    ("bergdahl", "--radii", "x", "'x'"),
+    ("bergdahl", "--quick", "4", "2 values"),
+    ("bench_peers_bergdahl", "--periods", "a", "'a'"),
+    ("bench_peers_bergdahl", "--radii", "0", "must be above 0"),
+    ("work_precision", "--elements", "10;30", "'10;30'"),
+    ("work_precision", "--rtols", "1e-3,abc", "'abc'"),
+    ("bench_rfem", "--elements", "ten", "'ten'"),
+    ("bench_models", "--elements", "ten", "'ten'"),
+    ("cost_model", "--rtols", "1e-3 0", "must be above 0"),
+]
+
+
+@pytest.mark.parametrize("study,option,value,words", BAD,
+                         ids=[f"{s}{o}" for s, o, _, _ in BAD])
+def test_bad_list_is_a_usage_error(study, option, value, words, capsys):
+    module = importlib.import_module(f"ropedyn_tools.studies.{study}")
+    with pytest.raises(SystemExit) as e:
+        module.main([option, value, "--exe", "/nonexistent"])
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert f"argument {option}:" in err and words in err, err
+    assert "Traceback" not in err
+
+
+def test_list_types_keep_or_convert_the_text():
+    """list_text returns the text as given (a study quotes it in its Command line);
+    listing returns the numbers; each separator splits as documented."""
+    assert list_text(positive(int))("10 30  100") == "10 30  100"
+    assert listing(positive(int))("10 30  100") == [10, 30, 100]
+    assert listing(positive(float), ",")("1.25,2") == [1.25, 2.0]
+    assert listing(positive(int), ", ")("10,30 70") == [10, 30, 70]
+    for text, sep in (("10,30", None), ("10 30", ","), ("", None), ("1,0", ", ")):
+        with pytest.raises(argparse.ArgumentTypeError):
+            listing(positive(int), sep)(text)
+    with pytest.raises(argparse.ArgumentTypeError):
+        listing(positive(int), ",", length=2)("4,5,6")

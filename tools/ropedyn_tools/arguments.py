@@ -1,0 +1,65 @@
+"""argparse types that the studies share: a number above 0, and lists of such numbers. A bad
+value is then one usage error that names the option, the list and the bad item (exit 2),
+before anything is built or run, for example
+    argument --elements: 'ten', a list separated by blanks: not a whole number: 'ten'
+Without a type the study would trace back where it first converts the list.
+
+`listing` returns the list; `list_text` checks the list and returns the text as given, for
+the studies that quote the option's text in their Command line."""
+import argparse
+
+#: how a list's items are separated: blanks, commas, or either
+SEPARATORS = {None: "blanks", ",": "commas", ", ": "commas or blanks"}
+
+
+def positive(kind):
+    """An argparse type: a number of `kind` (int or float) above 0."""
+    def parse(text):
+        try:
+            value = kind(text)
+        except ValueError:
+            what = "a whole number" if kind is int else "a number"
+            raise argparse.ArgumentTypeError(f"not {what}: {text!r}") from None
+        if not value > 0:
+            raise argparse.ArgumentTypeError(f"must be above 0: {text!r}")
+        return value
+    parse.__name__ = kind.__name__
+    return parse
+
+
+def items(text, sep=None):
+    """The items of a list: split at blanks (sep None), at commas (","), or at either (", ")."""
+    if sep not in SEPARATORS:
+        raise ValueError(f"unknown separator {sep!r}")
+    if sep == ", ":
+        return text.replace(",", " ").split()
+    return text.split(sep)
+
+
+def listing(item, sep=None, length=None):
+    """An argparse type: a non-empty list of `item` (an argparse type such as positive(int)),
+    separated as `items` reads them; with `length`, exactly that many."""
+    def parse(text):
+        try:
+            values = [item(x) for x in items(text, sep)]
+        except argparse.ArgumentTypeError as e:
+            raise argparse.ArgumentTypeError(
+                f"{text!r}, a list separated by {SEPARATORS[sep]}: {e}") from None
+        if not values:
+            raise argparse.ArgumentTypeError("an empty list")
+        if length is not None and len(values) != length:
+            raise argparse.ArgumentTypeError(
+                f"{text!r}: {length} values separated by {SEPARATORS[sep]}, not {len(values)}")
+        return values
+    return parse
+
+
+def list_text(item, sep=None, length=None):
+    """An argparse type: the text of a list that `listing(item, sep, length)` accepts, as
+    given."""
+    check = listing(item, sep, length)
+
+    def parse(text):
+        check(text)
+        return text
+    return parse
