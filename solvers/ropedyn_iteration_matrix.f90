@@ -20,6 +20,7 @@
 !! Both: LAPACK band (dgbtrf/dgbtrs), or dense (dgetrf/dgetrs) when the band is nearly full.
 module ropedyn_iteration_matrix
     use ropedyn_kinds, only: wp, i8
+    use ropedyn_lapack, only: dgetrf, dgetrs, dgbtrf, dgbtrs
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_RECOVERABLE, STATUS_FATAL
     use ropedyn_block3, only: block3_t, block_tridiagonal
     use ropedyn_band_lu, only: RFEM_KL, factored_dense, band_lu_factor, band_lu_solve, &
@@ -88,37 +89,6 @@ module ropedyn_iteration_matrix
         procedure, private :: solve_first_order
         procedure, private :: solve_reduced
     end type iteration_matrix_t
-
-    interface
-        subroutine dgetrf(m, n, a, lda, ipiv, info)
-            import :: wp
-            integer, intent(in) :: m, n, lda
-            real(wp), intent(inout) :: a(lda, *)
-            integer, intent(out) :: ipiv(*), info
-        end subroutine dgetrf
-        subroutine dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
-            import :: wp
-            character, intent(in) :: trans
-            integer, intent(in) :: n, nrhs, lda, ldb, ipiv(*)
-            real(wp), intent(in) :: a(lda, *)
-            real(wp), intent(inout) :: b(ldb, *)
-            integer, intent(out) :: info
-        end subroutine dgetrs
-        subroutine dgbtrf(m, n, kl, ku, ab, ldab, ipiv, info)
-            import :: wp
-            integer, intent(in) :: m, n, kl, ku, ldab
-            real(wp), intent(inout) :: ab(ldab, *)
-            integer, intent(out) :: ipiv(*), info
-        end subroutine dgbtrf
-        subroutine dgbtrs(trans, n, kl, ku, nrhs, ab, ldab, ipiv, b, ldb, info)
-            import :: wp
-            character, intent(in) :: trans
-            integer, intent(in) :: n, kl, ku, nrhs, ldab, ldb, ipiv(*)
-            real(wp), intent(in) :: ab(ldab, *)
-            real(wp), intent(inout) :: b(ldb, *)
-            integer, intent(out) :: info
-        end subroutine dgbtrs
-    end interface
 
     interface
         ! the first-order path (submodule ropedyn_iteration_matrix_first)

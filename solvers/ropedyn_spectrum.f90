@@ -11,6 +11,7 @@
 !! f) and m band products, i.e. a few right-hand sides.
 module ropedyn_spectrum
     use ropedyn_kinds, only: wp
+    use ropedyn_lapack, only: dgeev, zgeev
     use ropedyn_problem, only: problem_t, STATUS_OK
     use ropedyn_erk_tables, only: erk_table_t
     implicit none
@@ -62,27 +63,6 @@ module ropedyn_spectrum
         procedure :: ritz_values => krylov_ritz_values
         procedure :: balance => krylov_balance
     end type krylov_t
-
-    interface
-        subroutine dgeev(jobvl, jobvr, n, a, lda, wr, wi, vl, ldvl, vr, ldvr, work, lwork, info)
-            import :: wp
-            character(len=1), intent(in) :: jobvl, jobvr
-            integer, intent(in) :: n, lda, ldvl, ldvr, lwork
-            real(wp), intent(inout) :: a(lda, *)
-            real(wp), intent(out) :: wr(*), wi(*), vl(ldvl, *), vr(ldvr, *), work(*)
-            integer, intent(out) :: info
-        end subroutine dgeev
-        subroutine zgeev(jobvl, jobvr, n, a, lda, w, vl, ldvl, vr, ldvr, work, lwork, rwork, &
-                         info)
-            import :: wp
-            character(len=1), intent(in) :: jobvl, jobvr
-            integer, intent(in) :: n, lda, ldvl, ldvr, lwork
-            complex(wp), intent(inout) :: a(lda, *)
-            complex(wp), intent(out) :: w(*), vl(ldvl, *), vr(ldvr, *), work(*)
-            real(wp), intent(out) :: rwork(*)
-            integer, intent(out) :: info
-        end subroutine zgeev
-    end interface
 
 contains
 

@@ -16,6 +16,7 @@
 module ropedyn_modes
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp
+    use ropedyn_lapack, only: dsygvx, dsbgvx
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER, ERR_INPUT, ERR_INTERNAL
     use ropedyn_problem, only: STATUS_OK
     use ropedyn_rope_model, only: energy_t
@@ -42,29 +43,6 @@ module ropedyn_modes
         real(wp) :: asymmetry = 0.0_wp                !< max |K - K^T| / max |K|
         character(len=:), allocatable :: eigensolver  !< 'dsbgvx' or 'dsygvx'
     end type modes_result_t
-
-    interface
-        subroutine dsygvx(itype, jobz, range, uplo, n, a, lda, b, ldb, vl, vu, il, iu, &
-                          abstol, m, w, z, ldz, work, lwork, iwork, ifail, info)
-            import :: wp
-            integer, intent(in) :: itype, n, lda, ldb, il, iu, ldz, lwork
-            character, intent(in) :: jobz, range, uplo
-            real(wp), intent(inout) :: a(lda, *), b(ldb, *)
-            real(wp), intent(in) :: vl, vu, abstol
-            integer, intent(out) :: m, iwork(*), ifail(*), info
-            real(wp), intent(out) :: w(*), z(ldz, *), work(*)
-        end subroutine dsygvx
-        subroutine dsbgvx(jobz, range, uplo, n, ka, kb, ab, ldab, bb, ldbb, q, ldq, vl, vu, &
-                          il, iu, abstol, m, w, z, ldz, work, iwork, ifail, info)
-            import :: wp
-            character, intent(in) :: jobz, range, uplo
-            integer, intent(in) :: n, ka, kb, ldab, ldbb, ldq, il, iu, ldz
-            real(wp), intent(inout) :: ab(ldab, *), bb(ldbb, *)
-            real(wp), intent(out) :: q(ldq, *), w(*), z(ldz, *), work(*)
-            real(wp), intent(in) :: vl, vu, abstol
-            integer, intent(out) :: m, iwork(*), ifail(*), info
-        end subroutine dsbgvx
-    end interface
 
 contains
 

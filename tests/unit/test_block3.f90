@@ -9,6 +9,7 @@
 !!   back to the band LU.
 program test_block3
     use ropedyn_kinds, only: wp
+    use ropedyn_lapack, only: dgesv
     use ropedyn_block3, only: block3_t, block_tridiagonal
     use ropedyn_band_lu, only: band_lu_factor, band_solve_rfem
     use ropedyn_assert, only: test_suite_t

@@ -3,6 +3,7 @@
 !! trajectories converging to each other as n grows.
 program test_mpp_physics
     use ropedyn_kinds, only: wp
+    use ropedyn_lapack, only: dsygv
     use ropedyn_error, only: error_t
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_rope_model, only: rope_model_t
@@ -19,17 +20,6 @@ program test_mpp_physics
     real(wp), parameter :: PI = 4.0_wp*atan(1.0_wp)
     type(test_suite_t) :: suite
     character(len=1024) :: source_dir
-
-    interface
-        subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
-            import :: wp
-            integer, intent(in) :: itype, n, lda, ldb, lwork
-            character, intent(in) :: jobz, uplo
-            real(wp), intent(inout) :: a(lda, *), b(ldb, *)
-            real(wp), intent(out) :: w(*), work(*)
-            integer, intent(out) :: info
-        end subroutine dsygv
-    end interface
 
     suite%name = 'mpp_physics'
     call get_command_argument(1, source_dir)

@@ -128,6 +128,7 @@ end module test_newton_matrix_toy
 
 program test_newton_matrix
     use ropedyn_kinds, only: wp, i8
+    use ropedyn_lapack, only: dgesv
     use ropedyn_error, only: error_t
     use ropedyn_problem, only: STATUS_OK
     use ropedyn_scene, only: scene_t, read_scene
@@ -137,16 +138,6 @@ program test_newton_matrix
     use ropedyn_assert, only: test_suite_t
     use test_newton_matrix_toy, only: toy_t, TOY_KL, TOY_KU
     implicit none
-
-
-    interface
-        subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
-            import :: wp
-            integer, intent(in) :: n, nrhs, lda, ldb
-            real(wp), intent(inout) :: a(lda, *), b(ldb, *)
-            integer, intent(out) :: ipiv(*), info
-        end subroutine dgesv
-    end interface
 
     type(test_suite_t) :: suite
     character(len=1024) :: source_dir

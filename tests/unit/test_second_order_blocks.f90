@@ -83,6 +83,7 @@ end module test_second_order_default
 !! - the MPP's O(n) solve: M(q) times the accelerations of `rhs` equals f = r(q, q', 0).
 program test_second_order_blocks
     use ropedyn_kinds, only: wp
+    use ropedyn_lapack, only: dgesv
     use ropedyn_error, only: error_t
     use ropedyn_problem, only: problem_t, STATUS_OK
     use ropedyn_scene, only: scene_t, read_scene
@@ -92,15 +93,6 @@ program test_second_order_blocks
     use ropedyn_assert, only: test_suite_t
     use test_second_order_default, only: default_blocks_t
     implicit none
-
-    interface
-        subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
-            import :: wp
-            integer, intent(in) :: n, nrhs, lda, ldb
-            real(wp), intent(inout) :: a(lda, *), b(ldb, *)
-            integer, intent(out) :: ipiv(*), info
-        end subroutine dgesv
-    end interface
 
     type(test_suite_t) :: suite
     character(len=*), parameter :: TABLE = 'test_blocks_table.dat'

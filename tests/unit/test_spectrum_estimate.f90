@@ -8,20 +8,11 @@
 !! is what this checks there.
 program test_spectrum_estimate
     use ropedyn_kinds, only: wp
+    use ropedyn_lapack, only: dgeev
     use ropedyn_spectrum, only: spectrum_t, estimate_spectrum
     use ropedyn_test_run, only: run_t, simulate
     use ropedyn_assert, only: test_suite_t
     implicit none
-    interface
-        subroutine dgeev(jobvl, jobvr, n, a, lda, wr, wi, vl, ldvl, vr, ldvr, work, lwork, info)
-            import :: wp
-            character(len=1), intent(in) :: jobvl, jobvr
-            integer, intent(in) :: n, lda, ldvl, ldvr, lwork
-            real(wp), intent(inout) :: a(lda, *)
-            real(wp), intent(out) :: wr(*), wi(*), vl(ldvl, *), vr(ldvr, *), work(*)
-            integer, intent(out) :: info
-        end subroutine dgeev
-    end interface
     integer, parameter :: ELEMENTS(3) = [4, 10, 30]
     type(test_suite_t) :: suite
     integer :: e
