@@ -62,11 +62,8 @@ module ropedyn_symplectic
     !> the step over the stable step where the mode that limits it is lightly damped: the
     !! combination frequencies of such modes (up to twice the fastest) near the stability
     !! limit feed an energy drift. On the undamped paper rope at rtol 1e-3 SRKN_6^b drifted
-    !! over 300 s at 0.55 (n = 20); Chin's 4A at 0.4 over 1000 s let the largest
-    !! |T + V - E0| per 100 s wander up to 7.5e-4 m g L (n = 20, four starts) and drift to
-    !! 1.5e-4 (n = 100, one start of two), and at 0.35 it stayed within 1.5e-4 and 3.8e-5,
-    !! following the elastic energy, where the fast modes' energy is
-    !! (docs/theory/symplectic.md, "The step")
+    !! over 300 s at 0.55 (n = 20); Chin's 4A over 1000 s at this factor and at others:
+    !! scripts/symplectic_factors, whose table is in docs/theory/symplectic.md ("The step")
     real(wp), parameter :: RESONANT_SAFETY = 0.35_wp
     !> where the fast modes are lightly damped, the relative energy error of an undamped mode
     !! at the spectral radius (the spread of its energy along the numerical orbit) over rtol

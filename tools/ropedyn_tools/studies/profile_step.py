@@ -124,13 +124,16 @@ def profile(exe, method, t_end, workdir, tag, whole=False):
     return steps, parts, total
 
 
-def build_baseline(rev, workdir):
-    """The ropedyn executable of git revision `rev` (Release, git archive)."""
+def build_baseline(rev, workdir, edit=None):
+    """The ropedyn executable of git revision `rev` (Release, git archive); `edit(src)`, when
+    given, changes the extracted source tree before the build (a variant of `rev`)."""
     src, build = workdir / "src", workdir / "build"
     src.mkdir()
     archive = subprocess.run(["git", "-C", str(ROOT), "archive", rev], capture_output=True,
                              check=True)
     subprocess.run(["tar", "-x", "-C", str(src)], input=archive.stdout, check=True)
+    if edit is not None:
+        edit(src)
     log = workdir / "build.log"
     with open(log, "w") as f:
         ok = subprocess.run(["cmake", "-S", str(src), "-B", str(build),
