@@ -22,7 +22,9 @@
 !! (10 eps sum_j |K_kj| (|q_j| + L)). The iteration's state is a `descent_t` whose steps
 !! are start, assemble (K, M, the rounding test), trial (solve, corrections), accept or
 !! reject (the shift), finish. `find_equilibrium` adds a continuation in the support
-!! stiffness for a bottom anchor far from the start (`continuation_t`: plan, run).
+!! stiffness for a bottom anchor far from the start (`continuation_t`: plan, run), and in a
+!! current, whose drag has no potential, a continuation in the current's speed on the
+!! residual instead (submodule ropedyn_statics_flow).
 !! Derivation and limits: docs/theory/statics-modes.md.
 module ropedyn_statics
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -133,6 +135,27 @@ module ropedyn_statics
         procedure :: finish => descent_finish
     end type descent_t
 
+    interface
+        !> True when the spec's current drags the rope at rest (submodule
+        !! ropedyn_statics_flow): drag or water on, and a current.
+        module function current_drags(spec) result(drags)
+            type(rope_spec_t), intent(in) :: spec
+            logical :: drags
+        end function current_drags
+
+        !> The equilibrium in a current (submodule ropedyn_statics_flow): without the
+        !! current by find_equilibrium, then continued in the current's speed by a
+        !! pseudo-transient continuation on the residual.
+        recursive module subroutine flow_equilibrium(model, spec, y, options, result, err)
+            class(rope_model_t), intent(inout) :: model
+            type(rope_spec_t), intent(in) :: spec
+            real(wp), intent(inout) :: y(:)
+            type(statics_options_t), intent(in) :: options
+            type(statics_result_t), intent(out) :: result
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine flow_equilibrium
+    end interface
+
 contains
 
     !> ERR_SOLVER when the spec cannot have an equilibrium: both ends free under gravity.
@@ -154,8 +177,9 @@ contains
     !! (continuation_t, ON_GROUND): the equilibrium on a soft ground (the rope sinks by
     !! GROUND_START_SINK of its length), then geometric stages up to the spec's stiffness,
     !! each from the previous equilibrium, as in `equilibrium_of`'s continuation. If that
-    !! fails, `equilibrium_of` solves directly from the start.
-    subroutine find_equilibrium(model, spec, y, options, result, err)
+    !! fails, `equilibrium_of` solves directly from the start. In a current whose drag has
+    !! no potential (current_drags), flow_equilibrium instead.
+    recursive subroutine find_equilibrium(model, spec, y, options, result, err)
         class(rope_model_t), intent(inout) :: model
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(inout) :: y(:)
@@ -173,6 +197,11 @@ contains
         ground%fallback = ''
         call check_equilibrium_exists(spec, err)
         if (allocated(err)) return
+        if (current_drags(spec)) then
+            ! drag without a potential: the descent on V cannot take it
+            call flow_equilibrium(model, spec, y, options, result, err)
+            return
+        end if
         needed = .false.
         if (options%continuation) call ground%plan_ground(model, spec, needed)
         if (needed) then

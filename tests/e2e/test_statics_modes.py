@@ -1,5 +1,6 @@
 """`ropedyn statics` and `ropedyn modes`: exit codes, printed summary, HDF5 layout (every
-dataset with units), errors; `&initial shape = 'equilibrium'` starts a run at rest."""
+dataset with units), errors; `&initial shape = 'equilibrium'` starts a run at rest, in a
+current too."""
 import h5py
 import numpy as np
 import pytest
@@ -87,6 +88,32 @@ def test_initial_equilibrium_run(run, tmp_path):
     assert np.max(np.abs(q[0, :, 1])) < 1e-10, "the equilibrium hangs vertically"
     assert np.max(np.abs(qdot)) < 1e-6
     assert np.max(kinetic) < 1e-12
+
+
+CURRENT = ("&model kind = '{kind}', elements = 12 /\n"
+           "&initial shape = '{shape}' /\n"
+           "&effects drag = .true. /\n"
+           "&fluid density = 1000.0, current = 0.0, 0.5 /\n"
+           "&solver t_end = 1.0, output_interval = 0.1 /\n")
+
+
+@pytest.mark.parametrize("kind", ["rfem", "mpp"])
+def test_equilibrium_in_a_current_is_one_of_the_dynamics(run, tmp_path, kind):
+    """The statics' equilibrium in a current (drag without a potential: continued in the
+    current's speed) is an equilibrium of the run: started there, the rope stays at rest
+    in the current for 1 s, while from the hanging shape it streams out."""
+    moved = {}
+    for shape in ("equilibrium", "hanging"):
+        (tmp_path / f"{shape}.nml").write_text(CURRENT.format(kind=kind, shape=shape))
+        result = run("run", f"{shape}.nml")
+        assert result.returncode == 0, result.stderr
+        with h5py.File(tmp_path / "out" / f"{shape}.h5") as f:
+            q = f["state/q"][:]
+            moved[shape] = (np.max(np.abs(q - q[0])), np.max(np.abs(f["state/qdot"][:])))
+            if shape == "equilibrium":
+                assert np.max(np.abs(q[0, :, 1])) > 0.1, "streamed out across the rope"
+    assert moved["equilibrium"][0] < 1e-9 and moved["equilibrium"][1] < 1e-8, moved
+    assert moved["hanging"][0] > 0.1, moved
 
 
 @pytest.mark.parametrize("args,code,fragments", [

@@ -5,7 +5,10 @@
 !!   (EA = 687.22 N) and a soft (EA = 10 N) rope hung between two pins 0.8 m apart, started
 !!   hanging vertically with the bottom support spring stretched by 1.28 m;
 !! - the equilibrium residual, the 'equilibrium' and 'mode' initial shapes, and the errors
-!!   for a scene without equilibrium (free-free under gravity) and a capped iteration.
+!!   for a scene without equilibrium (free-free under gravity) and a capped iteration;
+!! - the rope in a current (normal drag only): a straight line at the angle theta from the
+!!   vertical where the normal drag balances the weight's normal part,
+!!   q_n U^2 cos^2 theta = w sin theta, RFEM and MPP, slow and fast, either way.
 program test_statics
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, ERR_SOLVER
@@ -37,6 +40,10 @@ program test_statics
     call test_catenary('mpp', 50, 10.0_wp/AREA, 0.340871_wp, 0.300012_wp, 0.670904_wp)
     call test_initial_shapes()
     call test_errors()
+    call test_current('rfem', 0.5_wp)
+    call test_current('mpp', 0.5_wp)
+    call test_current('rfem', -3.0_wp)
+    call test_current('mpp', 3.0_wp)
     call suite%finish()
 
 contains
@@ -263,4 +270,48 @@ contains
                                       'capped: message')
         end if
     end subroutine test_errors
+
+    !> The paper's rope (n = 30) pinned at the top in a current U across gravity, drag on
+    !! with the normal part only (fluid density 1000 kg/m^3, C_n = 1.2, C_t = 0): every
+    !! element lies at theta from the vertical, sin theta = (sqrt(1 + 4 k^2) - 1)/(2 k),
+    !! k = q_n U^2/w, q_n = rho C_n d/2 (the normal drag per length q_n U^2 cos^2 theta
+    !! balances the weight's normal part w sin theta; the weight's part along the rope is
+    !! the tension's gradient). The drag has no potential: the equilibrium is continued
+    !! in the current's speed (ropedyn_statics_flow).
+    subroutine test_current(kind, u)
+        character(len=*), intent(in) :: kind
+        real(wp), intent(in) :: u
+        real(wp), parameter :: QN = 0.5_wp*1000.0_wp*1.2_wp*0.005_wp
+        type(scene_t) :: scene
+        class(rope_model_t), allocatable :: model
+        real(wp), allocatable :: y(:), points(:, :)
+        type(statics_result_t) :: res
+        real(wp) :: k, theta, worst, seg(2)
+        integer :: i
+        character(len=64) :: sets(6)
+        character(len=120) :: label
+
+        write (sets(1), '(a)') 'model.kind = "'//kind//'"'
+        sets(2) = 'model.elements = 30'
+        sets(3) = 'effects.drag = .true.'
+        sets(4) = 'fluid.density = 1000.0'
+        sets(5) = 'fluid.tangential_drag_coefficient = 0.0'
+        write (sets(6), '(a, es12.5)') 'fluid.current = 0.0, ', u
+        call scene_of(sets, scene)
+        call equilibrium(scene, model, y, res)
+        k = QN*u**2/W_LEN
+        theta = sign(asin((sqrt(1.0_wp + 4.0_wp*k**2) - 1.0_wp)/(2.0_wp*k)), u)
+        allocate (points(2, 2*30))
+        call model%polyline(y, points)
+        worst = 0.0_wp
+        do i = 1, size(points, 2) - 1
+            seg = points(:, i + 1) - points(:, i)
+            if (norm2(seg) > 1.0e-6_wp) worst = max(worst, abs(atan2(seg(2), seg(1)) - theta))
+        end do
+        write (label, '(a, f5.1, a, f8.4, a, i0, a)') kind//' in a current of ', u, &
+            ' m/s: every element at theta = ', theta*180/PI, ' deg (', res%stages, ' stages)'
+        call suite%check_le(worst, 1.0e-8_wp, trim(label))
+        call suite%check_true(res%stages >= 1, kind//': continued in the current')
+        call suite%check_le(res%residual_relative, 1.0e-9_wp, kind//': residual in the current')
+    end subroutine test_current
 end program test_statics
