@@ -2,7 +2,7 @@
 module ropedyn_cmd_run
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_text, only: int_text, fixed_text
+    use ropedyn_text, only: int_text, fixed_text, significant_text
     use ropedyn_switch_log, only: switch_event_t
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_INTERRUPTED
     use ropedyn_cli, only: cli_t
@@ -157,6 +157,7 @@ contains
                                     s%stats%time_factor + s%stats%time_solve)
         call print_switches(scene, s, verbose)
         call print_energies(s)
+        call warn_lost_energy(scene, s)
         if (s%peak_joint >= 0) write (output_unit, '(a, es12.5, a)') '  peak tension   ', &
             s%peak_tension, ' N at joint '//int_text(s%peak_joint)//' ('// &
             fixed_text(s%peak_arc, 4)//' m from the top), t = '//fixed_text(s%peak_time, 4)//' s'
@@ -188,6 +189,24 @@ contains
             write (output_unit, '(a)') '  balance error   '//trim(adjustl(number))//' J'//terms
         end if
     end subroutine print_energies
+
+    !> On stderr, when the balance fell by more than a tenth of the energy the run moved
+    !! (run_summary_t%lost_energy): how much, and what keeps it.
+    subroutine warn_lost_energy(scene, s)
+        type(scene_t), intent(in) :: scene
+        type(run_summary_t), intent(in) :: s
+        real(wp) :: lost
+        character(len=16) :: number
+        if (.not. s%lost_energy) return
+        lost = s%initial_energy%balance() - s%final_energy%balance()
+        write (number, '(es10.2)') lost
+        write (error_unit, '(a)') 'warning: the integration lost '//trim(adjustl(number))// &
+            ' J of the balance, '//int_text(nint(100*lost/s%energy_scale))//' % of the '// &
+            'energy the run moved: numerical damping at rtol '// &
+            significant_text(scene%solver%rtol, 3)// &
+            '; a tighter rtol keeps more, and on a lightly damped RFEM rope method = '// &
+            '''symplectic'' keeps the balance (docs/guide/choosing.md)'
+    end subroutine warn_lost_energy
 
     !> What the order safety did, a line for each kind of action.
     subroutine print_safety(s)

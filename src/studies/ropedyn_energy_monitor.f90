@@ -31,6 +31,7 @@ module ropedyn_energy_monitor
     implicit none
     private
     public :: energy_monitor_t, safety_record_t, high_order_to_blame, sudden_gain
+    public :: MAX_BOUND_SHARE
     public :: look_budget, look_action, LOOK_LOWER, LOOK_KEEP, LOOK_NO_VERDICT, LOOK_FAIL
 
     !> the largest bound, as a share of S, whatever factor rtol is: at rtol 0.1 the default
@@ -78,6 +79,8 @@ module ropedyn_energy_monitor
         procedure :: accept => monitor_accept
         procedure :: runaway_limit => monitor_runaway_limit
         procedure :: runaway => monitor_runaway
+        procedure :: big_change => monitor_big_change
+        procedure :: lost => monitor_lost
     end type energy_monitor_t
 
     !> What the order safety did in a run (docs/theory/energy-balance.md; times in s, < 0: never).
@@ -278,8 +281,25 @@ contains
         type(energy_monitor_t) :: next
         next = self
         call next%observe(e)
-        limit = MAX_BOUND_SHARE*max(next%scale(), self%floor, RUNAWAY_LEAST_SCALE)
+        limit = next%big_change()
     end function monitor_runaway_limit
+
+    !> A change of B that no tolerance makes an integration error a run may keep (J):
+    !! MAX_BOUND_SHARE max(S, floor, RUNAWAY_LEAST_SCALE), S as observed so far. A gain that
+    !! large fails the run (a runaway); a loss that large is said (`lost`).
+    pure real(wp) function monitor_big_change(self) result(limit)
+        class(energy_monitor_t), intent(in) :: self
+        limit = MAX_BOUND_SHARE*max(self%scale(), self%floor, RUNAWAY_LEAST_SCALE)
+    end function monitor_big_change
+
+    !> True when the balance of a state observed last has fallen below E0 by more than
+    !! big_change: the integrator damped a tenth of the energy the run moved (adaptive
+    !! methods on a lightly damped rope over long runs; docs/theory/energy-balance.md).
+    pure logical function monitor_lost(self, e) result(yes)
+        class(energy_monitor_t), intent(in) :: self
+        type(energy_t), intent(in) :: e
+        yes = self%e0 - e%balance() > self%big_change()
+    end function monitor_lost
 
     !> True when a state's B - E0 is above runaway_limit, whatever gain was accepted.
     pure logical function monitor_runaway(self, e) result(yes)

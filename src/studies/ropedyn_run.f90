@@ -53,7 +53,7 @@ module ropedyn_run
     use ropedyn_version, only: version_string
     use ropedyn_modes, only: equilibrium_initial_state
     use ropedyn_methods, only: METHODS, method_index, resolved_max_order
-    use ropedyn_energy_monitor, only: energy_monitor_t, safety_record_t
+    use ropedyn_energy_monitor, only: energy_monitor_t, safety_record_t, MAX_BOUND_SHARE
     use ropedyn_state_start, only: state_initial_state
     use ropedyn_process, only: heartbeat_t
     implicit none
@@ -93,6 +93,11 @@ module ropedyn_run
         !! short): the steps the rest of the run takes at its last step (a resume goes on
         !! from the last record with a budget of its own); 0 otherwise
         integer(i8) :: budget_rest = 0
+        !> the balance fell by more than a tenth of the energy the run moved (the energy
+        !! monitor's `lost`; only with the order safety on): the summary warns of it, with
+        !! the scale, J
+        logical :: lost_energy = .false.
+        real(wp) :: energy_scale = 0.0_wp
     end type run_summary_t
 
     !> A state of a run without output kept in memory (`save`, `restore`): time, ODE state,
@@ -715,6 +720,10 @@ contains
             s%stats%time_advance = self%time_advance
             call add_counter_values(s%stats, self%counters_before)
             s%t_reached = max(s%t_reached, self%t)
+            if (self%monitoring .and. s%records > 0) then
+                s%lost_energy = self%monitor%lost(s%final_energy)
+                s%energy_scale = self%monitor%big_change()/MAX_BOUND_SHARE
+            end if
             call self%out%write_stats(s%stats, s%cpu_time, ferr, t_reached=self%t)
             ! (a local copy, not an array constructor of the two function results: that
             ! leaked their reasons, valgrind in the library's memory test)

@@ -13,7 +13,8 @@
 !!   (less than half the bound in the last one) whatever the safe order did; a gain of the
 !!   last interval exactly when the safe order, over the same interval, changed the balance
 !!   less (a gain or a loss alike);
-!! - a runaway: B - E0 above a tenth of max(S, m g L), whatever was accepted;
+!! - a runaway: B - E0 above a tenth of max(S, m g L), whatever was accepted; a loss beyond
+!!   the same limit is `lost` (the run summary's warning);
 !! - the second look's budget (20 times the interval's steps, at least 500, for a sudden
 !!   gain's first look; else all that is left) and its action in every case (lower, keep,
 !!   no verdict once, the run's failure).
@@ -174,6 +175,22 @@ program test_energy_monitor
     call m%start(e0, 0.1_wp, factor)
     call suite%check_true(m%runaway(e2), 'without m g L, S alone')
     call suite%check_true(m%gained(e2), 'a restart forgets the accepted gain')
+
+    ! a loss of more than a tenth of max(S, m g L) is `lost` (the summary warns), a gain or
+    ! a smaller loss not: the kinetic energy of e1 falls by y, B by y, S stays 1.12 J
+    call m%start(e0, 0.1_wp, factor, floor=0.5_wp)
+    call m%observe(e1)
+    e2 = e1
+    e2%kinetic = e1%kinetic - 0.99_wp*0.112_wp
+    call suite%check_true(.not. m%lost(e2), 'a loss below a tenth of S is not lost')
+    e2%kinetic = e1%kinetic - 1.01_wp*0.112_wp
+    call suite%check_true(m%lost(e2), 'a loss above a tenth of S is lost')
+    call suite%check_close(m%big_change(), m%runaway_limit(e1), 1.0e-15_wp, 0.0_wp, &
+                           'lost and runaway share one limit')
+    call m%start(e0, 0.1_wp, factor, floor=20.0_wp)
+    call m%observe(e1)
+    call suite%check_true(.not. m%lost(e2), 'below a tenth of m g L: not lost')
+
     ! without gravity, at rest: energies of round-off (S = 2e-27 J) are no runaway
     e2 = energy_t(kinetic=0.0_wp, elastic=9.0e-28_wp, gravity=0.0_wp, dissipated=0.0_wp, &
                   support_work=0.0_wp)
