@@ -1,14 +1,16 @@
 !> Warnings for a scene whose values are legal but probably a unit slip: a diameter in mm
 !! (more than a tenth of the length), a modulus or stiffness in the wrong unit (the static
 !! strain under the rope's own weight above 10 %), a damping coefficient in the wrong unit
-!! (an element's axial damping ratio below 1e-6 or above 1000), air's density for water. Each
-!! warning names the key, its value and why; a run goes ahead.
+!! (an element's axial damping ratio below 1e-6 or above 1000), air's density for water, a
+!! straight start reaching into the ground (x points down: a ground point in the wrong
+!! sign). Each warning names the key, its value and why; a run goes ahead.
 module ropedyn_scene_warnings
     use, intrinsic :: iso_fortran_env, only: error_unit
     use ropedyn_kinds, only: wp
     use ropedyn_text, only: text_t, append_text, real_text, significant_text
     use ropedyn_rope_section, only: section_t, rope_section, section_set_given
     use ropedyn_scene_types, only: scene_t
+    use ropedyn_rope_setup, only: initial_angle
     implicit none
     private
     public :: scene_warnings, print_warnings
@@ -22,6 +24,9 @@ module ropedyn_scene_warnings
     !! reverse, is off by the section area, 1e4 .. 1e8 for ropes
     real(wp), parameter :: MIN_DAMPING_RATIO = 1.0e-6_wp, MAX_DAMPING_RATIO = 1.0e3_wp
     real(wp), parameter :: MIN_WATER_DENSITY = 100.0_wp  !< kg/m^3
+    !> a straight start may touch the ground (a rope laid on the seabed) but not reach
+    !! deeper into it than this share of its length
+    real(wp), parameter :: MAX_START_DEPTH_SHARE = 1.0e-3_wp
 
 contains
 
@@ -78,6 +83,7 @@ contains
             call append_text(list, scene%path//': &fluid: density = '// &
                 real_text(scene%fluid%density)//': water = .true. in a fluid this light '// &
                 '(air is 1.225 kg/m^3): water is about 1000 (fresh) or 1025 (sea)')
+        if (scene%effects%ground) call ground_start(scene, list)
     contains
         function stiffness_text() result(text)
             character(len=:), allocatable :: text
@@ -97,4 +103,32 @@ contains
             end if
         end function damping_text
     end function scene_warnings
+
+    !> The straight starts ('straight', 'hanging': from &supports top_anchor along the
+    !! initial angle) whose far end lies deeper in the ground than MAX_START_DEPTH_SHARE of
+    !! the length: the contact springs hold that penetration at the start and throw the rope
+    !! out at once. The depth of a point p is -(p - point).normal/|normal|, the normal
+    !! pointing to the free side; along a straight rope it is deepest at an end.
+    subroutine ground_start(scene, list)
+        type(scene_t), intent(in) :: scene
+        type(text_t), allocatable, intent(inout) :: list(:)
+        real(wp) :: unit_normal(2), ends(2, 2), depth
+        real(wp) :: angle
+        if (scene%initial%shape /= 'straight' .and. scene%initial%shape /= 'hanging') return
+        if (.not. norm2(scene%ground%normal) > 0.0_wp) return
+        unit_normal = scene%ground%normal/norm2(scene%ground%normal)
+        angle = initial_angle(scene%rope_spec_t)
+        ends(:, 1) = scene%supports%top_anchor
+        ends(:, 2) = ends(:, 1) + scene%rope%length*[cos(angle), sin(angle)]
+        depth = maxval(-matmul(unit_normal, ends - spread(scene%ground%point, 2, 2)))
+        if (depth > MAX_START_DEPTH_SHARE*scene%rope%length) call append_text(list, &
+            scene%path//': &ground: point = '//real_text(scene%ground%point(1))//', '// &
+            real_text(scene%ground%point(2))//": the rope's "//trim(scene%initial%shape)// &
+            ' start reaches '//significant_text(depth, 3)//' m into the ground (its ends: '// &
+            real_text(ends(1, 1))//', '//real_text(ends(2, 1))//' and '// &
+            significant_text(ends(1, 2), 6)//', '//significant_text(ends(2, 2), 6)// &
+            ' m; x points down, the normal to the free side): the contact springs throw '// &
+            'it out at once; move the ground or the start, or start from the equilibrium '// &
+            "(&initial shape = 'equilibrium')")
+    end subroutine ground_start
 end module ropedyn_scene_warnings

@@ -124,6 +124,10 @@ def test_a_chain_without_bending_stiffness_hangs(run, tmp_path, kind):
     (["rope.normal_damping=1e9"], "&rope: normal_damping = 1.0e9: an element's axial damping"),
     (["rope.normal_damping=1e-9"], "&rope: normal_damping = 1.0e-9: an element's axial damping"),
     (["effects.water=.true."], "&fluid: density = 1.225: water = .true. in a fluid this light"),
+    (["effects.ground=.true.", "ground.point=0.5,0", "initial.shape='hanging'"],
+     "&ground: point = 0.5, 0.0: the rope's hanging start reaches 0.5 m into the ground"),
+    (["effects.ground=.true.", "ground.point=0.1,0"],
+     "&ground: point = 0.1, 0.0: the rope's straight start reaches 0.159 m into the ground"),
 ])
 def test_a_probable_unit_slip_gets_one_warning(run, tmp_path, sets, fragment):
     args = ["run", PAPER, "--set", "solver.t_end=1e-4", "--set", "solver.output_interval=1e-4",
@@ -133,6 +137,14 @@ def test_a_probable_unit_slip_gets_one_warning(run, tmp_path, sets, fragment):
     proc = run(*args)
     warnings = [x for x in proc.stderr.splitlines() if x.startswith("ropedyn: warning: ")]
     assert len(warnings) == 1 and fragment in warnings[0], proc.stderr
+
+
+def test_a_rope_laid_on_the_ground_has_no_warning(run, tmp_path):
+    """A straight start along the ground's surface touches it (depth 0): no warning."""
+    proc = run("run", PAPER, "--set", "solver.t_end=1e-4", "--set", "solver.output_interval=1e-4",
+               "--set", "output.file='w.h5'", "--set", "effects.ground=.true.",
+               "--set", "ground.point=0,0", "--set", "initial.angle_deg=90")
+    assert proc.returncode == 0 and "warning" not in proc.stderr, proc.stderr
 
 
 def test_the_shipped_paper_scene_has_no_warning(run, tmp_path):
