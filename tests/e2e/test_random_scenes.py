@@ -1,0 +1,33 @@
+"""scripts/random_scenes (tools/ropedyn_tools/random_scenes.py): the outcomes are sorted as
+documented (a crash is anything but exit 0, 2 or 3, or crash text), the draws depend on the
+seed alone, and a short sweep runs."""
+import random
+import types
+
+from ropedyn_tools import random_scenes as rs
+
+
+def test_outcomes():
+    ok, refused, failed = (types.SimpleNamespace(returncode=c) for c in (0, 2, 3))
+    assert rs.outcome(ok, "  output x.h5") == "ok"
+    assert rs.outcome(refused, "ropedyn: error: ...") == "refused"
+    assert rs.outcome(failed, "ropedyn: error: erk failed at t = ...") == "failed"
+    assert rs.outcome(types.SimpleNamespace(returncode=5), "modes: ...") == "crash"
+    assert rs.outcome(ok, "At line 12\nFortran runtime error: ...") == "crash"
+    assert rs.outcome(None, "timeout") == "crash"
+
+
+def test_draws_depend_on_the_seed_alone():
+    first = [rs.draw(random.Random(7), "run") for _ in range(3)]
+    again = [rs.draw(random.Random(7), "run") for _ in range(3)]
+    other = [rs.draw(random.Random(8), "run") for _ in range(3)]
+    assert first == again and first != other
+    sets, _ = first[0]
+    assert {"model.kind", "solver.method", "initial.shape"} <= set(sets)
+    assert "solver.method" not in rs.draw(random.Random(7), "statics")[0]
+
+
+def test_a_short_sweep(ropedyn_exe, capsys):
+    assert rs.main(["statics", "--exe", str(ropedyn_exe), "--seed", "3", "--count", "4"]) == 0
+    out = capsys.readouterr().out
+    assert "random_scenes statics --seed 3 --count 4: ok " in out and "crash 0" in out
