@@ -7,7 +7,7 @@ import importlib
 
 import pytest
 
-from ropedyn_tools.arguments import list_text, listing, positive
+from ropedyn_tools.arguments import list_text, listing, named_lists, positive
 
 BAD = [
     ("stiff_modes", "--elements", "abc", "'abc'"),
@@ -28,6 +28,9 @@ BAD = [
     ("bench_rfem", "--elements", "ten", "'ten'"),
     ("bench_models", "--elements", "ten", "'ten'"),
     ("cost_model", "--rtols", "1e-3 0", "must be above 0"),
+    ("work_precision", "--max-orders", "cvode", "'cvode': not NAME=VALUES"),
+    ("work_precision", "--max-orders", "cvode=2+5,mebdf=x", "'mebdf=x': 'x'"),
+    ("work_precision", "--model-elements", "mpp=a", "'mpp=a': 'a'"),
 ]
 
 
@@ -55,3 +58,12 @@ def test_list_types_keep_or_convert_the_text():
             listing(positive(int), sep)(text)
     with pytest.raises(argparse.ArgumentTypeError):
         listing(positive(int), ",", length=2)("4,5,6")
+
+
+def test_named_lists_keep_the_text():
+    assert named_lists(positive(int), "+", entries=",")("cvode=2+5,mebdf=4+7") == \
+        "cvode=2+5,mebdf=4+7"
+    assert named_lists(positive(int), ", ")("mpp=10,30 70") == "mpp=10,30 70"
+    for text in ("=2", "cvode2", "cvode=", "cvode=0"):
+        with pytest.raises(argparse.ArgumentTypeError):
+            named_lists(positive(int), "+")(text)

@@ -9,7 +9,7 @@ the studies that quote the option's text in their Command line."""
 import argparse
 
 #: how a list's items are separated: blanks, commas, or either
-SEPARATORS = {None: "blanks", ",": "commas", ", ": "commas or blanks"}
+SEPARATORS = {None: "blanks", ",": "commas", ", ": "commas or blanks", "+": "plus signs"}
 
 
 def positive(kind):
@@ -28,7 +28,8 @@ def positive(kind):
 
 
 def items(text, sep=None):
-    """The items of a list: split at blanks (sep None), at commas (","), or at either (", ")."""
+    """The items of a list: split at blanks (sep None), at commas (","), at either (", "),
+    or at plus signs ("+")."""
     if sep not in SEPARATORS:
         raise ValueError(f"unknown separator {sep!r}")
     if sep == ", ":
@@ -61,5 +62,24 @@ def list_text(item, sep=None, length=None):
 
     def parse(text):
         check(text)
+        return text
+    return parse
+
+
+def named_lists(item, sep, entries=None):
+    """An argparse type: NAME=LIST, LIST as `listing(item, sep)` reads it ('mpp=10,30,70'),
+    or with `entries` a separator of several such ('cvode=2+5,mebdf=4+7'); returns the text
+    as given."""
+    check = listing(item, sep)
+
+    def parse(text):
+        for entry in (text.split(entries) if entries else [text]):
+            name, equals, values = entry.partition("=")
+            if not equals or not name.strip():
+                raise argparse.ArgumentTypeError(f"{entry!r}: not NAME=VALUES")
+            try:
+                check(values)
+            except argparse.ArgumentTypeError as e:
+                raise argparse.ArgumentTypeError(f"{entry!r}: {e}") from None
         return text
     return parse

@@ -36,7 +36,7 @@ import time
 import numpy as np
 
 from ropedyn import io
-from ropedyn_tools.arguments import list_text, positive
+from ropedyn_tools.arguments import list_text, named_lists, positive
 from ropedyn_tools.repo import DOCS, PAPER, ROOT, add_exe_argument, exe_or_build
 from ropedyn_tools.studies.common import machine, update_doc, run_stamp
 
@@ -177,11 +177,13 @@ def main(argv=None):
     p.add_argument("--elements", type=list_text(positive(int), ", "), default=None,
                    help="default 10,30,70,100 (--quick: 10,30)")
     p.add_argument("--model-elements", action="append", default=None,
+                   type=named_lists(positive(int), ", "),
                    help="MODEL=N,N,... element counts for one model (default: mpp=10,30,70: "
                         "MPP's dense mass matrix makes n = 100 cost 100 s per 2-s run)")
     p.add_argument("--methods", default="cvode,mebdf,erk,auto",
                    help="integrators to measure (default cvode,mebdf,erk,auto)")
     p.add_argument("--max-orders", default="cvode=2+5,mebdf=4+7",
+                   type=named_lists(positive(int), "+", entries=","),
                    help="METHOD=K[+K...] per method, e.g. cvode=2+5,mebdf=4+7")
     p.add_argument("--rtols", type=list_text(positive(float), ", "), default=None, help="default 1e-3,1e-4,1e-5,1e-6 (--quick: "
                    "1e-3,1e-4,1e-5)")
