@@ -37,7 +37,8 @@ module ropedyn_statics
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_ldl, only: ldl_t, ldl_factor, ldl_solve, band_matvec
     use ropedyn_statics_terms, only: generalized_force, tangent_matrices, potential_energy, &
-                                     rope_length, total_weight, tangent_band, tangent_bandwidth
+                                     rope_length, total_weight, tangent_band, tangent_bandwidth, &
+                                     at_rest_near
     implicit none
     private
     public :: statics_options_t, statics_result_t
@@ -66,6 +67,8 @@ module ropedyn_statics
         real(wp) :: elastic = 0.0_wp       !< elastic energy at the equilibrium, J
         real(wp) :: gravity = 0.0_wp       !< gravity potential at the equilibrium, J
         character(len=:), allocatable :: criterion  !< 'newton step' or 'rounding level'
+    contains
+        procedure :: report => result_report
     end type statics_result_t
 
     !> the parameters `find_equilibrium` continues in
@@ -769,23 +772,24 @@ contains
         class(descent_t), intent(inout) :: self
         class(rope_model_t), intent(inout) :: model
         real(wp), intent(inout) :: y(:)
+        call at_rest_near(model, y, self%pos, self%vel, self%q0)
+        call self%result%report(model, y, self%f)
+    end subroutine descent_finish
+
+    !> What an equilibrium iteration (the descent, the flow in a current) reports at the
+    !! equilibrium y with its generalized force f: the residual max |f| (absolute and over
+    !! self%weight, which the iteration set), the elastic and gravity energies.
+    subroutine result_report(self, model, y, f)
+        class(statics_result_t), intent(inout) :: self
+        class(rope_model_t), intent(inout) :: model
+        real(wp), intent(in) :: y(:), f(:)
         type(energy_t) :: e
         real(wp) :: yq(max(1, model%quad_size()))
-        real(wp), parameter :: TWO_PI = 8.0_wp*atan(1.0_wp)
-        logical, allocatable :: angle(:)
-        integer :: k
-        y(self%vel) = 0.0_wp
-        angle = model%angle_coordinates()
-        do k = 1, size(self%pos)
-            if (angle(k)) y(self%pos(k)) = y(self%pos(k)) - &
-                TWO_PI*anint((y(self%pos(k)) - self%q0(k))/TWO_PI)
-        end do
-        self%result%residual = maxval(abs(self%f))
-        self%result%residual_relative = self%result%residual/ &
-            merge(self%result%weight, 1.0_wp, self%result%weight > 0.0_wp)
+        self%residual = maxval(abs(f))
+        self%residual_relative = self%residual/merge(self%weight, 1.0_wp, self%weight > 0.0_wp)
         yq = 0.0_wp
         e = model%energy(0.0_wp, y, yq)
-        self%result%elastic = e%elastic
-        self%result%gravity = e%gravity
-    end subroutine descent_finish
+        self%elastic = e%elastic
+        self%gravity = e%gravity
+    end subroutine result_report
 end module ropedyn_statics

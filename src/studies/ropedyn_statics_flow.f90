@@ -13,8 +13,8 @@
 !! 1/sigma. sigma starts at the descent's scale (a step of L/10), follows the residual's
 !! norm r (r^2 = sum f_k^2 / |K_kk| at the stage's start; switched evolution relaxation:
 !! sigma r_new / r_old), halved again after a step that lowered r, and is 0 (Newton) once
-!! it fell to a thousandth of its start (NEWTON_BELOW). Every step is taken unless r^2 grows by GROWTH_ALLOWED (then
-!! sigma grows); up to two chord corrections with the same factors pull a trial point back
+!! it fell to a thousandth of its start (NEWTON_BELOW). Every step is taken unless r^2
+!! grows by GROWTH_ALLOWED (then sigma grows); up to two chord corrections with the same factors pull a trial point back
 !! towards the stiff springs' manifold. Converged after a Newton step below
 !! step_tolerance L. A stage that fails is retried with a quarter of the increment in s; a
 !! stage that succeeds doubles it.
@@ -93,7 +93,6 @@ contains
             if (s_try < 1.0_wp) then
                 stage_spec = spec
                 stage_spec%fluid%current = s_try*spec%fluid%current
-                deallocate (stage_model)
                 call create_model(stage_spec, stage_model, err)
                 if (allocated(err)) return
                 call stage_iterate(stage_model, y_try, options, used, result, ok)
@@ -149,8 +148,9 @@ contains
             'dynamics from rest instead), or needs more iterations (--max-iterations)')
     end subroutine stalled
 
-    !> Set up the iteration at y (velocities zeroed): coordinates, residual, mass;
-    !! `ok` false when the forces are not finite.
+    !> Set up the iteration at y (velocities zeroed): coordinates, residual, mass, tangent
+    !! (the norm's weights, and the first step's matrix); `ok` false when the forces or the
+    !! tangent are not finite.
     subroutine flow_start(self, model, y, ok)
         class(flow_t), intent(inout) :: self
         class(rope_model_t), intent(inout) :: model
@@ -183,7 +183,7 @@ contains
         self%sigma0 = maxval(abs(self%f)/self%mdiag)/(0.1_wp*max(self%length, 1.0e-3_wp))
         self%sigma0 = max(self%sigma0, sqrt(tiny(1.0_wp)))
         self%sigma = self%sigma0
-        self%fresh = .true.
+        self%fresh = .false.            ! kb and mm are those of y
     end subroutine flow_start
 
     !> K + sigma M in LAPACK's band storage, factored; `ok` false when it is singular.
@@ -209,7 +209,8 @@ contains
         ok = info == 0
     end subroutine flow_factor
 
-    !> Levenberg-Marquardt steps on the residual from y, at most `budget` linear solves;
+    !> Pseudo-transient continuation steps on the residual from y (the submodule header), at
+    !! most `budget` linear solves;
     !! `ok` when a Newton step falls below options%step_tolerance times the length; `used`:
     !! the linear solves it took.
     subroutine flow_solve(self, model, y, options, budget, result, ok, used)
@@ -292,37 +293,23 @@ contains
         end subroutine accept_trial
     end subroutine flow_solve
 
-    !> The equilibrium's results as the descent's (descent_finish): velocities zeroed,
-    !! angles within pi of the start, the residual, the energies.
+    !> The equilibrium's results as the descent's (at_rest_near, statics_result_t%report),
+    !! the residual evaluated at the end (the stages' iterations keep theirs).
     subroutine flow_finish(model, spec, y, q0, result)
         class(rope_model_t), intent(inout) :: model
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(inout) :: y(:)
         real(wp), intent(in) :: q0(:)
         type(statics_result_t), intent(inout) :: result
-        type(energy_t) :: e
-        real(wp) :: yq(max(1, model%quad_size()))
         real(wp), allocatable :: f(:)
-        real(wp), parameter :: TWO_PI = 8.0_wp*atan(1.0_wp)
         integer, allocatable :: pos(:), vel(:)
-        logical, allocatable :: angle(:)
-        integer :: k, status
+        integer :: status
         call model%coordinates(pos, vel)
-        y(vel) = 0.0_wp
-        angle = model%angle_coordinates()
-        do k = 1, size(pos)
-            if (angle(k)) y(pos(k)) = y(pos(k)) - TWO_PI*anint((y(pos(k)) - q0(k))/TWO_PI)
-        end do
         allocate (f(size(pos)))
+        call at_rest_near(model, y, pos, vel, q0)
         call generalized_force(model, y, pos, vel, f, status)
         result%weight = total_weight(model, spec)
-        result%residual = maxval(abs(f))
-        result%residual_relative = result%residual/ &
-            merge(result%weight, 1.0_wp, result%weight > 0.0_wp)
         result%rounding_level = 0.0_wp
-        yq = 0.0_wp
-        e = model%energy(0.0_wp, y, yq)
-        result%elastic = e%elastic
-        result%gravity = e%gravity
+        call result%report(model, y, f)
     end subroutine flow_finish
 end submodule ropedyn_statics_flow

@@ -17,11 +17,29 @@ module ropedyn_statics_terms
     implicit none
     private
     public :: generalized_force, tangent_matrices, potential_energy, rope_length, total_weight
-    public :: tangent_band, tangent_bandwidth
+    public :: tangent_band, tangent_bandwidth, at_rest_near
 
     real(wp), parameter :: PI = 4.0_wp*atan(1.0_wp)
 
 contains
+
+    !> An equilibrium y at rest: its velocities zeroed and each angle brought within pi of
+    !! q0, where the iteration that found it started it (a step may turn an element by
+    !! whole turns, which changes nothing but the angle's value).
+    subroutine at_rest_near(model, y, pos, vel, q0)
+        class(rope_model_t), intent(in) :: model
+        real(wp), intent(inout) :: y(:)
+        integer, intent(in) :: pos(:), vel(:)
+        real(wp), intent(in) :: q0(:)
+        real(wp), parameter :: TWO_PI = 2.0_wp*PI
+        logical, allocatable :: angle(:)
+        integer :: k
+        y(vel) = 0.0_wp
+        angle = model%angle_coordinates()
+        do k = 1, size(pos)
+            if (angle(k)) y(pos(k)) = y(pos(k)) - TWO_PI*anint((y(pos(k)) - q0(k))/TWO_PI)
+        end do
+    end subroutine at_rest_near
 
     !> Total length of the elements, m.
     real(wp) function rope_length(model) result(length)
