@@ -31,7 +31,6 @@ module ropedyn_energy_monitor
     implicit none
     private
     public :: energy_monitor_t, safety_record_t, high_order_to_blame, sudden_gain
-    public :: MAX_BOUND_SHARE
     public :: look_budget, look_action, LOOK_LOWER, LOOK_KEEP, LOOK_NO_VERDICT, LOOK_FAIL
 
     !> the largest bound, as a share of S, whatever factor rtol is: at rtol 0.1 the default
@@ -79,6 +78,7 @@ module ropedyn_energy_monitor
         procedure :: accept => monitor_accept
         procedure :: runaway_limit => monitor_runaway_limit
         procedure :: runaway => monitor_runaway
+        procedure :: floored_scale => monitor_floored_scale
         procedure :: big_change => monitor_big_change
         procedure :: lost => monitor_lost
     end type energy_monitor_t
@@ -284,12 +284,19 @@ contains
         limit = next%big_change()
     end function monitor_runaway_limit
 
+    !> max(S, floor, RUNAWAY_LEAST_SCALE), S as observed so far (J): the scale of a runaway
+    !! and of a loss.
+    pure real(wp) function monitor_floored_scale(self) result(scale)
+        class(energy_monitor_t), intent(in) :: self
+        scale = max(self%scale(), self%floor, RUNAWAY_LEAST_SCALE)
+    end function monitor_floored_scale
+
     !> A change of B that no tolerance makes an integration error a run may keep (J):
-    !! MAX_BOUND_SHARE max(S, floor, RUNAWAY_LEAST_SCALE), S as observed so far. A gain that
-    !! large fails the run (a runaway); a loss that large is said (`lost`).
+    !! MAX_BOUND_SHARE times the floored scale. A gain that large fails the run (a
+    !! runaway); a loss that large is said (`lost`).
     pure real(wp) function monitor_big_change(self) result(limit)
         class(energy_monitor_t), intent(in) :: self
-        limit = MAX_BOUND_SHARE*max(self%scale(), self%floor, RUNAWAY_LEAST_SCALE)
+        limit = MAX_BOUND_SHARE*self%floored_scale()
     end function monitor_big_change
 
     !> True when the balance of a state observed last has fallen below E0 by more than

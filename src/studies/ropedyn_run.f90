@@ -53,7 +53,7 @@ module ropedyn_run
     use ropedyn_version, only: version_string
     use ropedyn_modes, only: equilibrium_initial_state
     use ropedyn_methods, only: METHODS, method_index, resolved_max_order
-    use ropedyn_energy_monitor, only: energy_monitor_t, safety_record_t, MAX_BOUND_SHARE
+    use ropedyn_energy_monitor, only: energy_monitor_t, safety_record_t
     use ropedyn_state_start, only: state_initial_state
     use ropedyn_process, only: heartbeat_t
     implicit none
@@ -722,7 +722,7 @@ contains
             s%t_reached = max(s%t_reached, self%t)
             if (self%monitoring .and. s%records > 0) then
                 s%lost_energy = self%monitor%lost(s%final_energy)
-                s%energy_scale = self%monitor%big_change()/MAX_BOUND_SHARE
+                s%energy_scale = self%monitor%floored_scale()
             end if
             call self%out%write_stats(s%stats, s%cpu_time, ferr, t_reached=self%t)
             ! (a local copy, not an array constructor of the two function results: that
