@@ -94,18 +94,23 @@ def elastic_growth(r, span=WINDOW):
     return float(e[t >= t[-1] - span].mean() / e[t <= span].mean())
 
 
+def window_masks(t, span):
+    """The windows of `span` seconds over the record times t: their starts, and a mask of
+    the records in each (the last window takes the last record too)."""
+    edges = np.arange(0.0, t[-1] + 1e-9, span)[:-1]
+    return edges, [(t >= a) & ((t < a + span) | (a + span >= t[-1])) for a in edges]
+
+
 def window_rows(n, r, span=WINDOW):
     """The symplectic run's error and elastic energy window by window (`span` s each):
     the largest |T + V - E0|, its mean, and the mean elastic energy, m g L."""
     t = r["t"]
-    edges = np.arange(0.0, t[-1] + 1e-9, span)
-    # (the last window takes the last record too)
-    masks = [(t >= a) & ((t < a + span) | (a + span >= t[-1])) for a in edges[:-1]]
+    edges, masks = window_masks(t, span)
     quantities = (("largest abs error", lambda m: np.abs(r["drift"][m]).max(), ".1e"),
                   ("mean error", lambda m: r["drift"][m].mean(), "+.1e"),
                   ("mean elastic energy", lambda m: r["elastic"][m].mean(), ".3f"))
     head = f"| n | per window of {span:g} s (m g L) | " + " | ".join(
-        f"{a:g}-{a + span:g} s" for a in edges[:-1]) + " |"
+        f"{a:g}-{a + span:g} s" for a in edges) + " |"
     rows = [f"| {n} | {name} | " + " | ".join(format(f(m), spec) for m in masks) + " |"
             for name, f, spec in quantities]
     return head, rows

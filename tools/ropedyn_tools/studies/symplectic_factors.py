@@ -32,7 +32,7 @@ import numpy as np
 
 from ropedyn_tools.arguments import list_text, positive
 from ropedyn_tools.repo import DOCS, INPUT, PAPER, ROOT, add_exe_argument, exe_or_build
-from ropedyn_tools.studies.bench_symplectic import run, undamped_sets
+from ropedyn_tools.studies.bench_symplectic import run, undamped_sets, window_masks
 from ropedyn_tools.studies.common import machine, run_stamp, update_doc
 from ropedyn_tools.studies.profile_step import build_baseline
 
@@ -71,9 +71,7 @@ def with_factor(factor):
 def windows(r, span=WINDOW):
     """Per window of `span` s: the largest |B - E0|, the mean of B - E0 and the mean
     elastic energy (m g L)."""
-    t = r["t"]
-    edges = np.arange(0.0, t[-1] - 1e-9, span)
-    masks = [(t >= a) & ((t < a + span) | (a + span >= t[-1] - 1e-9)) for a in edges]
+    _, masks = window_masks(r["t"], span)
     return [(float(np.abs(r["drift"][m]).max()), float(r["drift"][m].mean()),
              float(r["elastic"][m].mean())) for m in masks]
 
