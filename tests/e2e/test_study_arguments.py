@@ -7,7 +7,8 @@ import importlib
 
 import pytest
 
-from ropedyn_tools.arguments import list_text, listing, named_lists, positive
+from ropedyn_tools.arguments import (check_names, choice, list_text, listing, named_lists,
+                                  positive)
 
 BAD = [
     ("stiff_modes", "--elements", "abc", "'abc'"),
@@ -67,3 +68,59 @@ def test_named_lists_keep_the_text():
     for text in ("=2", "cvode2", "cvode=", "cvode=0"):
         with pytest.raises(argparse.ArgumentTypeError):
             named_lists(positive(int), "+")(text)
+
+
+# the name lists, checked against the executable's own list (`ropedyn keys`) once the study
+# knows it, before anything runs: (study, arguments, option, bad name)
+BAD_NAMES = [
+    ("calibrate", ["--method", "rk4"], "--method", "'rk4'"),
+    ("fig5", ["--method", "Auto"], "--method", "'Auto'"),
+    ("bench_rfem", ["--solvers", "cvode bogus"], "--solvers", "'bogus'"),
+    ("accuracy", ["windows", "--methods", "cvode:2,mebd:4"], "--methods", "'mebd'"),
+    ("work_precision", ["--models", "rfem,bogus"], "--models", "'bogus'"),
+    ("work_precision", ["--methods", "cvode,,erk"], "--methods", "''"),
+    ("work_precision", ["--max-orders", "cvod=2"], "--max-orders", "'cvod'"),
+    ("profile_step", ["--methods", "erk rk4"], "--methods", "'rk4'"),
+]
+
+
+@pytest.mark.parametrize("study,arguments,option,words", BAD_NAMES,
+                         ids=[f"{s}{o}" for s, _, o, _ in BAD_NAMES])
+def test_bad_name_is_a_usage_error(study, arguments, option, words, ropedyn_exe, capsys,
+                                   monkeypatch, tmp_path):
+    """Before, bergdahl --models bogus (and the like) failed only when its runs started, or
+    a study skipped the name with a message."""
+    monkeypatch.chdir(tmp_path)            # nothing may be written; if it were, not in docs/
+    module = importlib.import_module(f"ropedyn_tools.studies.{study}")
+    with pytest.raises(SystemExit) as e:
+        module.main([*arguments, "--exe", str(ropedyn_exe)])
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert f"argument {option}: unknown: {words}" in err or \
+        (words == "''" and f"argument {option}: unknown" in err), err
+    assert "allowed: " in err and "Traceback" not in err
+
+
+def test_study_labels_are_checked_when_parsed(capsys):
+    """bergdahl's labels are the study's own (MODEL or MODEL_VARIANT): no executable needed."""
+    module = importlib.import_module("ropedyn_tools.studies.bergdahl")
+    for option, value in (("--models", "rfem,mpp_bogus"), ("--convergence-models", "rfem_x")):
+        with pytest.raises(SystemExit) as e:
+            module.main([option, value, "--exe", "/nonexistent"])
+        assert e.value.code == 2
+        err = capsys.readouterr().err
+        assert f"argument {option}:" in err and "unknown" in err, err
+    assert choice(module.LABELS)("rfem_perimeter") == "rfem_perimeter"
+
+
+def test_check_names_reads_the_code_list(ropedyn_exe):
+    """The allowed names are those of `ropedyn keys`: every method and model the scene
+    reader takes passes, in any list; an empty list does not."""
+    from ropedyn_tools.keys_reference import allowed
+    parser = argparse.ArgumentParser()
+    methods = allowed(ropedyn_exe, "solver", "method")
+    assert {"auto", "cvode", "mebdf", "erk", "symplectic"} <= set(methods)
+    check_names(parser, ropedyn_exe, "--methods", methods, "solver", "method")
+    check_names(parser, ropedyn_exe, "--models", ["mpp", "rfem"], "model", "kind")
+    with pytest.raises(SystemExit):
+        check_names(parser, ropedyn_exe, "--models", [], "model", "kind")

@@ -5,7 +5,9 @@ before anything is built or run, for example
 Without a type the study would trace back where it first converts the list.
 
 `listing` returns the list; `list_text` checks the list and returns the text as given, for
-the studies that quote the option's text in their Command line."""
+the studies that quote the option's text in their Command line. Names are checked too: a
+study's own labels by `choice`, the code's methods and models by `check_names`, which asks
+the executable for its list (`ropedyn keys`) once the study knows it, before anything runs."""
 import argparse
 
 #: how a list's items are separated: blanks, commas, or either
@@ -25,6 +27,28 @@ def positive(kind):
         return value
     parse.__name__ = kind.__name__
     return parse
+
+
+def choice(allowed):
+    """An argparse type: one of the names `allowed`, as given."""
+    def parse(text):
+        if text not in allowed:
+            raise argparse.ArgumentTypeError(f"unknown: {text!r} (allowed: {', '.join(allowed)})")
+        return text
+    return parse
+
+
+def check_names(parser, exe, option, names, group, key, extra=()):
+    """A usage error (exit 2) naming `option` unless `names` is not empty and each is a value
+    the code allows for group.key (the `allowed` column of `ropedyn keys`: the code's one
+    list) or one of `extra`. Call it once the executable is known, before anything runs."""
+    from ropedyn_tools.keys_reference import allowed   # it imports repo, which imports this
+    known = [*allowed(exe, group, key), *extra]
+    bad = [name for name in names if name not in known]
+    if bad or not names:
+        what = f"unknown: {', '.join(map(repr, bad))}" if bad else "an empty list"
+        parser.error(f"argument {option}: {what} (allowed: {', '.join(known)}; "
+                     f"the {group}.{key} of `ropedyn keys`)")
 
 
 def items(text, sep=None):

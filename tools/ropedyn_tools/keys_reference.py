@@ -47,6 +47,23 @@ def listing(text):
     return [dict(zip(COLUMNS, line.split("\t"))) for line in lines[1:] if line.strip()]
 
 
+def table(exe):
+    """The rows of `exe keys` (`listing`)."""
+    result = subprocess.run([str(exe), "keys"], capture_output=True, text=True)
+    if result.returncode != 0:
+        raise SystemExit(f"keys_reference: {exe} keys failed:\n{result.stderr}")
+    return listing(result.stdout)
+
+
+def allowed(exe, group, key):
+    """The values the code allows for group.key: the `allowed` column of `exe keys`, split at
+    commas."""
+    for row in table(exe):
+        if (row["group"], row["key"]) == (group, key):
+            return [value.strip() for value in row["allowed"].split(",")]
+    raise SystemExit(f"keys_reference: `{exe} keys` has no key {group}.{key}")
+
+
 def cell(text):
     """A table cell: '|' escaped."""
     return text.replace("|", "\\|")
@@ -97,10 +114,7 @@ def main(argv=None):
                         help="compare the page with the table; exit 1 when it differs")
     args = parser.parse_args(argv)
     exe = exe_or_build(args.exe)
-    result = subprocess.run([exe, "keys"], capture_output=True, text=True)
-    if result.returncode != 0:
-        raise SystemExit(f"keys_reference: {exe} keys failed:\n{result.stderr}")
-    block = render(listing(result.stdout))
+    block = render(table(exe))
     text = PAGE.read_text()
     if args.check:
         if section(text) != block:

@@ -44,6 +44,7 @@ import h5py
 import numpy as np
 
 from ropedyn_tools import docs_status
+from ropedyn_tools.arguments import check_names
 from ropedyn_tools.repo import DOCS, add_exe_argument, exe_or_build
 from ropedyn_tools.studies.common import machine, update_doc, run_stamp
 
@@ -969,6 +970,8 @@ def main(argv=None):
         choosing(args)
         return
     exe = exe_or_build(args.exe)
+    check_names(parser, exe, "--methods", [m.partition(":")[0] for m in args.methods],
+                "solver", "method")
     names = list(STUDIES) if args.study == "all" else [args.study]
     for name in names:
         wall0 = time.perf_counter()

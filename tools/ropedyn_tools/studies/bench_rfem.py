@@ -14,6 +14,7 @@ import sys
 import tempfile
 
 from ropedyn import io
+from ropedyn_tools.arguments import check_names
 from ropedyn_tools.repo import DOCS, PAPER, add_scaling_arguments, exe_or_build, set_args
 from ropedyn_tools.studies.common import SPLIT_HEADER, machine, time_split, update_doc, run_stamp
 
@@ -60,6 +61,7 @@ def main(argv=None):
     parser.add_argument("--no-write", action="store_true", help="print only")
     args = parser.parse_args(argv)
     exe = exe_or_build(args.exe)
+    check_names(parser, exe, "--solvers", args.solvers.split(), "solver", "method")
     extra = ["solver.first_order_newton=.true."] if args.first_order_newton else []
 
     rows = []

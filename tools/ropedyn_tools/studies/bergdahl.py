@@ -25,7 +25,7 @@ import time
 import h5py
 import numpy as np
 
-from ropedyn_tools.arguments import list_text, positive
+from ropedyn_tools.arguments import choice, list_text, positive
 from ropedyn_tools.repo import DOCS, INPUT, ROOT, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import least_cpu, run_stamp, scene_number, update_doc
 
@@ -50,6 +50,8 @@ MODELS = ("rfem", "mpp")
 #: perimeter: the paper's tangential drag 0.5 read on the 2.2 mm perimeter (0.5 x 2.2 / 3.654
 #: on our pi d), the reading the page does not take (docs/validation/bergdahl.md)
 VARIANTS = {"perimeter": ["fluid.tangential_drag_coefficient=0.30104"]}
+#: the labels --models takes
+LABELS = (*MODELS, *(f"{m}_{v}" for m in MODELS for v in VARIANTS))
 LENGTH = 33.0
 #: the two conditions whose tension histories the page shows
 HISTORIES = ((1.25, 0.2), (3.5, 0.075))
@@ -751,7 +753,8 @@ def main(argv=None):
     parser.add_argument("--out", default=str(DOCS / "validation" / "bergdahl.md"))
     parser.add_argument("--work", default=str(ROOT / "out" / "bergdahl"),
                         help="directory of the case files (kept: a rerun reuses them)")
-    parser.add_argument("--models", default="rfem,mpp")
+    parser.add_argument("--models", default="rfem,mpp", type=list_text(choice(LABELS), ","),
+                        help="models or MODEL_VARIANT labels, comma-separated (default rfem,mpp)")
     parser.add_argument("--periods", type=list_text(positive(float), ","),
                         default=",".join(str(p) for p in PERIODS))
     parser.add_argument("--radii", type=list_text(positive(float), ","),
@@ -760,6 +763,7 @@ def main(argv=None):
     parser.add_argument("--convergence", action="store_true",
                         help="also the runs at other element lengths and tolerances")
     parser.add_argument("--convergence-models", default=None,
+                        type=list_text(choice(MODELS), ","),
                         help="the models of the convergence runs (default: --models)")
     parser.add_argument("--contact-cost", action="store_true",
                         help="also the cost of the floor: one window with other methods and "

@@ -30,6 +30,7 @@ import tempfile
 import numpy as np
 
 from ropedyn import io
+from ropedyn_tools.arguments import check_names
 from ropedyn_tools.repo import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
 
 #: where the fit is written (and scripts/fig5 reads it)
@@ -109,6 +110,7 @@ def main(argv=None):
     parser.add_argument("--set", action="append", default=[], dest="sets")
     args = parser.parse_args(argv)
     exe = exe_or_build(args.exe)
+    check_names(parser, exe, "--method", [args.method], "solver", "method")
 
     common = [f"model.elements={args.elements}", f"solver.t_end={args.t_fit}",
               f'solver.method="{args.method}"', "solver.output_interval=0.05"] + args.sets

@@ -22,7 +22,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from ropedyn import io  # noqa: E402
-from ropedyn_tools.arguments import list_text, positive  # noqa: E402
+from ropedyn_tools.arguments import check_names, list_text, positive  # noqa: E402
 from ropedyn_tools.repo import (DOCS, PAPER, ROOT, add_exe_argument, exe_or_build,  # noqa: E402
                                 set_args)
 from ropedyn_tools.studies.calibrate import FIT_DATA, read_fit  # noqa: E402
@@ -66,6 +66,7 @@ def main(argv=None):
                         help=f"do not write the section of {PAGE.name}")
     args = parser.parse_args(argv)
     exe = exe_or_build(args.exe)
+    check_names(parser, exe, "--method", [args.method], "solver", "method")
     outdir = pathlib.Path(args.outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     fit = read_fit()

@@ -36,6 +36,7 @@ import subprocess
 import sys
 import tempfile
 
+from ropedyn_tools.arguments import check_names
 from ropedyn_tools.repo import DOCS, PAPER, ROOT, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import baseline_revision, machine, update_doc, run_stamp
 
@@ -172,6 +173,8 @@ def main(argv=None):
     if shutil.which("valgrind") is None:
         raise SystemExit("profile_step: valgrind is not installed")
     exe = exe_or_build(args.exe)
+    check_names(parser, exe, "--methods", args.methods.split(), "solver", "method",
+                extra=("default",))
     header = ("| build | solver | steps | instructions per step (k) | "
               + " | ".join(f"{p}: k per step (share)" for p in parts_names) + " |")
     rule = "|---|---|---|---|" + "---|" * len(parts_names)

@@ -36,7 +36,7 @@ import time
 import numpy as np
 
 from ropedyn import io
-from ropedyn_tools.arguments import list_text, named_lists, positive
+from ropedyn_tools.arguments import check_names, list_text, named_lists, positive
 from ropedyn_tools.repo import DOCS, PAPER, ROOT, add_exe_argument, exe_or_build
 from ropedyn_tools.studies.common import machine, update_doc, run_stamp
 
@@ -211,6 +211,10 @@ def main(argv=None):
     args.rtols = args.rtols or "1e-3,1e-4,1e-5,1e-6"
     args.horizon_t = args.horizon_t or 6.0
     exe = pathlib.Path(exe_or_build(args.exe)).resolve()
+    check_names(p, exe, "--models", args.models.split(","), "model", "kind")
+    check_names(p, exe, "--methods", args.methods.split(","), "solver", "method")
+    check_names(p, exe, "--max-orders", [e.partition("=")[0] for e in args.max_orders.split(",")],
+                "solver", "method")
     work = pathlib.Path(args.work)
     work.mkdir(parents=True, exist_ok=True)
     started = time.monotonic()
