@@ -55,6 +55,7 @@ module ropedyn_rope_model
         procedure :: mass_bandwidth => rope_mass_bandwidth
         procedure :: coordinate_mass_band => rope_coordinate_mass_band
         procedure :: angle_coordinates => rope_angle_coordinates
+        procedure :: displace => rope_displace
         procedure :: has_second_order => rope_has_second_order, &
                      second_order_layout => rope_second_order_layout
         procedure :: state_from_fields => rope_state_from_fields
@@ -239,6 +240,19 @@ contains
         allocate (angle(size(pos)))
         angle = .false.
     end function rope_angle_coordinates
+
+    !> The state y moved by delta in its generalized coordinates (the order of
+    !! `coordinates`), as an iteration on the configuration steps (statics): any update equal
+    !! to y + delta to first order in delta. The default: y + delta.
+    pure subroutine rope_displace(self, y, delta, y_new)
+        class(rope_model_t), intent(in) :: self
+        real(wp), intent(in) :: y(:), delta(:)
+        real(wp), intent(out) :: y_new(:)
+        integer, allocatable :: pos(:), vel(:)
+        call self%coordinates(pos, vel)
+        y_new = y
+        y_new(pos) = y(pos) + delta
+    end subroutine rope_displace
 
     !> T + V (kinetic + elastic + gravity), J.
     pure real(wp) function energy_total(self) result(e)

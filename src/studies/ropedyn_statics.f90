@@ -13,6 +13,9 @@
 !!
 !! Solver (`solve_statics`): a trust-region (Levenberg-Marquardt) Newton iteration on V,
 !!     (K + sigma M + E) delta = f,    q <- q + delta,
+!! the trial point q + delta or, where it lowers V further, the model's `displace` (for the
+!! RFEM exact for joined elements that turn, so that the stiff joints do not shorten the
+!! steps);
 !! E >= 0 from a modified Cholesky factorization (Gill, Murray & Wright), so that every step
 !! descends even where K is indefinite (a compressed rope); a step is accepted when V falls
 !! by at least 1e-4 of the quadratic model's prediction, after up to two second-order
@@ -132,6 +135,9 @@ module ropedyn_statics
         procedure :: trial => descent_trial
         procedure :: limit_step => descent_limit_step
         procedure :: try_step => descent_try_step
+        procedure :: trial_point => descent_trial_point
+        procedure :: evaluate => descent_evaluate
+        procedure :: energy_noise => descent_energy_noise
         procedure :: reject => descent_reject
         procedure :: accept => descent_accept
         procedure :: update_shift => descent_update_shift
@@ -477,7 +483,8 @@ contains
         self%kw = max(tangent_bandwidth(model), self%km)
         allocate (self%f(nd), self%f_new(nd), self%kt(0:self%kw, nd), &
                   self%mm(0:self%km, nd), self%kfull(-self%kw:self%kw, nd), &
-                  self%shifted(0:self%kw, nd), self%delta(nd), self%mdiag(nd), self%kd(nd))
+                  self%shifted(0:self%kw, nd), self%delta(nd), self%mdiag(nd), self%kd(nd), &
+                  self%y_new(size(y)))
         y(self%vel) = 0.0_wp
         self%length = rope_length(model)
         self%step_limit = 0.5_wp*max(self%length, 1.0_wp)
@@ -640,8 +647,9 @@ contains
                          0.5_wp*dot_product(self%delta, self%kd)
         call self%try_step(model, spec, y, accept)
         ! second-order corrections: chord steps with the same matrix pull the trial
-        ! point back towards the manifold the linear step left (stiff springs
-        ! stretched by a linearized rotation), judged against the same prediction
+        ! point back towards the manifold the step left (stiff springs stretched at
+        ! second order where the model's displace is linear), judged against the same
+        ! prediction
         do k = 1, 2
             if (accept .or. self%status /= STATUS_OK) exit
             self%delta = self%delta + ldl_solve(self%fac, self%f_new)
@@ -659,8 +667,9 @@ contains
         self%step = maxval(abs(self%delta))
     end subroutine descent_limit_step
 
-    !> Evaluate q + delta (y_new, f_new, v_new): `ok` when V falls by at least 1e-4 of the
-    !! predicted decrease (rho: the ratio); status /= STATUS_OK when it is not finite.
+    !> Evaluate the trial point of the step delta (y_new, f_new, v_new: `trial_point`): `ok`
+    !! when V falls by at least 1e-4 of the predicted decrease (rho: the ratio); status /=
+    !! STATUS_OK when it is not finite.
     subroutine descent_try_step(self, model, spec, y, ok)
         class(descent_t), intent(inout) :: self
         class(rope_model_t), intent(inout) :: model
@@ -669,16 +678,9 @@ contains
         logical, intent(out) :: ok
         real(wp) :: noise
         ok = .false.
-        self%y_new = y
-        self%y_new(self%pos) = y(self%pos) + self%delta
-        call generalized_force(model, self%y_new, self%pos, self%vel, self%f_new, self%status)
+        call self%trial_point(model, spec, y)
         if (self%status /= STATUS_OK) return
-        self%v_new = potential_energy(model, self%y_new, spec)
-        if (.not. ieee_is_finite(self%v_new)) then
-            self%status = -1
-            return
-        end if
-        noise = 1.0e-13_wp*(abs(self%v_old) + self%result%weight*self%length) + tiny(1.0_wp)
+        noise = self%energy_noise()
         if (self%predicted <= noise) then
             ! at the rounding level of V: judge by the forces
             self%rho = 1.0_wp
@@ -689,6 +691,66 @@ contains
             ok = self%rho > 1.0e-4_wp
         end if
     end subroutine descent_try_step
+
+    !> The trial point of the step delta: y + delta, or the model's `displace` of y by delta
+    !! where that differs and lowers V further (by more than its rounding noise; within it:
+    !! the one with the smaller forces). The displacement turns an RFEM's joined elements
+    !! without stretching the joints, which lets a soft rope swing in long steps; y + delta
+    !! keeps Newton's last steps exact along the stiff springs (a pinned bottom end, to which
+    !! the displacement's second-order turn of every element above adds up).
+    subroutine descent_trial_point(self, model, spec, y)
+        class(descent_t), intent(inout) :: self
+        class(rope_model_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(in) :: y(:)
+        real(wp), allocatable :: y_turned(:), y_lin(:), f_lin(:)
+        real(wp) :: v_lin, noise
+        integer :: status_lin
+        logical :: better
+        y_lin = y
+        y_lin(self%pos) = y(self%pos) + self%delta
+        call self%evaluate(model, spec, y_lin)
+        allocate (y_turned(size(y)))
+        call model%displace(y, self%delta, y_turned)
+        if (all(y_turned == y_lin)) return
+        f_lin = self%f_new
+        v_lin = self%v_new
+        status_lin = self%status
+        call self%evaluate(model, spec, y_turned)
+        if (status_lin /= STATUS_OK .or. self%status /= STATUS_OK) then
+            better = self%status == STATUS_OK
+        else
+            noise = self%energy_noise()
+            better = self%v_new < v_lin - noise .or. (self%v_new <= v_lin + noise .and. &
+                     maxval(abs(self%f_new)) < maxval(abs(f_lin)))
+        end if
+        if (better) return
+        self%y_new = y_lin
+        self%f_new = f_lin
+        self%v_new = v_lin
+        self%status = status_lin
+    end subroutine descent_trial_point
+
+    !> The forces and the potential energy at the state y_trial (y_new, f_new, v_new);
+    !! status /= STATUS_OK when they are not finite.
+    subroutine descent_evaluate(self, model, spec, y_trial)
+        class(descent_t), intent(inout) :: self
+        class(rope_model_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(in) :: y_trial(:)
+        self%y_new = y_trial
+        self%v_new = huge(1.0_wp)
+        call generalized_force(model, self%y_new, self%pos, self%vel, self%f_new, self%status)
+        if (self%status /= STATUS_OK) return
+        self%v_new = potential_energy(model, self%y_new, spec)
+        if (.not. ieee_is_finite(self%v_new)) self%status = -1
+    end subroutine descent_evaluate
+
+    !> The rounding noise of V at the iteration's scale, J.
+    pure real(wp) function descent_energy_noise(self) result(noise)
+        class(descent_t), intent(in) :: self
+        noise = 1.0e-13_wp*(abs(self%v_old) + self%result%weight*self%length) + tiny(1.0_wp)
+    end function descent_energy_noise
 
     !> A rejected step: a larger shift (back to the last one that worked after a failed
     !! Newton step); ERR_SOLVER after 40 rejections in a row.

@@ -7,7 +7,7 @@
 !! is first found without the current (find_equilibrium, the descent), then continued in
 !! the current's velocity, U s for s from 0 to 1, each stage by a pseudo-transient
 !! continuation on the residual (`flow_solve`):
-!!     (K + sigma M) delta = f,   q <- q + delta,
+!!     (K + sigma M) delta = f,   q <- q + delta (or the model's `displace`),
 !! K = -df/dq the whole tangent stiffness, the drag's unsymmetric part included (LAPACK
 !! band LU, dgbtrf), M the mass: a backward Euler step of the flow M q' = f of pseudo-time
 !! 1/sigma. sigma starts at the descent's scale (a step of L/10), follows the residual's
@@ -47,6 +47,8 @@ submodule (ropedyn_statics) ropedyn_statics_flow
         procedure :: start => flow_start
         procedure :: factor => flow_factor
         procedure :: solve => flow_solve
+        procedure :: trial => flow_trial
+        procedure :: evaluate => flow_evaluate
     end type flow_t
 
 contains
@@ -162,7 +164,7 @@ contains
         self%km = model%mass_bandwidth()
         self%kw = max(tangent_bandwidth(model), self%km)
         allocate (self%f(nd), self%f_new(nd), self%delta(nd), self%mdiag(nd), self%ipiv(nd), &
-                  self%weight(nd), &
+                  self%weight(nd), self%y_new(size(y)), &
                   self%kb(-self%kw:self%kw, nd), self%mm(0:self%km, nd), &
                   self%ab(3*self%kw + 1, nd))
         y(self%vel) = 0.0_wp
@@ -242,8 +244,8 @@ contains
                 self%delta = 0.0_wp
                 self%f_new = self%f
                 ! the step, then up to two chord corrections with the same factors: they pull
-                ! the trial point back towards the manifold the linear step left (stiff
-                ! springs stretched by a linearized rotation), as in the descent
+                ! the trial point back towards the manifold the step left (stiff springs
+                ! stretched at second order), as in the descent
                 do k = 0, 2
                     step_k = self%f_new
                     call dgbtrs('N', size(self%pos), self%kw, self%kw, 1, self%ab, &
@@ -252,12 +254,7 @@ contains
                     if (k == 0) step = maxval(abs(self%delta))
                     if (maxval(abs(self%delta)) > FLOW_STEP_SHARE*self%length) self%delta = &
                         self%delta*(FLOW_STEP_SHARE*self%length/maxval(abs(self%delta)))
-                    self%y_new = y
-                    self%y_new(self%pos) = y(self%pos) + self%delta
-                    call generalized_force(model, self%y_new, self%pos, self%vel, &
-                                           self%f_new, status)
-                    phi_new = huge(1.0_wp)
-                    if (status == STATUS_OK) phi_new = sum(self%weight*self%f_new**2)
+                    call self%trial(model, y, phi_new, status)
                     if (phi_new < self%phi .or. status /= STATUS_OK) exit
                 end do
                 if (self%sigma == 0.0_wp .and. step <= options%step_tolerance*self%length &
@@ -292,6 +289,49 @@ contains
             result%last_step = maxval(abs(self%delta))
         end subroutine accept_trial
     end subroutine flow_solve
+
+    !> The trial point of the step delta (y_new, f_new; phi_new, huge when the forces are not
+    !! finite): y + delta, or the model's `displace` of y by delta where that differs and
+    !! has the smaller residual, as the descent chooses it (ropedyn_statics, trial_point).
+    subroutine flow_trial(self, model, y, phi_new, status)
+        class(flow_t), intent(inout) :: self
+        class(rope_model_t), intent(inout) :: model
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(out) :: phi_new
+        integer, intent(out) :: status
+        real(wp), allocatable :: y_lin(:), y_turned(:), f_lin(:)
+        real(wp) :: phi_lin
+        integer :: status_lin
+        y_lin = y
+        y_lin(self%pos) = y(self%pos) + self%delta
+        call self%evaluate(model, y_lin, phi_new, status)
+        allocate (y_turned(size(y)))
+        call model%displace(y, self%delta, y_turned)
+        if (all(y_turned == y_lin)) return
+        f_lin = self%f_new
+        phi_lin = phi_new
+        status_lin = status
+        call self%evaluate(model, y_turned, phi_new, status)
+        if (phi_new < phi_lin) return
+        self%y_new = y_lin
+        self%f_new = f_lin
+        phi_new = phi_lin
+        status = status_lin
+    end subroutine flow_trial
+
+    !> The residual at the state y_trial (y_new, f_new) and its weighted norm squared
+    !! phi_new, huge when it is not finite.
+    subroutine flow_evaluate(self, model, y_trial, phi_new, status)
+        class(flow_t), intent(inout) :: self
+        class(rope_model_t), intent(inout) :: model
+        real(wp), intent(in) :: y_trial(:)
+        real(wp), intent(out) :: phi_new
+        integer, intent(out) :: status
+        self%y_new = y_trial
+        call generalized_force(model, self%y_new, self%pos, self%vel, self%f_new, status)
+        phi_new = huge(1.0_wp)
+        if (status == STATUS_OK) phi_new = sum(self%weight*self%f_new**2)
+    end subroutine flow_evaluate
 
     !> The equilibrium's results as the descent's (at_rest_near, statics_result_t%report),
     !! the residual evaluated at the end (the stages' iterations keep theirs).

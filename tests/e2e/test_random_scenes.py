@@ -31,3 +31,18 @@ def test_a_short_sweep(ropedyn_exe, capsys):
     assert rs.main(["statics", "--exe", str(ropedyn_exe), "--seed", "3", "--count", "4"]) == 0
     out = capsys.readouterr().out
     assert "random_scenes statics --seed 3 --count 4: ok " in out and "crash 0" in out
+
+
+def test_show_prints_the_outcomes_asked_for(ropedyn_exe, capsys, monkeypatch):
+    """--show refused prints each refused case as a crash is printed: its last line and the
+    command that repeats it (a bad value drawn: model.elements = 0 is refused)."""
+    args = ["statics", "--exe", str(ropedyn_exe), "--seed", "3", "--count", "2"]
+    draw = rs.draw
+    monkeypatch.setattr(rs, "draw", lambda rng, command: (
+        {**draw(rng, command)[0], "model.elements": 0}, False))
+    assert rs.main(args + ["--show", "refused"]) == 0
+    shown = capsys.readouterr().out
+    assert rs.main(args) == 0
+    quiet = capsys.readouterr().out
+    assert shown.count("refused (case ") == 2 and "model.elements=0" in shown, shown
+    assert "refused 2" in shown and "refused (case " not in quiet

@@ -8,13 +8,17 @@
 !!   for a scene without equilibrium (free-free under gravity) and a capped iteration;
 !! - the rope in a current (normal drag only): a straight line at the angle theta from the
 !!   vertical where the normal drag balances the weight's normal part,
-!!   q_n U^2 cos^2 theta = w sin theta, RFEM and MPP, slow and fast, either way.
+!!   q_n U^2 cos^2 theta = w sin theta, RFEM and MPP, slow and fast, either way;
+!! - the RFEM's displace (the statics' trial point): y + delta to first order, and exact for
+!!   joined elements turned as one; and the soft rope with a heavy point mass that swings
+!!   down in a few hundred iterations with it (over 5000 with y + delta alone).
 program test_statics
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, ERR_SOLVER
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_model_factory, only: create_model
+    use ropedyn_rfem, only: rfem_t, rfem_create
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
                                generalized_force
     use ropedyn_modes, only: equilibrium_initial_state
@@ -44,6 +48,8 @@ program test_statics
     call test_current('mpp', 0.5_wp)
     call test_current('rfem', -3.0_wp)
     call test_current('mpp', 3.0_wp)
+    call test_displace()
+    call test_soft_swing()
     call suite%finish()
 
 contains
@@ -116,7 +122,9 @@ contains
         end if
         call suite%check_close(points(1, 2*n) - 1.0_wp, stretch, 1.0e-7_wp, 0.0_wp, &
                                kind//': static stretch of the tip (discrete closed form)')
-        call suite%check_le(abs(points(2, 2*n)), 1.0e-12_wp, kind//': hangs vertically')
+        ! to the iteration's rounding level: a sideways force of the residual's bound (1e-9
+        ! W) moves the tip by up to its lateral compliance, about ln(n)/w = 4 m/N, times it
+        call suite%check_le(abs(points(2, 2*n)), 1.0e-8_wp, kind//': hangs vertically (m)')
         call support_forces(scene%rope_spec_t, model, y, top, bottom, err)
         call suite%check_close(top(1), -W_LEN, 1.0e-9_wp, 0.0_wp, kind// &
                                ': top support force = -weight')
@@ -314,4 +322,86 @@ contains
         call suite%check_true(res%stages >= 1, kind//': continued in the current')
         call suite%check_le(res%residual_relative, 1.0e-9_wp, kind//': residual in the current')
     end subroutine test_current
+
+    !> rfem_t%displace: equal to y + delta to first order (the difference quarters when
+    !! delta halves), and for the straight rope turned as one about its top end by 0.3 rad
+    !! (delta: that turn linearized) exactly the turned rope, joints closed, where y + delta
+    !! opens each joint by about l theta^2/2.
+    subroutine test_displace()
+        real(wp), parameter :: THETA = 0.3_wp
+        type(scene_t) :: scene
+        type(rfem_t) :: model
+        type(error_t), allocatable :: err
+        real(wp), allocatable :: y(:), y_new(:), y_lin(:), delta(:)
+        real(wp), allocatable :: points(:, :), expected(:, :)
+        integer, allocatable :: pos(:), vel(:)
+        real(wp) :: top(2), c(2), gap(2)
+        integer :: i, n
+
+        call scene_of([character(len=64) :: 'model.elements = 6'], scene)
+        call rfem_create(model, scene%rope_spec_t, err)
+        n = model%n_elements()
+        allocate (y(model%size()), y_new(model%size()), points(2, 2*n), expected(2, 2*n))
+        call model%initial_state(y)                  ! straight at 75 degrees, joints closed
+        call model%coordinates(pos, vel)
+        allocate (delta(size(pos)))
+        call random_number(delta)
+        delta = delta - 0.5_wp
+        do i = 1, 2                                  ! delta of 1e-3 and 5e-4 (m or rad)
+            call model%displace(y, (1.0e-3_wp/i)*delta, y_new)
+            y_lin = y
+            y_lin(pos) = y(pos) + (1.0e-3_wp/i)*delta
+            gap(i) = maxval(abs(y_new - y_lin))
+        end do
+        call suite%check_close(gap(1)/gap(2), 4.0_wp, 0.05_wp, 0.0_wp, &
+                               'displace - (y + delta) is second order in delta')
+        ! the rigid turn about the top end, linearized: dphi = theta, dc = theta J (c - top)
+        call model%polyline(y, points)
+        top = points(:, 1)
+        do i = 1, n
+            c = y(6*(i - 1) + 1:6*(i - 1) + 2)
+            delta(3*(i - 1) + 1:3*(i - 1) + 3) = THETA*[-(c(2) - top(2)), c(1) - top(1), 1.0_wp]
+            expected(:, 2*i - 1) = top + turned(points(:, 2*i - 1) - top, THETA)
+            expected(:, 2*i) = top + turned(points(:, 2*i) - top, THETA)
+        end do
+        call model%displace(y, delta, y_new)
+        call model%polyline(y_new, points)
+        call suite%check_le(maxval(abs(points - expected)), 1.0e-15_wp, &
+                            'displace: the straight rope turned as one, exactly (m)')
+        y_lin = y
+        y_lin(pos) = y(pos) + delta
+        call model%polyline(y_lin, points)
+        call suite%check_close(maxval(norm2(points(:, 3:2*n:2) - points(:, 2:2*n - 1:2), &
+                                            dim=1)), (1.0_wp/n)*THETA**2/2, 0.5_wp, 0.0_wp, &
+                               'y + delta opens the joints by about l theta^2/2 (m)')
+    end subroutine test_displace
+
+    !> v turned by the angle a.
+    pure function turned(v, a) result(r)
+        real(wp), intent(in) :: v(2), a
+        real(wp) :: r(2)
+        r = [cos(a)*v(1) - sin(a)*v(2), sin(a)*v(1) + cos(a)*v(2)]
+    end function turned
+
+    !> A soft rope (the paper's, EI = 1.1e-3 N m^2, 1.8 m, n = 25) with a point mass of 3.4 kg
+    !! near its end and a sideways load, started straight at -75 degrees: it swings down in
+    !! long turning steps. With y + delta alone each step stretched the stiff joints and
+    !! the iteration took 5065 iterations (at 202c34b); with the displacement 147.
+    subroutine test_soft_swing()
+        type(scene_t) :: scene
+        class(rope_model_t), allocatable :: model
+        real(wp), allocatable :: y(:)
+        type(statics_result_t) :: res
+        character(len=120) :: label
+        call scene_of([character(len=64) :: 'model.elements = 25', 'rope.length = 1.8', &
+                       'attachments.mass_positions = 1.6', 'attachments.masses = 3.4', &
+                       'attachments.load_positions = 1.2', 'attachments.load_force_y = 2.0', &
+                       'initial.angle_deg = -75'], scene)
+        call equilibrium(scene, model, y, res)
+        write (label, '(a, i0, a, es9.2)') 'soft rope with a heavy mass swings down: ', &
+            res%iterations, ' iterations, residual ', res%residual_relative
+        call suite%check_le(res%residual_relative, 1.0e-9_wp, trim(label))
+        call suite%check_le(real(res%iterations, wp), 1000.0_wp, &
+                            'soft rope with a heavy mass: iterations')
+    end subroutine test_soft_swing
 end program test_statics

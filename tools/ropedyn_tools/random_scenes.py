@@ -113,6 +113,10 @@ def main(argv=None):
     parser.add_argument("--count", type=positive(int), default=50)
     parser.add_argument("--timeout", type=positive(float), default=180.0,
                         help="seconds a case may take (then it counts as a crash)")
+    parser.add_argument("--show", action="append", default=[],
+                        choices=("ok", "refused", "failed"),
+                        help="print these outcomes too, as crashes are: the last line of "
+                             "the output and the command (repeatable)")
     args = parser.parse_args(argv)
     exe = exe_or_build(args.exe)
     rng = random.Random(args.seed)
@@ -137,8 +141,8 @@ def main(argv=None):
             counts[kind] += 1
             if "statics: no" in text:
                 counts["no equilibrium"] += 1
-            if kind == "crash":
-                print(f"crash (case {k}): {text.strip().splitlines()[-1] if text else ''}\n"
+            if kind == "crash" or kind in args.show:
+                print(f"{kind} (case {k}): {text.strip().splitlines()[-1] if text else ''}\n"
                       f"  {' '.join(cmd)}", flush=True)
     print(f"random_scenes {args.command} --seed {args.seed} --count {args.count}: " +
           ", ".join(f"{name} {counts[name]}" for name in

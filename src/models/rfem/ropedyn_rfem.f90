@@ -147,6 +147,7 @@ module ropedyn_rfem
         procedure :: coordinate_mass => rfem_coordinate_mass
         procedure :: mass_bandwidth => rfem_mass_bandwidth
         procedure :: angle_coordinates => rfem_angle_coordinates
+        procedure :: displace => rfem_displace
         procedure :: coordinate_mass_band => rfem_coordinate_mass_band
         procedure :: second_order_blocks => rfem_second_order_blocks
         procedure :: generalized_forces => rfem_generalized_forces
@@ -594,6 +595,41 @@ contains
         integer :: k
         angle = [(mod(k, 3) == 0, k = 1, 3*self%n)]
     end function rfem_angle_coordinates
+
+    !> The state y moved by delta = (dx, dy, dphi) per element so that the joints move as
+    !! rigid links: the angles take phi + dphi; the top end of element 1 and each joint's gap
+    !! (end A of element i+1 minus end B of element i) take their changes linearized in
+    !! delta; the centres are then chained from the top. Equal to y + delta to first order,
+    !! and exact for a rotation of joined elements, which y + delta would stretch at second
+    !! order by l dphi^2/2 in each joint: the stiff joint springs then make every step of an
+    !! iteration on a soft rope short (docs/theory/statics-modes.md, "Steps that turn").
+    pure subroutine rfem_displace(self, y, delta, y_new)
+        class(rfem_t), intent(in) :: self
+        real(wp), intent(in) :: y(:), delta(:)
+        real(wp), intent(out) :: y_new(:)
+        real(wp) :: e(2), de(2), e_new(2), b_old(2), db_old(2), a_old(2), da(2), end_b(2)
+        integer :: i, k, d
+        y_new = y
+        do i = 1, self%n
+            k = 6*(i - 1)
+            d = 3*(i - 1)
+            e = [cos(y(k + 3)), sin(y(k + 3))]
+            de = [-e(2), e(1)]*delta(d + 3)             ! the change of e, linearized
+            a_old = y(k + 1:k + 2) - 0.5_wp*self%len(i)*e
+            da = delta(d + 1:d + 2) - 0.5_wp*self%len(i)*de
+            y_new(k + 3) = y(k + 3) + delta(d + 3)
+            e_new = [cos(y_new(k + 3)), sin(y_new(k + 3))]
+            if (i == 1) then
+                y_new(k + 1:k + 2) = a_old + da + 0.5_wp*self%len(i)*e_new
+            else                                        ! end B of i-1, plus the new gap
+                y_new(k + 1:k + 2) = end_b + (a_old - b_old) + (da - db_old) + &
+                                     0.5_wp*self%len(i)*e_new
+            end if
+            b_old = y(k + 1:k + 2) + 0.5_wp*self%len(i)*e
+            db_old = delta(d + 1:d + 2) + 0.5_wp*self%len(i)*de
+            end_b = y_new(k + 1:k + 2) + 0.5_wp*self%len(i)*e_new
+        end do
+    end subroutine rfem_displace
 
     !> The mass matrix is block diagonal (3x3 per element): bandwidth 2.
     pure integer function rfem_mass_bandwidth(self) result(kd)
