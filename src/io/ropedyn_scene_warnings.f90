@@ -2,14 +2,15 @@
 !! (more than a tenth of the length), a modulus or stiffness in the wrong unit (the static
 !! strain under the rope's own weight above 10 %), a damping coefficient in the wrong unit
 !! (an element's axial damping ratio below 1e-6 or above 1000), air's density for water, a
-!! straight start reaching into the ground (x points down: a ground point in the wrong
-!! sign). Each warning names the key, its value and why; a run goes ahead.
+!! straight start or a support's anchor inside the ground (x points down: a ground point in
+!! the wrong sign). Each warning names the key, its value and why; a run goes ahead.
 module ropedyn_scene_warnings
     use, intrinsic :: iso_fortran_env, only: error_unit
     use ropedyn_kinds, only: wp
     use ropedyn_text, only: text_t, append_text, real_text, significant_text
     use ropedyn_rope_section, only: section_t, rope_section, section_set_given
     use ropedyn_scene_types, only: scene_t
+    use ropedyn_rope_spec, only: bottom_anchor_given
     use ropedyn_rope_setup, only: initial_angle
     implicit none
     private
@@ -84,6 +85,7 @@ contains
                 real_text(scene%fluid%density)//': water = .true. in a fluid this light '// &
                 '(air is 1.225 kg/m^3): water is about 1000 (fresh) or 1025 (sea)')
         if (scene%effects%ground) call ground_start(scene, list)
+        if (scene%effects%ground) call ground_anchors(scene, list)
     contains
         function stiffness_text() result(text)
             character(len=:), allocatable :: text
@@ -104,6 +106,53 @@ contains
         end function damping_text
     end function scene_warnings
 
+    !> The depth of the point p in the scene's ground (m; below 0 on the free side):
+    !! -(p - point).normal/|normal|, the normal pointing to the free side; 0 without a normal.
+    pure real(wp) function ground_depth(scene, p) result(depth)
+        type(scene_t), intent(in) :: scene
+        real(wp), intent(in) :: p(2)
+        depth = 0.0_wp
+        if (.not. norm2(scene%ground%normal) > 0.0_wp) return
+        depth = -dot_product(scene%ground%normal/norm2(scene%ground%normal), &
+                             p - scene%ground%point)
+    end function ground_depth
+
+    !> The pinned or clamped ends whose anchor lies deeper in the ground than
+    !! MAX_START_DEPTH_SHARE of the length: the contact springs push the rope out against
+    !! the support for good, so the equilibrium holds the rope pressed into the ground (and
+    !! its iteration meets two stiff springs at odds). An anchor on the ground (a chain's
+    !! on the seabed) is within the share.
+    subroutine ground_anchors(scene, list)
+        type(scene_t), intent(in) :: scene
+        type(text_t), allocatable, intent(inout) :: list(:)
+        real(wp) :: depth
+        if (scene%supports%top /= 'free') then
+            depth = ground_depth(scene, scene%supports%top_anchor)
+            if (depth > MAX_START_DEPTH_SHARE*scene%rope%length) call append_text(list, &
+                anchor_text('top', scene%supports%top_anchor, depth))
+        end if
+        if (scene%supports%bottom /= 'free' .and. bottom_anchor_given(scene%rope_spec_t)) then
+            depth = ground_depth(scene, scene%supports%bottom_anchor)
+            if (depth > MAX_START_DEPTH_SHARE*scene%rope%length) call append_text(list, &
+                anchor_text('bottom', scene%supports%bottom_anchor, depth))
+        end if
+    contains
+        function anchor_text(end_name, anchor, depth) result(text)
+            character(len=*), intent(in) :: end_name
+            real(wp), intent(in) :: anchor(2), depth
+            character(len=:), allocatable :: text
+            text = scene%path//': &supports: '//end_name//'_anchor = '// &
+                significant_text(anchor(1), 6)//', '//significant_text(anchor(2), 6)// &
+                ': the '//trim(merge('top   ', 'bottom', end_name == 'top'))//' end is '// &
+                trim(merge('pinned ', 'clamped', merge(scene%supports%top, &
+                scene%supports%bottom, end_name == 'top') == 'pinned'))//' '// &
+                significant_text(depth, 3)//' m inside the ground (&ground point = '// &
+                real_text(scene%ground%point(1))//', '//real_text(scene%ground%point(2))// &
+                '; x points down, the normal to the free side): the contact springs push '// &
+                'the rope against the support for good; move the anchor or the ground'
+        end function anchor_text
+    end subroutine ground_anchors
+
     !> The straight starts ('straight', 'hanging': from &supports top_anchor along the
     !! initial angle) whose far end lies deeper in the ground than MAX_START_DEPTH_SHARE of
     !! the length: the contact springs hold that penetration at the start and throw the rope
@@ -112,15 +161,13 @@ contains
     subroutine ground_start(scene, list)
         type(scene_t), intent(in) :: scene
         type(text_t), allocatable, intent(inout) :: list(:)
-        real(wp) :: unit_normal(2), ends(2, 2), depth
+        real(wp) :: ends(2, 2), depth
         real(wp) :: angle
         if (scene%initial%shape /= 'straight' .and. scene%initial%shape /= 'hanging') return
-        if (.not. norm2(scene%ground%normal) > 0.0_wp) return
-        unit_normal = scene%ground%normal/norm2(scene%ground%normal)
         angle = initial_angle(scene%rope_spec_t)
         ends(:, 1) = scene%supports%top_anchor
         ends(:, 2) = ends(:, 1) + scene%rope%length*[cos(angle), sin(angle)]
-        depth = maxval(-matmul(unit_normal, ends - spread(scene%ground%point, 2, 2)))
+        depth = max(ground_depth(scene, ends(:, 1)), ground_depth(scene, ends(:, 2)))
         if (depth > MAX_START_DEPTH_SHARE*scene%rope%length) call append_text(list, &
             scene%path//': &ground: point = '//real_text(scene%ground%point(1))//', '// &
             real_text(scene%ground%point(2))//": the rope's "//trim(scene%initial%shape)// &

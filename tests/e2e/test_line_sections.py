@@ -128,6 +128,9 @@ def test_a_chain_without_bending_stiffness_hangs(run, tmp_path, kind):
      "&ground: point = 0.5, 0.0: the rope's hanging start reaches 0.5 m into the ground"),
     (["effects.ground=.true.", "ground.point=0.1,0"],
      "&ground: point = 0.1, 0.0: the rope's straight start reaches 0.159 m into the ground"),
+    (["effects.ground=.true.", "ground.point=2,0", "supports.bottom='clamped'",
+      "supports.bottom_anchor=2.5,0.3"],
+     "&supports: bottom_anchor = 2.5, 0.3: the bottom end is clamped 0.5 m inside the ground"),
 ])
 def test_a_probable_unit_slip_gets_one_warning(run, tmp_path, sets, fragment):
     args = ["run", PAPER, "--set", "solver.t_end=1e-4", "--set", "solver.output_interval=1e-4",
@@ -144,6 +147,15 @@ def test_a_rope_laid_on_the_ground_has_no_warning(run, tmp_path):
     proc = run("run", PAPER, "--set", "solver.t_end=1e-4", "--set", "solver.output_interval=1e-4",
                "--set", "output.file='w.h5'", "--set", "effects.ground=.true.",
                "--set", "ground.point=0,0", "--set", "initial.angle_deg=90")
+    assert proc.returncode == 0 and "warning" not in proc.stderr, proc.stderr
+
+
+def test_an_anchor_on_the_ground_has_no_warning(run, tmp_path):
+    """A chain anchored on the seabed: its bottom anchor on the ground (depth 0)."""
+    proc = run("run", PAPER, "--set", "solver.t_end=1e-4", "--set", "solver.output_interval=1e-4",
+               "--set", "output.file='w.h5'", "--set", "effects.ground=.true.",
+               "--set", "ground.point=1.0,0", "--set", "supports.bottom='pinned'",
+               "--set", "supports.bottom_anchor=1.0,0.5")
     assert proc.returncode == 0 and "warning" not in proc.stderr, proc.stderr
 
 

@@ -326,7 +326,7 @@ def beam(runner, ns):
           "SDE on a zero-length joint that lumps the part of the first primary section no "
           "internal SDE covers: RFEM splits the first section [0, dl] between the clamp and "
           "its neighbouring SDE (2 EI/dl each), the MPP's clamp takes the half member "
-          "[0, l/2] (2 EI/l); docs/theory/rfem.md. (A clamp of EI/dl on top of the "
+          "[0, l/2] (2 EI/l); [RFEM](../theory/rfem.md). (A clamp of EI/dl on top of the "
           "sections, the former model, added one section's compliance: order 0.5-0.8 in "
           "this range of n, -2.1e-3 (RFEM) and -8.6e-4 (MPP) at n = 300.)", ""]
     rows = {}
