@@ -125,32 +125,26 @@ contains
     subroutine ground_anchors(scene, list)
         type(scene_t), intent(in) :: scene
         type(text_t), allocatable, intent(inout) :: list(:)
-        real(wp) :: depth
-        if (scene%supports%top /= 'free') then
-            depth = ground_depth(scene, scene%supports%top_anchor)
-            if (depth > MAX_START_DEPTH_SHARE*scene%rope%length) call append_text(list, &
-                anchor_text('top', scene%supports%top_anchor, depth))
-        end if
-        if (scene%supports%bottom /= 'free' .and. bottom_anchor_given(scene%rope_spec_t)) then
-            depth = ground_depth(scene, scene%supports%bottom_anchor)
-            if (depth > MAX_START_DEPTH_SHARE*scene%rope%length) call append_text(list, &
-                anchor_text('bottom', scene%supports%bottom_anchor, depth))
-        end if
+        if (scene%supports%top /= 'free') &
+            call held_end('top', scene%supports%top, scene%supports%top_anchor)
+        if (scene%supports%bottom /= 'free' .and. bottom_anchor_given(scene%rope_spec_t)) &
+            call held_end('bottom', scene%supports%bottom, scene%supports%bottom_anchor)
     contains
-        function anchor_text(end_name, anchor, depth) result(text)
-            character(len=*), intent(in) :: end_name
-            real(wp), intent(in) :: anchor(2), depth
-            character(len=:), allocatable :: text
-            text = scene%path//': &supports: '//end_name//'_anchor = '// &
+        !> The warning of the end `end_name`, held as `kind`, when its anchor is too deep.
+        subroutine held_end(end_name, kind, anchor)
+            character(len=*), intent(in) :: end_name, kind
+            real(wp), intent(in) :: anchor(2)
+            real(wp) :: depth
+            depth = ground_depth(scene, anchor)
+            if (depth > MAX_START_DEPTH_SHARE*scene%rope%length) call append_text(list, &
+                scene%path//': &supports: '//end_name//'_anchor = '// &
                 significant_text(anchor(1), 6)//', '//significant_text(anchor(2), 6)// &
-                ': the '//trim(merge('top   ', 'bottom', end_name == 'top'))//' end is '// &
-                trim(merge('pinned ', 'clamped', merge(scene%supports%top, &
-                scene%supports%bottom, end_name == 'top') == 'pinned'))//' '// &
+                ': the '//end_name//' end is '//trim(kind)//' '// &
                 significant_text(depth, 3)//' m inside the ground (&ground point = '// &
                 real_text(scene%ground%point(1))//', '//real_text(scene%ground%point(2))// &
                 '; x points down, the normal to the free side): the contact springs push '// &
-                'the rope against the support for good; move the anchor or the ground'
-        end function anchor_text
+                'the rope against the support for good; move the anchor or the ground')
+        end subroutine held_end
     end subroutine ground_anchors
 
     !> The straight starts ('straight', 'hanging': from &supports top_anchor along the
