@@ -12,6 +12,7 @@ group's table links to (GUIDE).
                                       # is not what the table gives
 """
 import argparse
+import functools
 import subprocess
 import sys
 
@@ -47,12 +48,19 @@ def listing(text):
     return [dict(zip(COLUMNS, line.split("\t"))) for line in lines[1:] if line.strip()]
 
 
-def table(exe):
-    """The rows of `exe keys` (`listing`)."""
-    result = subprocess.run([str(exe), "keys"], capture_output=True, text=True)
+@functools.lru_cache(maxsize=None)
+def keys_text(exe):
+    """The output of `exe keys` (exe a str), read once per executable: a study checks
+    several options against it (arguments.check_names)."""
+    result = subprocess.run([exe, "keys"], capture_output=True, text=True)
     if result.returncode != 0:
         raise SystemExit(f"keys_reference: {exe} keys failed:\n{result.stderr}")
-    return listing(result.stdout)
+    return result.stdout
+
+
+def table(exe):
+    """The rows of `exe keys` (`listing`)."""
+    return listing(keys_text(str(exe)))
 
 
 def allowed(exe, group, key):
