@@ -54,6 +54,7 @@ A table someone wrote by hand.
 <!-- before erk:begin -->
 Command: `scripts/fig5` (Release). Run: 2026-01-02 06:00 UTC.
 <!-- before erk:end -->
+A study writes between `<!-- quoted:begin -->` and `<!-- quoted:end -->` markers.
 """)
     return second, with_page, later
 
@@ -73,6 +74,8 @@ def test_sections_count_the_code_commits_since_their_run(tmp_path):
     # the test set's numbers do not come from src/
     assert hashes["testset"] == []
     assert rows["undated"]["commits"] is None
+    # a marker quoted in a sentence is no section
+    assert "quoted" not in rows
     # a committed stamp is judged from the commit that wrote it: the code committed with it
     # (after the run's time) does not count, the next day's change does
     assert hashes["run"] == [later]

@@ -64,7 +64,9 @@ UNCHANGED_FILE = "docs/numbers-unchanged.txt"
 #: how many lines after the begin marker are searched for the command and the stamp
 HEAD_LINES = 6
 
-_BEGIN = re.compile(r"<!-- (?P<name>[^:>]+):begin -->")
+#: a begin marker stands alone on its line (one quoted in a sentence, as in the contributing
+#: guide's `<!-- name:begin -->`, is no section)
+_BEGIN = re.compile(r"^\s*<!-- (?P<name>[^:>]+):begin -->\s*$")
 _SCRIPT = re.compile(r"scripts/(?P<script>[a-z0-9_]+)")
 _STAMP = re.compile(r"(?P<date>20\d\d-\d\d-\d\d)(?:[ T](?P<time>\d\d:\d\d)(?: ?UTC)?)?")
 _COMMIT = re.compile(r"commit `(?P<rev>[0-9a-f]{7,40})`")
