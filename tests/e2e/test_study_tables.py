@@ -3,7 +3,8 @@ that needs more CPU than its cap as such, not as a failure of the method; the me
 count switches, not the symplectic method's changes of step; bench_step runs again where a
 run of another build left its file; calibrate runs its fit (each run to a file of its
 own); bench_peers at equal accuracy takes the loosest rung of a half-decade ladder whose tip
-error is within MoorDyn's."""
+error is within MoorDyn's; the stability report's stamp names the command that remakes
+what it wrote."""
 from ropedyn_tools.repo import ROOT
 from ropedyn_tools.studies import auto_accuracy as aa
 
@@ -98,3 +99,16 @@ def test_equal_accuracy_takes_the_loosest_rung_within_moordyns_error(monkeypatch
     cells = [c.strip() for c in row.split("|")[1:-1]]
     assert tried == [0.1, 0.03]
     assert cells[2] == "0.03" and cells[-1] == "4.00"
+
+
+def test_the_stability_reports_stamp_names_its_part():
+    """A report run for one part stamps the command that remakes that part, so that
+    docs_rerun runs no more than it needs."""
+    from ropedyn_tools.studies.stability_report import command_text
+    assert command_text(False, None) == "Command: `scripts/stability_report`"
+    assert command_text(False, "hard-scenes") == \
+        "Command: `scripts/stability_report --only hard-scenes`"
+    assert command_text(True, "cvode-order") == \
+        "Command: `scripts/stability_report --quick --only cvode-order`"
+    assert command_text(False, None, cached_only=True) == \
+        "Command: `scripts/stability_report --only long-horizon --cached-only`"

@@ -383,6 +383,17 @@ def long_sections(exe, jobs, command, stamp, cached_only=False):
     }
 
 
+def command_text(quick, only, cached_only=False):
+    """The stamp's command: the one that remakes the sections a run wrote, and only them
+    (the whole report remakes them too)."""
+    words = ["scripts/stability_report"] + (["--quick"] if quick else [])
+    if cached_only:
+        words += ["--only", "long-horizon", "--cached-only"]
+    elif only:
+        words += ["--only", only]
+    return "Command: `" + " ".join(words) + "`"
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     add_exe_argument(parser)
@@ -403,7 +414,7 @@ def main(argv=None):
     started = datetime.datetime.now(datetime.timezone.utc)
     stamp = (f"Machine: {machine()}. Run: {started:%Y-%m-%d %H:%M} UTC{run_commit()}, "
              f"--jobs {args.jobs}.")
-    command = "Command: `scripts/stability_report" + (" --quick" if args.quick else "") + "`"
+    command = command_text(args.quick, args.only)
     sections = {}
 
     for name, (heading, cases, intro, table) in STUDIES.items():
@@ -416,9 +427,9 @@ def main(argv=None):
 
     if args.only in (None, "long-horizon") and not args.quick:
         print("Long-horizon matrix:", flush=True)
-        if args.cached_only:
-            command = command[:-1] + " --only long-horizon --cached-only`"
-        sections.update(long_sections(exe, args.jobs, command, stamp, args.cached_only))
+        sections.update(long_sections(exe, args.jobs,
+                                      command_text(args.quick, args.only, args.cached_only),
+                                      stamp, args.cached_only))
 
     elapsed = datetime.datetime.now(datetime.timezone.utc) - started
     print(f"elapsed: {elapsed.total_seconds():.0f} s")
