@@ -134,9 +134,15 @@ module ropedyn_integrator
         !> no step ends beyond this time, s (`set_stop_time`; huge: no bound; `init`
         !! clears it)
         real(wp) :: t_stop = huge(1.0_wp)
+        !> advance_to returns early (t < tout, no error) after the accepted step that
+        !! brings the method's step count to this (`set_step_cap`, for auto's looks at a
+        !! method whose steps collapsed within a stretch; huge: never; `init` clears it)
+        integer(i8) :: step_cap = huge(1_i8)
     contains
         procedure :: init => integrator_init
         procedure :: set_stop_time => integrator_set_stop_time
+        procedure :: set_step_cap => integrator_set_step_cap
+        procedure :: stop_here => integrator_stop_here
         procedure :: rhs_changed => integrator_rhs_changed
         procedure(start_i), deferred :: start
         procedure(advance_to_i), deferred :: advance_to
@@ -234,6 +240,23 @@ contains
         real(wp), intent(in) :: t_stop
         self%t_stop = t_stop
     end subroutine integrator_set_stop_time
+
+    !> End advance_to early after the accepted step that brings the method's step count
+    !! (its stats' steps) to `steps` (huge: never).
+    subroutine integrator_set_step_cap(self, steps)
+        class(integrator_t), intent(inout) :: self
+        integer(i8), intent(in) :: steps
+        self%step_cap = steps
+    end subroutine integrator_set_step_cap
+
+    !> Whether advance_to ends after the accepted step that brought the method's step count
+    !! to `steps`: stopped on request (options%stop_requested) or at the step cap.
+    logical function integrator_stop_here(self, steps) result(stop)
+        class(integrator_t), intent(in) :: self
+        integer(i8), intent(in) :: steps
+        stop = steps >= self%step_cap
+        if (.not. stop) stop = stop_now(self%options)
+    end function integrator_stop_here
 
     !> The right-hand side has changed from the current time on (the driver changed what
     !! f depends on, at a time the integration stopped at): a method that keeps f of its
@@ -390,6 +413,7 @@ contains
         self%problem => problem
         self%options = options
         self%t_stop = huge(1.0_wp)
+        self%step_cap = huge(1_i8)
         self%n = problem%size()
         self%nq = problem%quad_size()
         start%max_order = resolved_max_order(name, options%max_order)

@@ -22,7 +22,7 @@ module ropedyn_cvode
     use ropedyn_c_strings, only: c_string
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK
-    use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, stop_now
+    use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t
     use ropedyn_clock, only: clock_seconds
     use ropedyn_iteration_matrix, only: iteration_matrix_t, factored_dense
     use ropedyn_switch_log, only: switch_log_t, switch_event_t

@@ -98,8 +98,10 @@ contains
                 call self%watch(cause)
                 if (len(cause) > 0) exit
             end if
-            if (self%tn < tout .and. stop_now(self%options)) then
-                ! stopped early on request: the state at the end of this step
+            if (self%tn < tout .and. self%stop_here(self%base%steps + int(nsteps(1), i8) + 1)) &
+                then
+                ! stopped early (on request, at the step cap): the state at the end of this
+                ! step
                 self%t = self%tn
                 y = self%y
                 if (self%nq > 0) then

@@ -40,7 +40,7 @@ module ropedyn_erk
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
     use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, &
-                                  STIFF_STEP_RATE, stop_now
+                                  STIFF_STEP_RATE
     use ropedyn_erk_tables, only: erk_table_t, erk_table, ERK_MAX_STAGES
     implicit none
     private
@@ -303,8 +303,10 @@ contains
         end if
         do while (self%t < tout)
             call self%attempt_step(err)
-            if (allocated(err) .or. (self%t < tout .and. stop_now(self%options))) then
-                ! failed, or stopped early on request: the state at the end of the last step
+            if (allocated(err) .or. (self%t < tout .and. &
+                                     self%stop_here(self%counters%steps))) then
+                ! failed, or stopped early (on request, at the step cap): the state at the
+                ! end of the last step
                 t = self%t
                 y = self%y
                 if (self%nq > 0) yq(1:self%nq) = self%yq

@@ -30,7 +30,7 @@ module ropedyn_mebdf
     use ropedyn_text, only: int_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
-    use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, stop_now
+    use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t
     use ropedyn_clock, only: clock_seconds
     use ropedyn_mebdf_coefficients, only: mebdf_coefficients_t, mebdf_coefficients, KMAX_MEBDF
     use ropedyn_iteration_matrix, only: iteration_matrix_t
@@ -373,8 +373,8 @@ contains
                 if (self%nq > 0) yq(1:self%nq) = self%dif(self%n + 1:, 0)
                 return
             end if
-            if (self%t < tout .and. stop_now(self%options)) then
-                ! stopped early on request (options%stop_requested): the state of this step
+            if (self%t < tout .and. self%stop_here(self%counters%steps)) then
+                ! stopped early (on request, at the step cap): the state of this step
                 t = self%t
                 y = self%dif(1:self%n, 0)
                 if (self%nq > 0) yq(1:self%nq) = self%dif(self%n + 1:, 0)

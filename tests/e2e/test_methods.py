@@ -512,6 +512,34 @@ def test_erk_resolves_the_ground_contact(run, tmp_path):
     assert d < 2e-4, d
 
 
+def test_auto_looks_at_erk_whose_steps_collapse_within_a_chunk(run, tmp_path):
+    """auto runs the method in use in chunks sized by time, from its last step. Here (a
+    9.6 m rope started straight 6 m into the ground, drawn by scripts/random_scenes run
+    --seed 1, reduced) auto leaves cvode for erk at 0.8 ms, at the stable step the
+    spectrum then gives (9e-4 s: the rope is thrown out, its contact springs loose), and
+    erk's steps collapse to 1e-9 s within its first chunk as the contact takes hold again.
+    Unlooked-at, that chunk spent the whole step budget (here 20,000; the default million
+    on 0.5 ms); with the chunk cut once its window is 10 windows overdue, auto goes back
+    to the implicit method at 1.5 ms and finishes in about 11,000 steps."""
+    from ropedyn_tools.random_scenes import section_scene
+    scene = section_scene(tmp_path)
+    proc, out = run_scene(
+        run, tmp_path, scene, "collapse", "model.elements=10",
+        "rope.length=9.64036590025285", "initial.angle_deg=-42.12530433268766",
+        "effects.ground=.true.", "attachments.mass_positions=7.284", "attachments.masses=1.06",
+        "attachments.load_positions=7.229", "solver.atol=5.8702700181086224e-08",
+        "solver.t_end=0.2", "rope.mass_per_length=0.04952459064448364",
+        "rope.axial_stiffness=1625.985876986998", "rope.bending_stiffness=0.0",
+        "solver.max_steps=20000")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods, times, _, _ = switch_log(f)
+    # the scene still shows what the test is about: erk taken early, then left early
+    erk = methods.index("erk")
+    assert times[erk] < 2e-3 and methods[erk + 1] != "erk" and times[erk + 1] < 3e-3, \
+        list(zip(methods, times))
+
+
 def test_auto_keeps_erk_on_the_paper_rope(run, tmp_path):
     """The paper's rope at rtol 1e-6: erk's step is held by accuracy (about a third of its
     stable step), so auto runs erk throughout: the order-4 pair, and the order-5 pair where

@@ -5,7 +5,10 @@
 !! there exactly and returns that step's end point, and the run stays accurate when the
 !! force changes at every stop (rhs_changed: erk evaluates its first stage anew).
 !! (Checked by breaking it: erk not clipped to the stop time evaluated f 0.39 s beyond it;
-!! erk without rhs_changed rejected 517 of 898 steps.)
+!! erk without rhs_changed rejected 517 of 898 steps.) Also the step cap
+!! (integrator_t%set_step_cap, auto's looks): each adaptive method returns, without an
+!! error and short of its output time, after the step that brings its count to the cap,
+!! and goes on to the output time once the cap is lifted.
 module test_stop_time_problem
     use ropedyn_kinds, only: wp
     use ropedyn_problem, only: problem_t, STATUS_OK
@@ -51,7 +54,7 @@ contains
 end module test_stop_time_problem
 
 program test_stop_time
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t
     use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
     use ropedyn_solvers, only: new_integrator
@@ -68,6 +71,9 @@ program test_stop_time
     suite%name = 'stop_time'
     do m = 1, size(NAMES)
         call check_method(trim(NAMES(m)))
+    end do
+    do m = 1, size(NAMES) - 1
+        call check_step_cap(trim(NAMES(m)))
     end do
     call suite%finish()
 
@@ -128,6 +134,34 @@ contains
                             name//': the piecewise solution')
         call integrator%finalize()
     end subroutine check_method
+
+    !> The step cap: 25 steps from the start, then lifted (huge).
+    subroutine check_step_cap(name)
+        character(len=*), intent(in) :: name
+        integer(i8), parameter :: CAP = 25
+        class(integrator_t), allocatable :: integrator
+        type(forced_t) :: problem
+        type(solver_options_t) :: options
+        type(solver_stats_t) :: stats
+        type(error_t), allocatable :: err
+        real(wp) :: t, y(2), yq(0)
+        call new_integrator(name, integrator, err)
+        options%rtol = 1.0e-9_wp
+        options%atol = 1.0e-11_wp
+        y = [1.0_wp, 0.0_wp]
+        problem%level = 0.0_wp      ! a free oscillation: many steps to t = 10
+        call integrator%init(problem, 0.0_wp, y, yq, options, err)
+        call integrator%set_step_cap(CAP)
+        call integrator%advance_to(10.0_wp, t, y, yq, err)
+        stats = integrator%stats()
+        call suite%check_true(.not. allocated(err) .and. t < 10.0_wp .and. &
+                              stats%steps == CAP, name//': ends at the step cap')
+        call integrator%set_step_cap(huge(1_i8))
+        call integrator%advance_to(10.0_wp, t, y, yq, err)
+        call suite%check_true(.not. allocated(err) .and. t == 10.0_wp, &
+                              name//': on to the output time without the cap')
+        call integrator%finalize()
+    end subroutine check_step_cap
 
     !> (x, v) after time h under the constant force c from (x0, v0).
     pure function segment(y0, c, h) result(y)
