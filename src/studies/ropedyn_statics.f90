@@ -6,7 +6,8 @@
 !! a zero of f, and the tangent stiffness K(q) = -df/dq is the Hessian of the potential
 !! energy V (elastic + gravity) there. f and K come from the model:
 !! - explicit models (RFEM): f = M a with a = ydot(vel) from `rhs`, K = -M da/dq from the
-!!   analytic band Jacobian (rows vel, columns pos);
+!!   analytic band Jacobian (rows vel, columns pos) less (dM/dq) a, differenced, for a mass
+!!   that turns with the elements (ropedyn_statics_terms);
 !! - linearly implicit models (MPP: M(y) y' = F(y)): f = F(vel) from `implicit_rhs` (O(n))
 !!   and K by central differences of it (step 1e-8: below a stiff ground's penetration;
 !!   docs/theory/statics-modes.md).
@@ -554,7 +555,8 @@ contains
 
         integer :: i, j
         converged = .false.
-        call tangent_band(model, y, self%pos, self%vel, self%kw, self%kfull, self%status)
+        call tangent_band(model, y, self%pos, self%vel, self%kw, self%kfull, self%status, &
+                          hessian=.true.)
         if (self%status /= STATUS_OK) then
             call make_error(err, ERR_SOLVER, spec%path//': statics: the stiffness '// &
                             'matrix is not finite at iteration '// &

@@ -176,7 +176,8 @@ contains
         self%mdiag = self%mm(0, :)
         ! the residual's norm weighs each coordinate by its stiffness, 1/|K_ii| at the start
         ! (units of energy: a moment and a force count alike)
-        call tangent_band(model, y, self%pos, self%vel, self%kw, self%kb, status)
+        call tangent_band(model, y, self%pos, self%vel, self%kw, self%kb, status, &
+                          hessian=.true.)
         ok = status == STATUS_OK
         if (.not. ok) return
         self%weight = 1.0_wp/max(abs(self%kb(0, :)), tiny(1.0_wp))
@@ -233,7 +234,8 @@ contains
         allocate (step_k(size(self%pos)))
         do it = 1, budget
             if (self%fresh) then
-                call tangent_band(model, y, self%pos, self%vel, self%kw, self%kb, status)
+                call tangent_band(model, y, self%pos, self%vel, self%kw, self%kb, status, &
+                                  hessian=.true.)
                 if (status /= STATUS_OK) return
                 call model%coordinate_mass_band(y, self%mm)
                 self%fresh = .false.

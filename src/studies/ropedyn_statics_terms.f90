@@ -143,24 +143,26 @@ contains
         kd = min(kd, max(kl, ku) + model%mass_bandwidth())
     end function tangent_bandwidth
 
-    !> Tangent stiffness kt = -df/dq and, if present, damping cv = -df/dq' at state y, dense.
-    subroutine tangent_matrices(model, y, pos, vel, kt, status, cv)
+    !> Tangent stiffness kt = -df/dq and, if present, damping cv = -df/dq' at state y, dense
+    !! (`hessian`: as tangent_band's).
+    subroutine tangent_matrices(model, y, pos, vel, kt, status, cv, hessian)
         class(rope_model_t), intent(inout) :: model
         real(wp), intent(in) :: y(:)
         integer, intent(in) :: pos(:), vel(:)
         real(wp), intent(out) :: kt(:, :)
         integer, intent(out) :: status
         real(wp), intent(out), optional :: cv(:, :)
+        logical, intent(in), optional :: hessian
         real(wp), allocatable :: kb(:, :), cb(:, :)
         integer :: kd
         kd = tangent_bandwidth(model)
         allocate (kb(-kd:kd, size(pos)))
         if (present(cv)) then
             allocate (cb(-kd:kd, size(pos)))
-            call tangent_band(model, y, pos, vel, kd, kb, status, cb)
+            call tangent_band(model, y, pos, vel, kd, kb, status, cb, hessian)
             cv = dense_of(cb)
         else
-            call tangent_band(model, y, pos, vel, kd, kb, status)
+            call tangent_band(model, y, pos, vel, kd, kb, status, hessian=hessian)
         end if
         kt = dense_of(kb)
     end subroutine tangent_matrices
@@ -181,8 +183,13 @@ contains
     end function dense_of
 
     !> tangent_matrices in band storage: kb(i - j, j) = K_ij for |i - j| <= kd, kb(-kd:kd,
-    !! size(pos)) with kd = `tangent_bandwidth` (and cb likewise for C).
-    subroutine tangent_band(model, y, pos, vel, kd, kb, status, cb)
+    !! size(pos)) with kd = `tangent_bandwidth` (and cb likewise for C). With `hessian`
+    !! (the equilibrium iterations) K = -df/dq, the Hessian of V, also away from an
+    !! equilibrium: it adds -(dM/dq) a (add_mass_slope) to -M da/dq, the linearization of
+    !! the motion there, which the modes keep (the two agree at an equilibrium; at one
+    !! found to the rounding level the motion's is the closer: a chain in water's lowest
+    !! frequency 7e-8 from its closed form, 1e-6 with the Hessian).
+    subroutine tangent_band(model, y, pos, vel, kd, kb, status, cb, hessian)
         class(rope_model_t), intent(inout) :: model
         real(wp), intent(in) :: y(:)
         integer, intent(in) :: pos(:), vel(:)
@@ -190,15 +197,16 @@ contains
         real(wp), intent(out) :: kb(-kd:, :)
         integer, intent(out) :: status
         real(wp), intent(out), optional :: cb(-kd:, :)
+        logical, intent(in), optional :: hessian
         logical :: held
         held = model%supports_at_rest
         model%supports_at_rest = .true.
-        call tangents(model, y, pos, vel, kd, kb, status, cb)
+        call tangents(model, y, pos, vel, kd, kb, status, cb, hessian)
         model%supports_at_rest = held
     end subroutine tangent_band
 
     !> tangent_band with the supports as the model has them.
-    subroutine tangents(model, y, pos, vel, kd, kb, status, cb)
+    subroutine tangents(model, y, pos, vel, kd, kb, status, cb, hessian)
         class(rope_model_t), intent(inout) :: model
         real(wp), intent(in) :: y(:)
         integer, intent(in) :: pos(:), vel(:)
@@ -206,6 +214,7 @@ contains
         real(wp), intent(out) :: kb(-kd:, :)
         integer, intent(out) :: status
         real(wp), intent(out), optional :: cb(-kd:, :)
+        logical, intent(in), optional :: hessian   !< K = -df/dq (tangent_band)
         real(wp), allocatable :: mb(:, :), ka(:, :), ca(:, :), yp(:), gp(:), gm(:)
         real(wp), allocatable :: col(:), unit_mass(:, :)
         integer, allocatable :: lpos(:), lvel(:)
@@ -251,12 +260,16 @@ contains
                                            status)
             if (status /= STATUS_OK) return
         end if
-        ! da/dz -> df/dz = M da/dz at rest (the dM/dq a term vanishes at an equilibrium and
-        ! is left out elsewhere: Newton on a(q) = 0 in the metric M)
+        ! da/dz -> M da/dz, and for the Hessian df/dz = M da/dz + (dM/dq) a at rest (the
+        ! second term vanishes at an equilibrium; add_mass_slope)
         allocate (mb(0:model%mass_bandwidth(), nd))
         call model%coordinate_mass_band(y, mb)
         call mass_times(mb, ubound(mb, 1), ka, ja, kb, kd)
         kb = -kb
+        if (present(hessian)) then
+            if (hessian) call add_mass_slope(model, y, pos, vel, kd, kb, status)
+            if (status /= STATUS_OK) return
+        end if
         if (present(cb)) then
             call mass_times(mb, ubound(mb, 1), ca, ja, cb, kd)
             cb = -cb
@@ -295,6 +308,49 @@ contains
             end if
         end subroutine evaluate
     end subroutine tangents
+
+    !> kb -= (dM/dq) a, a = ydot(vel) the accelerations at y (an explicit model, f = M a):
+    !! the part of K = -df/dq that a mass depending on the configuration adds (the RFEM's
+    !! point masses off the element centres, water's added mass). Away from an equilibrium
+    !! K without it is not the Hessian of V, not even symmetric: on a chain with a 7.6 kg
+    !! mass 1 mm off its element's centre it coupled the element's turn to its centre 5
+    !! times as strongly as the joint springs do, a spurious negative curvature that held
+    !! the statics to steps of 1e-4 for thousands of iterations. By central differences of
+    !! the mass, the coordinates perturbed together in 2 km + 1 colours (km the mass's
+    !! bandwidth: q_j changes only the rows of its element, within km of j). A constant mass
+    !! differences to zero: kb unchanged.
+    subroutine add_mass_slope(model, y, pos, vel, kd, kb, status)
+        class(rope_model_t), intent(inout) :: model
+        real(wp), intent(in) :: y(:)
+        integer, intent(in) :: pos(:), vel(:), kd
+        real(wp), intent(inout) :: kb(-kd:, :)
+        integer, intent(out) :: status
+        real(wp), parameter :: H = 1.0e-6_wp   !< m or rad: the mass is smooth in q
+        real(wp), allocatable :: ydot(:), a(:), yp(:), ym(:), mp(:, :), mm(:, :), g(:)
+        integer :: km, nd, colour, j, i
+        nd = size(pos)
+        km = model%mass_bandwidth()
+        allocate (ydot(size(y)), mp(0:km, nd), mm(0:km, nd))
+        call model%rhs(0.0_wp, y, ydot, status)
+        if (status /= STATUS_OK) return
+        a = ydot(vel)
+        do colour = 1, 2*km + 1
+            yp = y
+            ym = y
+            do j = colour, nd, 2*km + 1
+                yp(pos(j)) = y(pos(j)) + H
+                ym(pos(j)) = y(pos(j)) - H
+            end do
+            call model%coordinate_mass_band(yp, mp)
+            call model%coordinate_mass_band(ym, mm)
+            g = band_matvec((mp - mm)/(2.0_wp*H), a)
+            do j = colour, nd, 2*km + 1
+                do i = max(1, j - min(km, kd)), min(nd, j + min(km, kd))
+                    kb(i - j, j) = kb(i - j, j) - g(i)
+                end do
+            end do
+        end do
+    end subroutine add_mass_slope
 
     !> Column j of a matrix into its band b(-kd:kd, n) (the entries outside the band are
     !! dropped: they are zero).
