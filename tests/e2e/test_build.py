@@ -95,11 +95,18 @@ def test_version_follows_commits_and_edits_of_the_tree(tmp_path):
     assert other != edited and other.startswith(f"9.8.7+g{first}-dirty."), other
     (tree / "src" / "b.f90").write_text("c\n")
     assert write_version(tree, out) == edited
-    # an edit outside the code: dirty, but the digest of no code change
+    # a new source not in git yet counts too, with its contents
+    (tree / "src" / "new.f90").write_text("n\n")
+    added = write_version(tree, out)
+    assert added.startswith(f"9.8.7+g{first}-dirty.") and added not in (edited, other)
+    (tree / "src" / "new.f90").write_text("m\n")
+    assert write_version(tree, out) not in (added, edited, other)
+    (tree / "src" / "new.f90").unlink()
+    # an edit outside what the build is made of: the commit's version
     (tree / "src" / "b.f90").write_text("b\n")
     (tree / "a.txt").write_text("b\n")
-    clean_code = write_version(tree, out)
-    assert clean_code.startswith(f"9.8.7+g{first}-dirty.") and clean_code not in (edited, other)
+    assert write_version(tree, out) == f"9.8.7+g{first}"
+    (tree / "src" / "b.f90").write_text("c\n")
     git(tree, "commit", "-qam", "second")
     assert write_version(tree, out) == f"9.8.7+g{git(tree, 'rev-parse', '--short', 'HEAD')}"
     # no git, or no checkout: the project's version alone
