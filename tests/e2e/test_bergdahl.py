@@ -112,9 +112,44 @@ def test_one_short_condition_end_to_end(ropedyn_exe, tmp_path):
     assert bg.sweep_walls(tmp_path / "work", bg.MODELS) == {}
     assert (figs / "bergdahl_histories.png").stat().st_size > 0
     # the page was new: a rerun keeps one section
-    subprocess.run(
-        [sys.executable, "-m", "ropedyn_tools.studies.bergdahl", "--analyse-only",
-         "--quick", "20,2", "--periods", "1.25", "--radii", "0.2", "--work",
-         str(tmp_path / "work"), "--out", str(page), "--figures", str(figs)],
-        check=True, capture_output=True, env=env, timeout=300)
+    again = [sys.executable, "-m", "ropedyn_tools.studies.bergdahl", "--exe", str(ropedyn_exe),
+             "--quick", "20,2", "--periods", "1.25", "--radii", "0.2", "--work",
+             str(tmp_path / "work"), "--out", str(page), "--figures", str(figs)]
+    subprocess.run(again + ["--analyse-only"], check=True, capture_output=True, env=env,
+                   timeout=300)
     assert page.read_text().count(bg.BEGIN) == 1
+
+
+def created(path):
+    import h5py
+    with h5py.File(path, "r") as f:
+        return f.attrs["created"], f.attrs["version"].decode()
+
+
+def test_case_files_of_other_code_run_again(ropedyn_exe, tmp_path):
+    """A case file is kept only for the code that wrote it: one of another version is
+    refused by --analyse-only and run again by the whole command; one of this code is
+    kept."""
+    import h5py
+    work = tmp_path / "work"
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "tools"))
+    cmd = [sys.executable, "-m", "ropedyn_tools.studies.bergdahl", "--exe", str(ropedyn_exe),
+           "--quick", "12,2", "--periods", "1.25", "--radii", "0.2", "--work", str(work),
+           "--out", str(tmp_path / "bergdahl.md"), "--figures", str(tmp_path / "figures")]
+    subprocess.run(cmd, check=True, capture_output=True, env=env, timeout=900)
+    rfem, mpp = (bg.case_path(work, 1.25, m, 0.2) for m in ("rfem", "mpp"))
+    version = bg.exe_version(ropedyn_exe)
+    assert created(rfem)[1] == version and bg.current(rfem, version)
+    kept = created(mpp)
+    with h5py.File(rfem, "r+") as f:
+        f.attrs["version"] = np.bytes_(b"0.0.9+g0123456-dirty.89abcdef")
+    assert not bg.current(rfem, version) and bg.stale_files([rfem, mpp], version) == [rfem]
+    refused = subprocess.run(cmd + ["--analyse-only"], capture_output=True, text=True, env=env,
+                             timeout=300)
+    assert refused.returncode != 0 and str(rfem) in refused.stderr, refused.stderr
+    assert "0.0.9+g0123456-dirty.89abcdef" in refused.stderr
+    rerun = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=900)
+    assert rerun.returncode == 0, rerun.stderr
+    assert "rfem: 1 case files of other code" in rerun.stderr
+    assert created(rfem)[1] == version                      # run again by this code
+    assert created(mpp) == kept                             # current: kept as it was

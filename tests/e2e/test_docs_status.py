@@ -197,3 +197,34 @@ def test_a_derived_section_is_as_current_as_its_inputs(tmp_path, monkeypatch):
         later, with_page, second}
     monkeypatch.setattr(docs_status, "DERIVED", {"run": ("before", "undated")})
     assert {r["name"]: r["commits"] for r in docs_status.status(tmp_path)}["run"] is None
+
+
+def test_same_code_by_the_rule_of_the_sections(tmp_path):
+    """Two builds' versions name the same code for a section when no commit between them
+    counts against it (a study keeps its case files by this): docs, a Numbers-unchanged
+    commit and one listed for that section do not count; a code change does, in either
+    order; a build with uncommitted changes matches only its own text."""
+    second, with_page, later = _repo(tmp_path)
+    (tmp_path / "docs" / "numbers-unchanged.txt").write_text(f"{later}  sections=run  same\n")
+    # the first commit of _repo: its code changes on Jan 2
+    first = subprocess.run(["git", "-C", str(tmp_path), "rev-list", "--max-parents=0",
+                            "HEAD"], capture_output=True, text=True, check=True).stdout[:7]
+
+    def same(a, b, section="run"):
+        return docs_status.same_code(f"0.1.0+g{a}", f"0.1.0+g{b}", section, root=tmp_path)
+
+    assert same(second, second) and same(second, "v1.0-3-g" + second)
+    assert not same(first, second) and not same(second, first)
+    # Jan 3 (Numbers-unchanged) and Jan 4 (docs) do not count; Jan 5 changes the code
+    third = subprocess.run(["git", "-C", str(tmp_path), "rev-parse", "--short",
+                            f"{with_page}~2"], capture_output=True, text=True,
+                           check=True).stdout.strip()
+    assert same(second, third) and same(third, second)
+    assert not same(second, with_page)
+    # Jan 6 is listed for `run` only
+    assert same(with_page, later) and not same(with_page, later, section="before")
+    assert docs_status.same_code(f"0.1.0+g{later}-dirty.0123abcd",
+                                 f"0.1.0+g{later}-dirty.0123abcd", "run", root=tmp_path)
+    assert not docs_status.same_code(f"0.1.0+g{later}-dirty.0123abcd", f"0.1.0+g{later}",
+                                     "run", root=tmp_path)
+    assert not same("fedcba9", later)                     # a commit this clone does not know

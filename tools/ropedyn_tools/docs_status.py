@@ -162,15 +162,15 @@ def covers(name, section):
     return section == name or section.startswith(name + " ")
 
 
-def code_commits(root, since, paths, commit=None, skip=None, section=None):
+def code_commits(root, since, paths, commit=None, skip=None, section=None, until="HEAD"):
     """[(short hash, ISO date, subject)] of the commits that changed `paths` after the time
-    `since` (or, given `commit`, after that commit), newest first; not those whose message
-    has a line starting with UNCHANGED, nor those `skip` (unchanged_commits) lists for
-    every section or for `section`."""
+    `since` (or, given `commit`, after that commit, up to `until`), newest first; not those
+    whose message has a line starting with UNCHANGED, nor those `skip` (unchanged_commits)
+    lists for every section or for `section`."""
     skip = skip or {}
     cmd = ["log", "-z", "--format=%H%x09%h%x09%cI%x09%s%x09%b"]
     if commit:
-        cmd.append(f"{commit}..HEAD")
+        cmd.append(f"{commit}..{until}")
     else:
         cmd.append(f"--since={since.isoformat()}")
     if not any((pathlib.Path(root) / p).exists() for p in paths):
@@ -188,6 +188,43 @@ def code_commits(root, since, paths, commit=None, skip=None, section=None):
             continue
         commits.append((rev, date, subject))
     return commits
+
+
+def version_commit(version):
+    """The commit a `ropedyn --version` text names ('0.1.0+g48c82d8' -> '48c82d8', also after
+    a tag: '0.1.0+gv1.0-3-g48c82d8'); None for a tree with uncommitted changes ('-dirty...')
+    or a build without git."""
+    _, plus, described = version.partition("+g")
+    if not plus or "-dirty" in described:
+        return None
+    found = re.fullmatch(r".*-g([0-9a-f]{7,40})", described)
+    return found.group(1) if found else described
+
+
+def same_code(version, reference, section, root=ROOT):
+    """Whether a file that the build `version` wrote (its /@version) holds what the build
+    `reference` writes, as the numbers of docs/ `section` go: the same text (one commit, or
+    one set of edits to it), or two commits one after the other with no commit between
+    that counts against the section (the code paths, less those marked numbers-unchanged
+    for it)."""
+    if version == reference:
+        return True
+    a, b = version_commit(version), version_commit(reference)
+    if a is None or b is None:
+        return False
+    try:
+        a, b = (_git_text(root, "rev-parse", "--verify", "--quiet", r + "^{commit}")
+                for r in (a, b))
+        if subprocess.run(["git", "-C", str(root), "merge-base", "--is-ancestor", a, b],
+                          capture_output=True).returncode != 0:
+            a, b = b, a                                   # the reference may be the older
+            if subprocess.run(["git", "-C", str(root), "merge-base", "--is-ancestor", a, b],
+                              capture_output=True).returncode != 0:
+                return False
+    except subprocess.CalledProcessError:
+        return False                                      # a commit this clone does not know
+    return not code_commits(root, None, CODE_PATHS, commit=a, skip=unchanged_commits(root),
+                            section=section, until=b)
 
 
 def status(root=ROOT):

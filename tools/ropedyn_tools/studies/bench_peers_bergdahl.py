@@ -24,7 +24,8 @@ line, water, seabed and fairlead motion as input/validation/bergdahl/base.nml:
 
 ropedyn's side comes from the case files of `scripts/validation bergdahl` (its --work
 directory), its CPU from their /solver/cpu_time (the integration; the static start adds
-about 2 s, see the page). The table goes between the bergdahl_peers markers of
+about 2 s, see the page), and only from those of the code of the executable (--exe, else
+the Release build): a case file of other code is refused. The table goes between the bergdahl_peers markers of
 docs/performance/peers.md.
 """
 import argparse
@@ -38,7 +39,7 @@ import time
 import numpy as np
 
 from ropedyn_tools.arguments import list_text, positive
-from ropedyn_tools.repo import DOCS, ROOT
+from ropedyn_tools.repo import DOCS, ROOT, add_exe_argument, exe_or_build
 from ropedyn_tools.studies import bergdahl as bg
 from ropedyn_tools.studies.bench_peers import ensure_bench_venv
 from ropedyn_tools.studies.common import machine, run_stamp, update_doc
@@ -164,11 +165,20 @@ def main(argv=None):
                         help="also every condition with the other reading of the tangential "
                              "drag (0.5 on the 2.2 mm perimeter)")
     parser.add_argument("--no-write", action="store_true")
+    add_exe_argument(parser)
     args = parser.parse_args(argv)
-    py = ensure_bench_venv()
     periods = [float(p) for p in args.periods.split(",")]
     radii = [float(r) for r in args.radii.split(",")]
     work = pathlib.Path(args.work).resolve()
+    exe = pathlib.Path(exe_or_build(args.exe)).resolve()
+    stale = bg.stale_files([bg.case_path(work, p, m, r) for m in bg.MODELS for p in periods
+                            for r in radii], bg.exe_version(exe))
+    if stale:
+        raise SystemExit(f"bench_peers bergdahl: {len(stale)} case files in {work} hold runs "
+                         f"of other code than {exe}, e.g. {stale[0]} "
+                         f"({bg.file_version(stale[0])}); run scripts/validation bergdahl "
+                         "first")
+    py = ensure_bench_venv()
     ours = bg.collect(work, periods, bg.MODELS)
     cache = work / "moordyn"
     rows, md_res, md_per = [], {}, {}

@@ -9,6 +9,11 @@ MPP, two at a time, the longest periods first), takes the cycle maxima of |top r
 12 cycles, and compares them with the measurement; the convergence runs (element length and
 tolerance halved) on demand.
 
+The case files in --work are kept between runs, but only those of the same code: a file
+is used (and not run again) when its /@version is the executable's, or a commit from which
+no commit up to the executable's counts against this page (scripts/docs_status's rule). Any
+other is run again; --analyse-only refuses to analyse it.
+
     scripts/validation bergdahl [--models rfem,mpp] [--convergence] [--quick] [--out PAGE]
     (python -m ropedyn_tools.studies.bergdahl; without --exe it builds the Release executable)
 """
@@ -27,6 +32,7 @@ import numpy as np
 
 from ropedyn_tools.arguments import choice, list_text, positive
 from ropedyn_tools.repo import DOCS, INPUT, ROOT, add_exe_argument, exe_or_build, set_args
+from ropedyn_tools.docs_status import same_code
 from ropedyn_tools.studies.common import least_cpu, run_stamp, scene_number, update_doc
 
 SCENE_DIR = INPUT / "validation" / "bergdahl"
@@ -56,6 +62,8 @@ LENGTH = 33.0
 #: the two conditions whose tension histories the page shows
 HISTORIES = ((1.25, 0.2), (3.5, 0.075))
 BEGIN, END = "<!-- bergdahl:begin -->", "<!-- bergdahl:end -->"
+#: the section the case files' numbers go into (whose numbers-unchanged commits keep them)
+SECTION = "bergdahl"
 
 
 def sweep_path(period):
@@ -205,12 +213,15 @@ def static_start_cpu(work, label, exe=None, repeat=3):
     """The CPU (s, user + system, the least of `repeat`) of one static start of model label
     (`ropedyn statics` of the base scene with the model and variant keys): the same
     equilibrium starts every condition (the fairlead's motion grows from zero), and a run's
-    /solver/cpu_time does not include it. Kept in work/LABEL/static_start.json; measured
-    when missing and exe is given, else None."""
+    /solver/cpu_time does not include it. Kept in work/LABEL/static_start.json with the
+    version that measured it; measured when missing, or (exe given) of other code than exe's;
+    None when missing and no exe is given."""
     import resource
     path = work / label / "static_start.json"
     if path.exists():
-        return json.loads(path.read_text())["cpu"]
+        record = json.loads(path.read_text())
+        if exe is None or same_code(record.get("version", ""), exe_version(exe), SECTION):
+            return record["cpu"]
     if exe is None:
         return None
     model, _, variant = label.partition("_")
@@ -226,16 +237,18 @@ def static_start_cpu(work, label, exe=None, repeat=3):
         return {"cpu": after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime}
 
     best = least_cpu(one, repeat)["cpu"]
-    path.write_text(json.dumps({"cpu": best, "repeat": repeat}) + "\n")
+    path.write_text(json.dumps({"cpu": best, "repeat": repeat,
+                                "version": exe_version(exe)}) + "\n")
     return best
 
 
-def run_sweeps(exe, periods, models, radii, work, jobs, quick=None):
+def run_sweeps(exe, periods, models, radii, work, jobs, quick=None, version=None):
     """Run the cases of each model into work/MODEL/T<..> (the period sweeps' files), `jobs`
     at a time from one queue, the longest periods first (`ropedyn sweep FILE --task K`:
     one period's sweep alone would leave a core idle while its last case runs), then each
-    sweep's summary. Returns {model: wall seconds of its cases}, also kept in
-    work/MODEL/wall.json for --analyse-only."""
+    sweep's summary. A case whose file another code wrote (not current for `version`, the
+    executable's) runs anew (`--force`). Returns {model: wall seconds of its cases}, also
+    kept in work/MODEL/wall.json for --analyse-only."""
     from concurrent.futures import ThreadPoolExecutor
     walls = {}
     for label in models:
@@ -248,6 +261,8 @@ def run_sweeps(exe, periods, models, radii, work, jobs, quick=None):
             sweep = sweeps[period]
             cmd = [str(exe), "sweep", str(sweep), "--output-dir", str(sweep.parent),
                    "--quiet", "--task", str(task)]
+            if complete(case_path(work, period, label, RADII[task - 1])):
+                cmd.append("--force")                 # complete, but of other code
             result = subprocess.run(cmd, capture_output=True, text=True)
             if result.returncode != 0:
                 raise RuntimeError(f"{' '.join(cmd)}: exit {result.returncode}\n"
@@ -256,7 +271,11 @@ def run_sweeps(exe, periods, models, radii, work, jobs, quick=None):
         # the wall time counts only when every case of the queue runs now: kept cases
         # (a rerun) would make it short, and the file keeps the last full measurement
         todo = [(period, task) for period, task in queue
-                if not complete(case_path(work, period, label, RADII[task - 1]))]
+                if not current(case_path(work, period, label, RADII[task - 1]), version)]
+        stale = sum(complete(case_path(work, p, label, RADII[t - 1])) for p, t in todo)
+        if stale:
+            print(f"bergdahl: {label}: {stale} case files of other code: run again",
+                  file=sys.stderr)
         w0 = time.perf_counter()
         with ThreadPoolExecutor(max_workers=jobs) as pool:
             list(pool.map(one, todo))
@@ -278,6 +297,30 @@ def run_sweeps(exe, periods, models, radii, work, jobs, quick=None):
 def complete(path):
     """Whether a case file exists and holds a complete run."""
     return path.exists() and status(path)[0] == "complete"
+
+
+def exe_version(exe):
+    """The version the executable writes into its files (`ropedyn --version`'s last word)."""
+    return subprocess.run([str(exe), "--version"], check=True, capture_output=True,
+                          text=True).stdout.split()[-1]
+
+
+def file_version(path):
+    """The /@version of a run file."""
+    with h5py.File(path, "r") as f:
+        value = f.attrs.get("version", b"")
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def current(path, version):
+    """Whether a file holds a complete run of the code of `version` (see the module's
+    docstring)."""
+    return complete(path) and same_code(file_version(path), version, SECTION)
+
+
+def stale_files(paths, version):
+    """Those of the complete files `paths` that another code wrote than `version`'s."""
+    return [p for p in paths if complete(p) and not current(p, version)]
 
 
 def name(label):
@@ -351,35 +394,43 @@ CONV_METHODS = {"cvode": ["solver.method=cvode"],
                 "cvode, max order 2": ["solver.method=cvode", "solver.max_order=2"]}
 
 
-def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS):
-    """Mean cycle maxima at elements of 0.4, 0.2, 0.1 m (CONV_ELEMENTS) and at the
-    tolerances (rtol and atol together) halved twice from the study's setting, each run
-    CONV_CYCLES cycles with the last CONV_ANALYSED analysed; then the two coarsest element
-    lengths with the axial springs carrying compression (the law's share of the change);
-    `jobs` runs at a time."""
-    from concurrent.futures import ThreadPoolExecutor
+def convergence_files(work, periods=(1.25, 3.5), models=MODELS):
+    """The convergence runs [(model, period, n, rtol, law, atol, file)] (see convergence)."""
     base_n, base_r = base_elements(), base_rtol()
     finest = CONV_ELEMENTS[-1]
     variants = sorted({(n, base_r, "") for n in CONV_ELEMENTS + (base_n,)}) + [
         (base_n, base_r / 2, ""), (base_n, base_r / 4, "")] + [
         (n, base_r, law) for law in CONV_LAWS for n in CONV_ELEMENTS[:2]] + [
         (finest, base_r / 4, "")] + [(finest, base_r, method) for method in CONV_METHODS]
-    todo = []
+    runs = []
     for model in models:
         for period in periods:
             for n, rtol, law in variants:
                 atol = base_atol() * rtol / base_r
                 tag = "_" + re.sub(r"[^a-z0-9]+", "_", law) if law else ""
-                todo.append((model, period, n, rtol, law, atol, work / "convergence" / (
+                runs.append((model, period, n, rtol, law, atol, work / "convergence" / (
                     f"{model}_T{period}_n{n}_rtol{rtol:g}_atol{atol:g}{tag}_c{CONV_CYCLES}.h5")))
+    return runs
+
+
+def convergence(exe, work, jobs, periods=(1.25, 3.5), radius=0.2, models=MODELS,
+                version=None, run=True):
+    """Mean cycle maxima at elements of 0.4, 0.2, 0.1 m (CONV_ELEMENTS) and at the
+    tolerances (rtol and atol together) halved twice from the study's setting, each run
+    CONV_CYCLES cycles with the last CONV_ANALYSED analysed; then the two coarsest element
+    lengths with the axial springs carrying compression (the law's share of the change);
+    `jobs` runs at a time, each unless its file is current for `version` (and none when not
+    `run`: the files as they are)."""
+    from concurrent.futures import ThreadPoolExecutor
+    todo = convergence_files(work, periods, models)
     (work / "convergence").mkdir(parents=True, exist_ok=True)
 
     def one(item):
         model, period, n, rtol, law, atol, out = item
+        if not run or current(out, version):
+            return
         if out.exists():
-            if status(out)[0] == "complete":
-                return
-            out.unlink()                      # a failed or interrupted run: again
+            out.unlink()          # a failed or interrupted run, or one of other code: again
         # 330 elements over 30 cycles of 3.5 s take more than the default budget
         sets = [f"model.kind={model}", f"model.elements={n}", f"solver.rtol={rtol:g}",
                 f"solver.atol={atol:g}", "solver.max_steps=100000000",
@@ -417,9 +468,16 @@ CONTACT_VARIANTS = (
 )
 
 
-def contact_cost(exe, work, jobs, period=1.25, radius=0.2, start_cycle=6, cycles=2):
+def contact_files(work):
+    """The files of the contact-cost variants, in CONTACT_VARIANTS' order."""
+    return [work / "contact_cost" / f"variant_{k}.h5" for k in range(len(CONTACT_VARIANTS))]
+
+
+def contact_cost(exe, work, jobs, period=1.25, radius=0.2, start_cycle=6, cycles=2,
+                 version=None, run=True):
     """The cost of the floor contact: the same window of the motion (from a record of the
-    sweep's run) with each of CONTACT_VARIANTS; rows (label, steps, rejected, rhs, CPU)."""
+    sweep's run) with each of CONTACT_VARIANTS, each run unless its file is current for
+    `version` (none when not `run`); rows (label, steps, rejected, rhs, CPU)."""
     from concurrent.futures import ThreadPoolExecutor
     src = case_path(work, period, "rfem", radius)
     if not src.exists():
@@ -434,8 +492,10 @@ def contact_cost(exe, work, jobs, period=1.25, radius=0.2, start_cycle=6, cycles
     folder.mkdir(parents=True, exist_ok=True)
 
     def one(k):
-        out = folder / f"variant_{k}.h5"
-        if not out.exists():
+        out = contact_files(work)[k]
+        if run and not current(out, version):
+            if out.exists():
+                out.unlink()                  # of other code, or not complete: again
             subprocess.run([str(exe), "run", str(BASE),
                             *set_args(common + CONTACT_VARIANTS[k][1] + [f"output.file={out}"])],
                            check=True, capture_output=True)
@@ -782,29 +842,38 @@ def main(argv=None):
     work = pathlib.Path(args.work).resolve()
     quick = tuple(int(v) for v in args.quick.split(",")) if args.quick else None
     cycles = 1 if quick else ANALYSED
+    conv_models = tuple((args.convergence_models or ",".join(
+        m for m in models if m in MODELS)).split(","))
     walls = {}
-    exe = None
-    if not args.analyse_only:
-        exe = pathlib.Path(exe_or_build(args.exe)).resolve()
-        walls = run_sweeps(exe, periods, models, radii, work, args.jobs, quick=quick)
+    exe = pathlib.Path(exe_or_build(args.exe)).resolve()
+    version = exe_version(exe)          # the code whose case files count
+    if args.analyse_only:
+        used = [case_path(work, p, m, r) for m in models for p in periods for r in RADII]
+        used += [run[-1] for run in convergence_files(work, models=conv_models)] \
+            if args.convergence else []
+        used += contact_files(work) if args.contact_cost else []
+        stale = stale_files(used, version)
+        if stale:
+            raise SystemExit(
+                f"bergdahl: --analyse-only: {len(stale)} of the case files in {work} hold "
+                f"runs of other code than {exe} ({version}), e.g. {stale[0]} "
+                f"({file_version(stale[0])}); run the command without --analyse-only, which "
+                "runs them again")
+    else:
+        walls = run_sweeps(exe, periods, models, radii, work, args.jobs, quick=quick,
+                           version=version)
     results = collect(work, periods, models, cycles)
     if not quick:
         walls = sweep_walls(work, models)
         for label in models:
-            if (work / label / "static_start.json").exists() or not any(
-                    k[0] == label for k in results):
-                continue
-            exe = exe or pathlib.Path(exe_or_build(args.exe)).resolve()
-            static_start_cpu(work, label, exe)
+            if any(k[0] == label for k in results):
+                static_start_cpu(work, label, exe)
     conv = []
     if args.convergence:
-        exe = exe or pathlib.Path(exe_or_build(args.exe)).resolve()
-        conv = convergence(exe, work, args.jobs, models=tuple(
-            (args.convergence_models or ",".join(m for m in models if m in MODELS)).split(",")))
+        conv = convergence(exe, work, args.jobs, models=conv_models, version=version)
     contact = []
     if args.contact_cost:
-        exe = exe or pathlib.Path(exe_or_build(args.exe)).resolve()
-        contact = contact_cost(exe, work, args.jobs)
+        contact = contact_cost(exe, work, args.jobs, version=version)
     out = pathlib.Path(args.out)
     stem = out.stem
     figs = figures(results, models, periods, work, pathlib.Path(args.figures), stem)
