@@ -12,7 +12,7 @@
 !! band LU, dgbtrf), M the mass: a backward Euler step of the flow M q' = f of pseudo-time
 !! 1/sigma. sigma starts at the descent's scale (a step of L/10), follows the residual's
 !! norm r (r^2 = sum f_k^2 / |K_kk| at the stage's start; switched evolution relaxation:
-!! sigma r_new / r_old), halved again after a step that lowered r, and is 0 (Newton) once
+!! sigma r_new / r_old), halved again after a step that did not raise r, and is 0 (Newton) once
 !! it fell to a thousandth of its start (NEWTON_BELOW). Every step is taken unless r^2
 !! grows by GROWTH_ALLOWED (then sigma grows); up to two chord corrections with the same factors pull a trial point back
 !! towards the stiff springs' manifold. Converged after a Newton step below
@@ -270,10 +270,12 @@ contains
                 if (phi_new <= GROWTH_ALLOWED*self%phi) then
                     ! pseudo-transient continuation: every finite step is taken, and the
                     ! shift follows the residual (switched evolution relaxation), halved
-                    ! besides after a step that lowered it (the pseudo-time step doubles)
+                    ! besides after a step that did not raise it (the pseudo-time step
+                    ! doubles; also where the stage starts at its equilibrium, where the
+                    ! residual stays at rounding and only Newton can say it converged)
                     if (self%sigma == 0.0_wp) result%newton_steps = result%newton_steps + 1
                     self%sigma = self%sigma*sqrt(phi_new/self%phi)
-                    if (phi_new < self%phi) self%sigma = 0.5_wp*self%sigma
+                    if (phi_new <= self%phi) self%sigma = 0.5_wp*self%sigma
                     if (self%sigma < NEWTON_BELOW*self%sigma0) self%sigma = 0.0_wp
                     call accept_trial()
                     cycle

@@ -52,6 +52,8 @@ program test_statics
     call test_current('mpp', 0.5_wp)
     call test_current('rfem', -3.0_wp)
     call test_current('mpp', 3.0_wp)
+    call test_dry_current('rfem')
+    call test_dry_current('mpp')
     call test_displace()
     call test_soft_swing()
     call test_mass_slope()
@@ -327,6 +329,41 @@ contains
         call suite%check_true(res%stages >= 1, kind//': continued in the current')
         call suite%check_le(res%residual_relative, 1.0e-9_wp, kind//': residual in the current')
     end subroutine test_current
+
+    !> A current that does not act on the rope at rest: water on, drag off, the rope
+    !! hanging wholly above the surface. The statics goes through the continuation in the
+    !! current (current_drags) and must find the still equilibrium, which every stage
+    !! starts at: the residual is rounding from the first iteration. (The pseudo-transient
+    !! shift halved only after a step that lowered the residual, so it never reached Newton
+    !! there and each stage ran out of iterations: a random scene's "no equilibrium in the
+    !! current".)
+    subroutine test_dry_current(kind)
+        character(len=*), intent(in) :: kind
+        type(scene_t) :: scene
+        class(rope_model_t), allocatable :: model, still_model
+        real(wp), allocatable :: y(:), y_still(:)
+        type(statics_result_t) :: res, still
+        character(len=64) :: sets(6)
+
+        write (sets(1), '(a)') 'model.kind = "'//kind//'"'
+        sets(2) = 'model.elements = 10'
+        sets(3) = 'effects.water = .true.'
+        sets(4) = 'effects.drag = .false.'
+        sets(5) = 'fluid.surface = 10.0'
+        sets(6) = 'fluid.current = 0.0, 0.0'
+        call scene_of(sets, scene)
+        call equilibrium(scene, still_model, y_still, still)
+        sets(6) = 'fluid.current = 0.3, 1.0'
+        call scene_of(sets, scene)
+        call equilibrium(scene, model, y, res)
+        call suite%check_true(res%stages >= 1, kind//', dry in a current: continued in it')
+        call suite%check_le(maxval(abs(y - y_still)), 1.0e-10_wp, &
+                            kind//', dry in a current: the still equilibrium')
+        ! each stage: the shift halved about ten times to Newton (NEWTON_BELOW), then a
+        ! Newton step at rounding; far below one stage's budget of 200
+        call suite%check_le(real(res%iterations - still%iterations, wp), 100.0_wp, &
+                            kind//', dry in a current: the stages reach Newton')
+    end subroutine test_dry_current
 
     !> rfem_t%displace: equal to y + delta to first order (the difference quarters when
     !! delta halves), and for the straight rope turned as one about its top end by 0.3 rad
