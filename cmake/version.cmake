@@ -3,10 +3,9 @@
 # given, "+g" and `git describe --always --tags` of it. When what the build is made of
 # (src solvers CMakeLists.txt cmake) has uncommitted changes, "-dirty", a dot and the first
 # 8 hex digits of the SHA-256 of those changes (`git diff HEAD` on them, and the files not
-# in git yet with their contents): two builds of one
-# commit with the same edits say the same, other edits say otherwise, and edits elsewhere
-# (docs, tools, tests) leave the commit's version (a study keeps the case files of its own
-# code by this text).
+# in git yet with their contents): two builds of one commit with the same edits say the
+# same, other edits say otherwise, and edits elsewhere (docs, tools, tests) leave the
+# commit's version (a study keeps the case files of its own code by this text).
 #
 # Run with `cmake -P` at every build (the target ropedyn_version_file), not once at
 # configure time: a commit or an edit after configuring must show in the version that every

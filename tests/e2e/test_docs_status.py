@@ -228,3 +228,16 @@ def test_same_code_by_the_rule_of_the_sections(tmp_path):
     assert not docs_status.same_code(f"0.1.0+g{later}-dirty.0123abcd", f"0.1.0+g{later}",
                                      "run", root=tmp_path)
     assert not same("fedcba9", later)                     # a commit this clone does not know
+    # a commit on another line of history, from with_page, with no code change of its own:
+    # it and `later` (whose code change counts not against `run`) follow with_page apart,
+    # so nothing says which code either build holds against the other
+    subprocess.run(["git", "-C", str(tmp_path), "checkout", "-q", "-b", "side", with_page],
+                   check=True)
+    (tmp_path / "docs" / "side.md").write_text("side\n")
+    subprocess.run(["git", "-C", str(tmp_path), "add", "docs/side.md"], check=True)
+    subprocess.run(["git", "-C", str(tmp_path), "-c", "user.name=t", "-c", "user.email=t@t",
+                    "commit", "-qm", "side"], check=True)
+    side = subprocess.run(["git", "-C", str(tmp_path), "rev-parse", "--short", "HEAD"],
+                          capture_output=True, text=True, check=True).stdout.strip()
+    assert same(with_page, side) and same(side, with_page)      # docs only between
+    assert not same(side, later) and not same(later, side)

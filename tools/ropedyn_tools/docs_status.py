@@ -212,17 +212,19 @@ def same_code(version, reference, section, root=ROOT):
     a, b = version_commit(version), version_commit(reference)
     if a is None or b is None:
         return False
+    def before(x, y):
+        return subprocess.run(["git", "-C", str(root), "merge-base", "--is-ancestor", x, y],
+                              capture_output=True).returncode == 0
+
     try:
         a, b = (_git_text(root, "rev-parse", "--verify", "--quiet", r + "^{commit}")
                 for r in (a, b))
-        if subprocess.run(["git", "-C", str(root), "merge-base", "--is-ancestor", a, b],
-                          capture_output=True).returncode != 0:
-            a, b = b, a                                   # the reference may be the older
-            if subprocess.run(["git", "-C", str(root), "merge-base", "--is-ancestor", a, b],
-                              capture_output=True).returncode != 0:
-                return False
     except subprocess.CalledProcessError:
         return False                                      # a commit this clone does not know
+    if not before(a, b):
+        a, b = b, a                                       # the reference may be the older
+        if not before(a, b):
+            return False
     return not code_commits(root, None, CODE_PATHS, commit=a, skip=unchanged_commits(root),
                             section=section, until=b)
 
