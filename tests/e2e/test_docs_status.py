@@ -96,6 +96,51 @@ def test_a_moved_section_is_judged_from_the_commit_that_first_wrote_it(tmp_path)
     assert [c[0] for c in rows["run"]["commits"]] == [later]
 
 
+
+def test_a_section_watches_the_module_its_command_runs_and_its_imports(tmp_path):
+    """A wrapper that branches on its first argument (`scripts/survey chain` runs
+    survey_chain.py, `scripts/survey` survey.py) has each section watch the module its own
+    command runs, and the study modules that module imports (directly or through another),
+    not the other branch's."""
+    _repo(tmp_path)
+    wrapper = ('#!/usr/bin/env bash\nif [ "${1:-}" = "chain" ]; then\n    shift\n'
+               '    exec python -m ropedyn_tools.studies.survey_chain "$@"\nfi\n'
+               'exec python -m ropedyn_tools.studies.survey "$@"\n')
+    studies = "tools/ropedyn_tools/studies"
+
+    def commit(message, files):
+        for name, text in files.items():
+            (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+            (tmp_path / name).write_text(text)
+        subprocess.run(["git", "-C", str(tmp_path), "add", "."], check=True)
+        subprocess.run(["git", "-C", str(tmp_path), "-c", "user.name=t", "-c",
+                        "user.email=t@t", "commit", "-qm", message], check=True)
+        return subprocess.run(["git", "-C", str(tmp_path), "rev-parse", "--short", "HEAD"],
+                              capture_output=True, text=True, check=True).stdout.strip()
+
+    ran = commit("the survey and its pages", {
+        "scripts/survey": wrapper,
+        f"{studies}/survey.py": "x = 1\n",
+        f"{studies}/survey_chain.py": "from ropedyn_tools.studies import chain_cases as c\n",
+        f"{studies}/chain_cases.py": "from ropedyn_tools.studies.cases_core import y\n",
+        f"{studies}/cases_core.py": "y = 1\n",
+        "docs/survey.md": "<!-- plain:begin -->\nCommand: `scripts/survey --fast`.\n"
+                          "Run: 2026-01-07 06:00 UTC.\n<!-- plain:end -->\n"
+                          "<!-- chain:begin -->\nCommand: `scripts/survey chain --all`.\n"
+                          "Run: 2026-01-07 06:00 UTC.\n<!-- chain:end -->\n"})
+    chain = commit("change the chain's study", {f"{studies}/survey_chain.py": "z = 2\n" +
+                   "from ropedyn_tools.studies import chain_cases as c\n"})
+    core = commit("change what the chain's cases import", {f"{studies}/cases_core.py": "y = 2\n"})
+    plain = commit("change the plain survey", {f"{studies}/survey.py": "x = 2\n"})
+    rows = {r["name"]: [c[0] for c in r["commits"]] for r in docs_status.status(tmp_path)
+            if r["name"] in ("plain", "chain")}
+    assert ran not in rows["chain"] + rows["plain"]
+    assert rows["chain"] == [core, chain]
+    assert rows["plain"] == [plain]
+    assert docs_status.wrapper_module(tmp_path, "survey", "chain") == "survey_chain"
+    assert docs_status.wrapper_module(tmp_path, "survey", "fast") == "survey"
+    assert docs_status.wrapper_module(tmp_path, "gone") == "gone"
+
 def test_check_fails_on_a_stale_section(tmp_path, capsys):
     _repo(tmp_path)
     assert docs_status.main(["--root", str(tmp_path)]) == 0

@@ -8,9 +8,12 @@ had no uncommitted changes: studies.common.run_stamp). For each section
 this lists the commits that changed the code its numbers come from after the commit that
 first wrote that stamp into docs/ (after the run's time while it is not committed): the
 Fortran (src/, solvers/, CMakeLists.txt), the scenes (input/) and the study's own module
-(tools/ropedyn_tools/studies/SCRIPT.py or tools/ropedyn_tools/SCRIPT.py, earlier
-python/ropedyn/studies/SCRIPT.py; SCRIPT read from the section's command; NARROWER lists
-the studies that read less). A commit there does not mean the numbers changed; it means the
+(the module scripts/SCRIPT runs for the section's command, SCRIPT and its first word read
+from the command: a wrapper that branches on its first argument, as `scripts/validation
+bergdahl` does, runs another module for that word; with the modules of the studies that
+module imports, whose code makes its numbers too; each in tools/ropedyn_tools/studies/,
+tools/ropedyn_tools/ or, for the runs before they moved, python/ropedyn/studies/; NARROWER
+lists the studies that read less than the Fortran and the scenes). A commit there does not mean the numbers changed; it means the
 study has not been run on the code as it is, and its page should say why not or be rerun by
 its script. A commit that changes code but, checked, none of the results (a refactoring, a
 comment) says so with a line `Numbers-unchanged: how it was checked` in its message, or,
@@ -27,6 +30,7 @@ that count against any of them.
     scripts/docs_status --check    # as --stale, exit status 1 when any is listed
 """
 import argparse
+import ast
 import datetime
 import pathlib
 import re
@@ -70,6 +74,13 @@ _BEGIN = re.compile(r"^\s*<!-- (?P<name>[^:>]+):begin -->\s*$")
 _SCRIPT = re.compile(r"scripts/(?P<script>[a-z0-9_]+)")
 _STAMP = re.compile(r"(?P<date>20\d\d-\d\d-\d\d)(?:[ T](?P<time>\d\d:\d\d)(?: ?UTC)?)?")
 _COMMIT = re.compile(r"commit `(?P<rev>[0-9a-f]{7,40})`")
+#: the first word after the script in a section's command (a wrapper may branch on it)
+_WORD = re.compile(r"scripts/[a-z0-9_]+ (?P<word>[a-z][a-z0-9_]*)")
+#: a wrapper's branch on its first argument: `if [ "${1:-}" = "WORD" ]; then ... fi`
+_BRANCH = re.compile(r'^if \[ "\$\{1:-\}" = "(?P<word>[^"]+)" \]; then\n(?P<body>.*?)^fi$',
+                     re.S | re.M)
+#: the Python module a wrapper runs
+_RUNS = re.compile(r"-m ropedyn_tools\.(?:studies\.)?(?P<module>[a-z0-9_]+)")
 
 
 def heads(page):
@@ -104,6 +115,57 @@ def sections(page):
         found.append((name, script and script.group("script"),
                       stamp and stamp.group(0), commit and commit.group("rev")))
     return found
+
+
+def wrapper_module(root, script, word=None):
+    """The module root/scripts/SCRIPT runs when its first argument is `word`: the one its
+    branch on that word runs (`if [ "${1:-}" = "WORD" ]; then ... fi`), else the last one it
+    runs outside such branches; SCRIPT itself when there is no such file or it names no
+    module (a study run before its wrapper was renamed or removed)."""
+    path = pathlib.Path(root) / "scripts" / script
+    if not path.is_file():
+        return script
+    text = path.read_text()
+    outside = text
+    for branch in _BRANCH.finditer(text):
+        runs = _RUNS.search(branch.group("body"))
+        if runs and branch.group("word") == word:
+            return runs.group("module")
+        outside = outside.replace(branch.group(0), "")
+    found = _RUNS.findall(outside)
+    return found[-1] if found else script
+
+
+def _imported_studies(path):
+    """The modules of ropedyn_tools.studies that the Python file at `path` imports."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            if node.module == "ropedyn_tools.studies":
+                found += [alias.name for alias in node.names]
+            elif node.module.startswith("ropedyn_tools.studies."):
+                found.append(node.module.split(".")[2])
+        elif isinstance(node, ast.Import):
+            found += [alias.name.split(".")[2] for alias in node.names
+                      if alias.name.startswith("ropedyn_tools.studies.")]
+    return found
+
+
+def study_modules(root, module):
+    """`module` and the study modules it imports, directly or through others (sorted
+    names): their code makes the numbers of its sections as much as its own does."""
+    seen, todo = set(), [module]
+    while todo:
+        name = todo.pop()
+        if name in seen:
+            continue
+        seen.add(name)
+        for folder in STUDY_FOLDERS:
+            path = pathlib.Path(root) / folder / f"{name}.py"
+            if path.is_file():
+                todo += _imported_studies(path)
+                break
+    return sorted(seen)
 
 
 def run_time(stamp):
@@ -237,12 +299,15 @@ def status(root=ROOT):
     skip = unchanged_commits(root, {s[0] for found in pages.values() for s in found})
     rows = []
     for page, found in pages.items():
+        words = {name: _WORD.search(head) for name, head in heads(page)}
         for name, script, stamp, commit in found:
             if script in CHECKED_BY_TESTS:
                 continue
             paths = list(NARROWER.get(script, CODE_PATHS))
             if script:
-                paths += [f"{folder}/{script}.py" for folder in STUDY_FOLDERS]
+                word = words[name] and words[name].group("word")
+                paths += [f"{folder}/{module}.py" for folder in STUDY_FOLDERS
+                          for module in study_modules(root, wrapper_module(root, script, word))]
             commits = None
             if stamp and not commit:
                 # the commit that first wrote this stamp into docs/: the code it ran is
