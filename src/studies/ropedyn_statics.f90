@@ -830,13 +830,13 @@ contains
     end subroutine descent_update_shift
 
     !> The equilibrium's results: velocities zeroed, each angle within pi of where the
-    !! iteration started it (a step may turn an element by whole turns, which changes
-    !! nothing but the angle's value), the residual, the energies.
+    !! iteration started it where that changes no force (at_rest_near), the residual there,
+    !! the energies.
     subroutine descent_finish(self, model, y)
         class(descent_t), intent(inout) :: self
         class(rope_model_t), intent(inout) :: model
         real(wp), intent(inout) :: y(:)
-        call at_rest_near(model, y, self%pos, self%vel, self%q0)
+        call at_rest_near(model, y, self%pos, self%vel, self%q0, self%f)
         call self%result%report(model, y, self%f)
     end subroutine descent_finish
 

@@ -350,8 +350,9 @@ contains
         integer :: status
         call model%coordinates(pos, vel)
         allocate (f(size(pos)))
-        call at_rest_near(model, y, pos, vel, q0)
+        y(vel) = 0.0_wp
         call generalized_force(model, y, pos, vel, f, status)
+        call at_rest_near(model, y, pos, vel, q0, f)
         result%weight = total_weight(model, spec)
         result%rounding_level = 0.0_wp
         call result%report(model, y, f)

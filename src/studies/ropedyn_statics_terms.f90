@@ -23,22 +23,43 @@ module ropedyn_statics_terms
 
 contains
 
-    !> An equilibrium y at rest: its velocities zeroed and each angle brought within pi of
-    !! q0, where the iteration that found it started it (a step may turn an element by
-    !! whole turns, which changes nothing but the angle's value).
-    subroutine at_rest_near(model, y, pos, vel, q0)
-        class(rope_model_t), intent(in) :: model
+    !> An equilibrium y at rest: its velocities zeroed and, where that changes no force,
+    !! each angle brought within pi of q0, where the iteration that found it started it. A
+    !! step may turn an element by whole turns; where the model sees its angle only through
+    !! its cosine and sine (a chain's links, no bending) that changes nothing but the angle's
+    !! value, which the error weights of a run started there would see. A spring on the
+    !! difference of two angles (bending, a clamp) sees the turn: its energy changes by about
+    !! 2 pi^2 times its stiffness, and the turns are then kept. Taken off only when the
+    !! elastic energy changes by no more than its rounding (TURN_ROUNDING eps times the
+    !! elastic and gravity energies; gravity and the loads see the positions alone). f: the
+    !! generalized force at y (at rest) on entry, at the y returned on exit.
+    subroutine at_rest_near(model, y, pos, vel, q0, f)
+        class(rope_model_t), intent(inout) :: model
         real(wp), intent(inout) :: y(:)
         integer, intent(in) :: pos(:), vel(:)
         real(wp), intent(in) :: q0(:)
-        real(wp), parameter :: TWO_PI = 2.0_wp*PI
+        real(wp), intent(inout) :: f(:)
+        real(wp), parameter :: TWO_PI = 2.0_wp*PI, TURN_ROUNDING = 1.0e3_wp
         logical, allocatable :: angle(:)
-        integer :: k
+        real(wp), allocatable :: turned(:), f_turned(:)
+        type(energy_t) :: e, e_turned
+        integer :: k, status
         y(vel) = 0.0_wp
         angle = model%angle_coordinates()
+        turned = y
         do k = 1, size(pos)
-            if (angle(k)) y(pos(k)) = y(pos(k)) - TWO_PI*anint((y(pos(k)) - q0(k))/TWO_PI)
+            if (angle(k)) turned(pos(k)) = y(pos(k)) - TWO_PI*anint((y(pos(k)) - q0(k))/TWO_PI)
         end do
+        if (all(turned == y)) return
+        e = rest_energy(model, y)
+        e_turned = rest_energy(model, turned)
+        if (abs(e_turned%elastic - e%elastic) > TURN_ROUNDING*epsilon(1.0_wp)* &
+            (abs(e%elastic) + abs(e%gravity))) return
+        allocate (f_turned(size(f)))
+        call generalized_force(model, turned, pos, vel, f_turned, status)
+        if (status /= STATUS_OK) return
+        y = turned
+        f = f_turned
     end subroutine at_rest_near
 
     !> Total length of the elements, m.
@@ -67,6 +88,15 @@ contains
         real(wp), intent(in) :: y(:)
         type(rope_spec_t), intent(in), optional :: spec
         type(energy_t) :: e
+        e = rest_energy(model, y)
+        v = e%elastic + e%gravity
+        if (present(spec)) v = v + load_potential(model, spec, y)
+    end function potential_energy
+
+    !> The model's energies at state y with its supports at rest (no quadratures), J.
+    type(energy_t) function rest_energy(model, y) result(e)
+        class(rope_model_t), intent(inout) :: model
+        real(wp), intent(in) :: y(:)
         real(wp) :: yq(max(1, model%quad_size()))
         logical :: held
         yq = 0.0_wp
@@ -74,9 +104,7 @@ contains
         model%supports_at_rest = .true.
         e = model%energy(0.0_wp, y, yq)
         model%supports_at_rest = held
-        v = e%elastic + e%gravity
-        if (present(spec)) v = v + load_potential(model, spec, y)
-    end function potential_energy
+    end function rest_energy
 
     !> Potential -sum F_k(0).X_k of the point loads of a spec (none when `&effects
     !! point_loads` is off), X_k = c + r e the load's point on its element, J. A load of

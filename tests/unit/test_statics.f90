@@ -15,7 +15,10 @@
 !! - the tangent stiffness of a rope with a heavy point mass off its element's centre,
 !!   away from an equilibrium: symmetric and -df/dq by differences (with the (dM/dq) a
 !!   term of its configuration-dependent mass), and the chain (bending off) that swings
-!!   down with it in tens of iterations (over a thousand without the term).
+!!   down with it in tens of iterations (over a thousand without the term);
+!! - the equilibrium handed back is the one solved: its residual there is the one reported
+!!   and no joint is bent by a whole turn (at_rest_near takes whole turns off an angle only
+!!   where that changes no force: without bending, not with it).
 program test_statics
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, ERR_SOLVER
@@ -25,6 +28,7 @@ program test_statics
     use ropedyn_rfem, only: rfem_t, rfem_create
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
                                generalized_force, tangent_matrices
+    use ropedyn_statics_terms, only: at_rest_near
     use ropedyn_modes, only: equilibrium_initial_state
     use ropedyn_analysis, only: support_forces
     use ropedyn_assert, only: test_suite_t
@@ -54,6 +58,11 @@ program test_statics
     call test_current('mpp', 3.0_wp)
     call test_dry_current('rfem')
     call test_dry_current('mpp')
+    call test_whole_turns('rfem')
+    call test_whole_turns('mpp')
+    call test_turn_taken_off('rfem', .true.)
+    call test_turn_taken_off('rfem', .false.)
+    call test_turn_taken_off('mpp', .true.)
     call test_displace()
     call test_soft_swing()
     call test_mass_slope()
@@ -364,6 +373,89 @@ contains
         call suite%check_le(real(res%iterations - still%iterations, wp), 100.0_wp, &
                             kind//', dry in a current: the stages reach Newton')
     end subroutine test_dry_current
+
+    !> A folded start of three elements with a point load near the top: to the equilibrium
+    !! the elements turn by about half a turn, some past pi from their start and some not.
+    !! Bringing each angle within pi of its start would turn some elements by a whole turn
+    !! and not their neighbours: with bending (a moment on the difference of two angles)
+    !! that bends the joint between them by 2 pi, a state far from equilibrium. The state
+    !! handed back must be the equilibrium solved: its residual, evaluated there, the one
+    !! reported (rounding level), and (RFEM) every joint bent by less than a radian.
+    subroutine test_whole_turns(kind)
+        character(len=*), intent(in) :: kind
+        type(scene_t) :: scene
+        class(rope_model_t), allocatable :: model
+        real(wp), allocatable :: y(:), f(:)
+        integer, allocatable :: pos(:), vel(:)
+        type(statics_result_t) :: res
+        integer :: status, i
+
+        call scene_of(folded_sets(kind, .true.), scene)
+        call equilibrium(scene, model, y, res)
+        call model%coordinates(pos, vel)
+        allocate (f(size(pos)))
+        call generalized_force(model, y, pos, vel, f, status)
+        call suite%check_le(maxval(abs(f)), max(2.0_wp*res%residual, 1.0e-12_wp*res%weight), &
+                            kind//', folded: the residual at the state handed back, N')
+        call suite%check_le(res%residual_relative, 1.0e-9_wp, kind//', folded: residual / weight')
+        if (kind == 'rfem') call suite%check_le(maxval(abs( &
+            y([(6*i - 3, i = 2, 3)]) - y([(6*i - 3, i = 1, 2)]))), 1.0_wp, &
+            kind//', folded: no joint bent by a whole turn (rad)')
+    end subroutine test_whole_turns
+
+    !> at_rest_near at the equilibrium of test_whole_turns' scene, given a start q0 one turn
+    !! away in the middle element's angle: the turn is taken off (that angle ends within pi
+    !! of q0, the forces the same) without bending, and kept with it (the state unchanged).
+    subroutine test_turn_taken_off(kind, bending)
+        character(len=*), intent(in) :: kind
+        logical, intent(in) :: bending
+        type(scene_t) :: scene
+        class(rope_model_t), allocatable :: model
+        real(wp), allocatable :: y(:), y_eq(:), q0(:), f(:), f_eq(:)
+        integer, allocatable :: pos(:), vel(:)
+        type(statics_result_t) :: res
+        character(len=:), allocatable :: label
+        logical, allocatable :: angle(:)
+        integer :: status, k
+
+        label = kind//merge(', bending:    ', ', no bending: ', bending)
+        call scene_of(folded_sets(kind, bending), scene)
+        call equilibrium(scene, model, y_eq, res)
+        call model%coordinates(pos, vel)
+        angle = model%angle_coordinates()
+        k = findloc(angle, .true., dim=1)
+        k = k + findloc(angle(k + 1:), .true., dim=1)   ! the second angle coordinate
+        allocate (f_eq(size(pos)))
+        call generalized_force(model, y_eq, pos, vel, f_eq, status)
+        q0 = y_eq(pos)
+        q0(k) = q0(k) + 2.0_wp*PI
+        y = y_eq
+        f = f_eq
+        call at_rest_near(model, y, pos, vel, q0, f)
+        if (bending) then
+            call suite%check_true(all(y == y_eq), label//'the turn is kept')
+        else
+            call suite%check_le(abs(y(pos(k)) - q0(k)), 1.0e-12_wp, &
+                                label//'the turn is taken off (rad)')
+        end if
+        call suite%check_le(maxval(abs(f - f_eq)), max(10.0_wp*maxval(abs(f_eq)), &
+                            1.0e-12_wp*res%weight), label//'the force the same, to rounding (N)')
+    end subroutine test_turn_taken_off
+
+    !> test_whole_turns' scene: three elements, folded, a point load near the top.
+    function folded_sets(kind, bending) result(sets)
+        character(len=*), intent(in) :: kind
+        logical, intent(in) :: bending
+        character(len=64) :: sets(8)
+        write (sets(1), '(a)') 'model.kind = "'//kind//'"'
+        sets(2) = 'model.elements = 3'
+        sets(3) = 'initial.shape = "folded"'
+        sets(4) = 'attachments.mass_positions = 0.2104'
+        sets(5) = 'attachments.masses = 0.00205'
+        sets(6) = 'attachments.load_positions = 0.06462'
+        sets(7) = 'attachments.load_force_y = -1.44'
+        write (sets(8), '(a, l1)') 'effects.bending = ', bending
+    end function folded_sets
 
     !> rfem_t%displace: equal to y + delta to first order (the difference quarters when
     !! delta halves), and for the straight rope turned as one about its top end by 0.3 rad
