@@ -17,6 +17,20 @@ def test_outcomes():
     assert rs.outcome(None, "timeout") == "crash"
 
 
+def test_an_equilibrium_with_a_loose_residual_is_suspect():
+    """A statics or modes summary that reports an equilibrium (exit 0) with a residual above
+    LOOSE_RESIDUAL of the weight is a wrong result given as right; a run is not judged so."""
+    ok = types.SimpleNamespace(returncode=0)
+    line = "  residual        max |f| =  {} N ( {} of the weight   2.4953 N)\n"
+    tight, loose = line.format("6.2E-16", "2.5E-16"), line.format("1.960E+01", "7.856E+00")
+    assert rs.residual_ratio(loose) == 7.856
+    assert rs.sorted_outcome(ok, tight, "statics") == "ok"
+    assert rs.sorted_outcome(ok, loose, "statics") == "suspect"
+    assert rs.sorted_outcome(ok, loose, "modes") == "suspect"
+    assert rs.sorted_outcome(ok, loose, "run") == "ok"
+    assert rs.sorted_outcome(types.SimpleNamespace(returncode=3), loose, "statics") == "failed"
+
+
 def test_draws_depend_on_the_seed_alone():
     first = [rs.draw(random.Random(7), "run") for _ in range(3)]
     again = [rs.draw(random.Random(7), "run") for _ in range(3)]
@@ -31,6 +45,7 @@ def test_a_short_sweep(ropedyn_exe, capsys):
     assert rs.main(["statics", "--exe", str(ropedyn_exe), "--seed", "3", "--count", "4"]) == 0
     out = capsys.readouterr().out
     assert "random_scenes statics --seed 3 --count 4: ok " in out and "crash 0" in out
+    assert "suspect 0" in out
 
 
 def test_show_prints_the_outcomes_asked_for(ropedyn_exe, capsys, monkeypatch):
