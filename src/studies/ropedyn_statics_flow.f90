@@ -85,6 +85,13 @@ contains
         call model%coordinates(pos, vel)
         q0 = y(pos)
         used = first%iterations
+        if (used >= options%max_iterations) then
+            call make_error(err, ERR_SOLVER, spec%path//': statics: the equilibrium '// &
+                'without the current, where the continuation in the current starts, '// &
+                'used up the iterations allowed ('//int_text(used)//' of '// &
+                int_text(options%max_iterations)//'); allow more (--max-iterations)')
+            return
+        end if
         result = first
         result%stages = 0
         s = 0.0_wp
@@ -110,7 +117,7 @@ contains
                 ds = 0.25_wp*ds
             end if
             if (ds < LEAST_STAGE .or. used >= options%max_iterations) then
-                call stalled(spec, s, used, err)
+                call stalled(spec, s, used, first%iterations, err)
                 return
             end if
         end do
@@ -136,18 +143,20 @@ contains
         used = used + taken
     end subroutine stage_iterate
 
-    !> ERR_SOLVER: the continuation in the current stalled at the share s of its speed.
-    subroutine stalled(spec, s, used, err)
+    !> ERR_SOLVER: the continuation in the current stalled at the share s of its speed,
+    !! after `used` iterations, `still` of them those of the equilibrium without it.
+    subroutine stalled(spec, s, used, still, err)
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(in) :: s
-        integer, intent(in) :: used
+        integer, intent(in) :: used, still
         type(error_t), allocatable, intent(out) :: err
         call make_error(err, ERR_SOLVER, spec%path//': statics: no equilibrium in the '// &
             'current (&fluid current = '//fixed_text(spec%fluid%current(1), 3)//', '// &
             fixed_text(spec%fluid%current(2), 3)//' m/s): the continuation in its speed '// &
             'stalled at '//fixed_text(s, 3)//' of it after '//int_text(used)// &
-            ' iterations; the rope may have no steady state in this current (run the '// &
-            'dynamics from rest instead), or needs more iterations (--max-iterations)')
+            ' iterations ('//int_text(still)//' of them without the current); the rope '// &
+            'may have no steady state in this current (run the dynamics from rest '// &
+            'instead), or needs more iterations (--max-iterations)')
     end subroutine stalled
 
     !> Set up the iteration at y (velocities zeroed): coordinates, residual, mass, tangent

@@ -8,7 +8,9 @@
 !!   for a scene without equilibrium (free-free under gravity) and a capped iteration;
 !! - the rope in a current (normal drag only): a straight line at the angle theta from the
 !!   vertical where the normal drag balances the weight's normal part,
-!!   q_n U^2 cos^2 theta = w sin theta, RFEM and MPP, slow and fast, either way;
+!!   q_n U^2 cos^2 theta = w sin theta, RFEM and MPP, slow and fast, either way; and a
+!!   current that does not reach the rope at rest, whose budget the equilibrium without it
+!!   can use up (said so);
 !! - the RFEM's displace (the statics' trial point): y + delta to first order, and exact for
 !!   joined elements turned as one; and the soft rope with a heavy point mass that swings
 !!   down in a few hundred iterations with it (over 5000 with y + delta alone);
@@ -352,6 +354,8 @@ contains
         class(rope_model_t), allocatable :: model, still_model
         real(wp), allocatable :: y(:), y_still(:)
         type(statics_result_t) :: res, still
+        type(statics_options_t) :: options
+        type(error_t), allocatable :: err
         character(len=64) :: sets(6)
 
         write (sets(1), '(a)') 'model.kind = "'//kind//'"'
@@ -372,6 +376,18 @@ contains
         ! Newton step at rounding; far below one stage's budget of 200
         call suite%check_le(real(res%iterations - still%iterations, wp), 100.0_wp, &
                             kind//', dry in a current: the stages reach Newton')
+        ! a budget the equilibrium without the current uses up: said so, not blamed on the
+        ! current
+        call create_model(scene%rope_spec_t, model, err)
+        deallocate (y)
+        allocate (y(model%size()))
+        call model%initial_state(y)
+        options%max_iterations = still%iterations
+        call find_equilibrium(model, scene%rope_spec_t, y, options, res, err)
+        call suite%check_true(allocated(err), kind//', dry in a current, budget used up: error')
+        if (allocated(err)) call suite%check_contains(err%message, 'the equilibrium without '// &
+            'the current, where the continuation in the current starts, used up the '// &
+            'iterations allowed', kind//', budget used up by the still equilibrium: message')
     end subroutine test_dry_current
 
     !> A folded start of three elements with a point load near the top: to the equilibrium
