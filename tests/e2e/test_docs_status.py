@@ -7,19 +7,30 @@ import pytest
 from ropedyn_tools import docs_status
 
 
+def _rev(root, rev="HEAD"):
+    """The short hash of `rev` in the checkout at root."""
+    return subprocess.run(["git", "-C", str(root), "rev-parse", "--short", rev],
+                          capture_output=True, text=True, check=True).stdout.strip()
+
+
+def _commit(root, message, files, date=None):
+    """Write `files` ({path: text}) into the checkout at root and commit them all (at
+    `date`, ISO, when given); the new commit's short hash."""
+    for name, text in files.items():
+        (root / name).parent.mkdir(parents=True, exist_ok=True)
+        (root / name).write_text(text)
+    env = dict(os.environ, GIT_COMMITTER_DATE=date, GIT_AUTHOR_DATE=date) if date else None
+    subprocess.run(["git", "-C", str(root), "add", "."], check=True, env=env)
+    subprocess.run(["git", "-C", str(root), "-c", "user.name=t", "-c", "user.email=t@t",
+                    "commit", "-qm", message], check=True, env=env)
+    return _rev(root)
+
+
 def _repo(tmp_path):
     """A scratch checkout: code committed on Jan 1, changed on Jan 2 (counts), changed again
     on Jan 3 with a Numbers-unchanged line (does not count), docs changed on Jan 4."""
     def commit(date, message, files):
-        for name, text in files.items():
-            (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
-            (tmp_path / name).write_text(text)
-        env = dict(os.environ, GIT_COMMITTER_DATE=date, GIT_AUTHOR_DATE=date)
-        subprocess.run(["git", "-C", str(tmp_path), "add", "."], check=True, env=env)
-        subprocess.run(["git", "-C", str(tmp_path), "-c", "user.name=t", "-c",
-                        "user.email=t@t", "commit", "-qm", message], check=True, env=env)
-        return subprocess.run(["git", "-C", str(tmp_path), "rev-parse", "--short", "HEAD"],
-                              capture_output=True, text=True, check=True).stdout.strip()
+        return _commit(tmp_path, message, files, date)
 
     subprocess.run(["git", "init", "-q", str(tmp_path)], check=True)
     first = commit("2026-01-01T12:00:00Z", "start", {"src/a.f90": "1\n", "docs/x.md": "x\n"})
@@ -96,7 +107,6 @@ def test_a_moved_section_is_judged_from_the_commit_that_first_wrote_it(tmp_path)
     assert [c[0] for c in rows["run"]["commits"]] == [later]
 
 
-
 def test_a_section_watches_the_module_its_command_runs_and_its_imports(tmp_path):
     """A wrapper that branches on its first argument (`scripts/survey chain` runs
     survey_chain.py, `scripts/survey` survey.py) has each section watch the module its own
@@ -109,14 +119,7 @@ def test_a_section_watches_the_module_its_command_runs_and_its_imports(tmp_path)
     studies = "tools/ropedyn_tools/studies"
 
     def commit(message, files):
-        for name, text in files.items():
-            (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
-            (tmp_path / name).write_text(text)
-        subprocess.run(["git", "-C", str(tmp_path), "add", "."], check=True)
-        subprocess.run(["git", "-C", str(tmp_path), "-c", "user.name=t", "-c",
-                        "user.email=t@t", "commit", "-qm", message], check=True)
-        return subprocess.run(["git", "-C", str(tmp_path), "rev-parse", "--short", "HEAD"],
-                              capture_output=True, text=True, check=True).stdout.strip()
+        return _commit(tmp_path, message, files)
 
     ran = commit("the survey and its pages", {
         "scripts/survey": wrapper,
@@ -140,6 +143,7 @@ def test_a_section_watches_the_module_its_command_runs_and_its_imports(tmp_path)
     assert docs_status.wrapper_module(tmp_path, "survey", "chain") == "survey_chain"
     assert docs_status.wrapper_module(tmp_path, "survey", "fast") == "survey"
     assert docs_status.wrapper_module(tmp_path, "gone") == "gone"
+
 
 def test_check_fails_on_a_stale_section(tmp_path, capsys):
     _repo(tmp_path)
@@ -261,9 +265,7 @@ def test_same_code_by_the_rule_of_the_sections(tmp_path):
     assert same(second, second) and same(second, "v1.0-3-g" + second)
     assert not same(first, second) and not same(second, first)
     # Jan 3 (Numbers-unchanged) and Jan 4 (docs) do not count; Jan 5 changes the code
-    third = subprocess.run(["git", "-C", str(tmp_path), "rev-parse", "--short",
-                            f"{with_page}~2"], capture_output=True, text=True,
-                           check=True).stdout.strip()
+    third = _rev(tmp_path, f"{with_page}~2")
     assert same(second, third) and same(third, second)
     assert not same(second, with_page)
     # Jan 6 is listed for `run` only
@@ -278,11 +280,6 @@ def test_same_code_by_the_rule_of_the_sections(tmp_path):
     # so nothing says which code either build holds against the other
     subprocess.run(["git", "-C", str(tmp_path), "checkout", "-q", "-b", "side", with_page],
                    check=True)
-    (tmp_path / "docs" / "side.md").write_text("side\n")
-    subprocess.run(["git", "-C", str(tmp_path), "add", "docs/side.md"], check=True)
-    subprocess.run(["git", "-C", str(tmp_path), "-c", "user.name=t", "-c", "user.email=t@t",
-                    "commit", "-qm", "side"], check=True)
-    side = subprocess.run(["git", "-C", str(tmp_path), "rev-parse", "--short", "HEAD"],
-                          capture_output=True, text=True, check=True).stdout.strip()
+    side = _commit(tmp_path, "side", {"docs/side.md": "side\n"})
     assert same(with_page, side) and same(side, with_page)      # docs only between
     assert not same(side, later) and not same(later, side)

@@ -13,9 +13,9 @@ from the command: a wrapper that branches on its first argument, as `scripts/val
 bergdahl` does, runs another module for that word; with the modules of the studies that
 module imports, whose code makes its numbers too; each in tools/ropedyn_tools/studies/,
 tools/ropedyn_tools/ or, for the runs before they moved, python/ropedyn/studies/; NARROWER
-lists the studies that read less than the Fortran and the scenes). A commit there does not mean the numbers changed; it means the
-study has not been run on the code as it is, and its page should say why not or be rerun by
-its script. A commit that changes code but, checked, none of the results (a refactoring, a
+lists the studies that read less than the Fortran and the scenes). A commit there does not
+mean the numbers changed; it means the study has not been run on the code as it is, and its
+page should say why not or be rerun by its script. A commit that changes code but, checked, none of the results (a refactoring, a
 comment) says so with a line `Numbers-unchanged: how it was checked` in its message, or,
 once committed, with a line `HASH  how it was checked` in docs/numbers-unchanged.txt; it is
 not counted. A line `HASH  sections=NAME,NAME  how it was checked` there keeps it from
@@ -71,11 +71,10 @@ HEAD_LINES = 6
 #: a begin marker stands alone on its line (one quoted in a sentence, as in the contributing
 #: guide's `<!-- name:begin -->`, is no section)
 _BEGIN = re.compile(r"^\s*<!-- (?P<name>[^:>]+):begin -->\s*$")
-_SCRIPT = re.compile(r"scripts/(?P<script>[a-z0-9_]+)")
+#: the section's script and the first word after it (a wrapper may branch on that word)
+_SCRIPT = re.compile(r"scripts/(?P<script>[a-z0-9_]+)(?: (?P<word>[a-z][a-z0-9_]*))?")
 _STAMP = re.compile(r"(?P<date>20\d\d-\d\d-\d\d)(?:[ T](?P<time>\d\d:\d\d)(?: ?UTC)?)?")
 _COMMIT = re.compile(r"commit `(?P<rev>[0-9a-f]{7,40})`")
-#: the first word after the script in a section's command (a wrapper may branch on it)
-_WORD = re.compile(r"scripts/[a-z0-9_]+ (?P<word>[a-z][a-z0-9_]*)")
 #: a wrapper's branch on its first argument: `if [ "${1:-}" = "WORD" ]; then ... fi`
 _BRANCH = re.compile(r'^if \[ "\$\{1:-\}" = "(?P<word>[^"]+)" \]; then\n(?P<body>.*?)^fi$',
                      re.S | re.M)
@@ -107,13 +106,19 @@ def heads(page):
 def sections(page):
     """[(name, script or None, stamp text or None, commit or None)] of the generated
     sections of the Markdown page at `page`, in page order."""
+    return [found[:4] for found in _sections(page)]
+
+
+def _sections(page):
+    """sections(), each with the first word after its script (or None) last."""
     found = []
     for name, head in heads(page):
         script = _SCRIPT.search(head)
         stamp = _STAMP.search(head)
         commit = _COMMIT.search(head)
         found.append((name, script and script.group("script"),
-                      stamp and stamp.group(0), commit and commit.group("rev")))
+                      stamp and stamp.group(0), commit and commit.group("rev"),
+                      script and script.group("word")))
     return found
 
 
@@ -295,19 +300,21 @@ def status(root=ROOT):
     """One row per generated section of root/docs/**/*.md: dict(page, name, script, stamp,
     commits); commits None when the section names no run time."""
     root = pathlib.Path(root)
-    pages = {page: sections(page) for page in sorted((root / "docs").rglob("*.md"))}
+    pages = {page: _sections(page) for page in sorted((root / "docs").rglob("*.md"))}
     skip = unchanged_commits(root, {s[0] for found in pages.values() for s in found})
+    modules = {}                 # (script, word): the study modules, read once per command
     rows = []
     for page, found in pages.items():
-        words = {name: _WORD.search(head) for name, head in heads(page)}
-        for name, script, stamp, commit in found:
+        for name, script, stamp, commit, word in found:
             if script in CHECKED_BY_TESTS:
                 continue
             paths = list(NARROWER.get(script, CODE_PATHS))
             if script:
-                word = words[name] and words[name].group("word")
+                if (script, word) not in modules:
+                    modules[script, word] = study_modules(
+                        root, wrapper_module(root, script, word))
                 paths += [f"{folder}/{module}.py" for folder in STUDY_FOLDERS
-                          for module in study_modules(root, wrapper_module(root, script, word))]
+                          for module in modules[script, word]]
             commits = None
             if stamp and not commit:
                 # the commit that first wrote this stamp into docs/: the code it ran is
