@@ -148,6 +148,15 @@ def test_case_files_of_other_code_run_again(ropedyn_exe, tmp_path):
                              timeout=300)
     assert refused.returncode != 0 and str(rfem) in refused.stderr, refused.stderr
     assert "0.0.9+g0123456-dirty.89abcdef" in refused.stderr
+    # the MoorDyn comparison reads the same files: refused there too, before MoorDyn is set up
+    from ropedyn_tools.studies import bench_peers_bergdahl
+    try:
+        bench_peers_bergdahl.main(["--work", str(work), "--exe", str(ropedyn_exe),
+                                   "--periods", "1.25", "--radii", "0.2", "--no-write"])
+    except SystemExit as stop:
+        assert str(rfem) in str(stop) and "0.0.9+g0123456-dirty.89abcdef" in str(stop), stop
+    else:
+        raise AssertionError("bench_peers bergdahl used a case file of other code")
     rerun = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=900)
     assert rerun.returncode == 0, rerun.stderr
     assert "rfem: 1 case files of other code" in rerun.stderr

@@ -171,13 +171,9 @@ def main(argv=None):
     radii = [float(r) for r in args.radii.split(",")]
     work = pathlib.Path(args.work).resolve()
     exe = pathlib.Path(exe_or_build(args.exe)).resolve()
-    stale = bg.stale_files([bg.case_path(work, p, m, r) for m in bg.MODELS for p in periods
-                            for r in radii], bg.exe_version(exe))
-    if stale:
-        raise SystemExit(f"bench_peers bergdahl: {len(stale)} case files in {work} hold runs "
-                         f"of other code than {exe}, e.g. {stale[0]} "
-                         f"({bg.file_version(stale[0])}); run scripts/validation bergdahl "
-                         "first")
+    bg.refuse_stale([bg.case_path(work, p, m, r) for m in bg.MODELS for p in periods
+                     for r in radii], work, exe, bg.exe_version(exe), "bench_peers bergdahl",
+                    "run scripts/validation bergdahl first")
     py = ensure_bench_venv()
     ours = bg.collect(work, periods, bg.MODELS)
     cache = work / "moordyn"

@@ -332,6 +332,17 @@ def stale_files(paths, version):
     return [p for p in paths if complete(p) and not current(p, version)]
 
 
+def refuse_stale(paths, work, exe, version, who, advice):
+    """Stop (SystemExit, naming one file and its version) when any of the case files
+    `paths` (in `work`) holds a run of other code than the executable exe's (`version`):
+    `who` says which command refuses, `advice` what runs them again."""
+    stale = stale_files(paths, version)
+    if stale:
+        raise SystemExit(
+            f"{who}: {len(stale)} of the case files in {work} hold runs of other code than "
+            f"{exe} ({version}), e.g. {stale[0]} ({file_version(stale[0])}); {advice}")
+
+
 def name(label):
     """RFEM, MPP, or e.g. 'RFEM, perimeter' for a variant."""
     model, _, variant = label.partition("_")
@@ -860,13 +871,8 @@ def main(argv=None):
         used += [run[-1] for run in convergence_files(work, models=conv_models)] \
             if args.convergence else []
         used += contact_files(work) if args.contact_cost else []
-        stale = stale_files(used, version)
-        if stale:
-            raise SystemExit(
-                f"bergdahl: --analyse-only: {len(stale)} of the case files in {work} hold "
-                f"runs of other code than {exe} ({version}), e.g. {stale[0]} "
-                f"({file_version(stale[0])}); run the command without --analyse-only, which "
-                "runs them again")
+        refuse_stale(used, work, exe, version, "bergdahl: --analyse-only",
+                     "run the command without --analyse-only, which runs them again")
     else:
         walls = run_sweeps(exe, periods, models, radii, work, args.jobs, quick=quick,
                            version=version)
