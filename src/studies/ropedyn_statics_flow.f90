@@ -12,12 +12,12 @@
 !! band LU, dgbtrf), M the mass: a backward Euler step of the flow M q' = f of pseudo-time
 !! 1/sigma. sigma starts at the descent's scale (a step of L/10), follows the residual's
 !! norm r (r^2 = sum f_k^2 / |K_kk| at the stage's start; switched evolution relaxation:
-!! sigma r_new / r_old), halved again after a step that did not raise r, and is 0 (Newton) once
-!! it fell to a thousandth of its start (NEWTON_BELOW). Every step is taken unless r^2
-!! grows by GROWTH_ALLOWED (then sigma grows); up to two chord corrections with the same factors pull a trial point back
-!! towards the stiff springs' manifold. Converged after a Newton step below
-!! step_tolerance L. A stage that fails is retried with a quarter of the increment in s; a
-!! stage that succeeds doubles it.
+!! sigma r_new / r_old), halved again after a step that did not raise r, and is 0 (Newton)
+!! once it fell to a thousandth of its start (NEWTON_BELOW). Every step is taken unless r^2
+!! grows by GROWTH_ALLOWED (then sigma grows); up to two chord corrections with the same
+!! factors pull a trial point back towards the stiff springs' manifold. Converged after a
+!! Newton step below step_tolerance L. A stage that fails is retried with a quarter of the
+!! increment in s; a stage that succeeds doubles it.
 submodule (ropedyn_statics) ropedyn_statics_flow
     use ropedyn_lapack, only: dgbtrf, dgbtrs
     implicit none
