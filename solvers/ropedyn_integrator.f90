@@ -155,6 +155,7 @@ module ropedyn_integrator
         procedure :: switch_log => integrator_switch_log
         procedure :: steps_exhausted => integrator_steps_exhausted
         procedure :: budget_shortfall => integrator_budget_shortfall
+        procedure :: refusal => integrator_refusal
     end type integrator_t
 
     abstract interface
@@ -321,6 +322,16 @@ contains
         if (stats%steps < self%options%max_steps) return
         rest = max(1_i8, steps_to_end(t, self%options%t_end, stats%last_step))
     end function integrator_budget_shortfall
+
+    !> Why the method cannot integrate `problem` at all ('' when it can): asked before a
+    !! run starts, so that a method the scene names for a problem it does not fit is bad
+    !! input, not a failed integration. The default: every method fits every problem.
+    function integrator_refusal(self, problem) result(why)
+        class(integrator_t), intent(in) :: self
+        class(problem_t), intent(in) :: problem
+        character(len=:), allocatable :: why
+        why = ''
+    end function integrator_refusal
 
     !> 'max_steps exceeded (N steps)': how a message says that a budget of N steps ran out.
     pure function exceeded_text(max_steps) result(text)

@@ -151,6 +151,7 @@ module ropedyn_symplectic
         procedure :: fix_step => symplectic_fix_step
         procedure :: budget_shortfall => symplectic_budget_shortfall
         procedure :: failed_fatally => symplectic_failed_fatally
+        procedure :: refusal => symplectic_refusal
         procedure, private :: begin
         procedure, private :: review_step
         procedure, private :: set_step
@@ -272,6 +273,28 @@ contains
         self%fixed_h = h
     end subroutine symplectic_fix_step
 
+    !> Why the method cannot integrate `problem` ('' when it can): it needs the force split
+    !! (a constant diagonal mass matrix, forces from a potential and the rest) and a state of
+    !! coordinates and their rates alone.
+    function symplectic_refusal(self, problem) result(why)
+        class(symplectic_t), intent(in) :: self
+        class(problem_t), intent(in) :: problem
+        character(len=:), allocatable :: why
+        integer, allocatable :: pos(:), vel(:)
+        integer :: kl, ku
+        why = problem%force_split_refusal()
+        if (len(why) > 0 .and. problem%has_mass_matrix()) why = 'the mass matrix '// &
+            'depends on the state, which no explicit symplectic method integrates '// &
+            '(docs/theory/symplectic.md, "The MPP")'
+        if (len(why) == 0 .and. .not. problem%has_second_order()) &
+            why = 'the problem has no coordinates and rates'
+        if (len(why) == 0) then
+            call problem%second_order_layout(pos, vel, kl, ku)
+            if (2*size(pos) /= problem%size()) why = 'the problem has unknowns other than '// &
+                'coordinates and their rates'
+        end if
+    end function symplectic_refusal
+
     subroutine symplectic_start(self, start, err)
         class(symplectic_t), intent(inout) :: self
         type(start_t), intent(in) :: start
@@ -279,22 +302,13 @@ contains
         character(len=:), allocatable :: why
         integer :: kl, ku, j
 
-        why = self%problem%force_split_refusal()
-        if (len(why) > 0 .and. self%problem%has_mass_matrix()) why = why//'; its mass '// &
-            'matrix depends on the state, which no explicit symplectic method integrates '// &
-            '(docs/theory/symplectic.md, "The MPP")'
-        if (len(why) == 0 .and. .not. self%problem%has_second_order()) &
-            why = 'the problem has no coordinates and rates'
-        if (len(why) == 0) then
-            call self%problem%second_order_layout(self%pos, self%vel, kl, ku)
-            if (2*size(self%pos) /= self%n) why = 'the problem has unknowns other than '// &
-                'coordinates and their rates'
-        end if
+        why = self%refusal(self%problem)
         if (len(why) > 0) then
             call make_error(err, ERR_SOLVER, 'symplectic: cannot integrate this problem: '// &
                             why//' (use method = ''auto'' or ''erk'')')
             return
         end if
+        call self%problem%second_order_layout(self%pos, self%vel, kl, ku)
         self%np = size(self%pos)
         allocate (self%mass(self%np), self%signs(self%nq))
         call self%problem%split_layout(self%mass, self%signs)

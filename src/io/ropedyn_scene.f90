@@ -204,9 +204,12 @@ contains
                 if (allocated(err)) return
             end do
         end do
+        scene%solver%method_origin = scene%path
         do i = 1, size(keys)
             if (keys(i)%group == group_index('output') .and. keys(i)%name == 'progress') &
                 scene%output%progress_given = keys(i)%given
+            if (keys(i)%group == group_index('solver') .and. keys(i)%name == 'method' .and. &
+                allocated(keys(i)%origin)) scene%solver%method_origin = keys(i)%origin
         end do
         call check_scene(keys, scene, err)
     end subroutine store_scene

@@ -1,13 +1,16 @@
 !> What a scene asks of the solvers: the integrator it names and the options it gives.
 module ropedyn_scene_solver
     use ropedyn_kinds, only: i8
-    use ropedyn_error, only: error_t
+    use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_integrator, only: integrator_t, solver_options_t, default_step_budget
     use ropedyn_solvers, only: new_integrator
     use ropedyn_scene_types, only: scene_t
+    use ropedyn_rope_model, only: rope_model_t
+    use ropedyn_model_factory, only: create_model
     implicit none
     private
-    public :: create_integrator, solver_options_of, step_budget
+    public :: create_integrator, solver_options_of, step_budget, check_method_fits, &
+        check_scene_method
 
 contains
 
@@ -19,6 +22,37 @@ contains
         call new_integrator(trim(scene%solver%method), integrator, err)
         if (allocated(err)) err%message = scene%path//': &solver: '//err%message
     end subroutine create_integrator
+
+    !> The method the scene names must be able to integrate its model at all (a method that
+    !! cannot, such as the symplectic method for the MPP, is bad input of &solver method,
+    !! reported before anything runs; `integrator_t%refusal`).
+    subroutine check_method_fits(scene, integrator, model, err)
+        type(scene_t), intent(in) :: scene
+        class(integrator_t), intent(in) :: integrator
+        class(rope_model_t), intent(in) :: model
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: why
+        why = integrator%refusal(model)
+        if (len(why) == 0) return
+        call make_error(err, ERR_INPUT, scene%solver%method_origin//': &solver: method = "'// &
+            trim(scene%solver%method)//'": cannot integrate the '//model%model_name()// &
+            ' model of this scene: '//why//' (use method = "auto" or "erk"; '// &
+            'docs/guide/choosing.md)')
+    end subroutine check_method_fits
+
+    !> `check_method_fits` for a scene alone (its model and integrator made and dropped):
+    !! the check of a scene read before it runs (a sweep's cases).
+    subroutine check_scene_method(scene, err)
+        type(scene_t), intent(in) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        class(rope_model_t), allocatable :: model
+        class(integrator_t), allocatable :: integrator
+        call create_model(scene%rope_spec_t, model, err)
+        if (allocated(err)) return
+        call create_integrator(scene, integrator, err)
+        if (allocated(err)) return
+        call check_method_fits(scene, integrator, model, err)
+    end subroutine check_scene_method
 
     !> The solver options of a scene's &solver group.
     pure function solver_options_of(scene) result(options)

@@ -45,7 +45,8 @@ module ropedyn_run
     use ropedyn_clock, only: clock_seconds
     use ropedyn_model_factory, only: create_model
     use ropedyn_scene, only: scene_t, scene_namelist_text
-    use ropedyn_scene_solver, only: create_integrator, solver_options_of, step_budget
+    use ropedyn_scene_solver, only: create_integrator, solver_options_of, step_budget, &
+        check_method_fits
     use ropedyn_os, only: make_parent_dirs
     use ropedyn_output, only: output_file_t, add_counter_values
     use ropedyn_progress, only: progress_t
@@ -412,6 +413,8 @@ contains
         call create_model(scene%rope_spec_t, self%model, err)
         if (allocated(err)) return
         call create_integrator(scene, self%integrator, err)
+        if (allocated(err)) return
+        call check_method_fits(scene, self%integrator, self%model, err)
         if (allocated(err)) return
         n = self%model%n_elements()
         self%nq = self%model%quad_size()

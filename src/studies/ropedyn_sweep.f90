@@ -10,6 +10,7 @@ module ropedyn_sweep
     use ropedyn_text, only: int_text, real_text, text_t, append_text, text_array
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_scene, only: scene_t, read_scene
+    use ropedyn_scene_solver, only: check_scene_method
     use ropedyn_kinds, only: wp
     use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_run_inputs, only: check_not_input
@@ -211,16 +212,23 @@ contains
         sweep%n_groups = size(group_keys)
     end subroutine expand
 
-    !> The effective scene of a case (with atol = atol_per_rtol rtol when given).
+    !> The effective scene of a case (with atol = atol_per_rtol rtol when given), its
+    !! method checked against its model.
     subroutine read_case(sweep, cs, err)
         type(sweep_t), intent(in) :: sweep
         type(sweep_case_t), intent(inout) :: cs
         type(error_t), allocatable, intent(out) :: err
         call read_scene(sweep%base, case_overrides(sweep, cs%overrides, cs%file), cs%scene, err)
-        if (allocated(err) .or. .not. sweep%atol_given) return
-        call append_text(cs%overrides, 'solver.atol='// &
-            real_text(sweep%atol_per_rtol*cs%scene%solver%rtol, compact=.true.))
-        call read_scene(sweep%base, case_overrides(sweep, cs%overrides, cs%file), cs%scene, err)
+        if (allocated(err)) return
+        if (sweep%atol_given) then
+            call append_text(cs%overrides, 'solver.atol='// &
+                real_text(sweep%atol_per_rtol*cs%scene%solver%rtol, compact=.true.))
+            call read_scene(sweep%base, case_overrides(sweep, cs%overrides, cs%file), &
+                            cs%scene, err)
+            if (allocated(err)) return
+        end if
+        ! the method must fit the case's model (bad input before anything runs)
+        call check_scene_method(cs%scene, err)
     end subroutine read_case
 
     !> The overrides of a case for read_scene: set, the case's own, its output file.

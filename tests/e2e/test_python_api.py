@@ -67,6 +67,22 @@ def test_bad_scene_and_bad_set_raise_the_cli_message(run, tmp_path):
         scene.set("solver.nosuchkey", 1)
 
 
+def test_a_method_that_cannot_integrate_the_model_is_bad_input(run, tmp_path):
+    """The symplectic method named for the MPP: exit 2 and no file from the command line,
+    an input error from the library, both naming &solver method and the reason."""
+    scene = tmp_path / "mpp.nml"
+    scene.write_text("&model\n    kind = 'mpp'\n    elements = 4\n/\n"
+                     "&solver\n    method = 'symplectic'\n/\n&output\n    file = 'x.h5'\n/\n")
+    message, code = cli_error(run, scene)
+    assert code == 2 and not (tmp_path / "x.h5").exists()
+    assert message.startswith(f"{scene}: &solver: method = \"symplectic\": cannot integrate "
+                              "the mpp model of this scene: the mass matrix depends on the state")
+    with pytest.raises(ropedyn.Error) as error:
+        ropedyn.Simulation(ropedyn.Scene.from_file(scene))
+    assert error.value.kind == "input" and error.value.code == 2
+    assert "cannot integrate the mpp model" in error.value.message
+
+
 def test_run_gives_the_cli_records_and_writes_no_file(run, tmp_path, monkeypatch):
     scene = small(n=8, t_end=0.5)
     path = scene.write(tmp_path / "s.nml")

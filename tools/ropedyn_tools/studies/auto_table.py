@@ -42,7 +42,7 @@ END = "<!-- auto_table:end -->"
 FIXED = ("cvode", "adams", "mebdf", "erk", "symplectic")
 #: how a method says it does not take a scene at all (the symplectic method on the MPP or
 #: with ground contact): shown as n/a, not as a failure
-REFUSED = "cannot integrate this problem"
+REFUSED = "cannot integrate the"
 ROUND = (1.0, 2.0, 5.0)
 
 

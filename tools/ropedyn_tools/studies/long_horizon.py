@@ -163,12 +163,14 @@ def run_case(exe, workdir, key, scene, overrides, timeout, cached_only=False):
     out = workdir / _file_name(key)
     meta = out.with_suffix(".json")
     stamp = _stamp(exe, scene, overrides)
-    if out.exists() and meta.exists():
+    if meta.exists():
         old = json.loads(meta.read_text())
-        if old.get("stamp") == stamp:
+        # (a refused case, exit 2, wrote no file)
+        if old.get("stamp") == stamp and (out.exists() or old["returncode"] == 2):
             return old["returncode"], old["stderr"], out
     if cached_only:
         return None, "not run (not in the cache)", workdir / "missing.h5"
+    out.unlink(missing_ok=True)   # an older code's file must not stand for this run's
     cmd = [str(exe), "run", str(HARD / f"{scene}.nml"), "--set", f"output.file={out}"]
     for o in overrides:
         cmd += ["--set", o]
@@ -189,6 +191,13 @@ def measures(rc, stderr, path, scene):
     r = {"returncode": rc, "stderr": stderr.strip(), "scene": scene}
     if rc is None:
         r["outcome"] = stderr
+        return r
+    if not path.exists() and rc == 2:
+        # a method the scene names for a model it cannot integrate (the symplectic method
+        # and the MPP, water, ground contact): bad input, refused before any file
+        reason = stderr.strip().removeprefix("ropedyn: error: ")
+        r.update({"status": "refused", "reason": reason, "nonfinite": [],
+                  "outcome": f"refused (exit 2): {reason}"})
         return r
     if not path.exists():
         r["outcome"] = f"no output (exit {rc}): {stderr.strip()}"

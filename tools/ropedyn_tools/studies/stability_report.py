@@ -105,7 +105,9 @@ def run(exe, scene, t_end, overrides, out, timeout):
     except subprocess.TimeoutExpired:
         return {"outcome": f"killed after {timeout} s wall time"}
     if not out.exists():
-        return {"outcome": f"no output (exit {res.returncode}): {res.stderr.strip()}"}
+        what = "refused" if res.returncode == 2 else "no output"
+        return {"outcome": f"{what} (exit {res.returncode}): "
+                           f"{res.stderr.strip().removeprefix('ropedyn: error: ')}"}
     m = stability_metrics.analyse(out)
     bad = stability_metrics.all_finite(out)
     if m["status"] == "complete" and res.returncode == 0:
