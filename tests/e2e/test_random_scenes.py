@@ -31,6 +31,16 @@ def test_an_equilibrium_with_a_loose_residual_is_suspect():
     assert rs.sorted_outcome(types.SimpleNamespace(returncode=3), loose, "statics") == "failed"
 
 
+def test_every_failure_of_the_statics_counts_as_no_equilibrium():
+    stalled = ("ropedyn: error: s.nml: statics: no equilibrium in the current (&fluid current "
+               "= 0.861, 0.213 m/s): the continuation in its speed stalled at 0.516 of it")
+    still = ("ropedyn: error: s.nml: statics: the equilibrium without the current, where the "
+             "continuation in the current starts, used up the iterations allowed")
+    assert rs.no_equilibrium("failed", stalled) and rs.no_equilibrium("failed", still)
+    assert not rs.no_equilibrium("failed", "ropedyn: error: erk failed at t = 0.1 s")
+    assert not rs.no_equilibrium("ok", "statics: converged")
+
+
 def test_draws_depend_on_the_seed_alone():
     first = [rs.draw(random.Random(7), "run") for _ in range(3)]
     again = [rs.draw(random.Random(7), "run") for _ in range(3)]

@@ -120,6 +120,13 @@ def residual_ratio(text):
     return float(found.group("ratio")) if found else None
 
 
+def no_equilibrium(kind, text):
+    """Whether a failure is the statics': every one of them (no equilibrium, the continuation
+    in a current stalled, its start without the current out of iterations) is said as
+    "...: statics: ..." (a run's start from 'equilibrium' or 'mode' too)."""
+    return kind == "failed" and "statics: " in text
+
+
 def sorted_outcome(proc_or_none, text, command):
     """outcome(), or 'suspect' for an equilibrium reported found (exit 0 of `statics` or
     `modes`) whose residual exceeds LOOSE_RESIDUAL of the weight."""
@@ -166,7 +173,7 @@ def main(argv=None):
                 proc, text = None, "timeout"
             kind = sorted_outcome(proc, text, args.command)
             counts[kind] += 1
-            if "statics: no" in text:
+            if no_equilibrium(kind, text):
                 counts["no equilibrium"] += 1
             if kind in ("crash", "suspect") or kind in args.show:
                 print(f"{kind} (case {k}): {text.strip().splitlines()[-1] if text else ''}\n"
