@@ -9,12 +9,15 @@
 !!   interrupted;
 !! - stale: its file holds another scene: the sweep changed;
 !! - unreadable: its file is there but does not read back (the reason says what failed);
-!! - missing: no file, no lock.
+!! - missing: no file, no lock (but a run that failed before it made its file, a statics
+!!   start that found no equilibrium for one, left a note `.case_<id>.failed` with its
+!!   message: the case is then failed, for that reason).
 !!
 !! Only `complete` counts as done; every other status runs again (`running` only once its
 !! writer is gone).
 module ropedyn_sweep_status
     use ropedyn_error, only: error_t
+    use ropedyn_os, only: rename_file, delete_file
     use ropedyn_scene, only: scene_namelist_text
     use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_sweep_lock, only: lock_t, read_lock
@@ -22,6 +25,7 @@ module ropedyn_sweep_status
     implicit none
     private
     public :: case_state_t, case_state, lock_path, part_path, STATUS_NAMES
+    public :: write_failure_note, drop_failure_note
 
     !> Every status, in the order of `--status`.
     character(len=*), parameter :: STATUS_NAMES(7) = [character(len=11) :: 'complete', &
@@ -79,6 +83,8 @@ contains
                 state%reason = err%message
             else if (.not. state%data%exists) then
                 state%status = 'missing'
+                state%reason = failure_note(c%file)
+                if (len(state%reason) > 0) state%status = 'failed'
             else if (state%data%scene /= scene_namelist_text(c%scene)) then
                 state%status = 'stale'
                 state%reason = 'the file holds another scene than this case (the sweep ' &
@@ -114,6 +120,54 @@ contains
             end if
         end associate
     end subroutine case_state
+
+    !> `<output_dir>/.case_<id>.failed`, the note of a case whose run failed before it made
+    !! its file (`file` the case file).
+    pure function note_path(file) result(path)
+        character(len=*), intent(in) :: file
+        character(len=:), allocatable :: path
+        path = hidden(file)
+        path = path(:len(path) - 3)//'.failed'
+    end function note_path
+
+    !> Leave the note of a run of case file `file` that failed with `message` and made no
+    !! file (written aside and renamed: a reader sees the whole message or none). A note
+    !! that cannot be written is left out: the message went to the task's output as well.
+    subroutine write_failure_note(file, message)
+        character(len=*), intent(in) :: file, message
+        type(error_t), allocatable :: err
+        integer :: unit, ios
+        logical :: removed
+        open (newunit=unit, file=note_path(file)//'.tmp', status='replace', action='write', &
+              iostat=ios)
+        if (ios /= 0) return
+        write (unit, '(a)', iostat=ios) message
+        close (unit)
+        if (ios == 0) call rename_file(note_path(file)//'.tmp', note_path(file), err)
+        if (ios /= 0 .or. allocated(err)) removed = delete_file(note_path(file)//'.tmp')
+    end subroutine write_failure_note
+
+    !> Remove the note of case file `file` (a run that made its file says itself how it
+    !! ended).
+    subroutine drop_failure_note(file)
+        character(len=*), intent(in) :: file
+        logical :: removed
+        removed = delete_file(note_path(file))
+    end subroutine drop_failure_note
+
+    !> The message of the note of case file `file` ('' when there is none).
+    function failure_note(file) result(message)
+        character(len=*), intent(in) :: file
+        character(len=:), allocatable :: message
+        character(len=4096) :: line
+        integer :: unit, ios
+        message = ''
+        open (newunit=unit, file=note_path(file), status='old', action='read', iostat=ios)
+        if (ios /= 0) return
+        read (unit, '(a)', iostat=ios) line
+        close (unit)
+        if (ios == 0) message = 'not run: '//trim(line)
+    end function failure_note
 
     !> `dir/.name` for `dir/name`.
     pure function hidden(file) result(path)

@@ -30,7 +30,8 @@ module ropedyn_sweep_task
     use ropedyn_case_file, only: case_data_t, read_case_file, finish_case_file
     use ropedyn_sweep_lock, only: take_lock, drop_lock, heartbeat_t
     use ropedyn_sweep, only: sweep_t, sweep_case_t
-    use ropedyn_sweep_status, only: case_state_t, case_state, lock_path, part_path
+    use ropedyn_sweep_status, only: case_state_t, case_state, lock_path, part_path, &
+        write_failure_note, drop_failure_note
     implicit none
     private
     public :: run_cases, case_label, case_id
@@ -182,6 +183,12 @@ contains
                 wall = clock_seconds() - start
                 call put_in_place(c, part, wall, ferr)
                 if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
+                ! a run that failed without a file leaves its message for the status
+                call drop_failure_note(c%file)
+                if (allocated(err)) then
+                    if (err%code /= ERR_INTERRUPTED .and. len(file_status(c%file)) == 0) &
+                        call write_failure_note(c%file, err%message)
+                end if
                 if (allocated(err)) then
                     err%message = label//' ('//c%file//'): '//err%message
                     if (err%code == ERR_INTERRUPTED) err%message = err%message// &

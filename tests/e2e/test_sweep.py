@@ -154,6 +154,40 @@ def test_failing_case_recorded_others_finish(run, sweep_dir):
     assert result.returncode == 3 and "2 complete already, running 2" in result.stderr
 
 
+def test_case_failing_before_its_file_says_why(run, sweep_dir):
+    """A case whose run fails before it makes its file (here: its start, a record of a run
+    of the other model) is failed with that reason in the status and the summary, not
+    missing without one; once it completes, the reason is gone."""
+    (sweep_dir / "scenes" / "mpp.nml").write_text(
+        BASE.replace("'rfem'", "'mpp'") + "&output file = 'start.h5' /\n")
+    assert run("run", "scenes/mpp.nml").returncode == 0
+    (sweep_dir / "scenes" / "from.nml").write_text(
+        BASE.replace("t_end = 0.1", "t_end = 0.2")
+        + "&initial shape = 'state', state_file = '../start.h5' /\n")
+    (sweep_dir / "from.nml").write_text("&sweep base = 'scenes/from.nml', "
+                                        "output_dir = 'out/from', models = 'mpp', 'rfem' /\n")
+    result = run("sweep", "from.nml", "--jobs", "1")
+    assert result.returncode == 3, result.stderr
+    assert "case 0002: failed: not run: " in result.stderr
+    out = sweep_dir / "out" / "from"
+    rows = read_csv(out / "summary.csv")
+    assert [r["status"] for r in rows] == ["complete", "failed"]
+    assert rows[1]["reason"].startswith("not run: ") and \
+        "the file holds a run of the mpp model" in rows[1]["reason"]
+    assert not (out / "case_0002.h5").exists()
+    status = run("sweep", "from.nml", "--status")
+    assert "failed           1  0002" in status.stdout, status.stdout
+    # the cause gone (the same model), the case completes and its note is gone
+    (sweep_dir / "scenes" / "from.nml").write_text(
+        (sweep_dir / "scenes" / "from.nml").read_text().replace("'rfem'", "'mpp'"))
+    (sweep_dir / "from.nml").write_text("&sweep base = 'scenes/from.nml', output_dir = "
+                                        "'out/from', models = 'mpp', rtols = 1e-6, 1e-5 /\n")
+    result = run("sweep", "from.nml", "--jobs", "1", "--force")
+    assert result.returncode == 0, result.stderr
+    assert [r["reason"] for r in read_csv(out / "summary.csv")] == ["", ""]
+    assert not list(out.glob(".*.failed"))
+
+
 def test_task_equals_case_run_alone(run, sweep_dir):
     result = run("sweep", "sw.nml", "--task", "7")
     assert result.returncode == 0, result.stderr
