@@ -9,8 +9,7 @@ module ropedyn_scene_solver
     use ropedyn_model_factory, only: create_model
     implicit none
     private
-    public :: create_integrator, solver_options_of, step_budget, check_method_fits, &
-        check_scene_method
+    public :: create_integrator, solver_options_of, step_budget, check_scene_method
 
 contains
 
@@ -41,7 +40,8 @@ contains
     end subroutine check_method_fits
 
     !> `check_method_fits` for a scene alone (its model and integrator made and dropped):
-    !! the check of a scene read before it runs (a sweep's cases).
+    !! the check of a scene before it runs (a run before it touches its output, a sweep's
+    !! cases when it is read).
     subroutine check_scene_method(scene, err)
         type(scene_t), intent(in) :: scene
         type(error_t), allocatable, intent(out) :: err

@@ -46,7 +46,7 @@ module ropedyn_run
     use ropedyn_model_factory, only: create_model
     use ropedyn_scene, only: scene_t, scene_namelist_text
     use ropedyn_scene_solver, only: create_integrator, solver_options_of, step_budget, &
-        check_method_fits
+        check_scene_method
     use ropedyn_os, only: make_parent_dirs
     use ropedyn_output, only: output_file_t, add_counter_values
     use ropedyn_progress, only: progress_t
@@ -395,6 +395,10 @@ contains
             self%summary%file = ''
             if (present(name) .and. self%output == OUTPUT_MEMORY) self%summary%file = name
         end if
+        ! a method that cannot integrate the scene's model is bad input: said before the
+        ! guard touches the output's directory
+        call check_scene_method(scene, err)
+        if (allocated(err)) return
         if (guarding) then
             call self%guard_output(resuming, forced, err)
             if (allocated(err)) return
@@ -413,8 +417,6 @@ contains
         call create_model(scene%rope_spec_t, self%model, err)
         if (allocated(err)) return
         call create_integrator(scene, self%integrator, err)
-        if (allocated(err)) return
-        call check_method_fits(scene, self%integrator, self%model, err)
         if (allocated(err)) return
         n = self%model%n_elements()
         self%nq = self%model%quad_size()
