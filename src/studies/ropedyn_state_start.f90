@@ -10,27 +10,30 @@ module ropedyn_state_start
     use ropedyn_state_record, only: state_record_t, read_state_record
     implicit none
     private
-    public :: state_initial_state
+    public :: state_initial_state, check_state_start
 
 contains
 
-    !> The start of `&initial shape = 'state'`: the record of `state_file` nearest
-    !! `state_time` (the last for < 0) gives the time t, the model's ODE state y (stored, or
-    !! rebuilt from the element fields) and the quadratures yq (dissipated energy, external
-    !! work). The file must hold a run of the same model kind and number of elements.
-    subroutine state_initial_state(scene, model, t, y, yq, err)
+    !> Whether the record `&initial shape = 'state'` names can start a run of the scene's
+    !! `model` (the checks of `state_initial_state`, without taking the state): a sweep asks
+    !! it of every case before anything runs.
+    subroutine check_state_start(scene, model, err)
         type(scene_t), intent(in) :: scene
         class(rope_model_t), intent(in) :: model
-        real(wp), intent(out) :: t
-        real(wp), intent(inout) :: y(:), yq(:)
         type(error_t), allocatable, intent(out) :: err
         type(state_record_t) :: rec
-        character(len=:), allocatable :: where
-        logical :: ok
-        integer :: nq
+        call read_start_record(scene, model, rec, err)
+    end subroutine check_state_start
 
-        where = scene%path//': &initial: state_file = "'//trim(scene%initial%state_file)//'"'
-        t = 0.0_wp
+    !> The record of `state_file` nearest `state_time` (the last for < 0), checked: a run
+    !! of the same model kind and number of elements, before t_end.
+    subroutine read_start_record(scene, model, rec, err)
+        type(scene_t), intent(in) :: scene
+        class(rope_model_t), intent(in) :: model
+        type(state_record_t), intent(out) :: rec
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: where
+        where = start_where(scene)
         call read_state_record(trim(scene%initial%state_file), scene%initial%state_time, &
                                rec, err)
         if (allocated(err)) then
@@ -49,8 +52,33 @@ contains
             call make_error(err, ERR_INPUT, where//': its record '//int_text(rec%record)// &
                 ' is at t = '//real_text(rec%t)//' s, not before &solver t_end = '// &
                 real_text(scene%solver%t_end)//' s')
-            return
         end if
+    end subroutine read_start_record
+
+    !> 'SCENE: &initial: state_file = "FILE"', where the messages of the start begin.
+    pure function start_where(scene) result(where)
+        type(scene_t), intent(in) :: scene
+        character(len=:), allocatable :: where
+        where = scene%path//': &initial: state_file = "'//trim(scene%initial%state_file)//'"'
+    end function start_where
+
+    !> The start of `&initial shape = 'state'`: the record of `state_file` nearest
+    !! `state_time` (the last for < 0) gives the time t, the model's ODE state y (stored, or
+    !! rebuilt from the element fields) and the quadratures yq (dissipated energy, external
+    !! work). The file must hold a run of the same model kind and number of elements.
+    subroutine state_initial_state(scene, model, t, y, yq, err)
+        type(scene_t), intent(in) :: scene
+        class(rope_model_t), intent(in) :: model
+        real(wp), intent(out) :: t
+        real(wp), intent(inout) :: y(:), yq(:)
+        type(error_t), allocatable, intent(out) :: err
+        type(state_record_t) :: rec
+        logical :: ok
+        integer :: nq
+
+        t = 0.0_wp
+        call read_start_record(scene, model, rec, err)
+        if (allocated(err)) return
         nq = model%quad_size()
         ok = .false.
         if (allocated(rec%y)) then
@@ -64,8 +92,8 @@ contains
         if (.not. ok) then
             call model%state_from_fields(rec%q, rec%qdot, rec%t, y, ok)
             if (.not. ok) then
-                call make_error(err, ERR_INPUT, where//': the '//model%model_name()// &
-                    ' model cannot rebuild its state from the stored fields')
+                call make_error(err, ERR_INPUT, start_where(scene)//': the '// &
+                    model%model_name()//' model cannot rebuild its state from the stored fields')
                 return
             end if
             if (nq >= 1) yq(1) = rec%dissipated

@@ -4,13 +4,17 @@
 !! Case ids run from 1 in the order of the cartesian product models > elements > vary(1) >
 !! vary(2) ... > methods > max_orders > rtols, the last varying fastest. A list that is not
 !! given is one value: whatever the base scene (after `set`) says. Every case is read as a
-!! scene (`read_scene`), so a bad combination is reported before anything runs, naming the
-!! sweep file, the case and its overrides.
+!! scene (`read_scene`), its method checked against its model and a record it starts from
+!! against both, so a bad combination is reported before anything runs, naming the sweep
+!! file, the case and its overrides.
 module ropedyn_sweep
     use ropedyn_text, only: int_text, real_text, text_t, append_text, text_array
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_scene_solver, only: check_scene_method
+    use ropedyn_rope_model, only: rope_model_t
+    use ropedyn_model_factory, only: create_model
+    use ropedyn_state_start, only: check_state_start
     use ropedyn_kinds, only: wp
     use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_run_inputs, only: check_not_input
@@ -227,9 +231,23 @@ contains
                             cs%scene, err)
             if (allocated(err)) return
         end if
-        ! the method must fit the case's model (bad input before anything runs)
+        ! the method must fit the case's model, and a record it starts from the case
+        ! (bad input before anything runs)
         call check_scene_method(cs%scene, err)
+        if (allocated(err)) return
+        call check_case_start(cs%scene, err)
     end subroutine read_case
+
+    !> A case that starts from a record of another run (`&initial shape = 'state'`): the
+    !! record must fit its model and come before its t_end (`check_state_start`).
+    subroutine check_case_start(scene, err)
+        type(scene_t), intent(in) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        class(rope_model_t), allocatable :: model
+        if (trim(scene%initial%shape) /= 'state') return
+        call create_model(scene%rope_spec_t, model, err)
+        if (.not. allocated(err)) call check_state_start(scene, model, err)
+    end subroutine check_case_start
 
     !> The overrides of a case for read_scene: set, the case's own, its output file.
     function case_overrides(sweep, own, file) result(arr)

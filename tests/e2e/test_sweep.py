@@ -155,9 +155,37 @@ def test_failing_case_recorded_others_finish(run, sweep_dir):
 
 
 def test_case_failing_before_its_file_says_why(run, sweep_dir):
-    """A case whose run fails before it makes its file (here: its start, a record of a run
-    of the other model) is failed with that reason in the status and the summary, not
-    missing without one; once it completes, the reason is gone."""
+    """A case whose run fails before it makes its file (here: its start, an equilibrium of a
+    rope whose both ends are free) is failed with that reason in the status and the
+    summary, not missing without one; once it completes, the reason is gone."""
+    (sweep_dir / "scenes" / "eq.nml").write_text(
+        BASE + "&initial shape = 'equilibrium' /\n")
+    (sweep_dir / "eq.nml").write_text("&sweep base = 'scenes/eq.nml', output_dir = 'out/eq', "
+                                      "vary = 'supports.top = pinned; free' /\n")
+    result = run("sweep", "eq.nml", "--jobs", "1")
+    assert result.returncode == 3, result.stderr
+    assert "case 0002: failed: not run: " in result.stderr
+    out = sweep_dir / "out" / "eq"
+    rows = read_csv(out / "summary.csv")
+    assert [r["status"] for r in rows] == ["complete", "failed"]
+    assert rows[1]["reason"].startswith("not run: ") and \
+        "statics: no equilibrium: both supports are free" in rows[1]["reason"]
+    assert not (out / "case_0002.h5").exists()
+    status = run("sweep", "eq.nml", "--status")
+    assert "failed           1  0002" in status.stdout, status.stdout
+    # the cause gone (a clamped top), the case completes and its note is gone
+    (sweep_dir / "eq.nml").write_text("&sweep base = 'scenes/eq.nml', output_dir = 'out/eq', "
+                                      "vary = 'supports.top = pinned; clamped' /\n")
+    result = run("sweep", "eq.nml", "--jobs", "1")
+    assert result.returncode == 0, result.stderr
+    assert [r["reason"] for r in read_csv(out / "summary.csv")] == ["", ""]
+    assert not list(out.glob(".*.failed"))
+
+
+def test_case_starting_from_another_models_record_is_refused(run, sweep_dir):
+    """A case that starts from a record (&initial shape = 'state') of a run of another
+    model, or at or after its t_end, is bad input of the sweep: refused before anything
+    runs, naming the case."""
     (sweep_dir / "scenes" / "mpp.nml").write_text(
         BASE.replace("'rfem'", "'mpp'") + "&output file = 'start.h5' /\n")
     assert run("run", "scenes/mpp.nml").returncode == 0
@@ -167,25 +195,16 @@ def test_case_failing_before_its_file_says_why(run, sweep_dir):
     (sweep_dir / "from.nml").write_text("&sweep base = 'scenes/from.nml', "
                                         "output_dir = 'out/from', models = 'mpp', 'rfem' /\n")
     result = run("sweep", "from.nml", "--jobs", "1")
-    assert result.returncode == 3, result.stderr
-    assert "case 0002: failed: not run: " in result.stderr
-    out = sweep_dir / "out" / "from"
-    rows = read_csv(out / "summary.csv")
-    assert [r["status"] for r in rows] == ["complete", "failed"]
-    assert rows[1]["reason"].startswith("not run: ") and \
-        "the file holds a run of the mpp model" in rows[1]["reason"]
-    assert not (out / "case_0002.h5").exists()
-    status = run("sweep", "from.nml", "--status")
-    assert "failed           1  0002" in status.stdout, status.stdout
-    # the cause gone (the same model), the case completes and its note is gone
-    (sweep_dir / "scenes" / "from.nml").write_text(
-        (sweep_dir / "scenes" / "from.nml").read_text().replace("'rfem'", "'mpp'"))
+    assert result.returncode == 2, result.stderr
+    assert ("from.nml: &sweep: case 2 (model.kind=rfem): scenes/from.nml: &initial: "
+            "state_file = ") in result.stderr
+    assert "the file holds a run of the mpp model with 4 elements" in result.stderr
+    assert not (sweep_dir / "out" / "from").exists()
     (sweep_dir / "from.nml").write_text("&sweep base = 'scenes/from.nml', output_dir = "
-                                        "'out/from', models = 'mpp', rtols = 1e-6, 1e-5 /\n")
-    result = run("sweep", "from.nml", "--jobs", "1", "--force")
-    assert result.returncode == 0, result.stderr
-    assert [r["reason"] for r in read_csv(out / "summary.csv")] == ["", ""]
-    assert not list(out.glob(".*.failed"))
+                                        "'out/from', models = 'mpp', set = 'solver.t_end=0.1' /\n")
+    result = run("sweep", "from.nml", "--jobs", "1")
+    assert result.returncode == 2 and "not before &solver t_end" in result.stderr
+    assert not (sweep_dir / "out" / "from").exists()
 
 
 def test_task_equals_case_run_alone(run, sweep_dir):
