@@ -151,6 +151,7 @@ contains
         type(error_t), allocatable, intent(out) :: err
         integer :: sizes(size(sweep%dims)), digit(size(sweep%dims)), n_cases, c, i, v, g
         type(text_t), allocatable :: own(:), group_keys(:)
+        type(text_t), allocatable :: starts(:)   ! the state starts checked so far
         character(len=:), allocatable :: label, key
 
         associate (dims => sweep%dims)
@@ -158,7 +159,7 @@ contains
                 sizes(i) = max(1, size(dims(i)%values))
             end do
             n_cases = product(sizes)
-            allocate (sweep%cases(n_cases), group_keys(0))
+            allocate (sweep%cases(n_cases), group_keys(0), starts(0))
             digit = 1
             do c = 1, n_cases
                 associate (cs => sweep%cases(c))
@@ -184,7 +185,7 @@ contains
                     call move_alloc(own, cs%overrides)
                     label = join(cs%overrides)
                     if (len(label) == 0) label = '(the base scene)'
-                    call read_case(sweep, cs, err)
+                    call read_case(sweep, cs, starts, err)
                     if (allocated(err)) then
                         err%message = sweep%path//': &sweep: case '//int_text(c)//' ('// &
                             label//'): '//without_set(err%message)
@@ -218,9 +219,10 @@ contains
 
     !> The effective scene of a case (with atol = atol_per_rtol rtol when given), its
     !! method checked against its model.
-    subroutine read_case(sweep, cs, err)
+    subroutine read_case(sweep, cs, starts, err)
         type(sweep_t), intent(in) :: sweep
         type(sweep_case_t), intent(inout) :: cs
+        type(text_t), allocatable, intent(inout) :: starts(:)  !< see check_case_start
         type(error_t), allocatable, intent(out) :: err
         call read_scene(sweep%base, case_overrides(sweep, cs%overrides, cs%file), cs%scene, err)
         if (allocated(err)) return
@@ -235,18 +237,31 @@ contains
         ! (bad input before anything runs)
         call check_scene_method(cs%scene, err)
         if (allocated(err)) return
-        call check_case_start(cs%scene, err)
+        call check_case_start(cs%scene, starts, err)
     end subroutine read_case
 
     !> A case that starts from a record of another run (`&initial shape = 'state'`): the
-    !! record must fit its model and come before its t_end (`check_state_start`).
-    subroutine check_case_start(scene, err)
+    !! record must fit its model and come before its t_end (`check_state_start`). `starts`
+    !! holds the starts checked so far (file, time, model, elements, t_end), so that the
+    !! record is read once for the cases that share one (an HDF5 read per case made
+    !! `--count` of 1000 such cases 4.4 times as slow).
+    subroutine check_case_start(scene, starts, err)
         type(scene_t), intent(in) :: scene
+        type(text_t), allocatable, intent(inout) :: starts(:)
         type(error_t), allocatable, intent(out) :: err
         class(rope_model_t), allocatable :: model
+        character(len=:), allocatable :: key
+        integer :: k
         if (trim(scene%initial%shape) /= 'state') return
+        key = trim(scene%initial%state_file)//'|'//real_text(scene%initial%state_time)// &
+              '|'//trim(scene%model%kind)//'|'//int_text(scene%model%elements)//'|'// &
+              real_text(scene%solver%t_end)
+        do k = 1, size(starts)
+            if (starts(k)%s == key) return
+        end do
         call create_model(scene%rope_spec_t, model, err)
         if (.not. allocated(err)) call check_state_start(scene, model, err)
+        if (.not. allocated(err)) call append_text(starts, key)
     end subroutine check_case_start
 
     !> The overrides of a case for read_scene: set, the case's own, its output file.
