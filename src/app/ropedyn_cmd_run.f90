@@ -136,6 +136,7 @@ contains
         type(run_summary_t), intent(in) :: s
         logical, intent(in) :: verbose
         character(len=:), allocatable :: line
+        integer :: k
         write (output_unit, '(a)') 'ropedyn '//version_string//': '//trim(scene%model%kind)// &
             ' model, '//trim(scene%solver%method)//' solver, scene '//scene%path
         write (output_unit, '(a, i0, a, es10.3, a, f9.4, a)') '  elements        ', &
@@ -158,6 +159,11 @@ contains
         call print_switches(scene, s, verbose)
         call print_energies(s)
         call warn_lost_energy(scene, s)
+        if (allocated(s%start_warnings)) then
+            do k = 1, size(s%start_warnings)
+                write (error_unit, '(a)') 'ropedyn: warning: '//s%start_warnings(k)%s
+            end do
+        end if
         if (s%peak_joint >= 0) write (output_unit, '(a, es12.5, a)') '  peak tension   ', &
             s%peak_tension, ' N at joint '//int_text(s%peak_joint)//' ('// &
             fixed_text(s%peak_arc, 4)//' m from the top), t = '//fixed_text(s%peak_time, 4)//' s'

@@ -36,7 +36,8 @@ module ropedyn_run
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use, intrinsic :: iso_fortran_env, only: int8
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_text, only: real_text
+    use ropedyn_text, only: real_text, text_t
+    use ropedyn_start_checks, only: far_anchor_warnings
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_SOLVER
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_support_motion, only: support_motion_t
@@ -99,6 +100,9 @@ module ropedyn_run
         !! the scale, J
         logical :: lost_energy = .false.
         real(wp) :: energy_scale = 0.0_wp
+        !> what the initial state does against the scene (ropedyn_start_checks: a held end
+        !! far from its anchor), one line each; the summary warns of them
+        type(text_t), allocatable :: start_warnings(:)
     end type run_summary_t
 
     !> A state of a run without output kept in memory (`save`, `restore`): time, ODE state,
@@ -457,6 +461,8 @@ contains
                     self%k_next = floor(self%t/self%dt*(1.0_wp + 1.0e-12_wp)) + 1
             end if
             self%summary%initial_energy = model%energy(self%t, self%y, self%yq)
+            self%summary%start_warnings = far_anchor_warnings(scene, model, self%t, self%y, &
+                self%summary%initial_energy, self%summary%weight_length)
             ! the scene's limits keep the start finite; should a value still make it not,
             ! that is bad input: say so before any file is created
             if (.not. (all(ieee_is_finite(self%y)) .and. &

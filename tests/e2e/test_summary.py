@@ -85,3 +85,28 @@ def test_a_run_that_loses_a_tenth_of_its_energy_says_so(run, tmp_path):
     assert 10 <= int(match.group(2)) <= 30 and float(match.group(1)) > 0
     assert "method = 'symplectic'" in said["erk"]
     assert "integration lost" not in said["symplectic"], said["symplectic"]
+
+
+def test_a_held_end_started_far_from_its_anchor_is_warned_of(run):
+    """The paper's rope pinned at both ends, released straight at 75 degrees: its lower end
+    starts at (cos 75, sin 75) = (0.259, 0.966) m. With bottom_anchor left out the pin holds
+    it there: no warning. With the anchor at (1, 0) m it starts 1.22 m away (122 % of the
+    length): the summary warns, naming the key, the value, the distance and the energy."""
+    sets = ["model.elements=4", "solver.t_end=0.001", "solver.output_interval=0.001",
+            "supports.bottom=pinned", "output.file='s.h5'", "output.progress=.false."]
+    args = ["run", PAPER, "--force"]
+    near = run(*args, *[a for s in sets for a in ("--set", s)])
+    assert near.returncode == 0, near.stderr
+    assert "initial state leaves" not in near.stderr
+    far = run(*args, *[a for s in sets + ["supports.bottom_anchor=1.0, 0.0"]
+                       for a in ("--set", s)])
+    assert far.returncode == 0, far.stderr
+    line = [s for s in far.stderr.splitlines() if "initial state leaves" in s]
+    assert len(line) == 1, far.stderr
+    m = re.search(r"paper.nml: &supports: bottom_anchor = 1\.0, 0\.0: the initial state "
+                  r"leaves the lower end ([0-9.]+) m from it \(([0-9.]+) % of the length\)"
+                  r".* holds ([0-9.e+-]+) J \(([0-9.e+-]+) m g L\)", line[0])
+    assert m, line[0]
+    d = float(m.group(1))
+    assert abs(d - ((1 - 0.2588) ** 2 + 0.9659 ** 2) ** 0.5) < 0.01
+    assert float(m.group(3)) > 0.0
