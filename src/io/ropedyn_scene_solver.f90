@@ -6,10 +6,9 @@ module ropedyn_scene_solver
     use ropedyn_solvers, only: new_integrator
     use ropedyn_scene_types, only: scene_t
     use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_model_factory, only: create_model
     implicit none
     private
-    public :: create_integrator, solver_options_of, step_budget, check_scene_method
+    public :: create_integrator, solver_options_of, step_budget, check_method_fits
 
 contains
 
@@ -24,7 +23,8 @@ contains
 
     !> The method the scene names must be able to integrate its model at all (a method that
     !! cannot, such as the symplectic method for the MPP, is bad input of &solver method,
-    !! reported before anything runs; `integrator_t%refusal`).
+    !! reported before anything runs: a run before it touches its output, a sweep's cases
+    !! when it is read; `integrator_t%refusal`).
     subroutine check_method_fits(scene, integrator, model, err)
         type(scene_t), intent(in) :: scene
         class(integrator_t), intent(in) :: integrator
@@ -38,21 +38,6 @@ contains
             ' model of this scene: '//why//' (use method = "auto" or "erk"; '// &
             'docs/guide/choosing.md)')
     end subroutine check_method_fits
-
-    !> `check_method_fits` for a scene alone (its model and integrator made and dropped):
-    !! the check of a scene before it runs (a run before it touches its output, a sweep's
-    !! cases when it is read).
-    subroutine check_scene_method(scene, err)
-        type(scene_t), intent(in) :: scene
-        type(error_t), allocatable, intent(out) :: err
-        class(rope_model_t), allocatable :: model
-        class(integrator_t), allocatable :: integrator
-        call create_model(scene%rope_spec_t, model, err)
-        if (allocated(err)) return
-        call create_integrator(scene, integrator, err)
-        if (allocated(err)) return
-        call check_method_fits(scene, integrator, model, err)
-    end subroutine check_scene_method
 
     !> The solver options of a scene's &solver group.
     pure function solver_options_of(scene) result(options)

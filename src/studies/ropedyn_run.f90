@@ -47,7 +47,7 @@ module ropedyn_run
     use ropedyn_model_factory, only: create_model
     use ropedyn_scene, only: scene_t, scene_namelist_text
     use ropedyn_scene_solver, only: create_integrator, solver_options_of, step_budget, &
-        check_scene_method
+        check_method_fits
     use ropedyn_os, only: make_parent_dirs
     use ropedyn_output, only: output_file_t, add_counter_values
     use ropedyn_progress, only: progress_t
@@ -399,9 +399,13 @@ contains
             self%summary%file = ''
             if (present(name) .and. self%output == OUTPUT_MEMORY) self%summary%file = name
         end if
-        ! a method that cannot integrate the scene's model is bad input: said before the
-        ! guard touches the output's directory
-        call check_scene_method(scene, err)
+        ! the model and the integrator, and a method that cannot integrate the model is
+        ! bad input: said before the guard touches the output's directory
+        call create_model(scene%rope_spec_t, self%model, err)
+        if (allocated(err)) return
+        call create_integrator(scene, self%integrator, err)
+        if (allocated(err)) return
+        call check_method_fits(scene, self%integrator, self%model, err)
         if (allocated(err)) return
         if (guarding) then
             call self%guard_output(resuming, forced, err)
@@ -411,17 +415,13 @@ contains
         if (allocated(err) .and. guarding) call self%release_output(err)
     end subroutine run_open
 
-    !> open's work after the guard: the model, the integrator, the start.
+    !> open's work after the guard: the arrays of the model made before it, the start.
     subroutine start_from(self, resuming, err)
         class(run_t), intent(inout) :: self
         logical, intent(in) :: resuming
         type(error_t), allocatable, intent(out) :: err
         integer :: n
         associate (scene => self%scene)
-        call create_model(scene%rope_spec_t, self%model, err)
-        if (allocated(err)) return
-        call create_integrator(scene, self%integrator, err)
-        if (allocated(err)) return
         n = self%model%n_elements()
         self%nq = self%model%quad_size()
         self%summary%weight_length = weight_length(scene, self%model)

@@ -12,7 +12,7 @@ module ropedyn_start_checks
     use ropedyn_scene, only: scene_t
     implicit none
     private
-    public :: far_anchor_warnings, FAR_ANCHOR_SHARE
+    public :: far_anchor_warnings
 
     !> a held end further from its anchor than this share of the rope's length is warned
     !! of: a start from a shape, the equilibrium or a record meets its anchors within the
@@ -32,12 +32,15 @@ contains
         type(energy_t), intent(in) :: e
         real(wp), intent(in) :: weight_length
         type(text_t), allocatable :: list(:)
-        real(wp) :: anchors(2, 2), points(2, 2*model%n_elements()), d
+        real(wp) :: anchors(2, 2), d
+        real(wp), allocatable :: points(:, :)
         character(len=6), parameter :: ENDS(2) = [character(len=6) :: 'top', 'bottom']
         character(len=:), allocatable :: energy
         integer :: k, p
         allocate (list(0))
         call model%support_positions(t, anchors)
+        if (.not. any(ieee_is_finite(anchors))) return   ! both ends free
+        allocate (points(2, 2*model%n_elements()))
         call model%polyline(y, points, t)
         do k = 1, 2
             if (.not. all(ieee_is_finite(anchors(:, k)))) cycle   ! a free end

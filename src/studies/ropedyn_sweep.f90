@@ -11,7 +11,8 @@ module ropedyn_sweep
     use ropedyn_text, only: int_text, real_text, text_t, append_text, text_array
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_scene, only: scene_t, read_scene
-    use ropedyn_scene_solver, only: check_scene_method
+    use ropedyn_scene_solver, only: create_integrator, check_method_fits
+    use ropedyn_integrator, only: integrator_t
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_model_factory, only: create_model
     use ropedyn_state_start, only: check_state_start
@@ -224,6 +225,8 @@ contains
         type(sweep_case_t), intent(inout) :: cs
         type(text_t), allocatable, intent(inout) :: starts(:)  !< see check_case_start
         type(error_t), allocatable, intent(out) :: err
+        class(rope_model_t), allocatable :: model
+        class(integrator_t), allocatable :: integrator
         call read_scene(sweep%base, case_overrides(sweep, cs%overrides, cs%file), cs%scene, err)
         if (allocated(err)) return
         if (sweep%atol_given) then
@@ -235,9 +238,13 @@ contains
         end if
         ! the method must fit the case's model, and a record it starts from the case
         ! (bad input before anything runs)
-        call check_scene_method(cs%scene, err)
+        call create_model(cs%scene%rope_spec_t, model, err)
         if (allocated(err)) return
-        call check_case_start(cs%scene, starts, err)
+        call create_integrator(cs%scene, integrator, err)
+        if (allocated(err)) return
+        call check_method_fits(cs%scene, integrator, model, err)
+        if (allocated(err)) return
+        call check_case_start(cs%scene, model, starts, err)
     end subroutine read_case
 
     !> A case that starts from a record of another run (`&initial shape = 'state'`): the
@@ -245,11 +252,11 @@ contains
     !! holds the starts checked so far (file, time, model, elements, t_end), so that the
     !! record is read once for the cases that share one (an HDF5 read per case made
     !! `--count` of 1000 such cases 4.4 times as slow).
-    subroutine check_case_start(scene, starts, err)
+    subroutine check_case_start(scene, model, starts, err)
         type(scene_t), intent(in) :: scene
+        class(rope_model_t), intent(in) :: model   !< the case's
         type(text_t), allocatable, intent(inout) :: starts(:)
         type(error_t), allocatable, intent(out) :: err
-        class(rope_model_t), allocatable :: model
         character(len=:), allocatable :: key
         integer :: k
         if (trim(scene%initial%shape) /= 'state') return
@@ -259,8 +266,7 @@ contains
         do k = 1, size(starts)
             if (starts(k)%s == key) return
         end do
-        call create_model(scene%rope_spec_t, model, err)
-        if (.not. allocated(err)) call check_state_start(scene, model, err)
+        call check_state_start(scene, model, err)
         if (.not. allocated(err)) call append_text(starts, key)
     end subroutine check_case_start
 
