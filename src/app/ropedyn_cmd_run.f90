@@ -196,8 +196,8 @@ contains
         end if
     end subroutine print_energies
 
-    !> On stderr, when the balance fell by more than a tenth of the energy the run moved
-    !! (run_summary_t%lost_energy): how much, and what keeps it.
+    !> On stderr, when the balance fell by more than a tenth of the energy the motion took
+    !! in (run_summary_t%lost_energy): how much, of what, and what keeps it.
     subroutine warn_lost_energy(scene, s)
         type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(in) :: s
@@ -207,8 +207,10 @@ contains
         lost = s%initial_energy%balance() - s%final_energy%balance()
         write (number, '(es10.2)') lost
         write (error_unit, '(a)') 'warning: the integration lost '//trim(adjustl(number))// &
-            ' J of the balance, '//int_text(nint(100*lost/s%energy_scale))//' % of the '// &
-            'energy the run moved: numerical damping at rtol '// &
+            ' J of the balance, '//int_text(nint(100*lost/s%energy_intake))//' % of the '// &
+            significant_text(s%energy_intake, 3)//' J the motion took in (the largest '// &
+            'kinetic + elastic + gravity + dissipated above the lowest gravity energy): '// &
+            'numerical damping at rtol '// &
             significant_text(scene%solver%rtol, 3)// &
             '; a tighter rtol keeps more, and on a lightly damped RFEM rope method = '// &
             '''symplectic'' keeps the balance (docs/guide/choosing.md)'

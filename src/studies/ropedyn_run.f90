@@ -95,11 +95,11 @@ module ropedyn_run
         !! short): the steps the rest of the run takes at its last step (a resume goes on
         !! from the last record with a budget of its own); 0 otherwise
         integer(i8) :: budget_rest = 0
-        !> the balance fell by more than a tenth of the energy the run moved (the energy
+        !> the balance fell by more than a tenth of the energy the motion took in (the energy
         !! monitor's `lost`; only with the order safety on): the summary warns of it, with
-        !! the scale, J
+        !! that energy (the monitor's `intake`), J
         logical :: lost_energy = .false.
-        real(wp) :: energy_scale = 0.0_wp
+        real(wp) :: energy_intake = 0.0_wp
         !> what the initial state does against the scene (ropedyn_start_checks: a held end
         !! far from its anchor), one line each; the summary warns of them
         type(text_t), allocatable :: start_warnings(:)
@@ -733,7 +733,7 @@ contains
             s%t_reached = max(s%t_reached, self%t)
             if (self%monitoring .and. s%records > 0) then
                 s%lost_energy = self%monitor%lost(s%final_energy)
-                s%energy_scale = self%monitor%floored_scale()
+                s%energy_intake = self%monitor%intake()
             end if
             call self%out%write_stats(s%stats, s%cpu_time, ferr, t_reached=self%t)
             ! (a local copy, not an array constructor of the two function results: that
