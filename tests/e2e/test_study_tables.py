@@ -99,6 +99,15 @@ def test_equal_accuracy_takes_the_loosest_rung_within_moordyns_error(monkeypatch
     cells = [c.strip() for c in row.split("|")[1:-1]]
     assert tried == [0.1, 0.03]
     assert cells[2] == "0.03" and cells[-1] == "4.00"
+    # a method with its order: both settings reach the run, the row names it
+    said = []
+    monkeypatch.setattr(bp, "run_ropedyn", lambda *a, sets=(), name="run": (
+        said.append(list(sets)) or fake_run(*a, sets=sets, name=name)))
+    row = bp.at_equal_accuracy("exe", None, 30, 30.0, None, {"cpu": 4.0}, 3.1e-3,
+                               method="cvode:3")
+    assert "solver.method='cvode'" in said[0] and "solver.max_order=3" in said[0]
+    assert "| cvode:3 (erk 4) |" in row
+    assert bp.method_sets("mebdf") == ["solver.method='mebdf'"]
 
 
 def test_the_stability_reports_stamp_names_its_part():

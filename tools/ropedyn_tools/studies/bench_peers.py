@@ -37,7 +37,10 @@ venv) on the same rope as input/paper.nml, n segments against ropedyn's n elemen
   (atol = rtol / 100, as the scene's) whose tip error over [0, 2 s] is at most MoorDyn's
   time error, over the whole run.
 
-- At equal accuracy, both ropedyn's default method (auto) and `method = 'symplectic'`.
+- At equal accuracy, ropedyn's default method (auto) and each method of `--methods`
+  (`method` or `method:max_order`; by default `method = 'symplectic'`, and the implicit
+  methods, whose steps the fast modes do not hold: CVODE's BDF at its default order 5 and
+  at 3, the loosest-tolerance setting found by hand, and MEBDF).
 - The undamped rope over 300 s (`--undamped-elements`, `--undamped-t-end`; alone with
   `--only-undamped`): damping off in both codes and MoorDyn's bending off too (a chain of
   tension-only springs, whose energy its driver sums: kinetic and gravity of the lumped node
@@ -297,13 +300,22 @@ def tip_l2(time, tip, ref):
 EQUAL_RTOLS = (1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6)
 
 
+#: the methods of the equal-accuracy table besides auto (`method` or `method:max_order`)
+EQUAL_METHODS = "symplectic cvode cvode:3 mebdf"
+
+
+def method_sets(method):
+    """The scene settings of `method` or `method:max_order`."""
+    name, _, order = method.partition(":")
+    return [f"solver.method='{name}'"] + ([f"solver.max_order={order}"] if order else [])
+
+
 def at_equal_accuracy(exe, work, n, t_end, ref, md, md_error, repeat=1, method="auto"):
-    """ropedyn (`method`) at the loosest rtol of EQUAL_RTOLS whose tip error is <= MoorDyn's
-    time error: the table row (n, MoorDyn's error, rtol, method, error, balance, CPU (the
-    least of `repeat` runs), ratio)."""
+    """ropedyn (`method`, with `:max_order` if given) at the loosest rtol of EQUAL_RTOLS
+    whose tip error is <= MoorDyn's time error: the table row (n, MoorDyn's error, rtol,
+    method, error, balance, CPU (the least of `repeat` runs), ratio)."""
     for rtol in EQUAL_RTOLS:
-        sets = [f"solver.rtol={rtol:g}", f"solver.atol={rtol / 100:g}",
-                f"solver.method='{method}'"]
+        sets = [f"solver.rtol={rtol:g}", f"solver.atol={rtol / 100:g}", *method_sets(method)]
         r = run_ropedyn(exe, work, n, t_end, name=f"{method}_rtol{rtol:g}", sets=sets)
         if r["status"] != "complete":
             continue
@@ -553,8 +565,10 @@ def coupled_main(args, exe, py):
              "Python package, a Coupled point, RK4 at the step of the first table's ladder. "
              f"Tip columns as in the first table (ropedyn's reference: the same coupled "
              f"run with cvode at rtol 1e-10). Machine: {machine()}. Run: {run_stamp()}.", "",
-             "At equal accuracy: ropedyn's default method at the loosest rtol of "
-             f"{', '.join(f'{r:g}' for r in EQUAL_RTOLS)} (atol = rtol / 100) whose tip "
+             "At equal accuracy: ropedyn's default method, and the methods "
+             f"{', '.join(args.methods.split())} (method:max_order), each at the loosest "
+             f"rtol of {', '.join(f'{r:g}' for r in EQUAL_RTOLS)} (atol = rtol / 100) whose "
+             "tip "
              "error over [0, 2 s] is at most MoorDyn's time error.", "",
              COUPLED_HEADER, "|---|---|---|---|---|---|---|---|---|---|---|---|---|", *rows,
              COUPLED_END]
@@ -584,6 +598,9 @@ def main(argv=None):
                         help="only the undamped comparison (the other tables kept)")
     parser.add_argument("--no-undamped", action="store_true",
                         help="without the undamped comparison (its table kept)")
+    parser.add_argument("--methods", default=EQUAL_METHODS,
+                        help="methods at equal accuracy besides auto: method or "
+                             "method:max_order, space-separated (default: %(default)s)")
     parser.add_argument("--no-write", action="store_true")
     parser.add_argument("--coupled-elements", type=list_text(positive(int)), default="30",
                         help="n of the coupled case (top driven from Python)")
@@ -653,7 +670,7 @@ def main(argv=None):
                     md_time_error = float(np.sqrt(np.mean(d ** 2)))
                     md_self = f"{md_time_error:.1e}"
                     if ref["status"] == "complete":
-                        for method in ("auto", "symplectic"):
+                        for method in ("auto", *args.methods.split()):
                             equal_rows.append(at_equal_accuracy(
                                 exe, work, n, args.t_end, ref, md, md_time_error, args.repeat,
                                 method))
@@ -705,9 +722,10 @@ def main(argv=None):
              f"Machine: {machine()}. Run: {run_stamp()}.", "", header,
              "|---|---|---|---|---|---|---|---|---|---|---|---|",
              *rows, "",
-             "At equal accuracy: ropedyn's default method at the loosest rtol of "
-             f"{', '.join(f'{r:g}' for r in EQUAL_RTOLS)} (atol = rtol / 100) whose tip "
-             "error over [0, 2 s] is at most MoorDyn's time error (the same run length, "
+             "At equal accuracy: ropedyn's default method, and the methods "
+             f"{', '.join(args.methods.split())} (method:max_order), each at the loosest "
+             f"rtol of {', '.join(f'{r:g}' for r in EQUAL_RTOLS)} (atol = rtol / 100) whose "
+             "tip error over [0, 2 s] is at most MoorDyn's time error (the same run length, "
              "output and MoorDyn run as above):", "", equal_header,
              "|---|---|---|---|---|---|---|---|---|---|", *equal_rows, END]
     update_doc(DOCS / "performance" / "peers.md", BEGIN, END, "\n".join(lines),
