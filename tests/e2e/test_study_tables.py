@@ -107,6 +107,11 @@ def test_equal_accuracy_takes_the_loosest_rung_within_moordyns_error(monkeypatch
                                method="cvode:3")
     assert "solver.method='cvode'" in said[0] and "solver.max_order=3" in said[0]
     assert "| cvode:3 (erk 4) |" in row
+    monkeypatch.setattr(bp, "run_ropedyn", lambda *a, sets=(), name="run": dict(
+        fake_run(*a, sets=sets, name=name), methods=""))
+    row = bp.at_equal_accuracy("exe", None, 30, 30.0, None, {"cpu": 4.0}, 3.1e-3,
+                               method="mebdf")
+    assert "| mebdf | " in row                     # no switch log: no parentheses
     assert bp.method_sets("mebdf") == ["solver.method='mebdf'"]
 
 

@@ -327,7 +327,8 @@ def at_equal_accuracy(exe, work, n, t_end, ref, md, md_error, repeat=1, method="
                                   complete=lambda x: x["status"] == "complete")
                 if again["status"] == "complete" and again["cpu"] < r["cpu"]:
                     r["cpu"] = again["cpu"]
-            return (f"| {n} | {md_error:.1e} | {rtol:g} | {method} ({r['methods']}) | {err:.1e} "
+            used = f" ({r['methods']})" if r["methods"] else ""   # a switch log: auto's
+            return (f"| {n} | {md_error:.1e} | {rtol:g} | {method}{used} | {err:.1e} "
                     f"| {r['balance']:.1e} | {r['steps']} | {r['cpu']:.3g} | {md['cpu']:.3g} "
                     f"| {md['cpu'] / r['cpu']:.2f} |")
     return (f"| {n} | {md_error:.1e} | none of {EQUAL_RTOLS} | {method} | | | | | "
