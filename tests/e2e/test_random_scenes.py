@@ -34,8 +34,9 @@ def test_an_equilibrium_with_a_loose_residual_is_suspect():
 def test_every_failure_of_the_statics_counts_as_no_equilibrium():
     stalled = ("ropedyn: error: s.nml: statics: no equilibrium in the current (&fluid current "
                "= 0.861, 0.213 m/s): the continuation in its speed stalled at 0.516 of it")
-    still = ("ropedyn: error: s.nml: statics: the equilibrium without the current, where the "
-             "continuation in the current starts, used up the iterations allowed")
+    still = ("ropedyn: error: s.nml: statics: no convergence in 2000 iterations (max |f| = "
+             "1.0E-03 N, last step 1.0E-09 m or rad, shift 1.0E+00); the rope may have no "
+             "stable equilibrium near the start, or needs more iterations (--max-iterations)")
     assert rs.no_equilibrium("failed", stalled) and rs.no_equilibrium("failed", still)
     assert not rs.no_equilibrium("failed", "ropedyn: error: erk failed at t = 0.1 s")
     assert not rs.no_equilibrium("ok", "statics: converged")

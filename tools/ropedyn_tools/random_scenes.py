@@ -122,8 +122,8 @@ def residual_ratio(text):
 
 def no_equilibrium(kind, text):
     """Whether a failure is the statics': every one of them (no equilibrium, the continuation
-    in a current stalled, its start without the current out of iterations) is said as
-    "...: statics: ..." (a run's start from 'equilibrium' or 'mode' too)."""
+    in a current stalled) is said as "...: statics: ..." (a run's start from 'equilibrium'
+    or 'mode' too)."""
     return kind == "failed" and "statics: " in text
 
 
