@@ -63,6 +63,9 @@ class Run:
     reactions: dict = dataclasses.field(default_factory=dict)
     # each support's anchor at every record, 'top'/'bottom' -> (T, 2) m (none for a free end)
     anchors: dict = dataclasses.field(default_factory=dict)
+    # what the run warned of (/solver/warnings), one line each: the scene's warnings, a held
+    # end started far from its anchor, a loss of a tenth of the energy the motion took in
+    warnings: list = dataclasses.field(default_factory=list)
 
     @property
     def n(self):
@@ -89,6 +92,7 @@ def load_run(path):
         anchors = {k: series(f"supports/{k}/position") for k in SUPPORT_ENDS
                    if f"supports/{k}/position" in f}
         stats = {k: f[f"solver/{k}"][()].item() for k in SOLVER_STATS if f"solver/{k}" in f}
+        warnings = [text(w) for w in f["solver/warnings"][()]] if "solver/warnings" in f else []
         attrs = {k: text(v) for k, v in f.attrs.items()}
         units = {}
 
@@ -106,7 +110,8 @@ def load_run(path):
                    method=attrs.get("method", "").strip(),
                    status=attrs.get("status", "").strip(),
                    scene=parse_namelist(attrs.get("scene", "")), stats=stats, attrs=attrs,
-                   units=units, forces=forces, reactions=reactions, anchors=anchors)
+                   units=units, forces=forces, reactions=reactions, anchors=anchors,
+                   warnings=warnings)
 
 
 def title(run):

@@ -158,10 +158,9 @@ contains
                                     s%stats%time_factor + s%stats%time_solve)
         call print_switches(scene, s, verbose)
         call print_energies(s)
-        call warn_lost_energy(scene, s)
-        if (allocated(s%start_warnings)) then
-            do k = 1, size(s%start_warnings)
-                write (error_unit, '(a)') 'ropedyn: warning: '//s%start_warnings(k)%s
+        if (allocated(s%warnings)) then
+            do k = 1, size(s%warnings)
+                write (error_unit, '(a)') 'ropedyn: warning: '//s%warnings(k)%s
             end do
         end if
         if (s%peak_joint >= 0) write (output_unit, '(a, es12.5, a)') '  peak tension   ', &
@@ -195,26 +194,6 @@ contains
             write (output_unit, '(a)') '  balance error   '//trim(adjustl(number))//' J'//terms
         end if
     end subroutine print_energies
-
-    !> On stderr, when the balance fell by more than a tenth of the energy the motion took
-    !! in (run_summary_t%lost_energy): how much, of what, and what keeps it.
-    subroutine warn_lost_energy(scene, s)
-        type(scene_t), intent(in) :: scene
-        type(run_summary_t), intent(in) :: s
-        real(wp) :: lost
-        character(len=16) :: number
-        if (.not. s%lost_energy) return
-        lost = s%initial_energy%balance() - s%final_energy%balance()
-        write (number, '(es10.2)') lost
-        write (error_unit, '(a)') 'warning: the integration lost '//trim(adjustl(number))// &
-            ' J of the balance, '//int_text(nint(100*lost/s%energy_intake))//' % of the '// &
-            significant_text(s%energy_intake, 3)//' J the motion took in (the largest '// &
-            'kinetic + elastic + gravity + dissipated above the lowest gravity energy): '// &
-            'numerical damping at rtol '// &
-            significant_text(scene%solver%rtol, 3)// &
-            '; a tighter rtol keeps more, and on a lightly damped RFEM rope method = '// &
-            '''symplectic'' keeps the balance (docs/guide/choosing.md)'
-    end subroutine warn_lost_energy
 
     !> What the order safety did, a line for each kind of action.
     subroutine print_safety(s)

@@ -51,7 +51,7 @@ module ropedyn_output
     use hdf5, only: hsize_t
     use ropedyn_kinds, only: wp, i8
     use ropedyn_clock, only: utc_timestamp, clock_seconds
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, text_t
     use ropedyn_error, only: error_t, make_error, ERR_INTERNAL, ERR_IO
     use ropedyn_rope_model, only: energy_t
     use ropedyn_integrator, only: solver_stats_t
@@ -139,6 +139,8 @@ module ropedyn_output
     character(len=*), parameter :: RESTART_UNITS(7) = [character(len=1) :: 's', '1', '1', &
         's', '', '', '']
     integer, parameter :: RESTART_WIDTH(7) = [0, 0, 0, 0, 20, 16, 512]
+    !> /solver/warnings: the width of one line, characters (a longer line is cut there)
+    integer, parameter :: WARNING_WIDTH = 1024
 
     !> The solver counters of `write_stats` (/solver/<name>, int64, units 1), in the order
     !! of `counter_values`.
@@ -205,6 +207,7 @@ module ropedyn_output
         procedure :: write_stats => output_write_stats
         procedure :: write_switches => output_write_switches
         procedure :: write_order_safety => output_write_order_safety
+        procedure :: add_warnings => output_add_warnings
         procedure :: close_run => output_close_run
         procedure :: reopen => output_reopen
         procedure :: records => output_records
@@ -302,6 +305,14 @@ module ropedyn_output
             integer, intent(in) :: from, to, kept_count
             type(error_t), allocatable, intent(out) :: err
         end subroutine output_write_order_safety
+
+        !> Append the warnings `lines` to /solver/warnings, a series of strings (created
+        !! with the first; a resumed run appends its own). Nothing when there are none.
+        module subroutine output_add_warnings(self, lines, err)
+            class(output_file_t), intent(inout) :: self
+            type(text_t), intent(in) :: lines(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine output_add_warnings
 
         !> The integrator's changes of method or order limit during the run
         !! (ropedyn_switch_log) as /solver/switch_time (s), switch_method, switch_max_order

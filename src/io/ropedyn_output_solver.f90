@@ -1,5 +1,6 @@
-!> What the integrator did, for the run file: the order safety's actions and the changes of
-!! method or order limit (ropedyn_switch_log), written once when the run ends.
+!> What the integrator did, for the run file: the order safety's actions, the changes of
+!! method or order limit (ropedyn_switch_log) and the run's warnings, written when the run
+!! (or a resumed part of it) ends.
 submodule (ropedyn_output) ropedyn_output_solver
     implicit none
 
@@ -29,6 +30,35 @@ contains
         if (.not. allocated(err)) call flush_file(self, err)
         if (allocated(err)) call abandon(self, err)
     end procedure output_write_order_safety
+
+    module procedure output_add_warnings
+        type(h5_series_t) :: series
+        type(error_t), allocatable :: close_err
+        character(len=*), parameter :: NAME = '/solver/warnings'
+        integer(hsize_t) :: n
+        integer :: k
+        if (size(lines) == 0) return
+        if (.not. self%is_open) then
+            call not_open(self, 'add_warnings', err)
+            return
+        end if
+        if (self%file%exists(NAME)) then
+            call self%file%open_series(series, NAME, err)
+        else
+            call self%file%create_text_series(series, NAME, WARNING_WIDTH, '', err)
+        end if
+        if (.not. allocated(err)) then
+            n = series%length()
+            do k = 1, size(lines)
+                call series%append_text(n + k, lines(k)%s, err)
+                if (allocated(err)) exit
+            end do
+        end if
+        call series%close(close_err)
+        if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
+        if (.not. allocated(err)) call flush_file(self, err)
+        if (allocated(err)) call abandon(self, err)
+    end procedure output_add_warnings
 
     module procedure output_write_switches
         character(len=16), allocatable :: methods(:)

@@ -35,9 +35,10 @@
 module ropedyn_energy_monitor
     use ropedyn_kinds, only: wp, i8
     use ropedyn_rope_model, only: energy_t
+    use ropedyn_text, only: int_text, significant_text
     implicit none
     private
-    public :: energy_monitor_t, safety_record_t, high_order_to_blame, sudden_gain
+    public :: energy_monitor_t, safety_record_t, high_order_to_blame, sudden_gain, loss_warning
     public :: look_budget, look_action, LOOK_LOWER, LOOK_KEEP, LOOK_NO_VERDICT, LOOK_FAIL
 
     !> the largest bound, as a share of S, whatever factor rtol is: at rtol 0.1 the default
@@ -332,6 +333,22 @@ contains
         type(energy_t), intent(in) :: e
         yes = self%e0 - e%balance() > MAX_BOUND_SHARE*self%intake()
     end function monitor_lost
+
+    !> The warning of a loss `lost` (J) of the balance that `lost` found, `intake` (J) the
+    !! energy the motion took in, at tolerance `rtol`: how much, of what, and what keeps it.
+    function loss_warning(lost, intake, rtol) result(text)
+        real(wp), intent(in) :: lost, intake, rtol
+        character(len=:), allocatable :: text
+        character(len=16) :: number
+        write (number, '(es10.2)') lost
+        text = 'the integration lost '//trim(adjustl(number))//' J of the balance, '// &
+               int_text(nint(100*lost/intake))//' % of the '//significant_text(intake, 3)// &
+               ' J the motion took in (the largest kinetic + elastic + gravity + '// &
+               'dissipated above the lowest gravity energy): numerical damping at rtol '// &
+               significant_text(rtol, 3)//'; a tighter rtol keeps more, and on a lightly '// &
+               'damped RFEM rope method = ''symplectic'' keeps the balance '// &
+               '(docs/guide/choosing.md)'
+    end function loss_warning
 
     !> True when a state's B - E0 is above runaway_limit, whatever gain was accepted.
     pure logical function monitor_runaway(self, e) result(yes)

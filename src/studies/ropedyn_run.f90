@@ -36,8 +36,9 @@ module ropedyn_run
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use, intrinsic :: iso_fortran_env, only: int8
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_text, only: real_text, text_t
+    use ropedyn_text, only: real_text, text_t, append_text
     use ropedyn_start_checks, only: far_anchor_warnings
+    use ropedyn_scene_warnings, only: scene_warnings
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_SOLVER
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_support_motion, only: support_motion_t
@@ -55,7 +56,7 @@ module ropedyn_run
     use ropedyn_version, only: version_string
     use ropedyn_modes, only: equilibrium_initial_state
     use ropedyn_methods, only: METHODS, method_index, resolved_max_order
-    use ropedyn_energy_monitor, only: energy_monitor_t, safety_record_t
+    use ropedyn_energy_monitor, only: energy_monitor_t, safety_record_t, loss_warning
     use ropedyn_state_start, only: state_initial_state
     use ropedyn_process, only: heartbeat_t
     implicit none
@@ -100,9 +101,11 @@ module ropedyn_run
         !! that energy (the monitor's `intake`), J
         logical :: lost_energy = .false.
         real(wp) :: energy_intake = 0.0_wp
-        !> what the initial state does against the scene (ropedyn_start_checks: a held end
-        !! far from its anchor), one line each; the summary warns of them
-        type(text_t), allocatable :: start_warnings(:)
+        !> the run's own warnings, one line each: what the initial state does against the
+        !! scene (ropedyn_start_checks: a held end far from its anchor) and a loss of a tenth
+        !! of the energy the motion took in (`lost_energy`); the summary prints them, and
+        !! the file keeps them in /solver/warnings after the scene's own
+        type(text_t), allocatable :: warnings(:)
     end type run_summary_t
 
     !> A state of a run without output kept in memory (`save`, `restore`): time, ODE state,
@@ -133,6 +136,9 @@ module ropedyn_run
         type(switch_log_t) :: switches_before
         !> auto went on with MEBDF at its safe order after a runaway (once per run)
         logical :: rescued = .false.
+        !> the run goes on from its file (`open` with resume): its start, and the scene's
+        !! warnings, are the earlier part's
+        logical :: resumed = .false.
         !> resume: the counters and CPU time (s) of the earlier parts of the run
         integer(i8) :: counters_before(7) = 0
         real(wp) :: cpu_before = 0.0_wp
@@ -196,7 +202,7 @@ module ropedyn_run
                               start_monitor
         procedure, private :: resume_from_file, check_energy, second_look, note_peak, &
                               fail_runaway, rescue, retire_integrator, keep_switches
-        procedure, private :: guard_output, release_output
+        procedure, private :: guard_output, release_output, file_warnings
     end type run_t
 
     interface
@@ -433,6 +439,7 @@ contains
         self%n_out = max(1, ceiling(self%t_end/self%dt*(1.0_wp - 1.0e-12_wp)))
         self%k_next = 1
         end associate
+        self%resumed = resuming
         if (resuming) then
             call self%resume_from_file(err)
             if (.not. allocated(err)) call self%keep_as_previous()
@@ -461,7 +468,7 @@ contains
                     self%k_next = floor(self%t/self%dt*(1.0_wp + 1.0e-12_wp)) + 1
             end if
             self%summary%initial_energy = model%energy(self%t, self%y, self%yq)
-            self%summary%start_warnings = far_anchor_warnings(scene, model, self%t, self%y, &
+            self%summary%warnings = far_anchor_warnings(scene, model, self%t, self%y, &
                 self%summary%initial_energy, self%summary%weight_length)
             ! the scene's limits keep the start finite; should a value still make it not,
             ! that is bad input: say so before any file is created
@@ -734,8 +741,12 @@ contains
             if (self%monitoring .and. s%records > 0) then
                 s%lost_energy = self%monitor%lost(s%final_energy)
                 s%energy_intake = self%monitor%intake()
+                if (s%lost_energy) call append_text(s%warnings, loss_warning( &
+                    s%initial_energy%balance() - s%final_energy%balance(), s%energy_intake, &
+                    self%scene%solver%rtol))
             end if
             call self%out%write_stats(s%stats, s%cpu_time, ferr, t_reached=self%t)
+            if (.not. allocated(ferr)) call self%out%add_warnings(self%file_warnings(), ferr)
             ! (a local copy, not an array constructor of the two function results: that
             ! leaked their reasons, valgrind in the library's memory test)
             call self%keep_switches()
@@ -756,6 +767,20 @@ contains
         call self%integrator%finalize()
         call self%release_output(err)
     end subroutine run_finish
+
+    !> The warnings this part of the run adds to its file's /solver/warnings: the scene's
+    !! own (a fresh run: the part that read the scene) and the run's (the summary's).
+    function file_warnings(self) result(list)
+        class(run_t), intent(in) :: self
+        type(text_t), allocatable :: list(:)
+        integer :: k
+        allocate (list(0))
+        if (.not. self%resumed) list = scene_warnings(self%scene)
+        if (.not. allocated(self%summary%warnings)) return
+        do k = 1, size(self%summary%warnings)
+            call append_text(list, self%summary%warnings(k)%s)
+        end do
+    end function file_warnings
 
     !> m g L of a scene's rope (its model's element masses), J; 0 without gravity.
     function weight_length(scene, model) result(mgl)

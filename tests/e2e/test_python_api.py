@@ -101,6 +101,27 @@ def test_run_gives_the_cli_records_and_writes_no_file(run, tmp_path, monkeypatch
     assert (tmp_path / "asked.h5").is_file() and np.array_equal(written.q, result.q)
 
 
+def test_a_run_keeps_its_warnings_where_the_cli_prints_them(run, tmp_path):
+    """What a run warns of reaches a library user too: ropedyn.run's Run has the file's
+    /solver/warnings, the lines the command line prints after 'ropedyn: warning: ' (here a
+    scene warning, water in air, and a start warning, the lower end pinned 1.22 m from
+    where the straight start puts it), in that order; a run without them has none."""
+    scene = small(n=4, t_end=0.01).set({"supports.bottom": "'pinned'",
+                                        "supports.bottom_anchor": "1.0, 0.0",
+                                        "effects.water": ".true.", "fluid.density": 1.225})
+    path = scene.write(tmp_path / "w.nml")
+    cli = run("run", path, "--set", "output.file=cli.h5")
+    assert cli.returncode == 0, cli.stderr
+    printed = [line[len("ropedyn: warning: "):] for line in cli.stderr.splitlines()
+               if line.startswith("ropedyn: warning: ")]
+    assert len(printed) == 2 and "density = 1.225" in printed[0] \
+        and "bottom_anchor = 1.0, 0.0" in printed[1], cli.stderr
+    result = ropedyn.run(path)
+    assert result.warnings == printed
+    assert ropedyn.load_run(tmp_path / "cli.h5").warnings == printed
+    assert ropedyn.run(small(n=4, t_end=0.01)).warnings == []
+
+
 def advance_to_records(scene, times):
     with ropedyn.Simulation(scene) as sim:
         points = []

@@ -106,6 +106,13 @@ def test_a_run_that_loses_a_tenth_of_its_energy_says_so(run, tmp_path):
     assert int(match.group(2)) == round(100 * lost / intake) and lost > 0.1 * intake
     assert "method = 'symplectic'" in said["erk"]
     assert "integration lost" not in said["symplectic"], said["symplectic"]
+    # the file keeps the warning as printed; the symplectic run's has none
+    printed = [x for x in said["erk"].splitlines() if "integration lost" in x][0]
+    with h5py.File(tmp_path / "erk.h5") as f:
+        kept = [w.decode() for w in f["solver/warnings"][()]]
+    assert kept == [printed[len("ropedyn: warning: "):]]
+    with h5py.File(tmp_path / "symplectic.h5") as f:
+        assert "solver/warnings" not in f
 
 
 def test_a_held_end_started_far_from_its_anchor_is_warned_of(run):
@@ -131,3 +138,23 @@ def test_a_held_end_started_far_from_its_anchor_is_warned_of(run):
     d = float(m.group(1))
     assert abs(d - ((1 - 0.2588) ** 2 + 0.9659 ** 2) ** 0.5) < 0.01
     assert float(m.group(3)) > 0.0
+
+
+def test_a_resumed_run_keeps_its_warnings_once(run, tmp_path):
+    """/solver/warnings over a resume: the part that read the scene records the scene's
+    warnings (water in air), also when it ends for its step budget; the resumed part,
+    which goes on from the file, adds only its own, so the scene's warning is there once."""
+    sets = ["model.elements=4", "solver.t_end=0.2", "effects.water=.true.",
+            "fluid.density=1.225", "output.file='r.h5'", "output.progress=.false."]
+    first = run("run", PAPER, "--force", *[a for s in sets + ["solver.max_steps=40"]
+                                           for a in ("--set", s)])
+    assert first.returncode == 3, first.stderr
+    with h5py.File(tmp_path / "r.h5") as f:
+        before = [w.decode() for w in f["solver/warnings"][()]]
+    assert len(before) == 1 and "density = 1.225" in before[0], before
+    again = run("run", "--resume", "r.h5", "--set", "solver.max_steps=1000000")
+    assert again.returncode == 0, again.stderr
+    with h5py.File(tmp_path / "r.h5") as f:
+        after = [w.decode() for w in f["solver/warnings"][()]]
+        assert f.attrs["status"] == b"complete" or f.attrs["status"] == "complete"
+    assert after == before
