@@ -1,6 +1,6 @@
 !> Reading back a run file written by `ropedyn_output` (the case files of a sweep): the
-!! root attributes, the solver counters and, on request, the time series needed for
-!! error measures. Also finishes a sweep case's file before it is renamed into place: its
+!! root attributes, the solver counters, the run's warnings and, on request, the time
+!! series needed for error measures. Also finishes a sweep case's file before it is renamed into place: its
 !! wall-clock time (`/solver/wall_time`) and the case's scene (`finish_case_file`).
 !!
 !! The HDF5 calls are those of `ropedyn_h5`; failures are `ERR_IO` errors naming the file
@@ -10,6 +10,7 @@ module ropedyn_case_file
     use hdf5, only: hsize_t
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_IO
+    use ropedyn_text, only: text_t
     use ropedyn_h5, only: h5_file_t
     use ropedyn_output, only: COUNTER_NAMES
     implicit none
@@ -31,6 +32,8 @@ module ropedyn_case_file
         real(wp), allocatable :: points(:, :, :)    !< (2, 2n, records) m
         !> (records) J: kinetic + elastic + gravity + dissipated - support_work
         real(wp), allocatable :: balance(:)
+        !> what the run warned of (/solver/warnings), one line each; none when absent
+        type(text_t), allocatable :: warnings(:)
     end type case_data_t
 
 contains
@@ -74,6 +77,8 @@ contains
             call h5%read_scalar('/solver/cpu_time', data%cpu_time, err)
             if (allocated(err)) exit steps
             call h5%read_scalar('/solver/wall_time', data%wall_time, err)
+            if (allocated(err)) exit steps
+            call h5%read_texts('/solver/warnings', data%warnings, err)
             if (allocated(err)) exit steps
             call h5%read_reals('/time', data%time, dims1, err)
             if (allocated(err)) exit steps

@@ -40,7 +40,7 @@ module ropedyn_h5
         H5T_STRING_F, H5T_FLOAT_F, H5T_INTEGER_F, h5tis_variable_str_f, h5ldelete_f
     use, intrinsic :: iso_fortran_env, only: int8
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, text_t, append_text
     use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INPUT, ERR_INTERNAL
     use ropedyn_os, only: special_file_reason, try_lock, lock_holder, ERRNO_EWOULDBLOCK
     implicit none
@@ -78,6 +78,7 @@ module ropedyn_h5
         generic :: read_scalar => read_real_scalar, read_int64_scalar
         procedure :: read_reals => h5_read_reals
         procedure :: read_record => h5_read_record
+        procedure :: read_texts => h5_read_texts
         procedure :: create_series => h5_create_series
         procedure :: create_text_series => h5_create_text_series
         procedure :: open_series => h5_open_series
@@ -266,6 +267,16 @@ module ropedyn_h5
             character(len=*), intent(in) :: value
             type(error_t), allocatable, intent(out) :: err
         end subroutine series_append_text
+
+        !> The strings of the rank-1 dataset `name` of fixed-length strings (a series of
+        !! strings, create_text_series), each up to its first NUL and without trailing
+        !! blanks; none when the dataset is absent.
+        module subroutine h5_read_texts(self, name, lines, err)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            type(text_t), allocatable, intent(out) :: lines(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine h5_read_texts
 
         !> Read record `record` (1-based) of the real series `name` (a dataset whose last
         !! Fortran axis is time): its values in Fortran order.

@@ -309,6 +309,61 @@ contains
         if (.not. allocated(values)) allocate (values(0))
     end procedure h5_read_reals
 
+    module procedure h5_read_texts
+        integer(hid_t) :: dset_id, type_id, mem_type
+        integer(hsize_t) :: dims(1)
+        integer(size_t) :: width
+        integer :: hdferr, ierr, class, k, w, nul
+        logical :: vlen
+        character(len=:), allocatable, target :: whole
+        type(c_ptr) :: target_ptr
+
+        allocate (lines(0))
+        if (.not. self%exists(name)) return
+        call h5dopen_f(self%id, name, dset_id, hdferr)
+        if (h5_failed(hdferr, self%path//': '//name//': cannot open dataset', err)) return
+        steps: block
+            vlen = .false.
+            call h5dget_type_f(dset_id, type_id, hdferr)
+            if (hdferr >= 0) call h5tget_class_f(type_id, class, hdferr)
+            if (hdferr >= 0) call h5tget_size_f(type_id, width, hdferr)
+            if (hdferr >= 0 .and. class == H5T_STRING_F) &
+                call h5tis_variable_str_f(type_id, vlen, hdferr)
+            call h5tclose_f(type_id, ierr)
+            if (hdferr < 0) then
+                call h5_error(err, self%path//': '//name//': cannot get its type')
+                exit steps
+            end if
+            if (class /= H5T_STRING_F .or. vlen) then
+                call make_error(err, ERR_INPUT, self%path//': '//name//': not fixed-length '// &
+                                'strings (not written by ropedyn)')
+                exit steps
+            end if
+            call extents(self, name, dset_id, dims, err)
+            if (allocated(err) .or. dims(1) == 0) exit steps
+            w = int(width)
+            allocate (character(len=w*int(dims(1))) :: whole)
+            call string_type(w, mem_type, hdferr)
+            if (hdferr >= 0) then
+                target_ptr = c_loc(whole)
+                call h5dread_f(dset_id, mem_type, target_ptr, hdferr)
+                call h5tclose_f(mem_type, ierr)
+            end if
+            if (hdferr < 0) then
+                call h5_error(err, self%path//': '//name//': cannot read')
+                exit steps
+            end if
+            do k = 1, int(dims(1))
+                associate (line => whole((k - 1)*w + 1:k*w))
+                    nul = index(line, achar(0))
+                    if (nul == 0) nul = w + 1
+                    call append_text(lines, trim(line(:nul - 1)))
+                end associate
+            end do
+        end block steps
+        call h5dclose_f(dset_id, ierr)
+    end procedure h5_read_texts
+
     !> Read dataset `name` (nothing when absent): a scalar to `buffer`, or, with `values`,
     !! an array of rank size(dims) into `values` (allocated here, extents `dims`).
     subroutine read_data(self, name, type_id, buffer, dims, err, values)

@@ -503,6 +503,7 @@ contains
         if (.not. quiet) write (error_unit, '(a)') 'sweep: '//int_text(complete)//' of '// &
             int_text(size(rows))//' cases complete; summary: '//sweep%output_dir// &
             '/summary.csv, summary.h5 (reference: '//sweep%reference_setting()//')'
+        call report_run_warnings(sweep, rows)
         if (bad == 0) return
         shown = 0
         do c = 1, size(rows)
@@ -525,6 +526,30 @@ contains
             if (len(reason) > 0) text = ': '//reason
         end function reason_text
     end subroutine report_summary
+
+    !> One line naming the cases whose runs warned (the first 20 ids), what the first of
+    !! them said first, and where the rest is: the run_warnings column.
+    subroutine report_run_warnings(sweep, rows)
+        type(sweep_t), intent(in) :: sweep
+        type(case_row_t), intent(in) :: rows(:)
+        character(len=:), allocatable :: ids, first
+        integer :: c, warned, bar
+        ids = ''
+        warned = 0
+        do c = 1, size(rows)
+            if (len(rows(c)%run_warnings) == 0) cycle
+            warned = warned + 1
+            if (warned == 1) first = rows(c)%run_warnings
+            if (warned <= 20) ids = ids//merge(', ', '  ', warned > 1)//int_text(c)
+        end do
+        if (warned == 0) return
+        if (warned > 20) ids = ids//', ...'
+        bar = index(first, ' | ')
+        if (bar > 0) first = first(:bar - 1)
+        write (error_unit, '(a)') 'sweep: warning: '//int_text(warned)//' of '// &
+            int_text(size(rows))//' cases warned in their runs (cases'//ids(2:)//'), the '// &
+            'first: '//first//' (all in '//sweep%output_dir//'/summary.csv, run_warnings)'
+    end subroutine report_run_warnings
 
     integer function id_width(sweep)
         type(sweep_t), intent(in) :: sweep

@@ -25,6 +25,8 @@ module ropedyn_sweep_summary
     public :: case_row_t, build_summary
 
     !> Columns of summary.h5 measured per case: name and units (docs/reference/file-format.md).
+    !> between two of a case's run warnings in its row (a warning holds '; ' itself)
+    character(len=*), parameter :: RUN_WARNING_JOIN = ' | '
     character(len=*), parameter :: MEASURED(2, 8) = reshape([character(len=18) :: &
         't_reached', 's', 'wall_time', 's', 'cpu_time', 's', 'tip_error_final', 'm', &
         'tip_error_max', 'm', 'position_error_max', 'm', 'energy_error_final', 'J', &
@@ -42,6 +44,9 @@ module ropedyn_sweep_summary
         !> tighter | same_rtol | self | file | none (docs/guide/sweeps.md)
         character(len=:), allocatable :: reference_kind
         character(len=:), allocatable :: warning  !< about the reference ('' if none)
+        !> what the case's run warned of (its /solver/warnings), the lines joined by
+        !! RUN_WARNING_JOIN ('' if none)
+        character(len=:), allocatable :: run_warnings
         real(wp) :: tip_error_final, tip_error_max, position_error_max  !< m
         real(wp) :: energy_error_final, energy_error_max                !< J
     end type case_row_t
@@ -78,6 +83,7 @@ contains
             rows(c)%energy_error_max = nan
             rows(c)%reference_kind = ''
             rows(c)%warning = ''
+            rows(c)%run_warnings = ''
             call case_state(sweep%cases(c), state)
             rows(c)%status = state%status
             rows(c)%reason = state%reason
@@ -89,6 +95,7 @@ contains
                 state%data%status /= 'running') cycle
             rows(c)%wall_time = state%data%wall_time
             rows(c)%cpu_time = state%data%cpu_time
+            rows(c)%run_warnings = joined(state%data%warnings)
             rows(c)%counters = state%data%counters
             if (state%data%records > 0) rows(c)%t_reached = state%data%time(state%data%records)
             if (rows(c)%status == 'complete') call energy_errors(state%data, rows(c))
@@ -284,7 +291,8 @@ contains
             line = line//','//trim(COUNTER_NAMES(v))
         end do
         line = line//',reference,reference_kind,tip_error_final,tip_error_max,' &
-            //'position_error_max,energy_error_final,energy_error_max,file,reason,warning'
+            //'position_error_max,energy_error_final,energy_error_max,file,reason,warning,' &
+            //'run_warnings'
         write (unit, '(a)', iostat=ios, iomsg=msg) line
         do c = 1, size(rows)
             if (ios /= 0) exit
@@ -307,7 +315,7 @@ contains
                     num(r%tip_error_max)//','//num(r%position_error_max)//','// &
                     num(r%energy_error_final)//','//num(r%energy_error_max)//','// &
                     csv_text(sweep%cases(c)%file)//','//csv_text(one_line(r%reason))//','// &
-                    csv_text(one_line(r%warning))
+                    csv_text(one_line(r%warning))//','//csv_text(r%run_warnings)
             end associate
             write (unit, '(a)', iostat=ios, iomsg=msg) line
         end do
@@ -350,6 +358,19 @@ contains
             s = enclosed(text, '"', '""')
         end if
     end function csv_text
+
+    !> The lines joined by RUN_WARNING_JOIN, each on one line; '' for none.
+    function joined(lines) result(text)
+        type(text_t), allocatable, intent(in) :: lines(:)
+        character(len=:), allocatable :: text
+        integer :: k
+        text = ''
+        if (.not. allocated(lines)) return
+        do k = 1, size(lines)
+            if (k > 1) text = text//RUN_WARNING_JOIN
+            text = text//one_line(lines(k)%s)
+        end do
+    end function joined
 
     !> Newlines replaced by blanks.
     pure function one_line(text) result(s)
@@ -430,6 +451,8 @@ contains
             if (allocated(err)) exit steps
             call text_column('warning')
             if (allocated(err)) exit steps
+            call text_column('run_warnings')
+            if (allocated(err)) exit steps
             call h5%attribute('/', 'sweep', sweep%path, err)
             if (allocated(err)) exit steps
             call h5%attribute('/', 'base', sweep%base, err)
@@ -485,6 +508,8 @@ contains
                 value = rows(j)%reference_kind
             case ('warning')
                 value = rows(j)%warning
+            case ('run_warnings')
+                value = rows(j)%run_warnings
             case default
                 value = rows(j)%reason
             end select

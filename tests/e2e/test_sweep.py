@@ -504,3 +504,37 @@ def test_reference_file_checked_against_cases(run, sweep_dir):
     rows = read_csv(sweep_dir / "out" / "r" / "summary.csv")
     assert [r["reference_kind"] for r in rows] == ["file", "file"]
     assert all(float(r["tip_error_max"]) > 0 for r in rows)
+
+
+WARNED = """&sweep
+    base = 'scenes/base.nml'
+    output_dir = 'out/warned'
+    set = 'fluid.density = 1.225'
+    vary = 'effects.water = .false.; .true.'
+/
+"""
+
+
+def test_a_cases_run_warnings_reach_the_summary(run, sweep_dir):
+    """What a case's run warned of (its /solver/warnings) is its row's run_warnings, in
+    the CSV and the HDF5 summary, rebuilt alike by --summary from the case files; the
+    terminal names the cases that warned. Water in air warns (a slip of units?); without
+    water the same scene does not."""
+    (sweep_dir / "warned.nml").write_text(WARNED)
+    result = run("sweep", "warned.nml")
+    assert result.returncode == 0, result.stderr
+    rows = read_csv(sweep_dir / "out" / "warned" / "summary.csv")
+    assert rows[0]["run_warnings"] == ""
+    assert "&fluid: density = 1.225: water = .true. in a fluid this light" \
+        in rows[1]["run_warnings"]
+    with h5py.File(sweep_dir / "out" / "warned" / rows[1]["file"].split("/")[-1]) as f:
+        kept = [w.decode() for w in f["solver/warnings"][()]]
+    assert rows[1]["run_warnings"] == " | ".join(kept)
+    line = [x for x in result.stderr.splitlines() if "warned in their runs" in x]
+    assert line == [f"sweep: warning: 1 of 2 cases warned in their runs (cases 2), the first: "
+                    f"{kept[0]} (all in out/warned/summary.csv, run_warnings)"], result.stderr
+    with h5py.File(sweep_dir / "out" / "warned" / "summary.h5") as f:
+        assert [s.decode() for s in f["run_warnings"][()]] == ["", rows[1]["run_warnings"]]
+    again = run("sweep", "warned.nml", "--summary")
+    assert again.returncode == 0, again.stderr
+    assert read_csv(sweep_dir / "out" / "warned" / "summary.csv") == rows
