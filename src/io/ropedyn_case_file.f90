@@ -1,7 +1,8 @@
 !> Reading back a run file written by `ropedyn_output` (the case files of a sweep): the
 !! root attributes, the solver counters, the run's warnings and, on request, the time
-!! series needed for error measures. Also finishes a sweep case's file before it is renamed into place: its
-!! wall-clock time (`/solver/wall_time`) and the case's scene (`finish_case_file`).
+!! series needed for error measures. Also finishes a sweep case's file before it is
+!! renamed into place: its wall-clock time (`/solver/wall_time`) and the case's scene
+!! (`finish_case_file`).
 !!
 !! The HDF5 calls are those of `ropedyn_h5`; failures are `ERR_IO` errors naming the file
 !! and the object.

@@ -74,7 +74,8 @@ module ropedyn_energy_monitor
         real(wp) :: min_gravity = 0.0_wp    !< J
         real(wp) :: max_gravity = 0.0_wp    !< J
         real(wp) :: dissipated = 0.0_wp     !< |dissipated| at the last record, J
-        !> the largest T + V + dissipated over the records, J (the intake's top)
+        !> the largest T + V + dissipated over the records, J (the intake's top; E0 plus the
+        !! work put in so far, for the exact motion)
         real(wp) :: max_held = -huge(1.0_wp)
         real(wp) :: accepted = 0.0_wp       !< gain accepted as integration error, J
         real(wp) :: floor = 0.0_wp          !< the runaway's least scale (m g L), J
@@ -239,7 +240,7 @@ contains
         self%min_gravity = e%gravity
         self%max_gravity = e%gravity
         self%dissipated = abs(e%dissipated)
-        self%max_held = held(e)
+        self%max_held = e%total() + e%dissipated
     end subroutine monitor_start
 
     !> Take the energies of one more record into the scale S.
@@ -251,14 +252,8 @@ contains
         self%min_gravity = min(self%min_gravity, e%gravity)
         self%max_gravity = max(self%max_gravity, e%gravity)
         self%dissipated = abs(e%dissipated)
-        self%max_held = max(self%max_held, held(e))
+        self%max_held = max(self%max_held, e%total() + e%dissipated)
     end subroutine monitor_observe
-
-    !> T + V + dissipated of a state (J): E0 plus the work put in so far, for the exact motion.
-    pure real(wp) function held(e)
-        type(energy_t), intent(in) :: e
-        held = e%kinetic + e%elastic + e%gravity + e%dissipated
-    end function held
 
     !> S, the energy scale so far (J).
     pure real(wp) function monitor_scale(self) result(s)

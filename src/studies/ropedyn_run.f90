@@ -96,15 +96,11 @@ module ropedyn_run
         !! short): the steps the rest of the run takes at its last step (a resume goes on
         !! from the last record with a budget of its own); 0 otherwise
         integer(i8) :: budget_rest = 0
-        !> the balance fell by more than a tenth of the energy the motion took in (the energy
-        !! monitor's `lost`; only with the order safety on): the summary warns of it, with
-        !! that energy (the monitor's `intake`), J
-        logical :: lost_energy = .false.
-        real(wp) :: energy_intake = 0.0_wp
         !> the run's own warnings, one line each: what the initial state does against the
         !! scene (ropedyn_start_checks: a held end far from its anchor) and a loss of a tenth
-        !! of the energy the motion took in (`lost_energy`); the summary prints them, and
-        !! the file keeps them in /solver/warnings after the scene's own
+        !! of the energy the motion took in (the energy monitor's `lost`, with the order
+        !! safety on); the summary prints them, and the file keeps them in /solver/warnings
+        !! after the scene's own
         type(text_t), allocatable :: warnings(:)
     end type run_summary_t
 
@@ -739,11 +735,9 @@ contains
             call add_counter_values(s%stats, self%counters_before)
             s%t_reached = max(s%t_reached, self%t)
             if (self%monitoring .and. s%records > 0) then
-                s%lost_energy = self%monitor%lost(s%final_energy)
-                s%energy_intake = self%monitor%intake()
-                if (s%lost_energy) call append_text(s%warnings, loss_warning( &
-                    s%initial_energy%balance() - s%final_energy%balance(), s%energy_intake, &
-                    self%scene%solver%rtol))
+                if (self%monitor%lost(s%final_energy)) call append_text(s%warnings, &
+                    loss_warning(s%initial_energy%balance() - s%final_energy%balance(), &
+                                 self%monitor%intake(), self%scene%solver%rtol))
             end if
             call self%out%write_stats(s%stats, s%cpu_time, ferr, t_reached=self%t)
             if (.not. allocated(ferr)) call self%out%add_warnings(self%file_warnings(), ferr)

@@ -26,7 +26,7 @@ module ropedyn_sweep_runner
     use ropedyn_sweep, only: sweep_t, sweep_case_t, text_t
     use ropedyn_text, only: int_text
     use ropedyn_sweep_status, only: case_state_t, case_state, STATUS_NAMES
-    use ropedyn_sweep_summary, only: case_row_t, build_summary
+    use ropedyn_sweep_summary, only: case_row_t, build_summary, RUN_WARNING_JOIN
     use ropedyn_sweep_task, only: case_label
     implicit none
     private
@@ -539,15 +539,19 @@ contains
         do c = 1, size(rows)
             if (len(rows(c)%run_warnings) == 0) cycle
             warned = warned + 1
-            if (warned == 1) first = rows(c)%run_warnings
-            if (warned <= 20) ids = ids//merge(', ', '  ', warned > 1)//int_text(c)
+            if (warned == 1) then
+                first = rows(c)%run_warnings
+                ids = int_text(c)
+            else if (warned <= 20) then
+                ids = ids//', '//int_text(c)
+            end if
         end do
         if (warned == 0) return
         if (warned > 20) ids = ids//', ...'
-        bar = index(first, ' | ')
+        bar = index(first, RUN_WARNING_JOIN)
         if (bar > 0) first = first(:bar - 1)
         write (error_unit, '(a)') 'sweep: warning: '//int_text(warned)//' of '// &
-            int_text(size(rows))//' cases warned in their runs (cases'//ids(2:)//'), the '// &
+            int_text(size(rows))//' cases warned in their runs (cases '//ids//'), the '// &
             'first: '//first//' (all in '//sweep%output_dir//'/summary.csv, run_warnings)'
     end subroutine report_run_warnings
 

@@ -22,11 +22,11 @@ module ropedyn_sweep_summary
     use ropedyn_version, only: version_string
     implicit none
     private
-    public :: case_row_t, build_summary
+    public :: case_row_t, build_summary, RUN_WARNING_JOIN
 
-    !> Columns of summary.h5 measured per case: name and units (docs/reference/file-format.md).
     !> between two of a case's run warnings in its row (a warning holds '; ' itself)
     character(len=*), parameter :: RUN_WARNING_JOIN = ' | '
+    !> Columns of summary.h5 measured per case: name and units (docs/reference/file-format.md).
     character(len=*), parameter :: MEASURED(2, 8) = reshape([character(len=18) :: &
         't_reached', 's', 'wall_time', 's', 'cpu_time', 's', 'tip_error_final', 'm', &
         'tip_error_max', 'm', 'position_error_max', 'm', 'energy_error_final', 'J', &
