@@ -17,6 +17,8 @@ BAD = [
     ("bench_peers", "--elements", "10,30", "'10,30'"),
     ("bench_peers", "--undamped-elements", "20 a", "'a'"),
     ("bench_peers", "--coupled-elements", "-3", "must be above 0"),
+    ("bench_peers", "--methods", "cvode:x", "'x'"),
+    ("bench_peers", "--methods", "mebdf:0", "must be above 0"),
     ("bench_symplectic", "--elements", "2.5", "not a whole number"),
     ("fig5", "--elements", "30 70", "'30 70'"),
     ("bergdahl", "--periods", "1.25,,2", "not a number: ''"),

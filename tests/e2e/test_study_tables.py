@@ -112,7 +112,7 @@ def test_equal_accuracy_takes_the_loosest_rung_within_moordyns_error(monkeypatch
     row = bp.at_equal_accuracy("exe", None, 30, 30.0, None, {"cpu": 4.0}, 3.1e-3,
                                method="mebdf")
     assert "| mebdf | " in row                     # no switch log: no parentheses
-    assert bp.method_sets("mebdf") == ["solver.method='mebdf'"]
+    assert bp.method_sets("mebdf") == {"solver.method": "'mebdf'"}
 
 
 def test_the_stability_reports_stamp_names_its_part():

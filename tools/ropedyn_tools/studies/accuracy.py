@@ -46,7 +46,7 @@ import numpy as np
 from ropedyn_tools import docs_status
 from ropedyn_tools.arguments import check_names
 from ropedyn_tools.repo import DOCS, add_exe_argument, exe_or_build
-from ropedyn_tools.studies.common import machine, update_doc, run_stamp
+from ropedyn_tools.studies.common import machine, method_sets, update_doc, run_stamp
 
 PAGE = DOCS / "validation" / "accuracy.md"
 CHOOSING = DOCS / "guide" / "choosing.md"
@@ -93,14 +93,6 @@ class Runner:
         if r.returncode != 0:
             return None, r.stderr.strip().splitlines()[-1] if r.stderr else "failed"
         return out, ""
-
-
-def method_sets(method):
-    name, _, order = method.partition(":")
-    sets = {"solver.method": f"'{name}'"}
-    if order:
-        sets["solver.max_order"] = order
-    return sets
 
 
 def base_sets(model, n, rtol, t_end, dt=0.01):

@@ -73,10 +73,10 @@ import tempfile
 import numpy as np
 
 from ropedyn import io
-from ropedyn_tools.arguments import list_text, positive
+from ropedyn_tools.arguments import check_names, list_text, positive
 from ropedyn_tools.repo import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import (least_cpu, machine, method_chain, method_label,
-                                          update_doc, run_stamp)
+                                          method_sets, update_doc, run_stamp)
 
 BEGIN = "<!-- bench_peers:begin -->"
 END = "<!-- bench_peers:end -->"
@@ -303,10 +303,15 @@ EQUAL_RTOLS = (1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6)
 EQUAL_METHODS = "symplectic cvode mebdf"
 
 
-def method_sets(method):
-    """The scene settings of `method` or `method:max_order`."""
-    name, _, order = method.partition(":")
-    return [f"solver.method='{name}'"] + ([f"solver.max_order={order}"] if order else [])
+def method_list(text):
+    """An argparse type: methods `method` or `method:max_order` (max_order a whole number
+    above 0), space-separated, as given; the names are checked against `ropedyn keys`
+    once the executable is known."""
+    for item in text.split():
+        _, colon, order = item.partition(":")
+        if colon:
+            positive(int)(order)
+    return text
 
 
 def at_equal_accuracy(exe, work, n, t_end, ref, md, md_error, repeat=1, method="auto"):
@@ -314,7 +319,8 @@ def at_equal_accuracy(exe, work, n, t_end, ref, md, md_error, repeat=1, method="
     whose tip error is <= MoorDyn's time error: the table row (n, MoorDyn's error, rtol,
     method, error, balance, CPU (the least of `repeat` runs), ratio)."""
     for rtol in EQUAL_RTOLS:
-        sets = [f"solver.rtol={rtol:g}", f"solver.atol={rtol / 100:g}", *method_sets(method)]
+        sets = [f"solver.rtol={rtol:g}", f"solver.atol={rtol / 100:g}",
+                *(f"{k}={v}" for k, v in method_sets(method).items())]
         r = run_ropedyn(exe, work, n, t_end, name=f"{method}_rtol{rtol:g}", sets=sets)
         if r["status"] != "complete":
             continue
@@ -598,7 +604,7 @@ def main(argv=None):
                         help="only the undamped comparison (the other tables kept)")
     parser.add_argument("--no-undamped", action="store_true",
                         help="without the undamped comparison (its table kept)")
-    parser.add_argument("--methods", default=EQUAL_METHODS,
+    parser.add_argument("--methods", default=EQUAL_METHODS, type=method_list,
                         help="methods at equal accuracy besides auto: method or "
                              "method:max_order, space-separated (default: %(default)s)")
     parser.add_argument("--no-write", action="store_true")
@@ -610,6 +616,8 @@ def main(argv=None):
     args = parser.parse_args(argv)
     args.command = command_text(argv)
     exe = exe_or_build(args.exe)
+    check_names(parser, exe, "--methods", [m.partition(":")[0] for m in args.methods.split()],
+                "solver", "method")
     py = ensure_bench_venv()
     if args.coupled_only:
         return coupled_main(args, exe, py)

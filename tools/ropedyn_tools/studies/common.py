@@ -140,6 +140,16 @@ def least_cpu(run, repeat, complete=lambda r: True):
     return best
 
 
+def method_sets(method):
+    """The scene settings of a method given as `name` or `name:max_order` (the studies'
+    --methods): {'solver.method': "'name'", 'solver.max_order': order}."""
+    name, _, order = method.partition(":")
+    sets = {"solver.method": f"'{name}'"}
+    if order:
+        sets["solver.max_order"] = order
+    return sets
+
+
 def method_label(method, order):
     """A switch's method as the tables name it: erk with its pair's order ('erk 4',
     'erk 5': auto runs both pairs), any other by its name."""
