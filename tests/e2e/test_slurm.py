@@ -11,6 +11,9 @@ The test starts its own cluster on localhost, as root: munged (own key, socket a
 a temporary directory), slurmctld and slurmd in the foreground (-D) as child processes,
 with a slurm.conf for one node with 2 CPUs (select/cons_tres, proctrack/linuxproc,
 task/none, no cgroups, no accounting) on free ports; clients find it through SLURM_CONF.
+A requeued task may start again after cred_expire (Slurm's default 120 s), and pending
+tasks are looked at by the main scheduling loop (every 60 s by default): here 10 s and 2 s,
+so that the requeue test waits seconds, not three minutes.
 It stops exactly the processes it started. It skips (saying why) when not root or when
 Slurm or munge are not installed: scripts/setup installs slurm-wlm and munge.
 """
@@ -118,7 +121,7 @@ SlurmdPort={slurmd_port}
 SlurmUser=root
 SlurmdUser=root
 AuthType=auth/munge
-AuthInfo=socket={socket_path}
+AuthInfo=socket={socket_path},cred_expire=10
 CredType=cred/munge
 StateSaveLocation={r / 'state'}
 SlurmdSpoolDir={r / 'spool'}
@@ -131,6 +134,7 @@ TaskPlugin=task/none
 SelectType=select/cons_tres
 SelectTypeParameters=CR_CPU
 SchedulerType=sched/builtin
+SchedulerParameters=sched_interval=2
 MpiDefault=none
 ReturnToService=2
 SlurmdParameters=config_overrides
