@@ -248,11 +248,7 @@ contains
         call h5aopen_f(self%id, name, attr_id, hdferr)
         if (h5_failed(hdferr, label//': cannot open', err)) return
         call h5aget_type_f(attr_id, type_id, hdferr)
-        if (hdferr >= 0) call h5tget_class_f(type_id, class, hdferr)
-        if (hdferr >= 0) call h5tget_size_f(type_id, length, hdferr)
-        vlen = .false.
-        if (hdferr >= 0 .and. class == H5T_STRING_F) call h5tis_variable_str_f(type_id, &
-                                                                                vlen, hdferr)
+        if (hdferr >= 0) call type_facts(type_id, class, length, vlen, hdferr)
         if (hdferr < 0) then
             call h5_error(err, label//': cannot get its type')
         else if (class /= H5T_STRING_F) then
@@ -323,12 +319,8 @@ contains
         call h5dopen_f(self%id, name, dset_id, hdferr)
         if (h5_failed(hdferr, self%path//': '//name//': cannot open dataset', err)) return
         steps: block
-            vlen = .false.
             call h5dget_type_f(dset_id, type_id, hdferr)
-            if (hdferr >= 0) call h5tget_class_f(type_id, class, hdferr)
-            if (hdferr >= 0) call h5tget_size_f(type_id, width, hdferr)
-            if (hdferr >= 0 .and. class == H5T_STRING_F) &
-                call h5tis_variable_str_f(type_id, vlen, hdferr)
+            if (hdferr >= 0) call type_facts(type_id, class, width, vlen, hdferr)
             call h5tclose_f(type_id, ierr)
             if (hdferr < 0) then
                 call h5_error(err, self%path//': '//name//': cannot get its type')
@@ -363,6 +355,22 @@ contains
         end block steps
         call h5dclose_f(dset_id, ierr)
     end procedure h5_read_texts
+
+    !> The class of a type, its size (bytes) and whether it is a string of variable length;
+    !! hdferr < 0 when a query failed (then the later facts are unset).
+    subroutine type_facts(type_id, class, width, vlen, hdferr)
+        integer(hid_t), intent(in) :: type_id
+        integer, intent(out) :: class, hdferr
+        integer(size_t), intent(out) :: width
+        logical, intent(out) :: vlen
+        class = -1
+        width = 0
+        vlen = .false.
+        call h5tget_class_f(type_id, class, hdferr)
+        if (hdferr >= 0) call h5tget_size_f(type_id, width, hdferr)
+        if (hdferr >= 0 .and. class == H5T_STRING_F) call h5tis_variable_str_f(type_id, vlen, &
+                                                                                hdferr)
+    end subroutine type_facts
 
     !> Read dataset `name` (nothing when absent): a scalar to `buffer`, or, with `values`,
     !! an array of rank size(dims) into `values` (allocated here, extents `dims`).
