@@ -1,7 +1,20 @@
 !> One MEBDF step: the iteration matrix, the three stage solves (chord Newton), the error
-!! test, the history update and the choice of the next step size and order.
+!! test, the history update and the choice of the next step size and order. try_step runs
+!! the attempts; each part of one is a procedure of this submodule.
 submodule (ropedyn_mebdf) ropedyn_mebdf_step
     implicit none
+
+    !> A stage outcome of this submodule: the local error test failed
+    integer, parameter :: STAGE_ERROR_TEST = -1
+
+    !> The failures of one step's attempts (try_step): their counts, whether the next
+    !! attempt refreshes the Jacobian, and the cause of the last.
+    type :: attempts_t
+        integer :: error_fails = 0
+        integer :: conv_fails = 0
+        logical :: refresh = .false.
+        character(len=:), allocatable :: last_cause
+    end type attempts_t
 
 contains
 
@@ -116,148 +129,200 @@ contains
     end procedure stage
 
     module procedure try_step
-        real(wp) :: gam(KMAX_MEBDF), hmin, tn, err1, errkm1, errkp1, beta, hbeta
-        real(wp) :: ratio, r_same, r_down, r_up, binom, wd(0:KMAX_MEBDF)
-        integer :: k, j, i, outcome, status, error_fails, conv_fails, knew
-        logical :: refresh
-        character(len=:), allocatable :: last_cause
+        type(attempts_t) :: tries
+        real(wp) :: tn, err1
+        integer :: outcome, status
 
-        gam = 1.0_wp/self%coef%beta   ! gamma_j = sum_{i<=j} 1/i = 1/beta_j
-        error_fails = 0
-        conv_fails = 0
-        refresh = .false.
-        last_cause = 'none'
-        attempts: do
-            if (self%pending) then
-                if (self%pending_k /= self%k) then
-                    self%k = self%pending_k
-                end if
-                if (self%pending_ratio /= 1.0_wp) call self%rescale(self%pending_ratio, self%k)
-                self%pending = .false.
-                self%steps_at_h = 0
-            end if
-            ! a stop time ahead: the step that would reach it (or come within 1 % of a
-            ! step of it) ends exactly there (stage 2 still looks one step beyond)
-            if (self%t + 1.01_wp*self%h >= self%t_stop .and. self%t < self%t_stop) then
-                ratio = (self%t_stop - self%t)/self%h
-                if (ratio /= 1.0_wp) call self%rescale(ratio, self%k)
-                if (abs(ratio - 1.0_wp) > 0.01_wp) self%steps_at_h = 0
-            end if
-            k = self%k
-            beta = self%coef(k)%beta
-            hbeta = self%h*beta
-            tn = self%t + self%h
-            if (self%t + 1.01_wp*self%h >= self%t_stop) tn = self%t_stop
-            hmin = 16.0_wp*epsilon(1.0_wp)*max(abs(self%t), abs(tn))
-            if (self%counters%steps >= self%options%max_steps) then
-                call self%failure(err, self%steps_exhausted(self%t))
-                return
-            end if
-            if (self%h < hmin) then
-                call self%failure(err, 'step size fell below the round-off limit after: '// &
-                                  last_cause)
-                return
-            end if
+        tries%last_cause = 'none'
+        do
+            call begin_attempt(self, tn)
+            call check_progress(self, tn, tries%last_cause, err)
+            if (allocated(err)) return
             self%w = self%options%rtol*abs(self%dif(:, 0)) + self%atol
             self%wi = 1.0_wp/self%w
-
-            call self%prepare_matrix(hbeta, refresh, status)
-            refresh = .false.
-            if (status /= STATUS_OK) then
-                if (status == STATUS_FATAL) then
-                    call self%failure(err, 'the Jacobian or mass matrix could not be evaluated')
-                    return
-                end if
-                call newton_failed(STAGE_NO_CONVERGENCE)
-                if (allocated(err)) return
-                cycle attempts
+            call self%prepare_matrix(self%h*self%coef(self%k)%beta, tries%refresh, status)
+            tries%refresh = .false.
+            if (status == STATUS_FATAL) then
+                call self%failure(err, 'the Jacobian or mass matrix could not be evaluated')
+                return
             end if
+            outcome = STAGE_NO_CONVERGENCE
+            if (status == STATUS_OK) call three_stages(self, tn, err1, outcome)
+            select case (outcome)
+            case (STAGE_OK)
+                exit
+            case (STAGE_ERROR_TEST)
+                call error_failed(self, tries, err1, err)
+            case default
+                call newton_failed(self, tries, outcome, err)
+            end select
+            if (allocated(err)) return
+        end do
+        call accept_step(self, tn, err1)
+    end procedure try_step
 
-            ! Stage 1: k-step BDF to t_n + h.
-            ! pred = sum_{j=0..k} dif_j, psi = sum_{j=1..k} gam_j dif_j (c holds psi until
-            ! the last line). With P_j = sum_{i>=j} dif_i (the predictor's differences), psi
-            ! is sum_{j=1..k} (1/j) P_j, the BDF's known part. The loops over the
-            ! components are innermost (vector instructions); pred stays for the history.
-            self%pred = self%dif(:, 0) + self%dif(:, 1)
-            self%c = gam(1)*self%dif(:, 1)
-            do j = 2, k
-                self%pred = self%pred + self%dif(:, j)
-                self%c = self%c + gam(j)*self%dif(:, j)
+    !> Before an attempt: a step-size or order change that waits is made, and a step that
+    !! would reach a stop time ahead (or come within 1 % of a step of it) ends exactly
+    !! there (stage 2 still looks one step beyond). tn: where the attempt ends.
+    subroutine begin_attempt(self, tn)
+        class(mebdf_t), intent(inout) :: self
+        real(wp), intent(out) :: tn
+        real(wp) :: ratio
+        if (self%pending) then
+            if (self%pending_k /= self%k) then
+                self%k = self%pending_k
+            end if
+            if (self%pending_ratio /= 1.0_wp) call self%rescale(self%pending_ratio, self%k)
+            self%pending = .false.
+            self%steps_at_h = 0
+        end if
+        if (self%t + 1.01_wp*self%h >= self%t_stop .and. self%t < self%t_stop) then
+            ratio = (self%t_stop - self%t)/self%h
+            if (ratio /= 1.0_wp) call self%rescale(ratio, self%k)
+            if (abs(ratio - 1.0_wp) > 0.01_wp) self%steps_at_h = 0
+        end if
+        tn = self%t + self%h
+        if (self%t + 1.01_wp*self%h >= self%t_stop) tn = self%t_stop
+    end subroutine begin_attempt
+
+    !> The step budget and the round-off limit of the step size (after `last_cause`).
+    subroutine check_progress(self, tn, last_cause, err)
+        class(mebdf_t), intent(inout) :: self
+        real(wp), intent(in) :: tn
+        character(len=*), intent(in) :: last_cause
+        type(error_t), allocatable, intent(inout) :: err
+        real(wp) :: hmin
+        hmin = 16.0_wp*epsilon(1.0_wp)*max(abs(self%t), abs(tn))
+        if (self%counters%steps >= self%options%max_steps) then
+            call self%failure(err, self%steps_exhausted(self%t))
+        else if (self%h < hmin) then
+            call self%failure(err, 'step size fell below the round-off limit after: '// &
+                              last_cause)
+        end if
+    end subroutine check_progress
+
+    !> The three stages of a step to tn at order k + 1 (module header) and the error test
+    !! on stage 1 (err1, normalized): outcome STAGE_OK, a stage's failure, or
+    !! STAGE_ERROR_TEST (err1 then the error the step failed with).
+    subroutine three_stages(self, tn, err1, outcome)
+        class(mebdf_t), intent(inout) :: self
+        real(wp), intent(in) :: tn
+        real(wp), intent(out) :: err1
+        integer, intent(out) :: outcome
+        real(wp) :: beta, hbeta
+        integer :: k
+        k = self%k
+        beta = self%coef(k)%beta
+        hbeta = self%h*beta
+        err1 = 0.0_wp
+        call stage_bdf(self, tn, hbeta, outcome)
+        if (outcome /= STAGE_OK) return
+        self%hg1 = (self%ybar1 - self%c)*(1.0_wp/beta)
+        self%d1 = self%ybar1 - self%pred
+        err1 = self%wnorm(self%d1)/self%coef(k)%tq
+        if (self%fixed) err1 = 0.0_wp
+        if (.not. (err1 <= 1.0_wp)) then
+            outcome = STAGE_ERROR_TEST
+            return
+        end if
+        call stage_bdf_ahead(self, tn, hbeta, outcome)
+        if (outcome /= STAGE_OK) return
+        self%hg2 = (self%ybar2 - self%c)*(1.0_wp/beta)
+        call stage_corrector(self, tn, hbeta, outcome)
+        if (outcome /= STAGE_OK) return
+        self%tmp = self%y3 - self%ybar1
+        if (.not. (self%wnorm(self%tmp) <= EXTRA_CHECK .or. self%fixed)) then
+            err1 = max(err1, 1.01_wp)
+            outcome = STAGE_ERROR_TEST
+        end if
+    end subroutine three_stages
+
+    !> Stage 1: the k-step BDF to tn, into ybar1 (its predictor in pred, its known part in
+    !! c). pred = sum_{j=0..k} dif_j, psi = sum_{j=1..k} gam_j dif_j (c holds psi until
+    !! the last line). With P_j = sum_{i>=j} dif_i (the predictor's differences), psi is
+    !! sum_{j=1..k} (1/j) P_j, the BDF's known part. The loops over the components are
+    !! innermost (vector instructions); pred stays for the history.
+    subroutine stage_bdf(self, tn, hbeta, outcome)
+        class(mebdf_t), intent(inout) :: self
+        real(wp), intent(in) :: tn, hbeta
+        integer, intent(out) :: outcome
+        real(wp) :: gam(KMAX_MEBDF)
+        integer :: j, k
+        gam = 1.0_wp/self%coef%beta   ! gamma_j = sum_{i<=j} 1/i = 1/beta_j
+        k = self%k
+        self%pred = self%dif(:, 0) + self%dif(:, 1)
+        self%c = gam(1)*self%dif(:, 1)
+        do j = 2, k
+            self%pred = self%pred + self%dif(:, j)
+            self%c = self%c + gam(j)*self%dif(:, j)
+        end do
+        self%c = self%pred - self%coef(k)%beta*self%c
+        self%ybar1 = self%pred
+        call self%stage(tn, hbeta, self%c, self%ybar1, outcome)
+    end subroutine stage_bdf
+
+    !> Stage 2: the same BDF one step further, ybar1 joining the history, into ybar2. With
+    !! P_j = sum_{i=j..k} dif_i, the differences of ybar1 are P_j + d1; the predictor
+    !! (summed in ybar2) is their sum and psi (in c) = sum_{i=1..k} gam(i) (P_i + d1); tmp
+    !! carries P_i.
+    subroutine stage_bdf_ahead(self, tn, hbeta, outcome)
+        class(mebdf_t), intent(inout) :: self
+        real(wp), intent(in) :: tn, hbeta
+        integer, intent(out) :: outcome
+        real(wp) :: gam(KMAX_MEBDF)
+        integer :: i, k
+        gam = 1.0_wp/self%coef%beta
+        k = self%k
+        self%tmp = self%dif(:, k)
+        self%ybar2 = self%ybar1 + self%tmp + self%d1
+        self%c = gam(k)*(self%tmp + self%d1)
+        do i = k - 1, 1, -1
+            self%tmp = self%tmp + self%dif(:, i)
+            self%ybar2 = self%ybar2 + self%tmp + self%d1
+            self%c = self%c + gam(i)*(self%tmp + self%d1)
+        end do
+        self%c = self%ybar2 - self%coef(k)%beta*self%c
+        call self%stage(tn + self%h, hbeta, self%c, self%ybar2, outcome)
+    end subroutine stage_bdf_ahead
+
+    !> Stage 3: the modified extended corrector, into y3. Old values y_{n-i} from the
+    !! differences: y_{n-i} = sum_{j=0..i} (-1)^j binom(i, j) dif_j.
+    !! c = ... - sum_i ahat(k-1-i) y_{n-i} = ... + sum_j wd(j) dif_j: the weights of the
+    !! differences first (scalars), then one pass per difference.
+    subroutine stage_corrector(self, tn, hbeta, outcome)
+        class(mebdf_t), intent(inout) :: self
+        real(wp), intent(in) :: tn, hbeta
+        integer, intent(out) :: outcome
+        real(wp) :: wd(0:KMAX_MEBDF), binom, beta
+        integer :: i, j, k
+        k = self%k
+        beta = self%coef(k)%beta
+        wd = 0.0_wp
+        do i = 0, k - 1
+            ! point n - i has index k - 1 - i in the corrector's numbering
+            binom = 1.0_wp
+            do j = 0, i
+                wd(j) = wd(j) - self%coef(k)%ahat(k - 1 - i)*binom
+                binom = -binom*real(i - j, wp)/real(j + 1, wp)
             end do
-            self%c = self%pred - beta*self%c
-            self%ybar1 = self%pred
-            call self%stage(tn, hbeta, self%c, self%ybar1, outcome)
-            if (outcome /= STAGE_OK) then
-                call newton_failed(outcome)
-                if (allocated(err)) return
-                cycle attempts
-            end if
-            self%hg1 = (self%ybar1 - self%c)*(1.0_wp/beta)
-            self%d1 = self%ybar1 - self%pred
-            err1 = self%wnorm(self%d1)/self%coef(k)%tq
-            if (self%fixed) err1 = 0.0_wp
-            if (.not. (err1 <= 1.0_wp)) then
-                call error_failed(err1)
-                if (allocated(err)) return
-                cycle attempts
-            end if
+        end do
+        self%c = (self%coef(k)%bhat_k - beta)*self%hg1 + self%coef(k)%bhat_k1*self%hg2
+        do j = 0, k - 1
+            self%c = self%c + wd(j)*self%dif(:, j)
+        end do
+        self%y3 = self%ybar1
+        call self%stage(tn, hbeta, self%c, self%y3, outcome)
+    end subroutine stage_corrector
 
-            ! Stage 2: the same BDF one step further, ybar1 joining the history. With
-            ! P_j = sum_{i=j..k} dif_i, the differences of ybar1 are P_j + d1; the
-            ! predictor (summed in ybar2) is their sum and psi (in c) = sum_{i=1..k} gam(i)
-            ! (P_i + d1); tmp carries P_i.
-            self%tmp = self%dif(:, k)
-            self%ybar2 = self%ybar1 + self%tmp + self%d1
-            self%c = gam(k)*(self%tmp + self%d1)
-            do i = k - 1, 1, -1
-                self%tmp = self%tmp + self%dif(:, i)
-                self%ybar2 = self%ybar2 + self%tmp + self%d1
-                self%c = self%c + gam(i)*(self%tmp + self%d1)
-            end do
-            self%c = self%ybar2 - beta*self%c
-            call self%stage(tn + self%h, hbeta, self%c, self%ybar2, outcome)
-            if (outcome /= STAGE_OK) then
-                call newton_failed(outcome)
-                if (allocated(err)) return
-                cycle attempts
-            end if
-            self%hg2 = (self%ybar2 - self%c)*(1.0_wp/beta)
-
-            ! Stage 3: the modified extended corrector. Old values y_{n-i} from the
-            ! differences: y_{n-i} = sum_{j=0..i} (-1)^j binom(i, j) dif_j.
-            ! c = ... - sum_i ahat(k-1-i) y_{n-i} = ... + sum_j wd(j) dif_j: the weights of
-            ! the differences first (scalars), then one pass per difference
-            wd = 0.0_wp
-            do i = 0, k - 1
-                ! point n - i has index k - 1 - i in the corrector's numbering
-                binom = 1.0_wp
-                do j = 0, i
-                    wd(j) = wd(j) - self%coef(k)%ahat(k - 1 - i)*binom
-                    binom = -binom*real(i - j, wp)/real(j + 1, wp)
-                end do
-            end do
-            self%c = (self%coef(k)%bhat_k - beta)*self%hg1 + self%coef(k)%bhat_k1*self%hg2
-            do j = 0, k - 1
-                self%c = self%c + wd(j)*self%dif(:, j)
-            end do
-            self%y3 = self%ybar1
-            call self%stage(tn, hbeta, self%c, self%y3, outcome)
-            if (outcome /= STAGE_OK) then
-                call newton_failed(outcome)
-                if (allocated(err)) return
-                cycle attempts
-            end if
-            self%tmp = self%y3 - self%ybar1
-            if (.not. (self%wnorm(self%tmp) <= EXTRA_CHECK .or. self%fixed)) then
-                call error_failed(max(err1, 1.01_wp))
-                if (allocated(err)) return
-                cycle attempts
-            end if
-            exit attempts
-        end do attempts
-
-        ! Accepted. Order-change estimates (BDF errors at orders k-1 and k+1) use the old
-        ! differences; then the history moves to t_n + h with the MEBDF value.
+    !> The step to tn is accepted: order-change estimates (BDF errors at orders k-1 and
+    !! k+1) from the old differences, then the history moves to tn with the MEBDF value,
+    !! and the next step's size and order are chosen.
+    subroutine accept_step(self, tn, err1)
+        class(mebdf_t), intent(inout) :: self
+        real(wp), intent(in) :: tn, err1
+        real(wp) :: errkm1, errkp1
+        integer :: j, k
+        k = self%k
         errkm1 = huge(1.0_wp)
         errkp1 = huge(1.0_wp)
         if (k > 1) then
@@ -285,109 +350,121 @@ contains
         self%steps_at_h = self%steps_at_h + 1
         self%jacobian_age = self%jacobian_age + 1
         self%jacobian_current = .false.
+        if (self%steps_at_h >= k + 2 .and. .not. self%fixed) &
+            call choose_next(self, err1, errkm1, errkp1)
+    end subroutine accept_step
 
-        ! Step size and order for the next step (after k + 2 steps at this h and k).
-        if (self%steps_at_h >= k + 2 .and. .not. self%fixed) then
-            r_same = 1.0_wp/(SAFETY_SAME*max(err1, 1.0e-10_wp)**(1.0_wp/real(k + 1, wp)))
-            r_down = 0.0_wp
-            r_up = 0.0_wp
-            if (k > 1) r_down = 1.0_wp/(SAFETY_DOWN*max(errkm1, 1.0e-10_wp)**(1.0_wp/real(k, wp)))
-            if (errkp1 < huge(1.0_wp)) then
-                r_up = 1.0_wp/(SAFETY_UP*max(errkp1, 1.0e-10_wp)**(1.0_wp/real(k + 2, wp)))
-            end if
-            knew = k
-            ratio = r_same
-            if (r_down > ratio) then
-                knew = k - 1
-                ratio = r_down
-            end if
-            if (r_up > ratio) then
-                knew = k + 1
-                ratio = r_up
-            end if
-            if (ratio > MIN_GROWTH .or. knew /= k) then
-                ratio = min(ratio, merge(2.0_wp, 10.0_wp, self%recent_failure))
-                self%recent_failure = .false.
-                if (self%counters%steps <= k + 2 .and. .not. self%any_failure) &
-                    ratio = min(max(ratio, 1.0_wp), 1.0e4_wp)
-                ratio = max(ratio, 0.2_wp)
-                self%pending = .true.
-                self%pending_k = knew
-                self%pending_ratio = ratio
-            end if
+    !> Step size and order for the next step (after k + 2 steps at this h and k), from the
+    !! normalized errors at orders k, k-1 and k+1: the largest growth wins.
+    subroutine choose_next(self, err1, errkm1, errkp1)
+        class(mebdf_t), intent(inout) :: self
+        real(wp), intent(in) :: err1, errkm1, errkp1
+        real(wp) :: ratio, r_same, r_down, r_up
+        integer :: k, knew
+        k = self%k
+        r_same = 1.0_wp/(SAFETY_SAME*max(err1, 1.0e-10_wp)**(1.0_wp/real(k + 1, wp)))
+        r_down = 0.0_wp
+        r_up = 0.0_wp
+        if (k > 1) r_down = 1.0_wp/(SAFETY_DOWN*max(errkm1, 1.0e-10_wp)**(1.0_wp/real(k, wp)))
+        if (errkp1 < huge(1.0_wp)) then
+            r_up = 1.0_wp/(SAFETY_UP*max(errkp1, 1.0e-10_wp)**(1.0_wp/real(k + 2, wp)))
         end if
+        knew = k
+        ratio = r_same
+        if (r_down > ratio) then
+            knew = k - 1
+            ratio = r_down
+        end if
+        if (r_up > ratio) then
+            knew = k + 1
+            ratio = r_up
+        end if
+        if (ratio > MIN_GROWTH .or. knew /= k) then
+            ratio = min(ratio, merge(2.0_wp, 10.0_wp, self%recent_failure))
+            self%recent_failure = .false.
+            if (self%counters%steps <= k + 2 .and. .not. self%any_failure) &
+                ratio = min(max(ratio, 1.0_wp), 1.0e4_wp)
+            ratio = max(ratio, 0.2_wp)
+            self%pending = .true.
+            self%pending_k = knew
+            self%pending_ratio = ratio
+        end if
+    end subroutine choose_next
 
-    contains
-
-        !> A stage failed: a fatal right-hand side ends the run; otherwise refresh an old
-        !! Jacobian and retry, else cut the step by 4.
-        subroutine newton_failed(why)
-            integer, intent(in) :: why
-            if (why == STAGE_FATAL) then
-                call self%failure(err, 'the right-hand side reported a fatal error')
-                return
-            end if
-            self%counters%nonlin_conv_fails = self%counters%nonlin_conv_fails + 1
-            conv_fails = conv_fails + 1
-            self%any_failure = .true.
-            self%recent_failure = .true.
-            if (why == STAGE_RHS_FAILED) then
-                last_cause = 'repeated recoverable errors of the right-hand side (e.g. a NaN '// &
-                             'or Inf in the forces) during the Newton iteration'
-            else
-                last_cause = 'repeated Newton convergence failures (or a singular '// &
-                             'iteration matrix M - h beta J)'
-            end if
-            if (conv_fails > MAX_CONV_FAILS) then
-                call self%failure(err, last_cause)
-                return
-            end if
-            if (.not. self%jacobian_current .and. why /= STAGE_RHS_FAILED) then
-                refresh = .true.
-            else
-                self%pending = .true.
-                self%pending_k = self%k
-                self%pending_ratio = 0.25_wp
-            end if
-        end subroutine newton_failed
-
-        !> Local error test failed with normalized error e: smaller step, maybe lower order.
-        subroutine error_failed(e)
-            real(wp), intent(in) :: e
-            real(wp) :: r
-            self%counters%err_test_fails = self%counters%err_test_fails + 1
-            error_fails = error_fails + 1
-            last_cause = 'repeated local error test failures'
-            self%any_failure = .true.
-            self%recent_failure = .true.
-            if (error_fails >= MAX_ERROR_FAILS) then
-                call self%failure(err, 'repeated local error test failures')
-                return
-            end if
+    !> A stage failed: a fatal right-hand side ends the run; otherwise refresh an old
+    !! Jacobian and retry, else cut the step by 4.
+    subroutine newton_failed(self, tries, why, err)
+        class(mebdf_t), intent(inout) :: self
+        type(attempts_t), intent(inout) :: tries
+        integer, intent(in) :: why
+        type(error_t), allocatable, intent(inout) :: err
+        if (why == STAGE_FATAL) then
+            call self%failure(err, 'the right-hand side reported a fatal error')
+            return
+        end if
+        self%counters%nonlin_conv_fails = self%counters%nonlin_conv_fails + 1
+        tries%conv_fails = tries%conv_fails + 1
+        self%any_failure = .true.
+        self%recent_failure = .true.
+        if (why == STAGE_RHS_FAILED) then
+            tries%last_cause = 'repeated recoverable errors of the right-hand side (e.g. a '// &
+                               'NaN or Inf in the forces) during the Newton iteration'
+        else
+            tries%last_cause = 'repeated Newton convergence failures (or a singular '// &
+                               'iteration matrix M - h beta J)'
+        end if
+        if (tries%conv_fails > MAX_CONV_FAILS) then
+            call self%failure(err, tries%last_cause)
+            return
+        end if
+        if (.not. self%jacobian_current .and. why /= STAGE_RHS_FAILED) then
+            tries%refresh = .true.
+        else
             self%pending = .true.
             self%pending_k = self%k
-            if (error_fails >= 3) then
-                self%pending_k = 1
-                self%pending_ratio = 0.1_wp
-                return
+            self%pending_ratio = 0.25_wp
+        end if
+    end subroutine newton_failed
+
+    !> Local error test failed with normalized error e: smaller step, maybe lower order.
+    subroutine error_failed(self, tries, e, err)
+        class(mebdf_t), intent(inout) :: self
+        type(attempts_t), intent(inout) :: tries
+        real(wp), intent(in) :: e
+        type(error_t), allocatable, intent(inout) :: err
+        real(wp) :: r, errkm1
+        self%counters%err_test_fails = self%counters%err_test_fails + 1
+        tries%error_fails = tries%error_fails + 1
+        tries%last_cause = 'repeated local error test failures'
+        self%any_failure = .true.
+        self%recent_failure = .true.
+        if (tries%error_fails >= MAX_ERROR_FAILS) then
+            call self%failure(err, 'repeated local error test failures')
+            return
+        end if
+        self%pending = .true.
+        self%pending_k = self%k
+        if (tries%error_fails >= 3) then
+            self%pending_k = 1
+            self%pending_ratio = 0.1_wp
+            return
+        end if
+        r = 1.0_wp/(SAFETY_FAILED*e**(1.0_wp/real(self%k + 1, wp)))
+        if (tries%error_fails == 2) r = min(r, 0.5_wp)
+        ! the first step may be far too large: allow a deeper cut there
+        self%pending_ratio = min(max(r, merge(1.0e-3_wp, 0.1_wp, &
+                                              self%counters%steps == 0)), 0.9_wp)
+        if (self%k > 1) then
+            self%tmp = self%dif(:, self%k) + self%d1
+            errkm1 = self%wnorm(self%tmp)/self%coef(self%k - 1)%tq
+            if (errkm1 < e) then
+                self%pending_k = self%k - 1
+                r = 1.0_wp/(SAFETY_FAILED*max(errkm1, 1.0e-10_wp)** &
+                            (1.0_wp/real(self%k, wp)))
+                self%pending_ratio = min(max(r, 0.1_wp), 0.9_wp)
             end if
-            r = 1.0_wp/(SAFETY_FAILED*e**(1.0_wp/real(self%k + 1, wp)))
-            if (error_fails == 2) r = min(r, 0.5_wp)
-            ! the first step may be far too large: allow a deeper cut there
-            self%pending_ratio = min(max(r, merge(1.0e-3_wp, 0.1_wp, &
-                                                  self%counters%steps == 0)), 0.9_wp)
-            if (self%k > 1) then
-                self%tmp = self%dif(:, self%k) + self%d1
-                errkm1 = self%wnorm(self%tmp)/self%coef(self%k - 1)%tq
-                if (errkm1 < e) then
-                    self%pending_k = self%k - 1
-                    r = 1.0_wp/(SAFETY_FAILED*max(errkm1, 1.0e-10_wp)** &
-                                (1.0_wp/real(self%k, wp)))
-                    self%pending_ratio = min(max(r, 0.1_wp), 0.9_wp)
-                end if
-            end if
-        end subroutine error_failed
-    end procedure try_step
+        end if
+    end subroutine error_failed
 
     module procedure failure
         character(len=96) :: where
