@@ -489,8 +489,8 @@ contains
             [character(len=L) :: P//'mpp_damping_factor.nml: &model: ', &
             'mpp_axial_damping_factor = -1.0: must be >= 0'])
         call expect_error('method', [character(len=L) :: MODEL, '&solver method = ''euler'' /'], &
-            NO_SET, [character(len=L) :: &
-            P//'method.nml: &solver: method = "euler": unknown (allowed: cvode, mebdf, erk, adams, auto, symplectic)'])
+            NO_SET, [character(len=L) :: P//'method.nml: &solver: method = "euler": ', &
+            'unknown (allowed: cvode, mebdf, erk, adams, auto, symplectic)'])
         call expect_error('support', [character(len=L) :: MODEL, '&supports top = ''glued'' /'], &
             NO_SET, [character(len=L) :: P//'support.nml: &supports: top = "glued": ', &
             'unknown (allowed: pinned, clamped, free)'])
