@@ -122,7 +122,7 @@ module ropedyn_erk
         procedure :: set_stable_step => erk_set_stable_step
         procedure :: stopped_by_stiffness => erk_stopped_by_stiffness
         procedure :: rhs_changed => erk_rhs_changed
-        procedure, private :: attempt_step
+        procedure, private :: attempt_step, run_stages, step_error, accept_step, next_step
         procedure, private :: first_step, first_stage
         procedure, private :: quad_step
         procedure, private :: dense
@@ -394,17 +394,16 @@ contains
     subroutine attempt_step(self, err)
         class(erk_t), intent(inout) :: self
         type(error_t), allocatable, intent(out) :: err
-        real(wp) :: h, errnorm, errq, fac, tnew, gain_i, gain_p, h_wanted
-        integer :: i, status, s
+        real(wp) :: h, errnorm, h_wanted
+        integer :: status
         logical :: recoverable, clipped
 
-        s = self%s
         recoverable = .false.
         ! FSAL: the last stage of the previous step is f at this step's start (kept in
         ! place until now for the dense output of the previous step)
         if (self%counters%steps > 0) then
-            self%k(:, 1) = self%k(:, s)
-            if (self%nq > 0) self%gk(:, 1) = self%gk(:, s)
+            self%k(:, 1) = self%k(:, self%s)
+            if (self%nq > 0) self%gk(:, 1) = self%gk(:, self%s)
         end if
         if (self%fsal_stale) then
             ! f changed at t (a coupled support's new motion): the first stage anew
@@ -436,53 +435,80 @@ contains
                 end if
                 return
             end if
-            ! stages 2 .. s (stage 1 is f at the step's start, already known); loops over
-            ! the components with the table's nonzero entries only (no array temporaries)
-            do i = 2, s
-                call self%stage_state(i, h)
-                if (i == s - 1 .and. self%rho_last_two) self%yprev(:) = self%ytmp
-                if (self%nq > 0) then
-                    ! with the quadratures' right-hand side at the same stage
-                    call self%problem%rhs_quad(self%t + self%tab%c(i)*h, self%ytmp, &
-                                               self%k(:, i), self%gk(:, i), status)
-                else
-                    call self%problem%rhs(self%t + self%tab%c(i)*h, self%ytmp, &
-                                          self%k(:, i), status)
-                end if
-                self%counters%rhs_evals = self%counters%rhs_evals + 1
-                if (status == STATUS_FATAL) then
-                    call self%failure(err, 'the right-hand side reported a fatal error')
-                    return
-                end if
-                if (status /= STATUS_OK) then
-                    ! recoverable (e.g. NaN): retry smaller, as CVODE does
-                    recoverable = .true.
-                    self%h = h/4.0_wp
-                    self%rejected = .true.
-                    cycle attempts
-                end if
-            end do
-            ! FSAL: the last stage was evaluated at the new solution
-            call swap(self%ynew, self%ytmp)
-            errnorm = self%error_norm(h)
-            if (self%nq > 0) then
-                call self%quad_step(h, errq)
-                errnorm = max(errnorm, errq)
+            call self%run_stages(h, status)
+            if (status == STATUS_FATAL) then
+                call self%failure(err, 'the right-hand side reported a fatal error')
+                return
+            else if (status /= STATUS_OK) then
+                ! recoverable (e.g. NaN): retry smaller, as CVODE does
+                recoverable = .true.
+                self%h = h/4.0_wp
+                self%rejected = .true.
+                cycle attempts
             end if
-            if (.not. ieee_is_finite(errnorm)) errnorm = huge(1.0_wp)
+            errnorm = self%step_error(h)
             if (errnorm > 1.0_wp) then
                 self%counters%err_test_fails = self%counters%err_test_fails + 1
-                fac = max(SHRINK_MAX, SAFETY*errnorm**(-1.0_wp/self%tab%order))
-                self%h = h*fac
+                self%h = h*max(SHRINK_MAX, SAFETY*errnorm**(-1.0_wp/self%tab%order))
                 self%rejected = .true.
                 cycle attempts
             end if
             exit attempts
         end do attempts
+        call self%accept_step(h, merge(self%t_stop, self%t + h, clipped), errnorm)
+        ! a step cut short by the stop time: the next one as long as the one wanted
+        if (clipped) self%h = max(self%h, h_wanted)
+        call self%monitor_stiffness(h, err)
+    end subroutine attempt_step
 
-        ! accepted
-        tnew = self%t + h
-        if (clipped) tnew = self%t_stop
+    !> Stages 2 .. s of a step of size h (stage 1 is f at the step's start, already
+    !! known), the last at the new solution, left in ynew (FSAL). Loops over the components
+    !! with the table's nonzero entries only (no array temporaries). status: the right-hand
+    !! side's, STATUS_OK when every stage was evaluated.
+    subroutine run_stages(self, h, status)
+        class(erk_t), intent(inout) :: self
+        real(wp), intent(in) :: h
+        integer, intent(out) :: status
+        integer :: i, s
+        s = self%s
+        do i = 2, s
+            call self%stage_state(i, h)
+            if (i == s - 1 .and. self%rho_last_two) self%yprev(:) = self%ytmp
+            if (self%nq > 0) then
+                ! with the quadratures' right-hand side at the same stage
+                call self%problem%rhs_quad(self%t + self%tab%c(i)*h, self%ytmp, &
+                                           self%k(:, i), self%gk(:, i), status)
+            else
+                call self%problem%rhs(self%t + self%tab%c(i)*h, self%ytmp, self%k(:, i), &
+                                      status)
+            end if
+            self%counters%rhs_evals = self%counters%rhs_evals + 1
+            if (status /= STATUS_OK) return
+        end do
+        call swap(self%ynew, self%ytmp)
+    end subroutine run_stages
+
+    !> The weighted norm of the step's error estimate, the quadratures' included (their
+    !! increment over the step computed here); huge for a norm that is not finite.
+    real(wp) function step_error(self, h) result(errnorm)
+        class(erk_t), intent(inout) :: self
+        real(wp), intent(in) :: h
+        real(wp) :: errq
+        errnorm = self%error_norm(h)
+        if (self%nq > 0) then
+            call self%quad_step(h, errq)
+            errnorm = max(errnorm, errq)
+        end if
+        if (.not. ieee_is_finite(errnorm)) errnorm = huge(1.0_wp)
+    end function step_error
+
+    !> The step of size h to tnew is accepted with error errnorm: the spectral radius
+    !! estimate, the history, the counters, and the next step size.
+    subroutine accept_step(self, h, tnew, errnorm)
+        class(erk_t), intent(inout) :: self
+        real(wp), intent(in) :: h, tnew, errnorm
+        integer :: s
+        s = self%s
         if (self%rho_last_two) then
             self%dk = self%k(:, s) - self%k(:, s - 1)
             self%dy = self%ynew - self%yprev
@@ -508,26 +534,30 @@ contains
         self%counters%last_step = h
         self%counters%last_order = self%tab%order
         self%counters%order_steps(self%tab%order) = self%counters%order_steps(self%tab%order) + 1
-        ! PI controller (order of the estimate + 1 = order of the method), with the gains
-        ! for a stability-held step where h rho is near the stability limit
-        errnorm = max(errnorm, 1.0e-10_wp)
+        call self%next_step(h, errnorm)
+    end subroutine accept_step
+
+    !> The next step size after an accepted step of size h with error errnorm: a PI
+    !! controller (order of the estimate + 1 = order of the method), with the gains for a
+    !! stability-held step where h rho is near the stability limit.
+    subroutine next_step(self, h, errnorm)
+        class(erk_t), intent(inout) :: self
+        real(wp), intent(in) :: h, errnorm
+        real(wp) :: e, fac, gain_i, gain_p
+        e = max(errnorm, 1.0e-10_wp)
         gain_i = K_I
         gain_p = K_P
         if (h*self%rho > STABLE_CONTROL*self%tab%stability_limit) then
             gain_i = K_I_STABLE
             gain_p = K_P_STABLE
         end if
-        fac = SAFETY*errnorm**(-(gain_i + gain_p)/self%tab%order)* &
-              self%err_old**(gain_p/self%tab%order)
+        fac = SAFETY*e**(-(gain_i + gain_p)/self%tab%order)*self%err_old**(gain_p/self%tab%order)
         fac = min(GROW_MAX, max(SHRINK_MAX, fac))
         if (self%rejected) fac = min(1.0_wp, fac)
-        self%err_old = errnorm
+        self%err_old = e
         self%rejected = .false.
         self%h = h*fac
-        ! a step cut short by the stop time: the next one as long as the one wanted
-        if (clipped) self%h = max(self%h, h_wanted)
-        call self%monitor_stiffness(h, err)
-    end subroutine attempt_step
+    end subroutine next_step
 
     !> ytmp = y + h sum_j a(i, j) k(:, j): the argument of stage i (one vectorized
     !! update per nonzero entry of the table).
