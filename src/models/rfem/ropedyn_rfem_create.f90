@@ -6,14 +6,8 @@ submodule (ropedyn_rfem) ropedyn_rfem_create
 contains
 
     module procedure rfem_create
-        integer :: n, k, i
         type(section_t) :: sec
-        real(wp) :: dl, total_mass, cx, cy, cphi, bx, by, bphi, factor
-        real(wp) :: angles(2)
-        logical :: damped
-        character(len=:), allocatable :: kinds(:)
-        integer, allocatable :: pm_body(:)
-        real(wp), allocatable :: pm_r(:), pm_m(:), y0(:)
+        integer :: n
 
         n = spec%model%elements
         if (n < 2) then
@@ -22,6 +16,40 @@ contains
         end if
         model%n = n
         sec = rope_section(spec%rope)
+        call set_elements(model, spec, sec)
+        call set_joints(model, spec, sec)
+        call set_end_sections(model, spec)
+        model%init_angle = initial_angle(spec)
+        model%folded = spec%initial%shape == 'folded'
+        model%init_velocity = spec%initial%velocity
+        call set_masses(model, spec)
+        call build_body_effects(spec, model%len, model%effects)
+        if (size(model%effects) > 0) then
+            model%bodies%n = n
+            model%bodies%l = model%len
+            allocate (model%bodies%c(2, n), model%bodies%phi(n), model%bodies%v(2, n), &
+                      model%bodies%w(n), model%bodies%cs(2, n))
+        end if
+        call set_support_motion(model, spec)
+
+        model%half = 0.5_wp*model%len
+        model%weight = merge(model%mass*model%g, 0.0_wp*model%mass, model%gravity_on)
+        allocate (model%cs(2, n), model%phi(n), model%gen(3, n), model%gen_r(3, n), &
+                  model%blk(3, 6, -1:1, n))
+        model%cs = 0.0_wp
+        model%gen = 0.0_wp
+        model%gen_r = 0.0_wp
+        model%blk = 0.0_wp
+    end procedure rfem_create
+
+    !> The elements: lengths (half ones at the ends), masses and rotary inertias, gravity.
+    subroutine set_elements(model, spec, sec)
+        type(rfem_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        type(section_t), intent(in) :: sec
+        real(wp) :: dl, total_mass
+        integer :: n
+        n = model%n
         dl = spec%rope%length/real(n - 1, wp)
         total_mass = sec%mass_per_length*spec%rope%length
         allocate (model%len(n), model%mass(n), model%inertia(n))
@@ -30,9 +58,23 @@ contains
         model%len(n) = dl/2.0_wp
         model%mass = total_mass*model%len/spec%rope%length
         model%inertia = model%mass*(model%len**2/12.0_wp + sec%diameter**2/16.0_wp)
-
         model%g = spec%rope%gravity
         model%gravity_on = spec%effects%gravity
+    end subroutine set_elements
+
+    !> The spring-damping elements: the internal SDEs' constants (a strain exists only when
+    !! its effect is on, its damping only when damping is on), the supports' SDEs (a support
+    !! released at t <= 0 is free from the start: no SDE at all) and the release times.
+    subroutine set_joints(model, spec, sec)
+        type(rfem_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        type(section_t), intent(in) :: sec
+        real(wp) :: dl, cx, cy, cphi, bx, by, bphi, factor
+        logical :: damped
+        character(len=:), allocatable :: kinds(:)
+        integer :: k, n
+        n = model%n
+        dl = spec%rope%length/real(n - 1, wp)
         damped = spec%effects%damping
 
         cx = sec%ea/dl
@@ -49,8 +91,6 @@ contains
             end associate
         end if
 
-        ! internal SDEs: a strain exists only when its effect is on, its damping only when
-        ! damping is on
         model%tension = spec%effects%tension
         model%tension_only = .not. spec%rope%compression
         model%shear = spec%effects%shear
@@ -85,6 +125,15 @@ contains
                 end if
             end associate
         end do
+    end subroutine set_joints
+
+    !> The sections next to a clamp (bending) and, with end_compliance = 'split', next to a
+    !! pinned end (tension), shared between the support and its neighbour.
+    subroutine set_end_sections(model, spec)
+        type(rfem_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        integer :: k, n
+        n = model%n
         ! Bending next to a clamp. SDE j (between elements j-1 and j, at s = (j - 3/2) dl)
         ! lumps the bending of the primary section [(j-2) dl, (j-1) dl] (EI/dl): the
         ! internal SDEs alone cover the whole rope [0, L]. A clamp's rotational SDE at s = 0
@@ -125,17 +174,18 @@ contains
                                        model%sup(k)%bt, model%cxj, model%bxj)
             end do
         end if
+    end subroutine set_end_sections
 
-        model%init_angle = initial_angle(spec)
-        model%folded = spec%initial%shape == 'folded'
-        model%init_velocity = spec%initial%velocity
-        model%sup(1)%anchor = spec%supports%top_anchor
-        angles = clamp_angles(spec)
-        model%sup(1)%angle = angles(1)
-        model%sup(2)%angle = angles(2)
-
-        ! point masses at their place on the elements: mass, inertia about the centre and
-        ! the first moment m r that couples translation and rotation
+    !> Point masses at their place on the elements (mass, inertia about the centre and the
+    !! first moment m r that couples translation and rotation), the accelerations' row
+    !! scales, and the added mass in water (every element's accelerations from its block).
+    subroutine set_masses(model, spec)
+        type(rfem_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        integer, allocatable :: pm_body(:)
+        real(wp), allocatable :: pm_r(:), pm_m(:)
+        integer :: k, i, n
+        n = model%n
         call attached_masses(spec, model%len, pm_body, pm_r, pm_m)
         allocate (model%pm_elem(0), model%pm_moment(0))
         do k = 1, size(pm_body)
@@ -163,16 +213,22 @@ contains
             model%am_blk = 0.0_wp
             model%am_g = 0.0_wp
         end if
+    end subroutine set_masses
 
-        call build_body_effects(spec, model%len, model%effects)
-        if (size(model%effects) > 0) then
-            model%bodies%n = n
-            model%bodies%l = model%len
-            allocate (model%bodies%c(2, n), model%bodies%phi(n), model%bodies%v(2, n), &
-                      model%bodies%w(n), model%bodies%cs(2, n))
-        end if
-
-        ! supports: base anchor and angle, prescribed motion
+    !> The supports' anchors and angles (a bottom anchor not given: the rope's lower end in
+    !! its initial state) and their prescribed motions (a free or released support has
+    !! none); whether the model depends on time and does work.
+    subroutine set_support_motion(model, spec)
+        type(rfem_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        real(wp) :: angles(2)
+        real(wp), allocatable :: y0(:)
+        integer :: n
+        n = model%n
+        model%sup(1)%anchor = spec%supports%top_anchor
+        angles = clamp_angles(spec)
+        model%sup(1)%angle = angles(1)
+        model%sup(2)%angle = angles(2)
         model%motion(1)%p0 = model%sup(1)%anchor
         model%motion(1)%angle0 = model%sup(1)%angle
         if (bottom_anchor_given(spec)) then
@@ -192,16 +248,8 @@ contains
             model%release > 0.0_wp, model%motion, model%moving)
         model%timed = any(model%moving) .or. any(model%release < huge(1.0_wp))
         model%with_work = any_does_work(model%moving, model%effects)
+    end subroutine set_support_motion
 
-        model%half = 0.5_wp*model%len
-        model%weight = merge(model%mass*model%g, 0.0_wp*model%mass, model%gravity_on)
-        allocate (model%cs(2, n), model%phi(n), model%gen(3, n), model%gen_r(3, n), &
-                  model%blk(3, 6, -1:1, n))
-        model%cs = 0.0_wp
-        model%gen = 0.0_wp
-        model%gen_r = 0.0_wp
-        model%blk = 0.0_wp
-    end procedure rfem_create
     !> An end section shared between a support and its neighbour SDE i (at 2:n): the
     !! support's stiffness c_sup and damping b_sup and the neighbour's cj(i), bj(i) doubled,
     !! each then lumping half the section (rfem_create).
