@@ -409,8 +409,6 @@ contains
         type(rope_spec_t), intent(in) :: spec
         type(error_t), allocatable, intent(out) :: err
         type(section_t) :: sec
-        real(wp) :: total_mass, factor, angles(2)
-        integer :: k
 
         model%n = spec%model%elements
         if (model%n < 2) then
@@ -421,10 +419,25 @@ contains
             call make_error(err, ERR_INPUT, 'mpp: the top support must be pinned or clamped')
             return
         end if
+        sec = rope_section(spec%rope)
+        call set_members(model, spec, sec)
+        call set_support_springs(model, spec, sec)
+        call set_anchors(model, spec)
+        call set_masses(model, spec)
+        call set_support_motion(model, spec)
+        call allocate_work(model)
+    end subroutine mpp_create
+
+    !> The members: degrees of freedom, length, mass, inertia, gravity, and the springs and
+    !! dampers of the joints.
+    subroutine set_members(model, spec, sec)
+        type(mpp_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        type(section_t), intent(in) :: sec
+        real(wp) :: total_mass
         model%nu = merge(model%n, 0, spec%effects%tension)
         model%tension_only = .not. spec%rope%compression
         model%ndof = model%n + model%nu
-        sec = rope_section(spec%rope)
         total_mass = sec%mass_per_length*spec%rope%length
         model%l = spec%rope%length/real(model%n, wp)
         model%m = total_mass/real(model%n, wp)
@@ -437,6 +450,16 @@ contains
             if (spec%effects%bending) model%db = spec%model%mpp_bending_damping_factor* &
                                                   sec%bending_damping/model%l
         end if
+    end subroutine set_members
+
+    !> The supports' springs and dampers (the rope's own, times the factor; a clamp's
+    !! rotational one lumps a half member) and, with end_compliance = 'split', the last
+    !! member shared with the bottom pin.
+    subroutine set_support_springs(model, spec, sec)
+        type(mpp_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        type(section_t), intent(in) :: sec
+        real(wp) :: factor
         factor = spec%supports%support_stiffness_factor
         model%top_clamped = spec%supports%top == 'clamped'
         select case (spec%supports%bottom)
@@ -472,7 +495,14 @@ contains
             model%k_sup = 2.0_wp*model%k_sup
             model%d_sup = 2.0_wp*model%d_sup
         end if
+    end subroutine set_support_springs
 
+    !> The initial shape's angle, the anchors and the clamps' angles (a bottom anchor not
+    !! given: the lower end of the initial state).
+    subroutine set_anchors(model, spec)
+        type(mpp_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        real(wp) :: angles(2)
         model%init_angle = initial_angle(spec)
         model%folded = spec%initial%shape == 'folded'
         model%top_anchor = spec%supports%top_anchor
@@ -487,7 +517,14 @@ contains
                                   [cos(model%init_angle), sin(model%init_angle)]
             if (model%folded) model%bottom_anchor = model%top_anchor + [0.0_wp, model%l]
         end if
+    end subroutine set_anchors
 
+    !> Point masses on the members (their sums m, m r, m r^2 per member), the effects on
+    !! the members and the added mass in water.
+    subroutine set_masses(model, spec)
+        type(mpp_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        integer :: k
         call attached_masses(spec, [(model%l, k = 1, model%n)], model%pm_body, model%pm_r, &
                              model%pm_m)
         allocate (model%mbar(model%n), model%pm_s1(model%n), model%pm_s2(model%n))
@@ -511,6 +548,13 @@ contains
                       model%bodies%cs(2, model%n))
             model%bodies%l = [(model%l, k = 1, model%n)]
         end if
+    end subroutine set_masses
+
+    !> The supports' prescribed motions (the top joint is never free; a free or released
+    !! bottom has none) and whether the model does work.
+    subroutine set_support_motion(model, spec)
+        type(mpp_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
         model%motion(1)%p0 = model%top_anchor
         model%motion(1)%angle0 = model%top_angle
         model%motion(2)%p0 = model%bottom_anchor
@@ -524,7 +568,11 @@ contains
             call configure_motions(spec, [.true., model%bottom > 0], model%motion, model%moving)
         end if
         model%with_work = any_does_work(model%moving, model%effects)
+    end subroutine set_support_motion
 
+    !> The work arrays of the right-hand side and its Jacobian, zeroed.
+    subroutine allocate_work(model)
+        type(mpp_t), intent(inout) :: model
         associate (n => model%n, nd => model%ndof)
             allocate (model%cs(2, n), model%w(2, n), model%cacc(2, n), model%mom(n), &
                       model%ab_g(2, 2, n), model%ab_h(2, 2, n), model%ab_dinv(2, 2, n), &
@@ -548,7 +596,7 @@ contains
         model%ejac = 0.0_wp
         model%jmom = 0.0_wp
         model%wblk = 0.0_wp
-    end subroutine mpp_create
+    end subroutine allocate_work
 
     !> The supports at time t: top joint, bottom anchor (motion states) and whether the
     !! bottom support still holds. At rest (statics): no velocities, accelerations, rates.
