@@ -60,47 +60,16 @@ contains
         type(case_row_t), allocatable, intent(out) :: rows(:)
         type(text_t), allocatable, intent(out) :: warnings(:)
         type(error_t), allocatable, intent(out) :: err
-        type(case_data_t) :: data, ref_data
-        type(case_state_t) :: state
-        real(wp) :: nan
-        integer :: c, j, best, tightest, n
+        type(case_data_t) :: ref_data
+        integer :: c, j, n
         integer, allocatable :: members(:)
         logical, allocatable :: done(:)
-        character(len=:), allocatable :: warning
 
-        nan = ieee_value(1.0_wp, ieee_quiet_nan)
         n = size(sweep%cases)
         allocate (rows(n), warnings(0), done(n))
         do c = 1, n
-            rows(c)%id = c
-            rows(c)%t_reached = nan
-            rows(c)%wall_time = nan
-            rows(c)%cpu_time = nan
-            rows(c)%tip_error_final = nan
-            rows(c)%tip_error_max = nan
-            rows(c)%position_error_max = nan
-            rows(c)%energy_error_final = nan
-            rows(c)%energy_error_max = nan
-            rows(c)%reference_kind = ''
-            rows(c)%warning = ''
-            rows(c)%run_warnings = ''
-            call case_state(sweep%cases(c), state)
-            rows(c)%status = state%status
-            rows(c)%reason = state%reason
-            done(c) = rows(c)%status /= 'complete'
-            if (.not. state%data%exists .or. rows(c)%status == 'unreadable' .or. &
-                rows(c)%status == 'stale') cycle
-            ! interrupted by an abandoned lock: the file is an older run's
-            if (rows(c)%status == 'interrupted' .and. state%data%status /= 'interrupted' .and. &
-                state%data%status /= 'running') cycle
-            rows(c)%wall_time = state%data%wall_time
-            rows(c)%cpu_time = state%data%cpu_time
-            rows(c)%run_warnings = joined(state%data%warnings)
-            rows(c)%counters = state%data%counters
-            if (state%data%records > 0) rows(c)%t_reached = state%data%time(state%data%records)
-            if (rows(c)%status == 'complete') call energy_errors(state%data, rows(c))
+            call read_row(sweep%cases(c), c, rows(c))
         end do
-
         if (sweep%reference == REF_FILE) then
             call read_case_file(sweep%reference_file, ref_data, err, series=.true.)
             if (allocated(err)) return
@@ -114,100 +83,157 @@ contains
         done = .false.
         do c = 1, n
             if (done(c)) cycle
-            members = pack([(j, j=1, n)], [(same_set(c, j), j=1, n)])
+            members = pack([(j, j=1, n)], [(same_set(sweep, c, j), j=1, n)])
             done(members) = .true.
-            if (sweep%reference == REF_NONE) then
+            select case (sweep%reference)
+            case (REF_NONE)
                 do j = 1, size(members)
                     if (rows(members(j))%status == 'complete') &
                         rows(members(j))%reference_kind = 'none'
                 end do
-                cycle
-            end if
-            if (sweep%reference == REF_FILE) then
+            case (REF_FILE)
                 do j = 1, size(members)
                     associate (m => members(j))
                         if (rows(m)%status /= 'complete') cycle
                         rows(m)%reference_kind = 'file'
-                        call compare(m)
+                        call compare(sweep, m, ref_data, rows(m), err)
                         if (allocated(err)) return
                     end associate
                 end do
-                cycle
-            end if
-            ! the tightest case of the set, and the tightest complete one (ties: lowest id)
-            tightest = members(1)
-            best = 0
-            do j = 1, size(members)
-                associate (m => members(j))
-                    if (rtol(m) < rtol(tightest)) tightest = m
-                    if (rows(m)%status /= 'complete') cycle
-                    if (best == 0) then
-                        best = m
-                    else if (rtol(m) < rtol(best)) then
-                        best = m
-                    end if
-                end associate
-            end do
-            warning = ''
-            if (best == 0) then
-                cycle
-            else if (rtol(best) > rtol(tightest)) then
-                warning = 'reference falls back to case '//int_text(best)//' (rtol '// &
-                    real_text(rtol(best), compact=.true.)//'): the tightest case '// &
-                    int_text(tightest)//' (rtol '//real_text(rtol(tightest), compact=.true.)// &
-                    ') is not complete ('//rows(tightest)%status//')'
-                call append_text(warnings, 'cases '//id_list(members)//': '//warning)
-            end if
-            call read_case_file(sweep%cases(best)%file, ref_data, err, series=.true.)
-            if (allocated(err)) return
-            do j = 1, size(members)
-                associate (m => members(j))
-                    if (rows(m)%status /= 'complete') cycle
-                    rows(m)%warning = warning
-                    if (m == best) then
-                        rows(m)%reference_kind = 'self'
-                        cycle
-                    end if
-                    rows(m)%reference = best
-                    rows(m)%reference_kind = 'tighter'
-                    if (rtol(best) >= rtol(m)) rows(m)%reference_kind = 'same_rtol'
-                    call compare(m)
-                    if (allocated(err)) return
-                end associate
-            end do
+            case default
+                call against_tightest(sweep, members, rows, warnings, err)
+                if (allocated(err)) return
+            end select
         end do
 
         call write_csv(sweep, rows, err)
         if (allocated(err)) return
         call write_h5(sweep, rows, err)
-    contains
-        real(wp) function rtol(k)
-            integer, intent(in) :: k
-            rtol = sweep%cases(k)%scene%solver%rtol
-        end function rtol
-
-        !> Whether cases a and b share a reference.
-        logical function same_set(a, b)
-            integer, intent(in) :: a, b
-            same_set = sweep%cases(a)%group == sweep%cases(b)%group
-            if (sweep%reference == REF_TIGHTEST_PER_METHOD) same_set = same_set .and. &
-                sweep%cases(a)%scene%solver%method == sweep%cases(b)%scene%solver%method
-        end function same_set
-
-        !> Position errors of complete case k against ref_data.
-        subroutine compare(k)
-            integer, intent(in) :: k
-            logical :: matched
-            call read_case_file(sweep%cases(k)%file, data, err, series=.true.)
-            if (allocated(err)) return
-            call position_errors(data, ref_data, rows(k), matched)
-            if (.not. matched) then
-                if (len(rows(k)%warning) > 0) rows(k)%warning = rows(k)%warning//'; '
-                rows(k)%warning = rows(k)%warning//'no position errors: the output times or ' &
-                    //'the element count differ from the reference''s'
-            end if
-        end subroutine compare
     end subroutine build_summary
+
+    !> The row of case c from its file as far as it goes: status, times, counters, warnings
+    !! and, when complete, the energy errors; NaN where there is nothing to say.
+    subroutine read_row(sweep_case, c, row)
+        type(sweep_case_t), intent(in) :: sweep_case
+        integer, intent(in) :: c
+        type(case_row_t), intent(out) :: row
+        type(case_state_t) :: state
+        real(wp) :: nan
+        nan = ieee_value(1.0_wp, ieee_quiet_nan)
+        row%id = c
+        row%t_reached = nan
+        row%wall_time = nan
+        row%cpu_time = nan
+        row%tip_error_final = nan
+        row%tip_error_max = nan
+        row%position_error_max = nan
+        row%energy_error_final = nan
+        row%energy_error_max = nan
+        row%reference_kind = ''
+        row%warning = ''
+        row%run_warnings = ''
+        call case_state(sweep_case, state)
+        row%status = state%status
+        row%reason = state%reason
+        if (.not. state%data%exists .or. row%status == 'unreadable' .or. &
+            row%status == 'stale') return
+        ! interrupted by an abandoned lock: the file is an older run's
+        if (row%status == 'interrupted' .and. state%data%status /= 'interrupted' .and. &
+            state%data%status /= 'running') return
+        row%wall_time = state%data%wall_time
+        row%cpu_time = state%data%cpu_time
+        row%run_warnings = joined(state%data%warnings)
+        row%counters = state%data%counters
+        if (state%data%records > 0) row%t_reached = state%data%time(state%data%records)
+        if (row%status == 'complete') call energy_errors(state%data, row)
+    end subroutine read_row
+
+    !> The complete cases of one reference set against its tightest complete case (ties:
+    !! lowest id); a warning, in the rows and in `warnings`, when that is not the set's
+    !! tightest case.
+    subroutine against_tightest(sweep, members, rows, warnings, err)
+        type(sweep_t), intent(in) :: sweep
+        integer, intent(in) :: members(:)
+        type(case_row_t), intent(inout) :: rows(:)
+        type(text_t), allocatable, intent(inout) :: warnings(:)
+        type(error_t), allocatable, intent(out) :: err
+        type(case_data_t) :: ref_data
+        character(len=:), allocatable :: warning
+        integer :: j, best, tightest
+        tightest = members(1)
+        best = 0
+        do j = 1, size(members)
+            associate (m => members(j))
+                if (rtol(sweep, m) < rtol(sweep, tightest)) tightest = m
+                if (rows(m)%status /= 'complete') cycle
+                if (best == 0) then
+                    best = m
+                else if (rtol(sweep, m) < rtol(sweep, best)) then
+                    best = m
+                end if
+            end associate
+        end do
+        if (best == 0) return
+        warning = ''
+        if (rtol(sweep, best) > rtol(sweep, tightest)) then
+            warning = 'reference falls back to case '//int_text(best)//' (rtol '// &
+                real_text(rtol(sweep, best), compact=.true.)//'): the tightest case '// &
+                int_text(tightest)//' (rtol '//real_text(rtol(sweep, tightest), &
+                compact=.true.)//') is not complete ('//rows(tightest)%status//')'
+            call append_text(warnings, 'cases '//id_list(members)//': '//warning)
+        end if
+        call read_case_file(sweep%cases(best)%file, ref_data, err, series=.true.)
+        if (allocated(err)) return
+        do j = 1, size(members)
+            associate (m => members(j))
+                if (rows(m)%status /= 'complete') cycle
+                rows(m)%warning = warning
+                if (m == best) then
+                    rows(m)%reference_kind = 'self'
+                    cycle
+                end if
+                rows(m)%reference = best
+                rows(m)%reference_kind = 'tighter'
+                if (rtol(sweep, best) >= rtol(sweep, m)) rows(m)%reference_kind = 'same_rtol'
+                call compare(sweep, m, ref_data, rows(m), err)
+                if (allocated(err)) return
+            end associate
+        end do
+    end subroutine against_tightest
+
+    real(wp) function rtol(sweep, k)
+        type(sweep_t), intent(in) :: sweep
+        integer, intent(in) :: k
+        rtol = sweep%cases(k)%scene%solver%rtol
+    end function rtol
+
+    !> Whether cases a and b share a reference.
+    logical function same_set(sweep, a, b)
+        type(sweep_t), intent(in) :: sweep
+        integer, intent(in) :: a, b
+        same_set = sweep%cases(a)%group == sweep%cases(b)%group
+        if (sweep%reference == REF_TIGHTEST_PER_METHOD) same_set = same_set .and. &
+            sweep%cases(a)%scene%solver%method == sweep%cases(b)%scene%solver%method
+    end function same_set
+
+    !> Position errors of complete case k (its row) against ref_data.
+    subroutine compare(sweep, k, ref_data, row, err)
+        type(sweep_t), intent(in) :: sweep
+        integer, intent(in) :: k
+        type(case_data_t), intent(in) :: ref_data
+        type(case_row_t), intent(inout) :: row
+        type(error_t), allocatable, intent(out) :: err
+        type(case_data_t) :: data
+        logical :: matched
+        call read_case_file(sweep%cases(k)%file, data, err, series=.true.)
+        if (allocated(err)) return
+        call position_errors(data, ref_data, row, matched)
+        if (.not. matched) then
+            if (len(row%warning) > 0) row%warning = row%warning//'; '
+            row%warning = row%warning//'no position errors: the output times or ' &
+                //'the element count differ from the reference''s'
+        end if
+    end subroutine compare
 
     !> '1-4' or '1, 3, 5' for a sorted list of ids.
     function id_list(ids) result(text)
