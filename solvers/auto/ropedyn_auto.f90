@@ -70,6 +70,8 @@ module ropedyn_auto
     !> The methods: erk's order-4 pair, the implicit method, Adams, erk's order-5 pair, the
     !! symplectic method
     integer, parameter :: EXPLICIT = 1, IMPLICIT = 2, ADAMS = 3, HIGH = 4, SYMPLECTIC = 5
+    !> What one advance of the method in use came to (run_active)
+    integer, parameter :: RUN_DONE = 0, RUN_AGAIN = 1, RUN_STOPPED = 2
     !> the symplectic method for lightly damped fast modes (ropedyn_auto_switching's
     !! header, "Symplectic"): when its step costs at most this many times erk's predicted
     !! cost per simulated second, on a run at least LONG_RUN long (options%t_end)
@@ -425,7 +427,8 @@ contains
         real(wp), intent(inout) :: yq(:)
         type(error_t), allocatable, intent(out) :: err
         type(solver_stats_t) :: now
-        real(wp) :: target, h_look
+        real(wp) :: target
+        integer :: outcome
 
         t = self%t
         if (.not. self%initialized) then
@@ -433,16 +436,7 @@ contains
             return
         end if
         do while (self%t < tout)
-            ! look at the window after at most about WINDOW/4 steps of the method in use
-            ! (before its first step, of h_chunk): not only at the next output time
-            now = self%current_stats()
-            h_look = now%last_step
-            if (h_look <= 0.0_wp) h_look = self%h_chunk
-            target = tout
-            if (h_look > 0.0_wp) target = min(tout, self%t + 0.25_wp*WINDOW*h_look)
-            ! a look-ahead below the round-off of t rounds back to t: the method would take
-            ! no step (and never reach its own round-off limit): on to tout instead
-            if (target <= self%t) target = tout
+            target = look_ahead(self, tout)
             ! the stop time holds for every method it runs (the symplectic method's steps
             ! end on the output time, never beyond it)
             call self%erk%set_stop_time(self%t_stop)
@@ -451,48 +445,16 @@ contains
             call self%bdf%set_stop_time(self%t_stop)
             call self%mebdf%set_stop_time(self%t_stop)
             call cap_chunk(self)
-            if (self%active == SYMPLECTIC) then
-                ! kept, to the output time (where its steps fall)
-                target = tout
-                call self%sym%advance_to(tout, self%t, self%y, self%yq, err)
-                if (allocated(err)) then
-                    if (.not. self%sym%failed_fatally()) then
-                        call leave_symplectic(err)
-                        if (allocated(err)) exit
-                        cycle
-                    end if
-                end if
-            else if (self%active == EXPLICIT) then
-                call self%erk%advance_to(target, self%t, self%y, self%yq, err)
-            else if (self%active == HIGH) then
-                call self%erk_high%advance_to(target, self%t, self%y, self%yq, err)
-            else if (self%active == ADAMS) then
-                call self%am%advance_to(target, self%t, self%y, self%yq, err)
-                if (allocated(err)) then
-                    ! Adams gave up (e.g. no convergence: stiff); on with erk unless the
-                    ! step budget is spent
-                    now = self%stats()
-                    if (now%steps < self%options%max_steps) then
-                        self%rate_accurate = huge(1.0_wp)
-                        call self%start_method(EXPLICIT, 'adams failed: '// &
-                                               trim(err%message(1:min(160, len(err%message)))), &
-                                               err)
-                        if (allocated(err)) exit
-                        cycle
-                    end if
-                end if
-            else if (self%use_bdf) then
-                call self%bdf%advance_to(target, self%t, self%y, self%yq, err)
-            else
-                call self%mebdf%advance_to(target, self%t, self%y, self%yq, err)
-            end if
+            call run_active(self, tout, target, outcome, err)
+            if (outcome == RUN_AGAIN) cycle
+            if (outcome == RUN_STOPPED) exit
             if (allocated(err)) then
                 y = self%y
                 if (self%nq > 0) yq(1:self%nq) = self%yq
                 t = self%t
                 err%message = 'auto: '//err%message
                 now = self%stats()
-                if (now%steps >= self%options%max_steps) call budget_spent(err%message)
+                if (now%steps >= self%options%max_steps) call budget_spent(self, err%message)
                 return
             end if
             if (self%t < target .and. stop_now(self%options)) exit   ! stopped on request
@@ -502,37 +464,104 @@ contains
         y = self%y
         if (self%nq > 0) yq(1:self%nq) = self%yq
         t = self%t
-    contains
-        !> The symplectic method stopped (`err`: its step budget ran short, its step became
-        !! unstable or too short) at the last state it reached: on with erk from there,
-        !! whose steps adapt (and auto's switches from erk), without the symplectic method
-        !! for the rest of the run, and a warning (the balance may drift from here; a
-        !! larger max_steps keeps the method). `err` is then erk's start's, if it failed.
-        subroutine leave_symplectic(err)
-            type(error_t), allocatable, intent(inout) :: err
-            character(len=:), allocatable :: cause
-            cause = err%message(1:min(WHY_LEN - 120, len(err%message)))
-            deallocate (err)
-            self%sym_barred = .true.
-            self%sym_cost = -1.0_wp
-            call self%start_method(EXPLICIT, cause//'; on with erk, without the symplectic '// &
-                                   'method for the rest of the run', err, warn=.true.)
-        end subroutine leave_symplectic
-
-        !> The message of a method that spent the budget auto left it: with the run's own
-        !! budget in place of what was left of it, and auto's own diagnosis (the symplectic
-        !! method left out) at the end.
-        subroutine budget_spent(message)
-            character(len=:), allocatable, intent(inout) :: message
-            character(len=:), allocatable :: part
-            integer :: k
-            part = exceeded_text(max(1_i8, self%options%max_steps - self%done%steps))
-            k = index(message, part)
-            if (k > 0) message = message(:k - 1)//exceeded_text(self%options%max_steps)// &
-                                 message(k + len(part):)
-            message = message//last_warning(self%log%items())
-        end subroutine budget_spent
     end subroutine auto_advance_to
+
+    !> Where the method in use advances to next: the window is looked at after at most
+    !! about WINDOW/4 of its steps (before its first step, of h_chunk), not only at the
+    !! next output time tout.
+    real(wp) function look_ahead(self, tout) result(target)
+        class(auto_t), intent(inout) :: self
+        real(wp), intent(in) :: tout
+        type(solver_stats_t) :: now
+        real(wp) :: h_look
+        now = self%current_stats()
+        h_look = now%last_step
+        if (h_look <= 0.0_wp) h_look = self%h_chunk
+        target = tout
+        if (h_look > 0.0_wp) target = min(tout, self%t + 0.25_wp*WINDOW*h_look)
+        ! a look-ahead below the round-off of t rounds back to t: the method would take
+        ! no step (and never reach its own round-off limit): on to tout instead
+        if (target <= self%t) target = tout
+    end function look_ahead
+
+    !> The method in use advances to target (the symplectic method: to tout, where its
+    !! steps fall; target becomes tout). outcome RUN_DONE (err: the method's failure, if
+    !! any), RUN_AGAIN (the symplectic method or Adams gave up and erk goes on: advance
+    !! again) or RUN_STOPPED (going on with erk failed: err).
+    subroutine run_active(self, tout, target, outcome, err)
+        class(auto_t), intent(inout) :: self
+        real(wp), intent(in) :: tout
+        real(wp), intent(inout) :: target
+        integer, intent(out) :: outcome
+        type(error_t), allocatable, intent(out) :: err
+        type(solver_stats_t) :: now
+        outcome = RUN_DONE
+        if (self%active == SYMPLECTIC) then
+            ! kept, to the output time (where its steps fall)
+            target = tout
+            call self%sym%advance_to(tout, self%t, self%y, self%yq, err)
+            if (allocated(err)) then
+                if (.not. self%sym%failed_fatally()) then
+                    call leave_symplectic(self, err)
+                    outcome = merge(RUN_STOPPED, RUN_AGAIN, allocated(err))
+                end if
+            end if
+        else if (self%active == EXPLICIT) then
+            call self%erk%advance_to(target, self%t, self%y, self%yq, err)
+        else if (self%active == HIGH) then
+            call self%erk_high%advance_to(target, self%t, self%y, self%yq, err)
+        else if (self%active == ADAMS) then
+            call self%am%advance_to(target, self%t, self%y, self%yq, err)
+            if (allocated(err)) then
+                ! Adams gave up (e.g. no convergence: stiff); on with erk unless the step
+                ! budget is spent
+                now = self%stats()
+                if (now%steps < self%options%max_steps) then
+                    self%rate_accurate = huge(1.0_wp)
+                    call self%start_method(EXPLICIT, 'adams failed: '// &
+                                           trim(err%message(1:min(160, len(err%message)))), &
+                                           err)
+                    outcome = merge(RUN_STOPPED, RUN_AGAIN, allocated(err))
+                end if
+            end if
+        else if (self%use_bdf) then
+            call self%bdf%advance_to(target, self%t, self%y, self%yq, err)
+        else
+            call self%mebdf%advance_to(target, self%t, self%y, self%yq, err)
+        end if
+    end subroutine run_active
+
+    !> The symplectic method stopped (`err`: its step budget ran short, its step became
+    !! unstable or too short) at the last state it reached: on with erk from there, whose
+    !! steps adapt (and auto's switches from erk), without the symplectic method for the
+    !! rest of the run, and a warning (the balance may drift from here; a larger max_steps
+    !! keeps the method). `err` is then erk's start's, if it failed.
+    subroutine leave_symplectic(self, err)
+        class(auto_t), intent(inout) :: self
+        type(error_t), allocatable, intent(inout) :: err
+        character(len=:), allocatable :: cause
+        cause = err%message(1:min(WHY_LEN - 120, len(err%message)))
+        deallocate (err)
+        self%sym_barred = .true.
+        self%sym_cost = -1.0_wp
+        call self%start_method(EXPLICIT, cause//'; on with erk, without the symplectic '// &
+                               'method for the rest of the run', err, warn=.true.)
+    end subroutine leave_symplectic
+
+    !> The message of a method that spent the budget auto left it: with the run's own
+    !! budget in place of what was left of it, and auto's own diagnosis (the symplectic
+    !! method left out) at the end.
+    subroutine budget_spent(self, message)
+        class(auto_t), intent(inout) :: self
+        character(len=:), allocatable, intent(inout) :: message
+        character(len=:), allocatable :: part
+        integer :: k
+        part = exceeded_text(max(1_i8, self%options%max_steps - self%done%steps))
+        k = index(message, part)
+        if (k > 0) message = message(:k - 1)//exceeded_text(self%options%max_steps)// &
+                             message(k + len(part):)
+        message = message//last_warning(self%log%items())
+    end subroutine budget_spent
 
 
     !> Name of the method for stretches held by accuracy.
