@@ -417,67 +417,15 @@ contains
         type(sweep_t), intent(in) :: sweep
         type(case_row_t), intent(in) :: rows(:)
         type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: path
         type(h5_file_t) :: h5
         type(error_t), allocatable :: close_err
-        integer :: n, c, k
-        real(wp), allocatable :: measures(:, :)
-        integer(i8), allocatable :: counts(:, :)
 
-        path = sweep%output_dir//'/summary.h5'
-        n = size(rows)
-        measures = reshape([rows%t_reached, rows%wall_time, rows%cpu_time, &
-                            rows%tip_error_final, rows%tip_error_max, rows%position_error_max, &
-                            rows%energy_error_final, rows%energy_error_max], [n, 8])
-        counts = transpose(reshape([(rows(c)%counters, c=1, n)], [size(COUNTER_NAMES), n]))
-        call h5%create(path, err)
+        call h5%create(sweep%output_dir//'/summary.h5', err)
         if (allocated(err)) return
         steps: block
-            call h5%write('/case', int([(rows(c)%id, c=1, n)], i8), '1', err)
+            call write_setting_columns(h5, sweep, rows, err)
             if (allocated(err)) exit steps
-            call text_column('status')
-            if (allocated(err)) exit steps
-            call text_column('model')
-            if (allocated(err)) exit steps
-            call h5%write('/elements', int([(sweep%cases(c)%scene%model%elements, c=1, n)], &
-                i8), '1', err)
-            if (allocated(err)) exit steps
-            call text_column('method')
-            if (allocated(err)) exit steps
-            call h5%write('/max_order', int([(sweep%cases(c)%scene%solver%max_order, &
-                c=1, n)], i8), '1', err)
-            if (allocated(err)) exit steps
-            call h5%write('/rtol', [(sweep%cases(c)%scene%solver%rtol, c=1, n)], '1', err)
-            if (allocated(err)) exit steps
-            call h5%write('/atol', [(sweep%cases(c)%scene%solver%atol, c=1, n)], &
-                'state units (m, rad, m/s, rad/s)', err)
-            if (allocated(err)) exit steps
-            do k = 1, size(sweep%vary_keys)
-                call text_column(sweep%vary_keys(k)%s, k)
-                if (allocated(err)) exit steps
-            end do
-            call h5%write('/t_end', [(sweep%cases(c)%scene%solver%t_end, c=1, n)], 's', err)
-            if (allocated(err)) exit steps
-            do k = 1, size(MEASURED, 2)
-                call h5%write('/'//trim(MEASURED(1, k)), measures(:, k), trim(MEASURED(2, k)), &
-                              err)
-                if (allocated(err)) exit steps
-            end do
-            do k = 1, size(COUNTER_NAMES)
-                call h5%write('/'//trim(COUNTER_NAMES(k)), counts(:, k), '1', err)
-                if (allocated(err)) exit steps
-            end do
-            call h5%write('/reference', int(rows%reference, i8), '1', err)
-            if (allocated(err)) exit steps
-            call text_column('reference_kind')
-            if (allocated(err)) exit steps
-            call text_column('file')
-            if (allocated(err)) exit steps
-            call text_column('reason')
-            if (allocated(err)) exit steps
-            call text_column('warning')
-            if (allocated(err)) exit steps
-            call text_column('run_warnings')
+            call write_result_columns(h5, sweep, rows, err)
             if (allocated(err)) exit steps
             call h5%attribute('/', 'sweep', sweep%path, err)
             if (allocated(err)) exit steps
@@ -489,56 +437,130 @@ contains
         end block steps
         call h5%close(close_err)
         if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
-    contains
-        !> The column `name` of strings (a varied key's with its index `vary`), null-padded
-        !! to the longest entry (at least one character).
-        subroutine text_column(name, vary)
-            character(len=*), intent(in) :: name
-            integer, intent(in), optional :: vary
-            integer :: width, j
-            character(len=:), allocatable :: buffer(:), text
-            width = 1
-            do j = 1, n
-                width = max(width, len(cell(name, j, vary)))
-            end do
-            allocate (character(len=width) :: buffer(n))
-            do j = 1, n
-                text = cell(name, j, vary)
-                buffer(j) = text   ! blank-padded; NUL-padded below
-                if (len(text) < width) buffer(j)(len(text) + 1:) = &
-                    repeat(achar(0), width - len(text))
-            end do
-            call h5%write_text('/'//name, buffer, '', err)
-        end subroutine text_column
-
-        !> Case j's entry of the text column `name` (of varied key number `vary`).
-        function cell(name, j, vary) result(value)
-            character(len=*), intent(in) :: name
-            integer, intent(in) :: j
-            integer, intent(in), optional :: vary
-            character(len=:), allocatable :: value
-            if (present(vary)) then
-                value = sweep%cases(j)%vary_values(vary)%s
-                return
-            end if
-            select case (name)
-            case ('status')
-                value = rows(j)%status
-            case ('model')
-                value = trim(sweep%cases(j)%scene%model%kind)
-            case ('method')
-                value = trim(sweep%cases(j)%scene%solver%method)
-            case ('file')
-                value = sweep%cases(j)%file
-            case ('reference_kind')
-                value = rows(j)%reference_kind
-            case ('warning')
-                value = rows(j)%warning
-            case ('run_warnings')
-                value = rows(j)%run_warnings
-            case default
-                value = rows(j)%reason
-            end select
-        end function cell
     end subroutine write_h5
+
+    !> The columns of summary.h5 that say what each case is: id, status, model, elements,
+    !! method, max_order, rtol, atol, the varied keys, t_end.
+    subroutine write_setting_columns(h5, sweep, rows, err)
+        type(h5_file_t), intent(inout) :: h5
+        type(sweep_t), intent(in) :: sweep
+        type(case_row_t), intent(in) :: rows(:)
+        type(error_t), allocatable, intent(out) :: err
+        integer :: c, k, n
+        n = size(rows)
+        call h5%write('/case', int([(rows(c)%id, c=1, n)], i8), '1', err)
+        if (allocated(err)) return
+        call text_column(h5, sweep, rows, 'status', err)
+        if (allocated(err)) return
+        call text_column(h5, sweep, rows, 'model', err)
+        if (allocated(err)) return
+        call h5%write('/elements', int([(sweep%cases(c)%scene%model%elements, c=1, n)], &
+            i8), '1', err)
+        if (allocated(err)) return
+        call text_column(h5, sweep, rows, 'method', err)
+        if (allocated(err)) return
+        call h5%write('/max_order', int([(sweep%cases(c)%scene%solver%max_order, &
+            c=1, n)], i8), '1', err)
+        if (allocated(err)) return
+        call h5%write('/rtol', [(sweep%cases(c)%scene%solver%rtol, c=1, n)], '1', err)
+        if (allocated(err)) return
+        call h5%write('/atol', [(sweep%cases(c)%scene%solver%atol, c=1, n)], &
+            'state units (m, rad, m/s, rad/s)', err)
+        if (allocated(err)) return
+        do k = 1, size(sweep%vary_keys)
+            call text_column(h5, sweep, rows, sweep%vary_keys(k)%s, err, k)
+            if (allocated(err)) return
+        end do
+        call h5%write('/t_end', [(sweep%cases(c)%scene%solver%t_end, c=1, n)], 's', err)
+    end subroutine write_setting_columns
+
+    !> The columns of summary.h5 that say how each case went: the measures, the solver's
+    !! counters, the reference and the texts.
+    subroutine write_result_columns(h5, sweep, rows, err)
+        type(h5_file_t), intent(inout) :: h5
+        type(sweep_t), intent(in) :: sweep
+        type(case_row_t), intent(in) :: rows(:)
+        type(error_t), allocatable, intent(out) :: err
+        character(len=*), parameter :: TEXTS(5) = [character(len=14) :: 'reference_kind', &
+            'file', 'reason', 'warning', 'run_warnings']
+        real(wp), allocatable :: measures(:, :)
+        integer(i8), allocatable :: counts(:, :)
+        integer :: c, k, n
+        n = size(rows)
+        measures = reshape([rows%t_reached, rows%wall_time, rows%cpu_time, &
+                            rows%tip_error_final, rows%tip_error_max, rows%position_error_max, &
+                            rows%energy_error_final, rows%energy_error_max], [n, 8])
+        counts = transpose(reshape([(rows(c)%counters, c=1, n)], [size(COUNTER_NAMES), n]))
+        do k = 1, size(MEASURED, 2)
+            call h5%write('/'//trim(MEASURED(1, k)), measures(:, k), trim(MEASURED(2, k)), err)
+            if (allocated(err)) return
+        end do
+        do k = 1, size(COUNTER_NAMES)
+            call h5%write('/'//trim(COUNTER_NAMES(k)), counts(:, k), '1', err)
+            if (allocated(err)) return
+        end do
+        call h5%write('/reference', int(rows%reference, i8), '1', err)
+        if (allocated(err)) return
+        do k = 1, size(TEXTS)
+            call text_column(h5, sweep, rows, trim(TEXTS(k)), err)
+            if (allocated(err)) return
+        end do
+    end subroutine write_result_columns
+
+    !> The column `name` of strings (a varied key's with its index `vary`), null-padded to
+    !! the longest entry (at least one character).
+    subroutine text_column(h5, sweep, rows, name, err, vary)
+        type(h5_file_t), intent(inout) :: h5
+        type(sweep_t), intent(in) :: sweep
+        type(case_row_t), intent(in) :: rows(:)
+        character(len=*), intent(in) :: name
+        type(error_t), allocatable, intent(out) :: err
+        integer, intent(in), optional :: vary
+        integer :: width, j, n
+        character(len=:), allocatable :: buffer(:), text
+        n = size(rows)
+        width = 1
+        do j = 1, n
+            width = max(width, len(cell(sweep, rows, name, j, vary)))
+        end do
+        allocate (character(len=width) :: buffer(n))
+        do j = 1, n
+            text = cell(sweep, rows, name, j, vary)
+            buffer(j) = text   ! blank-padded; NUL-padded below
+            if (len(text) < width) buffer(j)(len(text) + 1:) = repeat(achar(0), width - len(text))
+        end do
+        call h5%write_text('/'//name, buffer, '', err)
+    end subroutine text_column
+
+    !> Case j's entry of the text column `name` (of varied key number `vary`).
+    function cell(sweep, rows, name, j, vary) result(value)
+        type(sweep_t), intent(in) :: sweep
+        type(case_row_t), intent(in) :: rows(:)
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: j
+        integer, intent(in), optional :: vary
+        character(len=:), allocatable :: value
+        if (present(vary)) then
+            value = sweep%cases(j)%vary_values(vary)%s
+            return
+        end if
+        select case (name)
+        case ('status')
+            value = rows(j)%status
+        case ('model')
+            value = trim(sweep%cases(j)%scene%model%kind)
+        case ('method')
+            value = trim(sweep%cases(j)%scene%solver%method)
+        case ('file')
+            value = sweep%cases(j)%file
+        case ('reference_kind')
+            value = rows(j)%reference_kind
+        case ('warning')
+            value = rows(j)%warning
+        case ('run_warnings')
+            value = rows(j)%run_warnings
+        case default
+            value = rows(j)%reason
+        end select
+    end function cell
 end module ropedyn_sweep_summary
