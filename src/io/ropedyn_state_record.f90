@@ -46,11 +46,9 @@ contains
         type(error_t), allocatable, intent(out) :: err
         type(h5_file_t) :: h5
         type(error_t), allocatable :: close_err
-        real(wp), allocatable :: time(:), values(:)
-        integer(hsize_t) :: dims1(1), dims2(2), dims3(3)
+        real(wp), allocatable :: time(:)
         logical :: found
-        real(wp) :: slack, bound
-        integer :: k, nt
+        integer :: k
 
         call h5%open(path, err)
         if (allocated(err)) then
@@ -68,101 +66,150 @@ contains
             end if
             call read_record_times(h5, path, time, err)
             if (allocated(err)) exit steps
-            nt = size(time)
-            rec%records = nt
-            if (state_time < 0.0_wp) then
-                k = nt
-            else
-                k = minloc(abs(time - state_time), dim=1)
-                slack = 1.0e-9_wp*max(1.0_wp, abs(state_time))
-                if (nt > 1) slack = slack + 0.5_wp*maxval(time(2:) - time(:nt - 1))
-                if (abs(time(k) - state_time) > slack) then
-                    call make_error(err, ERR_INPUT, path//': no record at t = '// &
-                        real_text(state_time)//' s (the records span '//real_text(time(1))// &
-                        ' .. '//real_text(time(nt))//' s)')
-                    exit steps
-                end if
-            end if
+            rec%records = size(time)
+            call pick_record(path, time, state_time, k, err)
+            if (allocated(err)) exit steps
             rec%record = k - 1
             rec%t = time(k)
-
-            call h5%read_reals('/state/q', values, dims3, err)
+            call read_positions(h5, path, k, rec, err)
             if (allocated(err)) exit steps
-            rec%n = int(dims3(2))
-            if (dims3(1) /= 3 .or. dims3(3) < nt) then
-                call make_error(err, ERR_INPUT, path//': /state/q: not (times, n, 3) with '// &
-                                int_text(nt)//' records')
-                exit steps
-            end if
-            rec%q = reshape(values(3*rec%n*(k - 1) + 1:3*rec%n*k), [3, rec%n])
-            call h5%read_reals('/state/qdot', values, dims3, err)
+            call read_scalar_record(h5, '/energy/dissipated', k, rec%dissipated, err)
             if (allocated(err)) exit steps
-            if (dims3(1) /= 3 .or. dims3(2) /= rec%n .or. dims3(3) < nt) then
-                call make_error(err, ERR_INPUT, path//': /state/qdot: not (times, '// &
-                                int_text(rec%n)//', 3) with '//int_text(nt)//' records')
-                exit steps
-            end if
-            rec%qdot = reshape(values(3*rec%n*(k - 1) + 1:3*rec%n*k), [3, rec%n])
-
-            call read_scalar_record('/energy/dissipated', rec%dissipated)
+            call read_scalar_record(h5, '/energy/support_work', k, rec%support_work, err)
             if (allocated(err)) exit steps
-            call read_scalar_record('/energy/support_work', rec%support_work)
+            call read_native_state(h5, k, rec, err)
             if (allocated(err)) exit steps
-
-            ! the native state, where the writer stores it (restart data)
-            if (h5%exists('/state/y') .and. h5%exists('/state/yq')) then
-                call h5%read_reals('/state/y', values, dims2, err)
-                if (allocated(err)) exit steps
-                if (dims2(2) >= nt) rec%y = values(dims2(1)*(k - 1) + 1:dims2(1)*k)
-                call h5%read_reals('/state/yq', values, dims2, err)
-                if (allocated(err)) exit steps
-                if (dims2(2) >= nt) rec%yq = values(dims2(1)*(k - 1) + 1:dims2(1)*k)
-                if (.not. (allocated(rec%y) .and. allocated(rec%yq))) then
-                    if (allocated(rec%y)) deallocate (rec%y)
-                    if (allocated(rec%yq)) deallocate (rec%yq)
-                end if
-            end if
-
-            ! finite, and within the limits of a scene (ropedyn_run_record)
-            bound = MAGNITUDE_LIMIT
-            if (h5%exists('/rope/element_mass')) then
-                call h5%read_reals('/rope/element_mass', values, dims1, err)
-                if (allocated(err)) exit steps
-                bound = speed_bound(values)
-            end if
-            call check_record_values(path, '/state/q', rec%record, rec%t, &
-                                     reshape(rec%q, [size(rec%q)]), bound, err)
-            if (allocated(err)) exit steps
-            call check_record_values(path, '/state/qdot', rec%record, rec%t, &
-                                     reshape(rec%qdot, [size(rec%qdot)]), bound, err)
-            if (allocated(err)) exit steps
-            if (allocated(rec%y)) then
-                call check_record_values(path, '/state/y', rec%record, rec%t, rec%y, bound, err)
-                if (allocated(err)) exit steps
-                call check_record_values(path, '/state/yq', rec%record, rec%t, rec%yq, &
-                                         MAGNITUDE_LIMIT, err)
-                if (allocated(err)) exit steps
-            end if
-            call check_record_values(path, '/energy/dissipated', rec%record, rec%t, &
-                                     [rec%dissipated], MAGNITUDE_LIMIT, err)
-            if (allocated(err)) exit steps
-            call check_record_values(path, '/energy/support_work', rec%record, rec%t, &
-                                     [rec%support_work], MAGNITUDE_LIMIT, err)
+            call check_record(h5, path, rec, err)
         end block steps
         call h5%close(close_err)
         if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
-    contains
-        !> Record k of a (times,) series; 0 when the file has no such dataset.
-        subroutine read_scalar_record(name, value)
-            character(len=*), intent(in) :: name
-            real(wp), intent(out) :: value
-            real(wp), allocatable :: series(:)
-            integer(hsize_t) :: d(1)
-            value = 0.0_wp
-            if (.not. h5%exists(name)) return
-            call h5%read_reals(name, series, d, err)
-            if (allocated(err)) return
-            if (size(series) >= k) value = series(k)
-        end subroutine read_scalar_record
     end subroutine read_state_record
+
+    !> The index k of the record at state_time (< 0: the last) among the records' times,
+    !! within half the largest spacing of the records.
+    subroutine pick_record(path, time, state_time, k, err)
+        character(len=*), intent(in) :: path
+        real(wp), intent(in) :: time(:), state_time
+        integer, intent(out) :: k
+        type(error_t), allocatable, intent(out) :: err
+        real(wp) :: slack
+        integer :: nt
+        nt = size(time)
+        if (state_time < 0.0_wp) then
+            k = nt
+            return
+        end if
+        k = minloc(abs(time - state_time), dim=1)
+        slack = 1.0e-9_wp*max(1.0_wp, abs(state_time))
+        if (nt > 1) slack = slack + 0.5_wp*maxval(time(2:) - time(:nt - 1))
+        if (abs(time(k) - state_time) > slack) then
+            call make_error(err, ERR_INPUT, path//': no record at t = '// &
+                real_text(state_time)//' s (the records span '//real_text(time(1))// &
+                ' .. '//real_text(time(nt))//' s)')
+        end if
+    end subroutine pick_record
+
+    !> Record k of /state/q and /state/qdot, checked to be (times, n, 3) series.
+    subroutine read_positions(h5, path, k, rec, err)
+        type(h5_file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: k
+        type(state_record_t), intent(inout) :: rec
+        type(error_t), allocatable, intent(out) :: err
+        real(wp), allocatable :: values(:)
+        integer(hsize_t) :: dims3(3)
+        integer :: nt
+        nt = rec%records
+        call h5%read_reals('/state/q', values, dims3, err)
+        if (allocated(err)) return
+        rec%n = int(dims3(2))
+        if (dims3(1) /= 3 .or. dims3(3) < nt) then
+            call make_error(err, ERR_INPUT, path//': /state/q: not (times, n, 3) with '// &
+                            int_text(nt)//' records')
+            return
+        end if
+        rec%q = reshape(values(3*rec%n*(k - 1) + 1:3*rec%n*k), [3, rec%n])
+        call h5%read_reals('/state/qdot', values, dims3, err)
+        if (allocated(err)) return
+        if (dims3(1) /= 3 .or. dims3(2) /= rec%n .or. dims3(3) < nt) then
+            call make_error(err, ERR_INPUT, path//': /state/qdot: not (times, '// &
+                            int_text(rec%n)//', 3) with '//int_text(nt)//' records')
+            return
+        end if
+        rec%qdot = reshape(values(3*rec%n*(k - 1) + 1:3*rec%n*k), [3, rec%n])
+    end subroutine read_positions
+
+    !> The native state of record k, where the writer stores it (restart data): y and yq
+    !! both, or neither.
+    subroutine read_native_state(h5, k, rec, err)
+        type(h5_file_t), intent(inout) :: h5
+        integer, intent(in) :: k
+        type(state_record_t), intent(inout) :: rec
+        type(error_t), allocatable, intent(out) :: err
+        real(wp), allocatable :: values(:)
+        integer(hsize_t) :: dims2(2)
+        if (.not. (h5%exists('/state/y') .and. h5%exists('/state/yq'))) return
+        call h5%read_reals('/state/y', values, dims2, err)
+        if (allocated(err)) return
+        if (dims2(2) >= rec%records) rec%y = values(dims2(1)*(k - 1) + 1:dims2(1)*k)
+        call h5%read_reals('/state/yq', values, dims2, err)
+        if (allocated(err)) return
+        if (dims2(2) >= rec%records) rec%yq = values(dims2(1)*(k - 1) + 1:dims2(1)*k)
+        if (.not. (allocated(rec%y) .and. allocated(rec%yq))) then
+            if (allocated(rec%y)) deallocate (rec%y)
+            if (allocated(rec%yq)) deallocate (rec%yq)
+        end if
+    end subroutine read_native_state
+
+    !> The record's values finite, and within the limits of a scene (ropedyn_run_record):
+    !! speeds by the rope's element masses where the file has them.
+    subroutine check_record(h5, path, rec, err)
+        type(h5_file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: path
+        type(state_record_t), intent(in) :: rec
+        type(error_t), allocatable, intent(out) :: err
+        real(wp), allocatable :: values(:)
+        integer(hsize_t) :: dims1(1)
+        real(wp) :: bound
+        bound = MAGNITUDE_LIMIT
+        if (h5%exists('/rope/element_mass')) then
+            call h5%read_reals('/rope/element_mass', values, dims1, err)
+            if (allocated(err)) return
+            bound = speed_bound(values)
+        end if
+        call check_record_values(path, '/state/q', rec%record, rec%t, &
+                                 reshape(rec%q, [size(rec%q)]), bound, err)
+        if (allocated(err)) return
+        call check_record_values(path, '/state/qdot', rec%record, rec%t, &
+                                 reshape(rec%qdot, [size(rec%qdot)]), bound, err)
+        if (allocated(err)) return
+        if (allocated(rec%y)) then
+            call check_record_values(path, '/state/y', rec%record, rec%t, rec%y, bound, err)
+            if (allocated(err)) return
+            call check_record_values(path, '/state/yq', rec%record, rec%t, rec%yq, &
+                                     MAGNITUDE_LIMIT, err)
+            if (allocated(err)) return
+        end if
+        call check_record_values(path, '/energy/dissipated', rec%record, rec%t, &
+                                 [rec%dissipated], MAGNITUDE_LIMIT, err)
+        if (allocated(err)) return
+        call check_record_values(path, '/energy/support_work', rec%record, rec%t, &
+                                 [rec%support_work], MAGNITUDE_LIMIT, err)
+    end subroutine check_record
+
+    !> Record k of a (times,) series; 0 when the file has no such dataset.
+    subroutine read_scalar_record(h5, name, k, value, err)
+        type(h5_file_t), intent(inout) :: h5
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: k
+        real(wp), intent(out) :: value
+        type(error_t), allocatable, intent(out) :: err
+        real(wp), allocatable :: series(:)
+        integer(hsize_t) :: d(1)
+        value = 0.0_wp
+        if (.not. h5%exists(name)) return
+        call h5%read_reals(name, series, d, err)
+        if (allocated(err)) return
+        if (size(series) >= k) value = series(k)
+    end subroutine read_scalar_record
 end module ropedyn_state_record
