@@ -10,58 +10,59 @@ contains
 
     module procedure output_append
         real(wp) :: scalars(S_KINETIC:S_STEP_SIZE)
-        real(wp) :: now
-        integer :: n, k, m
-        logical :: due
+        integer :: k, m
 
         if (.not. self%is_open) then
             call not_open(self, 'append', err)
             return
         end if
-        n = self%n_elements
-        call check_shape(q, '/state/q', 3, n)
-        if (allocated(err)) return
-        call check_shape(qdot, '/state/qdot', 3, n)
-        if (allocated(err)) return
-        call check_shape(points, '/rope/points', 2, 2*n)
-        if (allocated(err)) return
-        if (self%restart_data) call check_state()
-        if (allocated(err)) return
-        if (self%force_data) call check_forces()
+        call check_record_args(self, q, qdot, points, err, y, yq, axial, shear, moment, &
+                               reaction, position)
         if (allocated(err)) return
 
         m = self%n_pending + 1
-        call put(S_TIME, [t])
-        call put(S_Q, reshape(q, [size(q)]))
-        call put(S_QDOT, reshape(qdot, [size(qdot)]))
-        call put(S_POINTS, reshape(points, [size(points)]))
+        call put(self, S_TIME, m, [t])
+        call put(self, S_Q, m, reshape(q, [size(q)]))
+        call put(self, S_QDOT, m, reshape(qdot, [size(qdot)]))
+        call put(self, S_POINTS, m, reshape(points, [size(points)]))
         scalars = [energy%kinetic, energy%elastic, energy%gravity, energy%dissipated, &
                    energy%support_work, energy%total(), step_size]
         do k = S_KINETIC, S_STEP_SIZE
-            call put(k, scalars(k:k))
+            call put(self, k, m, scalars(k:k))
         end do
         self%pending_order(m) = order
         if (self%restart_data) then
-            call put(N_SERIES + 1, y)
-            call put(N_SERIES + 2, [yq(1:self%state_size(2)), &
-                                    spread(0.0_wp, 1, max(1, self%state_size(2)) &
-                                           - self%state_size(2))])
+            call put(self, N_SERIES + 1, m, y)
+            call put(self, N_SERIES + 2, m, [yq(1:self%state_size(2)), &
+                                             spread(0.0_wp, 1, max(1, self%state_size(2)) &
+                                                    - self%state_size(2))])
         end if
         if (self%force_data) then
-            call put(N_SERIES + 3, axial)
-            call put(N_SERIES + 4, shear)
-            call put(N_SERIES + 5, moment)
-            call put(N_SERIES + 6, reaction(:, 1))
-            call put(N_SERIES + 7, reaction(:, 2))
-            if (self%force_on(N_FORCE_SERIES - 1)) call put(N_SERIES + 8, position(:, 1))
-            if (self%force_on(N_FORCE_SERIES)) call put(N_SERIES + 9, position(:, 2))
+            call put(self, N_SERIES + 3, m, axial)
+            call put(self, N_SERIES + 4, m, shear)
+            call put(self, N_SERIES + 5, m, moment)
+            call put(self, N_SERIES + 6, m, reaction(:, 1))
+            call put(self, N_SERIES + 7, m, reaction(:, 2))
+            if (self%force_on(N_FORCE_SERIES - 1)) &
+                call put(self, N_SERIES + 8, m, position(:, 1))
+            if (self%force_on(N_FORCE_SERIES)) call put(self, N_SERIES + 9, m, position(:, 2))
         end if
         self%n_pending = m
+        call write_when_due(self, err)
+    end procedure output_append
 
+    !> The pending records written when they fill the block or are due (the first record,
+    !! or FLUSH_PERIOD since the last flush; then the file is flushed too); a failure
+    !! abandons the file.
+    subroutine write_when_due(self, err)
+        class(output_file_t), intent(inout) :: self
+        type(error_t), allocatable, intent(inout) :: err
+        real(wp) :: now
+        logical :: due
         now = clock_seconds()
-        due = self%n_records + m == 1 .or. &
+        due = self%n_records + self%n_pending == 1 .or. &
               now - self%last_flush >= FLUSH_PERIOD
-        if (due .or. m == self%capacity) then
+        if (due .or. self%n_pending == self%capacity) then
             call write_pending(self, err)
             ! room for what follows (not at the end: a run that got all its records written
             ! closes its file whatever room is left)
@@ -72,32 +73,36 @@ contains
             self%last_flush = now
         end if
         if (allocated(err)) call abandon(self, err)
+    end subroutine write_when_due
 
-    contains
+    !> Record m of series k.
+    subroutine put(self, k, m, values)
+        class(output_file_t), intent(inout) :: self
+        integer, intent(in) :: k, m
+        real(wp), intent(in) :: values(:)
+        integer :: r
+        r = size(values)
+        self%pending(k)%v((m - 1)*r + 1:m*r) = values
+    end subroutine put
 
-        !> Record m of series k.
-        subroutine put(k, values)
-            integer, intent(in) :: k
-            real(wp), intent(in) :: values(:)
-            integer :: r
-            r = size(values)
-            self%pending(k)%v((m - 1)*r + 1:m*r) = values
-        end subroutine put
-
-        !> ERR_INTERNAL unless the record `a` of dataset `name` has the shape (rows, cols).
-        subroutine check_shape(a, name, rows, cols)
-            real(wp), intent(in) :: a(:, :)
-            character(len=*), intent(in) :: name
-            integer, intent(in) :: rows, cols
-            if (size(a, 1) /= rows .or. size(a, 2) /= cols) &
-                call make_error(err, ERR_INTERNAL, self%file%file_name()//': '//name// &
-                                ': record has shape ('//int_text(size(a, 1))//', '// &
-                                int_text(size(a, 2))//'), expected ('//int_text(rows)//', '// &
-                                int_text(cols)//')')
-        end subroutine check_shape
-
-        !> ERR_INTERNAL unless y and yq are present with the sizes given at create.
-        subroutine check_state()
+    !> ERR_INTERNAL unless a record's arrays have the shapes the file was made for, with
+    !! the restart data and internal forces it holds.
+    subroutine check_record_args(self, q, qdot, points, err, y, yq, axial, shear, moment, &
+                                 reaction, position)
+        class(output_file_t), intent(in) :: self
+        real(wp), intent(in) :: q(:, :), qdot(:, :), points(:, :)
+        type(error_t), allocatable, intent(inout) :: err
+        real(wp), intent(in), optional :: y(:), yq(:), axial(:), shear(:), moment(:)
+        real(wp), intent(in), optional :: reaction(:, :), position(:, :)
+        integer :: n
+        n = self%n_elements
+        call check_shape(self, q, '/state/q', 3, n, err)
+        if (allocated(err)) return
+        call check_shape(self, qdot, '/state/qdot', 3, n, err)
+        if (allocated(err)) return
+        call check_shape(self, points, '/rope/points', 2, 2*n, err)
+        if (allocated(err)) return
+        if (self%restart_data) then
             if (.not. (present(y) .and. present(yq))) then
                 call make_error(err, ERR_INTERNAL, self%file%file_name()//': append: the '// &
                                 'file holds restart data: y and yq are needed')
@@ -107,29 +112,51 @@ contains
                                 ' values, expected '//int_text(self%state_size(1))//' and '// &
                                 int_text(self%state_size(2)))
             end if
-        end subroutine check_state
+            if (allocated(err)) return
+        end if
+        if (self%force_data) call check_forces(self, n, err, axial, shear, moment, reaction, &
+                                               position)
+    end subroutine check_record_args
 
-        !> ERR_INTERNAL unless the internal forces are present with n + 1 joints and the
-        !! reactions and positions with shape (2, 2).
-        subroutine check_forces()
-            if (.not. (present(axial) .and. present(shear) .and. present(moment) .and. &
-                       present(reaction) .and. present(position))) then
-                call make_error(err, ERR_INTERNAL, self%file%file_name()//': append: the '// &
-                                'file holds internal forces: axial, shear, moment, '// &
-                                'reaction and position are needed')
-            else if (size(axial) /= n + 1 .or. size(shear) /= n + 1 .or. &
-                     size(moment) /= n + 1) then
-                call make_error(err, ERR_INTERNAL, self%file%file_name()//': append: '// &
-                                'axial, shear, moment have '//int_text(size(axial))//', '// &
-                                int_text(size(shear))//', '//int_text(size(moment))// &
-                                ' values, expected '//int_text(n + 1))
-            else
-                call check_shape(reaction, '/supports/*/reaction', 2, 2)
-                if (.not. allocated(err)) &
-                    call check_shape(position, '/supports/*/position', 2, 2)
-            end if
-        end subroutine check_forces
-    end procedure output_append
+    !> ERR_INTERNAL unless the internal forces are present with n + 1 joints and the
+    !! reactions and positions with shape (2, 2).
+    subroutine check_forces(self, n, err, axial, shear, moment, reaction, position)
+        class(output_file_t), intent(in) :: self
+        integer, intent(in) :: n
+        type(error_t), allocatable, intent(inout) :: err
+        real(wp), intent(in), optional :: axial(:), shear(:), moment(:)
+        real(wp), intent(in), optional :: reaction(:, :), position(:, :)
+        if (.not. (present(axial) .and. present(shear) .and. present(moment) .and. &
+                   present(reaction) .and. present(position))) then
+            call make_error(err, ERR_INTERNAL, self%file%file_name()//': append: the '// &
+                            'file holds internal forces: axial, shear, moment, '// &
+                            'reaction and position are needed')
+        else if (size(axial) /= n + 1 .or. size(shear) /= n + 1 .or. &
+                 size(moment) /= n + 1) then
+            call make_error(err, ERR_INTERNAL, self%file%file_name()//': append: '// &
+                            'axial, shear, moment have '//int_text(size(axial))//', '// &
+                            int_text(size(shear))//', '//int_text(size(moment))// &
+                            ' values, expected '//int_text(n + 1))
+        else
+            call check_shape(self, reaction, '/supports/*/reaction', 2, 2, err)
+            if (.not. allocated(err)) &
+                call check_shape(self, position, '/supports/*/position', 2, 2, err)
+        end if
+    end subroutine check_forces
+
+    !> ERR_INTERNAL unless the record `a` of dataset `name` has the shape (rows, cols).
+    subroutine check_shape(self, a, name, rows, cols, err)
+        class(output_file_t), intent(in) :: self
+        real(wp), intent(in) :: a(:, :)
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: rows, cols
+        type(error_t), allocatable, intent(inout) :: err
+        if (size(a, 1) /= rows .or. size(a, 2) /= cols) &
+            call make_error(err, ERR_INTERNAL, self%file%file_name()//': '//name// &
+                            ': record has shape ('//int_text(size(a, 1))//', '// &
+                            int_text(size(a, 2))//'), expected ('//int_text(rows)//', '// &
+                            int_text(cols)//')')
+    end subroutine check_shape
 
     module procedure allocate_pending
         integer :: sizes(size(self%pending)), k
