@@ -7,12 +7,13 @@
 !! the growth, rejects steps and holds h far below what the smooth motion needs: a crawl
 !! (the steel wire: 8.5e5 steps per simulated second at order 5, 9e4 at order 2). The loop
 !! looks at every window of WINDOW steps: when the window and the whole run so far took
-!! more than CRAWL_RATE steps per simulated second (the run: VDPOL's fronts alone reach it), the order in use is >= 3 and at least FAIL_SHARE of the
-!! steps failed the error test (the signature of a step held by stability: on the steel
-!! wire 5 %, against under 1 % where accuracy limits the step),
-!! it tries the A-stable BDF2 for one window (CVODE re-initialized at its current state:
-!! `CVodeSetMaxOrd` cannot lower the order in force, only its limit). If order 2 covers
-!! the time in no more steps (ACCEPT) in its third window, the crawl is confirmed: the limit stays at
+!! more than CRAWL_RATE steps per simulated second (the run: VDPOL's fronts alone reach
+!! it), the order in use is >= 3 and at least FAIL_SHARE of the steps failed the error
+!! test (the signature of a step held by stability: on the steel wire 5 %, against under
+!! 1 % where accuracy limits the step), it tries the A-stable BDF2 for one window (CVODE
+!! re-initialized at its current state: `CVodeSetMaxOrd` cannot lower the order in force,
+!! only its limit). If order 2 covers the time in no more steps (ACCEPT) in its third
+!! window, the crawl is confirmed: the limit stays at
 !! 2 for a stretch, the run gets a warning naming the cause, and after the stretch the
 !! original limit is restored (without restart) to see whether the stiff modes have died
 !! away; a crawl that comes back doubles the next stretch. If order 2 is not faster (the
@@ -157,8 +158,6 @@ contains
         real(wp) :: rate, share, span
         integer(i8) :: steps, fails
         integer(c_int) :: flag, order(1)
-        logical :: ok
-        character(len=200) :: text
 
         now = self%stats()
         steps = now%steps - self%monitor%window_steps0
@@ -168,105 +167,137 @@ contains
         share = real(fails, wp)/max(1_i8, steps)
         order = 0
         flag = FCVodeGetCurrentOrder(self%mem, order)
-        block
-            character(len=16) :: env
-            integer :: st
-            call get_environment_variable('ROPEDYN_TRACE', env, status=st)
-            if (st == 0) write (0, '(a, f10.5, a, es10.3, a, f7.4, a, i0, a, i0, a, es10.3)') &
-                'TRACE t=', self%tn, ' rate=', rate, ' share=', share, ' q=', order(1), &
-                ' mode=', self%monitor%mode, ' h=', now%last_step
-        end block
+        if (self%adams) then
+            call watch_adams(self, rate, cause)
+        else
+            call watch_bdf_order(self, now, rate, share, int(order(1)))
+        end if
+        self%monitor%window_steps0 = now%steps
+        self%monitor%window_fails0 = now%err_test_fails
+        self%monitor%window_t0 = self%tn
+    end procedure cvode_watch
+
+    !> Adams: FAIL_WINDOWS windows in a row above STIFF_STEP_RATE steps per simulated
+    !! second (its fixed-point iteration needs h |lambda| < 1) end the run, with `cause`.
+    subroutine watch_adams(self, rate, cause)
+        class(cvode_t), intent(inout) :: self
+        real(wp), intent(in) :: rate
+        character(len=:), allocatable, intent(inout) :: cause
+        character(len=200) :: text
         associate (m => self%monitor)
-            if (self%adams) then
-                m%stiff_windows = merge(m%stiff_windows + 1, 0, rate > STIFF_STEP_RATE)
-                if (m%stiff_windows >= FAIL_WINDOWS) then
-                    write (text, '(a, es9.2, a)') 'the problem is stiff here: the fixed-point '// &
-                        'iteration of the Adams method converges only for h |lambda| < 1, '// &
-                        'which takes ', rate, ' steps per simulated second'
-                    cause = trim(text)//'; use method = ''auto'', ''mebdf'' or ''cvode'''
+            m%stiff_windows = merge(m%stiff_windows + 1, 0, rate > STIFF_STEP_RATE)
+            if (m%stiff_windows >= FAIL_WINDOWS) then
+                write (text, '(a, es9.2, a)') 'the problem is stiff here: the fixed-point '// &
+                    'iteration of the Adams method converges only for h |lambda| < 1, '// &
+                    'which takes ', rate, ' steps per simulated second'
+                cause = trim(text)//'; use method = ''auto'', ''mebdf'' or ''cvode'''
+            end if
+        end associate
+    end subroutine watch_adams
+
+    !> BDF: the order trial of the module header, one window at a time. Mode 0: watching
+    !! (a crawl at order > 2 starts a trial of order 2); 1: the trial's first windows;
+    !! 3: the trial judged (order 2 kept for a stretch, or the limit restored and the next
+    !! trial deferred); 2: the stretch at order 2, then the limit restored.
+    subroutine watch_bdf_order(self, now, rate, share, order)
+        class(cvode_t), intent(inout) :: self
+        type(solver_stats_t), intent(in) :: now
+        real(wp), intent(in) :: rate, share
+        integer, intent(in) :: order
+        integer(c_int) :: flag
+        logical :: ok
+        character(len=200) :: text
+        associate (m => self%monitor)
+            select case (m%mode)
+            case (0)
+                if (m%wait_windows > 0) then
+                    m%wait_windows = m%wait_windows - 1
+                else if (m%qmax > LOW_ORDER .and. order > LOW_ORDER .and. &
+                         share >= FAIL_SHARE .and. rate >= CRAWL_RATE .and. &
+                         real(now%steps, wp) >= CRAWL_RATE*(self%tn - m%t_start)) then
+                    ! a crawl? try the A-stable order for one window
+                    m%rate_before = rate
+                    call self%restart(LOW_ORDER, 8.0_wp*now%last_step, ok)
+                    if (ok) then
+                        m%mode = 1
+                        m%trial_windows = 1
+                        write (text, '(a, i0, a, f5.1, a, es9.2, a)') 'trying max order 2: '// &
+                            'step held at order ', order, ' (', 100.0_wp*share, &
+                            ' % error-test failures, ', rate, ' steps per second)'
+                        call note(self, trim(text))
+                    end if
+                end if
+            case (1)
+                ! the first windows at order 2 include CVODE's restart at order 1 and the
+                ! decay of what the high order kept ringing: judge on the last one
+                m%trial_windows = m%trial_windows + 1
+                if (m%trial_windows >= TRIAL_WINDOWS) m%mode = 3
+            case (3)
+                call judge_low_order(self, rate)
+            case (2)
+                m%stay_windows = m%stay_windows - 1
+                if (m%stay_windows <= 0) then
+                    flag = FCVodeSetMaxOrd(self%mem, int(m%qmax_user, c_int))
+                    m%qmax = m%qmax_user
+                    m%mode = 0
+                    m%wait_windows = 0
+                    call note(self, 'max order back to '//int_text(m%qmax_user)// &
+                              ': has the stability limit passed?')
+                end if
+            end select
+        end associate
+    end subroutine watch_bdf_order
+
+    !> The trial of order 2 judged on its last window (rate, steps per simulated second):
+    !! no more steps than before (ACCEPT): the crawl is confirmed, order 2 stays for a
+    !! stretch (doubled each time) with the run's one warning; else the limit is restored
+    !! and the next trial waits the longer, the more order 2 lost.
+    subroutine judge_low_order(self, rate)
+        class(cvode_t), intent(inout) :: self
+        real(wp), intent(in) :: rate
+        integer(c_int) :: flag
+        character(len=200) :: text
+        associate (m => self%monitor)
+            if (rate <= ACCEPT*m%rate_before) then
+                m%mode = 2
+                m%stay_windows = m%stay
+                m%stay = min(2*m%stay, MAX_STAY)
+                write (text, '(a, i0, a, es9.2, a, es9.2, a)') 'the step size was '// &
+                    'held by stability at BDF order ', m%qmax_user, ' (', &
+                    m%rate_before, ' steps per simulated second; at order 2: ', &
+                    rate, '): lightly damped stiff modes'
+                call note(self, 'max order stays 2: '//trim(text), .not. m%warned)
+                if (.not. m%warned) then
+                    ! the one warning of the run, with the cure
+                    self%log%events(self%log%count)%reason = trim(text)// &
+                        '; the maximum order is lowered to 2 while this lasts '// &
+                        '(method = ''mebdf'' or ''auto'' avoids it)'
+                    m%warned = .true.
                 end if
             else
-                select case (m%mode)
-                case (0)
-                    if (m%wait_windows > 0) then
-                        m%wait_windows = m%wait_windows - 1
-                    else if (m%qmax > LOW_ORDER .and. order(1) > LOW_ORDER .and. &
-                             share >= FAIL_SHARE .and. rate >= CRAWL_RATE .and. &
-                             real(now%steps, wp) >= CRAWL_RATE*(self%tn - m%t_start)) then
-                        ! a crawl? try the A-stable order for one window
-                        m%rate_before = rate
-                        call self%restart(LOW_ORDER, 8.0_wp*now%last_step, ok)
-                        if (ok) then
-                            m%mode = 1
-                            m%trial_windows = 1
-                            write (text, '(a, i0, a, f5.1, a, es9.2, a)') 'trying max order 2: '// &
-                                'step held at order ', order(1), ' (', 100.0_wp*share, &
-                                ' % error-test failures, ', rate, ' steps per second)'
-                            call note(trim(text))
-                        end if
-                    end if
-                case (1)
-                    ! the first windows at order 2 include CVODE's restart at order 1 and
-                    ! the decay of what the high order kept ringing: judge on the last one
-                    m%trial_windows = m%trial_windows + 1
-                    if (m%trial_windows >= TRIAL_WINDOWS) m%mode = 3
-                case (3)
-                    if (rate <= ACCEPT*m%rate_before) then
-                        m%mode = 2
-                        m%stay_windows = m%stay
-                        m%stay = min(2*m%stay, MAX_STAY)
-                        write (text, '(a, i0, a, es9.2, a, es9.2, a)') 'the step size was '// &
-                            'held by stability at BDF order ', m%qmax_user, ' (', &
-                            m%rate_before, ' steps per simulated second; at order 2: ', &
-                            rate, '): lightly damped stiff modes'
-                        call note('max order stays 2: '//trim(text), .not. m%warned)
-                        if (.not. m%warned) then
-                            ! the one warning of the run, with the cure
-                            self%log%events(self%log%count)%reason = trim(text)// &
-                                '; the maximum order is lowered to 2 while this lasts '// &
-                                '(method = ''mebdf'' or ''auto'' avoids it)'
-                            m%warned = .true.
-                        end if
-                    else
-                        flag = FCVodeSetMaxOrd(self%mem, int(m%qmax_user, c_int))
-                        m%qmax = m%qmax_user
-                        m%mode = 0
-                        ! the more order 2 lost, the longer until the next trial
-                        m%wait_windows = m%backoff
-                        m%backoff = min(MAX_BACKOFF, ceiling(m%backoff*max(2.0_wp, &
-                                        2.0_wp*rate/max(m%rate_before, tiny(1.0_wp)))))
-                        write (text, '(a, i0, a, es9.2, a, es9.2, a)') 'max order back to ', &
-                            m%qmax_user, ': order 2 was not faster (', rate, &
-                            ' steps per second against ', m%rate_before, ')'
-                        call note(trim(text))
-                    end if
-                case (2)
-                    m%stay_windows = m%stay_windows - 1
-                    if (m%stay_windows <= 0) then
-                        flag = FCVodeSetMaxOrd(self%mem, int(m%qmax_user, c_int))
-                        m%qmax = m%qmax_user
-                        m%mode = 0
-                        m%wait_windows = 0
-                        call note('max order back to '//int_text(m%qmax_user)// &
-                                  ': has the stability limit passed?')
-                    end if
-                end select
+                flag = FCVodeSetMaxOrd(self%mem, int(m%qmax_user, c_int))
+                m%qmax = m%qmax_user
+                m%mode = 0
+                m%wait_windows = m%backoff
+                m%backoff = min(MAX_BACKOFF, ceiling(m%backoff*max(2.0_wp, &
+                                2.0_wp*rate/max(m%rate_before, tiny(1.0_wp)))))
+                write (text, '(a, i0, a, es9.2, a, es9.2, a)') 'max order back to ', &
+                    m%qmax_user, ': order 2 was not faster (', rate, &
+                    ' steps per second against ', m%rate_before, ')'
+                call note(self, trim(text))
             end if
-            m%window_steps0 = now%steps
-            m%window_fails0 = now%err_test_fails
-            m%window_t0 = self%tn
-
         end associate
-    contains
-        !> Log a change of the order limit at the current time.
-        subroutine note(reason, warning)
-            character(len=*), intent(in) :: reason
-            logical, intent(in), optional :: warning
-            if (self%log%count == 0) call self%log%add(self%monitor%window_t0, self%name(), &
-                self%monitor%qmax_user, 'start')
-            call self%log%add(self%tn, self%name(), self%monitor%qmax, reason, warning)
-        end subroutine note
-    end procedure cvode_watch
+    end subroutine judge_low_order
+
+    !> Log a change of the order limit at the current time.
+    subroutine note(self, reason, warning)
+        class(cvode_t), intent(inout) :: self
+        character(len=*), intent(in) :: reason
+        logical, intent(in), optional :: warning
+        if (self%log%count == 0) call self%log%add(self%monitor%window_t0, self%name(), &
+            self%monitor%qmax_user, 'start')
+        call self%log%add(self%tn, self%name(), self%monitor%qmax, reason, warning)
+    end subroutine note
 
     module procedure cvode_restart
         real(c_double) :: tret(1)
