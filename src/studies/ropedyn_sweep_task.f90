@@ -106,31 +106,22 @@ contains
         integer, intent(in) :: k
         logical, intent(in) :: force, quiet
         type(error_t), allocatable, intent(out) :: err
-        type(run_summary_t) :: summary
-        type(case_state_t) :: state
-        type(scene_t) :: scene
-        type(error_t), allocatable :: ferr
         character(len=:), allocatable :: label, lock, part
         type(heartbeat_t) :: beat
-        real(wp) :: start
-        real(wp) :: wall
-        logical :: removed, resume
+        logical :: done
 
         label = case_label(sweep, k)
         associate (c => sweep%cases(k))
             lock = lock_path(c%file)
             part = part_path(c%file)
-            if (len(part) > len(scene%output%file)) then
+            if (len(part) > len(c%scene%output%file)) then
                 call make_error(err, ERR_INPUT, label//': '//part//': the file name is too ' &
-                    //'long (at most '//int_text(len(scene%output%file))//' characters)')
+                    //'long (at most '//int_text(len(c%scene%output%file))//' characters)')
                 return
             end if
             if (.not. force) then
-                call case_state(c, state)
-                if (state%status == 'complete') then
-                    call skipped()
-                    return
-                end if
+                call check_complete(c, label, quiet, done)
+                if (done) return
             end if
             call make_dirs(sweep%output_dir, err, 'sweep')
             if (allocated(err)) return
@@ -139,75 +130,105 @@ contains
                 err%message = label//' ('//c%file//'): not run: '//err%message
                 return
             end if
-            locked: block
-                if (signal_received() /= 0) then
-                    call make_error(err, ERR_INTERRUPTED, label//': not run: stopped by '// &
-                        signal_name(signal_received()))
-                    exit locked
-                end if
-                ! complete meanwhile (a writer that finished just before this one locked)?
-                if (.not. force) then
-                    call case_state(c, state)
-                    if (state%status == 'complete') then
-                        call skipped()
-                        exit locked
-                    end if
-                end if
-                removed = delete_file(part)
-                scene = c%scene
-                scene%output%file = part
-                ! an interrupted case continues from its last record
-                resume = .false.
-                if (.not. force) then
-                    call case_state(c, state)
-                    resume = state%status == 'interrupted' .and. file_status(c%file) == &
-                             'interrupted'
-                end if
-                if (resume) then
-                    call rename_file(c%file, part, err)
-                    if (allocated(err)) exit locked
-                    if (.not. quiet) write (output_unit, '(a)') label//': interrupted '// &
-                        'before: continuing it from its last record'
-                end if
-                start = clock_seconds()
-                call run_scene(scene, summary, err, resume=resume, guard=.false.)
-                if (resume .and. allocated(err)) then
-                    ! not to be continued (nothing left, no restart data, ...): run it anew
-                    if (err%code == ERR_INPUT) then
-                        write (error_unit, '(a)') label//': cannot be continued ('// &
-                            err%message//'): running it anew'
-                        removed = delete_file(part)
-                        call run_scene(scene, summary, err, guard=.false.)
-                    end if
-                end if
-                wall = clock_seconds() - start
-                call put_in_place(c, part, wall, ferr)
-                if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
-                ! a run that failed without a file leaves its message for the status
-                call drop_failure_note(c%file)
-                if (allocated(err)) then
-                    if (err%code /= ERR_INTERRUPTED .and. len(file_status(c%file)) == 0) &
-                        call write_failure_note(c%file, err%message)
-                end if
-                if (allocated(err)) then
-                    err%message = label//' ('//c%file//'): '//err%message
-                    if (err%code == ERR_INTERRUPTED) err%message = err%message// &
-                        '; running the sweep again continues it'
-                    exit locked
-                end if
-                if (.not. quiet) write (output_unit, '(a)') label//': complete: '// &
-                    int_text(int(summary%stats%steps))//' steps, cpu '// &
-                    fixed_text(summary%cpu_time, 3)//' s, wall '//fixed_text(wall, 3)//' s -> '// &
-                    c%file
-            end block locked
+            call run_locked(c, label, part, force, quiet, err)
             call drop_lock(lock, beat)
         end associate
-    contains
-        subroutine skipped()
-            if (.not. quiet) write (output_unit, '(a)') label//': complete already ('// &
-                sweep%cases(k)%file//'), skipped'
-        end subroutine skipped
     end subroutine run_one
+
+    !> Case c, its lock held: not when a signal came or another writer completed it
+    !! meanwhile; an interrupted case continues from its last record (run anew when it
+    !! cannot be continued); the file put in place and the outcome said.
+    subroutine run_locked(c, label, part, force, quiet, err)
+        type(sweep_case_t), intent(in) :: c
+        character(len=*), intent(in) :: label, part
+        logical, intent(in) :: force, quiet
+        type(error_t), allocatable, intent(out) :: err
+        type(run_summary_t) :: summary
+        type(case_state_t) :: state
+        type(scene_t) :: scene
+        real(wp) :: start
+        logical :: removed, resume, done
+
+        if (signal_received() /= 0) then
+            call make_error(err, ERR_INTERRUPTED, label//': not run: stopped by '// &
+                signal_name(signal_received()))
+            return
+        end if
+        ! complete meanwhile (a writer that finished just before this one locked)?
+        if (.not. force) then
+            call check_complete(c, label, quiet, done)
+            if (done) return
+        end if
+        removed = delete_file(part)
+        scene = c%scene
+        scene%output%file = part
+        ! an interrupted case continues from its last record
+        resume = .false.
+        if (.not. force) then
+            call case_state(c, state)
+            resume = state%status == 'interrupted' .and. file_status(c%file) == 'interrupted'
+        end if
+        if (resume) then
+            call rename_file(c%file, part, err)
+            if (allocated(err)) return
+            if (.not. quiet) write (output_unit, '(a)') label//': interrupted '// &
+                'before: continuing it from its last record'
+        end if
+        start = clock_seconds()
+        call run_scene(scene, summary, err, resume=resume, guard=.false.)
+        if (resume .and. allocated(err)) then
+            ! not to be continued (nothing left, no restart data, ...): run it anew
+            if (err%code == ERR_INPUT) then
+                write (error_unit, '(a)') label//': cannot be continued ('// &
+                    err%message//'): running it anew'
+                removed = delete_file(part)
+                call run_scene(scene, summary, err, guard=.false.)
+            end if
+        end if
+        call finish_case(c, label, part, clock_seconds() - start, summary, quiet, err)
+    end subroutine run_locked
+
+    !> The run's file put in place (part -> the case file, wall time its) and the failure
+    !! note of a run without a file; the outcome said: the error named after the case, or
+    !! the completion line.
+    subroutine finish_case(c, label, part, wall, summary, quiet, err)
+        type(sweep_case_t), intent(in) :: c
+        character(len=*), intent(in) :: label, part
+        real(wp), intent(in) :: wall
+        type(run_summary_t), intent(in) :: summary
+        logical, intent(in) :: quiet
+        type(error_t), allocatable, intent(inout) :: err
+        type(error_t), allocatable :: ferr
+        call put_in_place(c, part, wall, ferr)
+        if (allocated(ferr) .and. .not. allocated(err)) call move_alloc(ferr, err)
+        ! a run that failed without a file leaves its message for the status
+        call drop_failure_note(c%file)
+        if (allocated(err)) then
+            if (err%code /= ERR_INTERRUPTED .and. len(file_status(c%file)) == 0) &
+                call write_failure_note(c%file, err%message)
+            err%message = label//' ('//c%file//'): '//err%message
+            if (err%code == ERR_INTERRUPTED) err%message = err%message// &
+                '; running the sweep again continues it'
+            return
+        end if
+        if (.not. quiet) write (output_unit, '(a)') label//': complete: '// &
+            int_text(int(summary%stats%steps))//' steps, cpu '// &
+            fixed_text(summary%cpu_time, 3)//' s, wall '//fixed_text(wall, 3)//' s -> '// &
+            c%file
+    end subroutine finish_case
+
+    !> Whether case c is complete already (done; then it is skipped, and said unless quiet).
+    subroutine check_complete(c, label, quiet, done)
+        type(sweep_case_t), intent(in) :: c
+        character(len=*), intent(in) :: label
+        logical, intent(in) :: quiet
+        logical, intent(out) :: done
+        type(case_state_t) :: state
+        call case_state(c, state)
+        done = state%status == 'complete'
+        if (done .and. .not. quiet) write (output_unit, '(a)') label//': complete already ('// &
+            c%file//'), skipped'
+    end subroutine check_complete
 
     !> The .part file of a finished run becomes the case file: with its wall time and the
     !! case's scene, renamed into place. A run that did not finish its file (an error before
