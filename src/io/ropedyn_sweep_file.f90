@@ -94,7 +94,7 @@ contains
         type(error_t), allocatable, intent(out) :: err
         character(len=*), intent(in), optional :: output_dir
         type(raw_t) :: raw(size(KEYS))
-        character(len=:), allocatable :: where, dir, what
+        character(len=:), allocatable :: where, dir
         type(scene_t) :: scene
         type(dimension_t) :: lists(5)
         integer :: slash
@@ -123,13 +123,34 @@ contains
             err%message = where//'base = "'//clip(raw(K_BASE)%text(1)%s)//'": '//err%message
             return
         end if
+        call set_output_dir(where, raw(K_OUTPUT_DIR), sweep, err, output_dir)
+        if (allocated(err)) return
+        call read_reference(where, dir, raw(K_REFERENCE), sweep, err)
+        if (allocated(err)) return
+        call read_atol_per_rtol(where, raw(K_ATOL), sweep, err)
+        if (allocated(err)) return
 
-        ! the output directory
-        what = 'output_dir = "'
-        if (raw(K_OUTPUT_DIR)%n > 0) sweep%output_dir = raw(K_OUTPUT_DIR)%text(1)%s
+        call set_list(raw, lists(1), 'models', 'model.kind')
+        call set_list(raw, lists(2), 'elements', 'model.elements')
+        call set_list(raw, lists(3), 'methods', 'solver.method')
+        call set_list(raw, lists(4), 'max_orders', 'solver.max_order')
+        call set_list(raw, lists(5), 'rtols', 'solver.rtol')
+        call build_dimensions(where, sweep%base, list_of(raw, 'set'), list_of(raw, 'vary'), &
+            lists, sweep%atol_given, sweep%set, sweep%vary_keys, sweep%dims, err)
+    end subroutine read_sweep_file
+
+    !> The output directory: --output-dir, else output_dir, else out/sweep_<name>, without
+    !! trailing slashes; refused when it cannot hold the case files.
+    subroutine set_output_dir(where, given, sweep, err, output_dir)
+        character(len=*), intent(in) :: where
+        type(raw_t), intent(in) :: given
+        type(sweep_file_t), intent(inout) :: sweep
+        type(error_t), allocatable, intent(out) :: err
+        character(len=*), intent(in), optional :: output_dir
+        character(len=:), allocatable :: why
+        if (given%n > 0) sweep%output_dir = given%text(1)%s
         if (present(output_dir)) then
             if (len_trim(output_dir) > 0) sweep%output_dir = trim(adjustl(output_dir))
-            if (len_trim(output_dir) > 0) what = '--output-dir "'
         end if
         if (.not. allocated(sweep%output_dir)) sweep%output_dir = ''
         if (len(sweep%output_dir) == 0) sweep%output_dir = 'out/sweep_'//sweep%name
@@ -137,63 +158,54 @@ contains
             if (sweep%output_dir(len(sweep%output_dir):) /= '/') exit
             sweep%output_dir = sweep%output_dir(:len(sweep%output_dir) - 1)
         end do
-        what = unwritable_dir(sweep%output_dir)
-        if (len(what) > 0) then
-            call make_error(err, ERR_INPUT, where//'output_dir = "'//sweep%output_dir// &
-                '": cannot hold the case files: '//what)
-            if (present(output_dir)) then
-                if (len_trim(output_dir) > 0) err%message = 'sweep: --output-dir "'// &
-                    sweep%output_dir//'": cannot hold the case files: '//what
-            end if
-            return
+        why = unwritable_dir(sweep%output_dir)
+        if (len(why) == 0) return
+        call make_error(err, ERR_INPUT, where//'output_dir = "'//sweep%output_dir// &
+            '": cannot hold the case files: '//why)
+        if (present(output_dir)) then
+            if (len_trim(output_dir) > 0) err%message = 'sweep: --output-dir "'// &
+                sweep%output_dir//'": cannot hold the case files: '//why
         end if
+    end subroutine set_output_dir
 
-        ! the reference
-        call read_reference(where, dir, raw(K_REFERENCE), sweep, err)
-        if (allocated(err)) return
+    !> atol_per_rtol, when given: finite and > 0.
+    subroutine read_atol_per_rtol(where, given, sweep, err)
+        character(len=*), intent(in) :: where
+        type(raw_t), intent(in) :: given
+        type(sweep_file_t), intent(inout) :: sweep
+        type(error_t), allocatable, intent(out) :: err
+        sweep%atol_given = given%n > 0
+        if (.not. sweep%atol_given) return
+        sweep%atol_per_rtol = given%x(1)
+        if (.not. (ieee_is_finite(sweep%atol_per_rtol) .and. sweep%atol_per_rtol > 0.0_wp)) &
+            call make_error(err, ERR_INPUT, where//'atol_per_rtol = '// &
+                real_text(sweep%atol_per_rtol, compact=.true.)//': must be > 0')
+    end subroutine read_atol_per_rtol
 
-        ! atol_per_rtol
-        sweep%atol_given = raw(K_ATOL)%n > 0
-        if (sweep%atol_given) then
-            sweep%atol_per_rtol = raw(K_ATOL)%x(1)
-            if (.not. (ieee_is_finite(sweep%atol_per_rtol) .and. sweep%atol_per_rtol > 0.0_wp)) &
-                then
-                call make_error(err, ERR_INPUT, where//'atol_per_rtol = '// &
-                    real_text(sweep%atol_per_rtol, compact=.true.)//': must be > 0')
-                return
-            end if
-        end if
+    !> The values given of key `name`.
+    function list_of(raw, name) result(list)
+        type(raw_t), intent(in) :: raw(:)
+        character(len=*), intent(in) :: name
+        type(text_t), allocatable :: list(:)
+        integer :: k, i
+        do k = 1, size(KEYS)
+            if (KEYS(k)%name == name) exit
+        end do
+        allocate (list(raw(k)%n))
+        do i = 1, raw(k)%n
+            list(i)%s = raw(k)%text(i)%s
+        end do
+    end function list_of
 
-        call set_list(lists(1), 'models', 'model.kind')
-        call set_list(lists(2), 'elements', 'model.elements')
-        call set_list(lists(3), 'methods', 'solver.method')
-        call set_list(lists(4), 'max_orders', 'solver.max_order')
-        call set_list(lists(5), 'rtols', 'solver.rtol')
-        call build_dimensions(where, sweep%base, list_of('set'), list_of('vary'), lists, &
-            sweep%atol_given, sweep%set, sweep%vary_keys, sweep%dims, err)
-    contains
-        !> The values given of key `name`.
-        function list_of(name) result(list)
-            character(len=*), intent(in) :: name
-            type(text_t), allocatable :: list(:)
-            integer :: k, i
-            do k = 1, size(KEYS)
-                if (KEYS(k)%name == name) exit
-            end do
-            allocate (list(raw(k)%n))
-            do i = 1, raw(k)%n
-                list(i)%s = raw(k)%text(i)%s
-            end do
-        end function list_of
-
-        subroutine set_list(d, key, target)
-            type(dimension_t), intent(out) :: d
-            character(len=*), intent(in) :: key, target
-            d%key = key
-            d%target = target
-            d%values = list_of(key)
-        end subroutine set_list
-    end subroutine read_sweep_file
+    !> The dimension of a list key (`key`: the &sweep key, `target`: the scene key it sets).
+    subroutine set_list(raw, d, key, target)
+        type(raw_t), intent(in) :: raw(:)
+        type(dimension_t), intent(out) :: d
+        character(len=*), intent(in) :: key, target
+        d%key = key
+        d%target = target
+        d%values = list_of(raw, key)
+    end subroutine set_list
 
     !> A file name: as given when absolute, else relative to `dir`.
     pure function relative_to(dir, name) result(path)
