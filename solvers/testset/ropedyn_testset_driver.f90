@@ -63,24 +63,46 @@ contains
         real(wp), intent(in), optional :: atol
         integer, intent(in), optional :: max_order
         real(wp), intent(in), optional :: repeat_time
-        class(integrator_t), allocatable :: integrator
-        type(error_t), allocatable :: run_err
         type(solver_options_t) :: options
-        real(wp), allocatable :: y(:), times(:), grown(:)
-        real(wp) :: yq(0), t, start, finish, budget, total
-        integer :: n, lowest, highest
+        real(wp) :: budget
         character(len=120) :: buffer
-        character(len=:), allocatable :: context
 
-        n = problem%size()
         result%problem = problem%name
         result%method = method
         result%rtol = rtol
         result%use_mescd = problem%use_mescd
+        call check_settings(problem, method, rtol, result, budget, err, atol, max_order, &
+                            repeat_time)
+        if (allocated(err)) return
+        options%rtol = rtol
+        if (result%uniform_atol()) then
+            options%atol = result%atol(1)
+        else
+            options%atol = minval(result%atol)
+            options%atol_vector = result%atol
+        end if
+        options%max_order = result%max_order
         write (buffer, '(a, a, a, a, a, es9.2)') 'testset ', problem%name, ', method ', &
             method, ', rtol', rtol
-        context = trim(buffer)
+        call repeat_runs(problem, method, options, budget, trim(buffer), result, err)
+    end subroutine run_testset
 
+    !> The settings checked into the result: rtol, atol (the problem's recommendation when
+    !! not given), the maximum order within the method's range, the CPU budget of repeats.
+    subroutine check_settings(problem, method, rtol, result, budget, err, atol, max_order, &
+                              repeat_time)
+        class(testset_problem_t), intent(in) :: problem
+        character(len=*), intent(in) :: method
+        real(wp), intent(in) :: rtol
+        type(testset_run_t), intent(inout) :: result
+        real(wp), intent(out) :: budget
+        type(error_t), allocatable, intent(out) :: err
+        real(wp), intent(in), optional :: atol
+        integer, intent(in), optional :: max_order
+        real(wp), intent(in), optional :: repeat_time
+        character(len=120) :: buffer
+        integer :: lowest, highest
+        budget = DEFAULT_REPEAT_TIME
         if (.not. (rtol > 0.0_wp .and. rtol < 1.0_wp)) then
             write (buffer, '(es12.4)') rtol
             call make_error(err, ERR_INPUT, 'rtol = '//trim(adjustl(buffer))// &
@@ -94,45 +116,47 @@ contains
                                 ': must be > 0')
                 return
             end if
-            allocate (result%atol(n), source=atol)
+            allocate (result%atol(problem%size()), source=atol)
         else
             result%atol = problem%recommended_atol(rtol)
         end if
-        budget = DEFAULT_REPEAT_TIME
         if (present(repeat_time)) budget = repeat_time
         if (.not. (budget >= 0.0_wp)) then
             call make_error(err, ERR_INPUT, 'repeat time must be >= 0 s')
             return
         end if
-
         call method_order_range(method, lowest, highest, err)
         if (allocated(err)) return
         result%max_order = resolved_max_order(method, 0)
-        if (present(max_order)) then
-            if (max_order /= 0) then
-                if (max_order < lowest .or. max_order > highest) then
-                    write (buffer, '(a, i0, a, a, a, i0, a, i0, a)') 'max order ', max_order, &
-                        ' not available for method ', method, ' (', lowest, ' .. ', &
-                        highest, ', or 0 for the default)'
-                    call make_error(err, ERR_INPUT, trim(buffer))
-                    return
-                end if
-                result%max_order = max_order
-            end if
+        if (.not. present(max_order)) return
+        if (max_order == 0) return
+        if (max_order < lowest .or. max_order > highest) then
+            write (buffer, '(a, i0, a, a, a, i0, a, i0, a)') 'max order ', max_order, &
+                ' not available for method ', method, ' (', lowest, ' .. ', &
+                highest, ', or 0 for the default)'
+            call make_error(err, ERR_INPUT, trim(buffer))
+            return
         end if
+        result%max_order = max_order
+    end subroutine check_settings
 
-        options%rtol = rtol
-        if (result%uniform_atol()) then
-            options%atol = result%atol(1)
-        else
-            options%atol = minval(result%atol)
-            options%atol_vector = result%atol
-        end if
-        options%max_order = result%max_order
-
+    !> The problem integrated from its start again and again until the runs' CPU reaches
+    !! `budget` (or MAX_REPEATS runs): the first run's statistics, end state and accuracy,
+    !! the median CPU time. A failed run is an ERR_SOLVER error in `context`.
+    subroutine repeat_runs(problem, method, options, budget, context, result, err)
+        class(testset_problem_t), intent(inout), target :: problem
+        character(len=*), intent(in) :: method, context
+        type(solver_options_t), intent(in) :: options
+        real(wp), intent(in) :: budget
+        type(testset_run_t), intent(inout) :: result
+        type(error_t), allocatable, intent(out) :: err
+        class(integrator_t), allocatable :: integrator
+        type(error_t), allocatable :: run_err
+        real(wp), allocatable :: y(:), times(:), grown(:)
+        real(wp) :: yq(0), t, start, finish, total
         call new_integrator(method, integrator, err)
         if (allocated(err)) return
-        allocate (y(n), times(16))
+        allocate (y(problem%size()), times(16))
         total = 0.0_wp
         do
             y = problem%y0
@@ -161,13 +185,13 @@ contains
             if (result%runs == 1) then
                 result%y = y
                 result%scd = scd_of(y, problem%yref)
-                result%mescd = mescd_of(y, problem%yref, result%atol, rtol)
+                result%mescd = mescd_of(y, problem%yref, result%atol, options%rtol)
             end if
             total = total + times(result%runs)
             if (total >= budget .or. result%runs >= MAX_REPEATS) exit
         end do
         result%cpu_time = median_of(times(1:result%runs))
-    end subroutine run_testset
+    end subroutine repeat_runs
 
     !> The accuracy measure of this problem: mescd for E5, scd otherwise.
     pure real(wp) function run_accuracy(self) result(digits)

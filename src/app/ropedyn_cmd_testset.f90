@@ -15,81 +15,47 @@ module ropedyn_cmd_testset
     private
     public :: testset_command
 
+    !> The command line of `ropedyn testset`.
+    type :: testset_options_t
+        character(len=:), allocatable :: problem_name    !< a problem, or 'all'
+        character(len=:), allocatable :: method
+        real(wp) :: rtol = 1.0e-6_wp
+        real(wp) :: atol = 0.0_wp
+        logical :: have_atol = .false.
+        integer :: max_order = 0                         !< 0: the method's own
+        real(wp) :: repeat_time = DEFAULT_REPEAT_TIME    !< s of repeats for the CPU time
+        logical :: csv = .false.
+        logical :: list = .false.
+        logical :: help = .false.                        !< --help (printed)
+    end type testset_options_t
+
 contains
 
     !> ropedyn testset PROBLEM|all [options] | --list
     subroutine testset_command(cli, err)
         type(cli_t), intent(inout) :: cli
         type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: problem_name, method, value
+        type(testset_options_t) :: opts
         class(testset_problem_t), allocatable :: problem
-        type(testset_run_t) :: result
         type(error_t), allocatable :: terr
-        real(wp) :: rtol, atol, repeat_time
-        integer :: max_order, k, first, last, failures
-        logical :: have_atol, csv, list
+        integer :: first, last
 
-        method = 'cvode'
-        rtol = 1.0e-6_wp
-        atol = 0.0_wp
-        have_atol = .false.
-        max_order = 0
-        repeat_time = DEFAULT_REPEAT_TIME
-        csv = .false.
-        list = .false.
-        do while (cli%next())
-            select case (cli%option)
-            case ('--help', '-h')
-                call print_help('testset', output_unit, 'default_repeat_time', &
-                                real_text(DEFAULT_REPEAT_TIME, compact=.true.))
-                return
-            case ('--list')
-                list = .true.
-            case ('--csv')
-                csv = .true.
-            case ('--method')
-                call cli%take_value(value, err)
-                if (.not. allocated(err)) then
-                    method = value
-                    if (method_index(value) == 0) call cli%usage_error('--method "'//value// &
-                        '": unknown method (available: '//method_list()//')', err)
-                end if
-            case ('--rtol')
-                call cli%real_value(rtol, err)
-                if (.not. allocated(err) .and. .not. (rtol > 0.0_wp .and. rtol < 1.0_wp)) &
-                    call cli%usage_error('--rtol '//cli%value//': must be > 0 and < 1', err)
-            case ('--atol')
-                call cli%real_value(atol, err)
-                if (.not. allocated(err) .and. .not. (atol > 0.0_wp)) &
-                    call cli%usage_error('--atol '//cli%value//': must be > 0', err)
-                have_atol = .true.
-            case ('--max-order')
-                call cli%int_value(max_order, 0, err)
-            case ('--repeat-time')
-                call cli%real_value(repeat_time, err)
-                if (.not. allocated(err) .and. &
-                    .not. (repeat_time >= 0.0_wp .and. repeat_time <= 3600.0_wp)) &
-                    call cli%usage_error('--repeat-time '//cli%value//': must be 0 .. 3600 s', err)
-            case default
-                call cli%positional('problem', problem_name, err)
-            end select
-            if (allocated(err)) return
-        end do
-
-        if (list) then
+        call read_options(cli, opts, err)
+        if (allocated(err) .or. opts%help) return
+        if (opts%list) then
             call list_problems(err)
             return
         end if
-        if (.not. allocated(problem_name)) then
+        if (.not. allocated(opts%problem_name)) then
             call cli%usage_error('needs a problem name or "all" (available: '// &
                                  testset_name_list()//')', err)
             return
         end if
-        if (problem_name == 'all' .or. problem_name == 'ALL') then
+        if (opts%problem_name == 'all' .or. opts%problem_name == 'ALL') then
             first = 1
             last = size(testset_names)
         else
-            call new_testset_problem(problem_name, problem, terr)
+            call new_testset_problem(opts%problem_name, problem, terr)
             if (allocated(terr)) then
                 call cli%usage_error(terr%message, err)
                 return
@@ -97,20 +63,83 @@ contains
             first = 0
             last = 0
         end if
+        call run_problems(cli, opts, problem, first, last, err)
+    end subroutine testset_command
 
-        if (csv) call write_csv_header()
+    !> The command's options and its problem name (--help prints the help: opts%help).
+    subroutine read_options(cli, opts, err)
+        type(cli_t), intent(inout) :: cli
+        type(testset_options_t), intent(inout) :: opts
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: value
+        opts%method = 'cvode'
+        do while (cli%next())
+            select case (cli%option)
+            case ('--help', '-h')
+                call print_help('testset', output_unit, 'default_repeat_time', &
+                                real_text(DEFAULT_REPEAT_TIME, compact=.true.))
+                opts%help = .true.
+                return
+            case ('--list')
+                opts%list = .true.
+            case ('--csv')
+                opts%csv = .true.
+            case ('--method')
+                call cli%take_value(value, err)
+                if (.not. allocated(err)) then
+                    opts%method = value
+                    if (method_index(value) == 0) call cli%usage_error('--method "'//value// &
+                        '": unknown method (available: '//method_list()//')', err)
+                end if
+            case ('--rtol')
+                call cli%real_value(opts%rtol, err)
+                if (.not. allocated(err) .and. &
+                    .not. (opts%rtol > 0.0_wp .and. opts%rtol < 1.0_wp)) &
+                    call cli%usage_error('--rtol '//cli%value//': must be > 0 and < 1', err)
+            case ('--atol')
+                call cli%real_value(opts%atol, err)
+                if (.not. allocated(err) .and. .not. (opts%atol > 0.0_wp)) &
+                    call cli%usage_error('--atol '//cli%value//': must be > 0', err)
+                opts%have_atol = .true.
+            case ('--max-order')
+                call cli%int_value(opts%max_order, 0, err)
+            case ('--repeat-time')
+                call cli%real_value(opts%repeat_time, err)
+                if (.not. allocated(err) .and. &
+                    .not. (opts%repeat_time >= 0.0_wp .and. opts%repeat_time <= 3600.0_wp)) &
+                    call cli%usage_error('--repeat-time '//cli%value//': must be 0 .. 3600 s', err)
+            case default
+                call cli%positional('problem', opts%problem_name, err)
+            end select
+            if (allocated(err)) return
+        end do
+    end subroutine read_options
+
+    !> The problems first .. last of the test set (0 .. 0: `problem`), each against its
+    !! reference: a table each, or CSV rows; a failed integration is counted (and ends a
+    !! single problem's run), bad settings are a usage error.
+    subroutine run_problems(cli, opts, problem, first, last, err)
+        type(cli_t), intent(inout) :: cli
+        type(testset_options_t), intent(in) :: opts
+        class(testset_problem_t), allocatable, intent(inout) :: problem
+        integer, intent(in) :: first, last
+        type(error_t), allocatable, intent(out) :: err
+        type(testset_run_t) :: result
+        type(error_t), allocatable :: terr
+        integer :: k, failures
+        if (opts%csv) call write_csv_header()
         failures = 0
         do k = first, last
             if (k > 0) then
                 call new_testset_problem(testset_names(k), problem, err)
                 if (allocated(err)) return
             end if
-            if (have_atol) then
-                call run_testset(problem, method, rtol, result, terr, atol=atol, &
-                                 max_order=max_order, repeat_time=repeat_time)
+            if (opts%have_atol) then
+                call run_testset(problem, opts%method, opts%rtol, result, terr, atol=opts%atol, &
+                                 max_order=opts%max_order, repeat_time=opts%repeat_time)
             else
-                call run_testset(problem, method, rtol, result, terr, max_order=max_order, &
-                                 repeat_time=repeat_time)
+                call run_testset(problem, opts%method, opts%rtol, result, terr, &
+                                 max_order=opts%max_order, repeat_time=opts%repeat_time)
             end if
             if (allocated(terr)) then
                 if (terr%code /= ERR_SOLVER) then
@@ -125,16 +154,16 @@ contains
                 write (error_unit, '(a)') 'ropedyn: error: '//terr%message
                 cycle
             end if
-            if (csv) then
+            if (opts%csv) then
                 call write_csv_row(result)
             else
                 if (k > first) write (output_unit, '(a)') ''
-                call print_testset_result(problem, result, have_atol)
+                call print_testset_result(problem, result, opts%have_atol)
             end if
         end do
         if (failures > 0) call make_error(err, ERR_SOLVER, 'testset: '//int_text(failures)// &
             ' of '//int_text(last - first + 1)//' test problems failed')
-    end subroutine testset_command
+    end subroutine run_problems
 
     subroutine list_problems(err)
         type(error_t), allocatable, intent(out) :: err
@@ -197,7 +226,8 @@ contains
         character(len=400) :: line
         write (line, '(9(a, ","), 8(i0, ","), es12.5, ",", i0)') r%problem, &
             r%method, number(r%rtol), atol_text(r), int_text(r%max_order), fixed_text(r%scd, 4), &
-            fixed_text(r%mescd, 4), merge('mescd', 'scd  ', r%use_mescd), fixed_text(r%accuracy(), 4), &
+            fixed_text(r%mescd, 4), merge('mescd', 'scd  ', r%use_mescd), &
+            fixed_text(r%accuracy(), 4), &
             r%stats%steps, r%stats%err_test_fails, r%stats%rhs_evals, r%stats%jac_rhs_evals, &
             r%stats%jac_evals, r%stats%lin_setups, r%stats%nonlin_iters, &
             r%stats%nonlin_conv_fails, r%cpu_time, r%runs
