@@ -113,3 +113,32 @@ def test_each_test_program_links_the_lowest_layer_it_needs(tmp_path):
     assert report("core SCENE_RUNS", "io", "studies", "solvers", "models") == [
         where + "test_a: SCENE_RUNS without a use of ropedyn_test_run",
         where + "test_c: SCENE_RUNS missing (it uses ropedyn_test_run)"]
+
+
+def test_check_reports_a_routine_longer_than_a_screen(tmp_path):
+    """A routine longer than ROUTINE_LIMIT lines (its internal procedures counted in) is
+    reported by file and name; one at the limit is not, nor a kernel of LONG_KERNELS; the
+    tree itself has none."""
+    assert arch.long_routines() == []
+    limit = arch.ROUTINE_LIMIT
+
+    def routine(kind, name, lines, inner=""):
+        body = "".join(f"        x = x + {i}\n" for i in range(lines - 3 - inner.count("\n")))
+        head = f"    {kind} {name}(x)\n        real, intent(inout) :: x\n"
+        return head + body + inner + f"    end {kind.split()[-1]} {name}\n"
+
+    inner = "    contains\n        subroutine helper()\n        end subroutine helper\n"
+    _tree(tmp_path, {
+        "src/core/ropedyn_long.f90": (
+            "module ropedyn_long\ncontains\n"
+            + routine("subroutine", "at_limit", limit)
+            + routine("pure real function", "too_long", limit + 1, inner)
+            + "end module ropedyn_long\n"),
+        "src/models/rfem/ropedyn_rfem_kernels.f90": (
+            "submodule (ropedyn_rfem) ropedyn_rfem_kernels\ncontains\n"
+            + routine("module procedure", "forces", limit + 20).replace("(x)", "")
+            + "end submodule ropedyn_rfem_kernels\n"),
+    })
+    found = arch.long_routines(tmp_path)
+    assert found == [f"src/core/ropedyn_long.f90: too_long has {limit + 1} lines "
+                     f"(at most {limit}: split it where its ideas split)"], found

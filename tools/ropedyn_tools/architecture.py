@@ -10,9 +10,10 @@ program, the layer of each (by folder), and every `use ropedyn_*` between them. 
 
 It checks the layering rule that CMake enforces by separate module directories: a module
 uses only its own layer and the layers below it, and `solvers` and `models` never use
-each other. And it checks that each test program of tests/CMakeLists.txt links the lowest
+each other. It checks that each test program of tests/CMakeLists.txt links the lowest
 layer whose library holds what it uses (`ropedyn_unit_test(NAME LAYER)`; the build fails
-on a layer too low, this reports one too high). `--check` only checks (the rules, and that
+on a layer too low, this reports one too high), and that no routine is longer than
+ROUTINE_LIMIT lines but the kernels named in LONG_KERNELS. `--check` only checks (the rules, and that
 docs/development/architecture.md is current) and exits 1 on a violation; the test suite runs it.
 
     scripts/architecture            # regenerate docs/development/architecture.md and the figure
@@ -52,6 +53,25 @@ MODULE_PROCEDURE = re.compile(r"^\s*module\s+(procedure|function|subroutine|pure
                               r"elemental|recursive|non_recursive|integer|real|logical|"
                               r"character|complex|type)\b", re.I)
 USE = re.compile(r"^\s*use\s*(?:,\s*non_intrinsic\s*)?(?:::)?\s*(ropedyn_\w+)", re.I)
+
+#: A routine fits on a screen (docs/development/contributing.md): `--check` reports one longer
+#: than this many lines, from its first line to its `end`, its internal procedures included.
+ROUTINE_LIMIT = 110
+#: Longer routines kept whole: the kernels of the right-hand side and of the Jacobian, one
+#: pass over the elements each, whose cost per step docs/performance/step.md measures; split,
+#: their loops would call across procedures at every element.
+LONG_KERNELS = {
+    ("src/models/rfem/ropedyn_rfem_kernels.f90", "forces"),
+    ("src/models/rfem/ropedyn_rfem_kernels.f90", "jacobian_blocks"),
+    ("src/models/mpp/ropedyn_mpp_kernels.f90", "residual_core"),
+    ("src/models/mpp/ropedyn_mpp_tangent.f90", "residual_column"),
+}
+ROUTINE_START = re.compile(
+    r"^\s*(?:(?:pure|impure|elemental|recursive|non_recursive|module)\s+)*"
+    r"(?:(?:integer|real|logical|character|complex)(?:\s*\([^)]*\))?\s+|type\s*\([^)]*\)\s+)?"
+    r"(?:subroutine|function)\s+(\w+)", re.I)
+MODULE_PROCEDURE_START = re.compile(r"^\s*module\s+procedure\s+(\w+)\s*$", re.I)
+ROUTINE_END = re.compile(r"^\s*end\s+(?:subroutine|function|procedure)\b", re.I)
 
 
 def layer_of(path, root=ROOT):
@@ -120,6 +140,30 @@ UNIT_TEST = re.compile(r"^\s*ropedyn_unit_test\(\s*(\w+)\s+(\w+)((?:\s+\w+)*)\s*
 #: ropedyn_LAYER)`
 PROGRAM = re.compile(r"^\s*add_executable\(\s*(\w+)\s+([\w/]+\.f90)\s*\)", re.M)
 ANY_USE = re.compile(r"^\s*use\b\s*(,\s*(non_)?intrinsic\s*)?(::)?\s*(\w+)", re.I | re.M)
+
+
+def long_routines(root=ROOT, limit=ROUTINE_LIMIT):
+    """The routines of src/ and solvers/ longer than `limit` lines (LONG_KERNELS aside), as
+    'file: name has N lines'."""
+    found = []
+    for top in ("src", "solvers"):
+        for path in sorted((root / top).rglob("*.f90")):
+            rel = path.relative_to(root).as_posix()
+            open_routines = []
+            for i, line in enumerate(path.read_text().splitlines()):
+                code = line.split("!", 1)[0]
+                if ROUTINE_END.match(code):
+                    if open_routines:
+                        name, first = open_routines.pop()
+                        lines = i - first + 1
+                        if lines > limit and (rel, name.lower()) not in LONG_KERNELS:
+                            found.append(f"{rel}: {name} has {lines} lines (at most {limit}: "
+                                         "split it where its ideas split)")
+                    continue
+                start = MODULE_PROCEDURE_START.match(code) or ROUTINE_START.match(code)
+                if start:
+                    open_routines.append((start.group(1), i))
+    return found
 
 
 def lowest_library(layers):
@@ -269,7 +313,7 @@ def main(argv=None):
                         help="check the layering and that docs/development/architecture.md is current")
     args = parser.parse_args(argv)
     units = scan()
-    bad = violations(units) + link_violations(units)
+    bad = violations(units) + link_violations(units) + long_routines()
     for b in bad:
         print("architecture:", b, file=sys.stderr)
     gen = generated_markdown(units)
