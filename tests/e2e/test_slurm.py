@@ -397,7 +397,7 @@ def test_time_limit_warning_requeues_and_resumes(slurm, ropedyn_exe, tmp_path):
     `--signal=B:USR1@120` sends it; here by scancel) stops the case at a step boundary and
     requeues the task, which continues the case from its last record."""
     (tmp_path / "base.nml").write_text(BASE)
-    (tmp_path / "r.nml").write_text(LONG.format(t_end=3, rtols="1e-8"))
+    (tmp_path / "r.nml").write_text(LONG.format(t_end=6, rtols="1e-8"))
     job = subprocess.Popen([str(SUBMIT), "r.nml", "--wait", "--exe", str(ropedyn_exe)],
                            cwd=tmp_path, env=slurm.env, stdout=subprocess.PIPE,
                            stderr=subprocess.PIPE, text=True)
