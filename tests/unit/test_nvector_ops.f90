@@ -32,7 +32,7 @@ program test_nvector_ops
     type(c_ptr) :: ctx
     real(c_double), target :: dr(N, NV), df(N, NV), d0(N, NV)
     type(vec_t) :: r(NV), f(NV)
-    integer :: i, j, k, iz, ia, ib, nvec, bad
+    integer :: j, k, iz, ia, ib, nvec, bad
     integer(c_int) :: flag
     real(c_double) :: sr, sf, cr(NV), cf(NV), coef(NV)
     type(c_ptr) :: ar, af, br, bf, zr, zf
