@@ -92,6 +92,7 @@ module ropedyn_energy_monitor
         procedure :: floored_scale => monitor_floored_scale
         procedure :: big_change => monitor_big_change
         procedure :: intake => monitor_intake
+        procedure :: loss => monitor_loss
         procedure :: lost => monitor_lost
     end type energy_monitor_t
 
@@ -319,6 +320,13 @@ contains
         intake = max(self%max_held - self%min_gravity, RUNAWAY_LEAST_SCALE)
     end function monitor_intake
 
+    !> How far a state's balance has fallen below E0, J (negative: it rose).
+    pure real(wp) function monitor_loss(self, e) result(loss)
+        class(energy_monitor_t), intent(in) :: self
+        type(energy_t), intent(in) :: e
+        loss = self%e0 - e%balance()
+    end function monitor_loss
+
     !> True when the balance of a state observed last has fallen below E0 by more than
     !! MAX_BOUND_SHARE of the intake: the integrator damped a tenth of the energy the motion
     !! took in (adaptive methods on a lightly damped rope over long runs;
@@ -326,11 +334,12 @@ contains
     pure logical function monitor_lost(self, e) result(yes)
         class(energy_monitor_t), intent(in) :: self
         type(energy_t), intent(in) :: e
-        yes = self%e0 - e%balance() > MAX_BOUND_SHARE*self%intake()
+        yes = self%loss(e) > MAX_BOUND_SHARE*self%intake()
     end function monitor_lost
 
-    !> The warning of a loss `lost` (J) of the balance that `lost` found, `intake` (J) the
-    !! energy the motion took in, at tolerance `rtol`: how much, of what, and what keeps it.
+    !> The warning of a loss `lost` (J: `loss`) of the balance that `lost` found, `intake`
+    !! (J) the energy the motion took in, at tolerance `rtol`: how much, of what, and what
+    !! keeps it.
     function loss_warning(lost, intake, rtol) result(text)
         real(wp), intent(in) :: lost, intake, rtol
         character(len=:), allocatable :: text

@@ -736,8 +736,8 @@ contains
             s%t_reached = max(s%t_reached, self%t)
             if (self%monitoring .and. s%records > 0) then
                 if (self%monitor%lost(s%final_energy)) call append_text(s%warnings, &
-                    loss_warning(s%initial_energy%balance() - s%final_energy%balance(), &
-                                 self%monitor%intake(), self%scene%solver%rtol))
+                    loss_warning(self%monitor%loss(s%final_energy), self%monitor%intake(), &
+                                 self%scene%solver%rtol))
             end if
             call self%out%write_stats(s%stats, s%cpu_time, ferr, t_reached=self%t)
             if (.not. allocated(ferr)) call self%out%add_warnings(self%file_warnings(), ferr)

@@ -191,6 +191,9 @@ program test_energy_monitor
     call suite%check_true(.not. m%lost(e2), 'a loss below a tenth of I is not lost')
     e2%kinetic = e1%kinetic - 1.01_wp*0.061_wp
     call suite%check_true(m%lost(e2), 'a loss above a tenth of I (a twentieth of S) is lost')
+    ! the loss the summary reports is the one judged: from the balance at the start
+    call suite%check_close(m%loss(e2), e0%balance() - e2%balance(), 1.0e-14_wp, 0.0_wp, &
+                           'the loss is E0 - B')
     e2%kinetic = e1%kinetic + 0.05_wp
     call suite%check_true(.not. m%lost(e2), 'a gain is not lost')
     ! a support that puts 1 J in (kinetic and work both up by 1 J, B unchanged) raises I by
