@@ -209,13 +209,14 @@ contains
         real(wp), intent(in) :: tn
         real(wp), intent(out) :: err1
         integer, intent(out) :: outcome
-        real(wp) :: beta, hbeta
+        real(wp) :: beta, hbeta, gam(KMAX_MEBDF)
         integer :: k
         k = self%k
         beta = self%coef(k)%beta
         hbeta = self%h*beta
+        gam = 1.0_wp/self%coef%beta   ! gamma_j = sum_{i<=j} 1/i = 1/beta_j
         err1 = 0.0_wp
-        call stage_bdf(self, tn, hbeta, outcome)
+        call stage_bdf(self, tn, hbeta, gam, outcome)
         if (outcome /= STAGE_OK) return
         self%hg1 = (self%ybar1 - self%c)*(1.0_wp/beta)
         self%d1 = self%ybar1 - self%pred
@@ -225,7 +226,7 @@ contains
             outcome = STAGE_ERROR_TEST
             return
         end if
-        call stage_bdf_ahead(self, tn, hbeta, outcome)
+        call stage_bdf_ahead(self, tn, hbeta, gam, outcome)
         if (outcome /= STAGE_OK) return
         self%hg2 = (self%ybar2 - self%c)*(1.0_wp/beta)
         call stage_corrector(self, tn, hbeta, outcome)
@@ -242,13 +243,11 @@ contains
     !! the last line). With P_j = sum_{i>=j} dif_i (the predictor's differences), psi is
     !! sum_{j=1..k} (1/j) P_j, the BDF's known part. The loops over the components are
     !! innermost (vector instructions); pred stays for the history.
-    subroutine stage_bdf(self, tn, hbeta, outcome)
+    subroutine stage_bdf(self, tn, hbeta, gam, outcome)
         class(mebdf_t), intent(inout) :: self
-        real(wp), intent(in) :: tn, hbeta
+        real(wp), intent(in) :: tn, hbeta, gam(:)
         integer, intent(out) :: outcome
-        real(wp) :: gam(KMAX_MEBDF)
         integer :: j, k
-        gam = 1.0_wp/self%coef%beta   ! gamma_j = sum_{i<=j} 1/i = 1/beta_j
         k = self%k
         self%pred = self%dif(:, 0) + self%dif(:, 1)
         self%c = gam(1)*self%dif(:, 1)
@@ -265,13 +264,11 @@ contains
     !! P_j = sum_{i=j..k} dif_i, the differences of ybar1 are P_j + d1; the predictor
     !! (summed in ybar2) is their sum and psi (in c) = sum_{i=1..k} gam(i) (P_i + d1); tmp
     !! carries P_i.
-    subroutine stage_bdf_ahead(self, tn, hbeta, outcome)
+    subroutine stage_bdf_ahead(self, tn, hbeta, gam, outcome)
         class(mebdf_t), intent(inout) :: self
-        real(wp), intent(in) :: tn, hbeta
+        real(wp), intent(in) :: tn, hbeta, gam(:)
         integer, intent(out) :: outcome
-        real(wp) :: gam(KMAX_MEBDF)
         integer :: i, k
-        gam = 1.0_wp/self%coef%beta
         k = self%k
         self%tmp = self%dif(:, k)
         self%ybar2 = self%ybar1 + self%tmp + self%d1
