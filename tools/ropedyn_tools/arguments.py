@@ -6,8 +6,9 @@ Without a type the study would trace back where it first converts the list.
 
 `listing` returns the list; `list_text` checks the list and returns the text as given, for
 the studies that quote the option's text in their Command line. Names are checked too: a
-study's own labels by `choice`, the code's methods and models by `check_names`, which asks
-the executable for its list (`ropedyn keys`) once the study knows it, before anything runs."""
+study's own labels by `choice`, the code's methods and models by `check_names` (methods with
+a max order, `name:K`, by `method_specs` and `check_methods`), which asks the executable for
+its list (`ropedyn keys`) once the study knows it, before anything runs."""
 import argparse
 
 #: how a list's items are separated: blanks, commas, or either
@@ -49,6 +50,27 @@ def check_names(parser, exe, option, names, group, key, extra=()):
         what = f"unknown: {', '.join(map(repr, bad))}" if bad else "an empty list"
         parser.error(f"argument {option}: {what} (allowed: {', '.join(known)}; "
                      f"the {group}.{key} of `ropedyn keys`)")
+
+
+def method_specs(sep=None):
+    """An argparse type: methods given as `name` or `name:max_order` (the studies' --methods,
+    which studies.common.method_sets turns into scene settings), max_order a whole number
+    above 0, separated as `items` reads them; the text as given. Their names are checked
+    by check_methods once the executable is known."""
+    def parse(text):
+        for item in items(text, sep):
+            _, colon, order = item.partition(":")
+            if colon:
+                positive(int)(order)
+        return text
+    parse.__name__ = "method_specs"
+    return parse
+
+
+def check_methods(parser, exe, option, specs):
+    """check_names for the methods of `specs` (each `name` or `name:max_order`)."""
+    check_names(parser, exe, option, [spec.partition(":")[0] for spec in specs], "solver",
+                "method")
 
 
 def items(text, sep=None):

@@ -44,7 +44,7 @@ import h5py
 import numpy as np
 
 from ropedyn_tools import docs_status
-from ropedyn_tools.arguments import check_names
+from ropedyn_tools.arguments import check_methods, method_specs
 from ropedyn_tools.repo import DOCS, add_exe_argument, exe_or_build
 from ropedyn_tools.studies.common import machine, method_sets, update_doc, run_stamp
 
@@ -945,7 +945,7 @@ def main(argv=None):
     parser.add_argument("study", choices=[*STUDIES, "choosing", "all"])
     add_exe_argument(parser)
     parser.add_argument("--quick", action="store_true", help="smoke test: small n, short")
-    parser.add_argument("--methods", default=",".join(DEFAULT_METHODS),
+    parser.add_argument("--methods", default=",".join(DEFAULT_METHODS), type=method_specs(","),
                         help="comma list of method[:max_order] (any &solver method)")
     parser.add_argument("--cases", default=[], type=model_cases,
                         help="windows: only these model:n (comma list, e.g. mpp:100), merged "
@@ -957,13 +957,12 @@ def main(argv=None):
     parser.add_argument("--fig4-rtol", type=float, default=1e-5,
                         help="rtol for fig4 when the windows data has none below the target")
     args = parser.parse_args(argv)
-    args.methods = [m for m in args.methods.split(",") if m]
+    args.methods = args.methods.split(",")
     if args.study == "choosing":
         choosing(args)
         return
     exe = exe_or_build(args.exe)
-    check_names(parser, exe, "--methods", [m.partition(":")[0] for m in args.methods],
-                "solver", "method")
+    check_methods(parser, exe, "--methods", args.methods)
     names = list(STUDIES) if args.study == "all" else [args.study]
     for name in names:
         wall0 = time.perf_counter()

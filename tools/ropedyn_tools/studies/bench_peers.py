@@ -73,7 +73,7 @@ import tempfile
 import numpy as np
 
 from ropedyn import io
-from ropedyn_tools.arguments import check_names, list_text, positive
+from ropedyn_tools.arguments import check_methods, list_text, method_specs, positive
 from ropedyn_tools.repo import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import (least_cpu, machine, method_chain, method_label,
                                           method_sets, update_doc, run_stamp)
@@ -301,17 +301,6 @@ EQUAL_RTOLS = (1e-1, 3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6)
 
 #: the methods of the equal-accuracy table besides auto (`method` or `method:max_order`)
 EQUAL_METHODS = "symplectic cvode mebdf"
-
-
-def method_list(text):
-    """An argparse type: methods `method` or `method:max_order` (max_order a whole number
-    above 0), space-separated, as given; the names are checked against `ropedyn keys`
-    once the executable is known."""
-    for item in text.split():
-        _, colon, order = item.partition(":")
-        if colon:
-            positive(int)(order)
-    return text
 
 
 def at_equal_accuracy(exe, work, n, t_end, ref, md, md_error, repeat=1, method="auto"):
@@ -604,7 +593,7 @@ def main(argv=None):
                         help="only the undamped comparison (the other tables kept)")
     parser.add_argument("--no-undamped", action="store_true",
                         help="without the undamped comparison (its table kept)")
-    parser.add_argument("--methods", default=EQUAL_METHODS, type=method_list,
+    parser.add_argument("--methods", default=EQUAL_METHODS, type=method_specs(),
                         help="methods at equal accuracy besides auto: method or "
                              "method:max_order, space-separated (default: %(default)s)")
     parser.add_argument("--no-write", action="store_true")
@@ -616,8 +605,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     args.command = command_text(argv)
     exe = exe_or_build(args.exe)
-    check_names(parser, exe, "--methods", [m.partition(":")[0] for m in args.methods.split()],
-                "solver", "method")
+    check_methods(parser, exe, "--methods", args.methods.split())
     py = ensure_bench_venv()
     if args.coupled_only:
         return coupled_main(args, exe, py)
