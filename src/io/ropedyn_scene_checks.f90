@@ -140,6 +140,10 @@ contains
             else if (s%bottom_anchor_set .and. .not. all(ieee_is_finite(s%bottom_anchor))) then
                 call fail(keys, G_SUPPORTS, 'bottom_anchor', pair_text(s%bottom_anchor), &
                     'must be finite', err)
+            else if (s%bottom_anchor_set .and. s%bottom == 'free') then
+                call fail(keys, G_SUPPORTS, 'bottom_anchor', pair_text(s%bottom_anchor), &
+                    'the bottom end is free: no support holds it there (set bottom = ' &
+                    //'''pinned'' or ''clamped'', or leave bottom_anchor out)', err)
             else if (scene%model%kind == 'mpp' .and. s%top_release_time >= 0.0_wp) then
                 call fail(keys, G_SUPPORTS, 'top_release_time', real_text(s%top_release_time), &
                     'the mpp model hangs from its top joint, which cannot be released (use ' &
@@ -157,10 +161,17 @@ contains
         real(wp), allocatable, intent(out) :: rows(:, :)
         type(error_t), allocatable, intent(out) :: err
         character(len=:), allocatable :: support, motion, full
-        real(wp) :: frequency, angle_amplitude, release
+        real(wp) :: frequency, angle_amplitude, release, angle
         integer :: k
 
         support = trim(keys(find_key(keys, G_SUPPORTS, end))%s)
+        angle = keys(find_key(keys, G_SUPPORTS, end//'_angle_deg'))%r
+        if (angle /= 0.0_wp .and. support /= 'clamped') then
+            call fail(keys, G_SUPPORTS, end//'_angle_deg', real_text(angle), 'only a ' &
+                //'clamped support holds its end at an angle ('//end//' = "'//support// &
+                '"; set '//end//' = ''clamped'' or leave '//end//'_angle_deg out)', err)
+            return
+        end if
         motion = trim(keys(find_key(keys, G_SUPPORTS, end//'_motion'))%s)
         frequency = keys(find_key(keys, G_SUPPORTS, end//'_frequency'))%r
         angle_amplitude = keys(find_key(keys, G_SUPPORTS, end//'_angle_amplitude_deg'))%r

@@ -151,7 +151,7 @@ contains
             '', &
             '&MODEL kind = ''RFEM'', elements = 12 /', &
             '&supports', &
-            '    top = ''Clamped'', bottom = "pinned"', &
+            '    top = ''Clamped'', bottom = "clamped"', &
             '    top_anchor = 0.1, -0.2', &
             '    bottom_anchor = 2.6, 0.0', &
             '    top_angle_deg = 10.0', &
@@ -181,7 +181,7 @@ contains
         call suite%check_true(s%model%kind == 'rfem', 'values: kind stored in lower case')
         call suite%check_true(s%model%elements == 12, 'values: elements')
         call suite%check_true(s%supports%top == 'clamped', 'values: top lower case')
-        call suite%check_true(s%supports%bottom == 'pinned', 'values: bottom')
+        call suite%check_true(s%supports%bottom == 'clamped', 'values: bottom')
         call suite%check_close(s%supports%top_anchor(2), -0.2_wp, TIGHT, 0.0_wp, &
             'values: top_anchor(2)')
         call suite%check_true(bottom_anchor_given(s) .and. s%supports%bottom_anchor_set, &

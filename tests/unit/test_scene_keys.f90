@@ -63,6 +63,11 @@ contains
             case ('bending_stiffness', 'shear_stiffness', 'axial_damping', 'shear_damping', &
                   'bending_damping')
                 extra = 'mass_per_length = 0.1, axial_stiffness = 1000.0'
+            ! a clamp angle needs a clamped end
+            case ('top_angle_deg')
+                extra = "top = 'clamped'"
+            case ('bottom_angle_deg')
+                extra = "bottom = 'clamped'"
             end select
             if (ieee_is_nan(key%r)) then
                 ! not set by default: any value of its rule
@@ -94,6 +99,8 @@ contains
             call append_text(values, "'out/keys test.h5'")
         case (T_PAIR)
             call append_text(values, '0.5, -0.25')
+            ! an anchor needs an end that is held
+            if (key%name == 'bottom_anchor') extra = "bottom = 'pinned'"
         case (T_LIST)
             call append_text(values, '0.5, 0.25')
             if (key%name == 'masses') extra = 'mass_positions = 0.1, 0.2'
