@@ -3,7 +3,7 @@
 scripts/getting_started makes the page's numbers and pictures from full runs; this checks,
 in seconds, what a newcomer types: the scene and sweep files the page writes (its `cat >
 FILE <<'EOF'` blocks, read from the page) are read by the program, the sweep has as many
-cases as the page says, and every generated section of the page has its markers."""
+cases as the page says, and every generated section has its markers."""
 import re
 import sys
 
@@ -48,7 +48,8 @@ def test_own_scene_runs(tmp_path, run):
 
 
 def test_every_generated_section_has_its_markers():
-    for name in getting_started.SECTIONS:
+    for name, page in getting_started.SECTIONS.items():
+        text = page.read_text()
         begin, end = getting_started.markers(name)
-        assert PAGE.count(begin) == 1 and PAGE.count(end) == 1, name
-        assert PAGE.index(begin) < PAGE.index(end), name
+        assert text.count(begin) == 1 and text.count(end) == 1, (page, name)
+        assert text.index(begin) < text.index(end), (page, name)

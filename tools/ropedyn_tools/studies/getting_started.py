@@ -3,7 +3,8 @@
 usage: scripts/getting_started [--no-write] [--keep DIR]
 
 The code of scripts/getting_started; writes the sections between the `getting_started ...`
-markers of docs/getting-started.md and the pictures of docs/figures/getting-started/.
+markers of docs/getting-started.md (and the summary the output guide, docs/guide/output.md,
+shows: the same run) and the pictures of docs/figures/getting-started/.
 
 In a scratch folder that sees the clone's input/ (as the clone's top folder does), it does
 what the page tells a newcomer to do, with the files the page writes (its `cat > FILE
@@ -42,8 +43,11 @@ PAGE = DOCS / "getting-started.md"
 FIGURES = DOCS / "figures" / "getting-started"
 PYTHON = ROOT / ".venv" / "bin" / "python"
 
-#: the page's generated sections, `<!-- getting_started NAME:begin -->` .. `:end -->`
-SECTIONS = ("paper", "paper balance", "sweep", "chain", "chain tension", "my_rope")
+OUTPUT_GUIDE = DOCS / "guide" / "output.md"
+#: the generated sections, `<!-- getting_started NAME:begin -->` .. `:end -->`, and their
+#: pages: the page's own, and the output guide's summary (the page's first run)
+SECTIONS = {"paper": PAGE, "paper balance": PAGE, "sweep": PAGE, "chain": PAGE,
+            "chain tension": PAGE, "my_rope": PAGE, "summary": OUTPUT_GUIDE}
 #: a here-document of the page: the command line that opens it and its body
 _HEREDOC = re.compile(r"^(?P<command>[^\n]*)<<'EOF'\n(?P<body>.*?)^EOF$", re.S | re.M)
 #: the file a `cat > FILE` here-document writes
@@ -129,10 +133,15 @@ def paper_sections(work, figures):
         "the build and the machine:", "", "```text", printed.rstrip(), "```", "",
         f"Its balance error at the end is {sci(error[-1])} J, against a kinetic energy of "
         f"up to {largest_kinetic(run):.2f} J."])
+    program = "\n".join(line for line in printed.rstrip().splitlines()
+                        if not line.startswith(("plot:", "xdmf:")))
+    guide = "\n".join([
+        f"The summary of `ropedyn run input/paper.nml` {stamp()}:", "", "```text", program,
+        "```"])
     example = (f"The energy balance error (lower panel) stays within "
                f"{sci(np.max(np.abs(error)))} J over the {run.time[-1]:.0f} s {stamp()}: "
                "the numbers are right to that level even where the motion is chaotic.")
-    return {"paper": summary, "paper balance": example}
+    return {"paper": summary, "paper balance": example, "summary": guide}
 
 
 def cheapest_text(rows):
@@ -227,16 +236,18 @@ def markers(name):
     return (f"<!-- getting_started {name}:begin -->", f"<!-- getting_started {name}:end -->")
 
 
-def write_page(page, parts):
-    """Each part between its markers (see markers) on the page; all must be there."""
-    text = page.read_text()
-    for name, body in parts.items():
-        begin, end = markers(name)
-        new = splice(text, begin, end, f"{begin}\n{body}\n{end}")
-        if new is None:
-            sys.exit(f"getting_started: {page} has no markers {begin} .. {end}")
-        text = new
-    page.write_text(text)
+def write_pages(parts):
+    """Each part between its markers (see markers) on its page (SECTIONS); all must be
+    there."""
+    for page in dict.fromkeys(SECTIONS.values()):
+        text = page.read_text()
+        for name in (name for name, where in SECTIONS.items() if where == page):
+            begin, end = markers(name)
+            new = splice(text, begin, end, f"{begin}\n{parts[name]}\n{end}")
+            if new is None:
+                sys.exit(f"getting_started: {page} has no markers {begin} .. {end}")
+            text = new
+        page.write_text(text)
 
 
 def main(argv=None):
@@ -256,12 +267,12 @@ def main(argv=None):
         print(f"getting_started: in {work}, the page's files {', '.join(files)}", flush=True)
         parts = {**paper_sections(work, figures), **sweep_section(work, figures, snippets),
                  **chain_section(work, figures), **own_scene_section(work, figures)}
-    assert tuple(parts) == SECTIONS, "every section of SECTIONS is made, in page order"
+    assert set(parts) == set(SECTIONS), "every section of SECTIONS is made"
     for name, body in parts.items():
         print(f"[{name}]\n{body}\n")
     if not args.no_write:
-        write_page(PAGE, parts)
-        print(f"getting_started: {PAGE}, pictures in {figures}")
+        write_pages(parts)
+        print(f"getting_started: {PAGE}, {OUTPUT_GUIDE}, pictures in {figures}")
     return 0
 
 
