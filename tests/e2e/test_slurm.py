@@ -420,3 +420,41 @@ def test_time_limit_warning_requeues_and_resumes(slurm, ropedyn_exe, tmp_path):
     with h5py.File(out / "case_0001.h5") as f:
         assert f.attrs["status"] == b"complete"
         assert f["solver/restarts/time"].shape == (1,)
+
+
+def no_controller(tmp_path, sbatch_says):
+    """The environment of a machine with Slurm's clients but no controller: squeue, sinfo
+    and scontrol fail, sbatch fails with `sbatch_says` (fakes first on PATH)."""
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    for tool, text in (("squeue", "squeue: error: no controller"), ("sinfo", ""),
+                       ("scontrol", ""), ("sbatch", sbatch_says), ("scancel", "")):
+        (bin_dir / tool).write_text(f"#!/bin/sh\necho '{text}' >&2\nexit 1\n")
+        (bin_dir / tool).chmod(0o755)
+    (tmp_path / "base.nml").write_text(BASE)
+    (tmp_path / "s.nml").write_text(SWEEP)
+    return {**os.environ, "PATH": f"{bin_dir}:{os.environ['PATH']}"}
+
+
+def test_dry_run_without_a_controller(ropedyn_exe, tmp_path):
+    """Before, `submit --dry-run` stopped with exit 1 and no word where squeue reached no
+    controller (pipefail on squeue's pipeline): now it warns that earlier jobs were not
+    checked and prints the task file it would queue (16 cases, one slot: 4 tasks of 4)."""
+    env = no_controller(tmp_path, "sbatch: fatal: no controller")
+    result = subprocess.run([str(SUBMIT), "s.nml", "--dry-run", "--exe", str(ropedyn_exe)],
+                            cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    assert "squeue failed" in result.stderr and "nothing queued" in result.stderr
+    assert result.stdout.split() == ["1-4", "5-8", "9-12", "13-16"], result.stdout
+    assert not list((tmp_path / "out").rglob("tasks_*.txt"))
+
+
+def test_failed_sbatch_queues_nothing_and_says_so(ropedyn_exe, tmp_path):
+    """sbatch's own message, then submit's: nothing queued (exit 4), no task file left."""
+    env = no_controller(tmp_path, "sbatch: fatal: Could not establish a configuration source")
+    result = subprocess.run([str(SUBMIT), "s.nml", "--exe", str(ropedyn_exe)], cwd=tmp_path,
+                            env=env, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 4, result.stderr
+    assert "Could not establish" in result.stderr
+    assert "submit: sbatch failed (its message above): nothing queued" in result.stderr
+    assert not list((tmp_path / "out").rglob("tasks_*.txt"))
