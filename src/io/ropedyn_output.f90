@@ -113,9 +113,11 @@ module ropedyn_output
         '/supports/bottom/reaction', '/supports/top/position', '/supports/bottom/position']
     character(len=*), parameter :: FORCE_UNITS(N_FORCE_SERIES) = [character(len=3) :: 'N', &
         'N', 'N m', 'N', 'N', 'm', 'm']
+    !> (FORCE_DESCRIPTION's length holds the longest text: an array constructor with a
+    !! length cuts a longer one without a word; tests/e2e/test_internal_forces.py checks)
     character(len=*), parameter :: FORCE_FRAME = ' (frame: rfem, the element above the '// &
         'joint, at joint 0 element 1; mpp, the member below the joint, at joint n member n)'
-    character(len=*), parameter :: FORCE_DESCRIPTION(N_FORCE_SERIES) = [character(len=300) :: &
+    character(len=*), parameter :: FORCE_DESCRIPTION(N_FORCE_SERIES) = [character(len=400) :: &
         'tension (> 0: stretched) at joints 0 (top end) .. n (bottom end): the component '// &
         'along the rope of the force of the rope below the joint on the rope above it (at '// &
         'the ends: of the rope on the top support, of the bottom support on the rope)'// &

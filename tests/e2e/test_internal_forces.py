@@ -60,6 +60,11 @@ def test_run_file_datasets(ropedyn_exe, tmp_path, kind):
             assert f[name].maxshape[0] is None
         assert "tension (> 0: stretched)" in text(f["forces/axial"].attrs["description"])
         assert "from x towards y" in text(f["forces/moment"].attrs["description"])
+        # whole: the frame of both models (the axial text was cut at 300 characters, before
+        # the mpp's frame)
+        for name in ("forces/axial", "forces/shear"):
+            assert text(f[name].attrs["description"]).endswith(
+                "; mpp, the member below the joint, at joint n member n)"), name
         for name, units in SUPPORTS.items():
             if name == "supports/bottom/position":
                 assert name not in f
