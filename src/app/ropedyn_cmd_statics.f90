@@ -2,6 +2,7 @@
 !! line shared with `ropedyn modes` (docs/guide/statics-modes.md).
 !!
 !!   ropedyn statics SCENE.nml [--set group.key=value ...] [-o FILE.h5] [--max-iterations N]
+!!                             [--no-continuation] [--force]
 module ropedyn_cmd_statics
     use, intrinsic :: iso_fortran_env, only: output_unit
     use ropedyn_error, only: error_t
@@ -26,9 +27,11 @@ contains
         type(statics_options_t) :: options
         type(scene_t) :: scene
         integer :: count
+        logical :: force
 
         count = DEFAULT_MODE_COUNT
         out_path = ''
+        force = .false.
         do while (cli%next())
             select case (cli%option)
             case ('--help', '-h')
@@ -36,6 +39,8 @@ contains
                 return
             case ('--no-continuation')
                 options%continuation = .false.
+            case ('--force')
+                force = .true.
             case ('-o', '--output')
                 if (len(out_path) > 0) then
                     call cli%usage_error(cli%option//' is given twice', err)
@@ -60,7 +65,7 @@ contains
         call read_scene(cli%scene_path, cli%scene_overrides(), scene, err)
         if (allocated(err)) return
         call print_warnings(scene)
-        call run_analysis(command, scene, options, count, out_path, err)
+        call run_analysis(command, scene, options, count, out_path, err, force)
     end subroutine analysis_command
 
 

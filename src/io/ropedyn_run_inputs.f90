@@ -127,32 +127,45 @@ contains
     end subroutine check_replaceable
 
     !> A run replaces a file of its own source only (a rerun of the same scene file with
-    !! the same --set overrides): ERR_USAGE naming what the existing ropedyn file at `path`
-    !! holds when its root attribute `source` is another (a --set variant, another scene)
-    !! or missing (written by a version before the rule). Nothing when `path` does not
-    !! exist; call check_replaceable first (a file ropedyn did not write).
-    subroutine check_own_source(path, source, err)
+    !! the same --set overrides), and `ropedyn statics|modes` (`analysis`) a file of that
+    !! analysis of its own source only: ERR_USAGE naming what the existing ropedyn file at
+    !! `path` holds when it is of another kind (a run, a statics or a modes result: root
+    !! attribute `analysis`, absent for a run), its root attribute `source` is another (a
+    !! --set variant, another scene) or missing (written by a version before the rule).
+    !! Nothing when `path` does not exist; call check_replaceable first (a file ropedyn did
+    !! not write).
+    subroutine check_own_source(path, source, err, analysis)
         character(len=*), intent(in) :: path, source
         type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: stored
+        character(len=*), intent(in), optional :: analysis
+        character(len=:), allocatable :: stored, kind, mine, hint
         type(h5_file_t) :: h5
         type(error_t), allocatable :: close_err
-        logical :: exists, found
+        logical :: exists, found, has_kind
         inquire (file=path, exist=exists)
         if (.not. exists) return
         call h5%open(path, err)
         if (allocated(err)) return
         call h5%read_attribute('source', stored, err, found)
+        if (.not. allocated(err)) call h5%read_attribute('analysis', kind, err, has_kind)
         call h5%close(close_err)
         if (allocated(err)) return
-        if (.not. found) then
-            call make_error(err, ERR_USAGE, path//': exists and holds a run whose source '// &
-                'is not recorded (an older file): not replaced; give this run another '// &
-                'file (--set output.file=...) or --force')
+        mine = 'run'
+        hint = 'give this run another file (--set output.file=...) or --force'
+        if (present(analysis)) then
+            mine = analysis
+            hint = 'give it another file (-o FILE.h5) or --force'
+        end if
+        if (.not. has_kind) kind = 'run'
+        if (kind /= mine) then
+            call make_error(err, ERR_USAGE, path//': exists and holds a '//kind// &
+                ' result, not a '//mine//' one: not replaced; '//hint)
+        else if (.not. found) then
+            call make_error(err, ERR_USAGE, path//': exists and holds a '//kind//' whose '// &
+                'source is not recorded (an older file): not replaced; '//hint)
         else if (stored /= source) then
-            call make_error(err, ERR_USAGE, path//': exists and holds the run of "'// &
-                stored//'", not of this run "'//source//'": not replaced; give this run '// &
-                'another file (--set output.file=...) or --force')
+            call make_error(err, ERR_USAGE, path//': exists and holds the '//kind//' of "'// &
+                stored//'", not of this '//mine//' "'//source//'": not replaced; '//hint)
         end if
     end subroutine check_own_source
 end module ropedyn_run_inputs

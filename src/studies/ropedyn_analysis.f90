@@ -6,12 +6,13 @@
 module ropedyn_analysis
     use, intrinsic :: iso_fortran_env, only: output_unit
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_error, only: error_t, make_error, ERR_INTERNAL
+    use ropedyn_error, only: error_t, make_error, ERR_INTERNAL, ERR_USAGE
     use ropedyn_scene, only: scene_t, scene_namelist_text
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_os, only: make_parent_dirs
-    use ropedyn_run_inputs, only: check_not_input
+    use ropedyn_os, only: make_parent_dirs, special_file_reason, file_kind, real_path, &
+                          rename_file, delete_file, FILE_SYMLINK, FILE_MISSING
+    use ropedyn_run_inputs, only: check_not_input, check_replaceable, check_own_source
     use ropedyn_text, only: int_text
     use ropedyn_model_factory, only: create_model
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
@@ -71,21 +72,28 @@ contains
 
     !> `ropedyn statics|modes` on a scene that is read already: the equilibrium from the
     !! scene's initial shape, the support forces, for 'modes' the lowest `count` modes;
-    !! the HDF5 file `out_path` ('': out/<scene>_<command>.h5) and a printed summary.
-    subroutine run_analysis(command, scene, options, count, out_path_given, err)
+    !! the HDF5 file `out_path` ('': out/<scene>_<command>.h5) and a printed summary. The
+    !! file replaces an existing one only when that is the same analysis of the same source
+    !! (or `force`), never an input of the scene or a special file, and is written as
+    !! FILE.part, renamed to FILE when whole (the output guide's rules for a run's file).
+    subroutine run_analysis(command, scene, options, count, out_path_given, err, force)
         character(len=*), intent(in) :: command   !< 'statics' or 'modes'
         type(scene_t), intent(in) :: scene
         type(statics_options_t), intent(in) :: options
         integer, intent(in) :: count              !< modes wanted ('modes' only)
         character(len=*), intent(in) :: out_path_given
         type(error_t), allocatable, intent(out) :: err
+        logical, intent(in), optional :: force    !< replace any regular file that is no input
         type(analysis_t) :: analysis
 
         analysis%command = command
         analysis%out_path = out_path_given
         if (len(analysis%out_path) == 0) analysis%out_path = default_output(scene, command)
-        ! never over an input (the scene, its tables, its state file): before any work
+        ! never over an input (the scene, its tables, its state file) or a file of another
+        ! analysis or source: before any work
         call check_not_input(analysis%out_path, scene, err)
+        if (allocated(err)) return
+        call guard_output(analysis%out_path, command, scene, err, force)
         if (allocated(err)) return
         call analysis%solve(scene, options, count, err)
         if (allocated(err)) return
@@ -122,20 +130,51 @@ contains
         if (self%command == 'modes') call compute_modes(self%model, self%y, count, self%mres, err)
     end subroutine analysis_solve
 
-    !> The HDF5 file: /statics and /energy, the forces, the shape, for 'modes' /modes.
+    !> The output `path` of `command` may be written: no special file (a device, a FIFO, a
+    !! link to one), whatever `force`; unless `force`, an existing file only when ropedyn
+    !! wrote it for the same analysis of the same source (check_own_source).
+    subroutine guard_output(path, command, scene, err, force)
+        character(len=*), intent(in) :: path, command
+        type(scene_t), intent(in) :: scene
+        type(error_t), allocatable, intent(out) :: err
+        logical, intent(in), optional :: force
+        if (len(special_file_reason(path)) > 0) then
+            call make_error(err, ERR_USAGE, path//': exists and is '// &
+                            special_file_reason(path)//': not replaced')
+            return
+        end if
+        if (present(force)) then
+            if (force) return
+        end if
+        call check_replaceable(path, err)
+        if (allocated(err)) return
+        if (allocated(scene%source)) call check_own_source(path, scene%source, err, command)
+    end subroutine guard_output
+
+    !> The HDF5 file: /statics and /energy, the forces, the shape, for 'modes' /modes;
+    !! written as FILE.part (FILE: the file a link names) and renamed to FILE when closed,
+    !! so that an earlier FILE stays whole until then and a failed write leaves no file.
     subroutine analysis_write_file(self, scene, err)
         class(analysis_t), intent(inout) :: self
         type(scene_t), intent(in) :: scene
         type(error_t), allocatable, intent(out) :: err
         type(h5_file_t) :: h5
         type(error_t), allocatable :: close_err
-        call h5%create(self%out_path, err)
+        character(len=:), allocatable :: file
+        logical :: removed
+        file = self%out_path
+        if (file_kind(file, follow=.false.) == FILE_SYMLINK) then
+            if (file_kind(file) /= FILE_MISSING) file = real_path(file)
+        end if
+        call h5%create(file//'.part', err)
         if (allocated(err)) return
         call self%write_statics(h5, scene, err)
         if (.not. allocated(err)) call self%write_shape(h5, err)
         if (.not. allocated(err) .and. self%command == 'modes') call self%write_modes(h5, err)
         call h5%close(close_err)
         if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
+        if (.not. allocated(err)) call rename_file(file//'.part', file, err)
+        if (allocated(err)) removed = delete_file(file//'.part')
     end subroutine analysis_write_file
 
     !> The root's attributes and provenance, /statics (the equilibrium, how it was found,
@@ -156,6 +195,8 @@ contains
         call h5%attribute('/', 'status', 'complete', err)
         if (allocated(err)) return
         call h5%attribute('/', 'analysis', self%command, err)
+        if (allocated(err)) return
+        if (allocated(scene%source)) call h5%attribute('/', 'source', scene%source, err)
         if (allocated(err)) return
         call write_provenance(h5, version_string, self%model%model_name(), &
                               scene_namelist_text(scene), err)

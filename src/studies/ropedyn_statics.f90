@@ -51,7 +51,9 @@ module ropedyn_statics
 
     !> Controls of `solve_statics`.
     type :: statics_options_t
-        integer :: max_iterations = 2000           !< linear solves (accepted + rejected steps)
+        !> linear solves (accepted + rejected steps) of a solve: the direct one, and each
+        !! stage of a continuation (which has STAGE_ITERATIONS when that is less)
+        integer :: max_iterations = 2000
         real(wp) :: step_tolerance = 1.0e-10_wp    !< final Newton step / rope length
         logical :: continuation = .true.           !< find_equilibrium may use continuation
     end type statics_options_t
@@ -91,6 +93,9 @@ module ropedyn_statics
         real(wp) :: log_f0 = 0.0_wp, log_f1 = 0.0_wp
         integer :: iterations = 0, rejected = 0   !< of all its stages
         integer :: stages = 0                     !< 0 when given up
+        !> linear solves a stage may take: STAGE_ITERATIONS, or the caller's limit of a
+        !! solve when that is smaller (statics_options_t%max_iterations)
+        integer :: stage_limit = STAGE_ITERATIONS
         character(len=:), allocatable :: fallback !< '' or how far it got before given up
     contains
         procedure :: plan => continuation_plan
@@ -205,6 +210,7 @@ contains
         logical :: needed
 
         ground%fallback = ''
+        ground%stage_limit = min(STAGE_ITERATIONS, options%max_iterations)
         call check_equilibrium_exists(spec, err)
         if (allocated(err)) return
         if (current_drags(spec)) then
@@ -259,6 +265,7 @@ contains
         logical :: needed
 
         path%fallback = ''
+        path%stage_limit = min(STAGE_ITERATIONS, options%max_iterations)
         if (options%continuation) then
             call path%plan(model, spec, y, needed, err)
             if (allocated(err)) return
@@ -383,7 +390,7 @@ contains
         logical :: solved
 
         y_start = y
-        stage_options%max_iterations = STAGE_ITERATIONS
+        stage_options%max_iterations = self%stage_limit
         stage_options%step_tolerance = 1.0e-8_wp
         s = 0.0_wp
         ds = log(10.0_wp)/(self%log_f1 - self%log_f0)

@@ -134,3 +134,48 @@ def test_a_killed_run_leaves_the_earlier_file_whole(run, ropedyn_exe, tmp_path, 
     resumed = run("run", "--resume", "out/paper.h5.part", "--set", f"solver.t_end={last + 0.05}")
     assert resumed.returncode == 0, resumed.stderr
     assert digest(out) == before
+
+
+CATENARY = ROOT / "input" / "catenary.nml"
+
+
+def test_statics_and_modes_replace_only_their_own_result(run, tmp_path):
+    """`ropedyn statics|modes -o FILE` followed the run's rules only for inputs and special
+    files: before, it replaced any regular file (a run's, a text file) without a word. Now
+    it replaces only the same analysis of the same source (a rerun), else exit 2 with the
+    file unchanged, unless --force; and a run does not replace a statics or modes file."""
+    scene = tmp_path / "c.nml"
+    scene.write_text(CATENARY.read_text())
+    assert run("run", scene, "--set", "solver.t_end=0.02", "--set",
+               "output.file='r.h5'").returncode == 0
+    (tmp_path / "notes.txt").write_text("my notes\n")
+    kept = {name: digest(tmp_path / name) for name in ("r.h5", "notes.txt")}
+    refused = [(("statics", scene, "-o", "r.h5"), "r.h5: exists and holds a run result, "
+                "not a statics one: not replaced"),
+               (("modes", scene, "-o", "notes.txt"), "notes.txt: exists and is not an HDF5")]
+    for args, words in refused:
+        proc = run(*args)
+        assert proc.returncode == 2 and words in proc.stderr, proc.stderr
+    assert {name: digest(tmp_path / name) for name in kept} == kept
+
+    first = run("statics", scene, "-o", "s.h5")
+    assert first.returncode == 0, first.stderr
+    with h5py.File(tmp_path / "s.h5") as f:
+        assert f.attrs["source"].decode() == str(scene)
+    assert run("statics", scene, "-o", "s.h5").returncode == 0       # a rerun
+    before = digest(tmp_path / "s.h5")
+    for args, words in [
+            (("statics", scene, "-o", "s.h5", "--set", "model.elements=20"),
+             f's.h5: exists and holds the statics of "{scene}", not of this statics'),
+            (("modes", scene, "-o", "s.h5", "--count", "2"),
+             "s.h5: exists and holds a statics result, not a modes one"),
+            (("run", scene, "--set", "solver.t_end=0.02", "--set", "output.file='s.h5'"),
+             "s.h5: exists and holds a statics result, not a run one")]:
+        proc = run(*args)
+        assert proc.returncode == 2 and words in proc.stderr, proc.stderr
+    assert digest(tmp_path / "s.h5") == before
+    forced = run("modes", scene, "-o", "s.h5", "--count", "2", "--force")
+    assert forced.returncode == 0, forced.stderr
+    with h5py.File(tmp_path / "s.h5") as f:
+        assert f.attrs["analysis"].decode() == "modes" and len(f["modes/omega"]) == 2
+    assert not list(tmp_path.glob("*.part"))

@@ -154,6 +154,19 @@ def test_no_convergence(run, tmp_path):
     assert "no convergence in 2 iterations" in result.stderr
 
 
+def test_iteration_limit_holds_in_the_continuation(run, tmp_path):
+    """The catenary's far bottom anchor is reached by continuation (stages of at most 150
+    solves each): --max-iterations limits each stage too. Before, the stages ignored it and
+    `--max-iterations 1` converged after 70 iterations, exit 0."""
+    (tmp_path / "c.nml").write_text(CATENARY.format(kind="rfem", n=30))
+    free = run("statics", "c.nml", "-o", "free.h5")
+    assert free.returncode == 0 and "continuation stages" in free.stdout, free.stdout
+    result = run("statics", "c.nml", "--max-iterations", "1", "-o", "one.h5")
+    assert result.returncode == 3, result.stderr
+    assert "no convergence in 1 iterations" in result.stderr
+    assert not (tmp_path / "one.h5").exists()
+
+
 def test_help(run):
     for command in ("statics", "modes"):
         result = run(command, "--help")
