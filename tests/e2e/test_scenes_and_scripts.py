@@ -86,3 +86,38 @@ def test_energy_plot(run, tmp_path):
     assert result.returncode == 0, result.stderr
     data = png.read_bytes()
     assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10000
+
+
+def test_energy_plot_script_runs_itself_in_the_venv(run, tmp_path):
+    """Started by the system's python3 (the shebang), which has no ropedyn package: before,
+    an ImportError; now it runs itself with the project's venv."""
+    (tmp_path / "e.nml").write_text("&model kind = 'rfem', elements = 4 /\n"
+                                    "&solver t_end = 0.05, output_interval = 0.01 /\n")
+    assert run("run", "e.nml").returncode == 0
+    png = tmp_path / "e.png"
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+    result = subprocess.run(["/usr/bin/python3", str(ROOT / "scripts" / "plot_energy.py"),
+                             str(tmp_path / "out" / "e.h5"), "-o", str(png)],
+                            capture_output=True, text=True, env=env)
+    assert result.returncode == 0, result.stderr
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("script,words", [("build", "scripts/build [Release|Debug]"),
+                                          ("setup", "scripts/setup --tests"),
+                                          ("test", "scripts/test --long"),
+                                          ("run", "ropedyn run --help")])
+def test_shell_scripts_answer_help(script, words):
+    """`--help` prints the script's usage and does nothing else (before, scripts/build --help
+    configured a build in build/--help, and setup and run installed and built first)."""
+    result = subprocess.run([str(ROOT / "scripts" / script), "--help"], capture_output=True,
+                            text=True, timeout=30)
+    assert result.returncode == 0 and words in result.stdout, result.stdout + result.stderr
+    assert not (ROOT / "build" / "--help").exists()
+
+
+def test_build_refuses_an_unknown_type():
+    result = subprocess.run([str(ROOT / "scripts" / "build"), "Relase"], capture_output=True,
+                            text=True, timeout=30)
+    assert result.returncode == 2 and 'not "Relase"' in result.stderr
+    assert not (ROOT / "build" / "relase").exists()
