@@ -4,6 +4,7 @@ user pages (getting started, the user guide, the reference) name no source file,
 issue; and no page grows into a lab notebook (at most MAX_LINES lines)."""
 import pathlib
 import re
+import subprocess
 
 import pytest
 
@@ -130,3 +131,18 @@ def test_the_index_links_every_page():
               for target in LINK.findall(prose(index)) if not re.match(r"^[a-z]+:", target)}
     pages = {p.resolve() for p in DOCS.rglob("*.md")} - {index.resolve()}
     assert not pages - linked, sorted(str(p.relative_to(DOCS)) for p in pages - linked)
+
+
+def test_readme_layout_names_the_tree():
+    """The README's layout table: every folder it names exists, and every top-level folder of
+    the repository with code, scenes, scripts or pages is named (its `python/` row once still
+    listed the studies after they moved to tools/, which the table did not name)."""
+    text = (ROOT / "README.md").read_text()
+    table = text[text.index("| folder | contents |"):]
+    table = table[:table.index("\n\n")]
+    named = {m.group(1).rstrip("/") for m in re.finditer(r"^\| `([^`]+)` \|", table, re.M)}
+    assert all((ROOT / name).is_dir() for name in named), named
+    tracked = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True,
+                             check=True).stdout.split()
+    tops = {path.split("/")[0] for path in tracked if "/" in path} - {".ci"}
+    assert tops <= {name.split("/")[0] for name in named}, tops - named
