@@ -14,7 +14,11 @@ module ropedyn_rope_model
     !> Energy bookkeeping of a state, all in J.
     type :: energy_t
         real(wp) :: kinetic = 0.0_wp       !< T
-        real(wp) :: elastic = 0.0_wp       !< springs (internal and supports)
+        real(wp) :: elastic = 0.0_wp       !< springs (internal and supports), effects
+        !> the part of `elastic` whose zero is arbitrary, a potential of the bodies' level as
+        !! gravity's is (in water, the buoyancy's): the energy monitor counts its range, not
+        !! its value (docs/theory/energy-balance.md)
+        real(wp) :: level = 0.0_wp
         real(wp) :: gravity = 0.0_wp       !< -sum m g x
         real(wp) :: dissipated = 0.0_wp    !< integral of the dissipation power so far
         !> external work done on the rope so far: moving supports, point loads, a current

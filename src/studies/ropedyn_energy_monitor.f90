@@ -9,7 +9,10 @@
 !! models give the energies and the dissipated energy and work as quadratures.
 !!
 !! S is the energy the run moves around so far, as in `stability_metrics` (python): max T +
-!! max elastic + (max - min) of the gravity energy + the energy dissipated (J); one accepted
+!! max elastic + (max - min) of the gravity energy + the energy dissipated (J), the part of
+!! the elastic energy whose zero is arbitrary (energy_t%level: in water the buoyancy's, which
+!! grows with the depth below the surface) counted with gravity, by its range (the python
+!! study reads files without that part, and its scenes have no water); one accepted
 !! step moves B by about rtol times the energies in play, so the bound rtol S follows the
 !! tolerance. The monitor knows nothing of integrators: the run driver
 !! (`ropedyn_run`) decides what a gain means (lower the order, stop), and may
@@ -70,9 +73,9 @@ module ropedyn_energy_monitor
         real(wp) :: rtol = 0.0_wp           !< relative tolerance of the run
         real(wp) :: factor = 0.0_wp         !< the bound in units of rtol S
         real(wp) :: max_kinetic = 0.0_wp    !< J
-        real(wp) :: max_elastic = 0.0_wp    !< J
-        real(wp) :: min_gravity = 0.0_wp    !< J
-        real(wp) :: max_gravity = 0.0_wp    !< J
+        real(wp) :: max_elastic = 0.0_wp    !< of elastic - level, J
+        real(wp) :: min_gravity = 0.0_wp    !< of gravity + level, J
+        real(wp) :: max_gravity = 0.0_wp    !< of gravity + level, J
         real(wp) :: dissipated = 0.0_wp     !< |dissipated| at the last record, J
         !> the largest T + V + dissipated over the records, J (the intake's top; E0 plus the
         !! work put in so far, for the exact motion)
@@ -237,9 +240,9 @@ contains
         if (present(floor)) self%floor = max(0.0_wp, floor)
         self%accepted = 0.0_wp
         self%max_kinetic = e%kinetic
-        self%max_elastic = e%elastic
-        self%min_gravity = e%gravity
-        self%max_gravity = e%gravity
+        self%max_elastic = e%elastic - e%level
+        self%min_gravity = e%gravity + e%level
+        self%max_gravity = e%gravity + e%level
         self%dissipated = abs(e%dissipated)
         self%max_held = e%total() + e%dissipated
     end subroutine monitor_start
@@ -249,9 +252,9 @@ contains
         class(energy_monitor_t), intent(inout) :: self
         type(energy_t), intent(in) :: e
         self%max_kinetic = max(self%max_kinetic, e%kinetic)
-        self%max_elastic = max(self%max_elastic, e%elastic)
-        self%min_gravity = min(self%min_gravity, e%gravity)
-        self%max_gravity = max(self%max_gravity, e%gravity)
+        self%max_elastic = max(self%max_elastic, e%elastic - e%level)
+        self%min_gravity = min(self%min_gravity, e%gravity + e%level)
+        self%max_gravity = max(self%max_gravity, e%gravity + e%level)
         self%dissipated = abs(e%dissipated)
         self%max_held = max(self%max_held, e%total() + e%dissipated)
     end subroutine monitor_observe
@@ -313,8 +316,8 @@ contains
     end function monitor_big_change
 
     !> I, the energy the motion took in so far (J): the largest T + V + dissipated over the
-    !! records above the lowest gravity energy, at least RUNAWAY_LEAST_SCALE (a rope at rest
-    !! without gravity).
+    !! records above the lowest gravity + level energy, at least RUNAWAY_LEAST_SCALE (a
+    !! rope at rest without gravity).
     pure real(wp) function monitor_intake(self) result(intake)
         class(energy_monitor_t), intent(in) :: self
         intake = max(self%max_held - self%min_gravity, RUNAWAY_LEAST_SCALE)

@@ -47,6 +47,10 @@ contains
             call read_run_record(file, 0, first, err)
             if (allocated(err)) return
             self%summary%initial_energy = first%energy
+            ! the file does not keep the level part of the elastic energy: the model's, at
+            ! that record's state (the energy monitor counts it with gravity)
+            self%summary%initial_energy%level = level_energy(self%model, first%t, first%y, &
+                                                             first%yq)
             self%t = rec%t
             self%y = rec%y
             self%yq = 0.0_wp
@@ -87,4 +91,13 @@ contains
                 'that follow)'
         end associate
     end procedure resume_from_file
+
+    !> The level part of the model's elastic energy at a state (energy_t%level), J.
+    real(wp) function level_energy(model, t, y, yq) result(level)
+        class(rope_model_t), intent(inout) :: model
+        real(wp), intent(in) :: t, y(:), yq(:)
+        type(energy_t) :: e
+        e = model%energy(t, y, yq)
+        level = e%level
+    end function level_energy
 end submodule ropedyn_run_resume

@@ -140,6 +140,23 @@ program test_energy_monitor
                           dissipated=0.0_wp, support_work=0.0_wp), rtol, factor)
     call suite%check_close(m%scale(), 0.0_wp, 0.0_wp, 1.0e-300_wp, 'gravity zero arbitrary')
 
+    ! the level part of the elastic energy (in water the buoyancy's potential, which grows
+    ! with the depth below the surface) counts with gravity, by its range: the records of
+    ! 'S after a record' 1000 m deeper (level and elastic raised alike) give the same S and I
+    e2 = e0
+    e2%elastic = e0%elastic + 1000.0_wp
+    e2%level = 1000.0_wp
+    call m%start(e2, rtol, factor)
+    e2 = e1
+    e2%elastic = e1%elastic + 1000.0_wp
+    e2%level = 1000.0_wp
+    call m%observe(e2)
+    call suite%check_close(m%scale(), 1.12_wp, 1.0e-10_wp, 0.0_wp, 'S: the level by its range')
+    x = m%intake()
+    call m%start(e0, rtol, factor)
+    call m%observe(e1)
+    call suite%check_close(x, m%intake(), 1.0e-10_wp, 0.0_wp, 'I: the level by its range')
+
     ! at a loose tolerance the bound is at most a tenth of S: energy created and then
     ! dissipated raises S with it, and 10 rtol S at rtol 0.1 (S itself) would never be passed
     call m%start(e0, 0.1_wp, factor)

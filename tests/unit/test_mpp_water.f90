@@ -15,7 +15,7 @@ program test_mpp_water
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t
     use ropedyn_scene, only: scene_t, read_scene
-    use ropedyn_rope_model, only: rope_model_t
+    use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_model_factory, only: create_model
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium
     use ropedyn_modes, only: modes_result_t, compute_modes
@@ -40,6 +40,8 @@ program test_mpp_water
     suite%name = 'mpp_water'
     call swing()
     call modes()
+    call level('rfem')
+    call level('mpp')
     call suite%finish()
 
 contains
@@ -141,6 +143,48 @@ contains
         end if
         omega = res%omega(1:3)
     end subroutine modes_of
+
+    !> The model of the chain with `kind`, its surface at `surface`, and its energies at the
+    !! straight start (wholly under water).
+    function energies_at(kind, surface) result(e)
+        character(len=*), intent(in) :: kind, surface
+        type(energy_t) :: e
+        character(len=SET_LEN) :: sets(size(CHAIN) + 2)
+        type(scene_t) :: scene
+        type(error_t), allocatable :: err
+        class(rope_model_t), allocatable :: model
+        real(wp), allocatable :: y(:)
+        integer :: unit
+        sets(1:size(CHAIN)) = CHAIN
+        sets(size(CHAIN) + 1) = kind_set(kind)
+        sets(size(CHAIN) + 2) = 'fluid.surface = '//surface
+        open (newunit=unit, file='test_mpp_water.nml', status='replace', action='write')
+        write (unit, '(a)') '&model /'
+        close (unit)
+        call read_scene('test_mpp_water.nml', sets, scene, err)
+        if (.not. allocated(err)) call create_model(scene%rope_spec_t, model, err)
+        call suite%check_true(.not. allocated(err), kind//': the chain at surface '//surface)
+        if (allocated(err)) return
+        allocate (y(model%size()))
+        call model%initial_state(y)
+        e = model%energy(0.0_wp, y, [0.0_wp])
+    end function energies_at
+
+    !> The buoyancy's potential is the level part of the elastic energy (energy_t%level,
+    !! which the energy monitor counts by its range, as gravity): the chain wholly under water
+    !! with its surface 0.1 m and 100.1 m above the top, the same state: the level part
+    !! changes by the displaced water's weight times 100 m (rho g A L 100: the buoyancy's
+    !! potential -rho g V x_c), the rest of the elastic energy not at all.
+    subroutine level(kind)
+        character(len=*), intent(in) :: kind
+        type(energy_t) :: near, deep
+        near = energies_at(kind, '-0.1')
+        deep = energies_at(kind, '-100.1')
+        call suite%check_close(deep%level - near%level, RHO_A*G*1.0_wp*100.0_wp, 1.0e-9_wp, &
+                               0.0_wp, kind//': the level part grows with the depth')
+        call suite%check_close(deep%elastic - deep%level, near%elastic - near%level, &
+                               1.0e-12_wp, 1.0e-12_wp, kind//': the rest of elastic does not')
+    end subroutine level
 
     subroutine modes()
         real(wp) :: mpp(3), rfem(3), bare(3), chain(3)

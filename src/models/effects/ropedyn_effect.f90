@@ -20,7 +20,7 @@ module ropedyn_effect
     private
     public :: body_effect_t, effect_box_t, bodies_t, point_force_block, set_axes
     public :: add_forces_of, add_jacobians_of, add_energies_of, add_powers_of
-    public :: add_forces_powers_of
+    public :: add_forces_powers_of, add_level_energies_of
 
     !> Kinematics of all bodies of a model at one instant.
     type :: bodies_t
@@ -42,6 +42,8 @@ module ropedyn_effect
         procedure(add_jacobian_i), deferred :: add_jacobian
         ! its part of the energy balance (the defaults: none)
         procedure :: does_work => effect_does_work, energy => effect_energy, power => effect_power
+        ! the part of its energy that is a potential of the bodies' level (default: none)
+        procedure :: level_energy => effect_energy
         ! add_forces and power at one instant in one call (default: the two one after the
         ! other; an effect whose power repeats its forces' work overrides it)
         procedure :: add_forces_power => effect_add_forces_power
@@ -188,6 +190,19 @@ contains
             energy = energy + effects(k)%e%energy(t, b)
         end do
     end subroutine add_energies_of
+
+    !> Add the level potentials of all `effects` at time t to `energy`, J (the part of
+    !! their energies whose zero is arbitrary: body_effect_t%level_energy).
+    pure subroutine add_level_energies_of(effects, t, b, energy)
+        type(effect_box_t), intent(in) :: effects(:)
+        real(wp), intent(in) :: t
+        type(bodies_t), intent(in) :: b
+        real(wp), intent(inout) :: energy
+        integer :: k
+        do k = 1, size(effects)
+            energy = energy + effects(k)%e%level_energy(t, b)
+        end do
+    end subroutine add_level_energies_of
 
     !> Add the dissipation rates and external powers (W) of all `effects` at time t.
     pure subroutine add_powers_of(effects, t, b, dissipation, work)

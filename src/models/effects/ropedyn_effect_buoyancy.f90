@@ -24,6 +24,8 @@ module ropedyn_effect_buoyancy
         procedure :: add_forces => buoyancy_add_forces
         procedure :: add_jacobian => buoyancy_add_jacobian
         procedure :: energy => buoyancy_energy
+        ! all of it: rho g A v grows with the depth below the surface, as gravity's with x
+        procedure :: level_energy => buoyancy_energy
     end type buoyancy_effect_t
 
 contains

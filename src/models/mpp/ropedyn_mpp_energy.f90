@@ -42,7 +42,10 @@ contains
                                                           (phi(n) - bottom%angle)**2
         if (size(self%effects) > 0 .or. self%water) then
             call rod_bodies(self, y, top, b)
-            if (size(self%effects) > 0) call add_energies_of(self%effects, t, b, en%elastic)
+            if (size(self%effects) > 0) then
+                call add_energies_of(self%effects, t, b, en%elastic)
+                call add_level_energies_of(self%effects, t, b, en%level)
+            end if
             if (self%water) then
                 ! the added mass's kinetic energy; the current's potential -1/2 u^T A u
                 call water_energy(self, b, e_kin, e_pot)

@@ -34,7 +34,8 @@ module ropedyn_rfem
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_effect, only: effect_box_t, bodies_t, add_forces_of, add_jacobians_of, &
-                              add_energies_of, add_powers_of, add_forces_powers_of
+                              add_energies_of, add_powers_of, add_forces_powers_of, &
+                              add_level_energies_of
     use ropedyn_effect_factory, only: build_body_effects, attached_masses, water_added_mass
     use ropedyn_added_mass, only: added_mass_t
     use ropedyn_support_motion, only: motion_state_t
