@@ -567,10 +567,11 @@ def time_domain(runner):
            "M(q) and K (central differences of the O(n) implicit force, O(n^2)), dense steps "
            "and dsygvx, O(n^3); at n = 300 (600 coordinates with the member springs) the "
            "hanging rope takes about a second, a catenary started far from its equilibrium "
-           "(200-400 iterations) 10-20 s; the time-domain MPP runs are kept at n = 30 (each "
-           "step of the integrator factors the dense M(q)). The RFEM catenaries take 300-1300 "
-           "iterations (their linearized steps rotate elements by ~0.1 rad at most before the "
-           "stiff joints object), a few seconds at n = 300.", ""]
+           "(its iterations: the catenary table) 10-20 s; the time-domain MPP runs are kept "
+           "at n = 30 (each step of the integrator factors the dense M(q)). The RFEM "
+           "catenaries take the most iterations (the same table: their linearized steps "
+           "rotate elements by ~0.1 rad at most before the stiff joints object), a few "
+           "seconds at n = 300.", ""]
     return md
 
 
