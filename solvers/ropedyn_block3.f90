@@ -8,7 +8,7 @@
 !! keeping D'_i^{-1} (the adjugate over the determinant: exact under the scaling of the
 !! translational and rotational rows, see invert3) and W_i = D'_i^{-1} U_i. Solve:
 !!     z_i = b_i - L'_i z_{i-1},  c_i = D'_i^{-1} z_i,  x_i = c_i - W_i x_{i+1}.
-!! 27 multiply-adds per block row in the solve against 3 (2 kl + ku + 1) = 78 for the band
+!! 27 multiply-adds per block row in the solve against 3 (2 kl + ku + 1) = 48 for the band
 !! LU with partial pivoting (whose row interchanges fill U to kl + ku super-diagonals on
 !! the rope), and the 3 x 3 products are independent operations instead of a chain.
 !!

@@ -8,11 +8,12 @@
 !!   a new g costs the matrix M_v - g C - g^2 K of size(pos) unknowns (half the system) and
 !!   its factorization; a solve of (M - g J) x = b is
 !!       (M_v - g C - g^2 K) x_v = b_v + g K b_q,   x_q = b_q + g x_v.
-!!   The blocks are the problem's `second_order_blocks` of the form asked for. When the
-!!   problem has none for the implicit form (the MPP without an analytic implicit Jacobian:
-!!   STATUS_FATAL), they are difference quotients of the implicit F, taken as the first-order
-!!   path takes them (the term dM/dq v' is left to the chord iteration, as there), and M_v
-!!   comes from the mass matrix. Without any blocks the first-order path is taken.
+!!   The blocks are the problem's `second_order_blocks` of the form asked for (both models
+!!   have them in both forms; the MPP's implicit ones hold the d(M a)/dq term). When a
+!!   problem has none for the implicit form (STATUS_FATAL), they are difference quotients
+!!   of the implicit F, taken as the first-order path takes them (the term dM/dq v' is left
+!!   to the chord iteration, as there), and M_v comes from the mass matrix. Without any
+!!   blocks the first-order path is taken.
 !! - **first order** (problems without that structure, the stiff test set, or on request):
 !!   J = dF/dy over all unknowns, analytic when the problem supplies it, else difference
 !!   quotients of F (a band Jacobian by column groups of width ml + mu + 1: one F evaluation

@@ -18,7 +18,9 @@
 !! original limit is restored (without restart) to see whether the stiff modes have died
 !! away; a crawl that comes back doubles the next stretch. If order 2 is not faster (the
 !! rope's resolved bending oscillations, where order 5 is right), the limit is restored
-!! and the next trial waits 4 times longer. Every change goes into the switch log.
+!! and the next trial waits longer (the wait grows by at least 2, by twice the ratio of the
+!! step rates when order 2 lost more; docs/theory/cvode.md). Every change goes into the
+!! switch log.
 !!
 !! **Adams.** Its fixed-point iteration converges only for h |lambda| < 1: on a stiff
 !! problem the step collapses. After FAIL_WINDOWS consecutive windows at more than
