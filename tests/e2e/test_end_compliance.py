@@ -44,3 +44,33 @@ def test_split_end_sections_converge_at_second_order(ropedyn_exe, tmp_path, mode
     limit = tension["split"][2] + (tension["split"][2] - tension["split"][1]) / 3
     assert tension["split"][0] > tension["added"][2]
     assert abs(tension["added"][2] - limit) / limit < 0.01
+
+
+TAUT = """&model kind = 'mpp', elements = 10, mpp_axial_damping_factor = {factor} /
+&rope length = 1.0, mass_per_length = 0.1, axial_stiffness = 1000.0, axial_damping = 0.01 /
+&supports top = 'pinned', bottom = 'pinned', bottom_anchor = 1.01, 0.0,
+    end_compliance = 'split', support_stiffness_factor = 2.0 /
+&effects gravity = .false. /
+&initial shape = 'straight', angle_deg = 0.0 /
+"""
+
+
+@pytest.mark.parametrize("factor", [1.0, 3.0])
+def test_split_pin_damps_as_the_member_it_shares(ropedyn_exe, tmp_path, factor):
+    """MPP, 'split': the pin's half of the last section damps as the member's other half.
+    A straight line stretched between two pins without gravity has axial damping
+    proportional to its axial stiffness (d/k = factor eta/E for every member), so each axial
+    mode's damping ratio is omega d/(2 k). Before, the pin took the rope's damping without
+    the MPP's damping factor: at factor 3 the axial modes' ratios fell 0.87 .. 0.998 of it."""
+    import h5py
+    (tmp_path / "t.nml").write_text(TAUT.format(factor=factor))
+    result = subprocess.run([str(ropedyn_exe), "modes", "t.nml", "--count", "30", "-o",
+                             "m.h5"], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    with h5py.File(tmp_path / "m.h5") as f:
+        omega, zeta = f["modes/omega"][()], f["modes/damping_ratio"][()]
+        axial = f["modes/axial_fraction"][()] > 0.99
+    assert axial.sum() >= 8
+    expected = factor * 0.01 / 1000.0 / 2.0
+    ratios = zeta[axial] / omega[axial] / expected
+    assert abs(ratios - 1.0).max() < 1e-6, ratios

@@ -485,8 +485,10 @@ contains
 
         ! The members' springs (EA/l) cover [0, L]; the top pin is ideal, but the bottom
         ! pin's spring adds one member's compliance l/EA (an O(l) error, as RFEM's supports).
-        ! With end_compliance = 'split' the last member is shared with it: each 2 EA/l
-        ! (damping alike), the compliance adds up to L/EA.
+        ! With end_compliance = 'split' the last member is shared with it: each 2 EA/l, the
+        ! compliance adds up to L/EA; the pin's half of the section damps as the member's
+        ! other half, 2 d_s (with the MPP's damping factor), so that the line's axial
+        ! damping stays proportional to its stiffness (docs/theory/mpp.md).
         allocate (model%ksj(model%n), model%dsj(model%n))
         model%ksj = model%ks
         model%dsj = model%ds
@@ -494,7 +496,7 @@ contains
             model%ksj(model%n) = 2.0_wp*model%ks
             model%dsj(model%n) = 2.0_wp*model%ds
             model%k_sup = 2.0_wp*model%k_sup
-            model%d_sup = 2.0_wp*model%d_sup
+            if (spec%effects%damping) model%d_sup = 2.0_wp*factor*model%ds
         end if
     end subroutine set_support_springs
 
