@@ -74,3 +74,23 @@ def test_split_pin_damps_as_the_member_it_shares(ropedyn_exe, tmp_path, factor):
     expected = factor * 0.01 / 1000.0 / 2.0
     ratios = zeta[axial] / omega[axial] / expected
     assert abs(ratios - 1.0).max() < 1e-6, ratios
+
+
+@pytest.mark.parametrize("model", ["rfem", "mpp"])
+def test_a_bottom_released_at_the_start_shares_no_section(ropedyn_exe, tmp_path, model):
+    """A bottom pin released at t = 0 is a free end: with 'split' (the top pin's section
+    shared in both runs) its last section must not keep the doubled spring. Before, the MPP doubled it anyway (its release was resolved
+    after the springs): its hanging rope's lower end sat 5e-5 m higher than the free one's."""
+    lower = re.compile(r"lower end\s+x =\s+(\S+) m")
+    ends = []
+    for sets in (["supports.end_compliance=split"],
+                 ["supports.bottom=pinned", "supports.end_compliance=split",
+                  "supports.bottom_release_time=0"]):
+        result = subprocess.run(
+            [str(ropedyn_exe), "statics", str(ROOT / "input" / "paper.nml"), "--set",
+             f"model.kind={model}", "--set", "model.elements=4",
+             *[a for s in sets for a in ("--set", s)], "-o", str(tmp_path / "s.h5"), "--force"],
+            capture_output=True, text=True, timeout=120)
+        assert result.returncode == 0, result.stderr
+        ends.append(float(lower.search(result.stdout).group(1)))
+    assert ends[0] == pytest.approx(ends[1], rel=1e-12, abs=1e-12), ends

@@ -72,7 +72,7 @@ module ropedyn_mpp
         real(wp) :: top_anchor(2) = 0.0_wp, bottom_anchor(2) = 0.0_wp
         real(wp) :: top_angle = 0.0_wp, bottom_angle = 0.0_wp
         real(wp) :: init_angle = 0.0_wp
-        logical :: folded = .false.    !< initial shape 'folded' (n even)
+        logical :: folded = .false.    !< initial shape 'folded' (n odd)
         ! supports (1 top joint, 2 bottom): base anchors and angles in top_anchor, ...;
         ! their motions: rope_model_t%motion
         real(wp) :: bottom_release = huge(1.0_wp)  !< s
@@ -461,7 +461,12 @@ contains
         type(rope_spec_t), intent(in) :: spec
         type(section_t), intent(in) :: sec
         real(wp) :: factor
+        logical :: free_from_start
         factor = spec%supports%support_stiffness_factor
+        ! a bottom released at t = 0 is free (set_support_motion): it shares no section
+        free_from_start = spec%effects%support_motion .and. &
+                          spec%supports%bottom_release_time >= 0.0_wp .and. &
+                          .not. spec%supports%bottom_release_time > 0.0_wp
         model%top_clamped = spec%supports%top == 'clamped'
         select case (spec%supports%bottom)
         case ('pinned')
@@ -492,7 +497,8 @@ contains
         allocate (model%ksj(model%n), model%dsj(model%n))
         model%ksj = model%ks
         model%dsj = model%ds
-        if (model%bottom > 0 .and. spec%supports%end_compliance == 'split') then
+        if (model%bottom > 0 .and. .not. free_from_start .and. &
+            spec%supports%end_compliance == 'split') then
             model%ksj(model%n) = 2.0_wp*model%ks
             model%dsj(model%n) = 2.0_wp*model%ds
             model%k_sup = 2.0_wp*model%k_sup
