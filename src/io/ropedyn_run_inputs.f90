@@ -20,7 +20,8 @@ module ropedyn_run_inputs
     use ropedyn_h5, only: h5_file_t
     implicit none
     private
-    public :: scene_inputs, check_not_input, check_replaceable, check_own_source
+    public :: scene_inputs, check_not_input, check_replaceable, check_own_source, &
+              check_may_replace
 
     !> The first bytes of an HDF5 file (its signature at offset 0: ropedyn writes no user
     !! block).
@@ -168,4 +169,26 @@ contains
                 stored//'", not of this '//mine//' "'//source//'": not replaced; '//hint)
         end if
     end subroutine check_own_source
+
+    !> May an existing output `path` be replaced by this run (or by the analysis
+    !! `analysis`, 'statics' or 'modes') of `scene`? Never a special file (a device, a FIFO,
+    !! a link to one), whatever `force`; unless `force`, only a file ropedyn wrote for the
+    !! same kind of result of the same source (check_replaceable, check_own_source): else
+    !! ERR_USAGE naming what the file is. Nothing when `path` does not exist.
+    subroutine check_may_replace(path, scene, force, err, analysis)
+        character(len=*), intent(in) :: path
+        type(scene_t), intent(in) :: scene
+        logical, intent(in) :: force
+        type(error_t), allocatable, intent(out) :: err
+        character(len=*), intent(in), optional :: analysis
+        if (len(special_file_reason(path)) > 0) then
+            call make_error(err, ERR_USAGE, path//': exists and is '// &
+                            special_file_reason(path)//': not replaced')
+            return
+        end if
+        if (force) return
+        call check_replaceable(path, err)
+        if (.not. allocated(err) .and. allocated(scene%source)) &
+            call check_own_source(path, scene%source, err, analysis)
+    end subroutine check_may_replace
 end module ropedyn_run_inputs

@@ -6,13 +6,13 @@
 module ropedyn_analysis
     use, intrinsic :: iso_fortran_env, only: output_unit
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_error, only: error_t, make_error, ERR_INTERNAL, ERR_USAGE
+    use ropedyn_error, only: error_t, make_error, ERR_INTERNAL
     use ropedyn_scene, only: scene_t, scene_namelist_text
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_os, only: make_parent_dirs, special_file_reason, file_kind, real_path, &
-                          rename_file, delete_file, FILE_SYMLINK, FILE_MISSING
-    use ropedyn_run_inputs, only: check_not_input, check_replaceable, check_own_source
+    use ropedyn_os, only: make_parent_dirs, file_kind, real_path, rename_file, delete_file, &
+                          FILE_SYMLINK, FILE_MISSING
+    use ropedyn_run_inputs, only: check_not_input, check_may_replace
     use ropedyn_text, only: int_text
     use ropedyn_model_factory, only: create_model
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
@@ -83,7 +83,7 @@ contains
         integer, intent(in) :: count              !< modes wanted ('modes' only)
         character(len=*), intent(in) :: out_path_given
         type(error_t), allocatable, intent(out) :: err
-        logical, intent(in), optional :: force    !< replace any regular file that is no input
+        logical, intent(in) :: force              !< replace any regular file that is no input
         type(analysis_t) :: analysis
 
         analysis%command = command
@@ -93,7 +93,7 @@ contains
         ! analysis or source: before any work
         call check_not_input(analysis%out_path, scene, err)
         if (allocated(err)) return
-        call guard_output(analysis%out_path, command, scene, err, force)
+        call check_may_replace(analysis%out_path, scene, force, err, command)
         if (allocated(err)) return
         call analysis%solve(scene, options, count, err)
         if (allocated(err)) return
@@ -129,27 +129,6 @@ contains
         call self%model%support_positions(0.0_wp, self%anchors)
         if (self%command == 'modes') call compute_modes(self%model, self%y, count, self%mres, err)
     end subroutine analysis_solve
-
-    !> The output `path` of `command` may be written: no special file (a device, a FIFO, a
-    !! link to one), whatever `force`; unless `force`, an existing file only when ropedyn
-    !! wrote it for the same analysis of the same source (check_own_source).
-    subroutine guard_output(path, command, scene, err, force)
-        character(len=*), intent(in) :: path, command
-        type(scene_t), intent(in) :: scene
-        type(error_t), allocatable, intent(out) :: err
-        logical, intent(in), optional :: force
-        if (len(special_file_reason(path)) > 0) then
-            call make_error(err, ERR_USAGE, path//': exists and is '// &
-                            special_file_reason(path)//': not replaced')
-            return
-        end if
-        if (present(force)) then
-            if (force) return
-        end if
-        call check_replaceable(path, err)
-        if (allocated(err)) return
-        if (allocated(scene%source)) call check_own_source(path, scene%source, err, command)
-    end subroutine guard_output
 
     !> The HDF5 file: /statics and /energy, the forces, the shape, for 'modes' /modes;
     !! written as FILE.part (FILE: the file a link names) and renamed to FILE when closed,

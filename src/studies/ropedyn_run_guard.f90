@@ -18,7 +18,7 @@ submodule (ropedyn_run) ropedyn_run_guard
                           file_kind, real_path, canonical_path, errno_text, FILE_SYMLINK, &
                           FILE_MISSING
     use ropedyn_sweep_lock, only: take_lock, drop_lock
-    use ropedyn_run_inputs, only: check_not_input, check_replaceable, check_own_source
+    use ropedyn_run_inputs, only: check_not_input, check_may_replace
     use ropedyn_error, only: ERR_USAGE, ERR_IO
     implicit none
 
@@ -76,13 +76,8 @@ contains
             call make_error(err, ERR_USAGE, file//'.part: left by a run of '//file// &
                 ' that was killed: continue it (ropedyn run --resume '//file// &
                 '.part) or remove it, or give --force')
-        else if (len(special_file_reason(file)) > 0) then
-            call make_error(err, ERR_USAGE, file//': exists and is '// &
-                special_file_reason(file)//': not replaced')
-        else if (.not. force) then
-            call check_replaceable(file, err)
-            if (.not. allocated(err) .and. allocated(self%scene%source)) &
-                call check_own_source(file, self%scene%source, err)
+        else
+            call check_may_replace(file, self%scene, force, err)
         end if
         if (allocated(err)) then
             call drop_lock(self%lock_file, self%beat)

@@ -45,12 +45,11 @@ contains
         end do
         if (self%water) e%kinetic = e%kinetic + self%water_kinetic(y)
         ! the springs' and the effects' potential energy, and its part that is a level's
+        ! (forces, not split, has filled self%bodies at y for the effects)
         call self%forces(t, y, e%elastic)
         e%level = 0.0_wp
-        if (size(self%effects) > 0) then
-            call self%fill_bodies(y)
+        if (size(self%effects) > 0) &
             call add_level_energies_of(self%effects, t, self%bodies, e%level)
-        end if
         e%dissipated = 0.0_wp
         if (size(yq) >= 1) e%dissipated = yq(1)
         e%support_work = 0.0_wp  ! fixed supports and no loads: no external work

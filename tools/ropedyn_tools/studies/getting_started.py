@@ -23,6 +23,7 @@ number in the written sections is taken from these runs; the prose around them n
 """
 import argparse
 import csv
+import functools
 import math
 import os
 import pathlib
@@ -95,7 +96,9 @@ def scripts_run(work, scene, *sets):
     return command([ROOT / "scripts" / "run", scene, *extra], work)
 
 
+@functools.lru_cache(maxsize=None)
 def stamp():
+    """The run's stamp, the same on every section (git asked once)."""
     return f"(`scripts/getting_started`, {run_stamp()})"
 
 
