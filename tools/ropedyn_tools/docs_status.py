@@ -28,6 +28,8 @@ that count against any of them.
     scripts/docs_status            # every section, oldest first
     scripts/docs_status --stale    # only those with code commits since their run
     scripts/docs_status --check    # as --stale, exit status 1 when any is listed
+    scripts/docs_status --prose    # numbers in the pages' words that no section holds
+                                   # (ropedyn_tools.prose_numbers)
 """
 import argparse
 import ast
@@ -37,6 +39,7 @@ import re
 import subprocess
 import sys
 
+from ropedyn_tools import prose_numbers
 from ropedyn_tools.repo import ROOT
 from ropedyn_tools.studies.common import git
 
@@ -348,9 +351,14 @@ def main(argv=None):
                         help="list only the sections with code commits since their run")
     parser.add_argument("--check", action="store_true",
                         help="as --stale; exit status 1 when any section is listed")
+    parser.add_argument("--prose", action="store_true",
+                        help="list instead the numbers in the study pages' own words that "
+                             "their generated sections do not hold (exit status 1 if any)")
     parser.add_argument("--root", type=pathlib.Path, default=ROOT,
                         help="the checkout whose docs/ to read (default: this one)")
     args = parser.parse_args(argv)
+    if args.prose:
+        return prose_main(args.root)
     rows = status(args.root)
     rows.sort(key=lambda r: (r["stamp"] is not None, r["stamp"] or ""))
     listed = [r for r in rows if not (args.stale or args.check) or r["commits"] is None
@@ -366,6 +374,16 @@ def main(argv=None):
               f"{newest} |")
     print(f"\n{len(listed)} of {len(rows)} sections listed", file=sys.stderr)
     return 1 if args.check and listed else 0
+
+
+def prose_main(root):
+    """--prose: the quotes of prose_numbers, a line each; 1 when there are any."""
+    rows = prose_numbers.report(root)
+    for page, line, number in rows:
+        print(f"{page}:{line}: {number}")
+    print(f"{len(rows)} numbers in the study pages' words that no generated section or "
+          "scene holds", file=sys.stderr)
+    return 1 if rows else 0
 
 
 if __name__ == "__main__":
