@@ -291,12 +291,13 @@ contains
         end associate
     end subroutine judge_low_order
 
-    !> Log a change of the order limit at the current time.
+    !> Log a change of the order limit at the current time (the first one after the limit
+    !! the run started with, logged at the run's start: in force from there).
     subroutine note(self, reason, warning)
         class(cvode_t), intent(inout) :: self
         character(len=*), intent(in) :: reason
         logical, intent(in), optional :: warning
-        if (self%log%count == 0) call self%log%add(self%monitor%window_t0, self%name(), &
+        if (self%log%count == 0) call self%log%add(self%monitor%t_start, self%name(), &
             self%monitor%qmax_user, 'start')
         call self%log%add(self%tn, self%name(), self%monitor%qmax, reason, warning)
     end subroutine note

@@ -373,6 +373,21 @@ def test_erk_on_the_steel_wire_within_the_guarantee_or_diagnosed(run, tmp_path):
         assert "erk failed" in proc.stderr and "mebdf" in proc.stderr
 
 
+def test_cvode_logs_its_start_at_the_start_of_the_run(run, tmp_path):
+    """The steel wire with cvode: the crawl watch tries order 2 at 0.0094 s, its first
+    change, and the log gets the order limit the run started with in front of it. That
+    entry is at the run's start (t = 0), not at the start of the window that held the
+    trial (0.0088 s: the limit of 5 was in force from t = 0)."""
+    proc, out = run_scene(run, tmp_path, STEEL, "cvode", "solver.method='cvode'",
+                          "solver.t_end=0.012")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        methods, times, orders, reasons = switch_log(f)
+    assert len(times) >= 2 and "trying max order 2" in reasons[1], reasons
+    assert (methods[0], orders[0], reasons[0].strip()) == ("cvode", 5, "start"), reasons
+    assert times[0] == 0.0 and times[1] > 0.005, times
+
+
 def test_auto_takes_cvode_where_the_fast_modes_are_damped(run, tmp_path):
     """n = 1000: the fastest modes are damped by far more than 12 % (the segment damping
     ratio grows with n); the A-stable MEBDF order 4 is not needed for them, and auto's
