@@ -27,7 +27,7 @@ module ropedyn_sweep_runner
     use ropedyn_text, only: int_text
     use ropedyn_sweep_status, only: case_state_t, case_state, STATUS_NAMES
     use ropedyn_sweep_summary, only: case_row_t, build_summary, RUN_WARNING_JOIN
-    use ropedyn_sweep_task, only: case_label
+    use ropedyn_sweep_task, only: case_label, id_width
     implicit none
     private
     public :: sweep_options_t, list_cases, status_report, run_local, summarize
@@ -527,38 +527,25 @@ contains
         end function reason_text
     end subroutine report_summary
 
-    !> One line naming the cases whose runs warned (the first 20 ids), what the first of
-    !! them said first, and where the rest is: the run_warnings column.
+    !> One line naming the cases whose runs warned (the first 20 ids, as id_text writes
+    !! them), what the first of them said first, and where the rest is: the run_warnings
+    !! column.
     subroutine report_run_warnings(sweep, rows)
         type(sweep_t), intent(in) :: sweep
         type(case_row_t), intent(in) :: rows(:)
-        character(len=:), allocatable :: ids, first
-        integer :: c, warned, bar
-        ids = ''
-        warned = 0
-        do c = 1, size(rows)
-            if (len(rows(c)%run_warnings) == 0) cycle
-            warned = warned + 1
-            if (warned == 1) then
-                first = rows(c)%run_warnings
-                ids = int_text(c)
-            else if (warned <= 20) then
-                ids = ids//', '//int_text(c)
-            end if
-        end do
-        if (warned == 0) return
-        if (warned > 20) ids = ids//', ...'
+        character(len=:), allocatable :: first
+        integer, allocatable :: warned(:)
+        integer :: c, bar
+        warned = pack([(c, c=1, size(rows))], [(len(rows(c)%run_warnings) > 0, c=1, size(rows))])
+        if (size(warned) == 0) return
+        first = rows(warned(1))%run_warnings
         bar = index(first, RUN_WARNING_JOIN)
         if (bar > 0) first = first(:bar - 1)
-        write (error_unit, '(a)') 'sweep: warning: '//int_text(warned)//' of '// &
-            int_text(size(rows))//' cases warned in their runs (cases '//ids//'), the '// &
-            'first: '//first//' (all in '//sweep%output_dir//'/summary.csv, run_warnings)'
+        write (error_unit, '(a)') 'sweep: warning: '//int_text(size(warned))//' of '// &
+            int_text(size(rows))//' cases warned in their runs (cases '// &
+            id_text(warned, id_width(sweep))//'), the first: '//first//' (all in '// &
+            sweep%output_dir//'/summary.csv, run_warnings)'
     end subroutine report_run_warnings
-
-    integer function id_width(sweep)
-        type(sweep_t), intent(in) :: sweep
-        id_width = max(4, len(int_text(size(sweep%cases))))
-    end function id_width
 
     ! ------------------------------------------------------------------------------------
     ! Files and text

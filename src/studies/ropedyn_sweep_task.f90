@@ -34,7 +34,7 @@ module ropedyn_sweep_task
         write_failure_note, drop_failure_note
     implicit none
     private
-    public :: run_cases, case_label, case_id
+    public :: run_cases, case_label, case_id, id_width
 
 contains
 
@@ -52,9 +52,15 @@ contains
         integer, intent(in) :: k
         character(len=:), allocatable :: id
         character(len=16) :: buf
-        write (buf, '(i0.'//int_text(max(4, len(int_text(size(sweep%cases)))))//')') k
+        write (buf, '(i0.'//int_text(id_width(sweep))//')') k
         id = trim(buf)
     end function case_id
+
+    !> The digits of a case id: 4, or those of the number of cases when more.
+    pure integer function id_width(sweep)
+        type(sweep_t), intent(in) :: sweep
+        id_width = max(4, len(int_text(size(sweep%cases))))
+    end function id_width
 
     !> Run the cases `ids` one after the other. A case that fails does not stop the others;
     !! its message goes to stderr at once when there are several. The error: the case's

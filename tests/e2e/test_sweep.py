@@ -531,7 +531,7 @@ def test_a_cases_run_warnings_reach_the_summary(run, sweep_dir):
         kept = [w.decode() for w in f["solver/warnings"][()]]
     assert rows[1]["run_warnings"] == " | ".join(kept)
     line = [x for x in result.stderr.splitlines() if "warned in their runs" in x]
-    assert line == [f"sweep: warning: 1 of 2 cases warned in their runs (cases 2), the first: "
+    assert line == [f"sweep: warning: 1 of 2 cases warned in their runs (cases 0002), the first: "
                     f"{kept[0]} (all in out/warned/summary.csv, run_warnings)"], result.stderr
     with h5py.File(sweep_dir / "out" / "warned" / "summary.h5") as f:
         assert [s.decode() for s in f["run_warnings"][()]] == ["", rows[1]["run_warnings"]]
