@@ -700,8 +700,8 @@ def long_runs(chaos_rows=()):
         "`t_end`; a `max_steps` you give that they outnumber makes auto go on without it, "
         "with a warning that names the budget it needs ([the step "
         "budget](#tolerances-rtol-atol)). Name "
-        "`method = 'symplectic'` to have it "
-        "on any RFEM scene without ground contact or point masses off an element's centre "
+        "`method = 'symplectic'` to have it on any RFEM scene without water, ground contact "
+        "or point masses off an element's centre "
         "(not the MPP: [theory/symplectic.md](../theory/symplectic.md); the energy of every "
         "method over 300 s: [energy over long runs](../validation/energy.md)).")
 
