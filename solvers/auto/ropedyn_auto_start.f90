@@ -44,7 +44,8 @@ contains
         call newton_widths(self%problem, self%lambda, self%mebdf_eval_cost)
         call estimate_spectrum(self%problem, start%t0, start%y0, spec)
         self%use_bdf = spec%valid .and. spec%fast_damping >= BDF_DAMPING
-        self%mebdf_order = mebdf_order_for(spec%fast_damping)
+        ! (without an estimate the fast modes may be undamped: the A-stable order)
+        self%mebdf_order = mebdf_order_for(merge(spec%fast_damping, 0.0_wp, spec%valid))
         if (self%use_bdf) self%mebdf_order = BDF_ORDER
         if (self%user_order /= 0) self%mebdf_order = min(self%mebdf_order, self%user_order)
         h_e = erk_stable_step(self%tab, spec)
