@@ -178,8 +178,8 @@ contains
             self%v(:, j + 1) = self%w/self%hess(j + 1, j)
         end do
         allocate (wr(k), wi(k), work(8*k))
-        ! dgeev balances H first (half its cost here): its eigenvalues straight from the
-        ! Hessenberg QR (dhseqr) put the damping of catenary's fast modes at 0.45, not 0
+        ! dgeev balances H first (half its cost here): the Hessenberg QR alone (dhseqr),
+        ! on an H this far from normal, moves the fast Ritz values' real parts
         call dgeev('N', 'N', k, self%hess, m + 1, wr, wi, dummy, 1, dummy, 1, work, 8*k, info)
         if (info /= 0) return
         ritz = cmplx(wr, wi, wp)

@@ -87,8 +87,8 @@ module ropedyn_auto
     !! (Dormand-Prince 5(4))
     integer, parameter :: HIGH_ORDER = 5
     integer, parameter :: WINDOW = 400             !< steps between looks
-    !> a chunk ends early once its window is overdue by this many windows' steps
-    !! (cap_chunk: steps that collapsed within a chunk sized by time)
+    !> a chunk ends early once its window has taken this many windows' steps (cap_chunk:
+    !! steps that collapsed within a chunk sized by time)
     integer, parameter :: OVERDUE_WINDOWS = 10
     !> an earlier first look at erk, before the implicit method's cost is known: after
     !! EARLY_WINDOW steps, when at least EARLY_SHARE of them were held by stability
@@ -635,8 +635,8 @@ contains
         end select
     end function active_method
 
-    !> The step count of the method in use at which its chunk ends early: its window
-    !! overdue by OVERDUE_WINDOWS windows' steps. A chunk is sized by time, from the last
+    !> The step count of the method in use at which its chunk ends early: OVERDUE_WINDOWS
+    !! windows' steps after its window began. A chunk is sized by time, from the last
     !! step, so steps that collapse within it would otherwise run unlooked-at (a straight
     !! start reaching 3 m into a stiff ground took erk's steps from 1e-3 to 1e-9 s within
     !! its first chunk and spent the whole step budget, a million steps, on 0.5 ms). The
