@@ -51,6 +51,9 @@ CODE_PATHS = ("src", "solvers", "CMakeLists.txt", "input")
 NARROWER = {
     # the stiff test set: the integrators and their driver, no rope, no scene
     "work_precision_testset": ("solvers", "CMakeLists.txt"),
+    # the MEBDF and BDF stability tables: the formulas' coefficients, solved by the study
+    # itself in exact arithmetic; no run of the program
+    "mebdf_stability": (),
 }
 #: sections made from other sections' data, not from runs of their own: as current as those
 #: (the commits listed against any of them), whatever their own stamp says
