@@ -142,7 +142,8 @@ contains
 
     !> The problem integrated from its start again and again until the runs' CPU reaches
     !! `budget` (or MAX_REPEATS runs): the first run's statistics, end state and accuracy,
-    !! the median CPU time. A failed run is an ERR_SOLVER error in `context`.
+    !! the median CPU time. A failed run is an ERR_SOLVER error in `context`; a method that
+    !! refuses the problem (`integrator_t%refusal`) an ERR_INPUT error.
     subroutine repeat_runs(problem, method, options, budget, context, result, err)
         class(testset_problem_t), intent(inout), target :: problem
         character(len=*), intent(in) :: method, context
@@ -154,8 +155,16 @@ contains
         type(error_t), allocatable :: run_err
         real(wp), allocatable :: y(:), times(:), grown(:)
         real(wp) :: yq(0), t, start, finish, total
+        character(len=:), allocatable :: why
         call new_integrator(method, integrator, err)
         if (allocated(err)) return
+        ! a method that cannot integrate the problem at all is a bad argument, as in a scene
+        why = integrator%refusal(problem)
+        if (len(why) > 0) then
+            call make_error(err, ERR_INPUT, 'method '//method//' cannot integrate test '// &
+                            'problem '//problem%name//': '//why)
+            return
+        end if
         allocate (y(problem%size()), times(16))
         total = 0.0_wp
         do

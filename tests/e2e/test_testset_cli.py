@@ -95,6 +95,9 @@ def test_list(run):
     (["HIRES", "--atol", "-3"], ["--atol", "-3"]),
     (["HIRES", "--max-order", "9"], ["max order 9", "cvode"]),
     (["HIRES", "--method", "rk4"], ["--method", "rk4"]),
+    # a method of the method table that fits no test problem: refused before any run
+    (["HIRES", "--method", "symplectic"], ["symplectic", "HIRES", "cannot integrate"]),
+    (["all", "--method=symplectic"], ["symplectic", "cannot integrate"]),
     (["HIRES", "--bogus"], ["--bogus"]),
     (["HIRES", "--rtol"], ["--rtol", "needs a value"]),
     ([], ["problem"]),
