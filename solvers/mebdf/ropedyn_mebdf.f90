@@ -251,8 +251,9 @@ contains
     !! initial state damped by less than LIGHT_DAMPING) starts at the safe order, with a
     !! warning in the log. Orders 5 .. 7 amplify such modes (up to 1.027 .. 1.114 per step on
     !! the imaginary axis), and the order safety of the run driver acts only on a gain of
-    !! 2 rtol S, S the energy the run moves (about 4 m g L on the lightly damped paper rope,
-    !! where order 7 gained 7.7e-4 m g L by 18.3 s at rtol 1e-4; docs/validation/order-safety.md).
+    !! energy_gain_bound (10) rtol S, S the energy the run moves (about 0.8 m g L on the
+    !! lightly damped paper rope, where order 7 gained 7.7e-4 m g L by 18.3 s at rtol 1e-4;
+    !! docs/validation/order-safety.md).
     subroutine safe_start_order(self, start)
         class(mebdf_t), intent(inout) :: self
         type(start_t), intent(in) :: start
