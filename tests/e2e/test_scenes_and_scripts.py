@@ -121,3 +121,12 @@ def test_build_refuses_an_unknown_type():
                             text=True, timeout=30)
     assert result.returncode == 2 and 'not "Relase"' in result.stderr
     assert not (ROOT / "build" / "relase").exists()
+
+
+def test_build_refuses_an_option_as_a_target():
+    """`scripts/build Release -j1` passed -j1 to CMake as a target (and built nothing); the
+    way to fewer cores is CMAKE_BUILD_PARALLEL_LEVEL, which the refusal names."""
+    result = subprocess.run([str(ROOT / "scripts" / "build"), "Release", "-j1"],
+                            capture_output=True, text=True, timeout=30)
+    assert result.returncode == 2 and '"-j1" is no target' in result.stderr
+    assert "CMAKE_BUILD_PARALLEL_LEVEL" in result.stderr
