@@ -93,5 +93,13 @@ def analyse(path, run=None):
     # a rope held at both ends has no free tip: its midpoint (the middle element's centre)
     mid = qdot[:, qdot.shape[1] // 2, :2]
     r["mid_speed"] = np.hypot(mid[:, 0], mid[:, 1])
-    r["bottom_free"] = re.search(r"^\s*bottom = 'free'", r["scene"], re.M) is not None
+    r["bottom_free"] = lower_end_free(r["scene"])
     return r
+
+
+def lower_end_free(scene):
+    """Whether the rope's lower end is free at some time of the run: a free bottom, or a
+    held one released (its release time >= 0), as the folded ropes' is at the start."""
+    free = re.search(r"^\s*bottom = 'free'", scene, re.M) is not None
+    release = re.search(r"^\s*bottom_release_time = (\S+)", scene, re.M)
+    return free or (release is not None and float(release.group(1)) >= 0.0)

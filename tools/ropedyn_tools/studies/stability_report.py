@@ -253,8 +253,8 @@ STUDIES = {
         "Hard scenes:", hard_cases,
         "rtol 1e-6, atol 1e-8 (the scenes' solver settings) unless stated; S is the "
         "energy scale (max T + max elastic + gravity range + dissipated); max tip speed: "
-        "of the free end at the output times (of the midpoint for clamped_taut, held at "
-        "both ends).",
+        "of the free end at the output times, a released end's too (of the midpoint where "
+        "both ends are held throughout: clamped_taut and the snap loads).",
         hard_tables),
 }
 
