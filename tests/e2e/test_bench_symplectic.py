@@ -90,3 +90,41 @@ def test_the_tolerance_rows_say_what_a_tighter_rtol_buys(ropedyn_exe, tmp_path, 
     assert cells[0][1].startswith("Chin") and cells[1][1].endswith("SRKN6b")
     assert int(cells[1][2]) > int(cells[0][2])
     assert float(cells[1][3]) < 0.1 * float(cells[0][3])
+
+
+def test_the_growth_over_the_elastic_energy_tells_the_rope_from_a_drift():
+    """An error that follows the fast modes' energy (both four times larger after 30 s)
+    grows four times but not over that energy (1.0); a steady drift at a constant elastic
+    energy grows as much either way; the window table's last row is the ratio."""
+    def elastic(t):
+        return np.where(t < 30.0, 0.04, 0.16)
+
+    # (a record at 30 s is the second window's and up to 30 s: its error is the first's)
+    follows = records(lambda t: 1e-3 * np.where(t <= 30.0, 0.04, 0.16) * np.cos(10 * np.pi * t),
+                      elastic)
+    assert abs(bs.upto(follows, 300) / bs.upto(follows, 30) - 4.0) < 1e-3
+    assert abs(bs.scaled_growth(follows) - 1.0) < 1e-3
+    drift = records(lambda t: -1e-6 * (t + 1.0), lambda t: np.full_like(t, 0.05))
+    # (the first window ends before 30 s: its largest error is at 29.9 s)
+    assert abs(bs.scaled_growth(drift) - 3.01e-4 / 3.09e-5) < 1e-9
+    rows = bs.window_rows(20, drift)[1]
+    assert rows[3].split("|")[2].strip() == "largest abs error / mean elastic energy"
+    assert rows[3].split("|")[-2].strip() == f"{3.01e-4 / 0.05:.1e}"
+
+
+def test_the_ensemble_counts_the_starts_within_2_over_the_elastic_energy(monkeypatch):
+    """The ensemble's last two columns: the growth over the elastic energy (median, range)
+    and the starts where it is at most 2: two runs whose error follows the elastic energy
+    (1) and two whose error grows three times at a constant elastic energy (3)."""
+    def fake_run(exe, work, scene, name, sets):
+        def elastic(t):
+            return np.where(t < 30.0, 0.04, 0.12) if k < 2 else np.full_like(t, 0.04)
+        k = int(name.rsplit("_", 1)[1])
+        return {"ok": True, **records(
+            lambda t: 1e-5 * np.where(t <= 30.0, 1.0, 3.0) * np.cos(10 * np.pi * t), elastic)}
+
+    monkeypatch.setattr(bs, "run", fake_run)
+    (row,) = bs.ensemble_rows("exe", "work", [20], 300.0, 4)
+    cells = [c.strip() for c in row.split("|")[1:-1]]
+    assert cells[3] == "3.00" and cells[6] == "2.0 (1.0 - 3.0)"
+    assert cells[7] == "2.00 (1.00 - 3.00)" and cells[8] == "2"
