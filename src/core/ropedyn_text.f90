@@ -6,7 +6,7 @@ module ropedyn_text
     implicit none
     private
     public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, enclosed
-    public :: significant_text
+    public :: significant_text, decimal_product
     public :: lower, line_quote
     public :: text_t, append_text, text_array, printable, clip, name_hint, edit_distance
 
@@ -46,12 +46,9 @@ contains
         real(wp), intent(in) :: x
         logical, intent(in), optional :: compact
         character(len=:), allocatable :: s
-        character(len=40) :: buf
-        character(len=16) :: fmt
-        character(len=:), allocatable :: mant, digits
-        real(wp) :: y
-        integer :: d, ios, epos, e, n, e_low, e_high
-        logical :: negative, short
+        character(len=:), allocatable :: digits
+        integer :: e, n, e_low, e_high
+        logical :: short
 
         short = .false.
         if (present(compact)) short = compact
@@ -67,25 +64,8 @@ contains
             s = '0.0'
             return
         end if
-        do d = 1, 17
-            write (fmt, '(a, i0, a)') '(es40.', d, 'e3)'
-            write (buf, fmt) x
-            read (buf, *, iostat=ios) y
-            if (ios == 0 .and. abs(y - x) <= 0.0_wp) exit
-        end do
-        buf = adjustl(buf)
-        negative = buf(1:1) == '-'
-        if (negative) buf = buf(2:)
-        epos = scan(buf, 'Ee')
-        read (buf(epos + 1:), *) e
-        mant = buf(:epos - 1)
-        digits = mant(1:1)//mant(3:)
+        call shortest_digits(x, digits, e)
         n = len(digits)
-        do while (n > 1)
-            if (digits(n:n) /= '0') exit
-            n = n - 1
-        end do
-        digits = digits(:n)
         if (e >= 0 .and. e <= e_high) then
             if (n <= e + 1) then
                 s = digits//repeat('0', e + 1 - n)//'.0'
@@ -103,8 +83,73 @@ contains
         else
             s = digits(1:1)//'.'//digits(2:)//'e'//int_text(e)
         end if
-        if (negative) s = '-'//s
+        if (x < 0.0_wp) s = '-'//s
     end function real_text
+
+    !> The shortest decimal digits that read back to |x| (finite, not zero), without
+    !! trailing zeros: |x| = d1.d2d3... * 10**e ('1', -4 for 1e-4).
+    subroutine shortest_digits(x, digits, e)
+        real(wp), intent(in) :: x
+        character(len=:), allocatable, intent(out) :: digits
+        integer, intent(out) :: e
+        character(len=40) :: buf
+        character(len=16) :: fmt
+        real(wp) :: y
+        integer :: d, ios, epos, n
+        do d = 1, 17
+            write (fmt, '(a, i0, a)') '(es40.', d, 'e3)'
+            write (buf, fmt) abs(x)
+            read (buf, *, iostat=ios) y
+            if (ios == 0 .and. abs(y - abs(x)) <= 0.0_wp) exit
+        end do
+        buf = adjustl(buf)
+        epos = scan(buf, 'Ee')
+        read (buf(epos + 1:), *) e
+        digits = buf(1:1)//buf(3:epos - 1)
+        n = len(digits)
+        do while (n > 1)
+            if (digits(n:n) /= '0') exit
+            n = n - 1
+        end do
+        digits = digits(:n)
+    end subroutine shortest_digits
+
+    !> x*y as the product of the decimals that x and y read from (their shortest texts,
+    !! as real_text writes them), rounded once to the nearest real: 0.01*1e-4 is 1e-6,
+    !! where the binary product is 1.0000000000000002e-6. A derived input (a sweep's
+    !! atol = atol_per_rtol*rtol) is then the number its user would have written. A factor
+    !! that is zero, infinite or NaN, or a product out of range: the binary product.
+    function decimal_product(x, y) result(p)
+        real(wp), intent(in) :: x, y
+        real(wp) :: p
+        character(len=:), allocatable :: a, b, digits
+        integer :: prod(34), ex, ey, i, j, ios
+        real(wp) :: q
+        p = x*y
+        if (.not. (ieee_is_finite(p) .and. abs(p) > 0.0_wp)) return
+        call shortest_digits(x, a, ex)
+        call shortest_digits(y, b, ey)
+        ! schoolbook product of the digit strings, prod(i + j) collecting a(i) b(j)
+        prod = 0
+        do i = 1, len(a)
+            do j = 1, len(b)
+                prod(i + j) = prod(i + j) + (iachar(a(i:i)) - 48)*(iachar(b(j:j)) - 48)
+            end do
+        end do
+        do i = len(a) + len(b), 2, -1
+            prod(i - 1) = prod(i - 1) + prod(i)/10
+            prod(i) = mod(prod(i), 10)
+        end do
+        ! a = 0.a1a2... 10**(ex + 1), likewise b: the product 0.p1p2... 10**(ex + ey + 2)
+        digits = repeat(' ', len(a) + len(b))
+        do i = 1, len(digits)
+            digits(i:i) = achar(48 + prod(i))
+        end do
+        digits = digits(:1)//'.'//digits(2:)//'e'//int_text(ex + ey + 1)
+        read (digits, *, iostat=ios) q
+        if (ios /= 0 .or. .not. (ieee_is_finite(q) .and. q > 0.0_wp)) return
+        p = sign(q, p)
+    end function decimal_product
 
     !> x rounded to `digits` significant digits, as real_text writes that number: a
     !! measured or derived value without the noise of its last binary digits

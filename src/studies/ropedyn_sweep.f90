@@ -8,7 +8,8 @@
 !! against both, so a bad combination is reported before anything runs, naming the sweep
 !! file, the case and its overrides.
 module ropedyn_sweep
-    use ropedyn_text, only: int_text, real_text, text_t, append_text, text_array
+    use ropedyn_text, only: int_text, real_text, text_t, append_text, text_array, &
+        decimal_product
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_scene, only: scene_t, read_scene
     use ropedyn_scene_solver, only: create_integrator, check_method_fits
@@ -218,7 +219,9 @@ contains
         sweep%n_groups = size(group_keys)
     end subroutine expand
 
-    !> The effective scene of a case (with atol = atol_per_rtol rtol when given), its
+    !> The effective scene of a case (with atol = atol_per_rtol rtol when given, the
+    !! product of the decimals as written: 0.01 and 1e-4 give 1e-6, not the binary
+    !! product's 1.0000000000000002e-6, in its overrides, its file and the summary), its
     !! method checked against its model.
     subroutine read_case(sweep, cs, starts, err)
         type(sweep_t), intent(in) :: sweep
@@ -231,7 +234,8 @@ contains
         if (allocated(err)) return
         if (sweep%atol_given) then
             call append_text(cs%overrides, 'solver.atol='// &
-                real_text(sweep%atol_per_rtol*cs%scene%solver%rtol, compact=.true.))
+                real_text(decimal_product(sweep%atol_per_rtol, cs%scene%solver%rtol), &
+                compact=.true.))
             call read_scene(sweep%base, case_overrides(sweep, cs%overrides, cs%file), &
                             cs%scene, err)
             if (allocated(err)) return

@@ -70,6 +70,30 @@ def test_list_and_count(run, sweep_dir):
         assert fields[2:] == [f"model.elements={n}", f"solver.method={m}", f"solver.rtol={r}"]
 
 
+def test_atol_per_rtol_is_the_decimal_product(run, sweep_dir):
+    """atol = atol_per_rtol rtol as the user would have written it: 0.01 * 1e-4 is 1e-6
+    in the listing, the case's run (its stored scene), summary.csv and summary.h5, not the
+    binary product 1.0000000000000002e-6 (nor 1.0000000000000001e-7 for 1e-5)."""
+    (sweep_dir / "tol.nml").write_text("&sweep\n    base = 'scenes/base.nml'\n"
+                                       "    output_dir = 'out/tol'\n"
+                                       "    rtols = 1e-4, 1e-5\n    atol_per_rtol = 0.01\n/\n")
+    result = run("sweep", "tol.nml", "--list")
+    assert result.returncode == 0, result.stderr
+    lines = [line.split()[2:] for line in result.stdout.splitlines() if line[:4].isdigit()]
+    assert lines == [["solver.rtol=1e-4", "solver.atol=1e-6"],
+                     ["solver.rtol=1e-5", "solver.atol=1e-7"]]
+    result = run("sweep", "tol.nml", "--jobs", "1")
+    assert result.returncode == 0, result.stderr
+    out = sweep_dir / "out" / "tol"
+    assert [r["atol"] for r in read_csv(out / "summary.csv")] == ["1e-6", "1e-7"]
+    with h5py.File(out / "summary.h5") as f:
+        assert list(f["atol"][:]) == [1e-6, 1e-7]
+    for k, atol in ((1, "1.0e-6"), (2, "1.0e-7")):
+        with h5py.File(out / f"case_{k:04d}.h5") as f:
+            scene = f.attrs["scene"].decode().splitlines()
+            assert [line.strip() for line in scene if "atol" in line] == [f"atol = {atol}"]
+
+
 def test_bad_sweep_file(run, sweep_dir):
     (sweep_dir / "bad.nml").write_text("&sweep base = 'scenes/base.nml'\n elements = 10, 1 /\n")
     result = run("sweep", "bad.nml", "--list")

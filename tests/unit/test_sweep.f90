@@ -138,10 +138,22 @@ contains
         call read_sweep(PATH, s, err)
         call suite%check_true(.not. allocated(err), 'atol_per_rtol: no error')
         if (allocated(err)) return
-        call suite%check_close(s%cases(1)%scene%solver%atol, 1.0e-6_wp, 1.0e-12_wp, 0.0_wp, &
-                               'atol_per_rtol: case 1 atol')
-        call suite%check_close(s%cases(2)%scene%solver%atol, 1.0e-8_wp, 1.0e-12_wp, 0.0_wp, &
-                               'atol_per_rtol: case 2 atol')
+        ! 0.01*1e-4 in binary is 1.0000000000000002e-6: the case's atol is the 1e-6 the
+        ! user would have written, in its overrides (--list, the worker's --set) and scene
+        associate (c1 => s%cases(1), c2 => s%cases(2))
+            call suite%check_true(c1%overrides(size(c1%overrides))%s == 'solver.atol=1e-6', &
+                                  'atol_per_rtol: case 1 override: '// &
+                                  c1%overrides(size(c1%overrides))%s)
+            call suite%check_true(c1%scene%solver%atol == 1.0e-6_wp, &
+                                  'atol_per_rtol: case 1 atol: '// &
+                                  real_text(c1%scene%solver%atol))
+            call suite%check_true(c2%overrides(size(c2%overrides))%s == 'solver.atol=1e-8', &
+                                  'atol_per_rtol: case 2 override: '// &
+                                  c2%overrides(size(c2%overrides))%s)
+            call suite%check_true(c2%scene%solver%atol == 1.0e-8_wp, &
+                                  'atol_per_rtol: case 2 atol: '// &
+                                  real_text(c2%scene%solver%atol))
+        end associate
     end subroutine test_defaults_and_atol
 
     !> A bad sweep file: one message naming the file, the key and the value.

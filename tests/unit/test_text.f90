@@ -1,9 +1,11 @@
 !> Text of numbers (src/core/ropedyn_text.f90): real_text writes the shortest decimal that
 !! reads back to the value; significant_text rounds a measured value to its significant
-!! digits first, so that a table shows 0.091687 and not the noise 0.09168699999999999.
+!! digits first, so that a table shows 0.091687 and not the noise 0.09168699999999999;
+!! decimal_product multiplies the decimals as written (0.01*1e-4 = 1e-6, not the binary
+!! 1.0000000000000002e-6).
 program test_text
     use ropedyn_kinds, only: wp
-    use ropedyn_text, only: real_text, significant_text
+    use ropedyn_text, only: real_text, significant_text, decimal_product
     use ropedyn_assert, only: test_suite_t
     implicit none
 
@@ -28,8 +30,30 @@ program test_text
                           significant_text(x, 6))
     x = ieee_nan()
     call suite%check_true(significant_text(x, 6) == 'NaN', 'NaN')
+    call check_product(0.01_wp, 1.0e-4_wp, '1e-6')
+    call check_product(0.01_wp, 1.0e-5_wp, '1e-7')
+    call check_product(0.01_wp, 1.0e-9_wp, '1e-11')
+    call check_product(3.0_wp, 0.1_wp, '0.3')
+    call check_product(-0.1_wp, 0.2_wp, '-0.02')
+    call check_product(1.5_wp, 2.5e-7_wp, '3.75e-7')
+    ! 17 digits times 17: the exact 34-digit product, rounded once
+    call check_product(0.1_wp + epsilon(1.0_wp)/8.0_wp, 1.0_wp/3.0_wp, '0.03333333333333334')
+    call check_product(1.0_wp/3.0_wp, 3.0_wp, '0.9999999999999999')
+    call check_product(0.0_wp, 5.0_wp, '0.0')
+    call check_product(huge(1.0_wp), 10.0_wp, '+Infinity')
+    call check_product(1.0e-300_wp, 1.0e-300_wp, '0.0')
     call suite%finish()
 contains
+    !> decimal_product(a, b) reads as `expected` (real_text: shortest, every digit).
+    subroutine check_product(a, b, expected)
+        real(wp), intent(in) :: a, b
+        character(len=*), intent(in) :: expected
+        character(len=:), allocatable :: got
+        got = real_text(decimal_product(a, b), compact=.true.)
+        call suite%check_true(got == expected, 'decimal_product('//real_text(a)//', '// &
+                              real_text(b)//') = '//got//' (expected '//expected// &
+                              ', binary '//real_text(a*b, compact=.true.)//')')
+    end subroutine check_product
     real(wp) function ieee_nan() result(y)
         use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
         y = ieee_value(1.0_wp, ieee_quiet_nan)
