@@ -77,6 +77,7 @@ module ropedyn_h5
         procedure, private :: read_real_scalar, read_int64_scalar
         generic :: read_scalar => read_real_scalar, read_int64_scalar
         procedure :: read_reals => h5_read_reals
+        procedure :: extents => h5_extents
         procedure :: read_record => h5_read_record
         procedure :: read_texts => h5_read_texts
         procedure :: create_series => h5_create_series
@@ -416,6 +417,16 @@ module ropedyn_h5
             integer(hsize_t), intent(out) :: dims(:)
             type(error_t), allocatable, intent(out) :: err
         end subroutine h5_read_reals
+
+        !> The Fortran extents `dims` of the dataset `name`, which must have rank size(dims),
+        !! without reading its values (to read one record of a series, read_record); a
+        !! missing dataset has extents 0. The errors are read_reals'.
+        module subroutine h5_extents(self, name, dims, err)
+            class(h5_file_t), intent(inout) :: self
+            character(len=*), intent(in) :: name
+            integer(hsize_t), intent(out) :: dims(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine h5_extents
     end interface
 
 contains

@@ -305,6 +305,17 @@ contains
         if (.not. allocated(values)) allocate (values(0))
     end procedure h5_read_reals
 
+    module procedure h5_extents
+        integer(hid_t) :: dset_id
+        integer :: hdferr
+        dims = 0
+        if (.not. self%exists(name)) return
+        call h5dopen_f(self%id, name, dset_id, hdferr)
+        if (h5_failed(hdferr, self%path//': '//name//': cannot open dataset', err)) return
+        call extents(self, name, dset_id, dims, err)
+        call h5dclose_f(dset_id, hdferr)
+    end procedure h5_extents
+
     module procedure h5_read_texts
         integer(hid_t) :: dset_id, type_id, mem_type
         integer(hsize_t) :: dims(1)

@@ -109,7 +109,9 @@ contains
         end if
     end subroutine pick_record
 
-    !> Record k of /state/q and /state/qdot, checked to be (times, n, 3) series.
+    !> Record k of /state/q and /state/qdot, checked to be (times, n, 3) series: only that
+    !! record is read (one hyperslab), not the series, so that a long run's file is not
+    !! read whole to start from one of its records.
     subroutine read_positions(h5, path, k, rec, err)
         type(h5_file_t), intent(inout) :: h5
         character(len=*), intent(in) :: path
@@ -120,7 +122,7 @@ contains
         integer(hsize_t) :: dims3(3)
         integer :: nt
         nt = rec%records
-        call h5%read_reals('/state/q', values, dims3, err)
+        call h5%extents('/state/q', dims3, err)
         if (allocated(err)) return
         rec%n = int(dims3(2))
         if (dims3(1) /= 3 .or. dims3(3) < nt) then
@@ -128,19 +130,23 @@ contains
                             int_text(nt)//' records')
             return
         end if
-        rec%q = reshape(values(3*rec%n*(k - 1) + 1:3*rec%n*k), [3, rec%n])
-        call h5%read_reals('/state/qdot', values, dims3, err)
+        call h5%read_record('/state/q', int(k, hsize_t), values, err)
+        if (allocated(err)) return
+        rec%q = reshape(values, [3, rec%n])
+        call h5%extents('/state/qdot', dims3, err)
         if (allocated(err)) return
         if (dims3(1) /= 3 .or. dims3(2) /= rec%n .or. dims3(3) < nt) then
             call make_error(err, ERR_INPUT, path//': /state/qdot: not (times, '// &
                             int_text(rec%n)//', 3) with '//int_text(nt)//' records')
             return
         end if
-        rec%qdot = reshape(values(3*rec%n*(k - 1) + 1:3*rec%n*k), [3, rec%n])
+        call h5%read_record('/state/qdot', int(k, hsize_t), values, err)
+        if (allocated(err)) return
+        rec%qdot = reshape(values, [3, rec%n])
     end subroutine read_positions
 
     !> The native state of record k, where the writer stores it (restart data): y and yq
-    !! both, or neither.
+    !! both, or neither; record k only.
     subroutine read_native_state(h5, k, rec, err)
         type(h5_file_t), intent(inout) :: h5
         integer, intent(in) :: k
@@ -149,12 +155,20 @@ contains
         real(wp), allocatable :: values(:)
         integer(hsize_t) :: dims2(2)
         if (.not. (h5%exists('/state/y') .and. h5%exists('/state/yq'))) return
-        call h5%read_reals('/state/y', values, dims2, err)
+        call h5%extents('/state/y', dims2, err)
         if (allocated(err)) return
-        if (dims2(2) >= rec%records) rec%y = values(dims2(1)*(k - 1) + 1:dims2(1)*k)
-        call h5%read_reals('/state/yq', values, dims2, err)
+        if (dims2(2) >= rec%records) then
+            call h5%read_record('/state/y', int(k, hsize_t), values, err)
+            if (allocated(err)) return
+            rec%y = values
+        end if
+        call h5%extents('/state/yq', dims2, err)
         if (allocated(err)) return
-        if (dims2(2) >= rec%records) rec%yq = values(dims2(1)*(k - 1) + 1:dims2(1)*k)
+        if (dims2(2) >= rec%records) then
+            call h5%read_record('/state/yq', int(k, hsize_t), values, err)
+            if (allocated(err)) return
+            rec%yq = values
+        end if
         if (.not. (allocated(rec%y) .and. allocated(rec%yq))) then
             if (allocated(rec%y)) deallocate (rec%y)
             if (allocated(rec%yq)) deallocate (rec%yq)
@@ -197,19 +211,23 @@ contains
                                  [rec%support_work], MAGNITUDE_LIMIT, err)
     end subroutine check_record
 
-    !> Record k of a (times,) series; 0 when the file has no such dataset.
+    !> Record k of a (times,) series (that value only); 0 when the file has no such
+    !! dataset or the series is shorter.
     subroutine read_scalar_record(h5, name, k, value, err)
         type(h5_file_t), intent(inout) :: h5
         character(len=*), intent(in) :: name
         integer, intent(in) :: k
         real(wp), intent(out) :: value
         type(error_t), allocatable, intent(out) :: err
-        real(wp), allocatable :: series(:)
+        real(wp), allocatable :: values(:)
         integer(hsize_t) :: d(1)
         value = 0.0_wp
         if (.not. h5%exists(name)) return
-        call h5%read_reals(name, series, d, err)
+        call h5%extents(name, d, err)
         if (allocated(err)) return
-        if (size(series) >= k) value = series(k)
+        if (d(1) < k) return
+        call h5%read_record(name, int(k, hsize_t), values, err)
+        if (allocated(err)) return
+        value = values(1)
     end subroutine read_scalar_record
 end module ropedyn_state_record

@@ -62,6 +62,36 @@ def test_restart_matches_continuous_run(run, tmp_path, kind, n, tension, moving,
         assert b["energy/dissipated"][0] > 1e-6
 
 
+@pytest.mark.parametrize("kind", ["rfem", "mpp"])
+def test_start_from_the_fields_of_a_middle_record(run, tmp_path, kind):
+    """A file without restart data (/state/y, /state/yq: written by an older version)
+    starts from its record's element fields and energies: record 25 of 51, neither the
+    first nor the last, so that a neighbouring record read instead (the reader reads one
+    record of each series, not the series) shows in the first record of the new run: its
+    points (q), kinetic energy (qdot), dissipated energy and the top's work, each stored
+    at t0, rebuilt to rounding."""
+    (tmp_path / "s.nml").write_text(BASE.format(kind=kind, n=6, tension=".true.",
+                                                motion=MOTION))
+    assert run("run", "s.nml").returncode == 0
+    with h5py.File(tmp_path / "full.h5", "r+") as f:
+        del f["state/y"], f["state/yq"]
+    t0 = 0.5
+    result = run("run", "s.nml", "--set", "initial.shape='state'", "--set",
+                 "initial.state_file='full.h5'", "--set", f"initial.state_time={t0}",
+                 "--set", "output.file='re.h5'")
+    assert result.returncode == 0, result.stderr
+    with h5py.File(tmp_path / "full.h5") as a, h5py.File(tmp_path / "re.h5") as b:
+        ta = a["time"][:]
+        i0 = int(np.argmin(abs(ta - t0)))
+        assert i0 == 25 and len(ta) == 51 and b["time"][0] == ta[i0]
+        assert np.max(np.abs(a["rope/points"][i0] - b["rope/points"][0])) < 1e-12
+        for name in ("kinetic", "dissipated", "support_work"):
+            ea, eb = a["energy"][name], b["energy"][name]
+            assert abs(ea[i0] - eb[0]) < 1e-12 * max(1.0, abs(ea[i0])), name
+            # the neighbours differ from it by far more than that
+            assert min(abs(ea[i0 - 1] - ea[i0]), abs(ea[i0 + 1] - ea[i0])) > 1e-9, name
+
+
 def test_last_record_by_default(run, tmp_path):
     """state_time < 0 (the default) takes the last record: the run continues to a later
     t_end from where the first one stopped."""
