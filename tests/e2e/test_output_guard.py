@@ -88,17 +88,34 @@ def long_run(ropedyn_exe, cwd, scene, *extra):
                             cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
-def wait_for(path, proc, timeout=60):
+def records_in(part):
+    """The complete records of the file a running ropedyn writes, as its last flush left
+    them (/time is extended last in a record); 0 while it cannot be read (not yet created,
+    or caught between writes). Read without HDF5's file lock, which the writer holds."""
+    try:
+        with h5py.File(part, "r", locking=False) as f:
+            return len(f["time"]) if "time" in f else 0
+    except (OSError, KeyError, ValueError):
+        return 0
+
+
+def wait_for_records(part, proc, count=2, timeout=120):
+    """Wait until the run `proc` has flushed `count` records into `part`. Record 0 is
+    written while the run opens its file, before it catches SIGINT and SIGTERM; from
+    record 1 on it has caught them (a signal ends it in order, exit 130), and a killed run
+    leaves records to resume from. A condition, not a sleep: a loaded machine (a rebuild
+    beside the tests) only makes it wait longer."""
     deadline = time.monotonic() + timeout
-    while not path.exists():
-        assert proc.poll() is None and time.monotonic() < deadline, "the run ended early"
+    while records_in(part) < count:
+        assert proc.poll() is None, f"the run ended early: {proc.communicate()[1]}"
+        assert time.monotonic() < deadline, f"no {count} records in {part} after {timeout} s"
         time.sleep(0.02)
 
 
 def test_a_second_run_on_a_locked_file_is_refused(run, ropedyn_exe, tmp_path, scene):
     first = long_run(ropedyn_exe, tmp_path, scene)
     try:
-        wait_for(tmp_path / "out" / "paper.h5.part", first)
+        wait_for_records(tmp_path / "out" / "paper.h5.part", first)
         second = run("run", scene, "--set", "solver.t_end=30", "--set", "model.elements=60")
         assert second.returncode != 0
         assert "out/paper.h5: " in second.stderr and "lock" in second.stderr, second.stderr
@@ -120,8 +137,7 @@ def test_a_killed_run_leaves_the_earlier_file_whole(run, ropedyn_exe, tmp_path, 
     before = digest(out)
     proc = long_run(ropedyn_exe, tmp_path, scene, "--force")
     part = tmp_path / "out" / "paper.h5.part"
-    wait_for(part, proc)
-    time.sleep(0.5)
+    wait_for_records(part, proc)
     proc.kill()
     proc.wait(60)
     assert digest(out) == before and part.exists()
@@ -129,6 +145,7 @@ def test_a_killed_run_leaves_the_earlier_file_whole(run, ropedyn_exe, tmp_path, 
     assert refused.returncode == 2
     assert "paper.h5.part: left by a run of out/paper.h5 that was killed" in refused.stderr
     with h5py.File(part, "r+") as f:         # the user's way to continue a killed run
+        assert f.attrs["status"] == b"running" and len(f["time"]) >= 2
         f.attrs["status"] = "interrupted"
         last = f["time"][-1]
     resumed = run("run", "--resume", "out/paper.h5.part", "--set", f"solver.t_end={last + 0.05}")
