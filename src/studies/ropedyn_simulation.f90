@@ -28,7 +28,10 @@ contains
     !! scene%output%file to the scene's t_end. The file is written as the run goes; a failed
     !! integration leaves the data up to the failure and status 'failed'. The output file
     !! is guarded (run_t%open) unless `guard` is .false. (a sweep case guards its own);
-    !! `force` lets the run replace a file the guard would keep.
+    !! `force` lets the run replace a file the guard would keep. Signals are caught before
+    !! the file is opened: one that comes while the run starts (its lock and FILE.part
+    !! made, the start computed) stops it at its first step, as interrupted, and never
+    !! kills it with the lock and the part file left behind.
     subroutine run_scene(scene, summary, err, resume, guard, force)
         type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(out) :: summary
@@ -36,18 +39,18 @@ contains
         logical, intent(in), optional :: resume, guard, force
         type(run_t) :: run
         integer :: outcome
-        call run%open(scene, err, resume, guard, force)
-        if (allocated(err)) then
-            summary = run%summary
-            return
-        end if
         call catch_signals(err)
         if (allocated(err)) then
-            call run%finish('failed', (err%message), err)
             summary = run%summary
             return
         end if
         call end_on_second_signal(.true.)
+        call run%open(scene, err, resume, guard, force)
+        if (allocated(err)) then
+            call release_signals()
+            summary = run%summary
+            return
+        end if
         call run%begin(err, stop_on_signal)
         if (allocated(err)) then
             call run%finish('failed', (err%message), err)

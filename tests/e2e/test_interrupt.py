@@ -175,6 +175,36 @@ def test_second_signal_ends_at_once(ropedyn_exe, tmp_path, scene):
         assert attr(f, "status") == "running"
 
 
+def test_a_signal_while_the_run_starts_interrupts_it(ropedyn_exe, tmp_path, scene):
+    """A SIGTERM as soon as FILE.part exists (the run still starting: its lock taken, the
+    file being laid out) stops the run at its first step, interrupted (exit 130), with its
+    lock gone. Signals were caught only after the file was opened: a signal then killed
+    the run (exit -15), leaving FILE.part and the lock behind. The run is stopped
+    (SIGSTOP) the moment the part file appears, so the signal is pending there."""
+    out = "early.h5"
+    part = tmp_path / (out + ".part")
+    proc = start(ropedyn_exe, tmp_path, "run", scene, "--set", "model.elements=1000",
+                 "--set", "solver.method='mebdf'", "--set", f"output.file='{out}'")
+    try:
+        deadline = time.monotonic() + 60
+        while not part.exists() and proc.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.001)
+        proc.send_signal(signal.SIGSTOP)
+        assert part.exists(), "the run ended or never made its part file"
+        proc.send_signal(signal.SIGTERM)
+        proc.send_signal(signal.SIGCONT)
+        _, stderr = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, stderr
+    assert "interrupted by SIGTERM" in stderr
+    with h5py.File(tmp_path / out) as f:
+        assert attr(f, "status") == "interrupted" and f["time"].shape[0] >= 1
+    assert not part.exists()
+    assert not [p.name for p in tmp_path.iterdir() if "lock" in p.name]
+
+
 def test_resume_refusals(run, tmp_path, scene):
     assert run("run", scene, "--set", "output.file='done.h5'").returncode == 0
     done = run("run", "--resume", "done.h5")
