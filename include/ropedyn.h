@@ -20,8 +20,9 @@
  * Every function that can fail returns a status: ROPEDYN_OK (0) or the exit code the
  * command line gives for that kind of error; ropedyn_last_error(sim) is then the message
  * the command line prints after "ropedyn: error: ". A create function gives an instance
- * even when it fails (so that its message can be read): destroy it. Texts returned (const
- * char *) belong to the instance and stay valid until the next call on it.
+ * even when it fails (so that its message can be read): every other call on it returns
+ * the same error; destroy it. Texts returned (const char *) belong to the instance and
+ * stay valid until the next call on it.
  *
  * Frame and units: x points down (gravity), y horizontal; SI units (m, s, N, J). The
  * supports are ROPEDYN_TOP and ROPEDYN_BOTTOM.

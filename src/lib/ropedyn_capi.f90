@@ -99,6 +99,8 @@ contains
         type(instance_t), intent(in) :: h
         character(len=*), intent(in) :: what
         type(error_t), allocatable, intent(out) :: err
+        has_state = .false.
+        if (.not. h%readable(err)) return
         has_state = h%has_state()
         if (.not. has_state) call make_error(err, ERR_USAGE, what// &
             ': the simulation has not started (init)')
@@ -119,6 +121,7 @@ contains
         h => new_handle(sim)
         if (.not. c_associated(path)) then
             call null_argument('create_from_file: the path', err)
+            call h%unread(err)
         else
             call h%create(c_string(path), err)
         end if
@@ -137,6 +140,7 @@ contains
         if (len(origin) == 0) origin = 'scene'
         if (.not. c_associated(text)) then
             call null_argument('create_from_text: the text', err)
+            call h%unread(err)
         else
             call h%create(origin, err, text=c_string(text))
         end if
@@ -189,7 +193,7 @@ contains
         if (.not. associated(h)) return
         if (.not. c_associated(text)) then
             call null_argument('scene_text: the text', err)
-        else
+        else if (h%readable(err)) then
             h%text_out = c_text(scene_namelist_text(h%scene))
             call c_f_pointer(text, out)
             out = c_loc(h%text_out)
@@ -208,7 +212,7 @@ contains
         if (.not. associated(h)) return
         if (.not. c_associated(text)) then
             call null_argument('warnings: the text', err)
-        else
+        else if (h%readable(err)) then
             h%text_out = c_text(h%warnings())
             call c_f_pointer(text, out)
             out = c_loc(h%text_out)

@@ -4,8 +4,10 @@
 !! uses: instances do not share state, so that two can run in two threads.
 !!
 !! Life cycle: created (the scene only: `set` may change it) -> `init` (model, integrator,
-!! start state; from statics on request) -> `advance` and the rest -> destroyed. A failed
-!! integration ends the simulation: every later call that needs it returns that error.
+!! start state; from statics on request) -> `advance` and the rest -> destroyed. A scene
+!! that could not be read leaves an instance whose every later call returns the reader's
+!! error (it has no scene to set, show, run or simulate). A failed integration ends the
+!! simulation: every later call that moves it on returns that error.
 !! `run_whole` runs the scene from its start to t_end as `ropedyn run` does (records into
 !! a file, or into a file in memory whose bytes it returns) without touching the
 !! simulation.
@@ -24,10 +26,11 @@ module ropedyn_lib
     private
     public :: instance_t, snapshot_t, new_instance, delete_instance, new_snapshot, &
               delete_snapshot
-    public :: STAGE_SCENE, STAGE_RUNNING, STAGE_FAILED
+    public :: STAGE_SCENE, STAGE_RUNNING, STAGE_FAILED, STAGE_UNREAD
 
-    !> Where an instance is in its life cycle.
-    integer, parameter :: STAGE_SCENE = 0, STAGE_RUNNING = 1, STAGE_FAILED = 2
+    !> Where an instance is in its life cycle (STAGE_UNREAD: its scene could not be read).
+    integer, parameter :: STAGE_SCENE = 0, STAGE_RUNNING = 1, STAGE_FAILED = 2, &
+                          STAGE_UNREAD = 3
 
     type :: instance_t
         !> the scene's origin: a file (from_file) or a name for the text
@@ -37,7 +40,7 @@ module ropedyn_lib
         type(scene_t) :: scene
         type(run_t), allocatable :: run
         integer :: stage = STAGE_SCENE
-        !> the error that ended the simulation (STAGE_FAILED)
+        !> the error that ended the simulation (STAGE_FAILED) or the reading (STAGE_UNREAD)
         type(error_t), allocatable :: failure
         !> what the C interface hands out: the last error's message, a text (the scene,
         !! the warnings) and a run's file image, NUL-terminated where text; runs into
@@ -47,6 +50,8 @@ module ropedyn_lib
         integer :: runs = 0
     contains
         procedure :: create => instance_create
+        procedure :: readable => instance_readable
+        procedure :: unread => instance_unread
         procedure :: set => instance_set
         procedure :: init => instance_init
         procedure :: running => instance_running
@@ -117,7 +122,25 @@ contains
         if (present(text)) self%text = text
         allocate (self%overrides(0))
         call self%read(err)
+        if (allocated(err)) call self%unread(err)
     end subroutine instance_create
+
+    !> The instance has no scene: `err` (the reader's error, or a create call's bad
+    !! argument) is what every later call returns.
+    subroutine instance_unread(self, err)
+        class(instance_t), intent(inout) :: self
+        type(error_t), intent(in) :: err
+        self%stage = STAGE_UNREAD
+        self%failure = err
+    end subroutine instance_unread
+
+    !> Whether the instance has a scene (else `err` is the error that reading it gave).
+    logical function instance_readable(self, err) result(readable)
+        class(instance_t), intent(in) :: self
+        type(error_t), allocatable, intent(out) :: err
+        readable = self%stage /= STAGE_UNREAD
+        if (.not. readable) call make_error(err, self%failure%code, self%failure%message)
+    end function instance_readable
 
     !> The scene from its origin with the overrides so far.
     subroutine read(self, err)
@@ -148,6 +171,7 @@ contains
         type(error_t), allocatable, intent(out) :: err
         type(error_t), allocatable :: again
         integer :: before, start, nl
+        if (.not. self%readable(err)) return
         if (self%stage /= STAGE_SCENE) then
             call make_error(err, ERR_USAGE, 'set: the simulation has started: a scene '// &
                             'changes only before init')
@@ -176,6 +200,7 @@ contains
         logical, intent(in) :: from_statics
         type(error_t), allocatable, intent(out) :: err
         type(scene_t) :: scene
+        if (.not. self%readable(err)) return
         if (self%stage /= STAGE_SCENE) then
             call make_error(err, ERR_USAGE, 'init: the simulation has started already')
             return
@@ -193,14 +218,15 @@ contains
         self%stage = STAGE_RUNNING
     end subroutine instance_init
 
-    !> Whether the simulation runs (else `err` says why not: not started, or failed).
+    !> Whether the simulation runs (else `err` says why not: not started, failed, or no
+    !! scene).
     logical function instance_running(self, what, err) result(running)
         class(instance_t), intent(in) :: self
         character(len=*), intent(in) :: what
         type(error_t), allocatable, intent(out) :: err
         running = self%stage == STAGE_RUNNING
         if (running) return
-        if (self%stage == STAGE_FAILED) then
+        if (self%stage == STAGE_FAILED .or. self%stage == STAGE_UNREAD) then
             call make_error(err, self%failure%code, self%failure%message)
         else
             call make_error(err, ERR_USAGE, what//': the simulation has not started (init)')
@@ -233,6 +259,7 @@ contains
         type(run_t), allocatable :: run
         type(scene_t) :: scene
         integer :: outcome
+        if (.not. self%readable(err)) return
         scene = self%scene
         allocate (run)
         if (len(output) > 0) then

@@ -64,6 +64,37 @@ static void bad_calls(void)
     check(strstr(ropedyn_last_error(sim), "bad.nml: &model: elements = 1") != NULL,
           "a bad scene: the message names the scene, group, key and value");
     ropedyn_destroy(sim);
+    /* a scene that could not be read leaves no scene to show, run or simulate: before,
+       init simulated the defaults (an unknown key ignored, a length of -1 m kept) */
+    const char *unread[] = {"&model kind = 'rfem', elements = 4, bogus = 1 /",
+                            "&model kind = 'rfem', elements = 4 /\n&rope length = -1 /"};
+    for (int k = 0; k < 2; k++) {
+        const char *text = NULL;
+        const void *image = NULL;
+        size_t bytes = 0;
+        sim = NULL;
+        status = ropedyn_create_from_text(unread[k], "unread.nml", &sim);
+        char message[512];
+        snprintf(message, sizeof message, "%s", ropedyn_last_error(sim));
+        int same = status == ROPEDYN_ERROR_INPUT;
+        same = same && ropedyn_scene_text(sim, &text) == status && text == NULL;
+        same = same && ropedyn_warnings(sim, &text) == status;
+        same = same && ropedyn_set(sim, "model.elements=6") == status;
+        same = same && ropedyn_run(sim, NULL, &image, &bytes) == status && image == NULL;
+        same = same && ropedyn_init(sim, 0) == status;
+        same = same && strcmp(ropedyn_last_error(sim), message) == 0;
+        same = same && ropedyn_advance(sim, 0.01) == status;
+        check(same && strstr(message, "unread.nml: ") == message,
+              k == 0 ? "a scene with an unknown key: every later call returns its error"
+                     : "a scene with a bad value: every later call returns its error");
+        ropedyn_destroy(sim);
+    }
+    sim = NULL;
+    check(ropedyn_create_from_text(NULL, "x", &sim) == ROPEDYN_ERROR_INPUT &&
+              ropedyn_init(sim, 0) == ROPEDYN_ERROR_INPUT &&
+              strstr(ropedyn_last_error(sim), "text is NULL") != NULL,
+          "NULL text: no scene to simulate");
+    ropedyn_destroy(sim);
     status = ropedyn_create_from_file("/nonexistent/scene.nml", &sim);
     check(status == ROPEDYN_ERROR_INPUT && strlen(ropedyn_last_error(sim)) > 0,
           "a missing file: status 2 and a message");
