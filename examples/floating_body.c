@@ -2,7 +2,8 @@
  * surge y, sideways) are integrated here; the rope is ropedyn's, its top end coupled to
  * the body (a fairlead), its bottom end pinned to an anchor on the sea floor.
  *
- *     cc floating_body.c -I PREFIX/include -L PREFIX/lib -lropedyn -lm -o floating_body
+ *     cc floating_body.c -I PREFIX/include -L PREFIX/lib -Wl,-rpath,PREFIX/lib \
+ *        -lropedyn -lm -o floating_body
  *     ./floating_body [T_END] [EVERY]
  *
  * prints `t x y fx fy` (s, m, m, N, N: the body's position and the rope's force on it)
