@@ -81,8 +81,10 @@ int ropedyn_warnings(ropedyn_t *sim, const char **text);
 int ropedyn_init(ropedyn_t *sim, int from_statics);
 
 /* Integrate to time t (s, not before the time reached; the scene's t_end does not apply).
- * A failed integration keeps the last good state and ends the simulation: later calls
- * return the same error until ropedyn_restore. An integration that has created more than
+ * A failed integration keeps the last good state and ends the simulation: later calls of
+ * ropedyn_advance, ropedyn_set_state, ropedyn_set_support and ropedyn_save return the same
+ * error until ropedyn_restore; the reads give the last good state. An integration that
+ * has created more than
  * a tenth of the rope's energy scale (looked at up to twice per output interval) fails
  * too, keeping the state of the last look; a state set by ropedyn_set_state starts the
  * count again. */
@@ -128,7 +130,8 @@ void ropedyn_snapshot_destroy(ropedyn_snapshot_t *snapshot);
  * output NULL or "" into memory, whose bytes (an HDF5 file) *image and *size then give. */
 int ropedyn_run(ropedyn_t *sim, const char *output, const void **image, size_t *size);
 
-/* The message of the last call that failed on this instance ("" when it succeeded). */
+/* The message of the last call that failed on this instance ("" when it succeeded; NULL
+ * for a NULL instance). */
 const char *ropedyn_last_error(const ropedyn_t *sim);
 
 /* Free the instance (NULL: nothing). */

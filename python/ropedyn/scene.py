@@ -124,7 +124,8 @@ class Scene:
         return self
 
     def get(self, key):
-        """The value of "group.key" (a number, bool, string, or a list for a pair)."""
+        """The value of "group.key" (a number, bool, string, or a list for a pair); a key
+        that does not exist raises KeyError."""
         group, _, name = key.lower().partition(".")
         values = parse_namelist(self._text).get(group, {})
         if name not in values:

@@ -147,16 +147,20 @@ class Simulation:
     # ---- moving on -------------------------------------------------------------------
 
     def advance(self, t):
-        """Integrate to time `t` (s, not before the time reached)."""
+        """Integrate to time `t` (s, not before the time reached). A failed integration
+        raises ropedyn.Error, keeps the last good state and ends the simulation: later
+        `advance`, `set_support`, `save` and assignments to `state` raise the same error
+        until `restore`; the reads give the last good state."""
         status = self._advance(self._handle(), t)
         if status != 0:
             self._check(status)
 
     def set_support(self, end, position, velocity=(0.0, 0.0)):
         """Prescribe the coupled support `end` ('top' or 'bottom'; its &supports motion
-        'coupled') at the time of the next `advance`: position (x, y) in m, velocity in m/s.
-        In between it moves on the cubic Hermite curve from its position and velocity now
-        (as a motion table's segment)."""
+        'coupled') at the time of the next `advance`: position (x, y) in m, velocity in m/s
+        ((0, 0) when left out: at rest there, not on with its velocity now). In between it
+        moves on the cubic Hermite curve from its position and velocity now (as a motion
+        table's segment)."""
         p, v = self._p, self._v
         p[0], p[1] = position
         v[0], v[1] = velocity
