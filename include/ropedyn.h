@@ -3,7 +3,9 @@
  * A simulation is an instance made from a scene (a scene file, or its namelist text):
  *
  *     ropedyn_t *sim;
+ *     double force[2];
  *     if (ropedyn_create_from_file("input/paper.nml", &sim) != ROPEDYN_OK ||
+ *         ropedyn_set(sim, "supports.top_motion=coupled") != ROPEDYN_OK ||
  *         ropedyn_init(sim, 0) != ROPEDYN_OK) {
  *         fprintf(stderr, "ropedyn: error: %s\n", ropedyn_last_error(sim));
  *         ropedyn_destroy(sim);
@@ -11,7 +13,7 @@
  *     }
  *     for (int k = 1; k <= 1000; k++) {
  *         double p[2] = {0.0, 0.05 * sin(k * 1e-3)}, v[2] = {0.0, 0.05 * cos(k * 1e-3)};
- *         ropedyn_set_support(sim, ROPEDYN_TOP, p, v);   // needs top_motion = 'coupled'
+ *         ropedyn_set_support(sim, ROPEDYN_TOP, p, v);
  *         ropedyn_advance(sim, k * 1e-3);
  *         ropedyn_reaction(sim, ROPEDYN_TOP, force);
  *     }
