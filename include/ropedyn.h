@@ -82,14 +82,15 @@ int ropedyn_warnings(ropedyn_t *sim, const char **text);
  * static equilibrium (at rest). */
 int ropedyn_init(ropedyn_t *sim, int from_statics);
 
-/* Integrate to time t (s, not before the time reached; the scene's t_end does not apply).
- * A failed integration keeps the last good state and ends the simulation: later calls of
- * ropedyn_advance, ropedyn_set_state, ropedyn_set_support and ropedyn_save return the same
- * error until ropedyn_restore; the reads give the last good state. An integration that
- * has created more than
- * a tenth of the rope's energy scale (looked at up to twice per output interval) fails
- * too, keeping the state of the last look; a state set by ropedyn_set_state starts the
- * count again. */
+/* Integrate to time t (s, not before the time reached; the scene's t_end does not stop
+ * it). A failed integration keeps the last good state and ends the simulation: later
+ * calls of ropedyn_advance, ropedyn_set_state, ropedyn_set_support and ropedyn_save
+ * return the same error until ropedyn_restore; the reads give the last good state. An
+ * integration that has created more than a tenth of the rope's energy scale (looked at up
+ * to twice per output interval) fails too, keeping the state of the last look; a state
+ * set by ropedyn_set_state starts the count again. One that has spent the step budget
+ * fails too: solver.max_steps counts every step since ropedyn_init (those before a
+ * ropedyn_restore too), and its default follows the scene's t_end. */
 int ropedyn_advance(ropedyn_t *sim, double t);
 
 /* The time reached (s); the number of elements n and of unknowns of the ODE state. */

@@ -98,8 +98,9 @@ class Simulation:
     """A scene's simulation, moved on by `advance`; no file is written.
 
     `statics=True` starts at the static equilibrium (at rest) instead of the scene's
-    initial state. The scene's t_end and output interval do not apply; the order safety
-    does not run (docs/reference/api.md says why)."""
+    initial state. The scene's t_end does not stop it, and nothing is recorded; the step
+    budget (solver.max_steps) counts every step of the simulation, and the order safety's
+    second look does not run (docs/reference/api.md says why)."""
 
     def __init__(self, scene, statics=False):
         self.scene = _scene_of(scene)
