@@ -130,7 +130,10 @@ void ropedyn_snapshot_destroy(ropedyn_snapshot_t *snapshot);
 
 /* Run the scene from its start to t_end as `ropedyn run` does (same records, order
  * safety, statuses), apart from the instance's simulation: into the file `output`, or with
- * output NULL or "" into memory, whose bytes (an HDF5 file) *image and *size then give. */
+ * output NULL or "" into memory, whose bytes (an HDF5 file) *image and *size then give,
+ * also after a failed integration (the records up to the failure); NULL and 0 for a run
+ * into a file. The image belongs to the instance and stays valid until its next
+ * ropedyn_run or ropedyn_destroy. `image` and `size` may be NULL. */
 int ropedyn_run(ropedyn_t *sim, const char *output, const void **image, size_t *size);
 
 /* The message of the last call that failed on this instance ("" when it succeeded; NULL
