@@ -23,8 +23,11 @@
  * command line gives for that kind of error; ropedyn_last_error(sim) is then the message
  * the command line prints after "ropedyn: error: ". A create function gives an instance
  * even when it fails (so that its message can be read): every other call on it returns
- * the same error; destroy it. Texts returned (const char *) belong to the instance and
- * stay valid until the next call on it.
+ * the same error; destroy it. A NULL instance, or NULL for where a create function puts
+ * it, gives status 2 and no message; a NULL where a call reads or writes its values gives
+ * status 2 and a message (but the arrays of ropedyn_forces and the results of
+ * ropedyn_run, which may be NULL). Texts returned (const char *) belong to the instance
+ * and stay valid until the next call on it.
  *
  * Frame and units: x points down (gravity), y horizontal; SI units (m, s, N, J). The
  * supports are ROPEDYN_TOP and ROPEDYN_BOTTOM.

@@ -68,16 +68,14 @@ contains
         h%message = c_text(err%message)
     end function status_of
 
-    !> A new handle for the create functions: its address in `sim_out` (when not NULL).
+    !> A new handle for the create functions: its address in `sim_out` (not NULL).
     function new_handle(sim_out) result(h)
         type(c_ptr), intent(in) :: sim_out
         type(instance_t), pointer :: h
         type(c_ptr), pointer :: out
         h => new_instance()
-        if (c_associated(sim_out)) then
-            call c_f_pointer(sim_out, out)
-            out = c_loc(h)
-        end if
+        call c_f_pointer(sim_out, out)
+        out = c_loc(h)
     end function new_handle
 
     !> Support index of C (0 top, 1 bottom) as the run's (1, 2); 0 if neither.
@@ -118,6 +116,8 @@ contains
         type(c_ptr), value :: path, sim
         type(instance_t), pointer :: h
         type(error_t), allocatable :: err
+        status = 2
+        if (.not. c_associated(sim)) return   ! nowhere to put the instance
         h => new_handle(sim)
         if (.not. c_associated(path)) then
             call null_argument('create_from_file: the path', err)
@@ -126,7 +126,6 @@ contains
             call h%create(c_string(path), err)
         end if
         status = status_of(h, err)
-        if (.not. c_associated(sim)) call delete_instance(h)
     end function capi_create_from_file
 
     integer(c_int) function capi_create_from_text(text, name, sim) result(status) &
@@ -135,6 +134,8 @@ contains
         type(instance_t), pointer :: h
         type(error_t), allocatable :: err
         character(len=:), allocatable :: origin
+        status = 2
+        if (.not. c_associated(sim)) return   ! nowhere to put the instance
         h => new_handle(sim)
         origin = c_string(name)
         if (len(origin) == 0) origin = 'scene'
@@ -145,7 +146,6 @@ contains
             call h%create(origin, err, text=c_string(text))
         end if
         status = status_of(h, err)
-        if (.not. c_associated(sim)) call delete_instance(h)
     end function capi_create_from_text
 
     subroutine capi_destroy(sim) bind(C, name='ropedyn_f_destroy')
@@ -277,52 +277,65 @@ contains
     end function capi_advance
 
     integer(c_int) function capi_time(sim, t) result(status) bind(C, name='ropedyn_f_time')
-        type(c_ptr), value :: sim
-        real(c_double), intent(out) :: t
+        type(c_ptr), value :: sim, t
         type(instance_t), pointer :: h
         type(error_t), allocatable :: err
+        real(c_double), pointer :: out(:)
         status = 2
-        t = 0.0_c_double
+        out => zeroed(t, 1)
         h => handle_of(sim)
         if (.not. associated(h)) return
-        if (has_state(h, 'time', err)) t = real(h%time(), c_double)
+        if (.not. associated(out)) then
+            call null_argument('time: t', err)
+        else if (has_state(h, 'time', err)) then
+            out(1) = real(h%time(), c_double)
+        end if
         status = status_of(h, err)
     end function capi_time
 
     integer(c_int) function capi_size(sim, elements, state_size) result(status) &
             bind(C, name='ropedyn_f_size')
-        type(c_ptr), value :: sim
-        integer(c_int), intent(out) :: elements, state_size
+        type(c_ptr), value :: sim, elements, state_size
         type(instance_t), pointer :: h
         type(error_t), allocatable :: err
+        integer(c_int), pointer :: n_out, size_out
+        integer(c_int), target :: scratch(2)
         status = 2
-        elements = 0
-        state_size = 0
+        ! a NULL pointer stands for an integer nobody reads (the call then fails)
+        n_out => scratch(1)
+        size_out => scratch(2)
+        if (c_associated(elements)) call c_f_pointer(elements, n_out)
+        if (c_associated(state_size)) call c_f_pointer(state_size, size_out)
+        n_out = 0
+        size_out = 0
         h => handle_of(sim)
         if (.not. associated(h)) return
-        if (has_state(h, 'size', err)) then
-            elements = int(h%elements(), c_int)
-            state_size = int(h%state_size(), c_int)
+        if (.not. (c_associated(elements) .and. c_associated(state_size))) then
+            call null_argument('size: elements or state_size', err)
+        else if (has_state(h, 'size', err)) then
+            n_out = int(h%elements(), c_int)
+            size_out = int(h%state_size(), c_int)
         end if
         status = status_of(h, err)
     end function capi_size
 
     integer(c_int) function capi_get_state(sim, y, size) result(status) &
             bind(C, name='ropedyn_f_get_state')
-        type(c_ptr), value :: sim
+        type(c_ptr), value :: sim, y
         integer(c_int), value :: size
-        real(c_double), intent(out) :: y(size)
         type(instance_t), pointer :: h
         type(error_t), allocatable :: err
         status = 2
         h => handle_of(sim)
         if (.not. associated(h)) return
-        if (has_state(h, 'get_state', err)) then
+        if (.not. c_associated(y)) then
+            call null_argument('get_state: y', err)
+        else if (has_state(h, 'get_state', err)) then
             if (size /= h%state_size()) then
                 call make_error(err, ERR_USAGE, 'get_state: size '//int_text(int(size))// &
                     ', the state has '//int_text(h%state_size()))
             else
-                call h%get_state(y)
+                call h%get_state(doubles_at(y, int(size)))
             end if
         end if
         status = status_of(h, err)
@@ -330,34 +343,40 @@ contains
 
     integer(c_int) function capi_set_state(sim, y, size) result(status) &
             bind(C, name='ropedyn_f_set_state')
-        type(c_ptr), value :: sim
+        type(c_ptr), value :: sim, y
         integer(c_int), value :: size
-        real(c_double), intent(in) :: y(size)
         type(instance_t), pointer :: h
         type(error_t), allocatable :: err
         status = 2
         h => handle_of(sim)
         if (.not. associated(h)) return
-        if (h%running('set_state', err)) call h%set_state(y, err)
+        if (.not. c_associated(y)) then
+            call null_argument('set_state: y', err)
+        else if (h%running('set_state', err)) then
+            call h%set_state(doubles_at(y, max(0, int(size))), err)
+        end if
         status = status_of(h, err)
     end function capi_set_state
 
     integer(c_int) function capi_points(sim, xy, count) result(status) &
             bind(C, name='ropedyn_f_points')
-        type(c_ptr), value :: sim
+        type(c_ptr), value :: sim, xy
         integer(c_int), value :: count
-        real(c_double), intent(out) :: xy(2, count)
         type(instance_t), pointer :: h
         type(error_t), allocatable :: err
+        real(c_double), pointer :: out(:, :)
         status = 2
         h => handle_of(sim)
         if (.not. associated(h)) return
-        if (has_state(h, 'points', err)) then
+        if (.not. c_associated(xy)) then
+            call null_argument('points: xy', err)
+        else if (has_state(h, 'points', err)) then
             if (count /= 2*h%elements()) then
                 call make_error(err, ERR_USAGE, 'points: count '//int_text(int(count))// &
                     ', the rope has '//int_text(2*h%elements())//' points')
             else
-                call h%points(xy)
+                call c_f_pointer(xy, out, [2, int(count)])
+                call h%points(out)
             end if
         end if
         status = status_of(h, err)
@@ -389,6 +408,25 @@ contains
         status = status_of(h, err)
     end function capi_forces
 
+    !> The C array of `n` doubles at `p` (not NULL).
+    function doubles_at(p, n) result(values)
+        type(c_ptr), intent(in) :: p
+        integer, intent(in) :: n
+        real(c_double), pointer :: values(:)
+        call c_f_pointer(p, values, [n])
+    end function doubles_at
+
+    !> The C array of `n` doubles at `p`, set to 0 (disassociated for NULL).
+    function zeroed(p, n) result(values)
+        type(c_ptr), intent(in) :: p
+        integer, intent(in) :: n
+        real(c_double), pointer :: values(:)
+        values => null()
+        if (.not. c_associated(p)) return
+        call c_f_pointer(p, values, [n])
+        values = 0.0_c_double
+    end function zeroed
+
     !> Copy `values` to the C array at `p` (nothing for NULL).
     subroutine put(p, values)
         type(c_ptr), intent(in) :: p
@@ -401,86 +439,93 @@ contains
 
     integer(c_int) function capi_reaction(sim, support, force) result(status) &
             bind(C, name='ropedyn_f_reaction')
-        type(c_ptr), value :: sim
+        type(c_ptr), value :: sim, force
         integer(c_int), value :: support
-        real(c_double), intent(out) :: force(2)
         type(instance_t), pointer :: h
         type(error_t), allocatable :: err
         real(wp), allocatable :: a(:), s(:), m(:)
         real(wp) :: reaction(2, 2)
+        real(c_double), pointer :: out(:)
         integer :: n
         status = 2
-        force = 0.0_c_double
+        out => zeroed(force, 2)
         h => handle_of(sim)
         if (.not. associated(h)) return
-        if (support_of(support) == 0) then
+        if (.not. associated(out)) then
+            call null_argument('reaction: force', err)
+        else if (support_of(support) == 0) then
             call make_error(err, ERR_USAGE, 'reaction: support '//int_text(int(support))// &
                             ' (0 top, 1 bottom)')
         else if (has_state(h, 'reaction', err)) then
             n = h%elements()
             allocate (a(0:n), s(0:n), m(0:n))
             call h%forces(a, s, m, reaction)
-            force = reaction(:, support_of(support))
+            out = reaction(:, support_of(support))
         end if
         status = status_of(h, err)
     end function capi_reaction
 
     integer(c_int) function capi_support_position(sim, support, position) result(status) &
             bind(C, name='ropedyn_f_support_position')
-        type(c_ptr), value :: sim
+        type(c_ptr), value :: sim, position
         integer(c_int), value :: support
-        real(c_double), intent(out) :: position(2)
         type(instance_t), pointer :: h
         type(error_t), allocatable :: err
         real(wp) :: anchors(2, 2)
+        real(c_double), pointer :: out(:)
         status = 2
-        position = 0.0_c_double
+        out => zeroed(position, 2)
         h => handle_of(sim)
         if (.not. associated(h)) return
-        if (support_of(support) == 0) then
+        if (.not. associated(out)) then
+            call null_argument('support_position: position', err)
+        else if (support_of(support) == 0) then
             call make_error(err, ERR_USAGE, 'support_position: support '// &
                             int_text(int(support))//' (0 top, 1 bottom)')
         else if (has_state(h, 'support_position', err)) then
             call h%anchors(anchors)
-            position = anchors(:, support_of(support))
+            out = anchors(:, support_of(support))
         end if
         status = status_of(h, err)
     end function capi_support_position
 
     integer(c_int) function capi_energy(sim, energy) result(status) &
             bind(C, name='ropedyn_f_energy')
-        type(c_ptr), value :: sim
-        real(c_double), intent(out) :: energy(6)
+        type(c_ptr), value :: sim, energy
         type(instance_t), pointer :: h
         type(error_t), allocatable :: err
         type(energy_t) :: e
+        real(c_double), pointer :: out(:)
         status = 2
-        energy = 0.0_c_double
+        out => zeroed(energy, 6)
         h => handle_of(sim)
         if (.not. associated(h)) return
-        if (has_state(h, 'energy', err)) then
+        if (.not. associated(out)) then
+            call null_argument('energy: energy', err)
+        else if (has_state(h, 'energy', err)) then
             call h%energy(e)
-            energy = [e%kinetic, e%elastic, e%gravity, e%dissipated, e%support_work, e%total()]
+            out = [e%kinetic, e%elastic, e%gravity, e%dissipated, e%support_work, e%total()]
         end if
         status = status_of(h, err)
     end function capi_energy
 
     integer(c_int) function capi_set_support(sim, support, position, velocity) &
             result(status) bind(C, name='ropedyn_f_set_support')
-        type(c_ptr), value :: sim
+        type(c_ptr), value :: sim, position, velocity
         integer(c_int), value :: support
-        real(c_double), intent(in) :: position(2), velocity(2)
         type(instance_t), pointer :: h
         type(error_t), allocatable :: err
         status = 2
         h => handle_of(sim)
         if (.not. associated(h)) return
-        if (support_of(support) == 0) then
+        if (.not. (c_associated(position) .and. c_associated(velocity))) then
+            call null_argument('set_support: the position or velocity', err)
+        else if (support_of(support) == 0) then
             call make_error(err, ERR_USAGE, 'set_support: support '//int_text(int(support))// &
                             ' (0 top, 1 bottom)')
         else if (h%running('set_support', err)) then
-            call h%set_support(support_of(support), real(position, wp), &
-                                        real(velocity, wp), err)
+            call h%set_support(support_of(support), real(doubles_at(position, 2), wp), &
+                               real(doubles_at(velocity, 2), wp), err)
         end if
         status = status_of(h, err)
     end function capi_set_support

@@ -104,6 +104,9 @@ static void bad_calls(void)
     ropedyn_destroy(NULL);
     check(ropedyn_create_from_file(NULL, &sim) == ROPEDYN_ERROR_INPUT, "NULL path: status 2");
     ropedyn_destroy(sim);
+    check(ropedyn_create_from_file(scene_path, NULL) == ROPEDYN_ERROR_INPUT &&
+              ropedyn_create_from_text("&model elements = 4 /", "x", NULL) == ROPEDYN_ERROR_INPUT,
+          "NULL for the instance: status 2 (before: 0, and nothing made)");
 
     sim = NULL;
     ropedyn_create_from_file(scene_path, &sim);
@@ -121,6 +124,22 @@ static void bad_calls(void)
     check(ropedyn_set_support(sim, ROPEDYN_TOP, p, v) == ROPEDYN_ERROR_INPUT &&
               strstr(ropedyn_last_error(sim), "top_motion = 'coupled'") != NULL,
           "set_support of a fixed support: status 2, says how to couple it");
+    /* a NULL where a result goes or a value comes from: status 2 and a message, no crash
+       (before, each of these was a segmentation fault) */
+    int n = 0, size = 0, nulls = 0;
+    nulls += ropedyn_time(sim, NULL) == ROPEDYN_ERROR_INPUT;
+    nulls += ropedyn_size(sim, &n, NULL) == ROPEDYN_ERROR_INPUT && n == 0;
+    nulls += ropedyn_size(sim, NULL, &size) == ROPEDYN_ERROR_INPUT && size == 0;
+    nulls += ropedyn_get_state(sim, NULL, 0) == ROPEDYN_ERROR_INPUT;
+    nulls += ropedyn_set_state(sim, NULL, 0) == ROPEDYN_ERROR_INPUT;
+    nulls += ropedyn_points(sim, NULL, 16) == ROPEDYN_ERROR_INPUT;
+    nulls += ropedyn_reaction(sim, ROPEDYN_TOP, NULL) == ROPEDYN_ERROR_INPUT;
+    nulls += ropedyn_support_position(sim, ROPEDYN_TOP, NULL) == ROPEDYN_ERROR_INPUT;
+    nulls += ropedyn_energy(sim, NULL) == ROPEDYN_ERROR_INPUT;
+    nulls += ropedyn_set_support(sim, ROPEDYN_TOP, NULL, v) == ROPEDYN_ERROR_INPUT;
+    nulls += ropedyn_set_support(sim, ROPEDYN_TOP, p, NULL) == ROPEDYN_ERROR_INPUT &&
+             strstr(ropedyn_last_error(sim), "is NULL") != NULL;
+    check(nulls == 11, "NULL arrays and results: status 2 and a message, no crash");
     check(ropedyn_reaction(sim, 7, f) == ROPEDYN_ERROR_INPUT, "reaction of support 7: 2");
     check(ropedyn_get_state(sim, y, 3) == ROPEDYN_ERROR_INPUT, "get_state of a wrong size");
     ropedyn_advance(sim, 0.2);
