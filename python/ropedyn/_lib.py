@@ -8,7 +8,9 @@ Where it is looked for, in order:
    in, when it sits in one: a clone's package, used in place by the clone's venv, loads
    that clone's library.
 
-Calls release the GIL (ctypes.CDLL), so that simulations in two threads run at once.
+Calls release the GIL (ctypes.CDLL), so that other Python threads run meanwhile; the
+library itself runs one call at a time (docs/reference/api.md, "Threads"), so simulations
+in two threads do not integrate at once.
 """
 import ctypes
 import os
