@@ -2,7 +2,8 @@
 
 Where it is looked for, in order:
 
-1. the file named by the environment variable ROPEDYN_LIBRARY;
+1. the file named by the environment variable ROPEDYN_LIBRARY (set, it must exist: the
+   others are not looked at);
 2. beside this package (``pip install`` of the package builds it there);
 3. the build folders build/release and build/debug of the source tree this package sits
    in, when it sits in one: a clone's package, used in place by the clone's venv, loads
@@ -82,6 +83,10 @@ def library():
 
 def _load():
     from ropedyn.errors import Error
+    chosen = os.environ.get("ROPEDYN_LIBRARY")
+    if chosen and not pathlib.Path(chosen).is_file():
+        raise Error(f"ROPEDYN_LIBRARY={chosen}: no such file (unset it to load the "
+                    "package's own library)", 2)
     tried = candidates()
     for path in tried:
         if path.is_file():

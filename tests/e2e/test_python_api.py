@@ -303,3 +303,20 @@ def test_pip_install_builds_a_package_with_its_own_library(tmp_path):
                             capture_output=True, text=True)
     assert result.returncode == 0, result.stderr
     assert result.stdout.split() == [str(site / "ropedyn" / "libropedyn.so"), "complete"]
+
+
+def test_a_missing_ropedyn_library_is_an_error(tmp_path):
+    """ROPEDYN_LIBRARY naming no file is an error that names it; before, the package went
+    on silently with the next library it found (this clone's build)."""
+    missing = tmp_path / "nowhere" / "libropedyn.so"
+    env = dict(os.environ, ROPEDYN_LIBRARY=str(missing))
+    code = ("import ropedyn, ropedyn._lib as lib\n"
+            "try:\n"
+            "    print('loaded', lib.library().path)\n"
+            "except ropedyn.Error as e:\n"
+            "    print('error', e.code, e.message)\n")
+    result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env,
+                            capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith("error 2 "), result.stdout
+    assert f"ROPEDYN_LIBRARY={missing}" in result.stdout
