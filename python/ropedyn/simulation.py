@@ -163,8 +163,12 @@ class Simulation:
         moves on the cubic Hermite curve from its position and velocity now (as a motion
         table's segment)."""
         p, v = self._p, self._v
-        p[0], p[1] = position
-        v[0], v[1] = velocity
+        try:
+            p[0], p[1] = position
+            v[0], v[1] = velocity
+        except (TypeError, ValueError):
+            raise Error(f"set_support: position and velocity are two numbers each, (x, y) "
+                        f"in m and m/s, not {position!r} and {velocity!r}", 2) from None
         status = self._set_support(self._handle(), _support(end), p, v)
         if status != 0:
             self._check(status)
@@ -229,7 +233,10 @@ class Simulation:
 
     @state.setter
     def state(self, y):
-        y = np.ascontiguousarray(y, dtype=float)
+        try:
+            y = np.ascontiguousarray(y, dtype=float)
+        except (TypeError, ValueError):
+            raise Error(f"state: {self.state_size} numbers, not {y!r}", 2) from None
         self._check(self._lib.ropedyn_set_state(
             self._handle(), y.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), y.size))
 

@@ -224,6 +224,13 @@ def test_simulation_calls_and_their_errors():
             sim.advance(0.05)
         with pytest.raises(ropedyn.Error, match="unknown support"):
             sim.reaction("middle")
+        # malformed arguments are ropedyn.Error too (bad call: code 2), not Python's own
+        for bad in ((1.0,), (1.0, 2.0, 3.0), "xy", None):
+            with pytest.raises(ropedyn.Error, match="two numbers each") as error:
+                sim.set_support("top", position=bad)
+            assert error.value.code == 2
+        with pytest.raises(ropedyn.Error, match="numbers, not") as error:
+            sim.state = ["a", "b"]
         snap = sim.save()
         sim.advance(0.3)
         first = sim.state
