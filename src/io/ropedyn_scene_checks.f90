@@ -292,6 +292,8 @@ contains
                     call unused('load_force_y', a%load_force_y(k), 'load_positions')
                     call unused('load_amplitude_x', a%load_amplitude_x(k), 'load_positions')
                     call unused('load_amplitude_y', a%load_amplitude_y(k), 'load_positions')
+                    call unused('load_frequency', a%load_frequency(k), 'load_positions')
+                    call unused('load_phase_deg', a%load_phase_deg(k), 'load_positions')
                 else
                     call position('load_positions', a%load_positions(k))
                     call finite('load_force_x', a%load_force_x(k))
