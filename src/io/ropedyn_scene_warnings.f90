@@ -3,11 +3,13 @@
 !! strain under the rope's own weight above 10 %), a damping coefficient in the wrong unit
 !! (an element's axial damping ratio below 1e-6 or above 1000), air's density for water, a
 !! straight start or a support's anchor inside the ground (x points down: a ground point in
-!! the wrong sign). Each warning names the key, its value and why; a run goes ahead.
+!! the wrong sign), a key of a support's motion that its `*_motion` does not use (a
+!! harmonic key or a table with another motion). Each warning names the key, its value and
+!! why; a run goes ahead.
 module ropedyn_scene_warnings
     use, intrinsic :: iso_fortran_env, only: error_unit
     use ropedyn_kinds, only: wp
-    use ropedyn_text, only: text_t, append_text, real_text, significant_text
+    use ropedyn_text, only: text_t, append_text, real_text, significant_text, pair_text
     use ropedyn_rope_section, only: section_t, rope_section, section_set_given
     use ropedyn_scene_types, only: scene_t
     use ropedyn_rope_spec, only: bottom_anchor_given
@@ -86,6 +88,14 @@ contains
                 '(air is 1.225 kg/m^3): water is about 1000 (fresh) or 1025 (sea)')
         if (scene%effects%ground) call ground_start(scene, list)
         if (scene%effects%ground) call ground_anchors(scene, list)
+        associate (s => scene%supports)
+            call idle_motion_keys(scene%path, 'top', s%top_motion, s%top_amplitude, &
+                s%top_frequency, s%top_phase_deg, s%top_angle_amplitude_deg, &
+                s%top_angle_phase_deg, s%top_ramp_time, s%top_table, list)
+            call idle_motion_keys(scene%path, 'bottom', s%bottom_motion, s%bottom_amplitude, &
+                s%bottom_frequency, s%bottom_phase_deg, s%bottom_angle_amplitude_deg, &
+                s%bottom_angle_phase_deg, s%bottom_ramp_time, s%bottom_table, list)
+        end associate
     contains
         function stiffness_text() result(text)
             character(len=:), allocatable :: text
@@ -105,6 +115,51 @@ contains
             end if
         end function damping_text
     end function scene_warnings
+
+    !> The first key of the `end` support's motion that its motion does not use: a harmonic
+    !! key (amplitude, frequency, phase, angle amplitude and phase, ramp) other than 0 without
+    !! `*_motion = 'harmonic'`, a table without `*_motion = 'table'`. Such a key does nothing
+    !! (a sweep may still vary the motion over a base that gives them, so it is no error).
+    subroutine idle_motion_keys(path, end, motion, amplitude, frequency, phase_deg, &
+            angle_amplitude_deg, angle_phase_deg, ramp_time, table, list)
+        character(len=*), intent(in) :: path, end, motion, table
+        real(wp), intent(in) :: amplitude(2), frequency, phase_deg(2), angle_amplitude_deg, &
+            angle_phase_deg, ramp_time
+        type(text_t), allocatable, intent(inout) :: list(:)
+        character(len=:), allocatable :: key, value, used_by
+        key = ''
+        if (trim(motion) /= 'harmonic') then
+            used_by = 'harmonic'
+            if (any(amplitude /= 0.0_wp)) then
+                key = '_amplitude'
+                value = pair_text(amplitude)
+            else if (frequency /= 0.0_wp) then
+                key = '_frequency'
+                value = real_text(frequency)
+            else if (any(phase_deg /= 0.0_wp)) then
+                key = '_phase_deg'
+                value = pair_text(phase_deg)
+            else if (angle_amplitude_deg /= 0.0_wp) then
+                key = '_angle_amplitude_deg'
+                value = real_text(angle_amplitude_deg)
+            else if (angle_phase_deg /= 0.0_wp) then
+                key = '_angle_phase_deg'
+                value = real_text(angle_phase_deg)
+            else if (ramp_time /= 0.0_wp) then
+                key = '_ramp_time'
+                value = real_text(ramp_time)
+            end if
+        end if
+        if (len(key) == 0 .and. trim(motion) /= 'table' .and. len_trim(table) > 0) then
+            used_by = 'table'
+            key = '_table'
+            value = '"'//trim(table)//'"'
+        end if
+        if (len(key) == 0) return
+        call append_text(list, path//': &supports: '//end//key//' = '//value// &
+            ': does nothing: '//end//"_motion = '"//trim(motion)//"' (it is used with "// &
+            end//"_motion = '"//used_by//"')")
+    end subroutine idle_motion_keys
 
     !> The depth of the point p in the scene's ground (m; below 0 on the free side):
     !! -(p - point).normal/|normal|, the normal pointing to the free side; 0 without a normal.

@@ -2,6 +2,7 @@
 file (the table in src/io/ropedyn_scene_keys.f90); the page's generated section must be
 exactly what scripts/keys_reference makes of that listing, so a key added to the table, or
 a default or rule changed, fails here until the page is written again."""
+import pathlib
 import re
 
 import pytest
@@ -61,3 +62,51 @@ def test_a_key_added_to_the_table_changes_the_section(run):
                                           ("", "–"), ("'rfem'", "`'rfem'`")])
 def test_default_cells(default, cell):
     assert keys_reference.code(default) == cell
+
+
+PAPER = pathlib.Path(__file__).resolve().parents[2] / "input" / "paper.nml"
+
+
+def scene_warnings(proc):
+    return [x for x in proc.stderr.splitlines() if x.startswith("ropedyn: warning: ")]
+
+
+@pytest.mark.parametrize("sets,fragment", [
+    (["supports.top_frequency=2"], "&supports: top_frequency = 2.0: does nothing: "
+     "top_motion = 'fixed' (it is used with top_motion = 'harmonic')"),
+    (["supports.top_amplitude=0.1, 0"], "top_amplitude = 0.1, 0.0: does nothing"),
+    (["supports.bottom=pinned", "supports.bottom_angle_phase_deg=30"],
+     "bottom_angle_phase_deg = 30.0: does nothing: bottom_motion = 'fixed'"),
+    (["supports.top_motion=table", "supports.top_table=m.dat", "supports.top_ramp_time=2"],
+     "top_ramp_time = 2.0: does nothing: top_motion = 'table'"),
+    (["supports.top_motion=harmonic", "supports.top_frequency=2", "supports.top_table=m.dat"],
+     "m.dat\": does nothing: top_motion = 'harmonic' (it is used with top_motion = 'table')"),
+])
+def test_a_motion_key_its_motion_does_not_use_is_warned_of(run, tmp_path, sets, fragment):
+    """A key of a support's motion that the end's `*_motion` does not use does nothing:
+    one warning naming the key, its value and the motion; the run goes ahead."""
+    (tmp_path / "m.dat").write_text("0 0 0 0\n1 0 0.01 0\n")
+    args = ["run", PAPER, "--set", "solver.t_end=1e-3", "--set", "output.file=w.h5"]
+    for s in sets:  # the table relative to the scene file's directory: give it in full
+        args += ["--set", s.replace("m.dat", str(tmp_path / "m.dat"))]
+    proc = run(*args)
+    assert proc.returncode == 0, proc.stderr
+    warnings = scene_warnings(proc)
+    assert len(warnings) == 1 and fragment in warnings[0], proc.stderr
+
+
+def test_an_idle_motion_key_in_a_scene_file_names_the_file(run, tmp_path):
+    (tmp_path / "s.nml").write_text("&model elements = 4 /\n&supports top_ramp_time = 2.0 /\n"
+                                    "&solver t_end = 1e-3 /\n")
+    proc = run("run", "s.nml")
+    assert proc.returncode == 0, proc.stderr
+    assert scene_warnings(proc) == ["ropedyn: warning: s.nml: &supports: top_ramp_time = 2.0: "
+                                    "does nothing: top_motion = 'fixed' (it is used with "
+                                    "top_motion = 'harmonic')"], proc.stderr
+
+
+def test_a_harmonic_support_with_its_keys_has_no_warning(run):
+    proc = run("run", PAPER, "--set", "solver.t_end=1e-3", "--set", "output.file=w.h5",
+               "--set", "supports.top_motion=harmonic", "--set", "supports.top_frequency=2",
+               "--set", "supports.top_amplitude=0, 0.01", "--set", "supports.top_ramp_time=0.5")
+    assert proc.returncode == 0 and not scene_warnings(proc), proc.stderr
