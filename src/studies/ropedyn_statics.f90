@@ -173,16 +173,35 @@ module ropedyn_statics
 
 contains
 
-    !> ERR_SOLVER when the spec cannot have an equilibrium: both ends free under gravity.
+    !> ERR_SOLVER when the spec cannot have an equilibrium: both ends free under gravity,
+    !! an end released at t = 0 (with the support motions on) counting as free.
     subroutine check_equilibrium_exists(spec, err)
         type(rope_spec_t), intent(in) :: spec
         type(error_t), allocatable, intent(out) :: err
-        if (trim(spec%supports%top) == 'free' .and. trim(spec%supports%bottom) == 'free' &
-            .and. spec%effects%gravity .and. spec%rope%gravity > 0.0_wp) then
+        character(len=:), allocatable :: top, bottom
+        associate (s => spec%supports)
+            top = end_text('top', s%top, s%top_release_time)
+            bottom = end_text('bottom', s%bottom, s%bottom_release_time)
+        end associate
+        if (len(top) > 0 .and. len(bottom) > 0 .and. spec%effects%gravity .and. &
+            spec%rope%gravity > 0.0_wp) then
             call make_error(err, ERR_SOLVER, spec%path//': statics: no equilibrium: both '// &
-                "supports are free (&supports top = 'free', bottom = 'free') and gravity is "// &
+                'supports are free (&supports '//top//', '//bottom//') and gravity is '// &
                 'on, so the rope falls freely; pin or clamp an end, or switch gravity off')
         end if
+    contains
+        !> "top = 'free'" or "top_release_time = 0.0" for an end free at t = 0, else ''.
+        function end_text(end, kind, release) result(text)
+            character(len=*), intent(in) :: end, kind
+            real(wp), intent(in) :: release
+            character(len=:), allocatable :: text
+            text = ''
+            if (trim(kind) == 'free') then
+                text = end//" = 'free'"
+            else if (release == 0.0_wp .and. spec%effects%support_motion) then
+                text = end//'_release_time = 0.0'
+            end if
+        end function end_text
     end subroutine check_equilibrium_exists
 
     !> The equilibrium of the spec from the starting state y. On a ground much stiffer than

@@ -147,6 +147,21 @@ def test_no_equilibrium(run, tmp_path):
         assert "no equilibrium" in result.stderr and "free" in result.stderr
 
 
+
+@pytest.mark.parametrize("command", ["statics", "modes"])
+def test_an_end_released_at_the_start_is_free(run, tmp_path, command):
+    """A support released at t = 0 holds nothing at the start: with the other end free
+    there is no equilibrium, said at once (not 2000 iterations that fail to converge)."""
+    (tmp_path / "rel.nml").write_text("&model kind = 'rfem', elements = 6 /\n"
+                                      "&supports top_release_time = 0.0 /\n")
+    result = run(command, "rel.nml")
+    assert result.returncode == 3, result.stderr
+    assert ("rel.nml: statics: no equilibrium: both supports are free (&supports "
+            "top_release_time = 0.0, bottom = 'free')") in result.stderr, result.stderr
+    # frozen support motions keep the support: a hanging rope
+    assert run(command, "rel.nml", "--set", "effects.support_motion=.false.",
+               "-o", "frozen.h5").returncode == 0
+
 def test_no_convergence(run, tmp_path):
     (tmp_path / "s.nml").write_text("&model kind = 'rfem', elements = 10 /\n")
     result = run("statics", "s.nml", "--max-iterations", "2")
