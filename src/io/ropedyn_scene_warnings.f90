@@ -4,8 +4,8 @@
 !! (an element's axial damping ratio below 1e-6 or above 1000), air's density for water, a
 !! straight start or a support's anchor inside the ground (x points down: a ground point in
 !! the wrong sign), a key of a support's motion that its `*_motion` does not use (a
-!! harmonic key or a table with another motion). Each warning names the key, its value and
-!! why; a run goes ahead.
+!! harmonic key or a table with another motion), a release or a ramp that the run ends
+!! before. Each warning names the key, its value and why; a run goes ahead.
 module ropedyn_scene_warnings
     use, intrinsic :: iso_fortran_env, only: error_unit
     use ropedyn_kinds, only: wp
@@ -95,6 +95,10 @@ contains
             call idle_motion_keys(scene%path, 'bottom', s%bottom_motion, s%bottom_amplitude, &
                 s%bottom_frequency, s%bottom_phase_deg, s%bottom_angle_amplitude_deg, &
                 s%bottom_angle_phase_deg, s%bottom_ramp_time, s%bottom_table, list)
+            call late_motion(scene%path, 'top', s%top_motion, s%top_ramp_time, &
+                s%top_release_time, scene%solver%t_end, list)
+            call late_motion(scene%path, 'bottom', s%bottom_motion, s%bottom_ramp_time, &
+                s%bottom_release_time, scene%solver%t_end, list)
         end associate
     contains
         function stiffness_text() result(text)
@@ -160,6 +164,27 @@ contains
             ': does nothing: '//end//"_motion = '"//trim(motion)//"' (it is used with "// &
             end//"_motion = '"//used_by//"')")
     end subroutine idle_motion_keys
+
+    !> A release of the `end` support at or after t_end (it never happens in the run), and a
+    !! harmonic ramp longer than the run (the amplitudes never reach their full size).
+    subroutine late_motion(path, end, motion, ramp_time, release_time, t_end, list)
+        character(len=*), intent(in) :: path, end, motion
+        real(wp), intent(in) :: ramp_time, release_time, t_end
+        type(text_t), allocatable, intent(inout) :: list(:)
+        real(wp) :: u
+        if (release_time > 0.0_wp .and. release_time >= t_end) call append_text(list, &
+            path//': &supports: '//end//'_release_time = '//real_text(release_time)// &
+            ': at or after t_end = '//real_text(t_end)//' s: the support is not released '// &
+            'in the run (< 0: never)')
+        if (trim(motion) == 'harmonic' .and. ramp_time > t_end) then
+            u = t_end/ramp_time
+            call append_text(list, path//': &supports: '//end//'_ramp_time = '// &
+                real_text(ramp_time)//': longer than the run (t_end = '//real_text(t_end)// &
+                ' s): the amplitudes reach only '// &
+                significant_text(100.0_wp*u**3*(10.0_wp - 15.0_wp*u + 6.0_wp*u**2), 3)// &
+                ' % of their size by t_end')
+        end if
+    end subroutine late_motion
 
     !> The depth of the point p in the scene's ground (m; below 0 on the free side):
     !! -(p - point).normal/|normal|, the normal pointing to the free side; 0 without a normal.

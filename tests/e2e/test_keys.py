@@ -68,7 +68,9 @@ PAPER = pathlib.Path(__file__).resolve().parents[2] / "input" / "paper.nml"
 
 
 def scene_warnings(proc):
-    return [x for x in proc.stderr.splitlines() if x.startswith("ropedyn: warning: ")]
+    """The scene's warnings (each names its group; the run's own, of the summary, do not)."""
+    return [x for x in proc.stderr.splitlines() if x.startswith("ropedyn: warning: ")
+            and ": &" in x]
 
 
 @pytest.mark.parametrize("sets,fragment", [
@@ -106,7 +108,31 @@ def test_an_idle_motion_key_in_a_scene_file_names_the_file(run, tmp_path):
 
 
 def test_a_harmonic_support_with_its_keys_has_no_warning(run):
+    """Its keys used, the ramp and the release within the run: no warning."""
     proc = run("run", PAPER, "--set", "solver.t_end=1e-3", "--set", "output.file=w.h5",
                "--set", "supports.top_motion=harmonic", "--set", "supports.top_frequency=2",
-               "--set", "supports.top_amplitude=0, 0.01", "--set", "supports.top_ramp_time=0.5")
+               "--set", "supports.top_amplitude=0, 0.01", "--set", "supports.top_ramp_time=1e-3",
+               "--set", "supports.top_release_time=5e-4")
     assert proc.returncode == 0 and not scene_warnings(proc), proc.stderr
+
+
+HARMONIC = ["supports.top_motion=harmonic", "supports.top_frequency=2",
+            "supports.top_amplitude=0, 0.01"]
+
+
+@pytest.mark.parametrize("sets,fragment", [
+    (["supports.top_release_time=5"], "&supports: top_release_time = 5.0: at or after "
+     "t_end = 0.001 s: the support is not released in the run"),
+    (["supports.bottom=pinned", "supports.bottom_release_time=1e-3"],
+     "bottom_release_time = 0.001: at or after t_end = 0.001 s"),
+    (HARMONIC + ["supports.top_ramp_time=2e-3"], "&supports: top_ramp_time = 0.002: longer "
+     "than the run (t_end = 0.001 s): the amplitudes reach only 50.0 % of their size"),
+])
+def test_a_release_or_ramp_the_run_ends_before_is_warned_of(run, sets, fragment):
+    args = ["run", PAPER, "--set", "solver.t_end=1e-3", "--set", "output.file=w.h5"]
+    for s in sets:
+        args += ["--set", s]
+    proc = run(*args)
+    assert proc.returncode == 0, proc.stderr
+    warnings = scene_warnings(proc)
+    assert len(warnings) == 1 and fragment in warnings[0], proc.stderr
