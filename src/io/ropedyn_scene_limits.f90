@@ -45,9 +45,11 @@ module ropedyn_scene_limits
         'rope.normal_damping', 'rope.tangential_damping', 'rope.shape_factor', &
         'rope.diameter', 'rope.length', 'supports.support_stiffness_factor', &
         'rope.axial_damping', 'rope.shear_damping', 'rope.bending_damping']
-    character(len=KL), parameter :: REACH_KEYS(7) = [character(len=KL) :: &
+    character(len=KL), parameter :: REACH_KEYS(11) = [character(len=KL) :: &
         'supports.top_anchor', 'rope.length', 'supports.bottom_anchor', 'ground.point', &
-        'initial.mode_amplitude', 'supports.top_amplitude', 'supports.bottom_amplitude']
+        'initial.mode_amplitude', 'supports.top_amplitude', 'supports.bottom_amplitude', &
+        'supports.top_angle_deg', 'supports.bottom_angle_deg', &
+        'supports.top_angle_amplitude_deg', 'supports.bottom_angle_amplitude_deg']
     character(len=KL), parameter :: SPEED_KEYS(6) = [character(len=KL) :: 'initial.velocity', &
         'fluid.current', 'supports.top_frequency', 'supports.top_amplitude', &
         'supports.bottom_frequency', 'supports.bottom_amplitude']
@@ -164,7 +166,9 @@ contains
                               mass, c, table_reach, table_speed, table_accel, err)
             if (allocated(err)) return
             reach = norm2(s%top_anchor) + r%length + abs(scene%initial%mode_amplitude) &
-                + norm2(s%top_amplitude) + norm2(s%bottom_amplitude) + table_reach
+                + norm2(s%top_amplitude) + norm2(s%bottom_amplitude) + table_reach &
+                + r%length*pi/180.0_wp*(abs(s%top_angle_deg) + abs(s%bottom_angle_deg) + &
+                abs(s%top_angle_amplitude_deg) + abs(s%bottom_angle_amplitude_deg))
             if (s%bottom_anchor_set) reach = reach + norm2(s%bottom_anchor)
             if (scene%effects%ground) reach = reach + norm2(g%point)
             speed = norm2(scene%initial%velocity) + 2.0_wp*pi*(s%top_frequency* &
