@@ -179,8 +179,9 @@ contains
             call bound(mass*speed**2, 'the kinetic energy', 'J', KINETIC_KEYS, .false.)
             call bound(c*reach**2, 'the energy of a spring', 'J', [SPRING_KEYS, REACH_KEYS], &
                 .false.)
-            motion = mass*((2.0_wp*pi)**2*(s%top_frequency**2*norm2(s%top_amplitude) + &
-                s%bottom_frequency**2*norm2(s%bottom_amplitude)) + table_accel)*reach
+            ! (f sqrt(a))^2, not f^2 a: a huge frequency without an amplitude is no NaN
+            motion = mass*((2.0_wp*pi)**2*((s%top_frequency*sqrt(norm2(s%top_amplitude)))**2 &
+                + (s%bottom_frequency*sqrt(norm2(s%bottom_amplitude)))**2) + table_accel)*reach
             call bound(motion, 'the work of a moving support', 'J', MOTION_KEYS, .false.)
             if (scene%effects%ground) call bound((g%stiffness*reach + g%damping*speed)* &
                 r%length*reach, 'the ground contact energy', 'J', GROUND_KEYS, .false.)

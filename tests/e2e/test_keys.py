@@ -77,6 +77,8 @@ def scene_warnings(proc):
     (["supports.top_frequency=2"], "&supports: top_frequency = 2.0: does nothing: "
      "top_motion = 'fixed' (it is used with top_motion = 'harmonic')"),
     (["supports.top_amplitude=0.1, 0"], "top_amplitude = 0.1, 0.0: does nothing"),
+    # without an amplitude a huge frequency moves nothing: no "work ... NaN J" refusal
+    (["supports.top_frequency=1e300"], "top_frequency = 1.0e300: does nothing"),
     (["supports.bottom=pinned", "supports.bottom_angle_phase_deg=30"],
      "bottom_angle_phase_deg = 30.0: does nothing: bottom_motion = 'fixed'"),
     (["supports.top_motion=table", "supports.top_table=m.dat", "supports.top_ramp_time=2"],
