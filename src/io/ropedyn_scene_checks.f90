@@ -354,7 +354,7 @@ contains
                 call fail(keys, G_SOLVER, 'max_order', int_text(v%max_order), &
                     'out of range for method '//trim(v%method)//' (allowed: '// &
                     int_text(m%lowest_order)//' .. '//int_text(m%highest_order)// &
-                    ', or 0 for the default '//int_text(m%default_order)//')', err)
+                    ', or 0 for '//default_order_text(m%default_order)//')', err)
             else if (v%stability_limit_detection .and. v%method /= 'cvode') then
                 call fail(keys, G_SOLVER, 'stability_limit_detection', '.true.', &
                     'only for method cvode (method '//trim(v%method)//' has no such option; '// &
@@ -362,6 +362,17 @@ contains
             end if
         end associate
     end subroutine check_solver
+
+    !> What max_order = 0 means for a method whose default order is `order` (0: it chooses).
+    pure function default_order_text(order) result(text)
+        integer, intent(in) :: order
+        character(len=:), allocatable :: text
+        if (order == 0) then
+            text = 'the method''s own choice'
+        else
+            text = 'the default '//int_text(order)
+        end if
+    end function default_order_text
 
     !> The derived defaults: those of the rope's set (resolved_rope: tangential damping, eq.
     !! 13 of the paper; the section set's EI, joint shear stiffness and dampings), and the

@@ -452,6 +452,11 @@ contains
             '&solver method = ''mebdf'', max_order = 1 /'], NO_SET, [character(len=L) :: &
             P//'max_order_mebdf.nml: &solver: max_order = 1: ', &
             'out of range for method mebdf (allowed: 2 .. 7, or 0 for the default 4)'])
+        ! auto has no default order: 0 lets it choose (it said "the default 0")
+        call expect_error('max_order_auto', [character(len=L) :: MODEL, &
+            '&solver method = ''auto'', max_order = 9 /'], NO_SET, [character(len=L) :: &
+            P//'max_order_auto.nml: &solver: max_order = 9: ', &
+            'out of range for method auto (allowed: 2 .. 7, or 0 for the method''s own choice)'])
         call expect_error('stab_lim_det_mebdf', [character(len=L) :: MODEL, &
             '&solver method = ''mebdf'', stability_limit_detection = .true. /'], NO_SET, &
             [character(len=L) :: P//'stab_lim_det_mebdf.nml: &solver: ', &
