@@ -14,11 +14,11 @@ module ropedyn_testset_driver
     use ropedyn_error, only: error_t, make_error, ERR_INPUT, ERR_SOLVER
     use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t
     use ropedyn_solvers, only: new_integrator, method_order_range
-    use ropedyn_methods, only: resolved_max_order
+    use ropedyn_methods, only: resolved_max_order, METHODS
     use ropedyn_testset_problem, only: testset_problem_t
     implicit none
     private
-    public :: testset_run_t, run_testset, scd_of, mescd_of, median_of
+    public :: testset_run_t, run_testset, scd_of, mescd_of, median_of, methods_for
     public :: DEFAULT_REPEAT_TIME, MAX_REPEATS, SCD_MIN_REFERENCE
 
     real(wp), parameter :: DEFAULT_REPEAT_TIME = 0.5_wp  !< s of CPU time to accumulate
@@ -301,4 +301,22 @@ contains
             parent = child
         end do
     end subroutine sift_down
+
+    !> 'cvode, mebdf, ...': the methods of the method table that integrate `problem` (whose
+    !! integrator does not refuse it; the symplectic method needs a rope's force split).
+    function methods_for(problem) result(list)
+        class(testset_problem_t), intent(in) :: problem
+        character(len=:), allocatable :: list
+        class(integrator_t), allocatable :: integrator
+        type(error_t), allocatable :: err
+        integer :: k
+        list = ''
+        do k = 1, size(METHODS)
+            call new_integrator(trim(METHODS(k)%name), integrator, err)
+            if (allocated(err)) cycle
+            if (len(integrator%refusal(problem)) > 0) cycle
+            if (len(list) > 0) list = list//', '
+            list = list//trim(METHODS(k)%name)
+        end do
+    end function methods_for
 end module ropedyn_testset_driver

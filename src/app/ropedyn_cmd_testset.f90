@@ -5,12 +5,13 @@ module ropedyn_cmd_testset
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_text, only: int_text, real_text, fixed_text
-    use ropedyn_methods, only: method_index, method_list
+    use ropedyn_methods, only: method_index
     use ropedyn_cli, only: cli_t
     use ropedyn_help, only: print_help
     use ropedyn_testset, only: testset_problem_t, new_testset_problem, testset_names, &
                                testset_name_list
-    use ropedyn_testset_driver, only: testset_run_t, run_testset, DEFAULT_REPEAT_TIME
+    use ropedyn_testset_driver, only: testset_run_t, run_testset, DEFAULT_REPEAT_TIME, &
+                                      methods_for
     implicit none
     private
     public :: testset_command
@@ -89,7 +90,7 @@ contains
                 if (.not. allocated(err)) then
                     opts%method = value
                     if (method_index(value) == 0) call cli%usage_error('--method "'//value// &
-                        '": unknown method (available: '//method_list()//')', err)
+                        '": unknown method (available: '//offered_methods()//')', err)
                 end if
             case ('--rtol')
                 call cli%real_value(opts%rtol, err)
@@ -283,4 +284,15 @@ contains
             if (text(j:j) /= ' ') out = out//text(j:j)
         end do
     end function remove_blanks
+
+    !> The methods that integrate the test problems, for messages (those of the first
+    !! problem: every problem is a plain ODE, refused or taken alike).
+    function offered_methods() result(list)
+        character(len=:), allocatable :: list
+        class(testset_problem_t), allocatable :: problem
+        type(error_t), allocatable :: err
+        call new_testset_problem(testset_names(1), problem, err)
+        list = ''
+        if (.not. allocated(err)) list = methods_for(problem)
+    end function offered_methods
 end module ropedyn_cmd_testset

@@ -94,7 +94,9 @@ def test_list(run):
     (["HIRES", "--rtol=-1e-6"], ["--rtol", "-1e-6"]),
     (["HIRES", "--atol", "-3"], ["--atol", "-3"]),
     (["HIRES", "--max-order", "9"], ["max order 9", "cvode"]),
-    (["HIRES", "--method", "rk4"], ["--method", "rk4"]),
+    # the methods named are those that fit the test set: not the symplectic method
+    (["HIRES", "--method", "rk4"], ["--method", "rk4", "(available: cvode, mebdf, erk, adams, "
+                                                       "auto)"]),
     # a method of the method table that fits no test problem: refused before any run
     (["HIRES", "--method", "symplectic"], ["symplectic", "HIRES", "cannot integrate"]),
     (["all", "--method=symplectic"], ["symplectic", "cannot integrate"]),
