@@ -22,7 +22,7 @@ module ropedyn_sweep_runner
         SIGKILL
     use ropedyn_process, only: spawn, reap, signal_group, watch_children, unwatch_children, &
         wait_children
-    use ropedyn_error, only: error_t, make_error, ERR_SOLVER, ERR_INTERRUPTED
+    use ropedyn_error, only: error_t, make_error, ERR_SOLVER, ERR_INTERRUPTED, exit_code_of
     use ropedyn_sweep, only: sweep_t, sweep_case_t, text_t
     use ropedyn_text, only: int_text
     use ropedyn_sweep_status, only: case_state_t, case_state, STATUS_NAMES
@@ -63,7 +63,7 @@ module ropedyn_sweep_runner
         integer, allocatable :: slot(:)      !< the case of each worker slot (0: free)
         integer, allocatable :: pid(:)       !< the process of each busy slot
         integer :: next = 1                  !< the next case of todo to start
-        integer :: finished = 0, failed = 0  !< workers ended, of them failed
+        integer :: finished = 0, failed = 0  !< workers ended, of them failed (not interrupted)
         real(wp) :: start = 0.0_wp           !< monotonic clock at the first start, s
         real(wp) :: last_draw = 0.0_wp       !< ... at the last progress line, s
     contains
@@ -342,7 +342,8 @@ contains
             ! a worker that found the case being written by another runner did not fail
             other = ''
             if (rc /= 0) other = written_elsewhere(sweep%cases(c))
-            if (rc /= 0 .and. len(other) == 0) self%failed = self%failed + 1
+            if (rc /= 0 .and. rc /= exit_code_of(ERR_INTERRUPTED) .and. len(other) == 0) &
+                self%failed = self%failed + 1
             call remove_if_empty(self%log_path(c))
             if (.not. self%quiet) call self%report_case(c, rc, other)
             redraw = .true.
@@ -436,6 +437,11 @@ contains
         character(len=:), allocatable :: text
         if (code == 0) then
             text = 'complete'
+        else if (code == exit_code_of(ERR_INTERRUPTED)) then
+            ! ropedyn's own end after SIGINT or SIGTERM (its case written interrupted), not
+            ! necessarily 128 + SIGINT: the log names the signal
+            text = 'interrupted (exit '//int_text(code)//': stopped by a signal; see '// &
+                self%log_path(id)//')'
         else if (code > 128) then
             text = 'ended by '//signal_name(code - 128)//' (see '//self%log_path(id)//')'
         else

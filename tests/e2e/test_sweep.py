@@ -390,6 +390,34 @@ def test_sigterm_to_runner_stops_its_workers(run, ropedyn_exe, sweep_dir):
         assert f.attrs["status"] == b"complete" and f["solver/restarts/time"].shape == (1,)
 
 
+def test_sigterm_to_a_worker_reports_its_case_interrupted(run, ropedyn_exe, sweep_dir):
+    """A worker stopped by SIGTERM ends with ropedyn's exit code 130 and writes its case
+    interrupted: the runner says so (not "ended by SIGINT", which 128 + 2 would read as),
+    counts it apart from the failed cases, and the other case still runs."""
+    (sweep_dir / "long.nml").write_text(LONG.format(rtols="1e-7, 1e-4"))
+    out = sweep_dir / "out" / "long"
+    runner = subprocess.Popen([str(ropedyn_exe), "sweep", "long.nml", "--jobs", "1"],
+                              cwd=sweep_dir, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True)
+    try:
+        wait_for(lambda: (out / ".case_0001.h5.part").exists(), what="the first worker")
+        workers = processes_mentioning("long.nml --quiet")
+        assert len(workers) == 1
+        os.kill(workers[0], signal.SIGTERM)
+        _, stderr = runner.communicate(timeout=120)
+    finally:
+        if runner.poll() is None:
+            runner.kill()
+    assert runner.returncode == 3, stderr
+    line = next(l for l in stderr.splitlines() if l.startswith("sweep: case 0001 "))
+    assert line.startswith("sweep: case 0001 interrupted (exit 130"), line
+    assert "SIGINT" not in stderr and "0 failed" in line, stderr
+    assert "sweep: case 0002 complete" in stderr
+    result, counts = status_lines(run, "long.nml")
+    assert counts["interrupted"] == 1 and counts["complete"] == 1, result.stdout
+    assert "interrupted by SIGTERM at t = " in (out / "case_0001.log").read_text()
+
+
 def test_lock_rules(run, sweep_dir):
     """A lock of another host is live while its heartbeat is fresh; one of this host while
     its process lives; one that recorded a signal is abandoned; an abandoned lock is taken
