@@ -132,12 +132,14 @@ contains
 
     !> Finish a case file written under a temporary name: write (or overwrite) the scalar
     !! `/solver/wall_time` (s) and set the root attribute `scene` to `scene_text`, the
-    !! case's scene (the run saw the temporary file name as its output file).
-    subroutine finish_case_file(path, seconds, scene_text, err)
+    !! case's scene (the run saw the temporary file name as its output file), and, when
+    !! `reason` is not empty, the root attribute `reason` (the run's, naming the case file).
+    subroutine finish_case_file(path, seconds, scene_text, err, reason)
         character(len=*), intent(in) :: path
         real(wp), intent(in) :: seconds
         character(len=*), intent(in) :: scene_text
         type(error_t), allocatable, intent(out) :: err
+        character(len=*), intent(in), optional :: reason
         type(h5_file_t) :: h5
         type(error_t), allocatable :: close_err
 
@@ -149,6 +151,9 @@ contains
             call h5%write('/solver/wall_time', seconds, 's', err)
         end if
         if (.not. allocated(err)) call h5%attribute('/', 'scene', scene_text, err)
+        if (present(reason) .and. .not. allocated(err)) then
+            if (len(reason) > 0) call h5%attribute('/', 'reason', reason, err)
+        end if
         call h5%close(close_err)
         if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
     end subroutine finish_case_file

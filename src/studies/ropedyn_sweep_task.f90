@@ -212,7 +212,7 @@ contains
         if (allocated(err)) then
             if (err%code /= ERR_INTERRUPTED .and. len(file_status(c%file)) == 0) &
                 call write_failure_note(c%file, err%message)
-            err%message = label//' ('//c%file//'): '//err%message
+            err%message = label//' ('//c%file//'): '//renamed(err%message, part, c%file)
             if (err%code == ERR_INTERRUPTED) err%message = err%message// &
                 '; running the sweep again continues it'
             return
@@ -245,6 +245,7 @@ contains
         real(wp), intent(in) :: wall
         type(error_t), allocatable, intent(out) :: err
         type(case_data_t) :: data
+        character(len=:), allocatable :: reason
         logical :: removed
         call read_case_file(part, data, err)
         if (.not. data%exists) return
@@ -253,10 +254,27 @@ contains
             removed = delete_file(part)
             return
         end if
-        call finish_case_file(part, wall, scene_namelist_text(c%scene), err)
+        ! the run named its file by the .part name in its reason: name the case file
+        reason = ''
+        if (allocated(data%reason)) reason = renamed(data%reason, part, c%file)
+        call finish_case_file(part, wall, scene_namelist_text(c%scene), err, reason)
         if (.not. allocated(err)) call rename_file(part, c%file, err)
         if (allocated(err)) removed = delete_file(part)
     end subroutine put_in_place
+
+    !> `text` with every `part` (the name a case's run wrote its file under) replaced by
+    !! `file` (the case file it was renamed to).
+    pure recursive function renamed(text, part, file) result(s)
+        character(len=*), intent(in) :: text, part, file
+        character(len=:), allocatable :: s
+        integer :: at
+        at = index(text, part)
+        if (at == 0) then
+            s = text
+        else
+            s = text(:at - 1)//file//renamed(text(at + len(part):), part, file)
+        end if
+    end function renamed
 
     !> The status attribute of the run file `path` ('' when it cannot be read).
     function file_status(path) result(status)

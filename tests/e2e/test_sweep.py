@@ -393,7 +393,8 @@ def test_sigterm_to_runner_stops_its_workers(run, ropedyn_exe, sweep_dir):
 def test_sigterm_to_a_worker_reports_its_case_interrupted(run, ropedyn_exe, sweep_dir):
     """A worker stopped by SIGTERM ends with ropedyn's exit code 130 and writes its case
     interrupted: the runner says so (not "ended by SIGINT", which 128 + 2 would read as),
-    counts it apart from the failed cases, and the other case still runs."""
+    counts it apart from the failed cases, and the other case still runs; the reason
+    names the case file."""
     (sweep_dir / "long.nml").write_text(LONG.format(rtols="1e-7, 1e-4"))
     out = sweep_dir / "out" / "long"
     runner = subprocess.Popen([str(ropedyn_exe), "sweep", "long.nml", "--jobs", "1"],
@@ -415,7 +416,12 @@ def test_sigterm_to_a_worker_reports_its_case_interrupted(run, ropedyn_exe, swee
     assert "sweep: case 0002 complete" in stderr
     result, counts = status_lines(run, "long.nml")
     assert counts["interrupted"] == 1 and counts["complete"] == 1, result.stdout
-    assert "interrupted by SIGTERM at t = " in (out / "case_0001.log").read_text()
+    log = (out / "case_0001.log").read_text()
+    assert "interrupted by SIGTERM at t = " in log
+    # the reason names the case file, not the .part it was written as (renamed since)
+    reason = next(r["reason"] for r in read_csv(out / "summary.csv") if r["case"] == "1")
+    for text in (reason, result.stdout, log):
+        assert ".part" not in text and "out/long/case_0001.h5: interrupted by" in text, text
 
 
 def test_lock_rules(run, sweep_dir):
