@@ -27,7 +27,6 @@ its last character, as it is written in the list.
 """
 import argparse
 import dataclasses
-import datetime
 import filecmp
 import os
 import pathlib
@@ -38,7 +37,7 @@ import sys
 import time
 
 from ropedyn_tools.repo import ROOT
-from ropedyn_tools.studies.common import run_commit
+from ropedyn_tools.studies.common import run_commit, utc_stamp
 
 DOC = ROOT / "docs" / "development" / "testing.md"
 BEGIN, END = "<!-- mutation-results:begin -->", "<!-- mutation-results:end -->"
@@ -560,7 +559,7 @@ def results_table(results, commit, minutes):
     text (', commit `abc1234`')."""
     caught = sum(r["status"] == "caught" for r in results)
     lines = [BEGIN, "",
-             f"Last run: {datetime.date.today().isoformat()}{commit}, "
+             f"Last run: {utc_stamp()}{commit}, "
              f"{len(results)} mutations, **{caught} caught**, "
              f"{len(results) - caught} not caught; {minutes:.0f} min on two cores "
              "(`scripts/mutation_check`).", "",
