@@ -198,7 +198,8 @@ void ropedyn_stop_heartbeat(void *handle)
 
 /* Start `nargs` NUL-separated arguments (the first is the program, looked up in PATH
  * when it holds no '/') in a new process group, stdin from /dev/null, stdout and stderr
- * to `log` (truncated), SIGINT and SIGTERM at their default action. Returns 0 and the
+ * to `log` (appended to: a log is never cut, neither the one of an earlier run of the case nor
+ * the one another runner's worker is writing), SIGINT and SIGTERM at their default action. Returns 0 and the
  * child's pid, or errno. */
 int ropedyn_spawn(const char *args, int nargs, const char *log, int *pid)
 {
@@ -218,7 +219,7 @@ int ropedyn_spawn(const char *args, int nargs, const char *log, int *pid)
     }
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 1, log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 1, log, O_WRONLY | O_CREAT | O_APPEND, 0644);
     posix_spawn_file_actions_adddup2(&actions, 1, 2);
     posix_spawnattr_init(&attr);
     sigemptyset(&defaults);

@@ -101,7 +101,8 @@ contains
     end subroutine stop_heartbeat
 
     !> Start `args(1)` (looked up in PATH when it has no '/') with the other arguments in a
-    !! process group of its own, stdin from /dev/null, stdout and stderr to the file `log`.
+    !! process group of its own, stdin from /dev/null, stdout and stderr appended to the file
+    !! `log`.
     subroutine spawn(args, log, pid, err)
         character(len=*), intent(in) :: args(:)
         character(len=*), intent(in) :: log

@@ -422,6 +422,12 @@ def test_sigterm_to_a_worker_reports_its_case_interrupted(run, ropedyn_exe, swee
     reason = next(r["reason"] for r in read_csv(out / "summary.csv") if r["case"] == "1")
     for text in (reason, result.stdout, log):
         assert ".part" not in text and "out/long/case_0001.h5: interrupted by" in text, text
+    # run again, the case continues from its last record; its log keeps the message of the
+    # interrupted run (a worker appends to its case's log: it was cut before, and a second
+    # runner's worker finding the case taken cut the log of the one writing it)
+    again = run("sweep", "long.nml", "--jobs", "1")
+    assert again.returncode == 0, again.stderr
+    assert "interrupted by SIGTERM at t = " in (out / "case_0001.log").read_text()
 
 
 def test_lock_rules(run, sweep_dir):
