@@ -26,7 +26,8 @@
 !!              the rope; /supports/{top, bottom}/position (times, 2) m: its anchor (only
 !!              for a support with one: not for a free end)
 !!     /solver/restarts/{time, record, steps, cpu_time, wall_clock, previous_status,
-!!              previous_reason} (restarts,)   one entry per resume (add_restart)
+!!              previous_reason, version, overrides} (restarts,)   one entry per resume
+!!              (add_restart)
 !!     /solver/order_lowered_at () s, /solver/order_lowered_from, _to () int64 1,
 !!     /solver/energy_gain () J: only when the order safety lowered the order (the time
 !!              from which the run went on at the lower order, and the gain that caused it)
@@ -135,12 +136,16 @@ module ropedyn_output
         'motion (x, y)']
 
     !> The entries of /solver/restarts (one per resume): name, units, width of a string
-    !! (0: a number; integer for record and steps).
-    character(len=*), parameter :: RESTART_NAME(7) = [character(len=15) :: 'time', 'record', &
-        'steps', 'cpu_time', 'wall_clock', 'previous_status', 'previous_reason']
-    character(len=*), parameter :: RESTART_UNITS(7) = [character(len=1) :: 's', '1', '1', &
-        's', '', '', '']
-    integer, parameter :: RESTART_WIDTH(7) = [0, 0, 0, 0, 20, 16, 512]
+    !! (0: a number; integer for record and steps). The first RESTART_REQUIRED are in every
+    !! file with restarts; version and overrides (the code that continued the run and the
+    !! --set overrides it was given) are absent in files written before they were recorded.
+    character(len=*), parameter :: RESTART_NAME(9) = [character(len=15) :: 'time', 'record', &
+        'steps', 'cpu_time', 'wall_clock', 'previous_status', 'previous_reason', 'version', &
+        'overrides']
+    character(len=*), parameter :: RESTART_UNITS(9) = [character(len=1) :: 's', '1', '1', &
+        's', '', '', '', '', '']
+    integer, parameter :: RESTART_WIDTH(9) = [0, 0, 0, 0, 20, 16, 512, 64, 1024]
+    integer, parameter :: RESTART_REQUIRED = 7
     !> /solver/warnings: the width of one line, characters (a longer line is cut there)
     integer, parameter :: WARNING_WIDTH = 1024
 
@@ -241,15 +246,19 @@ module ropedyn_output
 
         !> Add an entry to /solver/restarts: the run continues from record `record` (0-based, as
         !! h5py counts) at time `t`; the file's status and reason before, and the solver steps
-        !! and CPU time of the run so far.
+        !! and CPU time of the run so far; the code version and the --set overrides of the
+        !! run that continues it.
         module subroutine output_add_restart(self, record, t, previous_status, &
-                                             previous_reason, steps, cpu_time, err)
+                                             previous_reason, steps, cpu_time, version, &
+                                             overrides, err)
             class(output_file_t), intent(inout) :: self
             integer, intent(in) :: record
             real(wp), intent(in) :: t                         !< s
             character(len=*), intent(in) :: previous_status, previous_reason
             integer(i8), intent(in) :: steps
             real(wp), intent(in) :: cpu_time                  !< s
+            !> code version; ' --set group.key=value' for each override ('' for none)
+            character(len=*), intent(in) :: version, overrides
             type(error_t), allocatable, intent(out) :: err
         end subroutine output_add_restart
 

@@ -117,6 +117,8 @@ contains
             if (k == 2 .or. k == 3) kind = SERIES_INTEGER
             if (RESTART_WIDTH(k) > 0) kind = SERIES_TEXT
             expected = 1
+            ! entries added later are absent in older files: created at the next restart
+            if (k > RESTART_REQUIRED .and. .not. self%file%exists(name)) cycle
             call open_one(entry)
             if (.not. allocated(err) .and. k == 1) n = entry%length()
             if (.not. allocated(err) .and. entry%length() /= n) call make_error(err, &
@@ -265,6 +267,8 @@ contains
             if (.not. allocated(err)) call entry(5)%append_text(n, utc_timestamp(), err)
             if (.not. allocated(err)) call entry(6)%append_text(n, previous_status, err)
             if (.not. allocated(err)) call entry(7)%append_text(n, previous_reason, err)
+            if (.not. allocated(err)) call entry(8)%append_text(n, version, err)
+            if (.not. allocated(err)) call entry(9)%append_text(n, overrides, err)
         end block steps_
         do k = 1, size(entry)
             call entry(k)%close(close_err)

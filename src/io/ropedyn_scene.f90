@@ -86,6 +86,11 @@ contains
         scene%path = origin
         call load_scene(overrides, scene, err, text)
         if (allocated(err)) return
+        scene%overrides = ''
+        do k = 1, size(overrides)
+            scene%overrides = trim(adjustl(scene%overrides//' --set '// &
+                                           trim(adjustl(overrides(k)))))
+        end do
         do k = 1, size(overrides)
             select case (override_target(overrides(k)))
             case ('output.file')

@@ -65,5 +65,8 @@ module ropedyn_scene_types
         !! run replaces only a file of its own source (the output guide, "Write, lock and
         !! resume rules")
         character(len=:), allocatable :: source
+        !> a resumed run's --set overrides in their order, ' --set group.key=value' each
+        !! ('' for none; set by read_scene_text): /solver/restarts/overrides records them
+        character(len=:), allocatable :: overrides
     end type scene_t
 end module ropedyn_scene_types

@@ -4,6 +4,7 @@
 submodule (ropedyn_run) ropedyn_run_resume
     use, intrinsic :: iso_fortran_env, only: error_unit
     use ropedyn_text, only: int_text
+    use ropedyn_version, only: version_string
     use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_run_record, only: run_record_t, read_run_record, check_record_fits, LAST_RECORD, &
                                   read_peak_tension
@@ -21,6 +22,7 @@ contains
         type(case_data_t) :: before
         real(wp) :: tol, peak, t_peak
         integer :: keep, j, joint
+        character(len=:), allocatable :: overrides
         associate (file => self%summary%file)
             call read_run_record(file, LAST_RECORD, rec, err)
             if (allocated(err)) return
@@ -79,8 +81,11 @@ contains
                                  err, keep=keep, internal_forces=.true., &
                                  anchored=ieee_is_finite(self%anchors(1, :)))
             if (allocated(err)) return
+            overrides = ''
+            if (allocated(self%scene%overrides)) overrides = self%scene%overrides
             call self%out%add_restart(rec%record, self%t, before%status, before%reason, &
-                                      self%counters_before(1), self%cpu_before, err)
+                                      self%counters_before(1), self%cpu_before, &
+                                      version_string, overrides, err)
             if (allocated(err)) return
             self%summary%records = keep
             self%summary%t_reached = self%t

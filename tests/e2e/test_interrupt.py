@@ -230,6 +230,33 @@ def test_resume_refusals(run, tmp_path, scene):
     assert running.returncode == 2 and "status running" in running.stderr
 
 
+def test_resume_records_its_version_and_overrides(run, tmp_path, scene):
+    """The file says what made each part: a resume with --set (a longer t_end, another
+    rtol) leaves the root `scene` the first part's and logs the resuming code's version
+    and its overrides in /solver/restarts; a file whose restarts predate these entries is
+    continued, its earlier entries empty."""
+    first = run("run", scene, "--set", "solver.t_end=0.1", "--set", "output.file='r.h5'")
+    assert first.returncode == 0, first.stderr
+    resumed = run("run", "--resume", "r.h5", "--set", "solver.t_end=0.2",
+                  "--set", " solver.RTOL = 1e-7")
+    assert resumed.returncode == 0, resumed.stderr
+    with h5py.File(tmp_path / "r.h5", "r+") as f:
+        restarts = f["solver/restarts"]
+        assert restarts["version"][:].tolist() == [f.attrs["version"]]
+        assert restarts["overrides"][:].tolist() == \
+            [b"--set solver.t_end=0.2 --set solver.rtol=1e-7"]
+        assert restarts["version"].attrs["units"] == b""
+        assert "t_end = 0.1" in attr(f, "scene") and "rtol = 1.0e-6" in attr(f, "scene")
+        del restarts["version"], restarts["overrides"]          # as an older file
+    again = run("run", "--resume", "r.h5", "--set", "solver.t_end=0.3")
+    assert again.returncode == 0, again.stderr
+    with h5py.File(tmp_path / "r.h5") as f:
+        restarts = f["solver/restarts"]
+        assert restarts["time"].shape == (2,)
+        assert restarts["overrides"][:].tolist() == [b"", b"--set solver.t_end=0.3"]
+        assert restarts["version"][0] == b"" and restarts["version"][1] == f.attrs["version"]
+
+
 SWEEP = """&sweep
     base = 's.nml'
     output_dir = 'out/sw'
