@@ -1,8 +1,8 @@
 """Write an XDMF sidecar for a ropedyn run so that ParaView opens it as a time series of
 polylines (one line cell per element) with per-element and per-point fields.
 
-usage: scripts/xdmf RUN.h5 [--every K]     writes RUN.xmf and RUN_fields.h5 next to RUN.h5
-       (python -m ropedyn.xdmf)
+usage: scripts/xdmf RUN.h5 [--every K] [--force]   writes RUN.xmf and RUN_fields.h5 next
+       to RUN.h5 (python -m ropedyn.xdmf)
 
 The geometry (the run's /rope/points, one plain dataset per described record) and the
 fields (the model's stored internal forces: tension, shear, moment; curvature, speed,
@@ -13,6 +13,7 @@ the Xdmf3 readers cannot read (a HyperSlab in a Geometry crashes them). The coor
 points down (gravity), y horizontal, z = 0.
 """
 import argparse
+import os
 import pathlib
 import sys
 import xml.etree.ElementTree as ET
@@ -26,6 +27,32 @@ from ropedyn import io
 FIELD_UNITS = {"tension": "N", "curvature": "1/m", "speed": "m/s", "velocity": "m/s",
                "angle": "rad", "joint_tension": "N", "joint_curvature": "1/m",
                "joint_shear": "N", "joint_moment": "N m"}
+
+
+WRITTEN_BY = "ropedyn.xdmf (scripts/xdmf)"
+PROVENANCE = ("version", "scene", "units_convention")
+
+
+def refusal(path, kind):
+    """Why the existing `path` is not a sidecar file of `kind` ('xmf' or 'fields') that this
+    script may replace (None when it is one, or when there is none)."""
+    if not os.path.lexists(path):
+        return None
+    if not path.is_file():
+        return f"{path}: exists and is not a regular file: not replaced"
+    if kind == "fields":
+        try:
+            with h5py.File(path, "r") as f:
+                ours = io.text(f.attrs.get("written_by", "")) == WRITTEN_BY
+        except OSError:
+            ours = False
+    else:
+        with open(path, "rb") as f:
+            ours = b"<!DOCTYPE Xdmf" in f.read(200)
+    if ours:
+        return None
+    return (f"{path}: exists and is not a file of scripts/xdmf: not replaced "
+            f"(--force replaces it)")
 
 
 def derived_fields(run):
@@ -69,7 +96,11 @@ def write_fields(path, run, fields, notes, picked, points):
     with h5py.File(path, "w") as f:
         f.attrs["source"] = pathlib.Path(run.path).name
         f.attrs["model"] = run.model
-        f.attrs["written_by"] = "ropedyn.xdmf (scripts/xdmf)"
+        f.attrs["written_by"] = WRITTEN_BY
+        # what made the data: the run file's code version, effective scene and convention
+        for name in PROVENANCE:
+            if name in run.attrs:
+                f.attrs[name] = run.attrs[name]
         conn = np.arange(2 * run.n, dtype=np.int32).reshape(run.n, 2)
         f.create_dataset("connectivity", data=conn)
         f.create_dataset("time", data=run.time).attrs["units"] = "s"
@@ -136,6 +167,9 @@ def main(argv=None):
     parser.add_argument("run", help="HDF5 output of ropedyn run")
     parser.add_argument("--every", type=int, default=1,
                         help="describe every K-th record only (default 1: all)")
+    parser.add_argument("--force", action="store_true",
+                        help="replace RUN.xmf and RUN_fields.h5 even when they are not "
+                             "files of this script")
     args = parser.parse_args(argv)
     if args.every < 1:
         parser.error("--every must be >= 1")
@@ -143,22 +177,40 @@ def main(argv=None):
     base = run_path.with_suffix("")
     xmf_path = base.with_name(base.name + ".xmf")
     fields_path = base.with_name(base.name + "_fields.h5")
+    for path, kind in ((xmf_path, "xmf"), (fields_path, "fields")):
+        why = refusal(path, kind)
+        if why and (not args.force or not path.is_file()):
+            print(f"xdmf: {why}", file=sys.stderr)
+            return 2
 
     run = io.load_run(run_path)
     if run.time.size == 0:
         print(f"xdmf: {run_path}: no output records", file=sys.stderr)
         return 1
-    with h5py.File(run_path, "r") as f:
-        points = f["rope/points"]  # may be one record longer than /time
-        points_shape = points.shape
-        picked = range(0, run.time.size, args.every)
-        fields, notes = derived_fields(run)
-        write_fields(fields_path, run, fields, notes, picked, points)
-    tree = build_xdmf(run_path, fields_path, [(k, run.time[k]) for k in picked],
-                      points_shape, fields)
-    with open(xmf_path, "wb") as out:
-        out.write(b'<?xml version="1.0" ?>\n<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>\n')
-        tree.write(out, encoding="utf-8", xml_declaration=False)
+    # both files are written whole as .part and then renamed: an interrupted script leaves
+    # the earlier pair as it was, and a reader holding them keeps reading them
+    parts = [path.with_name(path.name + ".part") for path in (fields_path, xmf_path)]
+    try:
+        with h5py.File(run_path, "r") as f:
+            points = f["rope/points"]  # may be one record longer than /time
+            points_shape = points.shape
+            picked = range(0, run.time.size, args.every)
+            fields, notes = derived_fields(run)
+            write_fields(parts[0], run, fields, notes, picked, points)
+        tree = build_xdmf(run_path, fields_path, [(k, run.time[k]) for k in picked],
+                          points_shape, fields)
+        with open(parts[1], "wb") as out:
+            out.write(b'<?xml version="1.0" ?>\n<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>\n')
+            out.write(f"<!-- {WRITTEN_BY} from {run_path.name}: ropedyn "
+                      f"{run.attrs.get('version', 'unknown')}, {run.model} model, status "
+                      f"{run.status} -->\n".encode())
+            tree.write(out, encoding="utf-8", xml_declaration=False)
+        os.replace(parts[0], fields_path)
+        os.replace(parts[1], xmf_path)
+    finally:
+        for part in parts:
+            if part.exists():
+                part.unlink()
     if "tension" not in fields["cell"]:
         print(f"xdmf: {notes['tension']}", file=sys.stderr)
     print(f"xdmf: {xmf_path} ({len(picked)} times, {run.n} elements; fields in "

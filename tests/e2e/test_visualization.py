@@ -325,6 +325,47 @@ def test_xdmf_for_mpp(tiny_mpp):
         assert f["point/joint_moment"].attrs["units"] == "N m"
 
 
+def test_xdmf_says_what_made_it_and_keeps_other_files(tiny, tmp_path):
+    """The sidecar carries the run's code version, scene and convention; a file of the
+    sidecar's name that scripts/xdmf did not write (here another run's file) is refused
+    (exit 2) and kept unless --force; an earlier sidecar is replaced without it."""
+    run = tmp_path / "r.h5"
+    shutil.copy(tiny, run)
+    other = tmp_path / "r_fields.h5"
+    shutil.copy(tiny, other)
+    before = sha256(other)
+    refused = script("xdmf", run)
+    assert refused.returncode == 2
+    assert "r_fields.h5: exists and is not a file of scripts/xdmf" in refused.stderr
+    assert sha256(other) == before and not (tmp_path / "r.xmf").exists()
+    assert script("xdmf", run, "--force").returncode == 0
+    assert script("xdmf", run).returncode == 0          # its own sidecar: replaced
+    with h5py.File(other) as f, h5py.File(run) as g:
+        for name in ("version", "scene", "units_convention"):
+            assert f.attrs[name] == io.text(g.attrs[name])
+        version = io.text(g.attrs["version"])
+    assert f"r.h5: ropedyn {version}," in (tmp_path / "r.xmf").read_text()
+    (tmp_path / "r.xmf").write_text("my notes\n")
+    assert script("xdmf", run).returncode == 2
+    assert (tmp_path / "r.xmf").read_text() == "my notes\n"
+
+
+def test_xdmf_that_fails_leaves_the_earlier_sidecar_whole(tiny, tmp_path):
+    """Both files are written as .part and renamed at the end: a sidecar that fails halfway
+    (a run file whose /rope/points is shorter than /time) leaves the earlier pair as it
+    was, and no .part file."""
+    run = tmp_path / "r.h5"
+    shutil.copy(tiny, run)
+    assert script("xdmf", run).returncode == 0
+    pair = {p: sha256(tmp_path / p) for p in ("r.xmf", "r_fields.h5")}
+    with h5py.File(run, "r+") as f:
+        f["rope/points"].resize(RECORDS - 3, axis=0)
+    failed = script("xdmf", run)
+    assert failed.returncode != 0 and "IndexError" in failed.stderr
+    assert {p: sha256(tmp_path / p) for p in pair} == pair
+    assert not list(tmp_path.glob("*.part"))
+
+
 # --- README figures -----------------------------------------------------------------------
 
 def test_readme_figures(tiny, tmp_path):
