@@ -140,9 +140,9 @@ def _swatches(width):
                            for c in rgb], axis=0)
 
 
-def save_gif(path, frames, fps):
+def save_gif(path, frames, fps, comment=""):
     """GIF with one palette for all frames (from the first, middle and last frame and the
-    artists' colours): no flicker, small frame deltas, fast."""
+    artists' colours): no flicker, small frame deltas, fast; `comment` says what made it."""
     from PIL import Image
 
     frames = list(frames)
@@ -151,19 +151,21 @@ def save_gif(path, frames, fps):
     palette = Image.fromarray(probe).quantize(colors=255, method=Image.Quantize.MEDIANCUT)
     images = [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE)
               for f in frames]
-    images[0].save(path, save_all=True, append_images=images[1:],
-                   duration=max(20, int(round(1000.0 / fps))), loop=0)
+    images[0].save(path, format="GIF", save_all=True, append_images=images[1:],
+                   duration=max(20, int(round(1000.0 / fps))), loop=0,
+                   comment=comment.encode("utf-8")[:255])
 
 
-def save_mp4(path, frames, fps):
-    """MP4 (H.264) by piping raw RGB frames to ffmpeg."""
+def save_mp4(path, frames, fps, comment=""):
+    """MP4 (H.264) by piping raw RGB frames to ffmpeg; `comment` says what made it."""
     frames = iter(frames)
     first = next(frames)
     height, width = first.shape[:2]
     command = ["ffmpeg", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
                "-s", f"{width}x{height}", "-r", f"{fps:.6g}", "-i", "-",
                "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264",
-               "-pix_fmt", "yuv420p", str(path)]
+               "-pix_fmt", "yuv420p", "-metadata", f"comment={comment}", "-f", "mp4",
+               str(path)]
     with subprocess.Popen(command, stdin=subprocess.PIPE) as proc:
         proc.stdin.write(first.tobytes())
         for frame in frames:
@@ -228,12 +230,14 @@ def main(argv=None):
     fps = args.fps or default_fps(run.time, frames)
     started = wallclock.perf_counter()
     drawer = RopeFrames(run, args.size, args.dpi, args.energy, args.trail)
+    comment = plot.made_by(run, "ropedyn.animate (scripts/animate)")
     try:
         images = (drawer.rgb(k) for k in frames)
-        if out.suffix.lower() == ".mp4":
-            save_mp4(out, images, fps)
-        else:
-            save_gif(out, images, fps)
+        with plot.written_whole(out) as part:
+            if out.suffix.lower() == ".mp4":
+                save_mp4(part, images, fps, comment)
+            else:
+                save_gif(part, images, fps, comment)
     finally:
         drawer.close()
     print(f"animate: {out} ({frames.size} frames at {fps:.1f} fps, "

@@ -366,6 +366,28 @@ def test_xdmf_that_fails_leaves_the_earlier_sidecar_whole(tiny, tmp_path):
     assert not list(tmp_path.glob("*.part"))
 
 
+def test_pictures_say_what_made_them(tiny, tmp_path):
+    """The overview and energy PNGs carry text chunks naming the run file, the code version
+    that wrote it and its effective scene; a GIF's comment names the run and the version.
+    Each is written whole (no .part left)."""
+    with h5py.File(tiny) as f:
+        version, scene = io.text(f.attrs["version"]), io.text(f.attrs["scene"])
+    made = {"overview": tmp_path / "o.png", "energy": tmp_path / "e.png"}
+    for module, out in made.items():
+        result = script(f"plot.{module}", tiny, "-o", out, package="ropedyn")
+        assert result.returncode == 0, result.stderr
+        text = Image.open(out).text
+        assert text["Software"] == f"ropedyn {version}" and text["Scene"] == scene
+        assert text["Source"] == str(tiny)
+        assert f"tiny.h5: ropedyn {version}, RFEM, n = 5" in text["Description"]
+    result = script("animate", tiny, "-o", tmp_path / "a.gif", "--max-frames", "3")
+    assert result.returncode == 0, result.stderr
+    comment = Image.open(tmp_path / "a.gif").info["comment"].decode()
+    assert comment.startswith("ropedyn.animate (scripts/animate) from tiny.h5: ropedyn "
+                              f"{version}, RFEM, n = 5")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.gif", "e.png", "o.png"]
+
+
 # --- README figures -----------------------------------------------------------------------
 
 def test_readme_figures(tiny, tmp_path):

@@ -3,10 +3,14 @@ right, x downward) and the command-line modules that draw: `ropedyn.plot.overvie
 (scripts/plot; also `python -m ropedyn.plot`) and `ropedyn.plot.energy`
 (scripts/plot_energy.py).
 """
+import contextlib
+import os
+import pathlib
 import re
 
 import numpy as np
 
+from ropedyn import io
 from ropedyn.fields import ground_plane, supports, water_surface
 
 SUPPORT_PATH_COLOR = "#2ca02c"
@@ -145,3 +149,42 @@ def parse_size(value):
     if not match:
         raise ValueError(f"size '{value}': expected WIDTHxHEIGHT in pixels, e.g. 640x480")
     return int(match.group(1)), int(match.group(2))
+
+
+def made_by(run, tool):
+    """What a picture of `run` says made it: the tool, the run file, the code version that
+    wrote the run, its model, method and status."""
+    return (f"{tool} from {pathlib.Path(run.path).name}: ropedyn "
+            f"{run.attrs.get('version', 'unknown')}, {io.title(run)}")
+
+
+def png_text(run, tool):
+    """The text chunks of a PNG of `run`: Software, Source (the run file), Description
+    (made_by) and the run's effective scene."""
+    return {"Software": f"ropedyn {run.attrs.get('version', 'unknown')}",
+            "Source": str(run.path), "Description": made_by(run, tool),
+            "Scene": run.attrs.get("scene", "")}
+
+
+@contextlib.contextmanager
+def written_whole(out):
+    """Yield OUT.part to write; rename it to `out` when the block ends without an error,
+    remove it otherwise: a picture is never left half-written under its name."""
+    out = pathlib.Path(out)
+    part = out.with_name(out.name + ".part")
+    try:
+        yield part
+        os.replace(part, out)
+    finally:
+        if part.exists():
+            part.unlink()
+
+
+def save_figure(fig, out, run, tool, **kwargs):
+    """fig saved whole to `out` (format from its suffix); a PNG says what made it
+    (png_text)."""
+    fmt = pathlib.Path(out).suffix.lstrip(".").lower() or "png"
+    if fmt == "png":
+        kwargs["metadata"] = png_text(run, tool)
+    with written_whole(out) as part:
+        fig.savefig(part, format=fmt, **kwargs)

@@ -10,7 +10,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from ropedyn import io  # noqa: E402
+from ropedyn import io, plot  # noqa: E402
 
 
 def main(argv=None):
@@ -42,7 +42,7 @@ def main(argv=None):
     bx.grid(alpha=0.3)
     bx.set_title("T + V + dissipated - support work - E0", fontsize=9)
     fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    plot.save_figure(fig, out, run, "ropedyn.plot.energy (scripts/plot_energy.py)", dpi=110)
     print(f"plot: {out}")
     return 0
 

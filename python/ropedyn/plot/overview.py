@@ -147,7 +147,7 @@ def main(argv=None):
         print(f"plot: {args.run}: no output records", file=sys.stderr)
         return 1
     fig = make_figure(run, args.times or default_times(run.time), size, args.dpi)
-    fig.savefig(out, dpi=args.dpi)
+    plot.save_figure(fig, out, run, "ropedyn.plot.overview (scripts/plot)", dpi=args.dpi)
     plt.close(fig)
     print(f"plot: {out}")
     return 0
