@@ -188,7 +188,11 @@ contains
         end if
         if (force) return
         call check_replaceable(path, err)
-        if (.not. allocated(err) .and. allocated(scene%source)) &
+        if (allocated(err)) then
+            if (err%code == ERR_USAGE) err%message = err%message//' (--force replaces it)'
+            return
+        end if
+        if (allocated(scene%source)) &
             call check_own_source(path, scene%source, err, analysis)
     end subroutine check_may_replace
 end module ropedyn_run_inputs

@@ -74,7 +74,8 @@ contains
             removed = delete_file(file//'.part')
         else if (exists) then
             call make_error(err, ERR_USAGE, file//'.part: left by a run of '//file// &
-                ' that was killed: continue it (ropedyn run --resume '//file// &
+                ' that was killed: continue it (set its status to interrupted, h5py '// &
+                'f.attrs["status"] = "interrupted", then ropedyn run --resume '//file// &
                 '.part) or remove it, or give --force')
         else
             call check_may_replace(file, self%scene, force, err)

@@ -64,7 +64,7 @@ def test_a_file_ropedyn_did_not_write_is_never_replaced_silently(run, tmp_path, 
     before = digest(out)
     proc = run("run", scene, "--set", "output.file='mine.h5'", "--set", "solver.t_end=0.01")
     assert proc.returncode == 2 and "mine.h5: exists and is" in proc.stderr, proc.stderr
-    assert "not replaced" in proc.stderr
+    assert "not replaced" in proc.stderr and "(--force replaces it)" in proc.stderr
     assert digest(out) == before
 
 
@@ -144,6 +144,8 @@ def test_a_killed_run_leaves_the_earlier_file_whole(run, ropedyn_exe, tmp_path, 
     refused = run("run", scene, *sets)
     assert refused.returncode == 2
     assert "paper.h5.part: left by a run of out/paper.h5 that was killed" in refused.stderr
+    assert ('set its status to interrupted, h5py f.attrs["status"] = "interrupted", then '
+            "ropedyn run --resume out/paper.h5.part") in refused.stderr
     with h5py.File(part, "r+") as f:         # the user's way to continue a killed run
         assert f.attrs["status"] == b"running" and len(f["time"]) >= 2
         f.attrs["status"] = "interrupted"
@@ -169,7 +171,8 @@ def test_statics_and_modes_replace_only_their_own_result(run, tmp_path):
     kept = {name: digest(tmp_path / name) for name in ("r.h5", "notes.txt")}
     refused = [(("statics", scene, "-o", "r.h5"), "r.h5: exists and holds a run result, "
                 "not a statics one: not replaced"),
-               (("modes", scene, "-o", "notes.txt"), "notes.txt: exists and is not an HDF5")]
+               (("modes", scene, "-o", "notes.txt"), "notes.txt: exists and is not an HDF5 "
+                "file (not written by ropedyn): not replaced (--force replaces it)")]
     for args, words in refused:
         proc = run(*args)
         assert proc.returncode == 2 and words in proc.stderr, proc.stderr
