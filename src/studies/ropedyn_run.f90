@@ -178,6 +178,7 @@ module ropedyn_run
         procedure :: time => run_time
         procedure :: end_time => run_end_time
         procedure :: output_file => run_output_file
+        procedure :: final_file_name => run_final_file_name
         procedure :: take_image => run_take_image
         procedure :: release => run_release
         procedure :: advance => run_advance
@@ -812,6 +813,16 @@ contains
         character(len=:), allocatable :: path
         path = self%summary%file
     end function run_output_file
+
+    !> The name the run's file has when the run ends: FILE, while it is written as FILE.part
+    !! (a message stored in the file names it where it will be).
+    pure function run_final_file_name(self) result(path)
+        class(run_t), intent(in) :: self
+        character(len=:), allocatable :: path
+        path = self%summary%file
+        if (.not. allocated(self%final_file)) return
+        if (len(self%final_file) > 0) path = self%final_file
+    end function run_final_file_name
 
     !> OUTPUT_MEMORY, after `finish`: the bytes of the run's file (an HDF5 file image),
     !! moved out of the run; none before, or after a failure to take them.

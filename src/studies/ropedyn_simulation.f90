@@ -60,8 +60,8 @@ contains
                 call run%step(outcome, err)
             end do
             if (outcome == STEP_STOPPED) then
-                call make_error(err, ERR_INTERRUPTED, run%output_file()//': interrupted by '// &
-                    signal_name(signal_received())//' at t = '//real_text(run%time())// &
+                call make_error(err, ERR_INTERRUPTED, run%final_file_name()// &
+                    ': interrupted by '//signal_name(signal_received())//' at t = '//real_text(run%time())// &
                     ' s of '//real_text(run%end_time())//' s (its last record; '// &
                     process_text()//')')
                 call run%finish('interrupted', (err%message), err)

@@ -201,6 +201,8 @@ def test_a_signal_while_the_run_starts_interrupts_it(ropedyn_exe, tmp_path, scen
     assert "interrupted by SIGTERM" in stderr
     with h5py.File(tmp_path / out) as f:
         assert attr(f, "status") == "interrupted" and f["time"].shape[0] >= 1
+        # the stored reason names the file where it is, not the .part it was written as
+        assert attr(f, "reason").startswith(f"{out}: interrupted by SIGTERM")
     assert not part.exists()
     assert not [p.name for p in tmp_path.iterdir() if "lock" in p.name]
 
