@@ -14,6 +14,7 @@ module ropedyn_scene_warnings
     use ropedyn_scene_types, only: scene_t
     use ropedyn_rope_spec, only: bottom_anchor_given
     use ropedyn_rope_setup, only: initial_angle
+    use ropedyn_support_motion, only: ramp
     implicit none
     private
     public :: scene_warnings, print_warnings
@@ -171,17 +172,17 @@ contains
         character(len=*), intent(in) :: path, end, motion
         real(wp), intent(in) :: ramp_time, release_time, t_end
         type(text_t), allocatable, intent(inout) :: list(:)
-        real(wp) :: u
+        real(wp) :: share(0:2)
         if (release_time > 0.0_wp .and. release_time >= t_end) call append_text(list, &
             path//': &supports: '//end//'_release_time = '//real_text(release_time)// &
             ': at or after t_end = '//real_text(t_end)//' s: the support is not released '// &
             'in the run (< 0: never)')
         if (trim(motion) == 'harmonic' .and. ramp_time > t_end) then
-            u = t_end/ramp_time
+            share = ramp(t_end, ramp_time)
             call append_text(list, path//': &supports: '//end//'_ramp_time = '// &
                 real_text(ramp_time)//': longer than the run (t_end = '//real_text(t_end)// &
                 ' s): the amplitudes reach only '// &
-                significant_text(100.0_wp*u**3*(10.0_wp - 15.0_wp*u + 6.0_wp*u**2), 3)// &
+                significant_text(100.0_wp*share(0), 3)// &
                 ' % of their size by t_end')
         end if
     end subroutine late_motion

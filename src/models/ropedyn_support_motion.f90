@@ -21,6 +21,7 @@ module ropedyn_support_motion
     private
     public :: support_motion_t, motion_state_t
     public :: MOTION_FIXED, MOTION_HARMONIC, MOTION_TABLE, MOTION_COUPLED
+    public :: ramp
 
     integer, parameter :: MOTION_FIXED = 0, MOTION_HARMONIC = 1, MOTION_TABLE = 2, &
                           MOTION_COUPLED = 3
