@@ -128,6 +128,22 @@ def test_animate_rejects_unknown_format(tiny, tmp_path):
 
 # --- plot ----------------------------------------------------------------------------------
 
+@pytest.mark.parametrize("module", ["plot.overview", "plot.energy"])
+def test_plots_refuse_a_name_that_takes_no_picture(module, tiny, tmp_path):
+    """A name whose suffix matplotlib cannot write (it ended in matplotlib's traceback), or
+    the run file itself (the picture would replace the data it is drawn from): a usage
+    error, exit 2, and the run file untouched."""
+    result = script(module, tiny, "-o", tmp_path / "plot.h5")
+    assert result.returncode == 2, result.stderr
+    assert "a picture's name ends in one of" in result.stderr
+    assert "Traceback" not in result.stderr and not (tmp_path / "plot.h5").exists()
+    run_as_png = tmp_path / "run.png"
+    shutil.copy(tiny, run_as_png)
+    result = script(module, run_as_png, "-o", run_as_png)
+    assert result.returncode == 2 and "is the run file itself" in result.stderr
+    assert run_as_png.read_bytes() == pathlib.Path(tiny).read_bytes()
+
+
 @pytest.mark.parametrize("which", ["tiny", "tiny_mpp"])
 def test_plot(which, request, tmp_path):
     run_file = request.getfixturevalue(which)

@@ -151,6 +151,19 @@ def parse_size(value):
     return int(match.group(1)), int(match.group(2))
 
 
+def check_picture_name(out, run_path):
+    """ValueError unless `out` can take a picture: a suffix matplotlib writes (.png, .pdf,
+    .svg, ...) and not the run file it is drawn from."""
+    from matplotlib.backend_bases import FigureCanvasBase
+    formats = FigureCanvasBase.get_supported_filetypes()
+    fmt = pathlib.Path(out).suffix.lstrip(".").lower()
+    if fmt not in formats:
+        raise ValueError(f"{out}: a picture's name ends in one of "
+                         f".{', .'.join(sorted(formats))} (not '.{fmt}')")
+    if pathlib.Path(out).resolve() == pathlib.Path(run_path).resolve():
+        raise ValueError(f"{out}: is the run file itself: give the picture another name")
+
+
 def made_by(run, tool):
     """What a picture of `run` says made it: the tool, the run file, the code version that
     wrote the run, its model, method and status."""

@@ -19,6 +19,10 @@ def main(argv=None):
     parser.add_argument("-o", "--output", help="PNG file (default: RUN_energy.png)")
     args = parser.parse_args(argv)
     out = args.output or args.run.rsplit(".h5", 1)[0] + "_energy.png"
+    try:
+        plot.check_picture_name(out, args.run)
+    except ValueError as exc:
+        parser.error(str(exc))
 
     run = io.load_run(args.run)
     t, e = run.time, run.energy

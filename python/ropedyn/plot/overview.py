@@ -142,6 +142,10 @@ def main(argv=None):
     except ValueError as exc:
         parser.error(str(exc))
     out = args.output or str(pathlib.Path(args.run).with_suffix("")) + "_plot.png"
+    try:
+        plot.check_picture_name(out, args.run)
+    except ValueError as exc:
+        parser.error(str(exc))
     run = io.load_run(args.run)
     if run.time.size == 0:
         print(f"plot: {args.run}: no output records", file=sys.stderr)
