@@ -23,6 +23,7 @@ import numpy as np
 
 from ropedyn import fields as derived
 from ropedyn import io
+from ropedyn.plot import made_by, written_whole
 
 FIELD_UNITS = {"tension": "N", "curvature": "1/m", "speed": "m/s", "velocity": "m/s",
                "angle": "rad", "joint_tension": "N", "joint_curvature": "1/m",
@@ -187,30 +188,22 @@ def main(argv=None):
     if run.time.size == 0:
         print(f"xdmf: {run_path}: no output records", file=sys.stderr)
         return 1
-    # both files are written whole as .part and then renamed: an interrupted script leaves
-    # the earlier pair as it was, and a reader holding them keeps reading them
-    parts = [path.with_name(path.name + ".part") for path in (fields_path, xmf_path)]
-    try:
+    # both files are written whole as .part and then renamed (the fields first): an
+    # interrupted script leaves the earlier pair as it was, and a reader holding them keeps
+    # reading them
+    with written_whole(xmf_path) as xmf_part, written_whole(fields_path) as fields_part:
         with h5py.File(run_path, "r") as f:
             points = f["rope/points"]  # may be one record longer than /time
             points_shape = points.shape
             picked = range(0, run.time.size, args.every)
             fields, notes = derived_fields(run)
-            write_fields(parts[0], run, fields, notes, picked, points)
+            write_fields(fields_part, run, fields, notes, picked, points)
         tree = build_xdmf(run_path, fields_path, [(k, run.time[k]) for k in picked],
                           points_shape, fields)
-        with open(parts[1], "wb") as out:
+        with open(xmf_part, "wb") as out:
             out.write(b'<?xml version="1.0" ?>\n<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>\n')
-            out.write(f"<!-- {WRITTEN_BY} from {run_path.name}: ropedyn "
-                      f"{run.attrs.get('version', 'unknown')}, {run.model} model, status "
-                      f"{run.status} -->\n".encode())
+            out.write(f"<!-- {made_by(run, WRITTEN_BY)} -->\n".encode())
             tree.write(out, encoding="utf-8", xml_declaration=False)
-        os.replace(parts[0], fields_path)
-        os.replace(parts[1], xmf_path)
-    finally:
-        for part in parts:
-            if part.exists():
-                part.unlink()
     if "tension" not in fields["cell"]:
         print(f"xdmf: {notes['tension']}", file=sys.stderr)
     print(f"xdmf: {xmf_path} ({len(picked)} times, {run.n} elements; fields in "

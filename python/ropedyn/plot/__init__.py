@@ -182,7 +182,8 @@ def png_text(run, tool):
 @contextlib.contextmanager
 def written_whole(out):
     """Yield OUT.part to write; rename it to `out` when the block ends without an error,
-    remove it otherwise: a picture is never left half-written under its name."""
+    remove it otherwise: a picture (or the XDMF sidecar) is never left half-written under
+    its name."""
     out = pathlib.Path(out)
     part = out.with_name(out.name + ".part")
     try:
