@@ -7,7 +7,7 @@ module ropedyn_text
     private
     public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, enclosed
     public :: significant_text, decimal_product
-    public :: lower, line_quote
+    public :: lower, line_quote, replaced
     public :: text_t, append_text, text_array, printable, clip, name_hint, edit_distance
 
     !> A string of any length, for lists of strings of different lengths.
@@ -239,6 +239,22 @@ contains
         end do
         s = s//mark
     end function enclosed
+
+    !> `text` with every `old` (not empty) replaced by `new`, left to right.
+    pure function replaced(text, old, new) result(out)
+        character(len=*), intent(in) :: text, old, new
+        character(len=:), allocatable :: out
+        integer :: k, from
+        out = ''
+        from = 1
+        do
+            k = index(text(from:), old)
+            if (k == 0) exit
+            out = out//text(from:from + k - 2)//new
+            from = from + k - 1 + len(old)
+        end do
+        out = out//text(from:)
+    end function replaced
 
     !> ASCII lower case.
     pure function lower(s) result(t)

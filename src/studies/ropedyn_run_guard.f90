@@ -20,6 +20,7 @@ submodule (ropedyn_run) ropedyn_run_guard
     use ropedyn_sweep_lock, only: take_lock, drop_lock
     use ropedyn_run_inputs, only: check_not_input, check_may_replace
     use ropedyn_error, only: ERR_USAGE, ERR_IO
+    use ropedyn_text, only: replaced
     implicit none
 
     !> The longest name of a file in a directory (Linux's NAME_MAX).
@@ -102,7 +103,7 @@ contains
                     if (allocated(rerr) .and. .not. allocated(err)) call move_alloc(rerr, err)
                     ! a message about the file names it where it now is
                     if (allocated(err) .and. .not. allocated(rerr)) &
-                        err%message = renamed(err%message, self%part_file, self%final_file)
+                        err%message = replaced(err%message, self%part_file, self%final_file)
                 end if
                 self%summary%file = self%final_file
                 self%part_file = ''
@@ -113,20 +114,4 @@ contains
             self%lock_file = ''
         end if
     end procedure release_output
-
-    !> `text` with every `old` replaced by `new`.
-    pure function renamed(text, old, new) result(out)
-        character(len=*), intent(in) :: text, old, new
-        character(len=:), allocatable :: out
-        integer :: k, from
-        out = ''
-        from = 1
-        do
-            k = index(text(from:), old)
-            if (k == 0) exit
-            out = out//text(from:from + k - 2)//new
-            from = from + k - 1 + len(old)
-        end do
-        out = out//text(from:)
-    end function renamed
 end submodule ropedyn_run_guard

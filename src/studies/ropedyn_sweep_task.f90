@@ -20,7 +20,7 @@
 module ropedyn_sweep_task
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use ropedyn_kinds, only: wp
-    use ropedyn_text, only: int_text, fixed_text
+    use ropedyn_text, only: int_text, fixed_text, replaced
     use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INPUT, ERR_INTERRUPTED
     use ropedyn_os, only: make_dirs, rename_file, delete_file
     use ropedyn_clock, only: clock_seconds
@@ -212,7 +212,7 @@ contains
         if (allocated(err)) then
             if (err%code /= ERR_INTERRUPTED .and. len(file_status(c%file)) == 0) &
                 call write_failure_note(c%file, err%message)
-            err%message = label//' ('//c%file//'): '//renamed(err%message, part, c%file)
+            err%message = label//' ('//c%file//'): '//replaced(err%message, part, c%file)
             if (err%code == ERR_INTERRUPTED) err%message = err%message// &
                 '; running the sweep again continues it'
             return
@@ -256,25 +256,11 @@ contains
         end if
         ! the run named its file by the .part name in its reason: name the case file
         reason = ''
-        if (allocated(data%reason)) reason = renamed(data%reason, part, c%file)
+        if (allocated(data%reason)) reason = replaced(data%reason, part, c%file)
         call finish_case_file(part, wall, scene_namelist_text(c%scene), err, reason)
         if (.not. allocated(err)) call rename_file(part, c%file, err)
         if (allocated(err)) removed = delete_file(part)
     end subroutine put_in_place
-
-    !> `text` with every `part` (the name a case's run wrote its file under) replaced by
-    !! `file` (the case file it was renamed to).
-    pure recursive function renamed(text, part, file) result(s)
-        character(len=*), intent(in) :: text, part, file
-        character(len=:), allocatable :: s
-        integer :: at
-        at = index(text, part)
-        if (at == 0) then
-            s = text
-        else
-            s = text(:at - 1)//file//renamed(text(at + len(part):), part, file)
-        end if
-    end function renamed
 
     !> The status attribute of the run file `path` ('' when it cannot be read).
     function file_status(path) result(status)

@@ -5,7 +5,7 @@
 !! 1.0000000000000002e-6).
 program test_text
     use ropedyn_kinds, only: wp
-    use ropedyn_text, only: real_text, significant_text, decimal_product
+    use ropedyn_text, only: real_text, significant_text, decimal_product, replaced
     use ropedyn_assert, only: test_suite_t
     implicit none
 
@@ -42,6 +42,12 @@ program test_text
     call check_product(0.0_wp, 5.0_wp, '0.0')
     call check_product(huge(1.0_wp), 10.0_wp, '+Infinity')
     call check_product(1.0e-300_wp, 1.0e-300_wp, '0.0')
+    ! every occurrence, left to right, none overlapping the replacement (a part file's
+    ! name in a message renamed to its file's)
+    call suite%check_true(replaced('a.h5.part: x; a.h5.part', 'a.h5.part', 'a.h5') == &
+                          'a.h5: x; a.h5', 'replaced: every occurrence')
+    call suite%check_true(replaced('aaa', 'a', 'aa') == 'aaaaaa', 'replaced: not again')
+    call suite%check_true(replaced('none', 'x', 'y') == 'none', 'replaced: none')
     call suite%finish()
 contains
     !> decimal_product(a, b) reads as `expected` (real_text: shortest, every digit).
