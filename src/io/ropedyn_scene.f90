@@ -51,7 +51,6 @@ contains
         type(scene_t), target, intent(out) :: scene
         type(error_t), allocatable, intent(out) :: err
 
-        integer :: k
         scene%path = trim(path)
         if (printable(scene%path) /= scene%path) then
             call make_error(err, ERR_INPUT, printable(scene%path)//': a control character in ' &
@@ -61,11 +60,7 @@ contains
         call load_scene(overrides, scene, err)
         if (allocated(err)) return
         ! the scene file and the overrides that change the run (not those of &output)
-        scene%source = canonical_path(scene%path)
-        do k = 1, size(overrides)
-            if (index(override_target(overrides(k)), 'output.') == 1) cycle
-            scene%source = scene%source//' --set '//trim(adjustl(overrides(k)))
-        end do
+        scene%source = canonical_path(scene%path)//set_arguments(overrides, .true.)
     end subroutine read_scene
 
     !> Read the scene of a run file being continued (its `scene` attribute, the echo of
@@ -86,11 +81,7 @@ contains
         scene%path = origin
         call load_scene(overrides, scene, err, text)
         if (allocated(err)) return
-        scene%overrides = ''
-        do k = 1, size(overrides)
-            scene%overrides = trim(adjustl(scene%overrides//' --set '// &
-                                           trim(adjustl(overrides(k)))))
-        end do
+        scene%overrides = trim(adjustl(set_arguments(overrides, .false.)))
         do k = 1, size(overrides)
             select case (override_target(overrides(k)))
             case ('output.file')
@@ -129,6 +120,20 @@ contains
         end if
         call load_scene(overrides, scene, err, text)
     end subroutine read_scene_string
+
+    !> ' --set group.key=value' for each of `overrides` in their order (as the command line
+    !! gave them); those of &output left out when `skip_output`.
+    pure function set_arguments(overrides, skip_output) result(text)
+        character(len=*), intent(in) :: overrides(:)
+        logical, intent(in) :: skip_output
+        character(len=:), allocatable :: text
+        integer :: k
+        text = ''
+        do k = 1, size(overrides)
+            if (skip_output .and. index(override_target(overrides(k)), 'output.') == 1) cycle
+            text = text//' --set '//trim(adjustl(overrides(k)))
+        end do
+    end function set_arguments
 
     !> 'group.key' of a `--set group.key=value` argument as the scene reads it (lower case,
     !! blanks around the parts removed; '' when it has no '=').
