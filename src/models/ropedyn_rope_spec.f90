@@ -10,7 +10,7 @@ module ropedyn_rope_spec
     private
     public :: rope_params_t, model_params_t, supports_params_t, initial_params_t
     public :: effects_params_t, fluid_params_t, ground_params_t, attachments_params_t
-    public :: rope_spec_t, bottom_anchor_given, NOT_SET
+    public :: rope_spec_t, bottom_anchor_given, release_time, released_at_start, NOT_SET
     public :: NAME_LEN, PATH_LEN, N_ATTACH
 
     integer, parameter :: NAME_LEN = 16    !< length of the kind/method/support/shape names
@@ -207,4 +207,26 @@ contains
         class(rope_spec_t), intent(in) :: spec
         bottom_anchor_given = .not. any(ieee_is_nan(spec%supports%bottom_anchor))
     end function bottom_anchor_given
+
+    !> When the support at `end` (1: top, 2: bottom) lets the rope go [s]: its
+    !! `*_release_time` when one is given (>= 0) and the support motions are on, else
+    !! huge (never).
+    pure real(wp) function release_time(spec, end)
+        class(rope_spec_t), intent(in) :: spec
+        integer, intent(in) :: end
+        real(wp) :: given
+        release_time = huge(1.0_wp)
+        if (.not. spec%effects%support_motion) return
+        given = merge(spec%supports%top_release_time, spec%supports%bottom_release_time, &
+                      end == 1)
+        if (given >= 0.0_wp) release_time = given
+    end function release_time
+
+    !> True when the support at `end` (1: top, 2: bottom) is released at t = 0: the end is
+    !! free from the start, whatever its kind.
+    pure logical function released_at_start(spec, end)
+        class(rope_spec_t), intent(in) :: spec
+        integer, intent(in) :: end
+        released_at_start = .not. release_time(spec, end) > 0.0_wp
+    end function released_at_start
 end module ropedyn_rope_spec

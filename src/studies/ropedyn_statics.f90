@@ -38,7 +38,7 @@ module ropedyn_statics
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_model_factory, only: create_model
     use ropedyn_text, only: int_text, fixed_text
-    use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
+    use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given, released_at_start
     use ropedyn_ldl, only: ldl_t, ldl_factor, ldl_solve, band_matvec
     use ropedyn_statics_terms, only: generalized_force, tangent_matrices, potential_energy, &
                                      rope_length, total_weight, tangent_band, tangent_bandwidth, &
@@ -180,8 +180,8 @@ contains
         type(error_t), allocatable, intent(out) :: err
         character(len=:), allocatable :: top, bottom
         associate (s => spec%supports)
-            top = end_text('top', s%top, s%top_release_time)
-            bottom = end_text('bottom', s%bottom, s%bottom_release_time)
+            top = end_text('top', s%top, 1)
+            bottom = end_text('bottom', s%bottom, 2)
         end associate
         if (len(top) > 0 .and. len(bottom) > 0 .and. spec%effects%gravity .and. &
             spec%rope%gravity > 0.0_wp) then
@@ -191,14 +191,14 @@ contains
         end if
     contains
         !> "top = 'free'" or "top_release_time = 0.0" for an end free at t = 0, else ''.
-        function end_text(end, kind, release) result(text)
+        function end_text(end, kind, k) result(text)
             character(len=*), intent(in) :: end, kind
-            real(wp), intent(in) :: release
+            integer, intent(in) :: k
             character(len=:), allocatable :: text
             text = ''
             if (trim(kind) == 'free') then
                 text = end//" = 'free'"
-            else if (release == 0.0_wp .and. spec%effects%support_motion) then
+            else if (released_at_start(spec, k)) then
                 text = end//'_release_time = 0.0'
             end if
         end function end_text

@@ -36,7 +36,7 @@ module ropedyn_mpp
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_problem, only: STATUS_OK, STATUS_RECOVERABLE
     use ropedyn_rope_model, only: rope_model_t, energy_t
-    use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
+    use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given, release_time, released_at_start
     use ropedyn_effect, only: effect_box_t, bodies_t, add_forces_of, add_jacobians_of, &
                               add_energies_of, add_forces_powers_of, set_axes, &
                               add_level_energies_of
@@ -464,9 +464,7 @@ contains
         logical :: free_from_start
         factor = spec%supports%support_stiffness_factor
         ! a bottom released at t = 0 is free (set_support_motion): it shares no section
-        free_from_start = spec%effects%support_motion .and. &
-                          spec%supports%bottom_release_time >= 0.0_wp .and. &
-                          .not. spec%supports%bottom_release_time > 0.0_wp
+        free_from_start = released_at_start(spec, 2)
         model%top_clamped = spec%supports%top == 'clamped'
         select case (spec%supports%bottom)
         case ('pinned')
@@ -569,10 +567,8 @@ contains
         model%motion(2)%p0 = model%bottom_anchor
         model%motion(2)%angle0 = model%bottom_angle
         if (spec%effects%support_motion) then
-            associate (s => spec%supports)
-                if (s%bottom_release_time >= 0.0_wp) model%bottom_release = s%bottom_release_time
-                if (.not. model%bottom_release > 0.0_wp) model%bottom = 0
-            end associate
+            model%bottom_release = release_time(spec, 2)
+            if (released_at_start(spec, 2)) model%bottom = 0
             ! the top joint is never free; a free or released bottom has no motion
             call configure_motions(spec, [.true., model%bottom > 0], model%motion, model%moving)
         end if

@@ -32,7 +32,7 @@ module ropedyn_rfem
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_problem, only: STATUS_OK, STATUS_RECOVERABLE
     use ropedyn_rope_model, only: rope_model_t, energy_t
-    use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
+    use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given, release_time, released_at_start
     use ropedyn_effect, only: effect_box_t, bodies_t, add_forces_of, add_jacobians_of, &
                               add_energies_of, add_powers_of, add_forces_powers_of, &
                               add_level_energies_of

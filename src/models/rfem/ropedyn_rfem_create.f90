@@ -84,12 +84,7 @@ contains
         by = sec%shear_damping/(sec%shape_factor*dl)
         bphi = sec%bending_damping/dl
         factor = spec%supports%support_stiffness_factor
-        if (spec%effects%support_motion) then
-            associate (s => spec%supports)
-                if (s%top_release_time >= 0.0_wp) model%release(1) = s%top_release_time
-                if (s%bottom_release_time >= 0.0_wp) model%release(2) = s%bottom_release_time
-            end associate
-        end if
+        model%release = [release_time(spec, 1), release_time(spec, 2)]
 
         model%tension = spec%effects%tension
         model%tension_only = .not. spec%rope%compression
@@ -110,7 +105,7 @@ contains
             associate (sup => model%sup(k))
                 sup%sgn = merge(1.0_wp, -1.0_wp, k == 1)
                 sup%elem = merge(1, n, k == 1)
-                if (.not. model%release(k) > 0.0_wp) cycle
+                if (released_at_start(spec, k)) cycle
                 sup%translational = kinds(k) == 'pinned' .or. kinds(k) == 'clamped'
                 sup%rotational = kinds(k) == 'clamped'
                 if (sup%translational) then
