@@ -363,7 +363,7 @@ contains
     end subroutine shaken_top
 
     !> Folded rope (both halves hanging from the top, bending off as for a chain), the free
-    !! end released at t = 0: the tip falls faster than g (theory: x = 0.04947, 0.20363 m
+    !! end released at t = 0: the tip falls faster than g (theory: x = 0.04946, 0.20363 m
     !! at 0.1, 0.2 s; a/g = 1.288 at 0.2 s).
     subroutine folded_fall()
         type(run_t) :: run
@@ -379,8 +379,8 @@ contains
             x(k) = tip(1) - tip0(1)
         end do
         write (*, '(a, 3f10.5, a)') '  folded: tip fall at 0.1, 0.2, 0.3 s', x(20), x(40), &
-            x(60), ' m (theory 0.04947, 0.20363, 0.48980)'
-        call suite%check_close(x(20), 0.04947_wp, 0.01_wp, 0.0_wp, 'folded: fall at 0.1 s')
+            x(60), ' m (theory 0.04946, 0.20363, 0.48980)'
+        call suite%check_close(x(20), 0.04946_wp, 0.01_wp, 0.0_wp, 'folded: fall at 0.1 s')
         call suite%check_close(x(40), 0.20363_wp, 0.01_wp, 0.0_wp, 'folded: fall at 0.2 s')
         call suite%check_close(x(60), 0.48980_wp, 0.02_wp, 0.0_wp, 'folded: fall at 0.3 s')
         a_rel = (x(42) - 2.0_wp*x(40) + x(38))/(0.01_wp**2*g)
