@@ -88,7 +88,7 @@ module ropedyn_h5
     end type h5_file_t
 
     !> An extendible, chunked dataset with time on its last Fortran axis, open while the
-    !! run writes it (real(wp) or default-integer records).
+    !! run writes it (real(wp), default-integer or int64 records).
     type, public :: h5_series_t
         private
         character(len=:), allocatable :: path     !< its file, for messages
@@ -102,8 +102,8 @@ module ropedyn_h5
         integer :: value_class = 0
         logical :: extendible = .true.
     contains
-        procedure, private :: append_real, append_integer
-        generic :: append => append_real, append_integer
+        procedure, private :: append_real, append_integer, append_int64
+        generic :: append => append_real, append_integer, append_int64
         procedure :: append_text => series_append_text
         procedure :: length => series_length
         procedure :: record_size => series_record_size
@@ -154,9 +154,10 @@ module ropedyn_h5
 
         !> Create the empty series `name` whose records have extents `record_dims` (none for a
         !! scalar time series; at most 2), of real(wp) values or, with `is_integer`, default
-        !! integers; write its units (and `columns`, if not empty). The series stays open.
+        !! integers (int64 with `wide`: counters); write its units (and `columns`, if not
+        !! empty). The series stays open.
         module subroutine h5_create_series(self, series, name, record_dims, is_integer, units, &
-                                           columns, err)
+                                           columns, err, wide)
             class(h5_file_t), intent(inout) :: self
             type(h5_series_t), intent(inout) :: series
             character(len=*), intent(in) :: name
@@ -165,6 +166,7 @@ module ropedyn_h5
             character(len=*), intent(in) :: units
             character(len=*), intent(in) :: columns
             type(error_t), allocatable, intent(out) :: err
+            logical, intent(in), optional :: wide
         end subroutine h5_create_series
 
         !> Open the HDF5 library (idempotent) and silence HDF5's own error printing.
@@ -312,6 +314,15 @@ module ropedyn_h5
             integer, intent(in), target :: values(:)
             type(error_t), allocatable, intent(out) :: err
         end subroutine append_integer
+
+        !> Write record number `record` of an integer series, as `append_real` (HDF5 converts
+        !! the values to the series' own integers).
+        module subroutine append_int64(self, record, values, err)
+            class(h5_series_t), intent(inout) :: self
+            integer(hsize_t), intent(in) :: record
+            integer(i8), intent(in), target :: values(:)
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine append_int64
 
         !> Whether an HDF5 call failed (hdferr < 0); then err says `message` (ERR_IO) and `id`,
         !! the identifier the call was to give, is marked as none (-1). The message is built

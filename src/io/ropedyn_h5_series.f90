@@ -8,6 +8,7 @@ contains
         integer(hsize_t) :: dims(3), max_dims(3), chunk(3), record_bytes
         integer(hid_t) :: type_id
         integer :: rank
+        logical :: int64
 
         rank = size(record_dims) + 1
         series%path = self%path
@@ -16,7 +17,12 @@ contains
         series%record_dims = 1
         series%record_dims(1:rank - 1) = record_dims
 
-        if (is_integer) then
+        int64 = .false.
+        if (present(wide)) int64 = wide
+        if (is_integer .and. int64) then
+            type_id = h5kind_to_type(i8, H5_INTEGER_KIND)
+            record_bytes = int(storage_size(0_i8)/8, hsize_t)*product(record_dims)
+        else if (is_integer) then
             type_id = h5kind_to_type(kind(0), H5_INTEGER_KIND)
             record_bytes = int(storage_size(0)/8, hsize_t)*product(record_dims)
         else
@@ -241,6 +247,11 @@ contains
         call write_record(self, record, size(values), h5kind_to_type(kind(0), H5_INTEGER_KIND), &
                           c_loc(values), is_contiguous(values), err)
     end procedure append_integer
+
+    module procedure append_int64
+        call write_record(self, record, size(values), h5kind_to_type(i8, H5_INTEGER_KIND), &
+                          c_loc(values), is_contiguous(values), err)
+    end procedure append_int64
 
     !> Write the `n_values` values at `buffer` (`packed`: one block) as the records `record`,
     !! `record` + 1, ... (as many as they fill), extending the series to the last of them.

@@ -136,7 +136,7 @@ module ropedyn_output
         'motion (x, y)']
 
     !> The entries of /solver/restarts (one per resume): name, units, width of a string
-    !! (0: a number; integer for record and steps). The first RESTART_REQUIRED are in every
+    !! (0: a number; integer for record, int64 for steps as for /solver/steps). The first RESTART_REQUIRED are in every
     !! file with restarts; version and overrides (the code that continued the run and the
     !! --set overrides it was given) are absent in files written before they were recorded.
     character(len=*), parameter :: RESTART_NAME(9) = [character(len=15) :: 'time', 'record', &

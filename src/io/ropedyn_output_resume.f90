@@ -254,15 +254,16 @@ contains
                 else
                     call self%file%create_series(entry(k), name, [integer(hsize_t) ::], &
                                                  k == 2 .or. k == 3, trim(RESTART_UNITS(k)), &
-                                                 '', err)
+                                                 '', err, wide=(k == 3))
                 end if
                 if (allocated(err)) exit steps_
             end do
             n = entry(1)%length() + 1
             call entry(1)%append(n, [t], err)
             if (.not. allocated(err)) call entry(2)%append(n, [record], err)
-            if (.not. allocated(err)) call entry(3)%append(n, [int(min(steps, &
-                int(huge(1), i8)))], err)
+            ! (a file written before steps were int64 keeps its int32 entries: HDF5
+            ! converts; one beyond their range is clipped)
+            if (.not. allocated(err)) call entry(3)%append(n, [steps], err)
             if (.not. allocated(err)) call entry(4)%append(n, [cpu_time], err)
             if (.not. allocated(err)) call entry(5)%append_text(n, utc_timestamp(), err)
             if (.not. allocated(err)) call entry(6)%append_text(n, previous_status, err)

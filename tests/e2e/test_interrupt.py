@@ -239,22 +239,33 @@ def test_resume_records_its_version_and_overrides(run, tmp_path, scene):
     continued, its earlier entries empty."""
     first = run("run", scene, "--set", "solver.t_end=0.1", "--set", "output.file='r.h5'")
     assert first.returncode == 0, first.stderr
+    with h5py.File(tmp_path / "r.h5") as f:
+        steps_before = f["solver/steps"][()]
     resumed = run("run", "--resume", "r.h5", "--set", "solver.t_end=0.2",
                   "--set", " solver.RTOL = 1e-7")
     assert resumed.returncode == 0, resumed.stderr
     with h5py.File(tmp_path / "r.h5", "r+") as f:
         restarts = f["solver/restarts"]
+        # a step count, int64 as /solver/steps is
+        assert restarts["steps"].dtype == np.int64 == f["solver/steps"].dtype
+        assert restarts["steps"][:].tolist() == [steps_before]
         assert restarts["version"][:].tolist() == [f.attrs["version"]]
         assert restarts["overrides"][:].tolist() == \
             [b"--set solver.t_end=0.2 --set solver.rtol=1e-7"]
         assert restarts["version"].attrs["units"] == b""
         assert "t_end = 0.1" in attr(f, "scene") and "rtol = 1.0e-6" in attr(f, "scene")
         del restarts["version"], restarts["overrides"]          # as an older file
+        steps = restarts["steps"][:]                            # whose steps were int32
+        del restarts["steps"]
+        restarts.create_dataset("steps", data=steps.astype(np.int32), maxshape=(None,),
+                                chunks=True).attrs["units"] = np.bytes_("1")
+        steps_before = f["solver/steps"][()]
     again = run("run", "--resume", "r.h5", "--set", "solver.t_end=0.3")
     assert again.returncode == 0, again.stderr
     with h5py.File(tmp_path / "r.h5") as f:
         restarts = f["solver/restarts"]
         assert restarts["time"].shape == (2,)
+        assert restarts["steps"][:].tolist() == [steps[0], steps_before]
         assert restarts["overrides"][:].tolist() == [b"", b"--set solver.t_end=0.3"]
         assert restarts["version"][0] == b"" and restarts["version"][1] == f.attrs["version"]
 
