@@ -15,7 +15,8 @@ Modules (each command-line module has `main(argv=None)` and runs with `python -m
 - `ropedyn.io`: read a run file into numpy arrays with units (`load_run` -> `Run`);
 - `ropedyn.namelist`: the scene text (Fortran namelist) as a dict;
 - `ropedyn.fields`: derived fields: supports, axial force, curvature, speed;
-- `ropedyn.layout`: check a run file against the documented layout (docs/reference/file-format.md);
+- `ropedyn.layout`: check a run, statics or modes file against the documented layout
+  (docs/reference/file-format.md);
 - `ropedyn.plot`: drawing helpers; `ropedyn.plot.overview` (scripts/plot),
   `ropedyn.plot.energy` (scripts/plot_energy.py);
 - `ropedyn.animate` (scripts/animate), `ropedyn.xdmf` (scripts/xdmf).

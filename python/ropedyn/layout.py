@@ -9,10 +9,13 @@ or by hand::
 
     .venv/bin/python -m ropedyn.layout out/run.h5 20
 
+The file's kind comes from its root attributes: a run file, or a file of `ropedyn statics`
+or `ropedyn modes` (attribute `analysis`), each checked against its own layout; a sweep's
+summary (attribute `sweep`) has no layout per element and is refused, saying so.
 `check_layout` raises AssertionError naming the file and the dataset or attribute at fault,
-and returns a small summary dict (records, status, reason) when the layout is right.
-Only finished runs pass: status must be 'complete' or 'failed' ('running' means the run
-crashed or is still going).
+and returns a small summary dict (kind, records, status, reason, modes) when the layout is
+right. Only finished runs pass: status must be 'complete' or 'failed' ('running' means the
+run crashed or is still going); a statics or modes file is always 'complete'.
 """
 
 import sys
@@ -83,6 +86,45 @@ COLUMNS = {
 ROOT_ATTRIBUTES = ("status", "version", "model", "method", "scene", "created",
                    "units_convention")
 
+#: The kinds of file `ropedyn statics` and `ropedyn modes` write (root attribute `analysis`).
+ANALYSES = ("statics", "modes")
+
+#: Root attributes of a statics or modes file (`source` only in newer files).
+ANALYSIS_ATTRIBUTES = ("status", "analysis", "version", "model", "scene", "created",
+                       "units_convention")
+
+#: The datasets of a statics or modes file that are one record of a run file's series (the
+#: equilibrium; shapes and units as in SERIES, with one time).
+ANALYSIS_RECORDS = ("state/q", "rope/points", "forces/axial", "forces/shear", "forces/moment",
+                    "supports/top/reaction", "supports/bottom/reaction")
+
+#: The results of a statics (and modes) file: path -> (shape, units, integer); "N" is the
+#: number of generalized coordinates (the length of /statics/q), None the units of /statics/q.
+STATICS = {
+    "statics/q": (("N",), None, False),
+    "statics/residual": ((), "N", False),
+    "statics/residual_relative": ((), "1", False),
+    "statics/last_step": ((), "m", False),
+    "statics/weight": ((), "N", False),
+    "statics/iterations": ((), "1", True),
+    "statics/rejected": ((), "1", True),
+    "statics/stages": ((), "1", True),
+    "energy/elastic": ((), "J", False),
+    "energy/gravity": ((), "J", False),
+}
+
+#: The results of a modes file beyond STATICS, as STATICS ("K": the number of modes).
+MODES = {
+    "modes/omega": (("K",), "rad/s", False),
+    "modes/frequency_hz": (("K",), "Hz", False),
+    "modes/period": (("K",), "s", False),
+    "modes/damping_ratio": (("K",), "1", False),
+    "modes/axial_fraction": (("K",), "1", False),
+    "modes/shape": (("K", "N"), None, False),
+    "modes/shape_points": (("K", "2n", 2), "m", False),
+    "modes/stiffness_asymmetry": ((), "1", False),
+}
+
 UNITS_CONVENTION = "SI; x points down (gravity), y horizontal, angles from x towards y"
 
 
@@ -91,103 +133,190 @@ def _require(condition, message):
         raise AssertionError(message)
 
 
+def file_kind(f, path):
+    """'run', 'statics' or 'modes', from the root attributes of the open file `f`; a sweep's
+    summary, or an analysis of another name, raises AssertionError saying why."""
+    _require("sweep" not in f.attrs,
+             f"{path}: a sweep summary (root attribute 'sweep'), not a run, statics or modes "
+             f"file: its datasets are one column per case, with no layout per element to check")
+    if "analysis" not in f.attrs:
+        return "run"
+    kind = _text(f.attrs["analysis"])
+    _require(kind in ANALYSES,
+             f"{path}: root attribute analysis is '{kind}', expected one of {ANALYSES}")
+    return kind
+
+
 def check_layout(path, n_elements):
-    """Assert the layout of output file `path` of a rope of `n_elements` elements."""
+    """Assert the layout of output file `path` (a run, statics or modes file) of a rope of
+    `n_elements` elements."""
     path = str(path)
     n_elements = int(n_elements)
     extents = {"n": n_elements, "2n": 2 * n_elements, "n+1": n_elements + 1}
     with h5py.File(path, "r") as f:
-        # root attributes
-        for name in ROOT_ATTRIBUTES:
-            _require(name in f.attrs, f"{path}: root attribute '{name}' is missing")
-        status = _text(f.attrs["status"])
-        _require(status in ("complete", "failed"),
-                 f"{path}: status is '{status}', expected 'complete' or 'failed'")
-        reason = None
-        if status == "failed":
-            _require("reason" in f.attrs, f"{path}: failed run without a 'reason' attribute")
-            reason = _text(f.attrs["reason"])
-            _require(reason.strip() != "", f"{path}: failed run with an empty reason")
+        kind = file_kind(f, path)
+        if kind == "run":
+            return _check_run(f, path, n_elements, extents)
+        return _check_analysis(f, path, kind, n_elements, extents)
+
+
+def _check_run(f, path, n_elements, extents):
+    """The layout of a run file (`check_layout`)."""
+    status, reason = _check_root(f, path, ROOT_ATTRIBUTES, ("complete", "failed"))
+    _check_units(f, path)
+
+    # step-by-step datasets: (times, ...) extendible along time
+    _require("time" in f, f"{path}: /time is missing")
+    n_times = f["time"].shape[0]
+    present = {k: v for k, v in OPTIONAL_SERIES.items() if k in f}
+    for name, (record, units) in {**SERIES, **present}.items():
+        _check_dataset(f, path, name, (n_times,) + record, units, extents)
+        dset = f[name]
+        _require(dset.chunks is not None and dset.maxshape[0] is None,
+                 f"{path}: /{name} is not chunked and extendible along time")
+    _check_columns(f, path)
+    _check_fixed(f, path, n_elements)
+
+    # solver statistics (written at the end of complete and failed runs)
+    for name, units in STATS.items():
+        _require(name in f, f"{path}: /{name} is missing")
+        dset = f[name]
+        _require(dset.shape == (), f"{path}: /{name} has shape {dset.shape}, expected ()")
+        if name == "solver/cpu_time":
+            _require(dset.dtype.kind == "f", f"{path}: /{name} has dtype {dset.dtype}")
         else:
-            _require("reason" not in f.attrs, f"{path}: complete run with a 'reason' attribute")
-        convention = _text(f.attrs["units_convention"])
-        _require(convention == UNITS_CONVENTION,
-                 f"{path}: units_convention is '{convention}'")
-        created = _text(f.attrs["created"])
-        _require(len(created) == 20 and created[10] == "T" and created.endswith("Z"),
-                 f"{path}: created '{created}' is not ISO 8601 UTC (yyyy-mm-ddThh:mm:ssZ)")
+            _require(dset.dtype == np.int64,
+                     f"{path}: /{name} has dtype {dset.dtype}, expected int64")
+            _require(dset[()] >= 0, f"{path}: /{name} is negative")
+        got = _text(dset.attrs["units"])
+        _require(got == units, f"{path}: /{name} units '{got}', expected '{units}'")
 
-        # every dataset has units
-        missing = []
+    # values
+    time = f["time"][()]
+    _require(np.all(np.isfinite(time)), f"{path}: /time has non-finite values")
+    _require(np.all(np.diff(time) > 0), f"{path}: /time is not strictly increasing")
+    kinetic = f["energy/kinetic"][()]
+    elastic = f["energy/elastic"][()]
+    gravity = f["energy/gravity"][()]
+    total = f["energy/total"][()]
+    expected_total = kinetic + elastic + gravity
+    bad = np.abs(total - expected_total) > 1e-12 * np.abs(expected_total) + 1e-12
+    _require(not np.any(bad),
+             f"{path}: /energy/total differs from kinetic + elastic + gravity at records "
+             f"{np.flatnonzero(bad).tolist()}")
+    return {"kind": "run", "records": int(n_times), "status": status, "reason": reason,
+            "modes": None}
 
-        def visit(name, obj):
-            if isinstance(obj, h5py.Dataset) and "units" not in obj.attrs:
-                missing.append(name)
 
-        f.visititems(visit)
-        _require(not missing, f"{path}: datasets without a 'units' attribute: {missing}")
+def _check_analysis(f, path, kind, n_elements, extents):
+    """The layout of a statics or modes file (`check_layout`): the equilibrium as one record
+    of a run file's series, its results, and for modes the modes."""
+    status, reason = _check_root(f, path, ANALYSIS_ATTRIBUTES, ("complete",))
+    _check_units(f, path)
+    for name in ANALYSIS_RECORDS:
+        record, units = SERIES[name]
+        _check_dataset(f, path, name, (1,) + record, units, extents)
+    for name, (record, units) in OPTIONAL_SERIES.items():
+        if name in f:
+            _check_dataset(f, path, name, (1,) + record, units, extents)
+    _check_columns(f, path)
+    _check_fixed(f, path, n_elements)
 
-        # step-by-step datasets: (times, ...) extendible along time
-        _require("time" in f, f"{path}: /time is missing")
-        n_times = f["time"].shape[0]
-        present = {k: v for k, v in OPTIONAL_SERIES.items() if k in f}
-        for name, (record, units) in {**SERIES, **present}.items():
-            _require(name in f, f"{path}: /{name} is missing")
-            dset = f[name]
-            expected = (n_times,) + tuple(extents.get(e, e) for e in record)
-            _require(dset.shape == expected,
-                     f"{path}: /{name} has shape {dset.shape}, expected {expected}")
-            _require(dset.chunks is not None and dset.maxshape[0] is None,
-                     f"{path}: /{name} is not chunked and extendible along time")
-            got = _text(dset.attrs["units"])
-            _require(got == units, f"{path}: /{name} units '{got}', expected '{units}'")
-        for name, columns in COLUMNS.items():
-            if name in OPTIONAL_SERIES and name not in f:
-                continue
-            _require("columns" in f[name].attrs, f"{path}: /{name} has no 'columns' attribute")
-            got = _text(f[name].attrs["columns"])
-            _require(got == columns, f"{path}: /{name} columns '{got}', expected '{columns}'")
+    _require("statics/q" in f and f["statics/q"].ndim == 1,
+             f"{path}: /statics/q is missing or not one-dimensional")
+    extents = {**extents, "N": f["statics/q"].shape[0]}
+    coordinate_units = _text(f["statics/q"].attrs["units"])
+    results = dict(STATICS)
+    if kind == "modes":
+        _require("modes/omega" in f and f["modes/omega"].ndim == 1,
+                 f"{path}: /modes/omega is missing or not one-dimensional")
+        extents["K"] = f["modes/omega"].shape[0]
+        results.update(MODES)
+    for name, (shape, units, integer) in results.items():
+        _check_dataset(f, path, name, shape, units or coordinate_units, extents)
+        dtype = f[name].dtype
+        _require(dtype == np.int64 if integer else dtype.kind == "f",
+                 f"{path}: /{name} has dtype {dtype}, expected "
+                 f"{'int64' if integer else 'float'}")
+    for end in ("top", "bottom"):
+        name = f"statics/support_force_{end}"
+        if name in f:
+            _check_dataset(f, path, name, (2,), "N", extents)
+            _require(np.array_equal(f[name][()], f[f"supports/{end}/reaction"][0]),
+                     f"{path}: /{name} differs from /supports/{end}/reaction")
+    for group, attribute in (("statics", "criterion"), ("modes", "eigensolver")):
+        if group in f:
+            _require(attribute in f[group].attrs,
+                     f"{path}: /{group} has no '{attribute}' attribute")
+    _require(kind == "modes" or "modes" not in f,
+             f"{path}: a statics file (root attribute analysis) with /modes")
+    return {"kind": kind, "records": 1, "status": status, "reason": reason,
+            "modes": extents.get("K")}
 
-        # fixed datasets
-        for name, units in FIXED.items():
-            _require(name in f, f"{path}: /{name} is missing")
-            dset = f[name]
-            _require(dset.shape == (n_elements,),
-                     f"{path}: /{name} has shape {dset.shape}, expected ({n_elements},)")
-            got = _text(dset.attrs["units"])
-            _require(got == units, f"{path}: /{name} units '{got}', expected '{units}'")
-            _require(np.all(np.isfinite(dset[()])) and np.all(dset[()] > 0),
-                     f"{path}: /{name} has non-positive or non-finite values")
 
-        # solver statistics (written at the end of complete and failed runs)
-        for name, units in STATS.items():
-            _require(name in f, f"{path}: /{name} is missing")
-            dset = f[name]
-            _require(dset.shape == (), f"{path}: /{name} has shape {dset.shape}, expected ()")
-            if name == "solver/cpu_time":
-                _require(dset.dtype.kind == "f", f"{path}: /{name} has dtype {dset.dtype}")
-            else:
-                _require(dset.dtype == np.int64,
-                         f"{path}: /{name} has dtype {dset.dtype}, expected int64")
-                _require(dset[()] >= 0, f"{path}: /{name} is negative")
-            got = _text(dset.attrs["units"])
-            _require(got == units, f"{path}: /{name} units '{got}', expected '{units}'")
+def _check_root(f, path, names, statuses):
+    """The root attributes `names`, the status (one of `statuses`; 'failed' with a reason),
+    the units convention and the creation time; returns (status, reason or None)."""
+    for name in names:
+        _require(name in f.attrs, f"{path}: root attribute '{name}' is missing")
+    status = _text(f.attrs["status"])
+    _require(status in statuses,
+             f"{path}: status is '{status}', expected " + " or ".join(f"'{s}'" for s in statuses))
+    reason = None
+    if status == "failed":
+        _require("reason" in f.attrs, f"{path}: failed run without a 'reason' attribute")
+        reason = _text(f.attrs["reason"])
+        _require(reason.strip() != "", f"{path}: failed run with an empty reason")
+    else:
+        _require("reason" not in f.attrs, f"{path}: {status} file with a 'reason' attribute")
+    convention = _text(f.attrs["units_convention"])
+    _require(convention == UNITS_CONVENTION, f"{path}: units_convention is '{convention}'")
+    created = _text(f.attrs["created"])
+    _require(len(created) == 20 and created[10] == "T" and created.endswith("Z"),
+             f"{path}: created '{created}' is not ISO 8601 UTC (yyyy-mm-ddThh:mm:ssZ)")
+    return status, reason
 
-        # values
-        time = f["time"][()]
-        _require(np.all(np.isfinite(time)), f"{path}: /time has non-finite values")
-        _require(np.all(np.diff(time) > 0), f"{path}: /time is not strictly increasing")
-        kinetic = f["energy/kinetic"][()]
-        elastic = f["energy/elastic"][()]
-        gravity = f["energy/gravity"][()]
-        total = f["energy/total"][()]
-        expected_total = kinetic + elastic + gravity
-        bad = np.abs(total - expected_total) > 1e-12 * np.abs(expected_total) + 1e-12
-        _require(not np.any(bad),
-                 f"{path}: /energy/total differs from kinetic + elastic + gravity at records "
-                 f"{np.flatnonzero(bad).tolist()}")
 
-        return {"records": int(n_times), "status": status, "reason": reason}
+def _check_units(f, path):
+    """Every dataset has units."""
+    missing = []
+
+    def visit(name, obj):
+        if isinstance(obj, h5py.Dataset) and "units" not in obj.attrs:
+            missing.append(name)
+
+    f.visititems(visit)
+    _require(not missing, f"{path}: datasets without a 'units' attribute: {missing}")
+
+
+def _check_dataset(f, path, name, shape, units, extents):
+    """Dataset `name` is there with `shape` (names of extents resolved) and `units`."""
+    _require(name in f, f"{path}: /{name} is missing")
+    dset = f[name]
+    expected = tuple(extents.get(e, e) for e in shape)
+    _require(dset.shape == expected,
+             f"{path}: /{name} has shape {dset.shape}, expected {expected}")
+    got = _text(dset.attrs["units"])
+    _require(got == units, f"{path}: /{name} units '{got}', expected '{units}'")
+
+
+def _check_columns(f, path):
+    """The `columns` attributes (COLUMNS) of the datasets that have them."""
+    for name, columns in COLUMNS.items():
+        if name in OPTIONAL_SERIES and name not in f:
+            continue
+        _require("columns" in f[name].attrs, f"{path}: /{name} has no 'columns' attribute")
+        got = _text(f[name].attrs["columns"])
+        _require(got == columns, f"{path}: /{name} columns '{got}', expected '{columns}'")
+
+
+def _check_fixed(f, path, n_elements):
+    """The datasets written once (FIXED): (n_elements,), positive and finite."""
+    for name, units in FIXED.items():
+        _check_dataset(f, path, name, (n_elements,), units, {})
+        values = f[name][()]
+        _require(np.all(np.isfinite(values)) and np.all(values > 0),
+                 f"{path}: /{name} has non-positive or non-finite values")
 
 
 def main(argv=None):
@@ -200,7 +329,13 @@ def main(argv=None):
     except (AssertionError, OSError, KeyError, ValueError) as exc:
         print(f"FAIL {exc}", file=sys.stderr)
         return 1
-    line = f"{argv[0]}: layout OK ({summary['records']} records, status {summary['status']}"
+    if summary["kind"] == "run":
+        line = f"{argv[0]}: layout OK (run file, {summary['records']} records"
+    else:
+        line = f"{argv[0]}: layout OK ({summary['kind']} file, {argv[1]} elements"
+    if summary["modes"] is not None:
+        line += f", {summary['modes']} modes"
+    line += f", status {summary['status']}"
     if summary["reason"]:
         line += f", reason: {summary['reason']}"
     print(line + ")")

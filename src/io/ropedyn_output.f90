@@ -61,7 +61,7 @@ module ropedyn_output
     implicit none
     private
     public :: output_file_t, write_provenance, COUNTER_NAMES, counter_values, TIMER_NAMES
-    public :: add_counter_values, write_forces
+    public :: add_counter_values, write_forces, write_shape_record
 
     !> The convention written into every file (root attribute `units_convention`).
     character(len=*), parameter :: units_convention = &
@@ -136,9 +136,10 @@ module ropedyn_output
         'motion (x, y)']
 
     !> The entries of /solver/restarts (one per resume): name, units, width of a string
-    !! (0: a number; integer for record, int64 for steps as for /solver/steps). The first RESTART_REQUIRED are in every
-    !! file with restarts; version and overrides (the code that continued the run and the
-    !! --set overrides it was given) are absent in files written before they were recorded.
+    !! (0: a number; integer for record, int64 for steps as for /solver/steps). The first
+    !! RESTART_REQUIRED are in every file with restarts; version and overrides (the code
+    !! that continued the run and the --set overrides it was given) are absent in files
+    !! written before they were recorded.
     character(len=*), parameter :: RESTART_NAME(9) = [character(len=15) :: 'time', 'record', &
         'steps', 'cpu_time', 'wall_clock', 'previous_status', 'previous_reason', 'version', &
         'overrides']
@@ -557,6 +558,33 @@ contains
             if (allocated(err)) return
         end do
     end subroutine write_forces
+
+    !> The shape of one state as the datasets of a run file with one record (SERIES_NAME,
+    !! with their units and columns: h5py shapes (1, n, 3) and (1, 2n, 2)), for the statics
+    !! and modes files: the element centres and angles q (3, n) and the polyline (2, 2n).
+    subroutine write_shape_record(file, q, points, err)
+        type(h5_file_t), intent(inout) :: file
+        real(wp), intent(in) :: q(:, :)         !< m, m, rad
+        real(wp), intent(in) :: points(:, :)    !< m
+        type(error_t), allocatable, intent(out) :: err
+        call file%group('/state', err)
+        if (allocated(err)) return
+        call file%write(trim(SERIES_NAME(S_Q)), reshape(q, [size(q, 1), size(q, 2), 1]), &
+                        trim(SERIES_UNITS(S_Q)), err, &
+                        'x, y, phi of each element centre (one record)')
+        if (allocated(err)) return
+        call file%attribute(trim(SERIES_NAME(S_Q)), 'columns', trim(SERIES_COLUMNS(S_Q)), err)
+        if (allocated(err)) return
+        call file%group('/rope', err)
+        if (allocated(err)) return
+        call file%write(trim(SERIES_NAME(S_POINTS)), &
+                        reshape(points, [size(points, 1), size(points, 2), 1]), &
+                        trim(SERIES_UNITS(S_POINTS)), err, &
+                        'element end points A_1, B_1, A_2, ... (one record)')
+        if (allocated(err)) return
+        call file%attribute(trim(SERIES_NAME(S_POINTS)), 'columns', &
+                            trim(SERIES_COLUMNS(S_POINTS)), err)
+    end subroutine write_shape_record
 
     !> The internal-force and support series of an open file (FORCE_NAME) with their groups.
     subroutine create_force_series(self, err)

@@ -19,7 +19,7 @@ module ropedyn_analysis
                                potential_energy, rope_length
     use ropedyn_modes, only: modes_result_t, compute_modes
     use ropedyn_h5, only: h5_file_t
-    use ropedyn_output, only: write_provenance, write_forces
+    use ropedyn_output, only: write_provenance, write_forces, write_shape_record
     use ropedyn_version, only: version_string
     implicit none
     private
@@ -231,15 +231,7 @@ contains
         call write_forces(h5, self%axial, self%shear, self%moment, self%reaction, self%anchors, &
                           err)
         if (allocated(err)) return
-        call h5%group('/state', err)
-        if (allocated(err)) return
-        call h5%write('/state/q', reshape(q, [3, n, 1]), 'm, m, rad', err, &
-                      'x, y, phi of each element centre (one record)')
-        if (allocated(err)) return
-        call h5%group('/rope', err)
-        if (allocated(err)) return
-        call h5%write('/rope/points', reshape(points, [2, 2*n, 1]), 'm', err, &
-                      'element end points A_1, B_1, A_2, ... (one record)')
+        call write_shape_record(h5, q, points, err)
         if (allocated(err)) return
         call h5%write('/rope/element_length', lengths, 'm', err)
         if (allocated(err)) return

@@ -1,5 +1,8 @@
 """The HDF5 output read back with h5py: layout, shapes, units, status, energies, and the
 effective scene stored in the file re-runs to the same result."""
+import subprocess
+import sys
+
 import h5py
 import numpy as np
 
@@ -64,3 +67,18 @@ def test_free_rope_falls_freely(run, tmp_path):
     fall = q[:, :, 0] - q[0, :, 0]
     assert np.max(np.abs(fall - 9.81 * t[:, None]**2 / 2)) < 5e-9
     assert np.max(np.abs(q[:, :, 1:] - q[0, :, 1:])) < 5e-9
+
+
+def test_layout_refuses_a_sweep_summary(tmp_path):
+    """A sweep's summary.h5 has no layout per element: python -m ropedyn.layout says what
+    the file is instead of failing on the first dataset a run file has."""
+    path = tmp_path / "summary.h5"
+    with h5py.File(path, "w") as f:
+        f.attrs["sweep"] = np.bytes_("s.sweep")
+        f["case"] = np.arange(1, 3)
+    result = subprocess.run([sys.executable, "-m", "ropedyn.layout", str(path), "5"],
+                            capture_output=True, text=True)
+    assert result.returncode == 1
+    assert f"{path}: a sweep summary (root attribute 'sweep')" in result.stderr, \
+        result.stderr
+

@@ -1,9 +1,14 @@
 """`ropedyn statics` and `ropedyn modes`: exit codes, printed summary, HDF5 layout (every
 dataset with units), errors; `&initial shape = 'equilibrium'` starts a run at rest, in a
 current too."""
+import subprocess
+import sys
+
 import h5py
 import numpy as np
 import pytest
+
+from ropedyn.layout import check_layout
 
 HANGING = ("&model kind = '{kind}', elements = {n} /\n"
            "&initial shape = 'hanging' /\n"
@@ -37,6 +42,9 @@ def test_statics_file(run, tmp_path, kind):
             assert "units" in d.attrs, name
         assert f["rope/points"].shape == (1, 2 * n, 2)
         assert f["state/q"].shape == (1, n, 3)
+        # the columns of a run file's record
+        assert f["state/q"].attrs["columns"] == b"x, y, phi"
+        assert f["rope/points"].attrs["columns"] == b"x, y"
         assert f["statics/residual_relative"][()] < 1e-8
         top, bottom = f["statics/support_force_top"][:], f["statics/support_force_bottom"][:]
         weight = f["statics/weight"][()]
@@ -69,6 +77,34 @@ def test_modes_file(run, tmp_path):
         assert f["modes/shape_points"].shape == (5, 2 * n, 2)
         assert np.all(f["modes/axial_fraction"][:] < 0.01)
         assert f["modes/stiffness_asymmetry"][()] < 1e-8
+
+
+@pytest.mark.parametrize("command", ["statics", "modes"])
+def test_layout_of_analysis_files(run, tmp_path, command):
+    """`python -m ropedyn.layout` checks a statics or modes file against its documented
+    layout (the kind from the root attribute `analysis`), and names what is wrong."""
+    n = 8
+    (tmp_path / "cat.nml").write_text(CATENARY.format(kind="mpp", n=n))
+    extra = ["--count", "4"] if command == "modes" else []
+    assert run(command, "cat.nml", "-o", "a.h5", *extra).returncode == 0
+    summary = check_layout(tmp_path / "a.h5", n)
+    assert summary["kind"] == command and summary["status"] == "complete"
+    assert summary["modes"] == (4 if command == "modes" else None)
+
+    def layout(*args):
+        return subprocess.run([sys.executable, "-m", "ropedyn.layout", *map(str, args)],
+                              cwd=tmp_path, capture_output=True, text=True)
+
+    ok = layout("a.h5", n)
+    assert ok.returncode == 0, ok.stderr
+    assert ok.stdout.startswith(f"a.h5: layout OK ({command} file, "), ok.stdout
+    wrong = layout("a.h5", n + 1)
+    assert wrong.returncode == 1 and "/state/q has shape" in wrong.stderr, wrong.stderr
+    with h5py.File(tmp_path / "a.h5", "r+") as f:
+        del f["state/q"].attrs["columns"]
+    bad = layout("a.h5", n)
+    assert bad.returncode == 1
+    assert "a.h5: /state/q has no 'columns' attribute" in bad.stderr, bad.stderr
 
 
 def test_initial_equilibrium_run(run, tmp_path):
