@@ -54,7 +54,7 @@ def energy_panel(ax, run):
     ax.plot(t, potential, lw=1, label="potential - V(0)")
     if "dissipated" in e:
         ax.plot(t, e["dissipated"], lw=1, ls="--", label="dissipated")
-    ax.plot(t, e["total"] - e["total"][0], "k", lw=1.2, label="total - E0")
+    ax.plot(t, e["total"] - run.e0, "k", lw=1.2, label="total - E0")
     ax.set_xlabel("t (s)")
     ax.set_ylabel("energy (J)")
     ax.legend(fontsize=7, loc="best")

@@ -72,6 +72,22 @@ class Run:
         """Number of elements (members)."""
         return self.q.shape[1]
 
+    @property
+    def balance(self):
+        """B = T + V + dissipated - support work at every record, J (T + V: energy/total):
+        the energy balance, which stays at its start value E0 up to the integration error."""
+        e = self.energy
+        none = np.zeros_like(e["total"])
+        return e["total"] + e.get("dissipated", none) - e.get("support_work", none)
+
+    @property
+    def e0(self):
+        """E0, the balance's start value, J: B at the first record, the E0 `ropedyn run`
+        prints. For a run started from a record of another (&initial shape = 'state') or
+        resumed, the energy dissipated and the work done before count in it (they carry
+        over), so it is not T + V at the first record."""
+        return float(self.balance[0])
+
     def group(self, name):
         """A scene group as a dict ({} when absent)."""
         return self.scene.get(name, {})

@@ -7,6 +7,7 @@ import hashlib
 import json
 import os
 import pathlib
+import re
 import shutil
 import subprocess
 import sys
@@ -171,6 +172,57 @@ def test_plot_of_a_file_without_forces(ropedyn_exe, tmp_path):
     assert result.returncode == 0 and "predates stored internal forces" in result.stderr
     with h5py.File(tmp_path / "old_fields.h5") as f:
         assert "cell/tension" not in f and "cell/curvature" in f
+
+
+# a damped rope on a shaken top: energy dissipated and work done by the first second tenth
+DAMPED_SHAKEN = ("&model kind = 'rfem', elements = 5 /\n&rope normal_damping = 2.0e4 /\n"
+                 "&supports top_motion = 'harmonic', top_amplitude = 0.0, 0.2, "
+                 "top_frequency = 2.0 /\n"
+                 "&solver t_end = 0.2, output_interval = 0.01 /\n")
+
+
+def test_plots_take_the_balances_e0(ropedyn_exe, tmp_path, monkeypatch):
+    """A run started from a record of another (&initial shape = 'state') carries the energy
+    dissipated and the work done before into its balance: E0 = T + V + dissipated - work at
+    its first record, as `ropedyn run` prints it. The energy plot, the overview and the
+    animation's panel draw against that E0 (T + V at the first record, which they took
+    before, is off by what was dissipated and done before: the balance started off zero)."""
+    import matplotlib.pyplot as plt
+    from ropedyn import animate, plot
+    from ropedyn.plot import energy, overview
+
+    ropedyn(ropedyn_exe, tmp_path, DAMPED_SHAKEN, "whole")
+    scene = tmp_path / "branch.nml"
+    scene.write_text(DAMPED_SHAKEN + "&initial shape = 'state', state_file = 'whole.h5', "
+                     "state_time = 0.1 /\n")
+    result = subprocess.run([str(ropedyn_exe), "run", str(scene), "--set",
+                             "output.file='branch.h5'"], capture_output=True, text=True,
+                            timeout=300, cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    printed = float(re.search(r"^ +E0 +(\S+) J$", result.stdout, re.M).group(1))
+    run = io.load_run(tmp_path / "branch.h5")
+    e = run.energy
+    e0 = e["total"][0] + e["dissipated"][0] - e["support_work"][0]
+    assert e["dissipated"][0] > 1e-5 and abs(e["support_work"][0]) > 1e-5, e
+    assert abs(e0 - printed) <= 5e-6 * abs(e0)          # printed to 6 digits
+
+    def start_of(ax, label):
+        """E0 as the curve `label` (total - E0) of `ax` has it."""
+        (line,) = [line for line in ax.lines if line.get_label() == label]
+        return e["total"][0] - line.get_ydata()[0]
+
+    figures = []
+    monkeypatch.setattr(plot, "save_figure", lambda fig, *args, **kw: figures.append(fig))
+    assert energy.main([str(run.path), "-o", str(tmp_path / "energy.png")]) == 0
+    ax, bx = figures[0].axes
+    assert abs(start_of(ax, "total E - E0 = T + V - E0") - e0) <= 1e-12
+    assert abs(bx.lines[0].get_ydata()[0]) <= 1e-12     # the balance error starts at 0
+    fig, (left, right) = plt.subplots(1, 2)
+    overview.plot_energies(left, run)
+    animate.energy_panel(right, run)
+    assert abs(start_of(left, "total - E0") - e0) <= 1e-12
+    assert abs(start_of(right, "total - E0") - e0) <= 1e-12
+    plt.close("all")
 
 
 SHAKEN_GROUND = ("&model kind = '{kind}', elements = 5 /\n"

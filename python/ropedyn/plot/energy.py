@@ -26,8 +26,8 @@ def main(argv=None):
 
     run = io.load_run(args.run)
     t, e = run.time, run.energy
-    e0 = e["total"][0]
-    balance = e["total"] + e["dissipated"] - e["support_work"] - e0
+    e0 = run.e0
+    balance = run.balance - e0
 
     fig, (ax, bx) = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True,
                                  gridspec_kw={"height_ratios": [3, 1]})

@@ -30,7 +30,7 @@ def plot_energies(ax, run):
     ax.plot(t, e["elastic"], lw=1, label="elastic")
     if "dissipated" in e:
         ax.plot(t, e["dissipated"], lw=1, ls="--", label="dissipated")
-    ax.plot(t, e["total"] - e["total"][0], "k", lw=1.4, label="total - E0")
+    ax.plot(t, e["total"] - run.e0, "k", lw=1.4, label="total - E0")
     ax.set_xlabel("t (s)")
     ax.set_ylabel("energy (J)")
     ax.set_title("energies", fontsize=10)
