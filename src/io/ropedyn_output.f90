@@ -114,6 +114,9 @@ module ropedyn_output
         '/supports/bottom/reaction', '/supports/top/position', '/supports/bottom/position']
     character(len=*), parameter :: FORCE_UNITS(N_FORCE_SERIES) = [character(len=3) :: 'N', &
         'N', 'N m', 'N', 'N', 'm', 'm']
+    !> Their columns: none for the joints' series, x and y for the supports'
+    character(len=*), parameter :: FORCE_COLUMNS(N_FORCE_SERIES) = [character(len=4) :: '', &
+        '', '', 'x, y', 'x, y', 'x, y', 'x, y']
     !> (FORCE_DESCRIPTION's length holds the longest text: an array constructor with a
     !! length cuts a longer one without a word; tests/e2e/test_internal_forces.py checks)
     character(len=*), parameter :: FORCE_FRAME = ' (frame: rfem, the element above the '// &
@@ -554,7 +557,8 @@ contains
             call file%write(trim(FORCE_NAME(k)), reshape(values(1:m, k), [m, 1]), &
                             trim(FORCE_UNITS(k)), err, trim(FORCE_DESCRIPTION(k)))
             if (allocated(err)) return
-            if (k > N_JOINT_SERIES) call file%attribute(trim(FORCE_NAME(k)), 'columns', 'x, y', err)
+            if (len_trim(FORCE_COLUMNS(k)) > 0) &
+                call file%attribute(trim(FORCE_NAME(k)), 'columns', trim(FORCE_COLUMNS(k)), err)
             if (allocated(err)) return
         end do
     end subroutine write_forces
@@ -598,7 +602,7 @@ contains
             call self%file%create_series(self%force(k), trim(FORCE_NAME(k)), &
                                          [int(force_record_size(k, self%n_elements), hsize_t)], &
                                          .false., trim(FORCE_UNITS(k)), &
-                                         trim(merge('    ', 'x, y', k <= N_JOINT_SERIES)), err)
+                                         trim(FORCE_COLUMNS(k)), err)
             if (allocated(err)) return
             call self%file%attribute(trim(FORCE_NAME(k)), 'description', &
                                      trim(FORCE_DESCRIPTION(k)), err)
