@@ -28,7 +28,8 @@ module ropedyn_integrator
     public :: integrator_t, start_t, solver_options_t, solver_stats_t, MAX_ORDER_LIMIT, &
         STIFF_STEP_RATE
     public :: stop_query_i, stop_now, steps_to_end, budget_covering, last_warning, &
-        exceeded_text, integrator_budget_shortfall, default_step_budget, error_weights
+        exceeded_text, integrator_budget_shortfall, default_step_budget, error_weights, &
+        budget_left
     public :: DEFAULT_RTOL, DEFAULT_ATOL, DEFAULT_MAX_STEPS, BUDGET_STEP_RATE
 
     !> The defaults of the options every method shares; the scene's &solver keys take
@@ -60,7 +61,20 @@ module ropedyn_integrator
         !! replace `atol` for the state (quadratures keep `atol`)
         real(wp), allocatable :: atol_vector(:)
         integer :: max_order = 0             !< highest order of accuracy (0: method default)
-        integer(i8) :: max_steps = DEFAULT_MAX_STEPS  !< step budget for the whole run
+        !> step budget of this integrator: the whole run's, or what is left of it to an
+        !! integrator started within the run (budget_left)
+        integer(i8) :: max_steps = DEFAULT_MAX_STEPS
+        !> what a message about a spent budget names (steps_exhausted): the budget of the
+        !! whole run or simulation this integration is part of (0: max_steps), and the steps
+        !! counted against it before this integrator started (an integrator started again
+        !! within the run: a library simulation's restore, the order safety's second look;
+        !! budget_left sets the three)
+        integer(i8) :: whole_budget = 0
+        integer(i8) :: steps_before = 0
+        !> the caller drives the integration advance by advance (a library simulation):
+        !! t_end is the scene's, not where the integration ends, so a message about the
+        !! budget speaks of the simulation instead of the rest of a run
+        logical :: driven = .false.
         logical :: fd_jacobian = .false.     !< difference f even if the problem has a Jacobian
         !> CVODE's BDF stability-limit detection (order reduction when a lightly damped
         !! oscillatory mode nears the stability boundary); other methods reject .true.
@@ -286,11 +300,13 @@ contains
         allocate (events(0))
     end function integrator_switch_log
 
-    !> The cause of a run that ran out of its step budget at time t: the budget, what the
-    !! rest of the run takes at the last step size (when the end is known), and, when the
-    !! integrator's own log diagnosed something on the way (its last warning: cvode's
-    !! lightly damped stiff modes, with the methods that avoid them), that diagnosis, so
-    !! that the message names the cause and the cure.
+    !> The cause of a run that ran out of its step budget at time t: the budget (the whole
+    !! run's or simulation's, not what was left of it to this integrator), what the rest of
+    !! the run takes at the last step size (when the end is known), or in a simulation its
+    !! steps so far and how to raise the budget; and, when the integrator's own log
+    !! diagnosed something on the way (its last warning: cvode's lightly damped stiff modes,
+    !! with the methods that avoid them), that diagnosis, so that the message names the
+    !! cause and the cure.
     function integrator_steps_exhausted(self, t) result(cause)
         class(integrator_t), intent(in) :: self
         real(wp), intent(in) :: t
@@ -298,13 +314,21 @@ contains
         type(solver_stats_t) :: stats
         integer(i8) :: rest
         real(wp) :: h
-        cause = exceeded_text(self%options%max_steps)
         stats = self%stats()
-        h = stats%last_step
-        rest = steps_to_end(t, self%options%t_end, h)
-        if (rest > 0) cause = cause//'; at the size of the last accepted step ('// &
-            significant_text(h, 3)//' s) the rest of the run, to t = '// &
-            real_text(self%options%t_end)//' s, takes about '//int_text(rest)//' steps more'
+        cause = exceeded_text(whole_budget(self%options))
+        if (self%options%driven) then
+            cause = cause//': the budget of the whole simulation, which has taken '// &
+                int_text(self%options%steps_before + stats%steps)//' steps since it '// &
+                'started (those before a restore too); a simulation that goes on longer '// &
+                'needs a larger solver.max_steps in its scene'
+        else
+            h = stats%last_step
+            rest = steps_to_end(t, self%options%t_end, h)
+            if (rest > 0) cause = cause//'; at the size of the last accepted step ('// &
+                significant_text(h, 3)//' s) the rest of the run, to t = '// &
+                real_text(self%options%t_end)//' s, takes about '//int_text(rest)// &
+                ' steps more'
+        end if
         cause = cause//last_warning(self%switch_log())
     end function integrator_steps_exhausted
 
@@ -332,6 +356,27 @@ contains
         character(len=:), allocatable :: why
         why = ''
     end function integrator_refusal
+
+    !> The options of an integrator that goes on within the step budget of `outer` after
+    !! `used` steps counted against it (by integrators before it in the run, or in a method
+    !! made of others): what is left of it (at least one step) as its max_steps, and the
+    !! whole budget and the steps before for its messages.
+    function budget_left(outer, used) result(options)
+        type(solver_options_t), intent(in) :: outer
+        integer(i8), intent(in) :: used
+        type(solver_options_t) :: options
+        options = outer
+        options%max_steps = max(1_i8, outer%max_steps - used)
+        options%whole_budget = whole_budget(outer)
+        options%steps_before = outer%steps_before + used
+    end function budget_left
+
+    !> The budget of the whole run or simulation `options` is part of (solver_options_t).
+    pure integer(i8) function whole_budget(options) result(budget)
+        type(solver_options_t), intent(in) :: options
+        budget = options%whole_budget
+        if (budget <= 0) budget = options%max_steps
+    end function whole_budget
 
     !> 'max_steps exceeded (N steps)': how a message says that a budget of N steps ran out.
     pure function exceeded_text(max_steps) result(text)

@@ -53,7 +53,7 @@ module ropedyn_auto
     use ropedyn_text, only: int_text, real_text, significant_text
     use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, &
                                   BUDGET_STEP_RATE, stop_now, steps_to_end, budget_covering, &
-                                  last_warning, exceeded_text, error_weights
+                                  last_warning, budget_left, error_weights
     use ropedyn_erk, only: erk_t
     use ropedyn_mebdf, only: mebdf_t
     use ropedyn_cvode, only: cvode_t, adams_t
@@ -346,8 +346,7 @@ contains
             call self%sym_past%add_all(self%sym%switch_log())
             call self%sym%finalize()
         end if
-        opts = self%options
-        opts%max_steps = max(1_i8, self%options%max_steps - self%done%steps)
+        opts = budget_left(self%options, self%done%steps)
         if (which == EXPLICIT) then
             opts%max_order = ERK_ORDER
             call self%erk%init(self%problem, self%t, self%y, self%yq, opts, err)
@@ -548,18 +547,12 @@ contains
                                'method for the rest of the run', err, warn=.true.)
     end subroutine leave_symplectic
 
-    !> The message of a method that spent the budget auto left it: with the run's own
-    !! budget in place of what was left of it, and auto's own diagnosis (the symplectic
-    !! method left out) at the end.
+    !> The message of a method that spent the budget auto left it (which names the run's
+    !! own budget: budget_left), with auto's own diagnosis (the symplectic method left out)
+    !! at the end.
     subroutine budget_spent(self, message)
         class(auto_t), intent(inout) :: self
         character(len=:), allocatable, intent(inout) :: message
-        character(len=:), allocatable :: part
-        integer :: k
-        part = exceeded_text(max(1_i8, self%options%max_steps - self%done%steps))
-        k = index(message, part)
-        if (k > 0) message = message(:k - 1)//exceeded_text(self%options%max_steps)// &
-                             message(k + len(part):)
         message = message//last_warning(self%log%items())
     end subroutine budget_spent
 

@@ -91,9 +91,8 @@ contains
             type(error_t), allocatable :: err
             real(wp), allocatable :: yq(:)
             real(wp) :: t, t1
-            opts = self%options
             used = self%stats()
-            opts%max_steps = max(1_i8, self%options%max_steps - used%steps)
+            opts = budget_left(self%options, used%steps)
             opts%max_order = 4
             y = self%y
             yq = self%yq

@@ -43,7 +43,7 @@ module ropedyn_run
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_support_motion, only: support_motion_t
     use ropedyn_integrator, only: integrator_t, solver_options_t, solver_stats_t, &
-                                  stop_query_i
+                                  stop_query_i, budget_left
     use ropedyn_clock, only: clock_seconds
     use ropedyn_model_factory, only: create_model
     use ropedyn_scene, only: scene_t, scene_namelist_text
@@ -195,6 +195,7 @@ module ropedyn_run
         procedure :: restore => run_restore
         procedure, private :: restart
         procedure, private :: fresh_start, output_time, start_integrator, record, &
+                              integrator_options, &
                               steps_taken, keep_as_previous, asked_to_stop, end_on, &
                               start_monitor
         procedure, private :: resume_from_file, check_energy, second_look, note_peak, &
@@ -543,13 +544,24 @@ contains
         class(run_t), intent(inout) :: self
         type(error_t), allocatable, intent(out) :: err
         type(solver_options_t) :: options
-        options = solver_options_of(self%scene)
-        options%stop_requested => self%stop_requested
+        options = self%integrator_options(self%stats_before%steps)
         options%max_order = self%max_order
-        options%max_steps = max(1_i8, options%max_steps - self%stats_before%steps)
         call self%integrator%init(self%model, self%t, self%y, self%yq(1:self%nq), options, err)
         self%steps_mark = 0
     end subroutine start_integrator
+
+    !> The scene's solver options for an integrator of this run that starts after `used`
+    !! steps counted against the run's budget (what is left of it, and the whole budget
+    !! and the steps before for its messages: budget_left), stopping when the driver asks;
+    !! a run without output (the library's simulation) is driven by its caller.
+    function integrator_options(self, used) result(options)
+        class(run_t), intent(in) :: self
+        integer(i8), intent(in) :: used
+        type(solver_options_t) :: options
+        options = budget_left(solver_options_of(self%scene), used)
+        options%stop_requested => self%stop_requested
+        options%driven = self%output == OUTPUT_NONE
+    end function integrator_options
 
     !> Integrate to the next output time, let the order safety look, and record it (see
     !! the module header for the outcomes).

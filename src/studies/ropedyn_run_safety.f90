@@ -121,8 +121,7 @@ contains
         yq_safe = self%yq_prev
         call create_integrator(self%scene, safe, err)
         if (allocated(err)) return
-        options = solver_options_of(self%scene)
-        options%stop_requested => self%stop_requested
+        options = self%integrator_options(self%stats_before%steps + self%steps_taken())
         options%max_order = self%safe_order
         options%max_steps = max(1_i8, budget)
         call safe%init(self%model, t_safe, y_safe, yq_safe(1:self%nq), options, err)
@@ -138,7 +137,8 @@ contains
             if (action == LOOK_LOWER) call self%summary%safety%lowered(self%t_prev, &
                 self%max_order, self%safe_order)
             call self%retire_integrator(safe)
-            ! the whole budget that is left, no longer the second look's
+            ! the whole budget that is left, no longer the second look's (the steps before
+            ! it, the retired integrator's included, are those it started after)
             self%integrator%options%max_steps = max(1_i8, max_steps - self%stats_before%steps)
             self%max_order = self%safe_order
             self%t = t_safe

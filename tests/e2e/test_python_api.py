@@ -172,6 +172,34 @@ def test_failed_advance_raises_the_cli_message(run, tmp_path):
     assert error.value.code == 3 and error.value.run.status == "failed"
 
 
+def test_a_spent_budget_speaks_of_the_simulation(run, tmp_path):
+    """A Simulation's step budget is the scene's max_steps for all its advances: when it is
+    spent, the message names that budget, the steps taken since the start (those before a
+    restore too: the one step a restore of a spent budget still allows makes 41) and the
+    key to raise, not the rest of a run to t_end, which a simulation does not have. The
+    command line's run of the scene keeps its message."""
+    scene = small(n=8, t_end=0.5).set("solver.max_steps", 40)
+    path = scene.write(tmp_path / "budget.nml")
+    message, code = cli_error(run, path, "--set", "output.file=b.h5")
+    assert code == 3 and "max_steps exceeded (40 steps); at the size of the last " \
+        "accepted step" in message and "the rest of the run, to t = 0.5 s" in message, message
+    messages = []
+    with ropedyn.Simulation(scene) as sim:
+        snap = sim.save()
+        for _ in range(2):
+            with pytest.raises(ropedyn.Error) as error:
+                sim.advance(0.5)
+            assert error.value.code == 3, error.value.message
+            messages.append(error.value.message)
+            sim.restore(snap)
+    for text, steps in zip(messages, (40, 41)):
+        assert f"max_steps exceeded (40 steps): the budget of the whole simulation, which " \
+            f"has taken {steps} steps since it started (those before a restore too); a " \
+            "simulation that goes on longer needs a larger solver.max_steps in its scene" \
+            in text, text
+        assert "rest of the run" not in text and "0.5 s" not in text, text
+
+
 def test_a_runaway_fails_the_advance_where_the_run_fails(run, tmp_path):
     """erk at rtol 0.3 on the paper's rope creates energy; the command line's run fails at
     the runaway (docs/theory/energy-balance.md, "A runaway ends the run"). A Simulation

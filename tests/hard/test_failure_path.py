@@ -16,6 +16,7 @@ from ropedyn_tools.studies import stability_metrics
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 PAPER = ROOT / "input" / "paper.nml"
 STEEL = ROOT / "input" / "hard" / "steel_wire.nml"
+LIGHT = ROOT / "input" / "paper_light_damping.nml"
 T_FAULT = 0.1234  # s, between two output times (0.12, 0.13)
 DT = 0.01
 MODELS = {"rfem": ["model.kind=rfem", "model.elements=10"],
@@ -39,6 +40,10 @@ def runs(run_many, tmp_path_factory):
     # the budget spent after cvode's own log diagnosed lightly damped stiff modes
     jobs["budget_diagnosed_cvode"] = (STEEL, ["solver.method=cvode", "solver.rtol=1e-7",
                                               "solver.atol=1e-9", "solver.max_steps=150000"])
+    # the budget spent after the order safety started cvode again at its safe order
+    jobs["budget_lowered_cvode"] = (LIGHT, ["solver.method=cvode", "solver.max_order=3",
+                                            "solver.energy_gain_bound=0.1", "solver.t_end=3",
+                                            "model.elements=10", "solver.max_steps=60000"])
     jobs["budget_erk"] = (PAPER, ["solver.method=erk", "model.elements=10",
                                   "solver.t_end=0.05", "solver.max_steps=30"])
     jobs["budget_symplectic"] = (PAPER, BUDGET_SYMPLECTIC + ["solver.max_steps=30"])
@@ -130,6 +135,22 @@ def test_step_budget_exhausted_explicit(runs, ropedyn_exe):
     assert m and int(m.group(1)) > 30, proc.stderr
     assert re.search(r" --set solver\.max_steps=(\d+)$", rest), rest
     resume_as_told(ropedyn_exe, path, rest)
+
+
+def test_step_budget_after_a_restart_names_the_whole_budget(runs):
+    """The order safety lowers cvode's order at 0.7 s, starting it again with what is left
+    of the budget: when that runs out, the message names the run's budget (it named what
+    was left, 47749 steps), which the run has taken."""
+    proc, path = runs["budget_lowered_cvode"]
+    assert proc.returncode == 3, proc.stderr
+    # (after the scene's warning on the damping ratio of 10 elements)
+    message = proc.stderr.strip().splitlines()[-1]
+    assert message.startswith("ropedyn: error: cvode failed at t = ") and \
+        "max_steps exceeded (60000 steps); at the size of the last accepted step" in message, \
+        message
+    with h5py.File(path, "r") as f:
+        assert f["solver/order_lowered_at"][()] == pytest.approx(0.7)
+        assert f["solver/steps"][()] == 60000
 
 
 def test_symplectic_says_at_once_that_the_budget_is_short(runs, ropedyn_exe, tmp_path):
