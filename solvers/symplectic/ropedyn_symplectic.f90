@@ -150,6 +150,7 @@ module ropedyn_symplectic
         procedure :: step_size => symplectic_step_size
         procedure :: fix_step => symplectic_fix_step
         procedure :: budget_shortfall => symplectic_budget_shortfall
+        procedure, private :: steps_left => symplectic_steps_left
         procedure :: failed_fatally => symplectic_failed_fatally
         procedure :: refusal => symplectic_refusal
         procedure, private :: begin
@@ -649,8 +650,19 @@ contains
         real(wp), intent(in) :: t
         integer(i8) :: rest
         rest = integrator_budget_shortfall(self, t)
-        if (self%budget_short) rest = max(1_i8, steps_to_end(t, self%options%t_end, self%h_rule))
+        if (self%budget_short) rest = max(1_i8, self%steps_left(t))
     end function symplectic_budget_shortfall
+
+    !> The steps from t to options%t_end at the step in use: the rule's, shortened so that an
+    !! output interval is a whole number of steps (set_step; an interval of m rule steps and
+    !! a fraction takes m + 1). That is what the run takes when its outputs are evenly spaced
+    !! and t_end is on them (the rounding of the fit adds no step there); the count at the
+    !! rule's step is short by up to one step an interval.
+    integer(i8) function symplectic_steps_left(self, t) result(steps)
+        class(symplectic_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        steps = steps_to_end(t, self%options%t_end, self%h*(1.0_wp + 1.0e-12_wp))
+    end function symplectic_steps_left
 
     !> The run ended because the forces reported a fatal error (not for want of steps, nor
     !! at a step that was unstable or too short): no other method can go on from there.
