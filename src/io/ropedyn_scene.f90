@@ -215,11 +215,14 @@ contains
             end do
         end do
         scene%solver%method_origin = scene%path
+        scene%output%file_origin = scene%path
         do i = 1, size(keys)
             if (keys(i)%group == group_index('output') .and. keys(i)%name == 'progress') &
                 scene%output%progress_given = keys(i)%given
             if (keys(i)%group == group_index('solver') .and. keys(i)%name == 'method' .and. &
                 allocated(keys(i)%origin)) scene%solver%method_origin = keys(i)%origin
+            if (keys(i)%group == group_index('output') .and. keys(i)%name == 'file' .and. &
+                allocated(keys(i)%origin)) scene%output%file_origin = keys(i)%origin
         end do
         call check_scene(keys, scene, err)
     end subroutine store_scene

@@ -52,6 +52,10 @@ module ropedyn_scene_types
         !! is a terminal)
         logical :: progress = .false.
         logical :: progress_given = .false.   !< the file or a --set gives `progress`
+        !> where `file` was set, for messages: the scene file or the `--set` argument (the
+        !! scene's path when neither set it: the default); '' when the caller named the file
+        !! instead (the library's whole run)
+        character(len=:), allocatable :: file_origin
     end type output_params_t
 
     !> A complete scene: the rope models' parameters (the parent `rope_spec_t`, whose

@@ -268,6 +268,7 @@ contains
                 return
             end if
             scene%output%file = output
+            scene%output%file_origin = ''   ! (named by the caller, not by a key)
             call run%open(scene, err)
         else
             call run%open(scene, err, output=OUTPUT_MEMORY, name=name)

@@ -21,6 +21,7 @@ submodule (ropedyn_run) ropedyn_run_guard
     use ropedyn_run_inputs, only: check_not_input, check_may_replace
     use ropedyn_error, only: ERR_USAGE, ERR_IO
     use ropedyn_text, only: replaced
+    use ropedyn_scene_types, only: output_params_t
     implicit none
 
     !> The longest name of a file in a directory (Linux's NAME_MAX).
@@ -39,8 +40,8 @@ contains
             call make_parent_dirs(file, err)
             if (allocated(err)) return
             if (len(special_file_reason(file)) > 0) then
-                call make_error(err, ERR_USAGE, file//': exists and is '// &
-                    special_file_reason(file)//': not replaced')
+                call make_error(err, ERR_USAGE, output_key(self%scene%output, file)// &
+                    ': exists and is '//special_file_reason(file)//': not replaced')
                 return
             end if
             ! a link: the file it points to (written there, renamed there)
@@ -90,6 +91,19 @@ contains
         self%part_file = file//'.part'
         self%summary%file = self%part_file
     end procedure guard_output
+
+    !> The run's output `file` as the input that named it, for a message that refuses it:
+    !! 'ORIGIN: &output: file = "FILE"' (ORIGIN: the scene file or the --set argument that
+    !! set it), or FILE alone when the caller named it (no origin: the library's whole run).
+    function output_key(output, file) result(text)
+        type(output_params_t), intent(in) :: output
+        character(len=*), intent(in) :: file
+        character(len=:), allocatable :: text
+        text = file
+        if (.not. allocated(output%file_origin)) return
+        if (len(output%file_origin) > 0) &
+            text = output%file_origin//': &output: file = "'//file//'"'
+    end function output_key
 
     module procedure release_output
         type(error_t), allocatable :: rerr

@@ -234,7 +234,8 @@ def test_resume_at_velocity_1e50_ends_on_sigterm(ropedyn_exe, work):
 def test_output_link_to_a_device_is_refused(ropedyn_exe, work):
     (work / "null.h5").symlink_to("/dev/null")
     refused(ropedyn_exe, work, ["run", "s.nml", "--set", "output.file=null.h5"], 2,
-            "null.h5: exists and is a character device, not a regular file: not replaced")
+            'output.file=null.h5: &output: file = "null.h5": exists and is a character '
+            "device, not a regular file: not replaced")
 
 
 def test_output_held_by_a_reader_is_not_truncated(ropedyn_exe, work):

@@ -81,6 +81,30 @@ def test_an_input_is_never_the_output(run, tmp_path, scene):
     assert {p: digest(p) for p in before} == before
 
 
+def test_an_output_that_is_a_directory_names_its_key(run, tmp_path, scene):
+    """An output path that is a directory (or a device) is bad input of &output file: the
+    message names where the key was set (the scene file or the --set argument), the group,
+    the key and the value, with exit code 2 as the other refusals of an output; the
+    directory stays as it was."""
+    (tmp_path / "somedir").mkdir()
+    (tmp_path / "somedir" / "kept.txt").write_text("kept\n")
+    reason = ': &output: file = "somedir": exists and is a directory, not a file: not replaced'
+    proc = run("run", scene, "--set", "output.file=somedir", "--set", "solver.t_end=0.01")
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.strip() == f"ropedyn: error: --set output.file=somedir{reason}"
+    given = tmp_path / "given.nml"
+    given.write_text(scene.read_text().replace("'out/paper.h5'", "'somedir'"))
+    proc = run("run", given, "--set", "solver.t_end=0.01")
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.strip() == f"ropedyn: error: {given}{reason}"
+    assert [p.name for p in (tmp_path / "somedir").iterdir()] == ["kept.txt"]
+    (tmp_path / "null.h5").symlink_to("/dev/null")
+    proc = run("run", given, "--set", "output.file=null.h5", "--set", "solver.t_end=0.01")
+    assert proc.returncode == 2, proc.stderr
+    assert '--set output.file=null.h5: &output: file = "null.h5": exists and is a ' \
+        "character device" in proc.stderr, proc.stderr
+
+
 def long_run(ropedyn_exe, cwd, scene, *extra):
     return subprocess.Popen([str(ropedyn_exe), "run", str(scene), "--set", "solver.t_end=30",
                              "--set", "model.elements=60", "--set", "output.progress=.false.",
