@@ -21,7 +21,6 @@ submodule (ropedyn_run) ropedyn_run_guard
     use ropedyn_run_inputs, only: check_not_input, check_may_replace
     use ropedyn_error, only: ERR_USAGE, ERR_IO
     use ropedyn_text, only: replaced
-    use ropedyn_scene_types, only: output_params_t
     implicit none
 
     !> The longest name of a file in a directory (Linux's NAME_MAX).
@@ -40,7 +39,7 @@ contains
             call make_parent_dirs(file, err)
             if (allocated(err)) return
             if (len(special_file_reason(file)) > 0) then
-                call make_error(err, ERR_USAGE, output_key(self%scene%output, file)// &
+                call make_error(err, ERR_USAGE, output_key(self%scene, file)// &
                     ': exists and is '//special_file_reason(file)//': not replaced')
                 return
             end if
@@ -92,17 +91,18 @@ contains
         self%summary%file = self%part_file
     end procedure guard_output
 
-    !> The run's output `file` as the input that named it, for a message that refuses it:
-    !! 'ORIGIN: &output: file = "FILE"' (ORIGIN: the scene file or the --set argument that
-    !! set it), or FILE alone when the caller named it (no origin: the library's whole run).
-    function output_key(output, file) result(text)
-        type(output_params_t), intent(in) :: output
+    !> The output `file` of a run of `scene` as the input that named it, for a message that
+    !! refuses it: 'ORIGIN: &output: file = "FILE"' (ORIGIN: the scene file or the --set
+    !! argument that set it), or FILE alone when the caller named it (no origin: the
+    !! library's whole run).
+    function output_key(scene, file) result(text)
+        type(scene_t), intent(in) :: scene
         character(len=*), intent(in) :: file
         character(len=:), allocatable :: text
         text = file
-        if (.not. allocated(output%file_origin)) return
-        if (len(output%file_origin) > 0) &
-            text = output%file_origin//': &output: file = "'//file//'"'
+        if (.not. allocated(scene%output%file_origin)) return
+        if (len(scene%output%file_origin) > 0) &
+            text = scene%output%file_origin//': &output: file = "'//file//'"'
     end function output_key
 
     module procedure release_output
