@@ -260,8 +260,9 @@ contains
 
     !> ainv = a^{-1} = adj(a)/det(a) (the cofactors written out); ok = .false. when det(a)
     !! is zero or the inverse is not finite. Each cofactor and each term of det takes one
-    !! entry from each of the rows involved, so scaling a row (the rope's rotational rows are
-    !! some 1e-4 of its translational ones) scales them exactly and costs no accuracy: the
+    !! entry from each of the rows involved, so scaling a row (the rope's rotational and
+    !! translational rows differ by orders of magnitude, e.g. about 6/dl in the neighbours'
+    !! translation columns) scales them exactly and costs no accuracy: the
     !! result is as good as for the equilibrated block. It is a short chain of operations
     !! with no branch, where the factorization spent its time in Gauss-Jordan's pivot
     !! searches and row exchanges, block after dependent block.

@@ -17,8 +17,9 @@
 !!   growth at most 5x (1x right after a rejection), reduction at most 10x.
 !! - **Quadratures** (dissipated energy, support work) are integrated by the same pair
 !!   from their right-hand side g at every stage, yq += h sum b_i g_i, with its error
-!!   estimate h sum e_i g_i in the error test (weights rtol |yq| + atol, the norm the
-!!   larger of the state's and the quadratures'), as CVODE does with its quadratures.
+!!   estimate h sum e_i g_i in the error test (weights rtol max(|yq|, |yq + dq|) + atol,
+!!   the norm the larger of the state's and the quadratures'), as CVODE does with its
+!!   quadratures.
 !!   The quadratures are then the pair's solution of the augmented system, so the
 !!   energy balance T + V + dissipated = E0 holds to the pair's accuracy even where g is
 !!   rough (impacts, stick-slip), where g at the step points alone aliases the

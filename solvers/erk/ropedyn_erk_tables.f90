@@ -135,9 +135,10 @@ contains
     !! cvode at the same rtol is within 6.6e-5 m, and tightening to 1e-10 still left
     !! 2.6e-5 m. With this pair: 1.9e-5 m at rtol 1e-6, 1.9e-6 m at 1e-8.
     !!
-    !! s = 0.15: the norm of the embedded solution's 4th-order error coefficients, s (1/18,
-    !! 1/12, 0, 1/12) for the trees t^3, t (t t), (t^2), ((t)), is then that of the
-    !! classical pair, (0, 0, 1/72, 1/72), so steps on smooth motion stay as long
+    !! s = 0.15: the norm of the embedded solution's 4th-order error coefficients,
+    !! -(sum e c^3, sum e c (A c), sum e A c^2, sum e A^2 c) = s (1/18, 1/12, 0, -1/12), is
+    !! then that of the classical pair, (0, 0, 1/72, -1/72) (docs/theory/erk.md), so steps
+    !! on smooth motion stay as long
     !! (scripts/auto_table: every scene within the noise of the classical pair's CPU).
     pure function rk4_fsal() result(tab)
         type(erk_table_t) :: tab
