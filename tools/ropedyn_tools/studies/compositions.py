@@ -16,9 +16,12 @@ abar_ij = b_j (c_i - c_j), j < i). For each composition:
 - **error constant**: the norm of the residuals of the six order-5 conditions (the leading
   local error of a 4th-order method on a nonlinear problem);
 - **stability**: the one-step matrix on the oscillator q'' = -w^2 q is a polynomial matrix
-  in x = h w; the method is stable where |trace| <= 2. The first x where it is not (scanned
-  in steps of 1e-5 up to 8, so that narrow gaps are found) is the limit X; the unstable
-  intervals below 8 are listed;
+  in x = h w with determinant 1; the method is stable where |trace| <= 2, and its
+  eigenvalues' largest modulus is (|trace| + sqrt(trace^2 - 4))/2 where it is not. The first
+  x where that modulus exceeds 1 + 1e-10 (scanned in steps of 1e-5 up to 8, so that narrow
+  gaps are found; a threshold on the trace itself would see a trace that leaves -2
+  tangentially, as Chin's does at 2 sqrt 3, only some 1e-3 later) is the limit X; the
+  unstable intervals below 8 are listed;
 - **the resonance-safe step**: S X, S = RESONANT_SAFETY of ropedyn_symplectic (what it takes
   where the fast modes are lightly damped: their combinations reach twice the fastest
   frequency, which must stay inside the stable interval with a margin), and at it the
@@ -137,7 +140,9 @@ def one_step(a, b, x, grad=None):
 def unstable_intervals(a, b, grad=None):
     x = np.arange(DX, XMAX, DX)
     m11, _, _, m22 = one_step(a, b, x, grad)
-    bad = np.abs(m11 + m22) > 2.0 * (1.0 + 1e-10)
+    trace = np.abs(m11 + m22)
+    radius = 0.5 * (trace + np.sqrt(np.maximum(trace * trace - 4.0, 0.0)))
+    bad = radius > 1.0 + 1e-10
     idx = np.nonzero(bad)[0]
     if not len(idx):
         return []
