@@ -183,7 +183,7 @@ def main(argv=None):
              f"process CPU ('> cap' when it needs more), 'failed': it ended with its "
              f"diagnosis. CPU: /solver/cpu_time, minimum "
              f"of {args.repeat} runs. Machine: {machine()}. Run: {run_stamp()}.", "",
-             header, "|" + "---|" * (11 + len(FIXED)), *rows, END]
+             header, "|" + "---|" * (10 + len(FIXED)), *rows, END]
     update_doc(DOCS / "performance" / "auto.md", BEGIN, END, "\n".join(lines),
                heading="## Auto's choice at equal accuracy (issue 15)\n\n")
     print(f"auto_accuracy: {DOCS / 'performance' / 'auto.md'}")

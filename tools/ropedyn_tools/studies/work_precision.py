@@ -475,8 +475,9 @@ def write_outputs(args, models, methods, orders, rtols, ref_rtol, rows, refs, hz
             b.append(f"![work-precision {name[8:-4]}](../figures/{name})")
             b.append("")
     b.append(f"**CPU time (s) at tip L2 error {args.target:.0e} m** (log-log interpolation "
-             "along each line; ≤: even the loosest rtol is more accurate, the value is that "
-             "run's CPU time, an upper bound, drawn as an open triangle; – : the line does not "
+             "along each line; ≤: even the loosest rtol is more accurate, the value is the "
+             "CPU time of the line's cheapest run, an upper bound, drawn as an open triangle; "
+             "– : the line does not "
              "reach that accuracy) — the paper's Figure 4:")
     b.append("")
     b.append("![cost versus n](../figures/rope_cost_vs_n.png)")
