@@ -40,15 +40,14 @@ contains
     !> The run ends at once (ERR_SOLVER) when its rest, to options%t_end, takes more steps at
     !! the step rule than the step budget has left. The step is fixed between estimates of
     !! the spectrum, so the method knows this now: it says so at the start (or where the step
-    !! shortens), with the budget that reaches the end, not when the budget runs out. The
-    !! message counts the steps at the step in use, the rule's fitted to the output interval
-    !! (steps_left), which the run takes.
+    !! shortens), with the budget that reaches the end, not when the budget runs out. It
+    !! counts the steps at the step in use, the rule's fitted to the output interval
+    !! (steps_left), which the run takes (never fewer than at the rule's step).
     module procedure budget_reaches_end
         integer(i8) :: rest, left
-        rest = steps_to_end(self%t, self%options%t_end, self%h_rule)
+        rest = max(steps_to_end(self%t, self%options%t_end, self%h_rule), self%steps_left(self%t))
         left = self%options%max_steps - self%counters%steps
         if (rest <= left) return
-        rest = max(rest, self%steps_left(self%t))
         self%budget_short = .true.
         call self%failure(err, 'the rest of the run, to t = '//real_text(self%options%t_end)// &
             ' s, takes about '//int_text(rest)//' steps of '//significant_text(self%h, 3)// &

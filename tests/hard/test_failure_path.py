@@ -178,6 +178,17 @@ def test_symplectic_says_at_once_that_the_budget_is_short(runs, ropedyn_exe, tmp
     # the count it said: at its step fitted to the output interval (t_end is on the
     # outputs), not at the rule's step before the fit (113 of the 115 steps)
     assert steps == needed, (steps, needed)
+    # a budget one step short of that (more than the count at the rule's step) is refused
+    # at the start too, not spent part of the way
+    short = tmp_path / "short.h5"
+    one_short = subprocess.run([str(ropedyn_exe), "run", str(PAPER), "--set",
+                                f"output.file={short}",
+                                *sum((["--set", s] for s in BUDGET_SYMPLECTIC), []),
+                                "--set", f"solver.max_steps={needed - 1}"],
+                               capture_output=True, text=True, timeout=600)
+    assert one_short.returncode == 3, one_short.stderr
+    assert f"takes about {needed} steps" in one_short.stderr, one_short.stderr
+    assert stability_metrics.analyse(short)["steps"] == 0
     resume_as_told(ropedyn_exe, path, rest)
 
 
