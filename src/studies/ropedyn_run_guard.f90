@@ -29,13 +29,17 @@ submodule (ropedyn_run) ropedyn_run_guard
 contains
 
     module procedure guard_output
-        character(len=:), allocatable :: file
+        character(len=:), allocatable :: file, given
         logical :: exists, removed
         integer :: errnum
         file = self%summary%file
+        given = file
         if (.not. resume) then
             call check_not_input(file, self%scene, err)
-            if (allocated(err)) return
+            if (allocated(err)) then
+                call name_key(self%scene, given, file, err)
+                return
+            end if
             call make_parent_dirs(file, err)
             if (allocated(err)) return
             if (len(special_file_reason(file)) > 0) then
@@ -80,6 +84,7 @@ contains
                 '.part) or remove it, or give --force')
         else
             call check_may_replace(file, self%scene, force, err)
+            if (allocated(err)) call name_key(self%scene, given, file, err)
         end if
         if (allocated(err)) then
             call drop_lock(self%lock_file, self%beat)
@@ -104,6 +109,16 @@ contains
         if (len(scene%output%file_origin) > 0) &
             text = scene%output%file_origin//': &output: file = "'//file//'"'
     end function output_key
+
+    !> A refusal of the output file `file` (given as `given`) that begins 'FILE: ' begins with
+    !! the input that named it instead (output_key).
+    subroutine name_key(scene, given, file, err)
+        type(scene_t), intent(in) :: scene
+        character(len=*), intent(in) :: given, file
+        type(error_t), intent(inout) :: err
+        if (index(err%message, file//': ') /= 1) return
+        err%message = output_key(scene, given)//err%message(len(file) + 1:)
+    end subroutine name_key
 
     module procedure release_output
         type(error_t), allocatable :: rerr

@@ -274,6 +274,10 @@ def test_statics_and_modes_never_write_their_scene(ropedyn_exe, work):
             'link.h5: the output file is the scene file "s.nml"')
     refused(ropedyn_exe, work, ["modes", "s.nml", "-o", "hard.h5"], 2,
             'hard.h5: the output file is the scene file "s.nml"')
+    # a run names the key that gave the file
+    refused(ropedyn_exe, work, ["run", "s.nml", "--set", "output.file=link.h5"], 2,
+            '--set output.file=link.h5: &output: file = "link.h5": the output file is the '
+            'scene file "s.nml"')
 
 
 @pytest.mark.parametrize("what", ["scene", "table", "sweep", "state", "resume", "lock"])

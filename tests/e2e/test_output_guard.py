@@ -44,8 +44,9 @@ def test_a_rerun_replaces_its_own_file_and_a_variant_is_refused(run, tmp_path, s
     before = digest(out)
     variant = run("run", scene, "--set", "solver.t_end=0.06")
     assert variant.returncode == 2
-    assert (f'out/paper.h5: exists and holds the run of "{source}", not of this run'
-            in variant.stderr), variant.stderr
+    # the refusal names the key that gave the file, where it was given (the scene file)
+    assert (f'{scene}: &output: file = "out/paper.h5": exists and holds the run of '
+            f'"{source}", not of this run' in variant.stderr), variant.stderr
     assert digest(out) == before
     forced = run("run", scene, "--set", "solver.t_end=0.06", "--force")
     assert forced.returncode == 0, forced.stderr
@@ -63,7 +64,9 @@ def test_a_file_ropedyn_did_not_write_is_never_replaced_silently(run, tmp_path, 
         out.write_bytes(content)
     before = digest(out)
     proc = run("run", scene, "--set", "output.file='mine.h5'", "--set", "solver.t_end=0.01")
-    assert proc.returncode == 2 and "mine.h5: exists and is" in proc.stderr, proc.stderr
+    assert proc.returncode == 2, proc.stderr
+    assert ("--set output.file='mine.h5': &output: file = \"mine.h5\": exists and is"
+            in proc.stderr), proc.stderr
     assert "not replaced" in proc.stderr and "(--force replaces it)" in proc.stderr
     assert digest(out) == before
 
@@ -214,7 +217,8 @@ def test_statics_and_modes_replace_only_their_own_result(run, tmp_path):
             (("modes", scene, "-o", "s.h5", "--count", "2"),
              "s.h5: exists and holds a statics result, not a modes one"),
             (("run", scene, "--set", "solver.t_end=0.02", "--set", "output.file='s.h5'"),
-             "s.h5: exists and holds a statics result, not a run one")]:
+             "--set output.file='s.h5': &output: file = \"s.h5\": exists and holds a "
+             "statics result, not a run one")]:
         proc = run(*args)
         assert proc.returncode == 2 and words in proc.stderr, proc.stderr
     assert digest(tmp_path / "s.h5") == before
