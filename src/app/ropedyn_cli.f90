@@ -25,6 +25,7 @@ module ropedyn_cli
     contains
         procedure :: next => cli_next
         procedure :: take_value => cli_take_value
+        procedure :: flag => cli_flag
         procedure :: usage_error => cli_usage_error
         procedure :: real_value => cli_real_value
         procedure :: int_value => cli_int_value
@@ -100,6 +101,15 @@ contains
         end if
         self%value = value
     end subroutine cli_take_value
+
+    !> The current option is a flag, which takes no value: '--flag=value' is a usage error
+    !! (a value there would be ignored, and '--force=no' would force).
+    subroutine cli_flag(self, err)
+        class(cli_t), intent(in) :: self
+        type(error_t), allocatable, intent(out) :: err
+        if (self%has_inline) call self%usage_error(self%option//' takes no value ("'// &
+            self%arg//'"): give '//self%option//' alone, or leave it out', err)
+    end subroutine cli_flag
 
     !> A usage error: 'COMMAND: message (see ropedyn COMMAND --help)'.
     subroutine cli_usage_error(self, message, err)

@@ -36,8 +36,10 @@ contains
                 call print_help('run', output_unit)
                 return
             case ('--verbose', '-v')
+                call cli%flag(err)
                 verbose = .true.
             case ('--force')
+                call cli%flag(err)
                 force = .true.
             case ('--resume')
                 if (allocated(resume_path)) then

@@ -38,8 +38,10 @@ contains
                 call print_help(command, output_unit)
                 return
             case ('--no-continuation')
+                call cli%flag(err)
                 options%continuation = .false.
             case ('--force')
+                call cli%flag(err)
                 force = .true.
             case ('-o', '--output')
                 if (len(out_path) > 0) then

@@ -72,16 +72,22 @@ contains
                 call print_help('sweep', output_unit)
                 return
             case ('--list')
+                call cli%flag(err)
                 opt%list = .true.
             case ('--count')
+                call cli%flag(err)
                 opt%count = .true.
             case ('--summary')
+                call cli%flag(err)
                 opt%summary = .true.
             case ('--status')
+                call cli%flag(err)
                 opt%status = .true.
             case ('--force')
+                call cli%flag(err)
                 opt%force = .true.
             case ('--quiet')
+                call cli%flag(err)
                 opt%quiet = .true.
             case ('--output-dir')
                 if (allocated(opt%output_dir)) then

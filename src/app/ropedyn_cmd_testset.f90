@@ -44,6 +44,11 @@ contains
         call read_options(cli, opts, err)
         if (allocated(err) .or. opts%help) return
         if (opts%list) then
+            if (allocated(opts%problem_name)) then
+                call cli%usage_error('--list lists every problem: give no problem ("'// &
+                                     opts%problem_name//'")', err)
+                return
+            end if
             call list_problems(err)
             return
         end if
@@ -82,8 +87,10 @@ contains
                 opts%help = .true.
                 return
             case ('--list')
+                call cli%flag(err)
                 opts%list = .true.
             case ('--csv')
+                call cli%flag(err)
                 opts%csv = .true.
             case ('--method')
                 call cli%take_value(value, err)

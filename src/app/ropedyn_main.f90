@@ -38,10 +38,15 @@ program ropedyn_main
     case ('')
         call print_help('ropedyn', error_unit)
         call make_error(err, ERR_USAGE, 'no command given (see ropedyn --help)')
-    case ('--version', 'version')
-        write (output_unit, '(a)') 'ropedyn '//version_string
-    case ('--help', '-h', 'help')
-        call print_help('ropedyn', output_unit)
+    case ('--version', 'version', '--help', '-h', 'help')
+        if (cli%count() > 0) then
+            call make_error(err, ERR_USAGE, cli%command//' takes no arguments ("'// &
+                            cli%args(1)%s//'") (see ropedyn --help)')
+        else if (cli%command == '--version' .or. cli%command == 'version') then
+            write (output_unit, '(a)') 'ropedyn '//version_string
+        else
+            call print_help('ropedyn', output_unit)
+        end if
     case ('run')
         call run_command(cli, err)
     case ('testset')

@@ -80,6 +80,30 @@ def test_version(run):
     assert result.returncode == 0 and result.stdout.startswith("ropedyn ")
 
 
+@pytest.mark.parametrize("args,fragment", [
+    (("run", "good.nml", "--force=no"), 'run: --force takes no value ("--force=no")'),
+    (("run", "good.nml", "--verbose=1"), "--verbose takes no value"),
+    (("statics", "good.nml", "--no-continuation=yes"), "--no-continuation takes no value"),
+    (("modes", "good.nml", "--force=0"), "--force takes no value"),
+    (("sweep", "s.nml", "--list=3"), "--list takes no value"),
+    (("testset", "hires", "--csv=1"), "--csv takes no value"),
+    (("testset", "--list", "hires"), '--list lists every problem: give no problem ("hires")'),
+    (("--version", "extra"), '--version takes no arguments ("extra")'),
+    (("--help", "extra"), '--help takes no arguments ("extra")'),
+])
+def test_a_flag_takes_no_value_and_no_stray_arguments(run, tmp_path, args, fragment):
+    """A flag given a value was taken as the flag, the value ignored: '--force=no'
+    forced the replacement of another run's file. Now it is a usage error, as are
+    arguments after a command that takes none."""
+    (tmp_path / "good.nml").write_text(GOOD)
+    result = run(*args)
+    assert result.returncode == 2, (args, result.stderr)
+    message = result.stderr.strip()
+    assert message.startswith("ropedyn: error: ") and len(message.splitlines()) == 1, message
+    assert fragment in message, message
+    assert not (tmp_path / "out").exists()
+
+
 def test_override_applies(run, tmp_path):
     (tmp_path / "good.nml").write_text(GOOD)
     result = run("run", "good.nml", "--set", "model.elements=6", "--set", "solver.rtol=1e-7")
