@@ -107,7 +107,10 @@ module ropedyn_auto
     !> Adams' order limit (CVODE's own; a user's max_order caps only the implicit method)
     integer, parameter :: ADAMS_ORDER = 12
     !> damping ratio of the fastest modes from which the implicit method is CVODE's BDF
+    !! (and below which MEBDF stops at order 5: mebdf_order_for)
     real(wp), parameter :: BDF_DAMPING = 0.12_wp
+    !> damping ratio below which MEBDF stops at its A-stable order 4 (mebdf_order_for)
+    real(wp), parameter :: MEBDF_A_STABLE_DAMPING = 0.03_wp
     integer, parameter :: BDF_ORDER = 5                 !< CVODE's order limit (its own)
     real(wp), parameter :: JACOBIAN_COST = 4.0_wp       !< f-equivalents per Jacobian
     !> the width scaling of the Newton matrix's costs (see Cost above): the RFEM's row width,

@@ -216,9 +216,9 @@ contains
     !> MEBDF's maximum order for fast modes damped by `zeta` (clipped at 0).
     pure integer function mebdf_order_for(zeta) result(order)
         real(wp), intent(in) :: zeta
-        if (zeta < 0.03_wp) then
+        if (zeta < MEBDF_A_STABLE_DAMPING) then
             order = 4
-        else if (zeta < 0.12_wp) then
+        else if (zeta < BDF_DAMPING) then
             order = 5
         else
             order = 6

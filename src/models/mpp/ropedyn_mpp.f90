@@ -29,7 +29,8 @@
 !! dense M(q), the energy and the tangent take them (submodule ropedyn_mpp_water).
 !!
 !! This module builds the model and maps its state (creation, supports, joint positions);
-!! the residual, mass matrix and energy kernels are in the submodule ropedyn_mpp_kernels.
+!! the residual and mass matrix kernels are in the submodule ropedyn_mpp_kernels, their
+!! tangent in ropedyn_mpp_tangent, the energies and powers in ropedyn_mpp_energy.
 module ropedyn_mpp
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp
@@ -166,7 +167,8 @@ module ropedyn_mpp
         end subroutine mpp_residual
 
         !> The residual with self%cs holding cos and sin of the angles of y (mpp_residual
-        !! without that step; the Jacobian's difference quotients update one angle at a time).
+        !! without that step; the Jacobian calls it at the accelerations and takes its tangent
+        !! from what it leaves: residual_column).
         !! With `powers`, the effects' dissipation and work rates (W) are added to it, from
         !! the same pass as their forces.
         module subroutine residual_core(self, t, y, qacc, r, pin, powers)
@@ -324,8 +326,9 @@ module ropedyn_mpp
         end subroutine mpp_mass_matrix
 
         !> Jacobian of y' = (q', a), a = M^{-1} f. With a0 = a(y) held fixed, M a = f gives
-        !! da/dz = M^{-1} d r(q, q', a0)/dz (z = q or q'), exact: the residual's difference
-        !! quotients are O(n) each, then an O(n) solve per column: O(n^2) in all.
+        !! da/dz = M^{-1} d r(q, q', a0)/dz (z = q or q'), exact: each column of the
+        !! residual's tangent is O(n) (residual_column), then an O(n) solve per column:
+        !! O(n^2) in all.
         module subroutine mpp_jacobian(self, t, y, jb, offset, status)
             class(mpp_t), intent(inout) :: self
             real(wp), intent(in) :: t

@@ -1,7 +1,8 @@
 !> The MPP kernels: the O(n) Lagrange residual, the O(n) solve of M(q) q'' = f by the
 !! articulated-body recursion, the dense mass matrix (O(n^2)), the Jacobian and the
-!! second-order blocks (O(n^2): a difference quotient of the residual and a solve per
-!! column), energies and powers. The derivation is in docs/theory/mpp.md.
+!! second-order blocks (O(n^2): a column of the residual's tangent, ropedyn_mpp_tangent, and
+!! a solve per column). The energies and powers are in ropedyn_mpp_energy. The derivation
+!! is in docs/theory/mpp.md.
 !!
 !! Work arrays are held by the model (allocated at creation): cos and sin of every angle
 !! once per call (self%cs), the rods' forces, the factors of M and the residual's
