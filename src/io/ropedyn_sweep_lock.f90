@@ -204,7 +204,7 @@ contains
             end if
             if (lock%live) then
                 call make_error(err, ERR_IO, 'being written by '//lock%holder()//' (lock '// &
-                    path//'): a case is written by one process at a time')
+                    path//'): a file is written by one process at a time')
                 return
             end if
             ! abandoned: break it under the lock <path>.break
@@ -223,7 +223,7 @@ contains
             if (lock%exists .and. lock%live) then
                 removed = delete_file(path//'.break')
                 call make_error(err, ERR_IO, 'being written by '//lock%holder()//' (lock '// &
-                    path//'): a case is written by one process at a time')
+                    path//'): a file is written by one process at a time')
                 return
             end if
             if (lock%exists) removed = delete_file(path)

@@ -332,7 +332,7 @@ def test_two_writers_of_one_case(run, ropedyn_exe, sweep_dir):
             assert second.returncode == 4, second.stderr
             assert f"not run: being written by host {socket.gethostname()}, pid {first.pid}" \
                    in second.stderr
-            assert "a case is written by one process at a time" in second.stderr
+            assert "a file is written by one process at a time" in second.stderr
         # the local runner does not start it either
         runner = run("sweep", "long.nml", "--jobs", "1")
         assert "being written by another process, not started here: 0001" in runner.stderr
