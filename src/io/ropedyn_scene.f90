@@ -214,16 +214,18 @@ contains
                 if (allocated(err)) return
             end do
         end do
-        scene%solver%method_origin = scene%path
-        scene%output%file_origin = scene%path
+        allocate (scene%set_keys(0), scene%set_origins(0))
         do i = 1, size(keys)
             if (keys(i)%group == group_index('output') .and. keys(i)%name == 'progress') &
                 scene%output%progress_given = keys(i)%given
-            if (keys(i)%group == group_index('solver') .and. keys(i)%name == 'method' .and. &
-                allocated(keys(i)%origin)) scene%solver%method_origin = keys(i)%origin
-            if (keys(i)%group == group_index('output') .and. keys(i)%name == 'file' .and. &
-                allocated(keys(i)%origin)) scene%output%file_origin = keys(i)%origin
+            if (.not. allocated(keys(i)%origin)) cycle
+            if (keys(i)%origin == scene%path) cycle
+            call append_text(scene%set_keys, trim(GROUP_NAMES(keys(i)%group))//'.'// &
+                             trim(keys(i)%name))
+            call append_text(scene%set_origins, keys(i)%origin)
         end do
+        scene%solver%method_origin = scene%origin('solver.method')
+        scene%output%file_origin = scene%origin('output.file')
         call check_scene(keys, scene, err)
     end subroutine store_scene
 

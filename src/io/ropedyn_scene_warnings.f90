@@ -50,20 +50,19 @@ contains
         type(scene_t), intent(in) :: scene
         type(text_t), allocatable :: list(:)
         type(section_t) :: sec
-        character(len=:), allocatable :: where
         real(wp) :: strain, dl, zeta
         logical :: section
         allocate (list(0))
-        where = scene%path//': &rope: '
         sec = rope_section(scene%rope)
         section = section_set_given(scene%rope)
         if (scene%rope%diameter > MAX_DIAMETER_SHARE*scene%rope%length) &
-            call append_text(list, where//'diameter = '//real_text(scene%rope%diameter)// &
+            call append_text(list, at('diameter')//'diameter = '//real_text(scene%rope%diameter)// &
                 ': more than a tenth of the length ('//real_text(scene%rope%length)// &
                 ' m): a diameter in mm? (the unit is m)')
         if (scene%effects%gravity .and. scene%effects%tension) then
             strain = sec%mass_per_length*scene%rope%gravity*scene%rope%length/sec%ea
-            if (strain > MAX_SELF_STRAIN) call append_text(list, where// &
+            if (strain > MAX_SELF_STRAIN) call append_text(list, &
+                at(trim(merge('axial_stiffness', 'young_modulus  ', section)))// &
                 trim(merge('axial_stiffness', 'young_modulus  ', section))//' = '// &
                 stiffness_text()//': the rope stretches by '// &
                 significant_text(100.0_wp*strain, 3)//' % under its own weight (m g L / '// &
@@ -77,31 +76,39 @@ contains
             ! B/(2 sqrt(K m)) of an element: B = eta_a/dl, K = EA/dl, m = mu dl
             zeta = sec%axial_damping/(2.0_wp*dl*sqrt(sec%ea*sec%mass_per_length))
             if (zeta < MIN_DAMPING_RATIO .or. zeta > MAX_DAMPING_RATIO) call append_text(list, &
-                where//trim(merge('axial_damping ', 'normal_damping', section))//' = '// &
+                at(trim(merge('axial_damping ', 'normal_damping', section)))// &
+                trim(merge('axial_damping ', 'normal_damping', section))//' = '// &
                 damping_text()//": an element's axial damping ratio is "// &
                 significant_text(zeta, 3)//' (plausible: '//real_text(MIN_DAMPING_RATIO)// &
                 ' .. '//real_text(MAX_DAMPING_RATIO)//'): a coefficient in the wrong unit? '// &
                 '(the unit is '//trim(merge('N s    ', 'N s/m^2', section))//')')
         end if
         if (scene%effects%water .and. scene%fluid%density < MIN_WATER_DENSITY) &
-            call append_text(list, scene%path//': &fluid: density = '// &
+            call append_text(list, scene%origin('fluid.density')//': &fluid: density = '// &
                 real_text(scene%fluid%density)//': water = .true. in a fluid this light '// &
                 '(air is 1.225 kg/m^3): water is about 1000 (fresh) or 1025 (sea)')
         if (scene%effects%ground) call ground_start(scene, list)
         if (scene%effects%ground) call ground_anchors(scene, list)
         associate (s => scene%supports)
-            call idle_motion_keys(scene%path, 'top', s%top_motion, s%top_amplitude, &
+            call idle_motion_keys(scene, 'top', s%top_motion, s%top_amplitude, &
                 s%top_frequency, s%top_phase_deg, s%top_angle_amplitude_deg, &
                 s%top_angle_phase_deg, s%top_ramp_time, s%top_table, list)
-            call idle_motion_keys(scene%path, 'bottom', s%bottom_motion, s%bottom_amplitude, &
+            call idle_motion_keys(scene, 'bottom', s%bottom_motion, s%bottom_amplitude, &
                 s%bottom_frequency, s%bottom_phase_deg, s%bottom_angle_amplitude_deg, &
                 s%bottom_angle_phase_deg, s%bottom_ramp_time, s%bottom_table, list)
-            call late_motion(scene%path, 'top', s%top_motion, s%top_ramp_time, &
+            call late_motion(scene, 'top', s%top_motion, s%top_ramp_time, &
                 s%top_release_time, scene%solver%t_end, list)
-            call late_motion(scene%path, 'bottom', s%bottom_motion, s%bottom_ramp_time, &
+            call late_motion(scene, 'bottom', s%bottom_motion, s%bottom_ramp_time, &
                 s%bottom_release_time, scene%solver%t_end, list)
         end associate
     contains
+        !> 'ORIGIN: &rope: ', ORIGIN where the &rope key `key` was given
+        function at(key) result(text)
+            character(len=*), intent(in) :: key
+            character(len=:), allocatable :: text
+            text = scene%origin('rope.'//key)//': &rope: '
+        end function at
+
         function stiffness_text() result(text)
             character(len=:), allocatable :: text
             if (section) then
@@ -125,9 +132,10 @@ contains
     !! key (amplitude, frequency, phase, angle amplitude and phase, ramp) other than 0 without
     !! `*_motion = 'harmonic'`, a table without `*_motion = 'table'`. Such a key does nothing
     !! (a sweep may still vary the motion over a base that gives them, so it is no error).
-    subroutine idle_motion_keys(path, end, motion, amplitude, frequency, phase_deg, &
+    subroutine idle_motion_keys(scene, end, motion, amplitude, frequency, phase_deg, &
             angle_amplitude_deg, angle_phase_deg, ramp_time, table, list)
-        character(len=*), intent(in) :: path, end, motion, table
+        type(scene_t), intent(in) :: scene
+        character(len=*), intent(in) :: end, motion, table
         real(wp), intent(in) :: amplitude(2), frequency, phase_deg(2), angle_amplitude_deg, &
             angle_phase_deg, ramp_time
         type(text_t), allocatable, intent(inout) :: list(:)
@@ -161,25 +169,29 @@ contains
             value = '"'//trim(table)//'"'
         end if
         if (len(key) == 0) return
-        call append_text(list, path//': &supports: '//end//key//' = '//value// &
+        call append_text(list, scene%origin('supports.'//end//key)//': &supports: '//end// &
+            key//' = '//value// &
             ': does nothing: '//end//"_motion = '"//trim(motion)//"' (it is used with "// &
             end//"_motion = '"//used_by//"')")
     end subroutine idle_motion_keys
 
     !> A release of the `end` support at or after t_end (it never happens in the run), and a
     !! harmonic ramp longer than the run (the amplitudes never reach their full size).
-    subroutine late_motion(path, end, motion, ramp_time, release_time, t_end, list)
-        character(len=*), intent(in) :: path, end, motion
+    subroutine late_motion(scene, end, motion, ramp_time, release_time, t_end, list)
+        type(scene_t), intent(in) :: scene
+        character(len=*), intent(in) :: end, motion
         real(wp), intent(in) :: ramp_time, release_time, t_end
         type(text_t), allocatable, intent(inout) :: list(:)
         real(wp) :: share(0:2)
         if (release_time > 0.0_wp .and. release_time >= t_end) call append_text(list, &
-            path//': &supports: '//end//'_release_time = '//real_text(release_time)// &
+            scene%origin('supports.'//end//'_release_time')//': &supports: '//end// &
+            '_release_time = '//real_text(release_time)// &
             ': at or after t_end = '//real_text(t_end)//' s: the support is not released '// &
             'in the run (< 0: never)')
         if (trim(motion) == 'harmonic' .and. ramp_time > t_end) then
             share = ramp(t_end, ramp_time)
-            call append_text(list, path//': &supports: '//end//'_ramp_time = '// &
+            call append_text(list, scene%origin('supports.'//end//'_ramp_time')// &
+                ': &supports: '//end//'_ramp_time = '// &
                 real_text(ramp_time)//': longer than the run (t_end = '//real_text(t_end)// &
                 ' s): the amplitudes reach only '// &
                 significant_text(100.0_wp*share(0), 3)// &
@@ -218,7 +230,8 @@ contains
             real(wp) :: depth
             depth = ground_depth(scene, anchor)
             if (depth > MAX_START_DEPTH_SHARE*scene%rope%length) call append_text(list, &
-                scene%path//': &supports: '//end_name//'_anchor = '// &
+                scene%origin('supports.'//end_name//'_anchor')//': &supports: '// &
+                end_name//'_anchor = '// &
                 significant_text(anchor(1), 6)//', '//significant_text(anchor(2), 6)// &
                 ': the '//end_name//' end is '//trim(kind)//' '// &
                 significant_text(depth, 3)//' m inside the ground (&ground point = '// &
@@ -244,7 +257,8 @@ contains
         ends(:, 2) = ends(:, 1) + scene%rope%length*[cos(angle), sin(angle)]
         depth = max(ground_depth(scene, ends(:, 1)), ground_depth(scene, ends(:, 2)))
         if (depth > MAX_START_DEPTH_SHARE*scene%rope%length) call append_text(list, &
-            scene%path//': &ground: point = '//real_text(scene%ground%point(1))//', '// &
+            scene%origin('ground.point')//': &ground: point = '// &
+            real_text(scene%ground%point(1))//', '// &
             real_text(scene%ground%point(2))//": the rope's "//trim(scene%initial%shape)// &
             ' start reaches '//significant_text(depth, 3)//' m into the ground (its ends: '// &
             real_text(ends(1, 1))//', '//real_text(ends(2, 1))//' and '// &

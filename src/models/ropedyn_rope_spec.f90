@@ -6,6 +6,7 @@
 module ropedyn_rope_spec
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
     use ropedyn_kinds, only: wp, i8
+    use ropedyn_text, only: text_t
     implicit none
     private
     public :: rope_params_t, model_params_t, supports_params_t, initial_params_t
@@ -189,6 +190,9 @@ module ropedyn_rope_spec
     !> Everything a rope model is built from.
     type :: rope_spec_t
         character(len=:), allocatable :: path  !< where the values came from (for messages)
+        !> the keys a --set gave ('group.key') and the --set argument of each, for messages
+        !! about their values (origin); the other keys come from `path`
+        type(text_t), allocatable :: set_keys(:), set_origins(:)
         type(rope_params_t) :: rope
         type(model_params_t) :: model
         type(supports_params_t) :: supports
@@ -197,6 +201,8 @@ module ropedyn_rope_spec
         type(fluid_params_t) :: fluid
         type(ground_params_t) :: ground
         type(attachments_params_t) :: attachments
+    contains
+        procedure :: origin => spec_origin
     end type rope_spec_t
 
 contains
@@ -207,6 +213,24 @@ contains
         class(rope_spec_t), intent(in) :: spec
         bottom_anchor_given = .not. any(ieee_is_nan(spec%supports%bottom_anchor))
     end function bottom_anchor_given
+
+    !> Where the value of `key` ('group.key') came from, for a message about it: the --set
+    !! argument that gave it, else the scene's path.
+    pure function spec_origin(self, key) result(origin)
+        class(rope_spec_t), intent(in) :: self
+        character(len=*), intent(in) :: key
+        character(len=:), allocatable :: origin
+        integer :: k
+        origin = ''
+        if (allocated(self%path)) origin = self%path
+        if (.not. allocated(self%set_keys)) return
+        do k = size(self%set_keys), 1, -1
+            if (self%set_keys(k)%s == key) then
+                origin = self%set_origins(k)%s
+                return
+            end if
+        end do
+    end function spec_origin
 
     !> When the support at `end` (1: top, 2: bottom) lets the rope go [s]: its
     !! `*_release_time` when one is given (>= 0) and the support motions are on, else

@@ -239,13 +239,15 @@ contains
         call compute_modes(model, y, k, mres, err)
         if (allocated(err)) return
         if (mres%count < k) then
-            call make_error(err, ERR_INPUT, spec%path//': &initial: mode = '//int_text(k)// &
+            call make_error(err, ERR_INPUT, spec%origin('initial.mode')//': &initial: mode = '// &
+                            int_text(k)// &
                             ': the model has only '//int_text(mres%ndof)//' modes')
             return
         end if
         largest = maxval(norm2(mres%shape_points(:, :, k), dim=1))
         if (.not. largest > 0.0_wp) then
-            call make_error(err, ERR_SOLVER, spec%path//': &initial: mode = '//int_text(k)// &
+            call make_error(err, ERR_SOLVER, spec%origin('initial.mode')//': &initial: mode = '// &
+                            int_text(k)// &
                             ': the mode does not move the rope')
             return
         end if

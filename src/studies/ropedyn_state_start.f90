@@ -59,7 +59,8 @@ contains
     pure function start_where(scene) result(where)
         type(scene_t), intent(in) :: scene
         character(len=:), allocatable :: where
-        where = scene%path//': &initial: state_file = "'//trim(scene%initial%state_file)//'"'
+        where = scene%origin('initial.state_file')//': &initial: state_file = "'// &
+                trim(scene%initial%state_file)//'"'
     end function start_where
 
     !> The start of `&initial shape = 'state'`: the record of `state_file` nearest

@@ -109,6 +109,27 @@ def test_an_idle_motion_key_in_a_scene_file_names_the_file(run, tmp_path):
                                     "top_motion = 'harmonic')"], proc.stderr
 
 
+def test_a_warning_or_a_model_check_names_the_set_that_gave_the_value(run, tmp_path):
+    """A value given by --set is named by that --set in a warning about it and in the
+    checks made with the model (the mode a 'mode' start asks for), as in the key checks;
+    a value from the file is named by the file."""
+    (tmp_path / "s.nml").write_text("&model elements = 4 /\n&rope diameter = 0.5 /\n"
+                                    "&solver t_end = 1e-3 /\n")
+    proc = run("run", "s.nml", "--set", "supports.top_ramp_time=2.0")
+    assert proc.returncode == 0, proc.stderr
+    assert sorted(scene_warnings(proc)) == sorted([
+        "ropedyn: warning: s.nml: &rope: diameter = 0.5: more than a tenth of the length "
+        "(1.0 m): a diameter in mm? (the unit is m)",
+        "ropedyn: warning: --set supports.top_ramp_time=2.0: &supports: top_ramp_time = "
+        "2.0: does nothing: top_motion = 'fixed' (it is used with top_motion = "
+        "'harmonic')"]), proc.stderr
+    proc = run("run", "s.nml", "--set", "rope.diameter=0.005", "--set", "initial.shape=mode",
+               "--set", "initial.mode=100", "--set", "output.file=m.h5")
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.strip() == ("ropedyn: error: --set initial.mode=100: &initial: mode = "
+                                   "100: the model has only 12 modes"), proc.stderr
+
+
 def test_a_harmonic_support_with_its_keys_has_no_warning(run):
     """Its keys used, the ramp and the release within the run: no warning."""
     proc = run("run", PAPER, "--set", "solver.t_end=1e-3", "--set", "output.file=w.h5",
