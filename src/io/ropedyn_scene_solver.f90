@@ -18,7 +18,8 @@ contains
         class(integrator_t), allocatable, intent(out) :: integrator
         type(error_t), allocatable, intent(out) :: err
         call new_integrator(trim(scene%solver%method), integrator, err)
-        if (allocated(err)) err%message = scene%path//': &solver: '//err%message
+        if (allocated(err)) err%message = scene%origin('solver.method')//': &solver: '// &
+                                          err%message
     end subroutine create_integrator
 
     !> The method the scene names must be able to integrate its model at all (a method that

@@ -30,7 +30,7 @@ contains
             if (allocated(err)) return
             call move_alloc(mpp, model)
         case default
-            call make_error(err, ERR_INPUT, spec%path//': &model: kind = "'// &
+            call make_error(err, ERR_INPUT, spec%origin('model.kind')//': &model: kind = "'// &
                             trim(spec%model%kind)//'": not available in this version')
         end select
     end subroutine create_model

@@ -50,7 +50,8 @@ contains
             energy = significant_text(e%elastic, 3)//' J'
             if (weight_length > 0.0_wp) energy = energy//' ('// &
                 significant_text(e%elastic/weight_length, 3)//' m g L)'
-            call append_text(list, scene%path//': &supports: '//trim(ENDS(k))//'_anchor = '// &
+            call append_text(list, scene%origin('supports.'//trim(ENDS(k))//'_anchor')// &
+                ': &supports: '//trim(ENDS(k))//'_anchor = '// &
                 real_text(anchors(1, k))//', '//real_text(anchors(2, k))//': the initial '// &
                 'state leaves the '//trim(merge('upper', 'lower', k == 1))//' end '// &
                 significant_text(d, 3)//' m from it ('// &
