@@ -131,7 +131,9 @@ def test_a_held_end_started_far_from_its_anchor_is_warned_of(run):
     assert far.returncode == 0, far.stderr
     line = [s for s in far.stderr.splitlines() if "initial state leaves" in s]
     assert len(line) == 1, far.stderr
-    m = re.search(r"paper.nml: &supports: bottom_anchor = 1\.0, 0\.0: the initial state "
+    # (named by the --set that gave it)
+    m = re.search(r"--set supports\.bottom_anchor=1\.0, 0\.0: &supports: bottom_anchor = "
+                  r"1\.0, 0\.0: the initial state "
                   r"leaves the lower end ([0-9.]+) m from it \(([0-9.]+) % of the length\)"
                   r".* holds ([0-9.e+-]+) J \(([0-9.e+-]+) m g L\)", line[0])
     assert m, line[0]
