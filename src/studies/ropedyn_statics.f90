@@ -174,7 +174,9 @@ module ropedyn_statics
 contains
 
     !> ERR_SOLVER when the spec cannot have an equilibrium: both ends free under gravity,
-    !! an end released at t = 0 (with the support motions on) counting as free.
+    !! an end released at t = 0 (with the support motions on) counting as free; or no
+    !! unique one: an RFEM without shear (and no ground to hold its elements), whose joints
+    !! slide across the rope without a force (docs/theory/rfem.md).
     subroutine check_equilibrium_exists(spec, err)
         type(rope_spec_t), intent(in) :: spec
         type(error_t), allocatable, intent(out) :: err
@@ -188,6 +190,13 @@ contains
             call make_error(err, ERR_SOLVER, spec%path//': statics: no equilibrium: both '// &
                 'supports are free (&supports '//top//', '//bottom//') and gravity is '// &
                 'on, so the rope falls freely; pin or clamp an end, or switch gravity off')
+        else if (spec%model%kind == 'rfem' .and. spec%model%elements > 1 .and. &
+                 .not. spec%effects%shear .and. .not. spec%effects%ground) then
+            call make_error(err, ERR_SOLVER, spec%origin('effects.shear')//': &effects: '// &
+                'shear = .false.: statics: no unique equilibrium: without shear the '// &
+                "RFEM's joints have no stiffness across the rope (their springs keep "// &
+                'tension and bending only), so the ends of neighbouring elements slide '// &
+                'apart freely; switch shear on for statics and modes')
         end if
     contains
         !> "top = 'free'" or "top_release_time = 0.0" for an end free at t = 0, else ''.

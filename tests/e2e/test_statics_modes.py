@@ -185,6 +185,25 @@ def test_no_equilibrium(run, tmp_path):
 
 
 @pytest.mark.parametrize("command", ["statics", "modes"])
+def test_an_rfem_without_shear_has_no_unique_equilibrium(run, tmp_path, command):
+    """Without shear the RFEM's joints carry no force across the rope: the tangent is
+    singular wherever the rope is, and the iteration used to wander for 2000 iterations
+    before it gave up. It is said at once, naming the key; the MPP, which has no such
+    springs, and a shear-less RFEM on the ground are not refused."""
+    (tmp_path / "ns.nml").write_text("&model kind = 'rfem', elements = 6 /\n")
+    result = run(command, "ns.nml", "--set", "effects.shear=.false.", "-o", "ns.h5")
+    assert result.returncode == 3, result.stderr
+    assert result.stderr.strip() == (
+        "ropedyn: error: --set effects.shear=.false.: &effects: shear = .false.: statics: no "
+        "unique equilibrium: without shear the RFEM's joints have no stiffness across the "
+        "rope (their springs keep tension and bending only), so the ends of neighbouring "
+        "elements slide apart freely; switch shear on for statics and modes"), result.stderr
+    assert not (tmp_path / "ns.h5").exists()
+    assert run(command, "ns.nml", "--set", "effects.shear=.false.", "--set", "model.kind=mpp",
+               "-o", "mpp.h5").returncode == 0
+
+
+@pytest.mark.parametrize("command", ["statics", "modes"])
 def test_an_end_released_at_the_start_is_free(run, tmp_path, command):
     """A support released at t = 0 holds nothing at the start: with the other end free
     there is no equilibrium, said at once (not 2000 iterations that fail to converge)."""
