@@ -5,54 +5,13 @@
 !! used to loop for ever in both: its look-ahead t + 0.25 WINDOW h rounded back to t, so
 !! erk was asked to advance by nothing, took no step and never reached its own round-off
 !! check or the stop request. A hang shows as this test's timeout.
-module test_no_progress_oscillator
-    use ropedyn_kinds, only: wp
-    use ropedyn_problem, only: problem_t, STATUS_OK
-    implicit none
-    private
-    public :: oscillator_t
-
-    !> y1' = y2, y2' = -w^2 y1.
-    type, extends(problem_t) :: oscillator_t
-        real(wp) :: w = 1.0_wp
-    contains
-        procedure :: size => oscillator_size
-        procedure :: bandwidths => oscillator_bandwidths
-        procedure :: rhs => oscillator_rhs
-    end type oscillator_t
-
-contains
-
-    pure integer function oscillator_size(self) result(n)
-        class(oscillator_t), intent(in) :: self
-        n = 2
-    end function oscillator_size
-
-    pure subroutine oscillator_bandwidths(self, ml, mu)
-        class(oscillator_t), intent(in) :: self
-        integer, intent(out) :: ml, mu
-        ml = 1
-        mu = 1
-    end subroutine oscillator_bandwidths
-
-    subroutine oscillator_rhs(self, t, y, ydot, status)
-        class(oscillator_t), intent(inout) :: self
-        real(wp), intent(in) :: t
-        real(wp), intent(in) :: y(:)
-        real(wp), intent(out) :: ydot(:)
-        integer, intent(out) :: status
-        ydot = [y(2), -self%w**2*y(1)]
-        status = STATUS_OK
-    end subroutine oscillator_rhs
-end module test_no_progress_oscillator
-
 program test_no_progress
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, ERR_SOLVER
     use ropedyn_integrator, only: integrator_t, solver_options_t
     use ropedyn_solvers, only: new_integrator
     use ropedyn_assert, only: test_suite_t
-    use test_no_progress_oscillator, only: oscillator_t
+    use ropedyn_test_oscillator, only: oscillator_t
     implicit none
 
     character(len=*), parameter :: METHOD_LIST(5) = [character(len=5) :: 'auto', 'erk', &

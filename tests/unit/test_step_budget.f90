@@ -9,46 +9,6 @@
 !! it: with the old message, the budget left, 20, and the rest of the run in a simulation.)
 !! The messages themselves, end to end: tests/hard/test_failure_path.py,
 !! tests/e2e/test_methods.py and tests/e2e/test_python_api.py.
-module test_step_budget_problem
-    use ropedyn_kinds, only: wp
-    use ropedyn_problem, only: problem_t, STATUS_OK
-    implicit none
-    private
-    public :: oscillator_t
-
-    !> y = (x, v): x' = v, v' = -x.
-    type, extends(problem_t) :: oscillator_t
-    contains
-        procedure :: size => oscillator_size
-        procedure :: bandwidths => oscillator_bandwidths
-        procedure :: rhs => oscillator_rhs
-    end type oscillator_t
-
-contains
-
-    pure integer function oscillator_size(self)
-        class(oscillator_t), intent(in) :: self
-        oscillator_size = 2
-    end function oscillator_size
-
-    pure subroutine oscillator_bandwidths(self, ml, mu)
-        class(oscillator_t), intent(in) :: self
-        integer, intent(out) :: ml, mu
-        ml = 1
-        mu = 1
-    end subroutine oscillator_bandwidths
-
-    subroutine oscillator_rhs(self, t, y, ydot, status)
-        class(oscillator_t), intent(inout) :: self
-        real(wp), intent(in) :: t
-        real(wp), intent(in) :: y(:)
-        real(wp), intent(out) :: ydot(:)
-        integer, intent(out) :: status
-        ydot = [y(2), -y(1)]
-        status = STATUS_OK
-    end subroutine oscillator_rhs
-end module test_step_budget_problem
-
 program test_step_budget
     use ropedyn_kinds, only: wp, i8
     use ropedyn_assert, only: test_suite_t
@@ -57,7 +17,7 @@ program test_step_budget
                                   DEFAULT_MAX_STEPS, BUDGET_STEP_RATE, integrator_t, &
                                   solver_options_t, budget_left
     use ropedyn_solvers, only: new_integrator
-    use test_step_budget_problem, only: oscillator_t
+    use ropedyn_test_oscillator, only: oscillator_t
     implicit none
     type(test_suite_t) :: suite
     character(len=5), parameter :: NAMES(3) = ['erk  ', 'mebdf', 'auto ']
