@@ -7,7 +7,7 @@ module ropedyn_cmd_keys
     use ropedyn_error, only: error_t
     use ropedyn_cli, only: cli_t
     use ropedyn_help, only: print_help
-    use ropedyn_text, only: text_t, append_text, name_hint
+    use ropedyn_text, only: text_t, append_text, name_hint, lower
     use ropedyn_scene, only: scene_key_listing
     use ropedyn_scene_keys, only: GROUP_NAMES, group_index
     implicit none
@@ -33,7 +33,8 @@ contains
             if (allocated(err)) return
         end do
         if (allocated(group)) then
-            if (group_index(group) == 0) then
+            ! group names are case-insensitive, as in a scene file
+            if (group_index(lower(group)) == 0) then
                 allocate (groups(0))
                 do k = 1, size(GROUP_NAMES)
                     call append_text(groups, trim(GROUP_NAMES(k)))
@@ -42,7 +43,7 @@ contains
                                      name_hint(groups, group, 'groups'), err)
                 return
             end if
-            lines = scene_key_listing(group)
+            lines = scene_key_listing(lower(group))
         else
             lines = scene_key_listing()
         end if

@@ -158,3 +158,5 @@ def test_keys_of_one_group(run):
     assert lines[0] == whole[0]
     assert lines[1:] == [x for x in whole[1:] if x.split("\t")[0] == "rope"]
     assert len(lines) > 5
+    # a group name in any case, as in a scene file
+    assert run("keys", "ROPE").stdout.splitlines() == lines
