@@ -36,9 +36,8 @@ def run_case(exe, n, method, t_end, rtol, workdir, extra=()):
     if result.returncode != 0:
         return {"n": n, "method": method, "status": f"failed ({result.stderr.strip()[:80]})"}
     run = io.load_run(out)
-    total, dissipated = run.energy["total"], run.energy["dissipated"]
     return {"n": n, "method": method, "status": "complete", **run.stats,
-            "balance": float(total[-1] + dissipated[-1] - total[0])}
+            "balance": float(run.balance[-1] - run.e0)}
 
 
 def line(r):

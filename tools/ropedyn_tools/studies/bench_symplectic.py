@@ -72,7 +72,7 @@ def run(exe, work, scene, name, sets):
                 "cpu": float("inf")}
     r = io.load_run(out)
     e = r.energy
-    drift = e["total"] + e["dissipated"] - e["support_work"] - e["total"][0]
+    drift = r.balance - r.e0
     mgl = stability_metrics.weight_length(r)
     return {"ok": True, "t": r.time, "drift": drift / mgl, "cpu": float(r.stats["cpu_time"]),
             "steps": int(r.stats["steps"]), "elastic": e["elastic"] / mgl}

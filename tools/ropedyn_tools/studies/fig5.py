@@ -86,16 +86,16 @@ def main(argv=None):
     for case, path in results:
         model, n, (a, b) = case
         run = io.load_run(path)
-        t, total, dissipated = run.time, run.energy["total"], run.energy["dissipated"]
+        t, total, e0 = run.time, run.energy["total"], run.e0
         cpu, steps = float(run.stats["cpu_time"]), run.stats["steps"]
-        e0 = total[0]
-        balance = total + dissipated - e0
+        balance = run.balance - e0
         style = "-" if model == "rfem" else ("--" if (a, b) == ("1", "1") else ":")
         ax.plot(t, total - e0, style, label=label(case))
         axb.plot(t, balance, style, label=label(case))
         rows.append({"model": model, "n": n, "axial_factor": a, "bending_factor": b,
                      "t_end": t[-1], "E_end_minus_E0_J": total[-1] - e0,
-                     "dissipated_J": dissipated[-1], "max_balance_error_J": abs(balance).max(),
+                     "dissipated_J": run.energy["dissipated"][-1],
+                     "max_balance_error_J": abs(balance).max(),
                      "steps": steps, "cpu_s": cpu})
         print(f"{label(case)}: E(t_end) - E0 = {total[-1] - e0:.5f} J, "
               f"balance error max {abs(balance).max():.2e} J, {steps} steps, {cpu:.2f} s CPU")

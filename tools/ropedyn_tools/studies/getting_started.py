@@ -119,9 +119,7 @@ def largest_kinetic(run):
 
 def balance_error(run):
     """The energy balance error of every record, J (docs/theory/energy-balance.md)."""
-    e = run.energy
-    balance = e["total"] + e["dissipated"] - e["support_work"]
-    return balance - balance[0]
+    return run.balance - run.e0
 
 
 def paper_sections(work, figures):

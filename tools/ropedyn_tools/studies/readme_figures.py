@@ -63,15 +63,14 @@ def energy_figure(run, size=(800, 450)):
     ax.plot(t, e["gravity"] - e["gravity"][0], lw=1, label="gravity - gravity(0)")
     ax.plot(t, e["elastic"], lw=1, label="elastic")
     ax.plot(t, e["dissipated"], lw=1, ls="--", label="dissipated")
-    ax.plot(t, e["total"] - e["total"][0], "k", lw=1.4, label="total - E0")
+    ax.plot(t, e["total"] - run.e0, "k", lw=1.4, label="total - E0")
     ax.set_ylabel("energy (J)")
     ax.legend(fontsize=7, ncol=5, loc="lower center", bbox_to_anchor=(0.5, 1.0),
               frameon=False)
     ax.grid(alpha=0.3)
     fig.suptitle(f"Energies of the paper's rope ({run.model.upper()}, n = {run.n}, "
                  f"{run.method})", fontsize=9)
-    balance = e["total"] + e["dissipated"] - e["support_work"]
-    bx.plot(t, balance - balance[0], "r", lw=1)
+    bx.plot(t, run.balance - run.e0, "r", lw=1)
     bx.set_ylabel("balance\nerror (J)", fontsize=8)
     bx.set_xlabel("t (s)")
     bx.grid(alpha=0.3)
