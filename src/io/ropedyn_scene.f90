@@ -224,7 +224,6 @@ contains
                              trim(keys(i)%name))
             call append_text(scene%set_origins, keys(i)%origin)
         end do
-        scene%solver%method_origin = scene%origin('solver.method')
         scene%output%file_origin = scene%origin('output.file')
         call check_scene(keys, scene, err)
     end subroutine store_scene

@@ -34,7 +34,7 @@ contains
         character(len=:), allocatable :: why
         why = integrator%refusal(model)
         if (len(why) == 0) return
-        call make_error(err, ERR_INPUT, scene%solver%method_origin//': &solver: method = "'// &
+        call make_error(err, ERR_INPUT, scene%origin('solver.method')//': &solver: method = "'// &
             trim(scene%solver%method)//'": cannot integrate the '//model%model_name()// &
             ' model of this scene: '//why//' (use method = "auto" or "erk"; '// &
             'docs/guide/choosing.md)')

@@ -39,9 +39,6 @@ module ropedyn_scene_types
         character(len=NAME_LEN) :: order_safety = 'lower'
         !> the gain that counts, in units of rtol S (S: the energy scale of the run) [-]
         real(wp) :: energy_gain_bound = 10.0_wp
-        !> where `method` was set, for messages: the scene file or the `--set` argument
-        !! (the scene's path when neither set it)
-        character(len=:), allocatable :: method_origin
     end type solver_params_t
 
     !> `&output`: where results go.

@@ -176,7 +176,7 @@ contains
     !> ERR_SOLVER when the spec cannot have an equilibrium: both ends free under gravity,
     !! an end released at t = 0 (with the support motions on) counting as free; or no
     !! unique one: an RFEM without shear (and no ground to hold its elements), whose joints
-    !! slide across the rope without a force (docs/theory/rfem.md).
+    !! slide across the rope without a force (docs/theory/statics-modes.md, Errors).
     subroutine check_equilibrium_exists(spec, err)
         type(rope_spec_t), intent(in) :: spec
         type(error_t), allocatable, intent(out) :: err

@@ -128,6 +128,13 @@ def test_a_warning_or_a_model_check_names_the_set_that_gave_the_value(run, tmp_p
     assert proc.returncode == 2, proc.stderr
     assert proc.stderr.strip() == ("ropedyn: error: --set initial.mode=100: &initial: mode = "
                                    "100: the model has only 12 modes"), proc.stderr
+    # the method's refusal of the model, made once both exist
+    proc = run("run", "s.nml", "--set", "rope.diameter=0.005", "--set", "model.kind=mpp",
+               "--set", "solver.method=symplectic", "--set", "output.file=m.h5")
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.startswith("ropedyn: error: --set solver.method=symplectic: &solver: "
+                                  "method = \"symplectic\": cannot integrate the mpp model"), \
+        proc.stderr
 
 
 def test_a_harmonic_support_with_its_keys_has_no_warning(run):
