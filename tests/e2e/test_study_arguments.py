@@ -130,3 +130,26 @@ def test_check_names_reads_the_code_list(ropedyn_exe):
     check_names(parser, ropedyn_exe, "--models", ["mpp", "rfem"], "model", "kind")
     with pytest.raises(SystemExit):
         check_names(parser, ropedyn_exe, "--models", [], "model", "kind")
+
+
+def test_fig5_no_write_touches_nothing(ropedyn_exe, tmp_path, monkeypatch):
+    """fig5 --no-write prints its runs and writes no figure, data or page section (it
+    wrote docs/figures and docs/data before, under the old --no-doc); without it, it
+    writes all three (the paths moved into tmp_path)."""
+    from ropedyn_tools.studies import fig5
+    docs = tmp_path / "docs"
+    (docs / "validation").mkdir(parents=True)
+    page = docs / "validation" / "fig5.md"
+    page.write_text(f"# Figure 5\n\n{fig5.BEGIN}\n{fig5.END}\n")
+    monkeypatch.setattr(fig5, "DOCS", docs)
+    monkeypatch.setattr(fig5, "PAGE", page)
+    argv = ["--exe", str(ropedyn_exe), "--t-end", "0.02", "--elements", "2", "--jobs", "1",
+            "--outdir", str(tmp_path / "runs")]
+    before = page.read_text()
+    assert fig5.main(argv + ["--no-write"]) == 0
+    assert sorted(p.name for p in docs.rglob("*") if p.is_file()) == ["fig5.md"]
+    assert page.read_text() == before
+    assert fig5.main(argv) == 0
+    assert (docs / "figures" / "fig5_energy.png").is_file()
+    assert (docs / "data" / "fig5_energy.csv").is_file()
+    assert page.read_text() != before

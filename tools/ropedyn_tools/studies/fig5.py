@@ -5,7 +5,8 @@ n = 30 and n = 70 for 30 s, the MPP twice: with the default damping rule (factor
 and with the factors fitted to the RFEM's energy history by `scripts/calibrate` (read from
 docs/data/mpp_damping_fit.csv). Plots T + V - E0 and the energy-balance error of each run;
 writes docs/figures/fig5_energy.png, docs/data/fig5_energy.csv and the section of
-docs/theory/mpp.md between its fig5 markers. The code of scripts/fig5 (python -m
+docs/validation/fig5.md between its fig5 markers (with --no-write: none of them, it
+prints the runs only). The code of scripts/fig5 (python -m
 ropedyn_tools.studies.fig5).
 """
 import argparse
@@ -62,8 +63,8 @@ def main(argv=None):
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--outdir", default=str(ROOT / "out" / "fig5"))
     parser.add_argument("--figure", default=str(DOCS / "figures" / "fig5_energy.png"))
-    parser.add_argument("--no-doc", action="store_true",
-                        help=f"do not write the section of {PAGE.name}")
+    parser.add_argument("--no-write", action="store_true",
+                        help=f"print only: no figure, data or section of {PAGE.name}")
     args = parser.parse_args(argv)
     exe = exe_or_build(args.exe)
     check_names(parser, exe, "--method", [args.method], "solver", "method")
@@ -106,6 +107,8 @@ def main(argv=None):
     axb.set_ylabel("balance error (J)")
     axb.set_xlabel("t (s)")
     axb.grid(alpha=0.3)
+    if args.no_write:
+        return 0
     fig.tight_layout()
     pathlib.Path(args.figure).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(args.figure, dpi=110)
@@ -116,14 +119,13 @@ def main(argv=None):
         writer.writeheader()
         writer.writerows(rows)
     print(f"fig5: {args.figure}, {data}")
-    if not args.no_doc:
-        update_doc(PAGE, BEGIN, END, section(rows, fit, args, time.perf_counter() - wall0))
-        print(f"fig5: wrote the section of {PAGE}")
+    update_doc(PAGE, BEGIN, END, section(rows, fit, args, time.perf_counter() - wall0))
+    print(f"fig5: wrote the section of {PAGE}")
     return 0
 
 
 def section(rows, fit, args, seconds):
-    """The Figure 5 section of physics-mpp.md: the runs' table and the calibration."""
+    """The Figure 5 section of docs/validation/fig5.md: the runs' table and the calibration."""
     lines = [BEGIN, "",
              f"Written by `scripts/fig5` (method `{args.method}`, {args.t_end:g} s from 75°, "
              f"Table 1 damping 10³/400; {seconds / 60:.1f} min, {run_stamp()}, "
