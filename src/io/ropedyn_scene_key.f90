@@ -127,6 +127,9 @@ contains
                 merge(' or ', ' .. ', key%type == T_PAIR)//int_text(size(key%v))
         else if (index > 0) then
             text = text//' ('//key%name//' takes no index)'
+        else if (size(values) > 1) then
+            text = text//' (one value, not '//int_text(size(values))// &
+                '; a repeat count r*x gives r values)'
         end if
         if ((key%type == T_NAME .or. key%type == T_PATH) .and. size(values) == 1) then
             if (values(1)%kind /= V_STRING) text = text//' ('//key%name//' = '// &
