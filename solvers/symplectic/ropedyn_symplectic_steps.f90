@@ -42,9 +42,11 @@ contains
     !! the spectrum, so the method knows this now: it says so at the start (or where the step
     !! shortens), with the budget that reaches the end, not when the budget runs out. It
     !! counts the steps at the step in use, the rule's fitted to the output interval
-    !! (steps_left), which the run takes (never fewer than at the rule's step).
+    !! (steps_left), which the run takes (never fewer than at the rule's step). A driven
+    !! run (the library's simulation) has no end to count to: t_end does not stop it.
     module procedure budget_reaches_end
         integer(i8) :: rest, left
+        if (self%options%driven) return
         rest = max(steps_to_end(self%t, self%options%t_end, self%h_rule), self%steps_left(self%t))
         left = self%options%max_steps - self%counters%steps
         if (rest <= left) return

@@ -200,6 +200,26 @@ def test_a_spent_budget_speaks_of_the_simulation(run, tmp_path):
         assert "rest of the run" not in text and "0.5 s" not in text, text
 
 
+def test_a_simulation_does_not_count_steps_to_the_scenes_t_end(run, tmp_path):
+    """A Simulation is not stopped by the scene's t_end, so no method may refuse it for the
+    steps to t_end: the symplectic method, which foresees a shortfall of its fixed step
+    count, refused a simulation of a 300 s scene with 20,000 steps at its start although
+    the caller advanced 0.5 s (about 1,100 steps); the command line's run of the same scene
+    still refuses at once, naming the budget that reaches t_end."""
+    scene = (small(n=10, t_end=300.0).set("solver.method", "symplectic")
+             .set("solver.max_steps", 20000))
+    path = scene.write(tmp_path / "long.nml")
+    message, code = cli_error(run, path, "--set", "output.file=l.h5")
+    assert code == 3 and "the rest of the run, to t = 300.0 s, takes about" in message, message
+    with ropedyn.Simulation(scene) as sim:
+        sim.advance(0.5)
+        assert sim.t == pytest.approx(0.5, abs=1e-12)
+        with pytest.raises(ropedyn.Error) as error:
+            sim.advance(20.0)
+        assert "the budget of the whole simulation" in error.value.message, error.value.message
+        assert "300" not in error.value.message, error.value.message
+
+
 def test_a_runaway_fails_the_advance_where_the_run_fails(run, tmp_path):
     """erk at rtol 0.3 on the paper's rope creates energy; the command line's run fails at
     the runaway (docs/theory/energy-balance.md, "A runaway ends the run"). A Simulation
