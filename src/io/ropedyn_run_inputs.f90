@@ -53,12 +53,14 @@ contains
     end subroutine scene_inputs
 
     !> ERR_USAGE (exit 2) when the file `output` is one of the inputs of `scene` or of
-    !! `extra` (described by `extra_roles`), naming both; nothing else happens.
-    subroutine check_not_input(output, scene, err, extra, extra_roles)
+    !! `extra` (described by `extra_roles`), naming both (`output` as `label` when given:
+    !! the input that named it); nothing else happens.
+    subroutine check_not_input(output, scene, err, extra, extra_roles, label)
         character(len=*), intent(in) :: output
         type(scene_t), intent(in) :: scene
         type(error_t), allocatable, intent(out) :: err
         character(len=*), intent(in), optional :: extra(:), extra_roles(:)
+        character(len=*), intent(in), optional :: label
         character(len=W) :: paths(4)
         character(len=40) :: roles(4)
         integer :: k
@@ -74,7 +76,8 @@ contains
     contains
         subroutine clash(role, path)
             character(len=*), intent(in) :: role, path
-            call make_error(err, ERR_USAGE, output//': the output file is '//role//' "'// &
+            call make_error(err, ERR_USAGE, named(output, label)//': the output file is '// &
+                role//' "'// &
                 path//'" (the same file): writing it would destroy an input of this run; '// &
                 'choose another output file')
         end subroutine clash
@@ -85,10 +88,13 @@ contains
     !! file, ...), or an HDF5 file without ropedyn's root attributes (version, model,
     !! created); an error of the file's own (locked by a process: ERR_IO) as it is. Nothing
     !! when `path` does not exist or is a file ropedyn wrote. For the rule that a run
-    !! replaces only what it wrote unless told to (--force).
-    subroutine check_replaceable(path, err)
+    !! replaces only what it wrote unless told to (--force). The messages name `path` as
+    !! `label` when given (the input that named it); an error of the file's own names the
+    !! file.
+    subroutine check_replaceable(path, err, label)
         character(len=*), intent(in) :: path
         type(error_t), allocatable, intent(out) :: err
+        character(len=*), intent(in), optional :: label
         character(len=len(HDF5_SIGNATURE)) :: head
         character(len=:), allocatable :: value
         type(h5_file_t) :: h5
@@ -98,7 +104,7 @@ contains
         inquire (file=path, exist=exists)
         if (.not. exists) return
         if (len(special_file_reason(path)) > 0) then
-            call make_error(err, ERR_USAGE, path//': exists and is '// &
+            call make_error(err, ERR_USAGE, named(path, label)//': exists and is '// &
                 special_file_reason(path)//': not replaced')
             return
         end if
@@ -108,7 +114,8 @@ contains
         if (ios == 0) read (unit, iostat=ios) head
         if (ios == 0) close (unit)
         if (head /= HDF5_SIGNATURE) then
-            call make_error(err, ERR_USAGE, path//': exists and is not an HDF5 file (not '// &
+            call make_error(err, ERR_USAGE, named(path, label)//': exists and is not an '// &
+                'HDF5 file (not '// &
                 'written by ropedyn): not replaced')
             return
         end if
@@ -122,7 +129,8 @@ contains
             if (allocated(err) .or. .not. found) exit
         end do
         call h5%close(close_err)
-        if (.not. allocated(err) .and. .not. found) call make_error(err, ERR_USAGE, path// &
+        if (.not. allocated(err) .and. .not. found) call make_error(err, ERR_USAGE, &
+            named(path, label)// &
             ': exists and is an HDF5 file not written by ropedyn (no root attribute '// &
             trim(OWN_ATTRIBUTES(k))//'): not replaced')
     end subroutine check_replaceable
@@ -134,11 +142,11 @@ contains
     !! attribute `analysis`, absent for a run), its root attribute `source` is another (a
     !! --set variant, another scene) or missing (written by a version before the rule).
     !! Nothing when `path` does not exist; call check_replaceable first (a file ropedyn did
-    !! not write).
-    subroutine check_own_source(path, source, err, analysis)
+    !! not write). `label`: as check_replaceable's.
+    subroutine check_own_source(path, source, err, analysis, label)
         character(len=*), intent(in) :: path, source
         type(error_t), allocatable, intent(out) :: err
-        character(len=*), intent(in), optional :: analysis
+        character(len=*), intent(in), optional :: analysis, label
         character(len=:), allocatable :: stored, kind, mine, hint
         type(h5_file_t) :: h5
         type(error_t), allocatable :: close_err
@@ -159,13 +167,13 @@ contains
         end if
         if (.not. has_kind) kind = 'run'
         if (kind /= mine) then
-            call make_error(err, ERR_USAGE, path//': exists and holds a '//kind// &
+            call make_error(err, ERR_USAGE, named(path, label)//': exists and holds a '//kind// &
                 ' result, not a '//mine//' one: not replaced; '//hint)
         else if (.not. found) then
-            call make_error(err, ERR_USAGE, path//': exists and holds a '//kind//' whose '// &
+            call make_error(err, ERR_USAGE, named(path, label)//': exists and holds a '//kind//' whose '// &
                 'source is not recorded (an older file): not replaced; '//hint)
         else if (stored /= source) then
-            call make_error(err, ERR_USAGE, path//': exists and holds the '//kind//' of "'// &
+            call make_error(err, ERR_USAGE, named(path, label)//': exists and holds the '//kind//' of "'// &
                 stored//'", not of this '//mine//' "'//source//'": not replaced; '//hint)
         end if
     end subroutine check_own_source
@@ -174,25 +182,35 @@ contains
     !! `analysis`, 'statics' or 'modes') of `scene`? Never a special file (a device, a FIFO,
     !! a link to one), whatever `force`; unless `force`, only a file ropedyn wrote for the
     !! same kind of result of the same source (check_replaceable, check_own_source): else
-    !! ERR_USAGE naming what the file is. Nothing when `path` does not exist.
-    subroutine check_may_replace(path, scene, force, err, analysis)
+    !! ERR_USAGE naming what the file is. Nothing when `path` does not exist. `label`: as
+    !! check_replaceable's.
+    subroutine check_may_replace(path, scene, force, err, analysis, label)
         character(len=*), intent(in) :: path
         type(scene_t), intent(in) :: scene
         logical, intent(in) :: force
         type(error_t), allocatable, intent(out) :: err
-        character(len=*), intent(in), optional :: analysis
+        character(len=*), intent(in), optional :: analysis, label
         if (len(special_file_reason(path)) > 0) then
-            call make_error(err, ERR_USAGE, path//': exists and is '// &
+            call make_error(err, ERR_USAGE, named(path, label)//': exists and is '// &
                             special_file_reason(path)//': not replaced')
             return
         end if
         if (force) return
-        call check_replaceable(path, err)
+        call check_replaceable(path, err, label)
         if (allocated(err)) then
             if (err%code == ERR_USAGE) err%message = err%message//' (--force replaces it)'
             return
         end if
         if (allocated(scene%source)) &
-            call check_own_source(path, scene%source, err, analysis)
+            call check_own_source(path, scene%source, err, analysis, label)
     end subroutine check_may_replace
+
+    !> How a message names the file `path`: as `label` when given, else by its path.
+    pure function named(path, label) result(text)
+        character(len=*), intent(in) :: path
+        character(len=*), intent(in), optional :: label
+        character(len=:), allocatable :: text
+        text = path
+        if (present(label)) text = label
+    end function named
 end module ropedyn_run_inputs

@@ -35,11 +35,8 @@ contains
         file = self%summary%file
         given = file
         if (.not. resume) then
-            call check_not_input(file, self%scene, err)
-            if (allocated(err)) then
-                call name_key(self%scene, given, file, err)
-                return
-            end if
+            call check_not_input(file, self%scene, err, label=output_key(self%scene, given))
+            if (allocated(err)) return
             call make_parent_dirs(file, err)
             if (allocated(err)) return
             if (len(special_file_reason(file)) > 0) then
@@ -83,8 +80,8 @@ contains
                 'f.attrs["status"] = "interrupted", then ropedyn run --resume '//file// &
                 '.part) or remove it, or give --force')
         else
-            call check_may_replace(file, self%scene, force, err)
-            if (allocated(err)) call name_key(self%scene, given, file, err)
+            call check_may_replace(file, self%scene, force, err, &
+                                   label=output_key(self%scene, given))
         end if
         if (allocated(err)) then
             call drop_lock(self%lock_file, self%beat)
@@ -109,16 +106,6 @@ contains
         if (len(scene%output%file_origin) > 0) &
             text = scene%output%file_origin//': &output: file = "'//file//'"'
     end function output_key
-
-    !> A refusal of the output file `file` (given as `given`) that begins 'FILE: ' begins with
-    !! the input that named it instead (output_key).
-    subroutine name_key(scene, given, file, err)
-        type(scene_t), intent(in) :: scene
-        character(len=*), intent(in) :: given, file
-        type(error_t), intent(inout) :: err
-        if (index(err%message, file//': ') /= 1) return
-        err%message = output_key(scene, given)//err%message(len(file) + 1:)
-    end subroutine name_key
 
     module procedure release_output
         type(error_t), allocatable :: rerr
