@@ -440,10 +440,12 @@ contains
         self%resumed = resuming
         if (resuming) then
             call self%resume_from_file(err)
-            if (.not. allocated(err)) call self%keep_as_previous()
         else
             call self%fresh_start(err)
         end if
+        ! the start is the first state looked back to (a library simulation, which records
+        ! nothing, has no other before its first look)
+        if (.not. allocated(err)) call self%keep_as_previous()
     end subroutine start_from
 
     !> The scene's start: the initial state (statics and modes first for 'equilibrium' and

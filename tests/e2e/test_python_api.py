@@ -256,6 +256,27 @@ def test_a_runaway_fails_the_advance_where_the_run_fails(run, tmp_path):
             sim.advance(t)
 
 
+def test_a_runaway_at_the_first_look_fails_cleanly(tmp_path):
+    """The runaway rule looks back to the previous look; at a simulation's first look that
+    is its start. A simulation records nothing, so nothing had kept the start: one advance
+    of the runaway scene over the whole run crashed the process (SIGSEGV, reading the
+    unset previous state). It now fails that advance with the runaway's message and keeps
+    the start. Run in a child process, so that a crash fails this test alone."""
+    code = ("import numpy as np, ropedyn\n"
+            f"s = ropedyn.Scene.from_file({str(PAPER)!r})\n"
+            "s = s.set('solver.method', 'erk').set('solver.rtol', 0.3).set('solver.atol', 1e-3)\n"
+            "with ropedyn.Simulation(s) as sim:\n"
+            "    y0 = sim.state\n"
+            "    try:\n"
+            "        sim.advance(30.0)\n"
+            "    except ropedyn.Error as e:\n"
+            "        print(e.code, 'it created' in e.message, sim.t, np.array_equal(sim.state, y0))\n")
+    result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                            text=True, timeout=300)
+    assert result.returncode == 0, (result.returncode, result.stderr)
+    assert result.stdout.split() == ["3", "True", "0.0", "True"], result.stdout
+
+
 def test_simulation_calls_and_their_errors():
     scene = small(n=8)
     with ropedyn.Simulation(scene) as sim:
