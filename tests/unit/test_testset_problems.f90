@@ -1,4 +1,4 @@
-!> The test-set problems (src/testset): sizes, intervals, initial values, f at y0, the
+!> The test-set problems (solvers/testset): sizes, intervals, initial values, f at y0, the
 !! conservation laws built into the equations, and every analytic Jacobian against
 !! central differences of f at y0, at yref and at an intermediate state.
 !!
