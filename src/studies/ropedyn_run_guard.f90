@@ -20,6 +20,7 @@ submodule (ropedyn_run) ropedyn_run_guard
     use ropedyn_sweep_lock, only: take_lock, drop_lock
     use ropedyn_run_inputs, only: check_not_input, check_may_replace
     use ropedyn_error, only: ERR_USAGE, ERR_IO
+    use ropedyn_h5, only: h5_file_t
     use ropedyn_text, only: replaced
     implicit none
 
@@ -117,9 +118,12 @@ contains
                 if (exists) then
                     call rename_file(self%part_file, self%final_file, rerr)
                     if (allocated(rerr) .and. .not. allocated(err)) call move_alloc(rerr, err)
-                    ! a message about the file names it where it now is
-                    if (allocated(err) .and. .not. allocated(rerr)) &
+                    ! a message about the file names it where it now is, and so does the
+                    ! reason the file keeps
+                    if (allocated(err) .and. .not. allocated(rerr)) then
                         err%message = replaced(err%message, self%part_file, self%final_file)
+                        call rename_in_reason(self%final_file, self%part_file)
+                    end if
                 end if
                 self%summary%file = self%final_file
                 self%part_file = ''
@@ -130,4 +134,24 @@ contains
             self%lock_file = ''
         end if
     end procedure release_output
+
+    !> The root attribute `reason` of the run file `path` (written while it was `part`, by
+    !! a failure that named it so) names `path` instead. Nothing when the file has no reason
+    !! naming `part`, or cannot be opened or written (the file is whole and closed with its
+    !! status; only the name in its reason stays the old one).
+    subroutine rename_in_reason(path, part)
+        character(len=*), intent(in) :: path, part
+        type(h5_file_t) :: h5
+        type(error_t), allocatable :: err, close_err
+        character(len=:), allocatable :: reason
+        logical :: found
+        call h5%open(path, err, writable=.true.)
+        if (allocated(err)) return
+        call h5%read_attribute('reason', reason, err, found)
+        if (.not. allocated(err) .and. found) then
+            if (index(reason, part) > 0) &
+                call h5%attribute('/', 'reason', replaced(reason, part, path), err)
+        end if
+        call h5%close(close_err)
+    end subroutine rename_in_reason
 end submodule ropedyn_run_guard

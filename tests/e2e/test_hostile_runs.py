@@ -431,6 +431,9 @@ def test_file_size_limit_ends_in_a_failed_file(ropedyn_exe, tmp_path):
     assert_fails(result, 4, "long.h5: File too large")
     with h5py.File(tmp_path / "long.h5", "r") as f:
         assert attr(f, "status") == "failed" and len(f["time"]) > 0
+        # the reason the file keeps names it where it is, as the message does (it named
+        # long.h5.part, where the run wrote it)
+        assert attr(f, "reason").startswith("long.h5: File too large"), attr(f, "reason")
 
 
 def test_tmpfs_full(ropedyn_exe, tmp_path):
