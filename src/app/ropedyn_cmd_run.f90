@@ -254,8 +254,8 @@ contains
                 method_chain(s%switches)
         end if
         do k = 1, size(s%switches)
-            if (s%switches(k)%warning) write (error_unit, '(a, f10.4, a)') 'warning: at t = ', &
-                s%switches(k)%t, ' s: '//s%switches(k)%reason
+            if (s%switches(k)%warning) write (error_unit, '(a, f10.4, a)') &
+                'ropedyn: warning: at t = ', s%switches(k)%t, ' s: '//s%switches(k)%reason
         end do
     end subroutine print_switches
 

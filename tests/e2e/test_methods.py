@@ -100,8 +100,8 @@ def test_auto_leaves_the_symplectic_method_out_when_the_budget_is_short(run, tmp
     with h5py.File(out, "r") as f:
         methods, _, _, reasons = switch_log(f)
     assert "symplectic" not in methods, (methods, reasons)
-    warning = re.findall(r"^warning: at t = +0\.0000 s: the symplectic method would keep the "
-                         r"energy bounded .* takes about (\d+) of its steps .* more than the "
+    warning = re.findall(r"^ropedyn: warning: at t = +0\.0000 s: the symplectic method would "
+                         r"keep the energy bounded .* takes about (\d+) of its steps .* more than the "
                          rf"{budget} that max_steps leaves: raise solver\.max_steps by (\d+) "
                          r"to use it$", proc.stderr, re.MULTILINE)
     assert len(warning) == 1, proc.stderr
