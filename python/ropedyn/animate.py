@@ -23,6 +23,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from ropedyn import fields, io, plot  # noqa: E402
+from ropedyn.docstrings import summary  # noqa: E402
 
 ROPE_COLOR = "#1f4e9c"
 TIP_COLOR = "#d62728"
@@ -186,7 +187,7 @@ def check_format(path):
 
 
 def parse_args(argv):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("run", help="HDF5 output of ropedyn run")
     parser.add_argument("-o", "--output", help="animation file, .gif or .mp4 "
                                                "(default: RUN.gif next to the run)")

@@ -24,6 +24,7 @@ import numpy as np
 from ropedyn import fields as derived
 from ropedyn import io
 from ropedyn.plot import made_by, written_whole
+from ropedyn.docstrings import summary
 
 FIELD_UNITS = {"tension": "N", "curvature": "1/m", "speed": "m/s", "velocity": "m/s",
                "angle": "rad", "joint_tension": "N", "joint_curvature": "1/m",
@@ -164,7 +165,7 @@ def build_xdmf(run_path, fields_path, records, points_shape, fields):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("run", help="HDF5 output of ropedyn run")
     parser.add_argument("--every", type=int, default=1,
                         help="describe every K-th record only (default 1: all)")

@@ -121,11 +121,15 @@ def test_module_main_takes_argv(module, capsys):
 
 @pytest.mark.parametrize("name", sorted(COMMANDS))
 def test_command_answers_help(name):
-    """scripts/NAME --help: exit 0 and the module's usage; no build (it would take minutes)."""
+    """scripts/NAME --help: exit 0 and the module's usage; no build (it would take minutes).
+    It says what the command does in the whole first paragraph of its module's docstring
+    (its first line alone stopped mid-sentence in most of them)."""
     result = subprocess.run(["bash", str(ROOT / "scripts" / name), "--help"],
                             capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
     assert result.stdout.startswith("usage:"), result.stdout
+    first = importlib.import_module(COMMANDS[name]).__doc__.strip().split("\n\n")[0]
+    assert " ".join(first.split()) in " ".join(result.stdout.split()), result.stdout
 
 
 @pytest.mark.parametrize("name", sorted(SHIMS))

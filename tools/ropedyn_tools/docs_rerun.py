@@ -32,6 +32,7 @@ import time
 
 from ropedyn_tools import docs_status
 from ropedyn_tools.repo import ROOT
+from ropedyn.docstrings import summary
 
 #: what a study reads that another command writes: {study: that command}, run once before
 #: the first command of the study. The stability report's long-horizon matrix comes from
@@ -129,7 +130,7 @@ def run(commands, root, logs):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--dry-run", action="store_true", help="print the plan only")
     parser.add_argument("--root", type=pathlib.Path, default=ROOT,
                         help="the checkout whose docs/ to bring up to date (default: this one)")

@@ -42,6 +42,7 @@ import sys
 from ropedyn_tools import prose_numbers
 from ropedyn_tools.repo import ROOT
 from ropedyn_tools.studies.common import git
+from ropedyn.docstrings import summary
 
 #: where a study's own module is, and (for the runs before it moved) was
 STUDY_FOLDERS = ("tools/ropedyn_tools/studies", "tools/ropedyn_tools", "python/ropedyn/studies")
@@ -349,7 +350,7 @@ def status(root=ROOT):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--stale", action="store_true",
                         help="list only the sections with code commits since their run")
     parser.add_argument("--check", action="store_true",

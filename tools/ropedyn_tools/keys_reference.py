@@ -18,6 +18,7 @@ import sys
 
 from ropedyn_tools.repo import DOCS, add_exe_argument, exe_or_build
 from ropedyn_tools.studies.common import splice
+from ropedyn.docstrings import summary
 
 PAGE = DOCS / "reference" / "keys.md"
 BEGIN, END = "<!-- keys:begin -->", "<!-- keys:end -->"
@@ -116,7 +117,7 @@ def section(page_text):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("--check", action="store_true",
                         help="compare the page with the table; exit 1 when it differs")

@@ -23,6 +23,7 @@ import tempfile
 
 from ropedyn_tools.arguments import positive
 from ropedyn_tools.repo import PAPER, add_exe_argument, exe_or_build
+from ropedyn.docstrings import summary
 
 #: what a crash prints (the Fortran runtime, glibc, the kernel)
 CRASH_TEXT = ("Fortran runtime", "Backtrace", "Segmentation", "Program received signal",
@@ -139,7 +140,7 @@ def sorted_outcome(proc_or_none, text, command):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("command", nargs="?", choices=("run", "statics", "modes"),
                         default="run")

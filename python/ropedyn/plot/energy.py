@@ -11,10 +11,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from ropedyn import io, plot  # noqa: E402
+from ropedyn.docstrings import summary  # noqa: E402
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("run", help="HDF5 output of ropedyn run")
     parser.add_argument("-o", "--output", help="PNG file (default: RUN_energy.png)")
     args = parser.parse_args(argv)

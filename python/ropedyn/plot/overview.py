@@ -20,6 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from ropedyn import fields, io, plot  # noqa: E402
+from ropedyn.docstrings import summary  # noqa: E402
 
 
 def plot_energies(ax, run):
@@ -128,7 +129,7 @@ def parse_times(value):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("run", help="HDF5 output of ropedyn run")
     parser.add_argument("-o", "--output", help="PNG file (default: RUN_plot.png)")
     parser.add_argument("--times", type=parse_times,

@@ -47,6 +47,7 @@ from ropedyn_tools import docs_status
 from ropedyn_tools.arguments import check_methods, method_specs
 from ropedyn_tools.repo import DOCS, add_exe_argument, exe_or_build
 from ropedyn_tools.studies.common import machine, method_sets, update_doc, run_stamp
+from ropedyn.docstrings import summary
 
 PAGE = DOCS / "validation" / "accuracy.md"
 CHOOSING = DOCS / "guide" / "choosing.md"
@@ -941,7 +942,7 @@ def model_cases(text):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("study", choices=[*STUDIES, "choosing", "all"])
     add_exe_argument(parser)
     parser.add_argument("--quick", action="store_true", help="smoke test: small n, short")

@@ -41,6 +41,7 @@ from ropedyn_tools.studies import auto_table
 from ropedyn_tools.studies.auto_table import FIXED, scene_t_end, scenes
 from ropedyn_tools.studies.common import (machine, method_chain, method_label, scene_number,
                                           update_doc, run_stamp)
+from ropedyn.docstrings import summary
 
 BEGIN = "<!-- auto_accuracy:begin -->"
 END = "<!-- auto_accuracy:end -->"
@@ -83,7 +84,7 @@ def error_cell(at_own, cap):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("--span", type=float, default=1.0,
                         help="simulated time (s), at most the scene's t_end")

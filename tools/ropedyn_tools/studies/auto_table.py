@@ -36,6 +36,7 @@ import h5py
 from ropedyn_tools.repo import DOCS, INPUT, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import (distinct_runs, machine, scene_number, update_doc,
                                           run_stamp)
+from ropedyn.docstrings import summary
 
 BEGIN = "<!-- auto_table:begin -->"
 END = "<!-- auto_table:end -->"
@@ -135,7 +136,7 @@ def choice_text(switches):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("--budget", type=float, default=20.0,
                         help="CPU (s) of auto's run above which the horizon is shortened")

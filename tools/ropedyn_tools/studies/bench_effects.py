@@ -18,6 +18,7 @@ import tempfile
 from ropedyn_tools.repo import DOCS, PAPER, build, set_args
 from ropedyn_tools.studies.bench_rhs import build_bench_rhs
 from ropedyn_tools.studies.common import baseline_revision, machine, update_doc, run_stamp
+from ropedyn.docstrings import summary
 
 BEGIN = "<!-- bench_effects:begin -->"
 END = "<!-- bench_effects:end -->"
@@ -60,7 +61,7 @@ def bench(exe, n, sets, seconds):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--build", default=None, help="Release build directory (default: "
                         "build the Release configuration with scripts/build and use it)")
     parser.add_argument("--elements", type=int, default=100)

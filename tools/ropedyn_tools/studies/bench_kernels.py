@@ -24,6 +24,7 @@ from ropedyn_tools.arguments import list_text, positive
 from ropedyn_tools.repo import DOCS, PAPER, build, set_args
 from ropedyn_tools.studies.bench_rhs import build_bench_rhs
 from ropedyn_tools.studies.common import baseline_revision, machine, update_doc, run_stamp
+from ropedyn.docstrings import summary
 
 BEGIN = "<!-- bench_kernels:begin -->"
 END = "<!-- bench_kernels:end -->"
@@ -77,7 +78,7 @@ def ratio(before, after):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--build", default=None, help="Release build directory (default: "
                         "build the Release configuration with scripts/build and use it)")
     parser.add_argument("--baseline", default=None,

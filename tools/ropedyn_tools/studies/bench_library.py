@@ -29,6 +29,7 @@ import time
 
 from ropedyn_tools.repo import DOCS, PAPER, build
 from ropedyn_tools.studies.common import machine, run_stamp, update_doc
+from ropedyn.docstrings import summary
 
 BEGIN = "<!-- bench_library:begin -->"
 END = "<!-- bench_library:end -->"
@@ -124,7 +125,7 @@ def rss_rows(memory, env, cycles):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--build", default=None,
                         help="a Release build folder (default: build it with scripts/build)")
     parser.add_argument("--t-end", type=float, default=10.0)

@@ -25,6 +25,7 @@ from ropedyn_tools.repo import (DOCS, PAPER, add_scaling_arguments, exe_or_build
                                 set_args)
 from ropedyn_tools.studies.common import (SPLIT_HEADER, machine, time_split,  # noqa: E402
                                           update_doc, run_stamp)
+from ropedyn.docstrings import summary
 
 BEGIN = "<!-- bench_models:begin -->"
 END = "<!-- bench_models:end -->"
@@ -50,7 +51,7 @@ def run_case(exe, model, method, n, t_end, rtol, workdir, timeout):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_scaling_arguments(parser, t_end=1.0, elements="10 20 30 50 70 100 150 200 300")
     parser.add_argument("--budget", type=float, default=300.0,
                         help="skip larger n of a (model, solver) after a case above this (s)")

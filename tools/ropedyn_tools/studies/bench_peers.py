@@ -73,6 +73,7 @@ import tempfile
 import numpy as np
 
 from ropedyn import io
+from ropedyn.docstrings import summary
 from ropedyn_tools.arguments import check_methods, list_text, method_specs, positive
 from ropedyn_tools.repo import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import (least_cpu, machine, method_chain, method_label,
@@ -578,7 +579,7 @@ def command_text(argv):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("--t-end", type=float, default=30.0)
     parser.add_argument("--probe", type=float, default=5.0, help="stability probe (s)")

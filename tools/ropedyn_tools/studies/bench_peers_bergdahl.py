@@ -43,6 +43,7 @@ from ropedyn_tools.repo import DOCS, ROOT, add_exe_argument, exe_or_build
 from ropedyn_tools.studies import bergdahl as bg
 from ropedyn_tools.studies.bench_peers import ensure_bench_venv
 from ropedyn_tools.studies.common import machine, run_stamp, update_doc
+from ropedyn.docstrings import summary
 
 BEGIN, END = "<!-- bergdahl_peers:begin -->", "<!-- bergdahl_peers:end -->"
 D = 0.003654
@@ -149,7 +150,7 @@ def run_moordyn(py, work, period, radius, segments, dt_m, ct, cycles):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--work", default=str(ROOT / "out" / "bergdahl"),
                         help="the case files of scripts/validation bergdahl")
     parser.add_argument("--segments", type=int, default=165)

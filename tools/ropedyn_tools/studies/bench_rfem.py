@@ -17,6 +17,7 @@ from ropedyn import io
 from ropedyn_tools.arguments import check_names
 from ropedyn_tools.repo import DOCS, PAPER, add_scaling_arguments, exe_or_build, set_args
 from ropedyn_tools.studies.common import SPLIT_HEADER, machine, time_split, update_doc, run_stamp
+from ropedyn.docstrings import summary
 
 BEGIN = "<!-- bench_rfem:begin -->"
 END = "<!-- bench_rfem:end -->"
@@ -51,7 +52,7 @@ def line(r):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_scaling_arguments(parser, t_end=30.0, elements="10 30 100 300 1000")
     parser.add_argument("--solvers", default="cvode mebdf")
     parser.add_argument("--first-order-newton", action="store_true",

@@ -18,6 +18,7 @@ import tempfile
 from ropedyn_tools.repo import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import baseline_revision, machine, update_doc, run_stamp
 from ropedyn_tools.studies.profile_step import build_baseline
+from ropedyn.docstrings import summary
 
 BEGIN = "<!-- bench_step:begin -->"
 END = "<!-- bench_step:end -->"
@@ -54,7 +55,7 @@ def cost(model, n, steps, cpu):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("--baseline", default="97a3272", help="git revision of 'before'")
     parser.add_argument("--baseline-exe", default=None,

@@ -48,6 +48,7 @@ from ropedyn_tools.studies import stability_metrics
 from ropedyn_tools.studies.common import (baseline_revision, least_cpu, machine, run_stamp,
                                           update_doc)
 from ropedyn_tools.studies.profile_step import build_baseline
+from ropedyn.docstrings import summary
 
 DOC = DOCS / "validation" / "energy.md"
 BEGIN = "<!-- symplectic-targets:begin -->"
@@ -346,7 +347,7 @@ def window_block(windows):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("mode", nargs="?", choices=("targets", "elastic", "tolerance"),
                         default="targets", help="the targets' section (default), the "

@@ -35,6 +35,7 @@ from ropedyn_tools.arguments import choice, list_text, positive
 from ropedyn_tools.repo import DOCS, INPUT, ROOT, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.docs_status import same_code
 from ropedyn_tools.studies.common import least_cpu, run_stamp, scene_number, update_doc
+from ropedyn.docstrings import summary
 
 SCENE_DIR = INPUT / "validation" / "bergdahl"
 BASE = SCENE_DIR / "base.nml"
@@ -827,7 +828,7 @@ def section(results, models, periods, walls, conv, figs, command, work, contact=
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("--out", default=str(DOCS / "validation" / "bergdahl.md"))
     parser.add_argument("--work", default=str(ROOT / "out" / "bergdahl"),

@@ -32,6 +32,7 @@ import numpy as np
 from ropedyn import io
 from ropedyn_tools.arguments import check_names
 from ropedyn_tools.repo import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
+from ropedyn.docstrings import summary
 
 #: where the fit is written (and scripts/fig5 reads it)
 FIT_DATA = DOCS / "data" / "mpp_damping_fit.csv"
@@ -96,7 +97,7 @@ def nelder_mead(fun, x0, step=0.5, tol=1e-3, max_evals=40):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("scene", nargs="?", default=str(PAPER))
     add_exe_argument(parser)
     parser.add_argument("--elements", type=int, default=10)

@@ -37,6 +37,7 @@ import numpy as np
 
 from ropedyn_tools.repo import DOCS, ROOT
 from ropedyn_tools.studies.common import run_stamp, update_doc
+from ropedyn.docstrings import summary
 
 DOC = DOCS / "theory" / "symplectic.md"
 TABLES = ROOT / "solvers" / "symplectic" / "ropedyn_split_tables.f90"
@@ -283,7 +284,7 @@ def force_gradient_row(bm_step):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--no-write", action="store_true")
     args = parser.parse_args(argv)
     table = rows()

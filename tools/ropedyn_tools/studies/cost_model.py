@@ -23,6 +23,7 @@ from ropedyn import io
 from ropedyn_tools.arguments import listing, positive
 from ropedyn_tools.repo import DOCS, PAPER, ROOT, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import least_cpu, machine, update_doc, run_stamp
+from ropedyn.docstrings import summary
 
 BEGIN = "<!-- cost_model:begin -->"
 END = "<!-- cost_model:end -->"
@@ -97,7 +98,7 @@ def rows(results, constants):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("--t-end", type=positive(float), default=10.0)
     parser.add_argument("--elements", type=listing(positive(int)), default="10 30 100",

@@ -28,6 +28,7 @@ from ropedyn_tools.repo import (DOCS, PAPER, ROOT, add_exe_argument, exe_or_buil
                                 set_args)
 from ropedyn_tools.studies.calibrate import FIT_DATA, read_fit  # noqa: E402
 from ropedyn_tools.studies.common import machine, update_doc, run_stamp  # noqa: E402
+from ropedyn.docstrings import summary
 
 PAGE = DOCS / "validation" / "fig5.md"
 BEGIN, END = "<!-- fig5:begin -->", "<!-- fig5:end -->"
@@ -55,7 +56,7 @@ def label(case):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("--t-end", type=float, default=30.0)
     parser.add_argument("--method", default="auto")

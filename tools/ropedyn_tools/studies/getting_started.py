@@ -39,6 +39,7 @@ from ropedyn import io
 from ropedyn_tools.repo import DOCS, ROOT
 from ropedyn_tools.studies.common import run_stamp, splice
 from ropedyn_tools.studies.readme_figures import draw
+from ropedyn.docstrings import summary
 
 PAGE = DOCS / "getting-started.md"
 FIGURES = DOCS / "figures" / "getting-started"
@@ -252,7 +253,7 @@ def write_pages(parts):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("--no-write", action="store_true",
                         help="run and print, write neither the page nor its pictures")
     parser.add_argument("--keep", type=pathlib.Path, default=None,

@@ -29,6 +29,7 @@ from ropedyn import fields, io
 from ropedyn_tools.repo import DOCS, INPUT, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies import stability_metrics
 from ropedyn_tools.studies.common import machine, run_stamp, update_doc
+from ropedyn.docstrings import summary
 
 DOC = DOCS / "validation" / "order-safety.md"
 BEGIN = "<!-- loose-tolerances:begin -->"
@@ -91,7 +92,7 @@ def cases():
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--no-write", action="store_true")

@@ -21,6 +21,7 @@ import numpy as np
 
 from ropedyn_tools.repo import ROOT
 from ropedyn_tools.studies.common import run_stamp, update_doc
+from ropedyn.docstrings import summary
 
 #: the pages and their markers
 MEBDF_PAGE = ROOT / "docs" / "theory" / "mebdf.md"
@@ -155,7 +156,7 @@ def head(kmax):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument('--kmax', type=int, default=6,
                         help='the largest k (order k + 1; default 6: order 7, MEBDF\'s limit)')
     parser.add_argument('--no-write', action='store_true',

@@ -39,6 +39,7 @@ import tempfile
 from ropedyn_tools.arguments import check_names
 from ropedyn_tools.repo import DOCS, PAPER, ROOT, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import baseline_revision, machine, update_doc, run_stamp
+from ropedyn.docstrings import summary
 
 BEGIN = "<!-- profile_step:begin -->"
 END = "<!-- profile_step:end -->"
@@ -154,7 +155,7 @@ def row(label, method, steps, parts, total):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("--t-end", type=float, default=1.0)
     parser.add_argument("--baseline", default=None,

@@ -22,6 +22,7 @@ from matplotlib.collections import LineCollection  # noqa: E402
 
 from ropedyn import io, plot  # noqa: E402
 from ropedyn_tools.repo import PAPER, add_exe_argument, exe_or_build, set_args  # noqa: E402
+from ropedyn.docstrings import summary
 
 DPI = 100
 
@@ -91,7 +92,7 @@ def draw(run_file, outdir, strobe_end, snapshots):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     parser.add_argument("run", nargs="?", help="HDF5 output of the paper scene (default: "
                         "run input/paper.nml for --t-end seconds)")
     parser.add_argument("--outdir", default="docs/figures", help="where the PNGs go")

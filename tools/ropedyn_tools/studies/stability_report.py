@@ -32,6 +32,7 @@ import tempfile
 from ropedyn_tools.repo import DOCS, INPUT, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies import long_horizon, stability_metrics
 from ropedyn_tools.studies.common import machine, run_commit, splice
+from ropedyn.docstrings import summary
 
 #: the page of each generated section
 PAGES = {
@@ -397,7 +398,7 @@ def command_text(quick, only, cached_only=False):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("--jobs", type=int, default=2, help="runs at a time (default 2)")
     parser.add_argument("--only", choices=["cvode-order", "hard-scenes", "long-horizon"],

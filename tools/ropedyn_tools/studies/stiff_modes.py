@@ -41,6 +41,7 @@ import numpy as np
 from ropedyn_tools.arguments import list_text, positive
 from ropedyn_tools.repo import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import machine, run_stamp, update_doc
+from ropedyn.docstrings import summary
 
 DOC = DOCS / "performance" / "peers.md"
 BEGIN, END = "<!-- stiff_modes:begin -->", "<!-- stiff_modes:end -->"
@@ -133,7 +134,7 @@ def row(exe, work, n):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("--elements", type=list_text(positive(int)), default=ELEMENTS)
     parser.add_argument("--no-write", action="store_true")

@@ -35,6 +35,7 @@ from ropedyn_tools.repo import DOCS, INPUT, PAPER, ROOT, add_exe_argument, exe_o
 from ropedyn_tools.studies.bench_symplectic import run, undamped_sets, window_masks
 from ropedyn_tools.studies.common import machine, run_stamp, update_doc
 from ropedyn_tools.studies.profile_step import build_baseline
+from ropedyn.docstrings import summary
 
 DOC = DOCS / "theory" / "symplectic.md"
 BEGIN = "<!-- symplectic-factors:begin -->"
@@ -114,7 +115,7 @@ def measure(exes, t_end, work):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser, "the ropedyn executable of this tree (the code's factor)")
     parser.add_argument("--factors", type=list_text(positive(float)), default="0.3 0.35 0.4",
                         help="the factors, space-separated (one of them the code's)")

@@ -23,6 +23,7 @@ import numpy as np
 
 from ropedyn_tools.repo import DOCS, add_exe_argument, exe_or_build
 from ropedyn_tools.studies.common import run_commit
+from ropedyn.docstrings import summary
 
 G, L, RHO, D, E, GSHEAR = 9.81, 1.0, 6000.0, 0.005, 35e6, 14e6
 AREA = math.pi * D**2 / 4
@@ -181,7 +182,7 @@ def modal_period_check(runner, text_modes, text_run, k, periods=3):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("--out", default=str(DOCS / "validation" / "statics-modes.md"))
     parser.add_argument("--quick", action="store_true", help="n up to 100 only (a smoke test)")

@@ -25,6 +25,7 @@ import numpy as np
 
 from ropedyn_tools.repo import DOCS, add_exe_argument, exe_or_build
 from ropedyn_tools.studies.common import machine, update_doc, run_stamp
+from ropedyn.docstrings import summary
 
 BEGIN = "<!-- testset-wp:begin -->"
 END = "<!-- testset-wp:end -->"
@@ -259,7 +260,7 @@ def write_csv(rows, path):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
     parser.add_argument("--methods", default="cvode,mebdf",
                         help="comma-separated methods (default: cvode,mebdf)")
