@@ -24,6 +24,7 @@ module ropedyn_scene
     private
     public :: solver_params_t, output_params_t, scene_t
     public :: read_scene, read_scene_text, read_scene_string, scene_namelist_text, &
+        echo_without_output_file, &
         scene_key_listing, check_override_value, override_target
 
     !> One `--set group.key=value` argument, parsed.
@@ -406,6 +407,24 @@ contains
             text = text//'/'
         end do
     end function scene_namelist_text
+
+    !> An effective scene `text` (scene_namelist_text) without the line of its output file
+    !! (the first of &output), for comparing two scenes that differ only in where their
+    !! output goes: a sweep's case under its output directory spelled another way.
+    pure function echo_without_output_file(text) result(rest)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: rest
+        character(len=*), parameter :: HEAD = new_line('a')//'&output'//new_line('a')
+        integer :: i, j
+        rest = text
+        i = index(text, HEAD)
+        if (i == 0) return
+        i = i + len(HEAD)
+        j = index(text(i:), new_line('a'))
+        if (j == 0) return
+        if (index(adjustl(text(i:i + j - 2)), 'file = ') /= 1) return
+        rest = text(:i - 1)//text(i + j:)
+    end function echo_without_output_file
 
     !> The listing of `ropedyn keys`: a header and one line per key (tab-separated group,
     !! key, type, unit, default, allowed values, meaning); with `group`, that group's keys

@@ -7,7 +7,7 @@
 !! - interrupted: its writer stopped before the end: a signal (Ctrl-C, scancel, a time
 !!   limit), a kill, a crash or a node failure (an abandoned lock), or a file with status
 !!   interrupted;
-!! - stale: its file holds another scene: the sweep changed;
+!! - stale: its file holds another scene (where the file is aside): the sweep changed;
 !! - unreadable: its file is there but does not read back (the reason says what failed);
 !! - missing: no file, no lock (but a run that failed before it made its file, a statics
 !!   start that found no equilibrium for one, left a note `.case_<id>.failed` with its
@@ -18,7 +18,7 @@
 module ropedyn_sweep_status
     use ropedyn_error, only: error_t
     use ropedyn_os, only: rename_file, delete_file
-    use ropedyn_scene, only: scene_namelist_text
+    use ropedyn_scene, only: scene_namelist_text, echo_without_output_file
     use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_sweep_lock, only: lock_t, read_lock
     use ropedyn_sweep, only: sweep_case_t
@@ -85,7 +85,10 @@ contains
                 state%status = 'missing'
                 state%reason = failure_note(c%file)
                 if (len(state%reason) > 0) state%status = 'failed'
-            else if (state%data%scene /= scene_namelist_text(c%scene)) then
+            else if (echo_without_output_file(state%data%scene) /= &
+                     echo_without_output_file(scene_namelist_text(c%scene))) then
+                ! (the case file's own path aside: the output directory may be spelled
+                ! another way, or moved)
                 state%status = 'stale'
                 state%reason = 'the file holds another scene than this case (the sweep ' &
                     //'changed); run the sweep again'

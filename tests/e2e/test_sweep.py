@@ -144,6 +144,11 @@ def test_local_runner_and_skip_if_done(run, sweep_dir):
     assert result.returncode == 0, result.stderr
     assert "8 complete already, running 0" in result.stderr
     assert mtimes == {p.name: p.stat().st_mtime_ns for p in out.glob("case_*.h5")}
+    # the same directory spelled another way: each case file holds its own path in its
+    # scene, which made every case stale (and a run redid them all)
+    for spelling in ("./out/sw", str(out)):
+        listing = run("sweep", "sw.nml", "--list", "--output-dir", spelling).stdout
+        assert listing.count("  complete") == 8, listing
 
     # a changed case is stale and runs again; a removed one runs again; the others do not
     (out / "case_0005.h5").unlink()
