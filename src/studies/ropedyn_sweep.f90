@@ -94,7 +94,7 @@ contains
         type(case_data_t) :: ref
         real(wp), allocatable :: times(:)
         real(wp) :: dt, t_end
-        integer :: c, k, n_out, n_ref
+        integer :: c, k, m, n_out, n_ref
         character(len=:), allocatable :: where
 
         where = sweep%path//': &sweep: reference = "'//sweep%reference_file//'": '
@@ -119,21 +119,30 @@ contains
                 n_out = max(1, ceiling(t_end/dt*(1.0_wp - 1.0e-12_wp)))
                 times = [(min(real(k, wp)*dt, t_end), k=0, n_out)]
                 times(n_out + 1) = t_end
+                ! the times both have first (a coarser output interval ends no earlier)
+                m = min(int(ref%records), size(times))
+                if (maxval(abs(times(:m) - ref%time(:m))) > 1.0e-9_wp*(1.0_wp + t_end)) then
+                    call make_error(err, ERR_INPUT, where//'its output times are not those ' &
+                        //'of case '//int_text(c)//' (every '//real_text(dt, compact=.true.)// &
+                        ' s up to '//real_text(t_end, compact=.true.)//' s)'//interval_text())
+                    return
+                end if
                 if (ref%records < size(times)) then
                     call make_error(err, ERR_INPUT, where//'it ends at t = '// &
                         real_text(ref%time(ref%records), compact=.true.)//' s, case '// &
                         int_text(c)//' at '//real_text(t_end, compact=.true.)//' s')
                     return
                 end if
-                if (maxval(abs(times - ref%time(:size(times)))) > &
-                    1.0e-9_wp*(1.0_wp + t_end)) then
-                    call make_error(err, ERR_INPUT, where//'its output times are not those ' &
-                        //'of case '//int_text(c)//' (every '//real_text(dt, compact=.true.)// &
-                        ' s up to '//real_text(t_end, compact=.true.)//' s)')
-                    return
-                end if
             end associate
         end do
+    contains
+        !> '; its records are every DT s' (from its first two; '' with fewer)
+        function interval_text() result(text)
+            character(len=:), allocatable :: text
+            text = ''
+            if (ref%records >= 2) text = '; its records are every '// &
+                real_text(ref%time(2) - ref%time(1), compact=.true.)//' s'
+        end function interval_text
     end subroutine check_reference_file
 
     !> The file name of case `id` in a sweep of `n` cases: case_0007.h5 (at least 4 digits).

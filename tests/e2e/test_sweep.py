@@ -566,8 +566,20 @@ def test_reference_file_checked_against_cases(run, sweep_dir):
     (sweep_dir / "r2.nml").write_text(body.format("set = 'solver.output_interval=0.02'\n"))
     result = run("sweep", "r2.nml", "--list")
     assert result.returncode == 2
-    assert "its output times are not those of case 1 (every 0.02 s up to 0.1 s)" \
-           in result.stderr
+    assert "its output times are not those of case 1 (every 0.02 s up to 0.1 s); its " \
+           "records are every 0.01 s" in result.stderr
+    # a finer case than the reference: its times, not its end (it ends at 0.1 s as the
+    # case does; the message said "it ends at t = 0.1 s, case 1 at 0.1 s")
+    (sweep_dir / "r4.nml").write_text(body.format("set = 'solver.output_interval=0.005'\n"))
+    result = run("sweep", "r4.nml", "--list")
+    assert result.returncode == 2
+    assert "its output times are not those of case 1 (every 0.005 s up to 0.1 s); its " \
+           "records are every 0.01 s" in result.stderr, result.stderr
+    # a longer case: its end
+    (sweep_dir / "r5.nml").write_text(body.format("set = 'solver.t_end=0.2'\n"))
+    result = run("sweep", "r5.nml", "--list")
+    assert result.returncode == 2
+    assert "it ends at t = 0.1 s, case 1 at 0.2 s" in result.stderr, result.stderr
     (sweep_dir / "r3.nml").write_text(body.format("rtols = 1e-4, 1e-5\n"))
     assert run("sweep", "r3.nml").returncode == 0
     rows = read_csv(sweep_dir / "out" / "r" / "summary.csv")
