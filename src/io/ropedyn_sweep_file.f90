@@ -71,6 +71,10 @@ module ropedyn_sweep_file
         character(len=:), allocatable :: name        !< file name without directory and .nml
         character(len=:), allocatable :: base        !< base scene, as a usable path
         character(len=:), allocatable :: output_dir  !< directory of the case files
+        !> what gave output_dir, for messages about the files in it: 'PATH: &sweep:
+        !! output_dir = "DIR"', '--output-dir "DIR"' or 'PATH: &sweep: output_dir (not given:
+        !! "DIR")'
+        character(len=:), allocatable :: output_dir_origin
         integer :: reference = REF_TIGHTEST           !< REF_*
         character(len=:), allocatable :: reference_file  !< REF_FILE: the run file
         type(text_t), allocatable :: set(:)          !< overrides of every case
@@ -158,6 +162,15 @@ contains
             if (sweep%output_dir(len(sweep%output_dir):) /= '/') exit
             sweep%output_dir = sweep%output_dir(:len(sweep%output_dir) - 1)
         end do
+        if (given%n > 0) then
+            sweep%output_dir_origin = where//'output_dir = "'//sweep%output_dir//'"'
+        else
+            sweep%output_dir_origin = where//'output_dir (not given: "'//sweep%output_dir//'")'
+        end if
+        if (present(output_dir)) then
+            if (len_trim(output_dir) > 0) &
+                sweep%output_dir_origin = '--output-dir "'//sweep%output_dir//'"'
+        end if
         why = unwritable_dir(sweep%output_dir)
         if (len(why) == 0) return
         call make_error(err, ERR_INPUT, where//'output_dir = "'//sweep%output_dir// &

@@ -76,14 +76,22 @@ contains
         extra(1) = sweep%path
         extra(2) = reference
         do c = 1, size(sweep%cases)
-            call check_not_input(sweep%cases(c)%file, sweep%cases(c)%scene, err, extra, ROLES)
+            call check_not_input(sweep%cases(c)%file, sweep%cases(c)%scene, err, extra, ROLES, &
+                label=sweep%output_dir_origin//': case '//int_text(c)//"'s file "// &
+                sweep%cases(c)%file)
             if (allocated(err)) return
         end do
         if (size(sweep%cases) == 0) return
         call check_not_input(sweep%output_dir//'/summary.csv', sweep%cases(1)%scene, err, &
-                             extra, ROLES)
+                             extra, ROLES, label=summary_label('summary.csv'))
         if (.not. allocated(err)) call check_not_input(sweep%output_dir//'/summary.h5', &
-            sweep%cases(1)%scene, err, extra, ROLES)
+            sweep%cases(1)%scene, err, extra, ROLES, label=summary_label('summary.h5'))
+    contains
+        function summary_label(name) result(text)
+            character(len=*), intent(in) :: name
+            character(len=:), allocatable :: text
+            text = sweep%output_dir_origin//': the summary '//sweep%output_dir//'/'//name
+        end function summary_label
     end subroutine check_outputs
 
     !> A reference file serves every case: the same number of elements, and the case's
