@@ -24,7 +24,7 @@ module ropedyn_scene
     private
     public :: solver_params_t, output_params_t, scene_t
     public :: read_scene, read_scene_text, read_scene_string, scene_namelist_text, &
-        echo_without_output_file, &
+        echo_without_output_file, override_value_text, &
         scene_key_listing, check_override_value, override_target
 
     !> One `--set group.key=value` argument, parsed.
@@ -377,6 +377,26 @@ contains
         end if
         reason = keys(ov%key)%check()
     end function check_override_value
+
+    !> The value a `group.key=value` setting gives its key, as the effective scene writes it
+    !! ('1.0' for 1 and 1.0, 'cvode' for CVODE): two settings of one key with the same text
+    !! set the same value. The setting's own value text when it cannot be applied.
+    function override_value_text(setting) result(text)
+        character(len=*), intent(in) :: setting
+        character(len=:), allocatable :: text
+        type(scene_t), target :: scene
+        type(scene_key_t), allocatable :: keys(:)
+        type(override_t) :: ov
+        type(error_t), allocatable :: err
+        call bind_keys(scene, keys)
+        call parse_override(setting, keys, ov, err)
+        if (.not. allocated(err)) call apply_override(ov, keys, err)
+        if (allocated(err)) then
+            text = setting(index(setting, '=') + 1:)
+            return
+        end if
+        text = keys(ov%key)%value_text()
+    end function override_value_text
 
 
     !> The effective scene as namelist text: all groups and keys, one per line,

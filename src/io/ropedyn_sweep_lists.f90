@@ -7,7 +7,7 @@ module ropedyn_sweep_lists
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_text, only: int_text, real_text, lower, text_t, append_text, text_array, clip
-    use ropedyn_scene, only: scene_t, read_scene, check_override_value
+    use ropedyn_scene, only: scene_t, read_scene, check_override_value, override_value_text
     implicit none
     private
     public :: dimension_t, build_dimensions, without_set
@@ -146,13 +146,14 @@ contains
         type(text_t), allocatable, intent(inout) :: targets(:)
         type(dimension_t), intent(out) :: d
         type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: entry, values, value, key, shown
+        character(len=:), allocatable :: entry, values, value, key, shown, same, shown_as
+        type(text_t), allocatable :: read_as(:)   !< each value as its key reads it
         integer :: eq, k, j
         entry = trim(adjustl(text))
         shown = clip(entry)
         key = 'vary('//int_text(i)//')'
         d%key = key
-        allocate (d%values(0))
+        allocate (d%values(0), read_as(0))
         eq = index(entry, '=')
         if (eq <= 1) then
             call make_error(err, ERR_INPUT, key//' = "'//shown//'": expected "group.key = ' &
@@ -172,13 +173,18 @@ contains
                     //'are separated by ";")')
                 return
             end if
+            ! the same value however written (1 and 1.0, 'CVODE' and 'cvode')
+            same = lower(override_value_text(d%target//'='//value))
             do j = 1, size(d%values)
-                if (lower(d%values(j)%s) /= lower(value)) cycle
+                if (read_as(j)%s /= same) cycle
+                shown_as = ''
+                if (d%values(j)%s /= value) shown_as = ' (as "'//d%values(j)%s//'")'
                 call make_error(err, ERR_INPUT, key//' = "'//shown//'": value "'//value// &
-                    '" given twice: a case would run twice')
+                    '" given twice'//shown_as//': a case would run twice')
                 return
             end do
             call append_text(d%values, value)
+            call append_text(read_as, same)
             if (k > len(values)) exit
             values = values(k + 1:)
         end do
