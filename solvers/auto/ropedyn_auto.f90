@@ -663,13 +663,16 @@ contains
         if (associated(method)) s = method%stats()
     end function current_stats
 
-    !> total += part (counters; the last step and order are the part's, the reduced Newton
-    !! path counts when either part used it).
+    !> total += part (counters; the last step and order are the part's once it has taken a
+    !! step: a method switched to at an output time has none yet, and the record there
+    !! keeps the step before the switch; the reduced Newton path counts when either part
+    !! used it).
     subroutine add_counters(total, part)
         type(solver_stats_t), intent(inout) :: total
         type(solver_stats_t), intent(in) :: part
         call total%add(part)
         total%reduced_newton = total%reduced_newton .or. part%reduced_newton
+        if (part%steps == 0) return
         total%last_step = part%last_step
         total%last_order = part%last_order
     end subroutine add_counters

@@ -657,3 +657,18 @@ def test_symplectic_without_other_forces_skips_only_zeros(run, tmp_path):
         assert a["/solver/steps"][()] == b["/solver/steps"][()] > 0
         for key in ("/state/y", "/energy/total", "/energy/dissipated"):
             assert np.array_equal(a[key][()], b[key][()]), key
+
+
+def test_records_keep_the_step_at_a_switch_of_method(run, tmp_path):
+    """/solver/step_size and /solver/order hold the last step taken before each record. At
+    a record where auto switched method, the new method had taken none yet, and the record
+    held step 0 and order 0 (input/ground_rest.nml switches at 0.08 and 0.21 s)."""
+    scene = ROOT / "input" / "ground_rest.nml"
+    proc, out = run_scene(run, tmp_path, str(scene), "ground", "solver.t_end=0.3")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(out, "r") as f:
+        times = f["/solver/switch_time"][()]
+        h, order, t = f["/solver/step_size"][()], f["/solver/order"][()], f["time"][()]
+    switched = [x for x in times[1:] if np.isclose(t, x, atol=1e-12).any()]
+    assert switched, (times, "no switch at a record: the test checks nothing")
+    assert (h[1:] > 0).all() and (order[1:] > 0).all(), (t[h == 0], t[order == 0])
