@@ -183,13 +183,16 @@ contains
     !! a link to one), whatever `force`; unless `force`, only a file ropedyn wrote for the
     !! same kind of result of the same source (check_replaceable, check_own_source): else
     !! ERR_USAGE naming what the file is. Nothing when `path` does not exist. `label`: as
-    !! check_replaceable's.
-    subroutine check_may_replace(path, scene, force, err, analysis, label)
+    !! check_replaceable's. `can_force` (default true): the caller has --force to offer (the
+    !! library's whole run has not: its refusal says to remove the file instead).
+    subroutine check_may_replace(path, scene, force, err, analysis, label, can_force)
         character(len=*), intent(in) :: path
         type(scene_t), intent(in) :: scene
         logical, intent(in) :: force
         type(error_t), allocatable, intent(out) :: err
         character(len=*), intent(in), optional :: analysis, label
+        logical, intent(in), optional :: can_force
+        logical :: offer
         if (len(special_file_reason(path)) > 0) then
             call make_error(err, ERR_USAGE, named(path, label)//': exists and is '// &
                             special_file_reason(path)//': not replaced')
@@ -198,7 +201,13 @@ contains
         if (force) return
         call check_replaceable(path, err, label)
         if (allocated(err)) then
-            if (err%code == ERR_USAGE) err%message = err%message//' (--force replaces it)'
+            offer = .true.
+            if (present(can_force)) offer = can_force
+            if (err%code == ERR_USAGE .and. offer) &
+                err%message = err%message//' (--force replaces it)'
+            if (err%code == ERR_USAGE .and. .not. offer) &
+                err%message = err%message//' (remove it, or write elsewhere)'
+
             return
         end if
         if (allocated(scene%source)) &

@@ -82,7 +82,8 @@ contains
                 '.part) or remove it, or give --force')
         else
             call check_may_replace(file, self%scene, force, err, &
-                                   label=output_key(self%scene, given))
+                                   label=output_key(self%scene, given), &
+                                   can_force=.not. caller_named(self%scene))
         end if
         if (allocated(err)) then
             call drop_lock(self%lock_file, self%beat)
@@ -107,6 +108,15 @@ contains
         if (len(scene%output%file_origin) > 0) &
             text = scene%output%file_origin//': &output: file = "'//file//'"'
     end function output_key
+
+    !> The output file was named by the library's caller (its whole run), which has no
+    !! --force: an &output file without an origin.
+    pure logical function caller_named(scene)
+        type(scene_t), intent(in) :: scene
+        caller_named = .false.
+        if (allocated(scene%output%file_origin)) &
+            caller_named = len(scene%output%file_origin) == 0
+    end function caller_named
 
     module procedure release_output
         type(error_t), allocatable :: rerr

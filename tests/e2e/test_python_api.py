@@ -99,6 +99,15 @@ def test_run_gives_the_cli_records_and_writes_no_file(run, tmp_path, monkeypatch
     assert result.status == "complete" and result.stats["steps"] > 0
     written = ropedyn.run(scene, output=tmp_path / "asked.h5")
     assert (tmp_path / "asked.h5").is_file() and np.array_equal(written.q, result.q)
+    # a file ropedyn did not write is refused; the caller has no --force to be offered
+    (tmp_path / "notes.h5").write_text("mine\n")
+    with pytest.raises(ropedyn.Error) as error:
+        ropedyn.run(scene, output=tmp_path / "notes.h5")
+    assert error.value.code == 2 and error.value.message.startswith(
+        f"{tmp_path / 'notes.h5'}: exists and is not an HDF5 file"), error.value.message
+    assert error.value.message.endswith("not replaced (remove it, or write elsewhere)"), \
+        error.value.message
+    assert (tmp_path / "notes.h5").read_text() == "mine\n"
 
 
 def test_a_run_keeps_its_warnings_where_the_cli_prints_them(run, tmp_path):
