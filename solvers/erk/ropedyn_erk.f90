@@ -24,9 +24,9 @@
 !!   energy balance T + V + dissipated = E0 holds to the pair's accuracy even where g is
 !!   rough (impacts, stick-slip), where g at the step points alone aliases the
 !!   element-scale oscillations that a stability-held step does not resolve.
-!! - **Stiffness**: the last two stages are both at t + h, so rho = |k_s - k_s-1| /
-!!   |Y_s - Y_s-1| estimates the spectral radius along the error for free (Hairer's
-!!   test); the order-4 pair (the 3/8 rule) takes a combination of all its stages
+!! - **Stiffness**: Dormand-Prince's last two stages are both at t + h, so rho =
+!!   |k_s - k_s-1| / |Y_s - Y_s-1| estimates the spectral radius along the error for free
+!!   (Hairer's test); the pairs of order 3 and 4 take a combination of their stages
 !!   instead, every 4th step (ropedyn_erk_tables: rho_alpha, and why). When most of the
 !!   last 500 steps had h rho near the stability limit and they averaged more than 2e5
 !!   steps per simulated second, the run ends (ERR_SOLVER) with a message naming the

@@ -672,3 +672,17 @@ def test_records_keep_the_step_at_a_switch_of_method(run, tmp_path):
     switched = [x for x in times[1:] if np.isclose(t, x, atol=1e-12).any()]
     assert switched, (times, "no switch at a record: the test checks nothing")
     assert (h[1:] > 0).all() and (order[1:] > 0).all(), (t[h == 0], t[order == 0])
+
+
+def test_erk_of_order_3_diagnoses_the_steel_wire(run, tmp_path):
+    """The order-3 pair's spectral estimate (a stage combination free of z and z^2 terms,
+    ropedyn_erk_tables) sees the steel wire's fast modes (4.4e5 1/s): erk at max_order = 3
+    is held by stability at 2.7e5 steps per simulated second and stops with the
+    diagnosis within 0.05 s. Its last two stages (c = 3/4 and 1) weighed the slow modes in
+    at O(z): the run went on for the whole second at 2.8e5 steps per second undiagnosed."""
+    proc, out = run_scene(run, tmp_path, STEEL, "erk3", "solver.method='erk'",
+                          "solver.max_order=3", "solver.t_end=0.05")
+    assert proc.returncode == 3, proc.stderr
+    assert "order 3: the problem is too stiff for an explicit method" in proc.stderr
+    rho = float(proc.stderr.split("spectral radius rho of about")[1].split()[0])
+    assert 2e5 < rho < 4.5e5, rho
