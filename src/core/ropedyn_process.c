@@ -5,9 +5,7 @@
  *   integration steps, the local sweep runner). Catching nests: every catch is matched by a
  *   release, and the handlers go with the last release. With "second ends" on, a signal
  *   that arrives when one was caught already ends the process at once by that signal (a
- *   second Ctrl-C). With a lock file given, the handler instead appends "signal=N" to that
- *   file and ends the process by the same signal (default action), so that a lock records
- *   why its writer stopped (docs/development/internals.md, "One writer per case").
+ *   second Ctrl-C).
  * - A lock's heartbeat: a thread that touches the lock file every few seconds, so that a
  *   reader on another host can tell a live writer from one that is gone. One thread per
  *   lock (a handle each): two runs in one process (the library's, in two threads) hold
@@ -44,7 +42,6 @@ static struct sigaction saved[2];
 static int installed = 0;   /* catches not yet released */
 static volatile sig_atomic_t received = 0;
 static volatile sig_atomic_t second_ends = 0;
-static volatile int note_fd = -1;
 
 /* One heartbeat: the lock file, its period, the thread that touches it. */
 struct heartbeat {
@@ -64,22 +61,6 @@ static void on_signal(int sig)
         return;
     }
     if (!received) received = sig;
-    if (note_fd >= 0) {
-        char line[32] = "signal=";
-        int n = 7, d = sig;
-        char digits[8];
-        int k = 0;
-        do {
-            digits[k++] = (char)('0' + d % 10);
-            d /= 10;
-        } while (d > 0 && k < 8);
-        while (k > 0) line[n++] = digits[--k];
-        line[n++] = '\n';
-        ssize_t rc = write(note_fd, line, (size_t)n);
-        (void)rc;
-        signal(sig, SIG_DFL);
-        raise(sig);
-    }
 }
 
 /* Catch SIGINT and SIGTERM: the handler sets the flag (a signal ignored at start stays
@@ -109,24 +90,8 @@ int ropedyn_catch_signals(void)
  * signal); 0: it only keeps the flag. */
 void ropedyn_second_signal_ends(int on) { second_ends = on ? 1 : 0; }
 
-/* With `path` not empty: from now on a caught signal is appended to that file and ends the
- * process (by the same signal). With "": back to setting the flag only. Returns 0, or
- * errno. */
-int ropedyn_signal_note(const char *path)
-{
-    int fd = -1, old;
-    if (path[0] != '\0') {
-        fd = open(path, O_WRONLY | O_APPEND | O_CLOEXEC);
-        if (fd < 0) return errno;
-    }
-    old = note_fd;
-    note_fd = fd;
-    if (old >= 0) close(old);
-    return 0;
-}
-
 /* Undo one ropedyn_catch_signals; the last one restores the dispositions from before the
- * first, forgets the note file and switches "second ends" off. The flag stays. */
+ * first and switches "second ends" off. The flag stays. */
 void ropedyn_release_signals(void)
 {
     int k;
@@ -139,7 +104,6 @@ void ropedyn_release_signals(void)
         installed = 0;
     }
     second_ends = 0;
-    ropedyn_signal_note("");
 }
 
 /* The first signal caught (its number), or 0. */

@@ -1,15 +1,14 @@
 !> Signals: SIGINT and SIGTERM caught as a flag that the program polls (nested catches
-!! count), optionally ending the process at a second signal, or noted in a file and then
-!! ending the process (for a writer that cannot stop on its own). Through the C glue
+!! count), optionally ending the process at a second signal. Through the C glue
 !! `ropedyn_process.c`. Used by the run driver and the sweep runner (the output guide,
 !! "Interrupts").
 module ropedyn_signals
-    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+    use, intrinsic :: iso_c_binding, only: c_int
     use ropedyn_error, only: error_t, make_error, ERR_IO
     use ropedyn_text, only: int_text
     implicit none
     private
-    public :: catch_signals, release_signals, signal_received, note_signals, signal_name
+    public :: catch_signals, release_signals, signal_received, signal_name
     public :: end_on_second_signal
     public :: SIGINT, SIGKILL, SIGTERM
 
@@ -29,10 +28,6 @@ module ropedyn_signals
         integer(c_int) function c_signal_received() bind(C, name='ropedyn_signal_received')
             import :: c_int
         end function c_signal_received
-        integer(c_int) function c_signal_note(path) bind(C, name='ropedyn_signal_note')
-            import :: c_char, c_int
-            character(kind=c_char), intent(in) :: path(*)
-        end function c_signal_note
     end interface
 
 contains
@@ -57,18 +52,6 @@ contains
     integer function signal_received()
         signal_received = int(c_signal_received())
     end function signal_received
-
-    !> With `path`: a signal caught from now on is appended to the file `path` as
-    !! "signal=N" and ends the process by that signal (for a writer that cannot stop on its
-    !! own). With '': a signal only sets the flag again.
-    subroutine note_signals(path, err)
-        character(len=*), intent(in) :: path
-        type(error_t), allocatable, intent(out) :: err
-        integer(c_int) :: rc
-        rc = c_signal_note(path//c_null_char)
-        if (rc /= 0) call make_error(err, ERR_IO, path//': cannot open to record signals '// &
-            '(errno '//int_text(int(rc))//')')
-    end subroutine note_signals
 
     !> 'SIGTERM', 'SIGINT', else 'signal N'.
     pure function signal_name(sig) result(name)

@@ -12,11 +12,12 @@
 !!     started=2024-05-01T12:34:56Z
 !!     job=8812_3                (SLURM_ARRAY_JOB_ID_SLURM_ARRAY_TASK_ID, or SLURM_JOB_ID)
 !!
-!! A thread touches the file every LOCK_BEAT s (its heartbeat) while the case runs; a signal
-!! that ends the writer is appended as `signal=15`. The writer removes the lock when the case
-!! file is in place. A lock is *live* while its writer runs and *abandoned* when it is gone:
+!! A thread touches the file every LOCK_BEAT s (its heartbeat) while the case runs. The
+!! writer removes the lock when the case file is in place. A lock is *live* while its writer
+!! runs and *abandoned* when it is gone:
 !!
-!! - it records a signal: abandoned (the writer ended right after writing it);
+!! - it records a signal (`signal=15`, appended by writers of earlier versions when a
+!!   signal ended them; a writer now stops its case itself): abandoned;
 !! - on this machine (the same host name and boot id): live while process `pid` exists
 !!   with the same start time, abandoned as soon as it does not;
 !! - on another machine: live while its heartbeat is at most LOCK_ABANDONED_AFTER s old (the
