@@ -5,16 +5,21 @@
 !! straight start or a support's anchor inside the ground (x points down: a ground point in
 !! the wrong sign), a key of a support's motion that its `*_motion` does not use (a
 !! harmonic key or a table with another motion), a release or a ramp that the run ends
-!! before. Each warning names the key, its value and why; a run goes ahead.
+!! before, a key of &ground or &fluid set away from its default while the effects that use
+!! it are off (a ground or a water given and not switched on). Each warning names the key,
+!! its value and why; a run goes ahead.
 module ropedyn_scene_warnings
     use, intrinsic :: iso_fortran_env, only: error_unit
     use ropedyn_kinds, only: wp
-    use ropedyn_text, only: text_t, append_text, real_text, significant_text, pair_text
+    use ropedyn_text, only: text_t, append_text, real_text, significant_text, pair_text, &
+        int_text
     use ropedyn_rope_section, only: section_t, rope_section, section_set_given
     use ropedyn_scene_types, only: scene_t
     use ropedyn_rope_spec, only: bottom_anchor_given
     use ropedyn_rope_setup, only: initial_angle
     use ropedyn_support_motion, only: ramp
+    use ropedyn_scene_key, only: scene_key_t
+    use ropedyn_scene_keys, only: bind_keys, GROUP_NAMES, G_FLUID, G_GROUND
     implicit none
     private
     public :: scene_warnings, print_warnings
@@ -89,6 +94,7 @@ contains
                 '(air is 1.225 kg/m^3): water is about 1000 (fresh) or 1025 (sea)')
         if (scene%effects%ground) call ground_start(scene, list)
         if (scene%effects%ground) call ground_anchors(scene, list)
+        call idle_groups(scene, list)
         associate (s => scene%supports)
             call idle_motion_keys(scene, 'top', s%top_motion, s%top_amplitude, &
                 s%top_frequency, s%top_phase_deg, s%top_angle_amplitude_deg, &
@@ -174,6 +180,58 @@ contains
             ': does nothing: '//end//"_motion = '"//trim(motion)//"' (it is used with "// &
             end//"_motion = '"//used_by//"')")
     end subroutine idle_motion_keys
+
+    !> The keys of &ground set away from their defaults while effects%ground is off, and
+    !! those of &fluid while drag and water are both off (or its water keys while water
+    !! is): one warning a group, naming the first such key and how many more. Such keys do
+    !! nothing (a sweep may still switch the effect over a base that gives them, so it is
+    !! no error); an effective scene's echo of the defaults says nothing.
+    subroutine idle_groups(scene, list)
+        type(scene_t), intent(in) :: scene
+        type(text_t), allocatable, intent(inout) :: list(:)
+        type(scene_t), target :: mine, base
+        type(scene_key_t), allocatable :: keys(:), defaults(:)
+        character(len=*), parameter :: WATER_KEYS = &
+            ' surface added_mass_coefficient tangential_added_mass_coefficient '
+        mine = scene
+        call bind_keys(mine, keys)
+        call bind_keys(base, defaults)
+        if (.not. scene%effects%ground) &
+            call idle(G_GROUND, '', 'effects.ground is .false.')
+        if (.not. (scene%effects%drag .or. scene%effects%water)) then
+            call idle(G_FLUID, '', 'effects.drag and effects.water are .false.')
+        else if (.not. scene%effects%water) then
+            call idle(G_FLUID, WATER_KEYS, 'effects.water is .false. (only water uses it)')
+        end if
+    contains
+        !> The warning for group g's keys (those named in `names` when not ''), if any.
+        subroutine idle(g, names, why)
+            integer, intent(in) :: g
+            character(len=*), intent(in) :: names, why
+            integer :: k, first, more
+            character(len=:), allocatable :: also, group, key
+            first = 0
+            more = 0
+            do k = 1, size(keys)
+                if (keys(k)%group /= g) cycle
+                if (len(names) > 0 .and. index(names, ' '//keys(k)%name//' ') == 0) cycle
+                if (keys(k)%value_text() == defaults(k)%value_text()) cycle
+                if (first == 0) then
+                    first = k
+                else
+                    more = more + 1
+                end if
+            end do
+            if (first == 0) return
+            group = trim(GROUP_NAMES(g))
+            key = keys(first)%name
+            also = ''
+            if (more == 1) also = '; so does 1 more key of &'//group
+            if (more > 1) also = '; so do '//int_text(more)//' more keys of &'//group
+            call append_text(list, scene%origin(group//'.'//key)//': &'//group//': '// &
+                key//' = '//keys(first)%value_text()//': does nothing: '//why//also)
+        end subroutine idle
+    end subroutine idle_groups
 
     !> A release of the `end` support at or after t_end (it never happens in the run), and a
     !! harmonic ramp longer than the run (the amplitudes never reach their full size).

@@ -5,6 +5,7 @@ a default or rule changed, fails here until the page is written again."""
 import pathlib
 import re
 
+import h5py
 import pytest
 
 from ropedyn_tools import keys_reference
@@ -166,3 +167,34 @@ def test_a_release_or_ramp_the_run_ends_before_is_warned_of(run, sets, fragment)
     assert proc.returncode == 0, proc.stderr
     warnings = scene_warnings(proc)
     assert len(warnings) == 1 and fragment in warnings[0], proc.stderr
+
+
+def test_keys_of_an_effect_that_is_off_are_warned_of(run, tmp_path):
+    """A &ground or &fluid written but not switched on does nothing: a warning names the
+    first key set away from its default and how many more there are; water's own keys warn
+    with drag alone on; switched on, or echoed at their defaults (an effective scene), no
+    warning."""
+    (tmp_path / "idle.nml").write_text(
+        "&model elements = 4 /\n&solver t_end = 1e-4 /\n"
+        "&ground stiffness = 2e5, friction_coefficient = 0.3 /\n"
+        "&fluid surface = 0.5, density = 1000 /\n")
+    proc = run("run", "idle.nml", "--set", "output.file=a.h5")
+    assert proc.returncode == 0, proc.stderr
+    assert scene_warnings(proc) == [
+        "ropedyn: warning: idle.nml: &ground: stiffness = 200000.0: does nothing: "
+        "effects.ground is .false.; so does 1 more key of &ground",
+        "ropedyn: warning: idle.nml: &fluid: density = 1000.0: does nothing: effects.drag "
+        "and effects.water are .false.; so does 1 more key of &fluid"], proc.stderr
+    proc = run("run", "idle.nml", "--set", "output.file=b.h5", "--set", "effects.drag=.true.",
+               "--set", "effects.ground=.true.")
+    assert scene_warnings(proc) == [
+        "ropedyn: warning: idle.nml: &fluid: surface = 0.5: does nothing: effects.water is "
+        ".false. (only water uses it)"], proc.stderr
+    proc = run("run", "idle.nml", "--set", "output.file=c.h5", "--set", "effects.water=.true.",
+               "--set", "effects.ground=.true.")
+    assert proc.returncode == 0 and not scene_warnings(proc), proc.stderr
+    proc = run("run", PAPER, "--set", "output.file=d.h5", "--set", "solver.t_end=1e-4")
+    with h5py.File(tmp_path / "d.h5") as f:
+        (tmp_path / "paper_echo.nml").write_text(f.attrs["scene"].decode())
+    proc = run("run", "paper_echo.nml", "--set", "output.file=e.h5")
+    assert proc.returncode == 0 and not scene_warnings(proc), proc.stderr
