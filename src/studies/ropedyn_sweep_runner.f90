@@ -63,7 +63,7 @@ module ropedyn_sweep_runner
         integer, allocatable :: slot(:)      !< the case of each worker slot (0: free)
         integer, allocatable :: pid(:)       !< the process of each busy slot
         integer :: next = 1                  !< the next case of todo to start
-        integer :: finished = 0, failed = 0  !< workers ended, of them failed (not interrupted)
+        integer :: finished = 0, failed = 0  !< workers ended, of them failed (not stopped)
         real(wp) :: start = 0.0_wp           !< monotonic clock at the first start, s
         real(wp) :: last_draw = 0.0_wp       !< ... at the last progress line, s
     contains
@@ -342,8 +342,9 @@ contains
             ! a worker that found the case being written by another runner did not fail
             other = ''
             if (rc /= 0) other = written_elsewhere(sweep%cases(c))
-            if (rc /= 0 .and. rc /= exit_code_of(ERR_INTERRUPTED) .and. len(other) == 0) &
-                self%failed = self%failed + 1
+            ! nor did one ended by a signal (its case is interrupted: its lock abandoned)
+            if (rc /= 0 .and. rc /= exit_code_of(ERR_INTERRUPTED) .and. rc <= 128 .and. &
+                len(other) == 0) self%failed = self%failed + 1
             call remove_if_empty(self%log_path(c))
             if (.not. self%quiet) call self%report_case(c, rc, other)
             redraw = .true.

@@ -395,6 +395,31 @@ def test_sigterm_to_runner_stops_its_workers(run, ropedyn_exe, sweep_dir):
         assert f.attrs["status"] == b"complete" and f["solver/restarts/time"].shape == (1,)
 
 
+def test_sigkill_to_a_worker_is_no_failed_case(run, ropedyn_exe, sweep_dir):
+    """A worker killed by SIGKILL leaves its case interrupted (an abandoned lock and a
+    .part): the runner says "ended by SIGKILL" and does not count it as failed (its
+    progress said "1 failed" while --status said interrupted)."""
+    (sweep_dir / "long.nml").write_text(LONG.format(rtols="1e-7"))
+    out = sweep_dir / "out" / "long"
+    runner = subprocess.Popen([str(ropedyn_exe), "sweep", "long.nml", "--jobs", "1"],
+                              cwd=sweep_dir, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True)
+    try:
+        wait_for(lambda: (out / ".case_0001.h5.part").exists(), what="the worker")
+        workers = processes_mentioning("long.nml --quiet")
+        assert len(workers) == 1
+        os.kill(workers[0], signal.SIGKILL)
+        _, stderr = runner.communicate(timeout=120)
+    finally:
+        if runner.poll() is None:
+            runner.kill()
+    assert runner.returncode == 3, stderr
+    line = next(l for l in stderr.splitlines() if l.startswith("sweep: case 0001 "))
+    assert line.startswith("sweep: case 0001 ended by SIGKILL") and "0 failed" in line, line
+    _, counts = status_lines(run, "long.nml")
+    assert counts["interrupted"] == 1, counts
+
+
 def test_sigterm_to_a_worker_reports_its_case_interrupted(run, ropedyn_exe, sweep_dir):
     """A worker stopped by SIGTERM ends with ropedyn's exit code 130 and writes its case
     interrupted: the runner says so (not "ended by SIGINT", which 128 + 2 would read as),
