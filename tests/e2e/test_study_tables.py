@@ -126,3 +126,15 @@ def test_the_stability_reports_stamp_names_its_part():
         "Command: `scripts/stability_report --quick --only cvode-order`"
     assert command_text(False, None, cached_only=True) == \
         "Command: `scripts/stability_report --only long-horizon --cached-only`"
+
+
+def test_a_command_line_shows_no_exe_path():
+    """The Command line of a study's section is the command a reader reruns: --exe PATH (a
+    path of the machine that ran it) is left out, in either form, and nothing else."""
+    from ropedyn_tools.studies.bench_peers import command_text
+    from ropedyn_tools.studies.common import shown_arguments
+    assert shown_arguments(["--perimeter", "--exe", "build/release/ropedyn",
+                            "--convergence", "--exe=/x/ropedyn"]) == ["--perimeter",
+                                                                       "--convergence"]
+    assert command_text(["--elements", "10 30", "--exe", "b/ropedyn"]) == \
+        "scripts/bench_peers --elements '10 30'"

@@ -77,7 +77,7 @@ from ropedyn.docstrings import summary
 from ropedyn_tools.arguments import check_methods, list_text, method_specs, positive
 from ropedyn_tools.repo import DOCS, PAPER, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.studies.common import (least_cpu, machine, method_chain, method_label,
-                                          method_sets, update_doc, run_stamp)
+                                          method_sets, shown_arguments, update_doc, run_stamp)
 
 BEGIN = "<!-- bench_peers:begin -->"
 END = "<!-- bench_peers:end -->"
@@ -574,8 +574,8 @@ def coupled_main(args, exe, py):
 
 
 def command_text(argv):
-    """The command as it ran (its arguments as given), for the pages' stamps."""
-    return shlex.join(["scripts/bench_peers", *argv])
+    """The command as it ran (its arguments as given, --exe aside), for the pages' stamps."""
+    return shlex.join(["scripts/bench_peers", *shown_arguments(argv)])
 
 
 def main(argv=None):

@@ -42,7 +42,7 @@ from ropedyn_tools.arguments import list_text, positive
 from ropedyn_tools.repo import DOCS, ROOT, add_exe_argument, exe_or_build
 from ropedyn_tools.studies import bergdahl as bg
 from ropedyn_tools.studies.bench_peers import ensure_bench_venv
-from ropedyn_tools.studies.common import machine, run_stamp, update_doc
+from ropedyn_tools.studies.common import machine, run_stamp, shown_arguments, update_doc
 from ropedyn.docstrings import summary
 
 BEGIN, END = "<!-- bergdahl_peers:begin -->", "<!-- bergdahl_peers:end -->"
@@ -223,7 +223,7 @@ def main(argv=None):
                     print(conv[-1], flush=True)
     ok = [(k, r) for k, r in md_res.items() if r.get("ok")]
     lines = [BEGIN, "",
-             f"Command: `{' '.join(['scripts/bench_peers bergdahl', *(argv if argv is not None else sys.argv[1:])])}` (code: "
+             f"Command: `{' '.join(['scripts/bench_peers bergdahl', *shown_arguments(argv if argv is not None else sys.argv[1:])])}` (code: "
              f"tools/ropedyn_tools/studies/bench_peers_bergdahl.py). MoorDyn-C 2.7.2 (PyPI "
              f"`moordyn`, .venv-bench): RK4 at dtM = {args.dt:g} s, {args.segments} segments, "
              f"its static start; CPU per case includes it. ropedyn: the case files of "

@@ -34,7 +34,8 @@ import numpy as np
 from ropedyn_tools.arguments import choice, list_text, positive
 from ropedyn_tools.repo import DOCS, INPUT, ROOT, add_exe_argument, exe_or_build, set_args
 from ropedyn_tools.docs_status import same_code
-from ropedyn_tools.studies.common import least_cpu, run_stamp, scene_number, update_doc
+from ropedyn_tools.studies.common import (least_cpu, run_stamp, scene_number, shown_arguments,
+                                          update_doc)
 from ropedyn.docstrings import summary
 
 SCENE_DIR = INPUT / "validation" / "bergdahl"
@@ -892,10 +893,7 @@ def main(argv=None):
     out = pathlib.Path(args.out)
     stem = out.stem
     figs = figures(results, models, periods, work, pathlib.Path(args.figures), stem)
-    shown = [a for a in (argv if argv is not None else sys.argv[1:])]
-    if "--exe" in shown:                       # a path of this machine: not part of the command
-        i = shown.index("--exe")
-        del shown[i:i + 2]
+    shown = shown_arguments(argv if argv is not None else sys.argv[1:])
     command = " ".join(["scripts/validation bergdahl", *shown])
     block = section(results, models, periods, walls, conv, figs, command, work, contact)
     update_doc(out, BEGIN, END, block, heading="## Results\n\n",

@@ -67,6 +67,20 @@ def run_commit(root=None, paths=RUN_PATHS):
     return f", on `{rev}` with uncommitted changes" if dirty else f", commit `{rev}`"
 
 
+def shown_arguments(argv):
+    """A study's arguments as its page's Command line shows them: as given, but for
+    `--exe PATH` (a path of this machine, not part of the command)."""
+    shown, skip = [], False
+    for a in argv:
+        if skip:
+            skip = False
+        elif a == "--exe":
+            skip = True
+        elif not a.startswith("--exe="):
+            shown.append(a)
+    return shown
+
+
 def run_stamp(root=None):
     """The stamp of a study's run: 'YYYY-MM-DD HH:MM UTC, commit `abc1234`' (see run_commit).
     Every generated section of docs/ names it, so that its page says when and on which code
