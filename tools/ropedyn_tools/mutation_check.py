@@ -512,6 +512,8 @@ class Runner:
                "-j", str(os.cpu_count() or 2)]
         if names:
             cmd += ["-R", "^(" + "|".join(re.escape(n) for n in names) + ")$"]
+        else:
+            cmd += ["-LE", "long"]   # the suite scripts/test runs: not the long-horizon label
         code, out = self._run(cmd, 3600)
         if code == 0:
             return None
