@@ -21,7 +21,7 @@ contains
         type(energy_t) :: e
         type(energy_monitor_t) :: next
         type(solver_stats_t) :: stats
-        character(len=200) :: what
+        character(len=40) :: what
         real(wp) :: next_bound
         logical :: gained
         e = self%model%energy(self%t, self%y, self%yq)
@@ -31,16 +31,20 @@ contains
             next = self%monitor
             call next%observe(e)
             next_bound = next%bound()
-            write (what, '(a, es10.3, a, es10.3, a, es12.5, a, i0)') 'energy gain ', &
-                next%gain(e), ' J above E0 (bound ', next_bound, ' J) at t = ', self%t, &
-                ' s, max order ', self%max_order
             call self%summary%safety%alarm(next%gain(e), next_bound)
             if (trim(self%scene%solver%order_safety) == 'stop') then
                 stats = self%integrator%stats()
+                ! (the order limit only for a method that has one: auto's is 0)
+                what = ''
+                if (self%max_order > 0) what = ', max order '//int_text(self%max_order)
                 call make_error(err, ERR_SOLVER, self%integrator%name()//' failed at t = '// &
-                    real_text(self%t_prev)//' s, step size '//real_text(stats%last_step)// &
-                    ' s: '//trim(what)//': the integrator created energy (&solver '// &
-                    'order_safety = ''stop''; docs/theory/energy-balance.md)')
+                    significant_text(self%t_prev, 6)//' s, step size '// &
+                    significant_text(stats%last_step, 3)//' s: energy gain '// &
+                    significant_text(next%gain(e), 3)//' J above E0 (bound '// &
+                    significant_text(next_bound, 3)//' J) at t = '// &
+                    significant_text(self%t, 6)//' s'//trim(what)//': the integrator '// &
+                    'created energy (&solver order_safety = ''stop''; '// &
+                    'docs/theory/energy-balance.md)')
                 ! the record with the gain is not written
                 call back_to_previous(self)
                 return

@@ -275,6 +275,13 @@ def test_auto_goes_on_with_mebdf_at_a_runaway(runaway_runs):
     assert abs(times[k] * 100 - round(times[k] * 100)) < 1e-6
     proc_stop, _ = runaway_runs["auto_stop"]
     assert proc_stop.returncode == 3, proc_stop.stderr
+    # its message in the house's numbers (it printed the step with 20 digits and auto's
+    # order limit, 0)
+    message = proc_stop.stderr.strip()
+    assert re.search(r"auto failed at t = [0-9.]+ s, step size [0-9.e-]+ s: energy gain "
+                     r"[0-9.e-]+ J above E0 \(bound [0-9.e-]+ J\) at t = [0-9.]+ s: the "
+                     r"integrator created energy", message), message
+    assert "max order" not in message and len(message.split("step size ")[1].split()[0]) < 10
 
 
 def test_weight_length_is_the_runs(runaway_runs):
