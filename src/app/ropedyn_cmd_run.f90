@@ -208,7 +208,9 @@ contains
                 ' from t = ', r%lowered_at, ' s'
             if (r%unresolved_at >= 0.0_wp) write (output_unit, '(a, es10.3, a, f9.4, a)') &
                 '  order safety    energy gain ', r%energy_gain, ' J above the bound at t = ', &
-                r%unresolved_at, ' s at the safe order (not an order instability)'
+                r%unresolved_at, trim(merge(' s: the method has no order to lower           ', &
+                                            ' s at the safe order (not an order instability)', &
+                                            r%orderless))
             if (r%kept_at >= 0.0_wp) write (output_unit, '(a, es10.3, a, f9.4, a)') &
                 '  order safety    energy gain ', r%energy_gain, ' J above the bound at t = ', &
                 r%kept_at, ' s: '//r%kept_reason//'; the order kept ('// &

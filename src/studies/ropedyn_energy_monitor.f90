@@ -108,6 +108,7 @@ module ropedyn_energy_monitor
         integer :: order_after = 0              !< ... to the safe order
         !> a gain that lowering could not cure (at the safe order, or a method without one)
         real(wp) :: unresolved_at = -1.0_wp
+        logical :: orderless = .false.          !< ... of a method without a safe order
         real(wp) :: kept_at = -1.0_wp           !< a gain judged the integration error
         integer :: kept_count = 0               !< ... how many
         character(len=:), allocatable :: kept_reason  !< ... why, the first time
@@ -142,11 +143,15 @@ contains
         self%order_after = to
     end subroutine record_lowered
 
-    !> A gain at time t that lowering cannot cure: remembered if it is the first.
-    pure subroutine record_unresolved(self, t)
+    !> A gain at time t that lowering cannot cure (`orderless`: the method has no order to
+    !! lower, else it runs at its safe order): remembered if it is the first.
+    pure subroutine record_unresolved(self, t, orderless)
         class(safety_record_t), intent(inout) :: self
         real(wp), intent(in) :: t
-        if (self%unresolved_at < 0.0_wp) self%unresolved_at = t
+        logical, intent(in) :: orderless
+        if (self%unresolved_at >= 0.0_wp) return
+        self%unresolved_at = t
+        self%orderless = orderless
     end subroutine record_unresolved
 
     !> The order kept at time t at a gain judged the integration error, for reason `why`.

@@ -53,7 +53,7 @@ contains
                 call self%second_look(tout, e, next_bound, err)
                 if (allocated(err)) return
             else
-                call self%summary%safety%unresolved(self%t)
+                call self%summary%safety%unresolved(self%t, self%safe_order == 0)
             end if
         end if
         ! the state the run goes on from (after a second look, perhaps another); auto has

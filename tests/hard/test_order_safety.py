@@ -235,6 +235,8 @@ def test_a_runaway_ends_the_run(runaway_runs):
     for part in ("erk failed at t = ", "step size", "it created", "m g L",
                  "tighten rtol (e.g. rtol = 0.03)"):
         assert part in message, message
+    # the summary says why no order was lowered: erk has none (it said "at the safe order")
+    assert "s: the method has no order to lower" in proc.stdout, proc.stdout
     m = stability_metrics.analyse(path)
     assert m["status"] == "failed"
     mgl = m["weight_length"]
