@@ -14,11 +14,11 @@ def test_paper_experiment_against_an_independent_implementation(run, tmp_path):
     solutions separate exponentially (5 s: 0.1 m at the tip, 8 % in the dissipated energy;
     a published "about 0.023 J in 5 s, 0.18 J in 30 s" of another implementation is in
     that regime and cannot be a sharp anchor). E0 = -m g (L/2) cos 75 deg = -0.1495603 J
-    exactly. Measured at rtol 1e-8 (Debug build, oracle dt = 5e-4 s): tip 6.0e-7 m,
-    dissipated 1.8e-8 J (of 1.486e-3 J at 2 s), T + V 3.7e-8 J, energy balance 2.7e-8 J;
-    the bounds are about three times these. The differences are mostly the oracle's own
-    RK4 error (6.3e-7 m, 2.5e-8 J, 4.2e-8 J against dt = 1.25e-4 s); a wrong damping or
-    stiffness constant moves the dissipated energy by 1e-5 J and more."""
+    exactly. Measured at rtol 1e-8 (Debug build, oracle dt = 5e-4 s): tip 6.3e-7 m,
+    dissipated 2.5e-8 J (of 1.486e-3 J at 2 s), T + V 4.2e-8 J, energy balance 1.1e-10 J;
+    the bounds are about three times these (the balance's five). The differences are the
+    oracle's own RK4 error (6.3e-7 m, 2.5e-8 J, 4.2e-8 J against dt = 1.25e-4 s); a wrong
+    damping or stiffness constant moves the dissipated energy by 1e-5 J and more."""
     (tmp_path / "n6.nml").write_text(
         "&model kind = 'rfem', elements = 6 /\n"
         "&solver t_end = 2.0, output_interval = 0.1, rtol = 1e-8, atol = 1e-10 /\n")
@@ -38,7 +38,7 @@ def test_paper_experiment_against_an_independent_implementation(run, tmp_path):
     assert abs(e["dissipated"][-1] - 1.4857e-3) < 1e-7      # the value itself, for the record
     assert np.max(np.abs(e["total"] - oracle_total)) < 1.2e-7
     balance = e["total"] + e["dissipated"] - e["support_work"]
-    assert np.max(np.abs(balance - balance[0])) < 1e-7        # measured 2.7e-8 J
+    assert np.max(np.abs(balance - balance[0])) < 5e-10       # measured 1.1e-10 J
 
 
 def test_axial_mode_of_hanging_rod(run, tmp_path):
