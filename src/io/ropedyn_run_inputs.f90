@@ -142,11 +142,13 @@ contains
     !! attribute `analysis`, absent for a run), its root attribute `source` is another (a
     !! --set variant, another scene) or missing (written by a version before the rule).
     !! Nothing when `path` does not exist; call check_replaceable first (a file ropedyn did
-    !! not write). `label`: as check_replaceable's.
-    subroutine check_own_source(path, source, err, analysis, label)
+    !! not write). `label`, `can_force`: as check_may_replace's. `source` '': a scene
+    !! without one (the library's, from text), whose file is checked for its kind only.
+    subroutine check_own_source(path, source, err, analysis, label, can_force)
         character(len=*), intent(in) :: path, source
         type(error_t), allocatable, intent(out) :: err
         character(len=*), intent(in), optional :: analysis, label
+        logical, intent(in), optional :: can_force
         character(len=:), allocatable :: stored, kind, mine, hint
         type(h5_file_t) :: h5
         type(error_t), allocatable :: close_err
@@ -165,16 +167,22 @@ contains
             mine = analysis
             hint = 'give it another file (-o FILE.h5) or --force'
         end if
+        if (present(can_force)) then
+            if (.not. can_force) hint = 'write elsewhere, or remove it'
+        end if
         if (.not. has_kind) kind = 'run'
         if (kind /= mine) then
-            call make_error(err, ERR_USAGE, named(path, label)//': exists and holds a '//kind// &
-                ' result, not a '//mine//' one: not replaced; '//hint)
+            call make_error(err, ERR_USAGE, named(path, label)//': exists and holds a '// &
+                kind//' result, not a '//mine//' one: not replaced; '//hint)
+        else if (len(source) == 0) then
+            return
         else if (.not. found) then
-            call make_error(err, ERR_USAGE, named(path, label)//': exists and holds a '//kind//' whose '// &
-                'source is not recorded (an older file): not replaced; '//hint)
+            call make_error(err, ERR_USAGE, named(path, label)//': exists and holds a '// &
+                kind//' whose source is not recorded (an older file): not replaced; '//hint)
         else if (stored /= source) then
-            call make_error(err, ERR_USAGE, named(path, label)//': exists and holds the '//kind//' of "'// &
-                stored//'", not of this '//mine//' "'//source//'": not replaced; '//hint)
+            call make_error(err, ERR_USAGE, named(path, label)//': exists and holds the '// &
+                kind//' of "'//stored//'", not of this '//mine//' "'//source// &
+                '": not replaced; '//hint)
         end if
     end subroutine check_own_source
 
@@ -210,8 +218,12 @@ contains
 
             return
         end if
-        if (allocated(scene%source)) &
-            call check_own_source(path, scene%source, err, analysis, label)
+        ! (a scene without a source, the library's: the file's kind only)
+        if (allocated(scene%source)) then
+            call check_own_source(path, scene%source, err, analysis, label, can_force)
+        else
+            call check_own_source(path, '', err, analysis, label, can_force)
+        end if
     end subroutine check_may_replace
 
     !> How a message names the file `path`: as `label` when given, else by its path.

@@ -108,6 +108,18 @@ def test_run_gives_the_cli_records_and_writes_no_file(run, tmp_path, monkeypatch
     assert error.value.message.endswith("not replaced (remove it, or write elsewhere)"), \
         error.value.message
     assert (tmp_path / "notes.h5").read_text() == "mine\n"
+    # a statics result is not a run's file: refused (a Scene has no source to compare, so
+    # the kind is what is checked; before, the run replaced it); a run's file is replaced
+    assert run("statics", path, "-o", "st.h5").returncode == 0
+    with pytest.raises(ropedyn.Error) as error:
+        ropedyn.run(scene, output=tmp_path / "st.h5")
+    assert error.value.code == 2 and error.value.message.endswith(
+        "exists and holds a statics result, not a run one: not replaced; write elsewhere, "
+        "or remove it"), error.value.message
+    with h5py.File(tmp_path / "st.h5") as f:
+        assert f.attrs["analysis"] in (b"statics", "statics")
+    assert ropedyn.run(scene.set("solver.t_end", 0.02), output=tmp_path / "asked.h5").status \
+        == "complete"
 
 
 def test_a_run_keeps_its_warnings_where_the_cli_prints_them(run, tmp_path):
