@@ -252,8 +252,8 @@ contains
     !! warning in the log. Orders 5 .. 7 amplify such modes (up to 1.027 .. 1.114 per step on
     !! the imaginary axis), and the order safety of the run driver acts only on a gain of
     !! energy_gain_bound (10) rtol S, S the energy the run moves (about 0.8 m g L on the
-    !! lightly damped paper rope, where order 7 gained 7.7e-4 m g L by 18.3 s at rtol 1e-4;
-    !! docs/validation/order-safety.md).
+    !! lightly damped paper rope: a gain of about 8 rtol m g L, four times the 2 rtol m g L
+    !! a run should keep to; docs/validation/order-safety.md).
     subroutine safe_start_order(self, start)
         class(mebdf_t), intent(inout) :: self
         type(start_t), intent(in) :: start
