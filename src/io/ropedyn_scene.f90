@@ -366,16 +366,14 @@ contains
         character(len=:), allocatable :: reason
         type(scene_t), target :: scene
         type(scene_key_t), allocatable :: keys(:)
-        type(override_t) :: ov
         type(error_t), allocatable :: err
-        call bind_keys(scene, keys)
-        call parse_override(setting, keys, ov, err)
-        if (.not. allocated(err)) call apply_override(ov, keys, err)
+        integer :: k
+        call set_alone(setting, scene, keys, k, err)
         if (allocated(err)) then
             reason = err%message
             return
         end if
-        reason = keys(ov%key)%check()
+        reason = keys(k)%check()
     end function check_override_value
 
     !> The value a `group.key=value` setting gives its key, as the effective scene writes it
@@ -386,17 +384,31 @@ contains
         character(len=:), allocatable :: text
         type(scene_t), target :: scene
         type(scene_key_t), allocatable :: keys(:)
-        type(override_t) :: ov
         type(error_t), allocatable :: err
-        call bind_keys(scene, keys)
-        call parse_override(setting, keys, ov, err)
-        if (.not. allocated(err)) call apply_override(ov, keys, err)
+        integer :: k
+        call set_alone(setting, scene, keys, k, err)
         if (allocated(err)) then
             text = setting(index(setting, '=') + 1:)
             return
         end if
-        text = keys(ov%key)%value_text()
+        text = keys(k)%value_text()
     end function override_value_text
+
+    !> `setting` ('group.key=value') applied alone to `scene` (a default one), through
+    !! `keys` bound to it; `k` the key it set.
+    subroutine set_alone(setting, scene, keys, k, err)
+        character(len=*), intent(in) :: setting
+        type(scene_t), target, intent(inout) :: scene
+        type(scene_key_t), allocatable, intent(out) :: keys(:)
+        integer, intent(out) :: k
+        type(error_t), allocatable, intent(out) :: err
+        type(override_t) :: ov
+        k = 0
+        call bind_keys(scene, keys)
+        call parse_override(setting, keys, ov, err)
+        if (.not. allocated(err)) call apply_override(ov, keys, err)
+        if (.not. allocated(err)) k = ov%key
+    end subroutine set_alone
 
 
     !> The effective scene as namelist text: all groups and keys, one per line,

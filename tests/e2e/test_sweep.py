@@ -395,25 +395,33 @@ def test_sigterm_to_runner_stops_its_workers(run, ropedyn_exe, sweep_dir):
         assert f.attrs["status"] == b"complete" and f["solver/restarts/time"].shape == (1,)
 
 
-def test_sigkill_to_a_worker_is_no_failed_case(run, ropedyn_exe, sweep_dir):
-    """A worker killed by SIGKILL leaves its case interrupted (an abandoned lock and a
-    .part): the runner says "ended by SIGKILL" and does not count it as failed (its
-    progress said "1 failed" while --status said interrupted)."""
-    (sweep_dir / "long.nml").write_text(LONG.format(rtols="1e-7"))
+def signal_the_first_worker(ropedyn_exe, sweep_dir, rtols, sig):
+    """Run the LONG sweep over `rtols` with one worker and send `sig` to that worker once
+    it writes its case: the runner's exit code and stderr."""
+    (sweep_dir / "long.nml").write_text(LONG.format(rtols=rtols))
     out = sweep_dir / "out" / "long"
     runner = subprocess.Popen([str(ropedyn_exe), "sweep", "long.nml", "--jobs", "1"],
                               cwd=sweep_dir, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                               text=True)
     try:
-        wait_for(lambda: (out / ".case_0001.h5.part").exists(), what="the worker")
+        wait_for(lambda: (out / ".case_0001.h5.part").exists(), what="the first worker")
         workers = processes_mentioning("long.nml --quiet")
         assert len(workers) == 1
-        os.kill(workers[0], signal.SIGKILL)
+        os.kill(workers[0], sig)
         _, stderr = runner.communicate(timeout=120)
     finally:
         if runner.poll() is None:
             runner.kill()
-    assert runner.returncode == 3, stderr
+    return runner.returncode, stderr
+
+
+def test_sigkill_to_a_worker_is_no_failed_case(run, ropedyn_exe, sweep_dir):
+    """A worker killed by SIGKILL leaves its case interrupted (an abandoned lock and a
+    .part): the runner says "ended by SIGKILL" and does not count it as failed (its
+    progress said "1 failed" while --status said interrupted)."""
+    returncode, stderr = signal_the_first_worker(ropedyn_exe, sweep_dir, "1e-7",
+                                                 signal.SIGKILL)
+    assert returncode == 3, stderr
     line = next(l for l in stderr.splitlines() if l.startswith("sweep: case 0001 "))
     assert line.startswith("sweep: case 0001 ended by SIGKILL") and "0 failed" in line, line
     _, counts = status_lines(run, "long.nml")
@@ -425,21 +433,10 @@ def test_sigterm_to_a_worker_reports_its_case_interrupted(run, ropedyn_exe, swee
     interrupted: the runner says so (not "ended by SIGINT", which 128 + 2 would read as),
     counts it apart from the failed cases, and the other case still runs; the reason
     names the case file."""
-    (sweep_dir / "long.nml").write_text(LONG.format(rtols="1e-7, 1e-4"))
+    returncode, stderr = signal_the_first_worker(ropedyn_exe, sweep_dir, "1e-7, 1e-4",
+                                                 signal.SIGTERM)
     out = sweep_dir / "out" / "long"
-    runner = subprocess.Popen([str(ropedyn_exe), "sweep", "long.nml", "--jobs", "1"],
-                              cwd=sweep_dir, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                              text=True)
-    try:
-        wait_for(lambda: (out / ".case_0001.h5.part").exists(), what="the first worker")
-        workers = processes_mentioning("long.nml --quiet")
-        assert len(workers) == 1
-        os.kill(workers[0], signal.SIGTERM)
-        _, stderr = runner.communicate(timeout=120)
-    finally:
-        if runner.poll() is None:
-            runner.kill()
-    assert runner.returncode == 3, stderr
+    assert returncode == 3, stderr
     line = next(l for l in stderr.splitlines() if l.startswith("sweep: case 0001 "))
     assert line.startswith("sweep: case 0001 interrupted (exit 130"), line
     assert "SIGINT" not in stderr and "0 failed" in line, stderr
