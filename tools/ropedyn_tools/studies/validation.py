@@ -275,10 +275,12 @@ def hanging_chain(runner, ns):
            "proportional to 1/EA, next table) and the rotary inertia of the cross-section "
            "(J includes m d^2/16, a Rayleigh-beam term that grows with the mode number: the "
            "offsets of -3e-6 (mode 1) to -1e-3 (mode 5) of the inextensible MPP, which "
-           "shrink with d, next table). For mode 1 of the inextensible MPP the two errors of "
+           "shrink with d, the second table below). For mode 1 of the inextensible MPP the "
+           "two errors of "
            "opposite sign (discretization from above, rotary inertia from below) nearly "
-           "cancel near n = 100. For mode 1 of the extensible ropes the discretization error "
-           "is a few 1e-6 from n = 30 on and changes sign, so no order can be fitted ('-').",
+           "cancel near n = 100. For mode 1 of the extensible ropes omega_1 changes by only "
+           "1e-5 to 2e-5 from n = 30 to 100 and by a few 1e-6 or less, the other way, from "
+           "n = 100 to 300, so no order can be fitted ('-').",
            ""]
     return md
 
@@ -287,7 +289,8 @@ def extensibility(runner, n):
     md = ["### Offsets of the limits", "",
           f"omega_1 at n = {n} against Bessel with the axial (and shear) stiffness scaled: "
           "the offset scales as 1/EA (static stretch w L/EA = "
-          f"{W * L / EA:.2e} of the length).", "",
+          f"{W * L / EA:.2e} of the length), on top of the inextensible chain's own error "
+          "at this n (section 1, first table).", "",
           "| E, G scaled by | RFEM err_1 | MPP err_1 |", "|---|---|---|"]
     for scale in (1, 10, 100):
         errs = []
@@ -322,8 +325,9 @@ def beam(runner, ns):
           "The rope's EI = 1.0738e-3 N m^2 (bending length (EI/w)^(1/3) = 0.098 m) raises the "
           "higher modes. References: converged beam with tension w(L - s) "
           "([closed forms](../theory/statics-modes.md#closed-forms-the-results-are-checked-against"
-          ")). RFEM with EA = 687 N (its extensibility lowers every mode by about "
-          "5e-4, see above); MPP with inextensible members. The clamped top is a rotational "
+          ")). RFEM with EA = 687 N (its extensibility lowers mode 1 by about 5e-4 and "
+          "modes 2-5 by about 3e-4: the offsets of the extensible and the inextensible MPP "
+          "above); MPP with inextensible members. The clamped top is a rotational "
           "SDE on a zero-length joint that lumps the part of the first primary section no "
           "internal SDE covers: RFEM splits the first section [0, dl] between the clamp and "
           "its neighbouring SDE (2 EI/dl each), the MPP's clamp takes the half member "
@@ -366,11 +370,12 @@ def rigid_rod(runner, quick):
           "period is 4 K(sin 37.5 deg) / sqrt(3 g/(2 L)) = 1.832795 s ([closed forms](../theory/statics-modes.md#closed-forms-the-results-are-checked-against)), and with "
           "the cross-section's rotary inertia m d^2/16 (which both models carry) "
           f"{RIGID_PERIOD * math.sqrt(1 + 3 * D**2 / 16):.6f} s. E, G and the dampers scaled "
-          "by the factor (the damping ratio of the stiff modes unchanged), released straight "
-          "at 75 degrees, CVODE at rtol 1e-10, output every 1 ms; the period is the spacing "
-          "of the tip's two downward crossings of y = 0 (cubic interpolation). Larger "
-          "factors make CVODE crawl on the stiff, lightly damped element modes (it hits "
-          "max_steps), so the stiffest setting per model is limited.", "",
+          "by the factor (the Kelvin-Voigt time eta/E unchanged), released straight "
+          "at 75 degrees, the default method `auto` at rtol 1e-10, output every 1 ms; the "
+          "period is the spacing of the tip's first two crossings of y = 0 with y decreasing "
+          "(cubic interpolation). Larger factors can exhaust max_steps on the stiff element "
+          "modes (the RFEM at n = 4 and factor 1e5 does), so the stiffest setting per model "
+          "is limited.", "",
           "| model | n | stiffness factor | period (s) | against 1.832795 | CPU (s) |",
           "|---|---|---|---|---|---|"]
     cases = [("rfem", 2, 1e4), ("mpp", 2, 1e4)] if quick else \
@@ -396,9 +401,9 @@ def rigid_rod(runner, quick):
                   f"{fmt_rel(period / RIGID_PERIOD - 1)} | {cpu:.1f} |")
     md += ["", "Both models swing like the rigid rod within 3e-5 of its period; the remaining "
            "difference shrinks with the stiffness factor (the rod still bends by about "
-           "M L^2/EI ~ 1e-3 of its length at factor 1e4, EI = 10.7 N m^2) and does not "
-           "depend on n (a rigid chain of RFEM elements has exactly the rod's mass and "
-           "inertia).", ""]
+           "M L^2/EI ~ 1e-3 of its length at factor 1e4, EI = 10.7 N m^2). For the RFEM it "
+           "hardly depends on n (a rigid chain of RFEM elements has exactly the rod's mass "
+           "and inertia); the MPP comes closer at n = 2 than at n = 4.", ""]
     return md
 
 
@@ -409,7 +414,7 @@ def catenary(runner, ns):
           "metre: `ropedyn statics` continues in the support stiffness, see "
           "statics-modes.md). Pins with `support_stiffness_factor = "
           f"{PIN_FACTOR:g}` (nearly rigid; at 1 each pin adds one joint's stretch, +0.3 % sag "
-          "for EA = 10 N). Reference: Irvine's elastic catenary ([closed forms](../theory/statics-modes.md#closed-forms-the-results-are-checked-against)). Sag = depth of "
+          "for EA = 10 N at n = 100). Reference: Irvine's elastic catenary ([closed forms](../theory/statics-modes.md#closed-forms-the-results-are-checked-against)). Sag = depth of "
           "the lowest point below the supports (vertex of the parabola through the lowest "
           "joint and its neighbours); H, V and T from the support forces "
           "(`/statics/support_force_*`, dV/d(anchor) at the equilibrium).", "",
@@ -476,7 +481,7 @@ def axial(runner, ns):
           "Gravity drops out of the axial vibration of a hanging elastic rod with a rigid top: "
           f"omega_k = (2k-1) pi c/(2L), c = sqrt(E/rho) = {C_AXIAL:.3f} m/s. Modes whose "
           "point motion is more than 90 % along the rope (`/modes/axial_fraction`) among the "
-          "lowest 200; RFEM with the top pin stiffened (`support_stiffness_factor = "
+          "lowest 3n (at most 200); RFEM with the top pin stiffened (`support_stiffness_factor = "
           f"{ROD_FACTOR:g}`), the MPP's top is an ideal pin; bending off.", "",
           "| model | n | omega_1 | err | omega_2 | err | omega_3 | err | zeta_1 |",
           "|---|---|---|---|---|---|---|---|---|"]
@@ -522,7 +527,8 @@ def time_domain(runner):
     md = ["## 5. Time-domain cross-checks", "",
           "Each comparison once more in the time domain: `ropedyn run` started in mode k "
           "(`&initial shape = 'mode'`: the equilibrium plus the mode shape scaled so that its "
-          "largest point displacement is `mode_amplitude`, at rest), CVODE with rtol 1e-9; the "
+          "largest point displacement is `mode_amplitude`, at rest), the default method "
+          "`auto` with rtol 1e-9; the "
           "period is the mean spacing of the downward zero crossings of the displacement "
           "projected on the mode's point shape (`/modes/shape_points`), over about "
           "three periods. Damping on (the Table 1 dampers barely damp these modes).", "",
@@ -567,12 +573,13 @@ def time_domain(runner):
            "and LAPACK dsbgvx, O(n) per iteration and O(n^2) for the eigenvectors. MPP: dense "
            "M(q) and K (central differences of the O(n) implicit force, O(n^2)), dense steps "
            "and dsygvx, O(n^3); at n = 300 (600 coordinates with the member springs) the "
-           "hanging rope takes about a second, a catenary started far from its equilibrium "
-           "(its iterations: the catenary table) 10-20 s; the time-domain MPP runs are kept "
+           "hanging rope takes a fraction of a second, a catenary started far from its "
+           "equilibrium (its iterations: the catenary table) several seconds; the time-domain "
+           "MPP runs are kept "
            "at n = 30 (each step of the integrator factors the dense M(q)). The RFEM "
-           "catenaries take the most iterations (the same table: their linearized steps "
-           "rotate elements by ~0.1 rad at most before the stiff joints object), a few "
-           "seconds at n = 300.", ""]
+           "catenary with EA = 10 N takes the most iterations (the same table: its linearized "
+           "steps rotate elements by ~0.1 rad at most before the stiff joints object), yet "
+           "under a second at n = 300.", ""]
     return md
 
 
