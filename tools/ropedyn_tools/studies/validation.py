@@ -204,7 +204,7 @@ def main(argv=None):
         header = HEADER.format(wall=wall, runs=runner.count, cpus=os.cpu_count(),
                                stamp=run_stamp())
     # one generated section, the whole page but its title (scripts/docs_status follows it)
-    pathlib.Path(args.out).write_text(header + "\n".join(md) + "\n\n" + END + "\n")
+    pathlib.Path(args.out).write_text(header + "\n".join(md) + "\n" + END + "\n")
     print(f"validation: wrote {args.out} ({runner.count} ropedyn runs, {wall:.0f} s)")
 
 
