@@ -17,7 +17,7 @@
 !! - **Energy balance**: a D-map changes v at fixed q, t, so it changes only T, by exactly
 !!   dT = m d . (v + d/2), d = (h/2) a_r: the quadratures of energy put in (external work)
 !!   advance by their rates (h/2) g_r, and the one of energy taken out (dissipated) by what
-!!   closes the balance, dT - work (problem_t's split_layout gives the signs). A kick at a
+!!   closes the balance, work - dT (problem_t's split_layout gives the signs). A kick at a
 !!   potential that depends on time advances the work by b_i h g_c (the p_t-kick of the
 !!   extended phase space). So T + V + dissipated - work changes only in the composition's
 !!   steps on the potential, whose energy error is bounded (a modified energy is

@@ -10,9 +10,9 @@
 !!
 !! Assumed by the split, and refused otherwise: the mass matrix of the coordinates is
 !! constant and diagonal, diag(m_i, m_i, J_i). Point masses at an element's centre keep it
-!! so; off the centre they couple translation and rotation through the angle. (Added mass
-!! that depends on an element's orientation would not be diagonal and constant either: a
-!! model with it must refuse the split in `rfem_force_split_refusal`.)
+!! so; off the centre they couple translation and rotation through the angle. (Water's added
+!! mass depends on an element's orientation, so it is neither: `rfem_force_split_refusal`
+!! refuses the split with water on.)
 submodule (ropedyn_rfem:ropedyn_rfem_kernels) ropedyn_rfem_energy
     implicit none
 
