@@ -129,6 +129,7 @@ module ropedyn_symplectic
         integer(i8) :: estimated_at = 0        !< steps at the last spectrum estimate
         integer(i8) :: respectrum = RESPECTRUM_STEPS  !< steps to the next
         real(wp) :: radius = 0.0_wp            !< spectral radius of that estimate, 1/s
+        real(wp) :: h_stable = 0.0_wp          !< the composition's stable step there, s
         real(wp) :: fast_damping = 0.0_wp
         integer :: order_limit = 4
         real(wp) :: fixed_h = 0.0_wp           !< fix_step's step (0: the rule's)
@@ -203,9 +204,9 @@ module ropedyn_symplectic
         !! forces outside the potential (problem_t's split_has_rest); `light`: the mode that
         !! limits the step is lightly damped (below LIGHT_DAMPING); `cost`: the step's work
         !! per simulated second, in evaluations of the potential's forces (step_cost over h);
-        !! h = 0: no estimate.
+        !! `h_stable`: the stable step of the composition taken; h = 0: no estimate.
         module subroutine choose_step(spec, rtol, max_order, rest, tab, h, light, text, cost, &
-                                      stay_light)
+                                      stay_light, h_stable)
             type(spectrum_t), intent(in) :: spec
             real(wp), intent(in) :: rtol
             integer, intent(in) :: max_order
@@ -220,6 +221,7 @@ module ropedyn_symplectic
             !! the next, and each change between Verlet and a 4th-order composition moves the
             !! modified energy)
             logical, intent(in), optional :: stay_light
+            real(wp), intent(out), optional :: h_stable
         end subroutine choose_step
 
         !> The largest step (s) at which the composition `tab` is stable for every fast Ritz

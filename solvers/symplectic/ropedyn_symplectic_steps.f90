@@ -62,13 +62,20 @@ contains
 
     !> The run ends (ERR_SOLVER) when the step h would take more than STIFF_STEP_RATE steps
     !! per simulated second, as erk's and adams' do: the step of an explicit method held by
-    !! the spectral radius, where an implicit method takes steps many times longer.
+    !! the spectral radius, where an implicit method takes steps many times longer. A step
+    !! below ACCURACY_HELD of the composition's stable step is held by the tolerance instead
+    !! (its order's step at rtol, or the fast modes' energy error): the message says so.
     subroutine too_stiff(self, h, err)
         class(symplectic_t), intent(inout) :: self
         real(wp), intent(in) :: h
         type(error_t), allocatable, intent(out) :: err
+        real(wp), parameter :: ACCURACY_HELD = 0.2_wp
         character(len=240) :: text
         if (1.0_wp/h <= STIFF_STEP_RATE) return
+        if (h < ACCURACY_HELD*self%h_stable) then
+            call tolerance_held(self, h, err)
+            return
+        end if
         write (text, '(a, es9.2, a, es9.2, a, es9.2, a)') 'the problem is too stiff for an '// &
             'explicit method here: the step is held by stability (spectral radius ', &
             self%radius, ' 1/s, step ', h, ' s), which takes ', 1.0_wp/h, &
@@ -77,6 +84,26 @@ contains
         call self%failure(err, trim(text)//'; use method = ''auto'' (it switches to an '// &
                           'implicit method where this happens) or ''mebdf''')
     end subroutine too_stiff
+
+    !> too_stiff's end for a step held by the tolerance, not by stability.
+    subroutine tolerance_held(self, h, err)
+        class(symplectic_t), intent(inout) :: self
+        real(wp), intent(in) :: h
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: cure
+        character(len=12) :: rate
+        write (rate, '(es9.2)') 1.0_wp/h
+        cure = 'loosen rtol, or use method = ''auto'' or ''mebdf'''
+        if (self%order_limit < 4) cure = 'allow the 4th-order compositions (max_order = 4, '// &
+            'the default), loosen rtol, or use method = ''auto'''
+        self%h = h
+        call self%failure(err, 'the tolerance (rtol = '// &
+            significant_text(self%options%rtol, 3)//') asks for steps of '// &
+            significant_text(h, 3)//' s of '//trim(self%tab%label)//' (order '// &
+            int_text(self%tab%order)//'), '//trim(adjustl(rate))// &
+            ' steps per simulated second, where its stable step is '// &
+            significant_text(self%h_stable, 3)//' s: '//cure)
+    end subroutine tolerance_held
 
     !> The spectrum at the current state again; the step changed when it must shrink or
     !! may grow by GROW_AT (the first output interval from here a whole number of steps).
@@ -113,7 +140,7 @@ contains
         call estimate_spectrum(self%problem, self%t, self%y, spec)
         self%estimated_at = self%counters%steps
         call choose_step(spec, self%options%rtol, self%order_limit, self%rest, tab, h, light, &
-                         text, stay_light=self%light_seen)
+                         text, stay_light=self%light_seen, h_stable=self%h_stable)
         self%light_seen = self%light_seen .or. light
         self%radius = spec%radius
         self%fast_damping = spec%fast_damping
@@ -140,6 +167,7 @@ contains
         text = 'no estimate of the spectrum'
         best = huge(1.0_wp)
         if (present(cost)) cost = 0.0_wp
+        if (present(h_stable)) h_stable = 0.0_wp
         tab = split_table(TABLE_VERLET)
         do kind = TABLE_VERLET, TABLE_CHIN
             if (kind /= TABLE_VERLET .and. max_order < 4) exit
@@ -167,6 +195,7 @@ contains
             h = min(hk, he)
             light = slight
             if (present(cost)) cost = best
+            if (present(h_stable)) h_stable = hs
             write (text, '(a, es9.2, a, f6.3, a, es9.2, a, f5.2, a, f5.3, a)') &
                 'spectral radius ', spec%radius, ' 1/s, the mode limiting the step damped ', &
                 zeta, ', stable step ', hs, ' s, the step ', safety, ' x', scale, ' of it'

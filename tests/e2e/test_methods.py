@@ -686,3 +686,22 @@ def test_erk_of_order_3_diagnoses_the_steel_wire(run, tmp_path):
     assert "order 3: the problem is too stiff for an explicit method" in proc.stderr
     rho = float(proc.stderr.split("spectral radius rho of about")[1].split()[0])
     assert 2e5 < rho < 4.5e5, rho
+
+
+def test_symplectic_held_by_its_tolerance_says_so(run, tmp_path):
+    """Störmer-Verlet alone (max_order = 2) on the paper's rope at rtol 1e-6: its energy
+    limit for the lightly damped fast modes takes steps of about 1e-6 s, far below its
+    stable step (2.5e-4 s). The run stops at its spectrum's second look (0.03 s), and the
+    message names the tolerance, the composition and the cures; it said the step was held
+    by stability. The steel wire, whose step is held by stability, keeps that message."""
+    proc, _ = run_scene(run, tmp_path, PAPER, "verlet", "solver.method='symplectic'",
+                        "solver.max_order=2", "solver.t_end=0.1")
+    assert proc.returncode == 3, proc.stderr
+    assert "the tolerance (rtol = 1.0e-6) asks for steps of" in proc.stderr, proc.stderr
+    assert "of Stormer-Verlet (order 2)" in proc.stderr and "allow the 4th-order " \
+        "compositions (max_order = 4, the default)" in proc.stderr, proc.stderr
+    assert "held by stability" not in proc.stderr, proc.stderr
+    proc, _ = run_scene(run, tmp_path, STEEL, "wire", "solver.method='symplectic'",
+                        "solver.t_end=0.01")
+    assert proc.returncode == 3 and "the step is held by stability" in proc.stderr, \
+        proc.stderr
