@@ -80,6 +80,20 @@ int ropedyn_real_path(const char *path, char *buf, int size)
     return 0;
 }
 
+/* The target of the symbolic link `path` as the link holds it (relative to the link's
+ * directory when it is relative) in `buf` of `size` bytes, NUL-terminated. Returns 0, or
+ * errno (EINVAL: not a link). */
+int ropedyn_link_target(const char *path, char *buf, int size)
+{
+    ssize_t n;
+    if (size < 1) return ENAMETOOLONG;
+    n = readlink(path, buf, (size_t)size);
+    if (n < 0) return errno;
+    if (n >= size) return ENAMETOOLONG;
+    buf[n] = '\0';
+    return 0;
+}
+
 /* The system's text of `errnum` in `buf` of `size` bytes, NUL-terminated. */
 void ropedyn_errno_text(int errnum, char *buf, int size)
 {

@@ -13,7 +13,7 @@ module ropedyn_os
     public :: make_dirs, make_parent_dirs, current_dir, is_terminal, sleep_microseconds, &
               processor_count, absolute_path, unwritable_dir, rename_file, delete_file
     public :: file_kind, file_kind_name, special_file_reason, errno_text, real_path, &
-              canonical_path, same_file, output_clash, lock_holder, try_lock, &
+              canonical_path, written_path, same_file, output_clash, lock_holder, try_lock, &
               reserve_space, release_space
     public :: FILE_MISSING, FILE_REGULAR, FILE_DIRECTORY, FILE_FIFO, FILE_CHAR_DEVICE, &
               FILE_BLOCK_DEVICE, FILE_SOCKET, FILE_SYMLINK, FILE_OTHER
@@ -80,6 +80,12 @@ module ropedyn_os
             character(kind=c_char), intent(out) :: buf(*)
             integer(c_int), value :: size
         end function c_real_path
+        integer(c_int) function c_link_target(path, buf, size) bind(C, name='ropedyn_link_target')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            character(kind=c_char), intent(out) :: buf(*)
+            integer(c_int), value :: size
+        end function c_link_target
         subroutine c_errno_text(errnum, buf, size) bind(C, name='ropedyn_errno_text')
             import :: c_char, c_int
             integer(c_int), value :: errnum, size
@@ -378,6 +384,33 @@ contains
             full = dir//'/'//path(slash + 1:)
         end if
     end function canonical_path
+
+    !> The file a write to `path` lands on: `path` itself, or for a symbolic link the file
+    !! it points to (followed through links to links, 40 at most, as the system does), an
+    !! existing one by its real_path, a missing one (a dangling link) by the canonical_path
+    !! of the link's target, so that the file is created there and the link stays.
+    function written_path(path) result(full)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: full, target
+        character(kind=c_char, len=4097) :: buf
+        integer :: hops, k, slash
+        full = path
+        if (file_kind(path, follow=.false.) /= FILE_SYMLINK) return
+        if (file_kind(path) /= FILE_MISSING) then
+            full = real_path(path)
+            return
+        end if
+        do hops = 1, 40
+            if (file_kind(full, follow=.false.) /= FILE_SYMLINK) exit
+            if (c_link_target(full//c_null_char, buf, int(len(buf), c_int)) /= 0) exit
+            k = index(buf, c_null_char)
+            target = buf(:k - 1)
+            slash = index(full, '/', back=.true.)
+            if (target(1:1) /= '/' .and. slash > 0) target = full(:slash)//target
+            full = target
+        end do
+        full = canonical_path(full)
+    end function written_path
 
     !> Whether the paths `a` and `b` name one file: the same device and inode when both
     !! exist (links, relative paths and hard links alike), else the same canonical_path.

@@ -10,8 +10,7 @@ module ropedyn_analysis
     use ropedyn_scene, only: scene_t, scene_namelist_text
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_os, only: make_parent_dirs, file_kind, real_path, rename_file, delete_file, &
-                          FILE_SYMLINK, FILE_MISSING
+    use ropedyn_os, only: make_parent_dirs, written_path, rename_file, delete_file
     use ropedyn_run_inputs, only: check_not_input, check_may_replace
     use ropedyn_text, only: int_text
     use ropedyn_model_factory, only: create_model
@@ -141,10 +140,10 @@ contains
         type(error_t), allocatable :: close_err
         character(len=:), allocatable :: file
         logical :: removed
-        file = self%out_path
-        if (file_kind(file, follow=.false.) == FILE_SYMLINK) then
-            if (file_kind(file) /= FILE_MISSING) file = real_path(file)
-        end if
+        ! a link: the file it points to, even one not there yet (the link stays)
+        file = written_path(self%out_path)
+        if (file /= self%out_path) call make_parent_dirs(file, err)
+        if (allocated(err)) return
         call h5%create(file//'.part', err)
         if (allocated(err)) return
         call self%write_statics(h5, scene, err)

@@ -15,7 +15,7 @@
 !!   left by a killed run is refused (resume it, or remove it) unless --force.
 submodule (ropedyn_run) ropedyn_run_guard
     use ropedyn_os, only: make_parent_dirs, rename_file, delete_file, special_file_reason, &
-                          file_kind, real_path, canonical_path, errno_text, FILE_SYMLINK, &
+                          file_kind, real_path, written_path, errno_text, FILE_SYMLINK, &
                           FILE_MISSING
     use ropedyn_sweep_lock, only: take_lock, drop_lock
     use ropedyn_run_inputs, only: check_not_input, check_may_replace
@@ -45,18 +45,19 @@ contains
                     ': exists and is '//special_file_reason(file)//': not replaced')
                 return
             end if
-            ! a link: the file it points to (written there, renamed there)
+            ! a link: the file it points to (written there, renamed there; the link stays)
             if (file_kind(file, follow=.false.) == FILE_SYMLINK) then
                 if (file_kind(file) == FILE_MISSING) then
-                    file = canonical_path(file)
+                    ! a dangling link (or a loop: the system's reason)
                     if (len(real_path(file, errnum)) == 0 .and. errnum /= 2) then
                         call make_error(err, ERR_IO, self%summary%file//': cannot create '// &
                                         'file: '//errno_text(errnum))
                         return
                     end if
-                else
-                    file = real_path(file)
                 end if
+                file = written_path(file)
+                call make_parent_dirs(file, err)
+                if (allocated(err)) return
             end if
             if (len(file) - index(file, '/', back=.true.) + len('.part') > NAME_MAX) then
                 call make_error(err, ERR_IO, file//': cannot create file: File name too '// &

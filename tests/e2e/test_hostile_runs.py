@@ -267,6 +267,27 @@ def test_create_errors_give_the_system_reason(ropedyn_exe, work, name, fragment)
     refused(ropedyn_exe, work, ["run", "s.nml", "--set", f"output.file={name}"], 4, fragment)
 
 
+def test_a_link_to_a_file_not_there_yet_is_written_through(ropedyn_exe, work):
+    """An output that is a link to a file not there yet (a dangling link, also through a
+    second link) is written where the link points, in directories made for it, and the
+    links stay; before, canonical_path kept the link's own name and the run's file
+    replaced the link, the target never written. So for statics and modes."""
+    (work / "lk.h5").symlink_to("sub/new.h5")
+    (work / "hop.h5").symlink_to("lk2.h5")
+    (work / "lk2.h5").symlink_to("deeper/dir/st.h5")
+    result = run_in(ropedyn_exe, work, "run", "s.nml", "--set", "output.file=lk.h5")
+    assert result.returncode == 0, result.stderr
+    result = run_in(ropedyn_exe, work, "statics", "s.nml", "-o", "hop.h5")
+    assert result.returncode == 0, result.stderr
+    for link, target in (("lk.h5", "sub/new.h5"), ("hop.h5", "lk2.h5"),
+                         ("lk2.h5", "deeper/dir/st.h5")):
+        assert (work / link).is_symlink() and os.readlink(work / link) == target
+    with h5py.File(work / "sub" / "new.h5", "r") as f:
+        assert attr(f, "status") == "complete"
+    with h5py.File(work / "deeper" / "dir" / "st.h5", "r") as f:
+        assert attr(f, "analysis") == "statics"
+
+
 def test_statics_and_modes_never_write_their_scene(ropedyn_exe, work):
     (work / "link.h5").symlink_to("s.nml")
     os.link(work / "s.nml", work / "hard.h5")
