@@ -25,6 +25,8 @@ contains
         do while (cli%next())
             select case (cli%option)
             case ('--help', '-h')
+                call cli%flag(err)
+                if (allocated(err)) return
                 call print_help('keys', output_unit)
                 return
             case default

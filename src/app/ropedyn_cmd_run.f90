@@ -33,6 +33,8 @@ contains
         do while (cli%next())
             select case (cli%option)
             case ('--help', '-h')
+                call cli%flag(err)
+                if (allocated(err)) return
                 call print_help('run', output_unit)
                 return
             case ('--verbose', '-v')
@@ -53,6 +55,11 @@ contains
             if (allocated(err)) return
         end do
         if (allocated(resume_path)) then
+            if (force) then
+                call cli%usage_error('--force does not apply to --resume (a resume continues '// &
+                                     'FILE.h5 in place)', err)
+                return
+            end if
             if (allocated(cli%scene_path)) then
                 call cli%usage_error('--resume takes the scene from FILE.h5: give no scene '// &
                                      'file ('//cli%scene_path//')', err)

@@ -35,6 +35,8 @@ contains
         do while (cli%next())
             select case (cli%option)
             case ('--help', '-h')
+                call cli%flag(err)
+                if (allocated(err)) return
                 call print_help(command, output_unit)
                 return
             case ('--no-continuation')

@@ -69,6 +69,8 @@ contains
         do while (cli%next())
             select case (cli%option)
             case ('--help', '-h')
+                call cli%flag(err)
+                if (allocated(err)) return
                 call print_help('sweep', output_unit)
                 return
             case ('--list')

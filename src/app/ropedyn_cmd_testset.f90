@@ -82,6 +82,8 @@ contains
         do while (cli%next())
             select case (cli%option)
             case ('--help', '-h')
+                call cli%flag(err)
+                if (allocated(err)) return
                 call print_help('testset', output_unit, 'default_repeat_time', &
                                 real_text(DEFAULT_REPEAT_TIME, compact=.true.))
                 opts%help = .true.

@@ -90,6 +90,9 @@ def test_version(run):
     (("testset", "--list", "hires"), '--list lists every problem: give no problem ("hires")'),
     (("--version", "extra"), '--version takes no arguments ("extra")'),
     (("--help", "extra"), '--help takes no arguments ("extra")'),
+    (("run", "--help=1"), 'run: --help takes no value ("--help=1")'),
+    (("testset", "--help=yes"), "testset: --help takes no value"),
+    (("run", "--resume", "x.h5", "--force"), "--force does not apply to --resume"),
 ])
 def test_a_flag_takes_no_value_and_no_stray_arguments(run, tmp_path, args, fragment):
     """A flag given a value was taken as the flag, the value ignored: '--force=no'
