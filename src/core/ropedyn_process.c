@@ -301,6 +301,9 @@ long long ropedyn_process_start(int pid)
     /* the command name (field 2) is in parentheses and may hold blanks */
     p = strrchr(buf, ')');
     if (!p) return 0;
+    /* field 3, the state: a zombie (Z) or a dead process (X) has ended; only its parent
+     * has not reaped it yet */
+    if (p[1] == ' ' && (p[2] == 'Z' || p[2] == 'X')) return -1;
     for (field = 2; field < 22 && p; field++) p = strchr(p + 1, ' ');
     if (!p || sscanf(p + 1, "%llu", &ticks) != 1) return 0;
     return (long long)ticks;

@@ -165,7 +165,8 @@ contains
     end function process_id
 
     !> Start time of process `pid` (0: this process) in clock ticks after boot; 0 when the
-    !! process exists but its start time is unknown; -1 when there is no such process.
+    !! process exists but its start time is unknown; -1 when there is no such process, or
+    !! it has ended and waits for its parent to reap it (a zombie).
     integer(int64) function process_start(pid)
         integer, intent(in) :: pid
         process_start = int(c_process_start(int(pid, c_int)), int64)

@@ -490,6 +490,18 @@ def test_lock_rules(run, sweep_dir):
     result = run("sweep", "sw.nml", "--status")
     assert f"0002 interrupted: its writer ended without finishing: killed or crashed " \
            f"(host {socket.gethostname()}, pid {gone.pid}; that process is gone)" in result.stdout
+    # this host: a process that has ended but is not reaped yet (a zombie) is gone too;
+    # it was taken as the live writer until its parent reaped it
+    zombie = subprocess.Popen(["true"])
+    wait_for(lambda: pathlib.Path(f"/proc/{zombie.pid}/stat").read_text()
+             .rsplit(")", 1)[1].split()[0] == "Z", what="the zombie")
+    lock2.write_text(f"ropedyn sweep case lock\nhost={socket.gethostname()}\n"
+                     f"pid={zombie.pid}\n")
+    result = run("sweep", "sw.nml", "--status")
+    zombie.wait()
+    assert f"0002 interrupted: its writer ended without finishing: killed or crashed " \
+           f"(host {socket.gethostname()}, pid {zombie.pid}; that process is gone)" \
+           in result.stdout, result.stdout
     # a recorded signal
     lock2.write_text(f"host={socket.gethostname()}\npid={os.getpid()}\nsignal=2\n")
     assert "0002 interrupted: stopped by SIGINT at" in run("sweep", "sw.nml", "--status").stdout
