@@ -207,17 +207,18 @@ contains
     !> What the order safety did, a line for each kind of action.
     subroutine print_safety(s)
         type(run_summary_t), intent(in) :: s
+        character(len=:), allocatable :: why
         associate (r => s%safety)
             if (r%lowered_at >= 0.0_wp) write (output_unit, &
                 '(a, es10.3, a, es10.3, a, i0, a, i0, a, f9.4, a)') &
                 '  order safety    energy gain ', r%energy_gain, ' J > bound ', &
                 r%energy_gain_bound, ' J: max order ', r%order_before, ' -> ', r%order_after, &
                 ' from t = ', r%lowered_at, ' s'
+            why = ' s at the safe order (not an order instability)'
+            if (r%orderless) why = ' s: the method has no order to lower'
             if (r%unresolved_at >= 0.0_wp) write (output_unit, '(a, es10.3, a, f9.4, a)') &
                 '  order safety    energy gain ', r%energy_gain, ' J above the bound at t = ', &
-                r%unresolved_at, trim(merge(' s: the method has no order to lower           ', &
-                                            ' s at the safe order (not an order instability)', &
-                                            r%orderless))
+                r%unresolved_at, why
             if (r%kept_at >= 0.0_wp) write (output_unit, '(a, es10.3, a, f9.4, a)') &
                 '  order safety    energy gain ', r%energy_gain, ' J above the bound at t = ', &
                 r%kept_at, ' s: '//r%kept_reason//'; the order kept ('// &
