@@ -30,7 +30,7 @@ contains
             call self%failure(err, 'no estimate of the spectrum to choose the step from')
             return
         end if
-        call too_stiff(self, h, err)
+        call too_stiff(self, tab, h, err)
         if (allocated(err)) return
         self%tab = tab
         call self%set_step(h, tout, trim(text), .false.)
@@ -60,50 +60,53 @@ contains
             'solver.max_steps by '//int_text(budget_covering(rest) - left))
     end procedure budget_reaches_end
 
-    !> The run ends (ERR_SOLVER) when the step h would take more than STIFF_STEP_RATE steps
-    !! per simulated second, as erk's and adams' do: the step of an explicit method held by
-    !! the spectral radius, where an implicit method takes steps many times longer. A step
-    !! below ACCURACY_HELD of the composition's stable step is held by the tolerance instead
-    !! (its order's step at rtol, or the fast modes' energy error): the message says so.
-    subroutine too_stiff(self, h, err)
+    !> The run ends (ERR_SOLVER) when the step h of the composition `tab` would take more
+    !! than STIFF_STEP_RATE steps per simulated second, as erk's and adams' do: the step of an
+    !! explicit method held by the spectral radius, where an implicit method takes steps many
+    !! times longer. A step below ACCURACY_HELD of the composition's stable step is held by
+    !! the tolerance instead (its order's step at rtol, or the fast modes' energy error): the
+    !! message says so. The failure is that of the step and composition it names.
+    subroutine too_stiff(self, tab, h, err)
         class(symplectic_t), intent(inout) :: self
+        type(split_table_t), intent(in) :: tab
         real(wp), intent(in) :: h
         type(error_t), allocatable, intent(out) :: err
         real(wp), parameter :: ACCURACY_HELD = 0.2_wp
-        character(len=240) :: text
+        character(len=:), allocatable :: cause, rate
         if (1.0_wp/h <= STIFF_STEP_RATE) return
+        self%h = h
+        self%tab = tab
+        rate = es_text(1.0_wp/h)
         if (h < ACCURACY_HELD*self%h_stable) then
-            call tolerance_held(self, h, err)
-            return
+            cause = 'the tolerance (rtol = '//significant_text(self%options%rtol, 3)// &
+                ') asks for steps of '//significant_text(h, 3)//' s of '//trim(tab%label)// &
+                ' (order '//int_text(tab%order)//'), '//rate// &
+                ' steps per simulated second, where its stable step is '// &
+                significant_text(self%h_stable, 3)//' s: '
+            if (self%order_limit < 4) then
+                cause = cause//'allow the 4th-order compositions (max_order = 4, the '// &
+                    'default), loosen rtol, or use method = ''auto'''
+            else
+                cause = cause//'loosen rtol, or use method = ''auto'' or ''mebdf'''
+            end if
+        else
+            cause = 'the problem is too stiff for an explicit method here: the step is held '// &
+                'by stability (spectral radius '//es_text(self%radius)//' 1/s, step '// &
+                es_text(h)//' s), which takes '//rate//' steps per simulated second; use '// &
+                'method = ''auto'' (it switches to an implicit method where this happens) '// &
+                'or ''mebdf'''
         end if
-        write (text, '(a, es9.2, a, es9.2, a, es9.2, a)') 'the problem is too stiff for an '// &
-            'explicit method here: the step is held by stability (spectral radius ', &
-            self%radius, ' 1/s, step ', h, ' s), which takes ', 1.0_wp/h, &
-            ' steps per simulated second'
-        self%h = h
-        call self%failure(err, trim(text)//'; use method = ''auto'' (it switches to an '// &
-                          'implicit method where this happens) or ''mebdf''')
+        call self%failure(err, cause)
+    contains
+        !> x as the message writes it: es9.2 without its leading blanks
+        function es_text(x) result(text)
+            real(wp), intent(in) :: x
+            character(len=:), allocatable :: text
+            character(len=12) :: buf
+            write (buf, '(es9.2)') x
+            text = trim(adjustl(buf))
+        end function es_text
     end subroutine too_stiff
-
-    !> too_stiff's end for a step held by the tolerance, not by stability.
-    subroutine tolerance_held(self, h, err)
-        class(symplectic_t), intent(inout) :: self
-        real(wp), intent(in) :: h
-        type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: cure
-        character(len=12) :: rate
-        write (rate, '(es9.2)') 1.0_wp/h
-        cure = 'loosen rtol, or use method = ''auto'' or ''mebdf'''
-        if (self%order_limit < 4) cure = 'allow the 4th-order compositions (max_order = 4, '// &
-            'the default), loosen rtol, or use method = ''auto'''
-        self%h = h
-        call self%failure(err, 'the tolerance (rtol = '// &
-            significant_text(self%options%rtol, 3)//') asks for steps of '// &
-            significant_text(h, 3)//' s of '//trim(self%tab%label)//' (order '// &
-            int_text(self%tab%order)//'), '//trim(adjustl(rate))// &
-            ' steps per simulated second, where its stable step is '// &
-            significant_text(self%h_stable, 3)//' s: '//cure)
-    end subroutine tolerance_held
 
     !> The spectrum at the current state again; the step changed when it must shrink or
     !! may grow by GROW_AT (the first output interval from here a whole number of steps).
@@ -113,7 +116,7 @@ contains
         type(split_table_t) :: tab
         call stable_step_here(self, tab, h, text)
         if (h <= 0.0_wp) return
-        call too_stiff(self, h, err)
+        call too_stiff(self, tab, h, err)
         if (allocated(err)) return
         ! the composition and its step change together (the step is the composition's)
         if (tab%kind /= self%tab%kind .or. h < self%h .or. h > GROW_AT*self%h) then
