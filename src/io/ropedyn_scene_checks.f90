@@ -348,9 +348,10 @@ contains
         type(error_t), allocatable, intent(out) :: err
         associate (v => scene%solver, m => METHODS(method_index(scene%solver%method)))
             v%max_order = resolved_max_order(v%method, v%max_order)
-            if (v%max_order == 0) then
-                ! the method chooses (auto)
-            else if (v%max_order < m%lowest_order .or. v%max_order > m%highest_order) then
+            ! max_order 0 after resolving: the method chooses (auto); the stability-limit
+            ! check below applies to it too
+            if (v%max_order /= 0 .and. (v%max_order < m%lowest_order .or. &
+                                        v%max_order > m%highest_order)) then
                 call fail(keys, G_SOLVER, 'max_order', int_text(v%max_order), &
                     'out of range for method '//trim(v%method)//' (allowed: '// &
                     int_text(m%lowest_order)//' .. '//int_text(m%highest_order)// &

@@ -461,6 +461,11 @@ contains
             '&solver method = ''mebdf'', stability_limit_detection = .true. /'], NO_SET, &
             [character(len=L) :: P//'stab_lim_det_mebdf.nml: &solver: ', &
             'stability_limit_detection = .true.: only for method cvode'])
+        ! auto too, whose max_order stays 0 (it read, and the run failed with exit 3)
+        call expect_error('stab_lim_det_auto', [character(len=L) :: MODEL, &
+            '&solver stability_limit_detection = .true. /'], NO_SET, &
+            [character(len=L) :: P//'stab_lim_det_auto.nml: &solver: ', &
+            'stability_limit_detection = .true.: only for method cvode (method auto'])
         call expect_error('set_stab_lim_det_mebdf', MODEL, [character(len=L) :: &
             'solver.method=mebdf', 'solver.stability_limit_detection=T'], [character(len=L) :: &
             '--set solver.stability_limit_detection=T: &solver: stability_limit_detection', &
