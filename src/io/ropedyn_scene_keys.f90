@@ -173,7 +173,7 @@ contains
         call t%add_real(G_INITIAL, 'angle_deg', i%angle_deg, R_FINITE, 'deg', &
             'angle of the straight initial rope from down x')
         call t%add_int(G_INITIAL, 'mode', i%mode, R_AT_LEAST, 1, &
-            "shape 'mode': which mode (1 = lowest)")
+            "shape 'mode': which mode (1 = lowest; at most the model's number of modes)")
         call t%add_real(G_INITIAL, 'mode_amplitude', i%mode_amplitude, R_FINITE, 'm', &
             "shape 'mode': largest displacement")
         call t%add_pair(G_INITIAL, 'velocity', i%velocity, R_FINITE, 'm/s', &
@@ -221,7 +221,8 @@ contains
             'step budget of a run (0: '//int_text(DEFAULT_MAX_STEPS)//', or '// &
             int_text(nint(BUDGET_STEP_RATE))//' per second of t_end if more; '// &
             'a resume has one of its own)')
-        call t%add_real(G_SOLVER, 't_end', v%t_end, R_POSITIVE, 's', 'end time')
+        call t%add_real(G_SOLVER, 't_end', v%t_end, R_POSITIVE, 's', &
+            'end time; at most a limit')
         call t%add_real(G_SOLVER, 'output_interval', v%output_interval, R_POSITIVE, 's', &
             'time between output records; at most a limit of records')
         call t%add_logical(G_SOLVER, 'stability_limit_detection', &
