@@ -379,8 +379,9 @@ contains
         if (ratio > MIN_GROWTH .or. knew /= k) then
             ratio = min(ratio, merge(2.0_wp, 10.0_wp, self%recent_failure))
             self%recent_failure = .false.
+            ! (at the start, before any failure, the step does not shrink)
             if (self%counters%steps <= k + 2 .and. .not. self%any_failure) &
-                ratio = min(max(ratio, 1.0_wp), 1.0e4_wp)
+                ratio = max(ratio, 1.0_wp)
             ratio = max(ratio, 0.2_wp)
             self%pending = .true.
             self%pending_k = knew
