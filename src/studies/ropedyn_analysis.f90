@@ -36,7 +36,7 @@ module ropedyn_analysis
     character(len=*), parameter :: STATICS_COUNTS(3, 3) = reshape([character(len=51) :: &
         'iterations', '1', 'linear solves (accepted and rejected steps)', &
         'rejected', '1', '', &
-        'stages', '1', 'continuation stages in the bottom anchor (0: none)'], [3, 3])
+        'stages', '1', 'continuation stages (anchor and ground, or current)'], [3, 3])
     !> The per-mode results in /modes of one value per mode: name, units, description.
     character(len=*), parameter :: MODE_VALUES(3, 5) = reshape([character(len=74) :: &
         'omega', 'rad/s', &

@@ -180,16 +180,20 @@ contains
     subroutine check_equilibrium_exists(spec, err)
         type(rope_spec_t), intent(in) :: spec
         type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: top, bottom
+        character(len=:), allocatable :: top, bottom, origin
         associate (s => spec%supports)
-            top = end_text('top', s%top, 1)
-            bottom = end_text('bottom', s%bottom, 2)
+            top = end_key('top', s%top, 1)
+            bottom = end_key('bottom', s%bottom, 2)
         end associate
         if (len(top) > 0 .and. len(bottom) > 0 .and. spec%effects%gravity .and. &
             spec%rope%gravity > 0.0_wp) then
-            call make_error(err, ERR_SOLVER, spec%path//': statics: no equilibrium: both '// &
-                'supports are free (&supports '//top//', '//bottom//') and gravity is '// &
-                'on, so the rope falls freely; pin or clamp an end, or switch gravity off')
+            ! (named by the --set that freed an end, if one did)
+            origin = spec%origin('supports.'//top)
+            if (origin == spec%origin('')) origin = spec%origin('supports.'//bottom)
+            call make_error(err, ERR_SOLVER, origin//': statics: no equilibrium: both '// &
+                'supports are free (&supports '//end_text(top)//', '//end_text(bottom)// &
+                ') and gravity is on, so the rope falls freely; pin or clamp an end, or '// &
+                'switch gravity off')
         else if (spec%model%kind == 'rfem' .and. spec%model%elements > 1 .and. &
                  .not. spec%effects%shear .and. .not. spec%effects%ground) then
             call make_error(err, ERR_SOLVER, spec%origin('effects.shear')//': &effects: '// &
@@ -199,16 +203,28 @@ contains
                 'apart freely; switch shear on for statics and modes')
         end if
     contains
-        !> "top = 'free'" or "top_release_time = 0.0" for an end free at t = 0, else ''.
-        function end_text(end, kind, k) result(text)
+        !> The key that frees the end at t = 0: "top" (its kind 'free') or
+        !! "top_release_time" (released at t = 0), else ''.
+        function end_key(end, kind, k) result(key)
             character(len=*), intent(in) :: end, kind
             integer, intent(in) :: k
-            character(len=:), allocatable :: text
-            text = ''
+            character(len=:), allocatable :: key
+            key = ''
             if (trim(kind) == 'free') then
-                text = end//" = 'free'"
+                key = end
             else if (released_at_start(spec, k)) then
-                text = end//'_release_time = 0.0'
+                key = end//'_release_time'
+            end if
+        end function end_key
+
+        !> "top = 'free'" or "top_release_time = 0.0" for the key end_key gave.
+        pure function end_text(key) result(text)
+            character(len=*), intent(in) :: key
+            character(len=:), allocatable :: text
+            if (index(key, '_release_time') > 0) then
+                text = key//' = 0.0'
+            else
+                text = key//" = 'free'"
             end if
         end function end_text
     end subroutine check_equilibrium_exists

@@ -216,6 +216,12 @@ def test_an_end_released_at_the_start_is_free(run, tmp_path, command):
     # frozen support motions keep the support: a hanging rope
     assert run(command, "rel.nml", "--set", "effects.support_motion=.false.",
                "-o", "frozen.h5").returncode == 0
+    # an end freed by --set: the message names that argument, not the scene file
+    (tmp_path / "hang.nml").write_text("&model kind = 'rfem', elements = 6 /\n")
+    result = run(command, "hang.nml", "--set", "supports.top=free")
+    assert result.returncode == 3, result.stderr
+    assert ("error: --set supports.top=free: statics: no equilibrium: both supports are "
+            "free (&supports top = 'free', bottom = 'free')") in result.stderr, result.stderr
 
 def test_no_convergence(run, tmp_path):
     (tmp_path / "s.nml").write_text("&model kind = 'rfem', elements = 10 /\n")
