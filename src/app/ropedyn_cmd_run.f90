@@ -106,6 +106,7 @@ contains
         type(error_t), allocatable, intent(out) :: err
         type(case_data_t) :: data
         integer :: k
+        logical :: there
         do k = 1, size(overrides)
             if (index(overrides(k), 'output.file') == 1) then
                 call make_error(err, ERR_INPUT, '--set '//trim(overrides(k))//': --resume '// &
@@ -115,12 +116,18 @@ contains
         end do
         call read_case_file(path, data, err)
         if (allocated(err)) then
+            ! (a file another process holds open stays an output error, as a live lock)
+            if (index(err%message, ': cannot open: locked') > 0) return
             err%code = ERR_INPUT   ! not a run file: bad input of --resume
             err%message = err%message//' (--resume needs a ropedyn run file)'
             return
         end if
         if (.not. data%exists) then
             call make_error(err, ERR_INPUT, path//': no such file (--resume)')
+            inquire (file=path//'.part', exist=there)
+            if (there) err%message = err%message//'; '//path//'.part is there, the file '// &
+                'of a run of '//path//' that did not end (killed, or still going on): '// &
+                'ropedyn run --resume '//path//'.part continues it'
             return
         end if
         if (len(data%scene) == 0) then

@@ -162,6 +162,9 @@ module ropedyn_run
         ! the guard of the output file: the lock held ('' none), and for a new run the
         ! file written (FILE.part) and its final name
         character(len=:), allocatable :: lock_file, part_file, final_file
+        !> a resume: why the writer of the file is gone, from its abandoned lock ('': no
+        !! lock of it was there); said when the file's status is still `running`
+        character(len=:), allocatable :: writer_gone
         type(heartbeat_t) :: beat                 !< the lock's heartbeat
         integer :: output = OUTPUT_FILE        !< where the records go
         integer(int8), allocatable :: image(:) !< OUTPUT_MEMORY: the file's bytes at its end

@@ -5,19 +5,21 @@
 !!   for FILE.part is an error with the system's reason);
 !! - FILE.lock is taken before anything is written, the lock a sweep case takes, so that a
 !!   second run on the same file is refused before it touches it; a resume continues FILE
-!!   in place under that lock;
+!!   in place under that lock, and a resume of FILE.part is refused while the run of FILE
+!!   that writes it holds FILE.lock;
 !! - a new run replaces an existing FILE only when it is a file ropedyn wrote for the same
 !!   source (the same scene file with the same --set overrides: a rerun); another file, a
 !!   run of another scene or of a --set variant, is refused unless --force; a special file
 !!   (a device, a FIFO, a link to one) always;
 !! - a new run writes FILE.part and renames it to FILE when it finishes (complete, failed
 !!   or interrupted), so that the earlier FILE stays whole until the new one is; a FILE.part
-!!   left by a killed run is refused (resume it, or remove it) unless --force.
+!!   left by a killed run is refused (resume it, or remove it) unless --force, and while a
+!!   resume of it goes on, always.
 submodule (ropedyn_run) ropedyn_run_guard
     use ropedyn_os, only: make_parent_dirs, rename_file, delete_file, special_file_reason, &
                           file_kind, real_path, written_path, errno_text, FILE_SYMLINK, &
                           FILE_MISSING
-    use ropedyn_sweep_lock, only: take_lock, drop_lock
+    use ropedyn_sweep_lock, only: take_lock, drop_lock, read_lock, lock_t
     use ropedyn_run_inputs, only: check_not_input, check_may_replace
     use ropedyn_error, only: ERR_USAGE, ERR_IO
     use ropedyn_h5, only: h5_file_t
@@ -65,6 +67,10 @@ contains
                 return
             end if
         end if
+        if (resume) then
+            call writers_gone(file, self%writer_gone, err)
+            if (allocated(err)) return
+        end if
         call take_lock(file//'.lock', self%beat, err)
         if (allocated(err)) then
             err%message = file//': '//err%message
@@ -74,13 +80,15 @@ contains
         if (resume) return
         ! a new run: is there a FILE.part of a killed run, may it replace FILE?
         inquire (file=file//'.part', exist=exists)
-        if (exists .and. force) then
+        if (exists) call check_part_idle(file//'.part', err)
+        if (allocated(err)) then
+            continue
+        else if (exists .and. force) then
             removed = delete_file(file//'.part')
         else if (exists) then
             call make_error(err, ERR_USAGE, file//'.part: left by a run of '//file// &
-                ' that was killed: continue it (set its status to interrupted, h5py '// &
-                'f.attrs["status"] = "interrupted", then ropedyn run --resume '//file// &
-                '.part) or remove it, or give --force')
+                ' that was killed: continue it (ropedyn run --resume '//file//'.part) or '// &
+                'remove it, or give --force')
         else
             call check_may_replace(file, self%scene, force, err, &
                                    label=output_key(self%scene, given), &
@@ -95,6 +103,60 @@ contains
         self%part_file = file//'.part'
         self%summary%file = self%part_file
     end procedure guard_output
+
+    !> Before a resume takes FILE.lock: the locks of the runs that may write `file` (a
+    !! resume of it: FILE.lock; for a FILE.part also the new run of FILE that writes it:
+    !! FILE's own lock). A live one of the latter refuses the resume (the former take_lock
+    !! refuses); `gone` says why the writer of an abandoned one is gone ('' when there is
+    !! none), for the warning of a resume of a file whose status is still `running`.
+    subroutine writers_gone(file, gone, err)
+        character(len=*), intent(in) :: file
+        character(len=:), allocatable, intent(out) :: gone
+        type(error_t), allocatable, intent(out) :: err
+        type(lock_t) :: lock
+        character(len=:), allocatable :: path
+        integer :: k
+        gone = ''
+        do k = 1, 2
+            path = file//'.lock'
+            if (k == 2) then
+                if (.not. is_part(file)) exit
+                path = file(1:len(file) - len('.part'))//'.lock'
+            end if
+            call read_lock(path, lock)
+            if (.not. lock%exists) cycle
+            if (k == 2 .and. len(lock%problem) > 0) then
+                call make_error(err, ERR_IO, file//': '//lock%problem)
+                return
+            else if (k == 2 .and. lock%live .and. .not. lock%mine) then
+                call make_error(err, ERR_IO, file//': being written by '//lock%holder()// &
+                    ' (lock '//path//'): the run of '//file(1:len(file) - len('.part'))// &
+                    ' that writes it is going on')
+                return
+            else if (.not. lock%live .and. len(lock%problem) == 0) then
+                gone = path//': '//lock%gone()
+            end if
+        end do
+    end subroutine writers_gone
+
+    !> A new run on FILE may not remove or refuse-and-name `part` (FILE.part) while a resume
+    !! of it holds its lock: an ERR_IO error naming the holder.
+    subroutine check_part_idle(part, err)
+        character(len=*), intent(in) :: part
+        type(error_t), allocatable, intent(out) :: err
+        type(lock_t) :: lock
+        call read_lock(part//'.lock', lock)
+        if (lock%exists .and. lock%live .and. .not. lock%mine) &
+            call make_error(err, ERR_IO, part//': being continued by '//lock%holder()// &
+                ' (lock '//part//'.lock): a file is written by one process at a time')
+    end subroutine check_part_idle
+
+    !> The name ends with '.part' (the file a new run writes before it is renamed).
+    pure logical function is_part(file)
+        character(len=*), intent(in) :: file
+        is_part = .false.
+        if (len(file) > len('.part')) is_part = file(len(file) - 4:) == '.part'
+    end function is_part
 
     !> The output `file` of a run of `scene` as the input that named it, for a message that
     !! refuses it: 'ORIGIN: &output: file = "FILE"' (ORIGIN: the scene file or the --set

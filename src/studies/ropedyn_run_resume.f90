@@ -3,7 +3,7 @@
 !! /solver/restarts; the solver counters and the CPU time of the earlier parts add up.
 submodule (ropedyn_run) ropedyn_run_resume
     use, intrinsic :: iso_fortran_env, only: error_unit
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, significant_text
     use ropedyn_version, only: version_string
     use ropedyn_case_file, only: case_data_t, read_case_file
     use ropedyn_run_record, only: run_record_t, read_run_record, check_record_fits, LAST_RECORD, &
@@ -32,16 +32,19 @@ contains
             call read_case_file(file, before, err)
             if (allocated(err)) return
             if (before%status == 'running') then
-                call make_error(err, ERR_INPUT, file//': status running: the run may '// &
-                    'still be going on (a run that was killed outright keeps this status; '// &
-                    'to continue it, set its status: h5py '// &
-                    'f.attrs["status"] = "interrupted")')
-                return
+                ! no live process holds a lock of it (guard_output): its run was killed
+                ! or crashed, and its records up to the last are valid
+                if (.not. allocated(self%writer_gone)) self%writer_gone = ''
+                if (len(self%writer_gone) == 0) self%writer_gone = 'no lock of it is there'
+                call append_text(self%summary%warnings, file//': status running, but no '// &
+                    'process writes it ('//self%writer_gone//'): its run was killed or '// &
+                    'crashed; continued from its last record, at t = '// &
+                    significant_text(rec%t, 10)//' s')
             end if
             tol = 1.0e-12_wp*max(abs(rec%t), self%dt)
             if (rec%t >= self%t_end - tol) then
                 call make_error(err, ERR_INPUT, file//': nothing to continue: its last '// &
-                    'record is at t = '//real_text(rec%t)//' s, t_end is '// &
+                    'record is at t = '//significant_text(rec%t, 10)//' s, t_end is '// &
                     real_text(self%t_end)//' s (status '//before%status//'; a longer '// &
                     'run: --set solver.t_end=...)')
                 return

@@ -251,9 +251,11 @@ def test_output_held_by_a_reader_is_not_truncated(ropedyn_exe, work):
 
 
 def test_resume_of_a_file_being_written_names_the_writer(ropedyn_exe, work):
+    """A file another program holds open is an output being written: exit 4, as for a
+    live lock (docs/reference/exit-codes.md), not the 2 of a file that is no run file."""
     with h5py.File(work / "run.h5", "a"):
         refused(ropedyn_exe, work, ["run", "--resume", "run.h5", "--set", "solver.t_end=0.4"],
-                2, f"run.h5: cannot open: locked by pid {os.getpid()}")
+                4, f"run.h5: cannot open: locked by pid {os.getpid()}")
 
 
 @pytest.mark.parametrize("name,fragment", [

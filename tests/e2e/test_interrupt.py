@@ -3,6 +3,7 @@
 and status `interrupted` (exit 130); a second signal ends it at once; `ropedyn run --resume
 FILE` continues it and ends with the records of the uninterrupted run; a sweep continues its
 interrupted cases."""
+import os
 import random
 import signal
 import subprocess
@@ -226,10 +227,70 @@ def test_resume_refusals(run, tmp_path, scene):
     other = run("run", "--resume", "done.h5", "--set", "model.elements=21",
                 "--set", "solver.t_end=5")
     assert other.returncode == 2 and "a state of 120 values (20 elements)" in other.stderr
+
+
+def lock_file(path, age):
+    """A lock of another machine whose heartbeat is `age` s old (live up to 120 s)."""
+    path.write_text("ropedyn sweep case lock\nhost=elsewhere\nboot=0\npid=4711\n"
+                    "started=2026-01-01T00:00:00Z\n")
+    beat = time.time() - age
+    os.utime(path, (beat, beat))
+
+
+def test_resume_of_a_killed_run(run, tmp_path, scene):
+    """A file whose status is still `running` was being written when its run was killed
+    (or is being written now). It is continued when no live process holds a lock of it,
+    with a warning that says so; refused (exit 4) while a writer's lock is live: FILE.lock
+    for FILE, and for FILE.part also the lock of the run of FILE that writes it."""
+    assert run("run", scene, "--set", "output.file='done.h5'").returncode == 0
     with h5py.File(tmp_path / "done.h5", "r+") as f:
         f.attrs["status"] = np.bytes_("running")
-    running = run("run", "--resume", "done.h5", "--set", "solver.t_end=5")
-    assert running.returncode == 2 and "status running" in running.stderr
+    lock_file(tmp_path / "done.h5.lock", 10)
+    live = run("run", "--resume", "done.h5", "--set", "solver.t_end=5")
+    assert live.returncode == 4, live.stderr
+    assert "done.h5: being written by host elsewhere, pid 4711" in live.stderr
+    lock_file(tmp_path / "done.h5.lock", 3600)
+    gone = run("run", "--resume", "done.h5", "--set", "solver.t_end=4.5")
+    assert gone.returncode == 0, gone.stderr
+    assert ("warning: done.h5: status running, but no process writes it (done.h5.lock: its "
+            "writer ended without finishing: killed, crashed or its node failed (host "
+            "elsewhere, pid 4711") in gone.stderr, gone.stderr
+    assert "its run was killed or crashed; continued from its last record, at t = 4.0 s" \
+        in gone.stderr
+    with h5py.File(tmp_path / "done.h5") as f:
+        assert attr(f, "status") == "complete" and abs(f["time"][-1] - 4.5) < 1e-12
+        assert "killed or crashed" in f["solver/warnings"][-1].decode()
+    assert not (tmp_path / "done.h5.lock").exists()
+    # FILE.part: the run of FILE that writes it holds FILE.lock
+    (tmp_path / "done.h5").rename(tmp_path / "p.h5.part")
+    with h5py.File(tmp_path / "p.h5.part", "r+") as f:
+        f.attrs["status"] = np.bytes_("running")
+    lock_file(tmp_path / "p.h5.lock", 10)
+    missing = run("run", "--resume", "p.h5")
+    assert missing.returncode == 2
+    assert ("p.h5: no such file (--resume); p.h5.part is there, the file of a run of p.h5 "
+            "that did not end (killed, or still going on): ropedyn run --resume p.h5.part "
+            "continues it") in missing.stderr, missing.stderr
+    writing = run("run", "--resume", "p.h5.part", "--set", "solver.t_end=5")
+    assert writing.returncode == 4, writing.stderr
+    assert ("p.h5.part: being written by host elsewhere, pid 4711, since "
+            "2026-01-01T00:00:00Z (lock p.h5.lock): the run of p.h5 that writes it is "
+            "going on") in writing.stderr, writing.stderr
+    # a resume of FILE.part holds FILE.part.lock: a new run on FILE leaves it alone
+    lock_file(tmp_path / "p.h5.lock", 3600)
+    lock_file(tmp_path / "p.h5.part.lock", 10)
+    forced = run("run", scene, "--set", "output.file='p.h5'", "--force")
+    assert forced.returncode == 4, forced.stderr
+    assert "p.h5.part: being continued by host elsewhere, pid 4711" in forced.stderr
+    assert (tmp_path / "p.h5.part").exists() and not (tmp_path / "p.h5").exists()
+    (tmp_path / "p.h5.part.lock").unlink()
+    # (the refused run broke the abandoned p.h5.lock, took it and removed it: as left
+    # by the killed run again)
+    assert not (tmp_path / "p.h5.lock").exists()
+    lock_file(tmp_path / "p.h5.lock", 3600)
+    resumed = run("run", "--resume", "p.h5.part", "--set", "solver.t_end=5")
+    assert resumed.returncode == 0, resumed.stderr
+    assert "(p.h5.lock: its writer ended without finishing" in resumed.stderr
 
 
 def test_resume_records_its_version_and_overrides(run, tmp_path, scene):
