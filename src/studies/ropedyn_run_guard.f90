@@ -69,8 +69,12 @@ contains
         end if
         if (resume) then
             call writers_gone(file, self%writer_gone, err)
-            if (allocated(err)) return
+        else if (.not. force) then
+            ! a FILE.part left by a killed run, refused before its abandoned lock is taken
+            ! (and removed): that lock tells the resume of FILE.part who wrote it
+            call check_part_left(file, err)
         end if
+        if (allocated(err)) return
         call take_lock(file//'.lock', self%beat, err)
         if (allocated(err)) then
             err%message = file//': '//err%message
@@ -86,9 +90,7 @@ contains
         else if (exists .and. force) then
             removed = delete_file(file//'.part')
         else if (exists) then
-            call make_error(err, ERR_USAGE, file//'.part: left by a run of '//file// &
-                ' that was killed: continue it (ropedyn run --resume '//file//'.part) or '// &
-                'remove it, or give --force')
+            call refuse_part(file, err)
         else
             call check_may_replace(file, self%scene, force, err, &
                                    label=output_key(self%scene, given), &
@@ -134,7 +136,7 @@ contains
                     ' that writes it is going on')
                 return
             else if (.not. lock%live .and. len(lock%problem) == 0) then
-                gone = path//': '//lock%gone()
+                gone = lock%gone()//' (lock '//path//')'
             end if
         end do
     end subroutine writers_gone
@@ -150,6 +152,31 @@ contains
             call make_error(err, ERR_IO, part//': being continued by '//lock%holder()// &
                 ' (lock '//part//'.lock): a file is written by one process at a time')
     end subroutine check_part_idle
+
+    !> Before a new run without --force takes FILE.lock: a FILE.part there, while no live
+    !! process holds FILE.lock (its run was killed), is refused (a live lock: take_lock
+    !! names its holder).
+    subroutine check_part_left(file, err)
+        character(len=*), intent(in) :: file
+        type(error_t), allocatable, intent(out) :: err
+        type(lock_t) :: lock
+        logical :: exists
+        inquire (file=file//'.part', exist=exists)
+        if (.not. exists) return
+        call read_lock(file//'.lock', lock)
+        if (lock%exists .and. (lock%live .or. len(lock%problem) > 0)) return
+        call check_part_idle(file//'.part', err)
+        if (.not. allocated(err)) call refuse_part(file, err)
+    end subroutine check_part_left
+
+    !> The error of a new run on FILE that finds FILE.part (without --force).
+    subroutine refuse_part(file, err)
+        character(len=*), intent(in) :: file
+        type(error_t), allocatable, intent(out) :: err
+        call make_error(err, ERR_USAGE, file//'.part: left by a run of '//file// &
+            ' that was killed: continue it (ropedyn run --resume '//file//'.part) or '// &
+            'remove it, or give --force')
+    end subroutine refuse_part
 
     !> The name ends with '.part' (the file a new run writes before it is renamed).
     pure logical function is_part(file)

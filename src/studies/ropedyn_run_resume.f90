@@ -35,10 +35,10 @@ contains
                 ! no live process holds a lock of it (guard_output): its run was killed
                 ! or crashed, and its records up to the last are valid
                 if (.not. allocated(self%writer_gone)) self%writer_gone = ''
-                if (len(self%writer_gone) == 0) self%writer_gone = 'no lock of it is there'
-                call append_text(self%summary%warnings, file//': status running, but no '// &
-                    'process writes it ('//self%writer_gone//'): its run was killed or '// &
-                    'crashed; continued from its last record, at t = '// &
+                if (len(self%writer_gone) == 0) self%writer_gone = 'no process holds a '// &
+                    'lock of it: its run was killed or crashed'
+                call append_text(self%summary%warnings, file//': status running: '// &
+                    self%writer_gone//'; continued from its last record, at t = '// &
                     significant_text(rec%t, 10)//' s')
             end if
             tol = 1.0e-12_wp*max(abs(rec%t), self%dt)

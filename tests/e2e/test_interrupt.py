@@ -252,14 +252,13 @@ def test_resume_of_a_killed_run(run, tmp_path, scene):
     lock_file(tmp_path / "done.h5.lock", 3600)
     gone = run("run", "--resume", "done.h5", "--set", "solver.t_end=4.5")
     assert gone.returncode == 0, gone.stderr
-    assert ("warning: done.h5: status running, but no process writes it (done.h5.lock: its "
-            "writer ended without finishing: killed, crashed or its node failed (host "
-            "elsewhere, pid 4711") in gone.stderr, gone.stderr
-    assert "its run was killed or crashed; continued from its last record, at t = 4.0 s" \
-        in gone.stderr
+    assert ("warning: done.h5: status running: its writer ended without finishing: killed, "
+            "crashed or its node failed (host elsewhere, pid 4711, since "
+            "2026-01-01T00:00:00Z; no heartbeat for 3600 s) (lock done.h5.lock); continued "
+            "from its last record, at t = 4.0 s") in gone.stderr, gone.stderr
     with h5py.File(tmp_path / "done.h5") as f:
         assert attr(f, "status") == "complete" and abs(f["time"][-1] - 4.5) < 1e-12
-        assert "killed or crashed" in f["solver/warnings"][-1].decode()
+        assert "its writer ended without finishing" in f["solver/warnings"][-1].decode()
     assert not (tmp_path / "done.h5.lock").exists()
     # FILE.part: the run of FILE that writes it holds FILE.lock
     (tmp_path / "done.h5").rename(tmp_path / "p.h5.part")
@@ -284,13 +283,16 @@ def test_resume_of_a_killed_run(run, tmp_path, scene):
     assert "p.h5.part: being continued by host elsewhere, pid 4711" in forced.stderr
     assert (tmp_path / "p.h5.part").exists() and not (tmp_path / "p.h5").exists()
     (tmp_path / "p.h5.part.lock").unlink()
-    # (the refused run broke the abandoned p.h5.lock, took it and removed it: as left
-    # by the killed run again)
+    # (the forced run broke the abandoned p.h5.lock, took it and removed it: as left
+    # by the killed run again; a run without --force is refused before it touches it)
     assert not (tmp_path / "p.h5.lock").exists()
     lock_file(tmp_path / "p.h5.lock", 3600)
+    refused = run("run", scene, "--set", "output.file='p.h5'")
+    assert refused.returncode == 2 and "p.h5.part: left by a run of p.h5" in refused.stderr
+    assert (tmp_path / "p.h5.lock").exists()
     resumed = run("run", "--resume", "p.h5.part", "--set", "solver.t_end=5")
     assert resumed.returncode == 0, resumed.stderr
-    assert "(p.h5.lock: its writer ended without finishing" in resumed.stderr
+    assert "no heartbeat for 3600 s) (lock p.h5.lock); continued" in resumed.stderr
 
 
 def test_resume_records_its_version_and_overrides(run, tmp_path, scene):
