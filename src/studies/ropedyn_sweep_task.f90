@@ -16,7 +16,9 @@
 !!
 !! Resume: a case whose file says `interrupted` is continued from its last record (the file
 !! is moved back to its .part name under the lock, `run_scene(..., resume=.true.)` appends
-!! to it, and it is renamed into place again), unless forced, which runs it anew.
+!! to it, and it is renamed into place again), unless forced, which runs it anew. So is the
+!! .part a killed writer left (status `running`, records beyond the start, this case's
+!! scene): it is continued where it is.
 module ropedyn_sweep_task
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use ropedyn_kinds, only: wp
@@ -25,7 +27,7 @@ module ropedyn_sweep_task
     use ropedyn_os, only: make_dirs, rename_file, delete_file
     use ropedyn_clock, only: clock_seconds
     use ropedyn_signals, only: catch_signals, release_signals, signal_received, signal_name
-    use ropedyn_scene, only: scene_t, scene_namelist_text
+    use ropedyn_scene, only: scene_t, scene_namelist_text, echo_without_output_file
     use ropedyn_simulation, only: run_summary_t, run_scene
     use ropedyn_case_file, only: case_data_t, read_case_file, finish_case_file
     use ropedyn_sweep_lock, only: take_lock, drop_lock, heartbeat_t
@@ -165,20 +167,27 @@ contains
             call check_complete(c, label, quiet, done)
             if (done) return
         end if
-        removed = delete_file(part)
         scene = c%scene
         scene%output%file = part
-        ! an interrupted case continues from its last record
+        ! an interrupted case continues from its last record, and so does the .part of a
+        ! case whose writer was killed (its lock, abandoned, is this task's now)
         resume = .false.
         if (.not. force) then
             call case_state(c, state)
             resume = state%status == 'interrupted' .and. file_status(c%file) == 'interrupted'
         end if
         if (resume) then
+            removed = delete_file(part)
             call rename_file(c%file, part, err)
             if (allocated(err)) return
             if (.not. quiet) write (output_unit, '(a)') label//': interrupted '// &
                 'before: continuing it from its last record'
+        else if (.not. force .and. killed_part(c, part)) then
+            resume = .true.
+            if (.not. quiet) write (output_unit, '(a)') label//': its writer was killed: '// &
+                'continuing '//part//' from its last record'
+        else
+            removed = delete_file(part)
         end if
         start = clock_seconds()
         call run_scene(scene, summary, err, resume=resume, guard=.false.)
@@ -263,6 +272,22 @@ contains
     end subroutine put_in_place
 
     !> The status attribute of the run file `path` ('' when it cannot be read).
+    !> `part` holds records of this very case beyond its start, written by a run that was
+    !! killed (status still `running`; its writer's lock is this task's now).
+    logical function killed_part(c, part)
+        type(sweep_case_t), intent(in) :: c
+        character(len=*), intent(in) :: part
+        type(case_data_t) :: data
+        type(error_t), allocatable :: err
+        killed_part = .false.
+        call read_case_file(part, data, err)
+        if (allocated(err)) return
+        if (.not. data%exists) return
+        killed_part = data%status == 'running' .and. data%records >= 2 .and. &
+            echo_without_output_file(data%scene) == &
+            echo_without_output_file(scene_namelist_text(c%scene))
+    end function killed_part
+
     function file_status(path) result(status)
         character(len=*), intent(in) :: path
         character(len=:), allocatable :: status

@@ -395,9 +395,20 @@ def test_sigterm_to_runner_stops_its_workers(run, ropedyn_exe, sweep_dir):
         assert f.attrs["status"] == b"complete" and f["solver/restarts/time"].shape == (1,)
 
 
-def signal_the_first_worker(ropedyn_exe, sweep_dir, rtols, sig):
+def records_in(part):
+    """The records the worker has flushed into `part` (0 while it cannot be read), read
+    without HDF5's file lock, which the worker holds."""
+    try:
+        with h5py.File(part, "r", locking=False) as f:
+            return len(f["time"]) if "time" in f else 0
+    except (OSError, KeyError, ValueError):
+        return 0
+
+
+def signal_the_first_worker(ropedyn_exe, sweep_dir, rtols, sig, records=0):
     """Run the LONG sweep over `rtols` with one worker and send `sig` to that worker once
-    it writes its case: the runner's exit code and stderr."""
+    it writes its case (and has flushed `records` records): the runner's exit code and
+    stderr."""
     (sweep_dir / "long.nml").write_text(LONG.format(rtols=rtols))
     out = sweep_dir / "out" / "long"
     runner = subprocess.Popen([str(ropedyn_exe), "sweep", "long.nml", "--jobs", "1"],
@@ -405,6 +416,8 @@ def signal_the_first_worker(ropedyn_exe, sweep_dir, rtols, sig):
                               text=True)
     try:
         wait_for(lambda: (out / ".case_0001.h5.part").exists(), what="the first worker")
+        wait_for(lambda: records_in(out / ".case_0001.h5.part") >= records, timeout=120,
+                 what=f"{records} records")
         workers = processes_mentioning("long.nml --quiet")
         assert len(workers) == 1
         os.kill(workers[0], sig)
@@ -418,14 +431,27 @@ def signal_the_first_worker(ropedyn_exe, sweep_dir, rtols, sig):
 def test_sigkill_to_a_worker_is_no_failed_case(run, ropedyn_exe, sweep_dir):
     """A worker killed by SIGKILL leaves its case interrupted (an abandoned lock and a
     .part): the runner says "ended by SIGKILL" and does not count it as failed (its
-    progress said "1 failed" while --status said interrupted)."""
+    progress said "1 failed" while --status said interrupted). Run again, the case
+    continues from the last record of its .part (it ran anew before)."""
     returncode, stderr = signal_the_first_worker(ropedyn_exe, sweep_dir, "1e-7",
-                                                 signal.SIGKILL)
+                                                 signal.SIGKILL, records=3)
     assert returncode == 3, stderr
     line = next(l for l in stderr.splitlines() if l.startswith("sweep: case 0001 "))
     assert line.startswith("sweep: case 0001 ended by SIGKILL") and "0 failed" in line, line
     _, counts = status_lines(run, "long.nml")
     assert counts["interrupted"] == 1, counts
+    out = sweep_dir / "out" / "long"
+    with h5py.File(out / ".case_0001.h5.part", "r") as f:
+        assert f.attrs["status"] == b"running"
+        kept = f["time"][-1]
+    again = run("sweep", "long.nml", "--task", "1")
+    assert again.returncode == 0, again.stderr
+    assert ("its writer was killed: continuing out/long/.case_0001.h5.part from its last "
+            "record") in again.stdout, again.stdout
+    with h5py.File(out / "case_0001.h5") as f:
+        assert f.attrs["status"] == b"complete" and abs(f["time"][-1] - 4.0) < 1e-12
+        assert f["solver/restarts/time"][:].tolist() == [kept]
+        assert "its run was killed or crashed" in f["solver/warnings"][-1].decode()
 
 
 def test_sigterm_to_a_worker_reports_its_case_interrupted(run, ropedyn_exe, sweep_dir):
