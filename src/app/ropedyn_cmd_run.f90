@@ -23,7 +23,7 @@ contains
     subroutine run_command(cli, err)
         type(cli_t), intent(inout) :: cli
         type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: resume_path
+        character(len=:), allocatable :: resume_path, file
         type(scene_t) :: scene
         type(run_summary_t) :: summary
         logical :: verbose, force
@@ -79,20 +79,24 @@ contains
         end if
         if (summary%records > 0) call print_summary(scene, summary, verbose)
         if (allocated(err)) then
+            ! (the file now: a resumed FILE.part may have been renamed to FILE)
+            file = trim(scene%output%file)
+            if (allocated(resume_path) .and. len(summary%file) > 0) file = summary%file
             if (err%code == ERR_INTERRUPTED) err%message = err%message// &
-                '; continue with: ropedyn run --resume '//trim(scene%output%file)
+                '; continue with: ropedyn run --resume '//file
             if (summary%budget_rest > 0 .and. summary%records > 0) &
-                err%message = err%message//resume_hint(scene, summary)
+                err%message = err%message//resume_hint(file, scene, summary)
         end if
     end subroutine run_command
 
     !> How to go on after a run ended for its step budget: a resume, which has a budget of
     !! its own, larger when the rest of the run takes more steps than max_steps.
-    function resume_hint(scene, summary) result(text)
+    function resume_hint(file, scene, summary) result(text)
+        character(len=*), intent(in) :: file
         type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(in) :: summary
         character(len=:), allocatable :: text
-        text = '; continue with: ropedyn run --resume '//trim(scene%output%file)
+        text = '; continue with: ropedyn run --resume '//file
         if (summary%budget_rest > step_budget(scene)) text = text// &
             ' --set solver.max_steps='//int_text(budget_covering(summary%budget_rest))
     end function resume_hint

@@ -419,7 +419,11 @@ contains
             if (allocated(err)) return
         end if
         call start_from(self, resuming, err)
-        if (allocated(err) .and. guarding) call self%release_output(err)
+        if (allocated(err) .and. guarding) then
+            ! (a refused resume leaves its file where it is: no FILE.part renamed to FILE)
+            if (resuming) self%part_file = ''
+            call self%release_output(err)
+        end if
     end subroutine run_open
 
     !> open's work after the guard: the arrays of the model made before it, the start.

@@ -5,16 +5,17 @@
 !!   for FILE.part is an error with the system's reason);
 !! - FILE.lock is taken before anything is written, the lock a sweep case takes, so that a
 !!   second run on the same file is refused before it touches it; a resume continues FILE
-!!   in place under that lock, and a resume of FILE.part is refused while the run of FILE
-!!   that writes it holds FILE.lock;
+!!   in place under that lock; a resume of FILE.part (left by a killed new run of FILE)
+!!   takes FILE.lock, as that run did, and renames it to FILE at its end when FILE is not
+!!   there or holds a run of the same source;
 !! - a new run replaces an existing FILE only when it is a file ropedyn wrote for the same
 !!   source (the same scene file with the same --set overrides: a rerun); another file, a
 !!   run of another scene or of a --set variant, is refused unless --force; a special file
 !!   (a device, a FIFO, a link to one) always;
 !! - a new run writes FILE.part and renames it to FILE when it finishes (complete, failed
 !!   or interrupted), so that the earlier FILE stays whole until the new one is; a FILE.part
-!!   left by a killed run is refused (resume it, or remove it) unless --force, and while a
-!!   resume of it goes on, always.
+!!   left by a killed run is refused (resume it, or remove it) unless --force; an output
+!!   named FILE.part is refused.
 submodule (ropedyn_run) ropedyn_run_guard
     use ropedyn_os, only: make_parent_dirs, rename_file, delete_file, special_file_reason, &
                           file_kind, real_path, written_path, errno_text, FILE_SYMLINK, &
@@ -32,62 +33,39 @@ submodule (ropedyn_run) ropedyn_run_guard
 contains
 
     module procedure guard_output
-        character(len=:), allocatable :: file, given
-        logical :: exists, removed
-        integer :: errnum
-        file = self%summary%file
-        given = file
-        if (.not. resume) then
-            call check_not_input(file, self%scene, err, label=output_key(self%scene, given))
-            if (allocated(err)) return
-            call make_parent_dirs(file, err)
-            if (allocated(err)) return
-            if (len(special_file_reason(file)) > 0) then
-                call make_error(err, ERR_USAGE, output_key(self%scene, file)// &
-                    ': exists and is '//special_file_reason(file)//': not replaced')
-                return
-            end if
-            ! a link: the file it points to (written there, renamed there; the link stays)
-            if (file_kind(file, follow=.false.) == FILE_SYMLINK) then
-                if (file_kind(file) == FILE_MISSING) then
-                    ! a dangling link (or a loop: the system's reason)
-                    if (len(real_path(file, errnum)) == 0 .and. errnum /= 2) then
-                        call make_error(err, ERR_IO, self%summary%file//': cannot create '// &
-                                        'file: '//errno_text(errnum))
-                        return
-                    end if
-                end if
-                file = written_path(file)
-                call make_parent_dirs(file, err)
-                if (allocated(err)) return
-            end if
-            if (len(file) - index(file, '/', back=.true.) + len('.part') > NAME_MAX) then
-                call make_error(err, ERR_IO, file//': cannot create file: File name too '// &
-                                'long (the run writes FILE.part and FILE.lock beside it)')
-                return
-            end if
-        end if
         if (resume) then
-            call writers_gone(file, self%writer_gone, err)
-        else if (.not. force) then
+            call guard_resume(self, self%summary%file, err)
+        else
+            call guard_new(self, self%summary%file, force, err)
+        end if
+    end procedure guard_output
+
+    !> The guard of a new run's output `given`: the checks of the path, the lock, a FILE.part
+    !! left by a killed run, may FILE be replaced; the run then writes FILE.part.
+    subroutine guard_new(self, given, force, err)
+        class(run_t), intent(inout) :: self
+        character(len=*), intent(in) :: given
+        logical, intent(in) :: force
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: file
+        logical :: exists, removed
+        call new_output_path(self, given, file, err)
+        if (allocated(err)) return
+        if (.not. force) then
             ! a FILE.part left by a killed run, refused before its abandoned lock is taken
             ! (and removed): that lock tells the resume of FILE.part who wrote it
             call check_part_left(file, err)
+            if (allocated(err)) return
         end if
-        if (allocated(err)) return
         call take_lock(file//'.lock', self%beat, err)
         if (allocated(err)) then
             err%message = file//': '//err%message
             return
         end if
         self%lock_file = file//'.lock'
-        if (resume) return
-        ! a new run: is there a FILE.part of a killed run, may it replace FILE?
+        ! is there a FILE.part of a killed run, may the run replace FILE?
         inquire (file=file//'.part', exist=exists)
-        if (exists) call check_part_idle(file//'.part', err)
-        if (allocated(err)) then
-            continue
-        else if (exists .and. force) then
+        if (exists .and. force) then
             removed = delete_file(file//'.part')
         else if (exists) then
             call refuse_part(file, err)
@@ -104,54 +82,119 @@ contains
         self%final_file = file
         self%part_file = file//'.part'
         self%summary%file = self%part_file
-    end procedure guard_output
+    end subroutine guard_new
 
-    !> Before a resume takes FILE.lock: the locks of the runs that may write `file` (a
-    !! resume of it: FILE.lock; for a FILE.part also the new run of FILE that writes it:
-    !! FILE's own lock). A live one of the latter refuses the resume (the former take_lock
-    !! refuses); `gone` says why the writer of an abandoned one is gone ('' when there is
-    !! none), for the warning of a resume of a file whose status is still `running`.
-    subroutine writers_gone(file, gone, err)
+    !> The file a new run writes for its output `given`, made ready: not an input, not a
+    !! special file, not named FILE.part, its directories made; a link is the file it points
+    !! to (written there, renamed there; the link stays).
+    subroutine new_output_path(self, given, file, err)
+        class(run_t), intent(in) :: self
+        character(len=*), intent(in) :: given
+        character(len=:), allocatable, intent(out) :: file
+        type(error_t), allocatable, intent(out) :: err
+        integer :: errnum
+        file = given
+        call check_not_input(file, self%scene, err, label=output_key(self%scene, given))
+        if (allocated(err)) return
+        if (is_part(file)) then
+            call make_error(err, ERR_USAGE, output_key(self%scene, given)//': ends in '// &
+                '".part", the name a run gives its file until it ends: choose another name')
+            return
+        end if
+        call make_parent_dirs(file, err)
+        if (allocated(err)) return
+        if (len(special_file_reason(file)) > 0) then
+            call make_error(err, ERR_USAGE, output_key(self%scene, file)// &
+                ': exists and is '//special_file_reason(file)//': not replaced')
+            return
+        end if
+        if (file_kind(file, follow=.false.) == FILE_SYMLINK) then
+            if (file_kind(file) == FILE_MISSING) then
+                ! a dangling link (or a loop: the system's reason)
+                if (len(real_path(file, errnum)) == 0 .and. errnum /= 2) then
+                    call make_error(err, ERR_IO, given//': cannot create file: '// &
+                                    errno_text(errnum))
+                    return
+                end if
+            end if
+            file = written_path(file)
+            call make_parent_dirs(file, err)
+            if (allocated(err)) return
+        end if
+        if (len(file) - index(file, '/', back=.true.) + len('.part') > NAME_MAX) then
+            call make_error(err, ERR_IO, file//': cannot create file: File name too '// &
+                            'long (the run writes FILE.part and FILE.lock beside it)')
+        end if
+    end subroutine new_output_path
+
+    !> The guard of a resume of `file`: the lock of the run that writes it (FILE.lock; for
+    !! FILE.part, the file of a new run of FILE, FILE's own lock, which that run held), and
+    !! what an abandoned one says of its writer. A FILE.part is renamed to FILE when the run
+    !! ends, as the new run's would have been, if FILE may be replaced by it.
+    subroutine guard_resume(self, file, err)
+        class(run_t), intent(inout) :: self
         character(len=*), intent(in) :: file
-        character(len=:), allocatable, intent(out) :: gone
         type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: lock_path
         type(lock_t) :: lock
-        character(len=:), allocatable :: path
-        integer :: k
-        gone = ''
-        do k = 1, 2
-            path = file//'.lock'
-            if (k == 2) then
-                if (.not. is_part(file)) exit
-                path = file(1:len(file) - len('.part'))//'.lock'
-            end if
-            call read_lock(path, lock)
-            if (.not. lock%exists) cycle
-            if (k == 2 .and. len(lock%problem) > 0) then
-                call make_error(err, ERR_IO, file//': '//lock%problem)
-                return
-            else if (k == 2 .and. lock%live .and. .not. lock%mine) then
-                call make_error(err, ERR_IO, file//': being written by '//lock%holder()// &
-                    ' (lock '//path//'): the run of '//file(1:len(file) - len('.part'))// &
-                    ' that writes it is going on')
-                return
-            else if (.not. lock%live .and. len(lock%problem) == 0) then
-                gone = lock%gone()//' (lock '//path//')'
-            end if
-        end do
-    end subroutine writers_gone
+        lock_path = file//'.lock'
+        if (is_part(file)) lock_path = whole_name(file)//'.lock'
+        self%writer_gone = ''
+        call read_lock(lock_path, lock)
+        if (lock%exists .and. .not. lock%live .and. len(lock%problem) == 0) &
+            self%writer_gone = lock%gone()//' (lock '//lock_path//')'
+        call take_lock(lock_path, self%beat, err)
+        if (allocated(err)) then
+            err%message = file//': '//err%message
+            return
+        end if
+        self%lock_file = lock_path
+        if (is_part(file)) call plan_rename(self, file)
+    end subroutine guard_resume
 
-    !> A new run on FILE may not remove or refuse-and-name `part` (FILE.part) while a resume
-    !! of it holds its lock: an ERR_IO error naming the holder.
-    subroutine check_part_idle(part, err)
+    !> A resume of `part` (FILE.part) renames it to FILE when it ends if FILE is not there
+    !! or holds a run of the same source (the run the killed one would have replaced); else
+    !! it keeps its name, with a warning saying why.
+    subroutine plan_rename(self, part)
+        class(run_t), intent(inout) :: self
         character(len=*), intent(in) :: part
-        type(error_t), allocatable, intent(out) :: err
-        type(lock_t) :: lock
-        call read_lock(part//'.lock', lock)
-        if (lock%exists .and. lock%live .and. .not. lock%mine) &
-            call make_error(err, ERR_IO, part//': being continued by '//lock%holder()// &
-                ' (lock '//part//'.lock): a file is written by one process at a time')
-    end subroutine check_part_idle
+        type(scene_t) :: probe
+        type(error_t), allocatable :: err
+        character(len=:), allocatable :: whole
+        whole = whole_name(part)
+        if (file_kind(whole, follow=.false.) /= FILE_MISSING) then
+            probe = self%scene
+            probe%source = stored_source(part)
+            if (len(probe%source) == 0) then
+                call make_error(err, ERR_USAGE, part//' records no source')
+            else
+                call check_may_replace(whole, probe, .false., err)
+            end if
+            if (allocated(err)) then
+                call append_text(self%summary%warnings, part//' keeps its name: '// &
+                    whole//' is there, not a file of its run to replace ('// &
+                    err%message//')')
+                return
+            end if
+        end if
+        self%part_file = part
+        self%final_file = whole
+    end subroutine plan_rename
+
+    !> The root attribute `source` of the run file `path` ('' when it has none).
+    function stored_source(path) result(source)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: source
+        type(h5_file_t) :: h5
+        type(error_t), allocatable :: err, close_err
+        logical :: found
+        source = ''
+        call h5%open(path, err)
+        if (allocated(err)) return
+        call h5%read_attribute('source', source, err, found)
+        call h5%close(close_err)
+        if (allocated(err) .or. .not. found) source = ''
+    end function stored_source
 
     !> Before a new run without --force takes FILE.lock: a FILE.part there, while no live
     !! process holds FILE.lock (its run was killed), is refused (a live lock: take_lock
@@ -165,8 +208,7 @@ contains
         if (.not. exists) return
         call read_lock(file//'.lock', lock)
         if (lock%exists .and. (lock%live .or. len(lock%problem) > 0)) return
-        call check_part_idle(file//'.part', err)
-        if (.not. allocated(err)) call refuse_part(file, err)
+        call refuse_part(file, err)
     end subroutine check_part_left
 
     !> The error of a new run on FILE that finds FILE.part (without --force).
@@ -184,6 +226,13 @@ contains
         is_part = .false.
         if (len(file) > len('.part')) is_part = file(len(file) - 4:) == '.part'
     end function is_part
+
+    !> FILE for FILE.part.
+    pure function whole_name(part) result(file)
+        character(len=*), intent(in) :: part
+        character(len=:), allocatable :: file
+        file = part(1:len(part) - len('.part'))
+    end function whole_name
 
     !> The output `file` of a run of `scene` as the input that named it, for a message that
     !! refuses it: 'ORIGIN: &output: file = "FILE"' (ORIGIN: the scene file or the --set

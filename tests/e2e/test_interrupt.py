@@ -260,7 +260,7 @@ def test_resume_of_a_killed_run(run, tmp_path, scene):
         assert attr(f, "status") == "complete" and abs(f["time"][-1] - 4.5) < 1e-12
         assert "its writer ended without finishing" in f["solver/warnings"][-1].decode()
     assert not (tmp_path / "done.h5.lock").exists()
-    # FILE.part: the run of FILE that writes it holds FILE.lock
+    # FILE.part, left by a killed new run of FILE, which held FILE.lock
     (tmp_path / "done.h5").rename(tmp_path / "p.h5.part")
     with h5py.File(tmp_path / "p.h5.part", "r+") as f:
         f.attrs["status"] = np.bytes_("running")
@@ -273,26 +273,50 @@ def test_resume_of_a_killed_run(run, tmp_path, scene):
     writing = run("run", "--resume", "p.h5.part", "--set", "solver.t_end=5")
     assert writing.returncode == 4, writing.stderr
     assert ("p.h5.part: being written by host elsewhere, pid 4711, since "
-            "2026-01-01T00:00:00Z (lock p.h5.lock): the run of p.h5 that writes it is "
-            "going on") in writing.stderr, writing.stderr
-    # a resume of FILE.part holds FILE.part.lock: a new run on FILE leaves it alone
-    lock_file(tmp_path / "p.h5.lock", 3600)
-    lock_file(tmp_path / "p.h5.part.lock", 10)
-    forced = run("run", scene, "--set", "output.file='p.h5'", "--force")
-    assert forced.returncode == 4, forced.stderr
-    assert "p.h5.part: being continued by host elsewhere, pid 4711" in forced.stderr
-    assert (tmp_path / "p.h5.part").exists() and not (tmp_path / "p.h5").exists()
-    (tmp_path / "p.h5.part.lock").unlink()
-    # (the forced run broke the abandoned p.h5.lock, took it and removed it: as left
-    # by the killed run again; a run without --force is refused before it touches it)
-    assert not (tmp_path / "p.h5.lock").exists()
+            "2026-01-01T00:00:00Z (lock p.h5.lock)") in writing.stderr, writing.stderr
+    # a run without --force is refused before it touches the abandoned lock, which then
+    # tells the resume who wrote the file
     lock_file(tmp_path / "p.h5.lock", 3600)
     refused = run("run", scene, "--set", "output.file='p.h5'")
     assert refused.returncode == 2 and "p.h5.part: left by a run of p.h5" in refused.stderr
     assert (tmp_path / "p.h5.lock").exists()
+    named = run("run", scene, "--set", "output.file='x.h5.part'")
+    assert named.returncode == 2
+    assert ("--set output.file='x.h5.part': &output: file = \"x.h5.part\": ends in \".part\", "
+            "the name a run gives its file until it ends: choose another name") \
+        in named.stderr, named.stderr
+    keep = tmp_path / "keep.h5.part"
+    keep.write_bytes((tmp_path / "p.h5.part").read_bytes())
     resumed = run("run", "--resume", "p.h5.part", "--set", "solver.t_end=5")
     assert resumed.returncode == 0, resumed.stderr
     assert "no heartbeat for 3600 s) (lock p.h5.lock); continued" in resumed.stderr
+    # renamed to FILE at its end, as the killed run's file would have been
+    assert "output          p.h5\n" in resumed.stdout, resumed.stdout
+    assert not (tmp_path / "p.h5.part").exists() and not (tmp_path / "p.h5.lock").exists()
+    with h5py.File(tmp_path / "p.h5") as f:
+        assert attr(f, "status") == "complete" and abs(f["time"][-1] - 5.0) < 1e-12
+    # FILE there: replaced by a run of the same source (a rerun), else the .part keeps
+    # its name, with a warning
+    for sets, renamed in (((), True),
+                          (("--set", "model.elements=21"), False)):
+        assert run("run", scene, "--set", "output.file='q.h5'", *sets,
+                   "--force").returncode == 0
+        keep_file = tmp_path / "q.h5.part"
+        keep_file.write_bytes(keep.read_bytes())
+        before = (tmp_path / "q.h5").read_bytes()
+        again = run("run", "--resume", "q.h5.part", "--set", "solver.t_end=4.8")
+        assert again.returncode == 0, again.stderr
+        assert keep_file.exists() != renamed
+        assert ((tmp_path / "q.h5").read_bytes() == before) != renamed
+        if not renamed:
+            assert ("q.h5.part keeps its name: q.h5 is there, not a file of its run to "
+                    "replace (q.h5: exists and holds the run of ") in again.stderr, again.stderr
+            keep_file.unlink()
+    # a refused resume leaves the .part where it is
+    (tmp_path / "r.h5.part").write_bytes(keep.read_bytes())
+    early = run("run", "--resume", "r.h5.part", "--set", "solver.t_end=4.5")
+    assert early.returncode == 2 and "r.h5.part: nothing to continue" in early.stderr
+    assert (tmp_path / "r.h5.part").exists() and not (tmp_path / "r.h5").exists()
 
 
 def test_resume_records_its_version_and_overrides(run, tmp_path, scene):
