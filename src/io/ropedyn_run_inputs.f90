@@ -21,7 +21,7 @@ module ropedyn_run_inputs
     implicit none
     private
     public :: scene_inputs, check_not_input, check_replaceable, check_own_source, &
-              check_may_replace
+              check_may_replace, check_part_free
 
     !> The first bytes of an HDF5 file (its signature at offset 0: ropedyn writes no user
     !! block).
@@ -225,6 +225,35 @@ contains
             call check_own_source(path, '', err, analysis, label, can_force)
         end if
     end subroutine check_may_replace
+
+    !> May a statics or modes result write `part` (FILE.part), its file until it is whole?
+    !! Unless `force`, only when it is not there or is such a result itself (one a killed
+    !! analysis left): a run's FILE.part holds the records of a run that was killed (or goes
+    !! on), and any other file is the user's: ERR_USAGE, the file untouched.
+    subroutine check_part_free(part, force, err)
+        character(len=*), intent(in) :: part
+        logical, intent(in) :: force
+        type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable :: kind
+        type(h5_file_t) :: h5
+        type(error_t), allocatable :: open_err, close_err
+        logical :: exists, found
+        inquire (file=part, exist=exists)
+        if (.not. exists .or. force) return
+        found = .false.
+        call h5%open(part, open_err)
+        if (.not. allocated(open_err)) then
+            call h5%read_attribute('analysis', kind, open_err, found)
+            call h5%close(close_err)
+        end if
+        if (found .and. .not. allocated(open_err)) then
+            if (kind == 'statics' .or. kind == 'modes') return
+        end if
+        call make_error(err, ERR_USAGE, part//': there already, and not a statics or '// &
+            'modes result (the file of a run that was killed or goes on: ropedyn run '// &
+            '--resume '//part//' continues a killed one): not replaced; remove it, or '// &
+            'give --force')
+    end subroutine check_part_free
 
     !> How a message names the file `path`: as `label` when given, else by its path.
     pure function named(path, label) result(text)

@@ -11,7 +11,7 @@ module ropedyn_analysis
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_os, only: make_parent_dirs, written_path, rename_file, delete_file
-    use ropedyn_run_inputs, only: check_not_input, check_may_replace
+    use ropedyn_run_inputs, only: check_not_input, check_may_replace, check_part_free
     use ropedyn_text, only: int_text
     use ropedyn_model_factory, only: create_model
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
@@ -93,6 +93,8 @@ contains
         call check_not_input(analysis%out_path, scene, err)
         if (allocated(err)) return
         call check_may_replace(analysis%out_path, scene, force, err, command)
+        if (allocated(err)) return
+        call check_part_free(written_path(analysis%out_path)//'.part', force, err)
         if (allocated(err)) return
         call analysis%solve(scene, options, count, err)
         if (allocated(err)) return

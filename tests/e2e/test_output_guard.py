@@ -229,3 +229,33 @@ def test_statics_and_modes_replace_only_their_own_result(run, tmp_path):
     with h5py.File(tmp_path / "s.h5") as f:
         assert f.attrs["analysis"].decode() == "modes" and len(f["modes/omega"]) == 2
     assert not list(tmp_path.glob("*.part"))
+
+
+def test_statics_and_modes_leave_a_foreign_part_file(run, tmp_path):
+    """`ropedyn statics|modes -o FILE` writes FILE.part and renames it: it created that
+    name over whatever was there, a killed run's records or a file of the user's. Now a
+    FILE.part that is not a statics or modes result (one a killed analysis left) is
+    refused with exit 2 and left as it was, unless --force."""
+    scene = tmp_path / "c.nml"
+    scene.write_text(CATENARY.read_text())
+    assert run("run", scene, "--set", "solver.t_end=0.02", "--set",
+               "output.file='r.h5'").returncode == 0
+    assert run("statics", scene, "-o", "done.h5").returncode == 0
+    (tmp_path / "a.h5.part").write_bytes((tmp_path / "r.h5").read_bytes())   # a run's
+    (tmp_path / "b.h5.part").write_text("my notes\n")
+    (tmp_path / "c.h5.part").write_bytes((tmp_path / "done.h5").read_bytes())
+    for name in ("a.h5", "b.h5"):
+        before = digest(tmp_path / f"{name}.part")
+        for command in ("statics", "modes"):
+            proc = run(command, scene, "-o", name)
+            assert proc.returncode == 2, proc.stderr
+            assert (f"{name}.part: there already, and not a statics or modes result (the file "
+                    f"of a run that was killed or goes on: ropedyn run --resume {name}.part "
+                    "continues a killed one): not replaced; remove it, or give --force") \
+                in proc.stderr, proc.stderr
+        assert digest(tmp_path / f"{name}.part") == before
+        assert not (tmp_path / name).exists()
+    # an analysis' own leftover is taken over; --force takes any
+    assert run("modes", scene, "-o", "c.h5", "--count", "2").returncode == 0
+    assert run("statics", scene, "-o", "b.h5", "--force").returncode == 0
+    assert not (tmp_path / "c.h5.part").exists() and not (tmp_path / "b.h5.part").exists()
