@@ -243,6 +243,17 @@ contains
         text = text//new_line('a')
     end function key_echo
 
+    !> The default of a key left out that has no value then: its `unset` text ('not set:
+    !! what stands for it'), or 'not set'.
+    function unset_text(self) result(text)
+        class(scene_key_t), intent(in) :: self
+        character(len=:), allocatable :: text
+        text = 'not set'
+        if (allocated(self%unset)) then
+            if (len(self%unset) > 0) text = self%unset
+        end if
+    end function unset_text
+
     !> The key's line of `ropedyn keys`: group, key, type, unit, default (the current value:
     !! call it on a default scene), allowed values and meaning, separated by tabs.
     function key_listing(self, group) result(text)
@@ -261,14 +272,15 @@ contains
         case default
             default = self%value_text()
         end select
+        ! not set: what stands for the value then, when the table says it
         if (self%type == T_PAIR .or. self%type == T_LIST) then
-            if (any(ieee_is_nan(self%v))) default = 'not set'
+            if (any(ieee_is_nan(self%v))) default = unset_text(self)
         end if
         if (self%type == T_REAL .and. len(self%unset) > 0) then
-            if (ieee_is_nan(self%r)) default = 'not set'
+            if (ieee_is_nan(self%r)) default = unset_text(self)
         end if
         ! a logical with an `unset` text is tri-state: its default is "not given"
-        if (self%type == T_LOGICAL .and. len(self%unset) > 0) default = 'not set'
+        if (self%type == T_LOGICAL .and. len(self%unset) > 0) default = unset_text(self)
         select case (self%rule)
         case (R_FINITE)
             allowed = 'finite'

@@ -60,6 +60,8 @@ def test_a_key_added_to_the_table_changes_the_section(run):
 
 
 @pytest.mark.parametrize("default,cell", [("1.0", "`1.0`"), ("not set", "not set"),
+                                          ("not set: 0 with x", "not set: 0 with x"),
+                                          ("not settle", "`not settle`"),
                                           ("", "–"), ("'rfem'", "`'rfem'`")])
 def test_default_cells(default, cell):
     assert keys_reference.code(default) == cell

@@ -79,8 +79,9 @@ def cell(text):
 
 
 def code(text):
-    """A value as code (`...`), or as it is for 'not set' and the empty string."""
-    if text in ("not set", ""):
+    """A value as code (`...`), or as it is for 'not set' (with what stands for the value
+    then: 'not set: ...') and the empty string."""
+    if text == "" or text == "not set" or text.startswith("not set: "):
         return text or "–"
     return f"`{text}`"
 
