@@ -281,10 +281,17 @@ contains
                 else
                     call position('mass_positions', a%mass_positions(k))
                     if (allocated(err)) return
-                    if (.not. (ieee_is_finite(a%masses(k)) .and. a%masses(k) > 0.0_wp)) &
+                    if (ieee_is_finite(a%masses(k)) .and. a%masses(k) > 0.0_wp) then
+                        continue
+                    else if (.not. keys(find_key(keys, G_ATTACHMENTS, 'masses'))%given) then
+                        ! (named by the position: where it came from, masses from nowhere)
+                        call fail_at('mass_positions', a%mass_positions(k), 'a point mass ' &
+                            //'there needs masses('//int_text(k)//') > 0 (kg), not given')
+                    else
                         call fail_at('masses', a%masses(k), 'must be > 0 (a mass at ' &
-                        //'mass_positions('//int_text(k)//') = ' &
-                        //real_text(a%mass_positions(k))//' m)')
+                            //'mass_positions('//int_text(k)//') = ' &
+                            //real_text(a%mass_positions(k))//' m)')
+                    end if
                 end if
                 if (allocated(err)) return
                 if (ieee_is_nan(a%load_positions(k))) then

@@ -674,8 +674,17 @@ contains
             '&attachments mass_positions = 1.5, masses = 0.1 /'], NO_SET, [character(len=L) :: &
             P//'mass_position.nml: &attachments: mass_positions(1) = 1.5: must be in 0 .. 1'])
         call expect_error('mass_value', [character(len=L) :: MODEL, &
+            '&attachments mass_positions = 0.5, 0.7, masses = 0.1 /'], NO_SET, &
+            [character(len=L) :: P//'mass_value.nml: &attachments: masses(2) = 0.0: must be > 0'])
+        ! no masses at all: the position names the error, and where it came from
+        call expect_error('mass_missing', [character(len=L) :: MODEL, &
             '&attachments mass_positions = 0.5 /'], NO_SET, [character(len=L) :: &
-            P//'mass_value.nml: &attachments: masses(1) = 0.0: must be > 0'])
+            P//'mass_missing.nml: &attachments: mass_positions(1) = 0.5: a point mass', &
+            'mass_positions(1) = 0.5: a point mass there needs masses(1) > 0 (kg), not given'])
+        call expect_error('set_mass_missing', MODEL, [character(len=L) :: &
+            'attachments.mass_positions=0.5'], [character(len=L) :: &
+            '--set attachments.mass_positions=0.5: &attachments: mass_positions(1) = 0.5: a', &
+            'mass_positions(1) = 0.5: a point mass there needs masses(1) > 0 (kg), not given'])
         call expect_error('set_mass_unused', MODEL, [character(len=L) :: &
             'attachments.masses(2)=0.5'], [character(len=L) :: &
             '--set attachments.masses(2)=0.5: &attachments: masses(2) = 0.5: no '// &
