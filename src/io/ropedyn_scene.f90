@@ -282,8 +282,12 @@ contains
         lhs = trim(s(:eq - 1))
         ov%value = trim(adjustl(s(eq + 1:)))
         dot = index(lhs, '.')
-        if (dot <= 1 .or. dot >= len(lhs) .or. len(ov%value) == 0) then
+        if (dot <= 1 .or. dot >= len(lhs)) then
             call make_error(err, ERR_INPUT, loc//': expected group.key=value')
+            return
+        else if (len(ov%value) == 0) then
+            call make_error(err, ERR_INPUT, loc//': no value after "=" (an empty text is '// &
+                "written '')")
             return
         end if
         group = lower(trim(lhs(:dot - 1)))
