@@ -12,6 +12,7 @@ docs/guide/visualization.md).
 import argparse
 import pathlib
 import sys
+import textwrap
 
 import matplotlib
 import numpy as np
@@ -92,8 +93,10 @@ def plot_axial_force(ax, run, wanted):
     force, message = fields.axial_force(run)
     ax.set_title("axial force along the rope", fontsize=10)
     if force is None:
-        ax.text(0.5, 0.5, message, ha="center", va="center", wrap=True, fontsize=9,
-                transform=ax.transAxes)
+        # (wrapped to the panel: matplotlib's wrap=True wraps at the figure's edge, and
+        # the text ran over the panel beside it)
+        ax.text(0.5, 0.5, "\n".join(textwrap.wrap(message, 48)), ha="center", va="center",
+                fontsize=9, transform=ax.transAxes)
         ax.set_axis_off()
         return
     for k in record_indices(run.time, wanted):
