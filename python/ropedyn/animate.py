@@ -242,6 +242,7 @@ def main(argv=None):
     finally:
         drawer.close()
     print(f"animate: {out} ({frames.size} frames at {fps:.1f} fps, "
+          f"{frames.size / fps:.1f} s long; written in "
           f"{wallclock.perf_counter() - started:.1f} s)")
     return 0
 
