@@ -195,6 +195,13 @@ contains
                 ') and gravity is on, so the rope falls freely; pin or clamp an end, or '// &
                 'switch gravity off')
         else if (spec%model%kind == 'rfem' .and. spec%model%elements > 1 .and. &
+                 .not. spec%effects%tension .and. .not. spec%effects%ground) then
+            ! (the MPP's members are then rigid pendulum links: it has an equilibrium)
+            call make_error(err, ERR_SOLVER, spec%origin('effects.tension')//': &effects: '// &
+                "tension = .false.: statics: no equilibrium: without tension the RFEM's "// &
+                'joints hold nothing along the rope, so its elements fall apart; switch '// &
+                'tension on for statics and modes')
+        else if (spec%model%kind == 'rfem' .and. spec%model%elements > 1 .and. &
                  .not. spec%effects%shear .and. .not. spec%effects%ground) then
             call make_error(err, ERR_SOLVER, spec%origin('effects.shear')//': &effects: '// &
                 'shear = .false.: statics: no unique equilibrium: without shear the '// &

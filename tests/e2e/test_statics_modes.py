@@ -184,6 +184,21 @@ def test_no_equilibrium(run, tmp_path):
 
 
 
+def test_an_rfem_without_tension_has_no_equilibrium(run, tmp_path):
+    """Without tension the RFEM's joints hold nothing along the rope: the statics used to
+    run its 2000 iterations and end "no convergence". It is said at once, naming the key
+    (the shear-less RFEM's rule); the MPP's members are then rigid links (its clamped-top
+    convergence test below uses that)."""
+    (tmp_path / "nt.nml").write_text("&model kind = 'rfem', elements = 6 /\n")
+    result = run("statics", "nt.nml", "--set", "effects.tension=.false.", "-o", "nt.h5")
+    assert result.returncode == 3, result.stderr
+    assert result.stderr.strip() == (
+        "ropedyn: error: --set effects.tension=.false.: &effects: tension = .false.: statics: "
+        "no equilibrium: without tension the RFEM's joints hold nothing along the rope, so "
+        "its elements fall apart; switch tension on for statics and modes"), result.stderr
+    assert not (tmp_path / "nt.h5").exists()
+
+
 @pytest.mark.parametrize("command", ["statics", "modes"])
 def test_an_rfem_without_shear_has_no_unique_equilibrium(run, tmp_path, command):
     """Without shear the RFEM's joints carry no force across the rope: the tangent is

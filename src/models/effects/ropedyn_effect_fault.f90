@@ -1,4 +1,4 @@
-!> Testing aid: forces and moments that turn NaN after a given time (`&solver
+!> Testing aid: forces and moments that turn NaN after a given time (`&effects
 !! fault_nan_after`, docs/guide/effects.md).
 !!
 !! It exists to test the failure path end to end through a real model: a NaN in the forces
