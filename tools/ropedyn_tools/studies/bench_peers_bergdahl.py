@@ -23,10 +23,10 @@ line, water, seabed and fairlead motion as input/validation/bergdahl/base.nml:
   kept in WORK/moordyn/ and reused by a rerun, CPU and all).
 
 ropedyn's side comes from the case files of `scripts/validation bergdahl` (its --work
-directory), its CPU from their /solver/cpu_time (the integration; the static start adds
-about 2 s, see the page), and only from those of the code of the executable (--exe, else
-the Release build): a case file of other code is refused. The table goes between the
-bergdahl_peers markers of docs/performance/peers.md.
+directory), its CPU from their /solver/cpu_time (the integration; the totals add the
+static start per case, bergdahl.static_start_cpu), and only from those of the code of the
+executable (--exe, else the Release build): a case file of other code is refused. The table
+goes between the bergdahl_peers markers of docs/performance/peers.md.
 """
 import argparse
 import json
