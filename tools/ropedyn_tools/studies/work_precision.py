@@ -44,7 +44,8 @@ BEGIN = "<!-- work-precision:begin -->"
 END = "<!-- work-precision:end -->"
 #: the reference a method's runs are judged against: the other integrator's, never the code
 #: that made the run (erk and auto against CVODE's; auto may run MEBDF, never CVODE on this
-#: rope's RFEM, and the two references agree within 4e-9 m over the horizon anyway)
+#: rope's RFEM, and the two references agree far below its errors anyway: the page's table
+#: of references)
 OTHER = {"cvode": "mebdf", "adams": "mebdf", "mebdf": "cvode", "erk": "cvode",
          "auto": "cvode"}
 FIELDS = ["model", "elements", "method", "max_order", "rtol", "atol", "status", "steps",
