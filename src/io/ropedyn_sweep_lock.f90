@@ -44,6 +44,8 @@ module ropedyn_sweep_lock
     integer, parameter :: LOCK_BEAT = 15                !< s between heartbeats
     integer, parameter :: LOCK_ABANDONED_AFTER = 120    !< s: a lock of another host is gone
     integer, parameter :: BREAK_ABANDONED_AFTER = 30    !< s: a .break lock is gone
+    !> The first line of every lock
+    character(len=*), parameter :: LOCK_HEADER = 'ropedyn sweep case lock'
 
     !> What a lock file says, and whether its writer runs.
     type :: lock_t
@@ -72,6 +74,7 @@ contains
         character(len=512) :: line
         integer :: unit, ios, eq
         integer(int64) :: ticks
+        logical :: empty, known
 
         lock%host = ''
         lock%boot = ''
@@ -88,11 +91,19 @@ contains
         open (newunit=unit, file=path, status='old', action='read', iostat=ios)
         if (ios /= 0) return
         lock%exists = .true.
+        empty = .true.
+        known = .false.
         do
             read (unit, '(a)', iostat=ios) line
             if (ios /= 0) exit
+            empty = .false.
+            if (line == LOCK_HEADER) known = .true.
             eq = index(line, '=')
             if (eq < 2) cycle
+            select case (line(:eq - 1))
+            case ('host', 'boot', 'job', 'started', 'pid', 'start_ticks', 'signal')
+                known = .true.
+            end select
             select case (line(:eq - 1))
             case ('host')
                 lock%host = trim(line(eq + 1:))
@@ -111,6 +122,13 @@ contains
             end select
         end do
         close (unit)
+        if (.not. empty .and. .not. known) then
+            ! not a lock of ropedyn (the user's FILE.lock): never taken over (removed); an
+            ! empty file is a lock whose writer has not said who it is yet
+            lock%problem = path//': not a lock of ropedyn (no "'//LOCK_HEADER//'" line, '// &
+                'no host=, pid=): left as it is; remove it or write elsewhere'
+            return
+        end if
         lock%changed = file_mtime(path)
         if (lock%changed < 0) then   ! removed meanwhile
             lock%exists = .false.
@@ -282,7 +300,7 @@ contains
         integer :: unit, ios
         open (newunit=unit, file=path, status='old', action='write', position='append', &
               iostat=ios, iomsg=msg)
-        if (ios == 0) write (unit, '(a)', iostat=ios, iomsg=msg) 'ropedyn sweep case lock'// &
+        if (ios == 0) write (unit, '(a)', iostat=ios, iomsg=msg) LOCK_HEADER// &
             new_line('a')//'host='//host_name()//new_line('a')//'boot='//boot_id()// &
             new_line('a')//'pid='// &
             int_text(process_id())//new_line('a')//'start_ticks='// &

@@ -165,6 +165,9 @@ module ropedyn_run
         !> a resume: why the writer of the file is gone, from its abandoned lock ('': no
         !! lock of it was there); said when the file's status is still `running`
         character(len=:), allocatable :: writer_gone
+        !> FILE (final_file) is checked again before FILE.part is renamed over it: a file put
+        !! there while the run went on is replaced only if the run may replace it (no --force)
+        logical :: recheck_final = .false.
         type(heartbeat_t) :: beat                 !< the lock's heartbeat
         integer :: output = OUTPUT_FILE        !< where the records go
         integer(int8), allocatable :: image(:) !< OUTPUT_MEMORY: the file's bytes at its end

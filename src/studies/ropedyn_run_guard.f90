@@ -82,6 +82,7 @@ contains
         self%final_file = file
         self%part_file = file//'.part'
         self%summary%file = self%part_file
+        self%recheck_final = .not. force
     end subroutine guard_new
 
     !> The file a new run writes for its output `given`, made ready: not an input, not a
@@ -135,10 +136,19 @@ contains
         class(run_t), intent(inout) :: self
         character(len=*), intent(in) :: file
         type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: lock_path
+        character(len=:), allocatable :: lock_path, real_file
         type(lock_t) :: lock
-        lock_path = file//'.lock'
-        if (is_part(file)) lock_path = whole_name(file)//'.lock'
+        ! a link: the file it points to, whose lock its writer took and whose FILE.part is
+        ! renamed (the link stays)
+        real_file = written_path(file)
+        if (is_case_part(real_file)) then
+            call make_error(err, ERR_USAGE, file//': the file of a sweep case being '// &
+                'written (its lock is .case_<id>.lock beside it): the sweep continues it '// &
+                '(ropedyn sweep SWEEP --task <id>), not ropedyn run --resume')
+            return
+        end if
+        lock_path = real_file//'.lock'
+        if (is_part(real_file)) lock_path = whole_name(real_file)//'.lock'
         self%writer_gone = ''
         call read_lock(lock_path, lock)
         if (lock%exists .and. .not. lock%live .and. len(lock%problem) == 0) &
@@ -149,8 +159,23 @@ contains
             return
         end if
         self%lock_file = lock_path
-        if (is_part(file)) call plan_rename(self, file)
+        if (is_part(real_file)) call plan_rename(self, real_file)
     end subroutine guard_resume
+
+    !> The name is that of a sweep case's file while it is written: .case_<digits>.h5.part.
+    pure logical function is_case_part(file)
+        character(len=*), intent(in) :: file
+        character(len=:), allocatable :: base, id
+        integer :: slash
+        is_case_part = .false.
+        slash = index(file, '/', back=.true.)
+        base = file(slash + 1:)
+        if (len(base) <= len('.case_.h5.part')) return
+        if (base(:len('.case_')) /= '.case_') return
+        if (base(len(base) - len('.h5.part') + 1:) /= '.h5.part') return
+        id = base(len('.case_') + 1:len(base) - len('.h5.part'))
+        is_case_part = verify(id, '0123456789') == 0
+    end function is_case_part
 
     !> A resume of `part` (FILE.part) renames it to FILE when it ends if FILE is not there
     !! or holds a run of the same source (the run the killed one would have replaced); else
@@ -179,6 +204,7 @@ contains
         end if
         self%part_file = part
         self%final_file = whole
+        self%recheck_final = .true.
     end subroutine plan_rename
 
     !> The root attribute `source` of the run file `path` ('' when it has none).
@@ -263,8 +289,11 @@ contains
         if (allocated(self%part_file)) then
             if (len(self%part_file) > 0) then
                 inquire (file=self%part_file, exist=exists)
+                ! a file put at FILE while the run went on, which the run may not replace:
+                ! the run's file keeps its .part name
+                if (exists .and. self%recheck_final) call recheck_final(self)
                 ! complete, failed or interrupted: the file is whole (closed, its status set)
-                if (exists) then
+                if (exists .and. len(self%part_file) > 0) then
                     call rename_file(self%part_file, self%final_file, rerr)
                     if (allocated(rerr) .and. .not. allocated(err)) call move_alloc(rerr, err)
                     ! a message about the file names it where it now is, and so does the
@@ -274,7 +303,7 @@ contains
                         call rename_in_reason(self%final_file, self%part_file)
                     end if
                 end if
-                self%summary%file = self%final_file
+                if (len(self%part_file) > 0) self%summary%file = self%final_file
                 self%part_file = ''
             end if
         end if
@@ -283,6 +312,28 @@ contains
             self%lock_file = ''
         end if
     end procedure release_output
+
+    !> Before FILE.part is renamed to FILE at the end: a FILE there now is checked again
+    !! (one put there while the run went on, by the user or another program), against the
+    !! source the .part records; when the run may not replace it, the run's file keeps its
+    !! .part name (part_file ''), with a warning saying why.
+    subroutine recheck_final(self)
+        class(run_t), intent(inout) :: self
+        type(scene_t) :: probe
+        type(error_t), allocatable :: err
+        character(len=:), allocatable :: source
+        if (file_kind(self%final_file, follow=.false.) == FILE_MISSING) return
+        probe = self%scene
+        source = stored_source(self%part_file)
+        if (len(source) > 0) probe%source = source
+        call check_may_replace(self%final_file, probe, .false., err, can_force=.false.)
+        if (.not. allocated(err)) return
+        call append_text(self%summary%warnings, self%part_file//' keeps its name: '// &
+            self%final_file//' was put there while the run went on, not a file of its '// &
+            'run to replace ('//err%message//')')
+        self%summary%file = self%part_file
+        self%part_file = ''
+    end subroutine recheck_final
 
     !> The root attribute `reason` of the run file `path` (written while it was `part`, by
     !! a failure that named it so) names `path` instead. Nothing when the file has no reason
