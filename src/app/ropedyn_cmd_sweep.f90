@@ -72,6 +72,7 @@ contains
                 call cli%flag(err)
                 if (allocated(err)) return
                 call print_help('sweep', output_unit)
+                if (allocated(opt%path)) deallocate (opt%path)  ! nothing else is done
                 return
             case ('--list')
                 call cli%flag(err)

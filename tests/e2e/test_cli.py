@@ -107,6 +107,20 @@ def test_a_flag_takes_no_value_and_no_stray_arguments(run, tmp_path, args, fragm
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.parametrize("options", [("--help",), ("-h", "--list"), ("--task", "1", "--help")])
+def test_sweep_help_after_the_file_does_only_help(run, tmp_path, options):
+    """'ropedyn sweep FILE --help' printed the help and then ran the whole sweep with 0
+    workers, which never ended ('--task 1 --help' ran case 1): --help after the sweep file
+    left the file set, the mark of a plain --help."""
+    (tmp_path / "good.nml").write_text(GOOD)
+    (tmp_path / "s.nml").write_text("&sweep base = 'good.nml', elements = 4, 6 /\n")
+    result = run("sweep", "s.nml", *options, timeout=20)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith("usage: ropedyn sweep"), result.stdout
+    assert result.stderr == ""
+    assert not (tmp_path / "out").exists()
+
+
 def test_override_applies(run, tmp_path):
     (tmp_path / "good.nml").write_text(GOOD)
     result = run("run", "good.nml", "--set", "model.elements=6", "--set", "solver.rtol=1e-7")
