@@ -274,7 +274,7 @@ contains
         character(len=*), intent(in) :: line
         character(len=:), allocatable :: s
         if (len_trim(line) > 80) then
-            s = '"'//printable(line(:77))//'..."'
+            s = '"'//printable(line(:char_start(line, 78) - 1))//'..."'
         else
             s = '"'//printable(trim(line))//'"'
         end if
@@ -369,16 +369,36 @@ contains
         end select
     end function invisible
 
-    !> A value for a message: at most 60 characters (a longer one as its first 40 and '...').
+    !> A value for a message: at most 60 bytes (a longer one as its first 40 and '...'),
+    !! not cut inside a UTF-8 character.
     pure function clip(text) result(s)
         character(len=*), intent(in) :: text
         character(len=:), allocatable :: s
         if (len(text) > 60) then
-            s = text(:40)//'...'
+            s = text(:char_start(text, 41) - 1)//'...'
         else
             s = text
         end if
     end function clip
+
+    !> The first byte of the UTF-8 character that holds byte i of `text` (i itself when it
+    !! is not a continuation byte; at most 3 bytes back), so that text(:result - 1) ends
+    !! on a whole character.
+    pure integer function char_start(text, i) result(k)
+        character(len=*), intent(in) :: text
+        integer, intent(in) :: i
+        integer :: c
+        k = i
+        do while (k > max(1, i - 3) .and. k <= len(text))
+            c = iachar(text(k:k))
+            if (c < 128 .or. c > 191) exit
+            k = k - 1
+        end do
+        if (k <= len(text)) then
+            c = iachar(text(k:k))
+            if (c >= 128 .and. c <= 191) k = i
+        end if
+    end function char_start
 
     !> A list of strings as a character array (as long as the longest, at least 1).
     pure function text_array(list) result(arr)

@@ -14,7 +14,7 @@ module ropedyn_scene_keys
     use ropedyn_scene_key, only: scene_key_t, T_REAL, T_INT, T_LOGICAL, T_NAME, T_PATH, &
         T_PAIR, T_LIST, R_NONE, R_FINITE, R_POSITIVE, R_NONNEGATIVE, R_UNIT, R_AT_LEAST, &
         R_NAMES
-    use ropedyn_text, only: text_t, append_text, name_hint, int_text
+    use ropedyn_text, only: text_t, append_text, name_hint, int_text, printable
     use ropedyn_integrator, only: DEFAULT_MAX_STEPS, BUDGET_STEP_RATE
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     implicit none
@@ -454,7 +454,7 @@ contains
         if (paren == 0) paren = len(key) + 1
         k = max(find_key(keys, g, key(:paren - 1)), 1)
         call make_error(err, ERR_INPUT, keys(k)%origin//': &'//trim(GROUP_NAMES(g))//': ' &
-            //key//' = '//value//': '//reason)
+            //key//' = '//printable(value)//': '//reason)
     end subroutine fail
 
     pure integer function group_index(name) result(g)

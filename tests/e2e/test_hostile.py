@@ -16,7 +16,8 @@ CRASH_TEXT = ("Fortran runtime", "Backtrace", "Segmentation", "Error termination
 
 def manifest():
     cases = []
-    for number, line in enumerate((HOSTILE / "manifest.txt").read_text().splitlines(), 1):
+    text = (HOSTILE / "manifest.txt").read_text(encoding="utf-8")
+    for number, line in enumerate(text.splitlines(), 1):
         if not line.strip() or line.startswith("#"):
             continue
         args, code, fragment = line.split(" | ", 2)
@@ -39,7 +40,7 @@ def test_hostile_input(ropedyn_exe, tmp_path, args, code, fragment):
     shutil.copytree(HOSTILE, work)
     before = files_below(work)
     result = subprocess.run([str(ropedyn_exe), *args], cwd=work, capture_output=True,
-                            text=True, errors="replace", timeout=20)
+                            text=True, encoding="utf-8", errors="replace", timeout=20)
     assert result.returncode == code, result.stderr
     assert fragment in result.stderr, f"{fragment!r} not in {result.stderr!r}"
     error_lines = [line for line in result.stderr.splitlines()
