@@ -18,7 +18,7 @@ program ropedyn_main
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use ropedyn_error, only: error_t, make_error, ERR_USAGE, exit_code_of
     use ropedyn_version, only: version_string
-    use ropedyn_text, only: name_hint, text_t, append_text
+    use ropedyn_text, only: name_hint, text_t, append_text, printable
     use ropedyn_cli, only: cli_t, cli_from_command_line
     use ropedyn_cmd_run, only: run_command
     use ropedyn_cmd_testset, only: testset_command
@@ -65,7 +65,8 @@ program ropedyn_main
                         name_hint(commands(), cli%command, 'commands')//' (see ropedyn --help)')
     end select
     if (allocated(err)) then
-        write (error_unit, '(a)') 'ropedyn: error: '//err%message
+        ! one line whatever an argument held (a newline, CR, an invisible character)
+        write (error_unit, '(a)') 'ropedyn: error: '//printable(err%message)
         stop exit_code_of(err%code), quiet=.true.
     end if
 

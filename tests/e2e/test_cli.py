@@ -121,6 +121,22 @@ def test_sweep_help_after_the_file_does_only_help(run, tmp_path, options):
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.parametrize("args,fragment", [
+    (("sweep", "s.nml", "a\nb", "--list"), 'more than one sweep file: "s.nml", "a\\x0ab"'),
+    (("sweep", "\r", "x", "--list"), 'more than one sweep file: "\\x0d", "x"'),
+    (("keys", "rope", "\u00a0"), 'more than one group: "rope", "<U+00A0>"'),
+    (("\ufeff",), 'unknown command "<U+FEFF>"'),
+])
+def test_usage_error_shows_control_and_invisible_characters(run, tmp_path, args, fragment):
+    """A usage error quoted its arguments raw: a newline in one split the message into two
+    lines, a CR or an invisible character hid what was wrong."""
+    result = run(*args)
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.startswith("ropedyn: error: ") and result.stderr.count("\n") == 1
+    assert fragment in result.stderr, result.stderr
+    assert "\r" not in result.stderr
+
+
 def test_override_applies(run, tmp_path):
     (tmp_path / "good.nml").write_text(GOOD)
     result = run("run", "good.nml", "--set", "model.elements=6", "--set", "solver.rtol=1e-7")
