@@ -90,14 +90,14 @@ contains
                 ' gives the section set: give one set (solid rod: density, young_modulus, '// &
                 'shear_modulus, normal_damping, tangential_damping, shape_factor; section: '// &
                 'mass_per_length, axial_stiffness, bending_stiffness, shear_stiffness and '// &
-                'the dampings)', err)
+                'the dampings)', err, also='rope.'//trim(SECTION(b)))
             return
         end do
         do b = 1, 2
             kb = find_key(keys, G_ROPE, trim(SECTION(b)))
             if (keys(kb)%given) cycle
             call fail(keys, G_ROPE, trim(SECTION(b)), 'not set', 'needed with the section '// &
-                'set (given: '//given_section_keys()//')', err)
+                'set (given: '//given_section_keys()//')', err, also=set_section_key())
             return
         end do
         associate (r => scene%rope)
@@ -109,6 +109,22 @@ contains
             r%shape_factor = NOT_SET
         end associate
     contains
+        !> 'rope.KEY' of a section key given by a --set (the first), else of the first given.
+        function set_section_key() result(name)
+            character(len=:), allocatable :: name
+            integer :: k, ks
+            name = ''
+            do k = 1, size(SECTION)
+                ks = find_key(keys, G_ROPE, trim(SECTION(k)))
+                if (.not. keys(ks)%given) cycle
+                if (len(name) == 0) name = 'rope.'//trim(SECTION(k))
+                if (index(keys(ks)%origin, '--set ') == 1) then
+                    name = 'rope.'//trim(SECTION(k))
+                    return
+                end if
+            end do
+        end function set_section_key
+
         function given_section_keys() result(list)
             character(len=:), allocatable :: list
             integer :: k
@@ -255,7 +271,7 @@ contains
             else if (i%shape == 'folded' .and. mod(scene%model%elements, 2) /= 1) then
                 call fail(keys, G_INITIAL, 'shape', '"folded"', 'needs an odd number of ' &
                     //'elements (two equal halves and one across the fold; elements = ' &
-                    //int_text(scene%model%elements)//')', err)
+                    //int_text(scene%model%elements)//')', err, also='model.elements')
             else if (scene%effects%drag .and. .not. any_drag) then
                 call fail(keys, G_EFFECTS, 'drag', '.true.', 'every drag coefficient of &fluid ' &
                     //'is zero (give density and a drag coefficient, or a linear drag)', err)

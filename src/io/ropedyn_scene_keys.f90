@@ -444,16 +444,29 @@ contains
 
     !> The error of a key whose value is wrong: 'origin: &group: key = value: reason', the
     !! origin being the file or the last `--set` of the key. `key` may carry an index.
-    subroutine fail(keys, g, key, value, reason, err)
+    !! `also` ('group.key'): a second key the error is about (a limit of the two together);
+    !! when the value of `key` is not from a --set and that of `also` is, that --set is the
+    !! origin: the error names the argument that made the scene wrong.
+    subroutine fail(keys, g, key, value, reason, err, also)
         type(scene_key_t), intent(in) :: keys(:)
         integer, intent(in) :: g
         character(len=*), intent(in) :: key, value, reason
         type(error_t), allocatable, intent(out) :: err
-        integer :: k, paren
+        character(len=*), intent(in), optional :: also
+        character(len=:), allocatable :: origin
+        integer :: k, paren, dot, ka
         paren = index(key, '(')
         if (paren == 0) paren = len(key) + 1
         k = max(find_key(keys, g, key(:paren - 1)), 1)
-        call make_error(err, ERR_INPUT, keys(k)%origin//': &'//trim(GROUP_NAMES(g))//': ' &
+        origin = keys(k)%origin
+        if (present(also)) then
+            dot = max(index(also, '.'), 1)
+            ka = find_key(keys, group_index(also(:dot - 1)), also(dot + 1:))
+            if (ka > 0 .and. index(origin, '--set ') /= 1) then
+                if (index(keys(ka)%origin, '--set ') == 1) origin = keys(ka)%origin
+            end if
+        end if
+        call make_error(err, ERR_INPUT, origin//': &'//trim(GROUP_NAMES(g))//': ' &
             //key//' = '//printable(value)//': '//reason)
     end subroutine fail
 

@@ -116,7 +116,8 @@ contains
             call fail(keys, G_SOLVER, 'output_interval', real_text(scene%solver%output_interval), &
                 'with t_end = '//real_text(scene%solver%t_end)//' that makes '// &
                 real_text(records)//' output records, more than the limit '// &
-                int_text(MAX_RECORDS)//' (docs/reference/scene-file.md, Limits)', err)
+                int_text(MAX_RECORDS)//' (docs/reference/scene-file.md, Limits)', err, &
+                also='solver.t_end')
         end if
         if (.not. allocated(err) .and. scene%solver%t_end > MAX_TIME) call fail(keys, G_SOLVER, &
             't_end', real_text(scene%solver%t_end), 'out of range (at most '// &

@@ -83,6 +83,16 @@ def test_the_two_sets_do_not_mix(run, tmp_path):
     half = run("run", "half.nml")
     assert half.returncode == 2
     assert "&rope: axial_stiffness = not set: needed with the section set" in half.stderr
+    # a --set that made the scene wrong is named, not the file whose keys are right
+    paper = run("run", ROOT / "input" / "paper.nml", "--set", "rope.axial_stiffness=1e4")
+    assert paper.returncode == 2
+    assert ("error: --set rope.axial_stiffness=1e4: &rope: density = 6000.0: a key of the "
+            "solid-rod set, but axial_stiffness = 10000.0 gives") in paper.stderr, paper.stderr
+    (tmp_path / "plain.nml").write_text("&model /\n")
+    added = run("run", "plain.nml", "--set", "rope.axial_damping=1")
+    assert added.returncode == 2
+    assert ("error: --set rope.axial_damping=1: &rope: mass_per_length = not set: needed "
+            "with the section set (given: axial_damping)") in added.stderr, added.stderr
 
 
 def test_derived_defaults_of_the_section_set(run, tmp_path):

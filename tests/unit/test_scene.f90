@@ -655,6 +655,16 @@ contains
         call expect_error('folded_even', [character(len=L) :: '&model elements = 10 /', &
             '&initial shape = ''folded'' /'], NO_SET, [character(len=L) :: &
             P//'folded_even.nml: &initial: shape = "folded": needs an odd number of elements'])
+        ! the other key of the check came from a --set: the error names that argument
+        call expect_error('folded_set_n', [character(len=L) :: '&model elements = 11 /', &
+            '&initial shape = ''folded'' /'], [character(len=L) :: 'model.elements=10'], &
+            [character(len=L) :: '--set model.elements=10: &initial: shape = "folded": needs'])
+        call expect_error('records_set_t_end', MODEL, [character(len=L) :: &
+            'solver.t_end=1e6', 'solver.output_interval=0.001'], [character(len=L) :: &
+            '--set solver.output_interval=0.001: &solver: output_interval = 0.001: with t_end'])
+        call expect_error('records_file_t_end', [character(len=L) :: MODEL, &
+            '&solver output_interval = 0.001 /'], [character(len=L) :: 'solver.t_end=1e6'], &
+            [character(len=L) :: '--set solver.t_end=1e6: &solver: output_interval = 0.001: '])
         call expect_error('mpp_velocity', [character(len=L) :: '&model kind = ''mpp'' /', &
             '&initial velocity = 1, 0 /'], NO_SET, [character(len=L) :: &
             P//'mpp_velocity.nml: &initial: velocity = 1.0, 0.0: the mpp model starts at rest'])
