@@ -10,6 +10,7 @@
 !! or from a difference of f when it has none. Cost: one Jacobian (or m evaluations of
 !! f) and m band products, i.e. a few right-hand sides.
 module ropedyn_spectrum
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp
     use ropedyn_lapack, only: dgeev, zgeev
     use ropedyn_problem, only: problem_t, STATUS_OK
@@ -177,6 +178,9 @@ contains
             end if
             self%v(:, j + 1) = self%w/self%hess(j + 1, j)
         end do
+        ! a J v that is not finite (a state whose forces overflow) gives no estimate: LAPACK's
+        ! dgeev refuses a NaN through xerbla, which prints and stops the whole process
+        if (.not. all(ieee_is_finite(self%hess(1:k + 1, 1:k)))) return
         allocate (wr(k), wi(k), work(8*k))
         ! dgeev balances H first (half its cost here): the Hessenberg QR alone (dhseqr),
         ! on an H this far from normal, moves the fast Ritz values' real parts

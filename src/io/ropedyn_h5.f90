@@ -14,7 +14,9 @@
 !! Values of any rank go to HDF5 through one pointer-based call per operation; the typed
 !! procedures only pick the HDF5 type. Scalars get a scalar dataspace, strings are
 !! fixed-length and null-padded (an empty string is one NUL byte, which readers see as '').
-!! The library is opened with `h5open_f` (idempotent), HDF5's own error printing silenced,
+!! The library is opened with `h5open_f` once (each call of it copies the Fortran
+!! interface's predefined types again and never frees the copies: 55 type ids a call, about
+!! 30 KB), HDF5's own error printing silenced,
 !! and never closed here: no module state, other HDF5 users undisturbed (HDF5 closes itself
 !! at exit, unless a file failed to close: ropedyn_h5_glue.c). A failure's message ends
 !! with the reason from HDF5's error stack (the system's, e.g. 'No space left on device'). An open `h5_file_t` or `h5_series_t` must not be copied (the copies would
@@ -37,7 +39,8 @@ module ropedyn_h5
         h5aexists_f, h5adelete_f, h5aget_type_f, h5tcopy_f, h5tclose_f, h5tset_size_f, &
         h5tget_size_f, h5tset_strpad_f, H5T_NATIVE_CHARACTER, H5T_STR_NULLPAD_F, &
         h5kind_to_type, H5_REAL_KIND, H5_INTEGER_KIND, h5dget_type_f, h5tget_class_f, &
-        H5T_STRING_F, H5T_FLOAT_F, H5T_INTEGER_F, h5tis_variable_str_f, h5ldelete_f
+        H5T_STRING_F, H5T_FLOAT_F, H5T_INTEGER_F, h5tis_variable_str_f, h5ldelete_f, &
+        h5iis_valid_f
     use, intrinsic :: iso_fortran_env, only: int8
     use ropedyn_kinds, only: wp, i8
     use ropedyn_text, only: int_text, text_t, append_text

@@ -8,9 +8,16 @@ contains
 
     module procedure library_acquire
         integer :: hdferr
+        logical :: opened
         call c_h5_prepare()
-        call h5open_f(hdferr)
-        if (h5_failed(hdferr, path//': cannot initialize the HDF5 library', err)) return
+        ! open once: h5open_f copies the Fortran interface's predefined types at every call
+        ! and never frees the copies (55 type ids a call: a leak of a run or more). Their
+        ! being valid says it was done (and not undone since by an h5close_f).
+        call h5iis_valid_f(H5T_NATIVE_CHARACTER, opened, hdferr)
+        if (hdferr < 0 .or. .not. opened) then
+            call h5open_f(hdferr)
+            if (h5_failed(hdferr, path//': cannot initialize the HDF5 library', err)) return
+        end if
         call h5eset_auto_f(0, hdferr)
         if (hdferr < 0) call h5_error(err, path//': cannot silence HDF5 error printing')
     end procedure library_acquire

@@ -172,9 +172,16 @@ contains
             call make_error(err, ERR_USAGE, 'restore: the snapshot holds no state')
             return
         end if
-        if (size(snap%y) /= size(self%y) .or. size(snap%yq) /= size(self%yq)) then
+        if (size(snap%y) /= size(self%y)) then
             call make_error(err, ERR_USAGE, 'restore: the snapshot is of another scene ('// &
                 int_text(size(snap%y))//' unknowns, this one has '//int_text(size(self%y))//')')
+            return
+        end if
+        if (size(snap%yq) /= size(self%yq)) then
+            ! the same unknowns, other energy integrals (a moving support's work)
+            call make_error(err, ERR_USAGE, 'restore: the snapshot is of another scene ('// &
+                int_text(size(snap%yq))//' energy integrals, this one has '// &
+                int_text(size(self%yq))//')')
             return
         end if
         self%t = snap%t
