@@ -17,3 +17,10 @@ class Error(Exception):
     @property
     def kind(self):
         return KINDS.get(self.code, "internal")
+
+
+def message_text(raw):
+    """A message of the library (bytes) as text. A message quotes at most so many bytes of
+    a value, which may cut a character of several bytes in two: that part shows as U+FFFD
+    instead of failing with UnicodeDecodeError."""
+    return raw.decode("utf-8", "replace")

@@ -31,7 +31,7 @@ def text(value):
     if isinstance(value, np.ndarray) and value.shape == ():
         value = value[()]
     if isinstance(value, (bytes, np.bytes_)):
-        return bytes(value).decode("utf-8")
+        return bytes(value).decode("utf-8", "surrogateescape")
     return str(value)
 
 

@@ -13,8 +13,13 @@ import ctypes
 import pathlib
 
 from ropedyn._lib import c_handle, library
-from ropedyn.errors import Error
+from ropedyn.errors import Error, message_text
 from ropedyn.namelist import parse_namelist
+
+#: how scene texts cross to the library and back: a byte that is not UTF-8 (a Latin-1
+#: file's string value, which the library reads as the command line does) comes back as
+#: the same byte
+TEXT = ("utf-8", "surrogateescape")
 
 
 def _value_text(value):
@@ -41,7 +46,7 @@ class _Handle:
             self.fail(status)
 
     def fail(self, status):
-        message = self.lib.ropedyn_last_error(self.h).decode()
+        message = message_text(self.lib.ropedyn_last_error(self.h))
         self.close()
         raise Error(message, status)
 
@@ -52,7 +57,7 @@ class _Handle:
     def text(self, function):
         out = ctypes.c_char_p()
         self.check(function(self.h, ctypes.byref(out)))
-        return out.value.decode()
+        return out.value.decode(*TEXT)
 
     def close(self):
         if self.h:
@@ -70,12 +75,15 @@ def _open(text, name, settings=()):
     """A library instance of the scene `text` named `name`, with `settings` applied
     together."""
     lib = library()
-    handle = _Handle(lib.ropedyn_create_from_text, text.encode(), name.encode())
+    if "\0" in text or "\0" in name:
+        # C strings: the library would see the text up to the NUL, and silently no more
+        raise Error(f"{name}: the scene text holds a NUL character", 2)
+    handle = _Handle(lib.ropedyn_create_from_text, text.encode(*TEXT), name.encode())
     if settings:
         if any("\n" in s for s in settings):
             handle.close()
             raise Error("set: a value holds a new line", 2)
-        handle.check(lib.ropedyn_set(handle.h, "\n".join(settings).encode()))
+        handle.check(lib.ropedyn_set(handle.h, "\n".join(settings).encode(*TEXT)))
     return handle
 
 
@@ -135,7 +143,7 @@ class Scene:
     def write(self, path):
         """Write the scene to `path` (a scene file: it reads in again to this scene)."""
         path = pathlib.Path(path)
-        path.write_text(self._text + "\n")
+        path.write_text(self._text + "\n", encoding=TEXT[0], errors=TEXT[1])
         return path
 
     def copy(self):

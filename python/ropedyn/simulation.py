@@ -20,8 +20,8 @@ import pathlib
 import numpy as np
 
 from ropedyn._lib import c_handle, library
-from ropedyn.errors import Error
-from ropedyn.scene import Scene
+from ropedyn.errors import Error, message_text
+from ropedyn.scene import TEXT, Scene
 
 SUPPORTS = {"top": 0, "bottom": 1}
 ENERGY_NAMES = ("kinetic", "elastic", "gravity", "dissipated", "support_work", "total")
@@ -49,12 +49,12 @@ def run(scene, output=None):
     h = c_handle()
     image, size = ctypes.c_void_p(), ctypes.c_size_t()
     try:
-        status = lib.ropedyn_create_from_text(scene.text.encode(), scene.name.encode(),
+        status = lib.ropedyn_create_from_text(scene.text.encode(*TEXT), scene.name.encode(),
                                               ctypes.byref(h))
         if status == 0:
             status = lib.ropedyn_run(h, str(output).encode() if output else None,
                                      ctypes.byref(image), ctypes.byref(size))
-        message = lib.ropedyn_last_error(h).decode()
+        message = message_text(lib.ropedyn_last_error(h))
         data = ctypes.string_at(image, size.value) if image.value and size.value else b""
     finally:
         lib.ropedyn_destroy(h)
@@ -107,7 +107,7 @@ class Simulation:
         self._lib = library()
         self._h = c_handle()
         status = self._lib.ropedyn_create_from_text(
-            self.scene.text.encode(), self.scene.name.encode(), ctypes.byref(self._h))
+            self.scene.text.encode(*TEXT), self.scene.name.encode(), ctypes.byref(self._h))
         if status == 0:
             status = self._lib.ropedyn_init(self._h, 1 if statics else 0)
         self._check(status)
@@ -132,7 +132,7 @@ class Simulation:
 
     def _check(self, status):
         if status != 0:
-            message = self._lib.ropedyn_last_error(self._h).decode()
+            message = message_text(self._lib.ropedyn_last_error(self._h))
             if not self._alive():
                 self.close()
             raise Error(message, status)
@@ -152,7 +152,10 @@ class Simulation:
         raises ropedyn.Error, keeps the last good state and ends the simulation: later
         `advance`, `set_support`, `save` and assignments to `state` raise the same error
         until `restore`; the reads give the last good state."""
-        status = self._advance(self._handle(), t)
+        try:
+            status = self._advance(self._handle(), t)
+        except ctypes.ArgumentError:
+            raise Error(f"advance: t is a time in s (a number), not {t!r}", 2) from None
         if status != 0:
             self._check(status)
 
@@ -251,6 +254,8 @@ class Simulation:
 
     def restore(self, snapshot):
         """Go back to a state kept by `save` (also after a failed advance)."""
+        if not isinstance(snapshot, Snapshot):
+            raise Error(f"restore: a Snapshot of Simulation.save, not {snapshot!r}", 2)
         if not snapshot._h:
             raise Error("restore: the snapshot is closed", 2)
         self._check(self._lib.ropedyn_restore(self._handle(), snapshot._h))

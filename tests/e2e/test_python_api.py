@@ -468,3 +468,31 @@ def test_runs_in_one_process_keep_no_hdf5_types():
     assert result.returncode == 0, result.stderr
     assert int(result.stdout) < 1024, f"grew by {result.stdout.strip()} KiB"
 
+
+def test_bad_arguments_and_texts_are_ropedyn_errors(tmp_path):
+    """What Python's own layers raised before: a message whose quoted value the library
+    cut inside a character of several bytes (UnicodeDecodeError), an advance to a time that
+    is no number (ctypes.ArgumentError), a restore of no Snapshot (AttributeError); a scene
+    text with a NUL was read up to the NUL, silently. A scene file that is not UTF-8 (a
+    Latin-1 string value, which the command line reads) reads, writes and runs."""
+    with pytest.raises(ropedyn.Error, match="too long") as error:
+        ropedyn.Scene("&model kind = '" + "é" * 200 + "' /")
+    assert error.value.code == 2
+    with pytest.raises(ropedyn.Error, match="NUL"):
+        ropedyn.Scene("&model elements = 4 /\0&rope length = -1 /")
+    with ropedyn.Simulation(small(n=4)) as sim:
+        for bad in ("0.1", None):
+            with pytest.raises(ropedyn.Error, match="advance: t is a time") as error:
+                sim.advance(bad)
+            assert error.value.code == 2
+        with pytest.raises(ropedyn.Error, match="restore: a Snapshot"):
+            sim.restore(None)
+        sim.advance(0.01)
+        assert sim.t == 0.01
+    latin = tmp_path / "latin.nml"
+    latin.write_bytes(PAPER.read_bytes().replace(b"out/paper.h5", b"out/caf\xe9.h5"))
+    scene = ropedyn.Scene.from_file(latin).set({"model.elements": 4, "solver.t_end": 0.02})
+    scene.write(tmp_path / "again.nml")
+    assert b"out/caf\xe9.h5" in (tmp_path / "again.nml").read_bytes()
+    assert ropedyn.Scene.from_file(tmp_path / "again.nml") == scene
+    assert ropedyn.run(scene).time[-1] == 0.02
