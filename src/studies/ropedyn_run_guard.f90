@@ -211,16 +211,24 @@ contains
     function stored_source(path) result(source)
         character(len=*), intent(in) :: path
         character(len=:), allocatable :: source
+        source = root_attribute(path, 'source')
+    end function stored_source
+
+    !> The root attribute `name` (a string) of the HDF5 file `path`; '' when the file cannot
+    !! be read or has none.
+    function root_attribute(path, name) result(value)
+        character(len=*), intent(in) :: path, name
+        character(len=:), allocatable :: value
         type(h5_file_t) :: h5
         type(error_t), allocatable :: err, close_err
         logical :: found
-        source = ''
+        value = ''
         call h5%open(path, err)
         if (allocated(err)) return
-        call h5%read_attribute('source', source, err, found)
+        call h5%read_attribute(name, value, err, found)
         call h5%close(close_err)
-        if (allocated(err) .or. .not. found) source = ''
-    end function stored_source
+        if (allocated(err) .or. .not. found) value = ''
+    end function root_attribute
 
     !> Before a new run without --force takes FILE.lock: a FILE.part there, while no live
     !! process holds FILE.lock (its run was killed), is refused (a live lock: take_lock
@@ -237,13 +245,28 @@ contains
         call refuse_part(file, err)
     end subroutine check_part_left
 
-    !> The error of a new run on FILE that finds FILE.part (without --force).
+    !> The error of a new run on FILE that finds FILE.part (without --force), by what its
+    !! status says: a killed run's (`running`, or unreadable), one that stopped, or a
+    !! finished run's file that kept its name (FILE was not its to replace).
     subroutine refuse_part(file, err)
         character(len=*), intent(in) :: file
         type(error_t), allocatable, intent(out) :: err
-        call make_error(err, ERR_USAGE, file//'.part: left by a run of '//file// &
-            ' that was killed: continue it (ropedyn run --resume '//file//'.part) or '// &
-            'remove it, or give --force')
+        character(len=:), allocatable :: status
+        status = trim(root_attribute(file//'.part', 'status'))
+        select case (status)
+        case ('complete')
+            call make_error(err, ERR_USAGE, file//'.part: a finished run of '//file// &
+                ' (status complete) that kept this name, as '//file//' was not its to '// &
+                'replace: rename it or remove it, or give --force')
+        case ('failed', 'interrupted')
+            call make_error(err, ERR_USAGE, file//'.part: a run of '//file//' that '// &
+                'stopped (status '//status//') and kept this name: continue it (ropedyn '// &
+                'run --resume '//file//'.part) or remove it, or give --force')
+        case default
+            call make_error(err, ERR_USAGE, file//'.part: left by a run of '//file// &
+                ' that was killed: continue it (ropedyn run --resume '//file//'.part) or '// &
+                'remove it, or give --force')
+        end select
     end subroutine refuse_part
 
     !> The name ends with '.part' (the file a new run writes before it is renamed).

@@ -182,10 +182,14 @@ contains
             if (allocated(err)) return
             if (.not. quiet) write (output_unit, '(a)') label//': interrupted '// &
                 'before: continuing it from its last record'
-        else if (.not. force .and. killed_part(c, part)) then
+        else if (.not. force .and. killed_part(c, part, err)) then
             resume = .true.
             if (.not. quiet) write (output_unit, '(a)') label//': its writer was killed: '// &
                 'continuing '//part//' from its last record'
+        else if (allocated(err)) then
+            ! (held open by another writer: not this task's to remove)
+            err%message = label//': not run: '//err%message
+            return
         else
             removed = delete_file(part)
         end if
@@ -273,15 +277,20 @@ contains
 
     !> The status attribute of the run file `path` ('' when it cannot be read).
     !> `part` holds records of this very case beyond its start, written by a run that was
-    !! killed (status still `running`; its writer's lock is this task's now).
-    logical function killed_part(c, part)
+    !! killed (status still `running`; its writer's lock is this task's now). A `part` that
+    !! another process holds open (HDF5's lock) is an ERR_IO error: not to be removed.
+    logical function killed_part(c, part, err)
         type(sweep_case_t), intent(in) :: c
         character(len=*), intent(in) :: part
+        type(error_t), allocatable, intent(out) :: err
         type(case_data_t) :: data
-        type(error_t), allocatable :: err
         killed_part = .false.
         call read_case_file(part, data, err)
-        if (allocated(err)) return
+        if (allocated(err)) then
+            ! unreadable (damaged): run anew; locked: the caller's error
+            if (index(err%message, ': cannot open: locked') == 0) deallocate (err)
+            return
+        end if
         if (.not. data%exists) return
         killed_part = data%status == 'running' .and. data%records >= 2 .and. &
             echo_without_output_file(data%scene) == &

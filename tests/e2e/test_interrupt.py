@@ -312,6 +312,18 @@ def test_resume_of_a_killed_run(run, tmp_path, scene):
             assert ("q.h5.part keeps its name: q.h5 is there, not a file of its run to "
                     "replace (q.h5: exists and holds the run of ") in again.stderr, again.stderr
             keep_file.unlink()
+    # a FILE.part that is not a killed run's is named by its status
+    for status, words in (("complete", "s.h5.part: a finished run of s.h5 (status complete) "
+                           "that kept this name, as s.h5 was not its to replace: rename it "
+                           "or remove it, or give --force"),
+                          ("interrupted", "s.h5.part: a run of s.h5 that stopped (status "
+                           "interrupted) and kept this name: continue it (ropedyn run "
+                           "--resume s.h5.part)")):
+        (tmp_path / "s.h5.part").write_bytes(keep.read_bytes())
+        with h5py.File(tmp_path / "s.h5.part", "r+") as f:
+            f.attrs["status"] = np.bytes_(status)
+        named = run("run", scene, "--set", "output.file='s.h5'")
+        assert named.returncode == 2 and words in named.stderr, named.stderr
     # a refused resume leaves the .part where it is
     (tmp_path / "r.h5.part").write_bytes(keep.read_bytes())
     early = run("run", "--resume", "r.h5.part", "--set", "solver.t_end=4.5")

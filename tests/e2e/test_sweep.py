@@ -535,6 +535,25 @@ def test_lock_rules(run, sweep_dir):
     assert not lock2.exists()
 
 
+def test_a_part_held_open_by_another_writer_is_left_alone(run, sweep_dir):
+    """A case's .part that another process holds open for writing (HDF5's lock) is not
+    the task's to remove: the case is not run (exit 4) and the file stays; once it is
+    closed, a .part of another scene is removed and the case runs anew."""
+    assert run("sweep", "sw.nml", "--task", "2").returncode == 0
+    out = sweep_dir / "out" / "sw"
+    part = out / ".case_0001.h5.part"
+    part.write_bytes((out / "case_0002.h5").read_bytes())
+    with h5py.File(part, "a"):
+        held = run("sweep", "sw.nml", "--task", "1")
+    assert held.returncode == 4, held.stderr
+    assert "sweep: case 0001: not run: " in held.stderr and "cannot open: locked by pid" \
+        in held.stderr, held.stderr
+    assert part.exists() and not (out / "case_0001.h5").exists()
+    again = run("sweep", "sw.nml", "--task", "1")
+    assert again.returncode == 0, again.stderr
+    assert not part.exists() and (out / "case_0001.h5").exists()
+
+
 def test_complete_only_if_it_reads_back(run, sweep_dir):
     assert run("sweep", "sw.nml", "--task", "1-3").returncode == 0
     out = sweep_dir / "out" / "sw"
