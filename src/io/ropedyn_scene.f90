@@ -25,7 +25,7 @@ module ropedyn_scene
     public :: solver_params_t, output_params_t, scene_t
     public :: read_scene, read_scene_text, read_scene_string, scene_namelist_text, &
         echo_without_output_file, override_value_text, &
-        scene_key_listing, check_override_value, override_target
+        scene_key_listing, check_override_value, override_target, scene_physics_text
 
     !> One `--set group.key=value` argument, parsed.
     type :: override_t
@@ -461,6 +461,33 @@ contains
         if (index(adjustl(text(i:i + j - 2)), 'file = ') /= 1) return
         rest = text(:i - 1)//text(i + j:)
     end function echo_without_output_file
+
+    !> The scene's effective text without the groups that do not define the rope and its
+    !! surroundings (&initial, &solver, &output): two simulations whose physics texts are
+    !! equal integrate the same equations, so a state of the one is a state of the other.
+    function scene_physics_text(scene) result(text)
+        type(scene_t), intent(in) :: scene
+        character(len=:), allocatable :: text
+        character(len=:), allocatable :: echo
+        character(len=1), parameter :: NL = new_line('a')
+        integer :: i, j
+        logical :: kept
+        echo = scene_namelist_text(scene)
+        text = ''
+        kept = .true.
+        i = 1
+        do while (i <= len(echo))
+            j = index(echo(i:), NL)
+            if (j == 0) j = len(echo) - i + 2
+            associate (line => echo(i:i + j - 2))
+                if (line == '&initial' .or. line == '&solver' .or. line == '&output') &
+                    kept = .false.
+                if (kept) text = text//line//NL
+                if (line == '/') kept = .true.
+            end associate
+            i = i + j
+        end do
+    end function scene_physics_text
 
     !> The listing of `ropedyn keys`: a header and one line per key (tab-separated group,
     !! key, type, unit, default, allowed values, meaning); with `group`, that group's keys

@@ -46,7 +46,7 @@ module ropedyn_run
                                   stop_query_i, budget_left
     use ropedyn_clock, only: clock_seconds
     use ropedyn_model_factory, only: create_model
-    use ropedyn_scene, only: scene_t, scene_namelist_text
+    use ropedyn_scene, only: scene_t, scene_namelist_text, scene_physics_text
     use ropedyn_scene_solver, only: create_integrator, solver_options_of, step_budget, &
         check_method_fits
     use ropedyn_os, only: make_parent_dirs
@@ -114,6 +114,9 @@ module ropedyn_run
         type(support_motion_t) :: motion(2)
         real(wp) :: target_p(2, 2) = 0.0_wp, target_v(2, 2) = 0.0_wp
         logical :: target_given(2) = .false.
+        !> the scene's rope and surroundings (scene_physics_text): a restore into a
+        !! simulation of another rope of the same size is refused
+        character(len=:), allocatable :: physics
     end type run_snapshot_t
 
     !> A run of one scene (see the module header for the order of the steps).
@@ -162,6 +165,9 @@ module ropedyn_run
         ! the guard of the output file: the lock held ('' none), and for a new run the
         ! file written (FILE.part) and its final name
         character(len=:), allocatable :: lock_file, part_file, final_file
+        !> the scene's rope and surroundings (scene_physics_text), made at the first save or
+        !! restore: the scene does not change after open
+        character(len=:), allocatable :: physics
         !> a resume: why the writer of the file is gone, from its abandoned lock ('': no
         !! lock of it was there); said when the file's status is still `running`
         character(len=:), allocatable :: writer_gone

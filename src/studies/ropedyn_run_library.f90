@@ -45,7 +45,9 @@ contains
                 'restore a saved state to go back)')
             return
         end if
-        if (t == self%t) return
+        ! (a t within rounding of the time reached: no step can end there, and none is
+        ! needed; a coupled support keeps its target for the next advance)
+        if (t - self%t <= 16.0_wp*epsilon(1.0_wp)*abs(t)) return
         coupled = self%model%moving .and. self%model%motion%kind == MOTION_COUPLED
         if (any(coupled)) then
             do k = 1, 2
@@ -164,6 +166,8 @@ contains
         snap%target_p = self%target_p
         snap%target_v = self%target_v
         snap%target_given = self%target_given
+        if (.not. allocated(self%physics)) self%physics = scene_physics_text(self%scene)
+        snap%physics = self%physics
         snap%valid = .true.
     end procedure run_save
 
@@ -176,6 +180,11 @@ contains
             call make_error(err, ERR_USAGE, 'restore: the snapshot is of another scene ('// &
                 int_text(size(snap%y))//' unknowns, this one has '//int_text(size(self%y))//')')
             return
+        end if
+        if (allocated(snap%physics)) then
+            if (.not. allocated(self%physics)) self%physics = scene_physics_text(self%scene)
+            call check_same_physics(snap%physics, self%physics, err)
+            if (allocated(err)) return
         end if
         if (size(snap%yq) /= size(self%yq)) then
             ! the same unknowns, other energy integrals (a moving support's work)
@@ -199,4 +208,31 @@ contains
         call self%stats_before%add(self%integrator%stats())
         call self%start_integrator(err)
     end procedure restart
+    !> A snapshot's rope and surroundings (`saved`, scene_physics_text) must be this
+    !! simulation's (`mine`): else ERR_USAGE naming the first line that differs and its group.
+    subroutine check_same_physics(saved, mine, err)
+        character(len=*), intent(in) :: saved, mine
+        type(error_t), allocatable, intent(out) :: err
+        character(len=1), parameter :: NL = new_line('a')
+        character(len=:), allocatable :: group
+        integer :: i, j, a, b
+        if (saved == mine) return
+        group = ''
+        i = 1
+        j = 1
+        do
+            a = index(saved(i:)//NL, NL)
+            b = index(mine(j:)//NL, NL)
+            if (saved(i:min(i + a - 2, len(saved))) /= mine(j:min(j + b - 2, len(mine)))) exit
+            if (i <= len(saved)) then
+                if (saved(i:i) == '&') group = ' (&'//saved(i + 1:i + a - 2)//')'
+            end if
+            i = i + a
+            j = j + b
+            if (i > len(saved) .and. j > len(mine)) return
+        end do
+        call make_error(err, ERR_USAGE, 'restore: the snapshot is of another scene: its "'// &
+            trim(adjustl(saved(i:min(i + a - 2, len(saved)))))//'" against this one''s "'// &
+            trim(adjustl(mine(j:min(j + b - 2, len(mine)))))//'"'//group)
+    end subroutine check_same_physics
 end submodule ropedyn_run_library

@@ -321,6 +321,10 @@ def test_simulation_calls_and_their_errors():
             assert error.value.code == 2
         with pytest.raises(ropedyn.Error, match="numbers, not") as error:
             sim.state = ["a", "b"]
+        # a t within rounding of the time reached does nothing (it ended the simulation:
+        # "step size fell below the round-off limit")
+        sim.advance(np.nextafter(0.1, 1.0))
+        assert sim.t == 0.1
         snap = sim.save()
         sim.advance(0.3)
         first = sim.state
@@ -338,6 +342,26 @@ def test_simulation_calls_and_their_errors():
                                  .set("supports.bottom_anchor", (0.9, 0.2)), statics=True)
     assert abs(statics.energy["kinetic"]) < 1e-20
     statics.close()
+
+
+def test_a_snapshot_restores_only_into_the_same_rope():
+    """A snapshot of one rope restored into a simulation of another rope with as many
+    unknowns was taken silently (its state on the other rope, a support where the other has
+    none): now refused, naming the first line of the two scenes that differs. Another
+    method or tolerance (&solver) or start (&initial) is the same rope."""
+    with ropedyn.Simulation(small(n=8)) as a:
+        a.advance(0.1)
+        snap = a.save()
+        with ropedyn.Simulation(small(n=8).set("rope.length", 3.0)) as b:
+            with pytest.raises(ropedyn.Error, match=r'restore: the snapshot is of another '
+                               r'scene: its "length = 1.0" against this one\'s "length = '
+                               r'3.0" \(&rope\)') as error:
+                b.restore(snap)
+            assert error.value.code == 2 and b.t == 0.0
+        other = small(n=8).set("solver.method", "mebdf").set("initial.angle_deg", 10.0)
+        with ropedyn.Simulation(other) as c:
+            c.restore(snap)
+            assert c.t == 0.1 and np.array_equal(c.state, a.state)
 
 
 @pytest.mark.parametrize("model", ["rfem", "mpp"])
@@ -450,7 +474,9 @@ def test_runs_in_one_process_keep_no_hdf5_types():
     interface's predefined types anew and never frees the copies: 55 type ids (about
     30 KB) a run into memory, 165 a run into a file, so a scan of 10^4 runs grew by
     hundreds of MB. The resident memory of 300 more runs now stays within 1 MB (before:
-    9 MB)."""
+    9 MB) in one of two batches of 300: the other may hold a step of about 2 MB that the
+    allocator takes or gives back once, at a moment that varies from process to process;
+    a leak grows both."""
     code = (
         "import ropedyn\n"
         "scene = ropedyn.Scene(\"&model kind = 'rfem', elements = 4 /\\n\"\n"
@@ -459,10 +485,13 @@ def test_runs_in_one_process_keep_no_hdf5_types():
         "    return int(open('/proc/self/statm').read().split()[1]) * 4\n"
         "for _ in range(50):\n"
         "    ropedyn.run(scene)\n"
-        "before = rss()\n"
-        "for _ in range(300):\n"
-        "    ropedyn.run(scene)\n"
-        "print(rss() - before)\n")
+        "growth = []\n"
+        "for batch in range(2):\n"
+        "    before = rss()\n"
+        "    for _ in range(300):\n"
+        "        ropedyn.run(scene)\n"
+        "    growth.append(rss() - before)\n"
+        "print(min(growth))\n")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                             timeout=300)
     assert result.returncode == 0, result.stderr
