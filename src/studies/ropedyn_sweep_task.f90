@@ -17,8 +17,8 @@
 !! Resume: a case whose file says `interrupted` is continued from its last record (the file
 !! is moved back to its .part name under the lock, `run_scene(..., resume=.true.)` appends
 !! to it, and it is renamed into place again), unless forced, which runs it anew. So is the
-!! .part a killed writer left (status `running`, records beyond the start, this case's
-!! scene): it is continued where it is.
+!! .part a killed writer left (status `running` or `interrupted`, records beyond the start,
+!! this case's scene): it is continued where it is.
 module ropedyn_sweep_task
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use ropedyn_kinds, only: wp
@@ -275,10 +275,11 @@ contains
         if (allocated(err)) removed = delete_file(part)
     end subroutine put_in_place
 
-    !> The status attribute of the run file `path` ('' when it cannot be read).
     !> `part` holds records of this very case beyond its start, written by a run that was
-    !! killed (status still `running`; its writer's lock is this task's now). A `part` that
-    !! another process holds open (HDF5's lock) is an ERR_IO error: not to be removed.
+    !! killed (status still `running`, or `interrupted`: the writer was killed after it
+    !! moved an interrupted case file back to its .part name, before the run reopened it;
+    !! its writer's lock is this task's now). A `part` that another process holds open
+    !! (HDF5's lock) is an ERR_IO error: not to be removed.
     logical function killed_part(c, part, err)
         type(sweep_case_t), intent(in) :: c
         character(len=*), intent(in) :: part
@@ -292,11 +293,15 @@ contains
             return
         end if
         if (.not. data%exists) return
-        killed_part = data%status == 'running' .and. data%records >= 2 .and. &
+        ! `interrupted`: an interrupted case file moved back to its .part name, or a run
+        ! stopped by a signal, whose writer was killed before it renamed the file
+        killed_part = (data%status == 'running' .or. data%status == 'interrupted') .and. &
+            data%records >= 2 .and. &
             echo_without_output_file(data%scene) == &
             echo_without_output_file(scene_namelist_text(c%scene))
     end function killed_part
 
+    !> The status attribute of the run file `path` ('' when it cannot be read).
     function file_status(path) result(status)
         character(len=*), intent(in) :: path
         character(len=:), allocatable :: status

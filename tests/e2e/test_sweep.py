@@ -454,6 +454,49 @@ def test_sigkill_to_a_worker_is_no_failed_case(run, ropedyn_exe, sweep_dir):
         assert "its run was killed or crashed" in f["solver/warnings"][-1].decode()
 
 
+def test_a_killed_continuation_of_an_interrupted_case_continues(run, ropedyn_exe,
+                                                                sweep_dir):
+    """A writer continuing an interrupted case moves the case file back to its .part name,
+    then reopens it (status `running`). Killed in between, it leaves a .part with status
+    `interrupted` and an abandoned lock; the next task continues that .part from its last
+    record (it was removed and the case run anew, losing the interrupted run's work)."""
+    (sweep_dir / "long.nml").write_text(LONG.format(rtols="1e-7"))
+    out = sweep_dir / "out" / "long"
+    part, final = out / ".case_0001.h5.part", out / "case_0001.h5"
+    first = subprocess.Popen([str(ropedyn_exe), "sweep", "long.nml", "--task", "1"],
+                             cwd=sweep_dir, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+    try:
+        wait_for(lambda: records_in(part) >= 3, timeout=120, what="3 records")
+        first.send_signal(signal.SIGTERM)
+        first.communicate(timeout=120)
+    finally:
+        if first.poll() is None:
+            first.kill()
+    assert first.returncode == 130
+    with h5py.File(final, "r") as f:
+        assert f.attrs["status"] == b"interrupted"
+        kept = f["time"][-1]
+    # the state of a writer killed right after it moved the file back: its lock (of a
+    # process that is gone) and the interrupted file under the .part name
+    final.rename(part)
+    gone = subprocess.Popen(["true"])
+    gone.wait()
+    (out / ".case_0001.lock").write_text(
+        f"ropedyn sweep case lock\nhost={socket.gethostname()}\npid={gone.pid}\n")
+    _, counts = status_lines(run, "long.nml")
+    assert counts["interrupted"] == 1, counts
+    again = run("sweep", "long.nml", "--task", "1")
+    assert again.returncode == 0, again.stderr
+    assert ("its writer was killed: continuing out/long/.case_0001.h5.part from its last "
+            "record") in again.stdout, again.stdout
+    with h5py.File(final, "r") as f:
+        assert f.attrs["status"] == b"complete" and abs(f["time"][-1] - 4.0) < 1e-12
+        assert f["solver/restarts/time"][:].tolist() == [kept]
+        assert f["solver/restarts/previous_status"][:].tolist() == [b"interrupted"]
+    assert not part.exists()
+
+
 def test_sigterm_to_a_worker_reports_its_case_interrupted(run, ropedyn_exe, sweep_dir):
     """A worker stopped by SIGTERM ends with ropedyn's exit code 130 and writes its case
     interrupted: the runner says so (not "ended by SIGINT", which 128 + 2 would read as),
