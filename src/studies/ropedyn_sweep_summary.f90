@@ -10,9 +10,11 @@
 module ropedyn_sweep_summary
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_text, only: int_text, real_text, significant_text, enclosed, text_t, &
+    use ropedyn_text, only: int_text, real_text, significant_text, enclosed, text_t, replaced, &
                             append_text
     use ropedyn_error, only: error_t, make_error, ERR_IO
+    use ropedyn_os, only: rename_file, delete_file
+    use ropedyn_process, only: process_id, host_name
     use ropedyn_sweep, only: sweep_t, sweep_case_t, REF_NONE, &
         REF_TIGHTEST_PER_METHOD, REF_FILE
     use ropedyn_sweep_status, only: case_state_t, case_state
@@ -303,7 +305,8 @@ contains
 
         path = sweep%output_dir//'/summary.csv'
         msg = ''
-        open (newunit=unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
+        open (newunit=unit, file=aside(path), status='replace', action='write', iostat=ios, &
+              iomsg=msg)
         if (ios /= 0) then
             call make_error(err, ERR_IO, path//': cannot write: '//trim(msg))
             return
@@ -347,7 +350,36 @@ contains
         end do
         if (ios /= 0) call make_error(err, ERR_IO, path//': cannot write: '//trim(msg))
         close (unit)
+        call put_in_place(path, err)
     end subroutine write_csv
+
+    !> `dir/.name.<host>.<pid>.part`: where this process writes the summary file `path`
+    !! before it renames it into place. Two runners of one sweep (or a runner and
+    !! `--summary`) then never write one file at once, and a reader sees a whole file:
+    !! the old one or the new one.
+    function aside(path) result(temp)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: temp
+        integer :: slash
+        slash = index(path, '/', back=.true.)
+        temp = path(:slash)//'.'//path(slash + 1:)//'.'//host_name()//'.'// &
+            int_text(process_id())//'.part'
+    end function aside
+
+    !> The summary file written aside renamed to `path`; when `err` is set, removed instead,
+    !! and the error names `path`.
+    subroutine put_in_place(path, err)
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(inout) :: err
+        logical :: removed
+        if (.not. allocated(err)) then
+            call rename_file(aside(path), path, err)
+            if (allocated(err)) removed = delete_file(aside(path))
+            return
+        end if
+        removed = delete_file(aside(path))
+        err%message = replaced(err%message, aside(path), path)
+    end subroutine put_in_place
 
     !> A measured or derived real for the table: six significant digits (no noise of the
     !! last binary digits: 0.091687, not 0.09168699999999999); empty when NaN.
@@ -420,8 +452,11 @@ contains
         type(h5_file_t) :: h5
         type(error_t), allocatable :: close_err
 
-        call h5%create(sweep%output_dir//'/summary.h5', err)
-        if (allocated(err)) return
+        call h5%create(aside(sweep%output_dir//'/summary.h5'), err)
+        if (allocated(err)) then
+            call put_in_place(sweep%output_dir//'/summary.h5', err)
+            return
+        end if
         steps: block
             call write_setting_columns(h5, sweep, rows, err)
             if (allocated(err)) exit steps
@@ -437,6 +472,7 @@ contains
         end block steps
         call h5%close(close_err)
         if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
+        call put_in_place(sweep%output_dir//'/summary.h5', err)
     end subroutine write_h5
 
     !> The columns of summary.h5 that say what each case is: id, status, model, elements,

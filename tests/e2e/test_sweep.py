@@ -621,6 +621,27 @@ def test_complete_only_if_it_reads_back(run, sweep_dir):
     assert rerun.stdout.count(": complete: ") == 2 and "0003: complete already" in rerun.stdout
 
 
+def test_summary_written_aside_and_renamed(run, sweep_dir):
+    """The summary files are written under a name of their own and renamed into place:
+    a reader holding summary.h5 open (HDF5's lock) does not stop the summary (exit 4,
+    "locked by another process", as did a second runner writing it at the same moment),
+    it keeps reading the old file, and nothing is left beside the new one."""
+    assert run("sweep", "sw.nml", "--task", "1-2").returncode == 0
+    out = sweep_dir / "out" / "sw"
+    assert run("sweep", "sw.nml", "--summary").returncode == 3
+    assert run("sweep", "sw.nml", "--task", "3").returncode == 0
+    with h5py.File(out / "summary.h5", "r") as held:
+        result = run("sweep", "sw.nml", "--summary")
+        assert result.returncode == 3 and "locked" not in result.stderr, result.stderr
+        assert [s.decode() for s in held["status"][:3]] == ["complete", "complete", "missing"]
+    with h5py.File(out / "summary.h5", "r") as f:
+        assert [s.decode() for s in f["status"][:3]] == ["complete"] * 3
+    assert [r["status"] for r in read_csv(out / "summary.csv")][:4] == \
+        ["complete"] * 3 + ["missing"]
+    assert sorted(p.name for p in out.iterdir() if "summary" in p.name) == \
+        ["summary.csv", "summary.h5"]
+
+
 def test_task_list_runs_on_after_a_failure(run, sweep_dir):
     result = run("sweep", "fail.nml", "--task", "1,3-4,2")
     assert result.returncode == 3
