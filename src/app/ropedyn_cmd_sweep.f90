@@ -48,7 +48,8 @@ contains
                     ' cases, 1 .. '//int_text(size(sweep%cases))//')')
                 return
             end if
-            call run_cases(sweep, opt%tasks, opt%force, opt%quiet, err)
+            call run_cases(sweep, once(opt%tasks, size(sweep%cases)), opt%force, opt%quiet, &
+                           err)
         else if (opt%summary) then
             call summarize(sweep, opt%quiet, err)
         else
@@ -137,6 +138,25 @@ contains
         end if
         if (.not. have_jobs) opt%jobs = processor_count()
     end subroutine parse_options
+
+    !> Each id of `ids` (1 .. n) once, at its first place: `--task 1,1-2` runs case 1 once
+    !! (with --force it ran twice).
+    pure function once(ids, n) result(kept)
+        integer, intent(in) :: ids(:), n
+        integer, allocatable :: kept(:)
+        logical :: seen(n)
+        integer :: k, m
+        allocate (kept(size(ids)))
+        seen = .false.
+        m = 0
+        do k = 1, size(ids)
+            if (seen(ids(k))) cycle
+            seen(ids(k)) = .true.
+            m = m + 1
+            kept(m) = ids(k)
+        end do
+        kept = kept(:m)
+    end function once
 
     !> Case ids from '7', '3-5' or '1,3-5,9' (each >= 1; at most 100000 of them), in the
     !! order given.

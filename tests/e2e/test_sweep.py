@@ -642,6 +642,15 @@ def test_summary_written_aside_and_renamed(run, sweep_dir):
         ["summary.csv", "summary.h5"]
 
 
+def test_a_case_named_twice_in_a_task_runs_once(run, sweep_dir):
+    """`--task 1,1,1-2 --force` ran case 1 three times (each anew): a case runs once, at
+    its first place in the list."""
+    result = run("sweep", "sw.nml", "--task", "1,1,1-2", "--force")
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.count("sweep: case 0001: complete") == 1, result.stdout
+    assert result.stdout.count("sweep: case 0002: complete") == 1, result.stdout
+
+
 def test_task_list_runs_on_after_a_failure(run, sweep_dir):
     result = run("sweep", "fail.nml", "--task", "1,3-4,2")
     assert result.returncode == 3
