@@ -177,7 +177,7 @@ contains
         call t%add_real(G_INITIAL, 'mode_amplitude', i%mode_amplitude, R_FINITE, 'm', &
             "shape 'mode': largest displacement")
         call t%add_pair(G_INITIAL, 'velocity', i%velocity, R_FINITE, 'm/s', &
-            'initial velocity (x, y) of every element')
+            'initial velocity (x, y) of every element (shapes straight, hanging, folded)')
         call t%add_path(G_INITIAL, 'state_file', i%state_file, &
             "shape 'state': run file (HDF5) whose record starts the run")
         call t%add_real(G_INITIAL, 'state_time', i%state_time, R_FINITE, 's', &

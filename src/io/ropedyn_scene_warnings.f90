@@ -95,6 +95,17 @@ contains
         if (scene%effects%ground) call ground_start(scene, list)
         if (scene%effects%ground) call ground_anchors(scene, list)
         call idle_groups(scene, list)
+        ! a start that sets the velocities itself (at rest, or the record's)
+        associate (i => scene%initial)
+            if (any(i%velocity /= 0.0_wp) .and. (i%shape == 'equilibrium' .or. &
+                i%shape == 'mode' .or. i%shape == 'state')) call append_text(list, &
+                scene%origin('initial.velocity')//': &initial: velocity = '// &
+                pair_text(i%velocity)//": does nothing: shape = '"//trim(i%shape)//"' "// &
+                trim(merge('starts from the record''s velocities', &
+                           'starts at rest                     ', &
+                           i%shape == 'state'))//' (it is used with the shapes straight, '// &
+                'hanging and folded)')
+        end associate
         associate (s => scene%supports)
             call idle_motion_keys(scene, 'top', s%top_motion, s%top_amplitude, &
                 s%top_frequency, s%top_phase_deg, s%top_angle_amplitude_deg, &

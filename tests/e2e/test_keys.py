@@ -102,6 +102,22 @@ def test_a_motion_key_its_motion_does_not_use_is_warned_of(run, tmp_path, sets, 
     assert len(warnings) == 1 and fragment in warnings[0], proc.stderr
 
 
+@pytest.mark.parametrize("shape,starts", [("equilibrium", "starts at rest"),
+                                          ("mode", "starts at rest")])
+def test_a_velocity_the_start_does_not_use_is_warned_of(run, tmp_path, shape, starts):
+    """`&initial velocity` with a start that sets the velocities itself did nothing without
+    a word; the other starts (straight, hanging, folded) take it."""
+    args = ["run", PAPER, "--set", "solver.t_end=1e-3", "--set", "output.file=v.h5",
+            "--set", "initial.velocity=1,2"]
+    proc = run(*args, "--set", f"initial.shape={shape}")
+    assert proc.returncode == 0, proc.stderr
+    assert scene_warnings(proc) == [
+        "ropedyn: warning: --set initial.velocity=1,2: &initial: velocity = 1.0, 2.0: does "
+        f"nothing: shape = '{shape}' {starts} (it is used with the shapes straight, hanging "
+        "and folded)"], proc.stderr
+    assert scene_warnings(run(*args, "--set", "initial.shape=hanging")) == []
+
+
 def test_an_idle_motion_key_in_a_scene_file_names_the_file(run, tmp_path):
     (tmp_path / "s.nml").write_text("&model elements = 4 /\n&supports top_ramp_time = 2.0 /\n"
                                     "&solver t_end = 1e-3 /\n")
