@@ -179,40 +179,43 @@ contains
 
     !> A resume of `part` (FILE.part) renames it to FILE when it ends if FILE is not there
     !! or holds a run of the same source (the run the killed one would have replaced); else
-    !! it keeps its name, with a warning saying why.
+    !! it keeps its name, with a warning saying why. The resumed run is a run of the source
+    !! the .part records: the scene's source from here on (a resume's scene has none, and
+    !! writes none: the file has its own).
     subroutine plan_rename(self, part)
         class(run_t), intent(inout) :: self
         character(len=*), intent(in) :: part
-        type(scene_t) :: probe
-        type(error_t), allocatable :: err
-        character(len=:), allocatable :: whole
+        character(len=:), allocatable :: whole, source
         whole = whole_name(part)
-        if (file_kind(whole, follow=.false.) /= FILE_MISSING) then
-            probe = self%scene
-            probe%source = stored_source(part)
-            if (len(probe%source) == 0) then
-                call make_error(err, ERR_USAGE, part//' records no source')
-            else
-                call check_may_replace(whole, probe, .false., err)
-            end if
-            if (allocated(err)) then
-                call append_text(self%summary%warnings, part//' keeps its name: '// &
-                    whole//' is there, not a file of its run to replace ('// &
-                    err%message//')')
-                return
-            end if
+        source = root_attribute(part, 'source')
+        if (len(source) > 0) then
+            self%scene%source = source
+            if (.not. may_take_name(self, part, whole, ' is there')) return
+        else if (file_kind(whole, follow=.false.) /= FILE_MISSING) then
+            call append_text(self%summary%warnings, part//' keeps its name: '//whole// &
+                ' is there, not a file of its run to replace ('//part//' records no source)')
+            return
         end if
         self%part_file = part
         self%final_file = whole
         self%recheck_final = .true.
     end subroutine plan_rename
 
-    !> The root attribute `source` of the run file `path` ('' when it has none).
-    function stored_source(path) result(source)
-        character(len=*), intent(in) :: path
-        character(len=:), allocatable :: source
-        source = root_attribute(path, 'source')
-    end function stored_source
+    !> May the run's file `part` take the name `whole` (FILE)? Yes when FILE is not there, or
+    !! holds a file the run may replace (a run of the scene's source: check_may_replace);
+    !! else a warning says why it keeps its name (`there`: how FILE is there).
+    logical function may_take_name(self, part, whole, there) result(may)
+        class(run_t), intent(inout) :: self
+        character(len=*), intent(in) :: part, whole, there
+        type(error_t), allocatable :: err
+        may = .true.
+        if (file_kind(whole, follow=.false.) == FILE_MISSING) return
+        call check_may_replace(whole, self%scene, .false., err, can_force=.false.)
+        if (.not. allocated(err)) return
+        may = .false.
+        call append_text(self%summary%warnings, part//' keeps its name: '//whole//there// &
+            ', not a file of its run to replace ('//err%message//')')
+    end function may_take_name
 
     !> The root attribute `name` (a string) of the HDF5 file `path`; '' when the file cannot
     !! be read or has none.
@@ -338,22 +341,13 @@ contains
 
     !> Before FILE.part is renamed to FILE at the end: a FILE there now is checked again
     !! (one put there while the run went on, by the user or another program), against the
-    !! source the .part records; when the run may not replace it, the run's file keeps its
-    !! .part name (part_file ''), with a warning saying why.
+    !! run's source (a new run's own, which its .part records; a resume's, plan_rename);
+    !! when the run may not replace it, the run's file keeps its .part name (part_file ''),
+    !! with a warning saying why.
     subroutine recheck_final(self)
         class(run_t), intent(inout) :: self
-        type(scene_t) :: probe
-        type(error_t), allocatable :: err
-        character(len=:), allocatable :: source
-        if (file_kind(self%final_file, follow=.false.) == FILE_MISSING) return
-        probe = self%scene
-        source = stored_source(self%part_file)
-        if (len(source) > 0) probe%source = source
-        call check_may_replace(self%final_file, probe, .false., err, can_force=.false.)
-        if (.not. allocated(err)) return
-        call append_text(self%summary%warnings, self%part_file//' keeps its name: '// &
-            self%final_file//' was put there while the run went on, not a file of its '// &
-            'run to replace ('//err%message//')')
+        if (may_take_name(self, self%part_file, self%final_file, &
+                          ' was put there while the run went on')) return
         self%summary%file = self%part_file
         self%part_file = ''
     end subroutine recheck_final
