@@ -9,6 +9,7 @@ module ropedyn_cmd_run
     use ropedyn_help, only: print_help
     use ropedyn_scene, only: scene_t, read_scene, read_scene_text
     use ropedyn_case_file, only: case_data_t, read_case_file
+    use ropedyn_h5, only: held_open
     use ropedyn_simulation, only: run_summary_t, run_scene
     use ropedyn_scene_warnings, only: print_warnings
     use ropedyn_version, only: version_string
@@ -121,7 +122,7 @@ contains
         call read_case_file(path, data, err)
         if (allocated(err)) then
             ! (a file another process holds open stays an output error, as a live lock)
-            if (index(err%message, ': cannot open: locked') > 0) return
+            if (held_open(err)) return
             err%code = ERR_INPUT   ! not a run file: bad input of --resume
             err%message = err%message//' (--resume needs a ropedyn run file)'
             return

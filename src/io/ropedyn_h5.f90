@@ -48,6 +48,7 @@ module ropedyn_h5
     use ropedyn_os, only: special_file_reason, try_lock, lock_holder, ERRNO_EWOULDBLOCK
     implicit none
     private
+    public :: held_open
 
     !> Target size of one chunk of a series, bytes.
     integer, parameter :: CHUNK_BYTES = 16384
@@ -444,6 +445,14 @@ module ropedyn_h5
     end interface
 
 contains
+
+    !> `err` is h5%open's refusal of a file another process holds open (HDF5's lock; the
+    !! message of ropedyn_h5_files's h5_open, "PATH: cannot open: locked by ..."): a file
+    !! being written or read, not a damaged one or no HDF5 file.
+    pure logical function held_open(err)
+        type(error_t), intent(in) :: err
+        held_open = index(err%message, ': cannot open: locked by ') > 0
+    end function held_open
 
     ! ---------------------------------------------------------------------------------------
     ! Library and file life cycle

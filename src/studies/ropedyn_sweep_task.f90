@@ -30,6 +30,7 @@ module ropedyn_sweep_task
     use ropedyn_scene, only: scene_t, scene_namelist_text, echo_without_output_file
     use ropedyn_simulation, only: run_summary_t, run_scene
     use ropedyn_case_file, only: case_data_t, read_case_file, finish_case_file
+    use ropedyn_h5, only: held_open
     use ropedyn_sweep_lock, only: take_lock, drop_lock, heartbeat_t
     use ropedyn_sweep, only: sweep_t, sweep_case_t
     use ropedyn_sweep_status, only: case_state_t, case_state, lock_path, part_path, &
@@ -289,7 +290,7 @@ contains
         call read_case_file(part, data, err)
         if (allocated(err)) then
             ! unreadable (damaged): run anew; locked: the caller's error
-            if (index(err%message, ': cannot open: locked') == 0) deallocate (err)
+            if (.not. held_open(err)) deallocate (err)
             return
         end if
         if (.not. data%exists) return
