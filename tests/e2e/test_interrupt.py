@@ -5,6 +5,7 @@ FILE` continues it and ends with the records of the uninterrupted run; a sweep c
 interrupted cases."""
 import os
 import random
+import re
 import signal
 import subprocess
 import time
@@ -235,6 +236,19 @@ def lock_file(path, age):
                     "started=2026-01-01T00:00:00Z\n")
     beat = time.time() - age
     os.utime(path, (beat, beat))
+    return beat
+
+
+def heartbeat_age(stderr, lock, beat):
+    """The age of the heartbeat the warning names for `lock` (whole seconds, on the
+    program's clock), checked against the time since `beat`: the wall clock moves on
+    between the test setting the heartbeat and the program reading it."""
+    found = re.search(rf"no heartbeat for (\d+) s\) \(lock {re.escape(lock)}\); continued",
+                      stderr)
+    assert found, stderr
+    age = int(found.group(1))
+    assert time.time() - beat - 1 <= age <= time.time() - beat + 1, (age, stderr)
+    return age
 
 
 def test_resume_of_a_killed_run(run, tmp_path, scene):
@@ -249,12 +263,13 @@ def test_resume_of_a_killed_run(run, tmp_path, scene):
     live = run("run", "--resume", "done.h5", "--set", "solver.t_end=5")
     assert live.returncode == 4, live.stderr
     assert "done.h5: being written by host elsewhere, pid 4711" in live.stderr
-    lock_file(tmp_path / "done.h5.lock", 3600)
+    beat = lock_file(tmp_path / "done.h5.lock", 3600)
     gone = run("run", "--resume", "done.h5", "--set", "solver.t_end=4.5")
     assert gone.returncode == 0, gone.stderr
+    age = heartbeat_age(gone.stderr, "done.h5.lock", beat)
     assert ("warning: done.h5: status running: its writer ended without finishing: killed, "
             "crashed or its node failed (host elsewhere, pid 4711, since "
-            "2026-01-01T00:00:00Z; no heartbeat for 3600 s) (lock done.h5.lock); continued "
+            f"2026-01-01T00:00:00Z; no heartbeat for {age} s) (lock done.h5.lock); continued "
             "from its last record, at t = 4.0 s") in gone.stderr, gone.stderr
     with h5py.File(tmp_path / "done.h5") as f:
         assert attr(f, "status") == "complete" and abs(f["time"][-1] - 4.5) < 1e-12
@@ -276,7 +291,7 @@ def test_resume_of_a_killed_run(run, tmp_path, scene):
             "2026-01-01T00:00:00Z (lock p.h5.lock)") in writing.stderr, writing.stderr
     # a run without --force is refused before it touches the abandoned lock, which then
     # tells the resume who wrote the file
-    lock_file(tmp_path / "p.h5.lock", 3600)
+    beat = lock_file(tmp_path / "p.h5.lock", 3600)
     refused = run("run", scene, "--set", "output.file='p.h5'")
     assert refused.returncode == 2 and "p.h5.part: left by a run of p.h5" in refused.stderr
     assert (tmp_path / "p.h5.lock").exists()
@@ -289,7 +304,7 @@ def test_resume_of_a_killed_run(run, tmp_path, scene):
     keep.write_bytes((tmp_path / "p.h5.part").read_bytes())
     resumed = run("run", "--resume", "p.h5.part", "--set", "solver.t_end=5")
     assert resumed.returncode == 0, resumed.stderr
-    assert "no heartbeat for 3600 s) (lock p.h5.lock); continued" in resumed.stderr
+    heartbeat_age(resumed.stderr, "p.h5.lock", beat)
     # renamed to FILE at its end, as the killed run's file would have been
     assert "output          p.h5\n" in resumed.stdout, resumed.stdout
     assert not (tmp_path / "p.h5.part").exists() and not (tmp_path / "p.h5.lock").exists()
