@@ -24,7 +24,7 @@ module ropedyn_sweep_status
     use ropedyn_sweep, only: sweep_case_t
     implicit none
     private
-    public :: case_state_t, case_state, lock_path, part_path, STATUS_NAMES
+    public :: case_state_t, case_state, lock_path, part_path, holds_case_scene, STATUS_NAMES
     public :: write_failure_note, drop_failure_note
 
     !> Every status, in the order of `--status`.
@@ -41,6 +41,17 @@ module ropedyn_sweep_status
     end type case_state_t
 
 contains
+
+    !> A run file whose effective scene is `stored` holds case c: the same scene, its own
+    !! &output file aside (the output directory may be spelled another way, or moved, and
+    !! a .part names itself).
+    function holds_case_scene(c, stored) result(holds)
+        type(sweep_case_t), intent(in) :: c
+        character(len=*), intent(in) :: stored
+        logical :: holds
+        holds = echo_without_output_file(stored) == &
+            echo_without_output_file(scene_namelist_text(c%scene))
+    end function holds_case_scene
 
     !> `<output_dir>/.case_<id>.lock`, the lock of the case file `file`.
     pure function lock_path(file) result(path)
@@ -85,10 +96,7 @@ contains
                 state%status = 'missing'
                 state%reason = failure_note(c%file)
                 if (len(state%reason) > 0) state%status = 'failed'
-            else if (echo_without_output_file(state%data%scene) /= &
-                     echo_without_output_file(scene_namelist_text(c%scene))) then
-                ! (the case file's own path aside: the output directory may be spelled
-                ! another way, or moved)
+            else if (.not. holds_case_scene(c, state%data%scene)) then
                 state%status = 'stale'
                 state%reason = 'the file holds another scene than this case (the sweep ' &
                     //'changed); run the sweep again'

@@ -27,13 +27,14 @@ module ropedyn_sweep_task
     use ropedyn_os, only: make_dirs, rename_file, delete_file
     use ropedyn_clock, only: clock_seconds
     use ropedyn_signals, only: catch_signals, release_signals, signal_received, signal_name
-    use ropedyn_scene, only: scene_t, scene_namelist_text, echo_without_output_file
+    use ropedyn_scene, only: scene_t, scene_namelist_text
     use ropedyn_simulation, only: run_summary_t, run_scene
     use ropedyn_case_file, only: case_data_t, read_case_file, finish_case_file
     use ropedyn_h5, only: held_open
     use ropedyn_sweep_lock, only: take_lock, drop_lock, heartbeat_t
     use ropedyn_sweep, only: sweep_t, sweep_case_t
     use ropedyn_sweep_status, only: case_state_t, case_state, lock_path, part_path, &
+        holds_case_scene, &
         write_failure_note, drop_failure_note
     implicit none
     private
@@ -297,9 +298,7 @@ contains
         ! `interrupted`: an interrupted case file moved back to its .part name, or a run
         ! stopped by a signal, whose writer was killed before it renamed the file
         killed_part = (data%status == 'running' .or. data%status == 'interrupted') .and. &
-            data%records >= 2 .and. &
-            echo_without_output_file(data%scene) == &
-            echo_without_output_file(scene_namelist_text(c%scene))
+            data%records >= 2 .and. holds_case_scene(c, data%scene)
     end function killed_part
 
     !> The status attribute of the run file `path` ('' when it cannot be read).
