@@ -7,7 +7,7 @@ module ropedyn_text
     private
     public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, enclosed
     public :: significant_text, decimal_product
-    public :: lower, line_quote, replaced
+    public :: lower, line_quote, replaced, stripped
     public :: text_t, append_text, text_array, printable, clip, name_hint, edit_distance
 
     !> A string of any length, for lists of strings of different lengths.
@@ -267,6 +267,22 @@ contains
             if (c >= iachar('A') .and. c <= iachar('Z')) t(i:i) = achar(c + 32)
         end do
     end function lower
+
+    !> `text` without the blanks and tabs at its ends (a namelist file's white space; a
+    !! command line's `--set` argument may carry tabs where a file would).
+    pure function stripped(text) result(s)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: s
+        character(len=*), parameter :: WHITE = ' '//achar(9)
+        integer :: first, last
+        first = verify(text, WHITE)
+        last = verify(text, WHITE, back=.true.)
+        if (first == 0) then
+            s = ''
+        else
+            s = text(first:last)
+        end if
+    end function stripped
 
     !> A line for a message: in double quotes, trailing blanks removed, long lines shortened,
     !! control characters shown as `printable` does.

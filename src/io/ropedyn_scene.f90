@@ -11,7 +11,7 @@
 module ropedyn_scene
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_text, only: int_text, real_text, lower, line_quote, printable, text_t, clip, &
-        append_text
+        append_text, stripped
     use ropedyn_namelist_file, only: nml_file_t, nml_value_t, read_namelist_file, &
         parse_namelist_lines, parse_values, V_STRING
     use ropedyn_scene_types, only: scene_t, solver_params_t, output_params_t
@@ -267,7 +267,7 @@ contains
         character(len=:), allocatable :: s, lhs, group, loc, base, reason
         integer :: eq, dot, paren
 
-        s = trim(adjustl(arg))
+        s = stripped(arg)
         ov%text = clip(printable(s))
         loc = '--set '//ov%text
         if (printable(s) /= s) then
@@ -279,8 +279,8 @@ contains
             call make_error(err, ERR_INPUT, loc//': expected group.key=value')
             return
         end if
-        lhs = trim(s(:eq - 1))
-        ov%value = trim(adjustl(s(eq + 1:)))
+        lhs = stripped(s(:eq - 1))
+        ov%value = stripped(s(eq + 1:))
         dot = index(lhs, '.')
         if (dot <= 1 .or. dot >= len(lhs)) then
             call make_error(err, ERR_INPUT, loc//': expected group.key=value')
@@ -290,8 +290,8 @@ contains
                 "written '')")
             return
         end if
-        group = lower(trim(lhs(:dot - 1)))
-        ov%name = lower(trim(adjustl(lhs(dot + 1:))))
+        group = lower(stripped(lhs(:dot - 1)))
+        ov%name = lower(stripped(lhs(dot + 1:)))
         ov%group = group_index(group)
         if (ov%group == 0) then
             call make_error(err, ERR_INPUT, loc//': unknown group "'//clip(printable(group))// &
