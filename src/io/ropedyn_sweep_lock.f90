@@ -18,6 +18,8 @@
 !!
 !! - it records a signal (`signal=15`, appended by writers of earlier versions when a
 !!   signal ended them; a writer now stops its case itself): abandoned;
+!! - it records why its writer is gone (`gone=...`: a lock handed back by a process that
+!!   took it over and then did not write, `hand_back_lock`): abandoned;
 !! - on this machine (the same host name and boot id): live while process `pid` exists
 !!   with the same start time, abandoned as soon as it does not;
 !! - on another machine: live while its heartbeat is at most LOCK_ABANDONED_AFTER s old (the
@@ -38,7 +40,8 @@ module ropedyn_sweep_lock
         start_heartbeat, stop_heartbeat, slurm_job, heartbeat_t
     implicit none
     private
-    public :: lock_t, read_lock, take_lock, drop_lock, LOCK_BEAT, LOCK_ABANDONED_AFTER
+    public :: lock_t, read_lock, take_lock, drop_lock, hand_back_lock, LOCK_BEAT
+    public :: LOCK_ABANDONED_AFTER
     public :: heartbeat_t
 
     integer, parameter :: LOCK_BEAT = 15                !< s between heartbeats
@@ -60,6 +63,10 @@ module ropedyn_sweep_lock
         integer(int64) :: age = 0      !< s since then
         !> '' or why the lock's path cannot be a lock (not a regular file: a FIFO, ...)
         character(len=:), allocatable :: problem
+        !> the file's lines as read (without `gone=`), for `hand_back_lock`
+        character(len=:), allocatable :: text
+        !> why its writer is gone, as a `gone=` line of a handed-back lock says ('': none)
+        character(len=:), allocatable :: gone_note
     contains
         procedure :: holder => lock_holder
         procedure :: gone => lock_gone
@@ -80,6 +87,8 @@ contains
         lock%boot = ''
         lock%job = ''
         lock%started = ''
+        lock%text = ''
+        lock%gone_note = ''
         lock%problem = special_file_reason(path)
         if (len(lock%problem) > 0) then
             ! a FIFO would block the open: not a lock of ropedyn, nor is a device
@@ -101,9 +110,10 @@ contains
             eq = index(line, '=')
             if (eq < 2) cycle
             select case (line(:eq - 1))
-            case ('host', 'boot', 'job', 'started', 'pid', 'start_ticks', 'signal')
+            case ('host', 'boot', 'job', 'started', 'pid', 'start_ticks', 'signal', 'gone')
                 known = .true.
             end select
+            if (line(:eq - 1) /= 'gone') lock%text = lock%text//trim(line)//new_line('a')
             select case (line(:eq - 1))
             case ('host')
                 lock%host = trim(line(eq + 1:))
@@ -119,6 +129,8 @@ contains
                 read (line(eq + 1:), *, iostat=ios) lock%start_ticks
             case ('signal')
                 read (line(eq + 1:), *, iostat=ios) lock%signal
+            case ('gone')
+                lock%gone_note = trim(line(eq + 1:))
             end select
         end do
         close (unit)
@@ -135,7 +147,7 @@ contains
             return
         end if
         lock%age = max(0_int64, unix_time() - lock%changed)
-        if (lock%signal > 0) then
+        if (lock%signal > 0 .or. len(lock%gone_note) > 0) then
             lock%live = .false.
         else if (lock%pid <= 0) then
             ! not written yet (just created) or damaged: live while young
@@ -189,7 +201,9 @@ contains
     function lock_gone(self) result(text)
         class(lock_t), intent(in) :: self
         character(len=:), allocatable :: text
-        if (self%signal > 0) then
+        if (len(self%gone_note) > 0) then
+            text = self%gone_note
+        else if (self%signal > 0) then
             text = 'stopped by '//signal_name(self%signal)//' at '//utc_text(self%changed)// &
                 ' ('//self%holder()//')'
         else if (this_machine(self)) then
@@ -273,6 +287,24 @@ contains
         call stop_heartbeat(beat)
         removed = delete_file(path)
     end subroutine drop_lock
+
+    !> Stop the lock's heartbeat and give the lock `path` back to the writer that held it
+    !! before this process took it over (`before`, abandoned, as read then): its lines, and
+    !! why that writer is gone (`gone=`), so that the lock stays abandoned and goes on naming
+    !! it. For a process that took over an abandoned lock and then wrote nothing (a refused
+    !! resume). The lock is removed when it cannot be written.
+    subroutine hand_back_lock(path, beat, before)
+        character(len=*), intent(in) :: path
+        type(heartbeat_t), intent(inout) :: beat
+        type(lock_t), intent(in) :: before
+        integer :: unit, ios
+        logical :: removed
+        call stop_heartbeat(beat)
+        open (newunit=unit, file=path, status='replace', action='write', iostat=ios)
+        if (ios == 0) write (unit, '(a)', iostat=ios) before%text//'gone='//before%gone()
+        if (ios == 0) close (unit, iostat=ios)
+        if (ios /= 0) removed = delete_file(path)
+    end subroutine hand_back_lock
 
     !> Create `path` if it does not exist (O_CREAT|O_EXCL); `created` false if it existed.
     subroutine create_exclusive(path, created, err)

@@ -59,6 +59,7 @@ module ropedyn_run
     use ropedyn_energy_monitor, only: energy_monitor_t, safety_record_t, loss_warning
     use ropedyn_state_start, only: state_initial_state
     use ropedyn_process, only: heartbeat_t
+    use ropedyn_sweep_lock, only: lock_t
     implicit none
     private
     public :: run_t, run_summary_t, run_snapshot_t, STEP_RECORDED, STEP_STOPPED, STEP_FAILED
@@ -171,6 +172,9 @@ module ropedyn_run
         !> a resume: why the writer of the file is gone, from its abandoned lock ('': no
         !! lock of it was there); said when the file's status is still `running`
         character(len=:), allocatable :: writer_gone
+        !> a resume: the abandoned lock it took over (exists false: none), handed back when
+        !! the resume is refused, so that the lock goes on naming the killed writer
+        type(lock_t) :: taken_over
         !> FILE (final_file) is checked again before FILE.part is renamed over it: a file put
         !! there while the run went on is replaced only if the run may replace it (no --force)
         logical :: recheck_final = .false.
@@ -212,7 +216,7 @@ module ropedyn_run
                               start_monitor
         procedure, private :: resume_from_file, check_energy, second_look, note_peak, &
                               fail_runaway, rescue, retire_integrator, keep_switches
-        procedure, private :: guard_output, release_output, file_warnings
+        procedure, private :: guard_output, release_output, hand_back, file_warnings
     end type run_t
 
     interface
@@ -231,6 +235,12 @@ module ropedyn_run
             class(run_t), intent(inout) :: self
             type(error_t), allocatable, intent(inout) :: err
         end subroutine release_output
+
+        !> A refused resume: the abandoned lock it took over goes back to its killed writer
+        !! (naming it still; the lock is then not the run's to drop).
+        module subroutine hand_back(self)
+            class(run_t), intent(inout) :: self
+        end subroutine hand_back
 
         !> Resume: the last record of the run file as the starting point, the file reopened
         !! (an off-grid last record cut), the restart recorded (submodule
@@ -429,8 +439,12 @@ contains
         end if
         call start_from(self, resuming, err)
         if (allocated(err) .and. guarding) then
-            ! (a refused resume leaves its file where it is: no FILE.part renamed to FILE)
-            if (resuming) self%part_file = ''
+            ! (a refused resume leaves its file where it is: no FILE.part renamed to FILE,
+            ! and the abandoned lock it took over to its killed writer)
+            if (resuming) then
+                self%part_file = ''
+                call self%hand_back()
+            end if
             call self%release_output(err)
         end if
     end subroutine run_open

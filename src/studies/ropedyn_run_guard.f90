@@ -20,7 +20,7 @@ submodule (ropedyn_run) ropedyn_run_guard
     use ropedyn_os, only: make_parent_dirs, rename_file, delete_file, special_file_reason, &
                           file_kind, real_path, written_path, errno_text, FILE_SYMLINK, &
                           FILE_MISSING
-    use ropedyn_sweep_lock, only: take_lock, drop_lock, read_lock, lock_t
+    use ropedyn_sweep_lock, only: take_lock, drop_lock, read_lock, hand_back_lock, lock_t
     use ropedyn_run_inputs, only: check_not_input, check_may_replace
     use ropedyn_error, only: ERR_USAGE, ERR_IO
     use ropedyn_h5, only: h5_file_t
@@ -151,8 +151,10 @@ contains
         if (is_part(real_file)) lock_path = whole_name(real_file)//'.lock'
         self%writer_gone = ''
         call read_lock(lock_path, lock)
-        if (lock%exists .and. .not. lock%live .and. len(lock%problem) == 0) &
+        if (lock%exists .and. .not. lock%live .and. len(lock%problem) == 0) then
             self%writer_gone = lock%gone()//' (lock '//lock_path//')'
+            self%taken_over = lock
+        end if
         call take_lock(lock_path, self%beat, err)
         if (allocated(err)) then
             err%message = file//': '//err%message
@@ -338,6 +340,13 @@ contains
             self%lock_file = ''
         end if
     end procedure release_output
+
+    module procedure hand_back
+        if (.not. self%taken_over%exists .or. .not. allocated(self%lock_file)) return
+        if (len(self%lock_file) == 0) return
+        call hand_back_lock(self%lock_file, self%beat, self%taken_over)
+        self%lock_file = ''
+    end procedure hand_back
 
     !> Before FILE.part is renamed to FILE at the end: a FILE there now is checked again
     !! (one put there while the run went on, by the user or another program), against the

@@ -302,6 +302,10 @@ def test_resume_of_a_killed_run(run, tmp_path, scene):
         in named.stderr, named.stderr
     keep = tmp_path / "keep.h5.part"
     keep.write_bytes((tmp_path / "p.h5.part").read_bytes())
+    # a refused resume gives the lock back, abandoned though its heartbeat is new
+    nothing = run("run", "--resume", "p.h5.part", "--set", "solver.t_end=4.5")
+    assert nothing.returncode == 2 and "nothing to continue" in nothing.stderr
+    assert "host=elsewhere" in (tmp_path / "p.h5.lock").read_text()
     resumed = run("run", "--resume", "p.h5.part", "--set", "solver.t_end=5")
     assert resumed.returncode == 0, resumed.stderr
     heartbeat_age(resumed.stderr, "p.h5.lock", beat)

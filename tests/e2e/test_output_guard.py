@@ -4,6 +4,7 @@ did not write or an input of the run is never replaced (exit 2, the file unchang
 --force (never an input); a second run on a locked file is refused; a killed run leaves the
 earlier file whole and its data in FILE.part; an interrupted run ends in FILE."""
 import hashlib
+import socket
 import signal
 import subprocess
 import time
@@ -176,11 +177,17 @@ def test_a_killed_run_leaves_the_earlier_file_whole(run, ropedyn_exe, tmp_path, 
     with h5py.File(part, "r") as f:
         assert f.attrs["status"] == b"running" and len(f["time"]) >= 2
         last = f["time"][-1]
+    # a refused resume takes the killed run's lock and gives it back: it goes on naming
+    # the killed writer
+    nothing = run("run", "--resume", "out/paper.h5.part", "--set", f"solver.t_end={last}")
+    assert nothing.returncode == 2 and "nothing to continue" in nothing.stderr, nothing.stderr
+    assert f"pid={proc.pid}" in (tmp_path / "out" / "paper.h5.lock").read_text()
     # its writer is gone (no live lock): continued as it is, with a warning
     resumed = run("run", "--resume", "out/paper.h5.part", "--set", f"solver.t_end={last + 0.05}")
     assert resumed.returncode == 0, resumed.stderr
-    assert ("status running: its writer ended without finishing: killed or crashed"
-            in resumed.stderr), resumed.stderr
+    assert ("status running: its writer ended without finishing: killed or crashed "
+            f"(host {socket.gethostname()}, pid {proc.pid}" in resumed.stderr), resumed.stderr
+    assert not (tmp_path / "out" / "paper.h5.lock").exists()
     assert digest(out) == before
 
 
