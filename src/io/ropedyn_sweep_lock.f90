@@ -224,9 +224,13 @@ contains
         type(lock_t) :: lock
         logical :: created, removed
         integer :: attempt
+        character(len=:), allocatable :: holder
 
+        ! who this writer is, found before the lock is made and written in the open that
+        ! makes it: a writer killed in between leaves no lock, or a whole one
+        holder = holder_text()
         do attempt = 1, 2
-            call create_exclusive(path, created, err)
+            call create_exclusive(path, created, err, holder)
             if (allocated(err)) return
             if (created) exit
             call read_lock(path, lock)
@@ -260,7 +264,7 @@ contains
                 return
             end if
             if (lock%exists) removed = delete_file(path)
-            call create_exclusive(path, created, err)
+            call create_exclusive(path, created, err, holder)
             removed = delete_file(path//'.break')
             if (allocated(err)) return
             if (.not. created) then
@@ -274,8 +278,6 @@ contains
             call make_error(err, ERR_IO, path//': cannot take the lock')
             return
         end if
-        call write_holder(path, err)
-        if (allocated(err)) return
         call start_heartbeat(path, LOCK_BEAT, beat, err)
     end subroutine take_lock
 
@@ -306,39 +308,38 @@ contains
         if (ios /= 0) removed = delete_file(path)
     end subroutine hand_back_lock
 
-    !> Create `path` if it does not exist (O_CREAT|O_EXCL); `created` false if it existed.
-    subroutine create_exclusive(path, created, err)
+    !> Create `path` if it does not exist (O_CREAT|O_EXCL), with the lines `text` if given;
+    !! `created` false if it existed.
+    subroutine create_exclusive(path, created, err, text)
         character(len=*), intent(in) :: path
         logical, intent(out) :: created
         type(error_t), allocatable, intent(out) :: err
+        character(len=*), intent(in), optional :: text
         integer :: unit, ios
         logical :: exists
         character(len=256) :: msg
         open (newunit=unit, file=path, status='new', action='write', iostat=ios, iomsg=msg)
         created = ios == 0
         if (created) then
-            close (unit)
+            if (present(text)) write (unit, '(a)', iostat=ios, iomsg=msg) text
+            if (ios == 0) close (unit, iostat=ios, iomsg=msg)
+            if (ios /= 0) then
+                ! a lock that does not say who holds it would hold its file for 120 s
+                exists = delete_file(path)
+                call make_error(err, ERR_IO, path//': cannot write: '//trim(msg))
+            end if
             return
         end if
         inquire (file=path, exist=exists)
         if (.not. exists) call make_error(err, ERR_IO, path//': cannot create: '//trim(msg))
     end subroutine create_exclusive
 
-    !> Write who holds the lock into it.
-    subroutine write_holder(path, err)
-        character(len=*), intent(in) :: path
-        type(error_t), allocatable, intent(out) :: err
-        character(len=256) :: msg
-        integer :: unit, ios
-        open (newunit=unit, file=path, status='old', action='write', position='append', &
-              iostat=ios, iomsg=msg)
-        if (ios == 0) write (unit, '(a)', iostat=ios, iomsg=msg) LOCK_HEADER// &
-            new_line('a')//'host='//host_name()//new_line('a')//'boot='//boot_id()// &
-            new_line('a')//'pid='// &
-            int_text(process_id())//new_line('a')//'start_ticks='// &
-            int_text(process_start(0))//new_line('a')//'started='//utc_timestamp()// &
-            new_line('a')//'job='//slurm_job()
-        if (ios == 0) close (unit, iostat=ios, iomsg=msg)
-        if (ios /= 0) call make_error(err, ERR_IO, path//': cannot write: '//trim(msg))
-    end subroutine write_holder
+    !> Who holds a lock this process takes: the lines written into it.
+    function holder_text() result(text)
+        character(len=:), allocatable :: text
+        text = LOCK_HEADER//new_line('a')//'host='//host_name()//new_line('a')//'boot='// &
+            boot_id()//new_line('a')//'pid='//int_text(process_id())//new_line('a')// &
+            'start_ticks='//int_text(process_start(0))//new_line('a')//'started='// &
+            utc_timestamp()//new_line('a')//'job='//slurm_job()
+    end function holder_text
 end module ropedyn_sweep_lock
