@@ -27,7 +27,8 @@ def _value_text(value):
     if isinstance(value, bool):
         return ".true." if value else ".false."
     if isinstance(value, float):
-        return repr(value)
+        # float(): numpy's float64 is a float whose repr is "np.float64(2.0)" (numpy 2)
+        return repr(float(value))
     if isinstance(value, (list, tuple)):
         return ", ".join(_value_text(v) for v in value)
     if hasattr(value, "tolist"):   # numpy scalars and arrays

@@ -67,6 +67,21 @@ def test_bad_scene_and_bad_set_raise_the_cli_message(run, tmp_path):
         scene.set("solver.nosuchkey", 1)
 
 
+def test_set_takes_numpy_numbers():
+    """A numpy float64 (what a scan over np.linspace gives) is a float whose repr under
+    numpy 2 is "np.float64(2.0)": the setting "rope.length=np.float64(2.0)" was refused
+    ("cannot read length"). Other numpy scalars and arrays went through tolist()."""
+    scene = small(n=4)
+    scene.set("rope.length", np.float64(2.5)).set("model.elements", np.int64(6))
+    scene.set({"solver.rtol": np.float32(1e-5), "supports.top_anchor": np.array([0.0, 0.1]),
+               "effects.drag": np.bool_(True)})
+    assert scene.get("rope.length") == 2.5 and scene.get("model.elements") == 6
+    assert scene.get("solver.rtol") == float(np.float32(1e-5))
+    assert scene.get("supports.top_anchor") == [0.0, 0.1] and scene.get("effects.drag")
+    for ea in np.linspace(100.0, 300.0, 2):   # the loop of examples/scan_ea.py
+        assert scene.copy().set("rope.young_modulus", ea).get("rope.young_modulus") == ea
+
+
 def test_a_method_that_cannot_integrate_the_model_is_bad_input(run, tmp_path):
     """The symplectic method named for the MPP: exit 2 and no file from the command line,
     an input error from the library, both naming &solver method and the reason."""
