@@ -41,3 +41,8 @@ def __getattr__(name):
         import importlib
         return getattr(importlib.import_module(_LAZY[name]), name)
     raise AttributeError(f"module 'ropedyn' has no attribute {name!r}")
+
+
+def __dir__():
+    # the lazy names too: dir(ropedyn), help() and a notebook's completion list them
+    return sorted(set(globals()) | set(_LAZY))

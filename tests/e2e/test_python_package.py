@@ -71,6 +71,14 @@ def test_import_from_another_directory(tmp_path):
     assert "No module named 'ropedyn_tools'" in result.stderr
 
 
+def test_dir_lists_the_lazy_names():
+    """The package loads Scene, Simulation, run, ... on first use (module __getattr__);
+    without a module __dir__ they were missing from dir(ropedyn), so a notebook's
+    completion of "ropedyn." offered none of them."""
+    import ropedyn
+    assert set(ropedyn.__all__) <= set(dir(ropedyn))
+
+
 def test_package_holds_no_tools():
     """What `pip install python/` installs is the user's package: no studies, no
     maintenance tools, no module that knows the repository's layout."""
