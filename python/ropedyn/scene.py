@@ -11,6 +11,7 @@ of `--set`, and a bad one raises ropedyn.Error and leaves the scene as it was.
 """
 import ctypes
 import pathlib
+import re
 
 from ropedyn._lib import c_handle, library
 from ropedyn.errors import Error, message_text
@@ -34,6 +35,21 @@ def _value_text(value):
     if hasattr(value, "tolist"):   # numpy scalars and arrays
         return _value_text(value.tolist())
     return str(value)
+
+
+def _unset_keys(text):
+    """{group: {key, ...}}: the keys that the effective scene text shows as not set, on
+    comment lines "! key = (not set: ...)"."""
+    unset, group = {}, None
+    for line in text.splitlines():
+        start = re.match(r"\s*&(\w+)", line)
+        if start:
+            group = start.group(1).lower()
+            continue
+        key = re.match(r"\s*!\s*(\w+)\s*=\s*\(not set\b", line)
+        if key and group:
+            unset.setdefault(group, set()).add(key.group(1).lower())
+    return unset
 
 
 class _Handle:
@@ -133,13 +149,16 @@ class Scene:
         return self
 
     def get(self, key):
-        """The value of "group.key" (a number, bool, string, or a list for a pair); a key
-        that does not exist raises KeyError."""
+        """The value of "group.key" (a number, bool, string, or a list for a pair); None
+        for a key that is not set (an optional key with no default, which the text shows as
+        "! key = (not set: ...)"); a key that does not exist raises KeyError."""
         group, _, name = key.lower().partition(".")
         values = parse_namelist(self._text).get(group, {})
-        if name not in values:
-            raise KeyError(key)
-        return values[name]
+        if name in values:
+            return values[name]
+        if name in _unset_keys(self._text).get(group, ()):
+            return None
+        raise KeyError(key)
 
     def write(self, path):
         """Write the scene to `path` (a scene file: it reads in again to this scene)."""

@@ -82,6 +82,21 @@ def test_set_takes_numpy_numbers():
         assert scene.copy().set("rope.young_modulus", ea).get("rope.young_modulus") == ea
 
 
+def test_get_of_a_key_not_set_is_none():
+    """An optional key with no default (rope.mass_per_length, output.progress, ...) is in
+    the effective text as "! key = (not set: ...)": get raised KeyError for it, as for a
+    key that does not exist. It gives None; a key that does not exist still raises."""
+    scene = small(n=4)
+    assert "! mass_per_length = (not set" in scene.text
+    assert scene.get("rope.mass_per_length") is None
+    assert scene.get("Output.Progress") is None
+    with pytest.raises(KeyError):
+        scene.get("rope.no_such_key")
+    with pytest.raises(KeyError):
+        scene.get("model.mass_per_length")   # a key of another group
+    assert scene.set("output.progress", False).get("output.progress") is False
+
+
 def test_a_method_that_cannot_integrate_the_model_is_bad_input(run, tmp_path):
     """The symplectic method named for the MPP: exit 2 and no file from the command line,
     an input error from the library, both naming &solver method and the reason."""
