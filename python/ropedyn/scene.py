@@ -110,7 +110,7 @@ class Scene:
     def __init__(self, text, name="scene"):
         """The scene of namelist `text`; `name` stands for its file in messages and in the
         default output file (out/NAME.h5). Relative paths in it are relative to the
-        current directory."""
+        folder of `name`, or to the current directory when `name` has none."""
         self.name = str(name)
         with _open(str(text), self.name) as handle:
             self._text = handle.text(handle.lib.ropedyn_scene_text)
