@@ -19,7 +19,7 @@
 module ropedyn_integrator
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
-    use ropedyn_text, only: int_text, real_text, significant_text
+    use ropedyn_text, only: int_text, real_text, significant_text, es_text
     use ropedyn_problem, only: problem_t
     use ropedyn_methods, only: METHODS, method_index, resolved_max_order
     use ropedyn_switch_log, only: switch_event_t
@@ -391,12 +391,11 @@ contains
         type(switch_event_t), intent(in) :: events(:)
         character(len=:), allocatable :: text
         integer :: k
-        character(len=16) :: at
         text = ''
         do k = size(events), 1, -1
             if (.not. events(k)%warning) cycle
-            write (at, '(es10.3)') events(k)%t
-            text = '; the run had diagnosed at t = '//trim(adjustl(at))//' s: '//events(k)%reason
+            text = '; the run had diagnosed at t = '//trim(adjustl(es_text(events(k)%t, 10, 3)))// &
+                ' s: '//events(k)%reason
             exit
         end do
     end function last_warning

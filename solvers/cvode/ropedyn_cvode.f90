@@ -18,7 +18,7 @@
 module ropedyn_cvode
     use, intrinsic :: iso_c_binding
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, es_text
     use ropedyn_c_strings, only: c_string
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK

@@ -330,7 +330,8 @@ contains
         real(wp), intent(in) :: t, h
         character(len=:), allocatable :: text
         character(len=64) :: buffer
-        write (buffer, '(a, es12.5, a, es11.3e3, a)') 't = ', t, ' s, step size ', h, ' s'
+        write (buffer, '(a, a, a, es11.3e3, a)') 't = ', es_text(t, 12, 5), ' s, step size ', &
+            h, ' s'
         text = trim(buffer)
     end function where_text
 end submodule ropedyn_cvode_stepping

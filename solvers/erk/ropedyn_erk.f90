@@ -37,7 +37,7 @@ module ropedyn_erk
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp, i8
     use ropedyn_sums, only: sum_squares
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, es_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
     use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t, &
@@ -646,8 +646,8 @@ contains
         type(error_t), allocatable, intent(out) :: err
         character(len=*), intent(in) :: cause
         character(len=96) :: buffer
-        write (buffer, '(a, es12.5, a, es11.3e3, a, i0)') 't = ', self%t, ' s, step size ', &
-            self%h, ' s, order ', self%tab%order
+        write (buffer, '(a, a, a, es11.3e3, a, i0)') 't = ', es_text(self%t, 12, 5), &
+            ' s, step size ', self%h, ' s, order ', self%tab%order
         call make_error(err, ERR_SOLVER, 'erk failed at '//trim(buffer)//': '//cause)
     end subroutine failure
 

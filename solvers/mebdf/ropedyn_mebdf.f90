@@ -27,7 +27,7 @@ module ropedyn_mebdf
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp, i8
     use ropedyn_sums, only: sum_squares
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, es_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
     use ropedyn_integrator, only: integrator_t, start_t, solver_options_t, solver_stats_t

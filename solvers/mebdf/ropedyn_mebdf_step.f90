@@ -466,8 +466,8 @@ contains
 
     module procedure failure
         character(len=96) :: where
-        write (where, '(a, es12.5, a, es10.3, a, i0)') 't = ', self%t, ' s, step size ', &
-            self%h, ' s, order ', self%k + 1
+        write (where, '(a, a, a, a, a, i0)') 't = ', es_text(self%t, 12, 5), &
+            ' s, step size ', es_text(self%h, 10, 3), ' s, order ', self%k + 1
         call make_error(err, ERR_SOLVER, 'mebdf failed at '//trim(where)//': '//cause)
     end procedure failure
 end submodule ropedyn_mebdf_step

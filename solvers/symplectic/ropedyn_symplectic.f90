@@ -44,7 +44,7 @@
 !!   problem must offer the force split (else `init` says why not).
 module ropedyn_symplectic
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_text, only: int_text, real_text, significant_text
+    use ropedyn_text, only: int_text, real_text, significant_text, es_text
     use ropedyn_sums, only: sum_products
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
@@ -640,8 +640,8 @@ contains
         type(error_t), allocatable, intent(out) :: err
         character(len=*), intent(in) :: cause
         character(len=96) :: buffer
-        write (buffer, '(a, es12.5, a, es11.3e3, a, i0)') 't = ', self%t, ' s, step size ', &
-            self%h, ' s, order ', self%tab%order
+        write (buffer, '(a, a, a, es11.3e3, a, i0)') 't = ', es_text(self%t, 12, 5), &
+            ' s, step size ', self%h, ' s, order ', self%tab%order
         call make_error(err, ERR_SOLVER, 'symplectic failed at '//trim(buffer)//': '//cause)
     end subroutine failure
 

@@ -76,7 +76,7 @@ contains
         if (1.0_wp/h <= STIFF_STEP_RATE) return
         self%h = h
         self%tab = tab
-        rate = es_text(1.0_wp/h)
+        rate = short_es(1.0_wp/h)
         if (h < ACCURACY_HELD*self%h_stable) then
             cause = 'the tolerance (rtol = '//significant_text(self%options%rtol, 3)// &
                 ') asks for steps of '//significant_text(h, 3)//' s of '//trim(tab%label)// &
@@ -91,21 +91,19 @@ contains
             end if
         else
             cause = 'the problem is too stiff for an explicit method here: the step is held '// &
-                'by stability (spectral radius '//es_text(self%radius)//' 1/s, step '// &
-                es_text(h)//' s), which takes '//rate//' steps per simulated second; use '// &
+                'by stability (spectral radius '//short_es(self%radius)//' 1/s, step '// &
+                short_es(h)//' s), which takes '//rate//' steps per simulated second; use '// &
                 'method = ''auto'' (it switches to an implicit method where this happens) '// &
                 'or ''mebdf'''
         end if
         call self%failure(err, cause)
     contains
         !> x as the message writes it: es9.2 without its leading blanks
-        function es_text(x) result(text)
+        function short_es(x) result(text)
             real(wp), intent(in) :: x
             character(len=:), allocatable :: text
-            character(len=12) :: buf
-            write (buf, '(es9.2)') x
-            text = trim(adjustl(buf))
-        end function es_text
+            text = trim(adjustl(es_text(x, 9, 2)))
+        end function short_es
     end subroutine too_stiff
 
     !> The spectrum at the current state again; the step changed when it must shrink or
@@ -230,7 +228,7 @@ contains
         if (span > 0.0_wp) self%h = span/real(ceiling(span/h*(1.0_wp - 1.0e-12_wp)), wp)
         self%t_base = self%t
         self%k = 0
-        write (what, '(a, a, es10.3, a)') trim(self%tab%label), ', step ', self%h, ' s: '
+        what = trim(self%tab%label)//', step '//es_text(self%h, 10, 3)//' s: '
         call self%log%add(self%t, self%name(), self%tab%order, trim(what)//' '//reason, warn)
     end procedure set_step
 

@@ -7,7 +7,7 @@ module ropedyn_text
     private
     public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, enclosed
     public :: significant_text, decimal_product
-    public :: lower, line_quote, replaced, stripped
+    public :: lower, line_quote, replaced, stripped, es_text
     public :: text_t, append_text, text_array, printable, clip, name_hint, edit_distance
 
     !> A string of any length, for lists of strings of different lengths.
@@ -267,6 +267,25 @@ contains
             if (c >= iachar('A') .and. c <= iachar('Z')) t(i:i) = achar(c + 32)
         end do
     end function lower
+
+    !> x as the edit descriptor ESw.d writes it (w wide, d digits after the point), with a
+    !! three-digit exponent where two do not hold it: ESw.d alone then drops the E
+    !! (2.23460-153). Such a number is one character wider; w must leave room for that.
+    pure function es_text(x, w, d) result(s)
+        real(wp), intent(in) :: x
+        integer, intent(in) :: w, d
+        character(len=:), allocatable :: s
+        character(len=32) :: buf, fmt
+        ! (9.99...e99 rounds up to an exponent of 100 at d digits)
+        if (abs(x) >= 9.99e99_wp .or. (abs(x) > 0.0_wp .and. abs(x) < 1.0e-99_wp)) then
+            write (fmt, '(a, i0, a, i0, a)') '(es', w + 1, '.', d, 'e3)'
+        else
+            write (fmt, '(a, i0, a, i0, a)') '(es', w, '.', d, ')'
+        end if
+        write (buf, fmt) x
+        s = buf(:len_trim(buf))
+        if (len(s) < w) s = repeat(' ', w - len(s))//s
+    end function es_text
 
     !> `text` without the blanks and tabs at its ends (a namelist file's white space; a
     !! command line's `--set` argument may carry tabs where a file would).

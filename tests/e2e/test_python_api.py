@@ -555,3 +555,16 @@ def test_bad_arguments_and_texts_are_ropedyn_errors(tmp_path):
     assert b"out/caf\xe9.h5" in (tmp_path / "again.nml").read_bytes()
     assert ropedyn.Scene.from_file(tmp_path / "again.nml") == scene
     assert ropedyn.run(scene).time[-1] == 0.02
+
+
+def test_a_failure_at_a_tiny_time_writes_the_times_exponent():
+    """A failure message wrote t with ES12.5, which drops the E of a three-digit exponent:
+    "auto: erk failed at t =  2.23463-153 s" (a coupled top sent to 1e300 m). The time
+    must read back as a number."""
+    scene = ropedyn.Scene.from_file(PAPER).set("supports.top_motion", "coupled")
+    with ropedyn.Simulation(scene.set("model.elements", 8)) as sim:
+        sim.set_support("top", position=(1e300, 0))
+        with pytest.raises(ropedyn.Error, match="failed at t = ") as failed:
+            sim.advance(1e-3)
+    t = float(str(failed.value).split("failed at t = ")[1].split(" s")[0])
+    assert 0.0 <= t < 1e-3, str(failed.value)

@@ -5,7 +5,7 @@
 !! 1.0000000000000002e-6).
 program test_text
     use ropedyn_kinds, only: wp
-    use ropedyn_text, only: real_text, significant_text, decimal_product, replaced
+    use ropedyn_text, only: real_text, significant_text, decimal_product, replaced, es_text
     use ropedyn_assert, only: test_suite_t
     implicit none
 
@@ -23,6 +23,13 @@ program test_text
     call suite%check_true(significant_text(-2.71828e-9_wp, 3, compact=.true.) == '-2.72e-9', &
                           'compact, small and negative: '// &
                           significant_text(-2.71828e-9_wp, 3, compact=.true.))
+    ! es_text: ESw.d, with a three-digit exponent where two do not hold it
+    call suite%check_true(es_text(2.48364_wp, 12, 5) == ' 2.48364E+00', 'es_text: '// &
+                          es_text(2.48364_wp, 12, 5))
+    call suite%check_true(es_text(2.2346e-153_wp, 12, 5) == ' 2.23460E-153', &
+                          'es_text, exponent -153: '//es_text(2.2346e-153_wp, 12, 5))
+    call suite%check_true(es_text(-9.9999e99_wp, 10, 3) == '-1.000E+100', &
+                          'es_text, rounded to exponent 100: '//es_text(-9.9999e99_wp, 10, 3))
     x = 0.0_wp
     call suite%check_true(significant_text(x, 6) == '0.0', 'zero')
     x = huge(1.0_wp)
