@@ -25,7 +25,8 @@ module ropedyn_scene
     public :: solver_params_t, output_params_t, scene_t
     public :: read_scene, read_scene_text, read_scene_string, scene_namelist_text, &
         echo_without_output_file, override_value_text, &
-        scene_key_listing, check_override_value, override_target, scene_physics_text
+        scene_key_listing, check_override_value, override_target, scene_physics_text, &
+        recorded_source
 
     !> One `--set group.key=value` argument, parsed.
     type :: override_t
@@ -106,7 +107,7 @@ contains
     !> Read a scene given as namelist text (the library's scenes) as `read_scene` reads a
     !! file: `name` names it in messages, gives the default output file (out/NAME.h5 without
     !! its .nml) and resolves relative paths (against its directory; the current one when
-    !! it has none). A scene read so has no `source`.
+    !! it has none). A scene read so has no `source` (its files record recorded_source's).
     subroutine read_scene_string(name, text, overrides, scene, err)
         character(len=*), intent(in) :: name          !< e.g. 'scene' or 'input/paper.nml'
         character(len=*), intent(in) :: text          !< lines separated by new lines
@@ -461,6 +462,20 @@ contains
         if (index(adjustl(text(i:i + j - 2)), 'file = ') /= 1) return
         rest = text(:i - 1)//text(i + j:)
     end function echo_without_output_file
+
+    !> The source a result file records for the scene (its root attribute `source`): the
+    !! scene file and its --set overrides; for a scene given as text (the library's,
+    !! read_scene_string, which has no source) what it was and the name it was given.
+    !! Another run replaces the file only if its source is the same (ropedyn_run_inputs).
+    function recorded_source(scene) result(text)
+        type(scene_t), intent(in) :: scene
+        character(len=:), allocatable :: text
+        if (allocated(scene%source)) then
+            text = scene%source
+        else
+            text = 'scene text given to the library, named "'//scene%path//'"'
+        end if
+    end function recorded_source
 
     !> The scene's effective text without the groups that do not define the rope and its
     !! surroundings (&initial, &solver, &output): two simulations whose physics texts are

@@ -7,7 +7,7 @@ module ropedyn_analysis
     use, intrinsic :: iso_fortran_env, only: output_unit
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_INTERNAL
-    use ropedyn_scene, only: scene_t, scene_namelist_text
+    use ropedyn_scene, only: scene_t, scene_namelist_text, recorded_source
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_os, only: make_parent_dirs, written_path, rename_file, delete_file
@@ -176,7 +176,7 @@ contains
         if (allocated(err)) return
         call h5%attribute('/', 'analysis', self%command, err)
         if (allocated(err)) return
-        if (allocated(scene%source)) call h5%attribute('/', 'source', scene%source, err)
+        call h5%attribute('/', 'source', recorded_source(scene), err)
         if (allocated(err)) return
         call write_provenance(h5, version_string, self%model%model_name(), &
                               scene_namelist_text(scene), err)

@@ -46,7 +46,7 @@ module ropedyn_run
                                   stop_query_i, budget_left
     use ropedyn_clock, only: clock_seconds
     use ropedyn_model_factory, only: create_model
-    use ropedyn_scene, only: scene_t, scene_namelist_text, scene_physics_text
+    use ropedyn_scene, only: scene_t, scene_namelist_text, scene_physics_text, recorded_source
     use ropedyn_scene_solver, only: create_integrator, solver_options_of, step_budget, &
         check_method_fits
     use ropedyn_os, only: make_parent_dirs
@@ -520,23 +520,13 @@ contains
             call model%element_data(lengths, masses)
             ! a free end has no anchor (NaN): the file has no position series for it
             call model%support_positions(self%t, self%anchors)
-            if (allocated(scene%source)) then
-                call self%out%create(self%summary%file, model%n_elements(), lengths, masses, &
-                                     model%model_name(), self%integrator%name(), &
-                                     version_string, scene_namelist_text(scene), err, &
-                                     state_size=model%size(), quad_size=self%nq, &
-                                     source=scene%source, internal_forces=.true., &
-                                     anchored=ieee_is_finite(self%anchors(1, :)), &
-                                     memory=self%output == OUTPUT_MEMORY)
-            else
-                call self%out%create(self%summary%file, model%n_elements(), lengths, masses, &
-                                     model%model_name(), self%integrator%name(), &
-                                     version_string, scene_namelist_text(scene), err, &
-                                     state_size=model%size(), quad_size=self%nq, &
-                                     internal_forces=.true., &
-                                     anchored=ieee_is_finite(self%anchors(1, :)), &
-                                     memory=self%output == OUTPUT_MEMORY)
-            end if
+            call self%out%create(self%summary%file, model%n_elements(), lengths, masses, &
+                                 model%model_name(), self%integrator%name(), &
+                                 version_string, scene_namelist_text(scene), err, &
+                                 state_size=model%size(), quad_size=self%nq, &
+                                 source=recorded_source(scene), internal_forces=.true., &
+                                 anchored=ieee_is_finite(self%anchors(1, :)), &
+                                 memory=self%output == OUTPUT_MEMORY)
             if (allocated(err)) return
         end associate
         call self%record(err)

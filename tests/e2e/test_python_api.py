@@ -129,6 +129,13 @@ def test_run_gives_the_cli_records_and_writes_no_file(run, tmp_path, monkeypatch
     assert result.status == "complete" and result.stats["steps"] > 0
     written = ropedyn.run(scene, output=tmp_path / "asked.h5")
     assert (tmp_path / "asked.h5").is_file() and np.array_equal(written.q, result.q)
+    # the file says where its scene came from; the command line, whose source is a file,
+    # does not replace it and says what it holds
+    with h5py.File(tmp_path / "asked.h5") as f:
+        source = f.attrs["source"].decode()
+    assert source.startswith("scene text given to the library, named "), source
+    cli = run("run", path, "--set", "output.file=asked.h5")
+    assert cli.returncode == 2 and f'holds the run of "{source}"' in cli.stderr, cli.stderr
     # a file ropedyn did not write is refused; the caller has no --force to be offered
     (tmp_path / "notes.h5").write_text("mine\n")
     with pytest.raises(ropedyn.Error) as error:
