@@ -194,7 +194,7 @@ contains
         character(len=:), allocatable :: reason, path
         integer(c_int), parameter :: W_OK = 2, X_OK = 1
         logical :: exists, is_dir
-        integer :: slash
+        integer :: slash, errnum
         path = trim(dir)
         if (len(path) == 0) path = '.'
         do
@@ -204,6 +204,14 @@ contains
             if (exists) then
                 reason = '"'//path//'" is not a directory'
                 return
+            end if
+            ! a dangling link (or a loop of links): mkdir cannot make a directory there
+            if (file_kind(path, follow=.false.) == FILE_SYMLINK) then
+                if (file_kind(path, errnum=errnum) == FILE_MISSING) then
+                    reason = '"'//path//'" is a symbolic link to "'//link_target(path)// &
+                        '": '//errno_text(errnum)
+                    return
+                end if
             end if
             slash = index(path, '/', back=.true.)
             if (slash == 0) then
@@ -218,6 +226,17 @@ contains
         if (c_access(path//c_null_char, W_OK + X_OK) /= 0) reason = 'the directory "'// &
             path//'" is not writable'
     end function unwritable_dir
+
+    !> The target of the symbolic link `path` as the link holds it ('' when it cannot be
+    !! read).
+    function link_target(path) result(target)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: target
+        character(kind=c_char, len=4097) :: buf
+        target = ''
+        if (c_link_target(path//c_null_char, buf, int(len(buf), c_int)) /= 0) return
+        target = buf(:index(buf, c_null_char) - 1)
+    end function link_target
 
     !> rename(2): `old` becomes `new` in one step (replacing `new`; both in the same file
     !! system).

@@ -105,6 +105,22 @@ def test_bad_sweep_file(run, sweep_dir):
     assert result.returncode == 2
 
 
+def test_output_dir_a_dangling_link_is_bad_input(run, sweep_dir):
+    """An output_dir that is a symbolic link to nothing cannot be made a directory: it is
+    refused when the sweep file is read (exit 2, the file, group, key, value and why), not
+    when the runner makes the directory (exit 4)."""
+    (sweep_dir / "out").mkdir()
+    (sweep_dir / "out" / "sw").symlink_to("nowhere")
+    for args in (["--list"], ["--jobs", "1"], ["--task", "1"], ["--summary"]):
+        result = run("sweep", "sw.nml", *args)
+        assert result.returncode == 2, (args, result.stderr)
+        assert result.stderr.strip() == (
+            'ropedyn: error: sw.nml: &sweep: output_dir = "out/sw": cannot hold the case '
+            'files: "out/sw" is a symbolic link to "nowhere": No such file or directory'), \
+            result.stderr
+    assert [p.name for p in (sweep_dir / "out").iterdir()] == ["sw"]
+
+
 def test_local_runner_and_skip_if_done(run, sweep_dir):
     result = run("sweep", "sw.nml", "--jobs", "2")
     assert result.returncode == 0, result.stderr
