@@ -212,7 +212,11 @@ contains
     end subroutine run_local
 
     !> The cases to run here: not complete (or all with --force), and not being written by
-    !! another process (those are listed apart).
+    !! another process (those are listed apart). The empty logs of complete cases go: a
+    !! runner killed by SIGKILL could not remove those of the cases its workers finished
+    !! on their own, which run no more (the logs of the cases run here go when their
+    !! workers end; a complete case is not started by another runner, which could be
+    !! about to write to its log).
     subroutine runner_select_cases(self, sweep, opt)
         class(local_runner_t), intent(inout) :: self
         type(sweep_t), intent(in) :: sweep
@@ -230,6 +234,7 @@ contains
                 self%elsewhere = [self%elsewhere, c]
                 cycle
             end if
+            if (state%status == 'complete') call remove_if_empty(self%log_path(c))
             if (state%status == 'complete' .and. .not. opt%force) cycle
             self%todo = [self%todo, c]
         end do

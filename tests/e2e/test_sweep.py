@@ -411,6 +411,34 @@ def test_sigterm_to_runner_stops_its_workers(run, ropedyn_exe, sweep_dir):
         assert f.attrs["status"] == b"complete" and f["solver/restarts/time"].shape == (1,)
 
 
+def test_empty_logs_of_a_killed_runner_go(run, ropedyn_exe, sweep_dir):
+    """A runner killed by SIGKILL cannot remove its workers' empty logs, and its workers
+    finish their cases on their own: the next runner removes the empty logs of the
+    complete cases (they stayed, the cases not being run again); a log with text stays."""
+    (sweep_dir / "long.nml").write_text(LONG.format(rtols="1e-7, 1e-8"))
+    out = sweep_dir / "out" / "long"
+    runner = subprocess.Popen([str(ropedyn_exe), "sweep", "long.nml", "--jobs", "2"],
+                              cwd=sweep_dir, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True)
+    try:
+        wait_for(lambda: len(list(out.glob(".case_*.h5.part"))) == 2, what="two workers")
+        runner.kill()
+        runner.communicate(timeout=60)
+        wait_for(lambda: processes_mentioning("long.nml --quiet") == [], timeout=120,
+                 what="the workers' ends")
+    finally:
+        if runner.poll() is None:
+            runner.kill()
+    assert sorted(p.name for p in out.glob("case_*")) == [
+        "case_0001.h5", "case_0001.log", "case_0002.h5", "case_0002.log"]
+    assert all(p.stat().st_size == 0 for p in out.glob("*.log"))
+    (out / "case_0002.log").write_text("a worker's message\n")
+    again = run("sweep", "long.nml", "--jobs", "1")
+    assert again.returncode == 0, again.stderr
+    assert "2 complete already, running 0" in again.stderr
+    assert sorted(p.name for p in out.glob("*.log")) == ["case_0002.log"]
+
+
 def records_in(part):
     """The records the worker has flushed into `part` (0 while it cannot be read), read
     without HDF5's file lock, which the worker holds."""
