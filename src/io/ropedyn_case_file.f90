@@ -12,7 +12,7 @@ module ropedyn_case_file
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_IO
     use ropedyn_text, only: text_t
-    use ropedyn_h5, only: h5_file_t
+    use ropedyn_h5, only: h5_file_t, h5_series_t
     use ropedyn_output, only: COUNTER_NAMES
     implicit none
     private
@@ -133,15 +133,20 @@ contains
     !> Finish a case file written under a temporary name: write (or overwrite) the scalar
     !! `/solver/wall_time` (s) and set the root attribute `scene` to `scene_text`, the
     !! case's scene (the run saw the temporary file name as its output file), and, when
-    !! `reason` is not empty, the root attribute `reason` (the run's, naming the case file).
-    subroutine finish_case_file(path, seconds, scene_text, err, reason)
+    !! `reason` is not empty, the root attribute `reason` (the run's, naming the case file);
+    !! with `warnings`, /solver/warnings line by line (as many lines as the file holds:
+    !! the run's, naming the case file).
+    subroutine finish_case_file(path, seconds, scene_text, err, reason, warnings)
         character(len=*), intent(in) :: path
         real(wp), intent(in) :: seconds
         character(len=*), intent(in) :: scene_text
         type(error_t), allocatable, intent(out) :: err
         character(len=*), intent(in), optional :: reason
+        type(text_t), intent(in), optional :: warnings(:)
         type(h5_file_t) :: h5
+        type(h5_series_t) :: series
         type(error_t), allocatable :: close_err
+        integer :: k
 
         call h5%open(path, err, writable=.true.)
         if (allocated(err)) return
@@ -153,6 +158,17 @@ contains
         if (.not. allocated(err)) call h5%attribute('/', 'scene', scene_text, err)
         if (present(reason) .and. .not. allocated(err)) then
             if (len(reason) > 0) call h5%attribute('/', 'reason', reason, err)
+        end if
+        if (present(warnings) .and. .not. allocated(err)) then
+            if (size(warnings) > 0) then
+                call h5%open_series(series, '/solver/warnings', err)
+                do k = 1, size(warnings)
+                    if (allocated(err)) exit
+                    call series%append_text(int(k, hsize_t), warnings(k)%s, err)
+                end do
+                call series%close(close_err)
+                if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
+            end if
         end if
         call h5%close(close_err)
         if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)

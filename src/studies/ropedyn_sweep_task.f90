@@ -262,6 +262,7 @@ contains
         type(case_data_t) :: data
         character(len=:), allocatable :: reason
         logical :: removed
+        integer :: k
         call read_case_file(part, data, err)
         if (.not. data%exists) return
         if (allocated(err) .or. (data%status /= 'complete' .and. data%status /= 'failed' .and. &
@@ -269,10 +270,15 @@ contains
             removed = delete_file(part)
             return
         end if
-        ! the run named its file by the .part name in its reason: name the case file
+        ! the run named its file by the .part name in its reason and warnings (a continued
+        ! run: the file it continued): name the case file
         reason = ''
         if (allocated(data%reason)) reason = replaced(data%reason, part, c%file)
-        call finish_case_file(part, wall, scene_namelist_text(c%scene), err, reason)
+        do k = 1, size(data%warnings)
+            data%warnings(k)%s = replaced(data%warnings(k)%s, part, c%file)
+        end do
+        call finish_case_file(part, wall, scene_namelist_text(c%scene), err, reason, &
+                              data%warnings)
         if (.not. allocated(err)) call rename_file(part, c%file, err)
         if (allocated(err)) removed = delete_file(part)
     end subroutine put_in_place

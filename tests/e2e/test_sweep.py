@@ -476,7 +476,8 @@ def test_sigkill_to_a_worker_is_no_failed_case(run, ropedyn_exe, sweep_dir):
     """A worker killed by SIGKILL leaves its case interrupted (an abandoned lock and a
     .part): the runner says "ended by SIGKILL" and does not count it as failed (its
     progress said "1 failed" while --status said interrupted). Run again, the case
-    continues from the last record of its .part (it ran anew before)."""
+    continues from the last record of its .part (it ran anew before); its warning that
+    it did names the case file (it named the .part)."""
     returncode, stderr = signal_the_first_worker(ropedyn_exe, sweep_dir, "1e-7",
                                                  signal.SIGKILL, records=3)
     assert returncode == 3, stderr
@@ -495,7 +496,11 @@ def test_sigkill_to_a_worker_is_no_failed_case(run, ropedyn_exe, sweep_dir):
     with h5py.File(out / "case_0001.h5") as f:
         assert f.attrs["status"] == b"complete" and abs(f["time"][-1] - 4.0) < 1e-12
         assert f["solver/restarts/time"][:].tolist() == [kept]
-        assert "its run was killed or crashed" in f["solver/warnings"][-1].decode()
+        # the warning names the case file, not the .part the user never sees
+        warning = f["solver/warnings"][-1].decode()
+        assert "its run was killed or crashed" in warning
+        assert warning.startswith("out/long/case_0001.h5: status running: ") and \
+            ".part" not in warning, warning
 
 
 def test_a_killed_continuation_of_an_interrupted_case_continues(run, ropedyn_exe,
