@@ -7,7 +7,7 @@
 !! The HDF5 calls are those of `ropedyn_h5`; failures are `ERR_IO` errors naming the file
 !! and the object.
 module ropedyn_case_file
-    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_is_nan
     use hdf5, only: hsize_t
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, make_error, ERR_IO
@@ -131,11 +131,11 @@ contains
     end subroutine read_case_file
 
     !> Finish a case file written under a temporary name: write (or overwrite) the scalar
-    !! `/solver/wall_time` (s) and set the root attribute `scene` to `scene_text`, the
-    !! case's scene (the run saw the temporary file name as its output file), and, when
-    !! `reason` is not empty, the root attribute `reason` (the run's, naming the case file);
-    !! with `warnings`, /solver/warnings line by line (as many lines as the file holds:
-    !! the run's, naming the case file).
+    !! `/solver/wall_time` (s; a NaN `seconds`, not known, leaves it as it is) and set the
+    !! root attribute `scene` to `scene_text`, the case's scene (the run saw the temporary
+    !! file name as its output file), and, when `reason` is not empty, the root attribute
+    !! `reason` (the run's, naming the case file); with `warnings`, /solver/warnings line
+    !! by line (as many lines as the file holds: the run's, naming the case file).
     subroutine finish_case_file(path, seconds, scene_text, err, reason, warnings)
         character(len=*), intent(in) :: path
         real(wp), intent(in) :: seconds
@@ -152,7 +152,7 @@ contains
         if (allocated(err)) return
         if (.not. h5%exists('/solver')) then
             call make_error(err, ERR_IO, path//': /solver: missing')
-        else
+        else if (.not. ieee_is_nan(seconds)) then
             call h5%write('/solver/wall_time', seconds, 's', err)
         end if
         if (.not. allocated(err)) call h5%attribute('/', 'scene', scene_text, err)

@@ -18,7 +18,8 @@
 !! is moved back to its .part name under the lock, `run_scene(..., resume=.true.)` appends
 !! to it, and it is renamed into place again), unless forced, which runs it anew. So is the
 !! .part a killed writer left (status `running` or `interrupted`, records beyond the start,
-!! this case's scene): it is continued where it is.
+!! this case's scene): it is continued where it is. A .part that holds a finished run of
+!! the case (status complete: its writer was killed before the rename) is put in place.
 module ropedyn_sweep_task
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use ropedyn_kinds, only: wp
@@ -156,7 +157,7 @@ contains
         type(run_summary_t) :: summary
         type(case_state_t) :: state
         type(scene_t) :: scene
-        real(wp) :: start
+        real(wp) :: start, wall
         logical :: removed, resume, done
 
         if (signal_received() /= 0) then
@@ -168,6 +169,21 @@ contains
         if (.not. force) then
             call check_complete(c, label, quiet, done)
             if (done) return
+        end if
+        ! a run of this case that finished, whose writer was killed before it renamed the
+        ! file: put in place, not run again
+        if (.not. force) then
+            if (finished_part(c, part, wall)) then
+                call put_in_place(c, part, wall, err)
+                if (allocated(err)) then
+                    err%message = label//' ('//c%file//'): '//err%message
+                else
+                    write (error_unit, '(a)') label//': complete in '//part//' (its writer '// &
+                        'was killed before it renamed the file): put in place as '//c%file// &
+                        ', not run again'
+                end if
+                return
+            end if
         end if
         scene = c%scene
         scene%output%file = part
@@ -282,6 +298,24 @@ contains
         if (.not. allocated(err)) call rename_file(part, c%file, err)
         if (allocated(err)) removed = delete_file(part)
     end subroutine put_in_place
+
+    !> `part` is a finished run of this very case (status complete, its data reads back)
+    !! whose writer was killed after the run ended, before it renamed the file into place.
+    !! `wall`: the wall time the file holds (NaN: the writer was killed before it wrote
+    !! it). A `part` that cannot be read (or is held open) is not: killed_part says which.
+    logical function finished_part(c, part, wall)
+        type(sweep_case_t), intent(in) :: c
+        character(len=*), intent(in) :: part
+        real(wp), intent(out) :: wall
+        type(case_data_t) :: data
+        type(error_t), allocatable :: err
+        call read_case_file(part, data, err, series=.true.)
+        wall = data%wall_time
+        finished_part = .false.
+        if (allocated(err) .or. .not. data%exists) return
+        finished_part = data%status == 'complete' .and. data%records >= 1 .and. &
+            holds_case_scene(c, data%scene)
+    end function finished_part
 
     !> `part` holds records of this very case beyond its start, written by a run that was
     !! killed (status still `running`, or `interrupted`: the writer was killed after it

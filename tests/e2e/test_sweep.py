@@ -546,6 +546,43 @@ def test_a_killed_continuation_of_an_interrupted_case_continues(run, ropedyn_exe
     assert not part.exists()
 
 
+def test_a_finished_part_of_a_killed_writer_is_put_in_place(run, sweep_dir):
+    """A writer killed after its run ended (status complete) but before it renamed its
+    .part into place leaves a finished run: the next sweep puts it in place, with the
+    case's scene, says so in the case's log and counts the case done; it does not run the
+    case again (it did)."""
+    assert run("sweep", "sw.nml", "--task", "1").returncode == 0
+    out = sweep_dir / "out" / "sw"
+    part, final = out / ".case_0001.h5.part", out / "case_0001.h5"
+    final.rename(part)
+    # as the run left it: its scene names the .part, no wall time yet; a mark to find
+    with h5py.File(part, "r+") as f:
+        f.attrs["scene"] = f.attrs["scene"].decode().replace("out/sw/case_0001.h5",
+                                                             "out/sw/.case_0001.h5.part")
+        del f["solver/wall_time"]
+        f.attrs["mark"] = "the finished run"
+        steps = int(f["solver/steps"][()])
+    gone = subprocess.Popen(["true"])
+    gone.wait()
+    (out / ".case_0001.lock").write_text(
+        f"ropedyn sweep case lock\nhost={socket.gethostname()}\npid={gone.pid}\n")
+    result = run("sweep", "sw.nml", "--jobs", "1")
+    assert result.returncode == 0, result.stderr
+    assert "sweep: case 0001 complete" in result.stderr
+    assert not part.exists() and not (out / ".case_0001.lock").exists()
+    with h5py.File(final) as f:
+        assert f.attrs["mark"] == "the finished run"
+        scene = f.attrs["scene"].decode()
+        assert "out/sw/case_0001.h5" in scene and ".part" not in scene
+        assert "wall_time" not in f["solver"]
+    assert ("sweep: case 0001: complete in out/sw/.case_0001.h5.part (its writer was killed "
+            "before it renamed the file): put in place as out/sw/case_0001.h5, not run "
+            "again") in (out / "case_0001.log").read_text()
+    row = read_csv(out / "summary.csv")[0]
+    assert row["status"] == "complete" and int(row["steps"]) == steps and \
+        row["wall_time"] == "", row
+
+
 def test_sigterm_to_a_worker_reports_its_case_interrupted(run, ropedyn_exe, sweep_dir):
     """A worker stopped by SIGTERM ends with ropedyn's exit code 130 and writes its case
     interrupted: the runner says so (not "ended by SIGINT", which 128 + 2 would read as),
