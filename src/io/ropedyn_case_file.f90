@@ -35,6 +35,9 @@ module ropedyn_case_file
         real(wp), allocatable :: balance(:)
         !> what the run warned of (/solver/warnings), one line each; none when absent
         type(text_t), allocatable :: warnings(:)
+        !> where a part of the run was killed, s: the times of the restarts that continued
+        !! a file with status running (/solver/restarts); that part wrote no counters
+        real(wp), allocatable :: killed_at(:)
     end type case_data_t
 
 contains
@@ -81,6 +84,8 @@ contains
             if (allocated(err)) exit steps
             call h5%read_texts('/solver/warnings', data%warnings, err)
             if (allocated(err)) exit steps
+            call read_killed_parts()
+            if (allocated(err)) exit steps
             call h5%read_reals('/time', data%time, dims1, err)
             if (allocated(err)) exit steps
             data%records = size(data%time)
@@ -119,6 +124,22 @@ contains
                 call make_error(err, ERR_IO, path//': attribute '//name//' is missing (not a ' &
                                 //'ropedyn run file?)')
         end subroutine required_attribute
+
+        !> data%killed_at from /solver/restarts (none when there are no restarts).
+        subroutine read_killed_parts()
+            type(text_t), allocatable :: previous(:)
+            real(wp), allocatable :: times(:)
+            integer(hsize_t) :: dims(1)
+            integer :: j
+            allocate (data%killed_at(0))
+            call h5%read_texts('/solver/restarts/previous_status', previous, err)
+            if (allocated(err) .or. size(previous) == 0) return
+            call h5%read_reals('/solver/restarts/time', times, dims, err)
+            if (allocated(err)) return
+            do j = 1, min(size(previous), size(times))
+                if (previous(j)%s == 'running') data%killed_at = [data%killed_at, times(j)]
+            end do
+        end subroutine read_killed_parts
 
         !> The solver counters (-1 when absent).
         subroutine read_counters()

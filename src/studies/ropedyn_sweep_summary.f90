@@ -45,7 +45,10 @@ module ropedyn_sweep_summary
         integer :: reference = 0                 !< case id of the reference (0: none)
         !> tighter | same_rtol | self | file | none (docs/guide/sweeps.md)
         character(len=:), allocatable :: reference_kind
-        character(len=:), allocatable :: warning  !< about the reference ('' if none)
+        !> about the reference, and that the counters are partial ('' if none)
+        character(len=:), allocatable :: warning
+        !> that the counters and CPU time leave out a killed part of the run ('' if not)
+        character(len=:), allocatable :: partial
         !> what the case's run warned of (its /solver/warnings), the lines joined by
         !! RUN_WARNING_JOIN ('' if none)
         character(len=:), allocatable :: run_warnings
@@ -108,10 +111,31 @@ contains
             end select
         end do
 
+        call note_partial(rows, warnings)
         call write_csv(sweep, rows, err)
         if (allocated(err)) return
         call write_h5(sweep, rows, err)
     end subroutine build_summary
+
+    !> The rows whose counters and CPU time leave out a killed part of the run: said in
+    !! their warning, and in one line of `warnings` naming them.
+    subroutine note_partial(rows, warnings)
+        type(case_row_t), intent(inout) :: rows(:)
+        type(text_t), allocatable, intent(inout) :: warnings(:)
+        integer, allocatable :: partial(:)
+        integer :: c
+        partial = pack([(c, c=1, size(rows))], [(len(rows(c)%partial) > 0, c=1, size(rows))])
+        if (size(partial) == 0) return
+        do c = 1, size(partial)
+            associate (row => rows(partial(c)))
+                if (len(row%warning) > 0) row%warning = row%warning//'; '
+                row%warning = row%warning//row%partial
+            end associate
+        end do
+        call append_text(warnings, trim(merge('case ', 'cases', size(partial) == 1))//' '// &
+            id_list(partial)//': the counters and cpu_time are partial: a part of the run '// &
+            'was killed before it wrote them (the warning column of summary.csv says where)')
+    end subroutine note_partial
 
     !> The row of case c from its file as far as it goes: status, times, counters, warnings
     !! and, when complete, the energy errors; NaN where there is nothing to say.
@@ -133,6 +157,7 @@ contains
         row%energy_error_max = nan
         row%reference_kind = ''
         row%warning = ''
+        row%partial = ''
         row%run_warnings = ''
         call case_state(sweep_case, state)
         row%status = state%status
@@ -146,9 +171,32 @@ contains
         row%cpu_time = state%data%cpu_time
         row%run_warnings = joined(state%data%warnings)
         row%counters = state%data%counters
+        row%partial = partial_text(state%data)
         if (state%data%records > 0) row%t_reached = state%data%time(state%data%records)
         if (row%status == 'complete') call energy_errors(state%data, row)
     end subroutine read_row
+
+    !> '' unless a part of the run in `data` was killed (its counters and CPU time lost):
+    !! then that, with where each such part stopped.
+    function partial_text(data) result(text)
+        type(case_data_t), intent(in) :: data
+        character(len=:), allocatable :: text
+        integer :: k
+        text = ''
+        if (.not. allocated(data%killed_at)) return
+        if (size(data%killed_at) == 0) return
+        do k = 1, size(data%killed_at)
+            if (k > 1) text = text//', '
+            text = text//significant_text(data%killed_at(k), 10)//' s'
+        end do
+        if (size(data%killed_at) == 1) then
+            text = 'the part of the run that ended at t = '//text//' (its last record) was'
+        else
+            text = 'the parts of the run that ended at t = '//text//' (their last records) were'
+        end if
+        text = 'steps, the other counters and cpu_time are partial: '//text//' killed '// &
+            'before writing them'
+    end function partial_text
 
     !> The complete cases of one reference set against its tightest complete case (ties:
     !! lowest id); a warning, in the rows and in `warnings`, when that is not the set's

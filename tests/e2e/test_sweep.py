@@ -477,7 +477,8 @@ def test_sigkill_to_a_worker_is_no_failed_case(run, ropedyn_exe, sweep_dir):
     .part): the runner says "ended by SIGKILL" and does not count it as failed (its
     progress said "1 failed" while --status said interrupted). Run again, the case
     continues from the last record of its .part (it ran anew before); its warning that
-    it did names the case file (it named the .part)."""
+    it did names the case file (it named the .part); the summary says its counters are
+    partial (the killed part's are lost)."""
     returncode, stderr = signal_the_first_worker(ropedyn_exe, sweep_dir, "1e-7",
                                                  signal.SIGKILL, records=3)
     assert returncode == 3, stderr
@@ -501,6 +502,17 @@ def test_sigkill_to_a_worker_is_no_failed_case(run, ropedyn_exe, sweep_dir):
         assert "its run was killed or crashed" in warning
         assert warning.startswith("out/long/case_0001.h5: status running: ") and \
             ".part" not in warning, warning
+    # the killed part wrote no counters (a run writes them at its end), and the file has
+    # nothing to count them by: the summary says the case's counts are partial
+    summary = run("sweep", "long.nml", "--summary")
+    assert summary.returncode == 0, summary.stderr
+    assert ("sweep: warning: case 1: the counters and cpu_time are partial: a part of the "
+            "run was killed before it wrote them") in summary.stderr, summary.stderr
+    row = read_csv(out / "summary.csv")[0]
+    assert row["warning"].startswith("steps, the other counters and cpu_time are partial: "
+                                     "the part of the run that ended at t = ") and \
+        row["warning"].endswith(" s (its last record) was killed before writing them"), row
+    assert float(row["warning"].split("t = ")[1].split(" s")[0]) == pytest.approx(kept)
 
 
 def test_a_killed_continuation_of_an_interrupted_case_continues(run, ropedyn_exe,
