@@ -133,7 +133,7 @@ contains
             end associate
         end do
         call append_text(warnings, trim(merge('case ', 'cases', size(partial) == 1))//' '// &
-            id_list(partial)//': the counters and cpu_time are partial: a part of the run '// &
+            id_list(partial)//': the counters, cpu_time and wall_time are partial: a part of the run '// &
             'was killed before it wrote them (the warning column of summary.csv says where)')
     end subroutine note_partial
 
@@ -194,7 +194,7 @@ contains
         else
             text = 'the parts of the run that ended at t = '//text//' (their last records) were'
         end if
-        text = 'steps, the other counters and cpu_time are partial: '//text//' killed '// &
+        text = 'steps, the other counters, cpu_time and wall_time are partial: '//text//' killed '// &
             'before writing them'
     end function partial_text
 

@@ -22,6 +22,7 @@
 !! the case (status complete: its writer was killed before the rename) is put in place.
 module ropedyn_sweep_task
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp
     use ropedyn_text, only: int_text, fixed_text, replaced
     use ropedyn_error, only: error_t, make_error, ERR_IO, ERR_INPUT, ERR_INTERRUPTED
@@ -157,7 +158,7 @@ contains
         type(run_summary_t) :: summary
         type(case_state_t) :: state
         type(scene_t) :: scene
-        real(wp) :: start, wall
+        real(wp) :: start, wall, earlier
         logical :: removed, resume, done
 
         if (signal_received() /= 0) then
@@ -211,6 +212,9 @@ contains
         else
             removed = delete_file(part)
         end if
+        ! a continued case's wall time is its parts' (a killed part wrote none)
+        earlier = 0.0_wp
+        if (resume) earlier = wall_before(part)
         start = clock_seconds()
         call run_scene(scene, summary, err, resume=resume, guard=.false.)
         if (resume .and. allocated(err)) then
@@ -219,10 +223,13 @@ contains
                 write (error_unit, '(a)') label//': cannot be continued ('// &
                     err%message//'): running it anew'
                 removed = delete_file(part)
+                earlier = 0.0_wp
+                start = clock_seconds()
                 call run_scene(scene, summary, err, guard=.false.)
             end if
         end if
-        call finish_case(c, label, part, clock_seconds() - start, summary, quiet, err)
+        call finish_case(c, label, part, earlier + clock_seconds() - start, summary, quiet, &
+                         err)
     end subroutine run_locked
 
     !> The run's file put in place (part -> the case file, wall time its) and the failure
@@ -298,6 +305,18 @@ contains
         if (.not. allocated(err)) call rename_file(part, c%file, err)
         if (allocated(err)) removed = delete_file(part)
     end subroutine put_in_place
+
+    !> The wall time (s) the earlier parts of a case wrote into `part`, the file a run is
+    !! about to continue; 0 when it holds none (a killed part writes none).
+    real(wp) function wall_before(part) result(wall)
+        character(len=*), intent(in) :: part
+        type(case_data_t) :: data
+        type(error_t), allocatable :: err
+        wall = 0.0_wp
+        call read_case_file(part, data, err)
+        if (allocated(err) .or. .not. data%exists) return
+        if (ieee_is_finite(data%wall_time)) wall = data%wall_time
+    end function wall_before
 
     !> `part` is a finished run of this very case (status complete, its data reads back)
     !! whose writer was killed after the run ended, before it renamed the file into place.

@@ -506,11 +506,11 @@ def test_sigkill_to_a_worker_is_no_failed_case(run, ropedyn_exe, sweep_dir):
     # nothing to count them by: the summary says the case's counts are partial
     summary = run("sweep", "long.nml", "--summary")
     assert summary.returncode == 0, summary.stderr
-    assert ("sweep: warning: case 1: the counters and cpu_time are partial: a part of the "
-            "run was killed before it wrote them") in summary.stderr, summary.stderr
+    assert ("sweep: warning: case 1: the counters, cpu_time and wall_time are partial: a "
+            "part of the run was killed before it wrote them") in summary.stderr, summary.stderr
     row = read_csv(out / "summary.csv")[0]
-    assert row["warning"].startswith("steps, the other counters and cpu_time are partial: "
-                                     "the part of the run that ended at t = ") and \
+    assert row["warning"].startswith("steps, the other counters, cpu_time and wall_time are "
+                                     "partial: the part of the run that ended at t = ") and \
         row["warning"].endswith(" s (its last record) was killed before writing them"), row
     assert float(row["warning"].split("t = ")[1].split(" s")[0]) == pytest.approx(kept)
 
@@ -535,9 +535,11 @@ def test_a_killed_continuation_of_an_interrupted_case_continues(run, ropedyn_exe
         if first.poll() is None:
             first.kill()
     assert first.returncode == 130
-    with h5py.File(final, "r") as f:
+    with h5py.File(final, "r+") as f:
         assert f.attrs["status"] == b"interrupted"
         kept = f["time"][-1]
+        # the interrupted part's wall time, made large to be told from the last part's
+        f["solver/wall_time"][()] = 1000.0
     # the state of a writer killed right after it moved the file back: its lock (of a
     # process that is gone) and the interrupted file under the .part name
     final.rename(part)
@@ -555,6 +557,8 @@ def test_a_killed_continuation_of_an_interrupted_case_continues(run, ropedyn_exe
         assert f.attrs["status"] == b"complete" and abs(f["time"][-1] - 4.0) < 1e-12
         assert f["solver/restarts/time"][:].tolist() == [kept]
         assert f["solver/restarts/previous_status"][:].tolist() == [b"interrupted"]
+        # the case's wall time is its parts': the interrupted one's and the last
+        assert 1000.0 < f["solver/wall_time"][()] < 1100.0
     assert not part.exists()
 
 
