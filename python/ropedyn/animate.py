@@ -218,7 +218,11 @@ def parse_args(argv):
 def main(argv=None):
     args = parse_args(argv)
     out = pathlib.Path(args.output or str(pathlib.Path(args.run).with_suffix(".gif")))
-    run = io.load_run(args.run)
+    try:
+        run = io.load_run(args.run)
+    except (OSError, ValueError) as exc:
+        print(f"animate: {exc}", file=sys.stderr)
+        return 2
     if run.time.size == 0:
         print(f"animate: {args.run}: no output records", file=sys.stderr)
         return 1

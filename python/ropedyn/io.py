@@ -9,6 +9,7 @@ The one reader of run files for the plots, the animation, the XDMF sidecar and t
 studies. Records beyond len(/time) (a half-written last record) are dropped.
 """
 import dataclasses
+import os
 
 import h5py
 import numpy as np
@@ -93,9 +94,47 @@ class Run:
         return self.scene.get(name, {})
 
 
+#: What every run file holds (docs/reference/file-format.md); a file without one of them is
+#: not a run file.
+RUN_DATASETS = ("time", "rope/points", "state/q", "state/qdot", "rope/element_length",
+                "rope/element_mass", "energy/total")
+
+
+def what_file(f):
+    """What an open HDF5 file that is not a run file is, as far as it can tell."""
+    if "modes" in f:
+        return "the file of `ropedyn modes`"
+    if "statics" in f:
+        return "the file of `ropedyn statics`"
+    if "case" in f and "reference" in f.attrs:
+        return "a sweep's summary"
+    return "not written by ropedyn"
+
+
+def _open_run(path):
+    """h5py.File of the run file at path (a name or a file object); ValueError saying what
+    the file is when it is not a run file, FileNotFoundError when there is none."""
+    if isinstance(path, (str, os.PathLike)):
+        if not os.path.exists(path):
+            raise FileNotFoundError(f"{path}: no such file")
+        if not os.path.isfile(path):
+            raise ValueError(f"{path}: not a file")
+        if not h5py.is_hdf5(path):
+            raise ValueError(f"{path}: not an HDF5 file, so not a run file of ropedyn")
+    f = h5py.File(path, "r")
+    missing = [name for name in RUN_DATASETS if name not in f]
+    if missing:
+        why = f"{path}: not a run file of ropedyn (no /{missing[0]}): {what_file(f)}"
+        f.close()
+        raise ValueError(why)
+    return f
+
+
 def load_run(path):
-    """Read a run file; records beyond len(/time) (a half-written record) are dropped."""
-    with h5py.File(path, "r") as f:
+    """Read a run file; records beyond len(/time) (a half-written record) are dropped.
+    ValueError (saying what the file is) for a file that is not a run file: not HDF5, a
+    statics or modes file, a sweep's summary; FileNotFoundError for a missing one."""
+    with _open_run(path) as f:
         records = f["time"].shape[0]
 
         def series(name):

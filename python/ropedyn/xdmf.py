@@ -185,7 +185,11 @@ def main(argv=None):
             print(f"xdmf: {why}", file=sys.stderr)
             return 2
 
-    run = io.load_run(run_path)
+    try:
+        run = io.load_run(run_path)
+    except (OSError, ValueError) as exc:
+        print(f"xdmf: {exc}", file=sys.stderr)
+        return 2
     if run.time.size == 0:
         print(f"xdmf: {run_path}: no output records", file=sys.stderr)
         return 1

@@ -41,10 +41,12 @@ def ropedyn(exe, workdir, scene_text, name, *overrides):
 def script(module, *args, package="ropedyn"):
     """Run `python -m PACKAGE.MODULE ARGS` (the code of scripts/animate, scripts/plot, ...)
     with this Python, tools/ on its path as the scripts/ commands put it (for the package
-    ropedyn_tools, not installed); returns the CompletedProcess."""
+    ropedyn_tools, not installed) and python/ before it (the package ropedyn of this tree,
+    also with a venv made for another worktree); returns the CompletedProcess."""
+    path = os.pathsep.join([str(ROOT / "python"), str(ROOT / "tools")])
     return subprocess.run([sys.executable, "-m", f"{package}.{module}", *map(str, args)],
                           capture_output=True, text=True, timeout=120,
-                          env=dict(os.environ, PYTHONPATH=str(ROOT / "tools")))
+                          env=dict(os.environ, PYTHONPATH=path))
 
 
 def assert_picture(image, size):
@@ -143,6 +145,28 @@ def test_plots_refuse_a_name_that_takes_no_picture(module, tiny, tmp_path):
     result = script(module, run_as_png, "-o", run_as_png)
     assert result.returncode == 2 and "is the run file itself" in result.stderr
     assert run_as_png.read_bytes() == pathlib.Path(tiny).read_bytes()
+
+
+@pytest.mark.parametrize("module", ["plot.overview", "plot.energy", "animate", "xdmf"])
+def test_scripts_say_that_a_file_is_no_run_file(module, ropedyn_exe, tmp_path):
+    """A file that is not a run file (the result of `ropedyn statics`, a text file, no file)
+    is a usage error: one line naming the file and what it is, exit 2 (it ended in h5py's
+    KeyError or OSError traceback)."""
+    scene = tmp_path / "s.nml"
+    scene.write_text(TINY)
+    made = subprocess.run([str(ropedyn_exe), "statics", str(scene), "-o",
+                           str(tmp_path / "statics.h5")], capture_output=True, text=True,
+                          timeout=300, cwd=tmp_path)
+    assert made.returncode == 0, made.stderr
+    (tmp_path / "notes.h5").write_text("not HDF5\n")
+    says = {"statics.h5": "statics.h5: not a run file of ropedyn (no /time): the file of "
+                          "`ropedyn statics`",
+            "notes.h5": "notes.h5: not an HDF5 file",
+            "missing.h5": "missing.h5: no such file"}
+    for name, message in says.items():
+        result = script(module, tmp_path / name)
+        assert result.returncode == 2, result.stderr
+        assert "Traceback" not in result.stderr and message in result.stderr, result.stderr
 
 
 @pytest.mark.parametrize("which", ["tiny", "tiny_mpp"])

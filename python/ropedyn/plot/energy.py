@@ -25,7 +25,11 @@ def main(argv=None):
     except ValueError as exc:
         parser.error(str(exc))
 
-    run = io.load_run(args.run)
+    try:
+        run = io.load_run(args.run)
+    except (OSError, ValueError) as exc:
+        print(f"plot_energy: {exc}", file=sys.stderr)
+        return 2
     t, e = run.time, run.energy
     e0 = run.e0
     balance = run.balance - e0

@@ -150,7 +150,11 @@ def main(argv=None):
         plot.check_picture_name(out, args.run)
     except ValueError as exc:
         parser.error(str(exc))
-    run = io.load_run(args.run)
+    try:
+        run = io.load_run(args.run)
+    except (OSError, ValueError) as exc:
+        print(f"plot: {exc}", file=sys.stderr)
+        return 2
     if run.time.size == 0:
         print(f"plot: {args.run}: no output records", file=sys.stderr)
         return 1
