@@ -169,6 +169,21 @@ def test_scripts_say_that_a_file_is_no_run_file(module, ropedyn_exe, tmp_path):
         assert "Traceback" not in result.stderr and message in result.stderr, result.stderr
 
 
+@pytest.mark.parametrize("module", ["plot.overview", "plot.energy", "animate", "xdmf"])
+def test_scripts_say_that_a_file_has_no_records(module, tiny, tmp_path):
+    """A run file without records (a run killed before its first flush): one line, exit 1
+    and no picture (plot_energy ended in an IndexError traceback)."""
+    empty = tmp_path / "empty.h5"
+    shutil.copy(tiny, empty)
+    with h5py.File(empty, "r+") as f:
+        f["time"].resize(0, axis=0)
+    result = script(module, empty)
+    assert result.returncode == 1, result.stderr
+    assert "Traceback" not in result.stderr
+    assert f"{empty}: no output records" in result.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["empty.h5"]
+
+
 @pytest.mark.parametrize("which", ["tiny", "tiny_mpp"])
 def test_plot(which, request, tmp_path):
     run_file = request.getfixturevalue(which)

@@ -30,6 +30,9 @@ def main(argv=None):
     except (OSError, ValueError) as exc:
         print(f"plot_energy: {exc}", file=sys.stderr)
         return 2
+    if run.time.size == 0:
+        print(f"plot_energy: {args.run}: no output records", file=sys.stderr)
+        return 1
     t, e = run.time, run.energy
     e0 = run.e0
     balance = run.balance - e0
