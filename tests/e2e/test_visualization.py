@@ -184,6 +184,23 @@ def test_scripts_say_that_a_file_has_no_records(module, tiny, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["empty.h5"]
 
 
+@pytest.mark.parametrize("module, suffix", [("plot.overview", "_plot.png"),
+                                            ("plot.energy", "_energy.png")])
+def test_plot_of_a_killed_run_keeps_the_complete_runs_picture(module, suffix, tiny,
+                                                              tmp_path):
+    """The picture of RUN.h5.part (a killed run's file, beside the complete RUN.h5 of an
+    earlier run) is RUN.h5_SUFFIX: RUN_SUFFIX, the complete run's picture, stays (the
+    energy plot cut the name at '.h5' and replaced it)."""
+    shutil.copy(tiny, tmp_path / "r.h5")
+    shutil.copy(tiny, tmp_path / "r.h5.part")
+    assert script(module, tmp_path / "r.h5").returncode == 0
+    before = sha256(tmp_path / f"r{suffix}")
+    result = script(module, tmp_path / "r.h5.part")
+    assert result.returncode == 0, result.stderr
+    assert sha256(tmp_path / f"r{suffix}") == before
+    assert (tmp_path / f"r.h5{suffix}").stat().st_size > 1000
+
+
 @pytest.mark.parametrize("which", ["tiny", "tiny_mpp"])
 def test_plot(which, request, tmp_path):
     run_file = request.getfixturevalue(which)

@@ -3,6 +3,7 @@
 usage: scripts/plot_energy.py RUN.h5 [-o RUN_energy.png]   (python -m ropedyn.plot.energy)
 """
 import argparse
+import pathlib
 import sys
 
 import matplotlib
@@ -19,7 +20,9 @@ def main(argv=None):
     parser.add_argument("run", help="HDF5 output of ropedyn run")
     parser.add_argument("-o", "--output", help="PNG file (default: RUN_energy.png)")
     args = parser.parse_args(argv)
-    out = args.output or args.run.rsplit(".h5", 1)[0] + "_energy.png"
+    # RUN.h5 -> RUN_energy.png and RUN.h5.part (a killed run's) -> RUN.h5_energy.png, as the
+    # overview names its picture: not the picture of the complete RUN.h5 beside it
+    out = args.output or str(pathlib.Path(args.run).with_suffix("")) + "_energy.png"
     try:
         plot.check_picture_name(out, args.run)
     except ValueError as exc:
