@@ -176,8 +176,11 @@ def save_mp4(path, frames, fps, comment=""):
             raise RuntimeError(f"{path}: ffmpeg failed (exit code {proc.returncode})")
 
 
-def check_format(path):
-    """ValueError if the animation cannot be written in the format of path's suffix."""
+def check_format(path, run_path):
+    """ValueError if the animation cannot be written in the format of path's suffix, or if
+    path is the run file it is drawn from."""
+    if path.resolve() == pathlib.Path(run_path).resolve():
+        raise ValueError(f"{path}: is the run file itself: give the animation another name")
     suffix = path.suffix.lower()
     if suffix == ".mp4" and shutil.which("ffmpeg") is None:
         raise ValueError(f"{path}: MP4 needs the ffmpeg program, which is not installed "
@@ -227,7 +230,7 @@ def main(argv=None):
         print(f"animate: {args.run}: no output records", file=sys.stderr)
         return 1
     try:
-        check_format(out)
+        check_format(out, args.run)
         frames = frame_indices(run.time, args.max_frames, args.start, args.end)
     except ValueError as exc:
         print(f"animate: {exc}", file=sys.stderr)

@@ -129,6 +129,18 @@ def test_animate_rejects_unknown_format(tiny, tmp_path):
     assert result.returncode == 2 and "unknown animation format '.avi'" in result.stderr
 
 
+def test_animate_refuses_to_replace_the_run_file(tiny, tmp_path):
+    """A run file named RUN.gif (default output RUN.gif) or given as -o: a usage error,
+    exit 2, and the run file untouched (the GIF replaced it)."""
+    run_as_gif = tmp_path / "run.gif"
+    shutil.copy(tiny, run_as_gif)
+    for args in ([], ["-o", run_as_gif]):
+        result = script("animate", run_as_gif, "--max-frames", "3", *args)
+        assert result.returncode == 2, result.stderr
+        assert "is the run file itself" in result.stderr
+        assert run_as_gif.read_bytes() == pathlib.Path(tiny).read_bytes()
+
+
 # --- plot ----------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("module", ["plot.overview", "plot.energy"])
