@@ -177,8 +177,8 @@ def save_mp4(path, frames, fps, comment=""):
 
 
 def check_format(path, run_path):
-    """ValueError if the animation cannot be written in the format of path's suffix, or if
-    path is the run file it is drawn from."""
+    """ValueError if the animation cannot be written in the format of path's suffix or in
+    its directory (none), or if path is the run file it is drawn from."""
     if path.resolve() == pathlib.Path(run_path).resolve():
         raise ValueError(f"{path}: is the run file itself: give the animation another name")
     suffix = path.suffix.lower()
@@ -187,6 +187,7 @@ def check_format(path, run_path):
                          "(Debian: apt-get install ffmpeg); write a .gif instead")
     if suffix not in (".gif", ".mp4"):
         raise ValueError(f"{path}: unknown animation format '{suffix}' (use .gif or .mp4)")
+    plot.check_directory(path)
 
 
 def parse_args(argv):

@@ -213,6 +213,18 @@ def test_plot_of_a_killed_run_keeps_the_complete_runs_picture(module, suffix, ti
     assert (tmp_path / f"r.h5{suffix}").stat().st_size > 1000
 
 
+@pytest.mark.parametrize("module, name", [("plot.overview", "p.png"),
+                                          ("plot.energy", "e.png"), ("animate", "a.gif")])
+def test_pictures_refuse_a_directory_that_does_not_exist(module, name, tiny, tmp_path):
+    """-o into a directory that does not exist: one line, exit 2 (it ended in a
+    FileNotFoundError traceback after the drawing)."""
+    result = script(module, tiny, "-o", tmp_path / "nowhere" / name)
+    assert result.returncode == 2, result.stderr
+    assert "Traceback" not in result.stderr
+    assert f"no such directory: {tmp_path / 'nowhere'}" in result.stderr
+    assert not (tmp_path / "nowhere").exists()
+
+
 @pytest.mark.parametrize("which", ["tiny", "tiny_mpp"])
 def test_plot(which, request, tmp_path):
     run_file = request.getfixturevalue(which)

@@ -151,9 +151,16 @@ def parse_size(value):
     return int(match.group(1)), int(match.group(2))
 
 
+def check_directory(out):
+    """ValueError unless the directory `out` goes into exists."""
+    folder = pathlib.Path(out).parent
+    if not folder.is_dir():
+        raise ValueError(f"{out}: no such directory: {folder}")
+
+
 def check_picture_name(out, run_path):
     """ValueError unless `out` can take a picture: a suffix matplotlib writes (.png, .pdf,
-    .svg, ...) and not the run file it is drawn from."""
+    .svg, ...), in a directory that exists, and not the run file it is drawn from."""
     from matplotlib.backend_bases import FigureCanvasBase
     formats = FigureCanvasBase.get_supported_filetypes()
     fmt = pathlib.Path(out).suffix.lstrip(".").lower()
@@ -162,6 +169,7 @@ def check_picture_name(out, run_path):
                          f".{', .'.join(sorted(formats))} (not '.{fmt}')")
     if pathlib.Path(out).resolve() == pathlib.Path(run_path).resolve():
         raise ValueError(f"{out}: is the run file itself: give the picture another name")
+    check_directory(out)
 
 
 def made_by(run, tool):
