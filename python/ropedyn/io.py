@@ -113,7 +113,8 @@ def what_file(f):
 
 def _open_run(path):
     """h5py.File of the run file at path (a name or a file object); ValueError saying what
-    the file is when it is not a run file, FileNotFoundError when there is none."""
+    the file is when it is not a run file, FileNotFoundError when there is none, OSError
+    saying so when a run holds it open for writing (HDF5's file lock)."""
     if isinstance(path, (str, os.PathLike)):
         if not os.path.exists(path):
             raise FileNotFoundError(f"{path}: no such file")
@@ -121,7 +122,13 @@ def _open_run(path):
             raise ValueError(f"{path}: not a file")
         if not h5py.is_hdf5(path):
             raise ValueError(f"{path}: not an HDF5 file, so not a run file of ropedyn")
-    f = h5py.File(path, "r")
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        if "unable to lock file" not in str(exc):
+            raise
+        raise OSError(f"{path}: held open for writing (a run is writing it; to "
+                      "read it as of its last flush, set HDF5_USE_FILE_LOCKING=FALSE)") from exc
     missing = [name for name in RUN_DATASETS if name not in f]
     if missing:
         why = f"{path}: not a run file of ropedyn (no /{missing[0]}): {what_file(f)}"

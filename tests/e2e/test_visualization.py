@@ -182,6 +182,24 @@ def test_scripts_say_that_a_file_is_no_run_file(module, ropedyn_exe, tmp_path):
 
 
 @pytest.mark.parametrize("module", ["plot.overview", "plot.energy", "animate", "xdmf"])
+def test_scripts_say_that_a_run_holds_the_file_open(module, tiny, tmp_path):
+    """A run file held open for writing (here by this test, as a running ropedyn holds its
+    FILE.part): one line naming the file and the way to read it anyway, exit 2 (h5py's
+    "[Errno 11] Unable to synchronously open file (unable to lock file ...)" before)."""
+    live = tmp_path / "live.h5.part"
+    shutil.copy(tiny, live)
+    env = {k: v for k, v in os.environ.items() if k != "HDF5_USE_FILE_LOCKING"}
+    with h5py.File(live, "r+"):
+        result = subprocess.run([sys.executable, "-m", f"ropedyn.{module}", str(live)],
+                                capture_output=True, text=True, timeout=120,
+                                env=dict(env, PYTHONPATH=str(ROOT / "python")))
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.endswith(f"{live}: held open for writing (a run is writing it; to "
+                                  "read it as of its last flush, set "
+                                  "HDF5_USE_FILE_LOCKING=FALSE)\n"), result.stderr
+
+
+@pytest.mark.parametrize("module", ["plot.overview", "plot.energy", "animate", "xdmf"])
 def test_scripts_say_that_a_file_has_no_records(module, tiny, tmp_path):
     """A run file without records (a run killed before its first flush): one line, exit 1
     and no picture (plot_energy ended in an IndexError traceback)."""
