@@ -206,7 +206,8 @@ def parse_args(argv):
     parser.add_argument("--energy", action="store_true", help="add an energy panel")
     parser.add_argument("--size", default=None,
                         help="WIDTHxHEIGHT in pixels (default 640x520, 1000x480 with --energy)")
-    parser.add_argument("--dpi", type=int, default=100, help="dots per inch (default 100)")
+    parser.add_argument("--dpi", type=plot.parse_dpi, default=100,
+                        help="dots per inch (default 100)")
     args = parser.parse_args(argv)
     if args.max_frames < 1:
         parser.error("--max-frames must be >= 1")

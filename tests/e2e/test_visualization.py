@@ -243,6 +243,20 @@ def test_pictures_refuse_a_directory_that_does_not_exist(module, name, tiny, tmp
     assert not (tmp_path / "nowhere").exists()
 
 
+@pytest.mark.parametrize("module", ["plot.overview", "animate"])
+@pytest.mark.parametrize("option, says", [
+    (("--size", "0x480"), "size '0x480': expected WIDTHxHEIGHT in pixels"),
+    (("--dpi", "0"), "argument --dpi: '0': expected dots per inch, an integer >= 1")])
+def test_pictures_refuse_a_size_or_dpi_of_zero(module, option, says, tiny, tmp_path):
+    """A picture of no pixels or no dots per inch: a usage error, exit 2 (they ended in
+    numpy's LinAlgError or a ZeroDivisionError traceback)."""
+    out = tmp_path / ("p.png" if module == "plot.overview" else "a.gif")
+    result = script(module, tiny, "-o", out, *option)
+    assert result.returncode == 2, result.stderr
+    assert says in result.stderr and "Traceback" not in result.stderr
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("which", ["tiny", "tiny_mpp"])
 def test_plot(which, request, tmp_path):
     run_file = request.getfixturevalue(which)

@@ -3,6 +3,7 @@ right, x downward) and the command-line modules that draw: `ropedyn.plot.overvie
 (scripts/plot; also `python -m ropedyn.plot`) and `ropedyn.plot.energy`
 (scripts/plot_energy.py).
 """
+import argparse
 import contextlib
 import os
 import pathlib
@@ -144,11 +145,22 @@ def fit_equal(ax):
 
 
 def parse_size(value):
-    """'WxH' -> (W, H) pixels."""
+    """'WxH' -> (W, H) pixels, each at least 1."""
     match = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", value)
-    if not match:
+    if not match or min(int(match.group(1)), int(match.group(2))) < 1:
         raise ValueError(f"size '{value}': expected WIDTHxHEIGHT in pixels, e.g. 640x480")
     return int(match.group(1)), int(match.group(2))
+
+
+def parse_dpi(value):
+    """--dpi: dots per inch, an integer >= 1 (argparse type)."""
+    try:
+        dpi = int(value)
+    except ValueError:
+        dpi = 0
+    if dpi < 1:
+        raise argparse.ArgumentTypeError(f"'{value}': expected dots per inch, an integer >= 1")
+    return dpi
 
 
 def check_directory(out):

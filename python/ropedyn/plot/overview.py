@@ -139,7 +139,7 @@ def main(argv=None):
                         help="times (s) of the axial-force curves, e.g. 0.5,1,2 "
                              "(default: 5 times spread over the run)")
     parser.add_argument("--size", default="1200x900", help="WIDTHxHEIGHT in pixels")
-    parser.add_argument("--dpi", type=int, default=100)
+    parser.add_argument("--dpi", type=plot.parse_dpi, default=100)
     args = parser.parse_args(argv)
     try:
         size = plot.parse_size(args.size)
