@@ -49,8 +49,13 @@ def refusal(path, kind):
         except OSError:
             ours = False
     else:
+        # an XDMF file of another program has the same DOCTYPE: ours names the script (in its
+        # comment) or, written before the comment, our RUN_fields.h5 in its first grid
         with open(path, "rb") as f:
-            ours = b"<!DOCTYPE Xdmf" in f.read(200)
+            head = f.read(1000)
+        ours = b"<!DOCTYPE Xdmf" in head and (
+            f"<!-- {WRITTEN_BY} from ".encode() in head
+            or f">{path.stem}_fields.h5:/connectivity<".encode() in head)
     if ours:
         return None
     return (f"{path}: exists and is not a file of scripts/xdmf: not replaced "

@@ -530,6 +530,24 @@ def test_xdmf_says_what_made_it_and_keeps_other_files(tiny, tmp_path):
     assert (tmp_path / "r.xmf").read_text() == "my notes\n"
 
 
+def test_xdmf_keeps_an_xdmf_file_of_another_program(tiny, tmp_path):
+    """An RUN.xmf that another program wrote (ParaView's XDMF writer starts with the same
+    DOCTYPE as the sidecar) is refused (exit 2) and kept unless --force (it was taken for
+    an earlier sidecar and replaced)."""
+    run = tmp_path / "r.h5"
+    shutil.copy(tiny, run)
+    theirs = ('<?xml version="1.0" ?>\n<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>\n'
+              '<Xdmf Version="2.0"><Domain><Grid Name="mesh"><Topology TopologyType='
+              '"Polyline"/></Grid></Domain></Xdmf>\n')
+    (tmp_path / "r.xmf").write_text(theirs)
+    refused = script("xdmf", run)
+    assert refused.returncode == 2
+    assert "r.xmf: exists and is not a file of scripts/xdmf" in refused.stderr
+    assert (tmp_path / "r.xmf").read_text() == theirs
+    assert script("xdmf", run, "--force").returncode == 0
+    assert script("xdmf", run).returncode == 0          # now its own sidecar: replaced
+
+
 def test_xdmf_that_fails_leaves_the_earlier_sidecar_whole(tiny, tmp_path):
     """Both files are written as .part and renamed at the end: a sidecar that fails halfway
     (a run file whose /rope/points is shorter than /time) leaves the earlier pair as it
