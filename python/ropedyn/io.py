@@ -84,9 +84,10 @@ class Run:
     @property
     def e0(self):
         """E0, the balance's start value, J: B at the first record, the E0 `ropedyn run`
-        prints. For a run started from a record of another (&initial shape = 'state') or
-        resumed, the energy dissipated and the work done before count in it (they carry
-        over), so it is not T + V at the first record."""
+        prints. For a run started from a record of another (&initial shape = 'state'), the
+        energy dissipated and the work done before count in it (they carry over), so it is
+        not T + V at the first record. A resumed run's file keeps its first record: its E0
+        is that of the first part."""
         return float(self.balance[0])
 
     def group(self, name):
