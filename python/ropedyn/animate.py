@@ -26,6 +26,8 @@ from ropedyn import fields, io, plot  # noqa: E402
 from ropedyn.docstrings import summary  # noqa: E402
 
 ROPE_COLOR = "#1f4e9c"
+#: the slowest playback --fps takes
+MIN_FPS = 0.01
 TIP_COLOR = "#d62728"
 
 
@@ -211,8 +213,9 @@ def parse_args(argv):
     args = parser.parse_args(argv)
     if args.max_frames < 1:
         parser.error("--max-frames must be >= 1")
-    if args.fps is not None and args.fps <= 0:
-        parser.error("--fps must be > 0")
+    if args.fps is not None and not args.fps >= MIN_FPS:
+        # (a GIF frame lasts at most 655.35 s; Pillow ended in an OverflowError)
+        parser.error(f"--fps must be >= {MIN_FPS:g} (a frame of at most 100 s)")
     try:
         args.size = plot.parse_size(args.size or ("1000x480" if args.energy else "640x520"))
     except ValueError as exc:
@@ -250,7 +253,7 @@ def main(argv=None):
                 save_gif(part, images, fps, comment)
     finally:
         drawer.close()
-    print(f"animate: {out} ({frames.size} frames at {fps:.1f} fps, "
+    print(f"animate: {out} ({frames.size} frames at {fps:.3g} fps, "
           f"{frames.size / fps:.1f} s long; written in "
           f"{wallclock.perf_counter() - started:.1f} s)")
     return 0

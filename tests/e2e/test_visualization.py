@@ -141,6 +141,17 @@ def test_animate_refuses_to_replace_the_run_file(tiny, tmp_path):
         assert run_as_gif.read_bytes() == pathlib.Path(tiny).read_bytes()
 
 
+@pytest.mark.parametrize("fps", ["0", "-1", "nan", "1e-9"])
+def test_animate_refuses_a_frame_rate_too_slow_to_write(fps, tiny, tmp_path):
+    """--fps at or below 0, not a number, or so slow that a GIF frame cannot last that long
+    (1e-9 ended in Pillow's OverflowError traceback): a usage error, exit 2."""
+    gif = tmp_path / "a.gif"
+    result = script("animate", tiny, "-o", gif, "--max-frames", "2", "--fps", fps)
+    assert result.returncode == 2, result.stderr
+    assert "--fps must be >= 0.01" in result.stderr and "Traceback" not in result.stderr
+    assert not gif.exists()
+
+
 # --- plot ----------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("module", ["plot.overview", "plot.energy"])
