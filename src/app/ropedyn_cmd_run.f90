@@ -98,8 +98,15 @@ contains
         type(run_summary_t), intent(in) :: summary
         character(len=:), allocatable :: text
         text = '; continue with: ropedyn run --resume '//file
-        if (summary%budget_rest > step_budget(scene)) text = text// &
-            ' --set solver.max_steps='//int_text(budget_covering(summary%budget_rest))
+        if (summary%budget_rest <= step_budget(scene)) return
+        if (budget_covering(summary%budget_rest) > huge(1)) then
+            ! (max_steps is a default integer)
+            text = '; no step budget covers that (solver.max_steps is at most '// &
+                int_text(huge(1))//'): loosen solver.rtol and atol, or use another method '// &
+                '(docs/guide/choosing.md)'
+        else
+            text = text//' --set solver.max_steps='//int_text(budget_covering(summary%budget_rest))
+        end if
     end function resume_hint
 
     !> The scene of the run file `path` (its `scene` attribute) with `overrides`, its output

@@ -95,6 +95,7 @@ contains
         if (scene%effects%ground) call ground_start(scene, list)
         if (scene%effects%ground) call ground_anchors(scene, list)
         call idle_groups(scene, list)
+        call tolerance_below_rounding(scene, list)
         ! a start that sets the velocities itself (at rest, or the record's)
         associate (i => scene%initial)
             if (any(i%velocity /= 0.0_wp) .and. (i%shape == 'equilibrium' .or. &
@@ -144,6 +145,21 @@ contains
             end if
         end function damping_text
     end function scene_warnings
+
+    !> A relative tolerance below what double precision resolves: a step's error estimate
+    !! is then rounding noise, no method meets the tolerance, and the steps shrink to the
+    !! rounding limit until the step budget runs out (rtol 1e-20 on the paper's rope: a
+    !! million steps for the first 5e-8 s).
+    subroutine tolerance_below_rounding(scene, list)
+        type(scene_t), intent(in) :: scene
+        type(text_t), allocatable, intent(inout) :: list(:)
+        real(wp), parameter :: LEAST_RTOL = 100.0_wp*epsilon(1.0_wp)
+        if (scene%solver%rtol >= LEAST_RTOL) return
+        call append_text(list, scene%origin('solver.rtol')//': &solver: rtol = '// &
+            real_text(scene%solver%rtol)//': below what double precision resolves ('// &
+            significant_text(LEAST_RTOL, 2)//', 100 times its rounding unit): no method '// &
+            'meets it, and its steps shrink to the rounding limit')
+    end subroutine tolerance_below_rounding
 
     !> The first key of the `end` support's motion that its motion does not use: a harmonic
     !! key (amplitude, frequency, phase, angle amplitude and phase, ramp) other than 0 without

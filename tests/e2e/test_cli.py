@@ -162,6 +162,25 @@ def test_override_tabs_are_white_space(run, tmp_path):
     assert len(rtol) == 1 and float(rtol[0].split("=")[1]) == 1e-7, rtol
 
 
+def test_a_tolerance_below_rounding_is_warned_of_and_not_budgeted(run, tmp_path):
+    """rtol 1e-20 is below what double precision resolves: a warning says so when the scene
+    is read; the run's steps shrink to the rounding limit, and the hint after max_steps
+    names no budget above max_steps' largest value (it named 1.8e13 steps, which --set
+    then refused) but a looser tolerance."""
+    (tmp_path / "good.nml").write_text(GOOD)
+    result = run("run", "good.nml", "--set", "solver.rtol=1e-20", "--set", "solver.atol=1e-30",
+                 "--set", "solver.max_steps=2000")
+    assert result.returncode == 3, result.stderr
+    assert ("--set solver.rtol=1e-20: &solver: rtol = 1.0e-20: below what double precision "
+            "resolves") in result.stderr, result.stderr
+    assert ("no step budget covers that (solver.max_steps is at most 2147483647): loosen "
+            "solver.rtol and atol") in result.stderr, result.stderr
+    assert "--set solver.max_steps=" not in result.stderr
+    tight = run("run", "good.nml", "--set", "solver.rtol=1e-13", "--set", "solver.t_end=0.01",
+                "--set", "output.file=tight.h5")
+    assert tight.returncode == 0 and "warning" not in tight.stderr, tight.stderr
+
+
 def test_failed_integration_is_marked(run, tmp_path):
     (tmp_path / "short.nml").write_text(
         "&model kind = 'rfem', elements = 8 /\n"
