@@ -96,6 +96,7 @@ contains
                 state%status = 'missing'
                 state%reason = failure_note(c%file)
                 if (len(state%reason) > 0) state%status = 'failed'
+                if (state%status == 'missing') state%reason = finished_part_note(c)
             else if (.not. holds_case_scene(c, state%data%scene)) then
                 state%status = 'stale'
                 state%reason = 'the file holds another scene than this case (the sweep ' &
@@ -126,11 +127,32 @@ contains
                 state%status = 'interrupted'
                 state%reason = lock%gone()
                 inquire (file=part_path(c%file), exist=partial)
-                if (partial) state%reason = state%reason//'; partial output in '// &
-                    part_path(c%file)
+                if (partial) then
+                    if (len(finished_part_note(c)) > 0) then
+                        state%reason = state%reason//'; '//finished_part_note(c)
+                    else
+                        state%reason = state%reason//'; partial output in '//part_path(c%file)
+                    end if
+                end if
             end if
         end associate
     end subroutine case_state
+
+    !> '' unless the case's .part holds a finished run of the case (status complete), left
+    !! by a writer killed before it renamed the file: then that, and that the next sweep
+    !! puts it in place (ropedyn_sweep_task).
+    function finished_part_note(c) result(text)
+        type(sweep_case_t), intent(in) :: c
+        character(len=:), allocatable :: text
+        type(case_data_t) :: data
+        type(error_t), allocatable :: err
+        text = ''
+        call read_case_file(part_path(c%file), data, err)
+        if (allocated(err) .or. .not. data%exists) return
+        if (data%status /= 'complete' .or. .not. holds_case_scene(c, data%scene)) return
+        text = part_path(c%file)//' holds the finished run (its writer was killed before '// &
+            'it renamed the file): the next sweep puts it in place'
+    end function finished_part_note
 
     !> `<output_dir>/.case_<id>.failed`, the note of a case whose run failed before it made
     !! its file (`file` the case file).

@@ -578,10 +578,20 @@ def test_a_finished_part_of_a_killed_writer_is_put_in_place(run, sweep_dir):
         del f["solver/wall_time"]
         f.attrs["mark"] = "the finished run"
         steps = int(f["solver/steps"][()])
+    missing = run("sweep", "sw.nml", "--status")
+    assert ("0001 missing: out/sw/.case_0001.h5.part holds the finished run"
+            in missing.stdout), missing.stdout
     gone = subprocess.Popen(["true"])
     gone.wait()
     (out / ".case_0001.lock").write_text(
         f"ropedyn sweep case lock\nhost={socket.gethostname()}\npid={gone.pid}\n")
+    # the status says what the .part holds and what the next sweep does with it
+    status = run("sweep", "sw.nml", "--status")
+    assert ("0001 interrupted: its writer ended without finishing: killed or crashed "
+            in status.stdout), status.stdout
+    assert ("out/sw/.case_0001.h5.part holds the finished run (its writer was killed before "
+            "it renamed the file): the next sweep puts it in place") in status.stdout, \
+        status.stdout
     result = run("sweep", "sw.nml", "--jobs", "1")
     assert result.returncode == 0, result.stderr
     assert "sweep: case 0001 complete" in result.stderr
