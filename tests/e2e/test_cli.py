@@ -138,22 +138,14 @@ def test_usage_error_shows_control_and_invisible_characters(run, tmp_path, args,
     assert "\r" not in result.stderr
 
 
-def test_override_applies(run, tmp_path):
+@pytest.mark.parametrize("sets", [
+    ("model.elements=6", "solver.rtol=1e-7"),
+    # a tab where a scene file allows white space is white space in --set too
+    ("\tmodel .\telements\t=\t6\t", "solver.rtol\t= 1e-7"),
+])
+def test_override_applies(run, tmp_path, sets):
     (tmp_path / "good.nml").write_text(GOOD)
-    result = run("run", "good.nml", "--set", "model.elements=6", "--set", "solver.rtol=1e-7")
-    assert result.returncode == 0, result.stderr
-    with h5py.File(tmp_path / "out" / "good.h5") as f:
-        assert f["state/q"].shape[1] == 6
-        scene = f.attrs["scene"].decode()
-    rtol = [line for line in scene.splitlines() if line.strip().startswith("rtol")]
-    assert len(rtol) == 1 and float(rtol[0].split("=")[1]) == 1e-7, rtol
-
-
-def test_override_tabs_are_white_space(run, tmp_path):
-    """A tab where a scene file allows white space is white space in --set too."""
-    (tmp_path / "good.nml").write_text(GOOD)
-    result = run("run", "good.nml", "--set", "\tmodel .\telements\t=\t6\t",
-                 "--set", "solver.rtol\t= 1e-7")
+    result = run("run", "good.nml", *(word for s in sets for word in ("--set", s)))
     assert result.returncode == 0, result.stderr
     with h5py.File(tmp_path / "out" / "good.h5") as f:
         assert f["state/q"].shape[1] == 6

@@ -370,14 +370,26 @@ def test_two_writers_of_one_case(run, ropedyn_exe, sweep_dir):
     assert status_lines(run, "long.nml")[1]["complete"] == 1
 
 
-def test_sigterm_to_runner_stops_its_workers(run, ropedyn_exe, sweep_dir):
-    (sweep_dir / "long.nml").write_text(LONG.format(rtols="1e-6, 1e-7, 1e-8"))
+def two_workers_running(ropedyn_exe, sweep_dir, rtols):
+    """A runner of the long sweep over `rtols` with two jobs, once both its workers write
+    their cases' .part files (killed if they do not)."""
+    (sweep_dir / "long.nml").write_text(LONG.format(rtols=rtols))
     out = sweep_dir / "out" / "long"
     runner = subprocess.Popen([str(ropedyn_exe), "sweep", "long.nml", "--jobs", "2"],
                               cwd=sweep_dir, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                               text=True)
     try:
         wait_for(lambda: len(list(out.glob(".case_*.h5.part"))) == 2, what="two workers")
+    except BaseException:
+        runner.kill()
+        raise
+    return runner
+
+
+def test_sigterm_to_runner_stops_its_workers(run, ropedyn_exe, sweep_dir):
+    out = sweep_dir / "out" / "long"
+    runner = two_workers_running(ropedyn_exe, sweep_dir, "1e-6, 1e-7, 1e-8")
+    try:
         workers = [p for p in processes_mentioning("long.nml --quiet")]
         assert len(workers) == 2
         runner.send_signal(signal.SIGTERM)
@@ -415,13 +427,9 @@ def test_empty_logs_of_a_killed_runner_go(run, ropedyn_exe, sweep_dir):
     """A runner killed by SIGKILL cannot remove its workers' empty logs, and its workers
     finish their cases on their own: the next runner removes the empty logs of the
     complete cases (they stayed, the cases not being run again); a log with text stays."""
-    (sweep_dir / "long.nml").write_text(LONG.format(rtols="1e-7, 1e-8"))
     out = sweep_dir / "out" / "long"
-    runner = subprocess.Popen([str(ropedyn_exe), "sweep", "long.nml", "--jobs", "2"],
-                              cwd=sweep_dir, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                              text=True)
+    runner = two_workers_running(ropedyn_exe, sweep_dir, "1e-7, 1e-8")
     try:
-        wait_for(lambda: len(list(out.glob(".case_*.h5.part"))) == 2, what="two workers")
         runner.kill()
         runner.communicate(timeout=60)
         wait_for(lambda: processes_mentioning("long.nml --quiet") == [], timeout=120,
