@@ -36,8 +36,11 @@ module ropedyn_case_file
         !> what the run warned of (/solver/warnings), one line each; none when absent
         type(text_t), allocatable :: warnings(:)
         !> where a part of the run was killed, s: the times of the restarts that continued
-        !! a file with status running (/solver/restarts); that part wrote no counters
+        !! a file with status running (/solver/restarts); that part wrote no wall time
         real(wp), allocatable :: killed_at(:)
+        !> for each of killed_at: the part's counters were in the file (written at each
+        !! flush, as of its last: the restart's steps > 0); else they were lost
+        logical, allocatable :: killed_counted(:)
     end type case_data_t
 
 contains
@@ -128,16 +131,20 @@ contains
         !> data%killed_at from /solver/restarts (none when there are no restarts).
         subroutine read_killed_parts()
             type(text_t), allocatable :: previous(:)
-            real(wp), allocatable :: times(:)
+            real(wp), allocatable :: times(:), steps(:)
             integer(hsize_t) :: dims(1)
             integer :: j
-            allocate (data%killed_at(0))
+            allocate (data%killed_at(0), data%killed_counted(0))
             call h5%read_texts('/solver/restarts/previous_status', previous, err)
             if (allocated(err) .or. size(previous) == 0) return
             call h5%read_reals('/solver/restarts/time', times, dims, err)
             if (allocated(err)) return
-            do j = 1, min(size(previous), size(times))
-                if (previous(j)%s == 'running') data%killed_at = [data%killed_at, times(j)]
+            call h5%read_reals('/solver/restarts/steps', steps, dims, err)
+            if (allocated(err)) return
+            do j = 1, min(size(previous), size(times), size(steps))
+                if (previous(j)%s /= 'running') cycle
+                data%killed_at = [data%killed_at, times(j)]
+                data%killed_counted = [data%killed_counted, steps(j) > 0.0_wp]
             end do
         end subroutine read_killed_parts
 

@@ -212,10 +212,17 @@ module ropedyn_output
         !> bytes of records written to HDF5 since the file was last flushed (held in its
         !! chunk cache: written to disk at the flush; keep_room keeps room for them)
         integer(i8) :: unflushed = 0
+        !> the run's counters and CPU time (s) so far, kept by `keep_counters` for the next
+        !! flush after an append, which writes them with the records (`has_kept`)
+        type(solver_stats_t) :: kept_stats
+        real(wp) :: kept_cpu = 0.0_wp
+        logical :: has_kept = .false.
     contains
         procedure :: create => output_create
         procedure :: append => output_append
         procedure :: write_stats => output_write_stats
+        procedure :: flush_due => output_flush_due
+        procedure :: keep_counters => output_keep_counters
         procedure :: write_switches => output_write_switches
         procedure :: write_order_safety => output_write_order_safety
         procedure :: add_warnings => output_add_warnings
@@ -265,6 +272,14 @@ module ropedyn_output
             character(len=*), intent(in) :: version, overrides
             type(error_t), allocatable, intent(out) :: err
         end subroutine output_add_restart
+
+        !> /solver's counters, CPU time (s), time split and reduced_newton (no flush).
+        module subroutine write_counters(self, stats, cpu_time, err)
+            type(output_file_t), intent(inout) :: self
+            type(solver_stats_t), intent(in) :: stats
+            real(wp), intent(in) :: cpu_time
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine write_counters
 
         !> Close all datasets and the file and mark `self` closed.
         !! Reports the first failure in `err` if present; closes everything regardless.
@@ -630,6 +645,26 @@ contains
         call file%attribute('/', 'units_convention', units_convention, err)
     end subroutine write_provenance
 
+    !> Whether the next `append` flushes the file (its first record, or FLUSH_PERIOD since
+    !! the last flush): the time to `keep_counters`.
+    logical function output_flush_due(self) result(due)
+        class(output_file_t), intent(in) :: self
+        due = self%is_open .and. (self%n_records + self%n_pending == 0 .or. &
+                                  clock_seconds() - self%last_flush >= FLUSH_PERIOD)
+    end function output_flush_due
+
+    !> Keep the run's counters and CPU time so far (s) for the next flush after an append,
+    !! which writes them into /solver with the records: a run killed later leaves them as
+    !! of its last flush, with the records up to it (a resume counts on from them).
+    subroutine output_keep_counters(self, stats, cpu_time)
+        class(output_file_t), intent(inout) :: self
+        type(solver_stats_t), intent(in) :: stats
+        real(wp), intent(in) :: cpu_time
+        self%kept_stats = stats
+        self%kept_cpu = cpu_time
+        self%has_kept = .true.
+    end subroutine output_keep_counters
+
     !> Write the solver counters and the CPU time (also for a failed run); may be repeated.
     !! With `t_reached`, also /solver/t_reached: the time the integration got to (s; for an
     !! interrupted or failed run, where it stopped).
@@ -639,31 +674,16 @@ contains
         real(wp), intent(in) :: cpu_time           !< CPU time of the run, s
         type(error_t), allocatable, intent(out) :: err
         real(wp), intent(in), optional :: t_reached
-        integer(i8) :: counters(size(COUNTER_NAMES))
-        real(wp) :: times(size(TIMER_NAMES))
-        integer :: k
 
         if (.not. self%is_open) then
             call not_open(self, 'write_stats', err)
             return
         end if
+        self%has_kept = .false.
         steps: block
             call write_pending(self, err)
             if (allocated(err)) exit steps
-            counters = counter_values(stats)
-            do k = 1, size(COUNTER_NAMES)
-                call self%file%write('/solver/'//trim(COUNTER_NAMES(k)), counters(k), '1', err)
-                if (allocated(err)) exit steps
-            end do
-            call self%file%write('/solver/cpu_time', cpu_time, 's', err)
-            if (allocated(err)) exit steps
-            times = timer_values(stats)
-            do k = 1, size(TIMER_NAMES)
-                call self%file%write('/solver/'//trim(TIMER_NAMES(k)), times(k), 's', err)
-                if (allocated(err)) exit steps
-            end do
-            call self%file%write('/solver/reduced_newton', merge(1_i8, 0_i8, &
-                                 stats%reduced_newton), '1', err)
+            call write_counters(self, stats, cpu_time, err)
             if (allocated(err)) exit steps
             if (present(t_reached)) then
                 call self%file%write('/solver/t_reached', t_reached, 's', err)
@@ -673,14 +693,6 @@ contains
         end block steps
         if (allocated(err)) call abandon(self, err)
     end subroutine output_write_stats
-
-    !> The time split of `stats` named in TIMER_NAMES, in that order (s).
-    pure function timer_values(stats) result(times)
-        type(solver_stats_t), intent(in) :: stats
-        real(wp) :: times(size(TIMER_NAMES))
-        times = [stats%time_advance, stats%time_rhs, stats%time_jac, stats%time_factor, &
-                 stats%time_solve]
-    end function timer_values
 
     !> The counters of `stats` named in COUNTER_NAMES, in that order.
     pure function counter_values(stats) result(counters)

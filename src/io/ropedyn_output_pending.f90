@@ -51,6 +51,28 @@ contains
         call write_when_due(self, err)
     end procedure output_append
 
+    module procedure write_counters
+        integer(i8) :: counters(size(COUNTER_NAMES))
+        real(wp) :: times(size(TIMER_NAMES))
+        integer :: k
+        counters = counter_values(stats)
+        do k = 1, size(COUNTER_NAMES)
+            call self%file%write('/solver/'//trim(COUNTER_NAMES(k)), counters(k), '1', err)
+            if (allocated(err)) return
+        end do
+        call self%file%write('/solver/cpu_time', cpu_time, 's', err)
+        if (allocated(err)) return
+        ! (in TIMER_NAMES' order)
+        times = [stats%time_advance, stats%time_rhs, stats%time_jac, stats%time_factor, &
+                 stats%time_solve]
+        do k = 1, size(TIMER_NAMES)
+            call self%file%write('/solver/'//trim(TIMER_NAMES(k)), times(k), 's', err)
+            if (allocated(err)) return
+        end do
+        call self%file%write('/solver/reduced_newton', merge(1_i8, 0_i8, &
+                             stats%reduced_newton), '1', err)
+    end procedure write_counters
+
     !> The pending records written when they fill the block or are due (the first record,
     !! or FLUSH_PERIOD since the last flush; then the file is flushed too); a failure
     !! abandons the file.
@@ -67,6 +89,11 @@ contains
             ! room for what follows (not at the end: a run that got all its records written
             ! closes its file whatever room is left)
             if (.not. allocated(err)) call keep_room(self, err)
+        end if
+        ! the counters kept for this flush: the file's as of its records
+        if (due .and. self%has_kept .and. .not. allocated(err)) then
+            call write_counters(self, self%kept_stats, self%kept_cpu, err)
+            self%has_kept = .false.
         end if
         if (due .and. .not. allocated(err)) then
             call flush_file(self, err)

@@ -143,6 +143,8 @@ module ropedyn_run
         integer(i8) :: counters_before(7) = 0
         real(wp) :: cpu_before = 0.0_wp
         real(wp) :: cpu_start = 0.0_wp      !< CPU clock at `begin`, s
+        !> the integration has begun: its counters are kept for the file's flushes
+        logical :: counting = .false.
         real(wp) :: time_advance = 0.0_wp   !< &solver profile: time in advance_to, s
         integer(i8) :: steps_now = 0        !< steps of the run at the last record
         ! the state: time (s), ODE state and quadratures; at the previous record too
@@ -217,6 +219,8 @@ module ropedyn_run
         procedure, private :: resume_from_file, check_energy, second_look, note_peak, &
                               fail_runaway, rescue, retire_integrator, keep_switches
         procedure, private :: guard_output, release_output, hand_back, file_warnings
+        procedure, private :: counters_so_far => run_counters_so_far, &
+                              cpu_so_far => run_cpu_so_far
     end type run_t
 
     interface
@@ -554,6 +558,7 @@ contains
         call self%start_monitor(self%summary%initial_energy)
         call self%start_integrator(err)
         if (allocated(err)) return
+        self%counting = .true.
         ! no progress display without a file: the caller's own loop is the run
         if (self%output == OUTPUT_FILE) &
             call self%progress%start_run(self%t, self%t_end, self%scene%output%progress, &
@@ -673,6 +678,12 @@ contains
                             '): not written to the output')
             return
         end if
+        ! the counters so far go with the records the next flush writes (a killed run's
+        ! file then holds them as of its last flush)
+        if (self%output /= OUTPUT_NONE .and. self%counting) then
+            if (self%out%flush_due()) call self%out%keep_counters(self%counters_so_far(), &
+                                                                   self%cpu_so_far())
+        end if
         if (self%output /= OUTPUT_NONE) &
             call self%out%append(self%t, self%q, self%qdot, self%points, e, h, order, err, &
                                  y=self%y, yq=self%yq, axial=self%axial, shear=self%shear, &
@@ -742,6 +753,25 @@ contains
         if (associated(self%stop_requested)) asked_to_stop = self%stop_requested()
     end function asked_to_stop
 
+    !> The run's counters so far, over its integrators and the earlier parts of a resumed
+    !! run (as the file's /solver holds them), with the time spent in `advance`.
+    function run_counters_so_far(self) result(stats)
+        class(run_t), intent(in) :: self
+        type(solver_stats_t) :: stats
+        stats = self%integrator%stats()
+        call stats%add(self%stats_before)
+        stats%time_advance = self%time_advance
+        call add_counter_values(stats, self%counters_before)
+    end function run_counters_so_far
+
+    !> The run's CPU time so far, s, with that of the earlier parts of a resumed run.
+    real(wp) function run_cpu_so_far(self) result(cpu)
+        class(run_t), intent(in) :: self
+        real(wp) :: now
+        call cpu_time(now)
+        cpu = self%cpu_before + (now - self%cpu_start)
+    end function run_cpu_so_far
+
     !> End the run: the summary's counters and CPU time, the solver's statistics, switches
     !! and order safety into the file, its status and reason, the file closed. An error of
     !! the file goes into `err` unless it already holds one.
@@ -762,12 +792,10 @@ contains
             call self%integrator%finalize()
             return
         end if
+        self%counting = .false.
         associate (s => self%summary)
-            s%cpu_time = self%cpu_before + (cpu_now - self%cpu_start)
-            s%stats = self%integrator%stats()
-            call s%stats%add(self%stats_before)
-            s%stats%time_advance = self%time_advance
-            call add_counter_values(s%stats, self%counters_before)
+            s%cpu_time = self%cpu_so_far()
+            s%stats = self%counters_so_far()
             s%t_reached = max(s%t_reached, self%t)
             if (self%monitoring .and. s%records > 0) then
                 if (self%monitor%lost(s%final_energy)) call append_text(s%warnings, &

@@ -133,8 +133,9 @@ contains
             end associate
         end do
         call append_text(warnings, trim(merge('case ', 'cases', size(partial) == 1))//' '// &
-            id_list(partial)//': the counters, cpu_time and wall_time are partial: a part of the run '// &
-            'was killed before it wrote them (the warning column of summary.csv says where)')
+            id_list(partial)//': wall_time (and where a killed part wrote none, the '// &
+            'counters and cpu_time) is partial: a part of the run was killed before it '// &
+            'wrote it (the warning column of summary.csv says which)')
     end subroutine note_partial
 
     !> The row of case c from its file as far as it goes: status, times, counters, warnings
@@ -194,8 +195,14 @@ contains
         else
             text = 'the parts of the run that ended at t = '//text//' (their last records) were'
         end if
-        text = 'steps, the other counters, cpu_time and wall_time are partial: '//text//' killed '// &
-            'before writing them'
+        if (all(data%killed_counted)) then
+            ! (a writer keeps its counters in the file at each flush, with its records)
+            text = 'wall_time is partial: '//text//' killed before writing it; steps, the '// &
+                'other counters and cpu_time count to its last flush'
+        else
+            text = 'steps, the other counters, cpu_time and wall_time are partial: '//text// &
+                ' killed before writing them'
+        end if
     end function partial_text
 
     !> The complete cases of one reference set against its tightest complete case (ties:

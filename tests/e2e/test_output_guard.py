@@ -123,7 +123,17 @@ def records_in(part):
     try:
         with h5py.File(part, "r", locking=False) as f:
             return len(f["time"]) if "time" in f else 0
-    except (OSError, KeyError, ValueError):
+    except (OSError, KeyError, ValueError, RuntimeError):  # (caught between writes)
+        return 0
+
+
+def counted_steps(part):
+    """/solver/steps of the file a running ropedyn writes, as its last flush left it (0
+    while there is none). Read without HDF5's file lock, which the writer holds."""
+    try:
+        with h5py.File(part, "r", locking=False) as f:
+            return int(f["solver/steps"][()]) if "solver/steps" in f else 0
+    except (OSError, KeyError, ValueError, RuntimeError):  # (caught between writes)
         return 0
 
 
@@ -166,9 +176,15 @@ def test_a_killed_run_leaves_the_earlier_file_whole(run, ropedyn_exe, tmp_path, 
     proc = long_run(ropedyn_exe, tmp_path, scene, "--force")
     part = tmp_path / "out" / "paper.h5.part"
     wait_for_records(part, proc)
+    # a flush writes the run's counters with its records
+    deadline = time.monotonic() + 120
+    while counted_steps(part) <= 0:
+        assert proc.poll() is None and time.monotonic() < deadline, "no counters flushed"
+        time.sleep(0.02)
     proc.kill()
     proc.wait(60)
     assert digest(out) == before and part.exists()
+    killed_steps = counted_steps(part)
     refused = run("run", scene, *sets)
     assert refused.returncode == 2
     assert "paper.h5.part: left by a run of out/paper.h5 that was killed" in refused.stderr
@@ -188,6 +204,11 @@ def test_a_killed_run_leaves_the_earlier_file_whole(run, ropedyn_exe, tmp_path, 
     assert ("status running: its writer ended without finishing: killed or crashed "
             f"(host {socket.gethostname()}, pid {proc.pid}" in resumed.stderr), resumed.stderr
     assert not (tmp_path / "out" / "paper.h5.lock").exists()
+    # the killed part's steps, as of its last flush, are the run's before the resume (the
+    # file keeps its .part name: paper.h5 holds a run of another variant)
+    with h5py.File(part) as f:
+        assert f["solver/restarts/steps"][0] == killed_steps > 0
+        assert f["solver/steps"][()] > killed_steps
     assert digest(out) == before
 
 
