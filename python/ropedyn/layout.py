@@ -14,8 +14,13 @@ or `ropedyn modes` (attribute `analysis`), each checked against its own layout; 
 summary (attribute `sweep`) has no layout per element and is refused, saying so.
 `check_layout` raises AssertionError naming the file and the dataset or attribute at fault,
 and returns a small summary dict (kind, records, status, reason, modes) when the layout is
-right. Only finished runs pass: status must be 'complete' or 'failed' ('running' means the
-run crashed or is still going); a statics or modes file is always 'complete'.
+right. A run file of any status passes: 'complete', 'failed', 'interrupted' (a signal
+stopped it; `ropedyn run --resume` continues it) and 'running' (its run was killed or
+crashed, or is still writing it: valid up to its last record); the layout is the same, but
+only a complete or interrupted file must have the solver statistics (a running file has
+those of a resumed run's earlier parts or none, a file given up after a write error none),
+and the series of a running or failed file may hold more records than /time (a block
+written halfway). A statics or modes file is always 'complete'.
 """
 
 import sys
@@ -127,6 +132,22 @@ MODES = {
 
 UNITS_CONVENTION = "SI; x points down (gravity), y horizontal, angles from x towards y"
 
+#: The statuses of a run file and what each means (docs/reference/file-format.md, "Status").
+RUN_STATUSES = {
+    "complete": "the run reached its end time",
+    "failed": "the run stopped on an error (see the reason)",
+    "interrupted": "a signal stopped the run at its last record (usually off the output "
+                   "grid); ropedyn run --resume FILE continues it",
+    "running": "the run was killed or crashed, or is still writing: the data are valid up "
+               "to the last record; ropedyn run --resume FILE continues it",
+}
+
+#: Statuses whose file has the solver statistics (STATS) of every part of the run.
+STATS_STATUSES = ("complete", "interrupted")
+
+#: Statuses whose file has a reason attribute.
+REASON_STATUSES = ("failed", "interrupted")
+
 
 def _require(condition, message):
     if not condition:
@@ -162,22 +183,54 @@ def check_layout(path, n_elements):
 
 def _check_run(f, path, n_elements, extents):
     """The layout of a run file (`check_layout`)."""
-    status, reason = _check_root(f, path, ROOT_ATTRIBUTES, ("complete", "failed"))
+    status, reason = _check_root(f, path, ROOT_ATTRIBUTES, tuple(RUN_STATUSES))
     _check_units(f, path)
 
-    # step-by-step datasets: (times, ...) extendible along time
+    # step-by-step datasets: (times, ...) extendible along time; /time is written last, so
+    # in a file whose run did not end normally (running, or failed writing) the others may
+    # hold the records of a block written halfway
     _require("time" in f, f"{path}: /time is missing")
     n_times = f["time"].shape[0]
     present = {k: v for k, v in OPTIONAL_SERIES.items() if k in f}
     for name, (record, units) in {**SERIES, **present}.items():
-        _check_dataset(f, path, name, (n_times,) + record, units, extents)
+        longer = (name != "time" and status in ("running", "failed") and name in f
+                  and f[name].ndim >= 1 and f[name].shape[0] > n_times)
+        _check_dataset(f, path, name, ((f[name].shape[0] if longer else n_times),) + record,
+                       units, extents)
         dset = f[name]
         _require(dset.chunks is not None and dset.maxshape[0] is None,
                  f"{path}: /{name} is not chunked and extendible along time")
     _check_columns(f, path)
     _check_fixed(f, path, n_elements)
 
-    # solver statistics (written at the end of complete and failed runs)
+    # solver statistics: written when a run ends (complete, failed in the integration,
+    # interrupted); none in a file given up after a write error, and a running file has
+    # none of its own run (a resumed run's file keeps those of the earlier parts)
+    have = [name for name in STATS if name in f]
+    if status in STATS_STATUSES or have:
+        _check_stats(f, path)
+    if status == "interrupted":
+        _require("solver/t_reached" in f, f"{path}: /solver/t_reached is missing")
+
+    # values
+    time = f["time"][()]
+    _require(np.all(np.isfinite(time)), f"{path}: /time has non-finite values")
+    _require(np.all(np.diff(time) > 0), f"{path}: /time is not strictly increasing")
+    kinetic = f["energy/kinetic"][:n_times]
+    elastic = f["energy/elastic"][:n_times]
+    gravity = f["energy/gravity"][:n_times]
+    total = f["energy/total"][:n_times]
+    expected_total = kinetic + elastic + gravity
+    bad = np.abs(total - expected_total) > 1e-12 * np.abs(expected_total) + 1e-12
+    _require(not np.any(bad),
+             f"{path}: /energy/total differs from kinetic + elastic + gravity at records "
+             f"{np.flatnonzero(bad).tolist()}")
+    return {"kind": "run", "records": int(n_times), "status": status, "reason": reason,
+            "modes": None}
+
+
+def _check_stats(f, path):
+    """The scalar solver statistics (STATS), all of them."""
     for name, units in STATS.items():
         _require(name in f, f"{path}: /{name} is missing")
         dset = f[name]
@@ -190,22 +243,6 @@ def _check_run(f, path, n_elements, extents):
             _require(dset[()] >= 0, f"{path}: /{name} is negative")
         got = _text(dset.attrs["units"])
         _require(got == units, f"{path}: /{name} units '{got}', expected '{units}'")
-
-    # values
-    time = f["time"][()]
-    _require(np.all(np.isfinite(time)), f"{path}: /time has non-finite values")
-    _require(np.all(np.diff(time) > 0), f"{path}: /time is not strictly increasing")
-    kinetic = f["energy/kinetic"][()]
-    elastic = f["energy/elastic"][()]
-    gravity = f["energy/gravity"][()]
-    total = f["energy/total"][()]
-    expected_total = kinetic + elastic + gravity
-    bad = np.abs(total - expected_total) > 1e-12 * np.abs(expected_total) + 1e-12
-    _require(not np.any(bad),
-             f"{path}: /energy/total differs from kinetic + elastic + gravity at records "
-             f"{np.flatnonzero(bad).tolist()}")
-    return {"kind": "run", "records": int(n_times), "status": status, "reason": reason,
-            "modes": None}
 
 
 def _check_analysis(f, path, kind, n_elements, extents):
@@ -263,10 +300,10 @@ def _check_root(f, path, names, statuses):
     _require(status in statuses,
              f"{path}: status is '{status}', expected " + " or ".join(f"'{s}'" for s in statuses))
     reason = None
-    if status == "failed":
-        _require("reason" in f.attrs, f"{path}: failed run without a 'reason' attribute")
+    if status in REASON_STATUSES:
+        _require("reason" in f.attrs, f"{path}: {status} run without a 'reason' attribute")
         reason = _text(f.attrs["reason"])
-        _require(reason.strip() != "", f"{path}: failed run with an empty reason")
+        _require(reason.strip() != "", f"{path}: {status} run with an empty reason")
     else:
         _require("reason" not in f.attrs, f"{path}: {status} file with a 'reason' attribute")
     convention = _text(f.attrs["units_convention"])
@@ -339,6 +376,8 @@ def main(argv=None):
     if summary["reason"]:
         line += f", reason: {summary['reason']}"
     print(line + ")")
+    if summary["kind"] == "run" and summary["status"] != "complete":
+        print(f"status {summary['status']}: {RUN_STATUSES[summary['status']]}")
     return 0
 
 

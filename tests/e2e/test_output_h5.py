@@ -5,6 +5,7 @@ import sys
 
 import h5py
 import numpy as np
+import pytest
 
 from ropedyn.layout import check_layout
 
@@ -82,3 +83,40 @@ def test_layout_refuses_a_sweep_summary(tmp_path):
     assert f"{path}: a sweep summary (root attribute 'sweep')" in result.stderr, \
         result.stderr
 
+
+
+def test_layout_checks_an_interrupted_and_a_killed_runs_file(run, tmp_path):
+    """The file of an interrupted run (status `interrupted`, a reason, its statistics) and of
+    a killed one (status `running`, no statistics of its own, a block of records written
+    halfway: the series one record longer than /time) have the layout of a complete run's:
+    python -m ropedyn.layout checks them and says what the status means. Made from a
+    complete run's file as the run would have left them."""
+    (tmp_path / "small.nml").write_text(SCENE)
+    assert run("run", "small.nml").returncode == 0
+    complete = tmp_path / "out" / "small.h5"
+    interrupted, killed = tmp_path / "interrupted.h5", tmp_path / "killed.h5.part"
+    for path in (interrupted, killed):
+        path.write_bytes(complete.read_bytes())
+    with h5py.File(interrupted, "r+") as f:
+        f.attrs["status"] = np.bytes_("interrupted")
+        f.attrs["reason"] = np.bytes_("interrupted.h5: interrupted by SIGTERM at t = 0.3 s "
+                                      "of 1.0 s (its last record; host h, pid 1)")
+    with h5py.File(killed, "r+") as f:
+        f.attrs["status"] = np.bytes_("running")
+        for name in [name for name in f["solver"] if f["solver"][name].shape == ()]:
+            del f["solver"][name]
+        for name in ("state/q", "energy/total"):              # written before /time
+            f[name].resize(f["time"].shape[0] + 1, axis=0)
+    for path, status, says in ((interrupted, "interrupted", "a signal stopped the run"),
+                               (killed, "running", "the run was killed or crashed")):
+        assert check_layout(str(path), 5)["status"] == status
+        result = subprocess.run([sys.executable, "-m", "ropedyn.layout", str(path), "5"],
+                                capture_output=True, text=True)
+        assert result.returncode == 0, result.stderr
+        assert f"layout OK (run file, 7 records, status {status}" in result.stdout
+        assert f"status {status}: {says}" in result.stdout, result.stdout
+    # a complete file must still have its statistics
+    with h5py.File(complete, "r+") as f:
+        del f["solver/steps"]
+    with pytest.raises(AssertionError, match="/solver/steps is missing"):
+        check_layout(str(complete), 5)
