@@ -52,12 +52,14 @@ def default_fps(times, frames):
 def energy_panel(ax, run):
     """Energies over the whole run; returns the moving time cursor (a vertical line)."""
     t, e = run.time, run.energy
-    ax.plot(t, e["kinetic"], lw=1, label="kinetic")
+    one = plot.point_marker(run)        # with one record: points, and the panel says so
+    ax.plot(t, e["kinetic"], lw=1, label="kinetic", **one)
     potential = e["gravity"] - e["gravity"][0] + e["elastic"]
-    ax.plot(t, potential, lw=1, label="potential - V(0)")
+    ax.plot(t, potential, lw=1, label="potential - V(0)", **one)
     if "dissipated" in e:
-        ax.plot(t, e["dissipated"], lw=1, ls="--", label="dissipated")
-    ax.plot(t, e["total"] - run.e0, "k", lw=1.2, label="total - E0")
+        ax.plot(t, e["dissipated"], lw=1, ls="--", label="dissipated", **one)
+    ax.plot(t, e["total"] - run.e0, "k", lw=1.2, label="total - E0", **one)
+    plot.say_one_record(ax, run)
     ax.set_xlabel("t (s)")
     ax.set_ylabel("energy (J)")
     ax.legend(fontsize=7, loc="best")

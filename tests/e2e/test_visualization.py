@@ -297,6 +297,56 @@ def test_plot_of_a_file_without_forces(ropedyn_exe, tmp_path):
         assert "cell/tension" not in f and "cell/curvature" in f
 
 
+def one_record_copy(run_file, path):
+    """A copy of a run file cut to its first record (the file of a run killed after its
+    first flush)."""
+    path.write_bytes(pathlib.Path(run_file).read_bytes())
+    with h5py.File(path, "r+") as f:
+        def cut(name, obj):
+            if isinstance(obj, h5py.Dataset) and obj.maxshape and obj.maxshape[0] is None:
+                obj.resize(1, axis=0)
+        f.visititems(cut)
+    return path
+
+
+def test_plots_of_one_record_draw_points(tiny, tmp_path, monkeypatch):
+    """With one record a line draws nothing: the energy curves (overview, energy plot,
+    animation panel) and the balance error are drawn as points, and the panels say "one
+    record"; the step-size panel says that there is no step before it."""
+    import matplotlib.pyplot as plt
+    from ropedyn import animate, plot
+    from ropedyn.plot import energy, overview
+
+    run = io.load_run(one_record_copy(tiny, tmp_path / "one.h5"))
+    assert run.time.size == 1
+
+    def texts(ax):
+        return " ".join(text.get_text() for text in ax.texts)
+
+    def assert_points(ax):
+        assert ax.lines and all(line.get_marker() not in (None, "None", "", " ")
+                                for line in ax.lines if len(line.get_xdata()) == 1)
+        assert "one record (t = 0 s)" in texts(ax)
+
+    fig, (left, middle, right) = plt.subplots(1, 3)
+    overview.plot_energies(left, run)
+    overview.plot_solver(middle, run)
+    animate.energy_panel(right, run)
+    assert_points(left)
+    assert_points(right)
+    assert "one record (t = 0 s):\nno step before it" in texts(middle)
+    figures = []
+    monkeypatch.setattr(plot, "save_figure", lambda fig, *args, **kw: figures.append(fig))
+    assert energy.main([str(run.path), "-o", str(tmp_path / "energy.png")]) == 0
+    for ax in figures[0].axes:
+        assert_points(ax)
+    plt.close("all")
+    result = script("plot", run.path)
+    assert result.returncode == 0, result.stderr
+    with Image.open(tmp_path / "one_plot.png") as image:
+        assert_picture(image, (1200, 900))
+
+
 # a damped rope on a shaken top: energy dissipated and work done by the first second tenth
 DAMPED_SHAKEN = ("&model kind = 'rfem', elements = 5 /\n&rope normal_damping = 2.0e4 /\n"
                  "&supports top_motion = 'harmonic', top_amplitude = 0.0, 0.2, "

@@ -98,6 +98,22 @@ def draw_water(ax, run, color=WATER_COLOR):
     return True
 
 
+def point_marker(run):
+    """Line keywords for curves over a run's records: a marker when the run has one record
+    only (a line through one point draws nothing), none otherwise."""
+    return {"marker": "o", "ms": 5} if run.time.size == 1 else {}
+
+
+def say_one_record(ax, run):
+    """With one record only: say so in the corner of a panel of curves over time (which
+    show single points); True if said."""
+    if run.time.size != 1:
+        return False
+    ax.text(0.5, 0.9, f"one record (t = {run.time[0]:.6g} s)", ha="center", va="top",
+            fontsize=9, color="0.3", transform=ax.transAxes)
+    return True
+
+
 def picture_limits(run, margin=0.08):
     """((ymin, ymax), (xmin, xmax)) covering every record, the anchors (over the whole run
     for moving ones) and, with ground contact, the ground below the rope's first point

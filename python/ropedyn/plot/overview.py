@@ -25,14 +25,17 @@ from ropedyn.docstrings import summary  # noqa: E402
 
 
 def plot_energies(ax, run):
-    """Energy parts relative to their start, the dissipated energy and the balance."""
+    """Energy parts relative to their start, the dissipated energy and the balance (with one
+    record: points, and the panel says so)."""
     t, e = run.time, run.energy
-    ax.plot(t, e["kinetic"], lw=1, label="kinetic T")
-    ax.plot(t, e["gravity"] - e["gravity"][0], lw=1, label="gravity - gravity(0)")
-    ax.plot(t, e["elastic"], lw=1, label="elastic")
+    one = plot.point_marker(run)
+    ax.plot(t, e["kinetic"], lw=1, label="kinetic T", **one)
+    ax.plot(t, e["gravity"] - e["gravity"][0], lw=1, label="gravity - gravity(0)", **one)
+    ax.plot(t, e["elastic"], lw=1, label="elastic", **one)
     if "dissipated" in e:
-        ax.plot(t, e["dissipated"], lw=1, ls="--", label="dissipated")
-    ax.plot(t, e["total"] - run.e0, "k", lw=1.4, label="total - E0")
+        ax.plot(t, e["dissipated"], lw=1, ls="--", label="dissipated", **one)
+    ax.plot(t, e["total"] - run.e0, "k", lw=1.4, label="total - E0", **one)
+    plot.say_one_record(ax, run)
     ax.set_xlabel("t (s)")
     ax.set_ylabel("energy (J)")
     ax.set_title("energies", fontsize=10)
@@ -61,6 +64,13 @@ def plot_solver(ax, run):
     """Step size (log scale) and method order over time."""
     if run.step_size is None:
         ax.text(0.5, 0.5, "no solver data", ha="center", transform=ax.transAxes)
+        return
+    if run.time.size == 1:
+        # the first record is the initial state: no step before it, nothing to draw
+        ax.text(0.5, 0.5, f"one record (t = {run.time[0]:.6g} s):\nno step before it",
+                ha="center", va="center", fontsize=9, transform=ax.transAxes)
+        ax.set_title("solver: last step size and order before each output", fontsize=10)
+        ax.set_axis_off()
         return
     ax.semilogy(run.time, np.where(run.step_size > 0, run.step_size, np.nan), lw=1,
                 color="C0")
