@@ -279,6 +279,25 @@ def test_plot(which, request, tmp_path):
         assert_picture(image, (900, 700))
 
 
+@pytest.mark.parametrize("times, says", [("0.1,5", "--times 5: outside the run"),
+                                         ("-0.1", "--times -0.1: outside the run"),
+                                         ("0.21", "--times 0.21: outside the run"),
+                                         ("nan", "--times nan: not a finite time"),
+                                         ("inf", "--times inf: not a finite time")])
+def test_plot_refuses_times_outside_the_run(times, says, tiny, tmp_path):
+    """A time of --times outside the run's records (0 to 0.2 s, output interval 0.01 s;
+    half an interval beyond either end is taken) or not finite is a usage error naming the
+    records' span: it was drawn at the nearest record (nan at t = 0) without a word."""
+    png = tmp_path / "plot.png"
+    result = script("plot.overview", tiny, "-o", png, f"--times={times}")
+    assert result.returncode == 2, result.stderr
+    assert f"error: {says}" in result.stderr and "Traceback" not in result.stderr
+    assert "the run's records span t = 0 to 0.2 s" in result.stderr
+    assert not png.exists()
+    inside = script("plot.overview", tiny, "-o", png, "--times=-0.004,0.1,0.204")
+    assert inside.returncode == 0, inside.stderr
+
+
 def test_plot_of_a_file_without_forces(ropedyn_exe, tmp_path):
     """A file written before the internal forces were stored (here: with them removed):
     no axial force is derived; the panel and the XDMF writer say why."""

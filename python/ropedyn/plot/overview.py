@@ -93,6 +93,29 @@ def record_indices(times, wanted):
     return np.unique(np.abs(times[None, :] - wanted[:, None]).argmin(axis=1))
 
 
+def output_interval(run):
+    """The run's output interval, s: &solver output_interval, else the median spacing of
+    its records (0 for one record)."""
+    interval = run.group("solver").get("output_interval")
+    if isinstance(interval, (int, float)) and interval > 0:
+        return float(interval)
+    return float(np.median(np.diff(run.time))) if run.time.size > 1 else 0.0
+
+
+def check_times(run, wanted):
+    """ValueError unless every wanted time is finite and within the run's records (from
+    the first to the last, with half an output interval of tolerance beyond either end)."""
+    first, last = float(run.time[0]), float(run.time[-1])
+    slack = 0.5 * output_interval(run)
+    span = f"the run's records span t = {first:g} to {last:g} s"
+    for t in wanted:
+        if not np.isfinite(t):
+            raise ValueError(f"--times {t:g}: not a finite time; {span}")
+        if not first - slack <= t <= last + slack:
+            raise ValueError(f"--times {t:g}: outside the run; {span} (half an output "
+                             f"interval, {slack:g} s, beyond either end is taken)")
+
+
 def default_times(times, count=5):
     """count times evenly spread over the run, leaving out the start."""
     return np.linspace(times[0], times[-1], count + 1)[1:]
@@ -146,7 +169,8 @@ def main(argv=None):
     parser.add_argument("run", help="HDF5 output of ropedyn run")
     parser.add_argument("-o", "--output", help="PNG file (default: RUN_plot.png)")
     parser.add_argument("--times", type=parse_times,
-                        help="times (s) of the axial-force curves, e.g. 0.5,1,2 "
+                        help="times (s) of the axial-force curves, e.g. 0.5,1,2, each "
+                             "drawn at the nearest record; within the run's records "
                              "(default: 5 times spread over the run)")
     parser.add_argument("--size", default="1200x900", help="WIDTHxHEIGHT in pixels")
     parser.add_argument("--dpi", type=plot.parse_dpi, default=100)
@@ -168,6 +192,11 @@ def main(argv=None):
     if run.time.size == 0:
         print(f"plot: {args.run}: no output records", file=sys.stderr)
         return 1
+    if args.times:
+        try:
+            check_times(run, args.times)
+        except ValueError as exc:
+            parser.error(str(exc))
     fig = make_figure(run, args.times or default_times(run.time), size, args.dpi)
     plot.save_figure(fig, out, run, "ropedyn.plot.overview (scripts/plot)", dpi=args.dpi)
     plt.close(fig)
