@@ -49,6 +49,31 @@ def default_fps(times, frames):
     return float(np.clip((frames.size - 1) / span, 5.0, 30.0))
 
 
+#: the shortest GIF frame, hundredths of a second: the format counts frame times in
+#: hundredths, and browsers play a shorter frame (0 or 0.01 s) at 0.1 s
+GIF_MIN_CENTISECONDS = 2
+
+
+def gif_centiseconds(fps):
+    """A GIF frame's time for `fps`, in whole hundredths of a second (the format's unit),
+    at least GIF_MIN_CENTISECONDS: at most 50 frames per second."""
+    return max(GIF_MIN_CENTISECONDS, int(round(100.0 / fps)))
+
+
+def written_fps(path, fps):
+    """(the frame rate the animation at `path` plays at, a note saying why it is not `fps`
+    or ''): a GIF's frame time is whole hundredths of a second, at least 0.02 s; an MP4
+    takes `fps` as it is."""
+    if pathlib.Path(path).suffix.lower() != ".gif":
+        return fps, ""
+    centiseconds = gif_centiseconds(fps)
+    written = 100.0 / centiseconds
+    if abs(written - fps) <= 1e-9 * fps:
+        return written, ""
+    return written, (f"; {fps:g} fps rounded to a GIF frame of {centiseconds / 100:g} s: "
+                     "whole hundredths of a second, at least 0.02 s, so at most 50 fps")
+
+
 def energy_panel(ax, run):
     """Energies over the whole run; returns the moving time cursor (a vertical line)."""
     t, e = run.time, run.energy
@@ -157,7 +182,7 @@ def save_gif(path, frames, fps, comment=""):
     images = [Image.fromarray(f).quantize(palette=palette, dither=Image.Dither.NONE)
               for f in frames]
     images[0].save(path, format="GIF", save_all=True, append_images=images[1:],
-                   duration=max(20, int(round(1000.0 / fps))), loop=0,
+                   duration=10 * gif_centiseconds(fps), loop=0,
                    comment=comment.encode("utf-8")[:255])
 
 
@@ -202,7 +227,8 @@ def parse_args(argv):
     parser.add_argument("--max-frames", type=int, default=300,
                         help="at most this many frames, evenly spaced (default 300)")
     parser.add_argument("--fps", type=float, help="frames per second "
-                        "(default: real time, within 5 .. 30)")
+                        "(default: real time, within 5 .. 30); a GIF plays at most 50, "
+                        "its frame time in whole hundredths of a second")
     parser.add_argument("--start", type=float, help="first time shown (s)")
     parser.add_argument("--end", type=float, help="last time shown (s)")
     parser.add_argument("--trail", type=float, default=1.0,
@@ -255,8 +281,9 @@ def main(argv=None):
                 save_gif(part, images, fps, comment)
     finally:
         drawer.close()
-    print(f"animate: {out} ({frames.size} frames at {fps:.3g} fps, "
-          f"{frames.size / fps:.1f} s long; written in "
+    played, note = written_fps(out, fps)
+    print(f"animate: {out} ({frames.size} frames at {played:.3g} fps, "
+          f"{frames.size / played:.1f} s long{note}; written in "
           f"{wallclock.perf_counter() - started:.1f} s)")
     return 0
 

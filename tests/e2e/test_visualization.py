@@ -152,6 +152,25 @@ def test_animate_refuses_a_frame_rate_too_slow_to_write(fps, tiny, tmp_path):
     assert not gif.exists()
 
 
+@pytest.mark.parametrize("fps, played, frame", [("60", "50", 20), ("1000", "50", 20),
+                                                ("30", "33.3", 30), ("25", "25", 40)])
+def test_animate_says_the_frame_rate_a_gif_plays_at(fps, played, frame, tiny, tmp_path):
+    """A GIF's frame time is whole hundredths of a second, at least 0.02 s: --fps 60 plays
+    at 50 fps, 30 at 33.3 (0.03 s). The report gives the rate written and says why it is
+    not the one asked for (it gave --fps as asked); an MP4 takes the rate as it is."""
+    from ropedyn import animate
+
+    gif = tmp_path / "a.gif"
+    result = script("animate", tiny, "-o", gif, "--max-frames", "3", "--fps", fps)
+    assert result.returncode == 0, result.stderr
+    assert f"(3 frames at {played} fps, " in result.stdout, result.stdout
+    rounded = f"{fps} fps rounded to a GIF frame of {frame / 1000:g} s"
+    assert (rounded in result.stdout) == (fps != played), result.stdout
+    with Image.open(gif) as image:
+        assert image.info["duration"] == frame
+    assert animate.written_fps(tmp_path / "a.mp4", 60.0) == (60.0, "")
+
+
 # --- plot ----------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("module", ["plot.overview", "plot.energy"])
