@@ -83,11 +83,14 @@ def energy_panel(ax, run):
     ax.plot(t, potential, lw=1, label="potential - V(0)", **one)
     if "dissipated" in e:
         ax.plot(t, e["dissipated"], lw=1, ls="--", label="dissipated", **one)
+    work = plot.work(run)
+    if work is not None:
+        ax.plot(t, work, lw=1, ls="-.", color="C5", label=plot.WORK_LABEL, **one)
     ax.plot(t, e["total"] - run.e0, "k", lw=1.2, label="total - E0", **one)
     plot.say_one_record(ax, run)
     ax.set_xlabel("t (s)")
     ax.set_ylabel("energy (J)")
-    ax.legend(fontsize=7, loc="best")
+    ax.legend(fontsize=7, loc="best", title=plot.BALANCE_NOTE, title_fontsize=7)
     ax.grid(alpha=0.3)
     return ax.axvline(t[0], color="0.3", lw=1, animated=True)
 

@@ -436,6 +436,49 @@ def test_plots_take_the_balances_e0(ropedyn_exe, tmp_path, monkeypatch):
     plt.close("all")
 
 
+def test_energy_plots_draw_the_work_done_on_the_rope(ropedyn_exe, tiny, tmp_path,
+                                                     monkeypatch):
+    """A shaken support does work on the rope, so T + V - E0 grows although the balance
+    holds: T + V - E0 = W - dissipated. The energy plot, the overview and the animation's
+    panel draw the work W (/energy/support_work) beside the total, and say what balances;
+    a run without work (no moving support, load or current) gets no work curve."""
+    import matplotlib.pyplot as plt
+    from ropedyn import animate, plot
+    from ropedyn.plot import energy, overview
+
+    run = io.load_run(ropedyn(ropedyn_exe, tmp_path, DAMPED_SHAKEN, "shaken"))
+    e = run.energy
+    assert e["support_work"][-1] > 0.01 and e["dissipated"][-1] > 0.01, e
+
+    def curve(ax, label):
+        found = [line for line in ax.lines if line.get_label() == label]
+        return found[0].get_ydata() if found else None
+
+    figures = []
+    monkeypatch.setattr(plot, "save_figure", lambda fig, *args, **kw: figures.append(fig))
+    assert energy.main([str(run.path), "-o", str(tmp_path / "energy.png")]) == 0
+    fig, (left, right) = plt.subplots(1, 2)
+    overview.plot_energies(left, run)
+    animate.energy_panel(right, run)
+    for ax, total in ((figures[0].axes[0], "total E - E0 = T + V - E0"), (left, "total - E0"),
+                      (right, "total - E0")):
+        work = curve(ax, "work W (supports, loads, current)")
+        assert work is not None, [line.get_label() for line in ax.lines]
+        assert np.array_equal(work, e["support_work"])
+        # what the legend says: the total follows the work less the dissipated energy
+        assert ax.get_legend().get_title().get_text() == "T + V - E0 = W - dissipated"
+        gap = curve(ax, total) - (work - e["dissipated"])
+        assert np.max(np.abs(gap)) < 1e-3 * np.max(np.abs(work))
+    # the balance panel stays: T + V + dissipated - work - E0
+    assert np.allclose(figures[0].axes[1].lines[0].get_ydata(), run.balance - run.e0)
+    still = io.load_run(tiny)
+    assert not np.any(still.energy["support_work"])
+    fig, ax = plt.subplots()
+    overview.plot_energies(ax, still)
+    assert curve(ax, "work W (supports, loads, current)") is None
+    plt.close("all")
+
+
 SHAKEN_GROUND = ("&model kind = '{kind}', elements = 5 /\n"
                  "&supports top_motion = 'harmonic', top_amplitude = 0.0, 0.2, "
                  "top_frequency = 2.0 /\n"

@@ -104,6 +104,24 @@ def point_marker(run):
     return {"marker": "o", "ms": 5} if run.time.size == 1 else {}
 
 
+#: The label of the work curve: the work done on the rope by moving supports, point loads
+#: and a current (/energy/support_work), which T + V - E0 follows together with the
+#: dissipated energy.
+WORK_LABEL = "work W (supports, loads, current)"
+
+#: What the energy curves add up to (the energy balance, docs/theory/energy-balance.md).
+BALANCE_NOTE = "T + V - E0 = W - dissipated"
+
+
+def work(run):
+    """The work done on the rope so far, J (/energy/support_work), or None when the run
+    has none (no moving support, point load or current: zero throughout)."""
+    w = run.energy.get("support_work")
+    if w is None or not np.any(w != 0.0):
+        return None
+    return w
+
+
 def say_one_record(ax, run):
     """With one record only: say so in the corner of a panel of curves over time (which
     show single points); True if said."""

@@ -1,4 +1,5 @@
-"""Plot the energies of a ropedyn run: E - E0 by part and the balance error.
+"""Plot the energies of a ropedyn run: E - E0 by part, the dissipated energy and the work
+done on the rope, and the balance error.
 
 usage: scripts/plot_energy.py RUN.h5 [-o RUN_energy.png]   (python -m ropedyn.plot.energy)
 """
@@ -48,10 +49,15 @@ def main(argv=None):
     ax.plot(t, e["gravity"] - e["gravity"][0], lw=1, label="gravity - gravity(0)", **one)
     ax.plot(t, e["elastic"], lw=1, label="elastic", **one)
     ax.plot(t, -e["dissipated"], "--", lw=1, label="- dissipated", **one)
+    # the work of moving supports, loads and a current: T + V - E0 = W - dissipated, so
+    # without it a shaken rope's total would seem to drift
+    work = plot.work(run)
+    if work is not None:
+        ax.plot(t, work, "-.", lw=1, color="C5", label=plot.WORK_LABEL, **one)
     plot.say_one_record(ax, run)
     ax.set_ylabel("energy (J)")
     ax.set_title(io.title(run))
-    ax.legend(fontsize=8, loc="lower left")
+    ax.legend(fontsize=8, loc="lower left", title=plot.BALANCE_NOTE, title_fontsize=8)
     ax.grid(alpha=0.3)
     bx.plot(t, balance, "r", lw=1, **one)
     plot.say_one_record(bx, run)

@@ -1,6 +1,6 @@
-"""Overview plot of a ropedyn run: energies over time, the tip's trajectory (with a moving
-support's path, the ground and the water surface), the solver's step size and order over
-time, and the axial force along the rope at chosen times.
+"""Overview plot of a ropedyn run: energies (with the work done on the rope) over time, the
+tip's trajectory (with a moving support's path, the ground and the water surface), the
+solver's step size and order over time, and the axial force along the rope at chosen times.
 
 usage: scripts/plot RUN.h5 [-o RUN_plot.png] [--times 0.5,1,2] [--size 1200x900]
        (python -m ropedyn.plot, or python -m ropedyn.plot.overview)
@@ -25,8 +25,9 @@ from ropedyn.docstrings import summary  # noqa: E402
 
 
 def plot_energies(ax, run):
-    """Energy parts relative to their start, the dissipated energy and the balance (with one
-    record: points, and the panel says so)."""
+    """Energy parts relative to their start, the dissipated energy, the work done on the
+    rope (when there is any) and T + V - E0, which is their difference W - dissipated (with
+    one record: points, and the panel says so)."""
     t, e = run.time, run.energy
     one = plot.point_marker(run)
     ax.plot(t, e["kinetic"], lw=1, label="kinetic T", **one)
@@ -34,12 +35,15 @@ def plot_energies(ax, run):
     ax.plot(t, e["elastic"], lw=1, label="elastic", **one)
     if "dissipated" in e:
         ax.plot(t, e["dissipated"], lw=1, ls="--", label="dissipated", **one)
+    work = plot.work(run)
+    if work is not None:
+        ax.plot(t, work, lw=1, ls="-.", color="C5", label=plot.WORK_LABEL, **one)
     ax.plot(t, e["total"] - run.e0, "k", lw=1.4, label="total - E0", **one)
     plot.say_one_record(ax, run)
     ax.set_xlabel("t (s)")
     ax.set_ylabel("energy (J)")
     ax.set_title("energies", fontsize=10)
-    ax.legend(fontsize=7, loc="best")
+    ax.legend(fontsize=7, loc="best", title=plot.BALANCE_NOTE, title_fontsize=7)
     ax.grid(alpha=0.3)
 
 
