@@ -103,6 +103,9 @@ class Simulation:
     second look does not run (docs/reference/api.md says why)."""
 
     def __init__(self, scene, statics=False):
+        if not isinstance(statics, (bool, np.bool_)):
+            # any truthy object ("no", 0.0 that was meant as a time) would start at rest
+            raise Error(f"Simulation: statics is True or False, not {statics!r}", 2)
         self.scene = _scene_of(scene)
         self._lib = library()
         self._h = c_handle()

@@ -575,3 +575,15 @@ def test_a_failure_at_a_tiny_time_writes_the_times_exponent():
             sim.advance(1e-3)
     t = float(str(failed.value).split("failed at t = ")[1].split(" s")[0])
     assert 0.0 <= t < 1e-3, str(failed.value)
+
+
+def test_statics_takes_only_a_bool():
+    """Simulation(scene, statics="no") started at the static equilibrium: any truthy
+    object was taken as True. Only a bool (or numpy bool) is taken."""
+    for bad in ("no", "False", 1, 0.0, None, [False]):
+        with pytest.raises(ropedyn.Error, match=r"statics is True or False, not ") as error:
+            ropedyn.Simulation(small(n=4), statics=bad)
+        assert error.value.code == 2 and repr(bad) in error.value.message
+    for good in (False, np.bool_(False)):
+        with ropedyn.Simulation(small(n=4), statics=good) as sim:
+            assert sim.energy["kinetic"] == 0.0 and sim.t == 0.0
