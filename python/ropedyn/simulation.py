@@ -239,12 +239,21 @@ class Simulation:
 
     @state.setter
     def state(self, y):
+        handle, size = self._handle(), self.state_size
         try:
-            y = np.ascontiguousarray(y, dtype=float)
-        except (TypeError, ValueError):
-            raise Error(f"state: {self.state_size} numbers, not {y!r}", 2) from None
+            given = np.asarray(y)
+        except (TypeError, ValueError):   # a ragged list
+            given = np.asarray(None)
+        if given.dtype.kind not in "iuf":
+            # strings ("1.0" is no number here), bools, objects
+            raise Error(f"state: {size} numbers, not {y!r}", 2)
+        if given.shape != (size,):
+            # a (2, size/2) array was flattened and taken
+            raise Error(f"state: a 1-D sequence of {size} numbers (shape ({size},)), not "
+                        f"one of shape {given.shape}", 2)
+        y = np.ascontiguousarray(given, dtype=float)
         self._check(self._lib.ropedyn_set_state(
-            self._handle(), y.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), y.size))
+            handle, y.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), y.size))
 
     # ---- keeping states --------------------------------------------------------------
 

@@ -7,6 +7,7 @@ top driven every 1 ms from the motion of a ramped harmonic top gives the command
 trajectory to the integration tolerance, for RFEM and MPP; save/restore; and
 `pip install ./python` builds a package that runs with its own library."""
 import os
+import re
 import subprocess
 import sys
 import threading
@@ -587,3 +588,31 @@ def test_statics_takes_only_a_bool():
     for good in (False, np.bool_(False)):
         with ropedyn.Simulation(small(n=4), statics=good) as sim:
             assert sim.energy["kinetic"] == 0.0 and sim.t == 0.0
+
+
+def test_state_takes_only_a_1d_sequence_of_its_length():
+    """sim.state = y.reshape(2, -1) was flattened and taken. Only a 1-D sequence of the
+    state's length is: the error names that length and the shape given. Texts and bools
+    are no numbers; a ragged list is refused as one."""
+    with ropedyn.Simulation(small(n=4)) as sim:
+        y = sim.state
+        size = sim.state_size
+        for bad in (y.reshape(2, -1), y.reshape(-1, 1), [list(y)], y[:3], np.float64(y[0]),
+                    np.append(y, 0.0)):
+            shape = np.shape(bad)
+            with pytest.raises(ropedyn.Error, match=rf"state: a 1-D sequence of {size} "
+                               rf"numbers \(shape \({size},\)\), not one of shape "
+                               rf"{re.escape(str(shape))}") as error:
+                sim.state = bad
+            assert error.value.code == 2
+        for bad in ([str(v) for v in y], np.ones(size, dtype=bool), [[1.0, 2.0], [3.0]],
+                    None, "y"):
+            with pytest.raises(ropedyn.Error, match=rf"state: {size} numbers, not "):
+                sim.state = bad
+        assert np.array_equal(sim.state, y)
+        z = y.copy()
+        z[0] += 1e-3
+        sim.state = list(z)
+        assert np.array_equal(sim.state, z)
+        sim.state = z.astype(np.float32)
+        assert np.array_equal(sim.state, z.astype(np.float32))
