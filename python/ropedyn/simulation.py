@@ -83,7 +83,14 @@ class Snapshot:
     def __init__(self, lib, handle, t):
         self._lib = lib
         self._h = handle
-        self.t = t
+        self._t = t
+
+    @property
+    def t(self):
+        """The time of the state kept, s."""
+        if not self._h:
+            raise Error("the snapshot is closed", 2)
+        return self._t
 
     def close(self):
         if self._h:
@@ -106,17 +113,17 @@ class Simulation:
         if not isinstance(statics, (bool, np.bool_)):
             # any truthy object ("no", 0.0 that was meant as a time) would start at rest
             raise Error(f"Simulation: statics is True or False, not {statics!r}", 2)
-        self.scene = _scene_of(scene)
+        self._scene = _scene_of(scene)
         self._lib = library()
         self._h = c_handle()
         status = self._lib.ropedyn_create_from_text(
-            self.scene.text.encode(*TEXT), self.scene.name.encode(), ctypes.byref(self._h))
+            self._scene.text.encode(*TEXT), self._scene.name.encode(), ctypes.byref(self._h))
         if status == 0:
             status = self._lib.ropedyn_init(self._h, 1 if statics else 0)
         self._check(status)
         n, size = ctypes.c_int(), ctypes.c_int()
         self._check(self._lib.ropedyn_size(self._h, ctypes.byref(n), ctypes.byref(size)))
-        self.n, self.state_size = n.value, size.value
+        self._n, self._state_size = n.value, size.value
         self._t = ctypes.c_double()
         self._p = (ctypes.c_double * 2)()
         self._v = (ctypes.c_double * 2)()
@@ -126,7 +133,7 @@ class Simulation:
         # than the call into the library)
         self._force = np.empty(2)
         self._force_ptr = self._force.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
-        self._xy = np.empty((2 * self.n, 2))
+        self._xy = np.empty((2 * self._n, 2))
         self._xy_ptr = self._xy.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._advance = self._lib.ropedyn_advance
         self._set_support = self._lib.ropedyn_set_support
@@ -141,12 +148,32 @@ class Simulation:
             raise Error(message, status)
 
     def _alive(self):
-        return bool(self._h) and hasattr(self, "n")
+        return bool(self._h) and hasattr(self, "_n")
 
     def _handle(self):
         if not self._h:
             raise Error("the simulation is closed", 2)
         return self._h
+
+    # ---- what it is (every property of a closed simulation raises, as its methods do) ---
+
+    @property
+    def scene(self):
+        """The scene simulated (a Scene)."""
+        self._handle()
+        return self._scene
+
+    @property
+    def n(self):
+        """The number of elements."""
+        self._handle()
+        return self._n
+
+    @property
+    def state_size(self):
+        """The number of unknowns: the length of `state`."""
+        self._handle()
+        return self._state_size
 
     # ---- moving on -------------------------------------------------------------------
 
@@ -191,7 +218,7 @@ class Simulation:
     def points(self):
         """The polyline (2n, 2), m: element end points A_1, B_1, A_2, ... (x, y), as a
         record of /rope/points."""
-        status = self._points(self._handle(), self._xy_ptr, 2 * self.n)
+        status = self._points(self._handle(), self._xy_ptr, 2 * self._n)
         if status != 0:
             self._check(status)
         return self._xy.copy()
@@ -200,11 +227,12 @@ class Simulation:
     def forces(self):
         """The internal forces at the joints 0 (top end) .. n: 'axial' (tension > 0, N),
         'shear' (N), 'moment' (N m), each (n + 1,)."""
-        out = {k: np.empty(self.n + 1) for k in ("axial", "shear", "moment")}
+        handle = self._handle()
+        out = {k: np.empty(self._n + 1) for k in ("axial", "shear", "moment")}
         ptr = ctypes.POINTER(ctypes.c_double)
         self._check(self._lib.ropedyn_forces(
-            self._handle(), *(out[k].ctypes.data_as(ptr) for k in ("axial", "shear", "moment")),
-            self.n + 1))
+            handle, *(out[k].ctypes.data_as(ptr) for k in ("axial", "shear", "moment")),
+            self._n + 1))
         return out
 
     def reaction(self, end):
@@ -231,15 +259,15 @@ class Simulation:
     @property
     def state(self):
         """The ODE state (as /state/y of a record)."""
-        out = np.empty(self.state_size)
+        handle = self._handle()
+        out = np.empty(self._state_size)
         self._check(self._lib.ropedyn_get_state(
-            self._handle(), out.ctypes.data_as(ctypes.POINTER(ctypes.c_double)),
-            self.state_size))
+            handle, out.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), self._state_size))
         return out
 
     @state.setter
     def state(self, y):
-        handle, size = self._handle(), self.state_size
+        handle, size = self._handle(), self._state_size
         try:
             given = np.asarray(y)
         except (TypeError, ValueError):   # a ragged list
@@ -275,7 +303,8 @@ class Simulation:
     # ---- the end ---------------------------------------------------------------------
 
     def close(self):
-        """Free the simulation (further calls raise ropedyn.Error)."""
+        """Free the simulation (further calls, and reads of its properties, raise
+        ropedyn.Error)."""
         if getattr(self, "_h", None):
             self._lib.ropedyn_destroy(self._h)
             self._h = c_handle()
@@ -291,4 +320,5 @@ class Simulation:
 
     def __repr__(self):
         state = f"t = {self.t:g} s" if self._h else "closed"
-        return f"<ropedyn.Simulation {self.scene.name!r}, n = {getattr(self, 'n', '?')}, {state}>"
+        return (f"<ropedyn.Simulation {self._scene.name!r}, n = {getattr(self, '_n', '?')}, "
+                f"{state}>")

@@ -616,3 +616,28 @@ def test_state_takes_only_a_1d_sequence_of_its_length():
         assert np.array_equal(sim.state, z)
         sim.state = z.astype(np.float32)
         assert np.array_equal(sim.state, z.astype(np.float32))
+
+
+def test_every_property_of_a_closed_simulation_raises():
+    """sim.n, sim.state_size and sim.scene were still read after sim.close(), while the
+    methods and the other properties raised "the simulation is closed". Every property
+    raises that error now, as the methods do; so does a closed snapshot's t."""
+    sim = ropedyn.Simulation(small(n=4))
+    names = {k for k, v in vars(ropedyn.Simulation).items() if isinstance(v, property)}
+    names = sorted(names | {"n", "state_size", "scene", "t", "points", "state"})
+    for name in names:
+        getattr(sim, name)
+    snap = sim.save()
+    assert snap.t == 0.0
+    snap.close()
+    with pytest.raises(ropedyn.Error, match="^the snapshot is closed$"):
+        snap.t
+    sim.close()
+    with pytest.raises(ropedyn.Error) as method:
+        sim.advance(1.0)
+    for name in names:
+        with pytest.raises(ropedyn.Error) as error:
+            getattr(sim, name)
+        assert (error.value.message, error.value.code) == (method.value.message, 2), name
+    assert method.value.message == "the simulation is closed"
+    assert "closed" in repr(sim)
