@@ -15,6 +15,7 @@ and the coupling rule: the API page of the manual (docs/reference/api.md).
 """
 import ctypes
 import io
+import numbers
 import pathlib
 
 import numpy as np
@@ -33,9 +34,37 @@ def _scene_of(scene):
 
 
 def _support(end):
-    if end not in SUPPORTS:
+    if not isinstance(end, str) or end not in SUPPORTS:
         raise Error(f"unknown support {end!r} (top or bottom)", 2)
     return SUPPORTS[end]
+
+
+def _real(value):
+    """`value` as a float when it is one real number: an int or float (numpy's too) or a
+    0-d array of one, not a bool; else None."""
+    if isinstance(value, (bool, np.bool_)):
+        return None
+    if isinstance(value, numbers.Real) or (isinstance(value, np.ndarray) and value.shape == ()
+                                           and value.dtype.kind in "iuf"):
+        try:
+            return float(value)
+        except OverflowError:   # an int past the range of a float: the library refuses it
+            return float("inf") if value > 0 else float("-inf")
+    return None
+
+
+def _pair(value):
+    """`value` as two floats when it is a pair of real numbers (a tuple, list or 1-D
+    array of two); else None. A dict or set, whose iteration gave two keys, is none."""
+    if type(value) is tuple and len(value) == 2 and type(value[0]) is type(value[1]) is float:
+        return value   # the common case, checked at little cost
+    if isinstance(value, np.ndarray):
+        if value.shape != (2,) or value.dtype.kind not in "iuf":
+            return None
+    elif not isinstance(value, (tuple, list)) or len(value) != 2:
+        return None
+    x, y = _real(value[0]), _real(value[1])
+    return None if x is None or y is None else (x, y)
 
 
 def run(scene, output=None):
@@ -182,10 +211,13 @@ class Simulation:
         raises ropedyn.Error, keeps the last good state and ends the simulation: later
         `advance`, `set_support`, `save` and assignments to `state` raise the same error
         until `restore`; the reads give the last good state."""
-        try:
-            status = self._advance(self._handle(), t)
-        except ctypes.ArgumentError:
-            raise Error(f"advance: t is a time in s (a number), not {t!r}", 2) from None
+        if type(t) is not float:   # the common case, checked at no cost
+            number = _real(t)
+            if number is None:
+                # a bool or an array of one number was taken, a text refused by ctypes
+                raise Error(f"advance: t is a time in s (a number), not {t!r}", 2)
+            t = number
+        status = self._advance(self._handle(), t)
         if status != 0:
             self._check(status)
 
@@ -196,12 +228,13 @@ class Simulation:
         moves on the cubic Hermite curve from its position and velocity now (as a motion
         table's segment)."""
         p, v = self._p, self._v
-        try:
-            p[0], p[1] = position
-            v[0], v[1] = velocity
-        except (TypeError, ValueError):
+        position_xy, velocity_xy = _pair(position), _pair(velocity)
+        if position_xy is None or velocity_xy is None:
+            # bools were taken as 0 and 1, a dict's or set's two keys as (x, y)
             raise Error(f"set_support: position and velocity are two numbers each, (x, y) "
-                        f"in m and m/s, not {position!r} and {velocity!r}", 2) from None
+                        f"in m and m/s, not {position!r} and {velocity!r}", 2)
+        p[0], p[1] = position_xy
+        v[0], v[1] = velocity_xy
         status = self._set_support(self._handle(), _support(end), p, v)
         if status != 0:
             self._check(status)

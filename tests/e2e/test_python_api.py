@@ -641,3 +641,36 @@ def test_every_property_of_a_closed_simulation_raises():
         assert (error.value.message, error.value.code) == (method.value.message, 2), name
     assert method.value.message == "the simulation is closed"
     assert "closed" in repr(sim)
+
+
+def test_times_and_positions_take_only_real_numbers():
+    """advance(True) integrated to 1 s and advance(np.array([2.5])) to 2.5 s;
+    set_support took (True, False) as (1, 0), and a dict's or a set's two keys as (x, y);
+    reaction(["top"]) raised Python's TypeError. Now a time is one real number (an int,
+    a float, numpy's, a 0-d array) and a position or velocity a tuple, list or 1-D array
+    of two; anything else raises ropedyn.Error of code 2, and nothing changes."""
+    scene = small(n=4).set("supports.top_motion", "coupled")
+    with ropedyn.Simulation(scene) as sim:
+        for bad in (True, np.bool_(True), np.array([0.25]), np.array(True), "0.1", [0.1],
+                    1j):
+            with pytest.raises(ropedyn.Error, match="advance: t is a time in s") as error:
+                sim.advance(bad)
+            assert error.value.code == 2 and sim.t == 0.0
+        with pytest.raises(ropedyn.Error, match="not finite"):
+            sim.advance(10 ** 400)
+        for bad in ((True, False), (0.0, np.bool_(True)), {0: 1.0, 1: 2.0}, {1.0, 2.0},
+                    np.zeros((1, 2)), np.array(["0", "1"]), ("0.0", "0.1"), (0.0, None),
+                    np.array(1.0), iter((0.0, 0.1))):
+            for args in ((bad,), ((0.0, 0.0), bad)):
+                with pytest.raises(ropedyn.Error, match="two numbers each") as error:
+                    sim.set_support("top", *args)
+                assert error.value.code == 2
+        for bad in (["top"], 0, None, b"top"):
+            with pytest.raises(ropedyn.Error, match="unknown support") as error:
+                sim.reaction(bad)
+            assert error.value.code == 2
+        sim.set_support("top", np.array([0.0, 1e-4]), [np.float32(0.0), np.array(0)])
+        sim.advance(np.array(0.01))
+        sim.set_support("top", (0, np.int64(0)))
+        sim.advance(np.int64(1) / 50)
+        assert sim.t == 0.02 and sim.anchor("top")[1] == 0.0
