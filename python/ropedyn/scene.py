@@ -10,6 +10,7 @@ A Scene holds the effective scene as the library reads it (every key, as a run f
 of `--set`, and a bad one raises ropedyn.Error and leaves the scene as it was.
 """
 import ctypes
+import os
 import pathlib
 import re
 
@@ -31,10 +32,22 @@ def _value_text(value):
         # float(): numpy's float64 is a float whose repr is "np.float64(2.0)" (numpy 2)
         return repr(float(value))
     if isinstance(value, (list, tuple)):
+        if any(isinstance(v, (list, tuple)) or getattr(v, "ndim", 0) for v in value):
+            # a 2-D array's rows were joined into one list of values
+            raise Error(f"set: a value is a bool, a number, a string or a pair, not "
+                        f"{value!r}", 2)
         return ", ".join(_value_text(v) for v in value)
     if hasattr(value, "tolist"):   # numpy scalars and arrays
         return _value_text(value.tolist())
     return str(value)
+
+
+def _path_text(what, path):
+    """The text of a file's path (a str, bytes or an os.PathLike); Error for anything
+    else (str() made a path "None" of None)."""
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise Error(f"{what} is a file's path (a str or a pathlib.Path), not {path!r}", 2)
+    return os.fsdecode(path)
 
 
 def _unset_keys(text):
@@ -111,8 +124,12 @@ class Scene:
         """The scene of namelist `text`; `name` stands for its file in messages and in the
         default output file (out/NAME.h5). Relative paths in it are relative to the
         folder of `name`, or to the current directory when `name` has none."""
-        self.name = str(name)
-        with _open(str(text), self.name) as handle:
+        if not isinstance(text, str):
+            # str() made a scene of "b'&model ...'" or of a file's path
+            raise Error(f"Scene: text is namelist text (a str), not {text!r}; "
+                        "Scene.from_file reads a scene file", 2)
+        self.name = _path_text("Scene: name", name)
+        with _open(text, self.name) as handle:
             self._text = handle.text(handle.lib.ropedyn_scene_text)
             self._warnings = handle.text(handle.lib.ropedyn_warnings)
 
@@ -121,8 +138,8 @@ class Scene:
         """The scene of a scene file (as `ropedyn run PATH` reads it)."""
         lib = library()
         scene = cls.__new__(cls)
-        scene.name = str(path)
-        with _Handle(lib.ropedyn_create_from_file, str(path).encode()) as handle:
+        scene.name = _path_text("Scene.from_file: path", path)
+        with _Handle(lib.ropedyn_create_from_file, scene.name.encode(*TEXT)) as handle:
             scene._text = handle.text(lib.ropedyn_scene_text)
             scene._warnings = handle.text(lib.ropedyn_warnings)
         return scene
@@ -152,6 +169,8 @@ class Scene:
         """The value of "group.key" (a number, bool, string, or a list for a pair); None
         for a key that is not set (an optional key with no default, which the text shows as
         "! key = (not set: ...)"); a key that does not exist raises KeyError."""
+        if not isinstance(key, str):
+            raise KeyError(key)
         group, _, name = key.lower().partition(".")
         values = parse_namelist(self._text).get(group, {})
         if name in values:

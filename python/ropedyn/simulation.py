@@ -16,6 +16,7 @@ and the coupling rule: the API page of the manual (docs/reference/api.md).
 import ctypes
 import io
 import numbers
+import os
 import pathlib
 
 import numpy as np
@@ -30,7 +31,11 @@ ENERGY_NAMES = ("kinetic", "elastic", "gravity", "dissipated", "support_work", "
 
 def _scene_of(scene):
     """A Scene from a Scene, or from the path of a scene file."""
-    return scene if isinstance(scene, Scene) else Scene.from_file(scene)
+    if isinstance(scene, Scene):
+        return scene
+    if not isinstance(scene, (str, bytes, os.PathLike)):
+        raise Error(f"the scene is a Scene or a scene file's path, not {scene!r}", 2)
+    return Scene.from_file(scene)
 
 
 def _support(end):

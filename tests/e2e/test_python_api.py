@@ -674,3 +674,42 @@ def test_times_and_positions_take_only_real_numbers():
         sim.set_support("top", (0, np.int64(0)))
         sim.advance(np.int64(1) / 50)
         assert sim.t == 0.02 and sim.anchor("top")[1] == 0.0
+
+
+def test_scene_arguments_of_the_wrong_type_are_refused(tmp_path):
+    """str() was taken of what Scene and Scene.from_file were given: Scene(b"&model ...")
+    read the text "b'&model ...'", Scene(path) the path as namelist text, name=None wrote
+    out/None.h5, and Simulation(None) looked for a file "None". A 2-D array set as a pair
+    was flattened into one ([[0.1, 0.2]] as 0.1, 0.2); get(5) raised AttributeError."""
+    text = PAPER.read_text()
+    for bad in (text.encode(), PAPER, None, 4):
+        with pytest.raises(ropedyn.Error, match=r"Scene: text is namelist text \(a str\), "
+                           r"not .*; Scene.from_file reads a scene file") as error:
+            ropedyn.Scene(bad)
+        assert error.value.code == 2
+    with pytest.raises(ropedyn.Error, match="Scene: name is a file's path .*, not None"):
+        ropedyn.Scene(text, name=None)
+    for bad in (None, 3, ["input/paper.nml"]):
+        with pytest.raises(ropedyn.Error, match=r"Scene.from_file: path is a file's path "
+                           r"\(a str or a pathlib.Path\), not ") as error:
+            ropedyn.Scene.from_file(bad)
+        assert error.value.code == 2
+        for call in (ropedyn.Simulation, ropedyn.run):
+            with pytest.raises(ropedyn.Error, match="the scene is a Scene or a scene file's "
+                               "path, not ") as error:
+                call(bad)
+            assert error.value.code == 2
+    assert ropedyn.Scene.from_file(os.fsencode(PAPER)) == ropedyn.Scene.from_file(PAPER)
+    assert ropedyn.Scene(text, name=tmp_path / "a.nml").name == str(tmp_path / "a.nml")
+    scene = small(n=4)
+    for bad in (np.array([[0.1, 0.2]]), [[0.1, 0.2]], ((0.1,), (0.2,)),
+                [np.array([0.1]), np.array([0.2])]):
+        with pytest.raises(ropedyn.Error, match="set: a value is a bool, a number, a string "
+                           "or a pair, not ") as error:
+            scene.set("supports.top_anchor", bad)
+        assert error.value.code == 2 and scene.get("supports.top_anchor") == [0.0, 0.0]
+    scene.set("supports.top_anchor", (np.array(0.1), np.float64(0.2)))
+    assert scene.get("supports.top_anchor") == [0.1, 0.2]
+    for bad in (5, None, ("model", "elements")):
+        with pytest.raises(KeyError):
+            scene.get(bad)
