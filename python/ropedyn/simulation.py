@@ -147,7 +147,8 @@ class Simulation:
         if not isinstance(statics, (bool, np.bool_)):
             # any truthy object ("no", 0.0 that was meant as a time) would start at rest
             raise Error(f"Simulation: statics is True or False, not {statics!r}", 2)
-        self._scene = _scene_of(scene)
+        # a copy: a later set on the Scene given changed sim.scene, not what it simulates
+        self._scene = _scene_of(scene).copy()
         self._lib = library()
         self._h = c_handle()
         status = self._lib.ropedyn_create_from_text(
@@ -193,7 +194,8 @@ class Simulation:
 
     @property
     def scene(self):
-        """The scene simulated (a Scene)."""
+        """The scene simulated (a copy of the Scene given: later changes to that do not
+        reach it)."""
         self._handle()
         return self._scene
 

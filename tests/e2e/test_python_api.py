@@ -713,3 +713,27 @@ def test_scene_arguments_of_the_wrong_type_are_refused(tmp_path):
     for bad in (5, None, ("model", "elements")):
         with pytest.raises(KeyError):
             scene.get(bad)
+
+
+def test_a_simulation_keeps_its_own_scene():
+    """sim.scene was the Scene given: a later scene.set changed sim.scene (40 elements)
+    while the simulation went on with the old one (n = 4). It is a copy now. A Scene whose
+    simulation failed is unchanged and runs again."""
+    scene = small(n=4).set("supports.top_motion", "coupled")
+    before = scene.copy()
+    with ropedyn.Simulation(scene) as sim:
+        scene.set("model.elements", 40)
+        assert sim.scene.get("model.elements") == 4 == sim.n and sim.scene == before
+        sim.scene.set("model.elements", 5)   # the copy's change reaches neither
+        assert scene.get("model.elements") == 40 and sim.n == 4
+    scene.set("model.elements", 4)
+    assert scene == before
+    with ropedyn.Simulation(scene) as sim:
+        sim.set_support("top", position=(1e300, 0.0))
+        with pytest.raises(ropedyn.Error) as failed:
+            sim.advance(1e-3)
+        assert failed.value.code == 3
+    assert scene == before and scene.warnings == before.warnings
+    with ropedyn.Simulation(scene) as sim:
+        sim.advance(0.01)
+        assert sim.t == 0.01
