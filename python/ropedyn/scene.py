@@ -181,7 +181,7 @@ class Scene:
 
     def write(self, path):
         """Write the scene to `path` (a scene file: it reads in again to this scene)."""
-        path = pathlib.Path(path)
+        path = pathlib.Path(_path_text("Scene.write: path", path))
         path.write_text(self._text + "\n", encoding=TEXT[0], errors=TEXT[1])
         return path
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from ropedyn._lib import c_handle, library
 from ropedyn.errors import Error, message_text
-from ropedyn.scene import TEXT, Scene
+from ropedyn.scene import TEXT, Scene, _path_text
 
 SUPPORTS = {"top": 0, "bottom": 1}
 ENERGY_NAMES = ("kinetic", "elastic", "gravity", "dissipated", "support_work", "total")
@@ -79,6 +79,9 @@ def run(scene, output=None):
     then guarded as the command line's output: a lock, FILE.part until the end)."""
     from ropedyn.io import load_run
     scene = _scene_of(scene)
+    if output is not None:
+        # str() wrote output=True to a file "True" (and then failed to read it back)
+        output = _path_text("run: output", output) or None
     lib = library()
     h = c_handle()
     image, size = ctypes.c_void_p(), ctypes.c_size_t()
@@ -86,7 +89,7 @@ def run(scene, output=None):
         status = lib.ropedyn_create_from_text(scene.text.encode(*TEXT), scene.name.encode(),
                                               ctypes.byref(h))
         if status == 0:
-            status = lib.ropedyn_run(h, str(output).encode() if output else None,
+            status = lib.ropedyn_run(h, output.encode(*TEXT) if output else None,
                                      ctypes.byref(image), ctypes.byref(size))
         message = message_text(lib.ropedyn_last_error(h))
         data = ctypes.string_at(image, size.value) if image.value and size.value else b""

@@ -737,3 +737,23 @@ def test_a_simulation_keeps_its_own_scene():
     with ropedyn.Simulation(scene) as sim:
         sim.advance(0.01)
         assert sim.t == 0.01
+
+
+def test_an_output_that_is_no_path_is_refused(tmp_path, monkeypatch):
+    """run(scene, output=True) wrote a run file named "True" (str() of the value), then
+    failed to read it back with Python's TypeError; output=1 wrote "1", and output=0 or
+    False ran in memory. Only None (in memory) or a path is taken now; so for
+    Scene.write."""
+    monkeypatch.chdir(tmp_path)
+    scene = small(n=4, t_end=0.01)
+    for bad in (True, False, 1, 0, 0.5, ["out.h5"]):
+        with pytest.raises(ropedyn.Error, match=r"run: output is a file's path \(a str or a "
+                           r"pathlib.Path\), not ") as error:
+            ropedyn.run(scene, output=bad)
+        assert error.value.code == 2
+        with pytest.raises(ropedyn.Error, match="Scene.write: path is a file's path"):
+            scene.write(bad)
+    assert list(tmp_path.iterdir()) == []
+    assert ropedyn.run(scene, output="").path.endswith("(in memory)")
+    assert ropedyn.run(scene, output=tmp_path / "a.h5").time[-1] == 0.01
+    assert ropedyn.Scene.from_file(scene.write(b"s.nml")) == scene
