@@ -81,15 +81,7 @@ def energy_panel(ax, run):
     ax.plot(t, e["kinetic"], lw=1, label="kinetic", **one)
     potential = e["gravity"] - e["gravity"][0] + e["elastic"]
     ax.plot(t, potential, lw=1, label="potential - V(0)", **one)
-    if "dissipated" in e:
-        ax.plot(t, e["dissipated"], lw=1, ls="--", label="dissipated", **one)
-    work = plot.work(run)
-    if work is not None:
-        ax.plot(t, work, lw=1, ls="-.", color="C5", label=plot.WORK_LABEL, **one)
-    ax.plot(t, e["total"] - run.e0, "k", lw=1.2, label="total - E0", **one)
-    plot.say_one_record(ax, run)
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("energy (J)")
+    plot.balance_curves(ax, run, 1.2)
     ax.legend(fontsize=7, loc="best", title=plot.BALANCE_NOTE, title_fontsize=7)
     ax.grid(alpha=0.3)
     return ax.axvline(t[0], color="0.3", lw=1, animated=True)
@@ -257,14 +249,9 @@ def parse_args(argv):
 def main(argv=None):
     args = parse_args(argv)
     out = pathlib.Path(args.output or str(pathlib.Path(args.run).with_suffix(".gif")))
-    try:
-        run = io.load_run(args.run)
-    except (OSError, ValueError) as exc:
-        print(f"animate: {exc}", file=sys.stderr)
-        return 2
-    if run.time.size == 0:
-        print(f"animate: {args.run}: no output records", file=sys.stderr)
-        return 1
+    run, code = plot.load_records("animate", args.run)
+    if run is None:
+        return code
     try:
         check_format(out, args.run)
         frames = frame_indices(run.time, args.max_frames, args.start, args.end)

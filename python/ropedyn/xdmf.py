@@ -23,7 +23,7 @@ import numpy as np
 
 from ropedyn import fields as derived
 from ropedyn import io
-from ropedyn.plot import made_by, written_whole
+from ropedyn.plot import load_records, made_by, written_whole
 from ropedyn.docstrings import summary
 
 FIELD_UNITS = {"tension": "N", "curvature": "1/m", "speed": "m/s", "velocity": "m/s",
@@ -190,14 +190,9 @@ def main(argv=None):
             print(f"xdmf: {why}", file=sys.stderr)
             return 2
 
-    try:
-        run = io.load_run(run_path)
-    except (OSError, ValueError) as exc:
-        print(f"xdmf: {exc}", file=sys.stderr)
-        return 2
-    if run.time.size == 0:
-        print(f"xdmf: {run_path}: no output records", file=sys.stderr)
-        return 1
+    run, code = load_records("xdmf", run_path)
+    if run is None:
+        return code
     # both files are written whole as .part and then renamed (the fields first): an
     # interrupted script leaves the earlier pair as it was, and a reader holding them keeps
     # reading them

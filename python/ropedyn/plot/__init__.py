@@ -8,6 +8,7 @@ import contextlib
 import os
 import pathlib
 import re
+import sys
 
 import numpy as np
 
@@ -130,6 +131,38 @@ def say_one_record(ax, run):
     ax.text(0.5, 0.9, f"one record (t = {run.time[0]:.6g} s)", ha="center", va="top",
             fontsize=9, color="0.3", transform=ax.transAxes)
     return True
+
+
+def balance_curves(ax, run, total_width):
+    """The curves of an energy panel after its energy parts: the dissipated energy, the
+    work done on the rope (when there is any), T + V - E0 (their difference W -
+    dissipated), the one-record note and the axes' labels."""
+    t, e = run.time, run.energy
+    one = point_marker(run)
+    if "dissipated" in e:
+        ax.plot(t, e["dissipated"], lw=1, ls="--", label="dissipated", **one)
+    w = work(run)
+    if w is not None:
+        ax.plot(t, w, lw=1, ls="-.", color="C5", label=WORK_LABEL, **one)
+    ax.plot(t, e["total"] - run.e0, "k", lw=total_width, label="total - E0", **one)
+    say_one_record(ax, run)
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("energy (J)")
+
+
+def load_records(tool, path):
+    """The run file `path` for the command-line tool `tool` (its name in messages), with at
+    least one record: (run, 0); else (None, exit code) after one line on stderr: 2 when it
+    is not a run file or cannot be read, 1 when it holds no output record."""
+    try:
+        run = io.load_run(path)
+    except (OSError, ValueError) as exc:
+        print(f"{tool}: {exc}", file=sys.stderr)
+        return None, 2
+    if run.time.size == 0:
+        print(f"{tool}: {path}: no output records", file=sys.stderr)
+        return None, 1
+    return run, 0
 
 
 def picture_limits(run, margin=0.08):

@@ -29,14 +29,9 @@ def main(argv=None):
     except ValueError as exc:
         parser.error(str(exc))
 
-    try:
-        run = io.load_run(args.run)
-    except (OSError, ValueError) as exc:
-        print(f"plot_energy: {exc}", file=sys.stderr)
-        return 2
-    if run.time.size == 0:
-        print(f"plot_energy: {args.run}: no output records", file=sys.stderr)
-        return 1
+    run, code = plot.load_records("plot_energy", args.run)
+    if run is None:
+        return code
     t, e = run.time, run.energy
     e0 = run.e0
     balance = run.balance - e0

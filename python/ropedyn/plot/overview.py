@@ -33,15 +33,7 @@ def plot_energies(ax, run):
     ax.plot(t, e["kinetic"], lw=1, label="kinetic T", **one)
     ax.plot(t, e["gravity"] - e["gravity"][0], lw=1, label="gravity - gravity(0)", **one)
     ax.plot(t, e["elastic"], lw=1, label="elastic", **one)
-    if "dissipated" in e:
-        ax.plot(t, e["dissipated"], lw=1, ls="--", label="dissipated", **one)
-    work = plot.work(run)
-    if work is not None:
-        ax.plot(t, work, lw=1, ls="-.", color="C5", label=plot.WORK_LABEL, **one)
-    ax.plot(t, e["total"] - run.e0, "k", lw=1.4, label="total - E0", **one)
-    plot.say_one_record(ax, run)
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("energy (J)")
+    plot.balance_curves(ax, run, 1.4)
     ax.set_title("energies", fontsize=10)
     ax.legend(fontsize=7, loc="best", title=plot.BALANCE_NOTE, title_fontsize=7)
     ax.grid(alpha=0.3)
@@ -188,14 +180,9 @@ def main(argv=None):
         plot.check_picture_name(out, args.run)
     except ValueError as exc:
         parser.error(str(exc))
-    try:
-        run = io.load_run(args.run)
-    except (OSError, ValueError) as exc:
-        print(f"plot: {exc}", file=sys.stderr)
-        return 2
-    if run.time.size == 0:
-        print(f"plot: {args.run}: no output records", file=sys.stderr)
-        return 1
+    run, code = plot.load_records("plot", args.run)
+    if run is None:
+        return code
     if args.times:
         try:
             check_times(run, args.times)
