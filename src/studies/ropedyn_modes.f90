@@ -26,6 +26,7 @@ module ropedyn_modes
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
                                tangent_matrices, rope_length
     use ropedyn_ldl, only: bandwidth
+    use ropedyn_mode_start, only: relaxed_mode_start
     implicit none
     private
     public :: modes_result_t, compute_modes, equilibrium_initial_state
@@ -211,19 +212,22 @@ contains
 
     !> The initial state of `&initial shape = 'equilibrium'` (the static equilibrium, at
     !! rest, found from the 'straight' start in y) or 'mode' (that equilibrium plus mode
-    !! `mode` scaled so that its largest point displacement is `mode_amplitude`, at rest).
-    !! Other shapes leave y unchanged.
-    subroutine equilibrium_initial_state(model, spec, y, err)
+    !! `mode` scaled so that its largest point displacement is `mode_amplitude`, relaxed
+    !! onto the stiff springs: ropedyn_mode_start; at rest). Other shapes leave y
+    !! unchanged. `note`: '' or a warning about the start.
+    subroutine equilibrium_initial_state(model, spec, y, err, note)
         class(rope_model_t), intent(inout) :: model
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(inout) :: y(:)
         type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable, intent(out), optional :: note
+        character(len=:), allocatable :: said
         type(statics_result_t) :: sres
         type(modes_result_t) :: mres
-        integer, allocatable :: pos(:), vel(:)
         integer :: k
         real(wp) :: largest
 
+        if (present(note)) note = ''
         select case (trim(spec%initial%shape))
         case ('equilibrium', 'mode')
         case default
@@ -251,8 +255,9 @@ contains
                             ': the mode does not move the rope')
             return
         end if
-        call model%coordinates(pos, vel)
-        y(pos) = y(pos) + (spec%initial%mode_amplitude/largest)*mres%shape(:, k)
+        call relaxed_mode_start(model, spec, y, mres%shape(:, k), &
+                                spec%initial%mode_amplitude/largest, said)
+        if (present(note)) note = said
     end subroutine equilibrium_initial_state
 
 end module ropedyn_modes

@@ -532,7 +532,9 @@ def time_domain(runner):
     md = ["## 5. Time-domain cross-checks", "",
           "Each comparison once more in the time domain: `ropedyn run` started in mode k "
           "(`&initial shape = 'mode'`: the equilibrium plus the mode shape scaled so that its "
-          "largest point displacement is `mode_amplitude`, at rest), the default method "
+          "largest point displacement is `mode_amplitude`, relaxed onto the stiff springs "
+          "([a mode start](../theory/statics-modes.md#a-mode-start)), at rest), the default "
+          "method "
           "`auto` with rtol 1e-9; the "
           "period is the mean spacing of the downward zero crossings of the displacement "
           "projected on the mode's point shape (`/modes/shape_points`), over about "
