@@ -17,8 +17,9 @@ and returns a small summary dict (kind, records, status, reason, modes) when the
 right. A run file of any status passes: 'complete', 'failed', 'interrupted' (a signal
 stopped it; `ropedyn run --resume` continues it) and 'running' (its run was killed or
 crashed, or is still writing it: valid up to its last record); the layout is the same, but
-only a complete or interrupted file must have the solver statistics (a running file has
-those of a resumed run's earlier parts or none, a file given up after a write error none),
+only a complete or interrupted file must have the solver statistics (a run writes them with
+its records at each flush, so a running file and one given up after a write error have
+those of their last flush, or none before the first),
 and the series of a running or failed file may hold more records than /time (a block
 written halfway). A statics or modes file is always 'complete'.
 """
@@ -203,9 +204,9 @@ def _check_run(f, path, n_elements, extents):
     _check_columns(f, path)
     _check_fixed(f, path, n_elements)
 
-    # solver statistics: written when a run ends (complete, failed in the integration,
-    # interrupted); none in a file given up after a write error, and a running file has
-    # none of its own run (a resumed run's file keeps those of the earlier parts)
+    # solver statistics: written with the records at each flush and when a run ends
+    # (complete, failed in the integration, interrupted); a running file or one given up
+    # after a write error has those of its last flush, or none before the first
     have = [name for name in STATS if name in f]
     if status in STATS_STATUSES or have:
         _check_stats(f, path)

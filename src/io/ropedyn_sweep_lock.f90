@@ -108,12 +108,13 @@ contains
             empty = .false.
             if (line == LOCK_HEADER) known = .true.
             eq = index(line, '=')
+            ! every line but `gone=`, the header too (hand_back_lock writes them back)
+            if (line(:len('gone=')) /= 'gone=') lock%text = lock%text//trim(line)//new_line('a')
             if (eq < 2) cycle
             select case (line(:eq - 1))
             case ('host', 'boot', 'job', 'started', 'pid', 'start_ticks', 'signal', 'gone')
                 known = .true.
             end select
-            if (line(:eq - 1) /= 'gone') lock%text = lock%text//trim(line)//new_line('a')
             select case (line(:eq - 1))
             case ('host')
                 lock%host = trim(line(eq + 1:))

@@ -177,8 +177,9 @@ contains
         if (row%status == 'complete') call energy_errors(state%data, row)
     end subroutine read_row
 
-    !> '' unless a part of the run in `data` was killed (its counters and CPU time lost):
-    !! then that, with where each such part stopped.
+    !> '' unless a part of the run in `data` was killed (its wall time lost; its counters
+    !! and CPU time too where an earlier version wrote them only at its end): then that,
+    !! with where each such part stopped.
     function partial_text(data) result(text)
         type(case_data_t), intent(in) :: data
         character(len=:), allocatable :: text

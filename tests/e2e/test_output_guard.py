@@ -197,7 +197,9 @@ def test_a_killed_run_leaves_the_earlier_file_whole(run, ropedyn_exe, tmp_path, 
     # the killed writer
     nothing = run("run", "--resume", "out/paper.h5.part", "--set", f"solver.t_end={last}")
     assert nothing.returncode == 2 and "nothing to continue" in nothing.stderr, nothing.stderr
-    assert f"pid={proc.pid}" in (tmp_path / "out" / "paper.h5.lock").read_text()
+    handed_back = (tmp_path / "out" / "paper.h5.lock").read_text()
+    assert handed_back.startswith("ropedyn sweep case lock\n") and \
+        f"pid={proc.pid}" in handed_back, handed_back
     # its writer is gone (no live lock): continued as it is, with a warning
     resumed = run("run", "--resume", "out/paper.h5.part", "--set", f"solver.t_end={last + 0.05}")
     assert resumed.returncode == 0, resumed.stderr
