@@ -46,7 +46,8 @@ def _path_text(what, path):
     """The text of a file's path (a str, bytes or an os.PathLike); Error for anything
     else (str() made a path "None" of None)."""
     if not isinstance(path, (str, bytes, os.PathLike)):
-        raise Error(f"{what} is a file's path (a str or a pathlib.Path), not {path!r}", 2)
+        raise Error(f"{what} is a file's path (a str, bytes or a pathlib.Path), not "
+                    f"{path!r}", 2)
     return os.fsdecode(path)
 
 
@@ -110,11 +111,17 @@ def _open(text, name, settings=()):
         raise Error(f"{name}: the scene text holds a NUL character", 2)
     handle = _Handle(lib.ropedyn_create_from_text, text.encode(*TEXT), name.encode())
     if settings:
-        if any("\n" in s for s in settings):
-            handle.close()
-            raise Error("set: a value holds a new line", 2)
-        handle.check(lib.ropedyn_set(handle.h, "\n".join(settings).encode(*TEXT)))
+        _apply(handle, settings)
     return handle
+
+
+def _apply(handle, settings):
+    """`settings` ('group.key=value' each) applied to the instance of `handle` together, as
+    several --set; Error (the handle closed) when one is bad."""
+    if any("\n" in s for s in settings):
+        handle.close()
+        raise Error("set: a value holds a new line", 2)
+    handle.check(handle.lib.ropedyn_set(handle.h, "\n".join(settings).encode(*TEXT)))
 
 
 class Scene:
@@ -129,20 +136,37 @@ class Scene:
             raise Error(f"Scene: text is namelist text (a str), not {text!r}; "
                         "Scene.from_file reads a scene file", 2)
         self.name = _path_text("Scene: name", name)
-        with _open(text, self.name) as handle:
-            self._text = handle.text(handle.lib.ropedyn_scene_text)
-            self._warnings = handle.text(handle.lib.ropedyn_warnings)
+        # what the scene was made of (its text, or its file when _source is None) and the
+        # settings made since, all applied again at each set, as several --set: a derived
+        # default (tangential_damping from normal_damping) follows the last of them
+        self._source = text
+        self._settings = []
+        self._read([])
 
     @classmethod
     def from_file(cls, path):
         """The scene of a scene file (as `ropedyn run PATH` reads it)."""
-        lib = library()
         scene = cls.__new__(cls)
         scene.name = _path_text("Scene.from_file: path", path)
-        with _Handle(lib.ropedyn_create_from_file, scene.name.encode(*TEXT)) as handle:
-            scene._text = handle.text(lib.ropedyn_scene_text)
-            scene._warnings = handle.text(lib.ropedyn_warnings)
+        scene._source = None
+        scene._settings = []
+        scene._read([])
         return scene
+
+    def _read(self, settings):
+        """The effective text and warnings of the source with `settings` (checked together;
+        Error, and the scene unchanged, when one is bad)."""
+        if self._source is None:
+            lib = library()
+            handle = _Handle(lib.ropedyn_create_from_file, self.name.encode(*TEXT))
+            if settings:
+                _apply(handle, settings)
+        else:
+            handle = _open(self._source, self.name, settings)
+        with handle:
+            self._text = handle.text(handle.lib.ropedyn_scene_text)
+            self._warnings = handle.text(handle.lib.ropedyn_warnings)
+        self._settings = list(settings)
 
     @property
     def text(self):
@@ -160,9 +184,7 @@ class Scene:
         (checked together, as several --set are). Returns the scene."""
         items = key.items() if isinstance(key, dict) else [(key, value)]
         settings = [f"{k}={_value_text(v)}" for k, v in items]
-        with _open(self._text, self.name, settings) as handle:
-            self._text = handle.text(handle.lib.ropedyn_scene_text)
-            self._warnings = handle.text(handle.lib.ropedyn_warnings)
+        self._read(self._settings + settings)
         return self
 
     def get(self, key):
@@ -189,6 +211,7 @@ class Scene:
         """An independent copy."""
         other = Scene.__new__(Scene)
         other.__dict__.update(self.__dict__)
+        other._settings = list(self._settings)
         return other
 
     def __eq__(self, other):

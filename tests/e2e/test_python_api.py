@@ -691,7 +691,7 @@ def test_scene_arguments_of_the_wrong_type_are_refused(tmp_path):
         ropedyn.Scene(text, name=None)
     for bad in (None, 3, ["input/paper.nml"]):
         with pytest.raises(ropedyn.Error, match=r"Scene.from_file: path is a file's path "
-                           r"\(a str or a pathlib.Path\), not ") as error:
+                           r"\(a str, bytes or a pathlib.Path\), not ") as error:
             ropedyn.Scene.from_file(bad)
         assert error.value.code == 2
         for call in (ropedyn.Simulation, ropedyn.run):
@@ -747,8 +747,8 @@ def test_an_output_that_is_no_path_is_refused(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     scene = small(n=4, t_end=0.01)
     for bad in (True, False, 1, 0, 0.5, ["out.h5"]):
-        with pytest.raises(ropedyn.Error, match=r"run: output is a file's path \(a str or a "
-                           r"pathlib.Path\), not ") as error:
+        with pytest.raises(ropedyn.Error, match=r"run: output is a file's path \(a str, bytes or "
+                           r"a pathlib.Path\), not ") as error:
             ropedyn.run(scene, output=bad)
         assert error.value.code == 2
         with pytest.raises(ropedyn.Error, match="Scene.write: path is a file's path"):
@@ -757,3 +757,30 @@ def test_an_output_that_is_no_path_is_refused(tmp_path, monkeypatch):
     assert ropedyn.run(scene, output="").path.endswith("(in memory)")
     assert ropedyn.run(scene, output=tmp_path / "a.h5").time[-1] == 0.01
     assert ropedyn.Scene.from_file(scene.write(b"s.nml")) == scene
+
+
+def test_set_resolves_derived_defaults_after_every_setting(run, tmp_path):
+    """A derived default (tangential_damping from normal_damping) is resolved after all
+    the settings, as after several --set. Scene.set rebuilt the scene from its effective
+    text, where the default was already written out: a later normal_damping left
+    tangential_damping at its first value (400, from the scene's 1000)."""
+    (tmp_path / "only.nml").write_text("&model /\n&solver t_end = 0.01 /\n")
+    for scene in (ropedyn.Scene("&model /\n&solver t_end = 0.01 /\n"),
+                  ropedyn.Scene.from_file(tmp_path / "only.nml")):
+        scene.set("rope.normal_damping", 0.1)
+        assert scene.get("rope.tangential_damping") == pytest.approx(0.04)
+        again = scene.copy().set("rope.normal_damping", 0.2)
+        assert again.get("rope.tangential_damping") == pytest.approx(0.08)
+        assert scene.get("rope.tangential_damping") == pytest.approx(0.04)
+        # a bad setting changes nothing
+        with pytest.raises(ropedyn.Error):
+            scene.set("rope.length", -1.0)
+        assert scene.set("rope.normal_damping", 0.3).get("rope.tangential_damping") == \
+            pytest.approx(0.12)
+    cli = run("run", tmp_path / "only.nml", "--set", "rope.normal_damping=0.1",
+              "--set", "rope.normal_damping=0.2", "--set", "output.file=c.h5")
+    assert cli.returncode == 0, cli.stderr
+    with h5py.File(tmp_path / "c.h5") as f:
+        line = [l for l in f.attrs["scene"].decode().splitlines()
+                if l.strip().startswith("tangential_damping")][0]
+    assert float(line.split("=")[1].split("!")[0]) == pytest.approx(0.08)
