@@ -27,7 +27,7 @@ module ropedyn_sweep_runner
     use ropedyn_text, only: int_text
     use ropedyn_sweep_status, only: case_state_t, case_state, STATUS_NAMES
     use ropedyn_sweep_summary, only: case_row_t, build_summary, RUN_WARNING_JOIN
-    use ropedyn_sweep_task, only: case_label, id_width
+    use ropedyn_sweep_task, only: case_label, id_width, drop_stale_lock
     implicit none
     private
     public :: sweep_options_t, list_cases, status_report, run_local, summarize
@@ -212,7 +212,8 @@ contains
     end subroutine run_local
 
     !> The cases to run here: not complete (or all with --force), and not being written by
-    !! another process (those are listed apart). The empty logs of complete cases go: a
+    !! another process (those are listed apart). The abandoned locks of complete cases go
+    !! (drop_stale_lock), and so do their empty logs: a
     !! runner killed by SIGKILL could not remove those of the cases its workers finished
     !! on their own, which run no more (the logs of the cases run here go when their
     !! workers end; a complete case is not started by another runner, which could be
@@ -234,7 +235,11 @@ contains
                 self%elsewhere = [self%elsewhere, c]
                 cycle
             end if
-            if (state%status == 'complete') call remove_if_empty(self%log_path(c))
+            if (state%status == 'complete') then
+                call remove_if_empty(self%log_path(c))
+                ! (the lock its writer, killed after the rename, left)
+                call drop_stale_lock(sweep%cases(c), state)
+            end if
             if (state%status == 'complete' .and. .not. opt%force) cycle
             self%todo = [self%todo, c]
         end do

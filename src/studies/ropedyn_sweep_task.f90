@@ -40,7 +40,7 @@ module ropedyn_sweep_task
         write_failure_note, drop_failure_note
     implicit none
     private
-    public :: run_cases, case_label, case_id, id_width
+    public :: run_cases, case_label, case_id, id_width, drop_stale_lock
 
 contains
 
@@ -270,9 +270,29 @@ contains
         type(case_state_t) :: state
         call case_state(c, state)
         done = state%status == 'complete'
+        if (done) call drop_stale_lock(c, state)
         if (done .and. .not. quiet) write (output_unit, '(a)') label//': complete already ('// &
             c%file//'), skipped'
     end subroutine check_complete
+
+    !> The abandoned lock of a complete case c (`state`: its status, read now) is removed:
+    !! its writer was killed after it renamed the case file into place, before it removed
+    !! the lock, and a complete case is not run again to remove it. It is taken over and
+    !! dropped, as by any writer (a live lock, or one taken meanwhile, stays). A lock with
+    !! a .part beside it (a killed rerun, --force) stays with its .part.
+    subroutine drop_stale_lock(c, state)
+        type(sweep_case_t), intent(in) :: c
+        type(case_state_t), intent(in) :: state
+        type(heartbeat_t) :: beat
+        type(error_t), allocatable :: err
+        logical :: partial
+        if (state%status /= 'complete' .or. .not. state%lock%exists) return
+        if (state%lock%live .or. len(state%lock%problem) > 0) return
+        inquire (file=part_path(c%file), exist=partial)
+        if (partial) return
+        call take_lock(lock_path(c%file), beat, err)
+        if (.not. allocated(err)) call drop_lock(lock_path(c%file), beat)
+    end subroutine drop_stale_lock
 
     !> The .part file of a finished run becomes the case file: with its wall time and the
     !! case's scene, renamed into place. A run that did not finish its file (an error before

@@ -902,3 +902,35 @@ def test_a_cases_run_warnings_reach_the_summary(run, sweep_dir):
     again = run("sweep", "warned.nml", "--summary")
     assert again.returncode == 0, again.stderr
     assert read_csv(sweep_dir / "out" / "warned" / "summary.csv") == rows
+
+
+def test_the_abandoned_lock_of_a_complete_case_goes(run, sweep_dir):
+    """A writer killed after it renamed its case file into place, before it removed the
+    lock, leaves a complete case with an abandoned lock. A complete case is not run again,
+    so the next task or runner removes that lock (taken over and dropped); a lock of a live
+    writer, or one with a .part beside it (a killed rerun), stays."""
+    assert run("sweep", "sw.nml", "--task", "1").returncode == 0
+    out = sweep_dir / "out" / "sw"
+    lock = out / ".case_0001.lock"
+    gone = subprocess.Popen(["true"])
+    gone.wait()
+    lock.write_text(f"ropedyn sweep case lock\nhost={socket.gethostname()}\npid={gone.pid}\n")
+    skipped = run("sweep", "sw.nml", "--task", "1")
+    assert skipped.returncode == 0 and "complete already" in skipped.stdout, skipped.stderr
+    assert not lock.exists()
+    # the local runner does the same for the complete cases it does not start
+    lock.write_text(f"ropedyn sweep case lock\nhost={socket.gethostname()}\npid={gone.pid}\n")
+    (out / ".case_0002.lock").write_text(f"ropedyn sweep case lock\nhost={socket.gethostname()}"
+                                         f"\npid={os.getpid()}\n")
+    for k in range(3, 9):
+        assert run("sweep", "sw.nml", "--task", str(k)).returncode == 0
+    runner = run("sweep", "sw.nml", "--jobs", "1")
+    assert runner.returncode == 3, runner.stderr       # case 2 is being written (this pid)
+    assert not lock.exists()
+    assert (out / ".case_0002.lock").exists()          # a live writer's lock stays
+    (out / ".case_0002.lock").unlink()
+    # a lock with a .part beside it stays with its .part
+    lock.write_text(f"ropedyn sweep case lock\nhost={socket.gethostname()}\npid={gone.pid}\n")
+    (out / ".case_0001.h5.part").write_bytes((out / "case_0001.h5").read_bytes())
+    assert run("sweep", "sw.nml", "--task", "1").returncode == 0
+    assert lock.exists() and (out / ".case_0001.h5.part").exists()
