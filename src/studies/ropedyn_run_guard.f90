@@ -23,7 +23,8 @@ submodule (ropedyn_run) ropedyn_run_guard
     use ropedyn_sweep_lock, only: take_lock, drop_lock, read_lock, hand_back_lock, lock_t
     use ropedyn_run_inputs, only: check_not_input, check_may_replace
     use ropedyn_error, only: ERR_USAGE, ERR_IO
-    use ropedyn_h5, only: h5_file_t
+    use ropedyn_h5, only: h5_file_t, held_open
+    use ropedyn_run_record, only: run_record_t, read_run_record, LAST_RECORD
     use ropedyn_text, only: replaced
     implicit none
 
@@ -256,7 +257,7 @@ contains
     subroutine refuse_part(file, err)
         character(len=*), intent(in) :: file
         type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable :: status
+        character(len=:), allocatable :: status, why
         status = trim(root_attribute(file//'.part', 'status'))
         select case (status)
         case ('complete')
@@ -268,11 +269,35 @@ contains
                 'stopped (status '//status//') and kept this name: continue it (ropedyn '// &
                 'run --resume '//file//'.part) or remove it, or give --force')
         case default
+            ! a run killed before its first flush leaves a file that cannot be read back:
+            ! a resume of it would be refused
+            why = unreadable_part(file//'.part')
+            if (len(why) > 0) then
+                call make_error(err, ERR_USAGE, file//'.part: left by a run of '//file// &
+                    ' that was killed, and cannot be continued ('//why//'): remove it, '// &
+                    'or give --force')
+                return
+            end if
             call make_error(err, ERR_USAGE, file//'.part: left by a run of '//file// &
                 ' that was killed: continue it (ropedyn run --resume '//file//'.part) or '// &
                 'remove it, or give --force')
         end select
     end subroutine refuse_part
+
+    !> Why the last record of the run file `part` cannot be read back, as a resume reads
+    !! it ('' when it can, or when another program holds the file open: then a resume
+    !! says who).
+    function unreadable_part(part) result(why)
+        character(len=*), intent(in) :: part
+        character(len=:), allocatable :: why
+        type(run_record_t) :: rec
+        type(error_t), allocatable :: err
+        why = ''
+        call read_run_record(part, LAST_RECORD, rec, err)
+        if (.not. allocated(err)) return
+        if (held_open(err)) return
+        why = replaced(err%message, part//': ', '')
+    end function unreadable_part
 
     !> The name ends with '.part' (the file a new run writes before it is renamed).
     pure logical function is_part(file)

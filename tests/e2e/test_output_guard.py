@@ -289,3 +289,34 @@ def test_statics_and_modes_leave_a_foreign_part_file(run, tmp_path):
     assert run("modes", scene, "-o", "c.h5", "--count", "2").returncode == 0
     assert run("statics", scene, "-o", "b.h5", "--force").returncode == 0
     assert not (tmp_path / "c.h5.part").exists() and not (tmp_path / "b.h5.part").exists()
+
+
+def test_a_killed_part_that_cannot_be_read_back_is_not_offered_to_resume(run, tmp_path, scene):
+    """A run killed in its first milliseconds, before its first flush, leaves a FILE.part
+    that does not open as a run file (only HDF5's superblock: 96 bytes). A resume of it is
+    refused; so the next run does not tell to resume it, but to remove it or give --force."""
+    out = tmp_path / "out"
+    out.mkdir()
+    part = out / "paper.h5.part"
+    # as a run killed 25 ms after its start left it: HDF5's superblock, its end of file
+    # at 2048 bytes
+    part.write_bytes(bytes.fromhex(
+        "894844460d0a1a0a000000000008080004001000010000000000000000000000"
+        "ffffffffffffffff0008000000000000ffffffffffffffff0000000000000000"
+        "600000000000000001000000000000008800000000000000a802000000000000"
+    ))
+    gone = subprocess.Popen(["true"])
+    gone.wait()
+    (out / "paper.h5.lock").write_text(
+        f"ropedyn sweep case lock\nhost={socket.gethostname()}\npid={gone.pid}\n")
+    resume = run("run", "--resume", "out/paper.h5.part")
+    assert resume.returncode == 2, resume.stderr
+    refused = run("run", scene)
+    assert refused.returncode == 2
+    assert ("out/paper.h5.part: left by a run of out/paper.h5 that was killed, and cannot be "
+            "continued (") in refused.stderr, refused.stderr
+    assert "remove it, or give --force" in refused.stderr and "--resume" not in refused.stderr
+    assert part.stat().st_size == 96                   # left as it is
+    forced = run("run", scene, "--set", "solver.t_end=0.02", "--force")
+    assert forced.returncode == 0, forced.stderr
+    assert not part.exists() and not (out / "paper.h5.lock").exists()
