@@ -218,8 +218,10 @@ contains
         start = clock_seconds()
         call run_scene(scene, summary, err, resume=resume, guard=.false.)
         if (resume .and. allocated(err)) then
-            ! not to be continued (nothing left, no restart data, ...): run it anew
-            if (err%code == ERR_INPUT) then
+            ! not to be continued (nothing left, no restart data, ...): run it anew; so is
+            ! a .part the resume could not read back (a writer killed in the middle of a
+            ! flush can leave records HDF5 cannot read), which it left `running`
+            if (err%code == ERR_INPUT .or. unread_part(part, err)) then
                 write (error_unit, '(a)') label//': cannot be continued ('// &
                     err%message//'): running it anew'
                 removed = delete_file(part)
@@ -379,6 +381,17 @@ contains
         killed_part = (data%status == 'running' .or. data%status == 'interrupted') .and. &
             data%records >= 2 .and. holds_case_scene(c, data%scene)
     end function killed_part
+
+    !> The resume of the killed writer's `part` failed with `err` and left it as it was
+    !! (status `running`: a resume that ran closes its file with a final status): its
+    !! records do not read back. Not for a signal, nor a file another process holds open.
+    logical function unread_part(part, err)
+        character(len=*), intent(in) :: part
+        type(error_t), intent(in) :: err
+        unread_part = .false.
+        if (err%code == ERR_INTERRUPTED .or. signal_received() /= 0) return
+        unread_part = file_status(part) == 'running'
+    end function unread_part
 
     !> The status attribute of the run file `path` ('' when it cannot be read).
     function file_status(path) result(status)

@@ -934,3 +934,33 @@ def test_the_abandoned_lock_of_a_complete_case_goes(run, sweep_dir):
     (out / ".case_0001.h5.part").write_bytes((out / "case_0001.h5").read_bytes())
     assert run("sweep", "sw.nml", "--task", "1").returncode == 0
     assert lock.exists() and (out / ".case_0001.h5.part").exists()
+
+
+def test_a_killed_part_whose_records_do_not_read_back_is_run_anew(run, sweep_dir):
+    """A writer killed in the middle of a flush can leave a .part (status `running`) whose
+    last records HDF5 cannot read back (/state/y shorter than /time, or a chunk past the
+    end of the file: "addr overflow"). Its resume is refused; the case is then run anew at
+    once, as one that cannot be continued, not written `failed` with its .part removed
+    and run anew only by the next sweep."""
+    assert run("sweep", "sw.nml", "--task", "1").returncode == 0
+    out = sweep_dir / "out" / "sw"
+    part, final = out / ".case_0001.h5.part", out / "case_0001.h5"
+    final.rename(part)
+    with h5py.File(part, "r+") as f:
+        f.attrs["status"] = "running"
+        f.attrs["scene"] = f.attrs["scene"].decode().replace("out/sw/case_0001.h5",
+                                                             "out/sw/.case_0001.h5.part")
+        del f["solver/wall_time"]
+        f["state/y"].resize(f["state/y"].shape[0] - 3, axis=0)
+    gone = subprocess.Popen(["true"])
+    gone.wait()
+    (out / ".case_0001.lock").write_text(
+        f"ropedyn sweep case lock\nhost={socket.gethostname()}\npid={gone.pid}\n")
+    again = run("sweep", "sw.nml", "--task", "1")
+    assert again.returncode == 0, again.stderr
+    assert "cannot be continued (" in again.stderr and "running it anew" in again.stderr, \
+        again.stderr
+    with h5py.File(final, "r") as f:
+        assert f.attrs["status"] == b"complete" and "restarts" not in f["solver"]
+    assert not part.exists() and not (out / ".case_0001.lock").exists()
+    assert not (out / ".case_0001.failed").exists()
