@@ -7,6 +7,7 @@ import h5py
 import numpy as np
 import pytest
 
+from ropedyn import layout
 from ropedyn.layout import check_layout
 
 SCENE = """
@@ -120,3 +121,44 @@ def test_layout_checks_an_interrupted_and_a_killed_runs_file(run, tmp_path):
         del f["solver/steps"]
     with pytest.raises(AssertionError, match="/solver/steps is missing"):
         check_layout(str(complete), 5)
+
+
+def test_layout_fails_a_killed_file_whose_last_record_does_not_read_back(run, tmp_path,
+                                                                          monkeypatch):
+    """A run killed in the middle of a flush can leave series whose last chunk HDF5 cannot
+    read ("addr overflow"); such a file is not "valid up to the last record", and a resume
+    of it is refused. python -m ropedyn.layout fails it, naming the series and the record,
+    and fails, not crashes, on a file h5py cannot walk (RuntimeError). Made here from a
+    complete run's file: /state/y rewritten compressed, its last chunk then damaged."""
+    (tmp_path / "small.nml").write_text(SCENE)
+    assert run("run", "small.nml").returncode == 0
+    killed = tmp_path / "killed.h5.part"
+    killed.write_bytes((tmp_path / "out" / "small.h5").read_bytes())
+    with h5py.File(killed, "r+") as f:
+        f.attrs["status"] = np.bytes_("running")
+        y = f["state/y"]
+        values, chunks, attrs = y[()], y.chunks, dict(y.attrs)
+        del f["state/y"]
+        y = f.create_dataset("state/y", data=values, chunks=chunks,
+                             maxshape=(None,) + values.shape[1:], compression="gzip")
+        y.attrs.update(attrs)
+    assert check_layout(str(killed), 5)["status"] == "running"
+    with h5py.File(killed, "r") as f:
+        y = f["state/y"]
+        last = y.id.get_chunk_info(y.id.get_num_chunks() - 1)
+    with open(killed, "r+b") as raw:
+        raw.seek(last.byte_offset)
+        raw.write(b"\xff" * last.size)
+    with pytest.raises(AssertionError, match=r"/state/y: record 6 \(the last of /time\) "
+                                             r"does not read back"):
+        check_layout(str(killed), 5)
+    result = subprocess.run([sys.executable, "-m", "ropedyn.layout", str(killed), "5"],
+                            capture_output=True, text=True)
+    assert result.returncode == 1 and "FAIL" in result.stderr, result.stderr
+    assert "Traceback" not in result.stderr
+
+    def walk_fails(path, n_elements):
+        raise RuntimeError("Object visitation failed (len not positive after adjustment "
+                           "for EOA)")
+    monkeypatch.setattr(layout, "check_layout", walk_fails)
+    assert layout.main([str(killed), "5"]) == 1
