@@ -90,14 +90,17 @@ contains
             ! closes its file whatever room is left)
             if (.not. allocated(err)) call keep_room(self, err)
         end if
-        ! the counters kept for this flush: the file's as of its records
-        if (due .and. self%has_kept .and. .not. allocated(err)) then
-            call write_counters(self, self%kept_stats, self%kept_cpu, err)
-            self%has_kept = .false.
-        end if
         if (due .and. .not. allocated(err)) then
             call flush_file(self, err)
             self%last_flush = now
+        end if
+        ! the counters kept for this flush, written and flushed after the records: a kill
+        ! inside a flush leaves the counters behind the records, never ahead of them (HDF5
+        ! writes small datasets first: a resume counted the lost steps twice)
+        if (due .and. self%has_kept .and. .not. allocated(err)) then
+            call write_counters(self, self%kept_stats, self%kept_cpu, err)
+            if (.not. allocated(err)) call flush_file(self, err)
+            self%has_kept = .false.
         end if
         if (allocated(err)) call abandon(self, err)
     end subroutine write_when_due
