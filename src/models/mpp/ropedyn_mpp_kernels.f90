@@ -44,23 +44,59 @@ contains
     end procedure mpp_residual
 
     module procedure residual_core
-        real(wp) :: pacc(2), pn(2), pnd(2), wsum(2), fb(2), fp(2), pv(2)
-        real(wp) :: c, s, u, ud, phd, pdd, udd, hk, lk, a1, a2, d, dd, floor
+        real(wp) :: pn(2), pnd(2), wsum(2), fb(2)
         type(motion_state_t) :: top, bottom
         logical :: bottom_on, effects, bodied
-        integer :: k, n, nd, i
 
-        n = self%n
-        nd = self%ndof
         effects = size(self%effects) > 0
         bodied = effects .or. self%water
         call self%supports_at(t, top, bottom, bottom_on)
+        call chain_kinematics(self, y, qacc, top, bodied, pn, pnd)
+        if (effects) self%bodies%cs = self%cs    ! the angles' of y (angles)
+        self%tip = pn
+        self%tipd = pnd
+        self%mom = 0.0_wp
+        call point_mass_forces(self, y, qacc)
+
+        ! The water's added mass on the rods as bodies.
+        if (self%water) call water_forces(self, qacc)
+
+        ! External effects on the rods as bodies (and their powers).
+        if (effects) then
+            if (present(powers)) then
+                call add_forces_powers_of(self%effects, t, self%bodies, self%w, self%mom, &
+                                          powers(1), powers(2))
+            else
+                call add_forces_of(self%effects, t, self%bodies, self%w, self%mom)
+            end if
+        end if
+
+        ! Force of the bottom support on the tip P_n.
+        fb = 0.0_wp
+        if (bottom_on) fb = -self%k_sup*(pn - bottom%p) - self%d_sup*(pnd - bottom%v)
+        call generalized_forces(self, y, qacc, fb, r, wsum)
+        if (present(pin)) pin = -wsum
+        call spring_forces(self, y, top, bottom, bottom_on, r)
+    end procedure residual_core
+
+    !> Accelerations of the joints (prefix sums, from the top joint's) and the
+    !! applied-minus-inertial force on each rod, w_k = m g x - m C_k'', into self%cacc and
+    !! self%w; with `bodied` the rods as bodies into self%bodies; the lower end P_n and its
+    !! velocity in pn, pnd (m, m/s).
+    pure subroutine chain_kinematics(self, y, qacc, top, bodied, pn, pnd)
+        class(mpp_t), intent(inout) :: self
+        real(wp), intent(in) :: y(:), qacc(:)
+        type(motion_state_t), intent(in) :: top
+        logical, intent(in) :: bodied
+        real(wp), intent(out) :: pn(2), pnd(2)
+        real(wp) :: pacc(2), c, s, u, ud, phd, pdd, udd, hk, lk, a1, a2
+        integer :: k, n, nd
+
+        n = self%n
+        nd = self%ndof
         u = 0.0_wp
         ud = 0.0_wp
         udd = 0.0_wp
-
-        ! Accelerations of the joints (prefix sums, from the top joint's) and the
-        ! applied-minus-inertial force on each rod: w_k = m g x - m C_k''.
         pacc = top%a
         pn = top%p
         pnd = top%v
@@ -100,13 +136,16 @@ contains
             pnd(1) = pnd(1) - lk*phd*s + ud*c
             pnd(2) = pnd(2) + lk*phd*c + ud*s
         end do
-        if (effects) self%bodies%cs = self%cs    ! the angles' of y (angles)
-        self%tip = pn
-        self%tipd = pnd
-        self%mom = 0.0_wp
+    end subroutine chain_kinematics
 
-        ! Point masses at P = C_i + r e_i: their applied-minus-inertial force joins w_i,
-        ! its moment r e_i x f about the centre joins the rod's moment.
+    !> Point masses at P = C_i + r e_i: their applied-minus-inertial force joins w_i,
+    !! its moment r e_i x f about the centre joins the rod's moment.
+    pure subroutine point_mass_forces(self, y, qacc)
+        class(mpp_t), intent(inout) :: self
+        real(wp), intent(in) :: y(:), qacc(:)
+        real(wp) :: c, s, fp(2), pv(2)
+        integer :: k, i, nd
+        nd = self%ndof
         do k = 1, size(self%pm_body)
             i = self%pm_body(k)
             c = self%cs(1, i)
@@ -117,26 +156,20 @@ contains
             self%w(:, i) = self%w(:, i) + fp
             self%mom(i) = self%mom(i) + self%pm_r(k)*(-s*fp(1) + c*fp(2))
         end do
+    end subroutine point_mass_forces
 
-        ! The water's added mass on the rods as bodies.
-        if (self%water) call water_forces(self, qacc)
-
-        ! External effects on the rods as bodies (and their powers).
-        if (effects) then
-            if (present(powers)) then
-                call add_forces_powers_of(self%effects, t, self%bodies, self%w, self%mom, &
-                                          powers(1), powers(2))
-            else
-                call add_forces_of(self%effects, t, self%bodies, self%w, self%mom)
-            end if
-        end if
-
-        ! Force of the bottom support on the tip P_n.
-        fb = 0.0_wp
-        if (bottom_on) fb = -self%k_sup*(pn - bottom%p) - self%d_sup*(pnd - bottom%v)
-
-        ! Generalized forces by suffix sums: Q[phi_k] = n_k . (h_k w_k + l_k sum_{i>k} w_i
-        ! + l_k F_b) + M_k, Q[u_k] = e_k . (sum_{i>=k} w_i + F_b).
+    !> Generalized forces by suffix sums, from the bottom support's force fb:
+    !! Q[phi_k] = n_k . (h_k w_k + l_k sum_{i>k} w_i + l_k F_b) + M_k,
+    !! Q[u_k] = e_k . (sum_{i>=k} w_i + F_b), into r; the sums into self%wsum, the
+    !! whole one (at the top joint) into wsum.
+    pure subroutine generalized_forces(self, y, qacc, fb, r, wsum)
+        class(mpp_t), intent(inout) :: self
+        real(wp), intent(in) :: y(:), qacc(:), fb(2)
+        real(wp), intent(out) :: r(:), wsum(2)
+        real(wp) :: c, s, u, hk, lk
+        integer :: k, n
+        n = self%n
+        u = 0.0_wp
         wsum = fb
         self%wsum(:, n + 1) = fb
         do k = n, 1, -1
@@ -151,8 +184,21 @@ contains
             self%wsum(:, k) = wsum
             if (self%nu > 0) r(n + k) = c*wsum(1) + s*wsum(2)
         end do
-        if (present(pin)) pin = -wsum
+    end subroutine generalized_forces
 
+    !> Subtract from r the member springs and dampers, the joint bending springs and
+    !! dampers and the clamped supports' rotational ones (top and bottom: the supports'
+    !! states); the joints' and clamps' moments into self%jmom.
+    pure subroutine spring_forces(self, y, top, bottom, bottom_on, r)
+        class(mpp_t), intent(inout) :: self
+        real(wp), intent(in) :: y(:)
+        type(motion_state_t), intent(in) :: top, bottom
+        logical, intent(in) :: bottom_on
+        real(wp), intent(inout) :: r(:)
+        real(wp) :: d, dd, floor
+        integer :: k, n, nd
+        n = self%n
+        nd = self%ndof
         ! Member springs and dampers (spring_stretch, with the floor taken once: a call per
         ! member cost more than the spring)
         if (self%nu > 0) then
@@ -182,7 +228,7 @@ contains
             r(n) = r(n) - dd
             self%jmom(n) = -dd
         end if
-    end procedure residual_core
+    end subroutine spring_forces
 
     !> The residual's pin force is -(F_b + sum_i w_i) and only the inertial part of w_i
     !! depends on the accelerations: w_i(a) = w_i(0) - (m I + A_i) dC_i, the point masses'
