@@ -33,6 +33,13 @@ submodule (ropedyn_rfem) ropedyn_rfem_kernels
         real(wp) :: wa, wb, rx, ry, rp
     end type sde_t
 
+    !> What a call of `forces` evaluates, from its optional arguments: the elastic energy,
+    !! the dissipation power, the force split (split; with_rest: the rest too) and the
+    !! dampers (damp: damping on, and not left out by the split).
+    type :: force_mode_t
+        logical :: energy, with_power, split, with_rest, damp
+    end type force_mode_t
+
 contains
 
     !> cos and sin of every element angle into self%cs, once per call (gathered, then
@@ -271,19 +278,13 @@ contains
     end procedure fill_bodies
 
     module procedure forces
-        integer :: j, n, p, i, k
         real(wp) :: fx, fy, fp, dx, dy, dp, c(3), cr(3), e_el, p_in, sup_sde(3, 2), floor
         type(sde_t) :: s
-        logical :: energy, with_power, split, with_rest, damp
+        type(force_mode_t) :: mode
+        integer :: j, n
 
         n = self%n
-        energy = present(elastic)
-        with_power = present(power)
-        ! the force split: the dampers' and effects' forces into gen_r (rest), or not at all
-        split = present(rest)
-        with_rest = .false.
-        if (split) with_rest = rest
-        damp = self%damped .and. (with_rest .or. .not. split)
+        mode = force_mode(self, present(elastic), present(power), rest)
         e_el = 0.0_wp
         p_in = 0.0_wp
         floor = self%stretch_floor()
@@ -294,14 +295,10 @@ contains
         c = 0.0_wp
         sup_sde = 0.0_wp
         cr = 0.0_wp
-        if (with_rest) self%gen_r = 0.0_wp
-        if (self%sup(1)%active) then
-            if (split) then
-                call support_force(self, 1, y, c, energy, e_el, fr=cr, rest=rest)
-            else
-                call support_force(self, 1, y, c, energy, e_el, sde=sup_sde(:, 1))
-            end if
-        end if
+        if (mode%with_rest) self%gen_r = 0.0_wp
+        call end_support_force(self, 1, y, mode, c, cr, e_el, sup_sde(:, 1), rest)
+        ! the internal SDEs, here and not in a helper: there gfortran 12 fused scatter's
+        ! products (vfmaddsub, despite -ffp-contract=off), which changed the last bits
         do j = 2, n
             s = sde_at(self, y, j)
             fx = 0.0_wp
@@ -315,16 +312,16 @@ contains
             end if
             if (self%shear) fy = self%cy*s%dwy
             if (self%bending) fp = self%cpj(j)*(y(s%kb + 3) - y(s%ka + 3))
-            if (energy) e_el = e_el + 0.5_wp*(fx*s%dwx + fy*s%dwy &
-                                              + fp*(y(s%kb + 3) - y(s%ka + 3)))
-            if (damp) then
+            if (mode%energy) e_el = e_el + 0.5_wp*(fx*s%dwx + fy*s%dwy &
+                                                   + fp*(y(s%kb + 3) - y(s%ka + 3)))
+            if (mode%damp) then
                 call sde_rates(s, y)
                 dx = self%bxj(j)*s%rx
                 dy = self%by*s%ry
                 dp = self%bpj(j)*s%rp
-                if (with_power) p_in = p_in + (self%bxj(j)*s%rx**2 + self%by*s%ry**2 + &
-                                               self%bpj(j)*s%rp**2)
-                if (.not. split) then
+                if (mode%with_power) p_in = p_in + (self%bxj(j)*s%rx**2 + self%by*s%ry**2 + &
+                                                    self%bpj(j)*s%rp**2)
+                if (.not. mode%split) then
                     fx = fx + dx
                     fy = fy + dy
                     fp = fp + dp
@@ -335,38 +332,97 @@ contains
                 dp = 0.0_wp
             end if
             if (present(joint)) joint(:, j - 1) = [fx, fy, fp]
-            if (with_rest) call scatter(self%gen_r, j, s, dx, dy, dp, cr)
+            if (mode%with_rest) call scatter(self%gen_r, j, s, dx, dy, dp, cr)
             call scatter(self%gen, j, s, fx, fy, fp, c)
             self%gen(1, j - 1) = self%gen(1, j - 1) + self%weight(j - 1)
         end do
-        if (self%sup(2)%active) then
-            if (split) then
-                call support_force(self, 2, y, c, energy, e_el, fr=cr, rest=rest)
-            else
-                call support_force(self, 2, y, c, energy, e_el, sde=sup_sde(:, 2))
-            end if
-        end if
+        call end_support_force(self, 2, y, mode, c, cr, e_el, sup_sde(:, 2), rest)
         if (present(support)) support = sup_sde
         self%gen(1, n) = c(1) + self%weight(n)
         self%gen(2:3, n) = c(2:3)
-        if (with_rest) self%gen_r(:, n) = cr
-        ! moment of the point masses' weight about their element's centre
+        if (mode%with_rest) self%gen_r(:, n) = cr
+        call point_mass_moments(self)
+        if (present(work)) call support_powers(self, y, p_in, work)
+        if (size(self%effects) > 0 .or. self%water) &
+            call effect_forces(self, t, y, mode, e_el, p_in, work)
+        if (mode%energy) elastic = e_el
+        if (mode%with_power) power = p_in
+    end procedure forces
+
+    !> The mode of a call of `forces` (force_mode_t) from which of its optional arguments
+    !! elastic and power are present, and its `rest`.
+    pure function force_mode(self, energy, with_power, rest) result(mode)
+        class(rfem_t), intent(in) :: self
+        logical, intent(in) :: energy, with_power
+        logical, intent(in), optional :: rest
+        type(force_mode_t) :: mode
+        mode%energy = energy
+        mode%with_power = with_power
+        ! the force split: the dampers' and effects' forces into gen_r (rest), or not at all
+        mode%split = present(rest)
+        mode%with_rest = .false.
+        if (mode%split) mode%with_rest = rest
+        mode%damp = self%damped .and. (mode%with_rest .or. .not. mode%split)
+    end function force_mode
+
+    !> Add the moment of the point masses' weight about their element's centre to self%gen.
+    pure subroutine point_mass_moments(self)
+        class(rfem_t), intent(inout) :: self
+        integer :: p, i
         if (self%gravity_on) then
             do p = 1, size(self%pm_elem)
                 i = self%pm_elem(p)
                 self%gen(3, i) = self%gen(3, i) - self%g*self%pm_moment(p)*self%cs(2, i)
             end do
         end if
-        if (present(work)) then
-            ! the supports' powers before the effects', as in store_powers
-            work = 0.0_wp
-            do k = 1, 2
-                if (self%sup(k)%active) call support_power(self, k, y, p_in, work)
-            end do
+    end subroutine point_mass_moments
+
+    !> The supports' dissipation added to p_in and their work rate into work (W), before
+    !! the effects', as in store_powers.
+    pure subroutine support_powers(self, y, p_in, work)
+        class(rfem_t), intent(in) :: self
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(inout) :: p_in
+        real(wp), intent(out) :: work
+        integer :: k
+        work = 0.0_wp
+        do k = 1, 2
+            if (self%sup(k)%active) call support_power(self, k, y, p_in, work)
+        end do
+    end subroutine support_powers
+
+    !> The force of support k (1 top, 2 bottom), when active, on its element: into the
+    !! carry c, with the dampers' part into cr when split (rest: forces' argument), else
+    !! its SDE's forces into sde (support_force).
+    pure subroutine end_support_force(self, k, y, mode, c, cr, e_el, sde, rest)
+        class(rfem_t), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: y(:)
+        type(force_mode_t), intent(in) :: mode
+        real(wp), intent(inout) :: c(3), cr(3), e_el, sde(3)
+        logical, intent(in), optional :: rest
+        if (self%sup(k)%active) then
+            if (mode%split) then
+                call support_force(self, k, y, c, mode%energy, e_el, fr=cr, rest=rest)
+            else
+                call support_force(self, k, y, c, mode%energy, e_el, sde=sde)
+            end if
         end if
-        if (size(self%effects) > 0 .and. (with_rest .or. .not. split)) then
+    end subroutine end_support_force
+
+    !> The external effects' forces (into self%gen_r when split with the rest, else with
+    !! their powers into p_in and work when work is present; their energy into e_el) and
+    !! the water's (forces' arguments; mode: which).
+    subroutine effect_forces(self, t, y, mode, e_el, p_in, work)
+        class(rfem_t), intent(inout) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(in) :: y(:)
+        type(force_mode_t), intent(in) :: mode
+        real(wp), intent(inout) :: e_el, p_in
+        real(wp), intent(inout), optional :: work
+        if (size(self%effects) > 0 .and. (mode%with_rest .or. .not. mode%split)) then
             call self%fill_bodies(y)
-            if (with_rest) then
+            if (mode%with_rest) then
                 call add_forces_of(self%effects, t, self%bodies, self%gen_r(1:2, :), &
                                    self%gen_r(3, :))
             else if (present(work)) then
@@ -376,18 +432,16 @@ contains
                 call add_forces_of(self%effects, t, self%bodies, self%gen(1:2, :), &
                                    self%gen(3, :))
             end if
-            if (energy) call add_energies_of(self%effects, t, self%bodies, e_el)
+            if (mode%energy) call add_energies_of(self%effects, t, self%bodies, e_el)
         end if
         if (self%water) then
-            if (energy) then
+            if (mode%energy) then
                 call self%water_forces(y, e_el)
             else
                 call self%water_forces(y)
             end if
         end if
-        if (energy) elastic = e_el
-        if (with_power) power = p_in
-    end procedure forces
+    end subroutine effect_forces
 
     !> The generalized forces of SDE j (geometry s) with forces (fx, fy, fp): element a's into
     !! g(:, j - 1), with the carry c (the previous SDE's force on its element b, which is a),
