@@ -40,6 +40,14 @@ submodule (ropedyn_rfem) ropedyn_rfem_kernels
         logical :: energy, with_power, split, with_rest, damp
     end type force_mode_t
 
+    !> For the Jacobian: the derivatives dfx, dfy, dfp of SDE j's forces fx, fy (N) and
+    !! fp (N m) with respect to the 12 local variables (a's x, y, phi, x', y', phi', then
+    !! b's) and the strain gradients gx, gy; kept from SDE to SDE (the entries that no
+    !! strain sets stay zero).
+    type :: sde_jac_t
+        real(wp) :: gx(12), gy(12), dfx(12), dfy(12), dfp(12)
+    end type sde_jac_t
+
 contains
 
     !> cos and sin of every element angle into self%cs, once per call (gathered, then
@@ -516,10 +524,10 @@ contains
 
     module procedure jacobian_blocks
         integer :: j, n
-        real(wp) :: fx, fy, fp, t6, floor
+        real(wp) :: floor
         type(sde_t) :: s
-        ! local coordinates of an SDE: (x, y, phi, x', y', phi') of element a, then of b
-        real(wp) :: gx(12), gy(12), dfx(12), dfy(12), dfp(12), r1(12), r2(12), carry(3, 6)
+        type(sde_jac_t) :: d
+        real(wp) :: r1(12), r2(12), carry(3, 6), t6, fx, fy, fp
 
         n = self%n
         floor = self%stretch_floor()
@@ -528,27 +536,90 @@ contains
         ! carry: the diagonal block of element b of the previous SDE (first: the top support)
         carry = 0.0_wp
         if (self%sup(1)%active) call support_jacobian(self, 1, y, carry)
-        gx = 0.0_wp
-        gy = 0.0_wp
-        dfx = 0.0_wp
-        dfy = 0.0_wp
-        dfp = 0.0_wp
+        d%gx = 0.0_wp
+        d%gy = 0.0_wp
+        d%dfx = 0.0_wp
+        d%dfy = 0.0_wp
+        d%dfp = 0.0_wp
         do j = 2, n
             s = sde_at(self, y, j)
-            ! gradients of the tension and shear strains (zero on the rates)
-            gx(1) = -s%ca
-            gx(2) = -s%sa
-            gx(3) = s%dwy
-            gx(7) = s%ca
-            gx(8) = s%sa
-            gx(9) = s%hb*s%sd
-            gy(1) = s%sa
-            gy(2) = -s%ca
-            gy(3) = -(s%dwx + s%ha)
-            gy(7) = -s%sa
-            gy(8) = s%ca
-            gy(9) = -s%hb*s%cd
-            ! forces fx, fy, fp and their derivatives
+            call strain_gradients(s, d)
+            call spring_derivatives(self, y, j, s, floor, fx, fy, fp, d)
+            if (self%damped) then
+                ! d(rate)/dq = H q' (ry and -rx on phi_a), d(rate)/dq' = the gradient
+                call sde_rates(s, y)
+                if (self%tension) call tension_damper(self%bxj(j), s, fx, d)
+                if (self%shear) call shear_damper(self%by, s, fy, d)
+                if (self%bending) then
+                    fp = fp + self%bpj(j)*s%rp
+                    d%dfp(6) = -self%bpj(j)
+                    d%dfp(12) = self%bpj(j)
+                end if
+            end if
+            associate (dfx => d%dfx, dfy => d%dfy, dfp => d%dfp, gx => d%gx, gy => d%gy)
+                ! rows of element a: d(F, fy (dwx + h_a) - fx dwy + fp); of element b:
+                ! d(-F, -h_b (fx sd - fy cd) - fp); columns: a's coordinates, then b's
+                r1 = s%ca*dfx - s%sa*dfy
+                r2 = s%sa*dfx + s%ca*dfy
+                r1(3) = r1(3) - fx*s%sa - fy*s%ca
+                r2(3) = r2(3) + fx*s%ca - fy*s%sa
+                self%blk(1, :, 0, j - 1) = carry(1, :) + r1(1:6)
+                self%blk(2, :, 0, j - 1) = carry(2, :) + r2(1:6)
+                self%blk(3, :, 0, j - 1) = carry(3, :) + (s%dwx + s%ha)*dfy(1:6) &
+                                           - s%dwy*dfx(1:6) + dfp(1:6) + fy*gx(1:6) - fx*gy(1:6)
+                self%blk(1, :, 1, j - 1) = r1(7:12)
+                self%blk(2, :, 1, j - 1) = r2(7:12)
+                self%blk(3, :, 1, j - 1) = (s%dwx + s%ha)*dfy(7:12) - s%dwy*dfx(7:12) &
+                                           + dfp(7:12) + fy*gx(7:12) - fx*gy(7:12)
+                t6 = s%hb*(fx*s%cd + fy*s%sd)
+                self%blk(1, :, -1, j) = -r1(1:6)
+                self%blk(2, :, -1, j) = -r2(1:6)
+                self%blk(3, :, -1, j) = -s%hb*(s%sd*dfx(1:6) - s%cd*dfy(1:6)) - dfp(1:6)
+                self%blk(3, 3, -1, j) = self%blk(3, 3, -1, j) + t6
+                carry(1, :) = -r1(7:12)
+                carry(2, :) = -r2(7:12)
+                carry(3, :) = -s%hb*(s%sd*dfx(7:12) - s%cd*dfy(7:12)) - dfp(7:12)
+                carry(3, 3) = carry(3, 3) - t6
+            end associate
+        end do
+        if (self%sup(2)%active) call support_jacobian(self, 2, y, carry)
+        self%blk(:, :, 0, n) = carry
+        ! external effects: 3x6 blocks on each element's own coordinates
+        if (size(self%effects) > 0) then
+            call self%fill_bodies(y)
+            call add_jacobians_of(self%effects, t, self%bodies, self%blk(:, :, 0, :))
+        end if
+    end procedure jacobian_blocks
+
+    !> The gradients of SDE s's tension and shear strains into d%gx, d%gy (their entries on
+    !! the rates stay zero).
+    pure subroutine strain_gradients(s, d)
+        type(sde_t), intent(in) :: s
+        type(sde_jac_t), intent(inout) :: d
+        d%gx(1) = -s%ca
+        d%gx(2) = -s%sa
+        d%gx(3) = s%dwy
+        d%gx(7) = s%ca
+        d%gx(8) = s%sa
+        d%gx(9) = s%hb*s%sd
+        d%gy(1) = s%sa
+        d%gy(2) = -s%ca
+        d%gy(3) = -(s%dwx + s%ha)
+        d%gy(7) = -s%sa
+        d%gy(8) = s%ca
+        d%gy(9) = -s%hb*s%cd
+    end subroutine strain_gradients
+
+    !> The springs' forces fx, fy, fp of SDE j (geometry s) and their derivatives into d.
+    pure subroutine spring_derivatives(self, y, j, s, floor, fx, fy, fp, d)
+        class(rfem_t), intent(in) :: self
+        real(wp), intent(in) :: y(:)
+        integer, intent(in) :: j
+        type(sde_t), intent(in) :: s
+        real(wp), intent(in) :: floor
+        real(wp), intent(out) :: fx, fy, fp
+        type(sde_jac_t), intent(inout) :: d
+        associate (dfx => d%dfx, dfy => d%dfy, dfp => d%dfp, gx => d%gx, gy => d%gy)
             fx = 0.0_wp
             fy = 0.0_wp
             fp = 0.0_wp
@@ -570,69 +641,44 @@ contains
                 dfp(3) = -self%cpj(j)
                 dfp(9) = self%cpj(j)
             end if
-            if (self%damped) then
-                call sde_rates(s, y)
-                ! d(rate)/dq = H q' (ry and -rx on phi_a), d(rate)/dq' = the gradient
-                if (self%tension) then
-                    fx = fx + self%bxj(j)*s%rx
-                    dfx(1) = dfx(1) + self%bxj(j)*s%sa*s%wa
-                    dfx(2) = dfx(2) - self%bxj(j)*s%ca*s%wa
-                    dfx(3) = dfx(3) + self%bxj(j)*s%ry
-                    dfx(7) = dfx(7) - self%bxj(j)*s%sa*s%wa
-                    dfx(8) = dfx(8) + self%bxj(j)*s%ca*s%wa
-                    dfx(9) = dfx(9) + self%bxj(j)*s%hb*s%cd*(s%wb - s%wa)
-                    dfx(4:6) = self%bxj(j)*gx(1:3)
-                    dfx(10:12) = self%bxj(j)*gx(7:9)
-                end if
-                if (self%shear) then
-                    fy = fy + self%by*s%ry
-                    dfy(1) = dfy(1) + self%by*s%ca*s%wa
-                    dfy(2) = dfy(2) + self%by*s%sa*s%wa
-                    dfy(3) = dfy(3) - self%by*s%rx
-                    dfy(7) = dfy(7) - self%by*s%ca*s%wa
-                    dfy(8) = dfy(8) - self%by*s%sa*s%wa
-                    dfy(9) = dfy(9) + self%by*s%hb*s%sd*(s%wb - s%wa)
-                    dfy(4:6) = self%by*gy(1:3)
-                    dfy(10:12) = self%by*gy(7:9)
-                end if
-                if (self%bending) then
-                    fp = fp + self%bpj(j)*s%rp
-                    dfp(6) = -self%bpj(j)
-                    dfp(12) = self%bpj(j)
-                end if
-            end if
-            ! rows of element a: d(F, fy (dwx + h_a) - fx dwy + fp); of element b:
-            ! d(-F, -h_b (fx sd - fy cd) - fp); columns: a's coordinates, then b's
-            r1 = s%ca*dfx - s%sa*dfy
-            r2 = s%sa*dfx + s%ca*dfy
-            r1(3) = r1(3) - fx*s%sa - fy*s%ca
-            r2(3) = r2(3) + fx*s%ca - fy*s%sa
-            self%blk(1, :, 0, j - 1) = carry(1, :) + r1(1:6)
-            self%blk(2, :, 0, j - 1) = carry(2, :) + r2(1:6)
-            self%blk(3, :, 0, j - 1) = carry(3, :) + (s%dwx + s%ha)*dfy(1:6) - s%dwy*dfx(1:6) &
-                                       + dfp(1:6) + fy*gx(1:6) - fx*gy(1:6)
-            self%blk(1, :, 1, j - 1) = r1(7:12)
-            self%blk(2, :, 1, j - 1) = r2(7:12)
-            self%blk(3, :, 1, j - 1) = (s%dwx + s%ha)*dfy(7:12) - s%dwy*dfx(7:12) + dfp(7:12) &
-                                       + fy*gx(7:12) - fx*gy(7:12)
-            t6 = s%hb*(fx*s%cd + fy*s%sd)
-            self%blk(1, :, -1, j) = -r1(1:6)
-            self%blk(2, :, -1, j) = -r2(1:6)
-            self%blk(3, :, -1, j) = -s%hb*(s%sd*dfx(1:6) - s%cd*dfy(1:6)) - dfp(1:6)
-            self%blk(3, 3, -1, j) = self%blk(3, 3, -1, j) + t6
-            carry(1, :) = -r1(7:12)
-            carry(2, :) = -r2(7:12)
-            carry(3, :) = -s%hb*(s%sd*dfx(7:12) - s%cd*dfy(7:12)) - dfp(7:12)
-            carry(3, 3) = carry(3, 3) - t6
-        end do
-        if (self%sup(2)%active) call support_jacobian(self, 2, y, carry)
-        self%blk(:, :, 0, n) = carry
-        ! external effects: 3x6 blocks on each element's own coordinates
-        if (size(self%effects) > 0) then
-            call self%fill_bodies(y)
-            call add_jacobians_of(self%effects, t, self%bodies, self%blk(:, :, 0, :))
-        end if
-    end procedure jacobian_blocks
+        end associate
+    end subroutine spring_derivatives
+
+    !> Add the tension damper's force (coefficient b, N s/m) of SDE s (its rates set) and
+    !! its derivatives to d: d(rx)/dq = H q' (ry on phi_a), d(rx)/dq' = the gradient gx.
+    pure subroutine tension_damper(b, s, fx, d)
+        real(wp), intent(in) :: b
+        type(sde_t), intent(in) :: s
+        real(wp), intent(inout) :: fx
+        type(sde_jac_t), intent(inout) :: d
+        fx = fx + b*s%rx
+        d%dfx(1) = d%dfx(1) + b*s%sa*s%wa
+        d%dfx(2) = d%dfx(2) - b*s%ca*s%wa
+        d%dfx(3) = d%dfx(3) + b*s%ry
+        d%dfx(7) = d%dfx(7) - b*s%sa*s%wa
+        d%dfx(8) = d%dfx(8) + b*s%ca*s%wa
+        d%dfx(9) = d%dfx(9) + b*s%hb*s%cd*(s%wb - s%wa)
+        d%dfx(4:6) = b*d%gx(1:3)
+        d%dfx(10:12) = b*d%gx(7:9)
+    end subroutine tension_damper
+
+    !> Add the shear damper's force (coefficient b, N s/m) of SDE s (its rates set) and
+    !! its derivatives to d: d(ry)/dq = H q' (-rx on phi_a), d(ry)/dq' = the gradient gy.
+    pure subroutine shear_damper(b, s, fy, d)
+        real(wp), intent(in) :: b
+        type(sde_t), intent(in) :: s
+        real(wp), intent(inout) :: fy
+        type(sde_jac_t), intent(inout) :: d
+        fy = fy + b*s%ry
+        d%dfy(1) = d%dfy(1) + b*s%ca*s%wa
+        d%dfy(2) = d%dfy(2) + b*s%sa*s%wa
+        d%dfy(3) = d%dfy(3) - b*s%rx
+        d%dfy(7) = d%dfy(7) - b*s%ca*s%wa
+        d%dfy(8) = d%dfy(8) - b*s%sa*s%wa
+        d%dfy(9) = d%dfy(9) + b*s%hb*s%sd*(s%wb - s%wa)
+        d%dfy(4:6) = b*d%gy(1:3)
+        d%dfy(10:12) = b*d%gy(7:9)
+    end subroutine shear_damper
 
     !> Add the dissipation power sum B s'^2 of the internal SDEs (self%cs holding the
     !! angles of y; the module header's geometry and rates).
