@@ -71,8 +71,10 @@ contains
         before = huge(1.0_wp)
         do it = 1, MAX_NEWTON
             call newton_step(model, y, pos, vel, c, dq, failed)
-            if (.not. failed) call take_step(model, spec, y, pos, dq, step, failed)
+            if (.not. failed) call take_step(model, spec, y, pos, dq, failed)
             if (failed) exit
+            ! (the Newton step's own size: a step halved many times is not convergence)
+            step = maxval(abs(dq))
             if (step <= STEP_TOL*scale_q) return
             if (step <= FLOOR_TOL*scale_q .and. step > 0.1_wp*before) return
             before = step
@@ -117,15 +119,13 @@ contains
     end subroutine newton_step
 
     !> y := y + alpha dq with alpha the first of 1, 1/2, 1/4, ... at which the potential
-    !! energy does not rise beyond its rounding; `step` the largest change of a coordinate
-    !! taken; `failed` when none does.
-    subroutine take_step(model, spec, y, pos, dq, step, failed)
+    !! energy does not rise beyond its rounding; `failed` when none does.
+    subroutine take_step(model, spec, y, pos, dq, failed)
         class(rope_model_t), intent(inout) :: model
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(inout) :: y(:)
         integer, intent(in) :: pos(:)
         real(wp), intent(in) :: dq(:)
-        real(wp), intent(out) :: step
         logical, intent(out) :: failed
         real(wp), allocatable :: trial(:)
         real(wp) :: v, v_trial, alpha
@@ -145,7 +145,6 @@ contains
         end do
         if (failed) return
         y = trial
-        step = alpha*maxval(abs(dq))
     end subroutine take_step
 
     !> b := K^-1 b for the columns of b, K square (LU of its band, LAPACK dgbtrf/dgbtrs).
