@@ -61,7 +61,7 @@ module ropedyn_output
     implicit none
     private
     public :: output_file_t, write_provenance, COUNTER_NAMES, counter_values, TIMER_NAMES
-    public :: add_counter_values, write_forces, write_shape_record
+    public :: add_counter_values, write_forces, write_shape_record, whole_records
 
     !> The convention written into every file (root attribute `units_convention`).
     character(len=*), parameter :: units_convention = &
@@ -240,7 +240,7 @@ module ropedyn_output
         !! status 'running' again and its old reason removed. The file must be for
         !! `n_elements` elements and the given state and quadrature sizes.
         module subroutine output_reopen(self, path, n_elements, state_size, quad_size, err, &
-                                        keep, internal_forces, anchored)
+                                        keep, internal_forces, anchored, salvage)
             class(output_file_t), intent(inout) :: self
             character(len=*), intent(in) :: path
             integer, intent(in) :: n_elements, state_size, quad_size
@@ -253,7 +253,22 @@ module ropedyn_output
             !> with internal_forces: which supports (top, bottom) have an anchor, as at
             !! `create` (default both); the file's positions must be those
             logical, intent(in), optional :: anchored(2)
+            !> with keep: the file of a killed run, cut back to its `keep` whole records
+            !! (whole_records): its series need only hold those, and records on its output
+            !! grid may be cut (default false)
+            logical, intent(in), optional :: salvage
         end subroutine output_reopen
+
+        !> The number of whole records of the run file `path`: the largest count such that
+        !! every series of the file (/time and the rest, the restart data, the internal
+        !! forces) reads its last of them back. A run killed inside a write (a flush) can
+        !! leave series of unequal length, or a record HDF5 cannot read ("addr overflow");
+        !! the records before it are whole. 0 when none reads back.
+        module subroutine whole_records(path, count, err)
+            character(len=*), intent(in) :: path
+            integer, intent(out) :: count
+            type(error_t), allocatable, intent(out) :: err
+        end subroutine whole_records
 
         !> Add an entry to /solver/restarts: the run continues from record `record` (0-based, as
         !! h5py counts) at time `t`; the file's status and reason before, and the solver steps

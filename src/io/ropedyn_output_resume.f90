@@ -14,6 +14,7 @@ contains
 
     module procedure output_reopen
         integer :: k
+        logical :: salvaging
 
         if (self%is_open) call shutdown(self)
         call self%file%open(path, err, writable=.true.)
@@ -24,12 +25,19 @@ contains
         self%state_size = [state_size, quad_size]
         ! first every check, with nothing changed: a file that cannot be continued is left
         ! as it was (its status, its reason, its records)
-        call open_checked(self, path, err)
+        salvaging = .false.
+        if (present(salvage) .and. present(keep)) salvaging = salvage
+        if (salvaging) then
+            call open_checked(self, path, err, int(keep, hsize_t))
+        else
+            call open_checked(self, path, err)
+        end if
         self%force_data = .false.
         if (present(internal_forces)) self%force_data = internal_forces
         call set_force_series(self, anchored)
         if (.not. allocated(err) .and. self%force_data) call open_forces(self, path, err)
-        if (.not. allocated(err) .and. present(keep)) call check_cut(self, path, keep, err)
+        if (.not. allocated(err) .and. present(keep) .and. .not. salvaging) &
+            call check_cut(self, path, keep, err)
         if (allocated(err)) then
             call shutdown(self)
             return
@@ -70,10 +78,12 @@ contains
     !! records as /time; the restart entries (if any) likewise. self%n_records: the
     !! length of /time. Errors are ERR_INPUT naming the dataset: the file was changed by
     !! something else than ropedyn.
-    subroutine open_checked(self, path, err)
+    subroutine open_checked(self, path, err, limit)
         type(output_file_t), intent(inout) :: self
         character(len=*), intent(in) :: path
         type(error_t), allocatable, intent(out) :: err
+        !> the records the series must hold when fewer than /time's (a salvaged file)
+        integer(hsize_t), intent(in), optional :: limit
         type(h5_series_t) :: entry
         type(error_t), allocatable :: close_err
         character(len=:), allocatable :: name
@@ -95,6 +105,7 @@ contains
             if (allocated(err)) return
         end do
         self%n_records = self%series(S_TIME)%length()
+        if (present(limit)) self%n_records = min(self%n_records, limit)
         do k = 1, N_SERIES + 2
             if (k <= N_SERIES) then
                 n = self%series(k)%length()
@@ -151,6 +162,56 @@ contains
                                               ': the file cannot be continued')
         end subroutine open_one
     end subroutine open_checked
+
+    module procedure whole_records
+        type(h5_file_t) :: h5
+        type(error_t), allocatable :: close_err
+        real(wp), allocatable :: time(:)
+        integer(hsize_t) :: dims(1), k
+
+        count = 0
+        call h5%open(path, err)
+        if (allocated(err)) return
+        call h5%read_reals('/time', time, dims, err)
+        if (.not. allocated(err)) then
+            do k = int(size(time), hsize_t), 1_hsize_t, -1_hsize_t
+                if (.not. record_reads(k)) cycle
+                count = int(k)
+                exit
+            end do
+        end if
+        call h5%close(close_err)
+        if (allocated(close_err) .and. .not. allocated(err)) call move_alloc(close_err, err)
+    contains
+        !> Record k of every series reads back.
+        logical function record_reads(k) result(reads)
+            integer(hsize_t), intent(in) :: k
+            integer :: j
+            reads = .false.
+            do j = 1, N_SERIES
+                if (.not. reads_one(trim(SERIES_NAME(j)), k)) return
+            end do
+            do j = 1, size(STATE_NAME)
+                if (.not. reads_one(trim(STATE_NAME(j)), k)) return
+            end do
+            do j = 1, N_FORCE_SERIES
+                if (.not. h5%exists(trim(FORCE_NAME(j)))) cycle
+                if (.not. reads_one(trim(FORCE_NAME(j)), k)) return
+            end do
+            reads = .true.
+        end function record_reads
+
+        !> Record k of the series `name` reads back, with finite values.
+        logical function reads_one(name, k) result(reads)
+            character(len=*), intent(in) :: name
+            integer(hsize_t), intent(in) :: k
+            real(wp), allocatable :: values(:)
+            type(error_t), allocatable :: rerr
+            call h5%read_record(name, k, values, rerr)
+            reads = .not. allocated(rerr)
+            if (reads) reads = all(ieee_is_finite(values))
+        end function reads_one
+    end procedure whole_records
 
     !> Records keep + 1 .. n_records are to be cut: only a last record off the file's own
     !! output grid may be (where an interrupted or failed run stopped). A record on that

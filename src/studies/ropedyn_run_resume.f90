@@ -6,6 +6,7 @@ submodule (ropedyn_run) ropedyn_run_resume
     use ropedyn_text, only: int_text, significant_text
     use ropedyn_version, only: version_string
     use ropedyn_case_file, only: case_data_t, read_case_file
+    use ropedyn_output, only: whole_records
     use ropedyn_run_record, only: run_record_t, read_run_record, check_record_fits, LAST_RECORD, &
                                   read_peak_tension
     implicit none
@@ -21,10 +22,22 @@ contains
         type(run_record_t) :: rec, first
         type(case_data_t) :: before
         real(wp) :: tol, peak, t_peak
-        integer :: keep, j, joint
-        character(len=:), allocatable :: overrides
+        integer :: keep, j, joint, whole
+        character(len=:), allocatable :: overrides, last_whole
+        logical :: salvaged
         associate (file => self%summary%file)
             call read_run_record(file, LAST_RECORD, rec, err)
+            ! a killed run's file (status running) may end in records cut in a write: it is
+            ! continued from its last whole record (whole_records)
+            salvaged = .false.
+            last_whole = 'its last record'
+            if (rec%status == 'running') then
+                call salvage_record(file, rec, err, whole)
+                salvaged = whole > 0
+                if (salvaged) last_whole = 'its last whole record (record '// &
+                    int_text(whole - 1)//'; the '//int_text(rec%records - whole)// &
+                    ' after it did not all read back: the run was killed while writing them)'
+            end if
             if (allocated(err)) return
             call check_record_fits(rec, self%model%model_name(), self%model%size(), self%nq, &
                                    err)
@@ -38,7 +51,7 @@ contains
                 if (len(self%writer_gone) == 0) self%writer_gone = 'no process holds a '// &
                     'lock of it: its run was killed or crashed'
                 call append_text(self%summary%warnings, file//': status running: '// &
-                    self%writer_gone//'; continued from its last record, at t = '// &
+                    self%writer_gone//'; continued from '//last_whole//', at t = '// &
                     significant_text(rec%t, 10)//' s')
             end if
             tol = 1.0e-12_wp*max(abs(rec%t), self%dt)
@@ -68,7 +81,7 @@ contains
                     exit
                 end if
             end do
-            keep = rec%records
+            keep = rec%record + 1
             if (rec%record > 0 .and. abs(self%output_time(self%k_next - 1) - self%t) > tol) &
                 keep = keep - 1
             do j = 1, size(self%counters_before)
@@ -82,7 +95,7 @@ contains
             call self%model%support_positions(self%t, self%anchors)
             call self%out%reopen(file, self%model%n_elements(), self%model%size(), self%nq, &
                                  err, keep=keep, internal_forces=.true., &
-                                 anchored=ieee_is_finite(self%anchors(1, :)))
+                                 anchored=ieee_is_finite(self%anchors(1, :)), salvage=salvaged)
             if (allocated(err)) return
             overrides = ''
             if (allocated(self%scene%overrides)) overrides = self%scene%overrides
@@ -99,6 +112,32 @@ contains
                 'that follow)'
         end associate
     end procedure resume_from_file
+
+    !> For the file of a killed run (status running): when its last record is not whole
+    !! (rec and err as read_run_record left them: a series shorter than /time, a record that
+    !! does not read back), rec becomes its last whole record and err is cleared. `whole`:
+    !! that record's count (0 when the last record is whole or no record is: rec and err
+    !! unchanged).
+    subroutine salvage_record(file, rec, err, whole)
+        character(len=*), intent(in) :: file
+        type(run_record_t), intent(inout) :: rec
+        type(error_t), allocatable, intent(inout) :: err
+        integer, intent(out) :: whole
+        type(run_record_t) :: earlier
+        type(error_t), allocatable :: werr
+        call whole_records(file, whole, werr)
+        if (allocated(werr) .or. whole < 1 .or. whole >= rec%records) then
+            whole = 0
+            return
+        end if
+        call read_run_record(file, whole - 1, earlier, werr)
+        if (allocated(werr)) then
+            whole = 0
+            return
+        end if
+        rec = earlier
+        if (allocated(err)) deallocate (err)
+    end subroutine salvage_record
 
     !> The level part of the model's elastic energy at a state (energy_t%level), J.
     real(wp) function level_energy(model, t, y, yq) result(level)

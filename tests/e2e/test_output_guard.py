@@ -11,6 +11,7 @@ import subprocess
 import time
 
 import h5py
+import numpy as np
 import pytest
 
 from conftest import ROOT
@@ -361,3 +362,27 @@ def test_a_kill_inside_a_flush_leaves_the_counters_no_further_than_the_records(
         assert steps <= steps_to[last], (when, last, steps, steps_to[last])
         checked += 1
     assert checked >= 5, checked
+
+
+def test_a_killed_file_is_continued_from_its_last_whole_record(run, tmp_path, scene):
+    """A run killed inside a flush can leave series of unequal length (HDF5 writes them one
+    after the other). The resume of such a file (status running) was refused (exit 4,
+    "/forces/shear: fewer records than /time"), and the user's only way on was --force, a
+    new run. It now continues from the last record every series reads back, cuts the
+    others, and says so."""
+    assert run("run", scene, "--set", "solver.t_end=0.5", "--set",
+               "output.file='k.h5'").returncode == 0
+    with h5py.File(tmp_path / "k.h5", "r+") as f:
+        f.attrs["status"] = np.bytes_("running")
+        records = f["time"].shape[0]
+        f["forces/shear"].resize(records - 3, axis=0)
+    resumed = run("run", "--resume", "k.h5", "--set", "solver.t_end=0.6")
+    assert resumed.returncode == 0, resumed.stderr
+    assert (f"continued from its last whole record (record {records - 4}; the 3 after it "
+            "did not all read back: the run was killed while writing them)") in resumed.stderr
+    with h5py.File(tmp_path / "k.h5") as f:
+        assert f.attrs["status"] == b"complete"
+        assert f["solver/restarts/record"][:].tolist() == [records - 4]
+        assert abs(f["time"][-1] - 0.6) < 1e-12
+        assert all(f[name].shape[0] == f["time"].shape[0]
+                   for name in ("forces/shear", "forces/axial", "state/y", "energy/total"))

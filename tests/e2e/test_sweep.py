@@ -936,12 +936,14 @@ def test_the_abandoned_lock_of_a_complete_case_goes(run, sweep_dir):
     assert lock.exists() and (out / ".case_0001.h5.part").exists()
 
 
-def test_a_killed_part_whose_records_do_not_read_back_is_run_anew(run, sweep_dir):
+@pytest.mark.parametrize("cut", [3, "all"])
+def test_a_killed_part_whose_records_do_not_read_back(run, sweep_dir, cut):
     """A writer killed in the middle of a flush can leave a .part (status `running`) whose
     last records HDF5 cannot read back (/state/y shorter than /time, or a chunk past the
-    end of the file: "addr overflow"). Its resume is refused; the case is then run anew at
-    once, as one that cannot be continued, not written `failed` with its .part removed
-    and run anew only by the next sweep."""
+    end of the file: "addr overflow"). Its resume continues from the last record every
+    series reads back (its resume was refused, and the case run anew). With no such
+    record, the case is run anew at once, as one that cannot be continued, not written
+    `failed` with its .part removed and run anew only by the next sweep."""
     assert run("sweep", "sw.nml", "--task", "1").returncode == 0
     out = sweep_dir / "out" / "sw"
     part, final = out / ".case_0001.h5.part", out / "case_0001.h5"
@@ -951,16 +953,25 @@ def test_a_killed_part_whose_records_do_not_read_back_is_run_anew(run, sweep_dir
         f.attrs["scene"] = f.attrs["scene"].decode().replace("out/sw/case_0001.h5",
                                                              "out/sw/.case_0001.h5.part")
         del f["solver/wall_time"]
-        f["state/y"].resize(f["state/y"].shape[0] - 3, axis=0)
+        records = f["time"].shape[0]
+        f["state/y"].resize(0 if cut == "all" else records - cut, axis=0)
     gone = subprocess.Popen(["true"])
     gone.wait()
     (out / ".case_0001.lock").write_text(
         f"ropedyn sweep case lock\nhost={socket.gethostname()}\npid={gone.pid}\n")
     again = run("sweep", "sw.nml", "--task", "1")
     assert again.returncode == 0, again.stderr
-    assert "cannot be continued (" in again.stderr and "running it anew" in again.stderr, \
-        again.stderr
     with h5py.File(final, "r") as f:
-        assert f.attrs["status"] == b"complete" and "restarts" not in f["solver"]
+        assert f.attrs["status"] == b"complete" and f["time"].shape[0] == records
+        if cut == "all":
+            assert "restarts" not in f["solver"]
+        else:
+            assert f["solver/restarts/record"][:].tolist() == [records - cut - 1]
+            assert (f"continued from its last whole record (record {records - cut - 1}; "
+                    f"the {cut} after it did not all read back") in \
+                f["solver/warnings"][-1].decode()
+    if cut == "all":
+        assert "cannot be continued (" in again.stderr and "running it anew" in again.stderr, \
+            again.stderr
     assert not part.exists() and not (out / ".case_0001.lock").exists()
     assert not (out / ".case_0001.failed").exists()
