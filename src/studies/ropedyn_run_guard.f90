@@ -148,6 +148,10 @@ contains
                 '(ropedyn sweep SWEEP --task <id>), not ropedyn run --resume')
             return
         end if
+        if (.not. is_part(real_file)) then
+            call check_killed_rerun(real_file, file, err)
+            if (allocated(err)) return
+        end if
         lock_path = real_file//'.lock'
         if (is_part(real_file)) lock_path = whole_name(real_file)//'.lock'
         self%writer_gone = ''
@@ -164,6 +168,29 @@ contains
         self%lock_file = lock_path
         if (is_part(real_file)) call plan_rename(self, real_file)
     end subroutine guard_resume
+
+    !> A resume of FILE (`given`, `file` where it points) while FILE.part of a killed rerun of
+    !! FILE is there (status running, no live lock, FILE's source): refused before FILE's
+    !! lock is taken (that lock names the killed writer). Continued, that run replaces FILE
+    !! at its end, as it would have: what this resume added to FILE would be lost.
+    subroutine check_killed_rerun(file, given, err)
+        character(len=*), intent(in) :: file, given
+        type(error_t), allocatable, intent(out) :: err
+        type(lock_t) :: lock
+        character(len=:), allocatable :: source
+        logical :: exists
+        inquire (file=file//'.part', exist=exists)
+        if (.not. exists) return
+        call read_lock(file//'.lock', lock)
+        if (lock%exists .and. (lock%live .or. len(lock%problem) > 0)) return
+        if (trim(root_attribute(file//'.part', 'status')) /= 'running') return
+        source = root_attribute(file//'.part', 'source')
+        if (len(source) == 0 .or. source /= root_attribute(file, 'source')) return
+        call make_error(err, ERR_USAGE, given//': '//file//'.part is there, left by a '// &
+            'rerun of '//file//' that was killed: continued, it replaces '//file// &
+            ' at its end, and what this resume adds would be lost. Continue it first '// &
+            '(ropedyn run --resume '//file//'.part), or remove it')
+    end subroutine check_killed_rerun
 
     !> The name is that of a sweep case's file while it is written: .case_<digits>.h5.part.
     pure logical function is_case_part(file)

@@ -386,3 +386,30 @@ def test_a_killed_file_is_continued_from_its_last_whole_record(run, tmp_path, sc
         assert abs(f["time"][-1] - 0.6) < 1e-12
         assert all(f[name].shape[0] == f["time"].shape[0]
                    for name in ("forces/shear", "forces/axial", "state/y", "energy/total"))
+
+
+def test_a_resume_of_a_file_is_refused_while_its_killed_rerun_is_there(run, tmp_path, scene):
+    """A rerun of FILE, killed, leaves FILE.part (status running), which replaces FILE when
+    it is continued. A resume of FILE in between went on, and the later resume of FILE.part
+    replaced what it had added, without a word (the file-safety probe). It is refused, as a
+    new run of FILE is, before FILE's lock is taken (the killed writer's). A killed run of
+    another variant keeps its .part name when continued: then the resume goes on."""
+    assert run("run", scene, "--set", "solver.t_end=0.05", "--set",
+               "output.file='r.h5'").returncode == 0
+    part, lock = tmp_path / "r.h5.part", tmp_path / "r.h5.lock"
+    part.write_bytes((tmp_path / "r.h5").read_bytes())
+    with h5py.File(part, "r+") as f:
+        f.attrs["status"] = np.bytes_("running")
+    gone = subprocess.Popen(["true"])
+    gone.wait()
+    lock.write_text(f"ropedyn sweep case lock\nhost={socket.gethostname()}\npid={gone.pid}\n")
+    before = digest(tmp_path / "r.h5")
+    refused = run("run", "--resume", "r.h5", "--set", "solver.t_end=0.1")
+    assert refused.returncode == 2, refused.stderr
+    assert ("r.h5: r.h5.part is there, left by a rerun of r.h5 that was killed: continued, "
+            "it replaces r.h5 at its end") in refused.stderr, refused.stderr
+    assert digest(tmp_path / "r.h5") == before and f"pid={gone.pid}" in lock.read_text()
+    with h5py.File(part, "r+") as f:
+        f.attrs["source"] = np.bytes_("another variant")
+    resumed = run("run", "--resume", "r.h5", "--set", "solver.t_end=0.1")
+    assert resumed.returncode == 0, resumed.stderr
