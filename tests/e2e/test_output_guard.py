@@ -324,7 +324,8 @@ def test_a_killed_part_that_cannot_be_read_back_is_not_offered_to_resume(run, tm
     assert not part.exists() and not (out / "paper.h5.lock").exists()
 
 
-@pytest.mark.skipif(shutil.which("strace") is None, reason="needs strace to kill inside a flush")
+@pytest.mark.skipif(shutil.which("strace") is None,
+                    reason="needs strace to kill inside a flush (scripts/setup --tests)")
 def test_a_kill_inside_a_flush_leaves_the_counters_no_further_than_the_records(
         run, ropedyn_exe, tmp_path):
     """A run's counters go with its records at each flush. HDF5 writes small datasets first,
