@@ -24,9 +24,9 @@ module ropedyn_mode_start
     use ropedyn_problem, only: STATUS_OK
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_rope_spec, only: rope_spec_t
-    use ropedyn_statics, only: generalized_force, tangent_matrices, rope_length, &
-                               potential_energy
-    use ropedyn_ldl, only: bandwidth
+    use ropedyn_statics_terms, only: generalized_force, tangent_band, tangent_bandwidth, &
+                                     rope_length, potential_energy
+    use ropedyn_ldl, only: band_matvec
     use ropedyn_text, only: int_text
     implicit none
     private
@@ -55,15 +55,15 @@ contains
         real(wp), intent(in) :: z(:), scale
         character(len=:), allocatable, intent(out) :: note
         integer, allocatable :: pos(:), vel(:)
-        real(wp), allocatable :: c(:), mm(:, :), y_linear(:), dq(:)
+        real(wp), allocatable :: c(:), mb(:, :), y_linear(:), dq(:)
         real(wp) :: step, before, scale_q
         integer :: it
         logical :: failed
 
         call model%coordinates(pos, vel)
-        allocate (mm(size(pos), size(pos)))
-        call model%coordinate_mass(y, mm)
-        c = matmul(mm, z)
+        allocate (mb(0:model%mass_bandwidth(), size(pos)))
+        call model%coordinate_mass_band(y, mb)
+        c = band_matvec(mb, z)
         y(pos) = y(pos) + scale*z
         y_linear = y
         note = ''
@@ -96,20 +96,21 @@ contains
         real(wp), intent(in) :: c(:)
         real(wp), allocatable, intent(out) :: dq(:)
         logical, intent(out) :: failed
-        real(wp), allocatable :: f(:), kt(:, :), rhs(:, :)
+        real(wp), allocatable :: f(:), kb(:, :), rhs(:, :)
         real(wp) :: mu
-        integer :: status, info
+        integer :: status, info, kd
 
-        allocate (f(size(pos)), kt(size(pos), size(pos)), rhs(size(pos), 2))
+        kd = tangent_bandwidth(model)
+        allocate (f(size(pos)), kb(-kd:kd, size(pos)), rhs(size(pos), 2))
         call generalized_force(model, y, pos, vel, f, status)
         failed = status /= STATUS_OK
         if (failed) return
-        call tangent_matrices(model, y, pos, vel, kt, status, hessian=.true.)
-        failed = status /= STATUS_OK .or. .not. all(ieee_is_finite(kt))
+        call tangent_band(model, y, pos, vel, kd, kb, status, hessian=.true.)
+        failed = status /= STATUS_OK .or. .not. all(ieee_is_finite(kb))
         if (failed) return
         rhs(:, 1) = f
         rhs(:, 2) = c
-        call band_solve(kt, rhs, info)
+        call band_solve(kd, kb, rhs, info)
         failed = info /= 0 .or. .not. all(ieee_is_finite(rhs))
         if (failed) return
         ! z1 = K^-1 f, z2 = K^-1 c, dq = z1 + mu z2 with c^T dq = 0
@@ -147,22 +148,23 @@ contains
         y = trial
     end subroutine take_step
 
-    !> b := K^-1 b for the columns of b, K square (LU of its band, LAPACK dgbtrf/dgbtrs).
-    subroutine band_solve(k, b, info)
-        real(wp), intent(in) :: k(:, :)
+    !> b := K^-1 b for the columns of b, K given by its band kb(i - j, j) (tangent_band's
+    !! storage; LU, LAPACK dgbtrf/dgbtrs).
+    subroutine band_solve(kd, kb, b, info)
+        integer, intent(in) :: kd
+        real(wp), intent(in) :: kb(-kd:, :)
         real(wp), intent(inout) :: b(:, :)
         integer, intent(out) :: info
         real(wp), allocatable :: ab(:, :)
         integer, allocatable :: ipiv(:)
-        integer :: n, kd, i, j
-        n = size(k, 1)
-        kd = bandwidth(k)
+        integer :: n, i, j
+        n = size(kb, 2)
         ! LAPACK's band storage with kd rows for the fill-in: ab(2 kd + 1 + i - j, j)
         allocate (ab(3*kd + 1, n), ipiv(n))
         ab = 0.0_wp
         do j = 1, n
             do i = max(1, j - kd), min(n, j + kd)
-                ab(2*kd + 1 + i - j, j) = k(i, j)
+                ab(2*kd + 1 + i - j, j) = kb(i - j, j)
             end do
         end do
         call dgbtrf(n, n, kd, kd, ab, 3*kd + 1, ipiv, info)
