@@ -176,13 +176,8 @@ contains
     subroutine check_killed_rerun(file, given, err)
         character(len=*), intent(in) :: file, given
         type(error_t), allocatable, intent(out) :: err
-        type(lock_t) :: lock
         character(len=:), allocatable :: source
-        logical :: exists
-        inquire (file=file//'.part', exist=exists)
-        if (.not. exists) return
-        call read_lock(file//'.lock', lock)
-        if (lock%exists .and. (lock%live .or. len(lock%problem) > 0)) return
+        if (.not. part_left(file)) return
         if (trim(root_attribute(file//'.part', 'status')) /= 'running') return
         source = root_attribute(file//'.part', 'source')
         if (len(source) == 0 .or. source /= root_attribute(file, 'source')) return
@@ -269,14 +264,19 @@ contains
     subroutine check_part_left(file, err)
         character(len=*), intent(in) :: file
         type(error_t), allocatable, intent(out) :: err
-        type(lock_t) :: lock
-        logical :: exists
-        inquire (file=file//'.part', exist=exists)
-        if (.not. exists) return
-        call read_lock(file//'.lock', lock)
-        if (lock%exists .and. (lock%live .or. len(lock%problem) > 0)) return
-        call refuse_part(file, err)
+        if (part_left(file)) call refuse_part(file, err)
     end subroutine check_part_left
+
+    !> FILE.part is there and no live writer holds FILE.lock: the file of a run of FILE that
+    !! stopped or was killed (a live lock, or one that is no lock, is take_lock's to report).
+    logical function part_left(file)
+        character(len=*), intent(in) :: file
+        type(lock_t) :: lock
+        inquire (file=file//'.part', exist=part_left)
+        if (.not. part_left) return
+        call read_lock(file//'.lock', lock)
+        part_left = .not. (lock%exists .and. (lock%live .or. len(lock%problem) > 0))
+    end function part_left
 
     !> The error of a new run on FILE that finds FILE.part (without --force), by what its
     !! status says: a killed run's (`running`, or unreadable), one that stopped, or a
