@@ -25,6 +25,7 @@ submodule (ropedyn_run) ropedyn_run_guard
     use ropedyn_error, only: ERR_USAGE, ERR_IO
     use ropedyn_h5, only: h5_file_t, held_open
     use ropedyn_run_record, only: run_record_t, read_run_record, LAST_RECORD
+    use ropedyn_output, only: whole_records
     use ropedyn_text, only: replaced
     implicit none
 
@@ -311,18 +312,22 @@ contains
         end select
     end subroutine refuse_part
 
-    !> Why the last record of the run file `part` cannot be read back, as a resume reads
-    !! it ('' when it can, or when another program holds the file open: then a resume
-    !! says who).
+    !> Why a resume of the run file `part` cannot start, as the resume reads it: its last
+    !! record does not read back and no earlier record is whole (whole_records) ('' when
+    !! it can start, or when another program holds the file open: then a resume says who).
     function unreadable_part(part) result(why)
         character(len=*), intent(in) :: part
         character(len=:), allocatable :: why
         type(run_record_t) :: rec
-        type(error_t), allocatable :: err
+        type(error_t), allocatable :: err, werr
+        integer :: whole
         why = ''
         call read_run_record(part, LAST_RECORD, rec, err)
         if (.not. allocated(err)) return
         if (held_open(err)) return
+        ! a last record cut in a write: a resume goes on from the last whole one
+        call whole_records(part, whole, werr)
+        if (.not. allocated(werr) .and. whole >= 1) return
         why = replaced(err%message, part//': ', '')
     end function unreadable_part
 

@@ -414,3 +414,24 @@ def test_a_resume_of_a_file_is_refused_while_its_killed_rerun_is_there(run, tmp_
         f.attrs["source"] = np.bytes_("another variant")
     resumed = run("run", "--resume", "r.h5", "--set", "solver.t_end=0.1")
     assert resumed.returncode == 0, resumed.stderr
+
+
+def test_a_new_run_offers_to_continue_a_killed_part_with_a_whole_record(run, tmp_path, scene):
+    """A FILE.part whose last record a kill cut (here /state/y three records short) has
+    earlier whole records: a resume goes on from the last of them. The refusal of a new run
+    of FILE said it could not be continued (the last record does not read back) and left
+    only removing it or --force; it now offers the resume, which then goes on."""
+    sets = ("--set", "solver.t_end=0.05", "--set", "output.file='k.h5'")
+    assert run("run", scene, *sets).returncode == 0
+    part = tmp_path / "k.h5.part"
+    (tmp_path / "k.h5").rename(part)
+    with h5py.File(part, "r+") as f:
+        f.attrs["status"] = np.bytes_("running")
+        f["state/y"].resize(f["time"].shape[0] - 3, axis=0)
+    refused = run("run", scene, *sets)
+    assert refused.returncode == 2, refused.stderr
+    assert ("k.h5.part: left by a run of k.h5 that was killed: continue it (ropedyn run "
+            "--resume k.h5.part)") in refused.stderr, refused.stderr
+    resumed = run("run", "--resume", "k.h5.part")
+    assert resumed.returncode == 0, resumed.stderr
+    assert "continued from its last whole record" in resumed.stderr
