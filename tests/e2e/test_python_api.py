@@ -26,6 +26,12 @@ def small(n=8, t_end=0.5):
     return ropedyn.Scene.from_file(PAPER).set("model.elements", n).set("solver.t_end", t_end)
 
 
+def python_process(code, **kwargs):
+    """`code` run by this Python in a process of its own (its output captured as text)."""
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          **{"timeout": 300, **kwargs})
+
+
 def cli_error(run, *args):
     """The message after 'ropedyn: error: ' and the exit code of `ropedyn run ARGS`."""
     result = run("run", *args)
@@ -330,8 +336,7 @@ def test_a_runaway_at_the_first_look_fails_cleanly(tmp_path):
             "        sim.advance(30.0)\n"
             "    except ropedyn.Error as e:\n"
             "        print(e.code, 'it created' in e.message, sim.t, np.array_equal(sim.state, y0))\n")
-    result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
-                            text=True, timeout=300)
+    result = python_process(code, cwd=tmp_path)
     assert result.returncode == 0, (result.returncode, result.stderr)
     assert result.stdout.split() == ["3", "True", "0.0", "True"], result.stdout
 
@@ -458,8 +463,7 @@ def test_pip_install_builds_a_package_with_its_own_library(tmp_path):
             f"s = ropedyn.Scene.from_file({str(PAPER)!r}).set('model.elements', 6)\n"
             "s.set('solver.t_end', 0.1)\n"
             "print(lib.library().path, ropedyn.run(s).status)\n")
-    result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env,
-                            capture_output=True, text=True)
+    result = python_process(code, cwd=tmp_path, env=env)
     assert result.returncode == 0, result.stderr
     assert result.stdout.split() == [str(site / "ropedyn" / "libropedyn.so"), "complete"]
 
@@ -474,8 +478,7 @@ def test_a_missing_ropedyn_library_is_an_error(tmp_path):
             "    print('loaded', lib.library().path)\n"
             "except ropedyn.Error as e:\n"
             "    print('error', e.code, e.message)\n")
-    result = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env,
-                            capture_output=True, text=True)
+    result = python_process(code, cwd=tmp_path, env=env)
     assert result.returncode == 0, result.stderr
     assert result.stdout.startswith("error 2 "), result.stdout
     assert f"ROPEDYN_LIBRARY={missing}" in result.stdout
@@ -500,8 +503,7 @@ def test_a_state_whose_forces_overflow_fails_the_advance_not_the_process():
         "    sim.restore(snap)\n"
         "    sim.advance(0.2)\n"
         "    print('alive', sim.t)\n")
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                            timeout=300)
+    result = python_process(code)
     assert "DGEBAL" not in result.stderr, result.stderr
     assert result.returncode == 0 and result.stdout.split() == ["code", "3", "alive", "0.2"], \
         (result.stdout, result.stderr)
@@ -530,8 +532,7 @@ def test_runs_in_one_process_keep_no_hdf5_types():
         "        ropedyn.run(scene)\n"
         "    growth.append(rss() - before)\n"
         "print(min(growth))\n")
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                            timeout=300)
+    result = python_process(code)
     assert result.returncode == 0, result.stderr
     assert int(result.stdout) < 1024, f"grew by {result.stdout.strip()} KiB"
 
