@@ -8,10 +8,13 @@
  *   form of a path (realpath), to tell whether two names are one file.
  * - The system's text of an errno value (strerror_r).
  * - The process that holds a lock on a file (flock or fcntl), from /proc/locks: the HDF5
- *   library locks the files it opens, and a second opener is told only "cannot lock". */
+ *   library locks the files it opens, and a second opener is told only "cannot lock".
+ * - A new file that appears whole or not at all (a lock and who holds it): written unnamed,
+ *   then linked into place, which fails when the name exists. */
 #define _GNU_SOURCE
 #include <errno.h>
 #include <fcntl.h>
+#include <libgen.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -186,5 +189,75 @@ int ropedyn_release_space(const char *path)
     if (fstat(fd, &st) != 0) rc = errno;
     else if (ftruncate(fd, st.st_size) != 0) rc = errno;
     close(fd);
+    return rc;
+}
+
+/* Write all `len` bytes of `text` to `fd`; 0 or errno. */
+static int write_all(int fd, const char *text, int len)
+{
+    while (len > 0) {
+        ssize_t done = write(fd, text, (size_t)len);
+        if (done < 0) {
+            if (errno == EINTR) continue;
+            return errno;
+        }
+        text += done;
+        len -= (int)done;
+    }
+    return 0;
+}
+
+/* Whether errno `rc` says that a way of making a file does not work here (no /proc, a file
+ * system without such files or links), so that the next is tried. */
+static int no_such_way(int rc)
+{
+    return rc == ENOENT || rc == EPERM || rc == EOPNOTSUPP || rc == ENOSYS || rc == EXDEV ||
+           rc == EMLINK || rc == EINVAL;
+}
+
+/* The new file `path` created with the contents `text` (`len` bytes) only if no file of
+ * that name exists, and never seen without them: 0 created, EEXIST when `path` exists, else
+ * errno. A process killed at any point leaves no `path`, or `path` whole.
+ * - Written to an unnamed file in the directory (O_TMPFILE), then given its name
+ *   (linkat, which fails with EEXIST when the name exists): nothing is left behind by a kill.
+ * - Where there are no unnamed files (NFS): written to `path`.HOST.PID.new, linked to
+ *   `path` (an exclusive creation also on NFS), then removed; a kill in between leaves that
+ *   file, never a part of `path`.
+ * - Where there are no hard links either: created exclusively and written (O_EXCL), as
+ *   before; a kill between the two leaves `path` empty. */
+int ropedyn_create_whole(const char *path, const char *text, int len)
+{
+    char dir[PATH_MAX], proc[64], host[256], temp[PATH_MAX + 320];
+    int fd, rc;
+    struct stat st;
+    if (snprintf(dir, sizeof dir, "%s", path) >= (int)sizeof dir) return ENAMETOOLONG;
+    fd = open(dirname(dir), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+        rc = write_all(fd, text, len);
+        snprintf(proc, sizeof proc, "/proc/self/fd/%d", fd);
+        if (rc == 0 && linkat(AT_FDCWD, proc, AT_FDCWD, path, AT_SYMLINK_FOLLOW) != 0)
+            rc = errno;
+        close(fd);
+        if (!no_such_way(rc)) return rc;
+    }
+    if (gethostname(host, sizeof host) != 0) snprintf(host, sizeof host, "host");
+    host[sizeof host - 1] = '\0';
+    snprintf(temp, sizeof temp, "%s.%s.%ld.new", path, host, (long)getpid());
+    fd = open(temp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0) return errno;
+    rc = write_all(fd, text, len);
+    if (close(fd) != 0 && rc == 0) rc = errno;
+    if (rc == 0 && link(temp, path) != 0) {
+        rc = errno;
+        /* over NFS a link can be made and its reply lost: the count of links tells */
+        if (rc != EEXIST && stat(temp, &st) == 0 && st.st_nlink == 2) rc = 0;
+    }
+    unlink(temp);
+    if (!no_such_way(rc)) return rc;
+    fd = open(path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0) return errno;
+    rc = write_all(fd, text, len);
+    if (close(fd) != 0 && rc == 0) rc = errno;
+    if (rc != 0) unlink(path);
     return rc;
 }

@@ -14,7 +14,7 @@ module ropedyn_os
               processor_count, absolute_path, unwritable_dir, rename_file, delete_file
     public :: file_kind, file_kind_name, special_file_reason, errno_text, real_path, &
               canonical_path, written_path, same_file, output_clash, lock_holder, try_lock, &
-              reserve_space, release_space
+              reserve_space, release_space, create_whole
     public :: FILE_MISSING, FILE_REGULAR, FILE_DIRECTORY, FILE_FIFO, FILE_CHAR_DEVICE, &
               FILE_BLOCK_DEVICE, FILE_SOCKET, FILE_SYMLINK, FILE_OTHER
 
@@ -95,6 +95,12 @@ module ropedyn_os
             import :: c_char, c_int
             character(kind=c_char), intent(in) :: path(*)
         end function c_lock_holder
+        integer(c_int) function c_create_whole(path, text, length) &
+                bind(C, name='ropedyn_create_whole')
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*), text(*)
+            integer(c_int), value :: length
+        end function c_create_whole
         integer(c_int) function c_try_lock(path) bind(C, name='ropedyn_try_lock')
             import :: c_char, c_int
             character(kind=c_char), intent(in) :: path(*)
@@ -471,6 +477,15 @@ contains
     !> Whether the existing file `path` could be locked exclusively now: 0 yes,
     !! ERRNO_EWOULDBLOCK when another process holds a lock on it, else the errno (the file
     !! is neither created nor truncated; a lock taken is released at once).
+    !> Create the file `path` with the contents `text`, if no file of that name exists, so
+    !! that it is never seen without them (a lock and its holder): 0 when created,
+    !! ERRNO_EEXIST when `path` exists, else errno. A process killed while creating it
+    !! leaves no `path`, or `path` whole (ropedyn_os.c tells the ways, by file system).
+    integer function create_whole(path, text)
+        character(len=*), intent(in) :: path, text
+        create_whole = int(c_create_whole(path//c_null_char, text, int(len(text), c_int)))
+    end function create_whole
+
     integer function try_lock(path)
         character(len=*), intent(in) :: path
         try_lock = int(c_try_lock(path//c_null_char))

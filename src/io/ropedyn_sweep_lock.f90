@@ -1,8 +1,7 @@
 !> The lock of a sweep case: one writer per case (docs/development/internals.md, "One writer per case").
 !!
-!! A writer creates `<output_dir>/.case_<id>.lock` exclusively (`open(status='new')`:
-!! O_CREAT|O_EXCL, atomic on local file systems and on NFS v3 and later) and writes who it
-!! is into it:
+!! A writer creates `<output_dir>/.case_<id>.lock`, if it does not exist, with who it is
+!! already in it (`create_whole`: the lock appears whole or not at all):
 !!
 !!     ropedyn sweep case lock
 !!     host=node12
@@ -33,7 +32,8 @@ module ropedyn_sweep_lock
     use, intrinsic :: iso_fortran_env, only: int64
     use ropedyn_error, only: error_t, make_error, ERR_IO
     use ropedyn_text, only: int_text
-    use ropedyn_os, only: delete_file, special_file_reason
+    use ropedyn_os, only: delete_file, special_file_reason, create_whole, errno_text, &
+        ERRNO_EEXIST
     use ropedyn_clock, only: utc_timestamp, utc_text, unix_time
     use ropedyn_signals, only: signal_name
     use ropedyn_process, only: process_id, process_start, host_name, file_mtime, &
@@ -309,26 +309,28 @@ contains
         if (ios /= 0) removed = delete_file(path)
     end subroutine hand_back_lock
 
-    !> Create `path` if it does not exist (O_CREAT|O_EXCL), with the lines `text` if given;
-    !! `created` false if it existed.
+    !> Create `path` if it does not exist, with the lines `text` if given (then whole or not
+    !! at all, `create_whole`: a lock that does not say who holds it would hold its file for
+    !! LOCK_ABANDONED_AFTER s); `created` false if it existed.
     subroutine create_exclusive(path, created, err, text)
         character(len=*), intent(in) :: path
         logical, intent(out) :: created
         type(error_t), allocatable, intent(out) :: err
         character(len=*), intent(in), optional :: text
-        integer :: unit, ios
+        integer :: unit, ios, rc
         logical :: exists
         character(len=256) :: msg
+        if (present(text)) then
+            rc = create_whole(path, text//new_line('a'))
+            created = rc == 0
+            if (rc /= 0 .and. rc /= ERRNO_EEXIST) &
+                call make_error(err, ERR_IO, path//': cannot create: '//errno_text(rc))
+            return
+        end if
         open (newunit=unit, file=path, status='new', action='write', iostat=ios, iomsg=msg)
         created = ios == 0
         if (created) then
-            if (present(text)) write (unit, '(a)', iostat=ios, iomsg=msg) text
-            if (ios == 0) close (unit, iostat=ios, iomsg=msg)
-            if (ios /= 0) then
-                ! a lock that does not say who holds it would hold its file for 120 s
-                exists = delete_file(path)
-                call make_error(err, ERR_IO, path//': cannot write: '//trim(msg))
-            end if
+            close (unit, iostat=ios)
             return
         end if
         inquire (file=path, exist=exists)

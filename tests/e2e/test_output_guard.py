@@ -365,6 +365,27 @@ def test_a_kill_inside_a_flush_leaves_the_counters_no_further_than_the_records(
     assert checked >= 5, checked
 
 
+@pytest.mark.skipif(shutil.which("strace") is None,
+                    reason="needs strace to kill at a write (scripts/setup --tests)")
+def test_a_run_killed_while_taking_its_lock_leaves_no_empty_lock(run, ropedyn_exe, tmp_path,
+                                                                 scene):
+    """A lock was created, then its holder written into it: a run killed in between left an
+    empty FILE.lock, which held FILE for 120 s ("live while young", as nobody could tell its
+    writer). The lock now appears with its holder or not at all. Killed at its first write
+    (the holder's lines), the run leaves no lock, or a whole one, and a run at once goes on."""
+    lock = tmp_path / "out" / "paper.h5.lock"
+    subprocess.run(["strace", "-f", "-o", "/dev/null", "-e", "trace=write", "-e",
+                    "inject=write:signal=KILL:when=1", str(ropedyn_exe), "run", str(scene),
+                    "--set", "solver.t_end=0.02", "--set", "output.progress=.false."],
+                   cwd=tmp_path, capture_output=True, timeout=300)
+    assert not lock.exists() or lock.read_text().startswith("ropedyn sweep case lock\nhost=")
+    assert not list((tmp_path / "out").glob("paper.h5.lock.*")), \
+        list((tmp_path / "out").iterdir())
+    again = run("run", scene, "--set", "solver.t_end=0.02")
+    assert again.returncode == 0, again.stderr
+    assert (tmp_path / "out" / "paper.h5").exists() and not lock.exists()
+
+
 def test_a_killed_file_is_continued_from_its_last_whole_record(run, tmp_path, scene):
     """A run killed inside a flush can leave series of unequal length (HDF5 writes them one
     after the other). The resume of such a file (status running) was refused (exit 4,
