@@ -6,7 +6,8 @@
 !! the wrong sign), a key of a support's motion that its `*_motion` does not use (a
 !! harmonic key or a table with another motion), a release or a ramp that the run ends
 !! before, a key of &ground or &fluid set away from its default while the effects that use
-!! it are off (a ground or a water given and not switched on). Each warning names the key,
+!! it are off (a ground or a water given and not switched on), a support_stiffness_factor
+!! that scales the rope's own end section (a clamp, a 'split' end). Each warning names the key,
 !! its value and why; a run goes ahead.
 module ropedyn_scene_warnings
     use, intrinsic :: iso_fortran_env, only: error_unit
@@ -95,6 +96,7 @@ contains
         if (scene%effects%ground) call ground_start(scene, list)
         if (scene%effects%ground) call ground_anchors(scene, list)
         call idle_groups(scene, list)
+        call shared_section_factor(scene, sec, list)
         call tolerance_below_rounding(scene, list)
         ! a start that sets the velocities itself (at rest, or the record's)
         associate (i => scene%initial)
@@ -145,6 +147,48 @@ contains
             end if
         end function damping_text
     end function scene_warnings
+
+    !> A support_stiffness_factor other than 1 where a support's spring is the rope's own
+    !! end section (docs/theory/rfem.md, "Supports"): a clamp's rotational spring (its
+    !! first half section in bending) and, with end_compliance = 'split', a held end's
+    !! spring (its half section in tension; the MPP's top is an ideal pin). The factor
+    !! stiffens that section too: a first-order error, where it is meant for the added pins.
+    subroutine shared_section_factor(scene, sec, list)
+        type(scene_t), intent(in) :: scene
+        type(section_t), intent(in) :: sec
+        type(text_t), allocatable, intent(inout) :: list(:)
+        character(len=:), allocatable :: ends
+        associate (s => scene%supports)
+            if (s%support_stiffness_factor == 1.0_wp) return
+            ends = ''
+            call shared_end('top', s%top, s%top_release_time, scene%model%kind /= 'mpp')
+            call shared_end('bottom', s%bottom, s%bottom_release_time, .true.)
+            if (len(ends) == 0) return
+            call append_text(list, scene%origin('supports.support_stiffness_factor')// &
+                ': &supports: support_stiffness_factor = '// &
+                real_text(s%support_stiffness_factor)//': it scales the rope''s own end '// &
+                'section too at the '//ends//' (an error that shrinks only as the element '// &
+                'length); keep it at 1 with a clamp and with end_compliance = ''split'' (it '// &
+                'is meant for the springs a pin adds)')
+        end associate
+    contains
+        !> Add END's name to `ends` when its support shares the rope's end section.
+        subroutine shared_end(end, kind, release_time, spring)
+            character(len=*), intent(in) :: end, kind
+            real(wp), intent(in) :: release_time
+            logical, intent(in) :: spring     !< a pinned END has a spring of its own
+            character(len=:), allocatable :: how
+            if (kind == 'free' .or. release_time == 0.0_wp) return
+            how = ''
+            if (kind == 'clamped' .and. sec%ei > 0.0_wp) how = 'clamped '
+            if (scene%supports%end_compliance == 'split' .and. spring .and. &
+                scene%effects%tension) how = trim(merge('split pinned ', 'split clamped', &
+                                                        kind == 'pinned'))//' '
+            if (len(how) == 0) return
+            if (len(ends) > 0) ends = ends//' and the '
+            ends = ends//how//end
+        end subroutine shared_end
+    end subroutine shared_section_factor
 
     !> A relative tolerance below what double precision resolves: a step's error estimate
     !! is then rounding noise, no method meets the tolerance, and the steps shrink to the

@@ -187,6 +187,39 @@ def test_a_release_or_ramp_the_run_ends_before_is_warned_of(run, sets, fragment)
     assert len(warnings) == 1 and fragment in warnings[0], proc.stderr
 
 
+@pytest.mark.parametrize("sets,ends", [
+    (["supports.top=clamped"], "the clamped top"),
+    (["supports.end_compliance=split", "supports.bottom=pinned"],
+     "the split pinned top and the split pinned bottom"),
+    (["model.kind=mpp", "supports.end_compliance=split", "supports.bottom=clamped"],
+     "the split clamped bottom"),
+    (["supports.bottom=pinned"], None),                      # the pins' added springs
+    (["model.kind=mpp", "supports.end_compliance=split"], None),   # the MPP's ideal top pin
+    (["supports.top=clamped", "supports.top_release_time=0"], None),   # free from the start
+])
+def test_a_support_factor_on_the_ropes_own_end_section_is_warned_of(run, sets, ends):
+    """A clamp's rotational spring is the rope's first half section in bending, and with
+    'split' a held end's spring is its half section in tension: support_stiffness_factor
+    stiffens that section too, a first-order error (a cantilever clamped at 1000 bent 10 %
+    too little at 20 elements). Where the factor only scales the spring a pin adds, or
+    nothing, there is no warning."""
+    args = ["run", PAPER, "--set", "solver.t_end=1e-4", "--set", "output.file=w.h5",
+            "--set", "supports.support_stiffness_factor=100"]
+    for s in sets:
+        args += ["--set", s]
+    proc = run(*args)
+    assert proc.returncode == 0, proc.stderr
+    warnings = [w for w in scene_warnings(proc) if "support_stiffness_factor" in w]
+    if ends is None:
+        assert not warnings, proc.stderr
+    else:
+        assert len(warnings) == 1, proc.stderr
+        assert warnings[0].startswith("ropedyn: warning: --set supports.support_stiffness_factor"
+                                      "=100: &supports: "
+                                      "support_stiffness_factor = 100.0: it scales the rope's "
+                                      f"own end section too at {ends} "), warnings[0]
+
+
 def test_keys_of_an_effect_that_is_off_are_warned_of(run, tmp_path):
     """A &ground or &fluid written but not switched on does nothing: a warning names the
     first key set away from its default and how many more there are; water's own keys warn
