@@ -128,3 +128,36 @@ def test_the_ensemble_counts_the_starts_within_2_over_the_elastic_energy(monkeyp
     cells = [c.strip() for c in row.split("|")[1:-1]]
     assert cells[3] == "3.00" and cells[6] == "2.0 (1.0 - 3.0)"
     assert cells[7] == "2.00 (1.00 - 3.00)" and cells[8] == "2"
+
+
+def test_the_plateau_section_gives_each_growth_and_every_window(monkeypatch):
+    """`plateau`: an error that grows with the elastic energy up to 300 s and stays after:
+    its growth from 30 s to 300 s is the energy's, from 300 s to the end 1; the windows of
+    300 s cover the run and the section is written between its markers with its command."""
+    t = np.arange(0.0, 3000.0 + 1e-9, 0.1)
+    energy = 0.04 + 0.12 * np.minimum(t, 300.0) / 300.0
+    made, written = [], {}
+
+    def fake_run(exe, work, scene, name, sets):
+        made.append(sets)
+        return {"ok": True, "t": t, "drift": 1e-3 * energy * np.cos(t), "elastic": energy,
+                "steps": 123, "cpu": 4.5}
+
+    monkeypatch.setattr(bs, "run", fake_run)
+    monkeypatch.setattr(bs, "update_doc", lambda doc, begin, end, block: written.update(
+        doc=doc, begin=begin, end=end, block=block))
+    assert bs.main(["plateau", "--elements", "20", "--exe", "/bin/true"]) == 0
+    assert "solver.t_end=3000" in made[0] and "effects.damping=.false." in made[0]
+    block = written["block"]
+    assert written["doc"] == bs.DOC and block.startswith(bs.PLATEAU_BEGIN)
+    assert block.endswith(bs.PLATEAU_END)
+    assert "`scripts/bench_symplectic plateau --elements \"20\" --t-end 3000`" in block
+    row = next(line for line in block.splitlines() if line.startswith("| 20 | 123 |"))
+    cells = [c.strip() for c in row.split("|")[1:-1]]
+    growth_30, growth_end = float(cells[6]), float(cells[7])
+    assert abs(growth_30 - bs.upto({"t": t, "drift": 1e-3 * energy * np.cos(t)}, 300)
+               / bs.upto({"t": t, "drift": 1e-3 * energy * np.cos(t)}, 30)) < 0.05
+    assert growth_30 > 3.0 and abs(growth_end - 1.0) < 0.01
+    assert cells[8] == "0.100" and cells[9] == "0.160"
+    head = next(line for line in block.splitlines() if line.startswith("| n | per window"))
+    assert "0-300 s" in head and "2700-3000 s" in head and head.count("|") == 13

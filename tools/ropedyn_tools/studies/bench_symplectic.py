@@ -27,6 +27,15 @@ at rtol 1e-3, 1e-5 and 1e-7 (ever shorter steps and, from 1e-5, SRKN6b) and with
 rtol 1e-9 (an independent method, its step held by accuracy): the growth of the elastic
 energy and of the largest |T + V - E0|, as in the table above. Two runs at a time, no CPU.
 
+`scripts/bench_symplectic plateau` writes the section between the energy-plateau markers
+(docs/validation/energy.md too): whether the error stops growing once the fast modes have
+filled. The undamped rope (n = 20 and 100, from 75 degrees, rtol 1e-3, as above) with the
+symplectic method to 3000 s: window by window (300 s each) the largest |T + V - E0|, its
+mean and the mean elastic energy, and the largest error up to 30 s, 300 s and the end.
+The rope starts at rest, with its fast modes empty; the chaotic motion fills them over
+minutes, and the error of a fixed step grows with their energy until they are full.
+Two runs at a time, with the CPU of each (they share the two cores).
+
 `scripts/bench_symplectic tolerance` writes the section between the symplectic-tolerance
 markers (docs/validation/energy.md too): what a tighter rtol buys on an undamped rope whose
 fast modes hold much of the energy (4 elements, 60 s; the step rule's energy spread of the
@@ -280,6 +289,65 @@ def write_elastic(exe, n, t_end, no_write):
     return 0
 
 
+PLATEAU_BEGIN = "<!-- energy-plateau:begin -->"
+PLATEAU_END = "<!-- energy-plateau:end -->"
+#: the plateau section's run length and window (s)
+PLATEAU_T_END, PLATEAU_WINDOW = 3000.0, 300.0
+
+
+def plateau_rows(r, t_end, span):
+    """The plateau section's summary cells of one run: its steps and CPU, the largest
+    |T + V - E0| up to WINDOW, up to `span` and up to `t_end`, the growths from each to the
+    next, and the mean elastic energy over the first and the last `span` (m g L)."""
+    t, e = r["t"], r["elastic"]
+    first, last = e[t <= span].mean(), e[t >= t[-1] - span].mean()
+    short, mid, end = upto(r, WINDOW), upto(r, span), upto(r, t_end)
+    return (f"{r['steps']} | {r['cpu']:.3g} | {short:.1e} | {mid:.1e} | {end:.1e} | "
+            f"{mid / short:.1f} | {end / mid:.2f} | {first:.3f} | {last:.3f}")
+
+
+def write_plateau(exe, ns, t_end, span, no_write):
+    with tempfile.TemporaryDirectory() as work:
+        def one(n):
+            return run(exe, work, PAPER, f"plateau{n}", undamped_sets(n, "symplectic", t_end))
+        with concurrent.futures.ThreadPoolExecutor(2) as pool:
+            results = dict(zip(ns, pool.map(one, ns)))
+    summary_rows, windows = [], {}
+    for n, r in results.items():
+        if not r["ok"]:
+            summary_rows.append(f"| {n} | | | | | | | | | {r['why']} |")
+            continue
+        summary_rows.append(f"| {n} | {plateau_rows(r, t_end, span)} |")
+        windows[n] = window_rows(n, r, span)
+        print(summary_rows[-1], flush=True)
+    if no_write:
+        return 0
+    block = [
+        PLATEAU_BEGIN,
+        f"Command: `scripts/bench_symplectic plateau --elements \"{' '.join(map(str, ns))}\" "
+        f"--t-end {t_end:g}"
+        + (f" --window {span:g}" if span != PLATEAU_WINDOW else "")
+        + "` (code: tools/ropedyn_tools/studies/bench_symplectic.py; the runs "
+        f"two at a time). Machine: {machine()}. Run: {run_stamp()}.", "",
+        f"The undamped paper rope from 75 degrees to {t_end:g} s, `method = 'symplectic'`, "
+        "rtol 1e-3, atol 1e-5, a record every 0.1 s: the steps and CPU (s) of the run, the "
+        f"largest |T + V - E0| (m g L) up to {WINDOW:g} s, up to {span:g} s and up to the "
+        f"end, the growth from the first to the second (the target's) and from the second to "
+        f"the third, and the mean elastic energy (m g L) over the first and the last "
+        f"{span:g} s:", "",
+        f"| n | steps | CPU (s) | max abs to {WINDOW:g} s | max abs to {span:g} s | max abs "
+        f"to the end | growth {WINDOW:g} s to {span:g} s | growth {span:g} s to the end | "
+        f"elastic energy, first {span:g} s | elastic energy, last {span:g} s |",
+        "|---|---|---|---|---|---|---|---|---|---|", *summary_rows, "",
+        f"Window by window ({span:g} s each): the largest |T + V - E0|, its mean, the mean "
+        "elastic energy, m g L, and the first over the third:", ""]
+    for n, (head, rows) in windows.items():
+        block += [head, "|" + "---|" * (head.count("|") - 1), *rows, ""]
+    update_doc(DOC, PLATEAU_BEGIN, PLATEAU_END, "\n".join([*block[:-1], PLATEAU_END]))
+    print(f"bench_symplectic plateau: {DOC}")
+    return 0
+
+
 TOLERANCE_BEGIN = "<!-- symplectic-tolerance:begin -->"
 TOLERANCE_END = "<!-- symplectic-tolerance:end -->"
 #: the tolerance section: the rtols, the rope's elements and the run's length (s)
@@ -349,11 +417,15 @@ def window_block(windows):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=summary(__doc__))
     add_exe_argument(parser)
-    parser.add_argument("mode", nargs="?", choices=("targets", "elastic", "tolerance"),
+    parser.add_argument("mode", nargs="?", choices=("targets", "elastic", "tolerance",
+                                                    "plateau"),
                         default="targets", help="the targets' section (default), the "
-                        "elastic-growth one, or the tolerance one")
+                        "elastic-growth one, the tolerance one or the energy-plateau one")
     parser.add_argument("--elements", type=list_text(positive(int)), default="20 100")
-    parser.add_argument("--t-end", type=float, default=300.0)
+    parser.add_argument("--t-end", type=positive(float), default=None,
+                        help=f"s (default 300; plateau: {PLATEAU_T_END:g})")
+    parser.add_argument("--window", type=positive(float), default=PLATEAU_WINDOW,
+                        help=f"plateau: the window of its table, s (default {PLATEAU_WINDOW:g})")
     parser.add_argument("--repeat", type=int, default=1)
     parser.add_argument("--starts", type=int, default=8,
                         help="release angles of the symplectic method's ensemble")
@@ -364,6 +436,11 @@ def main(argv=None):
                         help="that revision's Release executable, built before")
     parser.add_argument("--no-write", action="store_true")
     args = parser.parse_args(argv)
+    if args.mode == "plateau":
+        return write_plateau(exe_or_build(args.exe), [int(x) for x in args.elements.split()],
+                             args.t_end or PLATEAU_T_END, args.window, args.no_write)
+    if args.t_end is None:
+        args.t_end = 300.0
     if args.mode == "elastic":
         return write_elastic(exe_or_build(args.exe), int(args.elements.split()[0]),
                              args.t_end, args.no_write)
