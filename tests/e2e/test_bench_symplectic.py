@@ -148,16 +148,20 @@ def test_the_plateau_section_gives_each_growth_and_every_window(monkeypatch):
         doc=doc, begin=begin, end=end, block=block))
     assert bs.main(["plateau", "--elements", "20", "--exe", "/bin/true"]) == 0
     assert "solver.t_end=3000" in made[0] and "effects.damping=.false." in made[0]
+    # the largest n at rtol 1e-3, and again at the check's rtol
+    assert [[x for x in m if x.startswith("solver.rtol=")][-1] for m in made] == \
+        ["solver.rtol=0.001", "solver.rtol=1e-05"]
     block = written["block"]
     assert written["doc"] == bs.DOC and block.startswith(bs.PLATEAU_BEGIN)
     assert block.endswith(bs.PLATEAU_END)
     assert "`scripts/bench_symplectic plateau --elements \"20\" --t-end 3000`" in block
-    row = next(line for line in block.splitlines() if line.startswith("| 20 | 123 |"))
+    row = next(line for line in block.splitlines() if line.startswith("| 20 | 0.001 | 123 |"))
     cells = [c.strip() for c in row.split("|")[1:-1]]
-    growth_30, growth_end = float(cells[6]), float(cells[7])
+    growth_30, growth_end = float(cells[7]), float(cells[8])
     assert abs(growth_30 - bs.upto({"t": t, "drift": 1e-3 * energy * np.cos(t)}, 300)
                / bs.upto({"t": t, "drift": 1e-3 * energy * np.cos(t)}, 30)) < 0.05
     assert growth_30 > 3.0 and abs(growth_end - 1.0) < 0.01
-    assert cells[8] == "0.100" and cells[9] == "0.160"
+    assert cells[9] == "0.100" and cells[10] == "0.160"
     head = next(line for line in block.splitlines() if line.startswith("| n | per window"))
     assert "0-300 s" in head and "2700-3000 s" in head and head.count("|") == 13
+    assert "| 20, rtol 1e-05 | mean elastic energy |" in block
