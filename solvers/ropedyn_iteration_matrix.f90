@@ -327,7 +327,7 @@ contains
             self%use_block3 = .false.
             if (self%block3_pattern) then
                 if (.not. allocated(self%ra)) allocate (self%ra(kl + ku + 1, np))
-                self%ra = self%mk - g*self%cb - g2*self%kb
+                call combine_blocks(size(self%ra), self%mk, self%cb, self%kb, g, g2, self%ra)
                 call self%blk3%factor(np, self%ra, info)
                 self%use_block3 = info == 0
             end if
@@ -340,6 +340,19 @@ contains
         end if
         status = merge(STATUS_OK, STATUS_RECOVERABLE, info == 0)
     end subroutine factor_reduced
+
+    !> a = mk - g cb - g2 kb over the m entries of the band storage, as one vector (the
+    !! statement on the (kl+ku+1, np) arrays loops over columns of 11 entries: two vectors
+    !! and three single entries each).
+    pure subroutine combine_blocks(m, mk, cb, kb, g, g2, a)
+        integer, intent(in) :: m
+        real(wp), intent(in) :: mk(m), cb(m), kb(m), g, g2
+        real(wp), intent(out) :: a(m)
+        integer :: i
+        do i = 1, m
+            a(i) = mk(i) - g*cb(i) - g2*kb(i)
+        end do
+    end subroutine combine_blocks
 
     !> b <- (M - g J)^{-1} b with the current factors.
     subroutine matrix_solve(self, b)

@@ -26,7 +26,7 @@
 module ropedyn_mebdf
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use ropedyn_kinds, only: wp, i8
-    use ropedyn_sums, only: sum_squares
+    use ropedyn_sums, only: sum_scaled_squares
     use ropedyn_text, only: int_text, es_text
     use ropedyn_error, only: error_t, make_error, ERR_SOLVER
     use ropedyn_problem, only: problem_t, STATUS_OK, STATUS_FATAL
@@ -93,8 +93,8 @@ module ropedyn_mebdf
         real(wp), allocatable :: atol(:)  !< absolute tolerance per component (nt)
         real(wp), allocatable :: w(:)     !< error weights rtol |y| + atol (nt)
         real(wp), allocatable :: wi(:)    !< their inverses (the norms multiply)
-        !> work (n): F, M times the correction, the Newton correction and its weighted form
-        real(wp), allocatable :: f(:), mv(:), r(:), rw(:)
+        !> work (n): F, M times the correction and the Newton correction
+        real(wp), allocatable :: f(:), mv(:), r(:)
         !> work of a step (nt), allocated once: stage 1's predictor (kept for the history
         !! update), a stage's known part c, the stage solutions ybar1, ybar2, y3, ybar1's
         !! correction d1 and the slopes h g of stages 1 and 2, and a temporary (stage 2's
@@ -184,7 +184,7 @@ module ropedyn_mebdf
         !> Weighted RMS norm of v, the maximum of the state's and the quadratures' norms.
         module pure real(wp) function wnorm(self, v)
             class(mebdf_t), intent(in) :: self
-            real(wp), intent(in) :: v(:)
+            real(wp), contiguous, intent(in) :: v(:)
         end function wnorm
 
         !> Rescale the differences 1 .. kk to a step size ratio*h (interpolation of the
@@ -219,7 +219,7 @@ contains
         end do
         allocate (self%dif(self%nt, 0:KMAX_MEBDF + 2), self%atol(self%nt), self%w(self%nt), &
                   self%wi(self%nt))
-        allocate (self%f(self%n), self%mv(self%n), self%r(self%n), self%rw(self%n), &
+        allocate (self%f(self%n), self%mv(self%n), self%r(self%n), &
                   self%gq(max(self%nq, 1)))
         allocate (self%pred(self%nt), self%c(self%nt), self%ybar1(self%nt), &
                   self%ybar2(self%nt), self%y3(self%nt), self%d1(self%nt), self%hg1(self%nt), &
@@ -332,7 +332,7 @@ contains
         if (allocated(self%dif)) deallocate (self%dif)
         if (allocated(self%atol)) deallocate (self%atol)
         if (allocated(self%w)) deallocate (self%w, self%wi)
-        if (allocated(self%f)) deallocate (self%f, self%mv, self%r, self%rw)
+        if (allocated(self%f)) deallocate (self%f, self%mv, self%r)
         if (allocated(self%gq)) deallocate (self%gq)
         if (allocated(self%pred)) deallocate (self%pred, self%c, self%ybar1, self%ybar2, &
                                               self%y3, self%d1, self%hg1, self%hg2, self%tmp)

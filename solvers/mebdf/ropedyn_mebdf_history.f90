@@ -89,11 +89,12 @@ contains
     end procedure initial_step
 
     module procedure wnorm
-        real(wp) :: x(self%nt)
-        x = v(1:self%nt)*self%wi
-        wnorm = sqrt(sum_squares(x(1:self%n))/real(self%n, wp))
-        if (self%nq > 0) wnorm = max(wnorm, sqrt(sum_squares(x(self%n + 1:self%nt))/ &
-                                                  real(self%nq, wp)))
+        integer :: n, nt
+        n = self%n
+        nt = self%nt
+        wnorm = sqrt(sum_scaled_squares(v(1:n), self%wi(1:n))/real(n, wp))
+        if (self%nq > 0) wnorm = max(wnorm, sqrt(sum_scaled_squares(v(n + 1:nt), &
+                                                 self%wi(n + 1:nt))/real(self%nq, wp)))
     end procedure wnorm
 
     module procedure rescale

@@ -99,8 +99,7 @@ contains
             ! the correction and its norm; a NaN or Inf in it (or a norm beyond the
             ! floating-point range) fails the stage, whose z is then thrown away
             z(1:n) = z(1:n) + self%r
-            self%rw = self%r*self%wi(1:n)
-            dnorm = sum_squares(self%rw)
+            dnorm = sum_scaled_squares(self%r, self%wi(1:n))
             if (.not. ieee_is_finite(dnorm)) return
             dnorm = sqrt(dnorm/real(n, wp))
             if (iter > 1) then
@@ -138,8 +137,7 @@ contains
             call begin_attempt(self, tn)
             call check_progress(self, tn, tries%last_cause, err)
             if (allocated(err)) return
-            self%w = self%options%rtol*abs(self%dif(:, 0)) + self%atol
-            self%wi = 1.0_wp/self%w
+            call error_weights(self%nt, self%options%rtol, self%atol, self%dif, self%w, self%wi)
             call self%prepare_matrix(self%h*self%coef(self%k)%beta, tries%refresh, status)
             tries%refresh = .false.
             if (status == STATUS_FATAL) then
@@ -218,8 +216,8 @@ contains
         err1 = 0.0_wp
         call stage_bdf(self, tn, hbeta, gam, outcome)
         if (outcome /= STAGE_OK) return
-        self%hg1 = (self%ybar1 - self%c)*(1.0_wp/beta)
-        self%d1 = self%ybar1 - self%pred
+        call slope_and_correction(self%nt, 1.0_wp/beta, self%ybar1, self%c, self%pred, &
+                                  self%hg1, self%d1)
         err1 = self%wnorm(self%d1)/self%coef(k)%tq
         if (self%fixed) err1 = 0.0_wp
         if (.not. (err1 <= 1.0_wp)) then
@@ -247,16 +245,10 @@ contains
         class(mebdf_t), intent(inout) :: self
         real(wp), intent(in) :: tn, hbeta, gam(:)
         integer, intent(out) :: outcome
-        integer :: j, k
+        integer :: k
         k = self%k
-        self%pred = self%dif(:, 0) + self%dif(:, 1)
-        self%c = gam(1)*self%dif(:, 1)
-        do j = 2, k
-            self%pred = self%pred + self%dif(:, j)
-            self%c = self%c + gam(j)*self%dif(:, j)
-        end do
-        self%c = self%pred - self%coef(k)%beta*self%c
-        self%ybar1 = self%pred
+        call predict_bdf(self%nt, k, self%dif, gam, self%coef(k)%beta, self%pred, self%c, &
+                         self%ybar1)
         call self%stage(tn, hbeta, self%c, self%ybar1, outcome)
     end subroutine stage_bdf
 
@@ -268,17 +260,10 @@ contains
         class(mebdf_t), intent(inout) :: self
         real(wp), intent(in) :: tn, hbeta, gam(:)
         integer, intent(out) :: outcome
-        integer :: i, k
+        integer :: k
         k = self%k
-        self%tmp = self%dif(:, k)
-        self%ybar2 = self%ybar1 + self%tmp + self%d1
-        self%c = gam(k)*(self%tmp + self%d1)
-        do i = k - 1, 1, -1
-            self%tmp = self%tmp + self%dif(:, i)
-            self%ybar2 = self%ybar2 + self%tmp + self%d1
-            self%c = self%c + gam(i)*(self%tmp + self%d1)
-        end do
-        self%c = self%ybar2 - self%coef(k)%beta*self%c
+        call predict_ahead(self%nt, k, self%dif, gam, self%coef(k)%beta, self%ybar1, self%d1, &
+                           self%tmp, self%ybar2, self%c)
         call self%stage(tn + self%h, hbeta, self%c, self%ybar2, outcome)
     end subroutine stage_bdf_ahead
 
@@ -318,7 +303,7 @@ contains
         class(mebdf_t), intent(inout) :: self
         real(wp), intent(in) :: tn, err1
         real(wp) :: errkm1, errkp1
-        integer :: j, k
+        integer :: k
         k = self%k
         errkm1 = huge(1.0_wp)
         errkp1 = huge(1.0_wp)
@@ -332,12 +317,7 @@ contains
         end if
         ! nabla^{k+1} y_{n+1} = y3 - pred (stage 1's predictor, sum_{j=0..k} dif_j), then
         ! dif_j <- dif_j + dif_{j+1} (the new one) from j = k down
-        self%tmp = self%y3 - self%pred
-        self%dif(:, k + 2) = self%tmp - self%dif(:, k + 1)
-        self%dif(:, k + 1) = self%tmp
-        do j = k, 0, -1
-            self%dif(:, j) = self%dif(:, j) + self%dif(:, j + 1)
-        end do
+        call update_history(self%nt, k, self%y3, self%pred, self%dif)
         self%t = tn
         self%h_used = self%h
         self%counters%steps = self%counters%steps + 1
@@ -350,6 +330,104 @@ contains
         if (self%steps_at_h >= k + 2 .and. .not. self%fixed) &
             call choose_next(self, err1, errkm1, errkp1)
     end subroutine accept_step
+
+    ! The vector work of a step: explicit-shape arrays (dif as (nt, 0:*), the whole
+    ! history), each loop one pass over the components doing all that a statement per
+    ! vector did, with the same operations in the same order (the same bits).
+
+    !> The error weights w = rtol |y_n| + atol and their inverses wi, in one pass.
+    pure subroutine error_weights(nt, rtol, atol, dif, w, wi)
+        integer, intent(in) :: nt
+        real(wp), intent(in) :: rtol, atol(nt), dif(nt, 0:*)
+        real(wp), intent(out) :: w(nt), wi(nt)
+        integer :: i
+        do i = 1, nt
+            w(i) = rtol*abs(dif(i, 0)) + atol(i)
+            wi(i) = 1.0_wp/w(i)
+        end do
+    end subroutine error_weights
+
+    !> Stage 1's predictor pred = sum_{j=0..k} dif_j, its known part
+    !! c = pred - beta sum_{j=1..k} gam_j dif_j and its start ybar1 = pred: one pass per
+    !! difference for pred and c together.
+    pure subroutine predict_bdf(nt, k, dif, gam, beta, pred, c, ybar1)
+        integer, intent(in) :: nt, k
+        real(wp), intent(in) :: dif(nt, 0:*), gam(:), beta
+        real(wp), intent(out) :: pred(nt), c(nt), ybar1(nt)
+        integer :: i, j
+        do i = 1, nt
+            pred(i) = dif(i, 0) + dif(i, 1)
+            c(i) = gam(1)*dif(i, 1)
+        end do
+        do j = 2, k
+            do i = 1, nt
+                pred(i) = pred(i) + dif(i, j)
+                c(i) = c(i) + gam(j)*dif(i, j)
+            end do
+        end do
+        do i = 1, nt
+            c(i) = pred(i) - beta*c(i)
+            ybar1(i) = pred(i)
+        end do
+    end subroutine predict_bdf
+
+    !> Stage 2's predictor (in ybar2) and known part c (stage_bdf_ahead), p carrying
+    !! P_i = sum_{j=i..k} dif_j: one pass per difference for the three together.
+    pure subroutine predict_ahead(nt, k, dif, gam, beta, ybar1, d1, p, ybar2, c)
+        integer, intent(in) :: nt, k
+        real(wp), intent(in) :: dif(nt, 0:*), gam(:), beta, ybar1(nt), d1(nt)
+        real(wp), intent(out) :: p(nt), ybar2(nt), c(nt)
+        integer :: i, j
+        do i = 1, nt
+            p(i) = dif(i, k)
+            ybar2(i) = ybar1(i) + p(i) + d1(i)
+            c(i) = gam(k)*(p(i) + d1(i))
+        end do
+        do j = k - 1, 1, -1
+            do i = 1, nt
+                p(i) = p(i) + dif(i, j)
+                ybar2(i) = ybar2(i) + p(i) + d1(i)
+                c(i) = c(i) + gam(j)*(p(i) + d1(i))
+            end do
+        end do
+        do i = 1, nt
+            c(i) = ybar2(i) - beta*c(i)
+        end do
+    end subroutine predict_ahead
+
+    !> Stage 1's slope h g1 = (ybar1 - c) rbeta (rbeta = 1/beta) and its correction
+    !! d1 = ybar1 - pred, in one pass.
+    pure subroutine slope_and_correction(nt, rbeta, ybar1, c, pred, hg1, d1)
+        integer, intent(in) :: nt
+        real(wp), intent(in) :: rbeta, ybar1(nt), c(nt), pred(nt)
+        real(wp), intent(out) :: hg1(nt), d1(nt)
+        integer :: i
+        do i = 1, nt
+            hg1(i) = (ybar1(i) - c(i))*rbeta
+            d1(i) = ybar1(i) - pred(i)
+        end do
+    end subroutine slope_and_correction
+
+    !> The history moves to the new point y3: nabla^{k+1} y_{n+1} = y3 - pred (pred the
+    !! sum of dif_0 .. dif_k), dif_{k+2} its change, then dif_j <- dif_j + dif_{j+1} from
+    !! j = k down.
+    pure subroutine update_history(nt, k, y3, pred, dif)
+        integer, intent(in) :: nt, k
+        real(wp), intent(in) :: y3(nt), pred(nt)
+        real(wp), intent(inout) :: dif(nt, 0:k + 2)
+        real(wp) :: e
+        integer :: i, j
+        do i = 1, nt
+            e = y3(i) - pred(i)
+            dif(i, k + 2) = e - dif(i, k + 1)
+            dif(i, k + 1) = e
+        end do
+        do j = k, 0, -1
+            do i = 1, nt
+                dif(i, j) = dif(i, j) + dif(i, j + 1)
+            end do
+        end do
+    end subroutine update_history
 
     !> Step size and order for the next step (after k + 2 steps at this h and k), from the
     !! normalized errors at orders k, k-1 and k+1: the largest growth wins.

@@ -12,7 +12,7 @@ module ropedyn_sums
     use ropedyn_kinds, only: wp
     implicit none
     private
-    public :: sum_squares, sum_products, all_finite
+    public :: sum_squares, sum_scaled_squares, sum_products, all_finite
 
 contains
 
@@ -31,6 +31,23 @@ contains
         end do
         s = ((a(1) + a(2)) + (a(3) + a(4))) + ((a(5) + a(6)) + (a(7) + a(8)))
     end function sum_squares
+
+    !> sum_i (x_i s_i)**2, in the fixed order of the module header: sum_squares of the
+    !! products x_i s_i (the same bits) without storing them (a weighted norm's vector).
+    pure real(wp) function sum_scaled_squares(x, s) result(t)
+        real(wp), contiguous, intent(in) :: x(:), s(:)
+        real(wp) :: a(8)
+        integer :: i, n8
+        a = 0.0_wp
+        n8 = size(x) - mod(size(x), 8)
+        do i = 1, n8, 8
+            a = a + (x(i:i + 7)*s(i:i + 7))**2
+        end do
+        do i = n8 + 1, size(x)
+            a(i - n8) = a(i - n8) + (x(i)*s(i))**2
+        end do
+        t = ((a(1) + a(2)) + (a(3) + a(4))) + ((a(5) + a(6)) + (a(7) + a(8)))
+    end function sum_scaled_squares
 
     !> sum_i x_i y_i, in the fixed order of the module header.
     pure real(wp) function sum_products(x, y) result(s)

@@ -7,6 +7,8 @@
 !! - against the plain sum on 600 random values (within rounding);
 !! - the sums of products (sum_products) the same way: exact on integers for every length
 !!   0 .. 40, equal to sum_squares(x) for y = x;
+!! - the sums of scaled squares (sum_scaled_squares(x, s)): sum_squares(x s) bit for bit on
+!!   random values at every length 0 .. 40 (the weighted norms of MEBDF rely on it);
 !! - all_finite: true for finite vectors (huge and tiny values, negative zero, length 0, a
 !!   strided section), false for a NaN, +Inf or -Inf at every position of every length
 !!   1 .. 20 (the four running sums and the tail) and in a strided section.
@@ -14,12 +16,12 @@ program test_sums
     use ropedyn_kinds, only: wp
     use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf, &
                                              ieee_negative_inf
-    use ropedyn_sums, only: sum_squares, sum_products, all_finite
+    use ropedyn_sums, only: sum_squares, sum_scaled_squares, sum_products, all_finite
     use ropedyn_assert, only: test_suite_t
     implicit none
 
     type(test_suite_t) :: suite
-    real(wp), allocatable :: x(:)
+    real(wp), allocatable :: x(:), s(:)
     real(wp) :: a(8), expected, eps, bad(3), grid(4, 5)
     integer :: n, i, k, j
     logical :: caught
@@ -57,6 +59,18 @@ program test_sums
         call suite%check_true(sum_products(x, x + 1.0_wp) == sum(x*(x + 1.0_wp)), &
                               'products of integers, length '//trim(label))
     end do
+
+    caught = .true.
+    do n = 0, 40
+        allocate (s(n))
+        call random_number(s)
+        x = [(real(mod(7*i, 11) - 5, wp)/3.0_wp, i = 1, n)]
+        s = 1.0_wp/(1.0e-3_wp + s)
+        if (sum_scaled_squares(x, s) /= sum_squares(x*s)) caught = .false.
+        deallocate (s)
+    end do
+    call suite%check_true(caught, 'sum_scaled_squares(x, s) is sum_squares(x s), bit for '// &
+                          'bit, lengths 0 .. 40')
 
     ! all_finite
     bad = [ieee_value(1.0_wp, ieee_quiet_nan), ieee_value(1.0_wp, ieee_positive_inf), &
