@@ -671,12 +671,19 @@ contains
         type(rope_spec_t), intent(in) :: spec
         type(error_t), allocatable, intent(out) :: err
         character(len=200) :: text
+        character(len=:), allocatable :: hint
         write (text, '(a, i0, a, es10.3, a, es10.3, a, es9.2)') 'no convergence in ', &
             self%result%iterations, ' iterations (max |f| = ', maxval(abs(self%f)), &
             ' N, last step ', self%result%last_step, ' m or rad, shift ', self%sigma
+        hint = ''
+        ! a line on the seabed: the MPP's iteration crawls where the RFEM's does not
+        ! (docs/theory/statics-modes.md, "Stiff ground: continuation")
+        if (spec%model%kind == 'mpp' .and. spec%effects%ground) hint = '; on a ground '// &
+            "the MPP can need several thousand iterations (--max-iterations 10000), "// &
+            "the RFEM (--set model.kind='rfem') far fewer"
         call make_error(err, ERR_SOLVER, spec%path//': statics: '//trim(text)// &
             '); the rope may have no stable equilibrium near the start, or needs '// &
-            'more iterations (--max-iterations)')
+            'more iterations (--max-iterations)'//hint)
     end subroutine descent_no_convergence
 
     !> One linear solve and its trial point: (K + sigma M + E) delta = f, E >= 0 from the
