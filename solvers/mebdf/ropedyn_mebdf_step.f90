@@ -137,7 +137,8 @@ contains
             call begin_attempt(self, tn)
             call check_progress(self, tn, tries%last_cause, err)
             if (allocated(err)) return
-            call error_weights(self%nt, self%options%rtol, self%atol, self%dif, self%w, self%wi)
+            call weights_and_inverses(self%nt, self%options%rtol, self%atol, self%dif, &
+                                      self%w, self%wi)
             call self%prepare_matrix(self%h*self%coef(self%k)%beta, tries%refresh, status)
             tries%refresh = .false.
             if (status == STATUS_FATAL) then
@@ -335,8 +336,9 @@ contains
     ! history), each loop one pass over the components doing all that a statement per
     ! vector did, with the same operations in the same order (the same bits).
 
-    !> The error weights w = rtol |y_n| + atol and their inverses wi, in one pass.
-    pure subroutine error_weights(nt, rtol, atol, dif, w, wi)
+    !> The error weights w = rtol |y_n| + atol (ropedyn_integrator's error_weights at the
+    !! history's y_n) and their inverses wi, in one pass.
+    pure subroutine weights_and_inverses(nt, rtol, atol, dif, w, wi)
         integer, intent(in) :: nt
         real(wp), intent(in) :: rtol, atol(nt), dif(nt, 0:*)
         real(wp), intent(out) :: w(nt), wi(nt)
@@ -345,7 +347,7 @@ contains
             w(i) = rtol*abs(dif(i, 0)) + atol(i)
             wi(i) = 1.0_wp/w(i)
         end do
-    end subroutine error_weights
+    end subroutine weights_and_inverses
 
     !> Stage 1's predictor pred = sum_{j=0..k} dif_j, its known part
     !! c = pred - beta sum_{j=1..k} gam_j dif_j and its start ybar1 = pred: one pass per
