@@ -309,32 +309,23 @@ contains
         if (ios /= 0) removed = delete_file(path)
     end subroutine hand_back_lock
 
-    !> Create `path` if it does not exist, with the lines `text` if given (then whole or not
-    !! at all, `create_whole`: a lock that does not say who holds it would hold its file for
-    !! LOCK_ABANDONED_AFTER s); `created` false if it existed.
+    !> Create `path` if it does not exist, with the lines `text` if given (empty otherwise),
+    !! whole or not at all (`create_whole`: a lock that does not say who holds it would hold
+    !! its file for LOCK_ABANDONED_AFTER s); `created` false if it existed.
     subroutine create_exclusive(path, created, err, text)
         character(len=*), intent(in) :: path
         logical, intent(out) :: created
         type(error_t), allocatable, intent(out) :: err
         character(len=*), intent(in), optional :: text
-        integer :: unit, ios, rc
-        logical :: exists
-        character(len=256) :: msg
+        integer :: rc
         if (present(text)) then
             rc = create_whole(path, text//new_line('a'))
-            created = rc == 0
-            if (rc /= 0 .and. rc /= ERRNO_EEXIST) &
-                call make_error(err, ERR_IO, path//': cannot create: '//errno_text(rc))
-            return
+        else
+            rc = create_whole(path, '')
         end if
-        open (newunit=unit, file=path, status='new', action='write', iostat=ios, iomsg=msg)
-        created = ios == 0
-        if (created) then
-            close (unit, iostat=ios)
-            return
-        end if
-        inquire (file=path, exist=exists)
-        if (.not. exists) call make_error(err, ERR_IO, path//': cannot create: '//trim(msg))
+        created = rc == 0
+        if (rc /= 0 .and. rc /= ERRNO_EEXIST) &
+            call make_error(err, ERR_IO, path//': cannot create: '//errno_text(rc))
     end subroutine create_exclusive
 
     !> Who holds a lock this process takes: the lines written into it.
