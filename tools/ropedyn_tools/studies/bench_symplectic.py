@@ -359,8 +359,7 @@ def write_plateau(exe, ns, t_end, span, no_write):
         "|---|---|---|---|---|---|---|---|---|---|---|", *summary_rows, "",
         f"Window by window ({span:g} s each): the largest |T + V - E0|, its mean, the mean "
         "elastic energy, m g L, and the first over the third:", ""]
-    for head, rows in windows.values():
-        block += [head, "|" + "---|" * (head.count("|") - 1), *rows, ""]
+    block += window_tables(windows)
     update_doc(DOC, PLATEAU_BEGIN, PLATEAU_END, "\n".join([*block[:-1], PLATEAU_END]))
     print(f"bench_symplectic plateau: {DOC}")
     return 0
@@ -427,9 +426,16 @@ def window_block(windows):
     block = ["The symplectic method's runs window by window: the largest |T + V - E0| in "
              f"each {WINDOW:g} s, its mean, the mean elastic energy (where the fast "
              "modes' energy is), m g L, and the first over the third:", ""]
-    for n, (head, rows) in windows.items():
-        block += [head, "|" + "---|" * (head.count("|") - 1), *rows, ""]
-    return block
+    return block + window_tables(windows)
+
+
+def window_tables(windows):
+    """The window tables of `windows` (window_rows' (head, rows), by run), one after the
+    other, each followed by a blank line."""
+    lines = []
+    for head, rows in windows.values():
+        lines += [head, "|" + "---|" * (head.count("|") - 1), *rows, ""]
+    return lines
 
 
 def main(argv=None):
