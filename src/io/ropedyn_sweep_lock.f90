@@ -32,8 +32,8 @@ module ropedyn_sweep_lock
     use, intrinsic :: iso_fortran_env, only: int64
     use ropedyn_error, only: error_t, make_error, ERR_IO
     use ropedyn_text, only: int_text
-    use ropedyn_os, only: delete_file, special_file_reason, create_whole, errno_text, &
-        ERRNO_EEXIST
+    use ropedyn_os, only: delete_file, rename_file, special_file_reason, create_whole, &
+        errno_text, ERRNO_EEXIST
     use ropedyn_clock, only: utc_timestamp, utc_text, unix_time
     use ropedyn_signals, only: signal_name
     use ropedyn_process, only: process_id, process_start, host_name, file_mtime, &
@@ -282,12 +282,14 @@ contains
         call start_heartbeat(path, LOCK_BEAT, beat, err)
     end subroutine take_lock
 
-    !> Stop the lock's heartbeat and remove the lock.
+    !> Stop the lock's heartbeat and remove the lock (and a `path`.back left by a process
+    !! killed while it handed the lock back, `hand_back_lock`).
     subroutine drop_lock(path, beat)
         character(len=*), intent(in) :: path
         type(heartbeat_t), intent(inout) :: beat
         logical :: removed
         call stop_heartbeat(beat)
+        removed = delete_file(path//'.back')
         removed = delete_file(path)
     end subroutine drop_lock
 
@@ -295,18 +297,26 @@ contains
     !! before this process took it over (`before`, abandoned, as read then): its lines, and
     !! why that writer is gone (`gone=`), so that the lock stays abandoned and goes on naming
     !! it. For a process that took over an abandoned lock and then wrote nothing (a refused
-    !! resume). The lock is removed when it cannot be written.
+    !! resume). The lines are written to `path`.back and renamed over the lock, so that a kill
+    !! leaves this process's own lock (abandoned as soon as it is gone), never an empty one
+    !! (which would hold the file for LOCK_ABANDONED_AFTER s). The lock is removed when it
+    !! cannot be written.
     subroutine hand_back_lock(path, beat, before)
         character(len=*), intent(in) :: path
         type(heartbeat_t), intent(inout) :: beat
         type(lock_t), intent(in) :: before
+        type(error_t), allocatable :: err
         integer :: unit, ios
         logical :: removed
         call stop_heartbeat(beat)
-        open (newunit=unit, file=path, status='replace', action='write', iostat=ios)
+        open (newunit=unit, file=path//'.back', status='replace', action='write', iostat=ios)
         if (ios == 0) write (unit, '(a)', iostat=ios) before%text//'gone='//before%gone()
         if (ios == 0) close (unit, iostat=ios)
-        if (ios /= 0) removed = delete_file(path)
+        if (ios == 0) call rename_file(path//'.back', path, err)
+        if (ios /= 0 .or. allocated(err)) then
+            removed = delete_file(path//'.back')
+            removed = delete_file(path)
+        end if
     end subroutine hand_back_lock
 
     !> Create `path` if it does not exist, with the lines `text` if given (empty otherwise),

@@ -6,6 +6,7 @@ interrupted cases."""
 import os
 import random
 import re
+import shutil
 import signal
 import subprocess
 import time
@@ -348,6 +349,36 @@ def test_resume_of_a_killed_run(run, tmp_path, scene):
     early = run("run", "--resume", "r.h5.part", "--set", "solver.t_end=4.5")
     assert early.returncode == 2 and "r.h5.part: nothing to continue" in early.stderr
     assert (tmp_path / "r.h5.part").exists() and not (tmp_path / "r.h5").exists()
+
+
+@pytest.mark.skipif(shutil.which("strace") is None,
+                    reason="needs strace to kill at a write (scripts/setup --tests)")
+def test_a_run_killed_while_handing_back_a_lock_leaves_no_empty_lock(run, ropedyn_exe,
+                                                                     tmp_path, scene):
+    """A resume that takes over an abandoned lock and then continues nothing gives the lock
+    back to the writer it names (`gone=`). The lock was rewritten in place: a run killed at
+    that write left it empty, and an empty lock holds its file for 120 s (nobody can tell
+    its writer). The lines now go to FILE.lock.back, renamed over the lock. Killed at that
+    write, the run leaves its own lock, abandoned with it, and a resume goes on at once."""
+    assert run("run", scene, "--set", "solver.t_end=0.5", "--set",
+               "output.file='h.h5'").returncode == 0
+    with h5py.File(tmp_path / "h.h5", "r+") as f:
+        f.attrs["status"] = np.bytes_("running")
+    lock = tmp_path / "h.h5.lock"
+    lock_file(lock, 3600)
+    # t_end at the file's end: nothing to continue, the lock is handed back
+    killed = subprocess.run(
+        ["strace", "-f", "-o", "/dev/null", "-P", str(lock), "-P", f"{lock}.back",
+         "-e", "trace=write", "-e", "inject=write:signal=KILL:when=1", str(ropedyn_exe),
+         "run", "--resume", "h.h5", "--set", "solver.t_end=0.5"],
+        cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert killed.returncode == -signal.SIGKILL, killed.stderr
+    assert lock.read_text().startswith("ropedyn sweep case lock\nhost="), lock.read_text()
+    again = run("run", "--resume", "h.h5", "--set", "solver.t_end=0.6")
+    assert again.returncode == 0, again.stderr
+    with h5py.File(tmp_path / "h.h5") as f:
+        assert attr(f, "status") == "complete" and abs(f["time"][-1] - 0.6) < 1e-12
+    assert not lock.exists() and not (tmp_path / "h.h5.lock.back").exists()
 
 
 def test_resume_records_its_version_and_overrides(run, tmp_path, scene):
