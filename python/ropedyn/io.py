@@ -21,10 +21,11 @@ ENERGY_NAMES = ("kinetic", "elastic", "gravity", "dissipated", "support_work", "
 FORCE_NAMES = ("axial", "shear", "moment")
 #: The supports (/supports/END/reaction and /position, (T, 2)).
 SUPPORT_ENDS = ("top", "bottom")
-#: Scalar solver statistics written at the end of a run (/solver/NAME).
-SOLVER_STATS = ("steps", "rhs_evals", "jac_evals", "lin_setups", "err_test_fails",
-                "nonlin_iters", "nonlin_conv_fails", "cpu_time", "time_advance", "time_rhs", "time_jacobian",
-                "time_factor", "time_solve", "reduced_newton")
+#: Scalar solver statistics written at the end of a run (/solver/NAME; jac_rhs_evals, the f
+#: evaluations of differenced Jacobians, not in files of earlier versions).
+SOLVER_STATS = ("steps", "rhs_evals", "jac_rhs_evals", "jac_evals", "lin_setups",
+                "err_test_fails", "nonlin_iters", "nonlin_conv_fails", "cpu_time", "time_advance",
+                "time_rhs", "time_jacobian", "time_factor", "time_solve", "reduced_newton")
 
 
 def text(value):

@@ -79,6 +79,12 @@ STATS = {
     "solver/cpu_time": "s",
 }
 
+#: Scalar solver statistics that files of earlier versions lack, checked as STATS when
+#: present: the f evaluations spent differencing Jacobians (int64).
+OPTIONAL_STATS = {
+    "solver/jac_rhs_evals": "1",
+}
+
 #: Extra attributes on some datasets.
 COLUMNS = {
     "state/q": "x, y, phi",
@@ -243,8 +249,10 @@ def _check_run(f, path, n_elements, extents):
 
 
 def _check_stats(f, path):
-    """The scalar solver statistics (STATS), all of them."""
-    for name, units in STATS.items():
+    """The scalar solver statistics (STATS), all of them, and those of OPTIONAL_STATS the
+    file has."""
+    present = {k: v for k, v in OPTIONAL_STATS.items() if k in f}
+    for name, units in {**STATS, **present}.items():
         _require(name in f, f"{path}: /{name} is missing")
         dset = f[name]
         _require(dset.shape == (), f"{path}: /{name} has shape {dset.shape}, expected ()")

@@ -157,8 +157,9 @@ contains
 
     !> The summary of a run: what ran, its cost, the methods it used, its energies and how
     !! well they balance, the peak tension, the order safety's actions, the file. Counters that did not
-    !! apply (no implicit step: no Jacobians, factorizations) are left out. With `verbose`
-    !! every switch of method or order on a line of its own.
+    !! apply (no implicit step: no Jacobians, factorizations; no differenced Jacobian: the
+    !! f evaluations they took) are left out. With `verbose` every switch of method or order
+    !! on a line of its own.
     subroutine print_summary(scene, s, verbose)
         type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(in) :: s
@@ -171,6 +172,10 @@ contains
             scene%model%elements, '   rtol ', scene%solver%rtol, '   t = ', s%t_reached, ' s'
         line = '  steps           '//int_text(s%stats%steps)//'   rhs evals '// &
             int_text(s%stats%rhs_evals)
+        ! f evaluations of differenced Jacobians are not among the rhs evals (as in the
+        ! testset's summary, ropedyn_cmd_testset)
+        if (s%stats%jac_rhs_evals > 0) line = line//' (+ '//int_text(s%stats%jac_rhs_evals)// &
+            ' for Jacobian differencing)'
         if (s%stats%jac_evals > 0) line = line//'   jacobians '//int_text(s%stats%jac_evals)
         if (s%stats%err_test_fails > 0) line = line//'   error-test fails '// &
             int_text(s%stats%err_test_fails)

@@ -12,8 +12,9 @@
 !!     /energy/{kinetic, elastic, gravity, dissipated, support_work, total} (times,) J
 !!     /solver/step_size       (times,)               s
 !!     /solver/order           (times,)               1
-!!     /solver/{steps, rhs_evals, jac_evals, lin_setups, err_test_fails, nonlin_iters,
-!!              nonlin_conv_fails} () int64 1;  /solver/cpu_time () s   (write_stats)
+!!     /solver/{steps, rhs_evals, jac_rhs_evals, jac_evals, lin_setups, err_test_fails,
+!!              nonlin_iters, nonlin_conv_fails} () int64 1;  /solver/cpu_time () s
+!!              (write_stats; jac_rhs_evals: the f evaluations of differenced Jacobians)
 !!     /solver/{time_advance, time_rhs, time_jacobian, time_factor, time_solve} () s: the
 !!              time in the integrator and where it went (&solver profile = .true.; else 0)
 !!     /solver/reduced_newton () int64 1: 1 when the Newton systems were solved on the
@@ -155,9 +156,11 @@ module ropedyn_output
 
     !> The solver counters of `write_stats` (/solver/<name>, int64, units 1), in the order
     !! of `counter_values`.
-    character(len=*), parameter :: COUNTER_NAMES(7) = [character(len=17) :: 'steps', &
-        'rhs_evals', 'jac_evals', 'lin_setups', 'err_test_fails', 'nonlin_iters', &
-        'nonlin_conv_fails']
+    !! jac_rhs_evals (f evaluations spent differencing Jacobians) is absent in files of
+    !! earlier versions: read as absent (ropedyn_case_file), it counts 0 for their parts.
+    character(len=*), parameter :: COUNTER_NAMES(8) = [character(len=17) :: 'steps', &
+        'rhs_evals', 'jac_rhs_evals', 'jac_evals', 'lin_setups', 'err_test_fails', &
+        'nonlin_iters', 'nonlin_conv_fails']
 
     !> The time split of `write_stats` (/solver/<name>, s; solver_stats_t's time_* fields,
     !! measured with &solver profile = .true.), in the order of `timer_values`.
@@ -713,8 +716,9 @@ contains
     pure function counter_values(stats) result(counters)
         type(solver_stats_t), intent(in) :: stats
         integer(i8) :: counters(size(COUNTER_NAMES))
-        counters = [stats%steps, stats%rhs_evals, stats%jac_evals, stats%lin_setups, &
-                    stats%err_test_fails, stats%nonlin_iters, stats%nonlin_conv_fails]
+        counters = [stats%steps, stats%rhs_evals, stats%jac_rhs_evals, stats%jac_evals, &
+                    stats%lin_setups, stats%err_test_fails, stats%nonlin_iters, &
+                    stats%nonlin_conv_fails]
     end function counter_values
 
     !> Add counters in COUNTER_NAMES order (those of the earlier parts of a resumed run) to
@@ -724,11 +728,12 @@ contains
         integer(i8), intent(in) :: counters(size(COUNTER_NAMES))
         stats%steps = stats%steps + counters(1)
         stats%rhs_evals = stats%rhs_evals + counters(2)
-        stats%jac_evals = stats%jac_evals + counters(3)
-        stats%lin_setups = stats%lin_setups + counters(4)
-        stats%err_test_fails = stats%err_test_fails + counters(5)
-        stats%nonlin_iters = stats%nonlin_iters + counters(6)
-        stats%nonlin_conv_fails = stats%nonlin_conv_fails + counters(7)
+        stats%jac_rhs_evals = stats%jac_rhs_evals + counters(3)
+        stats%jac_evals = stats%jac_evals + counters(4)
+        stats%lin_setups = stats%lin_setups + counters(5)
+        stats%err_test_fails = stats%err_test_fails + counters(6)
+        stats%nonlin_iters = stats%nonlin_iters + counters(7)
+        stats%nonlin_conv_fails = stats%nonlin_conv_fails + counters(8)
     end subroutine add_counter_values
 
     !> Set the root status ('complete', or 'failed' or 'interrupted' with `reason`) and close

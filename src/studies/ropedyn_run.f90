@@ -50,7 +50,7 @@ module ropedyn_run
     use ropedyn_scene_solver, only: create_integrator, solver_options_of, step_budget, &
         check_method_fits
     use ropedyn_os, only: make_parent_dirs
-    use ropedyn_output, only: output_file_t, add_counter_values
+    use ropedyn_output, only: output_file_t, add_counter_values, COUNTER_NAMES
     use ropedyn_progress, only: progress_t
     use ropedyn_switch_log, only: switch_event_t, switch_log_t
     use ropedyn_version, only: version_string
@@ -139,8 +139,9 @@ module ropedyn_run
         !> the run goes on from its file (`open` with resume): its start, and the scene's
         !! warnings, are the earlier part's
         logical :: resumed = .false.
-        !> resume: the counters and CPU time (s) of the earlier parts of the run
-        integer(i8) :: counters_before(7) = 0
+        !> resume: the counters (COUNTER_NAMES; one a file lacks counts 0) and CPU time (s)
+        !! of the earlier parts of the run
+        integer(i8) :: counters_before(size(COUNTER_NAMES)) = 0
         real(wp) :: cpu_before = 0.0_wp
         real(wp) :: cpu_start = 0.0_wp      !< CPU clock at `begin`, s
         !> the integration has begun: its counters are kept for the file's flushes

@@ -84,6 +84,8 @@ contains
             keep = rec%record + 1
             if (rec%record > 0 .and. abs(self%output_time(self%k_next - 1) - self%t) > tol) &
                 keep = keep - 1
+            ! a counter the file lacks (-1: jac_rhs_evals in a file of an earlier version)
+            ! counts 0 for the earlier parts
             do j = 1, size(self%counters_before)
                 self%counters_before(j) = max(0_i8, before%counters(j))
             end do

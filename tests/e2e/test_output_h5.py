@@ -1,5 +1,6 @@
-"""The HDF5 output read back with h5py: layout, shapes, units, status, energies, and the
-effective scene stored in the file re-runs to the same result."""
+"""The HDF5 output read back with h5py: layout, shapes, units, status, energies, the
+effective scene stored in the file re-runs to the same result, and the f evaluations of
+differenced Jacobians are counted, printed and carried across resumes."""
 import subprocess
 import sys
 
@@ -8,6 +9,7 @@ import numpy as np
 import pytest
 
 from ropedyn import layout
+from ropedyn.io import load_run
 from ropedyn.layout import check_layout
 
 SCENE = """
@@ -162,3 +164,89 @@ def test_layout_fails_a_killed_file_whose_last_record_does_not_read_back(run, tm
                            "for EOA)")
     monkeypatch.setattr(layout, "check_layout", walk_fails)
     assert layout.main([str(killed), "5"]) == 1
+
+
+# the MPP model on MEBDF's first-order Newton matrix: its mass matrix leaves no analytic
+# Jacobian of the first-order system, so MEBDF differences it (ropedyn_iteration_matrix_first)
+DIFFERENCED = """
+&model kind = 'mpp', elements = 4 /
+&solver method = 'mebdf', first_order_newton = .true., t_end = 0.2, output_interval = 0.05,
+        rtol = 1e-5, atol = 1e-8 /
+&output file = 'fd.h5', progress = .false. /
+"""
+COUNTERS = ("rhs_evals", "jac_rhs_evals", "jac_evals")
+
+
+def counters(path):
+    """/solver's rhs_evals, jac_rhs_evals and jac_evals (None when absent) and the state
+    size."""
+    with h5py.File(path) as f:
+        return ({k: int(f[f"solver/{k}"][()]) if f"solver/{k}" in f else None
+                 for k in COUNTERS}, f["state/y"].shape[1])
+
+
+def test_f_evaluations_of_differenced_jacobians_are_written_and_printed(run, tmp_path):
+    """/solver/jac_rhs_evals holds the f evaluations spent differencing Jacobians, which
+    /solver/rhs_evals leaves out, and the summary adds them to its rhs evals. A differenced
+    Jacobian of MEBDF evaluates F at y and once per column group, and the MPP's band is
+    full: N + 1 evaluations per Jacobian for a state of N. With analytic Jacobians (MEBDF's
+    reduced matrix, CVODE's first-order one on the same rope) the counter is 0 and the
+    summary says nothing of it. ropedyn.load_run gives it among the stats."""
+    (tmp_path / "fd.nml").write_text(DIFFERENCED)
+    result = run("run", "fd.nml")
+    assert result.returncode == 0, result.stderr
+    c, n = counters(tmp_path / "fd.h5")
+    print(f"mebdf, first-order matrix: {c}, state size {n}")
+    assert c["jac_evals"] > 0 and c["jac_rhs_evals"] == (n + 1) * c["jac_evals"]
+    assert (f"rhs evals {c['rhs_evals']} (+ {c['jac_rhs_evals']} for Jacobian "
+            f"differencing)") in result.stdout, result.stdout
+    check_layout(str(tmp_path / "fd.h5"), 4)
+    with h5py.File(tmp_path / "fd.h5") as f:
+        dset = f["solver/jac_rhs_evals"]
+        assert dset.dtype == np.int64 and dset.attrs["units"] == b"1"
+    assert load_run(tmp_path / "fd.h5").stats["jac_rhs_evals"] == c["jac_rhs_evals"]
+    for name, setting in (("reduced", "solver.first_order_newton=.false."),
+                          ("cvode", "solver.method='cvode'")):
+        result = run("run", "fd.nml", "--set", f"output.file='{name}.h5'", "--set", setting)
+        assert result.returncode == 0, result.stderr
+        c, _ = counters(tmp_path / f"{name}.h5")
+        assert c["jac_evals"] > 0 and c["jac_rhs_evals"] == 0, (name, c)
+        assert "Jacobian differencing" not in result.stdout
+    # a layout check that holds the counter to the others' type and units
+    with h5py.File(tmp_path / "fd.h5", "r+") as f:
+        f["solver/jac_rhs_evals"].attrs["units"] = np.bytes_("s")
+    with pytest.raises(AssertionError, match="/solver/jac_rhs_evals units 's'"):
+        check_layout(str(tmp_path / "fd.h5"), 4)
+
+
+def test_f_evaluations_of_differenced_jacobians_add_up_over_a_resume(run, tmp_path):
+    """A resumed run's /solver/jac_rhs_evals counts its parts, as its jac_evals do: N + 1
+    per Jacobian over both (the second part's own alone would fall short by the first's).
+    A file of an earlier version, without the dataset, passes the layout check and is
+    continued; its earlier part counts 0, the dataset is written again for the part that
+    continued it."""
+    (tmp_path / "fd.nml").write_text(DIFFERENCED)
+    for name in ("a.h5", "b.h5"):
+        result = run("run", "fd.nml", "--set", "solver.t_end=0.1", "--set",
+                     f"output.file='{name}'")
+        assert result.returncode == 0, result.stderr
+    first, n = counters(tmp_path / "a.h5")
+    assert first["jac_rhs_evals"] > 0
+    result = run("run", "--resume", "a.h5", "--set", "solver.t_end=0.2")
+    assert result.returncode == 0, result.stderr
+    both, _ = counters(tmp_path / "a.h5")
+    print(f"first part {first}, both {both}")
+    assert both["jac_evals"] > first["jac_evals"]
+    assert both["jac_rhs_evals"] == (n + 1) * both["jac_evals"]
+    assert f"(+ {both['jac_rhs_evals']} for Jacobian differencing)" in result.stdout
+    # as a file of an earlier version
+    with h5py.File(tmp_path / "b.h5", "r+") as f:
+        del f["solver/jac_rhs_evals"]
+    check_layout(str(tmp_path / "b.h5"), 4)
+    assert "jac_rhs_evals" not in load_run(tmp_path / "b.h5").stats
+    result = run("run", "--resume", "b.h5", "--set", "solver.t_end=0.2")
+    assert result.returncode == 0, result.stderr
+    later, _ = counters(tmp_path / "b.h5")
+    assert later["jac_evals"] == both["jac_evals"]
+    assert later["jac_rhs_evals"] == (n + 1) * (later["jac_evals"] - first["jac_evals"]) > 0
+    check_layout(str(tmp_path / "b.h5"), 4)

@@ -199,6 +199,35 @@ def test_failing_case_recorded_others_finish(run, sweep_dir):
     assert result.returncode == 3 and "2 complete already, running 2" in result.stderr
 
 
+def test_summary_counts_the_f_evaluations_of_differenced_jacobians(run, sweep_dir):
+    """The summary's jac_rhs_evals is each case file's /solver/jac_rhs_evals: > 0 where MEBDF
+    differences the MPP's Jacobian (first-order matrix), 0 with the analytic blocks of the
+    reduced one. A case file of an earlier version lacks it: an empty field, -1 in
+    summary.h5, as for any counter a file lacks."""
+    (sweep_dir / "scenes" / "mpp.nml").write_text(
+        "&model kind = 'mpp', elements = 3 /\n&solver method = 'mebdf', t_end = 0.1 /\n")
+    (sweep_dir / "fd.nml").write_text("&sweep base = 'scenes/mpp.nml', output_dir = 'out/fd', "
+                                      "vary = 'solver.first_order_newton = .true.; .false.' /\n")
+    result = run("sweep", "fd.nml", "--jobs", "1")
+    assert result.returncode == 0, result.stderr
+    out = sweep_dir / "out" / "fd"
+    rows = read_csv(out / "summary.csv")
+    files = [h5py.File(out / f"case_{k:04d}.h5") for k in (1, 2)]
+    counts = [int(f["solver/jac_rhs_evals"][()]) for f in files]
+    for f in files:
+        f.close()
+    assert counts[0] > 0 and counts[1] == 0
+    assert [int(r["jac_rhs_evals"]) for r in rows] == counts
+    with h5py.File(out / "summary.h5") as f:
+        assert f["jac_rhs_evals"].dtype == np.int64 and list(f["jac_rhs_evals"][:]) == counts
+    with h5py.File(out / "case_0001.h5", "r+") as f:
+        del f["solver/jac_rhs_evals"]
+    assert run("sweep", "fd.nml", "--summary").returncode == 0
+    assert [r["jac_rhs_evals"] for r in read_csv(out / "summary.csv")] == ["", "0"]
+    with h5py.File(out / "summary.h5") as f:
+        assert list(f["jac_rhs_evals"][:]) == [-1, 0]
+
+
 def test_case_failing_before_its_file_says_why(run, sweep_dir):
     """A case whose run fails before it makes its file (here: its start, an equilibrium of a
     rope whose both ends are free) is failed with that reason in the status and the

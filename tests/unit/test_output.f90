@@ -13,7 +13,7 @@ program test_output
     use ropedyn_error, only: error_t, ERR_IO, ERR_INTERNAL
     use ropedyn_rope_model, only: energy_t
     use ropedyn_integrator, only: solver_stats_t
-    use ropedyn_output, only: output_file_t
+    use ropedyn_output, only: output_file_t, COUNTER_NAMES, counter_values, add_counter_values
     use ropedyn_assert, only: test_suite_t
     implicit none
 
@@ -50,8 +50,10 @@ program test_output
                         0.01_wp*k, k, err)
         call suite%check_true(.not. allocated(err), 'append record'//error_text(err))
     end do
-    stats = solver_stats_t(steps=123_i8, rhs_evals=456_i8, jac_evals=7_i8, lin_setups=8_i8, &
-                           err_test_fails=9_i8, nonlin_iters=1000_i8, nonlin_conv_fails=2_i8)
+    stats = solver_stats_t(steps=123_i8, rhs_evals=456_i8, jac_rhs_evals=45_i8, jac_evals=7_i8, &
+                           lin_setups=8_i8, err_test_fails=9_i8, nonlin_iters=1000_i8, &
+                           nonlin_conv_fails=2_i8)
+    call check_counter_values(stats)
     call out%write_stats(stats, 1.25_wp, err)
     call suite%check_true(.not. allocated(err), 'write_stats'//error_text(err))
     call out%write_stats(stats, 1.5_wp, err)
@@ -183,6 +185,22 @@ contains
 
     ! Checks of the files --------------------------------------------------------------------
 
+    !> counter_values gives every counter of `stats` once, under its name in COUNTER_NAMES,
+    !! and add_counter_values (a resume's earlier parts) adds each back to its own field.
+    subroutine check_counter_values(stats)
+        type(solver_stats_t), intent(in) :: stats
+        type(solver_stats_t) :: sum
+        integer(i8) :: values(size(COUNTER_NAMES))
+        values = counter_values(stats)
+        call suite%check_true(values(findloc(COUNTER_NAMES, 'jac_rhs_evals', 1)) == 45_i8 &
+                              .and. values(findloc(COUNTER_NAMES, 'rhs_evals', 1)) == 456_i8, &
+                              'counter_values: jac_rhs_evals, rhs_evals under their names')
+        sum = stats
+        call add_counter_values(sum, values)
+        call suite%check_true(all(counter_values(sum) == 2*values), &
+                              'add_counter_values adds each counter to its own field')
+    end subroutine check_counter_values
+
     subroutine check_complete_file()
         integer(hid_t) :: file_id
         integer(hsize_t), allocatable :: dims(:)
@@ -253,6 +271,8 @@ contains
                                                               '/solver/order values')
         call read_int8_scalar(file_id, '/solver/nonlin_iters', steps)
         call suite%check_true(steps == 1000_i8, '/solver/nonlin_iters = 1000')
+        call read_int8_scalar(file_id, '/solver/jac_rhs_evals', steps)
+        call suite%check_true(steps == 45_i8, '/solver/jac_rhs_evals = 45')
         call read_real_scalar(file_id, '/solver/cpu_time', cpu)
         call suite%check_close(cpu, 1.5_wp, 0.0_wp, 0.0_wp, '/solver/cpu_time (rewritten)')
 
