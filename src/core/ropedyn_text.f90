@@ -6,7 +6,7 @@ module ropedyn_text
     implicit none
     private
     public :: int_text, real_text, fixed_text, pair_text, logical_text, quoted, enclosed
-    public :: significant_text, decimal_product
+    public :: significant_text, decimal_product, column_text
     public :: lower, line_quote, replaced, stripped, es_text
     public :: text_t, append_text, text_array, printable, clip, name_hint, edit_distance
 
@@ -190,6 +190,32 @@ contains
             s = '-0'//s(2:)
         end if
     end function fixed_text
+
+    !> x right-aligned in a column of `width` characters: fixed-point with `decimals`
+    !! digits after the point, or fewer where the number needs the room (a force of 138 kN in
+    !! f12.6 is 14 characters), else in scientific notation (at least 11 characters wide).
+    !! Fortran's own fixed formats print asterisks for a number too wide, and numbers that
+    !! fill their whole field run into the next.
+    function column_text(x, width, decimals) result(s)
+        real(wp), intent(in) :: x
+        integer, intent(in) :: width, decimals
+        character(len=:), allocatable :: s
+        character(len=64) :: buf
+        character(len=24) :: fmt
+        integer :: d, w
+        do d = max(decimals, 0), 0, -1
+            write (fmt, '(a, i0, a, i0, a)') '(f', width, '.', d, ')'
+            write (buf, fmt) x
+            if (index(buf(1:width), '*') == 0) then
+                s = buf(1:width)
+                return
+            end if
+        end do
+        w = max(width, 11)
+        write (fmt, '(a, i0, a, i0, a)') '(es', w, '.', w - 8, ')'
+        write (buf, fmt) x
+        s = buf(1:w)
+    end function column_text
 
     !> 'x, y' of a pair, each as `real_text`.
     function pair_text(x) result(s)

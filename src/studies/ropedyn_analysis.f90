@@ -12,7 +12,7 @@ module ropedyn_analysis
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_os, only: make_parent_dirs, written_path, rename_file, delete_file
     use ropedyn_run_inputs, only: check_not_input, check_may_replace, check_part_free
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, column_text
     use ropedyn_model_factory, only: create_model
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
                                potential_energy, rope_length
@@ -291,23 +291,32 @@ contains
             self%sres%criterion//' after ', self%sres%iterations, ' iterations (', &
             self%sres%rejected, ' rejected, ', self%sres%newton_steps, ' Newton'// &
             trim(stage_text(self%sres%stages))//')'
-        write (output_unit, '(a, es10.3, a, es10.3, a, f8.4, a)') '  residual        '// &
+        write (output_unit, '(a, es10.3, a, es10.3, a)') '  residual        '// &
             'max |f| = ', self%sres%residual, ' N (', self%sres%residual_relative, &
-            ' of the weight ', self%sres%weight, ' N)'
+            ' of the weight '//column_text(self%sres%weight, 8, 4)//' N)'
         write (output_unit, '(a, es14.6, a, es14.6)') '  energy (J)      elastic', &
             self%sres%elastic, '   gravity', self%sres%gravity
-        write (output_unit, '(a, f12.7, a, f12.7, a)') '  lowest point    x = ', &
-            points(1, deepest), ' m at y = ', points(2, deepest), ' m'
-        write (output_unit, '(a, f12.7, a, f12.7, a)') '  lower end       x = ', &
-            points(1, 2*n), ' m,   y = ', points(2, 2*n), ' m'
-        if (trim(scene%supports%top) /= 'free') write (output_unit, '(a, 3f12.6)') &
-            '  top support force on the rope (x, y, |F|) N:   ', force_top, norm2(force_top)
-        if (trim(scene%supports%bottom) /= 'free') write (output_unit, '(a, 3f12.6)') &
-            '  bottom support force on the rope (x, y, |F|) N:', force_bottom, &
-            norm2(force_bottom)
+        write (output_unit, '(a)') '  lowest point    x = '// &
+            column_text(points(1, deepest), 12, 7)//' m at y = '// &
+            column_text(points(2, deepest), 12, 7)//' m'
+        write (output_unit, '(a)') '  lower end       x = '//column_text(points(1, 2*n), 12, 7)// &
+            ' m,   y = '//column_text(points(2, 2*n), 12, 7)//' m'
+        if (trim(scene%supports%top) /= 'free') write (output_unit, '(a)') &
+            '  top support force on the rope (x, y, |F|) N:   '//force_columns(force_top)
+        if (trim(scene%supports%bottom) /= 'free') write (output_unit, '(a)') &
+            '  bottom support force on the rope (x, y, |F|) N:'//force_columns(force_bottom)
         if (self%command == 'modes') call print_modes(self%mres)
         write (output_unit, '(a)') '  output          '//self%out_path
     end subroutine analysis_print_summary
+
+    !> A support force's columns x, y and |F| (N), each after a space: fixed-point where the
+    !! force fits (column_text).
+    function force_columns(force) result(text)
+        real(wp), intent(in) :: force(2)
+        character(len=:), allocatable :: text
+        text = ' '//column_text(force(1), 11, 6)//' '//column_text(force(2), 11, 6)//' '// &
+               column_text(norm2(force), 11, 6)
+    end function force_columns
 
     !> The modes' lines of the summary.
     subroutine print_modes(mres)

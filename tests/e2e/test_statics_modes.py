@@ -376,3 +376,29 @@ def test_a_mode_start_holds_the_modes_energy_not_the_pins(run, tmp_path, kind):
         per_square.append((v - rest) / amplitude**2)
         assert abs(top / tension - 1) < 0.02, (amplitude, top, tension)
     assert abs(per_square[0] / per_square[1] - 1) < 0.05, per_square
+
+
+def test_the_summary_prints_large_forces(run, tmp_path):
+    """A line of kilonewtons: the summary printed its weight and support forces in fixed
+    fields too narrow for them, as asterisks or run together
+    ("-214.01784439485.03655339485.616561"). Each number now stands apart, with as many
+    decimals as fit, and reads back as the file's value."""
+    (tmp_path / "heavy.nml").write_text(
+        "&model /\n&rope length = 10.0, mass_per_length = 120.0, axial_stiffness = 1.0e9 /\n"
+        "&supports bottom = 'pinned', bottom_anchor = 9.0, 4.0 /\n"
+        "&initial angle_deg = 0.0 /\n")
+    result = run("statics", "heavy.nml", "-o", "h.h5")
+    assert result.returncode == 0, result.stderr
+    assert "*" not in result.stdout, result.stdout
+    lines = {line.split(":")[0].strip(): line for line in result.stdout.splitlines()}
+    with h5py.File(tmp_path / "h.h5") as f:
+        weight = f["statics/weight"][()]
+        for end in ("top", "bottom"):
+            force = f[f"statics/support_force_{end}"][:]
+            printed = [float(v) for v in
+                       lines[f"{end} support force on the rope (x, y, |F|) N"].split(":")[1].split()]
+            expected = [*force, np.hypot(*force)]
+            assert np.allclose(printed, expected, rtol=1e-6, atol=1e-3), (printed, expected)
+    assert weight > 1e4
+    printed_weight = float(result.stdout.split("of the weight")[1].split()[0])
+    assert abs(printed_weight / weight - 1) < 1e-6, (printed_weight, weight)
