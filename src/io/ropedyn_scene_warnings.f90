@@ -7,8 +7,9 @@
 !! harmonic key or a table with another motion), a release or a ramp that the run ends
 !! before, a key of &ground or &fluid set away from its default while the effects that use
 !! it are off (a ground or a water given and not switched on), a support_stiffness_factor
-!! that scales the rope's own end section (a clamp, a 'split' end). Each warning names the key,
-!! its value and why; a run goes ahead.
+!! that scales the rope's own end section (a clamp, a 'split' end), anchors further apart
+!! than the rope can reach without stretching by more than 10 %. Each warning names the
+!! key, its value and why; a run goes ahead.
 module ropedyn_scene_warnings
     use, intrinsic :: iso_fortran_env, only: error_unit
     use ropedyn_kinds, only: wp
@@ -28,6 +29,10 @@ module ropedyn_scene_warnings
     !> The bounds of the checks.
     real(wp), parameter :: MAX_DIAMETER_SHARE = 0.1_wp   !< of the length
     real(wp), parameter :: MAX_SELF_STRAIN = 0.1_wp      !< under the rope's own weight
+    !> the stretch a line held at both ends needs to reach its anchors (their distance over
+    !! the length, less 1): a taut mooring leg stretches by a few per cent, a chain or wire
+    !! breaks near 1 to 2 %
+    real(wp), parameter :: MAX_REACH_STRAIN = 0.1_wp
     !> an element's axial damping ratio (as computed below) grows with n: the paper's rope
     !! with its heavy damping reading has 0.032 at n = 30 and 10.9 at n = 10,000 (10, the
     !! issue's example, warned there); a coefficient in N s/m^2 given as N s, or the
@@ -95,6 +100,7 @@ contains
                 '(air is 1.225 kg/m^3): water is about 1000 (fresh) or 1025 (sea)')
         if (scene%effects%ground) call ground_start(scene, list)
         if (scene%effects%ground) call ground_anchors(scene, list)
+        call anchor_reach(scene, sec, list)
         call idle_groups(scene, list)
         call shared_section_factor(scene, sec, list)
         call tolerance_below_rounding(scene, list)
@@ -369,6 +375,31 @@ contains
                 'the rope against the support for good; move the anchor or the ground')
         end subroutine held_end
     end subroutine ground_anchors
+
+    !> Both ends held and their anchors further apart than the rope's length by more than
+    !! MAX_REACH_STRAIN: the line is stretched by that much to reach them, at a tension of
+    !! about EA times the stretch, which the statics and the run then show without a word
+    !! (a newcomer's 120 m mooring chain between anchors 137.9 m apart: 8.7e7 N).
+    subroutine anchor_reach(scene, sec, list)
+        type(scene_t), intent(in) :: scene
+        type(section_t), intent(in) :: sec
+        type(text_t), allocatable, intent(inout) :: list(:)
+        real(wp) :: distance, strain
+        if (scene%supports%top == 'free' .or. scene%supports%bottom == 'free') return
+        if (.not. bottom_anchor_given(scene%rope_spec_t)) return
+        distance = norm2(scene%supports%bottom_anchor - scene%supports%top_anchor)
+        strain = distance/scene%rope%length - 1.0_wp
+        if (.not. strain > MAX_REACH_STRAIN) return
+        call append_text(list, scene%origin('supports.bottom_anchor')// &
+            ': &supports: bottom_anchor = '// &
+            significant_text(scene%supports%bottom_anchor(1), 6)//', '// &
+            significant_text(scene%supports%bottom_anchor(2), 6)//': '// &
+            significant_text(distance, 4)//' m from the top anchor, more than the rope''s '// &
+            'length ('//significant_text(scene%rope%length, 6)//' m): the line must stretch '// &
+            'by '//significant_text(100.0_wp*strain, 3)//' % to reach it, at a tension of '// &
+            'about '//significant_text(strain*sec%ea, 3)//' N (EA times the stretch); '// &
+            'an anchor out of reach, or a length in the wrong unit?')
+    end subroutine anchor_reach
 
     !> The straight starts ('straight', 'hanging': from &supports top_anchor along the
     !! initial angle) whose far end lies deeper in the ground than MAX_START_DEPTH_SHARE of

@@ -47,20 +47,56 @@ contains
             p = merge(1, size(points, 2), k == 1)
             d = norm2(points(:, p) - anchors(:, k))
             if (.not. d > FAR_ANCHOR_SHARE*scene%rope%length) cycle
+            if (at_rest_start(scene)) then
+                call append_text(list, anchor_text(k)//': the equilibrium leaves the '// &
+                    trim(merge('upper', 'lower', k == 1))//' end '//distance_text(d)// &
+                    ': the rope pulls its support''s spring that far'//reach(anchors))
+                cycle
+            end if
             energy = significant_text(e%elastic, 3)//' J'
             if (weight_length > 0.0_wp) energy = energy//' ('// &
                 significant_text(e%elastic/weight_length, 3)//' m g L)'
-            call append_text(list, scene%origin('supports.'//trim(ENDS(k))//'_anchor')// &
-                ': &supports: '//trim(ENDS(k))//'_anchor = '// &
-                real_text(anchors(1, k))//', '//real_text(anchors(2, k))//': the initial '// &
+            call append_text(list, anchor_text(k)//': the initial '// &
                 'state leaves the '//trim(merge('upper', 'lower', k == 1))//' end '// &
-                significant_text(d, 3)//' m from it ('// &
-                significant_text(100.0_wp*d/scene%rope%length, 3)//' % of the length): '// &
+                distance_text(d)//': '// &
                 'its support spring pulls the end there at the start, and the start holds '// &
                 energy//' of elastic energy; start from &initial shape = ''equilibrium'''// &
                 hint(k))
         end do
     contains
+        !> 'ORIGIN: &supports: END_anchor = X, Y'
+        function anchor_text(k) result(text)
+            integer, intent(in) :: k
+            character(len=:), allocatable :: text
+            text = scene%origin('supports.'//trim(ENDS(k))//'_anchor')//': &supports: '// &
+                trim(ENDS(k))//'_anchor = '//real_text(anchors(1, k))//', '// &
+                real_text(anchors(2, k))
+        end function anchor_text
+
+        !> 'D m from it (P % of the length)'
+        function distance_text(d) result(text)
+            real(wp), intent(in) :: d
+            character(len=:), allocatable :: text
+            text = significant_text(d, 3)//' m from it ('// &
+                significant_text(100.0_wp*d/scene%rope%length, 3)//' % of the length)'
+        end function distance_text
+
+        !> Why an equilibrium stretches a support's spring: the anchors out of the rope's
+        !! reach, or a soft support.
+        function reach(anchors) result(text)
+            real(wp), intent(in) :: anchors(2, 2)
+            character(len=:), allocatable :: text
+            real(wp) :: apart
+            apart = norm2(anchors(:, 2) - anchors(:, 1))
+            if (all(ieee_is_finite(anchors)) .and. apart > scene%rope%length) then
+                text = ' (the anchors are '//significant_text(apart, 4)//' m apart, the '// &
+                    'rope '//significant_text(scene%rope%length, 6)//' m long: out of its '// &
+                    'reach unless it stretches)'
+            else
+                text = '; a stiffer support: &supports support_stiffness_factor'
+            end if
+        end function reach
+
         pure function hint(k) result(text)
             integer, intent(in) :: k
             character(len=:), allocatable :: text
@@ -71,4 +107,11 @@ contains
             end if
         end function hint
     end function far_anchor_warnings
+
+    !> The scene starts in its equilibrium (&initial shape 'equilibrium', or 'mode': the
+    !! equilibrium and a small mode shape): its support springs carry the rope's pull.
+    pure logical function at_rest_start(scene)
+        type(scene_t), intent(in) :: scene
+        at_rest_start = scene%initial%shape == 'equilibrium' .or. scene%initial%shape == 'mode'
+    end function at_rest_start
 end module ropedyn_start_checks

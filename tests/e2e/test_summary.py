@@ -142,6 +142,36 @@ def test_a_held_end_started_far_from_its_anchor_is_warned_of(run):
     assert float(m.group(3)) > 0.0
 
 
+def test_anchors_out_of_reach_are_warned_of(run, tmp_path):
+    """A line held at both ends whose anchors are further apart than it is long: it is
+    stretched to reach them, by 50 % here, at a tension of about EA times that, and the
+    statics and the run showed it without a word. The scene now warns with the stretch and
+    that tension. A start in that equilibrium leaves both ends off their anchors by the
+    support springs' stretch: its warning said to start from the equilibrium, the start it
+    had; it now says why. Anchors within reach have neither warning."""
+    ea = 35.0e6 * np.pi * 0.005**2 / 4
+    sets = ["model.elements=10", "solver.t_end=0.001", "solver.output_interval=0.001",
+            "supports.bottom=pinned", "initial.shape='equilibrium'", "output.file='s.h5'",
+            "output.progress=.false."]
+    far = run("run", PAPER, "--force", *[a for s in sets + ["supports.bottom_anchor=1.5, 0.0"]
+                                         for a in ("--set", s)])
+    assert far.returncode == 0, far.stderr
+    m = re.search(r"bottom_anchor = 1\.5, 0\.0: 1\.5 m from the top anchor, more than the "
+                  r"rope's length \(1\.0 m\): the line must stretch by ([0-9.]+) % to reach "
+                  r"it, at a tension of about ([0-9.e+]+) N", far.stderr)
+    assert m, far.stderr
+    assert float(m.group(1)) == 50.0 and abs(float(m.group(2)) / (0.5 * ea) - 1) < 2e-3   # 3 digits
+    ends = [s for s in far.stderr.splitlines() if "the equilibrium leaves the" in s]
+    assert len(ends) == 2, far.stderr
+    assert all("(the anchors are 1.5 m apart, the rope 1.0 m long" in s for s in ends), ends
+    assert "start from &initial shape = 'equilibrium'" not in far.stderr, far.stderr
+    near = run("run", PAPER, "--force", *[a for s in sets + ["supports.bottom_anchor=0.6, 0.6"]
+                                          for a in ("--set", s)])
+    assert near.returncode == 0, near.stderr
+    assert "from the top anchor" not in near.stderr and "leaves the" not in near.stderr, \
+        near.stderr
+
+
 def test_a_resumed_run_keeps_its_warnings_once(run, tmp_path):
     """/solver/warnings over a resume: the part that read the scene records the scene's
     warnings (water in air), also when it ends for its step budget; the resumed part,
