@@ -14,9 +14,10 @@ module ropedyn_analysis
     use ropedyn_run_inputs, only: check_not_input, check_may_replace, check_part_free
     use ropedyn_text, only: int_text, column_text
     use ropedyn_model_factory, only: create_model
-    use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
+    use ropedyn_statics, only: statics_options_t, statics_result_t, &
                                potential_energy, rope_length
     use ropedyn_modes, only: modes_result_t, compute_modes
+    use ropedyn_line_equilibrium, only: static_equilibrium
     use ropedyn_h5, only: h5_file_t
     use ropedyn_output, only: write_provenance, write_forces, write_shape_record
     use ropedyn_version, only: version_string
@@ -121,7 +122,7 @@ contains
         self%model%supports_at_rest = .true.
         allocate (self%y(self%model%size()))
         call self%model%initial_state(self%y)
-        call find_equilibrium(self%model, scene%rope_spec_t, self%y, options, self%sres, err)
+        call static_equilibrium(self%model, scene%rope_spec_t, self%y, options, self%sres, err)
         if (allocated(err)) return
         n = self%model%n_elements()
         allocate (self%axial(0:n), self%shear(0:n), self%moment(0:n))
@@ -188,6 +189,15 @@ contains
         if (allocated(err)) return
         call h5%attribute('/statics', 'criterion', self%sres%criterion, err)
         if (allocated(err)) return
+        if (allocated(self%sres%restart)) then
+            call h5%attribute('/statics', 'restart', 'from a catenary between the '// &
+                              'supports: '//self%sres%restart, err)
+            if (allocated(err)) return
+        end if
+        if (allocated(self%sres%caution)) then
+            call h5%attribute('/statics', 'caution', self%sres%caution, err)
+            if (allocated(err)) return
+        end if
         do k = 1, size(reals)
             call h5%write('/statics/'//trim(STATICS_REALS(1, k)), reals(k), &
                           trim(STATICS_REALS(2, k)), err, trim(STATICS_REALS(3, k)))
@@ -294,6 +304,10 @@ contains
         write (output_unit, '(a, es10.3, a, es10.3, a)') '  residual        '// &
             'max |f| = ', self%sres%residual, ' N (', self%sres%residual_relative, &
             ' of the weight '//column_text(self%sres%weight, 8, 4)//' N)'
+        if (allocated(self%sres%restart)) write (output_unit, '(a)') '  start           '// &
+            'a catenary between the supports ('//self%sres%restart//')'
+        if (allocated(self%sres%caution)) write (output_unit, '(a)') '  caution         '// &
+            self%sres%caution
         write (output_unit, '(a, es14.6, a, es14.6)') '  energy (J)      elastic', &
             self%sres%elastic, '   gravity', self%sres%gravity
         write (output_unit, '(a)') '  lowest point    x = '// &

@@ -21,10 +21,11 @@ module ropedyn_modes
     use ropedyn_problem, only: STATUS_OK
     use ropedyn_rope_model, only: energy_t
     use ropedyn_rope_model, only: rope_model_t
-    use ropedyn_text, only: int_text
+    use ropedyn_text, only: int_text, text_t, append_text
     use ropedyn_rope_spec, only: rope_spec_t
-    use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
+    use ropedyn_statics, only: statics_options_t, statics_result_t, &
                                tangent_matrices, rope_length
+    use ropedyn_line_equilibrium, only: static_equilibrium
     use ropedyn_ldl, only: bandwidth
     use ropedyn_mode_start, only: relaxed_mode_start
     implicit none
@@ -214,30 +215,34 @@ contains
     !! rest, found from the 'straight' start in y) or 'mode' (that equilibrium plus mode
     !! `mode` scaled so that its largest point displacement is `mode_amplitude`, relaxed
     !! onto the stiff springs: ropedyn_mode_start; at rest). Other shapes leave y
-    !! unchanged. `note`: '' or a warning about the start.
-    subroutine equilibrium_initial_state(model, spec, y, err, note)
+    !! unchanged. `notes`: the warnings about the start (the statics' caution, the mode's
+    !! relaxation), each naming its key.
+    subroutine equilibrium_initial_state(model, spec, y, err, notes)
         class(rope_model_t), intent(inout) :: model
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(inout) :: y(:)
         type(error_t), allocatable, intent(out) :: err
-        character(len=:), allocatable, intent(out), optional :: note
+        type(text_t), allocatable, intent(out), optional :: notes(:)
         character(len=:), allocatable :: said
         type(statics_result_t) :: sres
         type(modes_result_t) :: mres
         integer :: k
         real(wp) :: largest
 
-        if (present(note)) note = ''
+        if (present(notes)) allocate (notes(0))
         select case (trim(spec%initial%shape))
         case ('equilibrium', 'mode')
         case default
             return
         end select
-        call find_equilibrium(model, spec, y, statics_options_t(), sres, err)
+        call static_equilibrium(model, spec, y, statics_options_t(), sres, err)
         if (allocated(err)) then
             err%message = err%message//" (&initial shape = '"//trim(spec%initial%shape)//"')"
             return
         end if
+        if (allocated(sres%caution) .and. present(notes)) call append_text(notes, &
+            spec%origin('initial.shape')//": &initial: shape = '"// &
+            trim(spec%initial%shape)//"': the statics: "//sres%caution)
         if (trim(spec%initial%shape) /= 'mode') return
         k = spec%initial%mode
         call compute_modes(model, y, k, mres, err)
@@ -257,7 +262,8 @@ contains
         end if
         call relaxed_mode_start(model, spec, y, mres%shape(:, k), &
                                 spec%initial%mode_amplitude/largest, said)
-        if (present(note)) note = said
+        if (present(notes) .and. len(said) > 0) call append_text(notes, &
+            spec%origin('initial.mode_amplitude')//': &initial: '//said)
     end subroutine equilibrium_initial_state
 
 end module ropedyn_modes

@@ -490,10 +490,11 @@ contains
         class(run_t), intent(inout) :: self
         type(error_t), allocatable, intent(out) :: err
         real(wp), allocatable :: lengths(:), masses(:)
-        character(len=:), allocatable :: start_note
+        type(text_t), allocatable :: start_notes(:)
+        integer :: k
         associate (scene => self%scene, model => self%model)
             call model%initial_state(self%y)
-            call equilibrium_initial_state(model, scene%rope_spec_t, self%y, err, start_note)
+            call equilibrium_initial_state(model, scene%rope_spec_t, self%y, err, start_notes)
             if (allocated(err)) return
             self%yq = 0.0_wp
             self%t = 0.0_wp
@@ -506,8 +507,9 @@ contains
             self%summary%initial_energy = model%energy(self%t, self%y, self%yq)
             self%summary%warnings = far_anchor_warnings(scene, model, self%t, self%y, &
                 self%summary%initial_energy, self%summary%weight_length)
-            if (len(start_note) > 0) call append_text(self%summary%warnings, &
-                scene%origin('initial.mode_amplitude')//': &initial: '//start_note)
+            do k = 1, size(start_notes)
+                call append_text(self%summary%warnings, start_notes(k)%s)
+            end do
             ! the scene's limits keep the start finite; should a value still make it not,
             ! that is bad input: say so before any file is created
             if (.not. (all(ieee_is_finite(self%y)) .and. &

@@ -73,6 +73,12 @@ module ropedyn_statics
         real(wp) :: elastic = 0.0_wp       !< elastic energy at the equilibrium, J
         real(wp) :: gravity = 0.0_wp       !< gravity potential at the equilibrium, J
         character(len=:), allocatable :: criterion  !< 'newton step' or 'rounding level'
+        !> why the equilibrium was found again from a catenary between the supports
+        !! (ropedyn_line_equilibrium); unallocated when the scene's start gave it
+        character(len=:), allocatable :: restart
+        !> a compression below an element's weight in a line that carries tension only
+        !! (ropedyn_line_equilibrium); unallocated when there is none
+        character(len=:), allocatable :: caution
     contains
         procedure :: report => result_report
     end type statics_result_t

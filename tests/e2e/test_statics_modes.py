@@ -402,3 +402,59 @@ def test_the_summary_prints_large_forces(run, tmp_path):
     assert weight > 1e4
     printed_weight = float(result.stdout.split("of the weight")[1].split()[0])
     assert abs(printed_weight / weight - 1) < 1e-6, (printed_weight, weight)
+
+
+MOORING = ("&rope length = 150.0, mass_per_length = 126.0, axial_stiffness = 5.8e8,"
+           " bending_stiffness = 0.0, diameter = 0.143, compression = .false. /\n"
+           "&model kind = '{kind}', elements = 40 /\n"
+           "&supports top = 'pinned', bottom = 'pinned', bottom_anchor = 95.0, {span},"
+           " end_compliance = 'split' /\n"
+           "&initial shape = 'equilibrium', angle_deg = 75.0 /\n"
+           "&effects ground = .true. /\n"
+           "&ground point = 95.0, 0.0, normal = -1.0, 0.0, stiffness = 1.0e7,"
+           " damping = 2.0e5 /\n")
+
+
+def test_a_mooring_chain_folded_on_the_seabed_starts_again_from_a_catenary(run, tmp_path):
+    """A 150 m chain from a fairlead 95 m above the seabed to an anchor 80 m across: from
+    the scene's straight start the MPP came to rest with its lower part folded back and
+    forth on the seabed, the folds held by joints compressed by 28 kN (the statics keep the
+    springs' linear law), its fairlead tension 8 % and its horizontal tension 66 % high,
+    without a word. The compression marks it; the statics start again from the catenary
+    between the supports and find the touchdown catenary (and the RFEM finds it too)."""
+    w = 126.0 * 9.81
+    expected = touchdown_top_tension(150.0, 95.0, 80.0, w)
+    for kind in ("mpp", "rfem"):
+        (tmp_path / "m.nml").write_text(MOORING.format(kind=kind, span=80.0))
+        result = run("statics", "m.nml", "-o", f"{kind}.h5")
+        assert result.returncode == 0, result.stderr
+        restarted = "start           a catenary between the supports (from the scene's start " \
+                    "the line is compressed by" in result.stdout
+        assert restarted == (kind == "mpp"), result.stdout
+        assert "caution" not in result.stdout, result.stdout
+        with h5py.File(tmp_path / f"{kind}.h5") as f:
+            top = np.linalg.norm(f["statics/support_force_top"][:])
+            axial = f["forces/axial"][0]
+            assert ("restart" in f["statics"].attrs) == restarted
+        assert abs(top / expected - 1) < 2e-3, (kind, top, expected)   # n = 40, EA finite
+        assert axial.min() > 0.99 * (expected - w * 95.0), (kind, axial.min())   # H on the floor
+
+
+def test_a_slack_chain_on_the_seabed_hangs_straight_down(run, tmp_path):
+    """The same chain with its anchor 30 m across: more chain than the drop and the span,
+    so that it hangs straight down and lies slack on the seabed, its fairlead tension the
+    weight of the hanging part, w h. From the scene's start it rested folded, compressed by
+    6.2 kN, at w h + 5 %. It starts again from the slack line's shape (down to the seabed,
+    back, and along to the anchor) and comes within 2 % of w h; the compression left, less
+    than an element's weight where the hanging line stands on the seabed, is a caution."""
+    (tmp_path / "m.nml").write_text(MOORING.format(kind="rfem", span=30.0))
+    result = run("statics", "m.nml", "-o", "s.h5")
+    assert result.returncode == 0, result.stderr
+    assert "start           a catenary between the supports" in result.stdout, result.stdout
+    assert "caution         the line is compressed by" in result.stdout, result.stdout
+    assert "less than the weight of one element" in result.stdout, result.stdout
+    with h5py.File(tmp_path / "s.h5") as f:
+        top = np.linalg.norm(f["statics/support_force_top"][:])
+        caution = f["statics"].attrs["caution"]
+        assert "less than the weight of one element" in (caution.decode() if isinstance(caution, bytes) else caution)
+    assert 0 < top / (126.0 * 9.81 * 95.0) - 1 < 0.02, top
