@@ -146,20 +146,11 @@ contains
     subroutine solve_touchdown(cat, drop, span)
         type(catenary_t), intent(inout) :: cat
         real(wp), intent(in) :: drop, span
-        real(wp) :: lo, hi, mid
-        integer :: k
+        real(wp) :: lo, hi
         hi = (cat%length**2 - drop**2)/(2.0_wp*drop)     ! Ls = L
         if (miss(hi) < 0.0_wp) return
         lo = 1.0e-12_wp*cat%length
-        do k = 1, BISECTIONS
-            mid = sqrt(lo*hi)
-            if (miss(mid) < 0.0_wp) then
-                lo = mid
-            else
-                hi = mid
-            end if
-        end do
-        cat%a = sqrt(lo*hi)
+        cat%a = rising_root(miss, lo, hi)
         cat%suspended = sqrt(drop**2 + 2.0_wp*cat%a*drop)
         cat%kind = TOUCHDOWN
     contains
@@ -175,8 +166,7 @@ contains
     subroutine suspended_between(cat, span, dx)
         type(catenary_t), intent(inout) :: cat
         real(wp), intent(in) :: span, dx
-        real(wp) :: lo, hi, mid, chord
-        integer :: k
+        real(wp) :: lo, hi, chord
         chord = sqrt(cat%length**2 - dx**2)
         lo = cat%length
         do while (excess(lo) <= 0.0_wp .and. lo > 1.0e-12_wp*cat%length)
@@ -187,15 +177,7 @@ contains
             hi = 2.0_wp*hi
         end do
         if (.not. (excess(lo) > 0.0_wp .and. excess(hi) <= 0.0_wp)) return
-        do k = 1, BISECTIONS
-            mid = sqrt(lo*hi)
-            if (excess(mid) > 0.0_wp) then
-                lo = mid
-            else
-                hi = mid
-            end if
-        end do
-        cat%a = sqrt(lo*hi)
+        cat%a = rising_root(shortfall, lo, hi)
         cat%xi0 = 0.5_wp*span - cat%a*asinh(-dx/(2.0_wp*cat%a*sinh(span/(2.0_wp*cat%a))))
         cat%kind = SUSPENDED
     contains
@@ -210,7 +192,38 @@ contains
                 excess = 2.0_wp*a*sinh(half) - chord
             end if
         end function excess
+
+        !> -excess (rises with a).
+        real(wp) function shortfall(a)
+            real(wp), intent(in) :: a
+            shortfall = -excess(a)
+        end function shortfall
     end subroutine suspended_between
+
+    !> The root of `f`, which rises with a, between lo (f < 0) and hi (f >= 0): BISECTIONS
+    !! halvings of the interval in log a.
+    real(wp) function rising_root(f, lo, hi) result(a)
+        interface
+            real(wp) function f(a)
+                import :: wp
+                real(wp), intent(in) :: a
+            end function f
+        end interface
+        real(wp), intent(in) :: lo, hi
+        real(wp) :: below, above, mid
+        integer :: k
+        below = lo
+        above = hi
+        do k = 1, BISECTIONS
+            mid = sqrt(below*above)
+            if (f(mid) < 0.0_wp) then
+                below = mid
+            else
+                above = mid
+            end if
+        end do
+        a = sqrt(below*above)
+    end function rising_root
 
     !> The point at arc length s from the top, m.
     pure function catenary_point(self, s) result(p)
