@@ -1,6 +1,6 @@
 !> Warnings for a scene whose values are legal but probably a unit slip: a diameter in mm
 !! (more than a tenth of the length), a modulus or stiffness in the wrong unit (the static
-!! strain under the rope's own weight above 10 %), a damping coefficient in the wrong unit
+!! strain under the rope's own weight and its point masses above 10 %), a damping coefficient in the wrong unit
 !! (an element's axial damping ratio below 1e-6 or above 1000), air's density for water, a
 !! straight start or a support's anchor inside the ground (x points down: a ground point in
 !! the wrong sign), a key of a support's motion that its `*_motion` does not use (a
@@ -12,6 +12,7 @@
 !! key, its value and why; a run goes ahead.
 module ropedyn_scene_warnings
     use, intrinsic :: iso_fortran_env, only: error_unit
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
     use ropedyn_kinds, only: wp
     use ropedyn_text, only: text_t, append_text, real_text, significant_text, pair_text, &
         int_text
@@ -61,7 +62,7 @@ contains
         type(scene_t), intent(in) :: scene
         type(text_t), allocatable :: list(:)
         type(section_t) :: sec
-        real(wp) :: strain, dl, zeta
+        real(wp) :: strain, dl, zeta, payload
         logical :: section
         allocate (list(0))
         sec = rope_section(scene%rope)
@@ -71,13 +72,20 @@ contains
                 ': more than a tenth of the length ('//real_text(scene%rope%length)// &
                 ' m): a diameter in mm? (the unit is m)')
         if (scene%effects%gravity .and. scene%effects%tension) then
-            strain = sec%mass_per_length*scene%rope%gravity*scene%rope%length/sec%ea
+            ! the top section carries the rope and its point masses (a crane's payload)
+            payload = 0.0_wp
+            if (scene%effects%point_masses) payload = sum(scene%attachments%masses, &
+                mask=.not. ieee_is_nan(scene%attachments%mass_positions))
+            strain = (sec%mass_per_length*scene%rope%length + payload)* &
+                     scene%rope%gravity/sec%ea
             if (strain > MAX_SELF_STRAIN) call append_text(list, &
                 at(trim(merge('axial_stiffness', 'young_modulus  ', section)))// &
                 trim(merge('axial_stiffness', 'young_modulus  ', section))//' = '// &
                 stiffness_text()//': the rope stretches by '// &
-                significant_text(100.0_wp*strain, 3)//' % under its own weight (m g L / '// &
-                'EA): '//trim(merge('EA in kN?        ', 'a modulus in GPa?', section))// &
+                significant_text(100.0_wp*strain, 3)//' % under its own weight'// &
+                trim(merge(' and its point masses ((m L + M) g / EA)', &
+                           ' (m g L / EA)                           ', payload > 0.0_wp))// &
+                ': '//trim(merge('EA in kN?        ', 'a modulus in GPa?', section))// &
                 ' (the unit is '//trim(merge('N ', 'Pa', section))//')')
         end if
         if (scene%effects%damping .and. scene%effects%tension .and. sec%axial_damping > 0.0_wp) &

@@ -131,6 +131,10 @@ def test_a_chain_without_bending_stiffness_hangs(run, tmp_path, kind):
 @pytest.mark.parametrize("sets,fragment", [
     (["rope.diameter=5"], "&rope: diameter = 5.0: more than a tenth of the length"),
     (["rope.young_modulus=200"], "&rope: young_modulus = 200.0: the rope stretches by"),
+    # a payload of 10 kg on the 1 m rope (EA 687 N): the rope alone stretches by 0.17 %
+    (["attachments.mass_positions=1.0", "attachments.masses=10.0"],
+     "&rope: young_modulus = 3.5e7: the rope stretches by 14.4 % under its own weight and its "
+     "point masses ((m L + M) g / EA)"),
     (["rope.normal_damping=1e9"], "&rope: normal_damping = 1.0e9: an element's axial damping"),
     (["rope.normal_damping=1e-9"], "&rope: normal_damping = 1.0e-9: an element's axial damping"),
     (["effects.water=.true."], "&fluid: density = 1.225: water = .true. in a fluid this light"),
