@@ -458,3 +458,55 @@ def test_a_slack_chain_on_the_seabed_hangs_straight_down(run, tmp_path):
         caution = f["statics"].attrs["caution"]
         assert "less than the weight of one element" in (caution.decode() if isinstance(caution, bytes) else caution)
     assert 0 < top / (126.0 * 9.81 * 95.0) - 1 < 0.02, top
+
+
+def elastic_catenary_top_tension(length, drop, span, w, ea):
+    """Top tension (N) of an elastic chain (weight w per unstretched metre, EA) hanging free
+    between a pin and an anchor `drop` below it and `span` across (Irvine's equations; s
+    from the anchor, V0 the vertical force there, H the horizontal force):
+        span = H L/EA + (H/w) [asinh((V0 + wL)/H) - asinh(V0/H)],
+        drop = w L^2/(2 EA) + V0 L/EA + (H/w) [sqrt(1 + ((V0 + wL)/H)^2) - sqrt(1 + (V0/H)^2)],
+    solved by Newton's method from a taut start; T = sqrt(H^2 + (V0 + wL)^2)."""
+    def residual(x):
+        h, v0 = x
+        vt = v0 + w * length
+        return np.array([h * length / ea + h / w * (np.arcsinh(vt / h) - np.arcsinh(v0 / h)) - span,
+                         w * length**2 / (2 * ea) + v0 * length / ea
+                         + h / w * (np.hypot(1, vt / h) - np.hypot(1, v0 / h)) - drop])
+    chord = np.hypot(drop, span)
+    pull = ea * max(chord / length - 1, 1e-3)          # the straight line's stretch
+    x = np.array([pull * span / chord, pull * drop / chord - w * length / 2])
+    for _ in range(100):
+        r = residual(x)
+        jac = np.column_stack([(residual(x + step) - r) / 1e-3
+                               for step in (np.array([1e-3, 0.0]), np.array([0.0, 1e-3]))])
+        delta = np.linalg.solve(jac, r)
+        while np.max(np.abs(residual(x - delta))) > np.max(np.abs(r)) > 1e-9 * length:
+            delta = delta / 2                           # damped: the residual must fall
+        x = x - delta
+    assert np.max(np.abs(residual(x))) < 1e-9 * length
+    return float(np.hypot(x[0], x[1] + w * length))
+
+
+def test_a_taut_chain_started_away_from_its_anchor_starts_again_from_a_catenary(run, tmp_path):
+    """The mooring chain with its anchor beyond reach (95 m down, 118 m across: 1 % beyond
+    its length), from a straight start pointing away from the anchor (-90 degrees). The MPP
+    came to rest with its joints compressed by 1.14e9 N, 6100 times its weight, its fairlead
+    tension 195 times the catenary's, without a word. The statics start again from the
+    straight line between the supports (the taut catenary start) and find the elastic
+    catenary: every joint in tension, the fairlead tension within 1e-3."""
+    w, ea = 126.0 * 9.81, 5.8e8
+    expected = elastic_catenary_top_tension(150.0, 95.0, 118.0, w, ea)
+    (tmp_path / "m.nml").write_text(MOORING.format(kind="mpp", span=118.0)
+                                    .replace("angle_deg = 75.0", "angle_deg = -90.0"))
+    result = run("statics", "m.nml", "-o", "t.h5")
+    assert result.returncode == 0, result.stderr
+    assert "start           a catenary between the supports (from the scene's start the line " \
+           "is compressed by" in result.stdout, result.stdout
+    assert "caution" not in result.stdout, result.stdout
+    with h5py.File(tmp_path / "t.h5") as f:
+        top = np.linalg.norm(f["statics/support_force_top"][:])
+        axial = f["forces/axial"][0]
+        assert "restart" in f["statics"].attrs and "caution" not in f["statics"].attrs
+    assert abs(top / expected - 1) < 1e-3, (top, expected)
+    assert axial.min() > 0.9 * w * 150.0, axial.min()
