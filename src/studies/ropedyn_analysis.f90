@@ -190,8 +190,8 @@ contains
         call h5%attribute('/statics', 'criterion', self%sres%criterion, err)
         if (allocated(err)) return
         if (allocated(self%sres%restart)) then
-            call h5%attribute('/statics', 'restart', 'from a catenary between the '// &
-                              'supports: '//self%sres%restart, err)
+            call h5%attribute('/statics', 'restart', 'started again from '// &
+                              self%sres%restart, err)
             if (allocated(err)) return
         end if
         if (allocated(self%sres%caution)) then
@@ -305,7 +305,7 @@ contains
             'max |f| = ', self%sres%residual, ' N (', self%sres%residual_relative, &
             ' of the weight '//column_text(self%sres%weight, 8, 4)//' N)'
         if (allocated(self%sres%restart)) write (output_unit, '(a)') '  start           '// &
-            'a catenary between the supports ('//self%sres%restart//')'
+            self%sres%restart
         if (allocated(self%sres%caution)) write (output_unit, '(a)') '  caution         '// &
             self%sres%caution
         write (output_unit, '(a, es14.6, a, es14.6)') '  energy (J)      elastic', &

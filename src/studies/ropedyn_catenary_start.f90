@@ -34,6 +34,9 @@ module ropedyn_catenary_start
 
     !> an anchor within this share of the length from the ground lies on it
     real(wp), parameter :: ON_GROUND_SHARE = 1.0e-3_wp
+    !> a ground whose slope (across over down of its normal) is at most this counts as
+    !! level (0.57 degrees): the catenary lies on the level through the anchor
+    real(wp), parameter :: LEVEL_SLOPE = 0.01_wp
     !> bisection steps of the parameter a (on log a: far below the rounding of a)
     integer, parameter :: BISECTIONS = 200
 
@@ -84,7 +87,8 @@ contains
         end do
         if (.not. all(ieee_is_finite(points))) return
         if (spec%effects%ground) then
-            if (any(depth_below(spec, points) > ON_GROUND_SHARE*cat%length)) return
+            if (any(depth_below(spec, points) > ON_GROUND_SHARE*cat%length + &
+                    tilt(spec)*abs(anchors(2, 2) - anchors(2, 1)))) return
         end if
         do i = 1, size(lengths)
             d = points(:, i) - points(:, i - 1)
@@ -113,7 +117,7 @@ contains
             return
         end if
         if (level_ground_under(spec, top, bottom, length)) then
-            cat%ground = spec%ground%point(1)
+            cat%ground = bottom(1)
             drop = cat%ground - top(1)
             if (length >= drop + span) then
                 cat%kind = SLACK
@@ -127,17 +131,25 @@ contains
         if (span > 0.0_wp) call suspended_between(cat, span, bottom(1) - top(1))
     end function shape_of
 
-    !> The ground is on, level (its normal along -x), below the top, and the anchor on it.
+    !> The ground is on, level (its normal along -x, to LEVEL_SLOPE), the anchor on it and
+    !! the top above it.
     logical function level_ground_under(spec, top, bottom, length) result(level)
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(in) :: top(2), bottom(2), length
-        associate (g => spec%ground)
-            level = spec%effects%ground .and. g%normal(1) < 0.0_wp .and. g%normal(2) == 0.0_wp
-            if (.not. level) return
-            level = g%point(1) > top(1) .and. &
-                    abs(bottom(1) - g%point(1)) <= ON_GROUND_SHARE*length
-        end associate
+        real(wp) :: depth(0:1)
+        level = spec%effects%ground .and. spec%ground%normal(1) < 0.0_wp
+        if (.not. level) return
+        level = tilt(spec) <= LEVEL_SLOPE
+        if (.not. level) return
+        depth = depth_below(spec, reshape([bottom, top], [2, 2]))
+        level = abs(depth(0)) <= ON_GROUND_SHARE*length .and. bottom(1) > top(1)
     end function level_ground_under
+
+    !> The ground's slope: across over down of its normal (0 for a level ground).
+    pure real(wp) function tilt(spec)
+        type(rope_spec_t), intent(in) :: spec
+        tilt = abs(spec%ground%normal(2))/max(abs(spec%ground%normal(1)), tiny(1.0_wp))
+    end function tilt
 
     !> The touchdown catenary from a top `drop` above the ground to an anchor on it `span`
     !! away: kind TOUCHDOWN with a and Ls, or unchanged where the whole line hangs free

@@ -16,11 +16,12 @@
 !! seabed, carries up to its weight); beyond it, a fold or a line pushed (a stiff wire
 !! between anchors closer than its length) that the statics' linear law holds.
 module ropedyn_line_equilibrium
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, ERR_SOLVER
     use ropedyn_text, only: int_text, significant_text
     use ropedyn_rope_model, only: rope_model_t
     use ropedyn_rope_spec, only: rope_spec_t
+    use ropedyn_rope_section, only: rope_section, section_t
     use ropedyn_statics, only: statics_options_t, statics_result_t, find_equilibrium, &
         check_equilibrium_exists
     use ropedyn_catenary_start, only: catenary_start
@@ -38,7 +39,12 @@ module ropedyn_line_equilibrium
         integer :: joint = 0                 !< where (0 the top)
         real(wp) :: weight = 0.0_wp          !< the line's, N
         real(wp) :: element_weight = 0.0_wp  !< its heaviest element's, N
+        logical :: ground = .false.          !< the scene has a ground
+        !> joints where neighbouring elements' angles differ by more than half a turn: a
+        !! line wound by whole turns, which its bending springs hold
+        integer :: wound = 0
     contains
+        procedure :: worse => compression_worse
         procedure :: suspect => compression_suspect
         procedure :: false => compression_false
         procedure :: text => compression_text
@@ -70,11 +76,15 @@ contains
         call find_equilibrium(model, spec, y, options, result, err)
         if (allocated(err)) then
             if (err%code /= ERR_SOLVER) return
-            why = 'from the scene''s start: '//err%message
+            why = 'from the scene''s start: '//reason(err%message)
         else
-            c1 = compression_at(model, y, result%weight)
+            c1 = compression_at(model, spec, y, result%weight)
             if (.not. c1%suspect()) return
             why = 'from the scene''s start the line '//c1%text()
+            if (c1%wound > 0) then
+                call unwound_descent(model, spec, y, options, result, c1, why)
+                if (.not. c1%suspect()) return
+            end if
         end if
         y_cat = y_start
         call catenary_start(model, spec, y_cat, found)
@@ -82,15 +92,15 @@ contains
         if (found) then
             call find_equilibrium(model, spec, y_cat, options, second, err2)
             if (allocated(err2)) then
-                tried = '; from a catenary between the supports: '//err2%message
+                tried = '; from a catenary between the supports: '//reason(err2%message)
             else
-                c2 = compression_at(model, y_cat, second%weight)
+                c2 = compression_at(model, spec, y_cat, second%weight)
                 tried = '; from a catenary between the supports the line '//c2%text()
-                if (allocated(err) .or. c2%force < c1%force) then
+                if (allocated(err) .or. c1%worse(c2)) then
                     if (allocated(err)) deallocate (err)
                     second%iterations = second%iterations + result%iterations
                     second%rejected = second%rejected + result%rejected
-                    second%restart = why
+                    second%restart = 'a catenary between the supports ('//why//')'
                     result = second
                     y = y_cat
                     c1 = c2
@@ -104,21 +114,65 @@ contains
         end if
     end subroutine static_equilibrium
 
+    !> The descent again from the equilibrium y of a wound line with its whole turns taken
+    !! off (each element's angle brought within half a turn of its neighbour's above it: the
+    !! same shape without the loops); where that is the better equilibrium (compression_t
+    !! %worse), it replaces y, `result` (with result%restart) and `c`.
+    subroutine unwound_descent(model, spec, y, options, result, c, why)
+        class(rope_model_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
+        real(wp), intent(inout) :: y(:)
+        type(statics_options_t), intent(in) :: options
+        type(statics_result_t), intent(inout) :: result
+        type(compression_t), intent(inout) :: c
+        character(len=*), intent(in) :: why
+        type(statics_result_t) :: again
+        type(compression_t) :: c_again
+        type(error_t), allocatable :: err
+        integer, allocatable :: pos(:), vel(:), at(:)
+        real(wp), allocatable :: y_again(:)
+        real(wp), parameter :: TWO_PI = 2.0_wp*acos(-1.0_wp)
+        integer :: k
+        call model%coordinates(pos, vel)
+        at = pack(pos, model%angle_coordinates())
+        y_again = y
+        do k = 2, size(at)
+            y_again(at(k)) = y_again(at(k)) - &
+                TWO_PI*anint((y_again(at(k)) - y_again(at(k - 1)))/TWO_PI)
+        end do
+        call find_equilibrium(model, spec, y_again, options, again, err)
+        if (allocated(err)) return
+        c_again = compression_at(model, spec, y_again, again%weight)
+        if (.not. c%worse(c_again)) return
+        again%iterations = again%iterations + result%iterations
+        again%rejected = again%rejected + result%rejected
+        again%restart = 'its equilibrium with the whole turns taken off ('//why//')'
+        result = again
+        y = y_again
+        c = c_again
+    end subroutine unwound_descent
+
     !> The compression of a line that carries tension only at the state y under the
     !! statics' linear law, which the forces of a run would clip (force 0 for a line that
     !! may be compressed, or without weight).
-    function compression_at(model, y, weight) result(c)
+    function compression_at(model, spec, y, weight) result(c)
         class(rope_model_t), intent(inout) :: model
+        type(rope_spec_t), intent(in) :: spec
         real(wp), intent(in) :: y(:), weight
         type(compression_t) :: c
         real(wp) :: axial(0:model%n_elements()), shear(0:model%n_elements())
         real(wp) :: moment(0:model%n_elements()), reaction(2, 2)
         real(wp) :: lengths(model%n_elements()), masses(model%n_elements())
+        type(section_t) :: sec
         logical :: held
+        ! (without bending springs a whole turn between neighbours changes no force)
+        sec = rope_section(spec%rope)
+        if (spec%effects%bending .and. sec%ei > 0.0_wp) c%wound = wound_joints(model, y)
         if (.not. model%tension_only .or. .not. weight > 0.0_wp) return
         call model%element_data(lengths, masses)
         c%weight = weight
         c%element_weight = weight*maxval(masses)/sum(masses)
+        c%ground = spec%effects%ground
         held = model%supports_at_rest
         model%supports_at_rest = .true.
         call model%internal_forces(0.0_wp, y, axial, shear, moment, reaction)
@@ -127,17 +181,42 @@ contains
         c%force = max(0.0_wp, -axial(c%joint))
     end function compression_at
 
-    !> Beyond FALSE_COMPRESSION of the weight: no equilibrium of the line, unless within an
-    !! element's weight.
+    !> Wound, or compressed beyond FALSE_COMPRESSION of the weight: no equilibrium of the
+    !! line (a compression within an element's weight excepted: compression_text).
     pure logical function compression_suspect(self) result(suspect)
         class(compression_t), intent(in) :: self
-        suspect = self%force > FALSE_COMPRESSION*self%weight
+        suspect = self%wound > 0 .or. self%force > FALSE_COMPRESSION*self%weight
     end function compression_suspect
 
-    !> Suspect and beyond the weight of an element: a fold or a push the linear law holds.
+    !> `other` is the better equilibrium: fewer wound joints, or as many and less compressed.
+    pure logical function compression_worse(self, other) result(worse)
+        class(compression_t), intent(in) :: self
+        type(compression_t), intent(in) :: other
+        worse = other%wound < self%wound .or. &
+                (other%wound == self%wound .and. other%force < self%force)
+    end function compression_worse
+
+    !> The joints where neighbouring elements' angles (the model's angle coordinates, in
+    !! order along the line) differ by more than half a turn.
+    function wound_joints(model, y) result(wound)
+        class(rope_model_t), intent(in) :: model
+        real(wp), intent(in) :: y(:)
+        integer :: wound
+        integer, allocatable :: pos(:), vel(:)
+        real(wp), allocatable :: phi(:)
+        real(wp), parameter :: PI = acos(-1.0_wp)
+        call model%coordinates(pos, vel)
+        phi = pack(y(pos), model%angle_coordinates())
+        wound = 0
+        if (size(phi) > 1) wound = count(abs(phi(2:) - phi(:size(phi) - 1)) > PI)
+    end function wound_joints
+
+    !> Compressed beyond FALSE_COMPRESSION of the weight and beyond the weight of an
+    !! element: a fold or a push the linear law holds.
     pure logical function compression_false(self) result(false)
         class(compression_t), intent(in) :: self
-        false = self%suspect() .and. self%force > self%element_weight
+        false = self%force > FALSE_COMPRESSION*self%weight .and. &
+                self%force > self%element_weight
     end function compression_false
 
     !> 'is compressed by F N at joint j (P of its weight), which it cannot carry (&rope
@@ -145,17 +224,60 @@ contains
     function compression_text(self) result(text)
         class(compression_t), intent(in) :: self
         character(len=:), allocatable :: text
+        if (self%wound > 0) then
+            text = 'is wound by whole turns at '//int_text(self%wound)//' joint'// &
+                trim(merge('s', ' ', self%wound > 1))//' (neighbouring elements turned '// &
+                'more than half a turn apart: loops its bending springs hold); check the '// &
+                'shape and the tensions, or start from another &initial angle_deg'
+            if (self%force > FALSE_COMPRESSION*self%weight) text = text//', and '// &
+                compressed_text(self)
+            return
+        end if
+        text = compressed_text(self)
+    end function compression_text
+
+    !> 'is compressed by ...' with what it means (compression_text).
+    function compressed_text(self) result(text)
+        class(compression_t), intent(in) :: self
+        character(len=:), allocatable :: text
         text = 'is compressed by '//significant_text(self%force, 3)//' N at joint '// &
-            int_text(self%joint)//' ('//significant_text(self%force/self%weight, 2)// &
-            ' of its weight), which it cannot carry (&rope compression = .false.)'
+            int_text(self%joint)//' ('//share_text(self%force/self%weight)// &
+            ' its weight), which it cannot carry (&rope compression = .false.)'
         if (self%false()) then
             text = text//': the statics keep the springs'' linear law, which holds it (a '// &
                 'fold, its tensions too high, or a stiff line pushed between its anchors): '// &
                 'no equilibrium of the line; check the tensions, or set compression = .true.'
-        else
+        else if (self%ground) then
             text = text//', less than the weight of one element: an element standing on '// &
                 'the ground where the line comes down onto it, within the discretization''s '// &
                 'error'
+        else
+            text = text//', less than the weight of one element: within the '// &
+                'discretization''s error'
         end if
-    end function compression_text
+    end function compressed_text
+
+    !> 'P of' (a share below 1) or 'P times' (from 1 on), 2 significant digits.
+    function share_text(share) result(text)
+        real(wp), intent(in) :: share
+        character(len=:), allocatable :: text
+        if (share < 1.0_wp) then
+            text = significant_text(share, 2)//' of'
+        else if (share < 10.0_wp) then
+            text = significant_text(share, 2)//' times'
+        else
+            text = int_text(nint(share, i8))//' times'
+        end if
+    end function share_text
+
+    !> An error of the statics without the scene's name and 'statics: ' before it (the
+    !! message that quotes it names them once).
+    function reason(message) result(text)
+        character(len=*), intent(in) :: message
+        character(len=:), allocatable :: text
+        integer :: k
+        k = index(message, 'statics: ')
+        text = message
+        if (k > 0) text = message(k + len('statics: '):)
+    end function reason
 end module ropedyn_line_equilibrium

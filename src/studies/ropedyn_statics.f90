@@ -73,7 +73,8 @@ module ropedyn_statics
         real(wp) :: elastic = 0.0_wp       !< elastic energy at the equilibrium, J
         real(wp) :: gravity = 0.0_wp       !< gravity potential at the equilibrium, J
         character(len=:), allocatable :: criterion  !< 'newton step' or 'rounding level'
-        !> why the equilibrium was found again from a catenary between the supports
+        !> where the equilibrium was found again from, and why: 'a catenary between the
+        !! supports (...)' or 'its equilibrium with the whole turns taken off (...)'
         !! (ropedyn_line_equilibrium); unallocated when the scene's start gave it
         character(len=:), allocatable :: restart
         !> a compression below an element's weight in a line that carries tension only

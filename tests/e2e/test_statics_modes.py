@@ -510,3 +510,35 @@ def test_a_taut_chain_started_away_from_its_anchor_starts_again_from_a_catenary(
         assert "restart" in f["statics"].attrs and "caution" not in f["statics"].attrs
     assert abs(top / expected - 1) < 1e-3, (top, expected)
     assert axial.min() > 0.9 * w * 150.0, axial.min()
+
+
+def test_a_wire_wound_by_whole_turns_starts_again_from_a_catenary(run, tmp_path):
+    """A heavy wire (EI = 660 N m^2) of 45.2 m in water from a fairlead 39.3 m above the
+    seabed to an anchor on it 16.4 m across: from its straight start the descent turned
+    neighbouring elements whole turns apart, loops that the bending springs hold without
+    any compression, and rested there with the fairlead tension many times too high (22
+    times at n = 150, found by a probe of the statics). Such a state now starts the
+    descent again from the catenary, and the tension is the touchdown catenary's with the
+    submerged weight (inextensible: within 1 %; the pins' added compliance and the wire's
+    stretch lower it a little)."""
+    (tmp_path / "w.nml").write_text(
+        "&rope length = 45.2, mass_per_length = 126.0, axial_stiffness = 9.87e6,"
+        " bending_stiffness = 660.0, diameter = 0.32704, compression = .false. /\n"
+        "&model kind = 'rfem', elements = 60 /\n"
+        "&supports top = 'pinned', bottom = 'pinned', bottom_anchor = 39.30592, -16.3593 /\n"
+        "&initial shape = 'equilibrium', angle_deg = 75.0 /\n"
+        "&effects ground = .true., water = .true. /\n"
+        "&fluid density = 1025.0, surface = -1.0 /\n"
+        "&ground point = 39.324, 0.0, normal = -1.0, 0.0, stiffness = 3.914e5,"
+        " damping = 7828.0 /\n")
+    result = run("statics", "w.nml", "-o", "w.h5")
+    assert result.returncode == 0, result.stderr
+    assert "from the scene's start the line is wound by whole turns at" in result.stdout, \
+        result.stdout
+    w = (126.0 - 1025.0 * np.pi * 0.32704**2 / 4) * 9.81
+    expected = touchdown_top_tension(45.2, 39.3059, 16.3593, w)
+    with h5py.File(tmp_path / "w.h5") as f:
+        top = np.linalg.norm(f["statics/support_force_top"][:])
+        phi = f["statics/q"][2::3]
+    assert abs(top / expected - 1) < 0.01, (top, expected)
+    assert np.abs(np.diff(phi)).max() < np.pi
