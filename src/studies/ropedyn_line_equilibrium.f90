@@ -43,6 +43,9 @@ module ropedyn_line_equilibrium
         !> joints where neighbouring elements' angles differ by more than half a turn: a
         !! line wound by whole turns, which its bending springs hold
         integer :: wound = 0
+        !> joints compressed by more than their section's length (strain below -1): turned
+        !! inside out, no equilibrium of any line (the linear law holds them)
+        integer :: inverted = 0
     contains
         procedure :: worse => compression_worse
         procedure :: suspect => compression_suspect
@@ -168,15 +171,17 @@ contains
         ! (without bending springs a whole turn between neighbours changes no force)
         sec = rope_section(spec%rope)
         if (spec%effects%bending .and. sec%ei > 0.0_wp) c%wound = wound_joints(model, y)
+        held = model%supports_at_rest
+        model%supports_at_rest = .true.
+        call model%internal_forces(0.0_wp, y, axial, shear, moment, reaction)
+        model%supports_at_rest = held
+        ! a section shortened by more than its length (axial force below -EA: strain < -1)
+        if (spec%effects%tension .and. sec%ea > 0.0_wp) c%inverted = count(axial < -sec%ea)
         if (.not. model%tension_only .or. .not. weight > 0.0_wp) return
         call model%element_data(lengths, masses)
         c%weight = weight
         c%element_weight = weight*maxval(masses)/sum(masses)
         c%ground = spec%effects%ground
-        held = model%supports_at_rest
-        model%supports_at_rest = .true.
-        call model%internal_forces(0.0_wp, y, axial, shear, moment, reaction)
-        model%supports_at_rest = held
         c%joint = minloc(axial, 1) - 1
         c%force = max(0.0_wp, -axial(c%joint))
     end function compression_at
@@ -185,15 +190,18 @@ contains
     !! line (a compression within an element's weight excepted: compression_text).
     pure logical function compression_suspect(self) result(suspect)
         class(compression_t), intent(in) :: self
-        suspect = self%wound > 0 .or. self%force > FALSE_COMPRESSION*self%weight
+        suspect = self%inverted > 0 .or. self%wound > 0 .or. &
+                  self%force > FALSE_COMPRESSION*self%weight
     end function compression_suspect
 
-    !> `other` is the better equilibrium: fewer wound joints, or as many and less compressed.
+    !> `other` is the better equilibrium: fewer inverted joints, then fewer wound ones, then
+    !! less compressed.
     pure logical function compression_worse(self, other) result(worse)
         class(compression_t), intent(in) :: self
         type(compression_t), intent(in) :: other
-        worse = other%wound < self%wound .or. &
-                (other%wound == self%wound .and. other%force < self%force)
+        worse = other%inverted < self%inverted .or. (other%inverted == self%inverted .and. &
+                (other%wound < self%wound .or. &
+                 (other%wound == self%wound .and. other%force < self%force)))
     end function compression_worse
 
     !> The joints where neighbouring elements' angles (the model's angle coordinates, in
@@ -224,6 +232,13 @@ contains
     function compression_text(self) result(text)
         class(compression_t), intent(in) :: self
         character(len=:), allocatable :: text
+        if (self%inverted > 0) then
+            text = 'is compressed beyond its length at '//int_text(self%inverted)// &
+                ' joint'//trim(merge('s', ' ', self%inverted > 1))//' (a strain below -1: '// &
+                'sections turned inside out, which the springs'' linear law holds): no '// &
+                'equilibrium of any line; check the anchors and the start'
+            return
+        end if
         if (self%wound > 0) then
             text = 'is wound by whole turns at '//int_text(self%wound)//' joint'// &
                 trim(merge('s', ' ', self%wound > 1))//' (neighbouring elements turned '// &
