@@ -15,6 +15,10 @@
 !! ground under the line above it, as where a slack chain hangs straight down onto the
 !! seabed, carries up to its weight); beyond it, a fold or a line pushed (a stiff wire
 !! between anchors closer than its length) that the statics' linear law holds.
+!! Two more false equilibria are checked on every line: sections turned inside out (an
+!! axial force below -EA), and a line with bending stiffness wound by whole turns
+!! (neighbouring angles more than half a turn apart: loops its bending springs hold),
+!! which first descends again with the turns taken off.
 module ropedyn_line_equilibrium
     use ropedyn_kinds, only: wp, i8
     use ropedyn_error, only: error_t, ERR_SOLVER
@@ -56,9 +60,12 @@ module ropedyn_line_equilibrium
 contains
 
     !> The equilibrium from the starting state y, as find_equilibrium, checked for a false
-    !! equilibrium; from a catenary between the supports where the first descent fails or
-    !! leaves the line compressed (result%restart says why; the lesser compression wins). A
-    !! compression left is kept with result%caution. On success y holds the equilibrium.
+    !! equilibrium (compression_t: sections turned inside out, a wound line, a line that
+    !! carries tension only left compressed): a wound one descends again with its whole
+    !! turns taken off; then, where the first descent failed or the result is still
+    !! suspect, from a catenary between the supports. The better result wins
+    !! (compression_t%worse; result%restart says which start and why); what is left is
+    !! kept with result%caution. On success y holds the equilibrium.
     subroutine static_equilibrium(model, spec, y, options, result, err)
         class(rope_model_t), intent(inout) :: model
         type(rope_spec_t), intent(in) :: spec
