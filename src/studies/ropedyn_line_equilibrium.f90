@@ -108,12 +108,8 @@ contains
                 tried = '; from a catenary between the supports the line '//c2%text()
                 if (allocated(err) .or. c1%worse(c2)) then
                     if (allocated(err)) deallocate (err)
-                    second%iterations = second%iterations + result%iterations
-                    second%rejected = second%rejected + result%rejected
-                    second%restart = 'a catenary between the supports ('//why//')'
-                    result = second
-                    y = y_cat
-                    c1 = c2
+                    call take(result, y, c1, second, y_cat, c2, &
+                              'a catenary between the supports ('//why//')')
                 end if
             end if
         end if
@@ -154,13 +150,31 @@ contains
         if (allocated(err)) return
         c_again = compression_at(model, spec, y_again, again%weight)
         if (.not. c%worse(c_again)) return
-        again%iterations = again%iterations + result%iterations
-        again%rejected = again%rejected + result%rejected
-        again%restart = 'its equilibrium with the whole turns taken off ('//why//')'
-        result = again
-        y = y_again
-        c = c_again
+        call take(result, y, c, again, y_again, c_again, &
+                  'its equilibrium with the whole turns taken off ('//why//')')
     end subroutine unwound_descent
+
+    !> The equilibrium of a later start (`later`, `y_later`, `c_later`) replaces the one kept
+    !! (`result`, `y`, `c`): its counts include those of the descents before it, and its
+    !! restart says where it came from and why.
+    subroutine take(result, y, c, later, y_later, c_later, restart)
+        type(statics_result_t), intent(inout) :: result
+        real(wp), intent(inout) :: y(:)
+        type(compression_t), intent(inout) :: c
+        type(statics_result_t), intent(in) :: later
+        real(wp), intent(in) :: y_later(:)
+        type(compression_t), intent(in) :: c_later
+        character(len=*), intent(in) :: restart
+        integer :: iterations, rejected
+        iterations = result%iterations + later%iterations
+        rejected = result%rejected + later%rejected
+        result = later
+        result%iterations = iterations
+        result%rejected = rejected
+        result%restart = restart
+        y = y_later
+        c = c_later
+    end subroutine take
 
     !> The compression of a line that carries tension only at the state y under the
     !! statics' linear law, which the forces of a run would clip (force 0 for a line that
