@@ -136,12 +136,12 @@ contains
     logical function level_ground_under(spec, top, bottom, length) result(level)
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(in) :: top(2), bottom(2), length
-        real(wp) :: depth(0:1)
+        real(wp) :: depth(0:0)
         level = spec%effects%ground .and. spec%ground%normal(1) < 0.0_wp
         if (.not. level) return
         level = tilt(spec) <= LEVEL_SLOPE
         if (.not. level) return
-        depth = depth_below(spec, reshape([bottom, top], [2, 2]))
+        depth = depth_below(spec, reshape(bottom, [2, 1]))
         level = abs(depth(0)) <= ON_GROUND_SHARE*length .and. bottom(1) > top(1)
     end function level_ground_under
 

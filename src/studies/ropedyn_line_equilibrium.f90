@@ -37,7 +37,9 @@ module ropedyn_line_equilibrium
     !! carries tension only (rounding and the iteration's last step leave far less)
     real(wp), parameter :: FALSE_COMPRESSION = 1.0e-3_wp
 
-    !> The largest compression of a line's axial springs at a state, against the bounds.
+    !> What marks a state as a false equilibrium: sections turned inside out, whole turns
+    !! between neighbours (a wound line), the largest compression of a line that carries
+    !! tension only; and the bounds that compression is judged against.
     type :: compression_t
         real(wp) :: force = 0.0_wp           !< N (0: none, or a line that may be compressed)
         integer :: joint = 0                 !< where (0 the top)
@@ -135,12 +137,11 @@ contains
         type(statics_result_t) :: again
         type(compression_t) :: c_again
         type(error_t), allocatable :: err
-        integer, allocatable :: pos(:), vel(:), at(:)
+        integer, allocatable :: at(:)
         real(wp), allocatable :: y_again(:)
         real(wp), parameter :: TWO_PI = 2.0_wp*acos(-1.0_wp)
         integer :: k
-        call model%coordinates(pos, vel)
-        at = pack(pos, model%angle_coordinates())
+        at = angle_places(model)
         y_again = y
         do k = 2, size(at)
             y_again(at(k)) = y_again(at(k)) - &
@@ -176,7 +177,8 @@ contains
         c = c_later
     end subroutine take
 
-    !> The compression of a line that carries tension only at the state y under the
+    !> The check of the state y (compression_t): its inverted joints, its wound ones (with
+    !! bending springs), and for a line that carries tension only its compression under the
     !! statics' linear law, which the forces of a run would clip (force 0 for a line that
     !! may be compressed, or without weight).
     function compression_at(model, spec, y, weight) result(c)
@@ -225,20 +227,27 @@ contains
                  (other%wound == self%wound .and. other%force < self%force)))
     end function compression_worse
 
-    !> The joints where neighbouring elements' angles (the model's angle coordinates, in
-    !! order along the line) differ by more than half a turn.
+    !> The joints where neighbouring elements' angles differ by more than half a turn.
     function wound_joints(model, y) result(wound)
         class(rope_model_t), intent(in) :: model
         real(wp), intent(in) :: y(:)
         integer :: wound
-        integer, allocatable :: pos(:), vel(:)
         real(wp), allocatable :: phi(:)
         real(wp), parameter :: PI = acos(-1.0_wp)
-        call model%coordinates(pos, vel)
-        phi = pack(y(pos), model%angle_coordinates())
+        phi = y(angle_places(model))
         wound = 0
         if (size(phi) > 1) wound = count(abs(phi(2:) - phi(:size(phi) - 1)) > PI)
     end function wound_joints
+
+    !> Where the elements' angles sit in the state, in order along the line (the model's
+    !! angle coordinates).
+    function angle_places(model) result(at)
+        class(rope_model_t), intent(in) :: model
+        integer, allocatable :: at(:)
+        integer, allocatable :: pos(:), vel(:)
+        call model%coordinates(pos, vel)
+        at = pack(pos, model%angle_coordinates())
+    end function angle_places
 
     !> Compressed beyond FALSE_COMPRESSION of the weight and beyond the weight of an
     !! element: a fold or a push the linear law holds.

@@ -77,8 +77,9 @@ module ropedyn_statics
         !! supports (...)' or 'its equilibrium with the whole turns taken off (...)'
         !! (ropedyn_line_equilibrium); unallocated when the scene's start gave it
         character(len=:), allocatable :: restart
-        !> a compression below an element's weight in a line that carries tension only
-        !! (ropedyn_line_equilibrium); unallocated when there is none
+        !> what is left of a false equilibrium, said (ropedyn_line_equilibrium: a line
+        !! that carries tension only left compressed, a wound line); unallocated when
+        !! nothing is
         character(len=:), allocatable :: caution
     contains
         procedure :: report => result_report
