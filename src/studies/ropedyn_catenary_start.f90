@@ -1,6 +1,6 @@
 !> A second start for the statics of a line held at both ends: the inextensible catenary
-!! between its supports, lying on a level ground from its touchdown to the anchor where the
-!! anchor is on that ground (docs/theory/statics-modes.md, "A catenary start").
+!! between its supports, lying on a level ground between its touchdown and the anchor's
+!! arc (docs/theory/statics-modes.md, "A catenary start").
 !!
 !! The descent from the scene's start may end in a false equilibrium: a chain whose lower
 !! part lies on the seabed folded back and forth, its folds held by compressed joints that a
@@ -11,16 +11,20 @@
 !! fold.
 !!
 !! x points down (gravity), y across. With a the catenary's parameter H/w:
-!! - touchdown (ground level, normal -x; anchor on it; the fairlead h above it; horizontal
-!!   span D; length L): the suspended arc Ls = sqrt(h^2 + 2 a h) spans a acosh(1 + h/a),
-!!   the rest lies straight to the anchor, so a solves a acosh(1 + h/a) + L - Ls - D = 0;
-!! - suspended (the anchor off the ground, or the line lifts off it): 2 a sinh(D/(2a)) =
-!!   sqrt(L^2 - dx^2), dx the anchor's depth below the top;
+!! - touchdown (ground level, normal -x; the fairlead h above it, the anchor on it or r
+!!   above it; horizontal span D; length L): the fairlead's arc Ls = sqrt(h^2 + 2 a h)
+!!   spans a acosh(1 + h/a), the anchor's arc Lr = sqrt(r^2 + 2 a r) spans a acosh(1 + r/a)
+!!   (both with their vertex on the ground, one horizontal tension), the rest lies straight
+!!   on the ground between them, so a solves
+!!   a acosh(1 + h/a) + a acosh(1 + r/a) + L - Ls - Lr - D = 0;
+!! - suspended (the anchor below the ground's level, or the line lifts off it):
+!!   2 a sinh(D/(2a)) = sqrt(L^2 - dx^2), dx the anchor's depth below the top;
 !! - taut (L at most the supports' distance): the straight line between them;
-!! - slack (on a level ground, L >= h + D: more than the drop and the span): the line hangs
-!!   straight down to the ground, lies back from its foot by half the excess e = L - h - D,
-!!   turns, and lies along the ground to the anchor, at no tension there (a slack line's
-!!   equilibrium on a ground without friction is any such shape).
+!! - slack (on a level ground, L >= h + r + D: more than the drops and the span): the line
+!!   hangs straight down to the ground, lies back from its foot by half the excess
+!!   e = L - h - r - D, turns, lies along the ground to below the anchor and rises straight
+!!   to it, at no tension on the ground (a slack line's equilibrium on a ground without
+!!   friction is any such shape).
 !! No start where it does not apply: a free end, gravity off, both supports on one vertical
 !! above the ground or without one, a catenary through the ground.
 module ropedyn_catenary_start
@@ -47,9 +51,10 @@ module ropedyn_catenary_start
         real(wp) :: length = 0.0_wp      !< L, m
         real(wp) :: a = 0.0_wp           !< H/w, m
         real(wp) :: side = 1.0_wp        !< +1 the anchor lies towards +y, -1 towards -y
-        integer :: kind = 0              !< NONE, TAUT, SUSPENDED or TOUCHDOWN
-        real(wp) :: ground = 0.0_wp      !< TOUCHDOWN: the ground's depth x, m
+        integer :: kind = 0              !< NONE, TAUT, SUSPENDED, TOUCHDOWN or SLACK
+        real(wp) :: ground = 0.0_wp      !< TOUCHDOWN, SLACK: the ground's depth x, m
         real(wp) :: suspended = 0.0_wp   !< TOUCHDOWN: Ls, m; SLACK: the drop h, m
+        real(wp) :: rise = 0.0_wp        !< TOUCHDOWN: Lr, m; SLACK: the anchor's height r, m
         real(wp) :: excess = 0.0_wp      !< SLACK: e, m
         real(wp) :: xi0 = 0.0_wp         !< SUSPENDED: the vertex's span from the top, m
     contains
@@ -106,7 +111,7 @@ contains
         real(wp), intent(in) :: top(2), bottom(2), length
         type(rope_spec_t), intent(in) :: spec
         type(catenary_t) :: cat
-        real(wp) :: span, drop
+        real(wp) :: span, drop, rise, ground
         cat%top = top
         cat%bottom = bottom
         cat%length = length
@@ -116,33 +121,40 @@ contains
             cat%kind = TAUT
             return
         end if
-        if (level_ground_under(spec, top, bottom, length)) then
-            cat%ground = bottom(1)
-            drop = cat%ground - top(1)
-            if (length >= drop + span) then
+        if (level_ground_under(spec, top, bottom, length, ground)) then
+            cat%ground = ground
+            drop = ground - top(1)
+            rise = ground - bottom(1)
+            if (length >= drop + rise + span) then
                 cat%kind = SLACK
                 cat%suspended = drop
-                cat%excess = length - drop - span
+                cat%rise = rise
+                cat%excess = length - drop - rise - span
                 return
             end if
-            call solve_touchdown(cat, drop, span)
+            call solve_touchdown(cat, drop, rise, span)
             if (cat%kind == TOUCHDOWN) return
         end if
         if (span > 0.0_wp) call suspended_between(cat, span, bottom(1) - top(1))
     end function shape_of
 
-    !> The ground is on, level (its normal along -x, to LEVEL_SLOPE), the anchor on it and
-    !! the top above it.
-    logical function level_ground_under(spec, top, bottom, length) result(level)
+    !> The ground is on, level (its normal along -x, to LEVEL_SLOPE), the top above it and
+    !! the anchor on it or above it; `ground` its depth x below the anchor (the anchor's own
+    !! where it lies within ON_GROUND_SHARE of the length from it).
+    logical function level_ground_under(spec, top, bottom, length, ground) result(level)
         type(rope_spec_t), intent(in) :: spec
         real(wp), intent(in) :: top(2), bottom(2), length
-        real(wp) :: depth(0:0)
+        real(wp), intent(out) :: ground
+        real(wp) :: depth(0:1)
+        ground = bottom(1)
         level = spec%effects%ground .and. spec%ground%normal(1) < 0.0_wp
         if (.not. level) return
         level = tilt(spec) <= LEVEL_SLOPE
         if (.not. level) return
-        depth = depth_below(spec, reshape(bottom, [2, 1]))
-        level = abs(depth(0)) <= ON_GROUND_SHARE*length .and. bottom(1) > top(1)
+        depth = depth_below(spec, reshape([bottom, top], [2, 2]))
+        level = depth(0) <= ON_GROUND_SHARE*length .and. depth(1) < -ON_GROUND_SHARE*length
+        if (level .and. abs(depth(0)) > ON_GROUND_SHARE*length) &
+            ground = bottom(1) - depth(0)*norm2(spec%ground%normal)/abs(spec%ground%normal(1))
     end function level_ground_under
 
     !> The ground's slope: across over down of its normal (0 for a level ground).
@@ -151,26 +163,45 @@ contains
         tilt = abs(spec%ground%normal(2))/max(abs(spec%ground%normal(1)), tiny(1.0_wp))
     end function tilt
 
-    !> The touchdown catenary from a top `drop` above the ground to an anchor on it `span`
-    !! away: kind TOUCHDOWN with a and Ls, or unchanged where the whole line hangs free
-    !! (the catenary that touches down at the anchor with all its length spans less than
-    !! `span`).
-    subroutine solve_touchdown(cat, drop, span)
+    !> The touchdown catenary from a top `drop` above the ground to an anchor `rise` above
+    !! it (0: on it) `span` away: kind TOUCHDOWN with a, Ls and Lr, or unchanged where the
+    !! whole line hangs free (the catenary whose two arcs take all its length spans less
+    !! than `span`, or the line cannot reach the ground from both ends).
+    subroutine solve_touchdown(cat, drop, rise, span)
         type(catenary_t), intent(inout) :: cat
-        real(wp), intent(in) :: drop, span
+        real(wp), intent(in) :: drop, rise, span
         real(wp) :: lo, hi
-        hi = (cat%length**2 - drop**2)/(2.0_wp*drop)     ! Ls = L
-        if (miss(hi) < 0.0_wp) return
+        if (cat%length <= drop + rise) return
         lo = 1.0e-12_wp*cat%length
+        if (rise > 0.0_wp) then
+            hi = rising_root(reach, lo, cat%length**2/(2.0_wp*max(drop, rise)))  ! Ls + Lr = L
+        else
+            hi = (cat%length**2 - drop**2)/(2.0_wp*drop)                         ! Ls = L
+        end if
+        if (miss(hi) < 0.0_wp) return
         cat%a = rising_root(miss, lo, hi)
-        cat%suspended = sqrt(drop**2 + 2.0_wp*cat%a*drop)
+        cat%suspended = arc(cat%a, drop)
+        cat%rise = arc(cat%a, rise)
         cat%kind = TOUCHDOWN
     contains
         !> The span reached less `span` (rises with a).
         real(wp) function miss(a)
             real(wp), intent(in) :: a
-            miss = a*acosh(1.0_wp + drop/a) + cat%length - sqrt(drop**2 + 2.0_wp*a*drop) - span
+            miss = a*acosh(1.0_wp + drop/a) + a*acosh(1.0_wp + rise/a) + cat%length &
+                   - arc(a, drop) - arc(a, rise) - span
         end function miss
+
+        !> The two arcs' length less L (rises with a).
+        real(wp) function reach(a)
+            real(wp), intent(in) :: a
+            reach = arc(a, drop) + arc(a, rise) - cat%length
+        end function reach
+
+        !> The arc of a catenary from its vertex to the height z above it, m.
+        pure real(wp) function arc(a, z)
+            real(wp), intent(in) :: a, z
+            arc = sqrt(z**2 + 2.0_wp*a*z)
+        end function arc
     end subroutine solve_touchdown
 
     !> The catenary hanging free between the supports, `span` apart across and the bottom
@@ -251,9 +282,14 @@ contains
                 u = self%suspended - s                 ! arc from the touchdown up
                 xi = a*asinh(self%suspended/a) - a*asinh(u/a)
                 p = [self%ground - (sqrt(a**2 + u**2) - a), self%top(2) + self%side*xi]
-            else
+            else if (s <= self%length - self%rise) then
                 xi = a*asinh(self%suspended/a) + s - self%suspended
                 p = [self%ground, self%top(2) + self%side*xi]
+            else
+                u = s - (self%length - self%rise)      ! arc from the anchor's vertex up
+                xi = a*asinh(self%suspended/a) + self%length - self%rise - self%suspended &
+                     + a*asinh(u/a)
+                p = [self%ground - (sqrt(a**2 + u**2) - a), self%top(2) + self%side*xi]
             end if
         case (SLACK)
             if (s <= self%suspended) then
@@ -268,6 +304,9 @@ contains
                     xi = xi - self%excess
                 end if
                 p = [self%ground, self%top(2) + self%side*xi]
+                ! up from below the anchor
+                if (s > self%length - self%rise) &
+                    p = [self%ground - (s - (self%length - self%rise)), self%bottom(2)]
             end if
         case default                                   ! SUSPENDED
             xi = self%xi0 + a*asinh(s/a + sinh(-self%xi0/a))

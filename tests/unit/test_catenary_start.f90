@@ -8,7 +8,11 @@
 !!   0 where it meets the ground (tangent), and the inextensible closed form of the
 !!   touchdown, a acosh(1 + h/a) + L - sqrt(h^2 + 2 a h) = D, holds for the a the slope
 !!   gives;
+!! - touchdown to a raised anchor (the ground 0.5 m down, the anchor 0.15 m above it, 0.6 m
+!!   across): an arc from the ground up to the anchor too, its slope linear in s with the
+!!   same 1/a as the top's (one horizontal tension), and the closed form with both arcs;
 !! - slack (the anchor 0.2 m across: L > h + D): straight down to the ground, then on it;
+!!   with the anchor 0.1 m above the ground, straight up to it at the end;
 !! - taut (the anchor 1.2 m away): the straight line between the supports;
 !! - none: a free bottom end.
 program test_catenary_start
@@ -31,7 +35,9 @@ program test_catenary_start
     call test_suspended()
     call test_touchdown('rfem')
     call test_touchdown('mpp')
+    call test_raised_anchor()
     call test_slack()
+    call test_slack_to_a_raised_anchor()
     call test_taut()
     call test_none()
     call suite%finish()
@@ -146,6 +152,37 @@ contains
                             kind//' touchdown: ends at the anchor')
     end subroutine test_touchdown
 
+    subroutine test_raised_anchor()
+        real(wp), allocatable :: p(:, :), c(:)
+        real(wp) :: g_top, g_anchor, b, worst_top, worst_anchor, a
+        logical :: found, on(N)
+        integer :: i, first, last
+        call start_of([character(len=64) :: 'supports.bottom_anchor=0.35,0.6', &
+                       'effects.ground=.true.', 'ground.point=0.5,0.0'], 'rfem', found, p, c)
+        call suite%check_true(found, 'raised anchor: found')
+        do i = 1, N
+            on(i) = all(abs(p(1, 2*i - 1:2*i) - 0.5_wp) < 1.0e-5_wp)
+        end do
+        first = findloc(on, .true., dim=1)
+        last = findloc(on, .true., dim=1, back=.true.)
+        call suite%check_true(first > 0 .and. last - first + 1 == count(on) .and. &
+                              count(on) >= 3 .and. last < N - 3, &
+                              'raised anchor: a part in the middle lies on the ground')
+        call fit_line(p, c, 1, first - 2, g_top, b, worst_top)
+        call fit_line(p, c, last + 2, N, g_anchor, b, worst_anchor)
+        call suite%check_le(max(worst_top/abs(g_top), worst_anchor/abs(g_anchor)), 2.0e-3_wp, &
+                            'raised anchor: both suspended parts catenaries')
+        call suite%check_close(g_anchor, g_top, 1.0e-2_wp, 0.0_wp, &
+                               'raised anchor: one horizontal tension (the same 1/a)')
+        a = -1.0_wp/g_top
+        call suite%check_close(a*acosh(1.0_wp + 0.5_wp/a) + a*acosh(1.0_wp + 0.15_wp/a) + &
+                               1.0_wp - sqrt(0.25_wp + a) - sqrt(0.0225_wp + 0.3_wp*a), &
+                               0.6_wp, 1.0e-4_wp, 0.0_wp, &
+                               'raised anchor: the closed form with both arcs holds')
+        call suite%check_le(norm2(p(:, 2*N) - [0.35_wp, 0.6_wp]), 1.0e-4_wp, &
+                            'raised anchor: ends at the anchor')
+    end subroutine test_raised_anchor
+
     subroutine test_slack()
         real(wp), allocatable :: p(:, :), c(:)
         logical :: found
@@ -167,6 +204,25 @@ contains
                             'slack: ends at the anchor')
         call suite%check_le(minval(p(2, :)), -0.099_wp, 'slack: lies back half the excess')
     end subroutine test_slack
+
+    subroutine test_slack_to_a_raised_anchor()
+        real(wp), allocatable :: p(:, :), c(:)
+        logical :: found
+        integer :: i, up
+        call start_of([character(len=64) :: 'supports.bottom_anchor=0.5,0.2', &
+                       'effects.ground=.true.', 'ground.point=0.6,0.0'], 'rfem', found, p, c)
+        call suite%check_true(found, 'slack, raised anchor: found')
+        up = 0
+        do i = 1, N
+            if (all(abs(p(2, 2*i - 1:2*i) - 0.2_wp) < 1.0e-12_wp) .and. &
+                all(p(1, 2*i - 1:2*i) < 0.6_wp - 1.0e-12_wp)) up = up + 1
+        end do
+        ! the last 0.1 m of 1 m straight up from the ground, but the element at the corner
+        call suite%check_true(up == count(c - 0.5_wp/(N - 1) >= 0.9_wp - 1.0e-12_wp) .and. &
+                              up > 1, 'slack, raised anchor: straight up to the anchor')
+        call suite%check_le(norm2(p(:, 2*N) - [0.5_wp, 0.2_wp]), 1.0e-12_wp, &
+                            'slack, raised anchor: ends at the anchor')
+    end subroutine test_slack_to_a_raised_anchor
 
     subroutine test_taut()
         real(wp), allocatable :: p(:, :), c(:)
