@@ -127,6 +127,42 @@ def test_initial_equilibrium_run(run, tmp_path):
     assert np.max(kinetic) < 1e-12
 
 
+CRANE = ("&model kind = '{kind}', elements = 6 /\n"
+         "&rope length = 12.0, diameter = 0.016, mass_per_length = 1.0,"
+         " axial_stiffness = 1.2e7 /\n"
+         "&initial shape = 'equilibrium', angle_deg = 0.0 /\n"
+         "&attachments mass_positions = 12.0, masses = 2000.0 /\n"
+         "&solver t_end = 0.02, output_interval = 0.01 /\n")
+
+
+@pytest.mark.parametrize("kind", ["rfem", "mpp"])
+def test_a_payload_counts_in_the_weight_and_the_masses(run, tmp_path, kind):
+    """A crane's wire (12 kg) with a 2000 kg payload at its end: the statics' weight, the
+    run's m g L and /rope/element_mass count the payload in both models (the MPP counted
+    the wire alone: a weight of 117.72 N against a top force of 19737.72 N)."""
+    (tmp_path / "crane.nml").write_text(CRANE.format(kind=kind))
+    weight = (12.0 + 2000.0) * 9.81
+    statics = run("statics", "crane.nml", "-o", "s.h5")
+    assert statics.returncode == 0, statics.stderr
+    with h5py.File(tmp_path / "s.h5") as f:
+        assert f["statics/weight"][()] == pytest.approx(weight, rel=1e-12)
+        assert np.hypot(*f["statics/support_force_top"][:]) == pytest.approx(weight, rel=1e-9)
+        assert f["rope/element_mass"][:].sum() == pytest.approx(2012.0, rel=1e-12)
+    assert f"of the weight {weight:.2f} N" in statics.stdout, statics.stdout
+    # a run that moves (the payload drops onto the unstretched wire), so that its balance
+    # error is not 0
+    result = run("run", "crane.nml", "--set", "output.file=r.h5",
+                 "--set", "initial.shape=straight")
+    assert result.returncode == 0, result.stderr
+    with h5py.File(tmp_path / "r.h5") as f:
+        assert f["rope/element_mass"][:].sum() == pytest.approx(2012.0, rel=1e-12)
+    # the summary gives the balance error in J and in m g L = 2012 kg g 12 m
+    line = next(x for x in result.stdout.splitlines() if x.strip().startswith("balance error"))
+    joules = float(line.split("(")[0].split()[2])
+    in_mgl = float(line.split("(")[1].split()[0])
+    assert joules != 0.0, line
+    assert joules / in_mgl == pytest.approx(weight * 12.0, rel=0.01), line
+
 CURRENT = ("&model kind = '{kind}', elements = 12 /\n"
            "&initial shape = '{shape}' /\n"
            "&effects drag = .true. /\n"

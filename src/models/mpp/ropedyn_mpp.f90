@@ -661,11 +661,14 @@ contains
         mpp_has_mass_matrix = .true.
     end function mpp_has_mass_matrix
 
+    !> Length (m) and mass (kg) of each member, its point masses included (as the RFEM's
+    !! element masses include theirs): the rope's m g L, the statics' weight and the run
+    !! file's /rope/element_mass are the same for both models.
     subroutine mpp_element_data(self, length, mass)
         class(mpp_t), intent(in) :: self
         real(wp), intent(out) :: length(:), mass(:)
         length = self%l
-        mass = self%m
+        mass = self%mbar
     end subroutine mpp_element_data
 
     subroutine mpp_initial_state(self, y)
