@@ -105,6 +105,13 @@ module ropedyn_run
         type(text_t), allocatable :: warnings(:)
     end type run_summary_t
 
+    !> Where a line that carries tension only passed through itself (note_turned_back): the
+    !! worst body (0: none), how far, in its lengths, and when; the time it first happened.
+    type :: turned_back_t
+        integer :: body = 0
+        real(wp) :: share = 0.0_wp, at = 0.0_wp, first = 0.0_wp
+    end type turned_back_t
+
     !> A state of a run without output kept in memory (`save`, `restore`): time, ODE state,
     !! quadratures, the supports' motions and the prescriptions for the next advance.
     type :: run_snapshot_t
@@ -157,6 +164,8 @@ module ropedyn_run
         real(wp), allocatable :: axial(:), shear(:), moment(:)
         real(wp) :: reaction(2, 2) = 0.0_wp, anchors(2, 2) = 0.0_wp
         integer :: nq = 0                   !< quadratures of the model
+        !> a line carrying tension only that passed through itself (note_turned_back)
+        type(turned_back_t) :: turned_back
         ! the output grid: every dt up to t_end, records 0 .. n_out; the next is k_next
         real(wp) :: dt = 1.0_wp, t_end = 0.0_wp
         integer :: n_out = 1, k_next = 1
@@ -217,6 +226,7 @@ module ropedyn_run
                               integrator_options, &
                               steps_taken, keep_as_previous, asked_to_stop, end_on, &
                               start_monitor
+        procedure, private :: note_turned_back, turned_back_warning
         procedure, private :: resume_from_file, check_energy, second_look, note_peak, &
                               fail_runaway, rescue, retire_integrator, keep_switches
         procedure, private :: guard_output, release_output, hand_back, file_warnings
@@ -684,6 +694,7 @@ contains
                             '): not written to the output')
             return
         end if
+        if (self%model%tension_only) call self%note_turned_back()
         ! the counters so far go with the records the next flush writes (a killed run's
         ! file then holds them as of its last flush)
         if (self%output /= OUTPUT_NONE .and. self%counting) then
@@ -702,6 +713,85 @@ contains
         self%summary%t_reached = self%t
         call self%keep_as_previous()
     end subroutine record
+
+    !> A line that carries tension only has no axial spring where it is slack, so nothing
+    !! stops two neighbours from sliding past each other where it folds back on itself or
+    !! whips slack (docs/guide/scenes.md, "A chain cannot push"). Keeps the record's worst
+    !! body whose successor starts more than twice the body's length behind it
+    !! (line_turned_back), and the time it first happened, for turned_back_warning.
+    subroutine note_turned_back(self)
+        class(run_t), intent(inout) :: self
+        real(wp) :: lengths(self%model%n_elements()), masses(self%model%n_elements())
+        integer :: k
+        real(wp) :: share
+        call self%model%element_data(lengths, masses)
+        call line_turned_back(self%q, self%points, lengths, k, share)
+        if (k == 0) return
+        associate (b => self%turned_back)
+            if (b%body == 0) b%first = self%t
+            if (b%body == 0 .or. share > b%share) then
+                b%body = k
+                b%share = share
+                b%at = self%t
+            end if
+        end associate
+    end subroutine note_turned_back
+
+    !> The warning of a line whose bodies slid past each other (note_turned_back).
+    function turned_back_warning(self, model_name) result(text)
+        use ropedyn_text, only: int_text
+        class(run_t), intent(in) :: self
+        character(len=*), intent(in) :: model_name
+        character(len=:), allocatable :: text, what
+        character(len=12) :: by, first, at
+        associate (b => self%turned_back)
+            write (by, '(f12.1)') b%share
+            write (first, '(f12.3)') b%first
+            write (at, '(f12.3)') b%at
+            if (model_name == 'mpp') then
+                what = 'member '//int_text(b%body)//' turned inside out'
+            else
+                what = 'element '//int_text(b%body + 1)//' slid past element '// &
+                       int_text(b%body)
+            end if
+            text = 'the line passed through itself from t = '//trim(adjustl(first))// &
+                   ' s on: '//what//' by up to '//trim(adjustl(by))//' times its length (t = '// &
+                   trim(adjustl(at))//' s). A line that carries tension only '// &
+                   '(&rope compression = .false.) has no axial spring where it is slack, '// &
+                   'so where it folds back on itself or whips slack its bodies can slide '// &
+                   'past each other, and a line torn open so lets its end fall through; '// &
+                   'the records from then on are not physical. Give the line some '// &
+                   'axial_damping (its dampers act while it is slack too), or let it push '// &
+                   '(compression = .true.)'
+        end associate
+    end function turned_back_warning
+
+    !> The body k (element or member) of the fields q (3, n) and polyline points (2, 2 n)
+    !! whose successor starts furthest behind it, along = e_k . (A_{k+1} - A_k) with
+    !! A_{n+1} = B_n, when that is more than twice its length (lengths, m) behind: share =
+    !! -along/length > 2; k = 0 where there is none. On the RFEM: a joint that overlaps
+    !! the element before it and more; on the MPP: a member turned inside out beyond its
+    !! own length. A slack chain's joints overlap a little: the chain of
+    !! tests/e2e/test_tension_only.py shaken slack reaches a share of 1.3.
+    pure subroutine line_turned_back(q, points, lengths, k, share)
+        real(wp), intent(in) :: q(:, :), points(:, :), lengths(:)
+        integer, intent(out) :: k
+        real(wp), intent(out) :: share
+        integer :: n, j
+        real(wp) :: a_next(2), along
+        n = size(q, 2)
+        k = 0
+        share = 2.0_wp
+        do j = 1, n
+            a_next = points(:, min(2*j + 1, 2*n))
+            along = cos(q(3, j))*(a_next(1) - points(1, 2*j - 1)) + &
+                    sin(q(3, j))*(a_next(2) - points(2, 2*j - 1))
+            if (-along > share*lengths(j)) then
+                k = j
+                share = -along/lengths(j)
+            end if
+        end do
+    end subroutine line_turned_back
 
     !> End the run on an error of `record`: a failed integration finishes it as 'failed';
     !! an error of the file (which the io layer has closed and marked failed) only releases
@@ -803,6 +893,8 @@ contains
             s%cpu_time = self%cpu_so_far()
             s%stats = self%counters_so_far()
             s%t_reached = max(s%t_reached, self%t)
+            if (self%turned_back%body > 0) call append_text(s%warnings, &
+                self%turned_back_warning(self%model%model_name()))
             if (self%monitoring .and. s%records > 0) then
                 if (self%monitor%lost(s%final_energy)) call append_text(s%warnings, &
                     loss_warning(self%monitor%loss(s%final_energy), self%monitor%intake(), &
