@@ -97,6 +97,17 @@ contains
         type(scene_t), intent(in) :: scene
         type(run_summary_t), intent(in) :: summary
         character(len=:), allocatable :: text
+        character(len=16) :: since
+        if (summary%passed_through >= 0.0_wp) then
+            ! the torn line's loose end holds the step: more steps go on with a line that is
+            ! no longer physical
+            write (since, '(f16.3)') summary%passed_through
+            text = '; the line passed through itself from t = '//trim(adjustl(since))// &
+                   ' s on (its warning above), and its loose end holds the step: a resume '// &
+                   'would not help. Give the line axial_damping, or let it push '// &
+                   '(compression = .true.), and run it again'
+            return
+        end if
         text = '; continue with: ropedyn run --resume '//file
         if (summary%budget_rest <= step_budget(scene)) return
         if (budget_covering(summary%budget_rest) > huge(1)) then

@@ -97,6 +97,9 @@ module ropedyn_run
         !! short): the steps the rest of the run takes at its last step (a resume goes on
         !! from the last record with a budget of its own); 0 otherwise
         integer(i8) :: budget_rest = 0
+        !> a line carrying tension only that passed through itself: the first record's time
+        !! at which it had (note_turned_back; its warning is in `warnings`), s; -1 if none
+        real(wp) :: passed_through = -1.0_wp
         !> the run's own warnings, one line each: what the initial state does against the
         !! scene (ropedyn_start_checks: a held end far from its anchor) and a loss of a tenth
         !! of the energy the motion took in (the energy monitor's `lost`, with the order
@@ -893,8 +896,10 @@ contains
             s%cpu_time = self%cpu_so_far()
             s%stats = self%counters_so_far()
             s%t_reached = max(s%t_reached, self%t)
-            if (self%turned_back%body > 0) call append_text(s%warnings, &
-                self%turned_back_warning(self%model%model_name()))
+            if (self%turned_back%body > 0) then
+                call append_text(s%warnings, self%turned_back_warning(self%model%model_name()))
+                s%passed_through = self%turned_back%first
+            end if
             if (self%monitoring .and. s%records > 0) then
                 if (self%monitor%lost(s%final_energy)) call append_text(s%warnings, &
                     loss_warning(self%monitor%loss(s%final_energy), self%monitor%intake(), &

@@ -2,8 +2,8 @@
 shaken up and down faster than gravity can follow goes slack, and its axial springs then carry
 no compression, while with the linear law (the default) they push. The energy balance holds
 with both laws: the tension-only spring stores k max(stretch, 0)^2 / 2. A line that came apart
-(two neighbours slid past each other where nothing holds them, at a fold) ends the run as
-failed, with the cause. Both models."""
+(two neighbours slid past each other where nothing holds them, at a fold) is warned of, with
+the cause, and a run that then spends its step budget is offered no resume. Both models."""
 import re
 import subprocess
 
@@ -136,3 +136,23 @@ def test_a_slack_chain_overlapping_a_little_is_not_warned_of(ropedyn_exe, tmp_pa
                             capture_output=True, text=True, timeout=120)
     assert result.returncode == 0 and "passed through itself" not in result.stderr, \
         result.stderr
+
+
+def test_a_torn_line_out_of_steps_is_not_offered_a_resume(ropedyn_exe, tmp_path):
+    """A line torn open (the RFEM drop with a bending spring, from 0.14 s on) whips its loose
+    end, which holds the step; a run that then spends its step budget was offered a resume
+    with a larger budget, which only goes on with a line no longer physical. The error now
+    names the tear and its time, and the remedies, and offers no resume."""
+    scene = tmp_path / "drop.nml"
+    scene.write_text(DROP)
+    sets = [*CAME_APART["rfem"][0], "solver.t_end=2.0", "solver.max_steps=5000",
+            f"output.file={tmp_path / 'torn.h5'}"]
+    result = subprocess.run([str(ropedyn_exe), "run", str(scene), "--force",
+                             *[a for s in sets for a in ("--set", s)]],
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode != 0
+    error = [line for line in result.stderr.splitlines() if line.startswith("ropedyn: error:")]
+    assert len(error) == 1, result.stderr
+    assert "max_steps exceeded" in error[0], error[0]
+    assert "the line passed through itself from t = 0.140 s on" in error[0], error[0]
+    assert "axial_damping" in error[0] and "--resume" not in error[0], error[0]
