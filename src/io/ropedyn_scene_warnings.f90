@@ -1,15 +1,15 @@
-!> Warnings for a scene whose values are legal but probably a unit slip: a diameter in mm
-!! (more than a tenth of the length), a modulus or stiffness in the wrong unit (the static
-!! strain under the rope's own weight and its point masses above 10 %), a damping coefficient in the wrong unit
-!! (an element's axial damping ratio below 1e-6 or above 1000), air's density for water, a
-!! straight start or a support's anchor inside the ground (x points down: a ground point in
-!! the wrong sign), a key of a support's motion that its `*_motion` does not use (a
-!! harmonic key or a table with another motion), a release or a ramp that the run ends
-!! before, a key of &ground or &fluid set away from its default while the effects that use
-!! it are off (a ground or a water given and not switched on), a support_stiffness_factor
-!! that scales the rope's own end section (a clamp, a 'split' end), anchors further apart
-!! than the rope can reach without stretching by more than 10 %. Each warning names the
-!! key, its value and why; a run goes ahead.
+!> Warnings for a scene whose values are legal but probably a unit slip: a diameter in mm (more
+!! than a tenth of the length), a modulus or stiffness in the wrong unit (the static strain under
+!! the rope's own weight and its point masses above 10 %), a damping coefficient in the wrong unit
+!! (an element's axial damping ratio below 1e-6 or above 1000), air's density for water, a straight
+!! start or a support's anchor inside the ground (x points down: a ground point in the wrong sign),
+!! a key of a support's motion that its `*_motion` does not use (a harmonic key or a table with
+!! another motion), a release or a ramp that the run ends before, a key of &ground or &fluid set
+!! away from its default while the effects that use it are off (a ground or a water given and not
+!! switched on), a line lighter than 10 kg/m^3 (a diameter in mm on a long line), a
+!! support_stiffness_factor that scales the rope's own end section (a clamp, a 'split' end),
+!! anchors further apart than the rope can reach without stretching by more than 10 %. Each warning
+!! names the key, its value and why; a run goes ahead.
 module ropedyn_scene_warnings
     use, intrinsic :: iso_fortran_env, only: error_unit
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
@@ -40,6 +40,12 @@ module ropedyn_scene_warnings
     !! reverse, is off by the section area, 1e4 .. 1e8 for ropes
     real(wp), parameter :: MIN_DAMPING_RATIO = 1.0e-6_wp, MAX_DAMPING_RATIO = 1.0e3_wp
     real(wp), parameter :: MIN_WATER_DENSITY = 100.0_wp  !< kg/m^3
+    !> a line's mean density mass_per_length/(pi d^2/4), kg/m^3: a diameter in mm makes the
+    !! area 1e6 times too large, so a steel or fibre line's 1000 .. 8000 becomes 1e-3 ..
+    !! 1e-2 (in cm: 0.1 .. 0.8), a slip the tenth of the length misses on a long line (12
+    !! for 12 mm on a 200 m cable); lines with floats or air in them stay above 100
+    real(wp), parameter :: MIN_LINE_DENSITY = 10.0_wp
+    real(wp), parameter :: pi = acos(-1.0_wp)
     !> a straight start may touch the ground (a rope laid on the seabed) but not reach
     !! deeper into it than this share of its length
     real(wp), parameter :: MAX_START_DEPTH_SHARE = 1.0e-3_wp
@@ -71,6 +77,7 @@ contains
             call append_text(list, at('diameter')//'diameter = '//real_text(scene%rope%diameter)// &
                 ': more than a tenth of the length ('//real_text(scene%rope%length)// &
                 ' m): a diameter in mm? (the unit is m)')
+        call light_line(scene, sec, section, list)
         if (scene%effects%gravity .and. scene%effects%tension) then
             ! the top section carries the rope and its point masses (a crane's payload)
             payload = 0.0_wp
@@ -161,6 +168,26 @@ contains
             end if
         end function damping_text
     end function scene_warnings
+
+    !> A line given by its section set whose mean density mass_per_length/(pi d^2/4) is
+    !! below MIN_LINE_DENSITY while drag or water uses its diameter: a diameter in mm on a
+    !! line long enough that the tenth of its length (warned of before, and then not here)
+    !! misses it. Its buoyancy and drag are then a million times too large.
+    subroutine light_line(scene, sec, section, list)
+        type(scene_t), intent(in) :: scene
+        type(section_t), intent(in) :: sec
+        logical, intent(in) :: section   !< the section set is given
+        type(text_t), allocatable, intent(inout) :: list(:)
+        real(wp) :: density
+        if (.not. section .or. .not. (scene%effects%drag .or. scene%effects%water)) return
+        if (scene%rope%diameter > MAX_DIAMETER_SHARE*scene%rope%length) return
+        density = sec%mass_per_length/(pi*scene%rope%diameter**2/4.0_wp)
+        if (.not. density < MIN_LINE_DENSITY) return
+        call append_text(list, scene%origin('rope.diameter')//': &rope: diameter = '// &
+            real_text(scene%rope%diameter)//': the line''s mean density, mass_per_length / '// &
+            '(pi d^2/4), is '//significant_text(density, 3)//' kg/m^3 (a real line''s is 100 '// &
+            'or more): a diameter in mm? (the unit is m)')
+    end subroutine light_line
 
     !> A support_stiffness_factor other than 1 where a support's spring is the rope's own
     !! end section (docs/theory/rfem.md, "Supports"): a clamp's rotational spring (its

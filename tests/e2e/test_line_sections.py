@@ -161,6 +161,45 @@ def test_a_probable_unit_slip_gets_one_warning(run, tmp_path, sets, fragment):
     assert len(warnings) == 1 and fragment in warnings[0], proc.stderr
 
 
+#: a towed cable as a user gives it (docs/guide/effects.md, "A towed cable"): 200 m, 12 mm
+TOWED = ("&model elements = 4 /\n"
+         "&rope length = 200.0, diameter = 0.012, mass_per_length = 0.25, "
+         "axial_stiffness = 2.0e6 /\n"
+         "&initial shape = 'hanging' /\n&effects drag = .true., water = .true. /\n"
+         "&fluid density = 1025.0, current = 0.0, -2.0 /\n"
+         "&solver t_end = 1e-3, output_interval = 1e-3 /\n")
+
+
+@pytest.mark.parametrize("sets,warned", [
+    ([], False),
+    # 12 mm written as 12 m is under a tenth of 200 m: its mean density, 0.00221 kg/m^3,
+    # gives it away (its buoyancy lifts 450 kN and the cable floats)
+    (["rope.diameter=12"], True),
+    # in cm: 0.221 kg/m^3
+    (["rope.diameter=1.2"], True),
+    # the diameter used by neither drag nor water: no slip it matters for
+    (["rope.diameter=12", "effects.drag=.false.", "effects.water=.false.",
+      "fluid.density=1.225", "fluid.current=0,0"], False),
+])
+def test_a_diameter_in_mm_on_a_long_line_is_warned_of(run, tmp_path, sets, warned):
+    (tmp_path / "towed.nml").write_text(TOWED)
+    args = ["run", "towed.nml", "--set", "output.file='w.h5'"]
+    for s in sets:
+        args += ["--set", s]
+    proc = run(*args)
+    assert proc.returncode == 0, proc.stderr
+    warnings = [x for x in proc.stderr.splitlines() if x.startswith("ropedyn: warning: ")]
+    if not warned:
+        assert warnings == [], proc.stderr
+        return
+    diameter = float(sets[0].split("=")[1])
+    density = 0.25 / (math.pi * diameter ** 2 / 4)
+    assert len(warnings) == 1, proc.stderr
+    assert (f"&rope: diameter = {diameter!r}: the line's mean density, "
+            f"mass_per_length / (pi d^2/4), is {density:.3g} kg/m^3") in warnings[0], warnings
+    assert "a diameter in mm? (the unit is m)" in warnings[0], warnings
+
+
 def test_a_rope_laid_on_the_ground_has_no_warning(run, tmp_path):
     """A straight start along the ground's surface touches it (depth 0): no warning."""
     proc = run("run", PAPER, "--set", "solver.t_end=1e-4", "--set", "solver.output_interval=1e-4",
