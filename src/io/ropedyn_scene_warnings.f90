@@ -6,10 +6,10 @@
 !! a key of a support's motion that its `*_motion` does not use (a harmonic key or a table with
 !! another motion), a release or a ramp that the run ends before, a key of &ground or &fluid set
 !! away from its default while the effects that use it are off (a ground or a water given and not
-!! switched on), a line lighter than 10 kg/m^3 (a diameter in mm on a long line), a
-!! support_stiffness_factor that scales the rope's own end section (a clamp, a 'split' end),
-!! anchors further apart than the rope can reach without stretching by more than 10 %. Each warning
-!! names the key, its value and why; a run goes ahead.
+!! switched on; a current or drag keys under water without drag), a line lighter than 10 kg/m^3 (a
+!! diameter in mm on a long line), a support_stiffness_factor that scales the rope's own end
+!! section (a clamp, a 'split' end), anchors further apart than the rope can reach without
+!! stretching by more than 10 %. Each warning names the key, its value and why; a run goes ahead.
 module ropedyn_scene_warnings
     use, intrinsic :: iso_fortran_env, only: error_unit
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
@@ -113,6 +113,12 @@ contains
             call append_text(list, scene%origin('fluid.density')//': &fluid: density = '// &
                 real_text(scene%fluid%density)//': water = .true. in a fluid this light '// &
                 '(air is 1.225 kg/m^3): water is about 1000 (fresh) or 1025 (sea)')
+        if (scene%effects%water .and. .not. scene%effects%drag .and. &
+            any(scene%fluid%current /= 0.0_wp)) call append_text(list, &
+            scene%origin('fluid.current')//': &fluid: current = '// &
+            pair_text(scene%fluid%current)//': effects.drag is .false.: the current drags '// &
+            'nothing (it moves only the water''s added mass); a rope in a current needs '// &
+            'effects.drag = .true.')
         if (scene%effects%ground) call ground_start(scene, list)
         if (scene%effects%ground) call ground_anchors(scene, list)
         call anchor_reach(scene, sec, list)
@@ -305,6 +311,8 @@ contains
         type(scene_key_t), allocatable :: keys(:), defaults(:)
         character(len=*), parameter :: WATER_KEYS = &
             ' surface added_mass_coefficient tangential_added_mass_coefficient '
+        character(len=*), parameter :: DRAG_KEYS = ' normal_drag_coefficient '// &
+            'tangential_drag_coefficient linear_normal_drag linear_tangential_drag '
         mine = scene
         call bind_keys(mine, keys)
         call bind_keys(base, defaults)
@@ -314,6 +322,8 @@ contains
             call idle(G_FLUID, '', 'effects.drag and effects.water are .false.')
         else if (.not. scene%effects%water) then
             call idle(G_FLUID, WATER_KEYS, 'effects.water is .false. (only water uses it)')
+        else if (.not. scene%effects%drag) then
+            call idle(G_FLUID, DRAG_KEYS, 'effects.drag is .false. (only drag uses it)')
         end if
     contains
         !> The warning for group g's keys (those named in `names` when not ''), if any.

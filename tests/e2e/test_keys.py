@@ -249,3 +249,23 @@ def test_keys_of_an_effect_that_is_off_are_warned_of(run, tmp_path):
         (tmp_path / "paper_echo.nml").write_text(f.attrs["scene"].decode())
     proc = run("run", "paper_echo.nml", "--set", "output.file=e.h5")
     assert proc.returncode == 0 and not scene_warnings(proc), proc.stderr
+
+
+def test_a_current_or_drag_keys_under_water_without_drag_are_warned_of(run, tmp_path):
+    """Under water with drag off the drag coefficients do nothing and a current drags
+    nothing (it moves only the water's added mass): a towed cable whose drag was left off
+    hangs straight down in its current. Each is warned of; with drag on, neither."""
+    (tmp_path / "wet.nml").write_text(
+        "&model elements = 4 /\n&solver t_end = 1e-4 /\n&effects water = .true. /\n"
+        "&fluid density = 1025, surface = -1, tangential_drag_coefficient = 0.01, "
+        "current = 0, -2 /\n")
+    proc = run("run", "wet.nml", "--set", "output.file=a.h5")
+    assert proc.returncode == 0, proc.stderr
+    assert scene_warnings(proc) == [
+        "ropedyn: warning: wet.nml: &fluid: current = 0.0, -2.0: effects.drag is .false.: "
+        "the current drags nothing (it moves only the water's added mass); a rope in a "
+        "current needs effects.drag = .true.",
+        "ropedyn: warning: wet.nml: &fluid: tangential_drag_coefficient = 0.01: does nothing: "
+        "effects.drag is .false. (only drag uses it)"], proc.stderr
+    proc = run("run", "wet.nml", "--set", "output.file=b.h5", "--set", "effects.drag=.true.")
+    assert proc.returncode == 0 and not scene_warnings(proc), proc.stderr
