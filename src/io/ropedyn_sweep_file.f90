@@ -84,6 +84,10 @@ module ropedyn_sweep_file
         type(dimension_t), allocatable :: dims(:)
         logical :: atol_given = .false.
         real(wp) :: atol_per_rtol = 0.0_wp           !< when atol_given
+        !> an error of the base scene with the common overrides (or with one value) that
+        !! the cases may not have: it stands when a case fails for `tentative_reason`
+        type(error_t), allocatable :: tentative
+        character(len=:), allocatable :: tentative_reason
     contains
         procedure :: reference_setting => sweep_reference_setting
     end type sweep_file_t
@@ -140,7 +144,8 @@ contains
         call set_list(raw, lists(4), 'max_orders', 'solver.max_order')
         call set_list(raw, lists(5), 'rtols', 'solver.rtol')
         call build_dimensions(where, sweep%base, list_of(raw, 'set'), list_of(raw, 'vary'), &
-            lists, sweep%atol_given, sweep%set, sweep%vary_keys, sweep%dims, err)
+            lists, sweep%atol_given, sweep%set, sweep%vary_keys, sweep%dims, &
+            sweep%tentative, sweep%tentative_reason, err)
     end subroutine read_sweep_file
 
     !> The output directory: --output-dir, else output_dir, else out/sweep_<name>, without

@@ -28,14 +28,20 @@ contains
 
     !> The dimensions in product order: models, elements, vary(1), ..., methods,
     !! max_orders, rtols (`lists` holds the five lists, each with its key and target).
+    !! The base scene with the common overrides, and with each value, may fail where the
+    !! cases do not (a harmonic top_motion in `set`, its frequencies in `vary`): the first
+    !! such error is `tentative`, with its scene message `tentative_reason`, and stands only
+    !! when a case fails for that reason (`ropedyn_sweep`'s expand).
     subroutine build_dimensions(where, base, set_in, vary_in, lists, atol_given, set, &
-            vary_keys, dims, err)
+            vary_keys, dims, tentative, tentative_reason, err)
         character(len=*), intent(in) :: where, base
         type(text_t), intent(in) :: set_in(:), vary_in(:)
         type(dimension_t), intent(in) :: lists(5)
         logical, intent(in) :: atol_given
         type(text_t), allocatable, intent(out) :: set(:), vary_keys(:)
         type(dimension_t), allocatable, intent(out) :: dims(:)
+        type(error_t), allocatable, intent(out) :: tentative
+        character(len=:), allocatable, intent(out) :: tentative_reason
         type(error_t), allocatable, intent(out) :: err
         type(text_t), allocatable :: targets(:)
         real(wp) :: cases
@@ -52,8 +58,8 @@ contains
             end if
             call append_text(set, set_in(k)%s)
         end do
-        call check_scene_with(where//'set: the common overrides: ', base, set, '', .true., err)
-        if (allocated(err)) return
+        call check_scene_with(where//'set: the common overrides: ', base, set, '', .true., &
+            tentative, tentative_reason)
 
         ! the dimensions and each value on its own
         allocate (dims(5 + size(vary_in)), vary_keys(size(vary_in)))
@@ -85,13 +91,15 @@ contains
         end if
 
         ! every value with the base scene and the common overrides (max_orders are checked
-        ! with their methods, in the cases: the order range is per method)
+        ! with their methods, in the cases: the order range is per method), until the
+        ! first tentative error
         do i = 1, size(dims)
             if (len(dims(i)%target) == 0 .or. dims(i)%key == 'max_orders') cycle
             do k = 1, size(dims(i)%values)
+                if (allocated(tentative)) return
                 call check_scene_with(where//label(dims(i), k, vary_in)//': ', base, set, &
-                    dims(i)%target//'='//dims(i)%values(k)%s, .false., err)
-                if (allocated(err)) return
+                    dims(i)%target//'='//dims(i)%values(k)%s, .false., tentative, &
+                    tentative_reason)
             end do
         end do
     end subroutine build_dimensions
@@ -227,18 +235,21 @@ contains
     end subroutine check_entry
 
     !> Read the base scene with the common overrides and `extra` (if not ''); an error starts
-    !! with `where`, then the scene's message (without its '--set ...: ' unless `keep_set`).
-    subroutine check_scene_with(where, base, set, extra, keep_set, err)
+    !! with `where`, then the scene's message (without its '--set ...: ' unless `keep_set`);
+    !! `reason` is the scene's message without its '--set ...: '.
+    subroutine check_scene_with(where, base, set, extra, keep_set, err, reason)
         character(len=*), intent(in) :: where, base, extra
         type(text_t), intent(in) :: set(:)
         logical, intent(in) :: keep_set
         type(error_t), allocatable, intent(out) :: err
+        character(len=:), allocatable, intent(out) :: reason
         type(scene_t) :: scene
         type(text_t), allocatable :: all(:)
         all = set
         if (len(extra) > 0) call append_text(all, extra)
         call read_scene(base, text_array(all), scene, err)
         if (.not. allocated(err)) return
+        reason = without_set(err%message)
         if (keep_set) then
             err%message = where//err%message
         else

@@ -205,6 +205,13 @@ contains
                     label = join(cs%overrides)
                     if (len(label) == 0) label = '(the base scene)'
                     call read_case(sweep, cs, starts, err)
+                    if (allocated(err) .and. allocated(sweep%tentative)) then
+                        ! the error of the common overrides (or of a value) it has too
+                        if (without_set(err%message) == sweep%tentative_reason) then
+                            err%message = sweep%tentative%message
+                            return
+                        end if
+                    end if
                     if (allocated(err)) then
                         err%message = sweep%path//': &sweep: case '//int_text(c)//' ('// &
                             label//'): '//without_set(err%message)

@@ -105,6 +105,34 @@ def test_bad_sweep_file(run, sweep_dir):
     assert result.returncode == 2
 
 
+def test_common_overrides_completed_by_the_cases(run, sweep_dir):
+    """A harmonic top in `set` and its frequencies in `vary`: the base scene with the common
+    overrides alone has no frequency, but every case has one, so the sweep is good. A case
+    that still lacks it (frequency 0) is named with its own overrides; an error that every
+    case has keeps the message of the common overrides."""
+    def sweep_with(vary, set_=("supports.top_motion=harmonic",)):
+        sets = ", ".join(f"'{s}'" for s in set_)
+        (sweep_dir / "motion.nml").write_text(
+            f"&sweep base = 'scenes/base.nml'\n output_dir = 'out/motion'\n"
+            f" set = {sets}\n vary = {vary}\n/\n")
+        return run("sweep", "motion.nml", "--list")
+    result = sweep_with("'supports.top_frequency = 1.0; 2.0', "
+                        "'supports.top_amplitude = 0.0,0.01; 0.01,0.0'")
+    assert result.returncode == 0, result.stderr
+    lines = [line.split()[2:] for line in result.stdout.splitlines() if line[:4].isdigit()]
+    assert len(lines) == 4 and lines[0] == ["supports.top_frequency=1.0",
+                                            "supports.top_amplitude=0.0,0.01"]
+    result = sweep_with("'supports.top_frequency = 1.0; 0.0'")
+    assert result.returncode == 2
+    assert ("motion.nml: &sweep: case 2 (supports.top_frequency=0.0): &supports: "
+            "top_frequency = 0.0: must be > 0") in result.stderr, result.stderr
+    result = sweep_with("'supports.top_frequency = 1.0; 2.0'",
+                        ("supports.top_motion=harmonic", "rope.length=-1"))
+    assert result.returncode == 2
+    assert ("motion.nml: &sweep: set: the common overrides: --set rope.length=-1: &rope: "
+            "length = -1.0: must be > 0") in result.stderr, result.stderr
+
+
 def test_output_dir_a_dangling_link_is_bad_input(run, sweep_dir):
     """An output_dir that is a symbolic link to nothing cannot be made a directory: it is
     refused when the sweep file is read (exit 2, the file, group, key, value and why), not
