@@ -5,6 +5,9 @@
 !! 5 with a current and a point mass): their Jacobian rows go through each element's mass
 !! block. (Their velocity-dependent forces include the added mass's, which do no work on
 !! balance but are not dissipation: the damping check is for configurations 1 to 3.)
+!! Configurations 6 and 7 carry tension only (compression = .false.), pinned at both ends,
+!! with element 1 (6) or element n (7) pushed 3 mm along its axis towards its pin: the
+!! slack pin's spring acts across the rope only (pin_offset), its own Jacobian.
 program test_rfem_derivatives
     use ropedyn_kinds, only: wp
     use ropedyn_error, only: error_t
@@ -17,7 +20,7 @@ program test_rfem_derivatives
 
     suite%name = 'rfem_derivatives'
     call random_seed_fixed()
-    do config = 1, 5
+    do config = 1, 7
         call check_config(config)
     end do
     call check_effects_off()
@@ -58,6 +61,10 @@ contains
             scene%supports%top = 'free'
             scene%supports%bottom = 'clamped'
             scene%effects%gravity = .false.
+        case (6, 7)
+            scene%supports%bottom = 'pinned'
+            scene%supports%bottom_anchor = [0.9_wp, 0.3_wp]
+            scene%rope%compression = .false.
         case (4, 5)
             ! the rope's middle at the surface; a thick rope: the smoothed surface 1 cm wide
             scene%rope%diameter = 0.02_wp
@@ -78,15 +85,21 @@ contains
         if (allocated(err)) return
         do trial = 1, 3
             write (tag, '(a, i0, a, i0)') ' config ', config, ' trial ', trial
-            call check_state(model, trim(tag), config <= 3)
+            if (config >= 6) then
+                call check_state(model, trim(tag), .true., merge(1, 7, config == 6))
+            else
+                call check_state(model, trim(tag), config <= 3)
+            end if
         end do
     end subroutine check_config
 
-    subroutine check_state(model, tag, dissipative_only)
+    subroutine check_state(model, tag, dissipative_only, pushed)
         type(rfem_t), intent(inout) :: model
         character(len=*), intent(in) :: tag
         !> the velocity-dependent forces are the dampers' alone (no added mass)
         logical, intent(in) :: dissipative_only
+        !> this end element (1 or n) pushed 3 mm along its axis towards its pin
+        integer, intent(in), optional :: pushed
         real(wp), allocatable :: y(:), yp(:), ym(:), fp(:), fm(:), f0(:), jb(:, :), jfd(:, :)
         real(wp), allocatable :: jan(:, :), gen(:, :), gen0(:, :), y0v(:)
         real(wp) :: h, worst, col_scale, vp, vm, grad_err, grad_scale, power, power_check
@@ -99,6 +112,11 @@ contains
         allocate (y(n), yp(n), ym(n), fp(n), fm(n), f0(n), jfd(n, n), jan(n, n))
         call model%initial_state(y)
         call random_state(y)
+        if (present(pushed)) then
+            k = 6*(pushed - 1)
+            y(k + 1:k + 2) = y(k + 1:k + 2) + merge(-3.0e-3_wp, 3.0e-3_wp, pushed == 1)* &
+                             [cos(y(k + 3)), sin(y(k + 3))]
+        end if
         call model%bandwidths(ml, mu)
         offset = ml + mu + 1
         allocate (jb(2*ml + mu + 1, n))

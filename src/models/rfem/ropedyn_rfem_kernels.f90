@@ -111,6 +111,36 @@ contains
         end associate
     end function support_offset
 
+    !> The displacement a support's spring acts on: d (support_offset), but on a line that
+    !! carries tension only (stretch_floor) with d along the rope, s = e.d, below the floor
+    !! (the end pushed towards the support: slack) only d's part across the rope, u n with
+    !! u = n.d. The spring stands for the end section of the rope (docs/theory/rfem.md,
+    !! Supports), which cannot push either. Its energy Ct u^2 / 2 then turns with the
+    !! element: besides the force Ct u n at the end it puts the couple Ct u s on the
+    !! element (-dV/dphi = Ct u (s + h); slack_couple), as an internal SDE's shear force
+    !! does through its fy dwx.
+    pure function pin_offset(self, k, y, co, si) result(d)
+        class(rfem_t), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: y(:), co, si
+        real(wp) :: d(2)
+        d = support_offset(self, k, y, co, si)
+        if (co*d(1) + si*d(2) < self%stretch_floor()) d = (co*d(2) - si*d(1))*[-si, co]
+    end function pin_offset
+
+    !> The couple (N m) on support k's element of its slack spring (pin_offset): Ct u s,
+    !! 0 where the spring is not slack.
+    pure real(wp) function slack_couple(self, k, y, co, si) result(couple)
+        class(rfem_t), intent(in) :: self
+        integer, intent(in) :: k
+        real(wp), intent(in) :: y(:), co, si
+        real(wp) :: d(2), s
+        couple = 0.0_wp
+        d = support_offset(self, k, y, co, si)
+        s = co*d(1) + si*d(2)
+        if (s < self%stretch_floor()) couple = self%sup(k)%ct*(co*d(2) - si*d(1))*s
+    end function slack_couple
+
     !> Its rate d' = sgn (v - P') - h w n.
     pure function support_offset_rate(self, k, y, co, si) result(dd)
         class(rfem_t), intent(in) :: self
@@ -152,7 +182,7 @@ contains
             co = self%cs(1, sp%elem)    ! cos and sin of its angle (angles, at y)
             si = self%cs(2, sp%elem)
             if (sp%translational) then
-                d = support_offset(self, k, y, co, si)
+                d = pin_offset(self, k, y, co, si)
                 fs = sp%ct*d
                 if (energy) e_el = e_el + 0.5_wp*sp%ct*(d(1)**2 + d(2)**2)
                 if (sp%damped_t .and. damp) then
@@ -166,6 +196,7 @@ contains
                 end if
                 f(1:2) = f(1:2) - sp%sgn*fs
                 f(3) = f(3) + h*(co*fs(2) - si*fs(1))
+                if (self%tension_only) f(3) = f(3) + slack_couple(self, k, y, co, si)
                 if (present(sde)) sde(1:2) = fs
             end if
             if (sp%rotational) then
@@ -199,7 +230,7 @@ contains
                    si => self%cs(2, self%sup(k)%elem))
             m = 6*(sp%elem - 1)
             if (sp%translational) then
-                fs = sp%ct*support_offset(self, k, y, co, si)
+                fs = sp%ct*pin_offset(self, k, y, co, si)
                 if (sp%damped_t) then
                     dd = support_offset_rate(self, k, y, co, si)
                     fs = fs + sp%bt*dd
@@ -236,6 +267,26 @@ contains
         b(3, 2) = b(3, 2) + sh*k*co
     end subroutine add_spring
 
+    !> Add to the 3x3 block b the derivatives of the force of a support's spring k (N/m)
+    !! that acts on d's part across the rope only, u n with u = n.d (pin_offset; s = e.d),
+    !! and of its couple k u s (slack_couple), except the (3, 3) entry's part that the
+    !! caller adds as for add_spring: d(k u n)/dc = sg k n n^T, d(k u n)/dphi =
+    !! k ((-h - s) n - u e); d(k u s)/dc = sg k (s n + u e), d(k u s)/dphi =
+    !! k (u^2 - s^2 - h s); the moment h n.(k u n) = h k u has d/dphi = -k h (h + s).
+    pure subroutine add_slack_spring(b, k, sg, h, d, co, si)
+        real(wp), intent(inout) :: b(3, 3)
+        real(wp), intent(in) :: k, sg, h, d(2), co, si
+        real(wp) :: nv(2), u, s
+        nv = [-si, co]
+        u = co*d(2) - si*d(1)
+        s = co*d(1) + si*d(2)
+        b(1:2, 1) = b(1:2, 1) - k*nv(1)*nv
+        b(1:2, 2) = b(1:2, 2) - k*nv(2)*nv
+        b(1:2, 3) = b(1:2, 3) - sg*k*((-h - s)*nv - u*[co, si])
+        b(3, 1:2) = b(3, 1:2) + sg*h*k*nv + sg*k*(s*nv + u*[co, si])
+        b(3, 3) = b(3, 3) - h*k*s + k*(u**2 - s**2 - h*s)
+    end subroutine add_slack_spring
+
     !> Add the derivatives of support k's generalized force with respect to its element's
     !! (x, y, phi, x', y', phi') to blk(3, 6).
     pure subroutine support_jacobian(self, k, y, blk)
@@ -243,8 +294,9 @@ contains
         integer, intent(in) :: k
         real(wp), intent(in) :: y(:)
         real(wp), intent(inout) :: blk(3, 6)
-        real(wp) :: h, co, si, w, fs(2), sg
+        real(wp) :: h, co, si, w, fs(2), sg, d(2)
         integer :: m
+        logical :: slack
         associate (sp => self%sup(k))
             m = 6*(sp%elem - 1)
             h = self%half(sp%elem)
@@ -255,9 +307,17 @@ contains
             if (sp%translational) then
                 ! F = Ct d + Bt d' acts as -sgn F on the centre and h n.F as moment; d and d'
                 ! have the same gradient G with respect to (x, y, phi) and (x', y', phi'),
-                ! so the spring's block and the damper's have one pattern (add_spring)
-                fs = sp%ct*support_offset(self, k, y, co, si)
-                call add_spring(blk(:, 1:3), sp%ct, sg*h, co, si)
+                ! so the spring's block and the damper's have one pattern (add_spring); a
+                ! slack end section's spring acts across the rope only (pin_offset)
+                d = support_offset(self, k, y, co, si)
+                slack = co*d(1) + si*d(2) < self%stretch_floor()
+                if (slack) then
+                    fs = sp%ct*pin_offset(self, k, y, co, si)
+                    call add_slack_spring(blk(:, 1:3), sp%ct, sg, h, d, co, si)
+                else
+                    fs = sp%ct*d
+                    call add_spring(blk(:, 1:3), sp%ct, sg*h, co, si)
+                end if
                 if (sp%damped_t) then
                     fs = fs + sp%bt*support_offset_rate(self, k, y, co, si)
                     blk(1, 3) = blk(1, 3) - sg*h*sp%bt*w*co
