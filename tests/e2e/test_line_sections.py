@@ -161,7 +161,7 @@ def test_a_probable_unit_slip_gets_one_warning(run, tmp_path, sets, fragment):
     assert len(warnings) == 1 and fragment in warnings[0], proc.stderr
 
 
-#: a towed cable as a user gives it (docs/guide/effects.md, "A towed cable"): 200 m, 12 mm
+#: a towed cable as a user gives it (docs/guide/examples.md, "A towed cable"): 200 m, 12 mm
 TOWED = ("&model elements = 4 /\n"
          "&rope length = 200.0, diameter = 0.012, mass_per_length = 0.25, "
          "axial_stiffness = 2.0e6 /\n"

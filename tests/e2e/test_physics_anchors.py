@@ -75,7 +75,7 @@ def test_axial_mode_of_hanging_rod(run, tmp_path):
 
 
 def test_a_trolley_stop_leaves_the_payload_swinging(run, tmp_path):
-    """A gantry crane's emergency stop (docs/guide/effects.md): 12 m of wire (1 kg/m,
+    """A gantry crane's emergency stop (docs/guide/examples.md): 12 m of wire (1 kg/m,
     EA = 1.2e7 N) with 2000 kg at its end, in the frame that travels with the trolley at
     v = 1 m/s: the trolley decelerates at a = v/tau for tau = 0.5 s. The swing's period at
     rest is the compound pendulum's, 2 pi sqrt(L' (M + m/3)/(g (M + m/2))) with the
