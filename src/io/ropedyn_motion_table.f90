@@ -2,7 +2,7 @@
 !! rows t (s), dx, dy (m), dangle (deg), read into the rows a `support_motion_t` takes.
 module ropedyn_motion_table
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-    use ropedyn_kinds, only: wp, i8
+    use ropedyn_kinds, only: wp, i8, PI
     use ropedyn_namelist_file, only: MAX_FILE_BYTES
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_text, only: int_text
@@ -11,7 +11,6 @@ module ropedyn_motion_table
     private
     public :: read_motion_table
 
-    real(wp), parameter :: pi = acos(-1.0_wp)
 
 contains
 

@@ -13,7 +13,7 @@
 !!   the derived value depends on (the one furthest from 1 in decades).
 module ropedyn_scene_limits
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, PI
     use ropedyn_error, only: error_t
     use ropedyn_text, only: int_text, real_text
     use ropedyn_rope_spec, only: N_ATTACH
@@ -32,7 +32,6 @@ module ropedyn_scene_limits
     !! is coarser than the steps of a rope's motion, and no integrator could advance t.
     real(wp), parameter :: MAX_TIME = 1.0e9_wp
 
-    real(wp), parameter :: pi = acos(-1.0_wp)
     integer, parameter :: KL = 40
     ! The keys each derived value depends on.
     character(len=KL), parameter :: MASS_KEYS(4) = [character(len=KL) :: 'rope.density', &

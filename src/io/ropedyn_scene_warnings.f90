@@ -13,7 +13,7 @@
 module ropedyn_scene_warnings
     use, intrinsic :: iso_fortran_env, only: error_unit
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, PI
     use ropedyn_text, only: text_t, append_text, real_text, significant_text, pair_text, &
         int_text
     use ropedyn_rope_section, only: section_t, rope_section, section_set_given
@@ -45,7 +45,6 @@ module ropedyn_scene_warnings
     !! 1e-2 (in cm: 0.1 .. 0.8), a slip the tenth of the length misses on a long line (12
     !! for 12 mm on a 200 m cable); lines with floats or air in them stay above 100
     real(wp), parameter :: MIN_LINE_DENSITY = 10.0_wp
-    real(wp), parameter :: pi = acos(-1.0_wp)
     !> a straight start may touch the ground (a rope laid on the seabed) but not reach
     !! deeper into it than this share of its length
     real(wp), parameter :: MAX_START_DEPTH_SHARE = 1.0e-3_wp

@@ -16,13 +16,12 @@
 !! of eq. 13). `diameter` is the hydrodynamic diameter: A = pi d^2/4 is the displaced area.
 module ropedyn_rope_section
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, PI
     use ropedyn_rope_spec, only: rope_params_t
     implicit none
     private
     public :: section_t, rope_section, resolved_rope, section_set_given, tangential_damping_of
 
-    real(wp), parameter :: pi = acos(-1.0_wp)
 
     !> A section. The shear values are divided by `shape_factor` where they are used (so
     !! that G A / (chi l) keeps the order of its operations).

@@ -2,7 +2,7 @@
 !! straight initial shape, the supports' clamp angles and prescribed motions, and whether
 !! external work has to be integrated.
 module ropedyn_rope_setup
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, PI
     use ropedyn_rope_spec, only: rope_spec_t
     use ropedyn_support_motion, only: support_motion_t
     use ropedyn_effect, only: effect_box_t
@@ -10,7 +10,6 @@ module ropedyn_rope_setup
     private
     public :: initial_angle, clamp_angles, configure_motions, any_does_work
 
-    real(wp), parameter :: pi = acos(-1.0_wp)
 
 contains
 

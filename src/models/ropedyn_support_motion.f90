@@ -16,7 +16,7 @@
 !! Frame: x down, y horizontal, angles from x towards y (docs/guide/scenes.md,
 !! `&supports`).
 module ropedyn_support_motion
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, PI
     implicit none
     private
     public :: support_motion_t, motion_state_t
@@ -25,7 +25,6 @@ module ropedyn_support_motion
 
     integer, parameter :: MOTION_FIXED = 0, MOTION_HARMONIC = 1, MOTION_TABLE = 2, &
                           MOTION_COUPLED = 3
-    real(wp), parameter :: pi = acos(-1.0_wp)
 
     !> The support at one time.
     type :: motion_state_t

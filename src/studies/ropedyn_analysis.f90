@@ -5,7 +5,7 @@
 !! docs/theory/statics-modes.md.
 module ropedyn_analysis
     use, intrinsic :: iso_fortran_env, only: output_unit
-    use ropedyn_kinds, only: wp, i8
+    use ropedyn_kinds, only: wp, i8, PI
     use ropedyn_error, only: error_t, make_error, ERR_INTERNAL
     use ropedyn_scene, only: scene_t, scene_namelist_text, recorded_source
     use ropedyn_rope_spec, only: rope_spec_t, bottom_anchor_given
@@ -26,7 +26,6 @@ module ropedyn_analysis
     public :: run_analysis, support_forces, DEFAULT_MODE_COUNT
 
     integer, parameter :: DEFAULT_MODE_COUNT = 10
-    real(wp), parameter :: PI = 4.0_wp*atan(1.0_wp)
 
     !> The scalar results in /statics: name, units, description ('': none).
     character(len=*), parameter :: STATICS_REALS(3, 4) = reshape([character(len=54) :: &

@@ -20,7 +20,7 @@
 !! (neighbouring angles more than half a turn apart: loops its bending springs hold),
 !! which first descends again with the turns taken off.
 module ropedyn_line_equilibrium
-    use ropedyn_kinds, only: wp, i8
+    use ropedyn_kinds, only: wp, i8, PI
     use ropedyn_error, only: error_t, ERR_SOLVER
     use ropedyn_text, only: int_text, significant_text
     use ropedyn_rope_model, only: rope_model_t
@@ -139,7 +139,7 @@ contains
         type(error_t), allocatable :: err
         integer, allocatable :: at(:)
         real(wp), allocatable :: y_again(:)
-        real(wp), parameter :: TWO_PI = 2.0_wp*acos(-1.0_wp)
+        real(wp), parameter :: TWO_PI = 2.0_wp*PI
         integer :: k
         at = angle_places(model)
         y_again = y
@@ -233,7 +233,6 @@ contains
         real(wp), intent(in) :: y(:)
         integer :: wound
         real(wp), allocatable :: phi(:)
-        real(wp), parameter :: PI = acos(-1.0_wp)
         phi = y(angle_places(model))
         wound = 0
         if (size(phi) > 1) wound = count(abs(phi(2:) - phi(:size(phi) - 1)) > PI)

@@ -8,7 +8,7 @@
 !! and acceleration there do not enter a static force.
 module ropedyn_statics_terms
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, PI
     use ropedyn_problem, only: STATUS_OK
     use ropedyn_rope_model, only: rope_model_t, energy_t
     use ropedyn_rope_spec, only: rope_spec_t, N_ATTACH
@@ -19,7 +19,6 @@ module ropedyn_statics_terms
     public :: generalized_force, tangent_matrices, potential_energy, rope_length, total_weight
     public :: tangent_band, tangent_bandwidth, at_rest_near
 
-    real(wp), parameter :: PI = 4.0_wp*atan(1.0_wp)
 
 contains
 

@@ -11,14 +11,13 @@
 !! In water with a free surface (`&effects water`) a body feels the drag of its wetted
 !! fraction f (ropedyn_wetting): F and M times f, and the derivatives of f in the Jacobian.
 module ropedyn_effect_drag
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, PI
     use ropedyn_effect, only: body_effect_t, bodies_t
     use ropedyn_wetting, only: wetting_t, wet_t
     implicit none
     private
     public :: drag_effect_t, drag_effect
 
-    real(wp), parameter :: pi = acos(-1.0_wp)
 
     type, extends(body_effect_t) :: drag_effect_t
         private

@@ -3,7 +3,7 @@
 !! Only enabled effects are allocated (docs/guide/effects.md, `&effects`).
 module ropedyn_effect_factory
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, PI
     use ropedyn_rope_spec, only: rope_spec_t, N_ATTACH
     use ropedyn_effect, only: effect_box_t
     use ropedyn_effect_drag, only: drag_effect
@@ -17,7 +17,6 @@ module ropedyn_effect_factory
     private
     public :: build_body_effects, locate_on_bodies, attached_masses, water_of, water_added_mass
 
-    real(wp), parameter :: pi = acos(-1.0_wp)
 
 contains
 

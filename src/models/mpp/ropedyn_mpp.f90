@@ -33,7 +33,7 @@
 !! tangent in ropedyn_mpp_tangent, the energies and powers in ropedyn_mpp_energy.
 module ropedyn_mpp
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, PI
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_problem, only: STATUS_OK, STATUS_RECOVERABLE
     use ropedyn_rope_model, only: rope_model_t, energy_t
@@ -51,7 +51,6 @@ module ropedyn_mpp
     private
     public :: mpp_t, mpp_create
 
-    real(wp), parameter :: pi = 4.0_wp*atan(1.0_wp)
 
     type, extends(rope_model_t) :: mpp_t
         private

@@ -27,7 +27,7 @@
 !! the force, Jacobian and energy kernels are in the submodule ropedyn_rfem_kernels.
 module ropedyn_rfem
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-    use ropedyn_kinds, only: wp
+    use ropedyn_kinds, only: wp, PI
     use ropedyn_sums, only: all_finite
     use ropedyn_error, only: error_t, make_error, ERR_INPUT
     use ropedyn_problem, only: STATUS_OK, STATUS_RECOVERABLE
@@ -46,7 +46,6 @@ module ropedyn_rfem
     private
     public :: rfem_t, rfem_create
 
-    real(wp), parameter :: pi = acos(-1.0_wp)
 
     !> A support's SDE (1 top: d = A_1 - P, 2 bottom: d = P - B_n, P the anchor): an
     !! isotropic translational spring and damper on d (pinned or clamped) and a rotational
