@@ -9,7 +9,9 @@
 !! switched on; a current or drag keys under water without drag), a line lighter than 10 kg/m^3 (a
 !! diameter in mm on a long line), a support_stiffness_factor that scales the rope's own end
 !! section (a clamp, a 'split' end), anchors further apart than the rope can reach without
-!! stretching by more than 10 %. Each warning names the key, its value and why; a run goes ahead.
+!! stretching by more than 10 %, a ground so soft that the rope's weight sinks it deeper than a
+!! thousandth of its length (a stiffness in kN/m^2?), a friction coefficient above 1 (a
+!! percentage?). Each warning names the key, its value and why; a run goes ahead.
 module ropedyn_scene_warnings
     use, intrinsic :: iso_fortran_env, only: error_unit
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
@@ -48,6 +50,9 @@ module ropedyn_scene_warnings
     !> a straight start may touch the ground (a rope laid on the seabed) but not reach
     !! deeper into it than this share of its length
     real(wp), parameter :: MAX_START_DEPTH_SHARE = 1.0e-3_wp
+    !> a Coulomb coefficient of a rope or chain on the ground lies between 0.1 and 1 (a
+    !! chain across a seabed about 1, along it 0.7); 60 for 0.6 is a percentage
+    real(wp), parameter :: MAX_FRICTION_COEFFICIENT = 1.0_wp
 
 contains
 
@@ -120,6 +125,7 @@ contains
             'effects.drag = .true.')
         if (scene%effects%ground) call ground_start(scene, list)
         if (scene%effects%ground) call ground_anchors(scene, list)
+        if (scene%effects%ground) call ground_law(scene, sec, list)
         call anchor_reach(scene, sec, list)
         call idle_groups(scene, list)
         call shared_section_factor(scene, sec, list)
@@ -444,6 +450,40 @@ contains
             'about '//significant_text(strain*sec%ea, 3)//' N (EA times the stretch); '// &
             'an anchor out of reach, or a length in the wrong unit?')
     end subroutine anchor_reach
+
+    !> The ground's law: a stiffness under which the rope's weight per metre w (in water
+    !! less its buoyancy) sinks it by w/k, deeper than MAX_START_DEPTH_SHARE of its length
+    !! (a stiffness in kN/m^2 where N/m^2 is meant sinks it a thousand times deeper; the
+    !! guide asks for k of 1000 w or more, a millimetre), and a friction coefficient above
+    !! MAX_FRICTION_COEFFICIENT. The buoyancy is taken off whenever water is on, also where
+    !! the ground lies above the surface: that sinking is the smaller one, and warns less.
+    subroutine ground_law(scene, sec, list)
+        type(scene_t), intent(in) :: scene
+        type(section_t), intent(in) :: sec
+        type(text_t), allocatable, intent(inout) :: list(:)
+        real(wp) :: w, sinking
+        associate (g => scene%ground)
+            if (scene%effects%gravity) then
+                w = sec%mass_per_length*scene%rope%gravity
+                if (scene%effects%water) w = w - scene%fluid%density*scene%rope%gravity* &
+                                             pi*scene%rope%diameter**2/4.0_wp
+                sinking = w/g%stiffness
+                if (sinking > MAX_START_DEPTH_SHARE*scene%rope%length) call append_text(list, &
+                    scene%origin('ground.stiffness')//': &ground: stiffness = '// &
+                    real_text(g%stiffness)//": the rope's weight, "// &
+                    significant_text(w, 4)//' N/m'// &
+                    trim(merge(' in water', '         ', scene%effects%water))// &
+                    ', sinks it '//significant_text(sinking, 3)//' m into the ground, more '// &
+                    'than a thousandth of its length: a stiffness in kN/m^2? (the unit is '// &
+                    'N/m^2; 1000 times the weight per metre sinks it 1 mm)')
+            end if
+            if (g%friction_coefficient > MAX_FRICTION_COEFFICIENT) call append_text(list, &
+                scene%origin('ground.friction_coefficient')// &
+                ': &ground: friction_coefficient = '//real_text(g%friction_coefficient)// &
+                ': above 1, more than a rope or chain has on the ground (0.1 .. 1): '// &
+                'a percentage? (0.6, not 60)')
+        end associate
+    end subroutine ground_law
 
     !> The straight starts ('straight', 'hanging': from &supports top_anchor along the
     !! initial angle) whose far end lies deeper in the ground than MAX_START_DEPTH_SHARE of

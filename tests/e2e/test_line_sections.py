@@ -145,6 +145,13 @@ def test_a_chain_without_bending_stiffness_hangs(run, tmp_path, kind):
     (["effects.ground=.true.", "ground.point=0.5,0", "supports.bottom='clamped'",
       "supports.bottom_anchor=0.9,0.3"],
      "&supports: bottom_anchor = 0.9, 0.3: the bottom end is clamped 0.4 m inside the ground"),
+    # the paper's rope weighs 1.156 N/m: on 100 N/m^2 it sinks 11.6 mm, 1.2 % of its length
+    (["effects.ground=.true.", "ground.stiffness=100"],
+     "&ground: stiffness = 100.0: the rope's weight, 1.156 N/m, sinks it 0.0116 m into the "
+     "ground, more than a thousandth of its length: a stiffness in kN/m^2?"),
+    (["effects.ground=.true.", "ground.friction_coefficient=60"],
+     "&ground: friction_coefficient = 60.0: above 1, more than a rope or chain has on the "
+     "ground (0.1 .. 1): a percentage? (0.6, not 60)"),
     (["supports.bottom='pinned'", "supports.bottom_anchor=2.5,0.3"],
      "&supports: bottom_anchor = 2.5, 0.3: 2.518 m from the top anchor, more than the rope's "
      "length (1.0 m): the line must stretch by 152.0 % to reach it"),
@@ -205,6 +212,15 @@ def test_a_rope_laid_on_the_ground_has_no_warning(run, tmp_path):
     proc = run("run", PAPER, "--set", "solver.t_end=1e-4", "--set", "solver.output_interval=1e-4",
                "--set", "output.file='w.h5'", "--set", "effects.ground=.true.",
                "--set", "ground.point=0,0", "--set", "initial.angle_deg=90")
+    assert proc.returncode == 0 and "warning" not in proc.stderr, proc.stderr
+
+
+def test_a_plausible_ground_law_has_no_warning(run, tmp_path):
+    """A soft ground that sinks the paper's rope (1.156 N/m) by 0.58 mm, under a thousandth
+    of its length, and a chain's lateral friction coefficient of 1: no warning."""
+    proc = run("run", PAPER, "--set", "solver.t_end=1e-4", "--set", "solver.output_interval=1e-4",
+               "--set", "output.file='w.h5'", "--set", "effects.ground=.true.",
+               "--set", "ground.stiffness=2000", "--set", "ground.friction_coefficient=1.0")
     assert proc.returncode == 0 and "warning" not in proc.stderr, proc.stderr
 
 
