@@ -137,7 +137,7 @@ module ropedyn_mpp
         procedure :: angle_coordinates => mpp_angle_coordinates
         procedure :: second_order_blocks => mpp_second_order_blocks
         procedure, private :: positions
-        procedure, private :: supports_at
+        procedure, private :: supports_at, bottom_pin_spring
         procedure, private :: residual_core
         procedure, private :: residual_column
         procedure, private :: mass_factor
@@ -793,6 +793,28 @@ contains
         real(wp), intent(out) :: mm(:, :)
         call self%mass_dense(y, mm)
     end subroutine mpp_coordinate_mass
+
+    !> The offset the bottom pin's spring acts on, for d = P_n - P_bottom and e the last
+    !! member's axis: d, or on a line that carries tension only (stretch_floor) with the
+    !! tip pushed past the anchor along the rope (s = -e.d below the floor: the end section
+    !! the spring stands for is slack) d's part across the rope, u n with u = n.d; and the
+    !! couple on member n of that spring's energy k u^2/2, which turns with the member:
+    !! dV/dphi_n at a fixed d, k u s (0 where the spring is not slack). As the RFEM's pins
+    !! (docs/theory/mpp.md, Supports).
+    pure subroutine bottom_pin_spring(self, d, e, offset, couple)
+        class(mpp_t), intent(in) :: self
+        real(wp), intent(in) :: d(2), e(2)
+        real(wp), intent(out) :: offset(2), couple
+        real(wp) :: s, u
+        offset = d
+        couple = 0.0_wp
+        s = -(e(1)*d(1) + e(2)*d(2))
+        if (s < self%stretch_floor()) then
+            u = e(1)*d(2) - e(2)*d(1)
+            offset = u*[-e(2), e(1)]
+            couple = self%k_sup*u*s
+        end if
+    end subroutine bottom_pin_spring
 
     !> The coordinates (phi_1 .. phi_n, u_1 .. u_nu): the first n are angles.
     pure function mpp_angle_coordinates(self) result(angle)

@@ -8,7 +8,7 @@ contains
     module procedure mpp_energy
         real(wp) :: p(2, 0:self%n), c(2, self%n), pd(2, 0:self%n), cd(2, self%n)
         real(wp), dimension(self%n) :: phi, u, phid, ud
-        real(wp) :: e(2), nv(2)
+        real(wp) :: e(2), nv(2), offset(2), couple
         type(motion_state_t) :: top, bottom
         type(bodies_t) :: b
         real(wp) :: e_kin, e_pot
@@ -36,8 +36,11 @@ contains
         end do
         if (self%top_clamped) en%elastic = en%elastic + 0.5_wp*self%c_rot* &
                                             (phi(1) - top%angle)**2
-        if (bottom_on) en%elastic = en%elastic + 0.5_wp*self%k_sup* &
-                                    sum((p(:, n) - bottom%p)**2)
+        if (bottom_on) then
+            call self%bottom_pin_spring(p(:, n) - bottom%p, [cos(phi(n)), sin(phi(n))], &
+                                        offset, couple)
+            en%elastic = en%elastic + 0.5_wp*self%k_sup*sum(offset**2)
+        end if
         if (self%bottom == 2 .and. bottom_on) en%elastic = en%elastic + 0.5_wp*self%c_rot* &
                                                           (phi(n) - bottom%angle)**2
         if (size(self%effects) > 0 .or. self%water) then
@@ -115,7 +118,7 @@ contains
         real(wp), intent(in) :: pin(2), powers(2)
         real(wp), intent(out) :: yqdot(:)
         integer, intent(out), optional :: status
-        real(wp) :: power, work, rel(2)
+        real(wp) :: power, work, rel(2), offset(2), couple
         type(motion_state_t) :: top, bottom
         logical :: bottom_on
         integer :: k, n, nd
@@ -137,7 +140,8 @@ contains
         if (bottom_on) then
             rel = self%tipd - bottom%v
             power = power + self%d_sup*sum(rel**2)
-            if (self%moving(2)) work = work + dot_product(-self%k_sup*(self%tip - bottom%p) &
+            call self%bottom_pin_spring(self%tip - bottom%p, self%cs(:, n), offset, couple)
+            if (self%moving(2)) work = work + dot_product(-self%k_sup*offset &
                                                           - self%d_sup*rel, bottom%v)
             if (self%bottom == 2) then
                 power = power + self%d_rot*(y(nd + n) - bottom%rate)**2

@@ -44,7 +44,7 @@ contains
     end procedure mpp_residual
 
     module procedure residual_core
-        real(wp) :: pn(2), pnd(2), wsum(2), fb(2)
+        real(wp) :: pn(2), pnd(2), wsum(2), fb(2), offset(2), couple
         type(motion_state_t) :: top, bottom
         logical :: bottom_on, effects, bodied
 
@@ -71,12 +71,18 @@ contains
             end if
         end if
 
-        ! Force of the bottom support on the tip P_n.
+        ! Force of the bottom support on the tip P_n (and the couple of a slack pin's
+        ! spring on member n: bottom_pin_spring).
         fb = 0.0_wp
-        if (bottom_on) fb = -self%k_sup*(pn - bottom%p) - self%d_sup*(pnd - bottom%v)
+        couple = 0.0_wp
+        if (bottom_on) then
+            call self%bottom_pin_spring(pn - bottom%p, self%cs(:, self%n), offset, couple)
+            fb = -self%k_sup*offset - self%d_sup*(pnd - bottom%v)
+        end if
         call generalized_forces(self, y, qacc, fb, r, wsum)
         if (present(pin)) pin = -wsum
         call spring_forces(self, y, top, bottom, bottom_on, r)
+        r(self%n) = r(self%n) - couple
     end procedure residual_core
 
     !> Accelerations of the joints (prefix sums, from the top joint's) and the

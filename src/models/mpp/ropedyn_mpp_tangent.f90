@@ -25,7 +25,7 @@ submodule (ropedyn_mpp) ropedyn_mpp_tangent
 contains
 
     module procedure residual_column
-        real(wp) :: dws(2)
+        real(wp) :: dws(2), dcouple
         type(motion_state_t) :: top, bottom
         type(perturbation_t) :: p
         logical :: bottom_on, effects
@@ -37,14 +37,47 @@ contains
         ! the bottom support's force on the tip
         call self%supports_at(t, top, bottom, bottom_on)
         dws = 0.0_wp
-        if (bottom_on) dws = -self%k_sup*p%sh_p - self%d_sup*p%sh_v
+        dcouple = 0.0_wp
+        if (bottom_on) then
+            dws = -self%k_sup*p%sh_p - self%d_sup*p%sh_v
+            call slack_pin_change(self, p, self%tip - bottom%p, dws, dcouple)
+        end if
 
         col = 0.0_wp
         call members_below(self, y, p, effects, dws, col)
         call member_itself(self, y, p, effects, dws, col)
         call members_above(self, y, p%m, dws, col)
         call own_springs(self, y, p, bottom_on, col)
+        col(self%n) = col(self%n) - dcouple
     end procedure residual_column
+
+    !> A slack bottom pin's spring (bottom_pin_spring, d = P_n - P_bottom): its force -k u n
+    !! changes by -k (du n + u dn) instead of -k sh_p (into dws, which holds the damper's
+    !! part already), and its couple k u s by dcouple = k (du s + u ds), with du = sh_p.n +
+    !! d.dn, ds = -sh_p.e - d.de, where e and n turn only with member n's angle (de = n,
+    !! dn = -e); dws and dcouple unchanged where the spring is not slack.
+    pure subroutine slack_pin_change(self, p, d, dws, dcouple)
+        class(mpp_t), intent(in) :: self
+        type(perturbation_t), intent(in) :: p
+        real(wp), intent(in) :: d(2)
+        real(wp), intent(inout) :: dws(2), dcouple
+        real(wp) :: e(2), nv(2), de(2), dn(2), s, u, du, ds
+        e = self%cs(:, self%n)
+        nv = [-e(2), e(1)]
+        s = -dot_product(e, d)
+        if (.not. s < self%stretch_floor()) return
+        u = dot_product(nv, d)
+        de = 0.0_wp
+        dn = 0.0_wp
+        if (p%kind == 1 .and. p%m == self%n) then
+            de = nv
+            dn = -e
+        end if
+        du = dot_product(p%sh_p, nv) + dot_product(d, dn)
+        ds = -dot_product(p%sh_p, e) - dot_product(d, de)
+        dws = dws + self%k_sup*p%sh_p - self%k_sup*(du*nv + u*dn)
+        dcouple = self%k_sup*(du*s + u*ds)
+    end subroutine slack_pin_change
 
     !> The perturbation of member m's kinematics by variable j of the column (perturbation_t).
     pure function perturbation(self, y, qacc, j) result(p)
