@@ -113,16 +113,7 @@ contains
                 ' .. '//real_text(MAX_DAMPING_RATIO)//'): a coefficient in the wrong unit? '// &
                 '(the unit is '//trim(merge('N s    ', 'N s/m^2', section))//')')
         end if
-        if (scene%effects%water .and. scene%fluid%density < MIN_WATER_DENSITY) &
-            call append_text(list, scene%origin('fluid.density')//': &fluid: density = '// &
-                real_text(scene%fluid%density)//': water = .true. in a fluid this light '// &
-                '(air is 1.225 kg/m^3): water is about 1000 (fresh) or 1025 (sea)')
-        if (scene%effects%water .and. .not. scene%effects%drag .and. &
-            any(scene%fluid%current /= 0.0_wp)) call append_text(list, &
-            scene%origin('fluid.current')//': &fluid: current = '// &
-            pair_text(scene%fluid%current)//': effects.drag is .false.: the current drags '// &
-            'nothing (it moves only the water''s added mass); a rope in a current needs '// &
-            'effects.drag = .true.')
+        if (scene%effects%water) call water_slips(scene, list)
         if (scene%effects%ground) call ground_start(scene, list)
         if (scene%effects%ground) call ground_anchors(scene, list)
         if (scene%effects%ground) call ground_law(scene, sec, list)
@@ -179,6 +170,22 @@ contains
             end if
         end function damping_text
     end function scene_warnings
+
+    !> With water on: air's density for water's, and a current without drag (it drags
+    !! nothing; it moves only the water's added mass).
+    subroutine water_slips(scene, list)
+        type(scene_t), intent(in) :: scene
+        type(text_t), allocatable, intent(inout) :: list(:)
+        if (scene%fluid%density < MIN_WATER_DENSITY) &
+            call append_text(list, scene%origin('fluid.density')//': &fluid: density = '// &
+                real_text(scene%fluid%density)//': water = .true. in a fluid this light '// &
+                '(air is 1.225 kg/m^3): water is about 1000 (fresh) or 1025 (sea)')
+        if (.not. scene%effects%drag .and. any(scene%fluid%current /= 0.0_wp)) &
+            call append_text(list, scene%origin('fluid.current')//': &fluid: current = '// &
+            pair_text(scene%fluid%current)//': effects.drag is .false.: the current drags '// &
+            'nothing (it moves only the water''s added mass); a rope in a current needs '// &
+            'effects.drag = .true.')
+    end subroutine water_slips
 
     !> A line given by its section set whose mean density mass_per_length/(pi d^2/4) is
     !! below MIN_LINE_DENSITY while drag or water uses its diameter: a diameter in mm on a
