@@ -2,7 +2,8 @@
 its lower part on the seabed (the elastic catenary with touchdown, submerged weight), a line
 lighter than water between two pins (the catenary upside down), the seabed's friction on
 the submerged weight, a line falling end first (tangential drag and tangential added
-mass), the tangential added mass in the axial modes, and no drag above the surface."""
+mass), the tangential added mass in the axial modes, a line heaved through the surface (its added mass's change), and
+no drag above the surface."""
 from math import pi, sqrt
 
 import h5py
@@ -205,6 +206,47 @@ def test_the_tangential_added_mass_slows_the_axial_modes(run, tmp_path, kind):
 
     ratio = axial_omega(cat) / axial_omega(0.0)
     assert abs(ratio / sqrt(mu / (mu + cat * RHO * area(d))) - 1) < 1e-9, ratio
+
+
+@pytest.mark.parametrize("kind", ["rfem", "mpp"])
+def test_a_line_heaved_through_the_surface(run, tmp_path, kind):
+    """A stiff line hanging half under water, its top heaved x = a sin(Omega t): with the
+    wet length w = w0 + x, Lagrange's equations of T_a = m_at w x'^2 / 2 give the water's
+    force -(m_at w x'' + m_at x'^2 / 2), so the top's reaction is
+    R = -(mu g L - rho g A w0) + (rho g A a - (mu L + m_at w0) a Omega^2) sin Omega t
+        + m_at a^2 Omega^2 (-1/4 + 3/4 cos 2 Omega t).
+    The Morison form (the force -m_at w x'' alone) gives -1/2 + 1/2 cos 2 Omega t.
+    Measured at n = 10: within 4e-6 N and 0.1 % of the second harmonic (RFEM), 5e-7 N
+    and 1e-5 (MPP)."""
+    mu, d, cat, a, freq, surface = 0.5, 0.02, 1.0, 0.02, 1.0, 0.55
+    (tmp_path / "heave.nml").write_text(f"""
+&rope length = 1.0, mass_per_length = {mu}, axial_stiffness = 1.0e7, bending_stiffness = 0.0,
+      axial_damping = 5000.0, diameter = {d} /
+&model kind = '{kind}', elements = 10 /
+&supports top = 'pinned', bottom = 'free', top_motion = 'harmonic', top_amplitude = {a}, 0.0,
+          top_frequency = {freq}, top_ramp_time = 1.0 /
+&initial shape = 'equilibrium' /
+&effects water = .true. /
+&fluid density = {RHO}, surface = {surface}, added_mass_coefficient = 1.0,
+       tangential_added_mass_coefficient = {cat} /
+&solver t_end = 3.0, output_interval = 0.005, rtol = 1e-9, atol = 1e-12 /
+""")
+    proc = run("run", "heave.nml", "--set", "output.file='heave.h5'")
+    assert proc.returncode == 0, proc.stderr
+    with h5py.File(tmp_path / "heave.h5") as f:
+        t = f["time"][()]
+        reaction = f["supports/top/reaction"][:, 0]
+    after_ramp = t > 1.0
+    t, reaction = t[after_ramp], reaction[after_ramp]
+    omega = 2 * pi * freq
+    basis = np.stack([np.ones_like(t), np.sin(omega * t), np.cos(omega * t),
+                      np.sin(2 * omega * t), np.cos(2 * omega * t)], axis=1)
+    c = np.linalg.lstsq(basis, reaction, rcond=None)[0]
+    m_at, wet = cat * RHO * area(d), 1.0 - surface
+    second = m_at * a * a * omega * omega
+    assert abs(c[0] - (-(mu * G - RHO * G * area(d) * wet) - second / 4)) < 2e-5, c
+    assert abs(c[1] - (RHO * G * area(d) * a - (mu + m_at * wet) * a * omega ** 2)) < 2e-5, c
+    assert abs(c[4] - 0.75 * second) < 0.01 * second, (c, second)
 
 
 def test_no_drag_above_the_surface(run, tmp_path):
