@@ -166,6 +166,8 @@ module ropedyn_integrator
         ! the method's order range, one statement
         procedure :: min_order => integrator_min_order, &
                      max_order_limit => integrator_max_order_limit
+        procedure :: order_in_use => integrator_order_in_use
+        procedure :: set_step_budget => integrator_set_step_budget
         procedure :: switch_log => integrator_switch_log
         procedure :: steps_exhausted => integrator_steps_exhausted
         procedure :: budget_shortfall => integrator_budget_shortfall
@@ -291,6 +293,21 @@ contains
         class(integrator_t), intent(in) :: self
         order = METHODS(method_index(self%name()))%highest_order
     end function integrator_max_order_limit
+
+    !> The order limit the method runs at: options%max_order or, when 0, its default (auto
+    !! overrides it: its implicit method's).
+    pure integer function integrator_order_in_use(self) result(order)
+        class(integrator_t), intent(in) :: self
+        order = resolved_max_order(self%name(), self%options%max_order)
+    end function integrator_order_in_use
+
+    !> A new step budget (options%max_steps) for the integration under way: the run's whole
+    !! budget for the integrator that took over from a second look with a capped one.
+    subroutine integrator_set_step_budget(self, max_steps)
+        class(integrator_t), intent(inout), target :: self
+        integer(i8), intent(in) :: max_steps
+        self%options%max_steps = max_steps
+    end subroutine integrator_set_step_budget
 
     !> The changes of method or order limit made during the run so far, oldest first
     !! (ropedyn_switch_log); none for an integrator that never changes them.

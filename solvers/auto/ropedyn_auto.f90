@@ -22,7 +22,9 @@
 !!   maximum order follows from the damping of the fast modes (A(alpha) of MEBDF,
 !!   docs/theory/mebdf.md): order 4, A-stable, when a fast mode is damped by less than 3 %, order
 !!   5 (A(88.4 deg)) up to BDF_DAMPING = 12 %; above, CVODE's BDF at up to order 5.
-!!   `max_order` given by the user caps either.
+!!   `max_order` given by the user caps either; below 5 it makes the implicit method
+!!   MEBDF (BDF's orders 3 and 4 are not A-stable). That is how the run's order safety
+!!   lowers auto: to max_order 4 (ropedyn_methods' safe order), MEBDF at most at order 4.
 !! - **Cost**: counted, not timed (runs stay reproducible): explicit, the evaluations of f;
 !!   implicit, those plus IMPLICIT_STEP_COST (MEBDF) or BDF_STEP_COST (CVODE) per step
 !!   for the Newton matrices, solves and vector work, FACTOR_BASE per factorization (both)
@@ -222,6 +224,8 @@ module ropedyn_auto
         procedure :: switch_log => auto_switch_log
         procedure :: rhs_changed => auto_rhs_changed
         procedure :: budget_shortfall => auto_budget_shortfall
+        procedure :: order_in_use => auto_order_in_use
+        procedure :: set_step_budget => auto_set_step_budget
         procedure, private :: start_method
         procedure, private :: watch
         procedure, private :: current_stats
@@ -567,6 +571,26 @@ contains
         name = 'adams'
         if (self%accurate == HIGH) name = 'the order-5 pair'
     end function accurate_name
+
+    !> The order limit of the implicit method of this run (what a user's max_order caps, and
+    !! the run's order safety lowers: ropedyn_methods).
+    pure integer function auto_order_in_use(self) result(order)
+        class(auto_t), intent(in) :: self
+        order = self%mebdf_order
+    end function auto_order_in_use
+
+    !> A new step budget: auto's, and what it leaves the method in use (which got what was
+    !! left of the old one when it started).
+    subroutine auto_set_step_budget(self, max_steps)
+        class(auto_t), intent(inout), target :: self
+        integer(i8), intent(in) :: max_steps
+        class(integrator_t), pointer :: method
+        type(solver_options_t) :: left
+        self%options%max_steps = max_steps
+        left = budget_left(self%options, self%done%steps)
+        method => self%active_method()
+        if (associated(method)) call method%set_step_budget(left%max_steps)
+    end subroutine auto_set_step_budget
 
     !> Name of the implicit method of this run.
     pure function implicit_name(self) result(name)

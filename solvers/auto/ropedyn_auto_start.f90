@@ -43,7 +43,10 @@ contains
 
         call newton_widths(self%problem, self%lambda, self%mebdf_eval_cost)
         call estimate_spectrum(self%problem, start%t0, start%y0, spec)
-        self%use_bdf = spec%valid .and. spec%fast_damping >= BDF_DAMPING
+        ! (a limit below BDF's order 5 asks for an A-stable implicit method: BDF is one
+        ! only up to order 2, MEBDF up to 4; the order safety lowers auto to 4)
+        self%use_bdf = spec%valid .and. spec%fast_damping >= BDF_DAMPING .and. &
+                       (self%user_order == 0 .or. self%user_order >= BDF_ORDER)
         ! (without an estimate the fast modes may be undamped: the A-stable order)
         self%mebdf_order = mebdf_order_for(merge(spec%fast_damping, 0.0_wp, spec%valid))
         if (self%use_bdf) self%mebdf_order = BDF_ORDER

@@ -8,7 +8,8 @@
 !! be resolved, and order 5 never amplified. MEBDF defaults to order 4 (k = 3), the highest
 !! at which it is A-stable and does not amplify undamped oscillations (order 5 amplifies by
 !! up to 1.027 per step on the imaginary axis, order 6 by 1.114; docs/theory/mebdf.md).
-!! The safe orders: BDF is A-stable up to order 2, MEBDF up to order 4.
+!! The safe orders: BDF is A-stable up to order 2, MEBDF up to order 4; auto's is the
+!! limit 4 on its implicit method, which makes that method MEBDF (ropedyn_auto, "Start").
 module ropedyn_methods
     implicit none
     private
@@ -33,7 +34,7 @@ module ropedyn_methods
         method_info_t('mebdf', 2, 7, 4, safe_order=4), &
         method_info_t('erk', 3, 5, 4), &
         method_info_t('adams', 1, 12, 12, safe_order=2), &
-        method_info_t('auto', 2, 7, 0), &
+        method_info_t('auto', 2, 7, 0, safe_order=4), &
         method_info_t('symplectic', 2, 4, 4)]
 
 contains

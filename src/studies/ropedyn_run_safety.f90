@@ -49,7 +49,9 @@ contains
                 call back_to_previous(self)
                 return
             end if
-            if (self%safe_order > 0 .and. self%max_order > self%safe_order) then
+            ! (auto's order in use: its implicit method's limit)
+            if (self%safe_order > 0 .and. &
+                self%integrator%order_in_use() > self%safe_order) then
                 call self%second_look(tout, e, next_bound, err)
                 if (allocated(err)) return
             else
@@ -109,8 +111,9 @@ contains
                     change_high, change_safe
         integer(i8) :: steps_high, budget, max_steps
         logical :: sudden, reached
-        integer :: action
+        integer :: action, high
         character(len=200) :: why
+        high = self%integrator%order_in_use()
         gain_prev = self%monitor%gain(self%model%energy(self%t_prev, self%y_prev, &
                                                         self%yq_prev))
         change_high = self%monitor%gain(e) - gain_prev
@@ -139,11 +142,11 @@ contains
         if (action == LOOK_LOWER .or. action == LOOK_FAIL) then
             ! on from where the safe order got, with it (its failure is the run's)
             if (action == LOOK_LOWER) call self%summary%safety%lowered(self%t_prev, &
-                self%max_order, self%safe_order)
+                high, self%safe_order)
             call self%retire_integrator(safe)
             ! the whole budget that is left, no longer the second look's (the steps before
             ! it, the retired integrator's included, are those it started after)
-            self%integrator%options%max_steps = max(1_i8, max_steps - self%stats_before%steps)
+            call self%integrator%set_step_budget(max(1_i8, max_steps - self%stats_before%steps))
             self%max_order = self%safe_order
             self%t = t_safe
             self%y = y_safe
@@ -156,11 +159,11 @@ contains
             self%summary%safety%crawled = .true.
             write (why, '(4(a, i0), a)') 'order ', self%safe_order, &
                 ' did not get through the same interval in ', budget, &
-                ' steps (order ', self%max_order, ' took ', steps_high, '): no verdict'
+                ' steps (order ', high, ' took ', steps_high, '): no verdict'
         else if (reached) then
             write (why, '(a, i0, a, es10.3, a, i0, a, es10.3, a)') 'order ', &
                 self%safe_order, ' changed the balance by ', change_safe, ' J over the '// &
-                'same interval, order ', self%max_order, ' by ', change_high, ' J: the '// &
+                'same interval, order ', high, ' by ', change_high, ' J: the '// &
                 'integration error at this rtol'
         else
             why = 'the second look at the safe order was interrupted'

@@ -303,3 +303,62 @@ def test_no_runaway_at_a_usable_tolerance(runaway_runs):
     proc, path = runaway_runs["fine"]
     assert proc.returncode == 0, proc.stderr
     assert stability_metrics.analyse(path)["status"] == "complete"
+
+
+# The wire of docs/guide/examples.md, "A long run for fatigue": its element-scale modes are
+# damped by 83 %, so auto's implicit method is CVODE at order 5; its swing and axial modes
+# are barely damped, and at rtol 1e-3 that BDF feeds them (measured: unguarded, dissipated
+# 0.98 J in 40 s against 3.4e-4 J at rtol 1e-6, and 258 J over the hour).
+WIRE = """\
+&rope length = 30.0, diameter = 0.02, mass_per_length = 1.6, axial_stiffness = 2.0e7,
+      bending_stiffness = 10.0, axial_damping = 11130.0 /
+&model elements = 20 /
+&supports top_motion = 'harmonic', top_amplitude = 0.0, 0.05, top_frequency = 0.0917,
+          end_compliance = 'split' /
+&initial shape = 'equilibrium', angle_deg = 0.0 /
+&attachments mass_positions = 30.0, masses = 500.0 /
+&solver t_end = 40.0, output_interval = 0.1, rtol = 1e-3, atol = 1e-5 /
+"""
+
+
+@pytest.fixture(scope="module")
+def wire_runs(run_many, tmp_path_factory):
+    workdir = tmp_path_factory.mktemp("wire")
+    scene = workdir / "wire.nml"
+    scene.write_text(WIRE)
+    return run_many({policy: (scene, [f"solver.order_safety={policy}"])
+                     for policy in ("lower", "off")}, workdir)
+
+
+def test_auto_is_lowered_to_an_a_stable_implicit_method(wire_runs):
+    """auto has an order to lower: its implicit method's. On the wire its CVODE at order 5
+    gains; the order safety takes the interval again with auto limited to order 4, whose
+    implicit method is then MEBDF (A-stable), and goes on with it: the summary and the file
+    say 5 -> 4, no CVODE after that, and the balance gains less than the bound from there
+    on, where unguarded it goes on gaining (dissipating energy its BDF made)."""
+    proc, path = wire_runs["lower"]
+    assert proc.returncode == 0, proc.stderr
+    assert "max order 5 -> 4 from t =" in proc.stdout, proc.stdout
+    with h5py.File(path, "r") as f:
+        t_low = f["solver/order_lowered_at"][()]
+        assert f["solver/order_lowered_from"][()] == 5
+        assert f["solver/order_lowered_to"][()] == 4
+        methods = [io.text(x).strip() for x in f["/solver/switch_method"][()]]
+        orders = f["/solver/switch_max_order"][()]
+        times = f["/solver/switch_time"][()]
+    before = [m for m, t in zip(methods, times) if t < t_low - 1e-9]
+    after = [(m, o) for m, o, t in zip(methods, orders, times) if t >= t_low - 1e-9]
+    print(f"lowered at {t_low} s; before {before}, after {after}")
+    assert "cvode" in before and after
+    assert all(m != "cvode" and (m != "mebdf" or o <= 4) for m, o in after)
+    assert ("mebdf", 4) in after
+    gains = {}
+    for policy in ("lower", "off"):
+        m = stability_metrics.analyse(wire_runs[policy][1])
+        assert m["status"] == "complete"
+        bound = BOUND * m["rtol"] * m["energy_scale"]
+        k = int(np.argmin(np.abs(m["time"] - t_low)))
+        gains[policy] = (m["balance_drift"][k:] - m["balance_drift"][k]).max() / bound
+    print(f"gain after {t_low} s / bound: lowered {gains['lower']:.3g}, "
+          f"unguarded {gains['off']:.3g}")
+    assert gains["lower"] <= 1.0 < gains["off"]
