@@ -2,7 +2,8 @@
 !! than a tenth of the length), a modulus or stiffness in the wrong unit (the static strain under
 !! the rope's own weight and its point masses above 10 %), a damping coefficient in the wrong unit
 !! (an element's axial damping ratio below 1e-6 or above 1000), air's density for water, a straight
-!! start or a support's anchor inside the ground (x points down: a ground point in the wrong sign),
+!! start or a support's anchor inside the ground (x points down: a ground point in the wrong sign;
+!! an anchor deeper than ten times the rope's own sinking),
 !! a key of a support's motion that its `*_motion` does not use (a harmonic key or a table with
 !! another motion), a release or a ramp that the run ends before, a key of &ground or &fluid set
 !! away from its default while the effects that use it are off (a ground or a water given and not
@@ -53,6 +54,13 @@ module ropedyn_scene_warnings
     !> a Coulomb coefficient of a rope or chain on the ground lies between 0.1 and 1 (a
     !! chain across a seabed about 1, along it 0.7); 60 for 0.6 is a percentage
     real(wp), parameter :: MAX_FRICTION_COEFFICIENT = 1.0_wp
+    !> an anchor may lie in the ground by up to this many times the depth w/k the rope's
+    !! weight sinks it: deeper, the contact pushes the rope up against the anchor by more
+    !! than ten times its weight per metre (a 100 m chain of 981 N/m on k = 1e7 N/m^2,
+    !! w/k = 0.1 mm, its anchor's force 53.8 kN along the seabed and 0.3 kN across it on
+    !! the seabed; across it 2.8 kN 1 mm deep, 19 kN 1 cm, 88 kN 5 cm, all within the
+    !! thousandth of the length)
+    real(wp), parameter :: ANCHOR_SINK_FACTOR = 10.0_wp
 
 contains
 
@@ -115,7 +123,7 @@ contains
         end if
         if (scene%effects%water) call water_slips(scene, list)
         if (scene%effects%ground) call ground_start(scene, list)
-        if (scene%effects%ground) call ground_anchors(scene, list)
+        if (scene%effects%ground) call ground_anchors(scene, sec, list)
         if (scene%effects%ground) call ground_law(scene, sec, list)
         call anchor_reach(scene, sec, list)
         call idle_groups(scene, list)
@@ -403,13 +411,25 @@ contains
     end function ground_depth
 
     !> The pinned or clamped ends whose anchor lies deeper in the ground than
-    !! MAX_START_DEPTH_SHARE of the length: the contact springs push the rope out against
+    !! MAX_START_DEPTH_SHARE of the length, or than ANCHOR_SINK_FACTOR times the depth the
+    !! rope's weight sinks it (sinking_depth): the contact springs push the rope out against
     !! the support for good, so the equilibrium holds the rope pressed into the ground (and
-    !! its iteration meets two stiff springs at odds). An anchor on the ground (a chain's
-    !! on the seabed) is within the share.
-    subroutine ground_anchors(scene, list)
+    !! its iteration meets two stiff springs at odds), and the anchor takes the push. An
+    !! anchor on the ground (a chain's on the seabed) is within both.
+    subroutine ground_anchors(scene, sec, list)
         type(scene_t), intent(in) :: scene
+        type(section_t), intent(in) :: sec
         type(text_t), allocatable, intent(inout) :: list(:)
+        real(wp) :: sinking, limit
+        character(len=:), allocatable :: why
+        sinking = sinking_depth(scene, sec)
+        limit = MAX_START_DEPTH_SHARE*scene%rope%length
+        why = ''
+        if (sinking > 0.0_wp .and. ANCHOR_SINK_FACTOR*sinking < limit) then
+            limit = ANCHOR_SINK_FACTOR*sinking
+            why = ", more than "//int_text(nint(ANCHOR_SINK_FACTOR))//" times the "// &
+                significant_text(sinking, 3)//" m the rope's weight sinks it"
+        end if
         if (scene%supports%top /= 'free') &
             call held_end('top', scene%supports%top, scene%supports%top_anchor)
         if (scene%supports%bottom /= 'free' .and. bottom_anchor_given(scene%rope_spec_t)) &
@@ -421,12 +441,12 @@ contains
             real(wp), intent(in) :: anchor(2)
             real(wp) :: depth
             depth = ground_depth(scene, anchor)
-            if (depth > MAX_START_DEPTH_SHARE*scene%rope%length) call append_text(list, &
+            if (depth > limit) call append_text(list, &
                 scene%origin('supports.'//end_name//'_anchor')//': &supports: '// &
                 end_name//'_anchor = '// &
                 significant_text(anchor(1), 6)//', '//significant_text(anchor(2), 6)// &
                 ': the '//end_name//' end is '//trim(kind)//' '// &
-                significant_text(depth, 3)//' m inside the ground (&ground point = '// &
+                significant_text(depth, 3)//' m inside the ground'//why//' (&ground point = '// &
                 real_text(scene%ground%point(1))//', '//real_text(scene%ground%point(2))// &
                 '; x points down, the normal to the free side): the contact springs push '// &
                 'the rope against the support for good; move the anchor or the ground')
@@ -468,17 +488,14 @@ contains
         type(scene_t), intent(in) :: scene
         type(section_t), intent(in) :: sec
         type(text_t), allocatable, intent(inout) :: list(:)
-        real(wp) :: w, sinking
+        real(wp) :: sinking
         associate (g => scene%ground)
-            if (scene%effects%gravity) then
-                w = sec%mass_per_length*scene%rope%gravity
-                if (scene%effects%water) w = w - scene%fluid%density*scene%rope%gravity* &
-                                             pi*scene%rope%diameter**2/4.0_wp
-                sinking = w/g%stiffness
+            sinking = sinking_depth(scene, sec)
+            if (sinking > 0.0_wp) then
                 if (sinking > MAX_START_DEPTH_SHARE*scene%rope%length) call append_text(list, &
                     scene%origin('ground.stiffness')//': &ground: stiffness = '// &
                     real_text(g%stiffness)//": the rope's weight, "// &
-                    significant_text(w, 4)//' N/m'// &
+                    significant_text(sinking*g%stiffness, 4)//' N/m'// &
                     trim(merge(' in water', '         ', scene%effects%water))// &
                     ', sinks it '//significant_text(sinking, 3)//' m into the ground, more '// &
                     'than a thousandth of its length: a stiffness in kN/m^2? (the unit is '// &
@@ -491,6 +508,21 @@ contains
                 'a percentage? (0.6, not 60)')
         end associate
     end subroutine ground_law
+
+    !> The depth w/k the rope's weight per metre w (in water less its buoyancy, whenever
+    !! water is on) sinks it into the ground of stiffness k, m; 0 without gravity or for a
+    !! rope that floats.
+    pure real(wp) function sinking_depth(scene, sec) result(depth)
+        type(scene_t), intent(in) :: scene
+        type(section_t), intent(in) :: sec
+        real(wp) :: w
+        depth = 0.0_wp
+        if (.not. scene%effects%gravity .or. .not. scene%ground%stiffness > 0.0_wp) return
+        w = sec%mass_per_length*scene%rope%gravity
+        if (scene%effects%water) w = w - scene%fluid%density*scene%rope%gravity* &
+                                     pi*scene%rope%diameter**2/4.0_wp
+        depth = max(0.0_wp, w/scene%ground%stiffness)
+    end function sinking_depth
 
     !> The straight starts ('straight', 'hanging': from &supports top_anchor along the
     !! initial angle) whose far end lies deeper in the ground than MAX_START_DEPTH_SHARE of

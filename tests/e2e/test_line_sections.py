@@ -145,6 +145,13 @@ def test_a_chain_without_bending_stiffness_hangs(run, tmp_path, kind):
     (["effects.ground=.true.", "ground.point=0.5,0", "supports.bottom='clamped'",
       "supports.bottom_anchor=0.9,0.3"],
      "&supports: bottom_anchor = 0.9, 0.3: the bottom end is clamped 0.4 m inside the ground"),
+    # half a millimetre, under the thousandth of the length, but 43 times the 1.16e-5 m the
+    # rope's 1.156 N/m sinks it into the default ground (1e5 N/m^2): the contact presses
+    # the rope up against the anchor
+    (["effects.ground=.true.", "ground.point=0.5,0", "supports.bottom='pinned'",
+      "supports.bottom_anchor=0.5005,0.3"],
+     "&supports: bottom_anchor = 0.5005, 0.3: the bottom end is pinned 0.0005 m inside the "
+     "ground, more than 10 times the 1.16e-5 m the rope's weight sinks it"),
     # the paper's rope weighs 1.156 N/m: on 100 N/m^2 it sinks 11.6 mm, 1.2 % of its length
     (["effects.ground=.true.", "ground.stiffness=100"],
      "&ground: stiffness = 100.0: the rope's weight, 1.156 N/m, sinks it 0.0116 m into the "
