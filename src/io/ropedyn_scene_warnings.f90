@@ -16,7 +16,7 @@
 module ropedyn_scene_warnings
     use, intrinsic :: iso_fortran_env, only: error_unit
     use, intrinsic :: ieee_arithmetic, only: ieee_is_nan
-    use ropedyn_kinds, only: wp, PI
+    use ropedyn_kinds, only: wp
     use ropedyn_text, only: text_t, append_text, real_text, significant_text, pair_text, &
         int_text
     use ropedyn_rope_section, only: section_t, rope_section, section_set_given
@@ -207,7 +207,7 @@ contains
         real(wp) :: density
         if (.not. section .or. .not. (scene%effects%drag .or. scene%effects%water)) return
         if (scene%rope%diameter > MAX_DIAMETER_SHARE*scene%rope%length) return
-        density = sec%mass_per_length/(pi*scene%rope%diameter**2/4.0_wp)
+        density = sec%mass_per_length/sec%area
         if (.not. density < MIN_LINE_DENSITY) return
         call append_text(list, scene%origin('rope.diameter')//': &rope: diameter = '// &
             real_text(scene%rope%diameter)//': the line''s mean density, mass_per_length / '// &
@@ -519,8 +519,7 @@ contains
         depth = 0.0_wp
         if (.not. scene%effects%gravity .or. .not. scene%ground%stiffness > 0.0_wp) return
         w = sec%mass_per_length*scene%rope%gravity
-        if (scene%effects%water) w = w - scene%fluid%density*scene%rope%gravity* &
-                                     pi*scene%rope%diameter**2/4.0_wp
+        if (scene%effects%water) w = w - scene%fluid%density*scene%rope%gravity*sec%area
         depth = max(0.0_wp, w/scene%ground%stiffness)
     end function sinking_depth
 
